@@ -1,0 +1,713 @@
+#include "Glsl.h"
+
+#include <clang/AST/RecordLayout.h>
+#include <clang/Basic/SourceManager.h>
+#include <clang/Lex/Lexer.h>
+
+#include <cstdio>
+#include <sstream>
+
+using namespace clang;
+
+namespace crossrt::engine {
+
+namespace {
+
+const std::set<std::string>& GlslKeywords() {
+  static const std::set<std::string> words = {
+      "in", "out", "inout", "input", "output", "uniform", "buffer", "shared", "attribute", "varying",
+      "layout", "centroid", "flat", "smooth", "noperspective", "patch", "sample", "coherent",
+      "volatile", "restrict", "readonly", "writeonly", "subroutine", "precise", "invariant",
+      "discard", "lowp", "mediump", "highp", "precision", "vec2", "vec3", "vec4", "ivec2", "ivec3",
+      "ivec4", "uvec2", "uvec3", "uvec4", "bvec2", "bvec3", "bvec4", "mat2", "mat3", "mat4",
+      "texture", "filter", "common", "partition", "active", "superp", "output", "resource",
+      "mix", "main", "gl_Position", "packed", "half", "fixed", "image1D", "image2D", "sampler2D"};
+  return words;
+}
+
+std::string TrimmedSourceText(const ASTContext& ctx, SourceRange range) {
+  auto& sm = ctx.getSourceManager();
+  return Lexer::getSourceText(CharSourceRange::getTokenRange(range), sm, ctx.getLangOpts()).str();
+}
+
+const NamedDecl* EnclosingNamespaceOrClass(const Decl* d) {
+  for (auto* dc = d->getDeclContext(); dc; dc = dc->getParent())
+    if (auto* nd = dyn_cast<NamedDecl>(dc)) return nd;
+  return nullptr;
+}
+
+bool InNamespace(const Decl* d, const char* ns) {
+  for (auto* dc = d->getDeclContext(); dc; dc = dc->getParent())
+    if (auto* nsd = dyn_cast<NamespaceDecl>(dc); nsd && nsd->getName() == ns) return true;
+  return false;
+}
+
+const char* LiteMathGlsl(StringRef name) {
+  static const std::map<std::string, const char*> table = {
+      {"float2", "vec2"},  {"float3", "vec3"},  {"float4", "vec4"},  {"int2", "ivec2"},
+      {"int3", "ivec3"},   {"int4", "ivec4"},   {"uint2", "uvec2"},  {"uint3", "uvec3"},
+      {"uint4", "uvec4"},  {"float3x3", "mat3"}, {"float4x4", "mat4"}};
+  auto it = table.find(name.str());
+  return it == table.end() ? nullptr : it->second;
+}
+
+}  // namespace
+
+bool IsSystemDecl(const Decl* decl) {
+  auto& sm = decl->getASTContext().getSourceManager();
+  return sm.isInSystemHeader(sm.getExpansionLoc(decl->getLocation()));
+}
+
+bool IsLiteMathType(QualType type, const char* name) {
+  auto* rd = type.getCanonicalType()->getAsCXXRecordDecl();
+  if (!rd || !InNamespace(rd, "LiteMath")) return false;
+  return name ? rd->getName() == name : LiteMathGlsl(rd->getName()) != nullptr;
+}
+
+bool IsStdVector(QualType type, QualType* element) {
+  auto* spec = dyn_cast_or_null<ClassTemplateSpecializationDecl>(type.getCanonicalType()->getAsCXXRecordDecl());
+  if (!spec || spec->getName() != "vector" || !spec->isInStdNamespace()) return false;
+  if (element) *element = spec->getTemplateArgs()[0].getAsType();
+  return true;
+}
+
+std::optional<std::string> GlslTypeOf(QualType type) {
+  type = type.getNonReferenceType().getCanonicalType().getUnqualifiedType();
+  if (auto* arr = dyn_cast<ConstantArrayType>(type.getTypePtr())) {
+    auto elem = GlslTypeOf(arr->getElementType());
+    if (!elem) return std::nullopt;
+    return *elem + "[" + std::to_string(arr->getSize().getZExtValue()) + "]";
+  }
+  if (auto* bt = type->getAs<BuiltinType>()) {
+    switch (bt->getKind()) {
+      case BuiltinType::Void: return "void";
+      case BuiltinType::Bool: return "bool";
+      case BuiltinType::Float: return "float";
+      case BuiltinType::Char_S: case BuiltinType::SChar: case BuiltinType::Short:
+      case BuiltinType::Int: case BuiltinType::Long: case BuiltinType::LongLong:
+        return "int";  // 64-bit integers become 32-bit: shader buffers cannot exceed 4 GiB anyway
+      case BuiltinType::Char_U: case BuiltinType::UChar: case BuiltinType::UShort:
+      case BuiltinType::UInt: case BuiltinType::ULong: case BuiltinType::ULongLong:
+        return "uint";
+      default: return std::nullopt;  // double and friends: reported by the caller
+    }
+  }
+  if (auto* et = type->getAs<EnumType>()) return GlslTypeOf(et->getDecl()->getIntegerType());
+  if (auto* rd = type->getAsCXXRecordDecl()) {
+    if (InNamespace(rd, "LiteMath")) {
+      if (auto* g = LiteMathGlsl(rd->getName())) return std::string(g);
+      return std::nullopt;
+    }
+    if (IsSystemDecl(rd) || rd->isUnion() || rd->isPolymorphic() || rd->getName().empty()) return std::nullopt;
+    return rd->getName().str();
+  }
+  return std::nullopt;
+}
+
+std::pair<std::string, std::string> SplitArray(const std::string& glslType) {
+  auto pos = glslType.find('[');
+  if (pos == std::string::npos) return {glslType, ""};
+  return {glslType.substr(0, pos), glslType.substr(pos)};
+}
+
+// std430 (or scalar) size and alignment, following the GLSL specification's rules.
+std::optional<LayoutInfo> Std430Layout(ASTContext& ctx, QualType type, bool scalar) {
+  type = type.getCanonicalType().getUnqualifiedType();
+  auto roundUp = [](uint64_t v, uint64_t a) { return (v + a - 1) / a * a; };
+  if (auto* arr = dyn_cast<ConstantArrayType>(type.getTypePtr())) {
+    auto e = Std430Layout(ctx, arr->getElementType(), scalar);
+    if (!e) return std::nullopt;
+    uint64_t stride = scalar ? e->size : roundUp(e->size, e->align);
+    return LayoutInfo{stride * arr->getSize().getZExtValue(), e->align};
+  }
+  if (auto* bt = type->getAs<BuiltinType>()) {
+    if (bt->isFloatingPoint() && bt->getKind() != BuiltinType::Float) return std::nullopt;
+    if (bt->getKind() == BuiltinType::Bool) return std::nullopt;  // 1 byte in C++, 4 in GLSL
+    if (ctx.getTypeSize(type) != 32) return std::nullopt;         // only 32-bit scalars are shared
+    return LayoutInfo{4, 4};
+  }
+  if (auto* et = type->getAs<EnumType>()) return Std430Layout(ctx, et->getDecl()->getIntegerType(), scalar);
+  auto* rd = type->getAsCXXRecordDecl();
+  if (!rd) return std::nullopt;
+  if (InNamespace(rd, "LiteMath")) {
+    auto name = rd->getName();
+    int n = name.ends_with("2") ? 2 : name.ends_with("3") ? 3 : name.ends_with("4") ? 4 : 0;
+    if (name == "float3x3") return scalar ? LayoutInfo{36, 4} : LayoutInfo{48, 16};
+    if (name == "float4x4") return scalar ? LayoutInfo{64, 4} : LayoutInfo{64, 16};
+    if (!LiteMathGlsl(name) || n == 0) return std::nullopt;
+    if (scalar) return LayoutInfo{uint64_t(4 * n), 4};
+    return LayoutInfo{uint64_t(4 * n), n == 2 ? 8u : 16u};
+  }
+  if (rd->isPolymorphic() || rd->isUnion()) return std::nullopt;
+  uint64_t offset = 0, align = 4;
+  for (auto* f : rd->fields()) {
+    auto fl = Std430Layout(ctx, f->getType(), scalar);
+    if (!fl) return std::nullopt;
+    offset = roundUp(offset, fl->align) + fl->size;
+    align = std::max(align, fl->align);
+  }
+  return LayoutInfo{roundUp(offset, align), align};
+}
+
+bool LayoutMatchesCpp(ASTContext& ctx, QualType type, bool scalar) {
+  type = type.getCanonicalType().getUnqualifiedType();
+  auto gl = Std430Layout(ctx, type, scalar);
+  if (!gl) return false;
+  uint64_t cppSize = ctx.getTypeSizeInChars(type).getQuantity();
+  uint64_t stride = scalar ? gl->size : (gl->size + gl->align - 1) / gl->align * gl->align;
+  if (stride != cppSize) return false;
+  // Field offsets of user structs must agree too.
+  auto* rd = type->getAsCXXRecordDecl();
+  if (!rd || InNamespace(rd, "LiteMath")) return true;
+  const ASTRecordLayout& cpp = ctx.getASTRecordLayout(rd);
+  uint64_t offset = 0;
+  for (auto* f : rd->fields()) {
+    auto fl = Std430Layout(ctx, f->getType(), scalar);
+    offset = (offset + fl->align - 1) / fl->align * fl->align;
+    if (cpp.getFieldOffset(f->getFieldIndex()) / 8 != offset) return false;
+    if (f->getType()->getAsCXXRecordDecl() && !LayoutMatchesCpp(ctx, f->getType(), scalar)) return false;
+    offset += fl->size;
+  }
+  return true;
+}
+
+GlslPrinter::GlslPrinter(ASTContext& ctx, const CXXRecordDecl* cls, Reporter& reporter)
+    : m_ctx(ctx), m_class(cls), m_reporter(reporter) {}
+
+std::string GlslPrinter::SafeName(const std::string& name) {
+  return GlslKeywords().count(name) ? name + "_" : name;
+}
+
+std::string GlslPrinter::Fail(SourceLocation loc, const std::string& message, const std::string& hint) {
+  m_reporter.Error(loc, message, hint);
+  return "/*error*/";
+}
+
+std::optional<std::string> GlslPrinter::Type(QualType t, SourceLocation loc) {
+  QualType base = t.getNonReferenceType();
+  while (auto* arr = dyn_cast<ConstantArrayType>(base.getCanonicalType().getTypePtr())) base = arr->getElementType();
+  base = base.getCanonicalType();
+  if (base->isPointerType()) {
+    Fail(loc, "pointer '" + t.getAsString() + "' cannot be used here in a kernel",
+         "pass arrays to kernels as pointer parameters of the kernel, or use a std::vector member");
+    return std::nullopt;
+  }
+  if (auto* bt = base->getAs<BuiltinType>(); bt && bt->isFloatingPoint() && bt->getKind() != BuiltinType::Float) {
+    Fail(loc, "type '" + t.getAsString() + "' is not supported in kernels (only 32-bit float)",
+         "use float; double-precision literals such as 0.5 are fine and become float");
+    return std::nullopt;
+  }
+  auto g = GlslTypeOf(t);
+  if (!g) {
+    Fail(loc, "type '" + t.getAsString() + "' has no GPU equivalent",
+         "kernels may use int, uint, float, bool, LiteMath vectors and matrices, and plain structs of those");
+    return std::nullopt;
+  }
+  if (auto* rd = base->getAsCXXRecordDecl(); rd && !InNamespace(rd, "LiteMath")) NeedStruct(rd);
+  return g;
+}
+
+std::string GlslPrinter::Declare(QualType t, const std::string& name, SourceLocation loc) {
+  auto g = Type(t, loc);
+  if (!g) return "/*error*/ " + name;
+  auto [base, dims] = SplitArray(*g);
+  return base + " " + SafeName(name) + dims;
+}
+
+void GlslPrinter::NeedStruct(const RecordDecl* rd) {
+  rd = rd->getDefinition() ? rd->getDefinition() : rd;
+  if (m_emitted.count(rd) || m_inProgress.count(rd)) return;
+  m_inProgress.insert(rd);
+  std::ostringstream os;
+  os << "struct " << rd->getName().str() << " {  // from " << rd->getQualifiedNameAsString() << "\n";
+  for (auto* f : rd->fields()) os << "  " << Declare(f->getType(), f->getName().str(), f->getLocation()) << ";\n";
+  os << "};\n";
+  m_inProgress.erase(rd);
+  m_emitted.insert(rd);
+  m_structs.push_back(os.str());
+}
+
+void GlslPrinter::NeedConstant(const VarDecl* vd) {
+  if (m_emitted.count(vd)) return;
+  m_emitted.insert(vd);
+  const clang::Expr* init = vd->getAnyInitializer();
+  std::string value = init ? Expr(init) : "0";
+  m_constants.push_back("const " + Declare(vd->getType(), vd->getName().str(), vd->getLocation()) + " = " + value + ";\n");
+}
+
+std::string GlslPrinter::Prelude() const {
+  std::string out;
+  for (auto& s : m_structs) out += s + "\n";
+  for (auto& c : m_constants) out += c;
+  if (!m_constants.empty()) out += "\n";
+  for (auto& f : m_functions) out += f + "\n";
+  return out;
+}
+
+std::string GlslPrinter::Literal(const clang::Expr* e) {
+  auto& sm = m_ctx.getSourceManager();
+  if (auto* il = dyn_cast<IntegerLiteral>(e)) {
+    bool isUnsigned = il->getType()->isUnsignedIntegerType();
+    auto v = il->getValue();
+    std::string digits = isUnsigned ? std::to_string(v.getZExtValue()) : std::to_string(v.getSExtValue());
+    return isUnsigned ? digits + "u" : digits;
+  }
+  if (auto* fl = dyn_cast<FloatingLiteral>(e)) {
+    std::string text;
+    if (!e->getBeginLoc().isMacroID()) text = TrimmedSourceText(m_ctx, e->getSourceRange());
+    while (!text.empty() && (text.back() == 'f' || text.back() == 'F' || text.back() == 'l' || text.back() == 'L'))
+      text.pop_back();
+    if (text.empty() || text.find_first_of("xXpP") != std::string::npos) {
+      char buf[64];
+      std::snprintf(buf, sizeof buf, "%.9g", fl->getValue().convertToDouble());
+      text = buf;
+      if (text.find_first_of(".eEin") == std::string::npos) text += ".0";
+    }
+    if (text.find_first_of(".eE") == std::string::npos) text += ".0";
+    (void)sm;
+    return text;
+  }
+  if (auto* bl = dyn_cast<CXXBoolLiteralExpr>(e)) return bl->getValue() ? "true" : "false";
+  if (auto* cl = dyn_cast<CharacterLiteral>(e)) return std::to_string(cl->getValue());
+  return "/*literal*/";
+}
+
+// An explicit or implicit conversion. GLSL converts implicitly only int->uint->float, so spell
+// the others out, and fold integer literals into the target type so the code stays readable.
+std::string GlslPrinter::Cast(QualType to, const clang::Expr* sub) {
+  auto target = GlslTypeOf(to);
+  auto source = GlslTypeOf(sub->getType());
+  if (!target) return Fail(sub->getBeginLoc(), "conversion to '" + to.getAsString() + "' is not supported in kernels", "");
+  if (source && *source == *target) return Expr(sub);
+  const clang::Expr* bare = sub->IgnoreParenImpCasts();
+  if (auto* il = dyn_cast<IntegerLiteral>(bare)) {
+    auto v = il->getValue().getSExtValue();
+    if (*target == "float") return std::to_string(v) + ".0";
+    if (*target == "uint" && v >= 0) return std::to_string(v) + "u";
+    if (*target == "int") return std::to_string(v);
+  }
+  if (*target == "bool") {
+    if (source && (*source == "float")) return "(" + Expr(sub) + " != 0.0)";
+    return "(" + Expr(sub) + " != 0)";
+  }
+  return *target + "(" + Expr(sub) + ")";
+}
+
+std::string GlslPrinter::Construct(QualType t, const std::vector<const clang::Expr*>& args, SourceLocation loc) {
+  auto g = Type(t, loc);
+  if (!g) return "/*error*/";
+  std::vector<const clang::Expr*> real;
+  for (auto* a : args)
+    if (!isa<CXXDefaultArgExpr>(a)) real.push_back(a);
+  // Copies and moves are plain values in GLSL.
+  if (real.size() == 1 && GlslTypeOf(real[0]->getType()) == g) return Expr(real[0]);
+  auto [base, dims] = SplitArray(*g);
+  std::string out = base + dims + "(";
+  if (real.empty()) {
+    if (IsLiteMathType(t)) return base + "(0)";
+    // Value-initialised struct: every field zero.
+    auto* rd = t.getCanonicalType()->getAsCXXRecordDecl();
+    bool first = true;
+    for (auto* f : rd->fields()) {
+      auto fg = Type(f->getType(), loc);
+      out += (first ? "" : ", ") + (fg ? SplitArray(*fg).first + SplitArray(*fg).second + "(0)" : "0");
+      first = false;
+    }
+    return out + ")";
+  }
+  for (size_t i = 0; i < real.size(); ++i) out += (i ? ", " : "") + Expr(real[i]);
+  return out + ")";
+}
+
+std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callLoc) {
+  const FunctionDecl* def = nullptr;
+  if (!fd->hasBody(def) || !def) {
+    return Fail(callLoc, "function '" + fd->getQualifiedNameAsString() + "' is called from a kernel but its body is not visible",
+                "define it in a header or in one of the class's source files");
+  }
+  std::string name = fd->getNameAsString();
+  if (m_inProgress.count(def))
+    return Fail(callLoc, "recursive call to '" + fd->getQualifiedNameAsString() + "' in a kernel",
+                "GPUs have no call stack: rewrite the recursion as a loop with an explicit stack array");
+  if (m_emitted.count(def)) return name;
+  if (isa<CXXMethodDecl>(def) && cast<CXXMethodDecl>(def)->isVirtual())
+    Fail(callLoc, "virtual call to '" + fd->getQualifiedNameAsString() + "' in a kernel", "call a non-virtual helper");
+  m_inProgress.insert(def);
+  std::ostringstream os;
+  auto ret = Type(def->getReturnType(), def->getLocation());
+  os << "// from " << def->getQualifiedNameAsString() << "\n" << (ret ? *ret : "void") << " " << name << "(";
+  for (unsigned i = 0; i < def->getNumParams(); ++i) {
+    auto* p = def->getParamDecl(i);
+    QualType pt = p->getType();
+    std::string qualifier;
+    if (pt->isReferenceType() && !pt.getNonReferenceType().isConstQualified()) qualifier = "inout ";
+    os << (i ? ", " : "") << qualifier << Declare(pt, p->getNameAsString(), p->getLocation());
+  }
+  os << ")\n";
+  int savedDepth = m_loopDepth;
+  bool savedThread = m_inThreadBody;
+  m_loopDepth = 0;
+  m_inThreadBody = false;
+  os << Stmt(def->getBody(), 0);
+  m_loopDepth = savedDepth;
+  m_inThreadBody = savedThread;
+  m_inProgress.erase(def);
+  m_emitted.insert(def);
+  m_functions.push_back(os.str());
+  return name;
+}
+
+namespace {
+bool IsIoFunction(const std::string& n) {
+  static const std::set<std::string> io = {"printf", "fprintf", "puts", "fputs", "putchar", "fopen", "fclose",
+      "fread", "fwrite", "fscanf", "scanf", "sprintf", "snprintf", "fflush", "perror", "getchar"};
+  return io.count(n) > 0;
+}
+bool IsHeapFunction(const std::string& n) {
+  return n == "malloc" || n == "calloc" || n == "realloc" || n == "free" || n == "aligned_alloc";
+}
+}  // namespace
+
+// Library functions with a GLSL counterpart: LiteMath, <cmath>, std::min/max.
+std::string GlslPrinter::Builtin(const FunctionDecl* fd, const std::vector<std::string>& a, const CallExpr* call) {
+  std::string n = fd->getNameAsString();
+  auto join = [&](const std::string& f) {
+    std::string s = f + "(";
+    for (size_t i = 0; i < a.size(); ++i) s += (i ? ", " : "") + a[i];
+    return s + ")";
+  };
+  static const std::map<std::string, std::string> same = {
+      {"sqrt", "sqrt"}, {"sqrtf", "sqrt"}, {"abs", "abs"}, {"fabs", "abs"}, {"fabsf", "abs"},
+      {"min", "min"}, {"max", "max"}, {"fmin", "min"}, {"fminf", "min"}, {"fmax", "max"}, {"fmaxf", "max"},
+      {"clamp", "clamp"}, {"pow", "pow"}, {"powf", "pow"}, {"exp", "exp"}, {"expf", "exp"},
+      {"exp2", "exp2"}, {"exp2f", "exp2"}, {"log", "log"}, {"logf", "log"}, {"log2", "log2"}, {"log2f", "log2"},
+      {"sin", "sin"}, {"sinf", "sin"}, {"cos", "cos"}, {"cosf", "cos"}, {"tan", "tan"}, {"tanf", "tan"},
+      {"asin", "asin"}, {"asinf", "asin"}, {"acos", "acos"}, {"acosf", "acos"}, {"atan", "atan"}, {"atanf", "atan"},
+      {"atan2", "atan"}, {"atan2f", "atan"}, {"floor", "floor"}, {"floorf", "floor"}, {"ceil", "ceil"},
+      {"ceilf", "ceil"}, {"round", "round"}, {"roundf", "round"}, {"trunc", "trunc"}, {"truncf", "trunc"},
+      {"fract", "fract"}, {"sign", "sign"}, {"dot", "dot"}, {"cross", "cross"}, {"length", "length"},
+      {"normalize", "normalize"}, {"distance", "distance"}, {"reflect", "reflect"}, {"refract", "refract"},
+      {"mix", "mix"}, {"lerp", "mix"}, {"step", "step"}, {"smoothstep", "smoothstep"},
+      {"inversesqrt", "inversesqrt"}, {"transpose", "transpose"}, {"inverse", "inverse"},
+      {"inverse4x4", "inverse"}, {"isnan", "isnan"}, {"isinf", "isinf"}, {"fma", "fma"}, {"fmaf", "fma"},
+      {"make_float2", "vec2"}, {"make_float3", "vec3"}, {"make_float4", "vec4"}, {"make_int2", "ivec2"},
+      {"make_int3", "ivec3"}, {"make_int4", "ivec4"}, {"make_uint2", "uvec2"}, {"make_uint3", "uvec3"},
+      {"make_uint4", "uvec4"}, {"to_float2", "vec2"}, {"to_int2", "ivec2"}, {"to_int3", "ivec3"},
+      {"to_int4", "ivec4"}, {"to_uint2", "uvec2"}, {"to_uint3", "uvec3"}, {"to_uint4", "uvec4"},
+      {"to_float4", "vec4"}};
+  bool library = IsSystemDecl(fd) || InNamespace(fd, "LiteMath");
+  if (!library) return "";
+  if (n == "to_float3") return "(" + a[0] + ").xyz";
+  if ((n == "to_float2" || n == "to_float4") && call->getNumArgs() >= 1 &&
+      GlslTypeOf(call->getArg(0)->getType()).value_or("") == "vec4" && n == "to_float2")
+    return "(" + a[0] + ").xy";
+  if (n == "as_int") return "floatBitsToInt(" + a[0] + ")";
+  if (n == "as_uint") return "floatBitsToUint(" + a[0] + ")";
+  if (n == "as_float") {
+    auto t = GlslTypeOf(call->getArg(0)->getType()).value_or("int");
+    return (t[0] == 'u' ? "uintBitsToFloat(" : "intBitsToFloat(") + a[0] + ")";
+  }
+  if (n == "hmin" || n == "hmax") {
+    auto t = GlslTypeOf(call->getArg(0)->getType()).value_or("vec3");
+    const char* f = n == "hmin" ? "min" : "max";
+    std::string v = "(" + a[0] + ")";
+    std::string r = std::string(f) + "(" + v + ".x, " + v + ".y)";
+    if (t.back() == '3' || t.back() == '4') r = std::string(f) + "(" + r + ", " + v + ".z)";
+    if (t.back() == '4') r = std::string(f) + "(" + r + ", " + v + ".w)";
+    return r;
+  }
+  if (n == "mul4x3") return "(" + a[0] + " * vec4(" + a[1] + ", 1.0)).xyz";
+  if (n == "mul3x3") return "(mat3(" + a[0] + ") * " + a[1] + ")";
+  if (n == "fmod" || n == "fmodf") return "(" + a[0] + " - " + a[1] + " * trunc(" + a[0] + " / " + a[1] + "))";
+  if (n == "isfinite") return "!(isinf(" + a[0] + ") || isnan(" + a[0] + "))";
+  auto it = same.find(n);
+  if (it != same.end()) return join(it->second);
+  return "";
+}
+
+std::string GlslPrinter::Call(const CallExpr* call) {
+  const FunctionDecl* fd = call->getDirectCallee();
+  if (!fd) return Fail(call->getBeginLoc(), "indirect call in a kernel", "call functions directly; lambdas and function pointers are not supported");
+  std::string name = fd->getNameAsString();
+  std::string qname = fd->getQualifiedNameAsString();
+
+  // Members of the user's class: helpers become GLSL functions.
+  if (auto* mc = dyn_cast<CXXMemberCallExpr>(call)) {
+    const clang::Expr* obj = mc->getImplicitObjectArgument()->IgnoreParenImpCasts();
+    auto* method = mc->getMethodDecl();
+    if (isa<CXXThisExpr>(obj)) {
+      if (StringRef(name).starts_with("kernel"))
+        return Fail(call->getBeginLoc(), "kernel '" + name + "' is called from inside a kernel", "call kernels only from control functions");
+      std::vector<std::string> args;
+      for (auto* arg : call->arguments()) args.push_back(Expr(arg));
+      std::string callee = EmitHelper(method, call->getBeginLoc());
+      std::string s = callee + "(";
+      for (size_t i = 0; i < args.size(); ++i) s += (i ? ", " : "") + args[i];
+      return s + ")";
+    }
+    // Calls on a std::vector member.
+    if (auto* me = dyn_cast<MemberExpr>(obj); me && IsStdVector(me->getType())) {
+      auto* field = dyn_cast<FieldDecl>(me->getMemberDecl());
+      if (field && isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts())) {
+        memberVectors.insert(field);
+        if (name == "size") return field->getNameAsString() + "_size";
+        if (name == "capacity") return field->getNameAsString() + "_capacity";
+      }
+      return Fail(call->getBeginLoc(), "std::vector::" + name + " is not supported in kernels",
+                  "kernels may index member vectors and call size(); push_back inside kernels is not supported yet");
+    }
+    // Member functions of LiteMath types and user structs.
+    if (IsSystemDecl(method) || method->getParent()->isInStdNamespace())
+      return Fail(call->getBeginLoc(), "call to '" + qname + "' is not supported in a kernel",
+                  "kernels may call LiteMath, <cmath> and std::min/max, and your own functions");
+    return Fail(call->getBeginLoc(), "member function call '" + qname + "' on an object is not supported in kernels",
+                "make it a free function or a member of the class that takes the object as a parameter");
+  }
+
+  if (IsHeapFunction(name))
+    return Fail(call->getBeginLoc(), "heap allocation ('" + name + "') in a kernel",
+                "GPU threads cannot allocate: use a fixed-size local array or a std::vector member sized before the call");
+  if (IsIoFunction(name))
+    return Fail(call->getBeginLoc(), "I/O ('" + name + "') in a kernel",
+                "kernels cannot do I/O: write results to an output buffer and print them in the control function");
+
+  std::vector<std::string> args;
+  for (auto* arg : call->arguments()) args.push_back(Expr(arg));
+  std::string b = Builtin(fd, args, call);
+  if (!b.empty()) return b;
+  if (IsSystemDecl(fd) || fd->isInStdNamespace())
+    return Fail(call->getBeginLoc(), "unsupported library call '" + qname + "' in a kernel",
+                "kernels may call LiteMath, <cmath> and std::min/max/abs, and your own functions with visible bodies");
+  // The user's own free function.
+  std::string callee = EmitHelper(fd, call->getBeginLoc());
+  std::string s = callee + "(";
+  for (size_t i = 0; i < args.size(); ++i) s += (i ? ", " : "") + args[i];
+  return s + ")";
+}
+
+std::string GlslPrinter::Expr(const clang::Expr* e) {
+  if (!e) return "";
+  if (auto* p = dyn_cast<ParenExpr>(e)) return "(" + Expr(p->getSubExpr()) + ")";
+  if (isa<IntegerLiteral, FloatingLiteral, CXXBoolLiteralExpr, CharacterLiteral>(e)) return Literal(e);
+  if (auto* ewc = dyn_cast<ExprWithCleanups>(e)) return Expr(ewc->getSubExpr());
+  if (auto* mt = dyn_cast<MaterializeTemporaryExpr>(e)) return Expr(mt->getSubExpr());
+  if (auto* bt = dyn_cast<CXXBindTemporaryExpr>(e)) return Expr(bt->getSubExpr());
+  if (auto* da = dyn_cast<CXXDefaultArgExpr>(e)) return Expr(da->getExpr());
+  if (auto* di = dyn_cast<CXXDefaultInitExpr>(e)) return Expr(di->getExpr());
+  if (auto* sn = dyn_cast<SubstNonTypeTemplateParmExpr>(e)) return Expr(sn->getReplacement());
+  if (auto* ce = dyn_cast<ConstantExpr>(e)) return Expr(ce->getSubExpr());
+
+  if (auto* ic = dyn_cast<ImplicitCastExpr>(e)) {
+    switch (ic->getCastKind()) {
+      case CK_IntegralCast: case CK_IntegralToFloating: case CK_FloatingToIntegral: case CK_FloatingCast:
+      case CK_IntegralToBoolean: case CK_FloatingToBoolean:
+        return Cast(ic->getType(), ic->getSubExpr());
+      case CK_PointerToBoolean:
+        return Fail(e->getBeginLoc(), "pointer tested as a condition in a kernel", "compare an index or a size instead");
+      default:
+        return Expr(ic->getSubExpr());
+    }
+  }
+  if (auto* ec = dyn_cast<ExplicitCastExpr>(e)) {
+    const clang::Expr* sub = ec->getSubExpr()->IgnoreImplicit();
+    if (auto* cons = dyn_cast<CXXConstructExpr>(sub)) {
+      std::vector<const clang::Expr*> args(cons->arg_begin(), cons->arg_end());
+      return Construct(cons->getType(), args, e->getBeginLoc());
+    }
+    if (ec->getType()->isPointerType())
+      return Fail(e->getBeginLoc(), "pointer cast in a kernel", "GLSL has no pointers: index arrays instead");
+    if (isa<ParenListExpr, InitListExpr>(sub)) return Expr(sub);
+    return Cast(ec->getType(), ec->getSubExpr());
+  }
+  if (auto* dr = dyn_cast<DeclRefExpr>(e)) {
+    const ValueDecl* d = dr->getDecl();
+    if (auto it = renames.find(d); it != renames.end()) return it->second;
+    if (auto* ec = dyn_cast<EnumConstantDecl>(d)) return std::to_string(ec->getInitVal().getSExtValue());
+    if (auto* vd = dyn_cast<VarDecl>(d)) {
+      if (vd->hasGlobalStorage() && !vd->isStaticLocal()) {
+        if (vd->getType().isConstQualified() && vd->getAnyInitializer()) {
+          NeedConstant(vd);
+          return vd->getNameAsString();
+        }
+        return Fail(e->getBeginLoc(), "global variable '" + vd->getNameAsString() + "' used in a kernel",
+                    "make it constexpr, or a member of the class so it is uploaded to the GPU");
+      }
+      if (vd->isStaticLocal())
+        return Fail(e->getBeginLoc(), "static local variable in a kernel", "use a class member or a constant");
+      return SafeName(vd->getNameAsString());
+    }
+    return Fail(e->getBeginLoc(), "'" + d->getNameAsString() + "' cannot be used in a kernel", "");
+  }
+  if (auto* me = dyn_cast<MemberExpr>(e)) {
+    const clang::Expr* base = me->getBase()->IgnoreParenImpCasts();
+    auto* field = dyn_cast<FieldDecl>(me->getMemberDecl());
+    if (isa<CXXThisExpr>(base)) {
+      if (auto it = renames.find(me->getMemberDecl()); it != renames.end()) return it->second;
+      if (!field) return Fail(e->getBeginLoc(), "member '" + me->getMemberDecl()->getNameAsString() + "' cannot be used here", "");
+      if (IsStdVector(field->getType())) {
+        memberVectors.insert(field);
+        return field->getNameAsString();
+      }
+      if (field->getType()->isPointerType() || !GlslTypeOf(field->getType()))
+        return Fail(e->getBeginLoc(), "member '" + field->getNameAsString() + "' of type '" + field->getType().getAsString() +
+                    "' cannot be used in a kernel", "kernels may use plain data members and std::vector members");
+      plainMembers.insert(field);
+      return field->getNameAsString();
+    }
+    if (me->isArrow()) return Fail(e->getBeginLoc(), "'->' in a kernel", "GLSL has no pointers: use a reference or a value");
+    if (!field) return Fail(e->getBeginLoc(), "member function used as a value", "");
+    return Expr(me->getBase()) + "." + field->getNameAsString();
+  }
+  if (auto* as = dyn_cast<ArraySubscriptExpr>(e)) return Expr(as->getBase()) + "[" + Expr(as->getIdx()) + "]";
+  if (auto* op = dyn_cast<CXXOperatorCallExpr>(e)) {
+    auto kind = op->getOperator();
+    if (kind == OO_Subscript) return Expr(op->getArg(0)) + "[" + Expr(op->getArg(1)) + "]";
+    if (kind == OO_Call) return Fail(e->getBeginLoc(), "call of a function object in a kernel", "call a plain function instead");
+    if (kind == OO_LessLess || kind == OO_GreaterGreater) {
+      if (IsSystemDecl(op->getDirectCallee() ? (const Decl*)op->getDirectCallee() : (const Decl*)m_class))
+        return Fail(e->getBeginLoc(), "I/O (stream operator) in a kernel",
+                    "kernels cannot do I/O: write results to an output buffer and print them in the control function");
+    }
+    std::string spelling = getOperatorSpelling(kind);
+    if (op->getNumArgs() == 1) return spelling + Expr(op->getArg(0));
+    if (op->getNumArgs() == 2 && (kind == OO_PlusPlus || kind == OO_MinusMinus)) return Expr(op->getArg(0)) + spelling;
+    if (op->getNumArgs() == 2) return Expr(op->getArg(0)) + " " + spelling + " " + Expr(op->getArg(1));
+    return Fail(e->getBeginLoc(), "operator not supported in kernels", "");
+  }
+  if (auto* bo = dyn_cast<BinaryOperator>(e)) {
+    if (bo->getOpcode() == BO_Comma) return Fail(e->getBeginLoc(), "comma operator in a kernel", "split it into separate statements");
+    return Expr(bo->getLHS()) + " " + bo->getOpcodeStr().str() + " " + Expr(bo->getRHS());
+  }
+  if (auto* uo = dyn_cast<UnaryOperator>(e)) {
+    auto opc = uo->getOpcode();
+    if (opc == UO_Deref || opc == UO_AddrOf)
+      return Fail(e->getBeginLoc(), std::string(opc == UO_Deref ? "pointer dereference" : "address-of") + " in a kernel",
+                  "GLSL has no pointers: index the array parameter, e.g. a[i]");
+    std::string sub = Expr(uo->getSubExpr());
+    if (uo->isPostfix()) return sub + UnaryOperator::getOpcodeStr(opc).str();
+    return UnaryOperator::getOpcodeStr(opc).str() + sub;
+  }
+  if (auto* co = dyn_cast<ConditionalOperator>(e))
+    return Expr(co->getCond()) + " ? " + Expr(co->getTrueExpr()) + " : " + Expr(co->getFalseExpr());
+  if (auto* call = dyn_cast<CallExpr>(e)) return Call(call);
+  if (auto* tmp = dyn_cast<CXXTemporaryObjectExpr>(e)) {
+    std::vector<const clang::Expr*> args(tmp->arg_begin(), tmp->arg_end());
+    return Construct(tmp->getType(), args, e->getBeginLoc());
+  }
+  if (auto* cons = dyn_cast<CXXConstructExpr>(e)) {
+    std::vector<const clang::Expr*> args(cons->arg_begin(), cons->arg_end());
+    return Construct(cons->getType(), args, e->getBeginLoc());
+  }
+  if (auto* il = dyn_cast<InitListExpr>(e)) {
+    if (il->isSyntacticForm() == false && il->getSyntacticForm()) il = il->getSyntacticForm() ? il : il;
+    std::vector<const clang::Expr*> args(il->begin(), il->end());
+    if (il->getType()->isArrayType() || !IsLiteMathType(il->getType())) {
+      auto g = Type(il->getType(), e->getBeginLoc());
+      if (!g) return "/*error*/";
+      auto [base, dims] = SplitArray(*g);
+      std::string out = base + dims + "(";
+      for (size_t i = 0; i < args.size(); ++i) out += (i ? ", " : "") + Expr(args[i]);
+      return out + ")";
+    }
+    return Construct(il->getType(), args, e->getBeginLoc());
+  }
+  if (auto* iv = dyn_cast<ImplicitValueInitExpr>(e)) return Construct(iv->getType(), {}, e->getBeginLoc());
+  if (isa<CXXNewExpr, CXXDeleteExpr>(e))
+    return Fail(e->getBeginLoc(), std::string(isa<CXXNewExpr>(e) ? "'new'" : "'delete'") + " in a kernel (heap allocation)",
+                "GPU threads cannot allocate: use a fixed-size local array or a std::vector member sized before the call");
+  if (isa<CXXThrowExpr>(e)) return Fail(e->getBeginLoc(), "'throw' in a kernel", "GPU code has no exceptions: return an error code in an output buffer");
+  if (isa<LambdaExpr>(e)) return Fail(e->getBeginLoc(), "lambda in a kernel", "use a helper member function");
+  if (isa<CXXThisExpr>(e)) return Fail(e->getBeginLoc(), "'this' used as a value in a kernel", "access members directly");
+  return Fail(e->getBeginLoc(), std::string("expression '") + e->getStmtClassName() + "' is not supported in kernels", "");
+}
+
+std::string GlslPrinter::ThreadBody(const clang::Stmt* body, int indent) {
+  m_inThreadBody = true;
+  m_loopDepth = 0;
+  std::string out = Stmt(body, indent);
+  m_inThreadBody = false;
+  return out;
+}
+
+std::string GlslPrinter::Stmt(const clang::Stmt* s, int indent) {
+  std::string pad(indent * 2, ' ');
+  if (!s) return pad + ";\n";
+  if (auto* cs = dyn_cast<CompoundStmt>(s)) {
+    std::string out = pad + "{\n";
+    for (auto* c : cs->body()) out += Stmt(c, indent + 1);
+    return out + pad + "}\n";
+  }
+  if (auto* ds = dyn_cast<DeclStmt>(s)) {
+    std::string out;
+    for (auto* d : ds->decls()) {
+      auto* vd = dyn_cast<VarDecl>(d);
+      if (!vd) continue;  // local typedefs and such need nothing
+      if (vd->isStaticLocal()) { Fail(vd->getLocation(), "static local variable in a kernel", "use a class member or a constant"); continue; }
+      QualType t = vd->getType();
+      if (t->isReferenceType() && !t.getNonReferenceType().isConstQualified())
+        Fail(vd->getLocation(), "non-const reference variable in a kernel",
+             "GLSL has no references: write through the original expression, e.g. arr[i].x = ...");
+      std::string decl = Declare(t, vd->getNameAsString(), vd->getLocation());
+      std::string cnst = t.getNonReferenceType().isConstQualified() && !t->isArrayType() ? "const " : "";
+      out += pad + cnst + decl;
+      if (auto* init = vd->getInit()) {
+        const clang::Expr* bare = init->IgnoreImplicit();
+        bool trivialDefault = false;
+        if (auto* cons = dyn_cast<CXXConstructExpr>(bare); cons && cons->getNumArgs() == 0 &&
+            cons->getConstructor()->isTrivial())
+          trivialDefault = true;
+        if (!trivialDefault) out += " = " + Expr(init);
+      }
+      out += ";\n";
+    }
+    return out;
+  }
+  if (auto* is = dyn_cast<IfStmt>(s)) {
+    if (is->getConditionVariable() || is->getInit())
+      Fail(is->getBeginLoc(), "declaration inside an if condition in a kernel", "declare the variable before the if");
+    std::string out = pad + "if (" + Expr(is->getCond()) + ")\n" + Stmt(is->getThen(), isa<CompoundStmt>(is->getThen()) ? indent : indent + 1);
+    if (is->getElse()) out += pad + "else\n" + Stmt(is->getElse(), isa<CompoundStmt>(is->getElse()) ? indent : indent + 1);
+    return out;
+  }
+  auto loopBody = [&](const clang::Stmt* body) {
+    ++m_loopDepth;
+    std::string b = Stmt(body, isa<CompoundStmt>(body) ? indent : indent + 1);
+    --m_loopDepth;
+    return b;
+  };
+  if (auto* fs = dyn_cast<ForStmt>(s)) {
+    std::string init;
+    if (fs->getInit()) {
+      init = Stmt(fs->getInit(), 0);
+      while (!init.empty() && (init.back() == '\n' || init.back() == ';')) init.pop_back();
+    }
+    return pad + "for (" + init + "; " + Expr(fs->getCond()) + "; " + Expr(fs->getInc()) + ")\n" + loopBody(fs->getBody());
+  }
+  if (auto* ws = dyn_cast<WhileStmt>(s)) return pad + "while (" + Expr(ws->getCond()) + ")\n" + loopBody(ws->getBody());
+  if (auto* dos = dyn_cast<DoStmt>(s)) return pad + "do\n" + loopBody(dos->getBody()) + pad + "while (" + Expr(dos->getCond()) + ");\n";
+  if (auto* rs = dyn_cast<ReturnStmt>(s)) {
+    if (m_inThreadBody && rs->getRetValue())
+      return Fail(s->getBeginLoc(), "kernel returns a value", "kernels return void; write results to an output buffer"), "";
+    return pad + "return" + (rs->getRetValue() ? " " + Expr(rs->getRetValue()) : "") + ";\n";
+  }
+  if (isa<ContinueStmt>(s)) return pad + (m_inThreadBody && m_loopDepth == 0 ? "return;  // 'continue' ends this thread\n" : "continue;\n");
+  if (isa<BreakStmt>(s)) {
+    if (m_inThreadBody && m_loopDepth == 0)
+      return Fail(s->getBeginLoc(), "'break' out of a parallel kernel loop", "each iteration is a thread: skip it with 'continue'"), "";
+    return pad + "break;\n";
+  }
+  if (auto* sw = dyn_cast<SwitchStmt>(s)) {
+    ++m_loopDepth;  // 'break' inside a switch is fine
+    std::string out = pad + "switch (" + Expr(sw->getCond()) + ")\n" + Stmt(sw->getBody(), indent);
+    --m_loopDepth;
+    return out;
+  }
+  if (auto* cs = dyn_cast<CaseStmt>(s)) return pad + "case " + Expr(cs->getLHS()) + ":\n" + Stmt(cs->getSubStmt(), indent + 1);
+  if (auto* ds = dyn_cast<DefaultStmt>(s)) return pad + "default:\n" + Stmt(ds->getSubStmt(), indent + 1);
+  if (isa<NullStmt>(s)) return pad + ";\n";
+  if (auto* e = dyn_cast<clang::Expr>(s)) return pad + Expr(e) + ";\n";
+  return Fail(s->getBeginLoc(), std::string("statement '") + s->getStmtClassName() + "' is not supported in kernels",
+              "kernels may use declarations, if, for, while, do, switch, return, break and continue"), "";
+}
+
+}  // namespace crossrt::engine

@@ -1,0 +1,78 @@
+// C++ (Clang AST) to GLSL: types, memory layouts and the statement/expression printer.
+#pragma once
+#include "Diagnostics.h"
+
+#include <clang/AST/ASTContext.h>
+#include <clang/AST/DeclCXX.h>
+#include <clang/AST/Expr.h>
+#include <clang/AST/ExprCXX.h>
+#include <clang/AST/Stmt.h>
+
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace crossrt::engine {
+
+// GLSL spelling of a C++ type, or nullopt when it has none (the caller reports).
+// Arrays come back as "float[4]"; use SplitArray() to declare a variable.
+std::optional<std::string> GlslTypeOf(clang::QualType type);
+// "float[4]" -> {"float", "[4]"}
+std::pair<std::string, std::string> SplitArray(const std::string& glslType);
+
+bool IsLiteMathType(clang::QualType type, const char* name = nullptr);
+bool IsStdVector(clang::QualType type, clang::QualType* element = nullptr);
+bool IsSystemDecl(const clang::Decl* decl);
+
+// Memory layouts a GLSL buffer block can use. A C++ type can be shared with the GPU only when one
+// of them gives exactly the C++ offsets and sizes.
+struct LayoutInfo { uint64_t size = 0, align = 0; };
+std::optional<LayoutInfo> Std430Layout(clang::ASTContext& ctx, clang::QualType type, bool scalar);
+// True when an array of `type` in the given layout has the C++ stride and field offsets.
+bool LayoutMatchesCpp(clang::ASTContext& ctx, clang::QualType type, bool scalar);
+
+// Prints the code one kernel reaches. One instance per kernel; it collects the helper functions,
+// structs and constants the kernel needs, in an order GLSL accepts (callees before callers).
+class GlslPrinter {
+public:
+  GlslPrinter(clang::ASTContext& ctx, const clang::CXXRecordDecl* cls, Reporter& reporter);
+
+  // Names that print differently: reduction members -> their per-thread accumulator, pointer params.
+  std::map<const clang::ValueDecl*, std::string> renames;
+  // Members declared std::vector that the kernel reaches, plain members it reads.
+  std::set<const clang::FieldDecl*> memberVectors, plainMembers;
+
+  std::string Expr(const clang::Expr* e);
+  std::string Stmt(const clang::Stmt* s, int indent);
+  // The thread's function body: `continue` at loop depth 0 ends the thread (becomes `return`).
+  std::string ThreadBody(const clang::Stmt* body, int indent);
+  std::optional<std::string> Type(clang::QualType t, clang::SourceLocation loc);
+  std::string Declare(clang::QualType t, const std::string& name, clang::SourceLocation loc);
+
+  // Helpers, structs and constants, ready to paste above the kernel.
+  std::string Prelude() const;
+  static std::string SafeName(const std::string& name);  // renames GLSL keywords
+
+private:
+  std::string Call(const clang::CallExpr* call);
+  std::string Builtin(const clang::FunctionDecl* fd, const std::vector<std::string>& args, const clang::CallExpr* call);
+  std::string Construct(clang::QualType t, const std::vector<const clang::Expr*>& args, clang::SourceLocation loc);
+  std::string Literal(const clang::Expr* e);
+  std::string Cast(clang::QualType to, const clang::Expr* sub);
+  std::string EmitHelper(const clang::FunctionDecl* fd, clang::SourceLocation callLoc);
+  void NeedStruct(const clang::RecordDecl* rd);
+  void NeedConstant(const clang::VarDecl* vd);
+  std::string Fail(clang::SourceLocation loc, const std::string& message, const std::string& hint);
+
+  clang::ASTContext& m_ctx;
+  const clang::CXXRecordDecl* m_class;
+  Reporter& m_reporter;
+  int m_loopDepth = 0;
+  bool m_inThreadBody = false;
+  std::vector<std::string> m_structs, m_constants, m_functions;  // in emission order
+  std::set<const clang::Decl*> m_emitted, m_inProgress;
+};
+
+}  // namespace crossrt::engine

@@ -1,0 +1,114 @@
+// What the analysis finds in a user class: the input to code generation.
+// Everything here is plain text and flags, so generation never touches the Clang AST.
+#pragma once
+#include <set>
+#include <string>
+#include <vector>
+
+namespace crossrt::engine {
+
+// A field of a block shared by C++ and GLSL (class data, push constants).
+struct BlockField {
+  std::string name;
+  std::string cppType;   // as the generated C++ mirror declares it
+  std::string glslType;  // GLSL type, may end with an array suffix "[N]"
+  unsigned std430Align = 4;
+};
+
+enum class MemberKind { Plain, Vector };
+
+struct Member {
+  std::string name;
+  MemberKind kind = MemberKind::Plain;
+  std::string cppType;          // full C++ type spelling
+  std::string glslType;         // plain: the GLSL type; vector: the element's GLSL type
+  std::string elemCppType;      // vector only
+  bool scalarLayout = false;    // vector whose element needs GL_EXT_scalar_block_layout to match C++
+  bool writtenByKernels = false;
+  bool usedByKernels = false;
+};
+
+enum class ReduceOp { Add, Sub, Min, Max };
+
+struct Reduction {
+  std::string member;
+  ReduceOp op = ReduceOp::Add;
+  std::string glslType;
+  std::string identity;  // GLSL expression of the identity element
+};
+
+struct KernelParam {
+  std::string name;       // as in the user's code
+  std::string glslName;   // renamed when it is a GLSL keyword
+  std::string cppType;    // host type for the ...Cmd signature
+  std::string glslType;
+  bool isPointer = false;
+  bool isConstPointee = false;
+  bool scalarLayout = false;
+  bool isThreadId = false;  // RTV kernels: tid, tidX, tidY, tidZ
+};
+
+struct Loop {                // one parallel dimension of an IPV kernel
+  std::string var;
+  std::string glslType;      // the loop variable's GLSL type
+  std::string startCpp;      // C++ expressions, evaluated on the host when recording
+  std::string countCpp;
+};
+
+struct Kernel {
+  std::string name;
+  bool rtv = false;                   // kernel_* called from a loop, else kernel1D/2D/3D_* holding loops
+  unsigned dims = 1;
+  std::vector<KernelParam> params;
+  std::vector<Loop> loops;            // IPV: outermost first
+  std::vector<Reduction> reductions;
+  std::vector<std::string> memberVectors;   // member vectors the kernel reaches (incl. helpers)
+  bool usesClassData = false;
+  std::string glslHelpers;            // structs, constants, helper functions it needs
+  std::string glslBody;               // the thread's code, as a GLSL function body
+  std::string cpuLoopNest;            // IPV, CPU backend: the loop nest with reductions renamed
+  std::string cpuPreamble;            // IPV, CPU backend: statements before the loops
+  std::string sourceFile;             // where the kernel is defined (for comments)
+};
+
+struct ControlParam {
+  std::string name;
+  std::string cppType;       // full spelling, e.g. "const float*"
+  bool isPointer = false;
+  bool isConst = false;
+  std::string pointeeCpp;    // element type of a pointer
+  std::string sizeExpr;      // from [[crossrt::size("...")]]
+};
+
+struct Control {
+  std::string name;
+  std::string returnType;
+  std::string paramsDecl;           // "int n, const float* in"
+  std::string argsForward;          // "n, in"
+  bool isConst = false;
+  std::vector<ControlParam> params;
+  std::string vulkanCmdBody;        // body with kernel calls turned into ...Cmd calls
+  std::string cpuBody;              // body with RTV loops parallelised
+  std::vector<std::string> kernelsCalled;
+  std::string sourceFile;
+};
+
+struct Constructor {
+  std::string paramsDecl;  // "int a_w, int a_h"
+  std::string argsForward; // "a_w, a_h"
+};
+
+struct ClassModel {
+  std::string className;
+  std::string headerFile;      // header declaring the class (as included by generated code)
+  std::vector<Member> members;
+  std::vector<Kernel> kernels;
+  std::vector<Control> controls;
+  std::vector<Constructor> constructors;
+  bool declaresCommitDeviceData = false;
+  bool declaresGetExecutionTime = false;
+  std::vector<BlockField> classData;   // plain members + vector sizes, in block order
+  bool classDataScalarLayout = false;
+};
+
+}  // namespace crossrt::engine

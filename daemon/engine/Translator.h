@@ -1,0 +1,38 @@
+// The translation engine: turns one user class into generated source files.
+// It knows nothing about sockets or processes: the client runs it in-process, the daemon will host it.
+#pragma once
+#include <map>
+#include <string>
+#include <vector>
+
+namespace crossrt::engine {
+
+enum class Backend { Vulkan, Cpu };
+
+struct TranslateRequest {
+  std::string className;                 // e.g. "MyRender"
+  Backend backend = Backend::Vulkan;
+  std::vector<std::string> sources;      // .cpp files that define the class's member functions
+  std::vector<std::string> compileArgs;  // -I, -D, -std=... as the target compiles them
+  std::string outputDir;                 // build-tree folder for the generated files
+  std::string templateDir;               // templates/ (vulkan, glsl, cpu subfolders)
+  std::string glslangValidator = "glslangValidator";  // compiles generated GLSL to SPIR-V
+};
+
+struct TranslateResult {
+  bool ok = false;
+  std::string diagnostics;                      // compiler-style text: file:line:col: error: ...
+  std::map<std::string, std::string> files;     // file name (relative to outputDir) -> contents
+  std::vector<std::string> inputs;              // every file the translation read (for depfiles)
+};
+
+// Parses, analyses and generates. Does not write anything.
+TranslateResult Translate(const TranslateRequest& request);
+
+// Writes result.files into outputDir atomically, touching only files whose bytes changed.
+// Returns the names of the files it rewrote. Throws std::runtime_error on IO failure.
+std::vector<std::string> WriteOutputs(const TranslateRequest& request, const TranslateResult& result);
+
+const char* TranslatorVersion();
+
+}  // namespace crossrt::engine

@@ -1,0 +1,250 @@
+// CrossRT Vulkan runtime: the small layer that translator-generated code links to.
+// It creates a compute-capable device, allocates storage buffers, builds compute pipelines from
+// embedded SPIR-V (push descriptors + push constants), dispatches, and times GPU work.
+#pragma once
+
+#include <vulkan/vulkan.h>
+
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <initializer_list>
+#include <memory>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace crossrt {
+
+struct Error : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Thrown when no Vulkan driver/device exists at all, so callers (tests, tools) can tell
+// "this machine cannot run Vulkan" apart from real failures.
+struct NoDeviceError : Error {
+  using Error::Error;
+};
+
+// Throws Error("<what> failed: VK_ERROR_... (code)") unless r == VK_SUCCESS.
+void Check(VkResult r, const char* what);
+// Name of a VkResult, e.g. "VK_ERROR_DEVICE_LOST".
+const char* ResultName(VkResult r);
+
+struct ContextOptions {
+  std::string device;        // "" = automatic; else a device index ("1") or a case-insensitive substring of the name
+  bool validation = false;   // enable VK_LAYER_KHRONOS_validation + VK_EXT_debug_utils messenger
+  std::vector<const char*> optionalDeviceExtensions;  // enabled when present
+  // Testing aid: never map device buffers, so Upload/Download take the staging path that GPUs
+  // without host-visible VRAM need (lavapipe's memory is always host-visible).
+  bool forceStaging = false;
+};
+
+class VulkanContext {
+public:
+  // Reads CROSSRT_DEVICE (index or name substring) and CROSSRT_VALIDATION=1.
+  // Automatic choice: discrete GPU > integrated > virtual > CPU (lavapipe).
+  static std::shared_ptr<VulkanContext> CreateDefault();
+  static std::shared_ptr<VulkanContext> Create(const ContextOptions& options);
+  ~VulkanContext();  // waits idle, saves the pipeline cache, destroys everything
+  VulkanContext(const VulkanContext&) = delete;
+  VulkanContext& operator=(const VulkanContext&) = delete;
+
+  VkInstance instance = VK_NULL_HANDLE;
+  VkPhysicalDevice physicalDevice = VK_NULL_HANDLE;
+  VkDevice device = VK_NULL_HANDLE;
+  VkQueue queue = VK_NULL_HANDLE;
+  uint32_t queueFamily = 0;
+  VkCommandPool commandPool = VK_NULL_HANDLE;
+  VkPipelineCache pipelineCache = VK_NULL_HANDLE;
+  VkPhysicalDeviceProperties properties{};  // limits, name, timestampPeriod
+  bool hasScalarBlockLayout = false, hasBufferDeviceAddress = false, hasRayQuery = false,
+       hasShaderFloat64 = false, hasShaderInt64 = false;
+  bool forceStaging = false;  // see ContextOptions::forceStaging
+
+  std::string DeviceName() const;
+
+  // Validation: WARNING/ERROR messages received by the debug messenger (thread-safe).
+  size_t ValidationMessageCount() const;
+  std::vector<std::string> ValidationMessages() const;
+  void ClearValidationMessages();
+
+  PFN_vkCmdPushDescriptorSetKHR vkCmdPushDescriptorSetKHR = nullptr;
+
+  // One-shot command buffers come from the shared commandPool: allocation, submission and freeing
+  // are locked, but Vulkan pools allow recording from only one thread at a time.
+  VkCommandBuffer BeginOneShot();           // allocate + begin a primary command buffer
+  // End, submit, wait on a fence, free. Ends with a device->host memory barrier, so mapped
+  // buffers can be read right after.
+  void SubmitAndWait(VkCommandBuffer cmd);
+  // Index of a memory type in typeBits having all of props; throws Error if there is none.
+  uint32_t FindMemoryType(uint32_t typeBits, VkMemoryPropertyFlags props) const;
+  // Same, but returns UINT32_MAX instead of throwing.
+  uint32_t TryFindMemoryType(uint32_t typeBits, VkMemoryPropertyFlags props) const;
+  VkMemoryPropertyFlags MemoryTypeFlags(uint32_t typeIndex) const;
+  // Names an object for validation messages and debuggers; no-op without VK_EXT_debug_utils.
+  void SetObjectName(VkObjectType type, uint64_t handle, const char* name) const;
+
+private:
+  VulkanContext() = default;
+  void Init(const ContextOptions& options);
+  void CreateInstance(const ContextOptions& options);
+  void CreateDevice(const ContextOptions& options);
+  void LoadPipelineCache();
+  void SavePipelineCache();
+  static VKAPI_ATTR VkBool32 VKAPI_CALL DebugCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                                      VkDebugUtilsMessageTypeFlagsEXT types,
+                                                      const VkDebugUtilsMessengerCallbackDataEXT* data,
+                                                      void* user);
+
+  VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+  PFN_vkSetDebugUtilsObjectNameEXT setObjectName_ = nullptr;
+  VkPhysicalDeviceMemoryProperties memoryProperties_{};
+  std::string pipelineCachePath_;
+  mutable std::mutex messagesMutex_;
+  std::vector<std::string> messages_;
+  std::mutex submitMutex_;  // command pool and queue need external synchronization
+};
+
+struct BufferView {
+  VkBuffer buffer = VK_NULL_HANDLE;
+  VkDeviceSize offset = 0;
+  VkDeviceSize range = VK_WHOLE_SIZE;
+};
+
+// RAII storage buffer, move-only.
+// Usage: STORAGE | TRANSFER_SRC | TRANSFER_DST (+ SHADER_DEVICE_ADDRESS if supported) | extraUsage.
+class Buffer {
+public:
+  Buffer() = default;
+  Buffer(std::shared_ptr<VulkanContext> ctx, VkDeviceSize bytes, VkBufferUsageFlags extraUsage = 0);
+  Buffer(Buffer&& other) noexcept;
+  Buffer& operator=(Buffer&& other) noexcept;
+  Buffer(const Buffer&) = delete;
+  Buffer& operator=(const Buffer&) = delete;
+  ~Buffer();
+
+  VkBuffer Handle() const { return buffer_; }
+  VkDeviceSize Size() const { return size_; }  // bytes requested (the allocation may be larger)
+  bool Empty() const { return buffer_ == VK_NULL_HANDLE; }
+  BufferView View(VkDeviceSize offset = 0, VkDeviceSize range = VK_WHOLE_SIZE) const {
+    return BufferView{buffer_, offset, range};
+  }
+  VkBufferUsageFlags ExtraUsage() const { return extraUsage_; }
+  bool HostMapped() const { return mapped_ != nullptr; }
+
+  // Mapped memcpy if host-visible, else staging buffer + one-shot copy (synchronous).
+  void Upload(const void* src, size_t bytes, size_t dstOffset = 0);
+  void Download(void* dst, size_t bytes, size_t srcOffset = 0) const;
+  void Fill(uint32_t value);         // vkCmdFillBuffer over the whole buffer, one-shot
+  VkDeviceAddress Address() const { return address_; }  // 0 if unsupported
+
+private:
+  void Release() noexcept;
+
+  std::shared_ptr<VulkanContext> ctx_;
+  VkBuffer buffer_ = VK_NULL_HANDLE;
+  VkDeviceMemory memory_ = VK_NULL_HANDLE;
+  VkDeviceSize size_ = 0;
+  void* mapped_ = nullptr;
+  VkDeviceAddress address_ = 0;
+  VkBufferUsageFlags extraUsage_ = 0;
+};
+
+// Reallocates b (keeping its extra usage) only when it is empty or smaller than bytes.
+void EnsureSize(std::shared_ptr<VulkanContext> ctx, Buffer& b, VkDeviceSize bytes);
+
+// RAII compute pipeline, move-only. Set 0 is a push-descriptor set of storage buffers.
+class ComputePipeline {
+public:
+  ComputePipeline() = default;
+  // storageBufferBindings: bindings 0..n-1 in set 0; pushConstantBytes may be 0.
+  ComputePipeline(std::shared_ptr<VulkanContext> ctx, const uint32_t* spirv, size_t spirvBytes,
+                  uint32_t storageBufferBindings, uint32_t pushConstantBytes, const char* debugName);
+  ComputePipeline(ComputePipeline&& other) noexcept;
+  ComputePipeline& operator=(ComputePipeline&& other) noexcept;
+  ComputePipeline(const ComputePipeline&) = delete;
+  ComputePipeline& operator=(const ComputePipeline&) = delete;
+  ~ComputePipeline();
+
+  void Bind(VkCommandBuffer cmd) const;
+  // Binding i = i-th view, via vkCmdPushDescriptorSetKHR. The count must equal the binding count.
+  void PushBuffers(VkCommandBuffer cmd, std::initializer_list<BufferView> buffers) const;
+  void PushConstants(VkCommandBuffer cmd, const void* data, uint32_t bytes) const;
+  VkPipeline Handle() const { return pipeline_; }
+  VkPipelineLayout Layout() const { return layout_; }
+
+private:
+  void Release() noexcept;
+
+  std::shared_ptr<VulkanContext> ctx_;
+  VkDescriptorSetLayout setLayout_ = VK_NULL_HANDLE;
+  VkPipelineLayout layout_ = VK_NULL_HANDLE;
+  VkPipeline pipeline_ = VK_NULL_HANDLE;
+  uint32_t bindings_ = 0;
+  uint32_t pushConstantBytes_ = 0;
+  std::string name_;
+};
+
+// Dispatch `threads` threads in groups of `groupSize` (1D). Above 65535 groups (the minimum
+// maxComputeWorkGroupCount every device has) the groups are spread over y; shaders compute
+//   id = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x
+// and skip ids >= threads. Returns the number of groups launched (x*y).
+uint32_t Dispatch1D(VkCommandBuffer cmd, uint64_t threads, uint32_t groupSize);
+void Dispatch2D(VkCommandBuffer cmd, uint32_t threadsX, uint32_t threadsY, uint32_t groupX, uint32_t groupY);
+void Dispatch3D(VkCommandBuffer cmd, uint32_t tx, uint32_t ty, uint32_t tz, uint32_t gx, uint32_t gy, uint32_t gz);
+uint32_t GroupCount1D(uint64_t threads, uint32_t groupSize);  // total groups Dispatch1D would launch
+// Shader writes -> later shader reads/writes and transfers (compute -> compute|transfer).
+void ComputeBarrier(VkCommandBuffer cmd);
+// Transfer writes (copy/fill) -> later shader reads/writes.
+void TransferToComputeBarrier(VkCommandBuffer cmd);
+
+// GPU timing with timestamp queries, for GetExecutionTime(). One per generated class.
+class GpuTimer {
+public:
+  GpuTimer() = default;
+  explicit GpuTimer(std::shared_ptr<VulkanContext> ctx, uint32_t maxQueries = 256);
+  GpuTimer(GpuTimer&& other) noexcept;
+  GpuTimer& operator=(GpuTimer&& other) noexcept;
+  GpuTimer(const GpuTimer&) = delete;
+  GpuTimer& operator=(const GpuTimer&) = delete;
+  ~GpuTimer();
+
+  void Reset(VkCommandBuffer cmd);                            // vkCmdResetQueryPool
+  void Begin(VkCommandBuffer cmd, const std::string& name);   // timestamp at TOP_OF_PIPE
+  void End(VkCommandBuffer cmd, const std::string& name);     // timestamp at ALL_COMMANDS
+  // After the submission completed: read results; the sum of this submission's intervals per name
+  // becomes that name's last duration.
+  void Collect();
+  float LastMs(const std::string& name) const;  // 0 if unknown
+
+private:
+  struct Interval {
+    std::string name;
+    uint32_t begin;
+    uint32_t end;  // UINT32_MAX while open
+  };
+  void Release() noexcept;
+
+  std::shared_ptr<VulkanContext> ctx_;
+  VkQueryPool pool_ = VK_NULL_HANDLE;  // null when timestamps are unsupported: everything reports 0
+  uint32_t maxQueries_ = 0;
+  uint32_t used_ = 0;
+  uint64_t validMask_ = 0;
+  std::vector<Interval> intervals_;
+  std::unordered_map<std::string, float> lastMs_;
+};
+
+// steady_clock stopwatch; starts on construction.
+struct CpuTimer {
+  CpuTimer() { start(); }
+  void start() { t0 = std::chrono::steady_clock::now(); }
+  float ElapsedMs() const {
+    return std::chrono::duration<float, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  }
+  std::chrono::steady_clock::time_point t0;
+};
+
+}  // namespace crossrt

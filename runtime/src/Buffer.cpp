@@ -1,0 +1,196 @@
+// Buffer: storage buffers in device-local memory, persistently mapped when that memory is also
+// host-visible (lavapipe, resizable-BAR GPUs), otherwise filled/read through a staging buffer.
+#include "crossrt/VulkanRuntime.h"
+#include "Internal.h"
+
+#include <cstring>
+#include <utility>
+
+namespace crossrt {
+namespace {
+
+// A buffer + its memory; the building block for Buffer and for temporary staging buffers.
+struct Allocation {
+  VkBuffer buffer = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  VkMemoryPropertyFlags flags = 0;
+};
+
+// Tries the memory property sets in order; falls back to the next one when a heap is full
+// (e.g. the 256 MiB BAR window on GPUs without resizable BAR).
+Allocation Allocate(const VulkanContext& ctx, VkDeviceSize size, VkBufferUsageFlags usage,
+                    std::initializer_list<VkMemoryPropertyFlags> preferences) {
+  Allocation a;
+  auto info = VkInit<VkBufferCreateInfo>(VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO);
+  info.size = size;
+  info.usage = usage;
+  info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  Check(vkCreateBuffer(ctx.device, &info, nullptr, &a.buffer), "vkCreateBuffer");
+
+  VkMemoryRequirements req;
+  vkGetBufferMemoryRequirements(ctx.device, a.buffer, &req);
+  auto flagsInfo = VkInit<VkMemoryAllocateFlagsInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO);
+  flagsInfo.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
+  auto alloc = VkInit<VkMemoryAllocateInfo>(VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO);
+  alloc.allocationSize = req.size;
+  if (usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) alloc.pNext = &flagsInfo;
+
+  VkResult last = VK_ERROR_OUT_OF_DEVICE_MEMORY;
+  for (VkMemoryPropertyFlags props : preferences) {
+    uint32_t type = ctx.TryFindMemoryType(req.memoryTypeBits, props);
+    if (type == UINT32_MAX) continue;
+    alloc.memoryTypeIndex = type;
+    last = vkAllocateMemory(ctx.device, &alloc, nullptr, &a.memory);
+    if (last == VK_SUCCESS) {
+      a.flags = ctx.MemoryTypeFlags(type);
+      break;
+    }
+    if (last != VK_ERROR_OUT_OF_DEVICE_MEMORY && last != VK_ERROR_OUT_OF_HOST_MEMORY) break;
+  }
+  if (last != VK_SUCCESS) {
+    vkDestroyBuffer(ctx.device, a.buffer, nullptr);
+    Check(last, ("vkAllocateMemory (" + std::to_string(size) + " bytes)").c_str());
+  }
+  VkResult r = vkBindBufferMemory(ctx.device, a.buffer, a.memory, 0);
+  if (r != VK_SUCCESS) {
+    vkDestroyBuffer(ctx.device, a.buffer, nullptr);
+    vkFreeMemory(ctx.device, a.memory, nullptr);
+    Check(r, "vkBindBufferMemory");
+  }
+  return a;
+}
+
+constexpr VkMemoryPropertyFlags kHostCoherent = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+
+// Host-visible, coherent, mapped temporary buffer for the non-mappable path.
+struct Staging {
+  const VulkanContext& ctx;
+  Allocation a;
+  void* mapped = nullptr;
+  Staging(const VulkanContext& c, VkDeviceSize size, VkBufferUsageFlags usage) : ctx(c) {
+    // Cached memory first: downloads read it with the CPU.
+    a = Allocate(ctx, size, usage, {kHostCoherent | VK_MEMORY_PROPERTY_HOST_CACHED_BIT, kHostCoherent});
+    VkResult r = vkMapMemory(ctx.device, a.memory, 0, VK_WHOLE_SIZE, 0, &mapped);
+    if (r != VK_SUCCESS) {
+      Free();
+      Check(r, "vkMapMemory (staging)");
+    }
+  }
+  ~Staging() { Free(); }
+  void Free() {
+    vkDestroyBuffer(ctx.device, a.buffer, nullptr);
+    vkFreeMemory(ctx.device, a.memory, nullptr);
+  }
+  Staging(const Staging&) = delete;
+  Staging& operator=(const Staging&) = delete;
+};
+
+void CheckRange(const Buffer& b, size_t bytes, size_t offset, const char* what) {
+  if (b.Empty()) throw Error(std::string(what) + ": the buffer is empty (default-constructed or moved-from)");
+  if (offset > b.Size() || bytes > b.Size() - offset)
+    throw Error(std::string(what) + ": range [" + std::to_string(offset) + ", " + std::to_string(offset + bytes) +
+                ") is outside the buffer of " + std::to_string(b.Size()) + " bytes");
+}
+
+}  // namespace
+
+Buffer::Buffer(std::shared_ptr<VulkanContext> ctx, VkDeviceSize bytes, VkBufferUsageFlags extraUsage)
+    : ctx_(std::move(ctx)), size_(bytes), extraUsage_(extraUsage) {
+  if (!ctx_) throw Error("crossrt::Buffer: null VulkanContext");
+  VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+                             VK_BUFFER_USAGE_TRANSFER_DST_BIT | extraUsage;
+  if (ctx_->hasBufferDeviceAddress) usage |= VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
+  // Never zero (Vulkan forbids it) and a multiple of 16 so Fill covers every byte and
+  // vec4/scalar accesses at the tail stay in bounds.
+  VkDeviceSize allocSize = ((bytes == 0 ? 1 : bytes) + 15) & ~VkDeviceSize(15);
+
+  const VkMemoryPropertyFlags deviceHost = VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT | kHostCoherent;
+  Allocation a = Allocate(*ctx_, allocSize, usage,
+                          {deviceHost, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, kHostCoherent, VkMemoryPropertyFlags(0)});
+  buffer_ = a.buffer;
+  memory_ = a.memory;
+  if (!ctx_->forceStaging && (a.flags & kHostCoherent) == kHostCoherent) {
+    VkResult r = vkMapMemory(ctx_->device, memory_, 0, VK_WHOLE_SIZE, 0, &mapped_);
+    if (r != VK_SUCCESS) mapped_ = nullptr;  // staging still works
+  }
+  if (usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) {
+    auto info = VkInit<VkBufferDeviceAddressInfo>(VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO);
+    info.buffer = buffer_;
+    address_ = vkGetBufferDeviceAddress(ctx_->device, &info);
+  }
+}
+
+Buffer::Buffer(Buffer&& other) noexcept { *this = std::move(other); }
+
+Buffer& Buffer::operator=(Buffer&& other) noexcept {
+  if (this != &other) {
+    Release();
+    ctx_ = std::move(other.ctx_);
+    buffer_ = std::exchange(other.buffer_, VK_NULL_HANDLE);
+    memory_ = std::exchange(other.memory_, VK_NULL_HANDLE);
+    size_ = std::exchange(other.size_, 0);
+    mapped_ = std::exchange(other.mapped_, nullptr);
+    address_ = std::exchange(other.address_, 0);
+    extraUsage_ = std::exchange(other.extraUsage_, 0);
+  }
+  return *this;
+}
+
+Buffer::~Buffer() { Release(); }
+
+void Buffer::Release() noexcept {
+  if (ctx_ && buffer_) {
+    vkDestroyBuffer(ctx_->device, buffer_, nullptr);
+    vkFreeMemory(ctx_->device, memory_, nullptr);  // also unmaps
+  }
+  buffer_ = VK_NULL_HANDLE;
+  memory_ = VK_NULL_HANDLE;
+  mapped_ = nullptr;
+  size_ = 0;
+  address_ = 0;
+  ctx_.reset();
+}
+
+void Buffer::Upload(const void* src, size_t bytes, size_t dstOffset) {
+  CheckRange(*this, bytes, dstOffset, "Buffer::Upload");
+  if (bytes == 0) return;
+  if (mapped_) {
+    std::memcpy(static_cast<char*>(mapped_) + dstOffset, src, bytes);  // coherent: no flush needed
+    return;
+  }
+  Staging staging(*ctx_, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+  std::memcpy(staging.mapped, src, bytes);
+  VkCommandBuffer cmd = ctx_->BeginOneShot();
+  VkBufferCopy region{0, dstOffset, bytes};
+  vkCmdCopyBuffer(cmd, staging.a.buffer, buffer_, 1, &region);
+  ctx_->SubmitAndWait(cmd);
+}
+
+void Buffer::Download(void* dst, size_t bytes, size_t srcOffset) const {
+  CheckRange(*this, bytes, srcOffset, "Buffer::Download");
+  if (bytes == 0) return;
+  if (mapped_) {
+    std::memcpy(dst, static_cast<const char*>(mapped_) + srcOffset, bytes);
+    return;
+  }
+  Staging staging(*ctx_, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  VkCommandBuffer cmd = ctx_->BeginOneShot();
+  VkBufferCopy region{srcOffset, 0, bytes};
+  vkCmdCopyBuffer(cmd, buffer_, staging.a.buffer, 1, &region);
+  ctx_->SubmitAndWait(cmd);  // ends with a transfer -> host barrier
+  std::memcpy(dst, staging.mapped, bytes);
+}
+
+void Buffer::Fill(uint32_t value) {
+  if (Empty()) throw Error("Buffer::Fill: the buffer is empty (default-constructed or moved-from)");
+  VkCommandBuffer cmd = ctx_->BeginOneShot();
+  vkCmdFillBuffer(cmd, buffer_, 0, VK_WHOLE_SIZE, value);
+  ctx_->SubmitAndWait(cmd);
+}
+
+void EnsureSize(std::shared_ptr<VulkanContext> ctx, Buffer& b, VkDeviceSize bytes) {
+  if (!b.Empty() && b.Size() >= bytes) return;
+  b = Buffer(std::move(ctx), bytes, b.ExtraUsage());
+}
+
+}  // namespace crossrt

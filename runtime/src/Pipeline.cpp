@@ -1,0 +1,201 @@
+// ComputePipeline (push-descriptor set 0 of storage buffers + push constants), dispatch helpers
+// and the barriers generated code puts between dispatches.
+#include "crossrt/VulkanRuntime.h"
+#include "Internal.h"
+
+#include <utility>
+
+namespace crossrt {
+
+ComputePipeline::ComputePipeline(std::shared_ptr<VulkanContext> ctx, const uint32_t* spirv, size_t spirvBytes,
+                                 uint32_t storageBufferBindings, uint32_t pushConstantBytes, const char* debugName)
+    : ctx_(std::move(ctx)), bindings_(storageBufferBindings), pushConstantBytes_(pushConstantBytes),
+      name_(debugName ? debugName : "") {
+  if (!ctx_) throw Error("ComputePipeline '" + name_ + "': null VulkanContext");
+  if (!spirv || spirvBytes == 0 || spirvBytes % 4 != 0)
+    throw Error("ComputePipeline '" + name_ + "': SPIR-V must be a non-empty multiple of 4 bytes");
+  if (pushConstantBytes > ctx_->properties.limits.maxPushConstantsSize || pushConstantBytes % 4 != 0)
+    throw Error("ComputePipeline '" + name_ + "': " + std::to_string(pushConstantBytes) +
+                " bytes of push constants (must be a multiple of 4 and at most " +
+                std::to_string(ctx_->properties.limits.maxPushConstantsSize) + " on this device)");
+
+  VkDevice dev = ctx_->device;
+  try {
+    if (bindings_ > 0) {
+      std::vector<VkDescriptorSetLayoutBinding> b(bindings_);
+      for (uint32_t i = 0; i < bindings_; ++i)
+        b[i] = VkDescriptorSetLayoutBinding{i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+      auto setInfo = VkInit<VkDescriptorSetLayoutCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO);
+      setInfo.flags = VK_DESCRIPTOR_SET_LAYOUT_CREATE_PUSH_DESCRIPTOR_BIT_KHR;
+      setInfo.bindingCount = bindings_;
+      setInfo.pBindings = b.data();
+      Check(vkCreateDescriptorSetLayout(dev, &setInfo, nullptr, &setLayout_), "vkCreateDescriptorSetLayout");
+    }
+
+    VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, pushConstantBytes_};
+    auto layoutInfo = VkInit<VkPipelineLayoutCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO);
+    layoutInfo.setLayoutCount = setLayout_ ? 1 : 0;
+    layoutInfo.pSetLayouts = setLayout_ ? &setLayout_ : nullptr;
+    layoutInfo.pushConstantRangeCount = pushConstantBytes_ ? 1 : 0;
+    layoutInfo.pPushConstantRanges = pushConstantBytes_ ? &range : nullptr;
+    Check(vkCreatePipelineLayout(dev, &layoutInfo, nullptr, &layout_), "vkCreatePipelineLayout");
+
+    auto moduleInfo = VkInit<VkShaderModuleCreateInfo>(VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO);
+    moduleInfo.codeSize = spirvBytes;
+    moduleInfo.pCode = spirv;
+    VkShaderModule module = VK_NULL_HANDLE;
+    Check(vkCreateShaderModule(dev, &moduleInfo, nullptr, &module), "vkCreateShaderModule");
+
+    auto info = VkInit<VkComputePipelineCreateInfo>(VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO);
+    info.stage = VkInit<VkPipelineShaderStageCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO);
+    info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    info.stage.module = module;
+    info.stage.pName = "main";
+    info.layout = layout_;
+    VkResult r = vkCreateComputePipelines(dev, ctx_->pipelineCache, 1, &info, nullptr, &pipeline_);
+    vkDestroyShaderModule(dev, module, nullptr);  // the pipeline keeps what it needs
+    Check(r, ("vkCreateComputePipelines '" + name_ + "'").c_str());
+    ctx_->SetObjectName(VK_OBJECT_TYPE_PIPELINE, reinterpret_cast<uint64_t>(pipeline_), name_.c_str());
+  } catch (...) {
+    Release();
+    throw;
+  }
+}
+
+ComputePipeline::ComputePipeline(ComputePipeline&& other) noexcept { *this = std::move(other); }
+
+ComputePipeline& ComputePipeline::operator=(ComputePipeline&& other) noexcept {
+  if (this != &other) {
+    Release();
+    ctx_ = std::move(other.ctx_);
+    setLayout_ = std::exchange(other.setLayout_, VK_NULL_HANDLE);
+    layout_ = std::exchange(other.layout_, VK_NULL_HANDLE);
+    pipeline_ = std::exchange(other.pipeline_, VK_NULL_HANDLE);
+    bindings_ = std::exchange(other.bindings_, 0);
+    pushConstantBytes_ = std::exchange(other.pushConstantBytes_, 0);
+    name_ = std::move(other.name_);
+  }
+  return *this;
+}
+
+ComputePipeline::~ComputePipeline() { Release(); }
+
+void ComputePipeline::Release() noexcept {
+  if (ctx_) {
+    if (pipeline_) vkDestroyPipeline(ctx_->device, pipeline_, nullptr);
+    if (layout_) vkDestroyPipelineLayout(ctx_->device, layout_, nullptr);
+    if (setLayout_) vkDestroyDescriptorSetLayout(ctx_->device, setLayout_, nullptr);
+  }
+  pipeline_ = VK_NULL_HANDLE;
+  layout_ = VK_NULL_HANDLE;
+  setLayout_ = VK_NULL_HANDLE;
+  ctx_.reset();
+}
+
+void ComputePipeline::Bind(VkCommandBuffer cmd) const {
+  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
+}
+
+void ComputePipeline::PushBuffers(VkCommandBuffer cmd, std::initializer_list<BufferView> buffers) const {
+  if (buffers.size() != bindings_)
+    throw Error("ComputePipeline '" + name_ + "': PushBuffers got " + std::to_string(buffers.size()) +
+                " buffers for " + std::to_string(bindings_) + " bindings");
+  if (bindings_ == 0) return;
+  std::vector<VkDescriptorBufferInfo> infos;
+  infos.reserve(bindings_);
+  for (const BufferView& v : buffers) {
+    if (!v.buffer)
+      throw Error("ComputePipeline '" + name_ + "': binding " + std::to_string(infos.size()) + " has no buffer");
+    infos.push_back(VkDescriptorBufferInfo{v.buffer, v.offset, v.range});
+  }
+  // One write per binding: binding i gets the i-th view.
+  std::vector<VkWriteDescriptorSet> writes(bindings_);
+  for (uint32_t i = 0; i < bindings_; ++i) {
+    writes[i] = VkInit<VkWriteDescriptorSet>(VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET);
+    writes[i].dstBinding = i;
+    writes[i].descriptorCount = 1;
+    writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    writes[i].pBufferInfo = &infos[i];
+  }
+  ctx_->vkCmdPushDescriptorSetKHR(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, bindings_, writes.data());
+}
+
+void ComputePipeline::PushConstants(VkCommandBuffer cmd, const void* data, uint32_t bytes) const {
+  if (bytes > pushConstantBytes_)
+    throw Error("ComputePipeline '" + name_ + "': " + std::to_string(bytes) + " bytes of push constants, layout has " +
+                std::to_string(pushConstantBytes_));
+  if (bytes == 0) return;
+  vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, bytes, data);
+}
+
+// ---- dispatch ------------------------------------------------------------------------------------
+
+namespace {
+// Every device supports at least this many groups per dimension; without a context we cannot
+// ask for more, and the shader's linear-id formula works with any x.
+constexpr uint64_t kMaxGroupsPerDim = 65535;
+
+uint32_t CeilDiv(uint32_t a, uint32_t b) { return static_cast<uint32_t>((uint64_t(a) + b - 1) / b); }  // no overflow
+
+void Split1D(uint64_t threads, uint32_t groupSize, uint32_t& x, uint32_t& y) {
+  if (groupSize == 0) throw Error("Dispatch1D: groupSize is 0");
+  uint64_t groups = (threads + groupSize - 1) / groupSize;
+  if (groups == 0) {
+    x = y = 0;
+    return;
+  }
+  uint64_t gy = (groups + kMaxGroupsPerDim - 1) / kMaxGroupsPerDim;
+  if (gy > kMaxGroupsPerDim)
+    throw Error("Dispatch1D: " + std::to_string(threads) + " threads in groups of " + std::to_string(groupSize) +
+                " need more than 65535 x 65535 groups");
+  // Balance x over the rows so few groups are wasted (70000 groups -> 35000 x 2).
+  uint64_t gx = (groups + gy - 1) / gy;
+  x = static_cast<uint32_t>(gx);
+  y = static_cast<uint32_t>(gy);
+}
+}  // namespace
+
+uint32_t GroupCount1D(uint64_t threads, uint32_t groupSize) {
+  uint32_t x = 0, y = 0;
+  Split1D(threads, groupSize, x, y);
+  return x * y;
+}
+
+uint32_t Dispatch1D(VkCommandBuffer cmd, uint64_t threads, uint32_t groupSize) {
+  uint32_t x = 0, y = 0;
+  Split1D(threads, groupSize, x, y);
+  if (x * y == 0) return 0;
+  vkCmdDispatch(cmd, x, y, 1);
+  return x * y;
+}
+
+void Dispatch2D(VkCommandBuffer cmd, uint32_t threadsX, uint32_t threadsY, uint32_t groupX, uint32_t groupY) {
+  Dispatch3D(cmd, threadsX, threadsY, 1, groupX, groupY, 1);
+}
+
+void Dispatch3D(VkCommandBuffer cmd, uint32_t tx, uint32_t ty, uint32_t tz, uint32_t gx, uint32_t gy, uint32_t gz) {
+  if (gx == 0 || gy == 0 || gz == 0) throw Error("Dispatch: a group size is 0");
+  uint32_t x = CeilDiv(tx, gx), y = CeilDiv(ty, gy), z = CeilDiv(tz, gz);
+  if (x == 0 || y == 0 || z == 0) return;  // nothing to do
+  vkCmdDispatch(cmd, x, y, z);
+}
+
+void ComputeBarrier(VkCommandBuffer cmd) {
+  auto b = VkInit<VkMemoryBarrier>(VK_STRUCTURE_TYPE_MEMORY_BARRIER);
+  b.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+  b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT |
+                    VK_ACCESS_TRANSFER_WRITE_BIT;
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 1, &b, 0, nullptr, 0,
+                       nullptr);
+}
+
+void TransferToComputeBarrier(VkCommandBuffer cmd) {
+  auto b = VkInit<VkMemoryBarrier>(VK_STRUCTURE_TYPE_MEMORY_BARRIER);
+  b.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
+  b.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &b, 0, nullptr,
+                       0, nullptr);
+}
+
+}  // namespace crossrt

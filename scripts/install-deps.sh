@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages CrossRT needs. Does nothing when they are already there.
+set -euo pipefail
+PACKAGES=(
+  cmake ninja-build g++ ccache pkg-config
+  clang-19 libclang-19-dev llvm-19-dev libzstd-dev          # the translator (Clang LibTooling)
+  glslang-tools glslang-dev spirv-tools                   # GLSL -> SPIR-V, spirv-val
+  libvulkan-dev vulkan-tools vulkan-validationlayers       # loader, headers, validation layers
+  mesa-vulkan-drivers                                      # lavapipe, the CPU Vulkan driver
+  libembree-dev                                            # CPU ray tracing reference
+  libopenimageio-dev openimageio-tools                     # image IO
+  catch2 nlohmann-json3-dev libkainjow-mustache-dev libxxhash-dev
+)
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#PACKAGES[@]} packages present"
+  exit 0
+fi
+echo "install-deps: installing ${missing[*]}"
+SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+$SUDO apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"

@@ -1,0 +1,274 @@
+// Tests for the CrossRT ray query interface (Embree backend).
+#include <catch2/catch.hpp>
+
+#include "CrossRT.h"
+
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+#include <thread>
+#include <vector>
+
+using namespace LiteMath;
+
+namespace
+{
+constexpr uint32_t MISS = 0xFFFFFFFFu;
+
+// Unit quad in the z=0 plane: triangle 0 = (v0,v1,v2) covers y < x, triangle 1 = (v0,v2,v3) covers y > x.
+const float    QUAD_VERTS[]   = {0, 0, 0, 1, 0, 0, 1, 1, 0, 0, 1, 0};
+const uint32_t QUAD_INDICES[] = {0, 1, 2, 0, 2, 3};
+
+float4 down(float tmax = 100.0f) { return float4(0, 0, -1, tmax); }
+float4 from(float x, float y, float z, float tmin = 0.0f) { return float4(x, y, z, tmin); }
+
+std::shared_ptr<ISceneObject> makeQuadScene()
+{
+  auto scene = CreateSceneRT("embree");
+  const uint32_t g = scene->AddGeom_Triangles3f(QUAD_VERTS, 4, QUAD_INDICES, 6);
+  REQUIRE(g == 0);
+  REQUIRE(scene->AddInstance(g, float4x4()) == 0);
+  scene->CommitScene();
+  return scene;
+}
+} // namespace
+
+TEST_CASE("CrossRT factory", "[litert]")
+{
+  auto scene = CreateSceneRT("embree");
+  REQUIRE(scene != nullptr);
+  CHECK(std::string(scene->Name()) == "embree");
+  CHECK_THROWS_AS(CreateSceneRT("nope"), std::invalid_argument);
+  CHECK_THROWS_WITH(CreateSceneRT("nope"), Catch::Contains("nope") && Catch::Contains("embree"));
+}
+
+TEST_CASE("CrossRT nearest hit on a quad", "[litert]")
+{
+  auto scene = makeQuadScene();
+
+  // (0.75, 0.25) lies in triangle 0: p = u*v1 + v*v2 = (u+v, v) -> v = 0.25, u = 0.5.
+  const CRT_Hit h0 = scene->RayQuery_NearestHit(from(0.75f, 0.25f, 1.0f), down());
+  CHECK(h0.primId == 0);
+  CHECK(h0.instId == 0);
+  CHECK(h0.geomId == 0);
+  CHECK(h0.t == Approx(1.0f));
+  CHECK(h0.coords[0] == Approx(0.5f));
+  CHECK(h0.coords[1] == Approx(0.25f));
+  CHECK(h0.coords[2] == 0.0f);
+  CHECK(h0.coords[3] == 0.0f);
+
+  // (0.25, 0.75) lies in triangle 1 = (v0, v2, v3): p = u*(1,1) + v*(0,1) -> u = 0.25, v = 0.5.
+  const CRT_Hit h1 = scene->RayQuery_NearestHit(from(0.25f, 0.75f, 3.0f), down());
+  CHECK(h1.primId == 1);
+  CHECK(h1.t == Approx(3.0f));
+  CHECK(h1.coords[0] == Approx(0.25f));
+  CHECK(h1.coords[1] == Approx(0.5f));
+
+  // Unnormalized direction: t is in units of the direction length.
+  const CRT_Hit h2 = scene->RayQuery_NearestHit(from(0.5f, 0.2f, 4.0f), float4(0, 0, -2, 100));
+  CHECK(h2.t == Approx(2.0f));
+
+  // Beside the quad: miss.
+  const CRT_Hit miss = scene->RayQuery_NearestHit(from(1.5f, 0.5f, 1.0f), down());
+  CHECK(miss.primId == MISS);
+  CHECK(miss.instId == MISS);
+  CHECK(miss.geomId == MISS);
+
+  // Pointing away, and a segment that ends before the quad, and one that starts after it.
+  CHECK(scene->RayQuery_NearestHit(from(0.5f, 0.2f, 1.0f), float4(0, 0, 1, 100)).primId == MISS);
+  CHECK(scene->RayQuery_NearestHit(from(0.5f, 0.2f, 1.0f), down(0.5f)).primId == MISS);
+  CHECK(scene->RayQuery_NearestHit(from(0.5f, 0.2f, 1.0f, 1.5f), down()).primId == MISS);
+  // tmin == tmax, even exactly at the hit distance: empty interval, miss.
+  CHECK(scene->RayQuery_NearestHit(from(0.5f, 0.2f, 1.0f, 1.0f), down(1.0f)).primId == MISS);
+  // Unbounded ray.
+  CHECK(scene->RayQuery_NearestHit(from(0.5f, 0.2f, 1.0f), down(INF_POSITIVE)).primId == 0);
+}
+
+TEST_CASE("CrossRT any hit", "[litert]")
+{
+  auto scene = makeQuadScene();
+  CHECK(scene->RayQuery_AnyHit(from(0.5f, 0.2f, 1.0f), down()));
+  CHECK(scene->RayQuery_AnyHit(from(0.5f, 0.2f, -1.0f), float4(0, 0, 1, 100))); // hits the back side too
+  CHECK_FALSE(scene->RayQuery_AnyHit(from(2.0f, 2.0f, 1.0f), down()));
+  CHECK_FALSE(scene->RayQuery_AnyHit(from(0.5f, 0.2f, 1.0f), down(0.99f)));
+  CHECK(scene->RayQuery_AnyHit(from(0.5f, 0.2f, 1.0f), down(1.01f)));
+  CHECK_FALSE(scene->RayQuery_AnyHit(from(0.5f, 0.2f, 1.0f, 2.0f), down(2.0f)));
+}
+
+TEST_CASE("CrossRT invalid rays miss without crashing", "[litert]")
+{
+  auto        scene = makeQuadScene();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const float inf = std::numeric_limits<float>::infinity();
+  const float4 rays[][2] = {
+      {from(nan, 0.5f, 1.0f), down()},
+      {from(0.5f, 0.2f, 1.0f), float4(nan, nan, nan, 100)},
+      {from(0.5f, 0.2f, 1.0f), float4(0, 0, -1, nan)},
+      {from(0.5f, 0.2f, 1.0f, nan), down()},
+      {from(inf, 0.2f, 1.0f), down()},
+      {from(0.5f, 0.2f, 1.0f), float4(0, -inf, -1, 100)},
+      {from(0.5f, 0.2f, 1.0f), float4(0, 0, 0, 100)}, // zero direction
+      {from(0.5f, 0.2f, 1.0f, 5.0f), down(1.0f)},     // tmin > tmax
+  };
+  for (const auto& r : rays)
+  {
+    CHECK(scene->RayQuery_NearestHit(r[0], r[1]).primId == MISS);
+    CHECK_FALSE(scene->RayQuery_AnyHit(r[0], r[1]));
+  }
+}
+
+TEST_CASE("CrossRT instances", "[litert]")
+{
+  auto           scene = CreateSceneRT("embree");
+  const uint32_t quad  = scene->AddGeom_Triangles3f(QUAD_VERTS, 4, QUAD_INDICES, 6, BUILD_MEDIUM);
+
+  // Second mesh: one triangle with a 4-float vertex stride (the 4th float is padding).
+  const float    strided[] = {0, 0, 0, 99, 1, 0, 0, 99, 0, 1, 0, 99};
+  const uint32_t triIdx[]  = {0, 1, 2};
+  const uint32_t tri = scene->AddGeom_Triangles3f(strided, 3, triIdx, 3, BUILD_LOW, 4 * sizeof(float));
+  CHECK(quad == 0);
+  CHECK(tri == 1);
+
+  const uint32_t i0 = scene->AddInstance(quad, float4x4());
+  const uint32_t i1 = scene->AddInstance(quad, translate4x4(float3(10, 0, 0)));
+  const uint32_t i2 = scene->AddInstance(tri, translate4x4(float3(0, 5, -2)) * scale4x4(float3(2, 2, 2)));
+  const uint32_t i3 = scene->AddInstance(quad, translate4x4(float3(20, 0, 0)) * rotate4x4X(0.5f * M_PI_F));
+  CHECK((i0 == 0 && i1 == 1 && i2 == 2 && i3 == 3));
+  scene->CommitScene(BUILD_HIGH);
+
+  // Translated copy of the quad.
+  CRT_Hit h = scene->RayQuery_NearestHit(from(10.75f, 0.25f, 1.0f), down());
+  CHECK(h.instId == 1);
+  CHECK(h.geomId == 0);
+  CHECK(h.primId == 0);
+  CHECK(h.t == Approx(1.0f));
+  CHECK(h.coords[0] == Approx(0.5f));
+  CHECK(scene->RayQuery_NearestHit(from(0.75f, 0.25f, 1.0f), down()).instId == 0);
+  CHECK(scene->RayQuery_NearestHit(from(5.0f, 0.25f, 1.0f), down()).primId == MISS);
+
+  // Scaled strided triangle: covers x + y < 2 around (0,5) at z = -2. A padding value leaking
+  // into the positions (stride bug) would move it.
+  h = scene->RayQuery_NearestHit(from(0.5f, 5.5f, 0.0f), down());
+  CHECK(h.instId == 2);
+  CHECK(h.geomId == 1);
+  CHECK(h.primId == 0);
+  CHECK(h.t == Approx(2.0f));
+  CHECK(scene->RayQuery_NearestHit(from(1.2f, 6.2f, 0.0f), down()).primId == MISS); // x+y = 2.4 in object space
+
+  // Quad rotated +90 degrees about X: y -> z, so it spans z in [0,1] in the plane y = 0.
+  h = scene->RayQuery_NearestHit(from(20.5f, 3.0f, 0.8f), float4(0, -1, 0, 100));
+  CHECK(h.instId == 3);
+  CHECK(h.t == Approx(3.0f));
+  CHECK(scene->RayQuery_NearestHit(from(20.5f, 3.0f, -0.2f), float4(0, -1, 0, 100)).primId == MISS);
+
+  // The nearest of two overlapping instances along a ray wins.
+  const uint32_t i4 = scene->AddInstance(quad, translate4x4(float3(10, 0, -1)));
+  scene->CommitScene();
+  h = scene->RayQuery_NearestHit(from(10.5f, 0.2f, -3.0f), float4(0, 0, 1, 100));
+  CHECK(h.instId == i4);
+  CHECK(h.t == Approx(2.0f));
+
+  // Moving an instance.
+  scene->UpdateInstance(i1, translate4x4(float3(30, 0, 0)));
+  scene->CommitScene();
+  CHECK(scene->RayQuery_NearestHit(from(10.75f, 0.25f, 1.0f), down()).instId == i4);
+  h = scene->RayQuery_NearestHit(from(30.75f, 0.25f, 1.0f), down());
+  CHECK(h.instId == i1);
+  CHECK(h.t == Approx(1.0f));
+
+  // Clearing the scene removes instances but keeps meshes.
+  scene->ClearScene();
+  scene->CommitScene();
+  CHECK(scene->RayQuery_NearestHit(from(0.75f, 0.25f, 1.0f), down()).primId == MISS);
+  CHECK(scene->AddInstance(tri, float4x4()) == 0);
+  scene->CommitScene();
+  h = scene->RayQuery_NearestHit(from(0.2f, 0.2f, 1.0f), down());
+  CHECK(h.geomId == tri);
+  CHECK(h.instId == 0);
+
+  CHECK_THROWS_AS(scene->AddInstance(7, float4x4()), std::out_of_range);
+  CHECK_THROWS_AS(scene->UpdateInstance(9, float4x4()), std::out_of_range);
+}
+
+TEST_CASE("CrossRT geometry update and validation", "[litert]")
+{
+  auto scene = makeQuadScene();
+
+  // Same sizes: in-place update (move the quad to z = -1).
+  float moved[12];
+  for (int i = 0; i < 12; i++)
+    moved[i] = QUAD_VERTS[i] - (i % 3 == 2 ? 1.0f : 0.0f);
+  scene->UpdateGeom_Triangles3f(0, moved, 4, QUAD_INDICES, 6, BUILD_REFIT);
+  scene->CommitScene(BUILD_REFIT);
+  CRT_Hit h = scene->RayQuery_NearestHit(from(0.75f, 0.25f, 1.0f), down());
+  CHECK(h.primId == 0);
+  CHECK(h.t == Approx(2.0f));
+
+  // Different size: a single bigger triangle replaces the quad.
+  const float    big[]   = {0, 0, 0, 4, 0, 0, 0, 4, 0};
+  const uint32_t bigIdx[] = {0, 1, 2};
+  scene->UpdateGeom_Triangles3f(0, big, 3, bigIdx, 3);
+  scene->CommitScene();
+  h = scene->RayQuery_NearestHit(from(2.5f, 0.5f, 1.0f), down());
+  CHECK(h.primId == 0);
+  CHECK(h.t == Approx(1.0f));
+
+  const uint32_t badIdx[] = {0, 1, 5};
+  CHECK_THROWS_AS(scene->AddGeom_Triangles3f(big, 3, badIdx, 3), std::invalid_argument);
+  CHECK_THROWS_AS(scene->AddGeom_Triangles3f(big, 3, bigIdx, 2), std::invalid_argument);
+  CHECK_THROWS_AS(scene->UpdateGeom_Triangles3f(5, big, 3, bigIdx, 3), std::out_of_range);
+
+  // An empty mesh is allowed and never hit.
+  const uint32_t empty = scene->AddGeom_Triangles3f(nullptr, 0, nullptr, 0);
+  scene->AddInstance(empty, translate4x4(float3(0, 0, 5)));
+  scene->CommitScene();
+  CHECK(scene->RayQuery_NearestHit(from(0.5f, 0.5f, 1.0f), down()).t == Approx(1.0f));
+
+  // ClearGeom drops everything.
+  scene->ClearGeom();
+  scene->CommitScene();
+  CHECK_FALSE(scene->RayQuery_AnyHit(from(0.5f, 0.5f, 1.0f), down()));
+  CHECK(scene->AddGeom_Triangles3f(QUAD_VERTS, 4, QUAD_INDICES, 6) == 0);
+}
+
+TEST_CASE("CrossRT queries before commit miss", "[litert]")
+{
+  auto scene = CreateSceneRT("embree");
+  CHECK(scene->RayQuery_NearestHit(from(0.5f, 0.2f, 1.0f), down()).primId == MISS);
+  scene->AddInstance(scene->AddGeom_Triangles3f(QUAD_VERTS, 4, QUAD_INDICES, 6), float4x4());
+  CHECK_FALSE(scene->RayQuery_AnyHit(from(0.5f, 0.2f, 1.0f), down()));
+  scene->CommitScene();
+  CHECK(scene->RayQuery_AnyHit(from(0.5f, 0.2f, 1.0f), down()));
+}
+
+TEST_CASE("CrossRT concurrent queries", "[litert]")
+{
+  auto scene = CreateSceneRT("embree");
+  const uint32_t g = scene->AddGeom_Triangles3f(QUAD_VERTS, 4, QUAD_INDICES, 6);
+  for (int i = 0; i < 16; i++)
+    scene->AddInstance(g, translate4x4(float3(2.0f * float(i), 0, -float(i))));
+  scene->CommitScene();
+
+  // Each thread shoots rays at every instance; the expected answer follows from the layout.
+  std::atomic<int>         errors{0};
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 4; t++)
+    threads.emplace_back([&, t]() {
+      for (int iter = 0; iter < 2000; iter++)
+      {
+        const int     i   = (iter + t) % 16;
+        const bool    low = (iter % 2) == 0; // alternate between the two triangles
+        const float   x   = 2.0f * float(i) + (low ? 0.75f : 0.25f);
+        const float   y   = low ? 0.25f : 0.75f;
+        const CRT_Hit h   = scene->RayQuery_NearestHit(from(x, y, 1.0f), down());
+        if (h.instId != uint32_t(i) || h.primId != (low ? 0u : 1u) || std::abs(h.t - (1.0f + float(i))) > 1e-4f)
+          errors++;
+        if (!scene->RayQuery_AnyHit(from(x, y, 1.0f), down()) || scene->RayQuery_AnyHit(from(x + 1.0f, y, 1.0f), down()))
+          errors++;
+      }
+    });
+  for (auto& th : threads)
+    th.join();
+  CHECK(errors.load() == 0);
+}

@@ -1,0 +1,442 @@
+// Tests of the CrossRT Vulkan runtime on a real device (lavapipe in CI) with validation enabled.
+// Shaders are GLSL compiled at test time with glslangValidator.
+#include <catch2/catch.hpp>
+
+#include <crossrt/VulkanRuntime.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#ifndef CROSSRT_GLSLANG_VALIDATOR
+#define CROSSRT_GLSLANG_VALIDATOR "glslangValidator"
+#endif
+
+#ifdef _WIN32
+#define popen _popen
+#define pclose _pclose
+#include <stdlib.h>
+static void setenv(const char* name, const char* value, int) { _putenv_s(name, value); }
+static void unsetenv(const char* name) { _putenv_s(name, ""); }
+#endif
+
+using namespace crossrt;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A directory unique to this test run, for compiled shaders and pipeline caches; removed at exit.
+const fs::path& TempDir() {
+  struct Dir {
+    fs::path path;
+    Dir() {
+      std::random_device rd;
+      path = fs::temp_directory_path() / ("crossrt_runtime_test_" + std::to_string(rd()));
+      fs::create_directories(path);
+    }
+    ~Dir() {
+      std::error_code ec;
+      fs::remove_all(path, ec);
+    }
+  };
+  static const Dir dir;
+  return dir.path;
+}
+
+std::vector<uint32_t> CompileGlsl(const std::string& source) {
+  static int counter = 0;
+  const fs::path spv = TempDir() / ("shader" + std::to_string(counter) + ".spv");
+  const fs::path log = TempDir() / ("shader" + std::to_string(counter) + ".log");
+  ++counter;
+  const std::string cmd = std::string("\"") + CROSSRT_GLSLANG_VALIDATOR +
+                          "\" -V --target-env vulkan1.2 --stdin -S comp -o \"" + spv.string() + "\" > \"" +
+                          log.string() + "\" 2>&1";
+  FILE* pipe = popen(cmd.c_str(), "w");
+  REQUIRE(pipe != nullptr);
+  std::fputs(source.c_str(), pipe);
+  const int rc = pclose(pipe);
+  if (rc != 0) {
+    std::ifstream in(log);
+    std::stringstream text;
+    text << in.rdbuf();
+    FAIL("glslangValidator failed (" << cmd << "):\n" << text.str());
+  }
+  std::ifstream in(spv, std::ios::binary);
+  std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  REQUIRE(!bytes.empty());
+  REQUIRE(bytes.size() % 4 == 0);
+  std::vector<uint32_t> words(bytes.size() / 4);
+  std::memcpy(words.data(), bytes.data(), bytes.size());
+  return words;
+}
+
+// Validation on; a missing driver is a visible skip, anything else is a failure.
+std::shared_ptr<VulkanContext> MakeContext() {
+  // Keep the tests from writing into the user's ~/.cache.
+  if (!std::getenv("CROSSRT_PIPELINE_CACHE_DIR"))
+    setenv("CROSSRT_PIPELINE_CACHE_DIR", (TempDir() / "cache").string().c_str(), 1);
+  ContextOptions options;
+  options.validation = true;
+  try {
+    return VulkanContext::Create(options);
+  } catch (const NoDeviceError& e) {
+    WARN("skipped, no Vulkan device: " << e.what());
+    return nullptr;
+  }
+}
+
+void RequireNoValidationMessages(const VulkanContext& ctx) {
+  for (const std::string& m : ctx.ValidationMessages()) UNSCOPED_INFO("validation: " << m);
+  REQUIRE(ctx.ValidationMessageCount() == 0);
+}
+
+const char* kSaxpy = R"(#version 450
+layout(local_size_x = 256) in;
+layout(std430, set = 0, binding = 0) readonly buffer X { float x[]; };
+layout(std430, set = 0, binding = 1) buffer Y { float y[]; };
+layout(push_constant) uniform Params { float a; uint n; } pc;
+void main() {
+  uint i = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x;
+  if (i >= pc.n) return;
+  precise float r = pc.a * x[i] + y[i];   // no FMA contraction: the CPU reference does not fuse either
+  y[i] = r;
+}
+)";
+
+const char* kCountIds = R"(#version 450
+layout(local_size_x = 64) in;
+layout(std430, set = 0, binding = 0) buffer Counts { uint counts[]; };
+layout(push_constant) uniform Params { uint n; } pc;
+void main() {
+  uint id = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x;
+  if (id >= pc.n) return;
+  atomicAdd(counts[id], 1u);
+}
+)";
+
+struct SaxpyParams {
+  float a;
+  uint32_t n;
+};
+
+}  // namespace
+
+TEST_CASE("Upload/Download round trip at an offset", "[runtime]") {
+  auto ctx = MakeContext();
+  if (!ctx) return;
+  INFO("device: " << ctx->DeviceName());
+  const size_t bytes = 1 << 20, offset = 12345;
+  std::mt19937 rng(42);
+  std::vector<uint8_t> data(bytes);
+  for (auto& b : data) b = static_cast<uint8_t>(rng());
+
+  Buffer buf(ctx, bytes + offset + 100);
+  REQUIRE(buf.Size() == bytes + offset + 100);
+  buf.Fill(0);
+  buf.Upload(data.data(), bytes, offset);
+  std::vector<uint8_t> back(bytes);
+  buf.Download(back.data(), bytes, offset);
+  REQUIRE(back == data);
+
+  // Bytes outside the uploaded range are untouched.
+  uint8_t edge[2] = {1, 1};
+  buf.Download(&edge[0], 1, offset - 1);
+  buf.Download(&edge[1], 1, offset + bytes);
+  CHECK(edge[0] == 0);
+  CHECK(edge[1] == 0);
+
+  CHECK_THROWS_AS(buf.Upload(data.data(), bytes, 200000), Error);  // out of range: clear error
+  RequireNoValidationMessages(*ctx);
+}
+
+TEST_CASE("Upload/Download through the staging path", "[runtime]") {
+  if (!std::getenv("CROSSRT_PIPELINE_CACHE_DIR"))
+    setenv("CROSSRT_PIPELINE_CACHE_DIR", (TempDir() / "cache").string().c_str(), 1);
+  ContextOptions options;
+  options.validation = true;
+  options.forceStaging = true;  // what GPUs without host-visible VRAM do
+  std::shared_ptr<VulkanContext> ctx;
+  try {
+    ctx = VulkanContext::Create(options);
+  } catch (const NoDeviceError& e) {
+    WARN("skipped, no Vulkan device: " << e.what());
+    return;
+  }
+  const size_t bytes = 300001, offset = 777;
+  std::mt19937 rng(7);
+  std::vector<uint8_t> data(bytes);
+  for (auto& b : data) b = static_cast<uint8_t>(rng());
+  Buffer buf(ctx, bytes + offset);
+  REQUIRE_FALSE(buf.HostMapped());
+  buf.Upload(data.data(), bytes, offset);
+  std::vector<uint8_t> back(bytes);
+  buf.Download(back.data(), bytes, offset);
+  REQUIRE(back == data);
+
+  buf.Fill(0x01020304u);
+  uint32_t word = 0;
+  buf.Download(&word, 4, 0);
+  CHECK(word == 0x01020304u);
+  RequireNoValidationMessages(*ctx);
+}
+
+TEST_CASE("SAXPY with push constants and push descriptors", "[runtime]") {
+  auto ctx = MakeContext();
+  if (!ctx) return;
+  const uint32_t n = 1'000'003;  // not a multiple of the group size
+  const float a = 1.5f;
+  // Dyadic values keep every product and sum exact, so GPU and CPU must agree bit for bit.
+  std::mt19937 rng(1);
+  std::uniform_int_distribution<int> dist(-(1 << 20), 1 << 20);
+  std::vector<float> x(n), y(n);
+  for (uint32_t i = 0; i < n; ++i) {
+    x[i] = dist(rng) / 256.0f;
+    y[i] = dist(rng) / 256.0f;
+  }
+
+  auto spirv = CompileGlsl(kSaxpy);
+  ComputePipeline pipe(ctx, spirv.data(), spirv.size() * 4, 2, sizeof(SaxpyParams), "saxpy");
+  Buffer bx(ctx, n * sizeof(float)), by(ctx, n * sizeof(float));
+  bx.Upload(x.data(), n * sizeof(float));
+  by.Upload(y.data(), n * sizeof(float));
+
+  VkCommandBuffer cmd = ctx->BeginOneShot();
+  pipe.Bind(cmd);
+  pipe.PushBuffers(cmd, {bx.View(), by.View()});
+  SaxpyParams params{a, n};
+  pipe.PushConstants(cmd, &params, sizeof(params));
+  uint32_t groups = Dispatch1D(cmd, n, 256);
+  ctx->SubmitAndWait(cmd);
+  CHECK(groups == GroupCount1D(n, 256));
+  CHECK(uint64_t(groups) * 256 >= n);
+
+  std::vector<float> result(n);
+  by.Download(result.data(), n * sizeof(float));
+  size_t mismatches = 0;
+  for (uint32_t i = 0; i < n; ++i) {
+    float expected = a * x[i];
+    expected += y[i];
+    if (result[i] != expected && mismatches++ < 5) UNSCOPED_INFO("i=" << i << " gpu=" << result[i] << " cpu=" << expected);
+  }
+  REQUIRE(mismatches == 0);
+  RequireNoValidationMessages(*ctx);
+}
+
+TEST_CASE("Dispatch1D spreads more than 65535 groups over y", "[runtime]") {
+  auto ctx = MakeContext();
+  if (!ctx) return;
+  const uint32_t groupSize = 64;
+  const uint64_t threads = 70'000ull * groupSize - 13;  // 70000 groups, last one partial
+  REQUIRE(GroupCount1D(threads, groupSize) >= 70'000u);
+
+  auto spirv = CompileGlsl(kCountIds);
+  ComputePipeline pipe(ctx, spirv.data(), spirv.size() * 4, 1, 4, "count_ids");
+  const size_t slots = threads + 1000;  // room to catch ids past the end
+  Buffer counts(ctx, slots * 4);
+  counts.Fill(0);
+
+  VkCommandBuffer cmd = ctx->BeginOneShot();
+  pipe.Bind(cmd);
+  pipe.PushBuffers(cmd, {counts.View()});
+  uint32_t n = static_cast<uint32_t>(threads);
+  pipe.PushConstants(cmd, &n, 4);
+  uint32_t groups = Dispatch1D(cmd, threads, groupSize);
+  ctx->SubmitAndWait(cmd);
+  CHECK(groups == GroupCount1D(threads, groupSize));
+  CHECK(uint64_t(groups) * groupSize >= threads);
+
+  std::vector<uint32_t> result(slots);
+  counts.Download(result.data(), slots * 4);
+  size_t wrong = 0;
+  for (size_t i = 0; i < slots; ++i) {
+    uint32_t expected = i < threads ? 1u : 0u;
+    if (result[i] != expected && wrong++ < 5) UNSCOPED_INFO("id " << i << " written " << result[i] << " times");
+  }
+  REQUIRE(wrong == 0);
+  RequireNoValidationMessages(*ctx);
+}
+
+TEST_CASE("Dispatch helpers compute group counts", "[runtime]") {
+  CHECK(GroupCount1D(0, 64) == 0);
+  CHECK(GroupCount1D(1, 64) == 1);
+  CHECK(GroupCount1D(64, 64) == 1);
+  CHECK(GroupCount1D(65, 64) == 2);
+  CHECK(GroupCount1D(65535ull * 64, 64) == 65535);
+  CHECK(GroupCount1D(70000ull * 64, 64) == 70000);        // 35000 x 2
+  CHECK(GroupCount1D(131071ull * 64, 64) >= 131071);      // 3 rows
+  CHECK_THROWS_AS(GroupCount1D(10, 0), Error);
+}
+
+TEST_CASE("A zero-size Buffer is valid and can be bound", "[runtime]") {
+  auto ctx = MakeContext();
+  if (!ctx) return;
+  Buffer x(ctx, 0), y(ctx, 0);
+  CHECK(x.Size() == 0);
+  CHECK_FALSE(x.Empty());
+  CHECK(x.Handle() != VK_NULL_HANDLE);
+  x.Fill(0);
+  x.Upload(nullptr, 0);
+  x.Download(nullptr, 0);
+
+  auto spirv = CompileGlsl(kSaxpy);
+  ComputePipeline pipe(ctx, spirv.data(), spirv.size() * 4, 2, sizeof(SaxpyParams), "saxpy_empty");
+  VkCommandBuffer cmd = ctx->BeginOneShot();
+  pipe.Bind(cmd);
+  pipe.PushBuffers(cmd, {x.View(), y.View()});
+  SaxpyParams params{2.0f, 1};  // one thread: the shader touches element 0, inside the padded allocation
+  pipe.PushConstants(cmd, &params, sizeof(params));
+  Dispatch1D(cmd, 1, 256);
+  CHECK(Dispatch1D(cmd, 0, 256) == 0);  // nothing to do is not an error
+  ctx->SubmitAndWait(cmd);
+
+  Buffer empty;
+  CHECK(empty.Empty());
+  CHECK_THROWS_AS(empty.Fill(0), Error);
+  RequireNoValidationMessages(*ctx);
+}
+
+TEST_CASE("CROSSRT_DEVICE naming no device lists the available ones", "[runtime]") {
+  setenv("CROSSRT_DEVICE", "no-such-gpu", 1);
+  std::string message;
+  bool noDriver = false;
+  try {
+    VulkanContext::CreateDefault();
+  } catch (const NoDeviceError& e) {
+    noDriver = true;
+    message = e.what();
+  } catch (const Error& e) {
+    message = e.what();
+  }
+  unsetenv("CROSSRT_DEVICE");
+  if (noDriver) {
+    WARN("skipped, no Vulkan device: " << message);
+    return;
+  }
+  INFO(message);
+  REQUIRE_FALSE(message.empty());
+  CHECK(message.find("no-such-gpu") != std::string::npos);
+  CHECK(message.find("[0]") != std::string::npos);
+  // lavapipe is always there where this test runs (mesa-vulkan-drivers).
+  CHECK(message.find("llvmpipe") != std::string::npos);
+
+  // An index out of range is reported the same way.
+  ContextOptions options;
+  options.device = "99";
+  CHECK_THROWS_AS(VulkanContext::Create(options), Error);
+}
+
+TEST_CASE("Device can be chosen by index or name", "[runtime]") {
+  ContextOptions options;
+  options.validation = true;
+  options.device = "LLVMPIPE";  // case-insensitive substring
+  std::shared_ptr<VulkanContext> ctx;
+  try {
+    ctx = VulkanContext::Create(options);
+  } catch (const NoDeviceError& e) {
+    WARN("skipped, no Vulkan device: " << e.what());
+    return;
+  }
+  CHECK(ctx->DeviceName().find("llvmpipe") != std::string::npos);
+  CHECK(ctx->hasScalarBlockLayout);
+  CHECK(ctx->hasBufferDeviceAddress);
+  CHECK_FALSE(ctx->hasRayQuery);
+  CHECK(ctx->vkCmdPushDescriptorSetKHR != nullptr);
+  Buffer b(ctx, 64);
+  CHECK(b.Address() != 0);
+  RequireNoValidationMessages(*ctx);
+}
+
+TEST_CASE("GpuTimer measures a dispatch", "[runtime]") {
+  auto ctx = MakeContext();
+  if (!ctx) return;
+  const uint32_t n = 1'000'003;
+  auto spirv = CompileGlsl(kSaxpy);
+  ComputePipeline pipe(ctx, spirv.data(), spirv.size() * 4, 2, sizeof(SaxpyParams), "saxpy_timed");
+  Buffer bx(ctx, n * 4), by(ctx, n * 4);
+  bx.Fill(0x3f800000u);  // 1.0f
+  by.Fill(0);
+
+  GpuTimer timer(ctx);
+  CpuTimer cpu;
+  VkCommandBuffer cmd = ctx->BeginOneShot();
+  timer.Reset(cmd);
+  timer.Begin(cmd, "saxpy");
+  pipe.Bind(cmd);
+  pipe.PushBuffers(cmd, {bx.View(), by.View()});
+  SaxpyParams params{2.0f, n};
+  pipe.PushConstants(cmd, &params, sizeof(params));
+  Dispatch1D(cmd, n, 256);
+  timer.End(cmd, "saxpy");
+  ctx->SubmitAndWait(cmd);
+  timer.Collect();
+
+  CHECK(timer.LastMs("saxpy") > 0.0f);
+  CHECK(timer.LastMs("saxpy") <= cpu.ElapsedMs() + 1.0f);
+  CHECK(timer.LastMs("unknown") == 0.0f);
+  RequireNoValidationMessages(*ctx);
+}
+
+TEST_CASE("EnsureSize reallocates only when growing", "[runtime]") {
+  auto ctx = MakeContext();
+  if (!ctx) return;
+  Buffer b;
+  EnsureSize(ctx, b, 100);
+  REQUIRE_FALSE(b.Empty());
+  CHECK(b.Size() == 100);
+  VkBuffer first = b.Handle();
+  EnsureSize(ctx, b, 50);
+  CHECK(b.Handle() == first);
+  CHECK(b.Size() == 100);
+  EnsureSize(ctx, b, 100);
+  CHECK(b.Handle() == first);
+  EnsureSize(ctx, b, 1000);  // the new buffer exists before the old one is freed, so handles differ
+  CHECK(b.Handle() != first);
+  CHECK(b.Size() == 1000);
+  RequireNoValidationMessages(*ctx);
+}
+
+TEST_CASE("The pipeline cache is saved when the context is destroyed", "[runtime]") {
+  const fs::path dir = TempDir() / "pipeline_cache_test";
+  fs::remove_all(dir);
+  const char* previous = std::getenv("CROSSRT_PIPELINE_CACHE_DIR");
+  const std::string saved = previous ? previous : "";
+  setenv("CROSSRT_PIPELINE_CACHE_DIR", dir.string().c_str(), 1);
+
+  auto spirv = CompileGlsl(kSaxpy);
+  for (int round = 0; round < 2; ++round) {  // the second round loads what the first saved
+    ContextOptions options;
+    options.validation = true;
+    std::shared_ptr<VulkanContext> ctx;
+    try {
+      ctx = VulkanContext::Create(options);
+    } catch (const NoDeviceError& e) {
+      WARN("skipped, no Vulkan device: " << e.what());
+      return;
+    }
+    {
+      ComputePipeline pipe(ctx, spirv.data(), spirv.size() * 4, 2, sizeof(SaxpyParams), "saxpy_cached");
+    }
+    RequireNoValidationMessages(*ctx);
+    ctx.reset();
+
+    size_t files = 0;
+    for (const auto& entry : fs::directory_iterator(dir)) {
+      INFO(entry.path().string());
+      CHECK(entry.path().filename().string().find("pipeline_cache_") == 0);
+      CHECK(fs::file_size(entry.path()) > 0);
+      ++files;
+    }
+    CHECK(files == 1);
+  }
+
+  if (previous)
+    setenv("CROSSRT_PIPELINE_CACHE_DIR", saved.c_str(), 1);
+  else
+    unsetenv("CROSSRT_PIPELINE_CACHE_DIR");
+}
