@@ -30,12 +30,6 @@ std::string TrimmedSourceText(const ASTContext& ctx, SourceRange range) {
   return Lexer::getSourceText(CharSourceRange::getTokenRange(range), sm, ctx.getLangOpts()).str();
 }
 
-const NamedDecl* EnclosingNamespaceOrClass(const Decl* d) {
-  for (auto* dc = d->getDeclContext(); dc; dc = dc->getParent())
-    if (auto* nd = dyn_cast<NamedDecl>(dc)) return nd;
-  return nullptr;
-}
-
 bool InNamespace(const Decl* d, const char* ns) {
   for (auto* dc = d->getDeclContext(); dc; dc = dc->getParent())
     if (auto* nsd = dyn_cast<NamespaceDecl>(dc); nsd && nsd->getName() == ns) return true;
@@ -216,7 +210,7 @@ std::string GlslPrinter::Declare(QualType t, const std::string& name, SourceLoca
 
 void GlslPrinter::NeedStruct(const RecordDecl* rd) {
   rd = rd->getDefinition() ? rd->getDefinition() : rd;
-  if (m_emitted.count(rd) || m_inProgress.count(rd)) return;
+  if (m_emitted.count(rd) || m_inProgress.count(rd) || predeclaredStructs.count(rd->getNameAsString())) return;
   m_inProgress.insert(rd);
   std::ostringstream os;
   os << "struct " << rd->getName().str() << " {  // from " << rd->getQualifiedNameAsString() << "\n";
@@ -235,9 +229,14 @@ void GlslPrinter::NeedConstant(const VarDecl* vd) {
   m_constants.push_back("const " + Declare(vd->getType(), vd->getName().str(), vd->getLocation()) + " = " + value + ";\n");
 }
 
-std::string GlslPrinter::Prelude() const {
+std::string GlslPrinter::PreludeTypes() const {
   std::string out;
   for (auto& s : m_structs) out += s + "\n";
+  return out;
+}
+
+std::string GlslPrinter::PreludeFunctions() const {
+  std::string out;
   for (auto& c : m_constants) out += c;
   if (!m_constants.empty()) out += "\n";
   for (auto& f : m_functions) out += f + "\n";
@@ -599,8 +598,8 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
     return Construct(cons->getType(), args, e->getBeginLoc());
   }
   if (auto* il = dyn_cast<InitListExpr>(e)) {
-    if (il->isSyntacticForm() == false && il->getSyntacticForm()) il = il->getSyntacticForm() ? il : il;
-    std::vector<const clang::Expr*> args(il->begin(), il->end());
+    // The semantic form lists every field (missing ones as ImplicitValueInitExpr), as GLSL needs.
+    std::vector<const clang::Expr*> args(il->inits().begin(), il->inits().end());
     if (il->getType()->isArrayType() || !IsLiteMathType(il->getType())) {
       auto g = Type(il->getType(), e->getBeginLoc());
       if (!g) return "/*error*/";

@@ -51,8 +51,11 @@ public:
   std::optional<std::string> Type(clang::QualType t, clang::SourceLocation loc);
   std::string Declare(clang::QualType t, const std::string& name, clang::SourceLocation loc);
 
-  // Helpers, structs and constants, ready to paste above the kernel.
-  std::string Prelude() const;
+  // Structs the code needs (above the buffer blocks), then constants and helper functions (below).
+  std::string PreludeTypes() const;
+  std::string PreludeFunctions() const;
+  // Structs declared once for the whole class (the class-data block needs them): not emitted again.
+  std::set<std::string> predeclaredStructs;
   static std::string SafeName(const std::string& name);  // renames GLSL keywords
 
 private:

@@ -26,6 +26,7 @@ struct Member {
   bool scalarLayout = false;    // vector whose element needs GL_EXT_scalar_block_layout to match C++
   bool writtenByKernels = false;
   bool usedByKernels = false;
+  bool inClassData = false;     // plain: accessible, and its C++ layout matches std430
 };
 
 enum class ReduceOp { Add, Sub, Min, Max };
@@ -41,6 +42,7 @@ struct KernelParam {
   std::string name;       // as in the user's code
   std::string glslName;   // renamed when it is a GLSL keyword
   std::string cppType;    // host type for the ...Cmd signature
+  std::string valueCppType;  // the value type, for the push-constant mirror
   std::string glslType;
   bool isPointer = false;
   bool isConstPointee = false;
@@ -60,11 +62,14 @@ struct Kernel {
   bool rtv = false;                   // kernel_* called from a loop, else kernel1D/2D/3D_* holding loops
   unsigned dims = 1;
   std::vector<KernelParam> params;
+  std::string cppParamsDecl;          // the parameter list as the user wrote it
+  std::vector<unsigned> threadAxes;   // axis (0=x,1=y,2=z) of each thread-function parameter
   std::vector<Loop> loops;            // IPV: outermost first
   std::vector<Reduction> reductions;
   std::vector<std::string> memberVectors;   // member vectors the kernel reaches (incl. helpers)
   bool usesClassData = false;
-  std::string glslHelpers;            // structs, constants, helper functions it needs
+  std::string glslStructs;            // structs it needs beyond the class's
+  std::string glslHelpers;            // constants and helper functions it needs
   std::string glslBody;               // the thread's code, as a GLSL function body
   std::string cpuLoopNest;            // IPV, CPU backend: the loop nest with reductions renamed
   std::string cpuPreamble;            // IPV, CPU backend: statements before the loops
@@ -108,7 +113,8 @@ struct ClassModel {
   bool declaresCommitDeviceData = false;
   bool declaresGetExecutionTime = false;
   std::vector<BlockField> classData;   // plain members + vector sizes, in block order
-  bool classDataScalarLayout = false;
+  std::string glslClassStructs;        // structs the class-data block and member vectors need
+  std::vector<std::string> usingDecls; // top-level using-directives of the sources: copied bodies need them
 };
 
 }  // namespace crossrt::engine

@@ -1,0 +1,104 @@
+# crossrt_add_class(<target> <Class> BACKEND vulkan|cpu [SOURCES file...] [HEADER file])
+#
+# Translates class <Class> into <Class>_Vulkan (or <Class>_CPU), in the build tree, and adds the
+# generated sources, their include path and the runtime to <target>. SOURCES are the files that
+# define <Class>'s member functions (default: <Class>.cpp next to the calling CMakeLists.txt, else
+# every .cpp source of <target>). The translation re-runs when any file it read changes (depfile),
+# and writes only files whose contents changed, so an unchanged class recompiles nothing.
+#
+# Works from the source tree (add_subdirectory) and from an installed package (find_package).
+include_guard(GLOBAL)
+
+function(crossrt_add_class target class)
+  cmake_parse_arguments(ARG "" "BACKEND" "SOURCES" ${ARGN})
+  if(NOT ARG_BACKEND)
+    set(ARG_BACKEND vulkan)
+  endif()
+  string(TOLOWER "${ARG_BACKEND}" backend)
+  if(backend STREQUAL "vulkan")
+    set(suffix Vulkan)
+  elseif(backend STREQUAL "cpu")
+    set(suffix CPU)
+  else()
+    message(FATAL_ERROR "crossrt_add_class(${target} ${class}): BACKEND must be vulkan or cpu, not '${ARG_BACKEND}'")
+  endif()
+  if(NOT TARGET ${target})
+    message(FATAL_ERROR "crossrt_add_class: '${target}' is not a target")
+  endif()
+
+  set(sources ${ARG_SOURCES})
+  if(NOT sources)
+    if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/${class}.cpp)
+      set(sources ${class}.cpp)
+    else()
+      get_target_property(target_sources ${target} SOURCES)
+      list(FILTER target_sources INCLUDE REGEX "\\.(cpp|cc|cxx)$")
+      set(sources ${target_sources})
+    endif()
+  endif()
+  set(abs_sources "")
+  set(source_args "")
+  foreach(s IN LISTS sources)
+    get_filename_component(a "${s}" ABSOLUTE BASE_DIR ${CMAKE_CURRENT_SOURCE_DIR})
+    list(APPEND abs_sources "${a}")
+    list(APPEND source_args --source "${a}")
+  endforeach()
+
+  set(out_dir ${CMAKE_CURRENT_BINARY_DIR}/crossrt/${class}_${suffix})
+  set(outputs ${out_dir}/${class}_${suffix}.h ${out_dir}/${class}_${suffix}.cpp)
+  if(suffix STREQUAL "Vulkan")
+    list(APPEND outputs ${out_dir}/${class}_Vulkan_shaders.cpp)
+  endif()
+
+  # Parse the class as the target compiles it: its include paths, definitions and standard,
+  # plus the CrossRT libraries' headers.
+  set(inc "$<TARGET_PROPERTY:${target},INCLUDE_DIRECTORIES>")
+  set(defs "$<TARGET_PROPERTY:${target},COMPILE_DEFINITIONS>")
+  set(std "$<TARGET_PROPERTY:${target},CXX_STANDARD>")
+  set(compile_args "$<$<BOOL:${inc}>:-I$<JOIN:${inc},$<SEMICOLON>-I>>")
+  foreach(lib crossrt::litemath crossrt::liteimage crossrt::litert)
+    list(APPEND compile_args "-I$<JOIN:$<TARGET_PROPERTY:${lib},INTERFACE_INCLUDE_DIRECTORIES>,$<SEMICOLON>-I>")
+  endforeach()
+  list(APPEND compile_args
+    "$<$<BOOL:${defs}>:-D$<JOIN:${defs},$<SEMICOLON>-D>>"
+    "$<$<BOOL:${std}>:-std=c++${std}>")
+
+  if(TARGET crossrt)
+    set(translator $<TARGET_FILE:crossrt>)
+    set(translator_dep crossrt)
+  else()
+    set(translator $<TARGET_FILE:crossrt::crossrt>)
+    set(translator_dep crossrt::crossrt)
+  endif()
+
+  list(GET outputs 0 first_output)
+  add_custom_command(
+    OUTPUT ${outputs}
+    COMMAND ${translator} translate
+            --class ${class} --backend ${backend} --out ${out_dir}
+            ${source_args}
+            --templates ${CROSSRT_TEMPLATE_DIR}
+            --glslang ${Vulkan_GLSLANG_VALIDATOR_EXECUTABLE}
+            --depfile ${out_dir}/${class}_${suffix}.d --depfile-target ${first_output}
+            -- ${compile_args}
+    DEPENDS ${abs_sources} ${translator_dep}
+    DEPFILE ${out_dir}/${class}_${suffix}.d
+    COMMENT "CrossRT: translating ${class} -> ${class}_${suffix}"
+    COMMAND_EXPAND_LISTS
+    VERBATIM)
+
+  target_sources(${target} PRIVATE ${outputs})
+  target_include_directories(${target} PRIVATE ${out_dir})
+  if(suffix STREQUAL "Vulkan")
+    target_link_libraries(${target} PRIVATE crossrt::runtime)
+  else()
+    target_link_libraries(${target} PRIVATE OpenMP::OpenMP_CXX)
+  endif()
+  target_link_libraries(${target} PRIVATE crossrt::litemath)
+  # The size annotation is for the translator; compilers need not warn about it.
+  if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU" AND CMAKE_CXX_COMPILER_VERSION VERSION_GREATER_EQUAL 12)
+    target_compile_options(${target} PRIVATE -Wno-attributes=crossrt::size)
+  elseif(CMAKE_CXX_COMPILER_ID MATCHES "Clang")
+    target_compile_options(${target} PRIVATE -Wno-unknown-attributes)
+  endif()
+endfunction()

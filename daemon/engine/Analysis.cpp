@@ -1,0 +1,821 @@
+#include "Analysis.h"
+
+#include "Glsl.h"
+
+#include <clang/AST/RecursiveASTVisitor.h>
+#include <clang/Basic/SourceManager.h>
+#include <clang/Lex/Lexer.h>
+#include <clang/Rewrite/Core/Rewriter.h>
+
+#include <algorithm>
+#include <map>
+#include <regex>
+#include <sstream>
+
+using namespace clang;
+
+namespace crossrt::engine {
+namespace {
+
+std::string BaseName(const std::string& path) {
+  auto pos = path.find_last_of('/');
+  return pos == std::string::npos ? path : path.substr(pos + 1);
+}
+
+std::string Text(const ASTContext& ctx, SourceRange range) {
+  auto& sm = ctx.getSourceManager();
+  CharSourceRange r = CharSourceRange::getTokenRange(sm.getExpansionRange(range).getAsRange());
+  return Lexer::getSourceText(r, sm, ctx.getLangOpts()).str();
+}
+
+std::string FileOf(const ASTContext& ctx, SourceLocation loc) {
+  auto& sm = ctx.getSourceManager();
+  auto entry = sm.getFileEntryRefForID(sm.getFileID(sm.getExpansionLoc(loc)));
+  return entry ? entry->getName().str() : std::string();
+}
+
+// "[[crossrt::size("n")]] const float* in" -> "const float* in"
+std::string StripAttributes(std::string s) {
+  static const std::regex cxx11(R"(\[\[[^\]]*\]\]\s*)");
+  static const std::regex gnu(R"(__attribute__\s*\(\((?:[^()]|\((?:[^()]|\([^()]*\))*\))*\)\)\s*)");
+  s = std::regex_replace(s, cxx11, "");
+  s = std::regex_replace(s, gnu, "");
+  while (!s.empty() && isspace((unsigned char)s.back())) s.pop_back();
+  return s;
+}
+
+std::string ParamDecl(const ASTContext& ctx, const ParmVarDecl* p, unsigned index) {
+  std::string name = p->getNameAsString();
+  if (name.empty()) return p->getType().getAsString() + " a_unnamed" + std::to_string(index);
+  SourceRange range(p->getBeginLoc(), p->getLocation());
+  return StripAttributes(Text(ctx, range));
+}
+
+std::string CppTypeName(const ASTContext& ctx, QualType t) {
+  PrintingPolicy pp(ctx.getLangOpts());
+  pp.SuppressTagKeyword = true;
+  pp.FullyQualifiedName = true;
+  pp.PrintCanonicalTypes = false;
+  return t.getUnqualifiedType().getAsString(pp);
+}
+
+const FieldDecl* ThisField(const Expr* e) {
+  auto* me = dyn_cast<MemberExpr>(e->IgnoreParenImpCasts());
+  if (!me || !isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts())) return nullptr;
+  return dyn_cast<FieldDecl>(me->getMemberDecl());
+}
+
+// The member a written lvalue belongs to: this->m_v[i].x -> m_v.
+const FieldDecl* RootField(const Expr* e) {
+  while (true) {
+    e = e->IgnoreParenImpCasts();
+    if (auto* f = ThisField(e)) return f;
+    if (auto* as = dyn_cast<ArraySubscriptExpr>(e)) { e = as->getBase(); continue; }
+    if (auto* op = dyn_cast<CXXOperatorCallExpr>(e); op && op->getOperator() == OO_Subscript) { e = op->getArg(0); continue; }
+    if (auto* me = dyn_cast<MemberExpr>(e)) { e = me->getBase(); continue; }
+    return nullptr;
+  }
+}
+
+bool IsKernelName(StringRef n) { return n.starts_with("kernel"); }
+unsigned IpvDims(StringRef n) {
+  if (n.starts_with("kernel1D_")) return 1;
+  if (n.starts_with("kernel2D_")) return 2;
+  if (n.starts_with("kernel3D_")) return 3;
+  return 0;
+}
+bool IsThreadIdName(StringRef n) { return n == "tid" || n == "tidX" || n == "tidY" || n == "tidZ"; }
+unsigned ThreadAxis(StringRef n) { return n == "tidY" ? 1 : n == "tidZ" ? 2 : 0; }
+
+struct Context {
+  ASTContext& ctx;
+  const CXXRecordDecl* cls;
+  Reporter& rep;
+  ClassModel& model;
+  std::string Text(SourceRange r) const { return engine::Text(ctx, r); }
+};
+
+// ---- members ---------------------------------------------------------------
+
+void AnalyzeMembers(Context& c) {
+  GlslPrinter structs(c.ctx, c.cls, c.rep);
+  for (auto* f : c.cls->fields()) {
+    Member m;
+    m.name = f->getNameAsString();
+    QualType elem;
+    if (IsStdVector(f->getType(), &elem)) {
+      auto g = GlslTypeOf(elem);
+      if (!g) continue;  // reported if a kernel uses it
+      m.kind = MemberKind::Vector;
+      m.glslType = *g;
+      m.elemCppType = CppTypeName(c.ctx, elem);
+      m.cppType = CppTypeName(c.ctx, f->getType());
+      m.scalarLayout = !LayoutMatchesCpp(c.ctx, elem, false);
+      if (f->getAccess() != AS_private && (!m.scalarLayout || LayoutMatchesCpp(c.ctx, elem, true))) structs.Type(elem, f->getLocation());
+    } else {
+      auto g = GlslTypeOf(f->getType());
+      if (!g) continue;
+      m.kind = MemberKind::Plain;
+      m.glslType = *g;
+      QualType base = f->getType();
+      while (auto* arr = dyn_cast<ConstantArrayType>(base.getCanonicalType().getTypePtr())) base = arr->getElementType();
+      m.cppType = CppTypeName(c.ctx, base);
+      m.inClassData = f->getAccess() != AS_private && LayoutMatchesCpp(c.ctx, f->getType(), false);
+      if (m.inClassData) structs.Type(f->getType(), f->getLocation());
+    }
+    c.model.members.push_back(m);
+  }
+  c.model.glslClassStructs = structs.PreludeTypes();
+  for (auto* ctor : c.cls->ctors()) {
+    if (ctor->isImplicit() || ctor->isCopyOrMoveConstructor() || ctor->isDeleted() || ctor->getAccess() == AS_private) continue;
+    Constructor k;
+    for (unsigned i = 0; i < ctor->getNumParams(); ++i) {
+      k.paramsDecl += (i ? ", " : "") + ParamDecl(c.ctx, ctor->getParamDecl(i), i);
+      std::string n = ctor->getParamDecl(i)->getNameAsString();
+      k.argsForward += (i ? ", " : "") + (n.empty() ? "a_unnamed" + std::to_string(i) : n);
+    }
+    c.model.constructors.push_back(k);
+  }
+  if (c.model.constructors.empty()) c.model.constructors.push_back({});
+  for (auto* md : c.cls->methods()) {
+    if (md->getName() == "CommitDeviceData" && md->isVirtual()) c.model.declaresCommitDeviceData = true;
+    if (md->getName() == "GetExecutionTime" && md->isVirtual()) c.model.declaresGetExecutionTime = true;
+  }
+}
+
+// Struct names already declared by the class-wide prelude ("struct Foo {  // ...").
+std::set<std::string> ClassStructNames(const ClassModel& model) {
+  std::set<std::string> names;
+  static const std::regex decl(R"(struct (\w+) \{)");
+  for (std::sregex_iterator it(model.glslClassStructs.begin(), model.glslClassStructs.end(), decl), end; it != end; ++it)
+    names.insert((*it)[1]);
+  return names;
+}
+
+Member* FindMember(ClassModel& model, const std::string& name) {
+  for (auto& m : model.members)
+    if (m.name == name) return &m;
+  return nullptr;
+}
+
+// ---- kernels ---------------------------------------------------------------
+
+// Bodies copied into generated files see only the class's header (and the sources' using-
+// directives): a name declared in the .cpp file itself would not compile there.
+void CheckCopiedBody(Context& c, const Stmt* body, const std::string& what) {
+  struct Finder : RecursiveASTVisitor<Finder> {
+    Context& c; const std::string& what; std::set<const Decl*> reported;
+    Finder(Context& ctx, const std::string& w) : c(ctx), what(w) {}
+    void Check(const NamedDecl* d, SourceLocation use) {
+      if (!d || d->isLocalExternDecl() || reported.count(d)) return;
+      if (auto* vd = dyn_cast<VarDecl>(d); vd && (vd->isLocalVarDeclOrParm())) return;
+      if (isa<FieldDecl, CXXMethodDecl, ParmVarDecl>(d) || d->getDeclContext()->isFunctionOrMethod()) return;
+      auto& sm = c.ctx.getSourceManager();
+      if (!sm.isInMainFile(sm.getExpansionLoc(d->getLocation()))) return;
+      reported.insert(d);
+      c.rep.Error(use, "'" + d->getNameAsString() + "' is declared in the source file, but " + what +
+                  " is copied into generated code that only sees the class's header",
+                  "declare it in the header (or in a header it includes)");
+    }
+    bool VisitDeclRefExpr(DeclRefExpr* e) { Check(e->getDecl(), e->getLocation()); return true; }
+  } finder(c, what);
+  finder.TraverseStmt(const_cast<Stmt*>(body));
+}
+
+
+// Collects the reductions (m += x, m = min(m, x), ...) and member writes of a thread body.
+struct WriteScanner : RecursiveASTVisitor<WriteScanner> {
+  Context& c;
+  std::map<const FieldDecl*, ReduceOp> reductions;
+  std::set<const MemberExpr*> reductionUses;  // member references that belong to a reduction statement
+  std::set<const FieldDecl*> vectorWrites;
+  explicit WriteScanner(Context& ctx) : c(ctx) {}
+
+  static const MemberExpr* AsThisMember(const Expr* e) {
+    auto* me = dyn_cast<MemberExpr>(e->IgnoreParenImpCasts());
+    return me && isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts()) ? me : nullptr;
+  }
+  void Write(const Expr* lhs, SourceLocation loc, std::optional<ReduceOp> op, const std::vector<const MemberExpr*>& uses) {
+    const FieldDecl* root = RootField(lhs);
+    if (!root) return;
+    if (IsStdVector(root->getType())) { vectorWrites.insert(root); return; }
+    auto* direct = AsThisMember(lhs);
+    if (op && direct) {
+      auto [it, fresh] = reductions.emplace(root, *op);
+      if (!fresh && it->second != *op)
+        c.rep.Error(loc, "member '" + root->getNameAsString() + "' is reduced with two different operations in one kernel",
+                    "use one of +=, -=, min or max per member");
+      for (auto* u : uses) reductionUses.insert(u);
+      return;
+    }
+    c.rep.Error(loc, "kernel writes class member '" + root->getNameAsString() + "' from every thread (a data race on the GPU)",
+                "accumulate with 'm += x', 'm = std::min(m, x)' or 'm = std::max(m, x)' (a reduction), or write to an element of a std::vector member");
+  }
+  std::optional<ReduceOp> MinMax(const Expr* lhs, const Expr* rhs, std::vector<const MemberExpr*>& uses) {
+    auto* call = dyn_cast<CallExpr>(rhs->IgnoreImplicit());
+    if (!call || !call->getDirectCallee() || call->getNumArgs() != 2) return std::nullopt;
+    std::string n = call->getDirectCallee()->getNameAsString();
+    bool isMin = n == "min" || n == "fmin" || n == "fminf", isMax = n == "max" || n == "fmax" || n == "fmaxf";
+    if (!isMin && !isMax) return std::nullopt;
+    auto* target = ThisField(lhs);
+    for (auto* arg : call->arguments())
+      if (auto* me = AsThisMember(arg); me && target && me->getMemberDecl() == target) {
+        uses.push_back(me);
+        return isMin ? ReduceOp::Min : ReduceOp::Max;
+      }
+    return std::nullopt;
+  }
+  bool VisitBinaryOperator(BinaryOperator* bo) {
+    if (!bo->isAssignmentOp()) return true;
+    std::vector<const MemberExpr*> uses;
+    if (auto* me = AsThisMember(bo->getLHS())) uses.push_back(me);
+    std::optional<ReduceOp> op;
+    if (bo->getOpcode() == BO_AddAssign) op = ReduceOp::Add;
+    else if (bo->getOpcode() == BO_SubAssign) op = ReduceOp::Sub;
+    else if (bo->getOpcode() == BO_Assign) op = MinMax(bo->getLHS(), bo->getRHS(), uses);
+    Write(bo->getLHS(), bo->getExprLoc(), op, uses);
+    return true;
+  }
+  bool VisitCXXOperatorCallExpr(CXXOperatorCallExpr* op) {
+    auto k = op->getOperator();
+    if (k != OO_PlusEqual && k != OO_MinusEqual && k != OO_Equal && k != OO_StarEqual && k != OO_SlashEqual &&
+        k != OO_PlusPlus && k != OO_MinusMinus)
+      return true;
+    std::vector<const MemberExpr*> uses;
+    if (auto* me = AsThisMember(op->getArg(0))) uses.push_back(me);
+    std::optional<ReduceOp> r;
+    if (k == OO_PlusEqual) r = ReduceOp::Add;
+    else if (k == OO_MinusEqual) r = ReduceOp::Sub;
+    else if (k == OO_Equal) r = MinMax(op->getArg(0), op->getArg(1), uses);
+    Write(op->getArg(0), op->getExprLoc(), r, uses);
+    return true;
+  }
+  bool VisitUnaryOperator(UnaryOperator* uo) {
+    if (uo->isIncrementDecrementOp()) Write(uo->getSubExpr(), uo->getExprLoc(), std::nullopt, {});
+    return true;
+  }
+};
+
+// Every other read of a reduction target inside the kernel would see a partial sum.
+struct ReductionReadScanner : RecursiveASTVisitor<ReductionReadScanner> {
+  Context& c;
+  const WriteScanner& w;
+  ReductionReadScanner(Context& ctx, const WriteScanner& ws) : c(ctx), w(ws) {}
+  bool VisitMemberExpr(MemberExpr* me) {
+    auto* f = dyn_cast<FieldDecl>(me->getMemberDecl());
+    if (f && w.reductions.count(f) && !w.reductionUses.count(me) && isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts()))
+      c.rep.Error(me->getExprLoc(), "kernel reads '" + f->getNameAsString() + "', which it also reduces",
+                  "the value is only known after all threads finish: read it in the control function after the kernel");
+    return true;
+  }
+};
+
+std::string Identity(ReduceOp op, const std::string& glslType) {
+  std::string scalar = glslType.find("vec") == std::string::npos ? glslType
+                       : glslType[0] == 'i' ? "int" : glslType[0] == 'u' ? "uint" : "float";
+  std::string v;
+  if (op == ReduceOp::Add || op == ReduceOp::Sub) v = scalar == "float" ? "0.0" : scalar == "uint" ? "0u" : "0";
+  else if (op == ReduceOp::Min) v = scalar == "float" ? "3.402823466e+38" : scalar == "uint" ? "0xFFFFFFFFu" : "0x7FFFFFFF";
+  else v = scalar == "float" ? "-3.402823466e+38" : scalar == "uint" ? "0u" : "(-2147483647 - 1)";
+  return glslType == scalar ? v : glslType + "(" + v + ")";
+}
+
+struct LoopHeader {
+  const VarDecl* var = nullptr;
+  const Expr* start = nullptr;
+  const Expr* end = nullptr;
+  bool inclusive = false;
+};
+
+// Accepts `for (T i = a; i < b; ++i)` (also i++, i += 1, <=). Returns false and reports otherwise.
+bool ParseLoop(Context& c, const ForStmt* fs, LoopHeader& h, const std::string& kernel) {
+  auto bad = [&](const std::string& what) {
+    c.rep.Error(fs->getBeginLoc(), "loop of kernel '" + kernel + "' is not a parallel loop: " + what,
+                "write it as 'for (int i = start; i < end; i++)'; each iteration becomes one GPU thread");
+    return false;
+  };
+  auto* ds = dyn_cast_or_null<DeclStmt>(fs->getInit());
+  if (!ds || !ds->isSingleDecl()) return bad("it must declare one loop variable");
+  h.var = dyn_cast<VarDecl>(ds->getSingleDecl());
+  if (!h.var || !h.var->getInit() || !h.var->getType()->isIntegerType()) return bad("the loop variable must be an initialised integer");
+  h.start = h.var->getInit();
+  auto* cond = dyn_cast_or_null<BinaryOperator>(fs->getCond() ? fs->getCond()->IgnoreImplicit() : nullptr);
+  if (!cond || (cond->getOpcode() != BO_LT && cond->getOpcode() != BO_LE)) return bad("the condition must be 'i < end' or 'i <= end'");
+  auto* lhs = dyn_cast<DeclRefExpr>(cond->getLHS()->IgnoreParenImpCasts());
+  if (!lhs || lhs->getDecl() != h.var) return bad("the condition must compare the loop variable");
+  h.end = cond->getRHS();
+  h.inclusive = cond->getOpcode() == BO_LE;
+  const Expr* inc = fs->getInc() ? fs->getInc()->IgnoreImplicit() : nullptr;
+  bool stepOne = false;
+  if (auto* uo = dyn_cast_or_null<UnaryOperator>(inc)) stepOne = uo->isIncrementOp();
+  if (auto* ca = dyn_cast_or_null<CompoundAssignOperator>(inc)) {
+    Expr::EvalResult r;
+    stepOne = ca->getOpcode() == BO_AddAssign && ca->getRHS()->EvaluateAsInt(r, c.ctx) && r.Val.getInt() == 1;
+  }
+  if (!stepOne) return bad("the step must be ++i, i++ or i += 1");
+  return true;
+}
+
+// Casts the host-side C++ count to the loop variable's range: (end) - (start) [+ 1].
+std::string CountExpr(Context& c, const LoopHeader& h) {
+  std::string end = c.Text(h.end->getSourceRange()), start = c.Text(h.start->getSourceRange());
+  Expr::EvalResult r;
+  bool zeroStart = h.start->EvaluateAsInt(r, c.ctx) && r.Val.getInt() == 0;
+  std::string count = zeroStart ? "(" + end + ")" : "(" + end + ") - (" + start + ")";
+  return h.inclusive ? count + " + 1" : count;
+}
+
+void CheckKernelParams(Context& c, const CXXMethodDecl* md, Kernel& k) {
+  for (unsigned i = 0; i < md->getNumParams(); ++i) {
+    auto* p = md->getParamDecl(i);
+    KernelParam kp;
+    kp.name = p->getNameAsString();
+    kp.glslName = GlslPrinter::SafeName(kp.name);
+    QualType t = p->getType();
+    kp.isThreadId = k.rtv && IsThreadIdName(kp.name);
+    if (t->isPointerType()) {
+      QualType pointee = t->getPointeeType();
+      kp.isPointer = true;
+      kp.isConstPointee = pointee.isConstQualified();
+      auto g = GlslTypeOf(pointee);
+      if (!g || pointee->isPointerType()) {
+        c.rep.Error(p->getLocation(), "kernel parameter '" + kp.name + "' points to '" + pointee.getAsString() + "', which has no GPU equivalent",
+                    "pass arrays of int, uint, float, LiteMath vectors or plain structs of those");
+        continue;
+      }
+      kp.glslType = *g;
+      kp.cppType = "crossrt::BufferView";
+      if (!LayoutMatchesCpp(c.ctx, pointee, false)) {
+        if (LayoutMatchesCpp(c.ctx, pointee, true)) kp.scalarLayout = true;
+        else c.rep.Error(p->getLocation(), "the C++ layout of '" + pointee.getAsString() + "' cannot be reproduced in a GPU buffer",
+                         "reorder the fields so 16-byte types (float4, float3) come first, or pad them to float4");
+      }
+    } else if (t->isReferenceType() && !t.getNonReferenceType().isConstQualified()) {
+      c.rep.Error(p->getLocation(), "kernel parameter '" + kp.name + "' is a non-const reference",
+                  "kernels return results through pointer parameters or members");
+    } else {
+      auto g = GlslTypeOf(t);
+      if (!g || (t.getNonReferenceType()->isFloatingType() && !t.getNonReferenceType()->isSpecificBuiltinType(BuiltinType::Float))) {
+        c.rep.Error(p->getLocation(), "kernel parameter '" + kp.name + "' of type '" + t.getAsString() + "' has no GPU equivalent",
+                    "use int, uint, float, LiteMath types, plain structs, or a pointer with a size");
+        continue;
+      }
+      kp.glslType = *g;
+      kp.valueCppType = CppTypeName(c.ctx, t.getNonReferenceType());
+      kp.cppType = ParamDecl(c.ctx, p, i);
+      kp.cppType = kp.cppType.substr(0, kp.cppType.size() - kp.name.size());  // type part only
+      while (!kp.cppType.empty() && isspace((unsigned char)kp.cppType.back())) kp.cppType.pop_back();
+    }
+    k.params.push_back(kp);
+  }
+}
+
+void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def) {
+  Kernel k;
+  k.name = md->getNameAsString();
+  k.dims = IpvDims(k.name);
+  k.rtv = k.dims == 0;
+  k.sourceFile = BaseName(FileOf(c.ctx, def->getLocation()));
+  if (!md->getReturnType()->isVoidType()) {
+    c.rep.Error(md->getLocation(), "kernel '" + k.name + "' returns a value", "kernels return void and write results to pointer parameters or members");
+    return;
+  }
+  CheckKernelParams(c, md, k);
+  for (unsigned i = 0; i < md->getNumParams(); ++i) k.cppParamsDecl += (i ? ", " : "") + ParamDecl(c.ctx, md->getParamDecl(i), i);
+  GlslPrinter printer(c.ctx, c.cls, c.rep);
+  for (auto& s : ClassStructNames(c.model)) printer.predeclaredStructs.insert(s);
+  auto* body = dyn_cast<CompoundStmt>(def->getBody());
+  std::vector<const Stmt*> preamble;
+  const Stmt* threadBody = body;
+  std::vector<std::pair<std::string, std::string>> threadParams;  // (glsl type, name)
+
+  if (k.rtv) {
+    for (auto& p : k.params)
+      if (p.isThreadId) {
+        k.dims = std::max(k.dims, ThreadAxis(p.name) + 1);
+        k.threadAxes.push_back(ThreadAxis(p.name));
+        threadParams.push_back({p.glslType, p.glslName});
+      }
+    if (k.dims == 0) {
+      c.rep.Error(md->getLocation(), "kernel '" + k.name + "' has no thread id parameter",
+                  "name the thread index parameter 'tid' (or tidX, tidY, tidZ), or name the kernel kernel1D_/kernel2D_ with loops inside");
+      return;
+    }
+  } else {
+    // kernelND_: optional declarations, then N perfectly nested loops.
+    const ForStmt* outer = nullptr;
+    for (auto* s : body->body()) {
+      if (!outer && isa<DeclStmt>(s)) { preamble.push_back(s); continue; }
+      if (!outer && isa<ForStmt>(s)) { outer = cast<ForStmt>(s); continue; }
+      if (isa<NullStmt>(s)) continue;
+      c.rep.Error(s->getBeginLoc(), "kernel '" + k.name + "' must consist of its parallel loop nest (and declarations before it)",
+                  "move this statement into the loop body, or into the control function");
+      return;
+    }
+    if (!outer) {
+      c.rep.Error(md->getLocation(), "kernel '" + k.name + "' has no loop", "a kernel" + std::to_string(k.dims) + "D_ function holds " + std::to_string(k.dims) + " nested for loops whose iterations become GPU threads");
+      return;
+    }
+    const Stmt* cur = outer;
+    std::vector<LoopHeader> headers;
+    for (unsigned d = 0; d < k.dims; ++d) {
+      auto* fs = dyn_cast<ForStmt>(cur);
+      if (!fs) {
+        c.rep.Error(cur->getBeginLoc(), "kernel '" + k.name + "' needs " + std::to_string(k.dims) + " perfectly nested loops",
+                    "put nothing between the loop headers; move per-row code into the innermost body");
+        return;
+      }
+      LoopHeader h;
+      if (!ParseLoop(c, fs, h, k.name)) return;
+      headers.push_back(h);
+      Loop loop;
+      loop.var = h.var->getNameAsString();
+      loop.glslType = GlslTypeOf(h.var->getType()).value_or("int");
+      loop.startCpp = c.Text(h.start->getSourceRange());
+      loop.countCpp = CountExpr(c, h);
+      k.loops.push_back(loop);
+      threadParams.push_back({loop.glslType, GlslPrinter::SafeName(loop.var)});
+      cur = fs->getBody();
+      if (d + 1 < k.dims)
+        if (auto* cs = dyn_cast<CompoundStmt>(cur); cs && cs->size() == 1) cur = cs->body_front();
+    }
+    threadBody = cur;
+    // Thread ids are listed innermost first (x), like the dispatch.
+    std::reverse(threadParams.begin(), threadParams.end());
+    for (unsigned d = 0; d < k.dims; ++d) k.threadAxes.push_back(d);
+  }
+
+  // Reductions and member writes.
+  WriteScanner ws(c);
+  ws.TraverseStmt(const_cast<Stmt*>(threadBody));
+  for (auto* s : preamble) ws.TraverseStmt(const_cast<Stmt*>(s));
+  ReductionReadScanner rs(c, ws);
+  rs.TraverseStmt(const_cast<Stmt*>(threadBody));
+  if (k.rtv && !ws.reductions.empty()) {
+    c.rep.Error(md->getLocation(), "member reductions are supported in kernel1D_/2D_/3D_ loops, not in '" + k.name + "'",
+                "write the loop inside the kernel (kernel1D_" + k.name.substr(7) + ") so the translator sees the whole reduction");
+    return;
+  }
+  for (auto& [field, op] : ws.reductions) {
+    Reduction r;
+    r.member = field->getNameAsString();
+    r.op = op;
+    r.glslType = GlslTypeOf(field->getType()).value_or("float");
+    r.identity = Identity(op, r.glslType);
+    printer.renames[field] = r.member + "Local";
+    k.reductions.push_back(r);
+  }
+  for (auto* f : ws.vectorWrites)
+    if (auto* m = FindMember(c.model, f->getNameAsString())) m->writtenByKernels = true;
+
+  // GLSL: the thread function.
+  std::ostringstream os;
+  os << "// from " << c.cls->getNameAsString() << "::" << k.name << " (" << k.sourceFile << ")\n";
+  os << "void " << k.name << "(";
+  for (size_t i = 0; i < threadParams.size(); ++i) os << (i ? ", " : "") << threadParams[i].first << " " << threadParams[i].second;
+  os << ")\n{\n";
+  for (auto* s : preamble) os << printer.Stmt(s, 1);
+  if (auto* cs = dyn_cast<CompoundStmt>(threadBody))
+    for (auto* s : cs->body()) os << printer.ThreadBody(s, 1);
+  else
+    os << printer.ThreadBody(threadBody, 1);
+  os << "}\n";
+  k.glslBody = os.str();
+  k.glslStructs = printer.PreludeTypes();
+  k.glslHelpers = printer.PreludeFunctions();
+  for (auto* f : printer.memberVectors) {
+    k.memberVectors.push_back(f->getNameAsString());
+    if (auto* m = FindMember(c.model, f->getNameAsString())) m->usedByKernels = true;
+    if (f->getAccess() == AS_private)
+      c.rep.Error(f->getLocation(), "member '" + f->getNameAsString() + "' is private, but the generated class derives from '" + c.cls->getNameAsString() + "' and must reach it",
+                  "declare it protected");
+  }
+  std::sort(k.memberVectors.begin(), k.memberVectors.end());
+  for (auto* f : printer.plainMembers) {
+    auto* m = FindMember(c.model, f->getNameAsString());
+    if (m) m->usedByKernels = true;
+    if (m && !m->inClassData && f->getAccess() != AS_private)
+      c.rep.Error(f->getLocation(), "member '" + f->getNameAsString() + "' of type '" + f->getType().getAsString() + "' has a C++ layout that a GPU buffer cannot reproduce",
+                  "use int instead of bool, float4x4 instead of float3x3, or reorder struct fields so 16-byte types come first");
+    if (f->getAccess() == AS_private)
+      c.rep.Error(f->getLocation(), "member '" + f->getNameAsString() + "' is private, but the generated class derives from '" + c.cls->getNameAsString() + "' and must reach it",
+                  "declare it protected");
+  }
+  for (auto& r : k.reductions)
+    if (auto* m = FindMember(c.model, r.member)) { m->usedByKernels = true; m->writtenByKernels = true; }
+  k.usesClassData = true;  // binding 0 is always the class data: simple and uniform
+
+  // CPU backend: the loop nest as the user wrote it, reduction targets renamed.
+  if (!k.rtv) {
+    Rewriter rw(c.ctx.getSourceManager(), c.ctx.getLangOpts());
+    struct Renamer : RecursiveASTVisitor<Renamer> {
+      Rewriter& rw; const std::map<const FieldDecl*, ReduceOp>& red;
+      Renamer(Rewriter& r, const std::map<const FieldDecl*, ReduceOp>& m) : rw(r), red(m) {}
+      bool VisitMemberExpr(MemberExpr* me) {
+        auto* f = dyn_cast<FieldDecl>(me->getMemberDecl());
+        if (f && red.count(f) && me->isImplicitAccess()) rw.ReplaceText(me->getMemberLoc(), f->getName().size(), f->getNameAsString() + "Local");
+        else if (f && red.count(f)) rw.ReplaceText(me->getSourceRange(), f->getNameAsString() + "Local");
+        return true;
+      }
+    } renamer(rw, ws.reductions);
+    const ForStmt* outer = nullptr;
+    for (auto* s : body->body())
+      if ((outer = dyn_cast<ForStmt>(s))) break;
+    renamer.TraverseStmt(const_cast<ForStmt*>(outer));
+    k.cpuLoopNest = rw.getRewrittenText(outer->getSourceRange());
+    CheckCopiedBody(c, def->getBody(), "kernel '" + k.name + "'");
+    for (auto* s : preamble) k.cpuPreamble += c.Text(s->getSourceRange()) + "\n";
+  }
+  c.model.kernels.push_back(k);
+}
+
+// ---- control functions -----------------------------------------------------
+
+struct KernelCallFinder : RecursiveASTVisitor<KernelCallFinder> {
+  std::vector<const CXXMemberCallExpr*> calls;
+  bool VisitCXXMemberCallExpr(CXXMemberCallExpr* call) {
+    if (auto* md = call->getMethodDecl(); md && IsKernelName(md->getName()) && isa<CXXThisExpr>(call->getImplicitObjectArgument()->IgnoreParenImpCasts()))
+      calls.push_back(call);
+    return true;
+  }
+};
+
+const Stmt* SingleStatement(const Stmt* s) {
+  while (auto* cs = dyn_cast_or_null<CompoundStmt>(s)) {
+    if (cs->size() != 1) return s;
+    s = cs->body_front();
+  }
+  return s;
+}
+
+class ControlRewriter {
+public:
+  ControlRewriter(Context& c, const CXXMethodDecl* md, const FunctionDecl* def, Control& ctrl)
+      : m_c(c), m_md(md), m_def(def), m_ctrl(ctrl),
+        m_gpu(c.ctx.getSourceManager(), c.ctx.getLangOpts()), m_cpu(c.ctx.getSourceManager(), c.ctx.getLangOpts()) {}
+
+  void Run() {
+    Visit(m_def->getBody());
+    m_ctrl.vulkanCmdBody = m_gpu.getRewrittenText(m_def->getBody()->getSourceRange());
+    m_ctrl.cpuBody = m_cpu.getRewrittenText(m_def->getBody()->getSourceRange());
+  }
+
+private:
+  // A pointer argument of a kernel call, as the BufferView the generated code binds.
+  std::string BufferArg(const Expr* arg) {
+    const Expr* e = arg->IgnoreParenImpCasts();
+    if (auto* dr = dyn_cast<DeclRefExpr>(e))
+      if (auto* p = dyn_cast<ParmVarDecl>(dr->getDecl()); p && p->getDeclContext() == m_def)
+        return "m_inOut_" + m_ctrl.name + "." + p->getNameAsString();
+    const Expr* offset = nullptr;
+    if (auto* bo = dyn_cast<BinaryOperator>(e); bo && bo->getOpcode() == BO_Add) {
+      offset = bo->getRHS();
+      e = bo->getLHS()->IgnoreParenImpCasts();
+    }
+    if (auto* mc = dyn_cast<CXXMemberCallExpr>(e); mc && mc->getMethodDecl()->getName() == "data") {
+      if (auto* f = ThisField(mc->getImplicitObjectArgument()); f && IsStdVector(f->getType())) {
+        if (auto* m = FindMember(m_c.model, f->getNameAsString())) m->usedByKernels = true;
+        std::string view = "m_vdata." + f->getNameAsString() + ".View(";
+        if (offset) {
+          auto* m = FindMember(m_c.model, f->getNameAsString());
+          view += "sizeof(" + (m ? m->elemCppType : std::string("float")) + ") * size_t(" + m_c.Text(offset->getSourceRange()) + ")";
+        }
+        return view + ")";
+      }
+    }
+    m_c.rep.Error(arg->getBeginLoc(), "pointer argument of a kernel call must be a parameter of '" + m_ctrl.name + "' or 'member.data()' (+ offset)",
+                  "pass the control function's size-annotated pointer, or a std::vector member's data()");
+    return "{}";
+  }
+
+  std::string Args(const CXXMemberCallExpr* call, bool skipThreadIds) {
+    std::string out;
+    auto* md = call->getMethodDecl();
+    for (unsigned i = 0; i < call->getNumArgs() && i < md->getNumParams(); ++i) {
+      auto* p = md->getParamDecl(i);
+      if (skipThreadIds && IsThreadIdName(p->getName())) continue;
+      const Expr* arg = call->getArg(i);
+      if (isa<CXXDefaultArgExpr>(arg)) continue;
+      out += ", " + (p->getType()->isPointerType() ? BufferArg(arg) : m_c.Text(arg->getSourceRange()));
+    }
+    return out;
+  }
+
+  void Note(const CXXMemberCallExpr* call) {
+    std::string n = call->getMethodDecl()->getNameAsString();
+    if (std::find(m_ctrl.kernelsCalled.begin(), m_ctrl.kernelsCalled.end(), n) == m_ctrl.kernelsCalled.end())
+      m_ctrl.kernelsCalled.push_back(n);
+  }
+
+  // for (...) for (...) kernel_X(tidX, tidY, ...): one dispatch of the whole nest.
+  bool TryRtvNest(const ForStmt* outer) {
+    std::vector<LoopHeader> loops;
+    const Stmt* cur = outer;
+    while (auto* fs = dyn_cast_or_null<ForStmt>(cur)) {
+      LoopHeader h;
+      if (!QuietParseLoop(fs, h)) return false;
+      loops.push_back(h);
+      cur = SingleStatement(fs->getBody());
+    }
+    auto* call = dyn_cast_or_null<CXXMemberCallExpr>(cur ? dyn_cast<Expr>(cur) ? cast<Expr>(cur)->IgnoreImplicit() : nullptr : nullptr);
+    if (!call || !call->getMethodDecl() || !IsKernelName(call->getMethodDecl()->getName()) || IpvDims(call->getMethodDecl()->getName()))
+      return false;
+    auto* md = call->getMethodDecl();
+    std::map<unsigned, const LoopHeader*> axes;
+    for (unsigned i = 0; i < md->getNumParams() && i < call->getNumArgs(); ++i) {
+      if (!IsThreadIdName(md->getParamDecl(i)->getName())) continue;
+      auto* dr = dyn_cast<DeclRefExpr>(call->getArg(i)->IgnoreParenImpCasts());
+      const LoopHeader* match = nullptr;
+      for (auto& h : loops)
+        if (dr && dr->getDecl() == h.var) match = &h;
+      if (!match) {
+        m_c.rep.Error(call->getArg(i)->getBeginLoc(), "thread id argument of '" + md->getNameAsString() + "' must be the variable of an enclosing loop",
+                      "call it as: for (int i = 0; i < n; i++) " + md->getNameAsString() + "(i, ...);");
+        return true;
+      }
+      axes[ThreadAxis(md->getParamDecl(i)->getName())] = match;
+    }
+    if (axes.size() != loops.size()) {
+      m_c.rep.Error(outer->getBeginLoc(), "loops around '" + md->getNameAsString() + "' do not match its thread id parameters",
+                    "use one loop per thread id parameter (tidX, tidY, ...), with nothing else in the loops");
+      return true;
+    }
+    std::string counts;
+    for (auto& [axis, h] : axes) {
+      Expr::EvalResult r;
+      if (!(h->start->EvaluateAsInt(r, m_c.ctx) && r.Val.getInt() == 0))
+        m_c.rep.Error(h->start->getBeginLoc(), "loop around kernel '" + md->getNameAsString() + "' must start at 0",
+                      "start at 0 and add the offset inside the kernel");
+      counts += ", " + CountExpr(m_c, *h);
+    }
+    Note(call);
+    m_gpu.ReplaceText(outer->getSourceRange(), md->getNameAsString() + "Cmd(a_cmd" + counts + Args(call, true) + ");");
+    auto& sm = m_c.ctx.getSourceManager();
+    unsigned col = sm.getExpansionColumnNumber(outer->getBeginLoc());
+    std::string indent(col > 0 ? col - 1 : 0, ' ');
+    std::string pragma = "#pragma omp parallel for schedule(dynamic, 16)";
+    if (loops.size() > 1) pragma += " collapse(" + std::to_string(loops.size()) + ")";
+    m_cpu.InsertTextBefore(outer->getBeginLoc(), pragma + "\n" + indent);
+    return true;
+  }
+
+  bool QuietParseLoop(const ForStmt* fs, LoopHeader& h) {
+    auto* ds = dyn_cast_or_null<DeclStmt>(fs->getInit());
+    if (!ds || !ds->isSingleDecl()) return false;
+    h.var = dyn_cast<VarDecl>(ds->getSingleDecl());
+    if (!h.var || !h.var->getInit()) return false;
+    h.start = h.var->getInit();
+    auto* cond = dyn_cast_or_null<BinaryOperator>(fs->getCond() ? fs->getCond()->IgnoreImplicit() : nullptr);
+    if (!cond || (cond->getOpcode() != BO_LT && cond->getOpcode() != BO_LE)) return false;
+    h.end = cond->getRHS();
+    h.inclusive = cond->getOpcode() == BO_LE;
+    return true;
+  }
+
+  void Visit(const Stmt* s) {
+    if (!s) return;
+    if (auto* fs = dyn_cast<ForStmt>(s); fs && TryRtvNest(fs)) return;
+    if (auto* call = dyn_cast<CXXMemberCallExpr>(s)) {
+      auto* md = call->getMethodDecl();
+      if (md && IsKernelName(md->getName()) && isa<CXXThisExpr>(call->getImplicitObjectArgument()->IgnoreParenImpCasts())) {
+        if (!IpvDims(md->getName())) {
+          m_c.rep.Error(call->getBeginLoc(), "kernel '" + md->getNameAsString() + "' must be called inside loops over its thread ids",
+                        "call it as: for (int i = 0; i < n; i++) " + md->getNameAsString() + "(i, ...);");
+          return;
+        }
+        Note(call);
+        m_gpu.ReplaceText(call->getSourceRange(), md->getNameAsString() + "Cmd(a_cmd" + Args(call, false) + ")");
+        return;
+      }
+    }
+    for (auto* child : s->children()) Visit(child);
+  }
+
+  Context& m_c;
+  const CXXMethodDecl* m_md;
+  const FunctionDecl* m_def;
+  Control& m_ctrl;
+  Rewriter m_gpu, m_cpu;
+};
+
+void AnalyzeControl(Context& c, const CXXMethodDecl* md, const FunctionDecl* def) {
+  Control ctrl;
+  ctrl.name = md->getNameAsString();
+  ctrl.sourceFile = BaseName(FileOf(c.ctx, def->getLocation()));
+  ctrl.isConst = md->isConst();
+  if (!md->isVirtual()) {
+    c.rep.Error(md->getLocation(), "control function '" + ctrl.name + "' calls kernels but is not virtual",
+                "declare it 'virtual' so the generated class can override it and run it on the GPU");
+    return;
+  }
+  if (!md->getReturnType()->isVoidType()) {
+    c.rep.Error(md->getLocation(), "control function '" + ctrl.name + "' returns a value",
+                "return results through size-annotated pointer parameters or members; control functions return void");
+    return;
+  }
+  ctrl.returnType = "void";
+  for (unsigned i = 0; i < md->getNumParams(); ++i) {
+    auto* p = md->getParamDecl(i);
+    ControlParam cp;
+    cp.name = p->getNameAsString();
+    cp.cppType = p->getType().getAsString();
+    ctrl.paramsDecl += (i ? ", " : "") + ParamDecl(c.ctx, p, i);
+    ctrl.argsForward += (i ? ", " : "") + cp.name;
+    if (p->getType()->isPointerType()) {
+      cp.isPointer = true;
+      QualType pointee = p->getType()->getPointeeType();
+      cp.isConst = pointee.isConstQualified();
+      cp.pointeeCpp = CppTypeName(c.ctx, pointee);
+      for (auto* a : p->specific_attrs<AnnotateAttr>())
+        if (a->getAnnotation().starts_with("crossrt.size=")) cp.sizeExpr = a->getAnnotation().substr(13).str();
+      if (cp.sizeExpr.empty())
+        c.rep.Error(p->getLocation(), "pointer parameter '" + cp.name + "' of control function '" + ctrl.name + "' has no size",
+                    "annotate it with its element count, e.g. '[[crossrt::size(\"n\")]] const float* " + cp.name +
+                    "' or 'const float* " + cp.name + " __attribute__((size(\"n\")))'");
+    }
+    ctrl.params.push_back(cp);
+  }
+  CheckCopiedBody(c, def->getBody(), "control function '" + ctrl.name + "'");
+  ControlRewriter rw(c, md, def, ctrl);
+  rw.Run();
+  c.model.controls.push_back(ctrl);
+}
+
+struct ClassFinder : RecursiveASTVisitor<ClassFinder> {
+  std::string name;
+  const CXXRecordDecl* found = nullptr;
+  bool VisitCXXRecordDecl(CXXRecordDecl* rd) {
+    if (!found && rd->isThisDeclarationADefinition() && rd->getName() == name && !isa<ClassTemplateSpecializationDecl>(rd))
+      found = rd;
+    return true;
+  }
+};
+
+}  // namespace
+
+bool AnalyzeTranslationUnit(ASTContext& ctx, const std::string& className, Reporter& reporter, ClassModel& model) {
+  ClassFinder finder;
+  finder.name = className;
+  finder.TraverseDecl(ctx.getTranslationUnitDecl());
+  if (!finder.found) return false;
+  Context c{ctx, finder.found, reporter, model};
+  bool first = model.className.empty();
+  if (first) {
+    model.className = className;
+    model.headerFile = FileOf(ctx, finder.found->getLocation());
+    AnalyzeMembers(c);
+  }
+  auto known = [](const auto& list, const std::string& n) {
+    return std::any_of(list.begin(), list.end(), [&](const auto& x) { return x.name == n; });
+  };
+  // using-directives at the top level of the source file: bodies copied from it rely on them.
+  for (auto* d : ctx.getTranslationUnitDecl()->decls()) {
+    auto& sm = ctx.getSourceManager();
+    if (!isa<UsingDirectiveDecl, UsingDecl>(d) || !sm.isInMainFile(sm.getExpansionLoc(d->getLocation()))) continue;
+    std::string text = c.Text(d->getSourceRange()) + ";";
+    if (std::find(model.usingDecls.begin(), model.usingDecls.end(), text) == model.usingDecls.end()) model.usingDecls.push_back(text);
+  }
+  // Kernels first: control functions refer to them.
+  for (int pass = 0; pass < 2; ++pass) {
+    for (auto* md : finder.found->methods()) {
+      const FunctionDecl* def = nullptr;
+      if (!md->hasBody(def) || !def) continue;
+      auto& sm = ctx.getSourceManager();
+      // A method defined in a header is seen by every source file: analyse it once.
+      std::string n = md->getNameAsString();
+      bool isKernel = IsKernelName(n);
+      if (pass == 0 && isKernel && !known(model.kernels, n)) AnalyzeKernel(c, md, def);
+      if (pass == 1 && !isKernel && !known(model.controls, n)) {
+        KernelCallFinder kc;
+        kc.TraverseStmt(def->getBody());
+        if (!kc.calls.empty()) AnalyzeControl(c, md, def);
+      }
+      (void)sm;
+    }
+  }
+  return true;
+}
+
+void FinishModel(ClassModel& model) {
+  // The class-data block: plain members kernels use, then sizes of member vectors.
+  // Ordered by alignment so that the C++ mirror with alignas() has the std430 offsets.
+  std::vector<BlockField> fields;
+  auto alignOf = [](const std::string& glsl) -> unsigned {
+    auto base = SplitArray(glsl).first;
+    if (base == "vec2" || base == "ivec2" || base == "uvec2") return 8;
+    if (base.find("vec") != std::string::npos || base.find("mat") != std::string::npos) return 16;
+    return base == "float" || base == "int" || base == "uint" ? 4 : 16;
+  };
+  for (auto& m : model.members)
+    if (m.kind == MemberKind::Plain && m.inClassData) fields.push_back({m.name, m.cppType, m.glslType, alignOf(m.glslType)});
+  for (auto& m : model.members) {
+    if (!m.usedByKernels || m.kind != MemberKind::Vector) continue;
+    fields.push_back({m.name + "_size", "uint32_t", "uint", 4});
+    fields.push_back({m.name + "_capacity", "uint32_t", "uint", 4});
+  }
+  std::stable_sort(fields.begin(), fields.end(), [](const BlockField& a, const BlockField& b) { return a.std430Align > b.std430Align; });
+  if (fields.empty()) fields.push_back({"dummy", "uint32_t", "uint", 4});  // a block needs a member
+  model.classData = fields;
+}
+
+}  // namespace crossrt::engine

@@ -1,0 +1,468 @@
+// Turns a ClassModel into the generated files by rendering the text templates in templates/.
+#include "CodeGen.h"
+
+#include "Glsl.h"
+
+#include <kainjow/mustache.hpp>
+
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace crossrt::engine {
+namespace {
+
+using Data = kainjow::mustache::data;
+
+Data List() { return Data(Data::type::list); }
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot read template '" + path + "'");
+  std::ostringstream os;
+  os << in.rdbuf();
+  return os.str();
+}
+
+std::string Render(const std::string& templatePath, const Data& data) {
+  kainjow::mustache::mustache tmpl(ReadFile(templatePath));
+  if (!tmpl.is_valid()) throw std::runtime_error(templatePath + ": " + tmpl.error_message());
+  tmpl.set_custom_escape([](const std::string& s) { return s; });  // code, not HTML
+  std::string out = tmpl.render(data);
+  if (!tmpl.is_valid()) throw std::runtime_error(templatePath + ": " + tmpl.error_message());
+  return out;
+}
+
+const char* Axis(unsigned a) { return a == 0 ? "X" : a == 1 ? "Y" : "Z"; }
+const char* GlAxis(unsigned a) { return a == 0 ? "x" : a == 1 ? "y" : "z"; }
+
+unsigned GroupSize(const Kernel& k, unsigned axis) {
+  static const unsigned sizes[3][3] = {{256, 1, 1}, {16, 16, 1}, {8, 8, 4}};
+  return sizes[k.dims - 1][axis];
+}
+
+std::string Combine(ReduceOp op, const std::string& a, const std::string& b) {
+  if (op == ReduceOp::Min) return "min(" + a + ", " + b + ")";
+  if (op == ReduceOp::Max) return "max(" + a + ", " + b + ")";
+  return a + " + " + b;  // Sub accumulates negative terms, so partials add up
+}
+
+std::string GroupCountExpr(const Kernel& k) {
+  if (k.dims == 1) return "crossrt::GroupCount1D(countX, 256)";
+  std::string e = "((countX + 15) / 16) * ((countY + 15) / 16)";
+  if (k.dims == 3) e = "((countX + 7) / 8) * ((countY + 7) / 8) * ((countZ + 3) / 4)";
+  return e;
+}
+
+const Member* FindMember(const ClassModel& m, const std::string& name) {
+  for (auto& x : m.members)
+    if (x.name == name) return &x;
+  return nullptr;
+}
+
+std::string ReductionCppType(const ClassModel& model, const Reduction& r) {
+  auto* m = FindMember(model, r.member);
+  return m ? m->cppType : "float";
+}
+
+Data ClassDataList(const ClassModel& model) {
+  Data list = List();
+  for (auto& f : model.classData) {
+    Data d;
+    auto [base, dims] = SplitArray(f.glslType);
+    d.set("name", f.name);
+    d.set("cppType", f.cppType);
+    d.set("arraySuffix", dims);
+    d.set("align", std::to_string(f.std430Align));
+    d.set("decl", base + " " + f.name + dims);
+    auto* m = FindMember(model, f.name);
+    d.set("isPlain", m != nullptr);
+    d.set("written", m != nullptr && m->writtenByKernels);
+    list.push_back(d);
+  }
+  return list;
+}
+
+Data Common(const ClassModel& model, const GenerateOptions& opt) {
+  Data d;
+  d.set("className", model.className);
+  d.set("headerName", opt.headerName);
+  d.set("headerInclude", opt.headerInclude);
+  d.set("commitOverride", model.declaresCommitDeviceData ? " override" : "");
+  d.set("timeOverride", model.declaresGetExecutionTime ? " override" : "");
+  Data ctors = List();
+  for (auto& c : model.constructors) {
+    Data x;
+    x.set("params", c.paramsDecl);
+    x.set("args", c.argsForward);
+    x.set("hasParams", !c.paramsDecl.empty());
+    ctors.push_back(x);
+  }
+  d.set("constructors", ctors);
+  d.set("classData", ClassDataList(model));
+  bool writtenPlain = false;
+  for (auto& m : model.members) writtenPlain |= m.kind == MemberKind::Plain && m.inClassData && m.writtenByKernels;
+  d.set("hasWrittenPlain", writtenPlain);
+  std::string usings;
+  for (auto& u : model.usingDecls) usings += u + "\n";
+  d.set("usingDecls", usings);
+  d.set("hasUsingDecls", !usings.empty());
+  return d;
+}
+
+// ---- GLSL ------------------------------------------------------------------
+
+std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateOptions& opt, bool& scalarAny) {
+  Data d = Common(model, opt);
+  d.set("kernel", k.name);
+  d.set("sourceFile", k.sourceFile);
+  d.set("groupX", std::to_string(GroupSize(k, 0)));
+  d.set("groupY", std::to_string(GroupSize(k, 1)));
+  d.set("groupZ", std::to_string(GroupSize(k, 2)));
+  d.set("groupSize", "256");
+  d.set("classStructs", model.glslClassStructs);
+  d.set("kernelStructs", k.glslStructs);
+  Data buffers = List();
+  unsigned binding = 1;
+  scalarAny = false;
+  for (auto& p : k.params) {
+    if (!p.isPointer) continue;
+    Data b;
+    b.set("layout", p.scalarLayout ? "scalar" : "std430");
+    scalarAny |= p.scalarLayout;
+    b.set("binding", std::to_string(binding++));
+    b.set("access", p.isConstPointee ? "readonly " : "");
+    b.set("blockName", p.glslName + "Buffer");
+    b.set("type", p.glslType);
+    b.set("name", p.glslName);
+    b.set("comment", "parameter '" + p.name + "'");
+    buffers.push_back(b);
+  }
+  for (auto& v : k.memberVectors) {
+    auto* m = FindMember(model, v);
+    Data b;
+    b.set("layout", m && m->scalarLayout ? "scalar" : "std430");
+    scalarAny |= m && m->scalarLayout;
+    b.set("binding", std::to_string(binding++));
+    b.set("access", "");
+    b.set("blockName", v + "Buffer");
+    b.set("type", m ? m->glslType : "float");
+    b.set("name", v);
+    b.set("comment", "member std::vector " + v);
+    buffers.push_back(b);
+  }
+  Data reductions = List();
+  for (auto& r : k.reductions) {
+    Data b;
+    b.set("layout", "std430");
+    b.set("binding", std::to_string(binding++));
+    b.set("access", "writeonly ");
+    b.set("blockName", r.member + "PartialsBlock");
+    b.set("type", r.glslType);
+    b.set("name", r.member + "Partials");
+    b.set("comment", "per-workgroup partial results of the reduction of " + r.member);
+    buffers.push_back(b);
+    Data x;
+    x.set("type", r.glslType);
+    x.set("member", r.member);
+    x.set("identity", r.identity);
+    x.set("groupSize", "256");
+    x.set("combineShared", Combine(r.op, r.member + "Shared[local]", r.member + "Shared[local + stride]"));
+    reductions.push_back(x);
+  }
+  d.set("scalarLayout", scalarAny);
+  d.set("buffers", buffers);
+  d.set("reductions", reductions);
+  d.set("hasReductions", !k.reductions.empty());
+  Data push = List();
+  for (unsigned a = 0; a < k.dims; ++a) {
+    Data s;
+    s.set("decl", std::string("int crt_start") + Axis(a));
+    push.push_back(s);
+  }
+  for (unsigned a = 0; a < k.dims; ++a) {
+    Data s;
+    s.set("decl", std::string("uint crt_count") + Axis(a));
+    push.push_back(s);
+  }
+  for (auto& p : k.params) {
+    if (p.isPointer || p.isThreadId) continue;
+    auto [base, dims] = SplitArray(p.glslType);
+    Data s;
+    s.set("decl", base + " " + p.glslName + dims);
+    push.push_back(s);
+  }
+  d.set("pushConstants", push);
+  d.set("helpers", k.glslHelpers);
+  d.set("body", k.glslBody);
+  d.set("dim1", k.dims == 1);
+  std::string threadArgs, active;
+  for (size_t i = 0; i < k.threadAxes.size(); ++i) {
+    unsigned a = k.threadAxes[i];
+    std::string id = k.dims == 1 ? "int(threadId)" : std::string("int(gl_GlobalInvocationID.") + GlAxis(a) + ")";
+    std::string type = k.rtv ? "uint" : k.loops[k.dims - 1 - a].glslType;
+    threadArgs += (i ? ", " : "") + type + "(crt_start" + Axis(a) + " + " + id + ")";
+  }
+  if (k.rtv) {  // thread-id parameters keep their declared types
+    threadArgs.clear();
+    size_t i = 0;
+    for (auto& p : k.params) {
+      if (!p.isThreadId) continue;
+      unsigned a = k.threadAxes[i];
+      std::string id = k.dims == 1 ? "int(threadId)" : std::string("int(gl_GlobalInvocationID.") + GlAxis(a) + ")";
+      threadArgs += (i++ ? ", " : "") + p.glslType + "(crt_start" + Axis(a) + " + " + id + ")";
+    }
+  }
+  for (unsigned a = 0; a < k.dims; ++a)
+    active += (a ? " && " : "") + std::string("gl_GlobalInvocationID.") + GlAxis(a) + " < crt_count" + Axis(a);
+  d.set("threadArgs", threadArgs);
+  d.set("activeTest", active);
+  return Render(opt.templateDir + "/glsl/kernel.comp.mustache", d);
+}
+
+std::string ReduceGlsl(const ClassModel& model, const Kernel& k, const GenerateOptions& opt) {
+  Data d = Common(model, opt);
+  d.set("kernel", k.name);
+  d.set("sourceFile", k.sourceFile);
+  d.set("groupSize", "256");
+  d.set("classStructs", model.glslClassStructs);
+  Data reductions = List();
+  unsigned binding = 1;
+  for (auto& r : k.reductions) {
+    Data x;
+    x.set("type", r.glslType);
+    x.set("member", r.member);
+    x.set("identity", r.identity);
+    x.set("binding", std::to_string(binding++));
+    x.set("combineShared", Combine(r.op, r.member + "Shared[local]", r.member + "Shared[local + stride]"));
+    x.set("combinePartial", Combine(r.op, r.member + "Local", r.member + "Partials[i]"));
+    x.set("combineMember", Combine(r.op, r.member, r.member + "Shared[0]"));
+    reductions.push_back(x);
+  }
+  d.set("reductions", reductions);
+  return Render(opt.templateDir + "/glsl/reduce.comp.mustache", d);
+}
+
+// ---- host code ---------------------------------------------------------------
+
+Data ControlsData(const ClassModel& model) {
+  Data controls = List();
+  for (auto& c : model.controls) {
+    Data x;
+    x.set("name", c.name);
+    x.set("paramsDecl", c.paramsDecl);
+    x.set("hasParams", !c.paramsDecl.empty());
+    x.set("argsForward", c.argsForward);
+    x.set("constQualifier", c.isConst ? " const" : "");
+    x.set("cmdBody", c.vulkanCmdBody);
+    x.set("cpuBody", c.cpuBody);
+    x.set("sourceFile", c.sourceFile);
+    Data ptrs = List(), outs = List();
+    std::string bindDecl, bindArgs;
+    for (auto& p : c.params) {
+      if (!p.isPointer) continue;
+      Data y;
+      y.set("name", p.name);
+      y.set("control", c.name);
+      y.set("pointeeCpp", p.pointeeCpp);
+      y.set("sizeExpr", p.sizeExpr);
+      ptrs.push_back(y);
+      if (!p.isConst) outs.push_back(y);
+      bindDecl += (bindDecl.empty() ? "" : ", ") + std::string("crossrt::BufferView a_") + p.name;
+      bindArgs += (bindArgs.empty() ? "" : ", ") + std::string("self->m_args.") + c.name + "_" + p.name + ".View()";
+    }
+    x.set("pointerParams", ptrs);
+    x.set("outputParams", outs);
+    x.set("bindParamsDecl", bindDecl);
+    x.set("bindArgs", bindArgs);
+    // Member vectors written by any kernel this function calls are read back after it.
+    Data written = List();
+    std::set<std::string> seen;
+    for (auto& kn : c.kernelsCalled)
+      for (auto& k : model.kernels)
+        if (k.name == kn)
+          for (auto& v : k.memberVectors) {
+            auto* m = FindMember(model, v);
+            if (m && m->writtenByKernels && seen.insert(v).second) {
+              Data y;
+              y.set("name", v);
+              y.set("control", c.name);
+              y.set("elemCppType", m->elemCppType);
+              written.push_back(y);
+            }
+          }
+    x.set("writtenVectors", written);
+    controls.push_back(x);
+  }
+  return controls;
+}
+
+Data VulkanKernelsData(const ClassModel& model) {
+  Data kernels = List();
+  for (auto& k : model.kernels) {
+    Data x;
+    x.set("name", k.name);
+    x.set("sourceFile", k.sourceFile);
+    std::string cmdParams;
+    for (unsigned a = 0; k.rtv && a < k.dims; ++a) cmdParams += std::string(", uint32_t a_threads") + Axis(a);
+    for (auto& p : k.params) {
+      if (p.isThreadId) continue;
+      cmdParams += ", " + (p.isPointer ? std::string("crossrt::BufferView") : p.cppType) + " " + p.name;
+    }
+    x.set("cmdParamsDecl", cmdParams);
+    // Push constants: starts, counts, then scalar arguments (same order as the GLSL block).
+    Data fields = List(), assign = List(), axes = List();
+    auto field = [&](const std::string& align, const std::string& type, const std::string& name, const std::string& value) {
+      Data f;
+      f.set("align", align);
+      f.set("cppType", type);
+      f.set("name", name);
+      fields.push_back(f);
+      Data a;
+      a.set("field", name);
+      a.set("value", value);
+      assign.push_back(a);
+    };
+    for (unsigned a = 0; a < k.dims; ++a) field("4", "int32_t", std::string("crt_start") + Axis(a), std::string("start") + Axis(a));
+    for (unsigned a = 0; a < k.dims; ++a) field("4", "uint32_t", std::string("crt_count") + Axis(a), std::string("count") + Axis(a));
+    for (auto& p : k.params) {
+      if (p.isPointer || p.isThreadId) continue;
+      std::string base = SplitArray(p.glslType).first;
+      std::string align = base.find("vec2") != std::string::npos ? "8" : (base.find("vec") != std::string::npos || base.find("mat") != std::string::npos) ? "16" : "4";
+      field(align, p.valueCppType, GlslPrinter::SafeName(p.name), p.name);
+    }
+    x.set("pushFields", fields);
+    x.set("pushAssign", assign);
+    for (unsigned a = 0; a < k.dims; ++a) {
+      Data ax;
+      ax.set("axis", Axis(a));
+      if (k.rtv) {
+        ax.set("startExpr", "0");
+        ax.set("countExpr", std::string("a_threads") + Axis(a));
+      } else {
+        const Loop& loop = k.loops[k.dims - 1 - a];  // innermost loop is x
+        ax.set("startExpr", "int(" + loop.startCpp + ")");
+        ax.set("countExpr", "uint32_t(std::max<int64_t>(0, int64_t(" + loop.countCpp + ")))");
+      }
+      axes.push_back(ax);
+    }
+    x.set("axes", axes);
+    std::string empty;
+    for (unsigned a = 0; a < k.dims; ++a) empty += (a ? " || " : "") + std::string("count") + Axis(a) + " == 0";
+    x.set("emptyTest", empty);
+    std::string buffers = "m_classDataBuffer.View()";
+    unsigned bindings = 1;
+    for (auto& p : k.params)
+      if (p.isPointer) { buffers += ", " + p.name; ++bindings; }
+    for (auto& v : k.memberVectors) { buffers += ", m_vdata." + v + ".View()"; ++bindings; }
+    Data reds = List();
+    for (auto& r : k.reductions) {
+      buffers += ", m_partials." + k.name + "_" + r.member + ".View()";
+      ++bindings;
+      Data y;
+      y.set("kernel", k.name);
+      y.set("member", r.member);
+      y.set("cppType", ReductionCppType(model, r));
+      y.set("groupCountExpr", GroupCountExpr(k));
+      reds.push_back(y);
+    }
+    x.set("bufferList", buffers);
+    x.set("bindingCount", std::to_string(bindings));
+    x.set("reduceBindingCount", std::to_string(1 + k.reductions.size()));
+    x.set("reductions", reds);
+    x.set("hasReductions", !k.reductions.empty());
+    x.set("groupCountExpr", GroupCountExpr(k));
+    std::string dispatch = k.dims == 1 ? "crossrt::Dispatch1D(a_cmd, countX, 256)"
+                         : k.dims == 2 ? "crossrt::Dispatch2D(a_cmd, countX, countY, 16, 16)"
+                                       : "crossrt::Dispatch3D(a_cmd, countX, countY, countZ, 8, 8, 4)";
+    x.set("dispatch", dispatch);
+    kernels.push_back(x);
+  }
+  return kernels;
+}
+
+Data VectorsData(const ClassModel& model) {
+  Data vectors = List();
+  for (auto& m : model.members) {
+    if (m.kind != MemberKind::Vector || !m.usedByKernels) continue;
+    Data x;
+    x.set("name", m.name);
+    x.set("elemCppType", m.elemCppType);
+    vectors.push_back(x);
+  }
+  return vectors;
+}
+
+std::string ScalarOmpOp(ReduceOp op) { return op == ReduceOp::Min ? "min" : op == ReduceOp::Max ? "max" : "+"; }
+
+}  // namespace
+
+std::vector<ShaderSource> GenerateShaders(const ClassModel& model, const GenerateOptions& opt) {
+  std::vector<ShaderSource> shaders;
+  for (auto& k : model.kernels) {
+    bool scalar = false;
+    shaders.push_back({k.name, KernelGlsl(model, k, opt, scalar)});
+    if (!k.reductions.empty()) shaders.push_back({k.name + "_Reduce", ReduceGlsl(model, k, opt)});
+  }
+  return shaders;
+}
+
+std::map<std::string, std::string> GenerateHost(const ClassModel& model, const GenerateOptions& opt, bool vulkan) {
+  std::map<std::string, std::string> files;
+  Data d = Common(model, opt);
+  d.set("controls", ControlsData(model));
+  d.set("vectors", VectorsData(model));
+  if (vulkan) {
+    d.set("kernels", VulkanKernelsData(model));
+    files[model.className + "_Vulkan.h"] = Render(opt.templateDir + "/vulkan/class.h.mustache", d);
+    files[model.className + "_Vulkan.cpp"] = Render(opt.templateDir + "/vulkan/class.cpp.mustache", d);
+    return files;
+  }
+  Data kernels = List(), ompReductions = List();
+  std::set<std::string> declared;
+  for (auto& k : model.kernels) {
+    if (k.rtv) continue;  // kernel_* bodies are inherited; their loops are parallelised in the control function
+    Data x;
+    x.set("name", k.name);
+    x.set("sourceFile", k.sourceFile);
+    x.set("paramsDecl", k.cppParamsDecl);
+    x.set("preamble", k.cpuPreamble);
+    x.set("loopNest", k.cpuLoopNest);
+    x.set("schedule", k.dims == 1 ? "static" : "dynamic, 1");
+    std::string clauses;
+    Data reds = List();
+    for (auto& r : k.reductions) {
+      Data y;
+      y.set("member", r.member);
+      reds.push_back(y);
+      std::string cppType = ReductionCppType(model, r);
+      bool scalar = r.glslType == "float" || r.glslType == "int" || r.glslType == "uint";
+      if (scalar) {
+        clauses += " reduction(" + ScalarOmpOp(r.op) + ":" + r.member + "Local)";
+        continue;
+      }
+      // LiteMath vectors need a declared reduction.
+      std::string opName = std::string(r.op == ReduceOp::Min ? "min" : r.op == ReduceOp::Max ? "max" : "add");
+      std::string name = "crossrt_" + opName + "_" + SplitArray(r.glslType).first;
+      clauses += " reduction(" + name + ":" + r.member + "Local)";
+      if (declared.insert(name).second) {
+        Data o;
+        o.set("name", name);
+        o.set("cppType", cppType);
+        o.set("combine", r.op == ReduceOp::Min ? "LiteMath::min(omp_out, omp_in)" : r.op == ReduceOp::Max ? "LiteMath::max(omp_out, omp_in)" : "omp_out + omp_in");
+        o.set("init", r.op == ReduceOp::Min || r.op == ReduceOp::Max ? "omp_orig" : cppType + "()");
+        ompReductions.push_back(o);
+      }
+    }
+    x.set("reductions", reds);
+    x.set("ompClauses", clauses);
+    kernels.push_back(x);
+  }
+  d.set("kernels", kernels);
+  d.set("ompReductions", ompReductions);
+  files[model.className + "_CPU.h"] = Render(opt.templateDir + "/cpu/class.h.mustache", d);
+  files[model.className + "_CPU.cpp"] = Render(opt.templateDir + "/cpu/class.cpp.mustache", d);
+  return files;
+}
+
+}  // namespace crossrt::engine

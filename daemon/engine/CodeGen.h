@@ -1,0 +1,26 @@
+// Code generation: renders the templates in templates/ from a ClassModel.
+#pragma once
+#include "Model.h"
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace crossrt::engine {
+
+struct GenerateOptions {
+  std::string templateDir;
+  std::string headerName;     // the user header's file name, for comments
+  std::string headerInclude;  // how generated code includes it
+};
+
+struct ShaderSource {
+  std::string name;  // kernel name, or kernel + "_Reduce"
+  std::string glsl;
+};
+
+std::vector<ShaderSource> GenerateShaders(const ClassModel& model, const GenerateOptions& options);
+// Host C++ of the Vulkan class (vulkan = true) or of the CPU class.
+std::map<std::string, std::string> GenerateHost(const ClassModel& model, const GenerateOptions& options, bool vulkan);
+
+}  // namespace crossrt::engine
