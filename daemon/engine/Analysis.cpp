@@ -6,6 +6,7 @@
 #include <clang/Basic/SourceManager.h>
 #include <clang/Lex/Lexer.h>
 #include <clang/Rewrite/Core/Rewriter.h>
+#include <llvm/Support/Path.h>
 
 #include <algorithm>
 #include <map>
@@ -275,8 +276,9 @@ std::string Identity(ReduceOp op, const std::string& glslType) {
                        : glslType[0] == 'i' ? "int" : glslType[0] == 'u' ? "uint" : "float";
   std::string v;
   if (op == ReduceOp::Add || op == ReduceOp::Sub) v = scalar == "float" ? "0.0" : scalar == "uint" ? "0u" : "0";
-  else if (op == ReduceOp::Min) v = scalar == "float" ? "3.402823466e+38" : scalar == "uint" ? "0xFFFFFFFFu" : "0x7FFFFFFF";
-  else v = scalar == "float" ? "-3.402823466e+38" : scalar == "uint" ? "0u" : "(-2147483647 - 1)";
+  // +-infinity, so that infinite inputs reduce exactly as on the CPU
+  else if (op == ReduceOp::Min) v = scalar == "float" ? "uintBitsToFloat(0x7F800000u)" : scalar == "uint" ? "0xFFFFFFFFu" : "0x7FFFFFFF";
+  else v = scalar == "float" ? "uintBitsToFloat(0xFF800000u)" : scalar == "uint" ? "0u" : "(-2147483647 - 1)";
   return glslType == scalar ? v : glslType + "(" + v + ")";
 }
 
@@ -768,6 +770,28 @@ bool AnalyzeTranslationUnit(ASTContext& ctx, const std::string& className, Repor
   auto known = [](const auto& list, const std::string& n) {
     return std::any_of(list.begin(), list.end(), [&](const auto& x) { return x.name == n; });
   };
+  // #include lines of the source file: bodies copied from it rely on them. Quoted includes are
+  // respelled so they resolve from the build tree.
+  {
+    auto& sm = ctx.getSourceManager();
+    StringRef buffer = sm.getBufferData(sm.getMainFileID());
+    static const std::regex inc(R"(^[ \t]*#[ \t]*include[ \t]*([<"])([^>"]+)[>"])");
+    std::string dir = llvm::sys::path::parent_path(FileOf(ctx, sm.getLocForStartOfFile(sm.getMainFileID()))).str();
+    std::istringstream lines(buffer.str());
+    for (std::string line; std::getline(lines, line);) {
+      std::smatch m;
+      if (!std::regex_search(line, m, inc)) continue;
+      std::string text;
+      if (m[1] == "<") text = "#include <" + m[2].str() + ">";
+      else {
+        std::string path = dir + "/" + m[2].str();
+        if (path == model.headerFile) continue;  // the generated header includes it already
+        text = "#include \"" + path + "\"";
+      }
+      if (std::find(model.sourceIncludes.begin(), model.sourceIncludes.end(), text) == model.sourceIncludes.end())
+        model.sourceIncludes.push_back(text);
+    }
+  }
   // using-directives at the top level of the source file: bodies copied from it rely on them.
   for (auto* d : ctx.getTranslationUnitDecl()->decls()) {
     auto& sm = ctx.getSourceManager();

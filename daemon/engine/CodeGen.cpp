@@ -104,6 +104,7 @@ Data Common(const ClassModel& model, const GenerateOptions& opt) {
   for (auto& m : model.members) writtenPlain |= m.kind == MemberKind::Plain && m.inClassData && m.writtenByKernels;
   d.set("hasWrittenPlain", writtenPlain);
   std::string usings;
+  for (auto& i : model.sourceIncludes) usings += i + "\n";
   for (auto& u : model.usingDecls) usings += u + "\n";
   d.set("usingDecls", usings);
   d.set("hasUsingDecls", !usings.empty());
@@ -167,7 +168,8 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
     x.set("member", r.member);
     x.set("identity", r.identity);
     x.set("groupSize", "256");
-    x.set("combineShared", Combine(r.op, r.member + "Shared[local]", r.member + "Shared[local + stride]"));
+    x.set("combineGroup", Combine(r.op, r.member + "Group", r.member + "Shared[s]"));
+    x.set("subgroupOp", r.op == ReduceOp::Min ? "subgroupMin" : r.op == ReduceOp::Max ? "subgroupMax" : "subgroupAdd");
     reductions.push_back(x);
   }
   d.set("scalarLayout", scalarAny);
@@ -427,6 +429,7 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
     x.set("sourceFile", k.sourceFile);
     x.set("paramsDecl", k.cppParamsDecl);
     x.set("preamble", k.cpuPreamble);
+    x.set("hasPreamble", !k.cpuPreamble.empty());
     x.set("loopNest", k.cpuLoopNest);
     x.set("schedule", k.dims == 1 ? "static" : "dynamic, 1");
     std::string clauses;

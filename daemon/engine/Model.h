@@ -114,6 +114,7 @@ struct ClassModel {
   bool declaresGetExecutionTime = false;
   std::vector<BlockField> classData;   // plain members + vector sizes, in block order
   std::string glslClassStructs;        // structs the class-data block and member vectors need
+  std::vector<std::string> sourceIncludes;  // #include lines of the sources (quoted ones made absolute)
   std::vector<std::string> usingDecls; // top-level using-directives of the sources: copied bodies need them
 };
 

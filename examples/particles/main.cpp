@@ -19,6 +19,7 @@ struct Run
   std::vector<float4> pos, vel;
   std::shared_ptr<Particles> impl;
   float ms = 0.0f;
+  float parts[3] = {0.0f, 0.0f, 0.0f};  // GPU time, copy in, copy out (generated classes)
 };
 
 int main(int argc, char** argv)
@@ -55,6 +56,7 @@ int main(int argc, char** argv)
       float t[4];
       r.impl->GetExecutionTime("Step", t);
       r.ms += t[3];
+      for (int k = 0; k < 3; ++k) r.parts[k] += t[k];
     }
   }
 
@@ -68,6 +70,9 @@ int main(int argc, char** argv)
     std::snprintf(box, sizeof box, "(%.3f %.3f %.3f)-(%.3f %.3f %.3f)", p.m_boxMin.x, p.m_boxMin.y, p.m_boxMin.z, p.m_boxMax.x, p.m_boxMax.y, p.m_boxMax.z);
     std::printf("| %-24s | %10.3f | %7.2fx | %-40s | %12.1f | %8d |\n", r.name, r.ms / steps, runs[0].ms / r.ms, box, p.m_kineticEnergy, p.m_bounces);
   }
+  for (auto& r : runs)
+    if (r.parts[0] > 0.0f)
+      std::printf("%s: GPU %.3f ms, copy in %.3f ms, copy out %.3f ms per step\n", r.name, r.parts[0] / steps, r.parts[1] / steps, r.parts[2] / steps);
   // The implementations must agree: positions within a relative 1e-4 of the original.
   double worst = 0.0;
   for (size_t k = 1; k < runs.size(); ++k)
