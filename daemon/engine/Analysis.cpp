@@ -98,6 +98,15 @@ struct Context {
 
 // ---- members ---------------------------------------------------------------
 
+// A single member of the class-data block: the C++ mirror declares it with alignas(std430
+// alignment), so a lone float3 matches; float3x3, bool and arrays of float3 do not.
+bool FitsClassData(ASTContext& ctx, QualType t) {
+  t = t.getCanonicalType();
+  if (IsLiteMathType(t)) return !IsLiteMathType(t, "float3x3");
+  if (t->isBuiltinType() || t->isEnumeralType()) return Std430Layout(ctx, t, false).has_value();
+  return LayoutMatchesCpp(ctx, t, false);
+}
+
 void AnalyzeMembers(Context& c) {
   GlslPrinter structs(c.ctx, c.cls, c.rep);
   for (auto* f : c.cls->fields()) {
@@ -121,7 +130,7 @@ void AnalyzeMembers(Context& c) {
       QualType base = f->getType();
       while (auto* arr = dyn_cast<ConstantArrayType>(base.getCanonicalType().getTypePtr())) base = arr->getElementType();
       m.cppType = CppTypeName(c.ctx, base);
-      m.inClassData = f->getAccess() != AS_private && LayoutMatchesCpp(c.ctx, f->getType(), false);
+      m.inClassData = f->getAccess() != AS_private && FitsClassData(c.ctx, f->getType());
       if (m.inClassData) structs.Type(f->getType(), f->getLocation());
     }
     c.model.members.push_back(m);
@@ -458,7 +467,11 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
                 "write the loop inside the kernel (kernel1D_" + k.name.substr(7) + ") so the translator sees the whole reduction");
     return;
   }
-  for (auto& [field, op] : ws.reductions) {
+  // In declaration order, so that regeneration is stable.
+  for (auto* field : c.cls->fields()) {
+    auto found = ws.reductions.find(field);
+    if (found == ws.reductions.end()) continue;
+    ReduceOp op = found->second;
     Reduction r;
     r.member = field->getNameAsString();
     r.op = op;
@@ -524,7 +537,10 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     for (auto* s : body->body())
       if ((outer = dyn_cast<ForStmt>(s))) break;
     renamer.TraverseStmt(const_cast<ForStmt*>(outer));
-    k.cpuLoopNest = rw.getRewrittenText(outer->getSourceRange());
+    // A loop whose body is a bare statement ends before its ';': take the ';' too.
+    SourceLocation end = Lexer::findLocationAfterToken(outer->getEndLoc(), tok::semi, c.ctx.getSourceManager(), c.ctx.getLangOpts(), false);
+    k.cpuLoopNest = end.isValid() ? rw.getRewrittenText(CharSourceRange::getCharRange(outer->getBeginLoc(), end))
+                                  : rw.getRewrittenText(outer->getSourceRange());
     CheckCopiedBody(c, def->getBody(), "kernel '" + k.name + "'");
     for (auto* s : preamble) k.cpuPreamble += c.Text(s->getSourceRange()) + "\n";
   }
@@ -626,7 +642,7 @@ private:
     std::map<unsigned, const LoopHeader*> axes;
     for (unsigned i = 0; i < md->getNumParams() && i < call->getNumArgs(); ++i) {
       if (!IsThreadIdName(md->getParamDecl(i)->getName())) continue;
-      auto* dr = dyn_cast<DeclRefExpr>(call->getArg(i)->IgnoreParenImpCasts());
+      auto* dr = dyn_cast<DeclRefExpr>(call->getArg(i)->IgnoreCasts()->IgnoreParens());  // uint32_t(i) is fine
       const LoopHeader* match = nullptr;
       for (auto& h : loops)
         if (dr && dr->getDecl() == h.var) match = &h;
@@ -651,7 +667,9 @@ private:
       counts += ", " + CountExpr(m_c, *h);
     }
     Note(call);
-    m_gpu.ReplaceText(outer->getSourceRange(), md->getNameAsString() + "Cmd(a_cmd" + counts + Args(call, true) + ");");
+    SourceLocation end = Lexer::findLocationAfterToken(outer->getEndLoc(), tok::semi, m_c.ctx.getSourceManager(), m_c.ctx.getLangOpts(), false);
+    CharSourceRange range = end.isValid() ? CharSourceRange::getCharRange(outer->getBeginLoc(), end) : CharSourceRange::getTokenRange(outer->getSourceRange());
+    m_gpu.ReplaceText(range, md->getNameAsString() + "Cmd(a_cmd" + counts + Args(call, true) + ");");
     auto& sm = m_c.ctx.getSourceManager();
     unsigned col = sm.getExpansionColumnNumber(outer->getBeginLoc());
     std::string indent(col > 0 ? col - 1 : 0, ' ');

@@ -103,9 +103,9 @@ std::string EmbedSpirv(const std::string& className, const std::vector<std::pair
 
 }  // namespace
 
-TranslateResult Translate(const TranslateRequest& request) {
+AnalyzeResult Analyze(const TranslateRequest& request) {
   LinkSizeAttribute();
-  TranslateResult result;
+  AnalyzeResult result;
   std::vector<std::string> args = {"-xc++", "-std=c++17", "-resource-dir=" CROSSRT_CLANG_RESOURCE_DIR, "-D__CROSSRT__=1",
                                    "-Wno-unused-command-line-argument"};
   args.insert(args.end(), request.compileArgs.begin(), request.compileArgs.end());
@@ -149,7 +149,7 @@ TranslateResult Translate(const TranslateRequest& request) {
     for (auto it = sm.fileinfo_begin(); it != sm.fileinfo_end(); ++it) inputs.insert(it->first.getName().str());
   }
 
-  ClassModel model;
+  ClassModel& model = result.model;
   unsigned errors = 0;
   for (auto& ast : asts) {
     printer.BeginSourceFile(ast->getLangOpts(), &ast->getPreprocessor());
@@ -174,7 +174,21 @@ TranslateResult Translate(const TranslateRequest& request) {
     return result;
   }
   FinishModel(model);
+  result.inputs.assign(inputs.begin(), inputs.end());
+  result.diagnostics = diagText;  // warnings, if any
+  result.ok = true;
+  return result;
+}
 
+
+TranslateResult Translate(const TranslateRequest& request) {
+  TranslateResult result;
+  AnalyzeResult analysis = Analyze(request);
+  result.diagnostics = analysis.diagnostics;
+  if (!analysis.ok) return result;
+  const ClassModel& model = analysis.model;
+  std::set<std::string> inputs(analysis.inputs.begin(), analysis.inputs.end());
+  const std::string diagText = analysis.diagnostics;
   GenerateOptions options;
   options.templateDir = request.templateDir;
   options.headerName = llvm::sys::path::filename(model.headerFile).str();

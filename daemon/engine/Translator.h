@@ -1,6 +1,8 @@
 // The translation engine: turns one user class into generated source files.
 // It knows nothing about sockets or processes: the client runs it in-process, the daemon will host it.
 #pragma once
+#include "Model.h"
+
 #include <map>
 #include <string>
 #include <vector>
@@ -25,6 +27,16 @@ struct TranslateResult {
   std::map<std::string, std::string> files;     // file name (relative to outputDir) -> contents
   std::vector<std::string> inputs;              // every file the translation read (for depfiles)
 };
+
+struct AnalyzeResult {
+  bool ok = false;
+  std::string diagnostics;
+  ClassModel model;
+  std::vector<std::string> inputs;
+};
+
+// Parses and analyses only: what the translator finds in the class.
+AnalyzeResult Analyze(const TranslateRequest& request);
 
 // Parses, analyses and generates. Does not write anything.
 TranslateResult Translate(const TranslateRequest& request);

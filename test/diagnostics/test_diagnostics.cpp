@@ -1,0 +1,159 @@
+// Each construct the translator cannot handle gets a compiler-style diagnostic that points at the
+// user's code (file:line:col: error:), names the construct and gives a hint. The real crossrt
+// command runs on each case: it must exit with status 1, never crash, and write no output files.
+#include "EngineSupport.h"
+
+#include <regex>
+
+namespace {
+
+struct Case
+{
+  const char* name;
+  const char* kernelBody;      // body of kernel1D_Bad's loop (line 8 of Bad.cpp is its first line)
+  const char* extraHeader;     // extra members or helpers in the class
+  const char* extraSource;     // extra definitions in Bad.cpp
+  const char* expectedMessage;
+  const char* expectedHint;
+  int expectedLine;            // in Bad.cpp (0: in Bad.h)
+};
+
+std::string Header(const Case& c)
+{
+  return std::string(R"(#pragma once
+#include "LiteMath.h"
+#include <vector>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <iostream>
+class Bad
+{
+public:
+  virtual ~Bad() = default;
+  virtual void Run(int n, [[crossrt::size("n")]] float* data);
+protected:
+  void kernel1D_Bad(int n, float* data);
+  float m_value = 1.0f;
+)") + c.extraHeader + "\n};\n";
+}
+
+std::string Source(const Case& c)
+{
+  return std::string(R"(#include "Bad.h"
+void Bad::Run(int n, float* data) { kernel1D_Bad(n, data); }
+void Bad::kernel1D_Bad(int n, float* data)
+{
+  for (int i = 0; i < n; i++)
+  {
+    float x = data[i];
+)") + c.kernelBody + "\n    data[i] = x;\n  }\n}\n" + c.extraSource;
+}
+
+const Case kCases[] = {
+    {"recursion", "    x = Fact(x);", "  float Fact(float v) const;",
+     "float Bad::Fact(float v) const { return v <= 1.0f ? 1.0f : v * Fact(v - 1.0f); }\n",
+     "recursive call to 'Bad::Fact' in a kernel", "explicit stack", 15},
+    {"new", "    float* p = new float[4]; x += p[0];", "", "", "'new' in a kernel (heap allocation)", "cannot allocate", 8},
+    {"delete", "    delete[] data;", "", "", "'delete' in a kernel (heap allocation)", "cannot allocate", 8},
+    {"malloc", "    x += float(std::malloc(4) != nullptr);", "", "", "heap allocation ('malloc') in a kernel", "cannot allocate", 8},
+    {"printf", "    std::printf(\"%f\\n\", x);", "", "", "I/O ('printf') in a kernel", "write results to an output buffer", 8},
+    {"iostream", "    std::cout << x;", "", "", "I/O (stream operator) in a kernel", "write results to an output buffer", 8},
+    {"library call", "    x += float(std::strlen(\"abc\"));", "", "", "unsupported library call 'strlen' in a kernel", "kernels may call LiteMath", 8},
+    {"member race", "    m_value = x;", "", "", "kernel writes class member 'm_value' from every thread", "reduction", 8},
+    {"double", "    double d = x; x = float(d);", "", "", "type 'double' is not supported in kernels", "use float", 8},
+};
+
+}  // namespace
+
+TEST_CASE("Unsupported constructs in kernels give file:line:col diagnostics with hints", "[diagnostics]")
+{
+  for (const Case& c : kCases)
+  {
+    SECTION(c.name)
+    {
+      TempClass tc("Bad", Header(c), Source(c));
+      const std::string out = (tc.dir / "out").string();
+      CommandResult r = RunCrossrt("translate --class Bad --backend vulkan --out " + out + " --source " + tc.Source("Bad") +
+                                   " --templates " CROSSRT_SOURCE_DIR "/templates -- -I" CROSSRT_SOURCE_DIR "/libs/litemath");
+      INFO(r.output);
+      REQUIRE_FALSE(r.crashed);
+      REQUIRE(r.exitCode == 1);
+      const std::string where = tc.Source("Bad") + ":" + std::to_string(c.expectedLine) + ":";
+      REQUIRE(r.output.find(where) != std::string::npos);
+      REQUIRE(std::regex_search(r.output, std::regex(R"(Bad\.cpp:\d+:\d+: error: )")));
+      REQUIRE(r.output.find(c.expectedMessage) != std::string::npos);
+      REQUIRE(r.output.find("note: hint: ") != std::string::npos);
+      REQUIRE(r.output.find(c.expectedHint) != std::string::npos);
+      REQUIRE_FALSE(fs::exists(out));  // nothing written on failure
+    }
+  }
+}
+
+TEST_CASE("A pointer parameter of a control function without a size is reported", "[diagnostics]")
+{
+  TempClass tc("NoSize", R"(#pragma once
+class NoSize
+{
+public:
+  virtual ~NoSize() = default;
+  virtual void Run(int n, const float* in, float* out);
+protected:
+  void kernel1D_Copy(int n, const float* in, float* out);
+};
+)",
+               R"(#include "NoSize.h"
+void NoSize::Run(int n, const float* in, float* out) { kernel1D_Copy(n, in, out); }
+void NoSize::kernel1D_Copy(int n, const float* in, float* out) { for (int i = 0; i < n; i++) out[i] = in[i]; }
+)");
+  CommandResult r = RunCrossrt("translate --class NoSize --backend cpu --out " + (tc.dir / "out").string() + " --source " + tc.Source("NoSize") +
+                               " --templates " CROSSRT_SOURCE_DIR "/templates");
+  INFO(r.output);
+  REQUIRE(r.exitCode == 1);
+  REQUIRE(r.output.find("NoSize.cpp:2:39: error: pointer parameter 'in' of control function 'Run' has no size") != std::string::npos);
+  REQUIRE(r.output.find("[[crossrt::size(\"n\")]]") != std::string::npos);
+}
+
+TEST_CASE("A control function that is not virtual is reported", "[diagnostics]")
+{
+  TempClass tc("NotVirtual", R"(#pragma once
+class NotVirtual
+{
+public:
+  void Run(int n, [[crossrt::size("n")]] float* out);
+protected:
+  void kernel1D_Fill(int n, float* out);
+};
+)",
+               R"(#include "NotVirtual.h"
+void NotVirtual::Run(int n, float* out) { kernel1D_Fill(n, out); }
+void NotVirtual::kernel1D_Fill(int n, float* out) { for (int i = 0; i < n; i++) out[i] = 1.0f; }
+)");
+  CommandResult r = RunCrossrt("translate --class NotVirtual --backend vulkan --out " + (tc.dir / "out").string() + " --source " +
+                               tc.Source("NotVirtual") + " --templates " CROSSRT_SOURCE_DIR "/templates");
+  INFO(r.output);
+  REQUIRE(r.exitCode == 1);
+  REQUIRE(r.output.find("NotVirtual.h:5:8: error: control function 'Run' calls kernels but is not virtual") != std::string::npos);
+  REQUIRE(r.output.find("hint: declare it 'virtual'") != std::string::npos);
+}
+
+TEST_CASE("A source that does not parse passes the compiler's diagnostics through", "[diagnostics]")
+{
+  TempClass tc("Broken", "#pragma once\nclass Broken { public: virtual void Run(); };\n",
+               "#include \"Broken.h\"\nvoid Broken::Run() { int x = ; }\n");
+  CommandResult r = RunCrossrt("translate --class Broken --backend vulkan --out " + (tc.dir / "out").string() + " --source " +
+                               tc.Source("Broken") + " --templates " CROSSRT_SOURCE_DIR "/templates");
+  INFO(r.output);
+  REQUIRE(r.exitCode == 1);
+  REQUIRE(r.output.find("Broken.cpp:2:30: error: expected expression") != std::string::npos);
+}
+
+TEST_CASE("Bad command lines get a usage message", "[diagnostics]")
+{
+  CommandResult r = RunCrossrt("translate --class X --backend metal --out /tmp/x --source /tmp/x.cpp");
+  REQUIRE(r.exitCode == 2);
+  REQUIRE(r.output.find("--backend must be 'vulkan' or 'cpu'") != std::string::npos);
+  r = RunCrossrt("translate --class X --backend cpu --out /tmp/x --source /nonexistent/x.cpp");
+  REQUIRE(r.exitCode == 1);
+  REQUIRE(r.output.find("source file '/nonexistent/x.cpp' does not exist") != std::string::npos);
+}

@@ -1,0 +1,166 @@
+// What the analysis finds in small input classes parsed with the real standard library.
+#include "EngineSupport.h"
+
+using namespace crossrt::engine;
+
+namespace {
+
+const char* kHeader = R"(#pragma once
+#include "LiteMath.h"
+#include <vector>
+#include <string>
+#include <map>
+using namespace LiteMath;
+struct Item { float4 a; float b; };
+class Finder
+{
+public:
+  virtual ~Finder() = default;
+  virtual void Run(int n, [[crossrt::size("n * 2")]] const float* in, float* out __attribute__((size("n"))));
+  virtual void RunRtv(int w, int h, [[crossrt::size("w*h")]] float* img);
+  void NotAControl(int n);
+  virtual void CommitDeviceData() {}
+protected:
+  void kernel1D_Scale(int n, const float* in, float* out);
+  void kernel2D_Fill(int w, int h, float* img);
+  void kernel_Pixel(int tidX, int tidY, int w, float* img);
+  float m_scale = 2.0f;
+  float m_total = 0.0f;
+  float3 m_lo;
+  std::vector<Item> m_items;
+  std::vector<float3> m_points;
+  std::string m_name;                 // never used by kernels: ignored
+  std::map<int, int> m_lookup;        // ditto
+};
+)";
+
+const char* kSource = R"(#include "Finder.h"
+void Finder::Run(int n, const float* in, float* out)
+{
+  m_total = 0.0f;
+  kernel1D_Scale(n, in, out);
+}
+void Finder::RunRtv(int w, int h, float* img)
+{
+  kernel2D_Fill(w, h, img);
+  for (int y = 0; y < h; y++)
+    for (int x = 0; x < w; x++)
+      kernel_Pixel(x, y, w, img);
+}
+void Finder::NotAControl(int n) { m_scale = float(n); }
+void Finder::kernel1D_Scale(int n, const float* in, float* out)
+{
+  for (int i = 0; i < n; i++)
+  {
+    out[i] = in[2 * i] * m_scale + m_items[i % m_items.size()].b;
+    m_total += out[i];
+    m_lo = min(m_lo, m_points[i]);
+  }
+}
+void Finder::kernel2D_Fill(int w, int h, float* img)
+{
+  for (int y = 0; y < h; y++)
+    for (int x = 0; x < w; x++)
+      img[y * w + x] = float(x + y);
+}
+void Finder::kernel_Pixel(int tidX, int tidY, int w, float* img) { img[tidY * w + tidX] *= 0.5f; }
+)";
+
+const Kernel* FindKernel(const ClassModel& m, const std::string& name)
+{
+  for (auto& k : m.kernels)
+    if (k.name == name) return &k;
+  return nullptr;
+}
+
+}  // namespace
+
+TEST_CASE("Analysis finds kernels, control functions, members and reductions", "[engine]")
+{
+  TempClass tc("Finder", kHeader, kSource);
+  AnalyzeResult r = Analyze(MakeRequest(tc, "Finder"));
+  INFO(r.diagnostics);
+  REQUIRE(r.ok);
+  const ClassModel& m = r.model;
+
+  REQUIRE(m.kernels.size() == 3);
+  const Kernel* scale = FindKernel(m, "kernel1D_Scale");
+  REQUIRE(scale);
+  CHECK_FALSE(scale->rtv);
+  CHECK(scale->dims == 1);
+  REQUIRE(scale->loops.size() == 1);
+  CHECK(scale->loops[0].var == "i");
+  CHECK(scale->loops[0].countCpp == "(n)");
+  REQUIRE(scale->reductions.size() == 2);
+  CHECK(scale->reductions[0].member == "m_lo");  // ordered by declaration
+  CHECK(scale->reductions[0].op == ReduceOp::Min);
+  CHECK(scale->reductions[1].member == "m_total");
+  CHECK(scale->reductions[1].op == ReduceOp::Add);
+  CHECK(scale->memberVectors == std::vector<std::string>{"m_items", "m_points"});
+
+  const Kernel* fill = FindKernel(m, "kernel2D_Fill");
+  REQUIRE(fill);
+  CHECK(fill->dims == 2);
+  CHECK(fill->loops[0].var == "y");  // outermost first
+  CHECK(fill->loops[1].var == "x");
+
+  const Kernel* pixel = FindKernel(m, "kernel_Pixel");
+  REQUIRE(pixel);
+  CHECK(pixel->rtv);
+  CHECK(pixel->dims == 2);
+
+  // Control functions: only those calling kernels, with their size annotations.
+  REQUIRE(m.controls.size() == 2);
+  const Control& run = m.controls[0].name == "Run" ? m.controls[0] : m.controls[1];
+  const Control& rtv = m.controls[0].name == "Run" ? m.controls[1] : m.controls[0];
+  REQUIRE(run.params.size() == 3);
+  CHECK(run.params[1].sizeExpr == "n * 2");
+  CHECK(run.params[1].isConst);
+  CHECK(run.params[2].sizeExpr == "n");
+  CHECK_FALSE(run.params[2].isConst);
+  CHECK(run.vulkanCmdBody.find("kernel1D_ScaleCmd(a_cmd, n, m_inOut_Run.in, m_inOut_Run.out)") != std::string::npos);
+  CHECK(rtv.vulkanCmdBody.find("kernel_PixelCmd(a_cmd, (w), (h), w, m_inOut_RunRtv.img);") != std::string::npos);
+  CHECK(rtv.cpuBody.find("#pragma omp parallel for") != std::string::npos);
+
+  // Members: plain data and vectors; the vector of float3 needs the scalar layout to match C++.
+  bool sawItems = false, sawPoints = false, sawName = false;
+  for (auto& mem : m.members)
+  {
+    if (mem.name == "m_items") { sawItems = true; CHECK(mem.kind == MemberKind::Vector); CHECK_FALSE(mem.scalarLayout); }
+    if (mem.name == "m_points") { sawPoints = true; CHECK(mem.scalarLayout); }
+    if (mem.name == "m_name") sawName = true;
+  }
+  CHECK(sawItems);
+  CHECK(sawPoints);
+  CHECK_FALSE(sawName);
+  CHECK(m.declaresCommitDeviceData);
+  CHECK_FALSE(m.declaresGetExecutionTime);
+}
+
+TEST_CASE("Generated GLSL keeps the user's names and compiles", "[engine]")
+{
+  TempClass tc("Finder", kHeader, kSource);
+  TranslateResult r = Translate(MakeRequest(tc, "Finder"));
+  INFO(r.diagnostics);
+  REQUIRE(r.ok);
+  const std::string& glsl = r.files.at("shaders/kernel1D_Scale.comp");
+  CHECK(glsl.find("void kernel1D_Scale(int i)") != std::string::npos);
+  CHECK(glsl.find("out_[i] = in_[2 * i] * m_scale") != std::string::npos);  // 'in'/'out' are GLSL keywords
+  CHECK(glsl.find("layout(scalar, binding") != std::string::npos);          // m_points: float3 array
+  CHECK(r.files.count("Finder_Vulkan.h") == 1);
+  CHECK(r.files.count("Finder_Vulkan_shaders.cpp") == 1);
+  // A translation is deterministic: the same input gives the same bytes.
+  TranslateResult again = Translate(MakeRequest(tc, "Finder"));
+  CHECK(again.files == r.files);
+}
+
+TEST_CASE("The CPU backend parallelises kernels with OpenMP", "[engine]")
+{
+  TempClass tc("Finder", kHeader, kSource);
+  TranslateResult r = Translate(MakeRequest(tc, "Finder", Backend::Cpu));
+  INFO(r.diagnostics);
+  REQUIRE(r.ok);
+  const std::string& cpp = r.files.at("Finder_CPU.cpp");
+  CHECK(cpp.find("#pragma omp parallel for schedule(static) reduction(crossrt_min_vec3:m_loLocal) reduction(+:m_totalLocal)") != std::string::npos);
+  CHECK(cpp.find("m_totalLocal += out[i];") != std::string::npos);
+}
