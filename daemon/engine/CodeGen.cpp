@@ -365,6 +365,9 @@ Data VulkanKernelsData(const ClassModel& model) {
       y.set("kernel", k.name);
       y.set("member", r.member);
       y.set("cppType", ReductionCppType(model, r));
+      // The GPU writes an std430 array: a vec3 element takes 16 bytes, not sizeof(float3).
+      auto base = SplitArray(r.glslType).first;
+      y.set("partialStride", base.find("vec2") != std::string::npos ? "8" : base.find("vec") != std::string::npos ? "16" : "4");
       y.set("groupCountExpr", GroupCountExpr(k));
       reds.push_back(y);
     }

@@ -92,10 +92,10 @@ TEST_CASE("Analysis finds kernels, control functions, members and reductions", "
   CHECK(scale->loops[0].var == "i");
   CHECK(scale->loops[0].countCpp == "(n)");
   REQUIRE(scale->reductions.size() == 2);
-  CHECK(scale->reductions[0].member == "m_lo");  // ordered by declaration
-  CHECK(scale->reductions[0].op == ReduceOp::Min);
-  CHECK(scale->reductions[1].member == "m_total");
-  CHECK(scale->reductions[1].op == ReduceOp::Add);
+  CHECK(scale->reductions[0].member == "m_total");  // in declaration order
+  CHECK(scale->reductions[0].op == ReduceOp::Add);
+  CHECK(scale->reductions[1].member == "m_lo");
+  CHECK(scale->reductions[1].op == ReduceOp::Min);
   CHECK(scale->memberVectors == std::vector<std::string>{"m_items", "m_points"});
 
   const Kernel* fill = FindKernel(m, "kernel2D_Fill");
@@ -161,6 +161,6 @@ TEST_CASE("The CPU backend parallelises kernels with OpenMP", "[engine]")
   INFO(r.diagnostics);
   REQUIRE(r.ok);
   const std::string& cpp = r.files.at("Finder_CPU.cpp");
-  CHECK(cpp.find("#pragma omp parallel for schedule(static) reduction(crossrt_min_vec3:m_loLocal) reduction(+:m_totalLocal)") != std::string::npos);
+  CHECK(cpp.find("#pragma omp parallel for schedule(static) reduction(+:m_totalLocal) reduction(crossrt_min_vec3:m_loLocal)") != std::string::npos);
   CHECK(cpp.find("m_totalLocal += out[i];") != std::string::npos);
 }
