@@ -1,6 +1,8 @@
 # Finds the libraries CrossRT's libraries and runtime link to. Shared by the build tree and the
 # installed package (CrossRTConfig.cmake includes this file).
 include_guard(GLOBAL)
+# Imported targets must be visible to a parent project that add_subdirectory()s CrossRT.
+set(CMAKE_FIND_PACKAGE_TARGETS_GLOBAL ON)
 find_package(Threads REQUIRED)
 find_package(Vulkan REQUIRED COMPONENTS glslangValidator)
 find_package(embree 3 REQUIRED)

@@ -692,8 +692,24 @@ private:
     return true;
   }
 
+  // `m_x = v;` in a control function runs on the host while recording; the kernels recorded
+  // around it must see it in order, so the ...Cmd also records an update of the GPU copy.
+  void RecordMemberWrite(const Stmt* s) {
+    const Expr* lhs = nullptr;
+    if (auto* bo = dyn_cast<BinaryOperator>(s); bo && bo->isAssignmentOp()) lhs = bo->getLHS();
+    if (auto* op = dyn_cast<CXXOperatorCallExpr>(s); op && op->isAssignmentOp()) lhs = op->getArg(0);
+    const FieldDecl* f = lhs ? ThisField(lhs) : nullptr;
+    const Member* m = f ? FindMember(m_c.model, f->getNameAsString()) : nullptr;
+    if (!m || m->kind != MemberKind::Plain || !m->inClassData) return;
+    SourceLocation end = Lexer::findLocationAfterToken(s->getEndLoc(), tok::semi, m_c.ctx.getSourceManager(), m_c.ctx.getLangOpts(), false);
+    if (end.isInvalid()) return;
+    m_gpu.InsertTextAfter(end, " UpdateMemberCmd(a_cmd, offsetof(ClassData, " + m->name + "), &" + m->name + ", sizeof(" + m->name + "));");
+  }
+
   void Visit(const Stmt* s) {
     if (!s) return;
+    if (auto* cs = dyn_cast<CompoundStmt>(s))
+      for (auto* child : cs->body()) RecordMemberWrite(child);
     if (auto* fs = dyn_cast<ForStmt>(s); fs && TryRtvNest(fs)) return;
     if (auto* call = dyn_cast<CXXMemberCallExpr>(s)) {
       auto* md = call->getMethodDecl();

@@ -1,7 +1,7 @@
 // Bloom on an image with the original class, Bloom_CPU and Bloom_Vulkan; prints a table of
 // times and the largest difference, and writes the Vulkan result.
 //   bloom [input image] [output image]
-// Without an input it renders its own HDR test scene (lights over a dark gradient).
+// Without an input (or with "") it renders its own HDR test scene (lights over a dark gradient).
 #include "Bloom.h"
 #include "Bloom_CPU.h"
 #include "Bloom_Vulkan.h"
@@ -39,7 +39,8 @@ static LiteImage::Image2D<float4> RenderTestScene(int w, int h)
 int main(int argc, char** argv)
 {
   LiteImage::Image2D<float4> input;
-  if (argc > 1)
+  const bool photo = argc > 1 && argv[1][0] != '\0';  // "" asks for the built-in scene
+  if (photo)
   {
     if (!LiteImage::LoadImage(argv[1], input)) return 1;
   }
@@ -63,7 +64,7 @@ int main(int argc, char** argv)
   const int repeats = 5;
   for (Run& r : runs)
   {
-    if (argc > 1) r.impl->m_threshold = 0.8f;  // photos are low dynamic range
+    if (photo) r.impl->m_threshold = 0.8f;  // photos are low dynamic range
     r.out.resize(size_t(w) * h);
     r.impl->CommitDeviceData();
     r.impl->Run(w, h, input.data(), r.out.data());  // warm-up

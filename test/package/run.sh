@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# Builds and runs the user project of this folder against CrossRT.
+#   run.sh install <crossrt build dir> <work dir>   : cmake --install, then find_package(CrossRT)
+#   run.sh subdirectory <crossrt source dir> <work dir> : add_subdirectory(crossrt)
+set -euo pipefail
+mode=$1 crossrt=$2 work=$3
+here=$(cd "$(dirname "$0")" && pwd)
+rm -rf "$work" && mkdir -p "$work"
+if [ "$mode" = install ]; then
+  cmake --install "$crossrt" --prefix "$work/prefix" > "$work/install.log"
+  cmake -S "$here" -B "$work/build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$work/prefix"
+else
+  cmake -S "$here" -B "$work/build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCROSSRT_SOURCE_DIR="$crossrt"
+fi
+cmake --build "$work/build"
+"$work/build/app"
