@@ -635,7 +635,8 @@ private:
       loops.push_back(h);
       cur = SingleStatement(fs->getBody());
     }
-    auto* call = dyn_cast_or_null<CXXMemberCallExpr>(cur ? dyn_cast<Expr>(cur) ? cast<Expr>(cur)->IgnoreImplicit() : nullptr : nullptr);
+    auto* expr = dyn_cast_or_null<Expr>(cur);
+    auto* call = expr ? dyn_cast<CXXMemberCallExpr>(expr->IgnoreImplicit()) : nullptr;
     if (!call || !call->getMethodDecl() || !IsKernelName(call->getMethodDecl()->getName()) || IpvDims(call->getMethodDecl()->getName()))
       return false;
     auto* md = call->getMethodDecl();
@@ -755,7 +756,8 @@ void AnalyzeControl(Context& c, const CXXMethodDecl* md, const FunctionDecl* def
     ControlParam cp;
     cp.name = p->getNameAsString();
     cp.cppType = p->getType().getAsString();
-    ctrl.paramsDecl += (i ? ", " : "") + ParamDecl(c.ctx, p, i);
+    cp.declText = ParamDecl(c.ctx, p, i);
+    ctrl.paramsDecl += (i ? ", " : "") + cp.declText;
     ctrl.argsForward += (i ? ", " : "") + cp.name;
     if (p->getType()->isPointerType()) {
       cp.isPointer = true;
@@ -838,7 +840,6 @@ bool AnalyzeTranslationUnit(ASTContext& ctx, const std::string& className, Repor
     for (auto* md : finder.found->methods()) {
       const FunctionDecl* def = nullptr;
       if (!md->hasBody(def) || !def) continue;
-      auto& sm = ctx.getSourceManager();
       // A method defined in a header is seen by every source file: analyse it once.
       std::string n = md->getNameAsString();
       bool isKernel = IsKernelName(n);
@@ -848,7 +849,6 @@ bool AnalyzeTranslationUnit(ASTContext& ctx, const std::string& className, Repor
         kc.TraverseStmt(def->getBody());
         if (!kc.calls.empty()) AnalyzeControl(c, md, def);
       }
-      (void)sm;
     }
   }
   return true;
@@ -858,14 +858,8 @@ void FinishModel(ClassModel& model) {
   // The class-data block: plain members kernels use, then sizes of member vectors.
   // Ordered by alignment so that the C++ mirror with alignas() has the std430 offsets.
   std::vector<BlockField> fields;
-  auto alignOf = [](const std::string& glsl) -> unsigned {
-    auto base = SplitArray(glsl).first;
-    if (base == "vec2" || base == "ivec2" || base == "uvec2") return 8;
-    if (base.find("vec") != std::string::npos || base.find("mat") != std::string::npos) return 16;
-    return base == "float" || base == "int" || base == "uint" ? 4 : 16;
-  };
   for (auto& m : model.members)
-    if (m.kind == MemberKind::Plain && m.inClassData) fields.push_back({m.name, m.cppType, m.glslType, alignOf(m.glslType)});
+    if (m.kind == MemberKind::Plain && m.inClassData) fields.push_back({m.name, m.cppType, m.glslType, Std430AlignOf(m.glslType)});
   for (auto& m : model.members) {
     if (!m.usedByKernels || m.kind != MemberKind::Vector) continue;
     fields.push_back({m.name + "_size", "uint32_t", "uint", 4});

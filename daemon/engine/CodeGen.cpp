@@ -36,9 +36,11 @@ std::string Render(const std::string& templatePath, const Data& data) {
 const char* Axis(unsigned a) { return a == 0 ? "X" : a == 1 ? "Y" : "Z"; }
 const char* GlAxis(unsigned a) { return a == 0 ? "x" : a == 1 ? "y" : "z"; }
 
-unsigned GroupSize(const Kernel& k, unsigned axis) {
-  static const unsigned sizes[3][3] = {{256, 1, 1}, {16, 16, 1}, {8, 8, 4}};
-  return sizes[k.dims - 1][axis];
+// Workgroup shape by dimension count: 256 threads each, so reductions see the same group size.
+struct GroupShape { unsigned x, y, z; };
+GroupShape Shape(const Kernel& k) {
+  static const GroupShape shapes[3] = {{256, 1, 1}, {16, 16, 1}, {8, 8, 4}};
+  return shapes[k.dims - 1];
 }
 
 std::string Combine(ReduceOp op, const std::string& a, const std::string& b) {
@@ -48,10 +50,20 @@ std::string Combine(ReduceOp op, const std::string& a, const std::string& b) {
 }
 
 std::string GroupCountExpr(const Kernel& k) {
-  if (k.dims == 1) return "crossrt::GroupCount1D(countX, 256)";
-  std::string e = "((countX + 15) / 16) * ((countY + 15) / 16)";
-  if (k.dims == 3) e = "((countX + 7) / 8) * ((countY + 7) / 8) * ((countZ + 3) / 4)";
-  return e;
+  GroupShape s = Shape(k);
+  if (k.dims == 1) return "crossrt::GroupCount1D(crt_countX, " + std::to_string(s.x) + ")";
+  auto groups = [](const char* count, unsigned size) {
+    return "((" + std::string(count) + " + " + std::to_string(size - 1) + ") / " + std::to_string(size) + ")";
+  };
+  std::string e = groups("crt_countX", s.x) + " * " + groups("crt_countY", s.y);
+  return k.dims == 3 ? e + " * " + groups("crt_countZ", s.z) : e;
+}
+
+std::string DispatchExpr(const Kernel& k) {
+  GroupShape s = Shape(k);
+  if (k.dims == 1) return "crossrt::Dispatch1D(a_cmd, crt_countX, " + std::to_string(s.x) + ")";
+  if (k.dims == 2) return "crossrt::Dispatch2D(a_cmd, crt_countX, crt_countY, " + std::to_string(s.x) + ", " + std::to_string(s.y) + ")";
+  return "crossrt::Dispatch3D(a_cmd, crt_countX, crt_countY, crt_countZ, " + std::to_string(s.x) + ", " + std::to_string(s.y) + ", " + std::to_string(s.z) + ")";
 }
 
 const Member* FindMember(const ClassModel& m, const std::string& name) {
@@ -113,19 +125,20 @@ Data Common(const ClassModel& model, const GenerateOptions& opt) {
 
 // ---- GLSL ------------------------------------------------------------------
 
-std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateOptions& opt, bool& scalarAny) {
+std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateOptions& opt) {
   Data d = Common(model, opt);
   d.set("kernel", k.name);
   d.set("sourceFile", k.sourceFile);
-  d.set("groupX", std::to_string(GroupSize(k, 0)));
-  d.set("groupY", std::to_string(GroupSize(k, 1)));
-  d.set("groupZ", std::to_string(GroupSize(k, 2)));
-  d.set("groupSize", "256");
+  const GroupShape shape = Shape(k);
+  d.set("groupX", std::to_string(shape.x));
+  d.set("groupY", std::to_string(Shape(k).y));
+  d.set("groupZ", std::to_string(Shape(k).z));
+  d.set("groupSize", std::to_string(shape.x * shape.y * shape.z));
   d.set("classStructs", model.glslClassStructs);
   d.set("kernelStructs", k.glslStructs);
   Data buffers = List();
   unsigned binding = 1;
-  scalarAny = false;
+  bool scalarAny = false;  // any buffer that needs GL_EXT_scalar_block_layout
   for (auto& p : k.params) {
     if (!p.isPointer) continue;
     Data b;
@@ -167,7 +180,6 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
     x.set("type", r.glslType);
     x.set("member", r.member);
     x.set("identity", r.identity);
-    x.set("groupSize", "256");
     x.set("combineGroup", Combine(r.op, r.member + "Group", r.member + "Shared[s]"));
     x.set("subgroupOp", r.op == ReduceOp::Min ? "subgroupMin" : r.op == ReduceOp::Max ? "subgroupMax" : "subgroupAdd");
     reductions.push_back(x);
@@ -198,22 +210,19 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   d.set("helpers", k.glslHelpers);
   d.set("body", k.glslBody);
   d.set("dim1", k.dims == 1);
+  // Arguments of the thread function: each thread id in the type its parameter or loop variable has.
+  std::vector<std::string> idTypes;
+  if (k.rtv) {
+    for (auto& p : k.params)
+      if (p.isThreadId) idTypes.push_back(p.glslType);
+  } else {
+    for (unsigned a = 0; a < k.dims; ++a) idTypes.push_back(k.loops[k.dims - 1 - a].glslType);  // x is the innermost loop
+  }
   std::string threadArgs, active;
   for (size_t i = 0; i < k.threadAxes.size(); ++i) {
     unsigned a = k.threadAxes[i];
     std::string id = k.dims == 1 ? "int(threadId)" : std::string("int(gl_GlobalInvocationID.") + GlAxis(a) + ")";
-    std::string type = k.rtv ? "uint" : k.loops[k.dims - 1 - a].glslType;
-    threadArgs += (i ? ", " : "") + type + "(crt_start" + Axis(a) + " + " + id + ")";
-  }
-  if (k.rtv) {  // thread-id parameters keep their declared types
-    threadArgs.clear();
-    size_t i = 0;
-    for (auto& p : k.params) {
-      if (!p.isThreadId) continue;
-      unsigned a = k.threadAxes[i];
-      std::string id = k.dims == 1 ? "int(threadId)" : std::string("int(gl_GlobalInvocationID.") + GlAxis(a) + ")";
-      threadArgs += (i++ ? ", " : "") + p.glslType + "(crt_start" + Axis(a) + " + " + id + ")";
-    }
+    threadArgs += (i ? ", " : "") + idTypes[i] + "(crt_start" + Axis(a) + " + " + id + ")";
   }
   for (unsigned a = 0; a < k.dims; ++a)
     active += (a ? " && " : "") + std::string("gl_GlobalInvocationID.") + GlAxis(a) + " < crt_count" + Axis(a);
@@ -226,7 +235,7 @@ std::string ReduceGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   Data d = Common(model, opt);
   d.set("kernel", k.name);
   d.set("sourceFile", k.sourceFile);
-  d.set("groupSize", "256");
+  d.set("groupSize", "256");  // the single workgroup folding the partial results
   d.set("classStructs", model.glslClassStructs);
   Data reductions = List();
   unsigned binding = 1;
@@ -271,11 +280,15 @@ Data ControlsData(const ClassModel& model) {
       ptrs.push_back(y);
       if (!p.isConst) outs.push_back(y);
       bindDecl += (bindDecl.empty() ? "" : ", ") + std::string("crossrt::BufferView a_") + p.name;
-      bindArgs += (bindArgs.empty() ? "" : ", ") + std::string("self->m_args.") + c.name + "_" + p.name + ".View()";
+      bindArgs += (bindArgs.empty() ? "" : ", ") + std::string("crt_self->m_args.") + c.name + "_" + p.name + ".View()";
     }
     x.set("pointerParams", ptrs);
     x.set("outputParams", outs);
     x.set("bindParamsDecl", bindDecl);
+    // In ...Cmd the kernels use the bound buffers, so host pointers may go unused.
+    std::string cmdDecl;
+    for (auto& p : c.params) cmdDecl += (cmdDecl.empty() ? "" : ", ") + std::string(p.isPointer ? "[[maybe_unused]] " : "") + p.declText;
+    x.set("cmdParamsDefinition", cmdDecl);
     x.set("bindArgs", bindArgs);
     // Member vectors written by any kernel this function calls are read back after it.
     Data written = List();
@@ -325,13 +338,11 @@ Data VulkanKernelsData(const ClassModel& model) {
       a.set("value", value);
       assign.push_back(a);
     };
-    for (unsigned a = 0; a < k.dims; ++a) field("4", "int32_t", std::string("crt_start") + Axis(a), std::string("start") + Axis(a));
-    for (unsigned a = 0; a < k.dims; ++a) field("4", "uint32_t", std::string("crt_count") + Axis(a), std::string("count") + Axis(a));
+    for (unsigned a = 0; a < k.dims; ++a) field("4", "int32_t", std::string("crt_start") + Axis(a), std::string("crt_start") + Axis(a));
+    for (unsigned a = 0; a < k.dims; ++a) field("4", "uint32_t", std::string("crt_count") + Axis(a), std::string("crt_count") + Axis(a));
     for (auto& p : k.params) {
       if (p.isPointer || p.isThreadId) continue;
-      std::string base = SplitArray(p.glslType).first;
-      std::string align = base.find("vec2") != std::string::npos ? "8" : (base.find("vec") != std::string::npos || base.find("mat") != std::string::npos) ? "16" : "4";
-      field(align, p.valueCppType, GlslPrinter::SafeName(p.name), p.name);
+      field(std::to_string(Std430AlignOf(p.glslType)), p.valueCppType, GlslPrinter::SafeName(p.name), p.name);
     }
     x.set("pushFields", fields);
     x.set("pushAssign", assign);
@@ -350,7 +361,7 @@ Data VulkanKernelsData(const ClassModel& model) {
     }
     x.set("axes", axes);
     std::string empty;
-    for (unsigned a = 0; a < k.dims; ++a) empty += (a ? " || " : "") + std::string("count") + Axis(a) + " == 0";
+    for (unsigned a = 0; a < k.dims; ++a) empty += (a ? " || " : "") + std::string("crt_count") + Axis(a) + " == 0";
     x.set("emptyTest", empty);
     std::string buffers = "m_classDataBuffer.View()";
     unsigned bindings = 1;
@@ -366,8 +377,7 @@ Data VulkanKernelsData(const ClassModel& model) {
       y.set("member", r.member);
       y.set("cppType", ReductionCppType(model, r));
       // The GPU writes an std430 array: a vec3 element takes 16 bytes, not sizeof(float3).
-      auto base = SplitArray(r.glslType).first;
-      y.set("partialStride", base.find("vec2") != std::string::npos ? "8" : base.find("vec") != std::string::npos ? "16" : "4");
+      y.set("partialStride", std::to_string(Std430StrideOf(r.glslType)));
       y.set("groupCountExpr", GroupCountExpr(k));
       reds.push_back(y);
     }
@@ -377,10 +387,7 @@ Data VulkanKernelsData(const ClassModel& model) {
     x.set("reductions", reds);
     x.set("hasReductions", !k.reductions.empty());
     x.set("groupCountExpr", GroupCountExpr(k));
-    std::string dispatch = k.dims == 1 ? "crossrt::Dispatch1D(a_cmd, countX, 256)"
-                         : k.dims == 2 ? "crossrt::Dispatch2D(a_cmd, countX, countY, 16, 16)"
-                                       : "crossrt::Dispatch3D(a_cmd, countX, countY, countZ, 8, 8, 4)";
-    x.set("dispatch", dispatch);
+    x.set("dispatch", DispatchExpr(k));
     kernels.push_back(x);
   }
   return kernels;
@@ -405,8 +412,7 @@ std::string ScalarOmpOp(ReduceOp op) { return op == ReduceOp::Min ? "min" : op =
 std::vector<ShaderSource> GenerateShaders(const ClassModel& model, const GenerateOptions& opt) {
   std::vector<ShaderSource> shaders;
   for (auto& k : model.kernels) {
-    bool scalar = false;
-    shaders.push_back({k.name, KernelGlsl(model, k, opt, scalar)});
+    shaders.push_back({k.name, KernelGlsl(model, k, opt)});
     if (!k.reductions.empty()) shaders.push_back({k.name + "_Reduce", ReduceGlsl(model, k, opt)});
   }
   return shaders;
@@ -419,6 +425,9 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
   d.set("vectors", VectorsData(model));
   if (vulkan) {
     d.set("kernels", VulkanKernelsData(model));
+    bool anyReductions = false;
+    for (auto& k : model.kernels) anyReductions |= !k.reductions.empty();
+    d.set("anyReductions", anyReductions);
     files[model.className + "_Vulkan.h"] = Render(opt.templateDir + "/vulkan/class.h.mustache", d);
     files[model.className + "_Vulkan.cpp"] = Render(opt.templateDir + "/vulkan/class.cpp.mustache", d);
     return files;

@@ -98,6 +98,15 @@ std::optional<std::string> GlslTypeOf(QualType type) {
   return std::nullopt;
 }
 
+unsigned Std430AlignOf(const std::string& glslType) {
+  std::string base = SplitArray(glslType).first;
+  if (base == "float" || base == "int" || base == "uint" || base == "bool") return 4;
+  if (base.size() >= 4 && base.compare(base.size() - 4, 4, "vec2") == 0) return 8;
+  return 16;  // vec3, vec4, matrices, structs holding them
+}
+
+unsigned Std430StrideOf(const std::string& glslType) { return Std430AlignOf(glslType); }
+
 std::pair<std::string, std::string> SplitArray(const std::string& glslType) {
   auto pos = glslType.find('[');
   if (pos == std::string::npos) return {glslType, ""};
@@ -244,7 +253,6 @@ std::string GlslPrinter::PreludeFunctions() const {
 }
 
 std::string GlslPrinter::Literal(const clang::Expr* e) {
-  auto& sm = m_ctx.getSourceManager();
   if (auto* il = dyn_cast<IntegerLiteral>(e)) {
     bool isUnsigned = il->getType()->isUnsignedIntegerType();
     auto v = il->getValue();
@@ -263,7 +271,6 @@ std::string GlslPrinter::Literal(const clang::Expr* e) {
       if (text.find_first_of(".eEin") == std::string::npos) text += ".0";
     }
     if (text.find_first_of(".eE") == std::string::npos) text += ".0";
-    (void)sm;
     return text;
   }
   if (auto* bl = dyn_cast<CXXBoolLiteralExpr>(e)) return bl->getValue() ? "true" : "false";

@@ -26,6 +26,11 @@ bool IsLiteMathType(clang::QualType type, const char* name = nullptr);
 bool IsStdVector(clang::QualType type, clang::QualType* element = nullptr);
 bool IsSystemDecl(const clang::Decl* decl);
 
+// std430 alignment and array stride of a GLSL type by name ("vec3" -> 16, 16; "vec2" -> 8, 8;
+// scalars 4; matrices and structs 16).
+unsigned Std430AlignOf(const std::string& glslType);
+unsigned Std430StrideOf(const std::string& glslType);
+
 // Memory layouts a GLSL buffer block can use. A C++ type can be shared with the GPU only when one
 // of them gives exactly the C++ offsets and sizes.
 struct LayoutInfo { uint64_t size = 0, align = 0; };

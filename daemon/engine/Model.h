@@ -83,6 +83,7 @@ struct ControlParam {
   bool isConst = false;
   std::string pointeeCpp;    // element type of a pointer
   std::string sizeExpr;      // from [[crossrt::size("...")]]
+  std::string declText;      // "const float* in", as written minus attributes
 };
 
 struct Control {

@@ -391,6 +391,16 @@ void VulkanContext::CreateDevice(const ContextOptions& options) {
   vkGetDeviceQueue(device, queueFamily, 0, &queue);
 
   hasShaderInt64 = enable.features.shaderInt64 == VK_TRUE;
+
+  VkPhysicalDeviceSubgroupProperties subgroup{};
+  subgroup.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES;
+  VkPhysicalDeviceProperties2 props2{};
+  props2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
+  props2.pNext = &subgroup;
+  vkGetPhysicalDeviceProperties2(physicalDevice, &props2);
+  subgroupSize = subgroup.subgroupSize;
+  hasSubgroupArithmetic = (subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) &&
+                          (subgroup.supportedOperations & VK_SUBGROUP_FEATURE_ARITHMETIC_BIT);
   hasShaderFloat64 = enable.features.shaderFloat64 == VK_TRUE;
   hasScalarBlockLayout = enable12.scalarBlockLayout == VK_TRUE;
   hasBufferDeviceAddress = enable12.bufferDeviceAddress == VK_TRUE;

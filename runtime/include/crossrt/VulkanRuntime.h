@@ -62,6 +62,9 @@ public:
   VkPhysicalDeviceProperties properties{};  // limits, name, timestampPeriod
   bool hasScalarBlockLayout = false, hasBufferDeviceAddress = false, hasRayQuery = false,
        hasShaderFloat64 = false, hasShaderInt64 = false;
+  // Subgroups of compute shaders: generated reductions need arithmetic ops and >= 4 lanes.
+  uint32_t subgroupSize = 0;
+  bool hasSubgroupArithmetic = false;
   bool forceStaging = false;  // see ContextOptions::forceStaging
 
   std::string DeviceName() const;
