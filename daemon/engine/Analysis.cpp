@@ -491,9 +491,9 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   os << ")\n{\n";
   for (auto* s : preamble) os << printer.Stmt(s, 1);
   if (auto* cs = dyn_cast<CompoundStmt>(threadBody))
-    for (auto* s : cs->body()) os << printer.ThreadBody(s, 1);
+    for (auto* s : cs->body()) os << printer.ThreadBody(s, 1, !k.rtv);
   else
-    os << printer.ThreadBody(threadBody, 1);
+    os << printer.ThreadBody(threadBody, 1, !k.rtv);
   os << "}\n";
   k.glslBody = os.str();
   k.glslStructs = printer.PreludeTypes();
@@ -707,10 +707,23 @@ private:
     m_gpu.InsertTextAfter(end, " UpdateMemberCmd(a_cmd, offsetof(ClassData, " + m->name + "), &" + m->name + ", sizeof(" + m->name + "));");
   }
 
+  // Another control function would submit its own work while this one is being recorded.
+  void CheckNestedControl(const CXXMemberCallExpr* call) {
+    auto* md = call->getMethodDecl();
+    const FunctionDecl* def = nullptr;
+    if (!md || IsKernelName(md->getName()) || !md->hasBody(def) || !def || md->getParent() != m_md->getParent()) return;
+    KernelCallFinder kc;
+    kc.TraverseStmt(def->getBody());
+    if (kc.calls.empty()) return;
+    m_c.rep.Error(call->getBeginLoc(), "control function '" + m_ctrl.name + "' calls control function '" + md->getNameAsString() + "'",
+                  "on the GPU each control function is one submission: call its kernels directly here, or call both from outside the class");
+  }
+
   void Visit(const Stmt* s) {
     if (!s) return;
     if (auto* cs = dyn_cast<CompoundStmt>(s))
       for (auto* child : cs->body()) RecordMemberWrite(child);
+    if (auto* mc = dyn_cast<CXXMemberCallExpr>(s)) CheckNestedControl(mc);
     if (auto* fs = dyn_cast<ForStmt>(s); fs && TryRtvNest(fs)) return;
     if (auto* call = dyn_cast<CXXMemberCallExpr>(s)) {
       auto* md = call->getMethodDecl();

@@ -351,12 +351,13 @@ std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callL
   }
   os << ")\n";
   int savedDepth = m_loopDepth;
-  bool savedThread = m_inThreadBody;
+  bool savedThread = m_inThreadBody, savedLoopBody = m_inLoopBody;
   m_loopDepth = 0;
-  m_inThreadBody = false;
+  m_inThreadBody = m_inLoopBody = false;
   os << Stmt(def->getBody(), 0);
   m_loopDepth = savedDepth;
   m_inThreadBody = savedThread;
+  m_inLoopBody = savedLoopBody;
   m_inProgress.erase(def);
   m_emitted.insert(def);
   m_functions.push_back(os.str());
@@ -627,11 +628,12 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
   return Fail(e->getBeginLoc(), std::string("expression '") + e->getStmtClassName() + "' is not supported in kernels", "");
 }
 
-std::string GlslPrinter::ThreadBody(const clang::Stmt* body, int indent) {
+std::string GlslPrinter::ThreadBody(const clang::Stmt* body, int indent, bool loopBody) {
   m_inThreadBody = true;
+  m_inLoopBody = loopBody;
   m_loopDepth = 0;
   std::string out = Stmt(body, indent);
-  m_inThreadBody = false;
+  m_inThreadBody = m_inLoopBody = false;
   return out;
 }
 
@@ -692,6 +694,9 @@ std::string GlslPrinter::Stmt(const clang::Stmt* s, int indent) {
   if (auto* ws = dyn_cast<WhileStmt>(s)) return pad + "while (" + Expr(ws->getCond()) + ")\n" + loopBody(ws->getBody());
   if (auto* dos = dyn_cast<DoStmt>(s)) return pad + "do\n" + loopBody(dos->getBody()) + pad + "while (" + Expr(dos->getCond()) + ");\n";
   if (auto* rs = dyn_cast<ReturnStmt>(s)) {
+    if (m_inThreadBody && m_inLoopBody)
+      return Fail(s->getBeginLoc(), "'return' inside a parallel kernel loop would end all later iterations",
+                  "each iteration is a thread: skip this one with 'continue'"), "";
     if (m_inThreadBody && rs->getRetValue())
       return Fail(s->getBeginLoc(), "kernel returns a value", "kernels return void; write results to an output buffer"), "";
     return pad + "return" + (rs->getRetValue() ? " " + Expr(rs->getRetValue()) : "") + ";\n";

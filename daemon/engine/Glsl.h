@@ -52,7 +52,9 @@ public:
   std::string Expr(const clang::Expr* e);
   std::string Stmt(const clang::Stmt* s, int indent);
   // The thread's function body: `continue` at loop depth 0 ends the thread (becomes `return`).
-  std::string ThreadBody(const clang::Stmt* body, int indent);
+  // In a loop-holding kernel (loopBody), `return` would end every later iteration on the CPU,
+  // which threads cannot do: it is reported.
+  std::string ThreadBody(const clang::Stmt* body, int indent, bool loopBody);
   std::optional<std::string> Type(clang::QualType t, clang::SourceLocation loc);
   std::string Declare(clang::QualType t, const std::string& name, clang::SourceLocation loc);
 
@@ -79,6 +81,7 @@ private:
   Reporter& m_reporter;
   int m_loopDepth = 0;
   bool m_inThreadBody = false;
+  bool m_inLoopBody = false;
   std::vector<std::string> m_structs, m_constants, m_functions;  // in emission order
   std::set<const clang::Decl*> m_emitted, m_inProgress;
 };

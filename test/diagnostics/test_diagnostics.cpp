@@ -62,6 +62,9 @@ const Case kCases[] = {
     {"library call", "    x += float(std::strlen(\"abc\"));", "", "", "unsupported library call 'strlen' in a kernel", "kernels may call LiteMath", 8},
     {"member race", "    m_value = x;", "", "", "kernel writes class member 'm_value' from every thread", "reduction", 8},
     {"double", "    double d = x; x = float(d);", "", "", "type 'double' is not supported in kernels", "use float", 8},
+    {"return in loop", "    if (x > 0.0f) return;", "", "", "'return' inside a parallel kernel loop would end all later iterations", "'continue'", 8},
+    {"nested control", "", "  virtual void Outer(int n, [[crossrt::size(\"n\")]] float* data);", "void Bad::Outer(int n, float* data) { kernel1D_Bad(n, data); Run(n, data); }\n",
+     "control function 'Outer' calls control function 'Run'", "one submission", 12},
 };
 
 }  // namespace

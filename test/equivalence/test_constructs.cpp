@@ -163,6 +163,22 @@ TEST_CASE("IPV 3D kernel with a shifted start and an inclusive bound", "[equival
   RequireNoValidationMessages(impls.ctx);
 }
 
+TEST_CASE("A std::vector member resized after CommitDeviceData() is seen at the next call", "[equivalence]")
+{
+  Impls impls(5);
+  for (auto& [name, impl] : impls.list)
+  {
+    INFO(name);
+    impl->m_squares.assign(100, 0);
+    impl->CommitDeviceData();
+    impl->FillSquares(100);
+    impl->m_squares.assign(3000, 0);  // no CommitDeviceData(): the CPU class needs none either
+    impl->FillSquares(3000);
+    REQUIRE(impl->m_squares[2999] == 2999 * 2999 - 3000);
+  }
+  RequireNoValidationMessages(impls.ctx);
+}
+
 TEST_CASE("A kernel that writes a std::vector member", "[equivalence]")
 {
   const int n = 5000;
