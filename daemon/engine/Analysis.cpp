@@ -1,5 +1,6 @@
 #include "Analysis.h"
 
+#include "Canonical.h"
 #include "Glsl.h"
 
 #include <clang/AST/RecursiveASTVisitor.h>
@@ -539,10 +540,11 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     renamer.TraverseStmt(const_cast<ForStmt*>(outer));
     // A loop whose body is a bare statement ends before its ';': take the ';' too.
     SourceLocation end = Lexer::findLocationAfterToken(outer->getEndLoc(), tok::semi, c.ctx.getSourceManager(), c.ctx.getLangOpts(), false);
-    k.cpuLoopNest = end.isValid() ? rw.getRewrittenText(CharSourceRange::getCharRange(outer->getBeginLoc(), end))
-                                  : rw.getRewrittenText(outer->getSourceRange());
+    k.cpuLoopNest = CanonicalCode(end.isValid() ? rw.getRewrittenText(CharSourceRange::getCharRange(outer->getBeginLoc(), end))
+                                                : rw.getRewrittenText(outer->getSourceRange()));
     CheckCopiedBody(c, def->getBody(), "kernel '" + k.name + "'");
     for (auto* s : preamble) k.cpuPreamble += c.Text(s->getSourceRange()) + "\n";
+    k.cpuPreamble = CanonicalCode(k.cpuPreamble);
   }
   c.model.kernels.push_back(k);
 }
@@ -574,8 +576,8 @@ public:
 
   void Run() {
     Visit(m_def->getBody());
-    m_ctrl.vulkanCmdBody = m_gpu.getRewrittenText(m_def->getBody()->getSourceRange());
-    m_ctrl.cpuBody = m_cpu.getRewrittenText(m_def->getBody()->getSourceRange());
+    m_ctrl.vulkanCmdBody = CanonicalCode(m_gpu.getRewrittenText(m_def->getBody()->getSourceRange()));
+    m_ctrl.cpuBody = CanonicalCode(m_cpu.getRewrittenText(m_def->getBody()->getSourceRange()));
   }
 
 private:

@@ -24,12 +24,39 @@ std::string ReadFile(const std::string& path) {
   return os.str();
 }
 
+// Sections that render nothing leave blank lines: keep at most one in a row, and none right
+// after an opening brace.
+std::string TidyBlankLines(const std::string& text) {
+  std::string out;
+  std::istringstream lines(text);
+  std::string line, previous = "x";
+  while (std::getline(lines, line)) {
+    bool blank = line.find_first_not_of(" \t") == std::string::npos;
+    bool afterBrace = !previous.empty() && previous.back() == '{';
+    if (blank && (previous.empty() || afterBrace)) continue;
+    out += (blank ? "" : line) + "\n";
+    previous = blank ? "" : line;
+  }
+  return out;
+}
+
 std::string Render(const std::string& templatePath, const Data& data) {
   kainjow::mustache::mustache tmpl(ReadFile(templatePath));
   if (!tmpl.is_valid()) throw std::runtime_error(templatePath + ": " + tmpl.error_message());
   tmpl.set_custom_escape([](const std::string& s) { return s; });  // code, not HTML
   std::string out = tmpl.render(data);
   if (!tmpl.is_valid()) throw std::runtime_error(templatePath + ": " + tmpl.error_message());
+  return TidyBlankLines(out);
+}
+
+// Indents every line but the first (which the template already indents).
+std::string IndentTail(const std::string& text, const std::string& pad) {
+  std::string out;
+  for (size_t i = 0; i < text.size(); ++i) {
+    out += text[i];
+    if (text[i] == '\n' && i + 1 < text.size() && text[i + 1] != '\n') out += pad;
+  }
+  while (!out.empty() && out.back() == '\n') out.pop_back();
   return out;
 }
 
@@ -265,8 +292,8 @@ Data ControlsData(const ClassModel& model) {
     x.set("hasParams", !c.paramsDecl.empty());
     x.set("argsForward", c.argsForward);
     x.set("constQualifier", c.isConst ? " const" : "");
-    x.set("cmdBody", c.vulkanCmdBody);
-    x.set("cpuBody", c.cpuBody);
+    x.set("cmdBody", IndentTail(c.vulkanCmdBody, ""));
+    x.set("cpuBody", IndentTail(c.cpuBody, "  "));
     x.set("sourceFile", c.sourceFile);
     Data ptrs = List(), outs = List();
     std::string bindDecl, bindArgs;
@@ -440,9 +467,9 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
     x.set("name", k.name);
     x.set("sourceFile", k.sourceFile);
     x.set("paramsDecl", k.cppParamsDecl);
-    x.set("preamble", k.cpuPreamble);
+    x.set("preamble", IndentTail(k.cpuPreamble, "  "));
     x.set("hasPreamble", !k.cpuPreamble.empty());
-    x.set("loopNest", k.cpuLoopNest);
+    x.set("loopNest", IndentTail(k.cpuLoopNest, "  "));
     x.set("schedule", k.dims == 1 ? "static" : "dynamic, 1");
     std::string clauses;
     Data reds = List();

@@ -1,6 +1,7 @@
 #include "Translator.h"
 
 #include "Analysis.h"
+#include "AstCache.h"
 #include "CodeGen.h"
 
 #include <clang/Basic/DiagnosticOptions.h>
@@ -103,17 +104,20 @@ std::string EmbedSpirv(const std::string& className, const std::vector<std::pair
 
 }  // namespace
 
-AnalyzeResult Analyze(const TranslateRequest& request) {
+std::vector<std::string> ParseArguments(const TranslateRequest& request) {
+  std::vector<std::string> args = {"-xc++", "-std=c++17", "-fsyntax-only", "-D__CROSSRT__=1", "-Wno-unused-command-line-argument"};
+  args.insert(args.end(), request.compileArgs.begin(), request.compileArgs.end());
+  return args;
+}
+
+AnalyzeResult Analyze(const TranslateRequest& request, AstCache* sharedCache) {
   LinkSizeAttribute();
   AnalyzeResult result;
-  std::vector<std::string> args = {"-xc++", "-std=c++17", "-resource-dir=" CROSSRT_CLANG_RESOURCE_DIR, "-D__CROSSRT__=1",
-                                   "-Wno-unused-command-line-argument"};
-  args.insert(args.end(), request.compileArgs.begin(), request.compileArgs.end());
-  clang::tooling::FixedCompilationDatabase db(".", args);
   std::vector<std::string> sources;
   for (auto& s : request.sources) {
     llvm::SmallString<256> abs(s);
     llvm::sys::fs::make_absolute(abs);
+    llvm::sys::path::remove_dots(abs, true);
     if (!llvm::sys::fs::exists(abs)) {
       result.diagnostics += "error: source file '" + s + "' does not exist\n";
       return result;
@@ -125,40 +129,43 @@ AnalyzeResult Analyze(const TranslateRequest& request) {
     return result;
   }
 
+  AstCache localCache(sources.size());
+  AstCache& cache = sharedCache ? *sharedCache : localCache;
+  const std::vector<std::string> args = ParseArguments(request);
+  std::vector<AstCache::Handle> handles;
   std::string diagText;
-  llvm::raw_string_ostream diagStream(diagText);
-  clang::DiagnosticOptions* diagOptions = new clang::DiagnosticOptions();
-  diagOptions->ShowColors = false;
-  clang::TextDiagnosticPrinter printer(diagStream, diagOptions);
-  clang::tooling::ClangTool tool(db, sources);
-  tool.setDiagnosticConsumer(&printer);
-  std::vector<std::unique_ptr<clang::ASTUnit>> asts;
-  int rc = tool.buildASTs(asts);
-  bool parseErrors = rc != 0 || printer.getNumErrors() > 0;
-  for (auto& ast : asts) parseErrors |= ast->getDiagnostics().hasErrorOccurred();
-  if (parseErrors || asts.size() != sources.size()) {
-    diagStream.flush();
+  bool parseErrors = false;
+  for (auto& s : sources) {
+    handles.push_back(cache.Get(s, args));
+    diagText += handles.back().diagnostics();
+    parseErrors |= handles.back().failed();
+  }
+  if (parseErrors) {
     result.diagnostics = diagText.empty() ? "error: parsing failed\n" : diagText;
     return result;
   }
+  std::vector<clang::ASTUnit*> asts;
+  for (auto& h : handles) asts.push_back(h.ast());
 
   // Every file the ASTs read is an input of the translation (for depfiles and cache keys).
   std::set<std::string> inputs;
-  for (auto& ast : asts) {
+  for (auto* ast : asts) {
     auto& sm = ast->getSourceManager();
     for (auto it = sm.fileinfo_begin(); it != sm.fileinfo_end(); ++it) inputs.insert(it->first.getName().str());
   }
 
   ClassModel& model = result.model;
   unsigned errors = 0;
-  for (auto& ast : asts) {
-    printer.BeginSourceFile(ast->getLangOpts(), &ast->getPreprocessor());
+  for (auto& handle : handles) {
+    clang::ASTUnit* ast = handle.ast();
+    size_t before = handle.diagnostics().size();
+    handle.printer().BeginSourceFile(ast->getLangOpts(), &ast->getPreprocessor());
     Reporter reporter(ast->getDiagnostics());
     AnalyzeTranslationUnit(ast->getASTContext(), request.className, reporter, model);
     errors += reporter.Errors();
-    printer.EndSourceFile();
+    handle.printer().EndSourceFile();
+    diagText += handle.diagnostics().substr(before);
   }
-  diagStream.flush();
   if (model.className.empty()) {
     result.diagnostics = diagText + "error: class '" + request.className + "' is not defined in " + sources.front() +
                          " or the headers it includes\n";
@@ -181,9 +188,9 @@ AnalyzeResult Analyze(const TranslateRequest& request) {
 }
 
 
-TranslateResult Translate(const TranslateRequest& request) {
+TranslateResult Translate(const TranslateRequest& request, AstCache* cache) {
   TranslateResult result;
-  AnalyzeResult analysis = Analyze(request);
+  AnalyzeResult analysis = Analyze(request, cache);
   result.diagnostics = analysis.diagnostics;
   if (!analysis.ok) return result;
   const ClassModel& model = analysis.model;

@@ -35,11 +35,17 @@ struct AnalyzeResult {
   std::vector<std::string> inputs;
 };
 
-// Parses and analyses only: what the translator finds in the class.
-AnalyzeResult Analyze(const TranslateRequest& request);
+class AstCache;
+
+// Parses and analyses only: what the translator finds in the class. With a cache, parsed files
+// are kept and reparsed (the daemon); without, they are parsed and dropped.
+AnalyzeResult Analyze(const TranslateRequest& request, AstCache* cache = nullptr);
 
 // Parses, analyses and generates. Does not write anything.
-TranslateResult Translate(const TranslateRequest& request);
+TranslateResult Translate(const TranslateRequest& request, AstCache* cache = nullptr);
+
+// The compile arguments the engine parses with: the request's, plus what the engine adds.
+std::vector<std::string> ParseArguments(const TranslateRequest& request);
 
 // Writes result.files into outputDir atomically, touching only files whose bytes changed.
 // Returns the names of the files it rewrote. Throws std::runtime_error on IO failure.

@@ -1,0 +1,53 @@
+#include "Canonical.h"
+
+#include <clang/Basic/LangOptions.h>
+#include <clang/Format/Format.h>
+#include <clang/Lex/Lexer.h>
+#include <clang/Tooling/Core/Replacement.h>
+
+namespace crossrt::engine {
+
+std::string CanonicalCode(const std::string& code) {
+  clang::LangOptions lang;
+  lang.CPlusPlus = lang.CPlusPlus11 = lang.CPlusPlus14 = lang.CPlusPlus17 = true;
+  // Re-emit the tokens without comments or the user's spacing; preprocessor lines (the OpenMP
+  // pragmas the CPU backend inserts) keep a line of their own.
+  clang::Lexer lexer(clang::SourceLocation(), lang, code.data(), code.data(), code.data() + code.size());
+  std::string flat;
+  bool skippingDirective = false;
+  clang::Token tok;
+  while (true) {
+    lexer.LexFromRawLexer(tok);
+    if (tok.is(clang::tok::eof)) break;
+    size_t begin = lexer.getCurrentBufferOffset() - tok.getLength();
+    if (skippingDirective && !tok.isAtStartOfLine()) continue;
+    skippingDirective = false;
+    if (tok.is(clang::tok::hash) && tok.isAtStartOfLine()) {
+      size_t eol = code.find('\n', begin);
+      flat += "\n" + code.substr(begin, eol == std::string::npos ? std::string::npos : eol - begin) + "\n";
+      skippingDirective = true;
+      continue;
+    }
+    // Whitespace in the user's code becomes one space; clang-format decides the rest.
+    if (!flat.empty() && flat.back() != '\n' && (tok.hasLeadingSpace() || tok.isAtStartOfLine())) flat += " ";
+    flat.append(code, begin, tok.getLength());
+  }
+
+  clang::format::FormatStyle style = clang::format::getLLVMStyle();
+  style.BreakBeforeBraces = clang::format::FormatStyle::BS_Allman;
+  style.IndentWidth = 2;
+  style.ColumnLimit = 110;
+  style.AllowShortFunctionsOnASingleLine = clang::format::FormatStyle::SFS_None;
+  style.AllowShortIfStatementsOnASingleLine = clang::format::FormatStyle::SIS_Never;
+  style.AllowShortLoopsOnASingleLine = false;
+  auto replacements = clang::format::reformat(style, flat, {clang::tooling::Range(0, flat.size())});
+  auto formatted = clang::tooling::applyAllReplacements(flat, replacements);
+  std::string out = formatted ? *formatted : flat;
+  size_t first = out.find_first_not_of(" \n");
+  if (first == std::string::npos) return "";
+  out.erase(0, first);
+  while (!out.empty() && (out.back() == '\n' || out.back() == ' ')) out.pop_back();
+  return out;
+}
+
+}  // namespace crossrt::engine

@@ -1,0 +1,11 @@
+// Canonical form of C++ code copied from the user's sources into generated files: comments are
+// dropped and the layout comes from clang-format, so an edit to a comment or to whitespace in the
+// user's code leaves the generated files byte-identical (and nothing generated recompiles).
+#pragma once
+#include <string>
+
+namespace crossrt::engine {
+
+std::string CanonicalCode(const std::string& code);
+
+}  // namespace crossrt::engine
