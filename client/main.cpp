@@ -1,21 +1,37 @@
-// crossrt: the command crossrt_add_class() runs. It translates one class into generated sources.
-// The translation runs in-process; the translation daemon (cached ASTs) comes later and will sit
-// behind the same command line.
+// crossrt: the command crossrt_add_class() runs.
+//
+//   crossrt translate --class NAME --backend vulkan|cpu --out DIR --source FILE... [options] [-- ARGS]
+//   crossrt daemon status [--build-dir DIR] [--json]
+//   crossrt daemon stop [--build-dir DIR]
+//
+// translate: when the recorded translation key is unchanged it writes nothing and returns at
+// once. Otherwise it asks the build tree's daemon (starting it when absent) and, when the daemon
+// cannot answer for any reason, translates in-process: the build never fails because of the
+// daemon. Outputs are written atomically, only where their bytes changed.
+#include "DaemonClient.h"
+#include "Manifest.h"
+#include "Protocol.h"
 #include "Translator.h"
 
 #include <cstdio>
-#include <cstring>
+#include <cstdlib>
 #include <fstream>
 #include <iostream>
 #include <string>
+#include <unistd.h>
 #include <vector>
+
+namespace engine = crossrt::engine;
+using crossrt::client::DaemonClient;
 
 namespace {
 
 const char* kUsage =
     "usage: crossrt translate --class NAME --backend vulkan|cpu --out DIR --source FILE [--source FILE...]\n"
     "                         [--templates DIR] [--glslang PATH] [--depfile FILE --depfile-target FILE]\n"
-    "                         [-- COMPILE_ARGS...]\n"
+    "                         [--build-dir DIR | --no-daemon] [-- COMPILE_ARGS...]\n"
+    "       crossrt daemon status [--build-dir DIR] [--json]\n"
+    "       crossrt daemon stop [--build-dir DIR]\n"
     "       crossrt --version\n";
 
 int Usage(const std::string& message) {
@@ -45,25 +61,79 @@ bool WriteDepfile(const std::string& path, const std::string& target, const std:
   return out.good();
 }
 
+std::string CurrentDir() {
+  char buf[4096];
+  return getcwd(buf, sizeof buf) ? buf : ".";
+}
+
+int DaemonCommand(const std::vector<std::string>& args) {
+  std::string buildDir = CurrentDir(), what = args.size() > 1 ? args[1] : "";
+  bool asJson = false;
+  for (size_t i = 2; i < args.size(); ++i) {
+    if (args[i] == "--json") asJson = true;
+    else if (args[i] == "--build-dir" && i + 1 < args.size()) buildDir = args[++i];
+    else return Usage("unknown option '" + args[i] + "'");
+  }
+  if (what != "status" && what != "stop") return Usage("daemon command must be 'status' or 'stop'");
+  DaemonClient daemon(buildDir);
+  auto response = daemon.Call({{"command", what}}, /*start=*/false, 10);
+  if (!response) {
+    if (asJson) std::cout << nlohmann::json{{"running", false}, {"buildDir", buildDir}}.dump(2) << "\n";
+    else std::cout << "no daemon serves " << buildDir << "\n";
+    return what == "stop" ? 0 : 1;
+  }
+  if (!response->value("ok", false)) {
+    std::cerr << "crossrt: daemon: " << response->value("error", "unknown error") << "\n";
+    return 1;
+  }
+  if (what == "stop") {
+    std::cout << "stopped the daemon of " << buildDir << "\n";
+    return 0;
+  }
+  const auto& s = (*response)["status"];
+  if (asJson) {
+    nlohmann::json out = s;
+    out["running"] = true;
+    std::cout << out.dump(2) << "\n";
+    return 0;
+  }
+  std::printf("crossrtd %s serving %s\n", s.value("version", "?").c_str(), s.value("buildDir", "?").c_str());
+  std::printf("  pid             %d\n", s.value("pid", 0));
+  std::printf("  uptime          %ld s (exits after %d s idle)\n", s.value("uptimeSeconds", 0L), s.value("idleTimeoutSeconds", 0));
+  std::printf("  cached ASTs     %zu of %zu\n", s.value("cachedAsts", size_t(0)), s.value("maxCachedAsts", size_t(0)));
+  std::printf("  memory          %.1f MiB resident\n", double(s.value("residentBytes", size_t(0))) / (1024.0 * 1024.0));
+  std::printf("  requests served %llu (%llu translations, %llu failed)\n", (unsigned long long)s.value("requestsServed", 0ull),
+              (unsigned long long)s.value("translations", 0ull), (unsigned long long)s.value("failedTranslations", 0ull));
+  std::printf("  AST hit rate    %.0f%% (%llu reparses, %llu parses)\n", 100.0 * s.value("astHitRate", 0.0),
+              (unsigned long long)s.value("reparses", 0ull), (unsigned long long)s.value("parses", 0ull));
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
   if (args.empty()) return Usage("no command given");
   if (args[0] == "--version") {
-    std::cout << "crossrt " << crossrt::engine::TranslatorVersion() << "\n";
+    std::cout << "crossrt " << engine::TranslatorVersion() << "\n";
     return 0;
   }
+  if (args[0] == "daemon") return DaemonCommand(args);
   if (args[0] != "translate") return Usage("unknown command '" + args[0] + "'");
 
-  crossrt::engine::TranslateRequest request;
+  engine::TranslateRequest request;
   request.templateDir = CROSSRT_DEFAULT_TEMPLATE_DIR;
-  std::string depfile, depfileTarget, backend;
+  std::string depfile, depfileTarget, backend, buildDir;
+  bool useDaemon = std::getenv("CROSSRT_NO_DAEMON") == nullptr;
   for (size_t i = 1; i < args.size(); ++i) {
     const std::string& a = args[i];
     if (a == "--") {
       request.compileArgs.assign(args.begin() + i + 1, args.end());
       break;
+    }
+    if (a == "--no-daemon") {
+      useDaemon = false;
+      continue;
     }
     if (i + 1 >= args.size()) return Usage("option '" + a + "' needs a value");
     const std::string& v = args[++i];
@@ -75,21 +145,46 @@ int main(int argc, char** argv) {
     else if (a == "--glslang") request.glslangValidator = v;
     else if (a == "--depfile") depfile = v;
     else if (a == "--depfile-target") depfileTarget = v;
+    else if (a == "--build-dir") buildDir = v;
     else return Usage("unknown option '" + a + "'");
   }
   if (request.className.empty()) return Usage("--class is required");
   if (request.outputDir.empty()) return Usage("--out is required");
   if (request.sources.empty()) return Usage("at least one --source is required");
-  if (backend == "vulkan") request.backend = crossrt::engine::Backend::Vulkan;
-  else if (backend == "cpu") request.backend = crossrt::engine::Backend::Cpu;
+  if (backend == "vulkan") request.backend = engine::Backend::Vulkan;
+  else if (backend == "cpu") request.backend = engine::Backend::Cpu;
   else return Usage("--backend must be 'vulkan' or 'cpu', not '" + backend + "'");
 
-  crossrt::engine::TranslateResult result;
-  try {
-    result = crossrt::engine::Translate(request);
-  } catch (const std::exception& e) {
-    std::cerr << "crossrt: internal error while translating '" << request.className << "': " << e.what() << "\n";
-    return 1;
+  // Unchanged key: nothing to translate, nothing to write.
+  if (crossrt::client::UpToDate(request)) return 0;
+
+  engine::TranslateResult result;
+  bool translated = false;
+  if (useDaemon && !buildDir.empty()) {
+    DaemonClient daemon(buildDir);
+    auto response = daemon.Call({{"command", "translate"}, {"request", crossrt::protocol::ToJson(request)}}, /*start=*/true);
+    std::string why = response ? response->value("error", "unknown error") : daemon.Error();
+    if (response && response->value("ok", false)) {
+      try {
+        result.ok = response->value("translated", false);
+        result.diagnostics = response->value("diagnostics", "");
+        result.files = response->at("files").get<std::map<std::string, std::string>>();
+        result.inputs = response->at("inputs").get<std::vector<std::string>>();
+        translated = true;
+      } catch (const std::exception& e) {
+        why = std::string("unreadable answer: ") + e.what();
+      }
+    }
+    if (!translated)
+      std::cerr << "crossrt: note: translation daemon unavailable (" << why << "); translating in-process\n";
+  }
+  if (!translated) {
+    try {
+      result = engine::Translate(request);
+    } catch (const std::exception& e) {
+      std::cerr << "crossrt: internal error while translating '" << request.className << "': " << e.what() << "\n";
+      return 1;
+    }
   }
   std::cerr << result.diagnostics;
   if (!result.ok) {
@@ -97,7 +192,8 @@ int main(int argc, char** argv) {
     return 1;
   }
   try {
-    crossrt::engine::WriteOutputs(request, result);
+    engine::WriteOutputs(request, result);
+    crossrt::client::WriteManifest(request, result);
   } catch (const std::exception& e) {
     std::cerr << "crossrt: error: " << e.what() << "\n";
     return 1;

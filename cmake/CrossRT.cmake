@@ -6,6 +6,9 @@
 # every .cpp source of <target>). The translation re-runs when any file it read changes (depfile),
 # and writes only files whose contents changed, so an unchanged class recompiles nothing.
 #
+# The translation goes through the build tree's daemon (crossrtd, started on demand, exits when
+# idle), which keeps parsed headers warm; set CROSSRT_NO_DAEMON=1 to translate in-process.
+#
 # Works from the source tree (add_subdirectory) and from an installed package (find_package).
 include_guard(GLOBAL)
 
@@ -80,6 +83,7 @@ function(crossrt_add_class target class)
             --templates ${CROSSRT_TEMPLATE_DIR}
             --glslang ${Vulkan_GLSLANG_VALIDATOR_EXECUTABLE}
             --depfile ${out_dir}/${class}_${suffix}.d --depfile-target ${first_output}
+            --build-dir ${CMAKE_BINARY_DIR}
             -- ${compile_args}
     DEPENDS ${abs_sources} ${translator_dep}
     DEPFILE ${out_dir}/${class}_${suffix}.d

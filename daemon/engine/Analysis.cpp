@@ -794,22 +794,14 @@ void AnalyzeControl(Context& c, const CXXMethodDecl* md, const FunctionDecl* def
   c.model.controls.push_back(ctrl);
 }
 
-struct ClassFinder : RecursiveASTVisitor<ClassFinder> {
-  std::string name;
-  const CXXRecordDecl* found = nullptr;
-  bool VisitCXXRecordDecl(CXXRecordDecl* rd) {
-    if (!found && rd->isThisDeclarationADefinition() && rd->getName() == name && !isa<ClassTemplateSpecializationDecl>(rd))
-      found = rd;
-    return true;
-  }
-};
-
 }  // namespace
 
 bool AnalyzeTranslationUnit(ASTContext& ctx, const std::string& className, Reporter& reporter, ClassModel& model) {
-  ClassFinder finder;
-  finder.name = className;
-  finder.TraverseDecl(ctx.getTranslationUnitDecl());
+  // A name lookup in the translation unit: walking every declaration of the standard library
+  // would cost more than the rest of the analysis.
+  struct { const CXXRecordDecl* found = nullptr; } finder;
+  for (auto* d : ctx.getTranslationUnitDecl()->lookup(&ctx.Idents.get(className)))
+    if (auto* rd = dyn_cast<CXXRecordDecl>(d); rd && rd->getDefinition()) finder.found = rd->getDefinition();
   if (!finder.found) return false;
   Context c{ctx, finder.found, reporter, model};
   bool first = model.className.empty();

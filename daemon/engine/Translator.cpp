@@ -16,6 +16,7 @@
 #include <llvm/Support/raw_ostream.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <set>
@@ -33,6 +34,10 @@ void LinkSizeAttribute();
 const char* TranslatorVersion() { return "0.1.0"; }
 
 namespace {
+
+double MsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
 
 std::string ReadFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -132,6 +137,7 @@ AnalyzeResult Analyze(const TranslateRequest& request, AstCache* sharedCache) {
   AstCache localCache(sources.size());
   AstCache& cache = sharedCache ? *sharedCache : localCache;
   const std::vector<std::string> args = ParseArguments(request);
+  auto t0 = std::chrono::steady_clock::now();
   std::vector<AstCache::Handle> handles;
   std::string diagText;
   bool parseErrors = false;
@@ -146,6 +152,8 @@ AnalyzeResult Analyze(const TranslateRequest& request, AstCache* sharedCache) {
   }
   std::vector<clang::ASTUnit*> asts;
   for (auto& h : handles) asts.push_back(h.ast());
+  result.timingsMs["parse"] = MsSince(t0);
+  t0 = std::chrono::steady_clock::now();
 
   // Every file the ASTs read is an input of the translation (for depfiles and cache keys).
   std::set<std::string> inputs;
@@ -181,6 +189,7 @@ AnalyzeResult Analyze(const TranslateRequest& request, AstCache* sharedCache) {
     return result;
   }
   FinishModel(model);
+  result.timingsMs["analyze"] = MsSince(t0);
   result.inputs.assign(inputs.begin(), inputs.end());
   result.diagnostics = diagText;  // warnings, if any
   result.ok = true;
@@ -188,10 +197,30 @@ AnalyzeResult Analyze(const TranslateRequest& request, AstCache* sharedCache) {
 }
 
 
-TranslateResult Translate(const TranslateRequest& request, AstCache* cache) {
+bool SpirvCache::Find(const std::string& glsl, std::vector<uint32_t>& words) const {
+  std::lock_guard<std::mutex> guard(m_mutex);
+  auto it = m_byGlsl.find(glsl);
+  if (it == m_byGlsl.end()) return false;
+  words = it->second;
+  return true;
+}
+
+void SpirvCache::Add(const std::string& glsl, const std::vector<uint32_t>& words) {
+  std::lock_guard<std::mutex> guard(m_mutex);
+  if (m_byGlsl.size() > 4096) m_byGlsl.clear();  // bounded: a few MiB at most
+  m_byGlsl[glsl] = words;
+}
+
+size_t SpirvCache::Size() const {
+  std::lock_guard<std::mutex> guard(m_mutex);
+  return m_byGlsl.size();
+}
+
+TranslateResult Translate(const TranslateRequest& request, AstCache* cache, SpirvCache* spirvCache) {
   TranslateResult result;
   AnalyzeResult analysis = Analyze(request, cache);
   result.diagnostics = analysis.diagnostics;
+  result.timingsMs = analysis.timingsMs;
   if (!analysis.ok) return result;
   const ClassModel& model = analysis.model;
   std::set<std::string> inputs(analysis.inputs.begin(), analysis.inputs.end());
@@ -201,15 +230,27 @@ TranslateResult Translate(const TranslateRequest& request, AstCache* cache) {
   options.headerName = llvm::sys::path::filename(model.headerFile).str();
   options.headerInclude = IncludeSpelling(model.headerFile, request.compileArgs);
   try {
+    auto t0 = std::chrono::steady_clock::now();
     bool vulkan = request.backend == Backend::Vulkan;
     result.files = GenerateHost(model, options, vulkan);
     if (vulkan) {
+      auto shaders = GenerateShaders(model, options);
+      result.timingsMs["generate"] = MsSince(t0);
+      t0 = std::chrono::steady_clock::now();
       std::vector<std::pair<std::string, std::vector<uint32_t>>> spirv;
-      for (auto& shader : GenerateShaders(model, options)) {
+      for (auto& shader : shaders) {
         result.files["shaders/" + shader.name + ".comp"] = shader.glsl;
-        spirv.push_back({shader.name, CompileGlsl(request.glslangValidator, shader.name, shader.glsl)});
+        std::vector<uint32_t> words;
+        if (!spirvCache || !spirvCache->Find(shader.glsl, words)) {
+          words = CompileGlsl(request.glslangValidator, shader.name, shader.glsl);
+          if (spirvCache) spirvCache->Add(shader.glsl, words);
+        }
+        spirv.push_back({shader.name, words});
       }
       result.files[model.className + "_Vulkan_shaders.cpp"] = EmbedSpirv(model.className, spirv);
+      result.timingsMs["spirv"] = MsSince(t0);
+    } else {
+      result.timingsMs["generate"] = MsSince(t0);
     }
   } catch (const std::exception& e) {
     result.diagnostics = diagText + "error: " + e.what() + "\n";

@@ -1,0 +1,69 @@
+#include "Manifest.h"
+
+#include <nlohmann/json.hpp>
+#include <xxhash.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace crossrt::client {
+
+namespace {
+std::string Hex(uint64_t v) {
+  char buf[24];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(v));
+  return buf;
+}
+}  // namespace
+
+std::string OptionsKey(const engine::TranslateRequest& r) {
+  std::string text = std::string(engine::TranslatorVersion()) + '\n' + r.className + '\n' +
+                     (r.backend == engine::Backend::Vulkan ? "vulkan" : "cpu") + '\n' + r.templateDir + '\n' + r.glslangValidator;
+  for (auto& s : r.sources) text += "\nsrc " + s;
+  for (auto& a : r.compileArgs) text += "\narg " + a;
+  return Hex(XXH64(text.data(), text.size(), 0));
+}
+
+std::string HashFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return "";
+  std::ostringstream os;
+  os << in.rdbuf();
+  std::string data = os.str();
+  return Hex(XXH64(data.data(), data.size(), 0));
+}
+
+std::string ManifestPath(const engine::TranslateRequest& r) { return r.outputDir + "/.crossrt-manifest.json"; }
+
+bool UpToDate(const engine::TranslateRequest& request) {
+  std::ifstream in(ManifestPath(request));
+  if (!in) return false;
+  nlohmann::json m;
+  try {
+    in >> m;
+    if (m.at("optionsKey").get<std::string>() != OptionsKey(request)) return false;
+    for (auto& out : m.at("outputs"))
+      if (!std::filesystem::exists(request.outputDir + "/" + out.get<std::string>())) return false;
+    for (auto& input : m.at("inputs"))
+      if (HashFile(input.at(0).get<std::string>()) != input.at(1).get<std::string>()) return false;
+  } catch (const std::exception&) {
+    return false;  // unreadable: translate again
+  }
+  return true;
+}
+
+void WriteManifest(const engine::TranslateRequest& request, const engine::TranslateResult& result) {
+  nlohmann::json m;
+  m["optionsKey"] = OptionsKey(request);
+  m["inputs"] = nlohmann::json::array();
+  for (auto& in : result.inputs) m["inputs"].push_back({in, HashFile(in)});
+  m["outputs"] = nlohmann::json::array();
+  for (auto& [name, contents] : result.files) m["outputs"].push_back(name);
+  std::string path = ManifestPath(request), tmp = path + ".tmp";
+  std::ofstream(tmp) << m.dump(1) << "\n";
+  std::filesystem::rename(tmp, path);
+}
+
+}  // namespace crossrt::client

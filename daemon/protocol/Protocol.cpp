@@ -1,0 +1,86 @@
+#include "Protocol.h"
+
+#include <xxhash.h>
+
+#include <cerrno>
+#include <climits>
+#include <cstdlib>
+#include <stdexcept>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+namespace crossrt::protocol {
+
+Endpoint EndpointFor(const std::string& buildDir) {
+  char resolved[PATH_MAX];
+  std::string tree = realpath(buildDir.c_str(), resolved) ? resolved : buildDir;
+  const char* runtime = std::getenv("XDG_RUNTIME_DIR");
+  std::string dir = (runtime && *runtime && access(runtime, W_OK) == 0) ? std::string(runtime) + "/crossrt"
+                                                                         : "/tmp/crossrt-" + std::to_string(getuid());
+  if (mkdir(dir.c_str(), 0700) != 0 && errno != EEXIST)
+    throw std::runtime_error("cannot create the daemon directory '" + dir + "'");
+  struct stat st {};
+  if (lstat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode) || st.st_uid != getuid() || (st.st_mode & 077) != 0)
+    throw std::runtime_error("the daemon directory '" + dir + "' is not a private directory of this user (mode 0700)");
+  char name[32];
+  std::snprintf(name, sizeof name, "%016llx", static_cast<unsigned long long>(XXH64(tree.data(), tree.size(), 0)));
+  return {dir, dir + "/" + name + ".sock", dir + "/" + name + ".lock"};
+}
+
+nlohmann::json ToJson(const engine::TranslateRequest& r) {
+  return {{"className", r.className},
+          {"backend", r.backend == engine::Backend::Vulkan ? "vulkan" : "cpu"},
+          {"sources", r.sources},
+          {"compileArgs", r.compileArgs},
+          {"outputDir", r.outputDir},
+          {"templateDir", r.templateDir},
+          {"glslangValidator", r.glslangValidator}};
+}
+
+engine::TranslateRequest RequestFromJson(const nlohmann::json& j) {
+  engine::TranslateRequest r;
+  r.className = j.at("className").get<std::string>();
+  std::string backend = j.at("backend").get<std::string>();
+  if (backend != "vulkan" && backend != "cpu") throw std::runtime_error("unknown backend '" + backend + "'");
+  r.backend = backend == "vulkan" ? engine::Backend::Vulkan : engine::Backend::Cpu;
+  r.sources = j.at("sources").get<std::vector<std::string>>();
+  r.compileArgs = j.at("compileArgs").get<std::vector<std::string>>();
+  r.outputDir = j.at("outputDir").get<std::string>();
+  r.templateDir = j.at("templateDir").get<std::string>();
+  r.glslangValidator = j.at("glslangValidator").get<std::string>();
+  if (r.className.empty() || r.sources.empty()) throw std::runtime_error("className and sources must not be empty");
+  return r;
+}
+
+bool WriteLine(int fd, const std::string& line) {
+  std::string data = line + "\n";
+  size_t done = 0;
+  while (done < data.size()) {
+    ssize_t n = ::send(fd, data.data() + done, data.size() - done, MSG_NOSIGNAL);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    done += size_t(n);
+  }
+  return true;
+}
+
+bool ReadLine(int fd, std::string& line, size_t maxBytes, bool* tooLong) {
+  line.clear();
+  if (tooLong) *tooLong = false;
+  char buf[65536];
+  while (true) {
+    ssize_t n = ::recv(fd, buf, sizeof buf, 0);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    const char* end = static_cast<const char*>(memchr(buf, '\n', size_t(n)));
+    line.append(buf, end ? size_t(end - buf) : size_t(n));
+    if (line.size() > maxBytes) {
+      if (tooLong) *tooLong = true;
+      return false;
+    }
+    if (end) return true;  // one request per connection: nothing follows the newline
+  }
+}
+
+}  // namespace crossrt::protocol
