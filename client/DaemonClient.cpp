@@ -68,7 +68,12 @@ bool DaemonClient::Start() {
     dup2(devnull, 0);
     dup2(devnull, 1);
     dup2(devnull, 2);
-    execl(exe.c_str(), exe.c_str(), "--build-dir", m_buildDir.c_str(), "--log", log.c_str(), (char*)nullptr);
+    // CROSSRT_DAEMON_IDLE_SECONDS shortens the idle timeout (tests use it).
+    const char* idle = std::getenv("CROSSRT_DAEMON_IDLE_SECONDS");
+    if (idle)
+      execl(exe.c_str(), exe.c_str(), "--build-dir", m_buildDir.c_str(), "--log", log.c_str(), "--idle-seconds", idle, (char*)nullptr);
+    else
+      execl(exe.c_str(), exe.c_str(), "--build-dir", m_buildDir.c_str(), "--log", log.c_str(), (char*)nullptr);
     _exit(127);
   }
   waitpid(child, nullptr, 0);

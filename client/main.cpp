@@ -18,6 +18,8 @@
 #include <fstream>
 #include <iostream>
 #include <string>
+#include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 #include <vector>
 
@@ -87,6 +89,15 @@ int DaemonCommand(const std::vector<std::string>& args) {
     return 1;
   }
   if (what == "stop") {
+    // Return once it has exited: its lock on the build tree is free again.
+    std::string lock = crossrt::protocol::EndpointFor(buildDir).lock;
+    for (int i = 0; i < 300; ++i) {
+      int fd = open(lock.c_str(), O_RDWR | O_CLOEXEC);
+      bool free = fd >= 0 && flock(fd, LOCK_EX | LOCK_NB) == 0;
+      if (fd >= 0) close(fd);
+      if (free) break;
+      usleep(50 * 1000);
+    }
     std::cout << "stopped the daemon of " << buildDir << "\n";
     return 0;
   }

@@ -52,6 +52,12 @@ struct Daemon {
   std::mutex logMutex;
   std::ofstream log;
   std::string crashAt;
+  std::string socketPath;
+
+  // Stop taking requests at once: new clients find no socket and start a fresh daemon.
+  void Stop() {
+    if (!stopping.exchange(true)) unlink(socketPath.c_str());
+  }
 
   long Now() const {
     return long(std::chrono::duration_cast<std::chrono::seconds>(std::chrono::steady_clock::now() - started).count());
@@ -111,14 +117,14 @@ json Handle(Daemon& d, const std::string& line) {
     return {{"ok", false}, {"error", "malformed request: no protocol version"}};
   if (request["protocol"].get<int>() != protocol::kProtocolVersion || request.value("version", "") != engine::TranslatorVersion()) {
     // The client runs another version: step aside so that it can start its own daemon.
-    d.stopping = true;
+    d.Stop();
     return {{"ok", false}, {"error", "version-mismatch"}, {"daemonVersion", engine::TranslatorVersion()},
             {"daemonProtocol", protocol::kProtocolVersion}};
   }
   std::string command = request.value("command", "");
   if (command == "status") return {{"ok", true}, {"status", Status(d)}};
   if (command == "stop") {
-    d.stopping = true;
+    d.Stop();
     return {{"ok", true}};
   }
   if (command != "translate") return {{"ok", false}, {"error", "malformed request: unknown command '" + command + "'"}};
@@ -238,9 +244,11 @@ int main(int argc, char** argv) {
   d.Log("serving " + d.buildDir + " on " + ep.socket + " (idle timeout " + std::to_string(d.idleSeconds) +
         " s, at most " + std::to_string(d.maxAsts) + " cached ASTs)");
 
+  d.socketPath = ep.socket;
   while (!d.stopping) {
     pollfd pfd{server, POLLIN, 0};
     int ready = poll(&pfd, 1, 1000);
+    if (d.stopping) break;  // a stopping daemon takes no new requests
     if (ready > 0) {
       int fd = accept4(server, nullptr, nullptr, SOCK_CLOEXEC);
       if (fd < 0) continue;
@@ -257,7 +265,7 @@ int main(int argc, char** argv) {
     }
   }
   // Stop taking connections, let running requests answer, then go.
-  unlink(ep.socket.c_str());
+  if (!d.stopping) unlink(ep.socket.c_str());
   close(server);
   for (int i = 0; i < 600 && d.active > 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(100));
   d.Log("stopped");
