@@ -91,6 +91,13 @@ function(crossrt_add_class target class)
     COMMAND_EXPAND_LISTS
     VERBATIM)
 
+  # `cmake --build . --target crossrt_generate` translates every class without compiling anything.
+  if(NOT TARGET crossrt_generate)
+    add_custom_target(crossrt_generate)
+  endif()
+  add_custom_target(crossrt_generate_${target}_${class}_${suffix} DEPENDS ${outputs})
+  add_dependencies(crossrt_generate crossrt_generate_${target}_${class}_${suffix})
+
   target_sources(${target} PRIVATE ${outputs})
   target_include_directories(${target} PRIVATE ${out_dir})
   if(suffix STREQUAL "Vulkan")
