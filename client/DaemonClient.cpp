@@ -1,7 +1,7 @@
 #include "DaemonClient.h"
 
 #include "Protocol.h"
-#include "Translator.h"
+#include "TranslateTypes.h"
 
 #include <chrono>
 #include <climits>
@@ -82,7 +82,7 @@ bool DaemonClient::Start() {
 
 std::optional<nlohmann::json> DaemonClient::Call(nlohmann::json request, bool start, int timeoutSeconds) {
   request["protocol"] = protocol::kProtocolVersion;
-  request["version"] = engine::TranslatorVersion();
+  request["version"] = engine::kTranslatorVersion;
   for (int attempt = 0; attempt < 2; ++attempt) {
     int fd = Connect();
     if (fd < 0 && start) {

@@ -19,8 +19,8 @@ std::string Hex(uint64_t v) {
 }  // namespace
 
 std::string OptionsKey(const engine::TranslateRequest& r) {
-  std::string text = std::string(engine::TranslatorVersion()) + '\n' + r.className + '\n' +
-                     (r.backend == engine::Backend::Vulkan ? "vulkan" : "cpu") + '\n' + r.templateDir + '\n' + r.glslangValidator;
+  std::string text = std::string(engine::kTranslatorVersion) + '\n' + r.className + '\n' +
+                     (r.backend == engine::Backend::Vulkan ? "vulkan" : "cpu") + '\n' + r.templateDir;
   for (auto& s : r.sources) text += "\nsrc " + s;
   for (auto& a : r.compileArgs) text += "\narg " + a;
   return Hex(XXH64(text.data(), text.size(), 0));

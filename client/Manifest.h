@@ -2,7 +2,7 @@
 // class's sources and every header they include, the templates), its options and the translator's
 // version; the manifest records their hashes, so an unchanged key is recognised without parsing.
 #pragma once
-#include "Translator.h"
+#include "TranslateTypes.h"
 
 #include <string>
 #include <vector>

@@ -9,9 +9,11 @@
 // cannot answer for any reason, translates in-process: the build never fails because of the
 // daemon. Outputs are written atomically, only where their bytes changed.
 #include "DaemonClient.h"
+#include "InProcess.h"
 #include "Manifest.h"
+#include "Outputs.h"
 #include "Protocol.h"
-#include "Translator.h"
+#include "TranslateTypes.h"
 
 #include <cstdio>
 #include <cstdlib>
@@ -30,7 +32,7 @@ namespace {
 
 const char* kUsage =
     "usage: crossrt translate --class NAME --backend vulkan|cpu --out DIR --source FILE [--source FILE...]\n"
-    "                         [--templates DIR] [--glslang PATH] [--depfile FILE --depfile-target FILE]\n"
+    "                         [--templates DIR] [--depfile FILE --depfile-target FILE]\n"
     "                         [--build-dir DIR | --no-daemon] [-- COMPILE_ARGS...]\n"
     "       crossrt daemon status [--build-dir DIR] [--json]\n"
     "       crossrt daemon stop [--build-dir DIR]\n"
@@ -126,7 +128,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
   if (args.empty()) return Usage("no command given");
   if (args[0] == "--version") {
-    std::cout << "crossrt " << engine::TranslatorVersion() << "\n";
+    std::cout << "crossrt " << engine::kTranslatorVersion << "\n";
     return 0;
   }
   if (args[0] == "daemon") return DaemonCommand(args);
@@ -153,7 +155,6 @@ int main(int argc, char** argv) {
     else if (a == "--out") request.outputDir = v;
     else if (a == "--source") request.sources.push_back(v);
     else if (a == "--templates") request.templateDir = v;
-    else if (a == "--glslang") request.glslangValidator = v;
     else if (a == "--depfile") depfile = v;
     else if (a == "--depfile-target") depfileTarget = v;
     else if (a == "--build-dir") buildDir = v;
@@ -177,10 +178,7 @@ int main(int argc, char** argv) {
     std::string why = response ? response->value("error", "unknown error") : daemon.Error();
     if (response && response->value("ok", false)) {
       try {
-        result.ok = response->value("translated", false);
-        result.diagnostics = response->value("diagnostics", "");
-        result.files = response->at("files").get<std::map<std::string, std::string>>();
-        result.inputs = response->at("inputs").get<std::vector<std::string>>();
+        result = crossrt::protocol::ResultFromJson(*response);
         translated = true;
       } catch (const std::exception& e) {
         why = std::string("unreadable answer: ") + e.what();
@@ -191,7 +189,7 @@ int main(int argc, char** argv) {
   }
   if (!translated) {
     try {
-      result = engine::Translate(request);
+      result = crossrt::client::TranslateInProcess(request);
     } catch (const std::exception& e) {
       std::cerr << "crossrt: internal error while translating '" << request.className << "': " << e.what() << "\n";
       return 1;
@@ -203,7 +201,7 @@ int main(int argc, char** argv) {
     return 1;
   }
   try {
-    engine::WriteOutputs(request, result);
+    crossrt::client::WriteOutputs(request, result);
     crossrt::client::WriteManifest(request, result);
   } catch (const std::exception& e) {
     std::cerr << "crossrt: error: " << e.what() << "\n";

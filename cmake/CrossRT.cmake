@@ -81,7 +81,6 @@ function(crossrt_add_class target class)
             --class ${class} --backend ${backend} --out ${out_dir}
             ${source_args}
             --templates ${CROSSRT_TEMPLATE_DIR}
-            --glslang ${Vulkan_GLSLANG_VALIDATOR_EXECUTABLE}
             --depfile ${out_dir}/${class}_${suffix}.d --depfile-target ${first_output}
             --build-dir ${CMAKE_BINARY_DIR}
             -- ${compile_args}

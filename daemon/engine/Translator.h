@@ -1,7 +1,9 @@
 // The translation engine: turns one user class into generated source files.
-// It knows nothing about sockets or processes: the client runs it in-process, the daemon will host it.
+// It knows nothing about sockets or processes: the daemon hosts it, and the client loads it
+// (EnginePlugin.cpp) to translate in-process when no daemon can answer.
 #pragma once
 #include "Model.h"
+#include "TranslateTypes.h"
 
 #include <map>
 #include <mutex>
@@ -9,26 +11,6 @@
 #include <vector>
 
 namespace crossrt::engine {
-
-enum class Backend { Vulkan, Cpu };
-
-struct TranslateRequest {
-  std::string className;                 // e.g. "MyRender"
-  Backend backend = Backend::Vulkan;
-  std::vector<std::string> sources;      // .cpp files that define the class's member functions
-  std::vector<std::string> compileArgs;  // -I, -D, -std=... as the target compiles them
-  std::string outputDir;                 // build-tree folder for the generated files
-  std::string templateDir;               // templates/ (vulkan, glsl, cpu subfolders)
-  std::string glslangValidator = "glslangValidator";  // compiles generated GLSL to SPIR-V
-};
-
-struct TranslateResult {
-  bool ok = false;
-  std::string diagnostics;                      // compiler-style text: file:line:col: error: ...
-  std::map<std::string, std::string> files;     // file name (relative to outputDir) -> contents
-  std::vector<std::string> inputs;              // every file the translation read (for depfiles)
-  std::map<std::string, double> timingsMs;      // parse, analyze, generate, spirv
-};
 
 struct AnalyzeResult {
   bool ok = false;
@@ -63,10 +45,6 @@ TranslateResult Translate(const TranslateRequest& request, AstCache* cache = nul
 // The compile arguments the engine parses with: the request's, plus what the engine adds.
 std::vector<std::string> ParseArguments(const TranslateRequest& request);
 
-// Writes result.files into outputDir atomically, touching only files whose bytes changed.
-// Returns the names of the files it rewrote. Throws std::runtime_error on IO failure.
-std::vector<std::string> WriteOutputs(const TranslateRequest& request, const TranslateResult& result);
-
-const char* TranslatorVersion();
+inline const char* TranslatorVersion() { return kTranslatorVersion; }
 
 }  // namespace crossrt::engine

@@ -3,6 +3,7 @@
 #include <xxhash.h>
 
 #include <cerrno>
+#include <cstring>
 #include <climits>
 #include <cstdlib>
 #include <stdexcept>
@@ -34,8 +35,7 @@ nlohmann::json ToJson(const engine::TranslateRequest& r) {
           {"sources", r.sources},
           {"compileArgs", r.compileArgs},
           {"outputDir", r.outputDir},
-          {"templateDir", r.templateDir},
-          {"glslangValidator", r.glslangValidator}};
+          {"templateDir", r.templateDir}};
 }
 
 engine::TranslateRequest RequestFromJson(const nlohmann::json& j) {
@@ -48,8 +48,22 @@ engine::TranslateRequest RequestFromJson(const nlohmann::json& j) {
   r.compileArgs = j.at("compileArgs").get<std::vector<std::string>>();
   r.outputDir = j.at("outputDir").get<std::string>();
   r.templateDir = j.at("templateDir").get<std::string>();
-  r.glslangValidator = j.at("glslangValidator").get<std::string>();
   if (r.className.empty() || r.sources.empty()) throw std::runtime_error("className and sources must not be empty");
+  return r;
+}
+
+nlohmann::json ResultToJson(const engine::TranslateResult& r) {
+  return {{"ok", true},       {"translated", r.ok}, {"diagnostics", r.diagnostics},
+          {"files", r.files}, {"inputs", r.inputs}, {"timingsMs", r.timingsMs}};
+}
+
+engine::TranslateResult ResultFromJson(const nlohmann::json& j) {
+  engine::TranslateResult r;
+  r.ok = j.at("translated").get<bool>();
+  r.diagnostics = j.at("diagnostics").get<std::string>();
+  r.files = j.at("files").get<std::map<std::string, std::string>>();
+  r.inputs = j.at("inputs").get<std::vector<std::string>>();
+  if (j.contains("timingsMs")) r.timingsMs = j["timingsMs"].get<std::map<std::string, double>>();
   return r;
 }
 

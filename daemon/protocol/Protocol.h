@@ -8,7 +8,7 @@
 //
 // Messages are single lines of JSON. Each connection carries one request and one response.
 #pragma once
-#include "Translator.h"
+#include "TranslateTypes.h"
 
 #include <nlohmann/json.hpp>
 
@@ -32,6 +32,10 @@ Endpoint EndpointFor(const std::string& buildDir);
 
 nlohmann::json ToJson(const engine::TranslateRequest& r);
 engine::TranslateRequest RequestFromJson(const nlohmann::json& j);  // throws on missing fields
+
+// The answer to a translate request: {"ok": true, "translated": ..., "diagnostics", "files", ...}.
+nlohmann::json ResultToJson(const engine::TranslateResult& r);
+engine::TranslateResult ResultFromJson(const nlohmann::json& j);   // throws on missing fields
 
 // Blocking line IO on a socket. ReadLine returns false on EOF, error or a line over maxBytes
 // (then `tooLong` is set).

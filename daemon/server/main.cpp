@@ -146,8 +146,7 @@ json Handle(Daemon& d, const std::string& line) {
   d.Log("translate " + tr.className + " (" + (tr.backend == engine::Backend::Vulkan ? "vulkan" : "cpu") + "): " +
         (result.ok ? "ok" : "failed") + " in " + std::to_string(int(ms)) + " ms (" + phases.substr(phases.empty() ? 0 : 1) + ")");
   d.MaybeCrash("translated");
-  return {{"ok", true},          {"translated", result.ok}, {"diagnostics", result.diagnostics},
-          {"files", result.files}, {"inputs", result.inputs}, {"timingsMs", result.timingsMs}};
+  return protocol::ResultToJson(result);
 }
 
 void Serve(Daemon& d, int fd) {

@@ -64,7 +64,7 @@ struct DaemonFixture
   std::string TranslateArgs(const fs::path& outDir, bool daemon = true) const
   {
     return "translate --class Scale --backend vulkan --out " + outDir.string() + " --source " + tc.Source("Scale") +
-           " --templates " CROSSRT_SOURCE_DIR "/templates --glslang " CROSSRT_GLSLANG_VALIDATOR +
+           " --templates " CROSSRT_SOURCE_DIR "/templates" +
            (daemon ? " --build-dir " + build.string() : std::string(" --no-daemon")) + " -- -I" CROSSRT_SOURCE_DIR "/libs/litemath";
   }
   CommandResult Translate(const fs::path& outDir) const { return RunCrossrt(TranslateArgs(outDir)); }
@@ -239,7 +239,7 @@ TEST_CASE("Malformed, oversized and foreign requests get an error while the daem
   expectError("[1, 2, 3]\n", "no protocol version");
   expectError(R"({"protocol": 1, "version": ")" + version + R"(", "command": "dance"})" "\n", "unknown command");
   expectError(R"({"protocol": 1, "version": ")" + version + R"(", "command": "translate", "request": {"className": "X"}})" "\n", "malformed request");
-  expectError(R"({"protocol": 1, "version": ")" + version + R"(", "command": "translate", "request": {"className": "X", "backend": "metal", "sources": ["a"], "compileArgs": [], "outputDir": "o", "templateDir": "t", "glslangValidator": "g"}})" "\n", "unknown backend");
+  expectError(R"({"protocol": 1, "version": ")" + version + R"(", "command": "translate", "request": {"className": "X", "backend": "metal", "sources": ["a"], "compileArgs": [], "outputDir": "o", "templateDir": "t"}})" "\n", "unknown backend");
   expectError(std::string(crossrt::protocol::kMaxRequestBytes + 10, 'x') + "\n", "request too large");
   // Still serving.
   auto s = f.Status();

@@ -38,7 +38,6 @@ inline crossrt::engine::TranslateRequest MakeRequest(const TempClass& tc, const 
   r.compileArgs = {"-I" CROSSRT_SOURCE_DIR "/libs/litemath", "-I" + tc.dir.string()};
   r.outputDir = (tc.dir / "out").string();
   r.templateDir = CROSSRT_SOURCE_DIR "/templates";
-  r.glslangValidator = CROSSRT_GLSLANG_VALIDATOR;
   return r;
 }
 

@@ -1,0 +1,31 @@
+// What a translation takes and gives: plain data shared by the engine, the daemon, the protocol
+// and the client (which does not link the engine).
+#pragma once
+#include <map>
+#include <string>
+#include <vector>
+
+namespace crossrt::engine {
+
+constexpr const char* kTranslatorVersion = "0.1.0";
+
+enum class Backend { Vulkan, Cpu };
+
+struct TranslateRequest {
+  std::string className;                 // e.g. "MyRender"
+  Backend backend = Backend::Vulkan;
+  std::vector<std::string> sources;      // .cpp files that define the class's member functions
+  std::vector<std::string> compileArgs;  // -I, -D, -std=... as the target compiles them
+  std::string outputDir;                 // build-tree folder for the generated files
+  std::string templateDir;               // templates/ (vulkan, glsl, cpu subfolders)
+};
+
+struct TranslateResult {
+  bool ok = false;
+  std::string diagnostics;                      // compiler-style text: file:line:col: error: ...
+  std::map<std::string, std::string> files;     // file name (relative to outputDir) -> contents
+  std::vector<std::string> inputs;              // every file the translation read (for depfiles)
+  std::map<std::string, double> timingsMs;      // parse, analyze, generate, spirv
+};
+
+}  // namespace crossrt::engine
