@@ -97,6 +97,10 @@ std::optional<nlohmann::json> DaemonClient::Call(nlohmann::json request, bool st
       }
     }
     if (fd < 0) return std::nullopt;
+    if (timeoutSeconds <= 0) {
+      const char* env = std::getenv("CROSSRT_DAEMON_TIMEOUT_SECONDS");
+      timeoutSeconds = env && std::atoi(env) > 0 ? std::atoi(env) : 120;
+    }
     timeval tv{timeoutSeconds, 0};  // a hung daemon must not hang the build
     setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
     std::string line;

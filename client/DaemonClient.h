@@ -15,7 +15,9 @@ public:
 
   // Sends `request` (protocol and version are added) and returns the response, starting the
   // daemon first when `start` and none answers. nullopt with Error() set when that failed.
-  std::optional<nlohmann::json> Call(nlohmann::json request, bool start, int timeoutSeconds = 600);
+  // A daemon that has not answered after `timeoutSeconds` is taken as hung (default: 120 s, or
+  // CROSSRT_DAEMON_TIMEOUT_SECONDS); the caller then translates in-process.
+  std::optional<nlohmann::json> Call(nlohmann::json request, bool start, int timeoutSeconds = 0);
   const std::string& Error() const { return m_error; }
 
 private:

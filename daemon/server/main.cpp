@@ -8,7 +8,8 @@
 // another version asks (so that the client can start its own).
 //
 // Test hook: CROSSRT_DAEMON_CRASH_AT=<stage> makes it SIGKILL itself at that stage of a
-// translate request (accepted, read, parsed, translated, responding), to test client recovery.
+// translate request (accepted, read, parsed, translated, responding), or hang with "hang", to
+// test client recovery.
 #include "AstCache.h"
 #include "Protocol.h"
 #include "Translator.h"
@@ -71,6 +72,10 @@ struct Daemon {
     log << stamp << " [" << getpid() << "] " << message << std::endl;
   }
   void MaybeCrash(const char* stage) {
+    if (crashAt == "hang" && std::string(stage) == "parsed") {
+      Log("test hook: hanging");
+      std::this_thread::sleep_for(std::chrono::hours(1));
+    }
     if (crashAt == stage) {
       Log(std::string("test hook: SIGKILL at stage '") + stage + "'");
       raise(SIGKILL);

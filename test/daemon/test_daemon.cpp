@@ -209,6 +209,28 @@ TEST_CASE("A SIGKILL of the daemon at any stage of a request still gives the rig
   }
 }
 
+TEST_CASE("A hung daemon does not hang the build", "[daemon]")
+{
+  DaemonFixture f;
+  fs::path reference = f.build / "reference";
+  REQUIRE(RunCrossrt(f.TranslateArgs(reference, false)).exitCode == 0);
+  setenv("CROSSRT_DAEMON_CRASH_AT", "hang", 1);
+  setenv("CROSSRT_DAEMON_TIMEOUT_SECONDS", "2", 1);
+  auto r = f.Translate(f.out);
+  unsetenv("CROSSRT_DAEMON_TIMEOUT_SECONDS");
+  INFO(r.output);
+  REQUIRE(r.exitCode == 0);
+  REQUIRE(r.output.find("translating in-process") != std::string::npos);
+  REQUIRE(f.Generated(f.out) == f.Generated(reference));
+  // The hung daemon is still there: stop it by its pid (the fixture's stop request would wait).
+  for (auto& e : fs::directory_iterator("/proc")) {
+    std::string cmdline = ReadText(e.path() / "cmdline");
+    std::replace(cmdline.begin(), cmdline.end(), '\0', ' ');
+    if (cmdline.find("crossrtd") != std::string::npos && cmdline.find(f.build.string() + " ") != std::string::npos)
+      kill(std::stoi(e.path().filename().string()), SIGKILL);
+  }
+}
+
 TEST_CASE("Clients racing to start the daemon end with exactly one", "[daemon]")
 {
   DaemonFixture f;
