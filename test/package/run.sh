@@ -6,6 +6,9 @@ set -euo pipefail
 mode=$1 crossrt=$2 work=$3
 here=$(cd "$(dirname "$0")" && pwd)
 rm -rf "$work" && mkdir -p "$work"
+export CROSSRT_DAEMON_IDLE_SECONDS=60
+# The daemon this build starts goes when the test ends.
+trap 'for c in "$work"/prefix/bin/crossrt "$work"/build/crossrt/bin/crossrt; do [ -x "$c" ] && "$c" daemon stop --build-dir "$work/build" > /dev/null 2>&1; done; true' EXIT
 if [ "$mode" = install ]; then
   cmake --install "$crossrt" --prefix "$work/prefix" > "$work/install.log"
   cmake -S "$here" -B "$work/build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$work/prefix"
