@@ -53,10 +53,11 @@ function(crossrt_add_class target class)
     list(APPEND outputs ${out_dir}/${class}_Vulkan_shaders.cpp)
   endif()
 
-  # Parse the class as the target compiles it: its include paths, definitions and standard,
-  # plus the CrossRT libraries' headers.
+  # Parse the class as the target compiles it: its include paths, definitions, options (the engine
+  # keeps those that change the meaning of the code) and standard, plus the CrossRT libraries' headers.
   set(inc "$<TARGET_PROPERTY:${target},INCLUDE_DIRECTORIES>")
   set(defs "$<TARGET_PROPERTY:${target},COMPILE_DEFINITIONS>")
+  set(opts "$<TARGET_PROPERTY:${target},COMPILE_OPTIONS>")
   set(std "$<TARGET_PROPERTY:${target},CXX_STANDARD>")
   set(compile_args "$<$<BOOL:${inc}>:-I$<JOIN:${inc},$<SEMICOLON>-I>>")
   foreach(lib crossrt::litemath crossrt::liteimage crossrt::litert)
@@ -64,6 +65,7 @@ function(crossrt_add_class target class)
   endforeach()
   list(APPEND compile_args
     "$<$<BOOL:${defs}>:-D$<JOIN:${defs},$<SEMICOLON>-D>>"
+    "${opts}"
     "$<$<BOOL:${std}>:-std=c++${std}>")
 
   if(TARGET crossrt)

@@ -110,11 +110,35 @@ std::string EmbedSpirv(const std::string& className, const std::vector<std::pair
   return os.str();
 }
 
+// The target's flags that change what the class means to Clang: include paths, macros, the
+// language standard, target and feature flags. The rest (warnings, optimisation, GCC-only
+// spellings) is dropped: the class is only parsed, and an unknown flag would stop Clang.
+bool KeepFlag(const std::string& a) {
+  static const char* prefixes[] = {"-D", "-U", "-I", "-std=", "-m", "-isystem", "-iquote", "-include", "-fopenmp",
+                                   "-fno-exceptions", "-fno-rtti", "-fexceptions", "-frtti", "-fchar8_t", "-fno-char8_t"};
+  for (const char* p : prefixes)
+    if (a.rfind(p, 0) == 0) return true;
+  return false;
+}
+
+std::vector<std::string> FilterFlags(const std::vector<std::string>& in) {
+  std::vector<std::string> out;
+  for (size_t i = 0; i < in.size(); ++i) {
+    const std::string& a = in[i];
+    bool takesValue = a == "-I" || a == "-D" || a == "-U" || a == "-isystem" || a == "-iquote" || a == "-include";
+    if (!KeepFlag(a)) continue;
+    out.push_back(a);
+    if (takesValue && i + 1 < in.size()) out.push_back(in[++i]);
+  }
+  return out;
+}
+
 }  // namespace
 
 std::vector<std::string> ParseArguments(const TranslateRequest& request) {
   std::vector<std::string> args = {"-xc++", "-std=c++17", "-fsyntax-only", "-D__CROSSRT__=1", "-Wno-unused-command-line-argument"};
-  args.insert(args.end(), request.compileArgs.begin(), request.compileArgs.end());
+  auto kept = FilterFlags(request.compileArgs);
+  args.insert(args.end(), kept.begin(), kept.end());
   return args;
 }
 

@@ -164,3 +164,32 @@ TEST_CASE("The CPU backend parallelises kernels with OpenMP", "[engine]")
   CHECK(cpp.find("#pragma omp parallel for schedule(static) reduction(+:m_totalLocal) reduction(crossrt_min_vec3:m_loLocal)") != std::string::npos);
   CHECK(cpp.find("m_totalLocal += out[i];") != std::string::npos);
 }
+
+TEST_CASE("Target compile options: meaning-changing flags are kept, GCC-only ones dropped", "[engine]")
+{
+  TranslateRequest r;
+  r.compileArgs = {"-I/a", "-isystem", "/b", "-DX=1", "-O3", "-Wall", "-Wno-attributes=crossrt::size",
+                   "-fconcepts-diagnostics-depth=2", "-march=x86-64", "-fopenmp", "-std=c++20", "-include", "pre.h"};
+  auto args = ParseArguments(r);
+  auto has = [&](const std::string& a) { return std::find(args.begin(), args.end(), a) != args.end(); };
+  CHECK(has("-I/a"));
+  CHECK(has("-isystem"));
+  CHECK(has("/b"));
+  CHECK(has("-DX=1"));
+  CHECK(has("-march=x86-64"));
+  CHECK(has("-fopenmp"));
+  CHECK(has("-std=c++20"));
+  CHECK(has("pre.h"));
+  CHECK_FALSE(has("-O3"));
+  CHECK_FALSE(has("-Wall"));
+  CHECK_FALSE(has("-Wno-attributes=crossrt::size"));
+  CHECK_FALSE(has("-fconcepts-diagnostics-depth=2"));
+
+  // With a GCC-only flag among the target's options, the class still parses, and -D applies.
+  TempClass tc("Finder", std::string("#if SCALE != 3\n#error SCALE must come from the options\n#endif\n") + kHeader, kSource);
+  auto req = MakeRequest(tc, "Finder");
+  req.compileArgs.insert(req.compileArgs.end(), {"-DSCALE=3", "-fconcepts-diagnostics-depth=2", "-O2"});
+  AnalyzeResult a = Analyze(req);
+  INFO(a.diagnostics);
+  CHECK(a.ok);
+}
