@@ -16,8 +16,6 @@
 
 namespace crossrt::client {
 
-namespace {
-
 // crossrtd lives next to crossrt (bin/ of the build tree or of the installation).
 std::string DaemonExecutable() {
   if (const char* env = std::getenv("CROSSRT_DAEMON")) return env;
@@ -28,8 +26,6 @@ std::string DaemonExecutable() {
   std::string dir(self);
   return dir.substr(0, dir.rfind('/')) + "/crossrtd";
 }
-
-}  // namespace
 
 int DaemonClient::Connect() {
   protocol::Endpoint ep;
@@ -83,6 +79,7 @@ bool DaemonClient::Start() {
 std::optional<nlohmann::json> DaemonClient::Call(nlohmann::json request, bool start, int timeoutSeconds) {
   request["protocol"] = protocol::kProtocolVersion;
   request["version"] = engine::kTranslatorVersion;
+  request["engine"] = protocol::TranslatorIdentity(DaemonExecutable());
   for (int attempt = 0; attempt < 2; ++attempt) {
     int fd = Connect();
     if (fd < 0 && start) {

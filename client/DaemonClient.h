@@ -9,6 +9,9 @@
 
 namespace crossrt::client {
 
+// The crossrtd executable next to crossrt (or CROSSRT_DAEMON).
+std::string DaemonExecutable();
+
 class DaemonClient {
 public:
   explicit DaemonClient(std::string buildDir) : m_buildDir(std::move(buildDir)) {}

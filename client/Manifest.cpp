@@ -1,5 +1,8 @@
 #include "Manifest.h"
 
+#include "DaemonClient.h"
+#include "Protocol.h"
+
 #include <nlohmann/json.hpp>
 #include <xxhash.h>
 
@@ -19,7 +22,8 @@ std::string Hex(uint64_t v) {
 }  // namespace
 
 std::string OptionsKey(const engine::TranslateRequest& r) {
-  std::string text = std::string(engine::kTranslatorVersion) + '\n' + r.className + '\n' +
+  // The translator's build is part of the key: a rebuilt translator translates again.
+  std::string text = protocol::TranslatorIdentity(DaemonExecutable()) + '\n' + r.className + '\n' +
                      (r.backend == engine::Backend::Vulkan ? "vulkan" : "cpu") + '\n' + r.templateDir;
   for (auto& s : r.sources) text += "\nsrc " + s;
   for (auto& a : r.compileArgs) text += "\narg " + a;

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <map>
+#include <optional>
 #include <regex>
 #include <sstream>
 
@@ -551,11 +552,27 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
 
 // ---- control functions -----------------------------------------------------
 
+// Kernel calls, and library calls that work on member vectors (scan, fill, memcpy): either makes
+// a member function a control function.
 struct KernelCallFinder : RecursiveASTVisitor<KernelCallFinder> {
-  std::vector<const CXXMemberCallExpr*> calls;
+  std::vector<const Expr*> calls;
   bool VisitCXXMemberCallExpr(CXXMemberCallExpr* call) {
     if (auto* md = call->getMethodDecl(); md && IsKernelName(md->getName()) && isa<CXXThisExpr>(call->getImplicitObjectArgument()->IgnoreParenImpCasts()))
       calls.push_back(call);
+    return true;
+  }
+  bool VisitCallExpr(CallExpr* call) {
+    auto* fd = call->getDirectCallee();
+    static const std::set<std::string> library = {"exclusive_scan", "inclusive_scan", "fill", "memcpy", "memmove"};
+    if (!fd || !fd->isInStdNamespace() || !library.count(fd->getNameAsString()) || isa<CXXMemberCallExpr>(call)) return true;
+    for (auto* arg : call->arguments()) {
+      auto* mc = dyn_cast<CXXMemberCallExpr>(arg->IgnoreParenImpCasts());
+      if (auto* bo = dyn_cast<BinaryOperator>(arg->IgnoreParenImpCasts())) mc = dyn_cast<CXXMemberCallExpr>(bo->getLHS()->IgnoreParenImpCasts());
+      if (mc && ThisField(mc->getImplicitObjectArgument()) && IsStdVector(ThisField(mc->getImplicitObjectArgument())->getType())) {
+        calls.push_back(call);
+        break;
+      }
+    }
     return true;
   }
 };
@@ -721,11 +738,133 @@ private:
                   "on the GPU each control function is one submission: call its kernels directly here, or call both from outside the class");
   }
 
+  // ---- library calls on device data: std::exclusive_scan/inclusive_scan, memcpy, std::fill ----
+
+  // A position in device data: `m_v.begin()`, `m_v.end()`, `m_v.data()`, a pointer parameter,
+  // each optionally `+ k`.
+  struct Position {
+    std::string view;      // BufferView expression of the start of the underlying buffer
+    std::string key;       // which buffer (member or parameter name)
+    std::string offset;    // elements from the start ("" for 0)
+    QualType element;
+    const Member* vector = nullptr;
+    bool isEnd = false;
+  };
+
+  std::optional<Position> PositionOf(const Expr* e) {
+    e = e->IgnoreParenImpCasts();
+    if (auto* bo = dyn_cast<BinaryOperator>(e); bo && bo->getOpcode() == BO_Add) {
+      auto p = PositionOf(bo->getLHS());
+      if (!p || p->isEnd) return std::nullopt;
+      p->offset = (p->offset.empty() ? "" : p->offset + " + ") + "(" + m_c.Text(bo->getRHS()->getSourceRange()) + ")";
+      return p;
+    }
+    if (auto* op = dyn_cast<CXXOperatorCallExpr>(e); op && op->getOperator() == OO_Plus && op->getNumArgs() == 2) {
+      auto p = PositionOf(op->getArg(0));
+      if (!p || p->isEnd) return std::nullopt;
+      p->offset = (p->offset.empty() ? "" : p->offset + " + ") + "(" + m_c.Text(op->getArg(1)->getSourceRange()) + ")";
+      return p;
+    }
+    if (auto* dr = dyn_cast<DeclRefExpr>(e))
+      if (auto* p = dyn_cast<ParmVarDecl>(dr->getDecl()); p && p->getDeclContext() == m_def && p->getType()->isPointerType())
+        return Position{"m_inOut_" + m_ctrl.name + "." + p->getNameAsString(), p->getNameAsString(), "", p->getType()->getPointeeType().getUnqualifiedType()};
+    if (auto* mc = dyn_cast<CXXMemberCallExpr>(e)) {
+      std::string method = mc->getMethodDecl() ? mc->getMethodDecl()->getNameAsString() : "";
+      auto* f = ThisField(mc->getImplicitObjectArgument());
+      QualType element;
+      if (f && IsStdVector(f->getType(), &element) && (method == "begin" || method == "end" || method == "data")) {
+        Member* m = FindMember(m_c.model, f->getNameAsString());
+        if (!m) return std::nullopt;
+        m->usedByKernels = true;  // so that it gets a device buffer
+        Position p{"m_vdata." + m->name + ".View()", m->name, "", element.getUnqualifiedType(), m};
+        p.isEnd = method == "end";
+        return p;
+      }
+    }
+    return std::nullopt;
+  }
+
+  std::string ViewAt(const Position& p) {
+    if (p.offset.empty()) return p.view;
+    return "crossrt::Offset(" + p.view + ", sizeof(" + CppTypeName(m_c.ctx, p.element) + ") * size_t(" + p.offset + "))";
+  }
+
+  // Elements from `first` to `last`.
+  std::optional<std::string> Count(const Position& first, const Position& last) {
+    if (first.key != last.key) return std::nullopt;
+    std::string end = last.isEnd ? first.vector->name + ".size()" : last.offset;
+    if (end.empty()) end = "0";
+    return first.offset.empty() ? "(" + end + ")" : "(" + end + ") - (" + first.offset + ")";
+  }
+
+  void WrittenVector(const Position& p) {
+    if (p.vector && std::find(m_ctrl.vectorsWritten.begin(), m_ctrl.vectorsWritten.end(), p.vector->name) == m_ctrl.vectorsWritten.end())
+      m_ctrl.vectorsWritten.push_back(p.vector->name);
+  }
+
+  bool TryLibraryCall(const CallExpr* call) {
+    auto* fd = call->getDirectCallee();
+    if (!fd) return false;
+    std::string name = fd->getNameAsString();
+    bool inStd = fd->isInStdNamespace() || IsSystemDecl(fd);
+    if (!inStd) return false;
+    auto bad = [&](const std::string& why) {
+      m_c.rep.Error(call->getBeginLoc(), "'" + fd->getQualifiedNameAsString() + "' on device data: " + why,
+                    "use member std::vector begin()/end()/data() or size-annotated pointer parameters, with + offsets");
+      return true;
+    };
+    std::string replacement;
+    if ((name == "exclusive_scan" && (call->getNumArgs() == 4)) || (name == "inclusive_scan" && call->getNumArgs() == 3)) {
+      auto first = PositionOf(call->getArg(0)), last = PositionOf(call->getArg(1)), out = PositionOf(call->getArg(2));
+      if (!first || !last || !out) return bad("its ranges are not device buffers the translator can name");
+      auto count = Count(*first, *last);
+      if (!count) return bad("first and last must belong to the same buffer");
+      const auto* bt = first->element.getCanonicalType()->getAs<BuiltinType>();
+      std::string type = !bt ? "" : bt->getKind() == BuiltinType::UInt ? "Uint" : bt->getKind() == BuiltinType::Int ? "Int"
+                                    : bt->getKind() == BuiltinType::Float ? "Float" : "";
+      if (type.empty()) return bad("scans on the GPU take uint32_t, int or float elements");
+      std::string elem = CppTypeName(m_c.ctx, first->element);
+      std::string init = name == "exclusive_scan" ? "crossrt::Bits32(static_cast<" + elem + ">(" + m_c.Text(call->getArg(3)->getSourceRange()) + "))" : "0u";
+      replacement = "m_scanner.RecordCmd(a_cmd, " + ViewAt(*first) + ", " + ViewAt(*out) + ", uint32_t" + *count + ", " +
+                    (name == "inclusive_scan" ? "true" : "false") + ", crossrt::ScanType::" + type + ", " + init + ")";
+      WrittenVector(*out);
+      m_ctrl.usesScan = true;
+    } else if ((name == "memcpy" || name == "memmove") && call->getNumArgs() == 3) {
+      auto dst = PositionOf(call->getArg(0)), src = PositionOf(call->getArg(1));
+      if (!dst || !src || dst->isEnd || src->isEnd) return bad("source and destination must be device buffers");
+      replacement = "crossrt::CopyCmd(a_cmd, " + ViewAt(*src) + ", " + ViewAt(*dst) + ", VkDeviceSize(" + m_c.Text(call->getArg(2)->getSourceRange()) + "))";
+      WrittenVector(*dst);
+    } else if (name == "fill" && call->getNumArgs() == 3) {
+      auto first = PositionOf(call->getArg(0)), last = PositionOf(call->getArg(1));
+      if (!first || !last) return bad("its range is not a device buffer the translator can name");
+      auto count = Count(*first, *last);
+      if (!count) return bad("first and last must belong to the same buffer");
+      if (m_c.ctx.getTypeSizeInChars(first->element).getQuantity() != 4) return bad("GPU fills take 32-bit elements");
+      std::string elem = CppTypeName(m_c.ctx, first->element);
+      replacement = "crossrt::FillCmd(a_cmd, " + ViewAt(*first) + ", sizeof(" + elem + ") * VkDeviceSize" + *count +
+                    ", crossrt::Bits32(static_cast<" + elem + ">(" + m_c.Text(call->getArg(2)->getSourceRange()) + ")))";
+      WrittenVector(*first);
+    } else {
+      // Any other library call handed pointers or iterators into device data would run on the
+      // host copy while the GPU holds the data: silently wrong, so refuse it.
+      for (auto* arg : call->arguments()) {
+        QualType t = arg->getType();
+        bool pointerLike = t->isPointerType() || (t->getAsCXXRecordDecl() && t->getAsCXXRecordDecl()->getName().contains("iterator"));
+        if (pointerLike && PositionOf(arg))
+          return bad("only std::exclusive_scan, std::inclusive_scan, std::fill and memcpy run on device data so far");
+      }
+      return false;
+    }
+    m_gpu.ReplaceText(call->getSourceRange(), replacement);
+    return true;
+  }
+
   void Visit(const Stmt* s) {
     if (!s) return;
     if (auto* cs = dyn_cast<CompoundStmt>(s))
       for (auto* child : cs->body()) RecordMemberWrite(child);
     if (auto* mc = dyn_cast<CXXMemberCallExpr>(s)) CheckNestedControl(mc);
+    if (auto* call = dyn_cast<CallExpr>(s); call && !isa<CXXMemberCallExpr>(s) && TryLibraryCall(call)) return;
     if (auto* fs = dyn_cast<ForStmt>(s); fs && TryRtvNest(fs)) return;
     if (auto* call = dyn_cast<CXXMemberCallExpr>(s)) {
       auto* md = call->getMethodDecl();

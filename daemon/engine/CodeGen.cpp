@@ -320,19 +320,21 @@ Data ControlsData(const ClassModel& model) {
     // Member vectors written by any kernel this function calls are read back after it.
     Data written = List();
     std::set<std::string> seen;
+    auto addWritten = [&](const std::string& v) {
+      auto* m = FindMember(model, v);
+      if (!m || !seen.insert(v).second) return;
+      Data y;
+      y.set("name", v);
+      y.set("control", c.name);
+      y.set("elemCppType", m->elemCppType);
+      written.push_back(y);
+    };
     for (auto& kn : c.kernelsCalled)
       for (auto& k : model.kernels)
         if (k.name == kn)
-          for (auto& v : k.memberVectors) {
-            auto* m = FindMember(model, v);
-            if (m && m->writtenByKernels && seen.insert(v).second) {
-              Data y;
-              y.set("name", v);
-              y.set("control", c.name);
-              y.set("elemCppType", m->elemCppType);
-              written.push_back(y);
-            }
-          }
+          for (auto& v : k.memberVectors)
+            if (auto* m = FindMember(model, v); m && m->writtenByKernels) addWritten(v);
+    for (auto& v : c.vectorsWritten) addWritten(v);  // by scans, fills, copies
     x.set("writtenVectors", written);
     controls.push_back(x);
   }

@@ -96,6 +96,8 @@ struct Control {
   std::string vulkanCmdBody;        // body with kernel calls turned into ...Cmd calls
   std::string cpuBody;              // body with RTV loops parallelised
   std::vector<std::string> kernelsCalled;
+  std::vector<std::string> vectorsWritten;  // member vectors its library calls (scan, fill, memcpy) write
+  bool usesScan = false;
   std::string sourceFile;
 };
 

@@ -29,6 +29,15 @@ Endpoint EndpointFor(const std::string& buildDir) {
   return {dir, dir + "/" + name + ".sock", dir + "/" + name + ".lock"};
 }
 
+std::string TranslatorIdentity(const std::string& executable) {
+  struct stat st {};
+  if (stat(executable.c_str(), &st) != 0) return std::string(engine::kTranslatorVersion) + "/unknown";
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "%s/%llx-%llx.%09ld-%llx", engine::kTranslatorVersion, (unsigned long long)st.st_size,
+                (unsigned long long)st.st_mtim.tv_sec, (long)st.st_mtim.tv_nsec, (unsigned long long)st.st_ino);
+  return buf;
+}
+
 nlohmann::json ToJson(const engine::TranslateRequest& r) {
   return {{"className", r.className},
           {"backend", r.backend == engine::Backend::Vulkan ? "vulkan" : "cpu"},

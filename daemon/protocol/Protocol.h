@@ -30,6 +30,11 @@ struct Endpoint {
 // throws std::runtime_error when it exists but is not private to this user.
 Endpoint EndpointFor(const std::string& buildDir);
 
+// Which build of the translator an executable is: its version, size and modification time. A
+// rebuilt translator is a different translator: its outputs may differ, so a daemon started
+// before the rebuild must not answer, and translation keys change.
+std::string TranslatorIdentity(const std::string& executable);
+
 nlohmann::json ToJson(const engine::TranslateRequest& r);
 engine::TranslateRequest RequestFromJson(const nlohmann::json& j);  // throws on missing fields
 

@@ -54,6 +54,7 @@ struct Daemon {
   std::ofstream log;
   std::string crashAt;
   std::string socketPath;
+  std::string identity = protocol::TranslatorIdentity("/proc/self/exe");  // this build, as started
 
   // Stop taking requests at once: new clients find no socket and start a fresh daemon.
   void Stop() {
@@ -95,6 +96,7 @@ json Status(Daemon& d) {
   uint64_t lookups = stats.parses + stats.reparses;
   return {{"pid", getpid()},
           {"version", engine::TranslatorVersion()},
+          {"engine", d.identity},
           {"protocol", protocol::kProtocolVersion},
           {"buildDir", d.buildDir},
           {"uptimeSeconds", d.Now()},
@@ -120,8 +122,11 @@ json Handle(Daemon& d, const std::string& line) {
   }
   if (!request.is_object() || !request.contains("protocol") || !request["protocol"].is_number_integer())
     return {{"ok", false}, {"error", "malformed request: no protocol version"}};
-  if (request["protocol"].get<int>() != protocol::kProtocolVersion || request.value("version", "") != engine::TranslatorVersion()) {
-    // The client runs another version: step aside so that it can start its own daemon.
+  bool otherBuild = request.contains("engine") && request["engine"] != d.identity;
+  if (request["protocol"].get<int>() != protocol::kProtocolVersion || request.value("version", "") != engine::TranslatorVersion() ||
+      otherBuild) {
+    // The client runs another version, or the translator was rebuilt since this daemon started:
+    // step aside so that the client can start a daemon of its own build.
     d.Stop();
     return {{"ok", false}, {"error", "version-mismatch"}, {"daemonVersion", engine::TranslatorVersion()},
             {"daemonProtocol", protocol::kProtocolVersion}};

@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <initializer_list>
+#include <cstring>
 #include <memory>
 #include <mutex>
 #include <stdexcept>
@@ -249,5 +250,48 @@ struct CpuTimer {
   }
   std::chrono::steady_clock::time_point t0;
 };
+
+// ---- primitives the translator maps library calls of control functions to ------------------
+
+enum class ScanType { Uint, Int, Float };
+
+// The 32-bit pattern of a value, for push constants and buffer fills.
+template <typename T>
+uint32_t Bits32(T value) {
+  static_assert(sizeof(T) == 4, "32-bit element types only");
+  uint32_t bits;
+  std::memcpy(&bits, &value, 4);
+  return bits;
+}
+
+// std::exclusive_scan / std::inclusive_scan on the GPU: blocks of 1024 elements scanned with
+// subgroup arithmetic, block totals scanned recursively, offsets added. Any n, no padding.
+class Scanner {
+public:
+  Scanner() = default;
+  explicit Scanner(std::shared_ptr<VulkanContext> ctx);
+  // out[i] = init + in[0] + ... + in[i-1] (exclusive) or ... + in[i] (inclusive), i < n.
+  // `in` may be `out`. Ends with a barrier. Scratch buffers grow as needed and are kept: do not
+  // record scans of growing sizes into one command buffer before submitting it.
+  void RecordCmd(VkCommandBuffer cmd, BufferView in, BufferView out, uint32_t n, bool inclusive, ScanType type,
+                 uint32_t initBits = 0);
+
+private:
+  struct Level { Buffer sums; };
+  void Init();
+  std::shared_ptr<VulkanContext> ctx_;
+  ComputePipeline blocks_[3], add_[3];
+  std::vector<Level> levels_;
+};
+
+// A view `bytes` further into a buffer view.
+inline BufferView Offset(BufferView v, VkDeviceSize bytes) {
+  return {v.buffer, v.offset + bytes, v.range == VK_WHOLE_SIZE ? VK_WHOLE_SIZE : v.range - bytes};
+}
+
+// memcpy between device buffers, with the barriers around it.
+void CopyCmd(VkCommandBuffer cmd, BufferView src, BufferView dst, VkDeviceSize bytes);
+// std::fill of 32-bit elements: fills `bytes` bytes with the pattern.
+void FillCmd(VkCommandBuffer cmd, BufferView dst, VkDeviceSize bytes, uint32_t bits);
 
 }  // namespace crossrt

@@ -1,0 +1,93 @@
+// GPU versions of the library calls control functions may make: scans, copies, fills.
+#include "crossrt/VulkanRuntime.h"
+
+#include "scan_add_float.h"
+#include "scan_add_int.h"
+#include "scan_add_uint.h"
+#include "scan_blocks_float.h"
+#include "scan_blocks_int.h"
+#include "scan_blocks_uint.h"
+
+namespace crossrt {
+
+namespace {
+constexpr uint32_t kBlock = 1024;  // elements per workgroup of the scan shaders
+
+// Groups for one pass, spread over y beyond the device's per-dimension limit.
+void DispatchBlocks(VkCommandBuffer cmd, uint32_t blocks) {
+  uint32_t x = std::min<uint32_t>(blocks, 65535), y = (blocks + x - 1) / x;
+  vkCmdDispatch(cmd, x, y, 1);
+}
+}  // namespace
+
+Scanner::Scanner(std::shared_ptr<VulkanContext> ctx) : ctx_(std::move(ctx)) {}
+
+void Scanner::Init() {
+  if (blocks_[0].Handle() != VK_NULL_HANDLE) return;  // pipelines are made on first use
+  if (!ctx_->hasSubgroupArithmetic || ctx_->subgroupSize < 4)
+    throw Error("GPU scan needs compute subgroup arithmetic with >= 4 lanes on '" + ctx_->DeviceName() + "'");
+  blocks_[0] = ComputePipeline(ctx_, scan_blocks_uint, sizeof(scan_blocks_uint), 3, 12, "crossrt::scan_blocks(uint)");
+  blocks_[1] = ComputePipeline(ctx_, scan_blocks_int, sizeof(scan_blocks_int), 3, 12, "crossrt::scan_blocks(int)");
+  blocks_[2] = ComputePipeline(ctx_, scan_blocks_float, sizeof(scan_blocks_float), 3, 12, "crossrt::scan_blocks(float)");
+  add_[0] = ComputePipeline(ctx_, scan_add_uint, sizeof(scan_add_uint), 2, 12, "crossrt::scan_add(uint)");
+  add_[1] = ComputePipeline(ctx_, scan_add_int, sizeof(scan_add_int), 2, 12, "crossrt::scan_add(int)");
+  add_[2] = ComputePipeline(ctx_, scan_add_float, sizeof(scan_add_float), 2, 12, "crossrt::scan_add(float)");
+}
+
+void Scanner::RecordCmd(VkCommandBuffer cmd, BufferView in, BufferView out, uint32_t n, bool inclusive, ScanType type,
+                        uint32_t initBits) {
+  if (n == 0) return;
+  Init();
+  const int t = int(type);
+  // Scratch: one buffer of block totals per level (n/1024, n/1024^2, ...).
+  std::vector<uint32_t> counts;
+  for (uint32_t m = n; m > 1 || counts.empty(); m = (m + kBlock - 1) / kBlock) {
+    counts.push_back(m);
+    if (m <= kBlock) break;
+  }
+  if (levels_.size() < counts.size()) levels_.resize(counts.size());
+  for (size_t l = 0; l < counts.size(); ++l)
+    EnsureSize(ctx_, levels_[l].sums, 4ull * ((counts[l] + kBlock - 1) / kBlock));
+
+  // Down: scan each level's blocks, collecting block totals into the next level.
+  for (size_t l = 0; l < counts.size(); ++l) {
+    const uint32_t m = counts[l], blocks = (m + kBlock - 1) / kBlock;
+    const bool last = blocks == 1;
+    struct { uint32_t n, inclusive, writeSums; } args{m, l == 0 && inclusive ? 1u : 0u, last ? 0u : 1u};
+    BufferView src = l == 0 ? in : levels_[l - 1].sums.View();
+    BufferView dst = l == 0 ? out : levels_[l - 1].sums.View();  // upper levels scan in place
+    blocks_[t].Bind(cmd);
+    blocks_[t].PushBuffers(cmd, {src, dst, levels_[l].sums.View()});
+    blocks_[t].PushConstants(cmd, &args, sizeof(args));
+    DispatchBlocks(cmd, blocks);
+    ComputeBarrier(cmd);
+  }
+  // Up: add each block's offset, from the top level down; the initial value joins at level 0.
+  for (size_t l = counts.size(); l-- > 0;) {
+    const uint32_t m = counts[l], blocks = (m + kBlock - 1) / kBlock;
+    const bool hasOffsets = blocks > 1;
+    if (!hasOffsets && (l > 0 || initBits == 0)) continue;  // nothing to add
+    struct { uint32_t n, hasOffsets, init; } args{m, hasOffsets ? 1u : 0u, l == 0 ? initBits : 0u};
+    BufferView data = l == 0 ? out : levels_[l - 1].sums.View();
+    add_[t].Bind(cmd);
+    add_[t].PushBuffers(cmd, {data, levels_[l].sums.View()});
+    add_[t].PushConstants(cmd, &args, sizeof(args));
+    DispatchBlocks(cmd, blocks);
+    ComputeBarrier(cmd);
+  }
+}
+
+void CopyCmd(VkCommandBuffer cmd, BufferView src, BufferView dst, VkDeviceSize bytes) {
+  if (bytes == 0) return;
+  VkBufferCopy region{src.offset, dst.offset, bytes};
+  vkCmdCopyBuffer(cmd, src.buffer, dst.buffer, 1, &region);
+  TransferToComputeBarrier(cmd);
+}
+
+void FillCmd(VkCommandBuffer cmd, BufferView dst, VkDeviceSize bytes, uint32_t bits) {
+  if (bytes == 0) return;
+  vkCmdFillBuffer(cmd, dst.buffer, dst.offset, bytes, bits);
+  TransferToComputeBarrier(cmd);
+}
+
+}  // namespace crossrt
