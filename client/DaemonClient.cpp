@@ -60,10 +60,14 @@ bool DaemonClient::Start() {
   if (child == 0) {
     setsid();
     if (fork() != 0) _exit(0);
+    // The daemon keeps nothing of the build: no inherited descriptors (a make jobserver's pipes
+    // would keep the build waiting), no working directory.
     int devnull = open("/dev/null", O_RDWR);
     dup2(devnull, 0);
     dup2(devnull, 1);
     dup2(devnull, 2);
+    for (int fd = 3; fd < 1024; ++fd) close(fd);
+    if (chdir("/") != 0) _exit(126);
     // CROSSRT_DAEMON_IDLE_SECONDS shortens the idle timeout (tests use it).
     const char* idle = std::getenv("CROSSRT_DAEMON_IDLE_SECONDS");
     if (idle)

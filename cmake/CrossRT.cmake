@@ -53,19 +53,19 @@ function(crossrt_add_class target class)
     list(APPEND outputs ${out_dir}/${class}_Vulkan_shaders.cpp)
   endif()
 
-  # Parse the class as the target compiles it: its include paths, definitions, options (the engine
-  # keeps those that change the meaning of the code) and standard, plus the CrossRT libraries' headers.
+  # Parse the class as the target compiles it: its include paths, definitions and standard, plus
+  # the CrossRT libraries' headers. (COMPILE_OPTIONS are left out: they may hold
+  # $<COMPILE_LANGUAGE:...> expressions, which a custom command cannot evaluate.)
   set(inc "$<TARGET_PROPERTY:${target},INCLUDE_DIRECTORIES>")
   set(defs "$<TARGET_PROPERTY:${target},COMPILE_DEFINITIONS>")
-  set(opts "$<TARGET_PROPERTY:${target},COMPILE_OPTIONS>")
   set(std "$<TARGET_PROPERTY:${target},CXX_STANDARD>")
   set(compile_args "$<$<BOOL:${inc}>:-I$<JOIN:${inc},$<SEMICOLON>-I>>")
   foreach(lib crossrt::litemath crossrt::liteimage crossrt::litert)
-    list(APPEND compile_args "-I$<JOIN:$<TARGET_PROPERTY:${lib},INTERFACE_INCLUDE_DIRECTORIES>,$<SEMICOLON>-I>")
+    set(lib_inc "$<TARGET_PROPERTY:${lib},INTERFACE_INCLUDE_DIRECTORIES>")
+    list(APPEND compile_args "$<$<BOOL:${lib_inc}>:-I$<JOIN:${lib_inc},$<SEMICOLON>-I>>")
   endforeach()
   list(APPEND compile_args
     "$<$<BOOL:${defs}>:-D$<JOIN:${defs},$<SEMICOLON>-D>>"
-    "${opts}"
     "$<$<BOOL:${std}>:-std=c++${std}>")
 
   if(TARGET crossrt)

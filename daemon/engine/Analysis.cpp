@@ -7,6 +7,7 @@
 #include <clang/Basic/SourceManager.h>
 #include <clang/Lex/Lexer.h>
 #include <clang/Rewrite/Core/Rewriter.h>
+#include <llvm/Support/FileSystem.h>
 #include <llvm/Support/Path.h>
 
 #include <algorithm>
@@ -49,7 +50,7 @@ std::string StripAttributes(std::string s) {
 
 std::string ParamDecl(const ASTContext& ctx, const ParmVarDecl* p, unsigned index) {
   std::string name = p->getNameAsString();
-  if (name.empty()) return p->getType().getAsString() + " a_unnamed" + std::to_string(index);
+  if (name.empty()) return p->getType().getAsString(ctx.getPrintingPolicy()) + " a_unnamed" + std::to_string(index);
   SourceRange range(p->getBeginLoc(), p->getLocation());
   return StripAttributes(Text(ctx, range));
 }
@@ -80,7 +81,9 @@ const FieldDecl* RootField(const Expr* e) {
   }
 }
 
-bool IsKernelName(StringRef n) { return n.starts_with("kernel"); }
+bool IsKernelName(StringRef n) {
+  return n.starts_with("kernel_") || n.starts_with("kernel1D_") || n.starts_with("kernel2D_") || n.starts_with("kernel3D_");
+}
 unsigned IpvDims(StringRef n) {
   if (n.starts_with("kernel1D_")) return 1;
   if (n.starts_with("kernel2D_")) return 2;
@@ -133,6 +136,7 @@ void AnalyzeMembers(Context& c) {
       while (auto* arr = dyn_cast<ConstantArrayType>(base.getCanonicalType().getTypePtr())) base = arr->getElementType();
       m.cppType = CppTypeName(c.ctx, base);
       m.inClassData = f->getAccess() != AS_private && FitsClassData(c.ctx, f->getType());
+      if (auto layout = Std430Layout(c.ctx, f->getType(), false)) m.std430Align = unsigned(layout->align);
       if (m.inClassData) structs.Type(f->getType(), f->getLocation());
     }
     c.model.members.push_back(m);
@@ -201,6 +205,7 @@ struct WriteScanner : RecursiveASTVisitor<WriteScanner> {
   std::map<const FieldDecl*, ReduceOp> reductions;
   std::set<const MemberExpr*> reductionUses;  // member references that belong to a reduction statement
   std::set<const FieldDecl*> vectorWrites;
+  const FunctionDecl* helper = nullptr;  // scanning a helper's body: reductions are not allowed there
   explicit WriteScanner(Context& ctx) : c(ctx) {}
 
   static const MemberExpr* AsThisMember(const Expr* e) {
@@ -212,6 +217,11 @@ struct WriteScanner : RecursiveASTVisitor<WriteScanner> {
     if (!root) return;
     if (IsStdVector(root->getType())) { vectorWrites.insert(root); return; }
     auto* direct = AsThisMember(lhs);
+    if (helper) {
+      c.rep.Error(loc, "helper function '" + helper->getNameAsString() + "' writes class member '" + root->getNameAsString() + "' (called from every thread: a data race)",
+                  "accumulate in the kernel's loop body (m += x, min, max), or return the value from the helper");
+      return;
+    }
     if (op && direct) {
       auto [it, fresh] = reductions.emplace(root, *op);
       if (!fresh && it->second != *op)
@@ -264,6 +274,17 @@ struct WriteScanner : RecursiveASTVisitor<WriteScanner> {
   }
   bool VisitUnaryOperator(UnaryOperator* uo) {
     if (uo->isIncrementDecrementOp()) Write(uo->getSubExpr(), uo->getExprLoc(), std::nullopt, {});
+    return true;
+  }
+  // A member passed to a non-const reference parameter may be written by the callee (GLSL inout).
+  bool VisitCallExpr(CallExpr* call) {
+    auto* fd = call->getDirectCallee();
+    if (!fd || IsSystemDecl(fd) || isa<CXXOperatorCallExpr>(call)) return true;
+    for (unsigned i = 0; i < call->getNumArgs() && i < fd->getNumParams(); ++i) {
+      QualType t = fd->getParamDecl(i)->getType();
+      if (t->isReferenceType() && !t.getNonReferenceType().isConstQualified())
+        Write(call->getArg(i), call->getArg(i)->getExprLoc(), std::nullopt, {});
+    }
     return true;
   }
 };
@@ -343,6 +364,10 @@ void CheckKernelParams(Context& c, const CXXMethodDecl* md, Kernel& k) {
     auto* p = md->getParamDecl(i);
     KernelParam kp;
     kp.name = p->getNameAsString();
+    if (kp.name.empty()) {
+      c.rep.Error(p->getLocation(), "kernel '" + k.name + "' has a parameter without a name", "name it, or remove it");
+      continue;
+    }
     kp.glslName = GlslPrinter::SafeName(kp.name);
     QualType t = p->getType();
     kp.isThreadId = k.rtv && IsThreadIdName(kp.name);
@@ -352,7 +377,7 @@ void CheckKernelParams(Context& c, const CXXMethodDecl* md, Kernel& k) {
       kp.isConstPointee = pointee.isConstQualified();
       auto g = GlslTypeOf(pointee);
       if (!g || pointee->isPointerType()) {
-        c.rep.Error(p->getLocation(), "kernel parameter '" + kp.name + "' points to '" + pointee.getAsString() + "', which has no GPU equivalent",
+        c.rep.Error(p->getLocation(), "kernel parameter '" + kp.name + "' points to '" + pointee.getAsString(c.ctx.getPrintingPolicy()) + "', which has no GPU equivalent",
                     "pass arrays of int, uint, float, LiteMath vectors or plain structs of those");
         continue;
       }
@@ -360,7 +385,7 @@ void CheckKernelParams(Context& c, const CXXMethodDecl* md, Kernel& k) {
       kp.cppType = "crossrt::BufferView";
       if (!LayoutMatchesCpp(c.ctx, pointee, false)) {
         if (LayoutMatchesCpp(c.ctx, pointee, true)) kp.scalarLayout = true;
-        else c.rep.Error(p->getLocation(), "the C++ layout of '" + pointee.getAsString() + "' cannot be reproduced in a GPU buffer",
+        else c.rep.Error(p->getLocation(), "the C++ layout of '" + pointee.getAsString(c.ctx.getPrintingPolicy()) + "' cannot be reproduced in a GPU buffer",
                          "reorder the fields so 16-byte types (float4, float3) come first, or pad them to float4");
       }
     } else if (t->isReferenceType() && !t.getNonReferenceType().isConstQualified()) {
@@ -369,12 +394,20 @@ void CheckKernelParams(Context& c, const CXXMethodDecl* md, Kernel& k) {
     } else {
       auto g = GlslTypeOf(t);
       if (!g || (t.getNonReferenceType()->isFloatingType() && !t.getNonReferenceType()->isSpecificBuiltinType(BuiltinType::Float))) {
-        c.rep.Error(p->getLocation(), "kernel parameter '" + kp.name + "' of type '" + t.getAsString() + "' has no GPU equivalent",
+        c.rep.Error(p->getLocation(), "kernel parameter '" + kp.name + "' of type '" + t.getAsString(c.ctx.getPrintingPolicy()) + "' has no GPU equivalent",
                     "use int, uint, float, LiteMath types, plain structs, or a pointer with a size");
         continue;
       }
+      QualType value = t.getNonReferenceType().getUnqualifiedType();
+      auto layout = Std430Layout(c.ctx, value, false);
+      if (!layout || !FitsClassData(c.ctx, value)) {
+        c.rep.Error(p->getLocation(), "kernel parameter '" + kp.name + "' of type '" + t.getAsString(c.ctx.getPrintingPolicy()) + "' cannot be passed to the GPU as it is laid out in C++",
+                    "use 32-bit int, uint or float, LiteMath vectors, float4x4, or structs whose fields keep the std430 layout (bool is 1 byte in C++, 4 on the GPU: use int)");
+        continue;
+      }
+      kp.std430Align = unsigned(layout->align);
       kp.glslType = *g;
-      kp.valueCppType = CppTypeName(c.ctx, t.getNonReferenceType());
+      kp.valueCppType = CppTypeName(c.ctx, value);
       kp.cppType = ParamDecl(c.ctx, p, i);
       kp.cppType = kp.cppType.substr(0, kp.cppType.size() - kp.name.size());  // type part only
       while (!kp.cppType.empty() && isspace((unsigned char)kp.cppType.back())) kp.cppType.pop_back();
@@ -398,6 +431,10 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   GlslPrinter printer(c.ctx, c.cls, c.rep);
   for (auto& s : ClassStructNames(c.model)) printer.predeclaredStructs.insert(s);
   auto* body = dyn_cast<CompoundStmt>(def->getBody());
+  if (!body) {
+    c.rep.Error(md->getLocation(), "kernel '" + k.name + "' has a function-try-block", "GPU code has no exceptions: remove the try/catch");
+    return;
+  }
   std::vector<const Stmt*> preamble;
   const Stmt* threadBody = body;
   std::vector<std::pair<std::string, std::string>> threadParams;  // (glsl type, name)
@@ -466,7 +503,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   rs.TraverseStmt(const_cast<Stmt*>(threadBody));
   if (k.rtv && !ws.reductions.empty()) {
     c.rep.Error(md->getLocation(), "member reductions are supported in kernel1D_/2D_/3D_ loops, not in '" + k.name + "'",
-                "write the loop inside the kernel (kernel1D_" + k.name.substr(7) + ") so the translator sees the whole reduction");
+                "write the loop inside the kernel (kernel1D_" + k.name.substr(std::string("kernel_").size()) + ") so the translator sees the whole reduction");
     return;
   }
   // In declaration order, so that regeneration is stable.
@@ -482,8 +519,12 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     printer.renames[field] = r.member + "Local";
     k.reductions.push_back(r);
   }
-  for (auto* f : ws.vectorWrites)
-    if (auto* m = FindMember(c.model, f->getNameAsString())) m->writtenByKernels = true;
+  // After printing, the printer knows the helpers the kernel reaches: their writes count too.
+  auto markVectorWrites = [&](const WriteScanner& scanner) {
+    for (auto* f : scanner.vectorWrites)
+      if (auto* m = FindMember(c.model, f->getNameAsString())) m->writtenByKernels = true;
+  };
+  markVectorWrites(ws);
 
   // GLSL: the thread function.
   std::ostringstream os;
@@ -498,6 +539,12 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     os << printer.ThreadBody(threadBody, 1, !k.rtv);
   os << "}\n";
   k.glslBody = os.str();
+  for (auto* helper : printer.helpers) {
+    WriteScanner hs(c);
+    hs.helper = helper;
+    hs.TraverseStmt(helper->getBody());
+    markVectorWrites(hs);
+  }
   k.glslStructs = printer.PreludeTypes();
   k.glslHelpers = printer.PreludeFunctions();
   for (auto* f : printer.memberVectors) {
@@ -512,7 +559,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     auto* m = FindMember(c.model, f->getNameAsString());
     if (m) m->usedByKernels = true;
     if (m && !m->inClassData && f->getAccess() != AS_private)
-      c.rep.Error(f->getLocation(), "member '" + f->getNameAsString() + "' of type '" + f->getType().getAsString() + "' has a C++ layout that a GPU buffer cannot reproduce",
+      c.rep.Error(f->getLocation(), "member '" + f->getNameAsString() + "' of type '" + f->getType().getAsString(c.ctx.getPrintingPolicy()) + "' has a C++ layout that a GPU buffer cannot reproduce",
                   "use int instead of bool, float4x4 instead of float3x3, or reorder struct fields so 16-byte types come first");
     if (f->getAccess() == AS_private)
       c.rep.Error(f->getLocation(), "member '" + f->getNameAsString() + "' is private, but the generated class derives from '" + c.cls->getNameAsString() + "' and must reach it",
@@ -673,6 +720,7 @@ private:
       }
       axes[ThreadAxis(md->getParamDecl(i)->getName())] = match;
     }
+    if (axes.size() < loops.size()) return false;  // outer loops are host loops: try the inner nest
     if (axes.size() != loops.size()) {
       m_c.rep.Error(outer->getBeginLoc(), "loops around '" + md->getNameAsString() + "' do not match its thread id parameters",
                     "use one loop per thread id parameter (tidX, tidY, ...), with nothing else in the loops");
@@ -699,6 +747,7 @@ private:
     return true;
   }
 
+  // The loop shape of ParseLoop, without reporting: `for (int i = a; i < b; ++i)`.
   bool QuietParseLoop(const ForStmt* fs, LoopHeader& h) {
     auto* ds = dyn_cast_or_null<DeclStmt>(fs->getInit());
     if (!ds || !ds->isSingleDecl()) return false;
@@ -707,17 +756,29 @@ private:
     h.start = h.var->getInit();
     auto* cond = dyn_cast_or_null<BinaryOperator>(fs->getCond() ? fs->getCond()->IgnoreImplicit() : nullptr);
     if (!cond || (cond->getOpcode() != BO_LT && cond->getOpcode() != BO_LE)) return false;
+    auto* lhs = dyn_cast<DeclRefExpr>(cond->getLHS()->IgnoreParenImpCasts());
+    if (!lhs || lhs->getDecl() != h.var) return false;
     h.end = cond->getRHS();
     h.inclusive = cond->getOpcode() == BO_LE;
-    return true;
+    const Expr* inc = fs->getInc() ? fs->getInc()->IgnoreImplicit() : nullptr;
+    if (auto* uo = dyn_cast_or_null<UnaryOperator>(inc)) return uo->isIncrementOp();
+    if (auto* ca = dyn_cast_or_null<CompoundAssignOperator>(inc)) {
+      Expr::EvalResult r;
+      return ca->getOpcode() == BO_AddAssign && ca->getRHS()->EvaluateAsInt(r, m_c.ctx) && r.Val.getInt() == 1;
+    }
+    return false;
   }
 
   // `m_x = v;` in a control function runs on the host while recording; the kernels recorded
   // around it must see it in order, so the ...Cmd also records an update of the GPU copy.
   void RecordMemberWrite(const Stmt* s) {
+    if (auto* ewc = dyn_cast_or_null<ExprWithCleanups>(s)) s = ewc->getSubExpr();
     const Expr* lhs = nullptr;
-    if (auto* bo = dyn_cast<BinaryOperator>(s); bo && bo->isAssignmentOp()) lhs = bo->getLHS();
-    if (auto* op = dyn_cast<CXXOperatorCallExpr>(s); op && op->isAssignmentOp()) lhs = op->getArg(0);
+    if (auto* bo = dyn_cast_or_null<BinaryOperator>(s); bo && bo->isAssignmentOp()) lhs = bo->getLHS();
+    if (auto* op = dyn_cast_or_null<CXXOperatorCallExpr>(s); op && (op->isAssignmentOp() || op->getOperator() == OO_PlusPlus ||
+                                                                     op->getOperator() == OO_MinusMinus))
+      lhs = op->getArg(0);
+    if (auto* uo = dyn_cast_or_null<UnaryOperator>(s); uo && uo->isIncrementDecrementOp()) lhs = uo->getSubExpr();
     const FieldDecl* f = lhs ? ThisField(lhs) : nullptr;
     const Member* m = f ? FindMember(m_c.model, f->getNameAsString()) : nullptr;
     if (!m || m->kind != MemberKind::Plain || !m->inClassData) return;
@@ -861,8 +922,16 @@ private:
 
   void Visit(const Stmt* s) {
     if (!s) return;
+    // Statement positions where a member may be assigned.
     if (auto* cs = dyn_cast<CompoundStmt>(s))
       for (auto* child : cs->body()) RecordMemberWrite(child);
+    if (auto* is = dyn_cast<IfStmt>(s)) {
+      RecordMemberWrite(is->getThen());
+      RecordMemberWrite(is->getElse());
+    }
+    if (auto* fs = dyn_cast<ForStmt>(s)) RecordMemberWrite(fs->getBody());
+    if (auto* ws = dyn_cast<WhileStmt>(s)) RecordMemberWrite(ws->getBody());
+    if (auto* ds = dyn_cast<DoStmt>(s)) RecordMemberWrite(ds->getBody());
     if (auto* mc = dyn_cast<CXXMemberCallExpr>(s)) CheckNestedControl(mc);
     if (auto* call = dyn_cast<CallExpr>(s); call && !isa<CXXMemberCallExpr>(s) && TryLibraryCall(call)) return;
     if (auto* fs = dyn_cast<ForStmt>(s); fs && TryRtvNest(fs)) return;
@@ -909,7 +978,8 @@ void AnalyzeControl(Context& c, const CXXMethodDecl* md, const FunctionDecl* def
     auto* p = md->getParamDecl(i);
     ControlParam cp;
     cp.name = p->getNameAsString();
-    cp.cppType = p->getType().getAsString();
+    if (cp.name.empty()) cp.name = "a_unnamed" + std::to_string(i);  // as ParamDecl() spells it
+    cp.cppType = p->getType().getAsString(c.ctx.getPrintingPolicy());
     cp.declText = ParamDecl(c.ctx, p, i);
     ctrl.paramsDecl += (i ? ", " : "") + cp.declText;
     ctrl.argsForward += (i ? ", " : "") + cp.name;
@@ -967,6 +1037,9 @@ bool AnalyzeTranslationUnit(ASTContext& ctx, const std::string& className, Repor
       if (m[1] == "<") text = "#include <" + m[2].str() + ">";
       else {
         std::string path = dir + "/" + m[2].str();
+        if (!llvm::sys::fs::exists(path))  // found through an include directory: take the file Clang read
+          for (auto it = sm.fileinfo_begin(); it != sm.fileinfo_end(); ++it)
+            if (StringRef(it->first.getName()).ends_with("/" + m[2].str())) path = it->first.getName().str();
         if (path == model.headerFile) continue;  // the generated header includes it already
         text = "#include \"" + path + "\"";
       }
@@ -1005,7 +1078,7 @@ void FinishModel(ClassModel& model) {
   // Ordered by alignment so that the C++ mirror with alignas() has the std430 offsets.
   std::vector<BlockField> fields;
   for (auto& m : model.members)
-    if (m.kind == MemberKind::Plain && m.inClassData) fields.push_back({m.name, m.cppType, m.glslType, Std430AlignOf(m.glslType)});
+    if (m.kind == MemberKind::Plain && m.inClassData) fields.push_back({m.name, m.cppType, m.glslType, m.std430Align});
   for (auto& m : model.members) {
     if (!m.usedByKernels || m.kind != MemberKind::Vector) continue;
     fields.push_back({m.name + "_size", "uint32_t", "uint", 4});

@@ -44,14 +44,12 @@ AstCache::Handle AstCache::Get(const std::string& file, const std::vector<std::s
   for (auto& a : args) key += '\x1f' + a;
 
   std::shared_ptr<Handle::Entry> entry;
-  bool fresh = false;
   {
     std::lock_guard<std::mutex> guard(m_mutex);
     auto it = m_entries.find(key);
     if (it == m_entries.end()) {
       entry = std::make_shared<Handle::Entry>();
       m_entries[key] = entry;
-      fresh = true;
     } else {
       entry = it->second;
     }
@@ -70,7 +68,7 @@ AstCache::Handle AstCache::Get(const std::string& file, const std::vector<std::s
   Handle handle(entry);  // waits while another translation uses this AST
   entry->diagStream.flush();
   entry->diagText.clear();
-  if (!fresh && entry->ast) {
+  if (entry->ast) {  // decided under the entry's lock: another request may have parsed it meanwhile
     // Reparse() reuses the preamble when the headers it covers are unchanged.
     entry->printer->clear();
     entry->diags->Reset(/*soft=*/true);

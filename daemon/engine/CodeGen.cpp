@@ -371,7 +371,7 @@ Data VulkanKernelsData(const ClassModel& model) {
     for (unsigned a = 0; a < k.dims; ++a) field("4", "uint32_t", std::string("crt_count") + Axis(a), std::string("crt_count") + Axis(a));
     for (auto& p : k.params) {
       if (p.isPointer || p.isThreadId) continue;
-      field(std::to_string(Std430AlignOf(p.glslType)), p.valueCppType, GlslPrinter::SafeName(p.name), p.name);
+      field(std::to_string(p.std430Align), p.valueCppType, GlslPrinter::SafeName(p.name), p.name);
     }
     x.set("pushFields", fields);
     x.set("pushAssign", assign);
@@ -406,7 +406,7 @@ Data VulkanKernelsData(const ClassModel& model) {
       y.set("member", r.member);
       y.set("cppType", ReductionCppType(model, r));
       // The GPU writes an std430 array: a vec3 element takes 16 bytes, not sizeof(float3).
-      y.set("partialStride", std::to_string(Std430StrideOf(r.glslType)));
+      y.set("partialStride", std::to_string(Std430VectorStride(r.glslType)));
       y.set("groupCountExpr", GroupCountExpr(k));
       reds.push_back(y);
     }

@@ -98,14 +98,12 @@ std::optional<std::string> GlslTypeOf(QualType type) {
   return std::nullopt;
 }
 
-unsigned Std430AlignOf(const std::string& glslType) {
+unsigned Std430VectorStride(const std::string& glslType) {
   std::string base = SplitArray(glslType).first;
   if (base == "float" || base == "int" || base == "uint" || base == "bool") return 4;
   if (base.size() >= 4 && base.compare(base.size() - 4, 4, "vec2") == 0) return 8;
-  return 16;  // vec3, vec4, matrices, structs holding them
+  return 16;
 }
-
-unsigned Std430StrideOf(const std::string& glslType) { return Std430AlignOf(glslType); }
 
 std::pair<std::string, std::string> SplitArray(const std::string& glslType) {
   auto pos = glslType.find('[');
@@ -191,18 +189,23 @@ std::optional<std::string> GlslPrinter::Type(QualType t, SourceLocation loc) {
   while (auto* arr = dyn_cast<ConstantArrayType>(base.getCanonicalType().getTypePtr())) base = arr->getElementType();
   base = base.getCanonicalType();
   if (base->isPointerType()) {
-    Fail(loc, "pointer '" + t.getAsString() + "' cannot be used here in a kernel",
+    Fail(loc, "pointer '" + t.getAsString(m_ctx.getPrintingPolicy()) + "' cannot be used here in a kernel",
          "pass arrays to kernels as pointer parameters of the kernel, or use a std::vector member");
     return std::nullopt;
   }
+  if (auto* bt = base->getAs<BuiltinType>(); bt && bt->isInteger() && m_ctx.getTypeSize(base) < 32 && bt->getKind() != BuiltinType::Bool) {
+    Fail(loc, "type '" + t.getAsString(m_ctx.getPrintingPolicy()) + "' is narrower than 32 bits, and GPU integers are 32-bit",
+         "use int or uint32_t in kernels (and mask explicitly where the wrap-around matters)");
+    return std::nullopt;
+  }
   if (auto* bt = base->getAs<BuiltinType>(); bt && bt->isFloatingPoint() && bt->getKind() != BuiltinType::Float) {
-    Fail(loc, "type '" + t.getAsString() + "' is not supported in kernels (only 32-bit float)",
+    Fail(loc, "type '" + t.getAsString(m_ctx.getPrintingPolicy()) + "' is not supported in kernels (only 32-bit float)",
          "use float; double-precision literals such as 0.5 are fine and become float");
     return std::nullopt;
   }
   auto g = GlslTypeOf(t);
   if (!g) {
-    Fail(loc, "type '" + t.getAsString() + "' has no GPU equivalent",
+    Fail(loc, "type '" + t.getAsString(m_ctx.getPrintingPolicy()) + "' has no GPU equivalent",
          "kernels may use int, uint, float, bool, LiteMath vectors and matrices, and plain structs of those");
     return std::nullopt;
   }
@@ -281,20 +284,29 @@ std::string GlslPrinter::Literal(const clang::Expr* e) {
 // An explicit or implicit conversion. GLSL converts implicitly only int->uint->float, so spell
 // the others out, and fold integer literals into the target type so the code stays readable.
 std::string GlslPrinter::Cast(QualType to, const clang::Expr* sub) {
+  // Double precision only arises from promotions such as `x * 0.5` (explicit double variables
+  // are refused): on the GPU the arithmetic stays in float.
+  if (to->isRealFloatingType() && !to->isSpecificBuiltinType(BuiltinType::Float) && sub->getType()->isFloatingType())
+    return Expr(sub);
+  if (to->isSpecificBuiltinType(BuiltinType::Float) && sub->getType()->isRealFloatingType() &&
+      !sub->getType()->isSpecificBuiltinType(BuiltinType::Float))
+    return Expr(sub);
+  if (to->isRealFloatingType() && !to->isSpecificBuiltinType(BuiltinType::Float) && sub->getType()->isIntegerType())
+    return "float(" + Expr(sub) + ")";
   auto target = GlslTypeOf(to);
   auto source = GlslTypeOf(sub->getType());
-  if (!target) return Fail(sub->getBeginLoc(), "conversion to '" + to.getAsString() + "' is not supported in kernels", "");
+  if (!target) return Fail(sub->getBeginLoc(), "conversion to '" + to.getAsString(m_ctx.getPrintingPolicy()) + "' is not supported in kernels", "");
   if (source && *source == *target) return Expr(sub);
   const clang::Expr* bare = sub->IgnoreParenImpCasts();
-  if (auto* il = dyn_cast<IntegerLiteral>(bare)) {
+  if (auto* il = dyn_cast<IntegerLiteral>(bare); il && !il->getType()->isUnsignedIntegerType()) {
     auto v = il->getValue().getSExtValue();
     if (*target == "float") return std::to_string(v) + ".0";
     if (*target == "uint" && v >= 0) return std::to_string(v) + "u";
     if (*target == "int") return std::to_string(v);
   }
   if (*target == "bool") {
-    if (source && (*source == "float")) return "(" + Expr(sub) + " != 0.0)";
-    return "(" + Expr(sub) + " != 0)";
+    if (source && (*source == "float")) return "((" + Expr(sub) + ") != 0.0)";
+    return "((" + Expr(sub) + ") != 0)";
   }
   return *target + "(" + Expr(sub) + ")";
 }
@@ -308,21 +320,29 @@ std::string GlslPrinter::Construct(QualType t, const std::vector<const clang::Ex
   // Copies and moves are plain values in GLSL.
   if (real.size() == 1 && GlslTypeOf(real[0]->getType()) == g) return Expr(real[0]);
   auto [base, dims] = SplitArray(*g);
+  bool matrix = IsLiteMathType(t, "float4x4") || IsLiteMathType(t, "float3x3");
   std::string out = base + dims + "(";
   if (real.empty()) {
-    if (IsLiteMathType(t)) return base + "(0)";
-    // Value-initialised struct: every field zero.
+    if (matrix) return base + "(1.0)";  // LiteMath matrices start as the identity
+    if (IsLiteMathType(t) || !dims.empty()) return base + dims + "(" + (dims.empty() ? "0" : "") + ")";
     auto* rd = t.getCanonicalType()->getAsCXXRecordDecl();
+    if (!rd) return base + "(0)";  // a value-initialised scalar
+    // Value-initialised struct: default member initialisers, else zero.
     bool first = true;
     for (auto* f : rd->fields()) {
       auto fg = Type(f->getType(), loc);
-      out += (first ? "" : ", ") + (fg ? SplitArray(*fg).first + SplitArray(*fg).second + "(0)" : "0");
+      std::string value = f->hasInClassInitializer() && f->getInClassInitializer() ? Expr(f->getInClassInitializer())
+                          : fg ? SplitArray(*fg).first + SplitArray(*fg).second + "(0)" : "0";
+      out += (first ? "" : ", ") + value;
       first = false;
     }
     return out + ")";
   }
   for (size_t i = 0; i < real.size(); ++i) out += (i ? ", " : "") + Expr(real[i]);
-  return out + ")";
+  out += ")";
+  // LiteMath lists matrix elements row by row; GLSL constructors take them column by column.
+  if (matrix && real.size() > 1) return "transpose(" + out + ")";
+  return out;
 }
 
 std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callLoc) {
@@ -361,6 +381,7 @@ std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callL
   m_inProgress.erase(def);
   m_emitted.insert(def);
   m_functions.push_back(os.str());
+  helpers.push_back(def);
   return name;
 }
 
@@ -391,7 +412,7 @@ std::string GlslPrinter::Builtin(const FunctionDecl* fd, const std::vector<std::
       {"sin", "sin"}, {"sinf", "sin"}, {"cos", "cos"}, {"cosf", "cos"}, {"tan", "tan"}, {"tanf", "tan"},
       {"asin", "asin"}, {"asinf", "asin"}, {"acos", "acos"}, {"acosf", "acos"}, {"atan", "atan"}, {"atanf", "atan"},
       {"atan2", "atan"}, {"atan2f", "atan"}, {"floor", "floor"}, {"floorf", "floor"}, {"ceil", "ceil"},
-      {"ceilf", "ceil"}, {"round", "round"}, {"roundf", "round"}, {"trunc", "trunc"}, {"truncf", "trunc"},
+      {"ceilf", "ceil"}, {"trunc", "trunc"}, {"truncf", "trunc"},
       {"fract", "fract"}, {"sign", "sign"}, {"dot", "dot"}, {"cross", "cross"}, {"length", "length"},
       {"normalize", "normalize"}, {"distance", "distance"}, {"reflect", "reflect"}, {"refract", "refract"},
       {"mix", "mix"}, {"lerp", "mix"}, {"step", "step"}, {"smoothstep", "smoothstep"},
@@ -404,10 +425,12 @@ std::string GlslPrinter::Builtin(const FunctionDecl* fd, const std::vector<std::
       {"to_float4", "vec4"}};
   bool library = IsSystemDecl(fd) || InNamespace(fd, "LiteMath");
   if (!library) return "";
-  if (n == "to_float3") return "(" + a[0] + ").xyz";
-  if ((n == "to_float2" || n == "to_float4") && call->getNumArgs() >= 1 &&
-      GlslTypeOf(call->getArg(0)->getType()).value_or("") == "vec4" && n == "to_float2")
-    return "(" + a[0] + ").xy";
+  const std::string arg0Type = call->getNumArgs() ? GlslTypeOf(call->getArg(0)->getType()).value_or("") : "";
+  if (n == "to_float3" && arg0Type == "vec4") return "(" + a[0] + ").xyz";
+  if (n == "to_float3") return "vec3(" + a[0] + ")";  // from int3/uint3: a conversion
+  if (n == "to_float2" && (arg0Type == "vec4" || arg0Type == "vec3")) return "(" + a[0] + ").xy";
+  // C++ rounds halves away from zero; GLSL's round() may round them to even.
+  if (n == "round" || n == "roundf") return "(sign(" + a[0] + ") * floor(abs(" + a[0] + ") + 0.5))";
   if (n == "as_int") return "floatBitsToInt(" + a[0] + ")";
   if (n == "as_uint") return "floatBitsToUint(" + a[0] + ")";
   if (n == "as_float") {
@@ -556,7 +579,7 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
         return field->getNameAsString();
       }
       if (field->getType()->isPointerType() || !GlslTypeOf(field->getType()))
-        return Fail(e->getBeginLoc(), "member '" + field->getNameAsString() + "' of type '" + field->getType().getAsString() +
+        return Fail(e->getBeginLoc(), "member '" + field->getNameAsString() + "' of type '" + field->getType().getAsString(m_ctx.getPrintingPolicy()) +
                     "' cannot be used in a kernel", "kernels may use plain data members and std::vector members");
       plainMembers.insert(field);
       return field->getNameAsString();
@@ -582,7 +605,13 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
     return Fail(e->getBeginLoc(), "operator not supported in kernels", "");
   }
   if (auto* bo = dyn_cast<BinaryOperator>(e)) {
-    if (bo->getOpcode() == BO_Comma) return Fail(e->getBeginLoc(), "comma operator in a kernel", "split it into separate statements");
+    // C++ gives the remainder the dividend's sign; GLSL's % is undefined for negative operands.
+    if ((bo->getOpcode() == BO_Rem || bo->getOpcode() == BO_RemAssign) && bo->getType()->isSignedIntegerType()) {
+      std::string a = Expr(bo->getLHS()), b = "(" + Expr(bo->getRHS()) + ")";
+      std::string rem = "(" + a + " - " + b + " * (" + a + " / " + b + "))";
+      return bo->getOpcode() == BO_Rem ? rem : a + " = " + rem;
+    }
+    if (bo->getOpcode() == BO_Comma) return Expr(bo->getLHS()) + ", " + Expr(bo->getRHS());  // GLSL has it too
     return Expr(bo->getLHS()) + " " + bo->getOpcodeStr().str() + " " + Expr(bo->getRHS());
   }
   if (auto* uo = dyn_cast<UnaryOperator>(e)) {
@@ -612,6 +641,9 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
       auto g = Type(il->getType(), e->getBeginLoc());
       if (!g) return "/*error*/";
       auto [base, dims] = SplitArray(*g);
+      // `float a[4] = {1}`: GLSL needs every element; the rest come from the array filler.
+      if (auto* arr = dyn_cast<ConstantArrayType>(il->getType().getCanonicalType().getTypePtr()); arr && il->hasArrayFiller())
+        while (args.size() < arr->getSize().getZExtValue()) args.push_back(il->getArrayFiller());
       std::string out = base + dims + "(";
       for (size_t i = 0; i < args.size(); ++i) out += (i ? ", " : "") + Expr(args[i]);
       return out + ")";
@@ -685,7 +717,14 @@ std::string GlslPrinter::Stmt(const clang::Stmt* s, int indent) {
   };
   if (auto* fs = dyn_cast<ForStmt>(s)) {
     std::string init;
-    if (fs->getInit()) {
+    if (auto* ds = dyn_cast_or_null<DeclStmt>(fs->getInit()); ds && !ds->isSingleDecl()) {
+      // `for (int i = 0, j = n - 1; ...)`: one declaration with several variables.
+      for (auto* d : ds->decls()) {
+        auto* vd = cast<VarDecl>(d);
+        std::string one = init.empty() ? Declare(vd->getType(), vd->getNameAsString(), vd->getLocation()) : SafeName(vd->getNameAsString());
+        init += (init.empty() ? "" : ", ") + one + (vd->getInit() ? " = " + Expr(vd->getInit()) : "");
+      }
+    } else if (fs->getInit()) {
       init = Stmt(fs->getInit(), 0);
       while (!init.empty() && (init.back() == '\n' || init.back() == ';')) init.pop_back();
     }

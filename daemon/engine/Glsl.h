@@ -26,10 +26,8 @@ bool IsLiteMathType(clang::QualType type, const char* name = nullptr);
 bool IsStdVector(clang::QualType type, clang::QualType* element = nullptr);
 bool IsSystemDecl(const clang::Decl* decl);
 
-// std430 alignment and array stride of a GLSL type by name ("vec3" -> 16, 16; "vec2" -> 8, 8;
-// scalars 4; matrices and structs 16).
-unsigned Std430AlignOf(const std::string& glslType);
-unsigned Std430StrideOf(const std::string& glslType);
+// std430 array stride of a scalar or vector GLSL type: "vec3" and "vec4" 16, "vec2" 8, scalars 4.
+unsigned Std430VectorStride(const std::string& glslType);
 
 // Memory layouts a GLSL buffer block can use. A C++ type can be shared with the GPU only when one
 // of them gives exactly the C++ offsets and sizes.
@@ -48,6 +46,8 @@ public:
   std::map<const clang::ValueDecl*, std::string> renames;
   // Members declared std::vector that the kernel reaches, plain members it reads.
   std::set<const clang::FieldDecl*> memberVectors, plainMembers;
+  // Helper functions the kernel reaches (their writes to members matter too).
+  std::vector<const clang::FunctionDecl*> helpers;
 
   std::string Expr(const clang::Expr* e);
   std::string Stmt(const clang::Stmt* s, int indent);

@@ -27,6 +27,7 @@ struct Member {
   bool writtenByKernels = false;
   bool usedByKernels = false;
   bool inClassData = false;     // plain: accessible, and its C++ layout matches std430
+  unsigned std430Align = 4;     // plain: alignment in a std430 block
 };
 
 enum class ReduceOp { Add, Sub, Min, Max };
@@ -48,6 +49,7 @@ struct KernelParam {
   bool isConstPointee = false;
   bool scalarLayout = false;
   bool isThreadId = false;  // RTV kernels: tid, tidX, tidY, tidZ
+  unsigned std430Align = 4;  // by-value parameters: alignment in the push-constant block
 };
 
 struct Loop {                // one parallel dimension of an IPV kernel

@@ -156,6 +156,9 @@ AnalyzeResult Analyze(const TranslateRequest& request, AstCache* sharedCache) {
     }
     sources.push_back(std::string(abs));
   }
+  // One handle per file, always locked in the same order: no self- or cross-request deadlock.
+  std::sort(sources.begin(), sources.end());
+  sources.erase(std::unique(sources.begin(), sources.end()), sources.end());
   if (sources.empty()) {
     result.diagnostics = "error: no source files given for class '" + request.className + "'\n";
     return result;

@@ -29,6 +29,7 @@
 #include <sys/file.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
+#include <sys/time.h>
 #include <sys/un.h>
 #include <thread>
 #include <unistd.h>
@@ -261,6 +262,13 @@ int main(int argc, char** argv) {
     if (ready > 0) {
       int fd = accept4(server, nullptr, nullptr, SOCK_CLOEXEC);
       if (fd < 0) continue;
+      if (d.active >= 64) {  // bounded: the client translates in-process instead
+        protocol::WriteLine(fd, json{{"ok", false}, {"error", "busy: 64 requests in progress"}}.dump());
+        close(fd);
+        continue;
+      }
+      timeval tv{30, 0};  // a client that connects and says nothing must not pin the daemon
+      setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
       d.lastActivity = d.Now();
       ++d.active;
       std::thread([&d, fd] {
@@ -278,5 +286,5 @@ int main(int argc, char** argv) {
   close(server);
   for (int i = 0; i < 600 && d.active > 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(100));
   d.Log("stopped");
-  return 0;
+  std::_Exit(0);  // requests still running after a minute are abandoned, not raced by destructors
 }

@@ -106,6 +106,12 @@ void ComputePipeline::PushBuffers(VkCommandBuffer cmd, std::initializer_list<Buf
   for (const BufferView& v : buffers) {
     if (!v.buffer)
       throw Error("ComputePipeline '" + name_ + "': binding " + std::to_string(infos.size()) + " has no buffer");
+    // e.g. `vec.data() + k` with k elements not a multiple of the device's offset alignment
+    const VkDeviceSize align = ctx_->properties.limits.minStorageBufferOffsetAlignment;
+    if (align > 1 && v.offset % align != 0)
+      throw Error("ComputePipeline '" + name_ + "': binding " + std::to_string(infos.size()) + " starts at byte offset " +
+                  std::to_string(v.offset) + ", which this device cannot bind (offsets must be multiples of " +
+                  std::to_string(align) + " bytes): use element offsets that keep that alignment");
     infos.push_back(VkDescriptorBufferInfo{v.buffer, v.offset, v.range});
   }
   // One write per binding: binding i gets the i-th view.

@@ -62,6 +62,9 @@ const Case kCases[] = {
     {"library call", "    x += float(std::strlen(\"abc\"));", "", "", "unsupported library call 'strlen' in a kernel", "kernels may call LiteMath", 8},
     {"member race", "    m_value = x;", "", "", "kernel writes class member 'm_value' from every thread", "reduction", 8},
     {"double", "    double d = x; x = float(d);", "", "", "type 'double' is not supported in kernels", "use float", 8},
+    {"narrow integer", "    short s = short(x); x = float(s);", "", "", "narrower than 32 bits", "use int", 8},
+    {"helper writes member", "    x = Touch(x);", "  float Touch(float v);", "float Bad::Touch(float v) { m_value = v; return v; }\n",
+     "helper function 'Touch' writes class member 'm_value'", "return the value", 12},
     {"return in loop", "    if (x > 0.0f) return;", "", "", "'return' inside a parallel kernel loop would end all later iterations", "'continue'", 8},
     {"nested control", "", "  virtual void Outer(int n, [[crossrt::size(\"n\")]] float* data);", "void Bad::Outer(int n, float* data) { kernel1D_Bad(n, data); Run(n, data); }\n",
      "control function 'Outer' calls control function 'Run'", "one submission", 12},
@@ -160,4 +163,28 @@ TEST_CASE("Bad command lines get a usage message", "[diagnostics]")
   r = RunCrossrt("translate --class X --backend cpu --out /tmp/x --source /nonexistent/x.cpp");
   REQUIRE(r.exitCode == 1);
   REQUIRE(r.output.find("source file '/nonexistent/x.cpp' does not exist") != std::string::npos);
+}
+
+TEST_CASE("A by-value kernel parameter whose C++ layout differs on the GPU is reported", "[diagnostics]")
+{
+  TempClass tc("Flags", R"(#pragma once
+class Flags
+{
+public:
+  virtual ~Flags() = default;
+  virtual void Run(int n, bool invert, [[crossrt::size("n")]] float* out);
+protected:
+  void kernel1D_Fill(int n, bool invert, float* out);
+};
+)",
+               R"(#include "Flags.h"
+void Flags::Run(int n, bool invert, float* out) { kernel1D_Fill(n, invert, out); }
+void Flags::kernel1D_Fill(int n, bool invert, float* out) { for (int i = 0; i < n; i++) out[i] = invert ? -1.0f : 1.0f; }
+)");
+  CommandResult r = RunCrossrt("translate --class Flags --backend vulkan --out " + (tc.dir / "out").string() + " --source " +
+                               tc.Source("Flags") + " --templates " CROSSRT_SOURCE_DIR "/templates");
+  INFO(r.output);
+  REQUIRE(r.exitCode == 1);
+  REQUIRE(r.output.find("Flags.h:8:34: error: kernel parameter 'invert' of type 'bool' cannot be passed to the GPU") != std::string::npos);
+  REQUIRE(r.output.find("use int") != std::string::npos);
 }

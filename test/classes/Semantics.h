@@ -1,0 +1,37 @@
+// C++ semantics the GPU code must keep (found in review): matrices, double promotions, signed
+// remainders, rounding, default member initialisers, array fillers, member updates between
+// kernels, RTV loops inside host loops, struct members' std430 alignment.
+#pragma once
+#include "LiteMath.h"
+
+#include <vector>
+
+using namespace LiteMath;
+
+struct Light  // 12 bytes, std430 alignment 4: two in a row sit at 0 and 12
+{
+  float x, y, z;
+};
+
+struct Interval
+{
+  float lo = 0.25f;
+  float hi = 8.0f;
+};
+
+class Semantics
+{
+public:
+  virtual ~Semantics() = default;
+  virtual void Evaluate(int n, [[crossrt::size("n * 8")]] float* out);
+  virtual void Steps(int n, int steps, [[crossrt::size("n")]] float* out);
+  virtual void CommitDeviceData() {}
+
+  Light m_a{1.0f, 2.0f, 3.0f}, m_b{4.0f, 5.0f, 6.0f};
+  float m_time = 0.0f;
+
+protected:
+  void kernel1D_Evaluate(int n, float* out);
+  void kernel1D_Accumulate(int n, float* out);
+  void kernel_Bump(int tid, float* out);
+};
