@@ -168,11 +168,6 @@ std::set<std::string> ClassStructNames(const ClassModel& model) {
   return names;
 }
 
-Member* FindMember(ClassModel& model, const std::string& name) {
-  for (auto& m : model.members)
-    if (m.name == name) return &m;
-  return nullptr;
-}
 
 // ---- kernels ---------------------------------------------------------------
 

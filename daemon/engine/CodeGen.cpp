@@ -93,11 +93,6 @@ std::string DispatchExpr(const Kernel& k) {
   return "crossrt::Dispatch3D(a_cmd, crt_countX, crt_countY, crt_countZ, " + std::to_string(s.x) + ", " + std::to_string(s.y) + ", " + std::to_string(s.z) + ")";
 }
 
-const Member* FindMember(const ClassModel& m, const std::string& name) {
-  for (auto& x : m.members)
-    if (x.name == name) return &x;
-  return nullptr;
-}
 
 std::string ReductionCppType(const ClassModel& model, const Reduction& r) {
   auto* m = FindMember(model, r.member);

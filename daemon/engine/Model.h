@@ -123,4 +123,12 @@ struct ClassModel {
   std::vector<std::string> usingDecls; // top-level using-directives of the sources: copied bodies need them
 };
 
+// The member named `name`, or null (works on a const and a mutable model).
+template <typename ModelT>
+auto* FindMember(ModelT& model, const std::string& name) {
+  for (auto& m : model.members)
+    if (m.name == name) return &m;
+  return static_cast<decltype(&model.members[0])>(nullptr);
+}
+
 }  // namespace crossrt::engine
