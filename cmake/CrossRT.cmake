@@ -59,6 +59,7 @@ function(crossrt_add_class target class)
   set(inc "$<TARGET_PROPERTY:${target},INCLUDE_DIRECTORIES>")
   set(defs "$<TARGET_PROPERTY:${target},COMPILE_DEFINITIONS>")
   set(std "$<TARGET_PROPERTY:${target},CXX_STANDARD>")
+  set(features "$<TARGET_PROPERTY:${target},COMPILE_FEATURES>")
   set(compile_args "$<$<BOOL:${inc}>:-I$<JOIN:${inc},$<SEMICOLON>-I>>")
   foreach(lib crossrt::litemath crossrt::liteimage crossrt::litert)
     set(lib_inc "$<TARGET_PROPERTY:${lib},INTERFACE_INCLUDE_DIRECTORIES>")
@@ -66,7 +67,8 @@ function(crossrt_add_class target class)
   endforeach()
   list(APPEND compile_args
     "$<$<BOOL:${defs}>:-D$<JOIN:${defs},$<SEMICOLON>-D>>"
-    "$<$<BOOL:${std}>:-std=c++${std}>")
+    "$<$<BOOL:${std}>:-std=c++${std}>"
+    "${features}")  # cxx_std_NN: the engine takes the highest standard asked for
 
   if(TARGET crossrt)
     set(translator $<TARGET_FILE:crossrt>)

@@ -19,6 +19,7 @@
 #include <llvm/Support/raw_ostream.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cstring>
 #include <mutex>
 #include <chrono>
@@ -123,8 +124,17 @@ bool KeepFlag(const std::string& a) {
 
 std::vector<std::string> FilterFlags(const std::vector<std::string>& in) {
   std::vector<std::string> out;
+  // The language standard: the highest of -std=c++NN and CMake's cxx_std_NN compile features.
+  int standard = 0;
+  for (auto& a : in) {
+    std::string digits = a.rfind("-std=c++", 0) == 0 ? a.substr(8) : a.rfind("-std=gnu++", 0) == 0 ? a.substr(10)
+                         : a.rfind("cxx_std_", 0) == 0 ? a.substr(8) : "";
+    if (!digits.empty() && std::isdigit(static_cast<unsigned char>(digits[0]))) standard = std::max(standard, std::atoi(digits.c_str()));
+  }
+  if (standard > 0) out.push_back("-std=c++" + std::to_string(standard));
   for (size_t i = 0; i < in.size(); ++i) {
     const std::string& a = in[i];
+    if (a.rfind("-std=", 0) == 0) continue;  // chosen above
     bool takesValue = a == "-I" || a == "-D" || a == "-U" || a == "-isystem" || a == "-iquote" || a == "-include";
     if (!KeepFlag(a)) continue;
     out.push_back(a);
@@ -136,8 +146,10 @@ std::vector<std::string> FilterFlags(const std::vector<std::string>& in) {
 }  // namespace
 
 std::vector<std::string> ParseArguments(const TranslateRequest& request) {
-  std::vector<std::string> args = {"-xc++", "-std=c++17", "-fsyntax-only", "-D__CROSSRT__=1", "-Wno-unused-command-line-argument"};
+  std::vector<std::string> args = {"-xc++", "-fsyntax-only", "-D__CROSSRT__=1", "-Wno-unused-command-line-argument"};
   auto kept = FilterFlags(request.compileArgs);
+  bool hasStandard = std::any_of(kept.begin(), kept.end(), [](const std::string& a) { return a.rfind("-std=", 0) == 0; });
+  if (!hasStandard) args.push_back("-std=c++17");  // the least the LiteMath headers need
   args.insert(args.end(), kept.begin(), kept.end());
   return args;
 }

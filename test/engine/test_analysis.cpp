@@ -179,6 +179,11 @@ TEST_CASE("Target compile options: meaning-changing flags are kept, GCC-only one
   CHECK(has("-march=x86-64"));
   CHECK(has("-fopenmp"));
   CHECK(has("-std=c++20"));
+  CHECK(std::count_if(args.begin(), args.end(), [](const std::string& a) { return a.rfind("-std=", 0) == 0; }) == 1);
+  r.compileArgs = {"-std=c++17", "cxx_std_20", "cxx_std_11"};  // CMake compile features count too
+  auto withFeatures = ParseArguments(r);
+  CHECK(std::find(withFeatures.begin(), withFeatures.end(), "-std=c++20") != withFeatures.end());
+  CHECK(std::find(withFeatures.begin(), withFeatures.end(), "-std=c++17") == withFeatures.end());
   CHECK(has("pre.h"));
   CHECK_FALSE(has("-O3"));
   CHECK_FALSE(has("-Wall"));
