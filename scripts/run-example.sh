@@ -3,12 +3,7 @@
 # examples, run them on the default Vulkan device (a GPU if there is one, else lavapipe), and
 # write the bloom image and the particle statistics table.
 set -euo pipefail
-cd "$(dirname "$0")/.."
-./scripts/install-deps.sh
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
-# The build's translation daemon (started by the build) goes when this script ends.
-root=$(pwd)
-trap '[ -x "$root/build/bin/crossrt" ] && "$root/build/bin/crossrt" daemon stop --build-dir "$root/build" > /dev/null 2>&1; true' EXIT
+source "$(dirname "$0")/configure.sh"
 cmake --build build --target particles bloom
 mkdir -p out
 ./build/examples/particles/particles 1000000 10 | tee out/particles.txt
