@@ -605,7 +605,7 @@ struct KernelCallFinder : RecursiveASTVisitor<KernelCallFinder> {
   }
   bool VisitCallExpr(CallExpr* call) {
     auto* fd = call->getDirectCallee();
-    static const std::set<std::string> library = {"exclusive_scan", "inclusive_scan", "fill", "memcpy", "memmove"};
+    static const std::set<std::string> library = {"exclusive_scan", "inclusive_scan", "fill", "memcpy", "memmove", "sort"};
     if (!fd || !fd->isInStdNamespace() || !library.count(fd->getNameAsString()) || isa<CXXMemberCallExpr>(call)) return true;
     for (auto* arg : call->arguments()) {
       auto* mc = dyn_cast<CXXMemberCallExpr>(arg->IgnoreParenImpCasts());
@@ -858,6 +858,22 @@ private:
       m_ctrl.vectorsWritten.push_back(p.vector->name);
   }
 
+  // `[](T a, T b) { return a < b; }`
+  static bool IsAscendingComparator(const Expr* e) {
+    auto* lambda = dyn_cast<LambdaExpr>(e->IgnoreImplicit()->IgnoreParenImpCasts());
+    if (auto* mt = dyn_cast<MaterializeTemporaryExpr>(e->IgnoreParenImpCasts())) lambda = dyn_cast<LambdaExpr>(mt->getSubExpr()->IgnoreImplicit());
+    if (!lambda) return false;
+    auto* op = lambda->getCallOperator();
+    auto* body = dyn_cast_or_null<CompoundStmt>(op->getBody());
+    if (!body || body->size() != 1 || op->getNumParams() != 2) return false;
+    auto* ret = dyn_cast<ReturnStmt>(body->body_front());
+    auto* lt = ret ? dyn_cast_or_null<BinaryOperator>(ret->getRetValue()->IgnoreParenImpCasts()) : nullptr;
+    if (!lt || lt->getOpcode() != BO_LT) return false;
+    auto* l = dyn_cast<DeclRefExpr>(lt->getLHS()->IgnoreParenImpCasts());
+    auto* r = dyn_cast<DeclRefExpr>(lt->getRHS()->IgnoreParenImpCasts());
+    return l && r && l->getDecl() == op->getParamDecl(0) && r->getDecl() == op->getParamDecl(1);
+  }
+
   bool TryLibraryCall(const CallExpr* call) {
     auto* fd = call->getDirectCallee();
     if (!fd) return false;
@@ -885,6 +901,17 @@ private:
                     (name == "inclusive_scan" ? "true" : "false") + ", crossrt::ScanType::" + type + ", " + init + ")";
       WrittenVector(*out);
       m_ctrl.usesScan = true;
+    } else if (name == "sort" && (call->getNumArgs() == 2 || call->getNumArgs() == 3)) {
+      auto first = PositionOf(call->getArg(0)), last = PositionOf(call->getArg(1));
+      if (!first || !last) return bad("its range is not a device buffer the translator can name");
+      auto count = Count(*first, *last);
+      if (!count) return bad("first and last must belong to the same buffer");
+      const auto* bt = first->element.getCanonicalType()->getAs<BuiltinType>();
+      if (!bt || bt->getKind() != BuiltinType::UInt) return bad("the GPU sort takes uint32_t keys so far");
+      if (call->getNumArgs() == 3 && !IsAscendingComparator(call->getArg(2)))
+        return bad("the GPU sort understands no comparator or `[](uint32_t a, uint32_t b) { return a < b; }` so far");
+      replacement = "m_sorter.RecordCmd(a_cmd, " + ViewAt(*first) + ", {}, uint32_t" + *count + ")";
+      WrittenVector(*first);
     } else if ((name == "memcpy" || name == "memmove") && call->getNumArgs() == 3) {
       auto dst = PositionOf(call->getArg(0)), src = PositionOf(call->getArg(1));
       if (!dst || !src || dst->isEnd || src->isEnd) return bad("source and destination must be device buffers");
@@ -907,7 +934,7 @@ private:
         QualType t = arg->getType();
         bool pointerLike = t->isPointerType() || (t->getAsCXXRecordDecl() && t->getAsCXXRecordDecl()->getName().contains("iterator"));
         if (pointerLike && PositionOf(arg))
-          return bad("only std::exclusive_scan, std::inclusive_scan, std::fill and memcpy run on device data so far");
+          return bad("only std::sort, std::exclusive_scan, std::inclusive_scan, std::fill and memcpy run on device data so far");
       }
       return false;
     }

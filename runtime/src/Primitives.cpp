@@ -1,6 +1,8 @@
 // GPU versions of the library calls control functions may make: scans, copies, fills.
 #include "crossrt/VulkanRuntime.h"
 
+#include "radix_histogram.h"
+#include "radix_scatter.h"
 #include "scan_add_float.h"
 #include "scan_add_int.h"
 #include "scan_add_uint.h"
@@ -73,6 +75,41 @@ void Scanner::RecordCmd(VkCommandBuffer cmd, BufferView in, BufferView out, uint
     add_[t].PushBuffers(cmd, {data, levels_[l].sums.View()});
     add_[t].PushConstants(cmd, &args, sizeof(args));
     DispatchBlocks(cmd, blocks);
+    ComputeBarrier(cmd);
+  }
+}
+
+RadixSorter::RadixSorter(std::shared_ptr<VulkanContext> ctx) : ctx_(ctx), scanner_(ctx) {}
+
+void RadixSorter::RecordCmd(VkCommandBuffer cmd, BufferView keys, BufferView values, uint32_t n) {
+  if (n <= 1) return;
+  if (histogram_.Handle() == VK_NULL_HANDLE) {  // pipelines are made on first use
+    histogram_ = ComputePipeline(ctx_, radix_histogram, sizeof(radix_histogram), 2, 12, "crossrt::radix_histogram");
+    scatter_ = ComputePipeline(ctx_, radix_scatter, sizeof(radix_scatter), 5, 12, "crossrt::radix_scatter");
+  }
+  const uint32_t tiles = (n + kBlock - 1) / kBlock;
+  EnsureSize(ctx_, keysTmp_, 4ull * n);
+  EnsureSize(ctx_, valuesTmp_, 4ull * n);
+  EnsureSize(ctx_, counts_, 4ull * 256 * tiles);
+  if (values.buffer == VK_NULL_HANDLE) {  // keys only: the values ride in scratch
+    EnsureSize(ctx_, valuesScratch_, 4ull * n);
+    values = valuesScratch_.View();
+  }
+  // Four passes ping-pong between the caller's buffers and scratch, ending in the caller's.
+  BufferView k[2] = {keys, keysTmp_.View()}, v[2] = {values, valuesTmp_.View()};
+  for (uint32_t pass = 0; pass < 4; ++pass) {
+    const uint32_t src = pass % 2, dst = 1 - src;
+    struct { uint32_t n, shift, tiles; } args{n, 8 * pass, tiles};
+    histogram_.Bind(cmd);
+    histogram_.PushBuffers(cmd, {k[src], counts_.View()});
+    histogram_.PushConstants(cmd, &args, sizeof(args));
+    DispatchBlocks(cmd, tiles);
+    ComputeBarrier(cmd);
+    scanner_.RecordCmd(cmd, counts_.View(), counts_.View(), 256 * tiles, false, ScanType::Uint);
+    scatter_.Bind(cmd);
+    scatter_.PushBuffers(cmd, {k[src], v[src], k[dst], v[dst], counts_.View()});
+    scatter_.PushConstants(cmd, &args, sizeof(args));
+    DispatchBlocks(cmd, tiles);
     ComputeBarrier(cmd);
   }
 }

@@ -34,3 +34,9 @@ void Compaction::kernel1D_Scatter(int n, const float* values, const uint32_t* ke
       m_kept += slot[i] + keep[i];
   }
 }
+
+void Compaction::SortSlots(int n)
+{
+  std::sort(m_slot.begin(), m_slot.begin() + n);
+  std::sort(m_keep.begin(), m_keep.end(), [](uint32_t a, uint32_t b) { return a < b; });
+}

@@ -15,6 +15,8 @@ public:
   // prefix[i] = values[0] + ... + values[i]; copy = values; m_marks filled with 7.
   virtual void PrefixSum(int n, [[crossrt::size("n")]] const float* values, [[crossrt::size("n")]] float* prefix,
                          [[crossrt::size("n")]] float* copy);
+  // Sorts the first n elements of m_slot and all of m_keep (radix sort on the GPU).
+  virtual void SortSlots(int n);
   virtual void CommitDeviceData() {}
 
   uint32_t m_kept = 0;

@@ -188,3 +188,35 @@ void Flags::kernel1D_Fill(int n, bool invert, float* out) { for (int i = 0; i < 
   REQUIRE(r.output.find("Flags.h:8:34: error: kernel parameter 'invert' of type 'bool' cannot be passed to the GPU") != std::string::npos);
   REQUIRE(r.output.find("use int") != std::string::npos);
 }
+
+TEST_CASE("A std::sort the GPU cannot do yet is reported, not run on a stale host copy", "[diagnostics]")
+{
+  TempClass tc("Sorter", R"(#pragma once
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+class Sorter
+{
+public:
+  virtual ~Sorter() = default;
+  virtual void Run(int n);
+  std::vector<uint32_t> m_keys;
+protected:
+  void kernel1D_Fill(int n);
+};
+)",
+               R"(#include "Sorter.h"
+void Sorter::Run(int n)
+{
+  kernel1D_Fill(n);
+  std::sort(m_keys.begin(), m_keys.end(), [](uint32_t a, uint32_t b) { return a > b; });
+}
+void Sorter::kernel1D_Fill(int n) { for (int i = 0; i < n; i++) m_keys[i] = uint32_t(i * 7 % 13); }
+)");
+  CommandResult r = RunCrossrt("translate --class Sorter --backend vulkan --out " + (tc.dir / "out").string() + " --source " +
+                               tc.Source("Sorter") + " --templates " CROSSRT_SOURCE_DIR "/templates");
+  INFO(r.output);
+  REQUIRE(r.exitCode == 1);
+  REQUIRE(r.output.find("Sorter.cpp:5:3: error: 'std::sort' on device data: the GPU sort understands no comparator or") != std::string::npos);
+  REQUIRE(r.output.find("hint:") != std::string::npos);
+}

@@ -7,6 +7,7 @@
 #include "Compaction_Vulkan.h"
 #include "TestSupport.h"
 
+#include <algorithm>
 #include <random>
 
 TEST_CASE("Stream compaction: a kernel, std::exclusive_scan, a kernel", "[equivalence][scan]")
@@ -67,6 +68,37 @@ TEST_CASE("std::inclusive_scan of floats, memcpy and std::fill in a control func
         REQUIRE(bad == 0);
         REQUIRE(copy == values);
         REQUIRE(std::all_of(impl->m_marks.begin(), impl->m_marks.end(), [](int m) { return m == 7; }));
+      }
+    }
+  }
+  RequireNoValidationMessages(ctx);
+}
+
+TEST_CASE("std::sort of uint32_t keys in a control function becomes a GPU radix sort", "[equivalence][sort]")
+{
+  auto ctx = ValidatedContext();
+  for (int n : {1, 2, 1000, 1025, 100003, (1 << 20) + 3})
+  {
+    DYNAMIC_SECTION("n = " << n)
+    {
+      std::vector<std::pair<const char*, std::shared_ptr<Compaction>>> impls = {
+          {"original", std::make_shared<Compaction>(n)}, {"CPU", CreateCompaction_CPU(n)}};
+      if (ctx) impls.push_back({"Vulkan", CreateCompaction_Vulkan(ctx, n)});
+      for (auto& [name, impl] : impls)
+      {
+        INFO(name);
+        uint32_t state = uint32_t(n);
+        for (int i = 0; i < n; ++i)
+        {
+          impl->m_slot[i] = (state = state * 1664525u + 1013904223u);  // full 32-bit keys
+          impl->m_keep[i] = state >> 29;                                 // many equal keys
+        }
+        impl->CommitDeviceData();
+        impl->SortSlots(n);
+        REQUIRE(std::is_sorted(impl->m_slot.begin(), impl->m_slot.end()));
+        REQUIRE(std::is_sorted(impl->m_keep.begin(), impl->m_keep.end()));
+        REQUIRE(impl->m_slot == impls[0].second->m_slot);
+        REQUIRE(impl->m_keep == impls[0].second->m_keep);
       }
     }
   }

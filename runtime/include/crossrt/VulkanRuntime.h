@@ -284,6 +284,23 @@ private:
   std::vector<Level> levels_;
 };
 
+// std::sort of uint32_t keys on the GPU: a stable LSD radix sort, 4 passes of 8 bits (tile
+// histograms, an exclusive scan of them, a stable scatter). Any n, no padding to a power of two.
+class RadixSorter {
+public:
+  RadixSorter() = default;
+  explicit RadixSorter(std::shared_ptr<VulkanContext> ctx);
+  // Sorts keys[0..n) ascending in place; `values` (uint32, may be an empty view) move along.
+  // Ends with a barrier. Scratch grows as needed (see Scanner::RecordCmd).
+  void RecordCmd(VkCommandBuffer cmd, BufferView keys, BufferView values, uint32_t n);
+
+private:
+  std::shared_ptr<VulkanContext> ctx_;
+  ComputePipeline histogram_, scatter_;
+  Scanner scanner_;
+  Buffer keysTmp_, valuesTmp_, valuesScratch_, counts_;
+};
+
 // A view `bytes` further into a buffer view.
 inline BufferView Offset(BufferView v, VkDeviceSize bytes) {
   return {v.buffer, v.offset + bytes, v.range == VK_WHOLE_SIZE ? VK_WHOLE_SIZE : v.range - bytes};
