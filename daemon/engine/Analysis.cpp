@@ -377,7 +377,6 @@ void CheckKernelParams(Context& c, const CXXMethodDecl* md, Kernel& k) {
         continue;
       }
       kp.glslType = *g;
-      kp.cppType = "crossrt::BufferView";
       if (!LayoutMatchesCpp(c.ctx, pointee, false)) {
         if (LayoutMatchesCpp(c.ctx, pointee, true)) kp.scalarLayout = true;
         else c.rep.Error(p->getLocation(), "the C++ layout of '" + pointee.getAsString(c.ctx.getPrintingPolicy()) + "' cannot be reproduced in a GPU buffer",
@@ -562,7 +561,6 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   }
   for (auto& r : k.reductions)
     if (auto* m = FindMember(c.model, r.member)) { m->usedByKernels = true; m->writtenByKernels = true; }
-  k.usesClassData = true;  // binding 0 is always the class data: simple and uniform
 
   // CPU backend: the loop nest as the user wrote it, reduction targets renamed.
   if (!k.rtv) {
@@ -900,7 +898,6 @@ private:
       replacement = "m_scanner.RecordCmd(a_cmd, " + ViewAt(*first) + ", " + ViewAt(*out) + ", uint32_t" + *count + ", " +
                     (name == "inclusive_scan" ? "true" : "false") + ", crossrt::ScanType::" + type + ", " + init + ")";
       WrittenVector(*out);
-      m_ctrl.usesScan = true;
     } else if (name == "sort" && (call->getNumArgs() == 2 || call->getNumArgs() == 3)) {
       auto first = PositionOf(call->getArg(0)), last = PositionOf(call->getArg(1));
       if (!first || !last) return bad("its range is not a device buffer the translator can name");
@@ -995,13 +992,11 @@ void AnalyzeControl(Context& c, const CXXMethodDecl* md, const FunctionDecl* def
                 "return results through size-annotated pointer parameters or members; control functions return void");
     return;
   }
-  ctrl.returnType = "void";
   for (unsigned i = 0; i < md->getNumParams(); ++i) {
     auto* p = md->getParamDecl(i);
     ControlParam cp;
     cp.name = p->getNameAsString();
     if (cp.name.empty()) cp.name = "a_unnamed" + std::to_string(i);  // as ParamDecl() spells it
-    cp.cppType = p->getType().getAsString(c.ctx.getPrintingPolicy());
     cp.declText = ParamDecl(c.ctx, p, i);
     ctrl.paramsDecl += (i ? ", " : "") + cp.declText;
     ctrl.argsForward += (i ? ", " : "") + cp.name;
@@ -1030,15 +1025,15 @@ void AnalyzeControl(Context& c, const CXXMethodDecl* md, const FunctionDecl* def
 bool AnalyzeTranslationUnit(ASTContext& ctx, const std::string& className, Reporter& reporter, ClassModel& model) {
   // A name lookup in the translation unit: walking every declaration of the standard library
   // would cost more than the rest of the analysis.
-  struct { const CXXRecordDecl* found = nullptr; } finder;
+  const CXXRecordDecl* cls = nullptr;
   for (auto* d : ctx.getTranslationUnitDecl()->lookup(&ctx.Idents.get(className)))
-    if (auto* rd = dyn_cast<CXXRecordDecl>(d); rd && rd->getDefinition()) finder.found = rd->getDefinition();
-  if (!finder.found) return false;
-  Context c{ctx, finder.found, reporter, model};
+    if (auto* rd = dyn_cast<CXXRecordDecl>(d); rd && rd->getDefinition()) cls = rd->getDefinition();
+  if (!cls) return false;
+  Context c{ctx, cls, reporter, model};
   bool first = model.className.empty();
   if (first) {
     model.className = className;
-    model.headerFile = FileOf(ctx, finder.found->getLocation());
+    model.headerFile = FileOf(ctx, cls->getLocation());
     AnalyzeMembers(c);
   }
   auto known = [](const auto& list, const std::string& n) {
@@ -1078,7 +1073,7 @@ bool AnalyzeTranslationUnit(ASTContext& ctx, const std::string& className, Repor
   }
   // Kernels first: control functions refer to them.
   for (int pass = 0; pass < 2; ++pass) {
-    for (auto* md : finder.found->methods()) {
+    for (auto* md : cls->methods()) {
       const FunctionDecl* def = nullptr;
       if (!md->hasBody(def) || !def) continue;
       // A method defined in a header is seen by every source file: analyse it once.

@@ -42,7 +42,7 @@ struct Reduction {
 struct KernelParam {
   std::string name;       // as in the user's code
   std::string glslName;   // renamed when it is a GLSL keyword
-  std::string cppType;    // host type for the ...Cmd signature
+  std::string cppType;    // by-value parameters: the type as written, for the ...Cmd signature
   std::string valueCppType;  // the value type, for the push-constant mirror
   std::string glslType;
   bool isPointer = false;
@@ -69,7 +69,6 @@ struct Kernel {
   std::vector<Loop> loops;            // IPV: outermost first
   std::vector<Reduction> reductions;
   std::vector<std::string> memberVectors;   // member vectors the kernel reaches (incl. helpers)
-  bool usesClassData = false;
   std::string glslStructs;            // structs it needs beyond the class's
   std::string glslHelpers;            // constants and helper functions it needs
   std::string glslBody;               // the thread's code, as a GLSL function body
@@ -80,7 +79,6 @@ struct Kernel {
 
 struct ControlParam {
   std::string name;
-  std::string cppType;       // full spelling, e.g. "const float*"
   bool isPointer = false;
   bool isConst = false;
   std::string pointeeCpp;    // element type of a pointer
@@ -90,7 +88,6 @@ struct ControlParam {
 
 struct Control {
   std::string name;
-  std::string returnType;
   std::string paramsDecl;           // "int n, const float* in"
   std::string argsForward;          // "n, in"
   bool isConst = false;
@@ -99,7 +96,6 @@ struct Control {
   std::string cpuBody;              // body with RTV loops parallelised
   std::vector<std::string> kernelsCalled;
   std::vector<std::string> vectorsWritten;  // member vectors its library calls (scan, fill, memcpy) write
-  bool usesScan = false;
   std::string sourceFile;
 };
 

@@ -6,13 +6,22 @@
 #include "Semantics_Vulkan.h"
 #include "TestSupport.h"
 
+namespace {
+// The original class, Semantics_CPU and, when a Vulkan device exists, Semantics_Vulkan.
+std::vector<std::pair<const char*, std::shared_ptr<Semantics>>> AllImplementations(const std::shared_ptr<crossrt::VulkanContext>& ctx)
+{
+  std::vector<std::pair<const char*, std::shared_ptr<Semantics>>> impls = {{"original", std::make_shared<Semantics>()},
+                                                                          {"CPU", CreateSemantics_CPU()}};
+  if (ctx) impls.push_back({"Vulkan", CreateSemantics_Vulkan(ctx)});
+  return impls;
+}
+}  // namespace
+
 TEST_CASE("Matrices, double promotions, remainders, rounding, initialisers and struct members keep C++ semantics", "[equivalence]")
 {
   auto ctx = ValidatedContext();
   const int n = 40;
-  std::vector<std::pair<const char*, std::shared_ptr<Semantics>>> impls = {{"original", std::make_shared<Semantics>()},
-                                                                          {"CPU", CreateSemantics_CPU()}};
-  if (ctx) impls.push_back({"Vulkan", CreateSemantics_Vulkan(ctx)});
+  auto impls = AllImplementations(ctx);
   std::vector<std::vector<float>> results;
   for (auto& [name, impl] : impls)
   {
@@ -48,9 +57,7 @@ TEST_CASE("Members changed between kernels, and RTV loops inside host loops, run
 {
   auto ctx = ValidatedContext();
   const int n = 1000;
-  std::vector<std::pair<const char*, std::shared_ptr<Semantics>>> impls = {{"original", std::make_shared<Semantics>()},
-                                                                          {"CPU", CreateSemantics_CPU()}};
-  if (ctx) impls.push_back({"Vulkan", CreateSemantics_Vulkan(ctx)});
+  auto impls = AllImplementations(ctx);
   std::vector<std::vector<float>> results;
   for (auto& [name, impl] : impls)
   {
