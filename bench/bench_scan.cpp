@@ -68,7 +68,7 @@ int main()
     crossrt::Buffer a(ctx, 4ull * n), b(ctx, 4ull * n);
     a.Upload(in.data(), 4ull * n);
     Timing t = Measure(*ctx, timer, [&] { std::exclusive_scan(in.begin(), in.end(), out.begin(), 0u); },
-                       [&](VkCommandBuffer cmd) { scanner.RecordCmd(cmd, a.View(), b.View(), n, false, crossrt::ScanType::Uint); });
+                       [&](VkCommandBuffer cmd) { scanner.RecordCmd(cmd, a.View(), b.View(), n, false, crossrt::ElementType::Uint); });
     b.Download(gpuOut.data(), 4ull * n);
     if (gpuOut != out)
     {
@@ -78,31 +78,50 @@ int main()
     Row(n, t);
   }
 
+  // Plain keys, then (key, index) pairs ordered by the key: LBVH's sort of Morton codes.
   crossrt::RadixSorter sorter(ctx);
-  Header("sort keys");
-  for (uint32_t n : {1u << 10, 1000u, 1u << 14, 100003u, 1u << 18, 1u << 20, 3000017u, 1u << 22})
+  for (uint32_t words : {1u, 2u})
   {
-    std::vector<uint32_t> keys(n), sorted, gpuOut(n);
-    uint32_t state = 12345u;
-    for (auto& k : keys) k = (state = state * 1664525u + 1013904223u);
-    crossrt::Buffer a(ctx, 4ull * n);
-    Timing t = Measure(
-        *ctx, timer,
-        [&] {
-          sorted = keys;
-          std::sort(sorted.begin(), sorted.end());
-        },
-        [&](VkCommandBuffer cmd) {
-          a.Upload(keys.data(), 4ull * n);  // before recording: the sort works in place
-          sorter.RecordCmd(cmd, a.View(), {}, n);
-        });
-    a.Download(gpuOut.data(), 4ull * n);
-    if (gpuOut != sorted)
+    Header(words == 1 ? "sort keys" : "sort pairs");
+    for (uint32_t n : {1u << 10, 1000u, 1u << 14, 100003u, 1u << 18, 1u << 20, 3000017u, 1u << 22})
     {
-      std::printf("MISMATCH in sort at n = %u\n", n);
-      return 1;
+      std::vector<uint32_t> records(size_t(words) * n), sorted, gpuOut(records.size());
+      uint32_t state = 12345u;
+      for (uint32_t i = 0; i < n; ++i)
+      {
+        records[size_t(words) * i] = (state = state * 1664525u + 1013904223u);
+        if (words == 2) records[2 * size_t(i) + 1] = i;
+      }
+      crossrt::Buffer a(ctx, 4ull * records.size());
+      auto cpuSort = [&] {
+        sorted = records;
+        if (words == 1)
+          std::sort(sorted.begin(), sorted.end());
+        else
+        {
+          auto* pairs = reinterpret_cast<uint64_t*>(sorted.data());  // little-endian: key in the low word
+          std::sort(pairs, pairs + n, [](uint64_t x, uint64_t y) { return uint32_t(x) < uint32_t(y); });
+        }
+      };
+      Timing t = Measure(*ctx, timer, cpuSort, [&](VkCommandBuffer cmd) {
+        a.Upload(records.data(), 4ull * records.size());  // before recording: the sort works in place
+        sorter.RecordCmd(cmd, a.View(), n, crossrt::SortKey{words, 0, crossrt::ElementType::Uint, false});
+      });
+      a.Download(gpuOut.data(), 4ull * records.size());
+      // The GPU sort is stable; std::sort need not be: compare with a stable sort of the input.
+      std::vector<uint32_t> expected = records;
+      auto* pairs = reinterpret_cast<uint64_t*>(expected.data());
+      if (words == 1)
+        std::stable_sort(expected.begin(), expected.end());
+      else
+        std::stable_sort(pairs, pairs + n, [](uint64_t x, uint64_t y) { return uint32_t(x) < uint32_t(y); });
+      if (gpuOut != expected)
+      {
+        std::printf("MISMATCH in sort (%u words) at n = %u\n", words, n);
+        return 1;
+      }
+      Row(n, t);
     }
-    Row(n, t);
   }
   return 0;
 }

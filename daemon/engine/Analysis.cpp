@@ -856,20 +856,78 @@ private:
       m_ctrl.vectorsWritten.push_back(p.vector->name);
   }
 
-  // `[](T a, T b) { return a < b; }`
-  static bool IsAscendingComparator(const Expr* e) {
-    auto* lambda = dyn_cast<LambdaExpr>(e->IgnoreImplicit()->IgnoreParenImpCasts());
-    if (auto* mt = dyn_cast<MaterializeTemporaryExpr>(e->IgnoreParenImpCasts())) lambda = dyn_cast<LambdaExpr>(mt->getSubExpr()->IgnoreImplicit());
-    if (!lambda) return false;
+  // How a std::sort call orders its elements, as the GPU radix sort needs it.
+  struct SortOrder {
+    uint32_t keyWord = 0;
+    std::string type;  // "Uint", "Int" or "Float"
+    bool descending = false;
+  };
+
+  static std::string KeyTypeName(QualType t) {
+    const auto* bt = t.getCanonicalType()->getAs<BuiltinType>();
+    if (!bt) return "";
+    return bt->getKind() == BuiltinType::UInt ? "Uint" : bt->getKind() == BuiltinType::Int ? "Int" : bt->getKind() == BuiltinType::Float ? "Float" : "";
+  }
+
+  // `a`, `a.key` or `a.inner.key` with `a` a comparator parameter: which parameter, and the key's
+  // byte offset in the element.
+  std::optional<std::pair<const ParmVarDecl*, uint64_t>> KeyPath(const Expr* e, std::string& keyType) {
+    e = e->IgnoreParenImpCasts();
+    uint64_t offset = 0;
+    const Expr* base = e;
+    keyType = KeyTypeName(e->getType());
+    while (auto* me = dyn_cast<MemberExpr>(base)) {
+      auto* fd = dyn_cast<FieldDecl>(me->getMemberDecl());
+      if (!fd || me->isArrow() || fd->isBitField()) return std::nullopt;
+      offset += m_c.ctx.getFieldOffset(fd) / 8;
+      base = me->getBase()->IgnoreParenImpCasts();
+    }
+    auto* dr = dyn_cast<DeclRefExpr>(base);
+    auto* parm = dr ? dyn_cast<ParmVarDecl>(dr->getDecl()) : nullptr;
+    if (!parm) return std::nullopt;
+    return std::make_pair(parm, offset);
+  }
+
+  // No comparator, std::less<>/std::greater<>, or a lambda `return a.key < b.key;` (or `>`, or
+  // with the parameters swapped) over a uint32_t, int or float key.
+  std::optional<SortOrder> OrderOf(const CallExpr* call, QualType element, std::string& why) {
+    const std::string scalarType = KeyTypeName(element);
+    if (call->getNumArgs() == 2) {
+      if (scalarType.empty()) why = "sorting elements without a comparator needs uint32_t, int or float elements";
+      return scalarType.empty() ? std::nullopt : std::optional<SortOrder>(SortOrder{0, scalarType, false});
+    }
+    const Expr* cmp = call->getArg(2)->IgnoreImplicit()->IgnoreParenImpCasts();
+    if (auto* mt = dyn_cast<MaterializeTemporaryExpr>(cmp)) cmp = mt->getSubExpr()->IgnoreImplicit();
+    if (auto* record = cmp->getType()->getAsCXXRecordDecl(); record && record->isInStdNamespace() &&
+                                                          (record->getName() == "less" || record->getName() == "greater")) {
+      if (scalarType.empty()) why = "std::less and std::greater sort uint32_t, int or float elements on the GPU";
+      return scalarType.empty() ? std::nullopt : std::optional<SortOrder>(SortOrder{0, scalarType, record->getName() == "greater"});
+    }
+    why = "the GPU sort understands comparators of the form `[](T a, T b) { return a.key < b.key; }` (or `>`) with a "
+          "uint32_t, int or float key";
+    auto* lambda = dyn_cast<LambdaExpr>(cmp);
+    if (!lambda) return std::nullopt;
     auto* op = lambda->getCallOperator();
     auto* body = dyn_cast_or_null<CompoundStmt>(op->getBody());
-    if (!body || body->size() != 1 || op->getNumParams() != 2) return false;
+    if (!body || body->size() != 1 || op->getNumParams() != 2) return std::nullopt;
     auto* ret = dyn_cast<ReturnStmt>(body->body_front());
-    auto* lt = ret ? dyn_cast_or_null<BinaryOperator>(ret->getRetValue()->IgnoreParenImpCasts()) : nullptr;
-    if (!lt || lt->getOpcode() != BO_LT) return false;
-    auto* l = dyn_cast<DeclRefExpr>(lt->getLHS()->IgnoreParenImpCasts());
-    auto* r = dyn_cast<DeclRefExpr>(lt->getRHS()->IgnoreParenImpCasts());
-    return l && r && l->getDecl() == op->getParamDecl(0) && r->getDecl() == op->getParamDecl(1);
+    auto* cmpOp = ret && ret->getRetValue() ? dyn_cast<BinaryOperator>(ret->getRetValue()->IgnoreParenImpCasts()) : nullptr;
+    if (!cmpOp || (cmpOp->getOpcode() != BO_LT && cmpOp->getOpcode() != BO_GT)) return std::nullopt;
+    std::string lType, rType;
+    auto l = KeyPath(cmpOp->getLHS(), lType), r = KeyPath(cmpOp->getRHS(), rType);
+    if (!l || !r || l->second != r->second || l->first == r->first) return std::nullopt;
+    if (lType.empty() || lType != rType) return std::nullopt;
+    // Both parameters must be the element type (by value or const reference).
+    for (auto* parm : op->parameters())
+      if (!m_c.ctx.hasSameUnqualifiedType(parm->getType().getNonReferenceType(), element)) return std::nullopt;
+    const uint64_t size = m_c.ctx.getTypeSizeInChars(element).getQuantity();
+    if (size % 4 != 0 || l->second % 4 != 0) {
+      why = "the GPU sort moves whole 32-bit words: the element's size and the key's offset must be multiples of 4 bytes";
+      return std::nullopt;
+    }
+    const bool firstOnLeft = l->first == op->getParamDecl(0);
+    const bool descending = (cmpOp->getOpcode() == BO_GT) == firstOnLeft;
+    return SortOrder{uint32_t(l->second / 4), lType, descending};
   }
 
   bool TryLibraryCall(const CallExpr* call) {
@@ -896,18 +954,20 @@ private:
       std::string elem = CppTypeName(m_c.ctx, first->element);
       std::string init = name == "exclusive_scan" ? "crossrt::Bits32(static_cast<" + elem + ">(" + m_c.Text(call->getArg(3)->getSourceRange()) + "))" : "0u";
       replacement = "m_scanner.RecordCmd(a_cmd, " + ViewAt(*first) + ", " + ViewAt(*out) + ", uint32_t" + *count + ", " +
-                    (name == "inclusive_scan" ? "true" : "false") + ", crossrt::ScanType::" + type + ", " + init + ")";
+                    (name == "inclusive_scan" ? "true" : "false") + ", crossrt::ElementType::" + type + ", " + init + ")";
       WrittenVector(*out);
     } else if (name == "sort" && (call->getNumArgs() == 2 || call->getNumArgs() == 3)) {
       auto first = PositionOf(call->getArg(0)), last = PositionOf(call->getArg(1));
       if (!first || !last) return bad("its range is not a device buffer the translator can name");
       auto count = Count(*first, *last);
       if (!count) return bad("first and last must belong to the same buffer");
-      const auto* bt = first->element.getCanonicalType()->getAs<BuiltinType>();
-      if (!bt || bt->getKind() != BuiltinType::UInt) return bad("the GPU sort takes uint32_t keys so far");
-      if (call->getNumArgs() == 3 && !IsAscendingComparator(call->getArg(2)))
-        return bad("the GPU sort understands no comparator or `[](uint32_t a, uint32_t b) { return a < b; }` so far");
-      replacement = "m_sorter.RecordCmd(a_cmd, " + ViewAt(*first) + ", {}, uint32_t" + *count + ")";
+      std::string why;
+      auto order = OrderOf(call, first->element, why);
+      if (!order) return bad(why);
+      const uint64_t words = m_c.ctx.getTypeSizeInChars(first->element).getQuantity() / 4;
+      replacement = "m_sorter.RecordCmd(a_cmd, " + ViewAt(*first) + ", uint32_t" + *count + ", crossrt::SortKey{" +
+                    std::to_string(words) + ", " + std::to_string(order->keyWord) + ", crossrt::ElementType::" + order->type +
+                    ", " + (order->descending ? "true" : "false") + "})";
       WrittenVector(*first);
     } else if ((name == "memcpy" || name == "memmove") && call->getNumArgs() == 3) {
       auto dst = PositionOf(call->getArg(0)), src = PositionOf(call->getArg(1));

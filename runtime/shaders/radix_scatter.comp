@@ -1,17 +1,17 @@
 #version 460
-// Radix sort, pass 2 of each digit: every workgroup moves its tile's keys (and values) to their
-// sorted positions. Stable: keys keep their order within a digit. Each of 4 rounds takes 256
-// consecutive keys; a key's rank among equal digits of the round comes from a bitmask per digit.
+#extension GL_GOOGLE_include_directive : require
+// Radix sort, pass 2 of each digit: every workgroup moves its tile's records to their sorted
+// positions. Stable: records keep their order within a digit. Each of 4 rounds takes 256
+// consecutive records; a record's rank among equal digits of the round comes from a bitmask per
+// digit.
 layout(local_size_x = 256) in;
-layout(std430, binding = 0) readonly buffer KeysIn { uint keysIn[]; };
-layout(std430, binding = 1) readonly buffer ValuesIn { uint valuesIn[]; };
-layout(std430, binding = 2) writeonly buffer KeysOut { uint keysOut[]; };
-layout(std430, binding = 3) writeonly buffer ValuesOut { uint valuesOut[]; };
-layout(std430, binding = 4) readonly buffer Offsets { uint offsets[]; };  // scanned counts
-layout(push_constant) uniform Args { uint n; uint shift; uint tiles; };
+layout(std430, binding = 0) readonly buffer RecordsIn { uint recordsIn[]; };
+layout(std430, binding = 1) writeonly buffer RecordsOut { uint recordsOut[]; };
+layout(std430, binding = 2) readonly buffer Offsets { uint offsets[]; };  // scanned counts
+#include "radix_key.glsl"
 
 shared uint masks[256][8];   // per digit: which threads of this round hold it
-shared uint placed[256];     // per digit: keys of this tile already placed
+shared uint placed[256];     // per digit: records of this tile already placed
 
 void main()
 {
@@ -25,8 +25,7 @@ void main()
   {
     const uint i = tile * 1024u + r * 256u + t;
     const bool valid = i < n;
-    const uint key = valid ? keysIn[i] : 0u;
-    const uint digit = (key >> shift) & 255u;
+    const uint digit = valid ? (SortableKey(recordsIn[i * stride + keyWord]) >> shift) & 255u : 0u;
     if (valid)
       atomicOr(masks[digit][t / 32u], 1u << (t % 32u));
     barrier();
@@ -37,11 +36,11 @@ void main()
         rank += bitCount(masks[digit][w]);
       rank += bitCount(masks[digit][t / 32u] & ((1u << (t % 32u)) - 1u));
       const uint position = placed[digit] + rank;
-      keysOut[position] = key;
-      valuesOut[position] = valuesIn[i];
+      for (uint w = 0u; w < stride; ++w)
+        recordsOut[position * stride + w] = recordsIn[i * stride + w];
     }
     barrier();
-    // Thread t owns digit t: advance past this round's keys, clear its masks.
+    // Thread t owns digit t: advance past this round's records, clear its masks.
     uint total = 0u;
     for (uint w = 0u; w < 8u; ++w)
     {

@@ -36,7 +36,7 @@ void Scanner::Init() {
   add_[2] = ComputePipeline(ctx_, scan_add_float, sizeof(scan_add_float), 2, 12, "crossrt::scan_add(float)");
 }
 
-void Scanner::RecordCmd(VkCommandBuffer cmd, BufferView in, BufferView out, uint32_t n, bool inclusive, ScanType type,
+void Scanner::RecordCmd(VkCommandBuffer cmd, BufferView in, BufferView out, uint32_t n, bool inclusive, ElementType type,
                         uint32_t initBits) {
   if (n == 0) return;
   Init();
@@ -81,33 +81,32 @@ void Scanner::RecordCmd(VkCommandBuffer cmd, BufferView in, BufferView out, uint
 
 RadixSorter::RadixSorter(std::shared_ptr<VulkanContext> ctx) : ctx_(ctx), scanner_(ctx) {}
 
-void RadixSorter::RecordCmd(VkCommandBuffer cmd, BufferView keys, BufferView values, uint32_t n) {
+void RadixSorter::RecordCmd(VkCommandBuffer cmd, BufferView records, uint32_t n, SortKey key) {
   if (n <= 1) return;
+  if (key.strideWords == 0 || key.keyWord >= key.strideWords)
+    throw Error("RadixSorter: key word " + std::to_string(key.keyWord) + " outside records of " +
+                std::to_string(key.strideWords) + " words");
   if (histogram_.Handle() == VK_NULL_HANDLE) {  // pipelines are made on first use
-    histogram_ = ComputePipeline(ctx_, radix_histogram, sizeof(radix_histogram), 2, 12, "crossrt::radix_histogram");
-    scatter_ = ComputePipeline(ctx_, radix_scatter, sizeof(radix_scatter), 5, 12, "crossrt::radix_scatter");
+    histogram_ = ComputePipeline(ctx_, radix_histogram, sizeof(radix_histogram), 2, 24, "crossrt::radix_histogram");
+    scatter_ = ComputePipeline(ctx_, radix_scatter, sizeof(radix_scatter), 3, 24, "crossrt::radix_scatter");
   }
   const uint32_t tiles = (n + kBlock - 1) / kBlock;
-  EnsureSize(ctx_, keysTmp_, 4ull * n);
-  EnsureSize(ctx_, valuesTmp_, 4ull * n);
+  EnsureSize(ctx_, recordsTmp_, 4ull * key.strideWords * n);
   EnsureSize(ctx_, counts_, 4ull * 256 * tiles);
-  if (values.buffer == VK_NULL_HANDLE) {  // keys only: the values ride in scratch
-    EnsureSize(ctx_, valuesScratch_, 4ull * n);
-    values = valuesScratch_.View();
-  }
-  // Four passes ping-pong between the caller's buffers and scratch, ending in the caller's.
-  BufferView k[2] = {keys, keysTmp_.View()}, v[2] = {values, valuesTmp_.View()};
+  const uint32_t keyMode = uint32_t(key.type) | (key.descending ? 4u : 0u);
+  // Four passes ping-pong between the caller's buffer and scratch, ending in the caller's.
+  BufferView r[2] = {records, recordsTmp_.View()};
   for (uint32_t pass = 0; pass < 4; ++pass) {
     const uint32_t src = pass % 2, dst = 1 - src;
-    struct { uint32_t n, shift, tiles; } args{n, 8 * pass, tiles};
+    struct { uint32_t n, shift, tiles, stride, keyWord, keyMode; } args{n, 8 * pass, tiles, key.strideWords, key.keyWord, keyMode};
     histogram_.Bind(cmd);
-    histogram_.PushBuffers(cmd, {k[src], counts_.View()});
+    histogram_.PushBuffers(cmd, {r[src], counts_.View()});
     histogram_.PushConstants(cmd, &args, sizeof(args));
     DispatchBlocks(cmd, tiles);
     ComputeBarrier(cmd);
-    scanner_.RecordCmd(cmd, counts_.View(), counts_.View(), 256 * tiles, false, ScanType::Uint);
+    scanner_.RecordCmd(cmd, counts_.View(), counts_.View(), 256 * tiles, false, ElementType::Uint);
     scatter_.Bind(cmd);
-    scatter_.PushBuffers(cmd, {k[src], v[src], k[dst], v[dst], counts_.View()});
+    scatter_.PushBuffers(cmd, {r[src], r[dst], counts_.View()});
     scatter_.PushConstants(cmd, &args, sizeof(args));
     DispatchBlocks(cmd, tiles);
     ComputeBarrier(cmd);

@@ -253,7 +253,8 @@ struct CpuTimer {
 
 // ---- primitives the translator maps library calls of control functions to ------------------
 
-enum class ScanType { Uint, Int, Float };
+// The 32-bit element types scans and sort keys come in.
+enum class ElementType : uint32_t { Uint = 0, Int = 1, Float = 2 };
 
 // The 32-bit pattern of a value, for push constants and buffer fills.
 template <typename T>
@@ -273,7 +274,7 @@ public:
   // out[i] = init + in[0] + ... + in[i-1] (exclusive) or ... + in[i] (inclusive), i < n.
   // `in` may be `out`. Ends with a barrier. Scratch buffers grow as needed and are kept: do not
   // record scans of growing sizes into one command buffer before submitting it.
-  void RecordCmd(VkCommandBuffer cmd, BufferView in, BufferView out, uint32_t n, bool inclusive, ScanType type,
+  void RecordCmd(VkCommandBuffer cmd, BufferView in, BufferView out, uint32_t n, bool inclusive, ElementType type,
                  uint32_t initBits = 0);
 
 private:
@@ -284,21 +285,31 @@ private:
   std::vector<Level> levels_;
 };
 
-// std::sort of uint32_t keys on the GPU: a stable LSD radix sort, 4 passes of 8 bits (tile
-// histograms, an exclusive scan of them, a stable scatter). Any n, no padding to a power of two.
+// What std::sort compares: records of `strideWords` 32-bit words, ordered by the word at
+// `keyWord` read as `type`, ascending or descending. Plain keys are records of one word.
+struct SortKey {
+  uint32_t strideWords = 1;
+  uint32_t keyWord = 0;
+  ElementType type = ElementType::Uint;
+  bool descending = false;
+};
+
+// std::sort on the GPU: a stable LSD radix sort, 4 passes of 8 bits (tile histograms, an
+// exclusive scan of them, a stable scatter of whole records). Any n, no padding to a power of
+// two. Records with equal keys keep their order (std::sort leaves it unspecified).
 class RadixSorter {
 public:
   RadixSorter() = default;
   explicit RadixSorter(std::shared_ptr<VulkanContext> ctx);
-  // Sorts keys[0..n) ascending in place; `values` (uint32, may be an empty view) move along.
-  // Ends with a barrier. Scratch grows as needed (see Scanner::RecordCmd).
-  void RecordCmd(VkCommandBuffer cmd, BufferView keys, BufferView values, uint32_t n);
+  // Sorts records[0..n) in place. Ends with a barrier. Scratch grows as needed (see
+  // Scanner::RecordCmd).
+  void RecordCmd(VkCommandBuffer cmd, BufferView records, uint32_t n, SortKey key = {});
 
 private:
   std::shared_ptr<VulkanContext> ctx_;
   ComputePipeline histogram_, scatter_;
   Scanner scanner_;
-  Buffer keysTmp_, valuesTmp_, valuesScratch_, counts_;
+  Buffer recordsTmp_, counts_;
 };
 
 // A view `bytes` further into a buffer view.
