@@ -70,7 +70,7 @@ function(crossrt_add_class target class)
     "$<$<BOOL:${std}>:-std=c++${std}>"
     "${features}")  # cxx_std_NN: the engine takes the highest standard asked for
 
-  if(TARGET crossrt)
+  if(TARGET crossrt OR CROSSRT_TRANSLATOR_IN_TREE)  # in-tree: the target may be defined later
     set(translator $<TARGET_FILE:crossrt>)
     set(translator_dep crossrt)
   else()

@@ -424,6 +424,9 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   for (unsigned i = 0; i < md->getNumParams(); ++i) k.cppParamsDecl += (i ? ", " : "") + ParamDecl(c.ctx, md->getParamDecl(i), i);
   GlslPrinter printer(c.ctx, c.cls, c.rep);
   for (auto& s : ClassStructNames(c.model)) printer.predeclaredStructs.insert(s);
+  // Structs the parameters' buffers hold are declared even when the body names no variable of them.
+  for (auto* p : def->parameters())
+    if (p->getType()->isPointerType()) printer.Type(p->getType()->getPointeeType(), p->getLocation());
   auto* body = dyn_cast<CompoundStmt>(def->getBody());
   if (!body) {
     c.rep.Error(md->getLocation(), "kernel '" + k.name + "' has a function-try-block", "GPU code has no exceptions: remove the try/catch");

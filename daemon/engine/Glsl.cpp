@@ -88,10 +88,9 @@ std::optional<std::string> GlslTypeOf(QualType type) {
   }
   if (auto* et = type->getAs<EnumType>()) return GlslTypeOf(et->getDecl()->getIntegerType());
   if (auto* rd = type->getAsCXXRecordDecl()) {
-    if (InNamespace(rd, "LiteMath")) {
+    if (InNamespace(rd, "LiteMath"))
       if (auto* g = LiteMathGlsl(rd->getName())) return std::string(g);
-      return std::nullopt;
-    }
+    // Other LiteMath records (Box4f) are plain structs like the user's.
     if (IsSystemDecl(rd) || rd->isUnion() || rd->isPolymorphic() || rd->getName().empty()) return std::nullopt;
     return rd->getName().str();
   }
@@ -130,7 +129,7 @@ std::optional<LayoutInfo> Std430Layout(ASTContext& ctx, QualType type, bool scal
   if (auto* et = type->getAs<EnumType>()) return Std430Layout(ctx, et->getDecl()->getIntegerType(), scalar);
   auto* rd = type->getAsCXXRecordDecl();
   if (!rd) return std::nullopt;
-  if (InNamespace(rd, "LiteMath")) {
+  if (InNamespace(rd, "LiteMath") && LiteMathGlsl(rd->getName())) {
     auto name = rd->getName();
     int n = name.ends_with("2") ? 2 : name.ends_with("3") ? 3 : name.ends_with("4") ? 4 : 0;
     if (name == "float3x3") return scalar ? LayoutInfo{36, 4} : LayoutInfo{48, 16};
@@ -159,7 +158,7 @@ bool LayoutMatchesCpp(ASTContext& ctx, QualType type, bool scalar) {
   if (stride != cppSize) return false;
   // Field offsets of user structs must agree too.
   auto* rd = type->getAsCXXRecordDecl();
-  if (!rd || InNamespace(rd, "LiteMath")) return true;
+  if (!rd || IsLiteMathType(type, nullptr)) return true;
   const ASTRecordLayout& cpp = ctx.getASTRecordLayout(rd);
   uint64_t offset = 0;
   for (auto* f : rd->fields()) {
@@ -209,7 +208,7 @@ std::optional<std::string> GlslPrinter::Type(QualType t, SourceLocation loc) {
          "kernels may use int, uint, float, bool, LiteMath vectors and matrices, and plain structs of those");
     return std::nullopt;
   }
-  if (auto* rd = base->getAsCXXRecordDecl(); rd && !InNamespace(rd, "LiteMath")) NeedStruct(rd);
+  if (auto* rd = base->getAsCXXRecordDecl(); rd && !IsLiteMathType(base, nullptr)) NeedStruct(rd);
   return g;
 }
 
@@ -423,6 +422,12 @@ std::string GlslPrinter::Builtin(const FunctionDecl* fd, const std::vector<std::
       {"make_uint4", "uvec4"}, {"to_float2", "vec2"}, {"to_int2", "ivec2"}, {"to_int3", "ivec3"},
       {"to_int4", "ivec4"}, {"to_uint2", "uvec2"}, {"to_uint3", "uvec3"}, {"to_uint4", "uvec4"},
       {"to_float4", "vec4"}};
+  // GCC/Clang bit builtins (C++ leaves clz and ctz of 0 undefined).
+  if (fd->getBuiltinID() != 0) {
+    if (n == "__builtin_clz") return "(31 - findMSB(uint(" + a[0] + ")))";
+    if (n == "__builtin_ctz") return "findLSB(uint(" + a[0] + "))";
+    if (n == "__builtin_popcount") return "bitCount(uint(" + a[0] + "))";
+  }
   bool library = IsSystemDecl(fd) || InNamespace(fd, "LiteMath");
   if (!library) return "";
   const std::string arg0Type = call->getNumArgs() ? GlslTypeOf(call->getArg(0)->getType()).value_or("") : "";

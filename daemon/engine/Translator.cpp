@@ -21,6 +21,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cstring>
+#include <cstdlib>
 #include <mutex>
 #include <chrono>
 #include <cstdio>
@@ -83,9 +84,21 @@ std::vector<uint32_t> CompileGlsl(const std::string& name, const std::string& gl
     program.addShader(&shader);
     ok = program.link(messages);
   }
-  if (!ok)
+  if (!ok) {
+    // Quote the generated lines the messages point at, so that a report carries what went wrong.
+    std::string log = std::string(shader.getInfoLog()) + program.getInfoLog(), quoted;
+    std::vector<std::string> lines;
+    std::istringstream glslLines(glsl);
+    for (std::string line; std::getline(glslLines, line);) lines.push_back(line);
+    const std::string marker = name + ":";
+    for (size_t at = log.find(marker); at != std::string::npos; at = log.find(marker, at + 1)) {
+      size_t lineNo = std::strtoul(log.c_str() + at + marker.size(), nullptr, 10);
+      if (lineNo >= 1 && lineNo <= lines.size())
+        quoted += "  " + std::to_string(lineNo) + " | " + lines[lineNo - 1] + "\n";
+    }
     throw std::runtime_error("internal error: the GLSL generated for '" + name + "' does not compile (please report it):\n" +
-                             shader.getInfoLog() + program.getInfoLog());
+                             log + quoted);
+  }
   std::vector<uint32_t> words;
   glslang::SpvOptions options;
   options.validate = true;
