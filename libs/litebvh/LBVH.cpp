@@ -194,3 +194,16 @@ void LBVH::kernel1D_RefitPass(int count, const uint32_t* readyBefore, uint32_t* 
     readyAfter[i] = ready;
   }
 }
+
+BVHTree BuildLBVH(LBVH& builder, const Box4f* boxes, int count)
+{
+  if (count <= 0)
+    return BVHTree{};
+  if (builder.Capacity() < count)
+  {
+    builder.Reserve(count);
+    builder.CommitDeviceData();
+  }
+  builder.Build(count, boxes);
+  return builder.Tree(count);
+}

@@ -34,6 +34,8 @@ public:
   virtual void Build(int count, [[crossrt::size("count")]] const LiteMath::Box4f* boxes);
   // The tree of the last Build, trimmed to its size.
   BVHTree Tree(int count) const;
+  // Boxes the work arrays hold (the last Reserve).
+  int Capacity() const { return int(m_codes.size()); }
 
   virtual void CommitDeviceData() {}
   virtual void GetExecutionTime(const char* a_funcName, float a_out[4]) { (void)a_funcName; a_out[0] = a_out[1] = a_out[2] = a_out[3] = 0.0f; }
@@ -68,3 +70,7 @@ protected:
   std::vector<uint32_t> m_leafCode;      // Morton code of each leaf, strictly increasing
   std::vector<uint32_t> m_readyA, m_readyB;  // per node: box final (ping-pong between passes)
 };
+
+// Builds with `builder` (the class as written or a translated one) over boxes[0, count), reserving
+// and committing its arrays when count exceeds what they hold. Empty tree for count <= 0.
+BVHTree BuildLBVH(LBVH& builder, const LiteMath::Box4f* boxes, int count);

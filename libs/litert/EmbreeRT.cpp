@@ -4,6 +4,7 @@
 // RTCScene whose geometries are INSTANCE geometries referencing the mesh scenes. Instance i is
 // attached with geometry id i, so Embree's instID is directly our instance id.
 #include "CrossRT.h"
+#include "SceneInput.h"
 
 #include <embree3/rtcore.h>
 
@@ -47,14 +48,8 @@ struct PreparedRay
 PreparedRay prepareRay(const LiteMath::float4& posAndNear, const LiteMath::float4& dirAndFar)
 {
   PreparedRay r{};
-  const float tnear = std::max(posAndNear.w, 0.0f); // Embree (like Vulkan) needs tmin >= 0
-  const float tfar  = dirAndFar.w;                  // +inf is a valid "unbounded" ray
-  const bool finiteInputs = std::isfinite(posAndNear.x) && std::isfinite(posAndNear.y) &&
-                            std::isfinite(posAndNear.z) && std::isfinite(posAndNear.w) &&
-                            std::isfinite(dirAndFar.x) && std::isfinite(dirAndFar.y) && std::isfinite(dirAndFar.z);
-  const bool nonZeroDir = dirAndFar.x != 0.0f || dirAndFar.y != 0.0f || dirAndFar.z != 0.0f;
-  // `tnear < tfar` is false for NaN tfar and for the empty interval tmin == tmax.
-  r.valid = finiteInputs && nonZeroDir && tnear < tfar;
+  float tnear = 0.0f, tfar = 0.0f;
+  r.valid = litert_detail::RayInterval(posAndNear, dirAndFar, tnear, tfar);
 
   r.ray.org_x = posAndNear.x;
   r.ray.org_y = posAndNear.y;
@@ -110,7 +105,7 @@ public:
   uint32_t AddGeom_Triangles3f(const float* vpos3f, size_t vertNum, const uint32_t* triIndices, size_t indNum,
                                uint32_t flags, size_t vByteStride) override
   {
-    validateMesh(vpos3f, vertNum, triIndices, indNum, vByteStride);
+    litert_detail::ValidateMesh("EmbreeRT", vpos3f, vertNum, triIndices, indNum, vByteStride);
     Mesh m;
     m.scene = rtcNewScene(m_device);
     m_meshes.push_back(m);
@@ -124,7 +119,7 @@ public:
   {
     if (geomId >= m_meshes.size())
       throw std::out_of_range("EmbreeRT::UpdateGeom_Triangles3f: invalid geomId " + std::to_string(geomId));
-    validateMesh(vpos3f, vertNum, triIndices, indNum, vByteStride);
+    litert_detail::ValidateMesh("EmbreeRT", vpos3f, vertNum, triIndices, indNum, vByteStride);
     setMeshData(m_meshes[geomId], vpos3f, vertNum, triIndices, indNum, flags, vByteStride);
     m_committed = false; // the top level has to be rebuilt around the changed mesh
   }
@@ -233,23 +228,6 @@ private:
     bool        changed = false;   // updated since the last CommitScene
   };
 
-  static void validateMesh(const float* vpos3f, size_t vertNum, const uint32_t* triIndices, size_t indNum,
-                           size_t vByteStride)
-  {
-    if (indNum % 3 != 0)
-      throw std::invalid_argument("EmbreeRT: index count " + std::to_string(indNum) + " is not a multiple of 3");
-    if ((vertNum > 0 && vpos3f == nullptr) || (indNum > 0 && triIndices == nullptr))
-      throw std::invalid_argument("EmbreeRT: null vertex or index pointer with non-zero count");
-    if (vByteStride < 3 * sizeof(float))
-      throw std::invalid_argument("EmbreeRT: vertex stride " + std::to_string(vByteStride) + " is less than 12 bytes");
-    if (vertNum >= 0xFFFFFFFFull || indNum / 3 >= 0xFFFFFFFFull)
-      throw std::invalid_argument("EmbreeRT: mesh too large");
-    for (size_t i = 0; i < indNum; i++) // Embree would read out of bounds otherwise
-      if (triIndices[i] >= vertNum)
-        throw std::invalid_argument("EmbreeRT: triangle index " + std::to_string(triIndices[i]) + " at position " +
-                                    std::to_string(i) + " is out of range (vertNum = " + std::to_string(vertNum) + ")");
-  }
-
   // (Re)fills the mesh's triangle geometry and commits its scene. Buffers are reused in place when
   // the sizes are unchanged (refit-friendly); otherwise the geometry is replaced.
   void setMeshData(Mesh& m, const float* vpos3f, size_t vertNum, const uint32_t* triIndices, size_t indNum,
@@ -325,13 +303,4 @@ private:
 };
 } // namespace
 
-// Factory for all ray tracing backends known to this build.
-std::shared_ptr<ISceneObject> CreateSceneRT(const char* name)
-{
-  std::string key = name ? name : "";
-  std::transform(key.begin(), key.end(), key.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  if (key == "embree")
-    return std::make_shared<EmbreeRT>();
-  throw std::invalid_argument("CreateSceneRT: unknown implementation '" + std::string(name ? name : "(null)") +
-                              "'; known implementations: embree");
-}
+std::shared_ptr<ISceneObject> CreateEmbreeRT() { return std::make_shared<EmbreeRT>(); }

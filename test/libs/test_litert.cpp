@@ -1,4 +1,5 @@
-// Tests for the CrossRT ray query interface (Embree backend).
+// Tests for the CrossRT ray query interface, run on every implementation: Embree, and CrossRT's
+// own BVH traversal over LBVH and binned SAH trees.
 #include <catch2/catch.hpp>
 
 #include "CrossRT.h"
@@ -23,9 +24,12 @@ const uint32_t QUAD_INDICES[] = {0, 1, 2, 0, 2, 3};
 float4 down(float tmax = 100.0f) { return float4(0, 0, -1, tmax); }
 float4 from(float x, float y, float z, float tmin = 0.0f) { return float4(x, y, z, tmin); }
 
-std::shared_ptr<ISceneObject> makeQuadScene()
+// Every implementation CreateSceneRT knows; each test runs once per name.
+const char* anyImplementation() { return GENERATE(as<const char*>{}, "embree", "lbvh", "sah"); }
+
+std::shared_ptr<ISceneObject> makeQuadScene(const char* name)
 {
-  auto scene = CreateSceneRT("embree");
+  auto scene = CreateSceneRT(name);
   const uint32_t g = scene->AddGeom_Triangles3f(QUAD_VERTS, 4, QUAD_INDICES, 6);
   REQUIRE(g == 0);
   REQUIRE(scene->AddInstance(g, float4x4()) == 0);
@@ -36,16 +40,23 @@ std::shared_ptr<ISceneObject> makeQuadScene()
 
 TEST_CASE("CrossRT factory", "[litert]")
 {
-  auto scene = CreateSceneRT("embree");
-  REQUIRE(scene != nullptr);
-  CHECK(std::string(scene->Name()) == "embree");
+  for (const char* name : {"embree", "lbvh", "sah"})
+  {
+    auto scene = CreateSceneRT(name);
+    REQUIRE(scene != nullptr);
+    CHECK(std::string(scene->Name()) == name);
+  }
+  CHECK(std::string(CreateSceneRT("LBVH")->Name()) == "lbvh");  // names are case-insensitive
   CHECK_THROWS_AS(CreateSceneRT("nope"), std::invalid_argument);
-  CHECK_THROWS_WITH(CreateSceneRT("nope"), Catch::Contains("nope") && Catch::Contains("embree"));
+  CHECK_THROWS_WITH(CreateSceneRT("nope"), Catch::Contains("nope") && Catch::Contains("embree") && Catch::Contains("lbvh") &&
+                                               Catch::Contains("sah"));
 }
 
 TEST_CASE("CrossRT nearest hit on a quad", "[litert]")
 {
-  auto scene = makeQuadScene();
+  const char* impl = anyImplementation();
+  INFO(impl);
+  auto scene = makeQuadScene(impl);
 
   // (0.75, 0.25) lies in triangle 0: p = u*v1 + v*v2 = (u+v, v) -> v = 0.25, u = 0.5.
   const CRT_Hit h0 = scene->RayQuery_NearestHit(from(0.75f, 0.25f, 1.0f), down());
@@ -87,7 +98,9 @@ TEST_CASE("CrossRT nearest hit on a quad", "[litert]")
 
 TEST_CASE("CrossRT any hit", "[litert]")
 {
-  auto scene = makeQuadScene();
+  const char* impl = anyImplementation();
+  INFO(impl);
+  auto scene = makeQuadScene(impl);
   CHECK(scene->RayQuery_AnyHit(from(0.5f, 0.2f, 1.0f), down()));
   CHECK(scene->RayQuery_AnyHit(from(0.5f, 0.2f, -1.0f), float4(0, 0, 1, 100))); // hits the back side too
   CHECK_FALSE(scene->RayQuery_AnyHit(from(2.0f, 2.0f, 1.0f), down()));
@@ -98,7 +111,9 @@ TEST_CASE("CrossRT any hit", "[litert]")
 
 TEST_CASE("CrossRT invalid rays miss without crashing", "[litert]")
 {
-  auto        scene = makeQuadScene();
+  const char* impl = anyImplementation();
+  INFO(impl);
+  auto        scene = makeQuadScene(impl);
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const float inf = std::numeric_limits<float>::infinity();
   const float4 rays[][2] = {
@@ -120,7 +135,9 @@ TEST_CASE("CrossRT invalid rays miss without crashing", "[litert]")
 
 TEST_CASE("CrossRT instances", "[litert]")
 {
-  auto           scene = CreateSceneRT("embree");
+  const char* impl = anyImplementation();
+  INFO(impl);
+  auto           scene = CreateSceneRT(impl);
   const uint32_t quad  = scene->AddGeom_Triangles3f(QUAD_VERTS, 4, QUAD_INDICES, 6, BUILD_MEDIUM);
 
   // Second mesh: one triangle with a 4-float vertex stride (the 4th float is padding).
@@ -193,7 +210,9 @@ TEST_CASE("CrossRT instances", "[litert]")
 
 TEST_CASE("CrossRT geometry update and validation", "[litert]")
 {
-  auto scene = makeQuadScene();
+  const char* impl = anyImplementation();
+  INFO(impl);
+  auto scene = makeQuadScene(impl);
 
   // Same sizes: in-place update (move the quad to z = -1).
   float moved[12];
@@ -234,7 +253,9 @@ TEST_CASE("CrossRT geometry update and validation", "[litert]")
 
 TEST_CASE("CrossRT queries before commit miss", "[litert]")
 {
-  auto scene = CreateSceneRT("embree");
+  const char* impl = anyImplementation();
+  INFO(impl);
+  auto scene = CreateSceneRT(impl);
   CHECK(scene->RayQuery_NearestHit(from(0.5f, 0.2f, 1.0f), down()).primId == MISS);
   scene->AddInstance(scene->AddGeom_Triangles3f(QUAD_VERTS, 4, QUAD_INDICES, 6), float4x4());
   CHECK_FALSE(scene->RayQuery_AnyHit(from(0.5f, 0.2f, 1.0f), down()));
@@ -244,7 +265,9 @@ TEST_CASE("CrossRT queries before commit miss", "[litert]")
 
 TEST_CASE("CrossRT concurrent queries", "[litert]")
 {
-  auto scene = CreateSceneRT("embree");
+  const char* impl = anyImplementation();
+  INFO(impl);
+  auto scene = CreateSceneRT(impl);
   const uint32_t g = scene->AddGeom_Triangles3f(QUAD_VERTS, 4, QUAD_INDICES, 6);
   for (int i = 0; i < 16; i++)
     scene->AddInstance(g, translate4x4(float3(2.0f * float(i), 0, -float(i))));

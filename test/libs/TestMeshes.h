@@ -1,0 +1,53 @@
+// Meshes built in code for the ray tracing tests: closed spheres (every edge shared by exactly
+// two triangles, every vertex by several), so rays through edges and vertices are easy to aim.
+#pragma once
+#include "LiteMath.h"
+
+#include <cmath>
+#include <cstdint>
+#include <map>
+#include <utility>
+#include <vector>
+
+struct TestMesh
+{
+  std::vector<float> vertices;  // xyz
+  std::vector<uint32_t> indices;
+  size_t VertexCount() const { return vertices.size() / 3; }
+  LiteMath::float3 Vertex(uint32_t i) const { return {vertices[3 * i], vertices[3 * i + 1], vertices[3 * i + 2]}; }
+};
+
+// An octahedron subdivided `levels` times and pushed onto the sphere |p - center| = radius:
+// 8 * 4^levels triangles, closed and consistently wound.
+inline TestMesh Sphere(int levels, LiteMath::float3 center = LiteMath::float3(0.0f), float radius = 1.0f)
+{
+  std::vector<LiteMath::float3> points = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  std::vector<uint32_t> tris = {0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5};
+  for (int l = 0; l < levels; ++l)
+  {
+    std::map<std::pair<uint32_t, uint32_t>, uint32_t> midpoints;
+    auto midpoint = [&](uint32_t a, uint32_t b) {
+      auto key = std::minmax(a, b);
+      auto it = midpoints.find(key);
+      if (it != midpoints.end()) return it->second;
+      points.push_back(normalize(points[a] + points[b]));
+      return midpoints[key] = uint32_t(points.size() - 1);
+    };
+    std::vector<uint32_t> next;
+    for (size_t t = 0; t < tris.size(); t += 3)
+    {
+      const uint32_t a = tris[t], b = tris[t + 1], c = tris[t + 2];
+      const uint32_t ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
+      next.insert(next.end(), {a, ab, ca, ab, b, bc, ca, bc, c, ab, bc, ca});
+    }
+    tris = std::move(next);
+  }
+  TestMesh mesh;
+  for (auto p : points)
+  {
+    const LiteMath::float3 q = center + radius * normalize(p);
+    mesh.vertices.insert(mesh.vertices.end(), {q.x, q.y, q.z});
+  }
+  mesh.indices = std::move(tris);
+  return mesh;
+}
