@@ -15,3 +15,7 @@ if(_crossrt_oiio_inc)
   list(FILTER _crossrt_oiio_inc EXCLUDE REGEX "opencv4")
   set_target_properties(OpenImageIO::OpenImageIO PROPERTIES INTERFACE_INCLUDE_DIRECTORIES "${_crossrt_oiio_inc}")
 endif()
+
+# Mesh files (OFF, PLY, OBJ) for litemesh; zlib reads gzipped ones.
+find_package(assimp CONFIG REQUIRED)
+find_package(ZLIB REQUIRED)

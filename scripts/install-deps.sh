@@ -8,6 +8,7 @@ PACKAGES=(
   libvulkan-dev vulkan-tools vulkan-validationlayers       # loader, headers, validation layers
   mesa-vulkan-drivers                                      # lavapipe, the CPU Vulkan driver
   libembree-dev                                            # CPU ray tracing reference
+  libassimp-dev zlib1g-dev                                 # mesh files (OFF, PLY, OBJ, gzipped)
   libopenimageio-dev openimageio-tools                     # image IO
   catch2 nlohmann-json3-dev libkainjow-mustache-dev libxxhash-dev
 )
