@@ -1,0 +1,321 @@
+// Benchmark in the form of the paper's Tables 1 and 3, for every mesh scripts/fetch-meshes.sh
+// cached: BVH build time (Embree LOW and MEDIUM, the LBVH as written, LBVH_CPU, LBVH_Vulkan on the
+// default device, binned SAH), SAH cost of each tree, and traversal of 1024x1024 primary rays
+// (Embree rtcIntersect1 and rtcIntersect16, CrossRT's traversal over the LBVH and SAH trees), with
+// ratios against Embree. Every figure is measured in this run: medians of 3 after a warm-up.
+// Then the speed-against-quality trade of LBVH against binned SAH, as a table and as a PNG.
+//
+//   bench_lbvh [mesh dir (default build/data/meshes)] [plot.png (default out/bvh_tradeoff.png)]
+#include "BVHScene.h"
+#include "CrossRT.h"
+#include "Image2D.h"
+#include "LBVH.h"
+#include "LBVH_CPU.h"
+#include "LBVH_Vulkan.h"
+#include "MeshIO.h"
+#include "SAHBuilder.h"
+
+#include <embree3/rtcore.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+using namespace LiteMath;
+using LiteImage::Image2D;
+
+namespace {
+
+constexpr int kImageSize = 1024;
+
+double Ms(std::chrono::steady_clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); }
+
+// Median wall time of 3 runs of `work` after one warm-up run.
+double MedianMs(const std::function<void()>& work)
+{
+  work();
+  std::vector<double> ms;
+  for (int i = 0; i < 3; ++i)
+  {
+    auto t0 = std::chrono::steady_clock::now();
+    work();
+    ms.push_back(Ms(std::chrono::steady_clock::now() - t0));
+  }
+  std::sort(ms.begin(), ms.end());
+  return ms[1];
+}
+
+struct Camera
+{
+  float3 eye, forward, right, up;
+  float4 Ray(int x, int y) const
+  {
+    const float tanHalf = std::tan(0.5f * 0.7f);  // 40 degrees
+    const float px = (2.0f * (x + 0.5f) / kImageSize - 1.0f) * tanHalf, py = (1.0f - 2.0f * (y + 0.5f) / kImageSize) * tanHalf;
+    const float3 d = normalize(forward + px * right + py * up);
+    return float4(d.x, d.y, d.z, 1e30f);
+  }
+};
+
+Camera LookAtMesh(const TriangleMesh& mesh)
+{
+  float3 lo(1e30f), hi(-1e30f);
+  for (size_t v = 0; v < mesh.VertexCount(); ++v)
+  {
+    const float3 p(mesh.positions[3 * v], mesh.positions[3 * v + 1], mesh.positions[3 * v + 2]);
+    lo = min(lo, p), hi = max(hi, p);
+  }
+  const float3 center = 0.5f * (lo + hi);
+  Camera c;
+  c.eye = center + 1.6f * length(hi - lo) * normalize(float3(0.3f, 0.4f, 1.0f));
+  c.forward = normalize(center - c.eye);
+  c.right = normalize(cross(c.forward, float3(0, 1, 0)));
+  c.up = cross(c.right, c.forward);
+  return c;
+}
+
+// Embree over one mesh, with the build quality given; returns the commit time.
+struct EmbreeMesh
+{
+  RTCDevice device = rtcNewDevice(nullptr);
+  RTCScene scene = nullptr;
+  double Build(const TriangleMesh& mesh, RTCBuildQuality quality)
+  {
+    if (scene) rtcReleaseScene(scene);
+    auto t0 = std::chrono::steady_clock::now();
+    scene = rtcNewScene(device);
+    rtcSetSceneBuildQuality(scene, quality);
+    RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, mesh.positions.data(), 0, 12, mesh.VertexCount());
+    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, mesh.indices.data(), 0, 12, mesh.TriangleCount());
+    rtcSetGeometryBuildQuality(geom, quality);
+    rtcCommitGeometry(geom);
+    rtcAttachGeometry(scene, geom);
+    rtcReleaseGeometry(geom);
+    rtcCommitScene(scene);
+    return Ms(std::chrono::steady_clock::now() - t0);
+  }
+  ~EmbreeMesh()
+  {
+    if (scene) rtcReleaseScene(scene);
+    rtcReleaseDevice(device);
+  }
+};
+
+std::vector<Box4f> TriangleBoxes(const TriangleMesh& mesh)
+{
+  std::vector<Box4f> boxes(mesh.TriangleCount());
+  for (size_t t = 0; t < boxes.size(); ++t)
+    for (int k = 0; k < 3; ++k)
+    {
+      const uint32_t v = mesh.indices[3 * t + k];
+      boxes[t].include(float4(mesh.positions[3 * v], mesh.positions[3 * v + 1], mesh.positions[3 * v + 2], 0.0f));
+    }
+  return boxes;
+}
+
+struct TradeOff { std::string mesh; double lbvhBuildMs, lbvhMrays, sahBuildMs, sahMrays; };
+
+// The trade as a scatter plot: x = build time (log scale, 0.1 ms .. 10 s), y = Mrays/s; one line
+// per mesh from its LBVH point (blue) to its SAH point (orange).
+void Plot(const std::vector<TradeOff>& rows, const std::string& path)
+{
+  const int w = 800, h = 500, margin = 40;
+  Image2D<float4> img(w, h, float4(1.0f));
+  double maxRays = 1.0;
+  for (auto& r : rows) maxRays = std::max({maxRays, r.lbvhMrays, r.sahMrays});
+  auto px = [&](double ms) { return margin + int((std::log10(std::max(ms, 0.1)) + 1.0) / 5.0 * (w - 2 * margin)); };
+  auto py = [&](double mrays) { return h - margin - int(mrays / (1.1 * maxRays) * (h - 2 * margin)); };
+  auto dot = [&](int x, int y, float4 c, int r) {
+    for (int dy = -r; dy <= r; ++dy)
+      for (int dx = -r; dx <= r; ++dx)
+        if (x + dx >= 0 && x + dx < w && y + dy >= 0 && y + dy < h) img[int2(x + dx, y + dy)] = c;
+  };
+  for (int decade = 0; decade <= 5; ++decade)  // grid lines at 0.1, 1, 10, 100, 1000, 10000 ms
+    for (int y = margin; y < h - margin; ++y) dot(margin + decade * (w - 2 * margin) / 5, y, float4(0.8f, 0.8f, 0.8f, 1), 0);
+  for (int x = margin; x < w - margin; ++x) dot(x, h - margin, float4(0, 0, 0, 1), 0);
+  for (int y = margin; y < h - margin; ++y) dot(margin, y, float4(0, 0, 0, 1), 0);
+  for (auto& r : rows)
+  {
+    const int x0 = px(r.lbvhBuildMs), y0 = py(r.lbvhMrays), x1 = px(r.sahBuildMs), y1 = py(r.sahMrays);
+    for (int s = 0; s <= 200; ++s) dot(x0 + (x1 - x0) * s / 200, y0 + (y1 - y0) * s / 200, float4(0.5f, 0.5f, 0.5f, 1), 0);
+    dot(x0, y0, float4(0.1f, 0.3f, 0.9f, 1), 4);
+    dot(x1, y1, float4(0.95f, 0.5f, 0.1f, 1), 4);
+  }
+  std::filesystem::create_directories(std::filesystem::path(path).parent_path());
+  if (!LiteImage::SaveImage(path.c_str(), img)) std::printf("could not write %s\n", path.c_str());
+}
+
+}  // namespace
+
+int main(int argc, char** argv)
+{
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);  // tables appear as they are measured
+  const std::string dir = argc > 1 ? argv[1] : "build/data/meshes";
+  const std::string plotPath = argc > 2 ? argv[2] : "out/bvh_tradeoff.png";
+  const char* names[] = {"teapot.obj", "dragon_vrip_res4.ply.gz", "dragon_vrip_res3.ply.gz", "armadillo.off", "bunny00.off",
+                         "dragon_vrip_res2.ply.gz", "dragon_vrip.ply.gz"};
+  std::shared_ptr<crossrt::VulkanContext> ctx;
+  try { ctx = crossrt::VulkanContext::CreateDefault(); }
+  catch (const std::exception& e) { std::printf("no Vulkan device (%s): the _Vulkan column is left out\n", e.what()); }
+  std::printf("CPU threads: %d; Vulkan device: %s\n", omp_get_max_threads(), ctx ? ctx->DeviceName().c_str() : "none");
+
+  std::printf("\nBuild time, ms (ratio = time / Embree LOW; Vulkan: wall time with copies, [GPU time])\n");
+  std::printf("| %-22s | %9s | %10s | %12s | %15s | %15s | %23s | %15s |\n", "mesh", "triangles", "Embree LOW", "Embree MEDIUM",
+              "LBVH original", "LBVH_CPU", "LBVH_Vulkan", "binned SAH");
+  std::printf("|%s|\n", std::string(146, '-').c_str());
+  struct Row { std::string name; TriangleMesh mesh; BVHTree lbvh, sah; double lbvhCpuMs, sahMs; };
+  std::vector<Row> rows;
+  auto lbvhCpu = CreateLBVH_CPU();
+  std::shared_ptr<LBVH> lbvhGpu = ctx ? CreateLBVH_Vulkan(ctx) : nullptr;
+  for (const char* name : names)
+  {
+    const std::string path = dir + "/" + name;
+    if (!std::filesystem::exists(path))
+    {
+      std::printf("| %-22s | skipped: not in %s (run scripts/fetch-meshes.sh)\n", name, dir.c_str());
+      continue;
+    }
+    Row row{name, LoadMesh(path), {}, {}, 0.0, 0.0};
+    const std::vector<Box4f> boxes = TriangleBoxes(row.mesh);
+    const int n = int(boxes.size());
+    EmbreeMesh embree;
+    const double low = MedianMs([&] { embree.Build(row.mesh, RTC_BUILD_QUALITY_LOW); });
+    const double medium = MedianMs([&] { embree.Build(row.mesh, RTC_BUILD_QUALITY_MEDIUM); });
+    LBVH original;
+    original.Reserve(n);
+    lbvhCpu->Reserve(n);
+    lbvhCpu->CommitDeviceData();
+    const double originalMs = MedianMs([&] { original.Build(n, boxes.data()); });
+    row.lbvh = original.Tree(n);
+    row.lbvhCpuMs = MedianMs([&] { lbvhCpu->Build(n, boxes.data()); });
+    char gpu[64] = "n/a";
+    if (lbvhGpu)
+    {
+      lbvhGpu->Reserve(n);
+      lbvhGpu->CommitDeviceData();
+      const double wall = MedianMs([&] { lbvhGpu->Build(n, boxes.data()); });
+      float times[4];
+      lbvhGpu->GetExecutionTime("Build", times);
+      std::snprintf(gpu, sizeof(gpu), "%7.1f (%4.2fx) [%6.1f]", wall, wall / low, times[0]);
+    }
+    row.sahMs = MedianMs([&] { row.sah = BuildBinnedSAH(boxes.data(), n); });
+    std::printf("| %-22s | %9d | %10.1f | %6.1f (%4.2fx) | %7.1f (%5.2fx) | %7.1f (%5.2fx) | %23s | %7.1f (%5.2fx) |\n", name, n, low,
+                medium, medium / low, originalMs, originalMs / low, row.lbvhCpuMs, row.lbvhCpuMs / low, gpu, row.sahMs, row.sahMs / low);
+    rows.push_back(std::move(row));
+  }
+
+  std::printf("\nTraversal of %dx%d primary rays, Mrays/s, all %d threads (ratio against Embree rtcIntersect1); SAH cost of the trees\n",
+              kImageSize, kImageSize, omp_get_max_threads());
+  std::printf("| %-22s | %9s | %9s | %15s | %15s | %15s | %9s | %9s | %8s |\n", "mesh", "Embree 1", "Embree 16", "CrossRT LBVH",
+              "CrossRT LBVH 1T", "CrossRT SAH", "SAH cost L", "SAH cost S", "same hit");
+  std::printf("|%s|\n", std::string(144, '-').c_str());
+  std::vector<TradeOff> trade;
+  for (Row& row : rows)
+  {
+    const Camera cam = LookAtMesh(row.mesh);
+    const int pixels = kImageSize * kImageSize;
+    EmbreeMesh embree;
+    embree.Build(row.mesh, RTC_BUILD_QUALITY_MEDIUM);
+    std::vector<uint32_t> embreePrim(pixels), ourPrim(pixels);
+    const double embree1 = MedianMs([&] {
+#pragma omp parallel for schedule(dynamic, 16)
+      for (int y = 0; y < kImageSize; ++y)
+      {
+        RTCIntersectContext context;
+        rtcInitIntersectContext(&context);
+        for (int x = 0; x < kImageSize; ++x)
+        {
+          const float4 d = cam.Ray(x, y);
+          RTCRayHit rh{};
+          rh.ray.org_x = cam.eye.x, rh.ray.org_y = cam.eye.y, rh.ray.org_z = cam.eye.z;
+          rh.ray.dir_x = d.x, rh.ray.dir_y = d.y, rh.ray.dir_z = d.z;
+          rh.ray.tnear = 0.0f, rh.ray.tfar = d.w, rh.ray.mask = 0xFFFFFFFFu;
+          rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+          rtcIntersect1(embree.scene, &context, &rh);
+          embreePrim[y * kImageSize + x] = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? 0xFFFFFFFFu : rh.hit.primID;
+        }
+      }
+    });
+    const double embree16 = MedianMs([&] {
+#pragma omp parallel for schedule(dynamic, 4)
+      for (int ty = 0; ty < kImageSize / 4; ++ty)
+      {
+        RTCIntersectContext context;
+        rtcInitIntersectContext(&context);
+        for (int tx = 0; tx < kImageSize / 4; ++tx)
+        {
+          alignas(64) RTCRayHit16 rh;
+          alignas(64) int valid[16];
+          for (int k = 0; k < 16; ++k)
+          {
+            const float4 d = cam.Ray(4 * tx + k % 4, 4 * ty + k / 4);
+            valid[k] = -1;
+            rh.ray.org_x[k] = cam.eye.x, rh.ray.org_y[k] = cam.eye.y, rh.ray.org_z[k] = cam.eye.z;
+            rh.ray.dir_x[k] = d.x, rh.ray.dir_y[k] = d.y, rh.ray.dir_z[k] = d.z;
+            rh.ray.tnear[k] = 0.0f, rh.ray.tfar[k] = d.w, rh.ray.mask[k] = 0xFFFFFFFFu, rh.ray.time[k] = 0.0f;
+            rh.ray.flags[k] = 0, rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+          }
+          rtcIntersect16(valid, embree.scene, &context, &rh);
+        }
+      }
+    });
+    auto traceWith = [&](ISceneObject& scene, int threads) {
+      return MedianMs([&] {
+#pragma omp parallel for schedule(dynamic, 16) num_threads(threads)
+        for (int y = 0; y < kImageSize; ++y)
+          for (int x = 0; x < kImageSize; ++x)
+            ourPrim[y * kImageSize + x] = scene.RayQuery_NearestHit(float4(cam.eye.x, cam.eye.y, cam.eye.z, 0.0f), cam.Ray(x, y)).primId;
+      });
+    };
+    const BVHTree lbvhTree = row.lbvh, sahTree = row.sah;
+    // Scenes over the trees built above; their one-instance top level gets a tree of its own.
+    auto reuse = [](const BVHTree& tree) {
+      return [&tree](const Box4f* boxes, int n) { return n == int(tree.primIndices.size()) ? tree : BuildBinnedSAH(boxes, n); };
+    };
+    BVHScene lbvhScene("lbvh", reuse(lbvhTree));
+    BVHScene sahScene("sah", reuse(sahTree));
+    for (BVHScene* s : {&lbvhScene, &sahScene})
+    {
+      s->AddInstance(s->AddGeom_Triangles3f(row.mesh.positions.data(), row.mesh.VertexCount(), row.mesh.indices.data(), row.mesh.indices.size()),
+                     float4x4());
+      s->CommitScene();
+    }
+    const int threads = omp_get_max_threads();
+    const double sahMs = traceWith(sahScene, threads);
+    const double lbvh1T = traceWith(lbvhScene, 1);
+    const double lbvhMs = traceWith(lbvhScene, threads);  // last: ourPrim holds the LBVH's hits
+    size_t same = 0;
+    for (int i = 0; i < pixels; ++i) same += ourPrim[i] == embreePrim[i];
+    auto mrays = [&](double ms) { return pixels / ms / 1e3; };
+    std::printf("| %-22s | %9.2f | %9.2f | %6.2f (%5.2fx) | %6.2f (%5.2fx) | %6.2f (%5.2fx) | %9.1f | %9.1f | %7.4f%% |\n", row.name.c_str(),
+                mrays(embree1), mrays(embree16), mrays(lbvhMs), embree1 / lbvhMs, mrays(lbvh1T), embree1 / lbvh1T, mrays(sahMs),
+                embree1 / sahMs, SAHCost(row.lbvh), SAHCost(row.sah), 100.0 * same / pixels);
+    trade.push_back({row.name, row.lbvhCpuMs, mrays(lbvhMs), row.sahMs, mrays(sahMs)});
+  }
+
+  std::printf("\nSpeed against quality: LBVH (LBVH_CPU build) against binned SAH\n");
+  std::printf("| %-22s | %14s | %14s | %14s | %14s | %22s |\n", "mesh", "LBVH build ms", "LBVH Mrays/s", "SAH build ms", "SAH Mrays/s",
+              "SAH pays off after");
+  std::printf("|%s|\n", std::string(123, '-').c_str());
+  for (auto& t : trade)
+  {
+    // Rays after which SAH's extra build time is repaid by its faster tracing.
+    const double perRayLbvh = 1e-3 / t.lbvhMrays, perRaySah = 1e-3 / t.sahMrays;  // ms per ray
+    const double breakEven = perRaySah < perRayLbvh ? (t.sahBuildMs - t.lbvhBuildMs) / (perRayLbvh - perRaySah) : -1.0;
+    char after[32];
+    if (breakEven < 0) std::snprintf(after, sizeof(after), "never");
+    else std::snprintf(after, sizeof(after), "%.1f Mrays", breakEven / 1e6);
+    std::printf("| %-22s | %14.1f | %14.2f | %14.1f | %14.2f | %22s |\n", t.mesh.c_str(), t.lbvhBuildMs, t.lbvhMrays, t.sahBuildMs,
+                t.sahMrays, after);
+  }
+  Plot(trade, plotPath);
+  std::printf("plot: %s (x: build ms, log scale 0.1 ms .. 10 s; y: Mrays/s; blue LBVH, orange SAH, one line per mesh)\n", plotPath.c_str());
+  return 0;
+}
