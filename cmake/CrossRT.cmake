@@ -106,7 +106,7 @@ function(crossrt_add_class target class)
   if(suffix STREQUAL "Vulkan")
     target_link_libraries(${target} PRIVATE crossrt::runtime)
   else()
-    target_link_libraries(${target} PRIVATE OpenMP::OpenMP_CXX)
+    target_link_libraries(${target} PRIVATE crossrt::cpu_runtime)
   endif()
   target_link_libraries(${target} PRIVATE crossrt::litemath)
   # The size annotation is for the translator; compilers need not warn about it.

@@ -968,9 +968,12 @@ private:
       auto order = OrderOf(call, first->element, why);
       if (!order) return bad(why);
       const uint64_t words = m_c.ctx.getTypeSizeInChars(first->element).getQuantity() / 4;
-      replacement = "m_sorter.RecordCmd(a_cmd, " + ViewAt(*first) + ", uint32_t" + *count + ", crossrt::SortKey{" +
-                    std::to_string(words) + ", " + std::to_string(order->keyWord) + ", crossrt::ElementType::" + order->type +
-                    ", " + (order->descending ? "true" : "false") + "})";
+      const std::string key = "crossrt::SortKey{" + std::to_string(words) + ", " + std::to_string(order->keyWord) +
+                              ", crossrt::ElementType::" + order->type + ", " + (order->descending ? "true" : "false") + "}";
+      replacement = "m_sorter.RecordCmd(a_cmd, " + ViewAt(*first) + ", uint32_t" + *count + ", " + key + ")";
+      // The CPU backend sorts on all cores too, with the same radix sort.
+      m_cpu.ReplaceText(call->getSourceRange(), "crossrt::RadixSort(" + m_c.Text(call->getArg(0)->getSourceRange()) + ", " +
+                                                    m_c.Text(call->getArg(1)->getSourceRange()) + ", " + key + ")");
       WrittenVector(*first);
     } else if ((name == "memcpy" || name == "memmove") && call->getNumArgs() == 3) {
       auto dst = PositionOf(call->getArg(0)), src = PositionOf(call->getArg(1));

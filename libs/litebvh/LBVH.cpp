@@ -46,9 +46,10 @@ void LBVH::Build(int count, const Box4f* boxes)
   kernel1D_MakeLeaves(count, boxes);
   // (4) the hierarchy over the leaves
   kernel1D_Karras12(count);
-  // (5) refit from the leaves up. Codes are unique 30-bit values, so a child's common prefix is
-  // longer than its parent's and the tree has at most 31 levels of inner nodes: 32 passes suffice.
-  for (int pass = 0; pass < 16; pass++)
+  // (5) refit from the leaves up, one level per pass. Leaf codes are unique 30-bit values, so the
+  // common prefix (clz of two codes' xor, 2..31) grows from parent to child: at most 30 levels of
+  // inner nodes, so 30 passes reach the root.
+  for (int pass = 0; pass < 15; pass++)
   {
     kernel1D_RefitPass(count, m_readyA.data(), m_readyB.data());
     kernel1D_RefitPass(count, m_readyB.data(), m_readyA.data());
@@ -184,12 +185,15 @@ void LBVH::kernel1D_RefitPass(int count, const uint32_t* readyBefore, uint32_t* 
     if (i >= int(m_leafCount) - 1)
       continue;  // leaves are ready from the start
     uint32_t ready = readyBefore[i];
-    const uint32_t left = m_nodes[i].left, right = m_nodes[i].right;
-    if (ready == 0u && readyBefore[left] != 0u && readyBefore[right] != 0u)
+    if (ready == 0u)  // most nodes are done after the first passes: test that before loading the node
     {
-      m_nodes[i].boxMin = min(m_nodes[left].boxMin, m_nodes[right].boxMin);
-      m_nodes[i].boxMax = max(m_nodes[left].boxMax, m_nodes[right].boxMax);
-      ready = 1u;
+      const uint32_t left = m_nodes[i].left, right = m_nodes[i].right;
+      if (readyBefore[left] != 0u && readyBefore[right] != 0u)
+      {
+        m_nodes[i].boxMin = min(m_nodes[left].boxMin, m_nodes[right].boxMin);
+        m_nodes[i].boxMax = max(m_nodes[left].boxMax, m_nodes[right].boxMax);
+        ready = 1u;
+      }
     }
     readyAfter[i] = ready;
   }

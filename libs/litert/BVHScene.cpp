@@ -27,6 +27,7 @@ struct TraceRay
   float sx, sy, sz;
   float tnear;
   bool zeroAxis[3];
+  bool anyZeroAxis;
 };
 
 TraceRay Prepare(float3 org, float3 dir, float tnear)
@@ -37,9 +38,11 @@ TraceRay Prepare(float3 org, float3 dir, float tnear)
   r.tnear = tnear;
   for (int a = 0; a < 3; ++a)
   {
-    r.zeroAxis[a] = dir[a] == 0.0f;
+    // Denormal components whose reciprocal overflows count as zero too: 0 * inf would be NaN.
+    r.zeroAxis[a] = dir[a] == 0.0f || std::isinf(1.0f / dir[a]);
     r.invDir[a] = r.zeroAxis[a] ? 0.0f : 1.0f / dir[a];
   }
+  r.anyZeroAxis = r.zeroAxis[0] || r.zeroAxis[1] || r.zeroAxis[2];
   const float3 ad(std::fabs(dir.x), std::fabs(dir.y), std::fabs(dir.z));
   r.kz = ad.x >= ad.y && ad.x >= ad.z ? 0 : ad.y >= ad.z ? 1 : 2;
   r.kx = (r.kz + 1) % 3;
@@ -56,17 +59,20 @@ TraceRay Prepare(float3 org, float3 dir, float tnear)
 // distance is widened by 2 gamma(3) (Ize 2013, "Robust BVH Ray Traversal"), so rounding in the
 // reciprocal never culls a box the exact ray touches. A ray parallel to an axis (direction +0 or
 // -0) is inside that slab when its origin is, boundaries included.
-float SlabEntry(const TraceRay& r, const float3& lo, const float3& hi, float tfar)
+constexpr float kWiden = 1.0f + 2.0f * (3.0f * std::numeric_limits<float>::epsilon() * 0.5f) /
+                                    (1.0f - 3.0f * std::numeric_limits<float>::epsilon() * 0.5f);
+constexpr float kMissed = std::numeric_limits<float>::infinity();
+
+// SlabEntry for rays with a zero direction component (rare): per axis, with the in-slab test.
+[[gnu::noinline]] float SlabEntryParallelAxes(const TraceRay& r, const float3& lo, const float3& hi, float tfar)
 {
-  constexpr float kWiden = 1.0f + 2.0f * (3.0f * std::numeric_limits<float>::epsilon() * 0.5f) /
-                                      (1.0f - 3.0f * std::numeric_limits<float>::epsilon() * 0.5f);
   float tmin = r.tnear, tmax = tfar;
   for (int a = 0; a < 3; ++a)
   {
     if (r.zeroAxis[a])
     {
       if (r.org[a] < lo[a] || r.org[a] > hi[a])
-        return std::numeric_limits<float>::infinity();
+        return kMissed;
       continue;
     }
     float t0 = (lo[a] - r.org[a]) * r.invDir[a], t1 = (hi[a] - r.org[a]) * r.invDir[a];
@@ -75,7 +81,20 @@ float SlabEntry(const TraceRay& r, const float3& lo, const float3& hi, float tfa
     tmin = std::max(tmin, t0);
     tmax = std::min(tmax, t1 * kWiden);
   }
-  return tmin <= tmax ? tmin : std::numeric_limits<float>::infinity();
+  return tmin <= tmax ? tmin : kMissed;
+}
+
+// Inlined into the traversal loop: it runs twice per step.
+[[gnu::always_inline]] inline float SlabEntry(const TraceRay& r, const float3& lo, const float3& hi, float tfar)
+{
+  if (r.anyZeroAxis)
+    return SlabEntryParallelAxes(r, lo, hi, tfar);
+  const float x0 = (lo.x - r.org.x) * r.invDir.x, x1 = (hi.x - r.org.x) * r.invDir.x;
+  const float y0 = (lo.y - r.org.y) * r.invDir.y, y1 = (hi.y - r.org.y) * r.invDir.y;
+  const float z0 = (lo.z - r.org.z) * r.invDir.z, z1 = (hi.z - r.org.z) * r.invDir.z;
+  const float tmin = std::max(std::max(std::min(x0, x1), std::min(y0, y1)), std::max(std::min(z0, z1), r.tnear));
+  const float tmax = std::min(std::min(std::min(std::max(x0, x1), std::max(y0, y1)), std::max(z0, z1)) * kWiden, tfar);
+  return tmin <= tmax ? tmin : kMissed;
 }
 
 // Watertight ray/triangle test, both sides. On a hit in [tnear, tfar] sets t and Embree-style
@@ -159,6 +178,35 @@ void Traverse(const BVHTree& tree, const TraceRay& ray, float tfar, LeafFn&& lea
   }
 }
 
+// The same tree with every pair of children side by side, in depth-first order: one cache line
+// holds both boxes a traversal step tests (the LBVH places siblings far apart).
+BVHTree WithSiblingsAdjacent(const BVHTree& tree)
+{
+  if (tree.nodes.size() <= 1)
+    return tree;
+  BVHTree out;
+  out.primIndices = tree.primIndices;
+  out.nodes.reserve(tree.nodes.size());
+  out.nodes.push_back(tree.nodes[0]);
+  std::vector<std::pair<uint32_t, uint32_t>> todo = {{0u, 0u}};  // (old index, new index)
+  while (!todo.empty())
+  {
+    const auto [from, to] = todo.back();
+    todo.pop_back();
+    const BVHNode& n = tree.nodes[from];
+    if (n.left & kLeafFlag)
+      continue;
+    const uint32_t children = uint32_t(out.nodes.size());
+    out.nodes.push_back(tree.nodes[n.left]);
+    out.nodes.push_back(tree.nodes[n.right]);
+    out.nodes[to].left = children;
+    out.nodes[to].right = children + 1;
+    todo.push_back({n.right, children + 1});
+    todo.push_back({n.left, children});
+  }
+  return out;
+}
+
 float3 TransformPoint(const float4x4& m, float3 p) { return to_float3(m * float4(p.x, p.y, p.z, 1.0f)); }
 float3 TransformVector(const float4x4& m, float3 d) { return to_float3(m * float4(d.x, d.y, d.z, 0.0f)); }
 
@@ -191,7 +239,7 @@ void BVHScene::SetMesh(Mesh& mesh, const float* vpos3f, size_t vertNum, const ui
     const float3 lo = min(tris[i].v0, min(tris[i].v1, tris[i].v2)), hi = max(tris[i].v0, max(tris[i].v1, tris[i].v2));
     boxes[i] = Box4f(float4(lo.x, lo.y, lo.z, 0.0f), float4(hi.x, hi.y, hi.z, 0.0f));
   }
-  mesh.tree = triCount > 0 ? m_builder(boxes.data(), triCount) : BVHTree{};
+  mesh.tree = triCount > 0 ? WithSiblingsAdjacent(m_builder(boxes.data(), triCount)) : BVHTree{};
   mesh.triangles.resize(mesh.tree.primIndices.size());
   for (size_t k = 0; k < mesh.tree.primIndices.size(); ++k)
     mesh.triangles[k] = tris[mesh.tree.primIndices[k]];

@@ -3,6 +3,8 @@
 // embedded SPIR-V (push descriptors + push constants), dispatches, and times GPU work.
 #pragma once
 
+#include "SortKey.h"
+
 #include <vulkan/vulkan.h>
 
 #include <chrono>
@@ -253,9 +255,6 @@ struct CpuTimer {
 
 // ---- primitives the translator maps library calls of control functions to ------------------
 
-// The 32-bit element types scans and sort keys come in.
-enum class ElementType : uint32_t { Uint = 0, Int = 1, Float = 2 };
-
 // The 32-bit pattern of a value, for push constants and buffer fills.
 template <typename T>
 uint32_t Bits32(T value) {
@@ -283,15 +282,6 @@ private:
   std::shared_ptr<VulkanContext> ctx_;
   ComputePipeline blocks_[3], add_[3];
   std::vector<Level> levels_;
-};
-
-// What std::sort compares: records of `strideWords` 32-bit words, ordered by the word at
-// `keyWord` read as `type`, ascending or descending. Plain keys are records of one word.
-struct SortKey {
-  uint32_t strideWords = 1;
-  uint32_t keyWord = 0;
-  ElementType type = ElementType::Uint;
-  bool descending = false;
 };
 
 // std::sort on the GPU: a stable LSD radix sort, 4 passes of 8 bits (tile histograms, an

@@ -1,0 +1,69 @@
+// The CPU backend's versions of library calls in control functions (header only; OpenMP).
+#pragma once
+#include "SortKey.h"
+
+#include <omp.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <vector>
+
+namespace crossrt {
+
+// Stable LSD radix sort of n records of key.strideWords words, on all cores: per pass of 8 bits,
+// each thread counts the digits of its slice, the counts are scanned in (digit, thread) order,
+// and each thread moves its slice's records to their places. A pass whose digit is the same for
+// every record is skipped.
+inline void RadixSortWords(uint32_t* records, size_t n, const SortKey& key) {
+  const size_t stride = key.strideWords;
+  std::vector<uint32_t> scratch(n * stride);
+  uint32_t* src = records;
+  uint32_t* dst = scratch.data();
+  const int threads = omp_get_max_threads();
+  std::vector<size_t> counts(size_t(threads) * 256);
+  for (uint32_t shift = 0; shift < 32; shift += 8) {
+    std::fill(counts.begin(), counts.end(), 0);
+#pragma omp parallel num_threads(threads)
+    {
+      const int t = omp_get_thread_num(), used = omp_get_num_threads();
+      const size_t begin = n * t / used, end = n * (t + 1) / used;
+      size_t* mine = &counts[size_t(t) * 256];
+      for (size_t i = begin; i < end; ++i) ++mine[(SortableBits(src[i * stride + key.keyWord], key) >> shift) & 255u];
+#pragma omp barrier
+#pragma omp single
+      {
+        size_t position = 0;
+        for (int digit = 0; digit < 256; ++digit)
+          for (int u = 0; u < used; ++u) {
+            const size_t c = counts[size_t(u) * 256 + digit];
+            counts[size_t(u) * 256 + digit] = position;
+            position += c;
+          }
+      }
+      for (size_t i = begin; i < end; ++i) {
+        const uint32_t digit = (SortableBits(src[i * stride + key.keyWord], key) >> shift) & 255u;
+        const size_t to = mine[digit]++;
+        if (stride == 1)  // the common shapes, without a call to memcpy per record
+          dst[to] = src[i];
+        else if (stride == 2)
+          std::memcpy(dst + 2 * to, src + 2 * i, 8);
+        else
+          std::memcpy(dst + to * stride, src + i * stride, stride * sizeof(uint32_t));
+      }
+    }
+    std::swap(src, dst);
+  }
+  // Four passes: the result is back in `records`.
+}
+
+// std::sort of a range the translator recognized (see SortKey), on all cores.
+template <typename Iterator>
+void RadixSort(Iterator first, Iterator last, const SortKey& key) {
+  const auto n = last - first;
+  if (n <= 1) return;
+  static_assert(sizeof(*first) % 4 == 0, "records of whole 32-bit words");
+  RadixSortWords(reinterpret_cast<uint32_t*>(&*first), size_t(n), key);
+}
+
+}  // namespace crossrt
