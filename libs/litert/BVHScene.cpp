@@ -16,7 +16,7 @@ using LiteMath::float4x4;
 namespace {
 
 constexpr uint32_t kNoId = 0xFFFFFFFFu;
-constexpr int kStackSize = 64;  // LBVH trees have at most 32 levels; the SAH builder stops at 48
+constexpr int kStackSize = 64;  // LBVH trees have at most 31 levels; the SAH builder stops at depth 48
 
 // A ray prepared for one tree: slab test reciprocals and the watertight test's shear (Woop,
 // Benthin and Wald 2013, "Watertight Ray/Triangle Intersection").
