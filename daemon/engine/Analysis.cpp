@@ -866,7 +866,8 @@ private:
     bool descending = false;
   };
 
-  static std::string KeyTypeName(QualType t) {
+  // The crossrt::ElementType of a scan element or sort key: "Uint", "Int", "Float", or "" for others.
+  static std::string ElementTypeName(QualType t) {
     const auto* bt = t.getCanonicalType()->getAs<BuiltinType>();
     if (!bt) return "";
     return bt->getKind() == BuiltinType::UInt ? "Uint" : bt->getKind() == BuiltinType::Int ? "Int" : bt->getKind() == BuiltinType::Float ? "Float" : "";
@@ -878,7 +879,7 @@ private:
     e = e->IgnoreParenImpCasts();
     uint64_t offset = 0;
     const Expr* base = e;
-    keyType = KeyTypeName(e->getType());
+    keyType = ElementTypeName(e->getType());
     while (auto* me = dyn_cast<MemberExpr>(base)) {
       auto* fd = dyn_cast<FieldDecl>(me->getMemberDecl());
       if (!fd || me->isArrow() || fd->isBitField()) return std::nullopt;
@@ -894,7 +895,7 @@ private:
   // No comparator, std::less<>/std::greater<>, or a lambda `return a.key < b.key;` (or `>`, or
   // with the parameters swapped) over a uint32_t, int or float key.
   std::optional<SortOrder> OrderOf(const CallExpr* call, QualType element, std::string& why) {
-    const std::string scalarType = KeyTypeName(element);
+    const std::string scalarType = ElementTypeName(element);
     if (call->getNumArgs() == 2) {
       if (scalarType.empty()) why = "sorting elements without a comparator needs uint32_t, int or float elements";
       return scalarType.empty() ? std::nullopt : std::optional<SortOrder>(SortOrder{0, scalarType, false});
@@ -950,9 +951,7 @@ private:
       if (!first || !last || !out) return bad("its ranges are not device buffers the translator can name");
       auto count = Count(*first, *last);
       if (!count) return bad("first and last must belong to the same buffer");
-      const auto* bt = first->element.getCanonicalType()->getAs<BuiltinType>();
-      std::string type = !bt ? "" : bt->getKind() == BuiltinType::UInt ? "Uint" : bt->getKind() == BuiltinType::Int ? "Int"
-                                    : bt->getKind() == BuiltinType::Float ? "Float" : "";
+      const std::string type = ElementTypeName(first->element);
       if (type.empty()) return bad("scans on the GPU take uint32_t, int or float elements");
       std::string elem = CppTypeName(m_c.ctx, first->element);
       std::string init = name == "exclusive_scan" ? "crossrt::Bits32(static_cast<" + elem + ">(" + m_c.Text(call->getArg(3)->getSourceRange()) + "))" : "0u";

@@ -2,6 +2,7 @@
 // two triangles, every vertex by several), so rays through edges and vertices are easy to aim.
 #pragma once
 #include "LiteMath.h"
+#include "MeshIO.h"
 
 #include <cmath>
 #include <cstdint>
@@ -9,17 +10,22 @@
 #include <utility>
 #include <vector>
 
-struct TestMesh
+inline LiteMath::float3 Vertex(const TriangleMesh& mesh, uint32_t i)
 {
-  std::vector<float> vertices;  // xyz
-  std::vector<uint32_t> indices;
-  size_t VertexCount() const { return vertices.size() / 3; }
-  LiteMath::float3 Vertex(uint32_t i) const { return {vertices[3 * i], vertices[3 * i + 1], vertices[3 * i + 2]}; }
-};
+  return {mesh.positions[3 * i], mesh.positions[3 * i + 1], mesh.positions[3 * i + 2]};
+}
+
+// Triangle prim's (unnormalized) normal, by its winding.
+inline LiteMath::float3 TriangleNormal(const TriangleMesh& mesh, uint32_t prim)
+{
+  const LiteMath::float3 a = Vertex(mesh, mesh.indices[3 * prim]), b = Vertex(mesh, mesh.indices[3 * prim + 1]),
+                         c = Vertex(mesh, mesh.indices[3 * prim + 2]);
+  return cross(b - a, c - a);
+}
 
 // An octahedron subdivided `levels` times and pushed onto the sphere |p - center| = radius:
 // 8 * 4^levels triangles, closed and consistently wound.
-inline TestMesh Sphere(int levels, LiteMath::float3 center = LiteMath::float3(0.0f), float radius = 1.0f)
+inline TriangleMesh Sphere(int levels, LiteMath::float3 center = LiteMath::float3(0.0f), float radius = 1.0f)
 {
   std::vector<LiteMath::float3> points = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
   std::vector<uint32_t> tris = {0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5};
@@ -42,11 +48,11 @@ inline TestMesh Sphere(int levels, LiteMath::float3 center = LiteMath::float3(0.
     }
     tris = std::move(next);
   }
-  TestMesh mesh;
+  TriangleMesh mesh;
   for (auto p : points)
   {
     const LiteMath::float3 q = center + radius * normalize(p);
-    mesh.vertices.insert(mesh.vertices.end(), {q.x, q.y, q.z});
+    mesh.positions.insert(mesh.positions.end(), {q.x, q.y, q.z});
   }
   mesh.indices = std::move(tris);
   return mesh;

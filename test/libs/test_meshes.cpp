@@ -5,6 +5,7 @@
 
 #include "CrossRT.h"
 #include "MeshIO.h"
+#include "TestMeshes.h"
 
 #include <zlib.h>
 
@@ -81,13 +82,12 @@ TEST_CASE("Rays from random points inside the closed bunny all hit it, and leave
   }
   const TriangleMesh mesh = LoadMesh(path);
   REQUIRE(mesh.TriangleCount() > 50000);
-  auto vertex = [&](uint32_t i) { return float3(mesh.positions[3 * i], mesh.positions[3 * i + 1], mesh.positions[3 * i + 2]); };
   float3 lo(1e30f), hi(-1e30f);
-  for (size_t v = 0; v < mesh.VertexCount(); ++v) lo = min(lo, vertex(uint32_t(v))), hi = max(hi, vertex(uint32_t(v)));
+  for (size_t v = 0; v < mesh.VertexCount(); ++v) lo = min(lo, Vertex(mesh, uint32_t(v))), hi = max(hi, Vertex(mesh, uint32_t(v)));
   // Orientation: the signed volume tells whether triangle normals point out.
   double volume = 0.0;
   for (size_t t = 0; t < mesh.indices.size(); t += 3)
-    volume += dot(vertex(mesh.indices[t]), cross(vertex(mesh.indices[t + 1]), vertex(mesh.indices[t + 2])));
+    volume += dot(Vertex(mesh, mesh.indices[t]), cross(Vertex(mesh, mesh.indices[t + 1]), Vertex(mesh, mesh.indices[t + 2])));
   const float outward = volume > 0.0 ? 1.0f : -1.0f;
 
   auto reference = CreateSceneRT("embree");
@@ -111,15 +111,14 @@ TEST_CASE("Rays from random points inside the closed bunny all hit it, and leave
       {
         const CRT_Hit h = reference->RayQuery_NearestHit(float4(p.x, p.y, p.z, 0.0f), float4(d.x, d.y, d.z, 1e30f));
         if (h.primId == 0xFFFFFFFFu) { inside = false; break; }
-        const float3 a = vertex(mesh.indices[3 * h.primId]), b = vertex(mesh.indices[3 * h.primId + 1]), c = vertex(mesh.indices[3 * h.primId + 2]);
-        inside = inside && outward * dot(cross(b - a, c - a), d) > 0.0f;
+        inside = inside && outward * dot(TriangleNormal(mesh, h.primId), d) > 0.0f;
       }
       if (!inside) continue;
       ++points;
       for (int r = 0; r < 50; ++r)
       {
         // Random directions, and directions exactly at vertices (rays through shared vertices).
-        const float3 target = r % 2 ? vertex(mesh.indices[rng() % mesh.indices.size()]) : p + float3(s(rng), s(rng), s(rng));
+        const float3 target = r % 2 ? Vertex(mesh, mesh.indices[rng() % mesh.indices.size()]) : p + float3(s(rng), s(rng), s(rng));
         const float3 d = target - p;
         ++rays;
         float tnear = 0.0f;
@@ -129,8 +128,7 @@ TEST_CASE("Rays from random points inside the closed bunny all hit it, and leave
         {
           const CRT_Hit h = scene->RayQuery_NearestHit(float4(p.x, p.y, p.z, tnear), float4(d.x, d.y, d.z, 1e30f));
           if (h.primId == 0xFFFFFFFFu) break;
-          const float3 a = vertex(mesh.indices[3 * h.primId]), b = vertex(mesh.indices[3 * h.primId + 1]), c = vertex(mesh.indices[3 * h.primId + 2]);
-          lastFacing = outward * dot(cross(b - a, c - a), d) > 0.0f ? 1 : -1;
+          lastFacing = outward * dot(TriangleNormal(mesh, h.primId), d) > 0.0f ? 1 : -1;
           ++hits;
           lastT = h.t;
           tnear = std::nextafter(h.t, 1e30f);

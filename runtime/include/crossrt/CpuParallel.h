@@ -13,8 +13,7 @@ namespace crossrt {
 
 // Stable LSD radix sort of n records of key.strideWords words, on all cores: per pass of 8 bits,
 // each thread counts the digits of its slice, the counts are scanned in (digit, thread) order,
-// and each thread moves its slice's records to their places. A pass whose digit is the same for
-// every record is skipped.
+// and each thread moves its slice's records to their places.
 inline void RadixSortWords(uint32_t* records, size_t n, const SortKey& key) {
   const size_t stride = key.strideWords;
   std::vector<uint32_t> scratch(n * stride);
