@@ -27,6 +27,7 @@ std::string OptionsKey(const engine::TranslateRequest& r) {
                      (r.backend == engine::Backend::Vulkan ? "vulkan" : "cpu") + '\n' + r.templateDir;
   for (auto& s : r.sources) text += "\nsrc " + s;
   for (auto& a : r.compileArgs) text += "\narg " + a;
+  for (auto& c : r.compositions) text += "\ncompose " + c;
   return Hex(XXH64(text.data(), text.size(), 0));
 }
 

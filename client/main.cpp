@@ -32,7 +32,8 @@ namespace {
 
 const char* kUsage =
     "usage: crossrt translate --class NAME --backend vulkan|cpu --out DIR --source FILE [--source FILE...]\n"
-    "                         [--templates DIR] [--depfile FILE --depfile-target FILE]\n"
+    "                         [--compose INTERFACE=IMPL...] [--templates DIR]\n"
+    "                         [--depfile FILE --depfile-target FILE]\n"
     "                         [--build-dir DIR | --no-daemon] [-- COMPILE_ARGS...]\n"
     "       crossrt daemon status [--build-dir DIR] [--json]\n"
     "       crossrt daemon stop [--build-dir DIR]\n"
@@ -155,6 +156,11 @@ int main(int argc, char** argv) {
     else if (a == "--out") request.outputDir = v;
     else if (a == "--source") request.sources.push_back(v);
     else if (a == "--templates") request.templateDir = v;
+    else if (a == "--compose") {
+      if (v.find('=') == std::string::npos || v.front() == '=' || v.back() == '=')
+        return Usage("--compose takes Interface=Implementation, e.g. ISceneObject=BVHScene, not '" + v + "'");
+      request.compositions.push_back(v);
+    }
     else if (a == "--depfile") depfile = v;
     else if (a == "--depfile-target") depfileTarget = v;
     else if (a == "--build-dir") buildDir = v;

@@ -1,4 +1,5 @@
-# crossrt_add_class(<target> <Class> BACKEND vulkan|cpu [SOURCES file...] [HEADER file])
+# crossrt_add_class(<target> <Class> BACKEND vulkan|cpu [SOURCES file...]
+#                   [COMPOSE Interface=Implementation...])
 #
 # Translates class <Class> into <Class>_Vulkan (or <Class>_CPU), in the build tree, and adds the
 # generated sources, their include path and the runtime to <target>. SOURCES are the files that
@@ -6,14 +7,31 @@
 # every .cpp source of <target>). The translation re-runs when any file it read changes (depfile),
 # and writes only files whose contents changed, so an unchanged class recompiles nothing.
 #
+# COMPOSE (paper 3.6): kernels that call Interface's methods through a member (a shared_ptr,
+# unique_ptr or pointer) run Implementation's code on the GPU, and its data is uploaded with the
+# class's. Implementation's source files are added to SOURCES when it was registered with
+# crossrt_register_implementation() (litert's BVHScene is); otherwise list them in SOURCES.
+#
 # The translation goes through the build tree's daemon (crossrtd, started on demand, exits when
 # idle), which keeps parsed headers warm; set CROSSRT_NO_DAEMON=1 to translate in-process.
 #
 # Works from the source tree (add_subdirectory) and from an installed package (find_package).
 include_guard(GLOBAL)
 
+# Registers the source files that define Implementation's methods, so that
+# crossrt_add_class(... COMPOSE Interface=Implementation) parses them (absolute paths).
+function(crossrt_register_implementation impl)
+  cmake_parse_arguments(ARG "" "" "SOURCES" ${ARGN})
+  set(abs "")
+  foreach(s IN LISTS ARG_SOURCES)
+    get_filename_component(a "${s}" ABSOLUTE BASE_DIR ${CMAKE_CURRENT_SOURCE_DIR})
+    list(APPEND abs "${a}")
+  endforeach()
+  set_property(GLOBAL PROPERTY CROSSRT_IMPLEMENTATION_SOURCES_${impl} "${abs}")
+endfunction()
+
 function(crossrt_add_class target class)
-  cmake_parse_arguments(ARG "" "BACKEND" "SOURCES" ${ARGN})
+  cmake_parse_arguments(ARG "" "BACKEND" "SOURCES;COMPOSE" ${ARGN})
   if(NOT ARG_BACKEND)
     set(ARG_BACKEND vulkan)
   endif()
@@ -39,6 +57,16 @@ function(crossrt_add_class target class)
       set(sources ${target_sources})
     endif()
   endif()
+  set(compose_args "")
+  foreach(c IN LISTS ARG_COMPOSE)
+    if(NOT c MATCHES "^[A-Za-z_][A-Za-z0-9_]*=[A-Za-z_][A-Za-z0-9_]*$")
+      message(FATAL_ERROR "crossrt_add_class(${target} ${class}): COMPOSE takes Interface=Implementation (e.g. ISceneObject=BVHScene), not '${c}'")
+    endif()
+    string(REGEX REPLACE "^.*=" "" impl "${c}")
+    get_property(impl_sources GLOBAL PROPERTY CROSSRT_IMPLEMENTATION_SOURCES_${impl})
+    list(APPEND sources ${impl_sources})
+    list(APPEND compose_args --compose "${c}")
+  endforeach()
   set(abs_sources "")
   set(source_args "")
   foreach(s IN LISTS sources)
@@ -61,7 +89,7 @@ function(crossrt_add_class target class)
   set(std "$<TARGET_PROPERTY:${target},CXX_STANDARD>")
   set(features "$<TARGET_PROPERTY:${target},COMPILE_FEATURES>")
   set(compile_args "$<$<BOOL:${inc}>:-I$<JOIN:${inc},$<SEMICOLON>-I>>")
-  foreach(lib crossrt::litemath crossrt::liteimage crossrt::litert)
+  foreach(lib crossrt::litemath crossrt::liteimage crossrt::litert crossrt::litebvh)
     set(lib_inc "$<TARGET_PROPERTY:${lib},INTERFACE_INCLUDE_DIRECTORIES>")
     list(APPEND compile_args "$<$<BOOL:${lib_inc}>:-I$<JOIN:${lib_inc},$<SEMICOLON>-I>>")
   endforeach()
@@ -83,7 +111,7 @@ function(crossrt_add_class target class)
     OUTPUT ${outputs}
     COMMAND ${translator} translate
             --class ${class} --backend ${backend} --out ${out_dir}
-            ${source_args}
+            ${source_args} ${compose_args}
             --templates ${CROSSRT_TEMPLATE_DIR}
             --depfile ${out_dir}/${class}_${suffix}.d --depfile-target ${first_output}
             --build-dir ${CMAKE_BINARY_DIR}

@@ -98,6 +98,7 @@ struct Context {
   const CXXRecordDecl* cls;
   Reporter& rep;
   ClassModel& model;
+  const std::map<std::string, std::string>& compositions;  // interface -> implementation
   std::string Text(SourceRange r) const { return engine::Text(ctx, r); }
 };
 
@@ -117,6 +118,7 @@ void AnalyzeMembers(Context& c) {
   for (auto* f : c.cls->fields()) {
     Member m;
     m.name = f->getNameAsString();
+    m.hostExpr = m.name;
     QualType elem;
     if (IsStdVector(f->getType(), &elem)) {
       auto g = GlslTypeOf(elem);
@@ -423,6 +425,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   CheckKernelParams(c, md, k);
   for (unsigned i = 0; i < md->getNumParams(); ++i) k.cppParamsDecl += (i ? ", " : "") + ParamDecl(c.ctx, md->getParamDecl(i), i);
   GlslPrinter printer(c.ctx, c.cls, c.rep);
+  printer.compositions = c.compositions;
   for (auto& s : ClassStructNames(c.model)) printer.predeclaredStructs.insert(s);
   // Structs the parameters' buffers hold are declared even when the body names no variable of them.
   for (auto* p : def->parameters())
@@ -544,6 +547,26 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   }
   k.glslStructs = printer.PreludeTypes();
   k.glslHelpers = printer.PreludeFunctions();
+  k.structList = printer.Structs();
+  k.constantList = printer.Constants();
+  k.functionList = printer.Functions();
+  k.composedCalls = printer.composedCalls;
+  for (auto& [holder, method] : printer.composedCalls) {
+    if (std::any_of(c.model.compositions.begin(), c.model.compositions.end(), [&](const Composition& x) { return x.holder == holder; }))
+      continue;
+    Composition comp;
+    comp.holder = holder;
+    for (auto* f : c.cls->fields())
+      if (f->getNameAsString() == holder) {
+        QualType t = f->getType().getCanonicalType();
+        const CXXRecordDecl* rd = t->isPointerType() ? t->getPointeeType()->getAsCXXRecordDecl() : nullptr;
+        if (auto* spec = dyn_cast_or_null<ClassTemplateSpecializationDecl>(t->getAsCXXRecordDecl()))
+          rd = spec->getTemplateArgs()[0].getAsType()->getAsCXXRecordDecl();
+        if (rd) comp.interfaceName = rd->getNameAsString();
+      }
+    comp.implName = c.compositions.count(comp.interfaceName) ? c.compositions.at(comp.interfaceName) : "";
+    c.model.compositions.push_back(comp);
+  }
   for (auto* f : printer.memberVectors) {
     k.memberVectors.push_back(f->getNameAsString());
     if (auto* m = FindMember(c.model, f->getNameAsString())) m->usedByKernels = true;
@@ -1087,14 +1110,15 @@ void AnalyzeControl(Context& c, const CXXMethodDecl* md, const FunctionDecl* def
 
 }  // namespace
 
-bool AnalyzeTranslationUnit(ASTContext& ctx, const std::string& className, Reporter& reporter, ClassModel& model) {
+bool AnalyzeTranslationUnit(ASTContext& ctx, const std::string& className, const std::map<std::string, std::string>& compositions,
+                            Reporter& reporter, ClassModel& model) {
   // A name lookup in the translation unit: walking every declaration of the standard library
   // would cost more than the rest of the analysis.
   const CXXRecordDecl* cls = nullptr;
   for (auto* d : ctx.getTranslationUnitDecl()->lookup(&ctx.Idents.get(className)))
     if (auto* rd = dyn_cast<CXXRecordDecl>(d); rd && rd->getDefinition()) cls = rd->getDefinition();
   if (!cls) return false;
-  Context c{ctx, cls, reporter, model};
+  Context c{ctx, cls, reporter, model, compositions};
   bool first = model.className.empty();
   if (first) {
     model.className = className;
@@ -1155,19 +1179,150 @@ bool AnalyzeTranslationUnit(ASTContext& ctx, const std::string& className, Repor
   return true;
 }
 
+// ---- composition -----------------------------------------------------------
+
+namespace {
+
+// The definition of `name` an implementation provides (itself or a base that is not abstract there).
+const CXXMethodDecl* ImplementationOf(const CXXRecordDecl* impl, const std::string& name, const FunctionDecl*& def) {
+  for (auto* d : impl->lookup(&impl->getASTContext().Idents.get(name)))
+    if (auto* md = dyn_cast<CXXMethodDecl>(d); md && !md->isPureVirtual() && md->hasBody(def) && def) return md;
+  for (auto& base : impl->bases())
+    if (auto* rd = base.getType()->getAsCXXRecordDecl(); rd && rd->hasDefinition())
+      if (auto* md = ImplementationOf(rd->getDefinition(), name, def)) return md;
+  return nullptr;
+}
+
+std::string StructName(const std::string& chunk) {
+  static const std::regex decl(R"(^struct (\w+) \{)");
+  std::smatch m;
+  return std::regex_search(chunk, m, decl) ? m[1].str() : "";
+}
+
+}  // namespace
+
+bool ComposeFromTranslationUnit(ASTContext& ctx, Reporter& reporter, ClassModel& model) {
+  bool any = false;
+  const std::set<std::string> classStructs = ClassStructNames(model);
+  for (auto& comp : model.compositions) {
+    if (!comp.implHeader.empty() || comp.implName.empty()) continue;
+    const CXXRecordDecl* impl = nullptr;
+    for (auto* d : ctx.getTranslationUnitDecl()->lookup(&ctx.Idents.get(comp.implName)))
+      if (auto* rd = dyn_cast<CXXRecordDecl>(d); rd && rd->getDefinition()) impl = rd->getDefinition();
+    if (!impl) continue;
+    // Every method the kernels call must have its body here (the implementation's own source).
+    bool complete = true;
+    for (auto& k : model.kernels)
+      for (auto& [holder, method] : k.composedCalls) {
+        const FunctionDecl* def = nullptr;
+        if (holder == comp.holder && !ImplementationOf(impl, method, def)) complete = false;
+      }
+    if (!complete) continue;
+    any = true;
+    comp.implHeader = FileOf(ctx, impl->getLocation());
+    std::string holderPrefix = comp.holder + "_";
+    for (auto& k : model.kernels) {
+      GlslPrinter printer(ctx, impl, reporter);
+      printer.composedPrefix = holderPrefix;
+      for (auto& s : classStructs) printer.predeclaredStructs.insert(s);
+      for (auto& [holder, method] : k.composedCalls) {
+        if (holder != comp.holder) continue;
+        const FunctionDecl* def = nullptr;
+        auto* md = ImplementationOf(impl, method, def);
+        comp.sourceFile = BaseName(FileOf(ctx, def->getLocation()));
+        printer.EmitComposedMethod(md);
+      }
+      if (printer.Functions().empty()) continue;
+      // The implementation's data: its std::vector members become buffers, plain members join
+      // the class data, all reached through the holder on the host.
+      std::vector<std::string> vectors;
+      for (auto* f : printer.memberVectors) {
+        QualType elem;
+        IsStdVector(f->getType(), &elem);
+        printer.Type(elem, f->getLocation());
+      }
+      auto requirePublic = [&](const FieldDecl* f) {
+        if (f->getAccess() != AS_public)
+          reporter.Error(f->getLocation(), "member '" + f->getNameAsString() + "' of " + comp.implName + " is read on the GPU through composition (" +
+                         comp.interfaceName + "=" + comp.implName + "), so the generated class must reach it through a " + comp.implName + "*",
+                         "declare it public");
+      };
+      for (auto* f : printer.memberVectors) {
+        requirePublic(f);
+        QualType elem;
+        IsStdVector(f->getType(), &elem);
+        std::string name = holderPrefix + f->getNameAsString();
+        vectors.push_back(name);
+        if (FindMember(model, name)) continue;
+        Member m;
+        m.name = name;
+        m.hostExpr = "crt_" + comp.holder + "()->" + f->getNameAsString();
+        m.kind = MemberKind::Vector;
+        m.glslType = GlslTypeOf(elem).value_or("float");
+        m.elemCppType = CppTypeName(ctx, elem);
+        m.cppType = CppTypeName(ctx, f->getType());
+        m.scalarLayout = !LayoutMatchesCpp(ctx, elem, false);
+        if (m.scalarLayout && !LayoutMatchesCpp(ctx, elem, true))
+          reporter.Error(f->getLocation(), "the elements of '" + f->getNameAsString() + "' have a C++ layout that a GPU buffer cannot reproduce",
+                         "use int instead of bool, and 32-bit scalars and LiteMath vectors in structs");
+        m.usedByKernels = true;
+        model.members.push_back(m);
+      }
+      for (auto* f : printer.plainMembers) {
+        requirePublic(f);
+        std::string name = holderPrefix + f->getNameAsString();
+        if (FindMember(model, name)) continue;
+        Member m;
+        m.name = name;
+        m.hostExpr = "crt_" + comp.holder + "()->" + f->getNameAsString();
+        m.glslType = GlslTypeOf(f->getType()).value_or("float");
+        m.cppType = CppTypeName(ctx, f->getType());
+        m.inClassData = FitsClassData(ctx, f->getType());
+        if (auto layout = Std430Layout(ctx, f->getType(), false)) m.std430Align = unsigned(layout->align);
+        if (!m.inClassData)
+          reporter.Error(f->getLocation(), "member '" + f->getNameAsString() + "' of type '" + f->getType().getAsString(ctx.getPrintingPolicy()) +
+                         "' has a C++ layout that a GPU buffer cannot reproduce",
+                         "use int instead of bool, float4x4 instead of float3x3");
+        m.usedByKernels = true;
+        model.members.push_back(m);
+      }
+      // Composed code first: the kernel's own code calls it and may use its structs.
+      std::vector<std::string> structs = printer.Structs(), constants = printer.Constants(), functions = printer.Functions();
+      for (auto& chunk : k.structList) {
+        auto same = std::find_if(structs.begin(), structs.end(), [&](const std::string& x) { return StructName(x) == StructName(chunk); });
+        if (same == structs.end()) structs.push_back(chunk);
+      }
+      for (auto& line : k.constantList)
+        if (std::find(constants.begin(), constants.end(), line) == constants.end()) constants.push_back(line);
+      functions.insert(functions.end(), k.functionList.begin(), k.functionList.end());
+      k.glslStructs.clear();
+      for (auto& x : structs) k.glslStructs += x + "\n";
+      k.glslHelpers.clear();
+      for (auto& x : constants) k.glslHelpers += x;
+      if (!constants.empty()) k.glslHelpers += "\n";
+      for (auto& x : functions) k.glslHelpers += x + "\n";
+      for (auto& v : vectors)
+        if (std::find(k.memberVectors.begin(), k.memberVectors.end(), v) == k.memberVectors.end()) k.memberVectors.push_back(v);
+      std::sort(k.memberVectors.begin(), k.memberVectors.end());
+    }
+  }
+  return any;
+}
+
 void FinishModel(ClassModel& model) {
   // The class-data block: plain members kernels use, then sizes of member vectors.
   // Ordered by alignment so that the C++ mirror with alignas() has the std430 offsets.
   std::vector<BlockField> fields;
   for (auto& m : model.members)
-    if (m.kind == MemberKind::Plain && m.inClassData) fields.push_back({m.name, m.cppType, m.glslType, m.std430Align});
+    if (m.kind == MemberKind::Plain && m.inClassData && (m.usedByKernels || m.hostExpr == m.name))
+      fields.push_back({m.name, m.cppType, m.glslType, m.std430Align, m.hostExpr});
   for (auto& m : model.members) {
     if (!m.usedByKernels || m.kind != MemberKind::Vector) continue;
-    fields.push_back({m.name + "_size", "uint32_t", "uint", 4});
-    fields.push_back({m.name + "_capacity", "uint32_t", "uint", 4});
+    fields.push_back({m.name + "_size", "uint32_t", "uint", 4, ""});
+    fields.push_back({m.name + "_capacity", "uint32_t", "uint", 4, ""});
   }
   std::stable_sort(fields.begin(), fields.end(), [](const BlockField& a, const BlockField& b) { return a.std430Align > b.std430Align; });
-  if (fields.empty()) fields.push_back({"dummy", "uint32_t", "uint", 4});  // a block needs a member
+  if (fields.empty()) fields.push_back({"dummy", "uint32_t", "uint", 4, ""});  // a block needs a member
   model.classData = fields;
 }
 

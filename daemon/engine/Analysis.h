@@ -5,11 +5,20 @@
 
 #include <clang/AST/ASTContext.h>
 
+#include <map>
+#include <string>
+
 namespace crossrt::engine {
 
 // Adds what this translation unit defines to `model`. The first call (the first source file) also
 // fills in members and constructors. Returns false when the class is not declared in this AST.
-bool AnalyzeTranslationUnit(clang::ASTContext& ctx, const std::string& className, Reporter& reporter, ClassModel& model);
+// `compositions` maps interfaces to the implementations the GPU code uses ("ISceneObject" -> "BVHScene").
+bool AnalyzeTranslationUnit(clang::ASTContext& ctx, const std::string& className,
+                            const std::map<std::string, std::string>& compositions, Reporter& reporter, ClassModel& model);
+
+// After AnalyzeTranslationUnit saw every AST: merges the code and data of composed implementations
+// defined in this AST into the kernels that call them. Returns true when it resolved any.
+bool ComposeFromTranslationUnit(clang::ASTContext& ctx, Reporter& reporter, ClassModel& model);
 
 // After every AST was analysed: builds the class-data block, marks used members. Reports what
 // only the whole picture shows (e.g. a control function calling an unknown kernel).

@@ -105,6 +105,7 @@ Data ClassDataList(const ClassModel& model) {
     Data d;
     auto [base, dims] = SplitArray(f.glslType);
     d.set("name", f.name);
+    d.set("host", f.hostExpr.empty() ? f.name : f.hostExpr);
     d.set("cppType", f.cppType);
     d.set("arraySuffix", dims);
     d.set("align", std::to_string(f.std430Align));
@@ -142,6 +143,17 @@ Data Common(const ClassModel& model, const GenerateOptions& opt) {
   for (auto& u : model.usingDecls) usings += u + "\n";
   d.set("usingDecls", usings);
   d.set("hasUsingDecls", !usings.empty());
+  Data comps = List();
+  for (auto& c : model.compositions) {
+    if (c.implHeader.empty()) continue;
+    Data x;
+    x.set("holder", c.holder);
+    x.set("interface", c.interfaceName);
+    x.set("impl", c.implName);
+    x.set("implInclude", opt.includeSpelling ? opt.includeSpelling(c.implHeader) : c.implHeader);
+    comps.push_back(x);
+  }
+  d.set("compositions", comps);
   return d;
 }
 
@@ -184,7 +196,7 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
     b.set("blockName", v + "Buffer");
     b.set("type", m ? m->glslType : "float");
     b.set("name", v);
-    b.set("comment", "member std::vector " + v);
+    b.set("comment", m && m->hostExpr != m->name ? "composed: " + m->hostExpr.substr(4) : "member std::vector " + v);
     buffers.push_back(b);
   }
   Data reductions = List();
@@ -320,6 +332,7 @@ Data ControlsData(const ClassModel& model) {
       if (!m || !seen.insert(v).second) return;
       Data y;
       y.set("name", v);
+      y.set("host", m->hostExpr);
       y.set("control", c.name);
       y.set("elemCppType", m->elemCppType);
       written.push_back(y);
@@ -423,6 +436,7 @@ Data VectorsData(const ClassModel& model) {
     if (m.kind != MemberKind::Vector || !m.usedByKernels) continue;
     Data x;
     x.set("name", m.name);
+    x.set("host", m.hostExpr);
     x.set("elemCppType", m.elemCppType);
     vectors.push_back(x);
   }

@@ -2,6 +2,7 @@
 #pragma once
 #include "Model.h"
 
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -12,6 +13,7 @@ struct GenerateOptions {
   std::string templateDir;
   std::string headerName;     // the user header's file name, for comments
   std::string headerInclude;  // how generated code includes it
+  std::function<std::string(const std::string&)> includeSpelling;  // the same, for any header
 };
 
 struct ShaderSource {

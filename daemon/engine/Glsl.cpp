@@ -237,7 +237,7 @@ void GlslPrinter::NeedConstant(const VarDecl* vd) {
   m_emitted.insert(vd);
   const clang::Expr* init = vd->getAnyInitializer();
   std::string value = init ? Expr(init) : "0";
-  m_constants.push_back("const " + Declare(vd->getType(), vd->getName().str(), vd->getLocation()) + " = " + value + ";\n");
+  m_constants.push_back("const " + Declare(vd->getType(), composedPrefix + vd->getName().str(), vd->getLocation()) + " = " + value + ";\n");
 }
 
 std::string GlslPrinter::PreludeTypes() const {
@@ -344,18 +344,19 @@ std::string GlslPrinter::Construct(QualType t, const std::vector<const clang::Ex
   return out;
 }
 
-std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callLoc) {
+std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callLoc, bool composedEntry) {
   const FunctionDecl* def = nullptr;
   if (!fd->hasBody(def) || !def) {
     return Fail(callLoc, "function '" + fd->getQualifiedNameAsString() + "' is called from a kernel but its body is not visible",
                 "define it in a header or in one of the class's source files");
   }
-  std::string name = fd->getNameAsString();
+  // Composed code keeps its names under the holder's prefix: no clash with the kernel's helpers.
+  std::string name = composedPrefix + fd->getNameAsString();
   if (m_inProgress.count(def))
     return Fail(callLoc, "recursive call to '" + fd->getQualifiedNameAsString() + "' in a kernel",
                 "GPUs have no call stack: rewrite the recursion as a loop with an explicit stack array");
   if (m_emitted.count(def)) return name;
-  if (isa<CXXMethodDecl>(def) && cast<CXXMethodDecl>(def)->isVirtual())
+  if (!composedEntry && isa<CXXMethodDecl>(def) && cast<CXXMethodDecl>(def)->isVirtual())
     Fail(callLoc, "virtual call to '" + fd->getQualifiedNameAsString() + "' in a kernel", "call a non-virtual helper");
   m_inProgress.insert(def);
   std::ostringstream os;
@@ -382,6 +383,41 @@ std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callL
   m_functions.push_back(os.str());
   helpers.push_back(def);
   return name;
+}
+
+std::string GlslPrinter::EmitComposedMethod(const CXXMethodDecl* method) {
+  return EmitHelper(method, method->getLocation(), true);
+}
+
+// `m_holder->Method(args)` where m_holder is a shared_ptr, unique_ptr or pointer to a polymorphic
+// class: the composed implementation's function, or "" when the call is not of that form.
+std::string GlslPrinter::ComposedCall(const CXXMemberCallExpr* mc) {
+  const clang::Expr* obj = mc->getImplicitObjectArgument()->IgnoreParenImpCasts();
+  if (auto* op = dyn_cast<CXXOperatorCallExpr>(obj); op && op->getOperator() == OO_Arrow) obj = op->getArg(0)->IgnoreParenImpCasts();
+  auto* me = dyn_cast<MemberExpr>(obj);
+  auto* field = me ? dyn_cast<FieldDecl>(me->getMemberDecl()) : nullptr;
+  if (!field || !isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts())) return "";
+  QualType t = field->getType().getCanonicalType();
+  const CXXRecordDecl* pointee = nullptr;
+  if (t->isPointerType()) pointee = t->getPointeeType()->getAsCXXRecordDecl();
+  else if (auto* spec = dyn_cast_or_null<ClassTemplateSpecializationDecl>(t->getAsCXXRecordDecl());
+           spec && spec->isInStdNamespace() && (spec->getName() == "shared_ptr" || spec->getName() == "unique_ptr"))
+    pointee = spec->getTemplateArgs()[0].getAsType()->getAsCXXRecordDecl();
+  if (!pointee || !pointee->hasDefinition() || !pointee->isPolymorphic()) return "";
+  const std::string interface = pointee->getNameAsString(), method = mc->getMethodDecl()->getNameAsString();
+  const std::string holder = field->getNameAsString();
+  if (!compositions.count(interface))
+    return Fail(mc->getBeginLoc(), "call of " + interface + "::" + method + " through member '" + holder +
+                "' in a kernel, but no implementation of " + interface + " is composed into the class",
+                "name the implementation the GPU runs: crossrt_add_class(... COMPOSE " + interface +
+                "=<Implementation>), e.g. ISceneObject=BVHScene, and list its source file in SOURCES");
+  std::vector<std::string> args;
+  for (auto* arg : mc->arguments()) args.push_back(Expr(arg));
+  Type(mc->getType(), mc->getBeginLoc());  // declares a returned struct (CRT_Hit)
+  composedCalls.insert({holder, method});
+  std::string s = holder + "_" + method + "(";
+  for (size_t i = 0; i < args.size(); ++i) s += (i ? ", " : "") + args[i];
+  return s + ")";
 }
 
 namespace {
@@ -480,13 +516,16 @@ std::string GlslPrinter::Call(const CallExpr* call) {
       for (size_t i = 0; i < args.size(); ++i) s += (i ? ", " : "") + args[i];
       return s + ")";
     }
+    // Calls through a member holding an interface: composition.
+    std::string composed = ComposedCall(mc);
+    if (!composed.empty()) return composed;
     // Calls on a std::vector member.
     if (auto* me = dyn_cast<MemberExpr>(obj); me && IsStdVector(me->getType())) {
       auto* field = dyn_cast<FieldDecl>(me->getMemberDecl());
       if (field && isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts())) {
         memberVectors.insert(field);
-        if (name == "size") return field->getNameAsString() + "_size";
-        if (name == "capacity") return field->getNameAsString() + "_capacity";
+        if (name == "size") return composedPrefix + field->getNameAsString() + "_size";
+        if (name == "capacity") return composedPrefix + field->getNameAsString() + "_capacity";
       }
       return Fail(call->getBeginLoc(), "std::vector::" + name + " is not supported in kernels",
                   "kernels may index member vectors and call size(); push_back inside kernels is not supported yet");
@@ -562,7 +601,7 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
       if (vd->hasGlobalStorage() && !vd->isStaticLocal()) {
         if (vd->getType().isConstQualified() && vd->getAnyInitializer()) {
           NeedConstant(vd);
-          return vd->getNameAsString();
+          return composedPrefix + vd->getNameAsString();
         }
         return Fail(e->getBeginLoc(), "global variable '" + vd->getNameAsString() + "' used in a kernel",
                     "make it constexpr, or a member of the class so it is uploaded to the GPU");
@@ -581,13 +620,13 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
       if (!field) return Fail(e->getBeginLoc(), "member '" + me->getMemberDecl()->getNameAsString() + "' cannot be used here", "");
       if (IsStdVector(field->getType())) {
         memberVectors.insert(field);
-        return field->getNameAsString();
+        return composedPrefix + field->getNameAsString();
       }
       if (field->getType()->isPointerType() || !GlslTypeOf(field->getType()))
         return Fail(e->getBeginLoc(), "member '" + field->getNameAsString() + "' of type '" + field->getType().getAsString(m_ctx.getPrintingPolicy()) +
                     "' cannot be used in a kernel", "kernels may use plain data members and std::vector members");
       plainMembers.insert(field);
-      return field->getNameAsString();
+      return composedPrefix + field->getNameAsString();
     }
     if (me->isArrow()) return Fail(e->getBeginLoc(), "'->' in a kernel", "GLSL has no pointers: use a reference or a value");
     if (!field) return Fail(e->getBeginLoc(), "member function used as a value", "");

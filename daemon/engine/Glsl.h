@@ -49,6 +49,17 @@ public:
   // Helper functions the kernel reaches (their writes to members matter too).
   std::vector<const clang::FunctionDecl*> helpers;
 
+  // Composition (paper 3.6). In a kernel's printer: interfaces with an implementation
+  // ("ISceneObject" -> "BVHScene"); a call through a member holding one prints as
+  // `<member>_<method>(...)` and is recorded in composedCalls (member, method) for the
+  // implementation's printer, which runs on the implementation's AST afterwards.
+  std::map<std::string, std::string> compositions;
+  std::set<std::pair<std::string, std::string>> composedCalls;
+  // In an implementation's printer: the prefix its members and functions get ("m_pAccelStruct_").
+  std::string composedPrefix;
+  // Prints the implementation of an interface method, called from kernels as <prefix><name>.
+  std::string EmitComposedMethod(const clang::CXXMethodDecl* method);
+
   std::string Expr(const clang::Expr* e);
   std::string Stmt(const clang::Stmt* s, int indent);
   // The thread's function body: `continue` at loop depth 0 ends the thread (becomes `return`).
@@ -61,6 +72,10 @@ public:
   // Structs the code needs (above the buffer blocks), then constants and helper functions (below).
   std::string PreludeTypes() const;
   std::string PreludeFunctions() const;
+  // The same pieces one by one, for merging the preludes of composed code with a kernel's.
+  const std::vector<std::string>& Structs() const { return m_structs; }
+  const std::vector<std::string>& Constants() const { return m_constants; }
+  const std::vector<std::string>& Functions() const { return m_functions; }
   // Structs declared once for the whole class (the class-data block needs them): not emitted again.
   std::set<std::string> predeclaredStructs;
   static std::string SafeName(const std::string& name);  // renames GLSL keywords
@@ -71,7 +86,8 @@ private:
   std::string Construct(clang::QualType t, const std::vector<const clang::Expr*>& args, clang::SourceLocation loc);
   std::string Literal(const clang::Expr* e);
   std::string Cast(clang::QualType to, const clang::Expr* sub);
-  std::string EmitHelper(const clang::FunctionDecl* fd, clang::SourceLocation callLoc);
+  std::string EmitHelper(const clang::FunctionDecl* fd, clang::SourceLocation callLoc, bool composedEntry = false);
+  std::string ComposedCall(const clang::CXXMemberCallExpr* call);
   void NeedStruct(const clang::RecordDecl* rd);
   void NeedConstant(const clang::VarDecl* vd);
   std::string Fail(clang::SourceLocation loc, const std::string& message, const std::string& hint);

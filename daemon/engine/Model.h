@@ -13,12 +13,14 @@ struct BlockField {
   std::string cppType;   // as the generated C++ mirror declares it
   std::string glslType;  // GLSL type, may end with an array suffix "[N]"
   unsigned std430Align = 4;
+  std::string hostExpr;  // how the generated class reaches the value (plain members)
 };
 
 enum class MemberKind { Plain, Vector };
 
 struct Member {
-  std::string name;
+  std::string name;             // as GLSL and the generated mirrors name it
+  std::string hostExpr;         // how the generated class reaches it: the name, or crt_<holder>()->name when composed
   MemberKind kind = MemberKind::Plain;
   std::string cppType;          // full C++ type spelling
   std::string glslType;         // plain: the GLSL type; vector: the element's GLSL type
@@ -75,6 +77,9 @@ struct Kernel {
   std::string cpuLoopNest;            // IPV, CPU backend: the loop nest with reductions renamed
   std::string cpuPreamble;            // IPV, CPU backend: statements before the loops
   std::string sourceFile;             // where the kernel is defined (for comments)
+  // The GLSL prelude in pieces, so composed code can be merged in ahead of the kernel's own.
+  std::vector<std::string> structList, constantList, functionList;
+  std::set<std::pair<std::string, std::string>> composedCalls;  // (holder member, interface method)
 };
 
 struct ControlParam {
@@ -104,6 +109,16 @@ struct Constructor {
   std::string argsForward; // "a_w, a_h"
 };
 
+// Composition (paper 3.6): a member holding an interface whose GPU code and data come from an
+// implementation class ("ISceneObject=BVHScene").
+struct Composition {
+  std::string holder;          // member of the user's class: m_pAccelStruct
+  std::string interfaceName;   // ISceneObject
+  std::string implName;        // BVHScene
+  std::string implHeader;      // file declaring the implementation (included by generated code)
+  std::string sourceFile;      // where the implementation's methods are defined (for comments)
+};
+
 struct ClassModel {
   std::string className;
   std::string headerFile;      // header declaring the class (as included by generated code)
@@ -117,6 +132,7 @@ struct ClassModel {
   std::string glslClassStructs;        // structs the class-data block and member vectors need
   std::vector<std::string> sourceIncludes;  // #include lines of the sources (quoted ones made absolute)
   std::vector<std::string> usingDecls; // top-level using-directives of the sources: copied bodies need them
+  std::vector<Composition> compositions;   // holders kernels call through, in declaration order
 };
 
 // The member named `name`, or null (works on a const and a mutable model).

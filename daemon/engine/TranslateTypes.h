@@ -18,6 +18,10 @@ struct TranslateRequest {
   std::vector<std::string> compileArgs;  // -I, -D, -std=... as the target compiles them
   std::string outputDir;                 // build-tree folder for the generated files
   std::string templateDir;               // templates/ (vulkan, glsl, cpu subfolders)
+  // Composition (paper 3.6): "Interface=Implementation", e.g. "ISceneObject=BVHScene". Kernels that
+  // call a member of type shared_ptr<Interface> get Implementation's code and data merged in; the
+  // implementation's source files are among `sources`.
+  std::vector<std::string> compositions;
 };
 
 struct TranslateResult {

@@ -217,17 +217,43 @@ AnalyzeResult Analyze(const TranslateRequest& request, AstCache* sharedCache) {
     for (auto it = sm.fileinfo_begin(); it != sm.fileinfo_end(); ++it) inputs.insert(it->first.getName().str());
   }
 
+  std::map<std::string, std::string> compositions;
+  for (auto& c : request.compositions) {
+    auto eq = c.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == c.size()) {
+      result.diagnostics = "error: composition '" + c + "' is not of the form Interface=Implementation (e.g. ISceneObject=BVHScene)\n";
+      return result;
+    }
+    compositions[c.substr(0, eq)] = c.substr(eq + 1);
+  }
   ClassModel& model = result.model;
   unsigned errors = 0;
-  for (auto& handle : handles) {
-    clang::ASTUnit* ast = handle.ast();
-    size_t before = handle.diagnostics().size();
-    handle.printer().BeginSourceFile(ast->getLangOpts(), &ast->getPreprocessor());
-    Reporter reporter(ast->getDiagnostics());
-    AnalyzeTranslationUnit(ast->getASTContext(), request.className, reporter, model);
-    errors += reporter.Errors();
-    handle.printer().EndSourceFile();
-    diagText += handle.diagnostics().substr(before);
+  // Runs one analysis step per AST with its diagnostics printed against that AST's sources.
+  auto forEachAst = [&](auto&& step) {
+    for (auto& handle : handles) {
+      clang::ASTUnit* ast = handle.ast();
+      size_t before = handle.diagnostics().size();
+      handle.printer().BeginSourceFile(ast->getLangOpts(), &ast->getPreprocessor());
+      Reporter reporter(ast->getDiagnostics());
+      step(ast->getASTContext(), reporter);
+      errors += reporter.Errors();
+      handle.printer().EndSourceFile();
+      diagText += handle.diagnostics().substr(before);
+    }
+  };
+  forEachAst([&](clang::ASTContext& ctx, Reporter& reporter) {
+    AnalyzeTranslationUnit(ctx, request.className, compositions, reporter, model);
+  });
+  // Composed implementations are printed from the AST that defines their methods.
+  if (errors == 0 && !model.compositions.empty()) {
+    forEachAst([&](clang::ASTContext& ctx, Reporter& reporter) { ComposeFromTranslationUnit(ctx, reporter, model); });
+    for (auto& comp : model.compositions)
+      if (errors == 0 && comp.implHeader.empty()) {
+        diagText += "error: " + request.className + "'s kernels call " + comp.interfaceName + " through '" + comp.holder +
+                    "', composed as " + comp.implName + ", but no source file defines class " + comp.implName +
+                    " with the bodies of the methods they call\nnote: hint: list the implementation's source file (e.g. BVHScene.cpp) in crossrt_add_class(... SOURCES ...)\n";
+        ++errors;
+      }
   }
   if (model.className.empty()) {
     result.diagnostics = diagText + "error: class '" + request.className + "' is not defined in " + sources.front() +
@@ -284,6 +310,7 @@ TranslateResult Translate(const TranslateRequest& request, AstCache* cache, Spir
   options.templateDir = request.templateDir;
   options.headerName = llvm::sys::path::filename(model.headerFile).str();
   options.headerInclude = IncludeSpelling(model.headerFile, request.compileArgs);
+  options.includeSpelling = [&](const std::string& header) { return IncludeSpelling(header, request.compileArgs); };
   try {
     auto t0 = std::chrono::steady_clock::now();
     bool vulkan = request.backend == Backend::Vulkan;

@@ -44,7 +44,8 @@ nlohmann::json ToJson(const engine::TranslateRequest& r) {
           {"sources", r.sources},
           {"compileArgs", r.compileArgs},
           {"outputDir", r.outputDir},
-          {"templateDir", r.templateDir}};
+          {"templateDir", r.templateDir},
+          {"compositions", r.compositions}};
 }
 
 engine::TranslateRequest RequestFromJson(const nlohmann::json& j) {
@@ -57,6 +58,7 @@ engine::TranslateRequest RequestFromJson(const nlohmann::json& j) {
   r.compileArgs = j.at("compileArgs").get<std::vector<std::string>>();
   r.outputDir = j.at("outputDir").get<std::string>();
   r.templateDir = j.at("templateDir").get<std::string>();
+  if (j.contains("compositions")) r.compositions = j.at("compositions").get<std::vector<std::string>>();
   if (r.className.empty() || r.sources.empty()) throw std::runtime_error("className and sources must not be empty");
   return r;
 }

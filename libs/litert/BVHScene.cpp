@@ -18,107 +18,119 @@ namespace {
 constexpr uint32_t kNoId = 0xFFFFFFFFu;
 constexpr int kStackSize = 64;  // LBVH trees have at most 31 levels; the SAH builder stops at depth 48
 
-// A ray prepared for one tree: slab test reciprocals and the watertight test's shear (Woop,
-// Benthin and Wald 2013, "Watertight Ray/Triangle Intersection").
-struct TraceRay
-{
-  float3 org, dir, invDir;
-  int kx, ky, kz;
-  float sx, sy, sz;
-  float tnear;
-  bool zeroAxis[3];
-  bool anyZeroAxis;
-};
+// The slab test widens the far distance by 2 gamma(3) (Ize 2013, "Robust BVH Ray Traversal"), so
+// rounding in the reciprocal never culls a box the exact ray touches: 1 + 3 ulp.
+constexpr float kWiden = 1.00000036f;
+static_assert(kWiden == 1.0f + 2.0f * (3.0f * std::numeric_limits<float>::epsilon() * 0.5f) /
+                                   (1.0f - 3.0f * std::numeric_limits<float>::epsilon() * 0.5f),
+              "kWiden is 1 + 2 gamma(3)");
+constexpr float kMissed = -1.0f;  // SlabEntry's answer for a box the ray misses (entries are >= 0)
 
-TraceRay Prepare(float3 org, float3 dir, float tnear)
+BVHTraceRay Prepare(float3 org, float3 dir, float tnear)
 {
-  TraceRay r;
+  BVHTraceRay r;
   r.org = org;
   r.dir = dir;
   r.tnear = tnear;
-  for (int a = 0; a < 3; ++a)
-  {
-    // Denormal components whose reciprocal overflows count as zero too: 0 * inf would be NaN.
-    r.zeroAxis[a] = dir[a] == 0.0f || std::isinf(1.0f / dir[a]);
-    r.invDir[a] = r.zeroAxis[a] ? 0.0f : 1.0f / dir[a];
-  }
-  r.anyZeroAxis = r.zeroAxis[0] || r.zeroAxis[1] || r.zeroAxis[2];
-  const float3 ad(std::fabs(dir.x), std::fabs(dir.y), std::fabs(dir.z));
+  // Denormal components whose reciprocal overflows count as zero too: 0 * inf would be NaN.
+  r.invDir = float3(std::isinf(1.0f / dir.x) ? 0.0f : 1.0f / dir.x, std::isinf(1.0f / dir.y) ? 0.0f : 1.0f / dir.y,
+                    std::isinf(1.0f / dir.z) ? 0.0f : 1.0f / dir.z);
+  r.anyZeroAxis = r.invDir.x == 0.0f || r.invDir.y == 0.0f || r.invDir.z == 0.0f;
+  const float3 ad = float3(std::fabs(dir.x), std::fabs(dir.y), std::fabs(dir.z));
   r.kz = ad.x >= ad.y && ad.x >= ad.z ? 0 : ad.y >= ad.z ? 1 : 2;
-  r.kx = (r.kz + 1) % 3;
-  r.ky = (r.kx + 1) % 3;
+  r.kx = r.kz == 2 ? 0 : r.kz + 1;
+  r.ky = r.kx == 2 ? 0 : r.kx + 1;
   if (dir[r.kz] < 0.0f)
-    std::swap(r.kx, r.ky);  // keeps the winding, so the edge tests' signs stay meaningful
+  {
+    const int k = r.kx;  // swapping keeps the winding, so the edge tests' signs stay meaningful
+    r.kx = r.ky;
+    r.ky = k;
+  }
   r.sx = dir[r.kx] / dir[r.kz];
   r.sy = dir[r.ky] / dir[r.kz];
   r.sz = 1.0f / dir[r.kz];
   return r;
 }
 
-// The entry distance into [lo, hi] along the ray within [tnear, tfar], or +inf when missed. The far
-// distance is widened by 2 gamma(3) (Ize 2013, "Robust BVH Ray Traversal"), so rounding in the
-// reciprocal never culls a box the exact ray touches. A ray parallel to an axis (direction +0 or
-// -0) is inside that slab when its origin is, boundaries included.
-constexpr float kWiden = 1.0f + 2.0f * (3.0f * std::numeric_limits<float>::epsilon() * 0.5f) /
-                                    (1.0f - 3.0f * std::numeric_limits<float>::epsilon() * 0.5f);
-constexpr float kMissed = std::numeric_limits<float>::infinity();
-
-// SlabEntry for rays with a zero direction component (rare): per axis, with the in-slab test.
-[[gnu::noinline]] float SlabEntryParallelAxes(const TraceRay& r, const float3& lo, const float3& hi, float tfar)
+// SlabEntry for rays with a zero direction component (rare): per axis. Such a ray is inside that
+// slab when its origin is, boundaries included.
+[[gnu::noinline]] float SlabEntryParallelAxes(const BVHTraceRay& r, const float3& lo, const float3& hi, float tfar)
 {
-  float tmin = r.tnear, tmax = tfar;
+  float tmin = r.tnear;
+  float tmax = tfar;
   for (int a = 0; a < 3; ++a)
   {
-    if (r.zeroAxis[a])
+    if (r.invDir[a] == 0.0f)
     {
       if (r.org[a] < lo[a] || r.org[a] > hi[a])
         return kMissed;
       continue;
     }
-    float t0 = (lo[a] - r.org[a]) * r.invDir[a], t1 = (hi[a] - r.org[a]) * r.invDir[a];
-    if (t0 > t1)
-      std::swap(t0, t1);
-    tmin = std::max(tmin, t0);
-    tmax = std::min(tmax, t1 * kWiden);
+    const float t0 = (lo[a] - r.org[a]) * r.invDir[a];
+    const float t1 = (hi[a] - r.org[a]) * r.invDir[a];
+    tmin = std::max(tmin, std::min(t0, t1));
+    tmax = std::min(tmax, std::max(t0, t1) * kWiden);
   }
   return tmin <= tmax ? tmin : kMissed;
 }
 
-// Inlined into the traversal loop: it runs twice per step.
-[[gnu::always_inline]] inline float SlabEntry(const TraceRay& r, const float3& lo, const float3& hi, float tfar)
+// The entry distance into [lo, hi] along the ray within [tnear, tfar], or kMissed. Inlined into
+// the traversal loop: it runs twice per step.
+[[gnu::always_inline]] inline float SlabEntry(const BVHTraceRay& r, const float3& lo, const float3& hi, float tfar)
 {
   if (r.anyZeroAxis)
     return SlabEntryParallelAxes(r, lo, hi, tfar);
-  const float x0 = (lo.x - r.org.x) * r.invDir.x, x1 = (hi.x - r.org.x) * r.invDir.x;
-  const float y0 = (lo.y - r.org.y) * r.invDir.y, y1 = (hi.y - r.org.y) * r.invDir.y;
-  const float z0 = (lo.z - r.org.z) * r.invDir.z, z1 = (hi.z - r.org.z) * r.invDir.z;
+  const float x0 = (lo.x - r.org.x) * r.invDir.x;
+  const float x1 = (hi.x - r.org.x) * r.invDir.x;
+  const float y0 = (lo.y - r.org.y) * r.invDir.y;
+  const float y1 = (hi.y - r.org.y) * r.invDir.y;
+  const float z0 = (lo.z - r.org.z) * r.invDir.z;
+  const float z1 = (hi.z - r.org.z) * r.invDir.z;
   const float tmin = std::max(std::max(std::min(x0, x1), std::min(y0, y1)), std::max(std::min(z0, z1), r.tnear));
   const float tmax = std::min(std::min(std::min(std::max(x0, x1), std::max(y0, y1)), std::max(z0, z1)) * kWiden, tfar);
   return tmin <= tmax ? tmin : kMissed;
 }
 
+// a * b - c * d within 1.5 ulp (Kahan's algorithm): its sign is exact, which decides on which side
+// of an edge a ray passes when the plain float products cancel.
+float DifferenceOfProducts(float a, float b, float c, float d)
+{
+  const float cd = c * d;
+  const float error = std::fma(-c, d, cd);
+  return std::fma(a, b, -cd) + error;
+}
+
 // Watertight ray/triangle test, both sides. On a hit in [tnear, tfar] sets t and Embree-style
 // barycentrics (u weights v1, v weights v2).
-bool IntersectTriangle(const TraceRay& r, const BVHScene::Triangle& tri, float tfar, float& t, float& u, float& v)
+bool IntersectTriangle(const BVHTraceRay& r, const BVHTriangle& tri, float tfar, float& t, float& u, float& v)
 {
-  const float3 a = tri.v0 - r.org, b = tri.v1 - r.org, c = tri.v2 - r.org;
-  const float ax = a[r.kx] - r.sx * a[r.kz], ay = a[r.ky] - r.sy * a[r.kz];
-  const float bx = b[r.kx] - r.sx * b[r.kz], by = b[r.ky] - r.sy * b[r.kz];
-  const float cx = c[r.kx] - r.sx * c[r.kz], cy = c[r.ky] - r.sy * c[r.kz];
-  float eu = cx * by - cy * bx, ev = ax * cy - ay * cx, ew = bx * ay - by * ax;
+  const float3 a = tri.v0 - r.org;
+  const float3 b = tri.v1 - r.org;
+  const float3 c = tri.v2 - r.org;
+  const float ax = a[r.kx] - r.sx * a[r.kz];
+  const float ay = a[r.ky] - r.sy * a[r.kz];
+  const float bx = b[r.kx] - r.sx * b[r.kz];
+  const float by = b[r.ky] - r.sy * b[r.kz];
+  const float cx = c[r.kx] - r.sx * c[r.kz];
+  const float cy = c[r.ky] - r.sy * c[r.kz];
+  float eu = cx * by - cy * bx;
+  float ev = ax * cy - ay * cx;
+  float ew = bx * ay - by * ax;
   if (eu == 0.0f || ev == 0.0f || ew == 0.0f)
   {
-    // On an edge in float: decide in double so that neighbouring triangles agree.
-    eu = float(double(cx) * double(by) - double(cy) * double(bx));
-    ev = float(double(ax) * double(cy) - double(ay) * double(cx));
-    ew = float(double(bx) * double(ay) - double(by) * double(ax));
+    // On an edge in float: decide exactly, so that neighbouring triangles agree.
+    eu = DifferenceOfProducts(cx, by, cy, bx);
+    ev = DifferenceOfProducts(ax, cy, ay, cx);
+    ew = DifferenceOfProducts(bx, ay, by, ax);
   }
   if ((eu < 0.0f || ev < 0.0f || ew < 0.0f) && (eu > 0.0f || ev > 0.0f || ew > 0.0f))
     return false;
   const float det = eu + ev + ew;
   if (det == 0.0f)
     return false;  // edge-on or degenerate
-  const float az = r.sz * a[r.kz], bz = r.sz * b[r.kz], cz = r.sz * c[r.kz];
+  const float az = r.sz * a[r.kz];
+  const float bz = r.sz * b[r.kz];
+  const float cz = r.sz * c[r.kz];
   const float distance = (eu * az + ev * bz + ew * cz) / det;
   if (!(distance >= r.tnear && distance <= tfar))
     return false;
@@ -128,55 +140,19 @@ bool IntersectTriangle(const TraceRay& r, const BVHScene::Triangle& tri, float t
   return true;
 }
 
-// Visits the leaves of `tree` that the ray may reach, nearest box first. `leaf(first, count, tfar)`
-// tests a leaf's primitives and returns the new tfar (smaller after a hit), or a negative value to stop.
-template <typename LeafFn>
-void Traverse(const BVHTree& tree, const TraceRay& ray, float tfar, LeafFn&& leaf)
+float3 ToObjectPoint(const BVHInstance& inst, float3 p)
 {
-  if (tree.nodes.empty() || SlabEntry(ray, tree.nodes[0].boxMin, tree.nodes[0].boxMax, tfar) > tfar)
-    return;
-  uint32_t stack[kStackSize];
-  float stackEntry[kStackSize];  // entry distances, to skip subtrees beyond a hit found since
-  int top = 0;
-  uint32_t node = 0;
-  while (true)
-  {
-    const BVHNode& n = tree.nodes[node];
-    if (n.left & kLeafFlag)
-    {
-      tfar = leaf(n.left & ~kLeafFlag, n.right, tfar);
-      if (tfar < 0.0f)
-        return;
-    }
-    else
-    {
-      const BVHNode &l = tree.nodes[n.left], &r = tree.nodes[n.right];
-      const float tl = SlabEntry(ray, l.boxMin, l.boxMax, tfar), tr = SlabEntry(ray, r.boxMin, r.boxMax, tfar);
-      const bool hitL = tl <= tfar, hitR = tr <= tfar;
-      if (hitL && hitR)
-      {
-        const bool leftFirst = tl <= tr;
-        stackEntry[top] = leftFirst ? tr : tl;
-        stack[top++] = leftFirst ? n.right : n.left;
-        node = leftFirst ? n.left : n.right;
-        continue;
-      }
-      if (hitL || hitR)
-      {
-        node = hitL ? n.left : n.right;
-        continue;
-      }
-    }
-    // Pop the next subtree that may still hold something nearer than tfar.
-    do
-    {
-      if (top == 0)
-        return;
-      --top;
-    } while (stackEntry[top] > tfar);
-    node = stack[top];
-  }
+  const float4 h = float4(p.x, p.y, p.z, 1.0f);
+  return float3(dot(inst.toObjectRow0, h), dot(inst.toObjectRow1, h), dot(inst.toObjectRow2, h));
 }
+
+float3 ToObjectVector(const BVHInstance& inst, float3 d)
+{
+  const float4 h = float4(d.x, d.y, d.z, 0.0f);
+  return float3(dot(inst.toObjectRow0, h), dot(inst.toObjectRow1, h), dot(inst.toObjectRow2, h));
+}
+
+// ---- host side ----
 
 // The same tree with every pair of children side by side, in depth-first order: one cache line
 // holds both boxes a traversal step tests (the LBVH places siblings far apart).
@@ -207,12 +183,38 @@ BVHTree WithSiblingsAdjacent(const BVHTree& tree)
   return out;
 }
 
+// Appends `tree` to `nodes` with child indices moved by the append position and leaf ranges
+// moved by firstPrim. Returns the root's index.
+uint32_t AppendTree(std::vector<BVHNode>& nodes, const BVHTree& tree, uint32_t firstPrim)
+{
+  const uint32_t base = uint32_t(nodes.size());
+  for (BVHNode n : tree.nodes)
+  {
+    if (n.left & kLeafFlag)
+      n.left = kLeafFlag | ((n.left & ~kLeafFlag) + firstPrim);
+    else
+    {
+      n.left += base;
+      n.right += base;
+    }
+    nodes.push_back(n);
+  }
+  return base;
+}
+
 float3 TransformPoint(const float4x4& m, float3 p) { return to_float3(m * float4(p.x, p.y, p.z, 1.0f)); }
-float3 TransformVector(const float4x4& m, float3 d) { return to_float3(m * float4(d.x, d.y, d.z, 0.0f)); }
 
 }  // namespace
 
 BVHScene::BVHScene(std::string name, Builder builder) : m_name(std::move(name)), m_builder(std::move(builder)) {}
+
+void BVHScene::ClearDeviceData()
+{
+  m_nodes.clear();
+  m_instances.clear();
+  m_triangles.clear();
+  m_primIds.clear();
+}
 
 void BVHScene::ClearGeom()
 {
@@ -231,7 +233,7 @@ void BVHScene::SetMesh(Mesh& mesh, const float* vpos3f, size_t vertNum, const ui
     return p;
   };
   const int triCount = int(indNum / 3);
-  std::vector<Triangle> tris(triCount);
+  std::vector<BVHTriangle> tris(triCount);
   std::vector<Box4f> boxes(triCount);
   for (int i = 0; i < triCount; ++i)
   {
@@ -243,7 +245,7 @@ void BVHScene::SetMesh(Mesh& mesh, const float* vpos3f, size_t vertNum, const ui
   mesh.triangles.resize(mesh.tree.primIndices.size());
   for (size_t k = 0; k < mesh.tree.primIndices.size(); ++k)
     mesh.triangles[k] = tris[mesh.tree.primIndices[k]];
-  m_committed = false;
+  ClearDeviceData();
 }
 
 uint32_t BVHScene::AddGeom_Triangles3f(const float* vpos3f, size_t vertNum, const uint32_t* triIndices, size_t indNum,
@@ -265,37 +267,37 @@ void BVHScene::UpdateGeom_Triangles3f(uint32_t geomId, const float* vpos3f, size
 
 void BVHScene::ClearScene()
 {
-  m_instances.clear();
-  m_top = BVHTree{};
-  m_committed = false;
+  m_placed.clear();
+  ClearDeviceData();
 }
 
 uint32_t BVHScene::AddInstance(uint32_t geomId, const float4x4& matrix)
 {
   if (geomId >= m_meshes.size())
     throw std::out_of_range(m_name + "::AddInstance: invalid geomId " + std::to_string(geomId));
-  m_instances.push_back({geomId, matrix, LiteMath::inverse4x4(matrix)});
-  m_committed = false;
-  return uint32_t(m_instances.size() - 1);
+  m_placed.push_back({geomId, matrix, LiteMath::inverse4x4(matrix)});
+  ClearDeviceData();
+  return uint32_t(m_placed.size() - 1);
 }
 
 void BVHScene::UpdateInstance(uint32_t instanceId, const float4x4& matrix)
 {
-  if (instanceId >= m_instances.size())
+  if (instanceId >= m_placed.size())
     throw std::out_of_range(m_name + "::UpdateInstance: invalid instanceId " + std::to_string(instanceId));
-  m_instances[instanceId].toWorld = matrix;
-  m_instances[instanceId].toObject = LiteMath::inverse4x4(matrix);
-  m_committed = false;
+  m_placed[instanceId].toWorld = matrix;
+  m_placed[instanceId].toObject = LiteMath::inverse4x4(matrix);
+  ClearDeviceData();
 }
 
 void BVHScene::CommitScene(uint32_t)
 {
+  ClearDeviceData();
   // World boxes of the instances whose meshes have triangles; the top tree indexes into `ids`.
   std::vector<Box4f> boxes;
   std::vector<uint32_t> ids;
-  for (uint32_t i = 0; i < m_instances.size(); ++i)
+  for (uint32_t i = 0; i < m_placed.size(); ++i)
   {
-    const BVHTree& tree = m_meshes[m_instances[i].geomId].tree;
+    const BVHTree& tree = m_meshes[m_placed[i].geomId].tree;
     if (tree.nodes.empty())
       continue;
     Box4f box;
@@ -303,74 +305,202 @@ void BVHScene::CommitScene(uint32_t)
     {
       const float3 lo = tree.nodes[0].boxMin, hi = tree.nodes[0].boxMax;
       const float3 p((corner & 1) ? hi.x : lo.x, (corner & 2) ? hi.y : lo.y, (corner & 4) ? hi.z : lo.z);
-      const float3 w = TransformPoint(m_instances[i].toWorld, p);
+      const float3 w = TransformPoint(m_placed[i].toWorld, p);
       box.include(float4(w.x, w.y, w.z, 0.0f));
     }
     boxes.push_back(box);
     ids.push_back(i);
   }
-  m_top = boxes.empty() ? BVHTree{} : m_builder(boxes.data(), int(boxes.size()));
-  for (uint32_t& p : m_top.primIndices)
-    p = ids[p];
-  m_committed = true;
+  if (boxes.empty())
+    return;  // nothing to hit: the device data stays empty
+  const BVHTree top = m_builder(boxes.data(), int(boxes.size()));
+
+  // Device data: the top tree first, so its root is node 0, then each mesh that has triangles.
+  AppendTree(m_nodes, top, 0);
+  std::vector<uint32_t> meshRoot(m_meshes.size(), kNoId);
+  for (uint32_t g = 0; g < m_meshes.size(); ++g)
+  {
+    const Mesh& mesh = m_meshes[g];
+    if (mesh.tree.nodes.empty())
+      continue;
+    meshRoot[g] = AppendTree(m_nodes, mesh.tree, uint32_t(m_triangles.size()));
+    m_triangles.insert(m_triangles.end(), mesh.triangles.begin(), mesh.triangles.end());
+    m_primIds.insert(m_primIds.end(), mesh.tree.primIndices.begin(), mesh.tree.primIndices.end());
+  }
+  for (uint32_t k : top.primIndices)
+  {
+    const Instance& placed = m_placed[ids[k]];
+    BVHInstance inst;
+    inst.toObjectRow0 = placed.toObject.get_row(0);
+    inst.toObjectRow1 = placed.toObject.get_row(1);
+    inst.toObjectRow2 = placed.toObject.get_row(2);
+    inst.instId = ids[k];
+    inst.geomId = placed.geomId;
+    inst.root = meshRoot[placed.geomId];
+    inst.unused = 0;
+    m_instances.push_back(inst);
+  }
 }
 
-template <bool anyHit>
-bool BVHScene::Trace(float4 posAndNear, float4 dirAndFar, CRT_Hit& hit) const
+// ---- traversal: plain C++ in the translator's conventions (composed into GPU kernels) ----
+
+// Visits the leaves of the mesh tree at `root` that the ray may reach, nearest box first, and
+// tests their triangles. On a hit nearer than tfar: sets tfar and the hit's t, primId and
+// barycentrics, and returns true (at the first hit when anyHit).
+bool BVHScene::TraceMesh(const BVHTraceRay& ray, uint32_t root, bool anyHit, float& tfar, CRT_Hit& hit) const
 {
-  float tnear = 0.0f, tfar = 0.0f;
-  if (!m_committed || !litert_detail::RayInterval(posAndNear, dirAndFar, tnear, tfar))
+  if (SlabEntry(ray, m_nodes[root].boxMin, m_nodes[root].boxMax, tfar) < 0.0f)
     return false;
-  const float3 org = to_float3(posAndNear), dir = to_float3(dirAndFar);
-  const TraceRay worldRay = Prepare(org, dir, tnear);
+  uint32_t stack[kStackSize];
+  float stackEntry[kStackSize];  // entry distances, to skip subtrees beyond a hit found since
+  int top = 0;
+  uint32_t node = root;
   bool found = false;
-  Traverse(m_top, worldRay, tfar, [&](uint32_t first, uint32_t count, float instFar) {
-    for (uint32_t k = first; k < first + count; ++k)
+  while (true)
+  {
+    const BVHNode& n = m_nodes[node];
+    if ((n.left & kLeafFlag) != 0)
     {
-      const Instance& inst = m_instances[m_top.primIndices[k]];
-      const Mesh& mesh = m_meshes[inst.geomId];
-      // Affine maps keep t: the object-space ray is not renormalized.
-      const TraceRay ray = Prepare(TransformPoint(inst.toObject, org), TransformVector(inst.toObject, dir), tnear);
-      Traverse(mesh.tree, ray, instFar, [&](uint32_t firstTri, uint32_t triCount, float triFar) {
-        for (uint32_t j = firstTri; j < firstTri + triCount; ++j)
-        {
-          float t, u, v;
-          if (!IntersectTriangle(ray, mesh.triangles[j], triFar, t, u, v))
-            continue;
-          found = true;
-          if (anyHit)
-            return -1.0f;
-          triFar = t;
-          hit.t = t;
-          hit.primId = mesh.tree.primIndices[j];
-          hit.instId = m_top.primIndices[k];
-          hit.geomId = inst.geomId;
-          hit.coords[0] = u;
-          hit.coords[1] = v;
-        }
-        return triFar;
-      });
-      if (anyHit && found)
-        return -1.0f;
-      instFar = found ? hit.t : instFar;
+      const uint32_t first = n.left & ~kLeafFlag;
+      for (uint32_t j = first; j < first + n.right; ++j)
+      {
+        float t = 0.0f;
+        float u = 0.0f;
+        float v = 0.0f;
+        if (!IntersectTriangle(ray, m_triangles[j], tfar, t, u, v))
+          continue;
+        found = true;
+        tfar = t;
+        hit.t = t;
+        hit.primId = m_primIds[j];
+        hit.coords[0] = u;
+        hit.coords[1] = v;
+        if (anyHit)
+          return true;
+      }
     }
-    return instFar;
-  });
-  return found;
+    else
+    {
+      const BVHNode& l = m_nodes[n.left];
+      const BVHNode& r = m_nodes[n.right];
+      const float tl = SlabEntry(ray, l.boxMin, l.boxMax, tfar);
+      const float tr = SlabEntry(ray, r.boxMin, r.boxMax, tfar);
+      const bool hitL = tl >= 0.0f;
+      const bool hitR = tr >= 0.0f;
+      if (hitL && hitR)
+      {
+        const bool leftFirst = tl <= tr;
+        stackEntry[top] = leftFirst ? tr : tl;
+        stack[top] = leftFirst ? n.right : n.left;
+        top = top + 1;
+        node = leftFirst ? n.left : n.right;
+        continue;
+      }
+      if (hitL || hitR)
+      {
+        node = hitL ? n.left : n.right;
+        continue;
+      }
+    }
+    // Pop the next subtree that may still hold something nearer than tfar.
+    do
+    {
+      if (top == 0)
+        return found;
+      top = top - 1;
+    } while (stackEntry[top] > tfar);
+    node = stack[top];
+  }
+}
+
+// The top tree's leaves hold instances: each is traced in its mesh's tree, in object space
+// (affine maps keep t: the object-space ray is not renormalized).
+bool BVHScene::Trace(float4 posAndNear, float4 dirAndFar, bool anyHit, CRT_Hit& hit) const
+{
+  float tnear = 0.0f;
+  float tfar = 0.0f;
+  if (m_nodes.size() == 0 || !litert_detail::RayInterval(posAndNear, dirAndFar, tnear, tfar))
+    return false;
+  const float3 org = to_float3(posAndNear);
+  const float3 dir = to_float3(dirAndFar);
+  const BVHTraceRay worldRay = Prepare(org, dir, tnear);
+  if (SlabEntry(worldRay, m_nodes[0].boxMin, m_nodes[0].boxMax, tfar) < 0.0f)
+    return false;
+  uint32_t stack[kStackSize];
+  float stackEntry[kStackSize];
+  int top = 0;
+  uint32_t node = 0;
+  bool found = false;
+  while (true)
+  {
+    const BVHNode& n = m_nodes[node];
+    if ((n.left & kLeafFlag) != 0)
+    {
+      const uint32_t first = n.left & ~kLeafFlag;
+      for (uint32_t k = first; k < first + n.right; ++k)
+      {
+        const BVHInstance& inst = m_instances[k];
+        const BVHTraceRay ray = Prepare(ToObjectPoint(inst, org), ToObjectVector(inst, dir), tnear);
+        if (!TraceMesh(ray, inst.root, anyHit, tfar, hit))
+          continue;
+        found = true;
+        hit.instId = inst.instId;
+        hit.geomId = inst.geomId;
+        if (anyHit)
+          return true;
+      }
+    }
+    else
+    {
+      const BVHNode& l = m_nodes[n.left];
+      const BVHNode& r = m_nodes[n.right];
+      const float tl = SlabEntry(worldRay, l.boxMin, l.boxMax, tfar);
+      const float tr = SlabEntry(worldRay, r.boxMin, r.boxMax, tfar);
+      const bool hitL = tl >= 0.0f;
+      const bool hitR = tr >= 0.0f;
+      if (hitL && hitR)
+      {
+        const bool leftFirst = tl <= tr;
+        stackEntry[top] = leftFirst ? tr : tl;
+        stack[top] = leftFirst ? n.right : n.left;
+        top = top + 1;
+        node = leftFirst ? n.left : n.right;
+        continue;
+      }
+      if (hitL || hitR)
+      {
+        node = hitL ? n.left : n.right;
+        continue;
+      }
+    }
+    do
+    {
+      if (top == 0)
+        return found;
+      top = top - 1;
+    } while (stackEntry[top] > tfar);
+    node = stack[top];
+  }
 }
 
 CRT_Hit BVHScene::RayQuery_NearestHit(float4 posAndNear, float4 dirAndFar)
 {
   CRT_Hit hit;
   hit.t = dirAndFar.w;
-  hit.primId = hit.instId = hit.geomId = kNoId;
-  hit.coords[0] = hit.coords[1] = hit.coords[2] = hit.coords[3] = 0.0f;
-  Trace<false>(posAndNear, dirAndFar, hit);
+  hit.primId = kNoId;
+  hit.instId = kNoId;
+  hit.geomId = kNoId;
+  hit.coords[0] = 0.0f;
+  hit.coords[1] = 0.0f;
+  hit.coords[2] = 0.0f;
+  hit.coords[3] = 0.0f;
+  Trace(posAndNear, dirAndFar, false, hit);
   return hit;
 }
 
 bool BVHScene::RayQuery_AnyHit(float4 posAndNear, float4 dirAndFar)
 {
   CRT_Hit unused;
-  return Trace<true>(posAndNear, dirAndFar, unused);
+  unused.t = dirAndFar.w;
+  return Trace(posAndNear, dirAndFar, true, unused);
 }

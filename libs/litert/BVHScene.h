@@ -1,6 +1,11 @@
 // ISceneObject over CrossRT's own BVHs: one tree per mesh, a top-level tree over the instances,
 // both built by a pluggable builder (the LBVH as written, LBVH_CPU, LBVH_Vulkan, binned SAH), and a
 // stack-based traversal with watertight ray/triangle tests and robust slab tests.
+//
+// The traversal is written in the translator's conventions, so a class that holds an ISceneObject
+// can run it on the GPU by composition: crossrt_add_class(... COMPOSE ISceneObject=BVHScene)
+// prints RayQuery_NearestHit/AnyHit and what they call into its shaders, and uploads the "device
+// data" members below with the class's own.
 #pragma once
 #include "BVHNode.h"
 #include "CrossRT.h"
@@ -8,6 +13,31 @@
 #include <functional>
 #include <string>
 #include <vector>
+
+// A triangle's corners (36 bytes; a scalar-layout buffer on the GPU).
+struct BVHTriangle
+{
+  LiteMath::float3 v0, v1, v2;
+};
+
+// An instance as the traversal reads it: rows 0-2 of its world-to-object matrix, the ids a hit
+// reports, and the root of its mesh's tree in BVHScene::m_nodes. 64 bytes, std430 as in C++.
+struct BVHInstance
+{
+  LiteMath::float4 toObjectRow0, toObjectRow1, toObjectRow2;
+  uint32_t instId, geomId, root, unused;
+};
+
+// A ray prepared for one tree: slab test reciprocals (0 for a zero or denormal direction
+// component) and the watertight test's shear (Woop, Benthin and Wald 2013).
+struct BVHTraceRay
+{
+  LiteMath::float3 org, dir, invDir;
+  float tnear;
+  int kx, ky, kz;
+  float sx, sy, sz;
+  bool anyZeroAxis;
+};
 
 class BVHScene : public ISceneObject
 {
@@ -32,31 +62,33 @@ public:
   // The tree of mesh geomId (for SAH cost and statistics).
   const BVHTree& MeshTree(uint32_t geomId) const { return m_meshes.at(geomId).tree; }
 
-  // A triangle's corners, stored in the order of the tree's leaves.
-  struct Triangle
-  {
-    LiteMath::float3 v0, v1, v2;
-  };
+  // ---- Device data: what the traversal reads, rebuilt by CommitScene and empty until then. ----
+  // Public because a class composing BVHScene uploads them to the GPU.
+  std::vector<BVHNode> m_nodes;          // the top tree (root 0, leaves index m_instances), then every mesh's
+  std::vector<BVHInstance> m_instances;  // in the top tree's leaf order
+  std::vector<BVHTriangle> m_triangles;  // every mesh's triangles in its leaf order (leaves index here)
+  std::vector<uint32_t> m_primIds;       // m_triangles[k] is triangle m_primIds[k] of its mesh
 
 private:
   struct Mesh
   {
     BVHTree tree;
-    std::vector<Triangle> triangles;  // triangles[k] is triangle tree.primIndices[k]
+    std::vector<BVHTriangle> triangles;  // triangles[k] is triangle tree.primIndices[k]
   };
   struct Instance
   {
     uint32_t geomId;
     LiteMath::float4x4 toWorld, toObject;
   };
-  template <bool anyHit>
-  bool Trace(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar, CRT_Hit& hit) const;
   void SetMesh(Mesh& mesh, const float* vpos3f, size_t vertNum, const uint32_t* triIndices, size_t indNum, size_t vByteStride);
+  void ClearDeviceData();
+
+  // The traversal (translated for the GPU when composed).
+  bool Trace(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar, bool anyHit, CRT_Hit& hit) const;
+  bool TraceMesh(const BVHTraceRay& ray, uint32_t root, bool anyHit, float& tfar, CRT_Hit& hit) const;
 
   std::string m_name;
   Builder m_builder;
   std::vector<Mesh> m_meshes;
-  std::vector<Instance> m_instances;
-  BVHTree m_top;  // over the instances with triangles; primIndices are instance ids
-  bool m_committed = false;
+  std::vector<Instance> m_placed;  // instances as added (m_instances holds them in top-tree order)
 };

@@ -26,15 +26,4 @@ void ValidateMesh(const char* who, const float* vpos3f, size_t vertNum, const ui
                                   std::to_string(i) + " is out of range (vertNum = " + std::to_string(vertNum) + ")");
 }
 
-bool RayInterval(const LiteMath::float4& posAndNear, const LiteMath::float4& dirAndFar, float& tnear, float& tfar)
-{
-  tnear = std::max(posAndNear.w, 0.0f);
-  tfar = dirAndFar.w;
-  const bool finite = std::isfinite(posAndNear.x) && std::isfinite(posAndNear.y) && std::isfinite(posAndNear.z) &&
-                      std::isfinite(posAndNear.w) && std::isfinite(dirAndFar.x) && std::isfinite(dirAndFar.y) &&
-                      std::isfinite(dirAndFar.z);
-  const bool nonZeroDir = dirAndFar.x != 0.0f || dirAndFar.y != 0.0f || dirAndFar.z != 0.0f;
-  return finite && nonZeroDir && tnear < tfar;  // false for a NaN tfar too
-}
-
 }  // namespace litert_detail

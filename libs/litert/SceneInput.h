@@ -2,6 +2,8 @@
 #pragma once
 #include "LiteMath.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 
@@ -15,5 +17,15 @@ void ValidateMesh(const char* who, const float* vpos3f, size_t vertNum, const ui
 // The ray interval [tnear, tfar] a query searches, or false when the ray must miss: NaN or inf
 // in the origin, direction or tmin, a zero direction, or an empty interval (tmin >= tmax, also
 // tmin == tmax). A negative tmin counts as 0, as in Embree and Vulkan; tmax = +inf is unbounded.
-bool RayInterval(const LiteMath::float4& posAndNear, const LiteMath::float4& dirAndFar, float& tnear, float& tfar);
+// Inline: BVHScene's traversal calls it, and the translator prints it for the GPU from here.
+inline bool RayInterval(const LiteMath::float4& posAndNear, const LiteMath::float4& dirAndFar, float& tnear, float& tfar)
+{
+  tnear = std::max(posAndNear.w, 0.0f);
+  tfar = dirAndFar.w;
+  const bool finite = std::isfinite(posAndNear.x) && std::isfinite(posAndNear.y) && std::isfinite(posAndNear.z) &&
+                      std::isfinite(posAndNear.w) && std::isfinite(dirAndFar.x) && std::isfinite(dirAndFar.y) &&
+                      std::isfinite(dirAndFar.z);
+  const bool nonZeroDir = dirAndFar.x != 0.0f || dirAndFar.y != 0.0f || dirAndFar.z != 0.0f;
+  return finite && nonZeroDir && tnear < tfar;  // false for a NaN tfar too
+}
 }  // namespace litert_detail

@@ -159,6 +159,12 @@ private:
   VkBufferUsageFlags extraUsage_ = 0;
 };
 
+// The object a composed member (shared_ptr, unique_ptr or plain pointer) holds, or null.
+template <typename T>
+T* RawPointer(T* p) { return p; }
+template <typename Smart>
+auto* RawPointer(const Smart& p) { return p.get(); }
+
 // Reallocates b (keeping its extra usage) only when it is empty or smaller than bytes.
 void EnsureSize(std::shared_ptr<VulkanContext> ctx, Buffer& b, VkDeviceSize bytes);
 
