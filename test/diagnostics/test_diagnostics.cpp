@@ -238,3 +238,83 @@ void Sorter::kernel1D_Fill(int n) { for (int i = 0; i < n; i++) m_keys[i] = uint
     REQUIRE(!std::filesystem::exists(tc.dir / "out" / "Sorter_Vulkan.cpp"));
   }
 }
+
+TEST_CASE("Calls through an interface need a composed implementation whose code and data the GPU can reach", "[diagnostics]")
+{
+  // Tracer calls IShape through a shared_ptr; Spheres implements it in Spheres.cpp.
+  TempClass tc("Tracer", R"(#pragma once
+#include "LiteMath.h"
+#include <memory>
+#include <vector>
+struct IShape
+{
+  virtual ~IShape() = default;
+  virtual float Distance(LiteMath::float3 p) = 0;
+};
+class Spheres : public IShape
+{
+public:
+  float Distance(LiteMath::float3 p) override;
+  std::vector<LiteMath::float4> m_spheres;
+private:
+  std::vector<float> m_hidden;
+};
+class Tracer
+{
+public:
+  virtual ~Tracer() = default;
+  virtual void Run(int n, [[crossrt::size("n")]] float* out);
+  std::shared_ptr<IShape> m_shape;
+protected:
+  void kernel1D_Run(int n, float* out);
+};
+)",
+               R"(#include "Tracer.h"
+void Tracer::Run(int n, float* out) { kernel1D_Run(n, out); }
+void Tracer::kernel1D_Run(int n, float* out)
+{
+  for (int i = 0; i < n; i++)
+    out[i] = m_shape->Distance(LiteMath::float3(float(i), 0.0f, 0.0f));
+}
+)");
+  auto writeSpheres = [&](const char* body) { std::ofstream(tc.dir / "Spheres.cpp") << "#include \"Tracer.h\"\n" << body; };
+  const std::string base = "translate --class Tracer --backend vulkan --out " + (tc.dir / "out").string() + " --source " +
+                           tc.Source("Tracer") + " --templates " CROSSRT_SOURCE_DIR "/templates";
+  const std::string args = " -- -I" CROSSRT_SOURCE_DIR "/libs/litemath -I" + tc.dir.string();
+  const std::string spheres = " --source " + (tc.dir / "Spheres.cpp").string();
+
+  SECTION("no implementation named")
+  {
+    CommandResult r = RunCrossrt(base + args);
+    INFO(r.output);
+    REQUIRE(r.exitCode == 1);
+    REQUIRE(r.output.find("Tracer.cpp:6:14: error: call of IShape::Distance through member 'm_shape' in a kernel, but no "
+                          "implementation of IShape is composed into the class") != std::string::npos);
+    REQUIRE(r.output.find("hint: name the implementation the GPU runs: crossrt_add_class(... COMPOSE IShape=<Implementation>)") != std::string::npos);
+  }
+  SECTION("the implementation's source is missing")
+  {
+    CommandResult r = RunCrossrt(base + " --compose IShape=Spheres" + args);
+    INFO(r.output);
+    REQUIRE(r.exitCode == 1);
+    REQUIRE(r.output.find("composed as Spheres, but no source file defines class Spheres with the bodies of the methods they call") != std::string::npos);
+    REQUIRE(r.output.find("hint: list the implementation's source file") != std::string::npos);
+  }
+  SECTION("the implementation reads a private member")
+  {
+    writeSpheres("float Spheres::Distance(LiteMath::float3 p)\n{\n  return LiteMath::length(p - LiteMath::to_float3(m_spheres[0])) - m_hidden[0];\n}\n");
+    CommandResult r = RunCrossrt(base + spheres + " --compose IShape=Spheres" + args);
+    INFO(r.output);
+    REQUIRE(r.exitCode == 1);
+    REQUIRE(r.output.find("Tracer.h:16:22: error: member 'm_hidden' of Spheres is read on the GPU through composition") != std::string::npos);
+    REQUIRE(r.output.find("hint: declare it public") != std::string::npos);
+  }
+  SECTION("a malformed composition is a usage error")
+  {
+    CommandResult r = RunCrossrt(base + " --compose IShape" + args);
+    INFO(r.output);
+    REQUIRE(r.exitCode == 2);
+    REQUIRE(r.output.find("--compose takes Interface=Implementation") != std::string::npos);
+  }
+  REQUIRE(!std::filesystem::exists(tc.dir / "out" / "Tracer_Vulkan.cpp"));
+}
