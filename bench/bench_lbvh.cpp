@@ -1,8 +1,9 @@
 // Benchmark in the form of the paper's Tables 1 and 3, for every mesh scripts/fetch-meshes.sh
 // cached: BVH build time (Embree LOW and MEDIUM, the LBVH as written, LBVH_CPU, LBVH_Vulkan on the
 // default device, binned SAH), SAH cost of each tree, and traversal of 1024x1024 primary rays
-// (Embree rtcIntersect1 and rtcIntersect16, CrossRT's traversal over the LBVH and SAH trees), with
-// ratios against Embree. Every figure is measured in this run: medians of 3 after a warm-up.
+// (Embree rtcIntersect1 and rtcIntersect16, CrossRT's traversal over the LBVH and SAH trees as
+// written, and translated: PrimaryRays_CPU and PrimaryRays_Vulkan, which compose BVHScene's
+// traversal), with ratios against Embree. Every figure is measured in this run: medians of 3 after a warm-up.
 // Then the speed-against-quality trade of LBVH against binned SAH, as a table and as a PNG.
 //
 //   bench_lbvh [mesh dir (default build/data/meshes)] [plot.png (default out/bvh_tradeoff.png)]
@@ -13,6 +14,8 @@
 #include "LBVH_CPU.h"
 #include "LBVH_Vulkan.h"
 #include "MeshIO.h"
+#include "PrimaryRays_CPU.h"
+#include "PrimaryRays_Vulkan.h"
 #include "SAHBuilder.h"
 
 #include <embree3/rtcore.h>
@@ -213,9 +216,20 @@ int main(int argc, char** argv)
 
   std::printf("\nTraversal of %dx%d primary rays, Mrays/s, all %d threads (ratio against Embree rtcIntersect1); SAH cost of the trees\n",
               kImageSize, kImageSize, omp_get_max_threads());
-  std::printf("| %-22s | %9s | %9s | %15s | %15s | %15s | %9s | %9s | %8s |\n", "mesh", "Embree 1", "Embree 16", "CrossRT LBVH",
-              "CrossRT LBVH 1T", "CrossRT SAH", "SAH cost L", "SAH cost S", "same hit");
-  std::printf("|%s|\n", std::string(144, '-').c_str());
+  std::printf("| %-22s | %9s | %9s | %15s | %15s | %15s | %15s | %23s | %9s | %9s | %8s |\n", "mesh", "Embree 1", "Embree 16",
+              "CrossRT LBVH", "CrossRT LBVH 1T", "LBVH _CPU", "CrossRT SAH", "LBVH _Vulkan [GPU]", "SAH cost L", "SAH cost S", "same hit");
+  std::printf("|%s|\n", std::string(188, '-').c_str());
+  // The translated traversal: PrimaryRays_CPU / _Vulkan trace ray batches through the composed BVHScene.
+  auto castCpu = CreatePrimaryRays_CPU(1, 1);
+  std::shared_ptr<PrimaryRays> castGpu;
+  try
+  {
+    castGpu = CreatePrimaryRays_Vulkan(1, 1);
+  }
+  catch (const std::exception& e)
+  {
+    std::fprintf(stderr, "bench_lbvh: no Vulkan device, skipping PrimaryRays_Vulkan: %s\n", e.what());
+  }
   std::vector<TradeOff> trade;
   for (Row& row : rows)
   {
@@ -291,12 +305,36 @@ int main(int argc, char** argv)
     const double sahMs = traceWith(sahScene, threads);
     const double lbvh1T = traceWith(lbvhScene, 1);
     const double lbvhMs = traceWith(lbvhScene, threads);  // last: ourPrim holds the LBVH's hits
+    auto mrays = [&](double ms) { return pixels / ms / 1e3; };
+    std::vector<float4> rayPos(pixels, float4(cam.eye.x, cam.eye.y, cam.eye.z, 0.0f)), rayDir(pixels);
+    for (int i = 0; i < pixels; ++i) rayDir[i] = cam.Ray(i % kImageSize, i / kImageSize);
+    std::vector<CRT_Hit> castHits(pixels);
+    std::shared_ptr<ISceneObject> lbvhShared(&lbvhScene, [](ISceneObject*) {});  // lives on this stack frame
+    castCpu->SetScene(lbvhShared, {}, {});
+    const double castCpuMs = MedianMs([&] { castCpu->CastRays(rayPos.data(), rayDir.data(), castHits.data(), pixels); });
+    size_t translatedDiffer = 0;
+    for (int i = 0; i < pixels; ++i) translatedDiffer += castHits[i].primId != ourPrim[i];
+    char gpuCast[48] = "no device";
+    if (castGpu)
+    {
+      castGpu->SetScene(lbvhShared, {}, {});
+      castGpu->CommitDeviceData();
+      const double wall = MedianMs([&] { castGpu->CastRays(rayPos.data(), rayDir.data(), castHits.data(), pixels); });
+      float times[4];
+      castGpu->GetExecutionTime("CastRays", times);
+      for (int i = 0; i < pixels; ++i) translatedDiffer += castHits[i].primId != ourPrim[i];
+      std::snprintf(gpuCast, sizeof(gpuCast), "%6.2f (%5.2fx) [%5.2f]", mrays(wall), embree1 / wall, pixels / times[0] / 1e3);
+      castGpu->SetScene(nullptr, {}, {});
+    }
+    castCpu->SetScene(nullptr, {}, {});
+    if (translatedDiffer > 0)
+      std::fprintf(stderr, "bench_lbvh: %s: the translated traversal differs from the original on %zu rays\n", row.name.c_str(), translatedDiffer);
     size_t same = 0;
     for (int i = 0; i < pixels; ++i) same += ourPrim[i] == embreePrim[i];
-    auto mrays = [&](double ms) { return pixels / ms / 1e3; };
-    std::printf("| %-22s | %9.2f | %9.2f | %6.2f (%5.2fx) | %6.2f (%5.2fx) | %6.2f (%5.2fx) | %9.1f | %9.1f | %7.4f%% |\n", row.name.c_str(),
-                mrays(embree1), mrays(embree16), mrays(lbvhMs), embree1 / lbvhMs, mrays(lbvh1T), embree1 / lbvh1T, mrays(sahMs),
-                embree1 / sahMs, SAHCost(row.lbvh), SAHCost(row.sah), 100.0 * same / pixels);
+    std::printf("| %-22s | %9.2f | %9.2f | %6.2f (%5.2fx) | %6.2f (%5.2fx) | %6.2f (%5.2fx) | %6.2f (%5.2fx) | %23s | %9.1f | %9.1f | %7.4f%% |\n",
+                row.name.c_str(), mrays(embree1), mrays(embree16), mrays(lbvhMs), embree1 / lbvhMs, mrays(lbvh1T), embree1 / lbvh1T,
+                mrays(castCpuMs), embree1 / castCpuMs, mrays(sahMs), embree1 / sahMs, gpuCast, SAHCost(row.lbvh), SAHCost(row.sah),
+                100.0 * same / pixels);
     trade.push_back({row.name, row.lbvhCpuMs, mrays(lbvhMs), row.sahMs, mrays(sahMs)});
   }
 
