@@ -1257,6 +1257,7 @@ bool ComposeFromTranslationUnit(ASTContext& ctx, Reporter& reporter, ClassModel&
         Member m;
         m.name = name;
         m.hostExpr = "crt_" + comp.holder + "()->" + f->getNameAsString();
+        m.composedFrom = comp.implName + "::" + f->getNameAsString() + " through " + comp.holder;
         m.kind = MemberKind::Vector;
         m.glslType = GlslTypeOf(elem).value_or("float");
         m.elemCppType = CppTypeName(ctx, elem);

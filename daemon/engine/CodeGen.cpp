@@ -196,7 +196,7 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
     b.set("blockName", v + "Buffer");
     b.set("type", m ? m->glslType : "float");
     b.set("name", v);
-    b.set("comment", m && m->hostExpr != m->name ? "composed: " + m->hostExpr.substr(4) : "member std::vector " + v);
+    b.set("comment", m && !m->composedFrom.empty() ? "composed: std::vector " + m->composedFrom : "member std::vector " + v);
     buffers.push_back(b);
   }
   Data reductions = List();

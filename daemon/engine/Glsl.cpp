@@ -165,7 +165,9 @@ bool LayoutMatchesCpp(ASTContext& ctx, QualType type, bool scalar) {
     auto fl = Std430Layout(ctx, f->getType(), scalar);
     offset = (offset + fl->align - 1) / fl->align * fl->align;
     if (cpp.getFieldOffset(f->getFieldIndex()) / 8 != offset) return false;
-    if (f->getType()->getAsCXXRecordDecl() && !LayoutMatchesCpp(ctx, f->getType(), scalar)) return false;
+    // A nested struct must match inside too; a nested LiteMath vector matched by size and offset
+    // (its array stride, which differs for vec3, does not apply to a field).
+    if (f->getType()->getAsCXXRecordDecl() && !IsLiteMathType(f->getType()) && !LayoutMatchesCpp(ctx, f->getType(), scalar)) return false;
     offset += fl->size;
   }
   return true;

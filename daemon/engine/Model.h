@@ -21,6 +21,7 @@ enum class MemberKind { Plain, Vector };
 struct Member {
   std::string name;             // as GLSL and the generated mirrors name it
   std::string hostExpr;         // how the generated class reaches it: the name, or crt_<holder>()->name when composed
+  std::string composedFrom;     // composed: "BVHScene::m_nodes through m_pAccelStruct" (for comments)
   MemberKind kind = MemberKind::Plain;
   std::string cppType;          // full C++ type spelling
   std::string glslType;         // plain: the GLSL type; vector: the element's GLSL type
