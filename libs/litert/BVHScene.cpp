@@ -414,7 +414,9 @@ bool BVHScene::TraceMesh(const BVHTraceRay& ray, uint32_t root, bool anyHit, flo
 }
 
 // The top tree's leaves hold instances: each is traced in its mesh's tree, in object space
-// (affine maps keep t: the object-space ray is not renormalized).
+// (affine maps keep t: the object-space ray is not renormalized). This loop and TraceMesh's walk
+// the stack alike; a shared step function would take the stack arrays as GLSL inout parameters,
+// which copy them on every call.
 bool BVHScene::Trace(float4 posAndNear, float4 dirAndFar, bool anyHit, CRT_Hit& hit) const
 {
   float tnear = 0.0f;

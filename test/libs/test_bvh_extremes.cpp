@@ -43,19 +43,6 @@ TriangleMesh Transformed(TriangleMesh mesh, const float4x4& m)
   return mesh;
 }
 
-// A sphere with bumps: closed like the sphere, but not convex, so lines cross it many times.
-TriangleMesh BumpySphere(int levels)
-{
-  TriangleMesh mesh = Sphere(levels);
-  for (size_t i = 0; i < mesh.VertexCount(); ++i)
-  {
-    float3 p = Vertex(mesh, uint32_t(i));
-    p = p * (1.0f + 0.3f * std::sin(5.0f * p.x) * std::sin(5.0f * p.y));
-    mesh.positions[3 * i] = p.x, mesh.positions[3 * i + 1] = p.y, mesh.positions[3 * i + 2] = p.z;
-  }
-  return mesh;
-}
-
 struct Agreement
 {
   size_t rays = 0, hits = 0, samePrim = 0, tOutside = 0;

@@ -138,18 +138,6 @@ Outcome TraceEverywhere(const std::shared_ptr<ISceneObject>& scene, const Rays& 
   return out;
 }
 
-TriangleMesh BumpySphere(int levels)
-{
-  TriangleMesh mesh = Sphere(levels);
-  for (size_t i = 0; i < mesh.VertexCount(); ++i)
-  {
-    float3 p = Vertex(mesh, uint32_t(i));
-    p = p * (1.0f + 0.3f * std::sin(5.0f * p.x) * std::sin(5.0f * p.y));
-    mesh.positions[3 * i] = p.x, mesh.positions[3 * i + 1] = p.y, mesh.positions[3 * i + 2] = p.z;
-  }
-  return mesh;
-}
-
 size_t Misses(const std::vector<CRT_Hit>& hits)
 {
   size_t n = 0;
