@@ -1193,6 +1193,27 @@ const CXXMethodDecl* ImplementationOf(const CXXRecordDecl* impl, const std::stri
   return nullptr;
 }
 
+// Writes to members of `this` in composed code: the GPU copy of an implementation's data is never
+// read back, so such a write would be lost silently.
+struct ComposedWriteFinder : RecursiveASTVisitor<ComposedWriteFinder> {
+  std::vector<std::pair<const FieldDecl*, SourceLocation>> writes;
+  void Check(const Expr* lhs, SourceLocation loc) {
+    if (auto* f = RootField(lhs)) writes.push_back({f, loc});
+  }
+  bool VisitBinaryOperator(BinaryOperator* bo) {
+    if (bo->isAssignmentOp()) Check(bo->getLHS(), bo->getExprLoc());
+    return true;
+  }
+  bool VisitUnaryOperator(UnaryOperator* uo) {
+    if (uo->isIncrementDecrementOp()) Check(uo->getSubExpr(), uo->getExprLoc());
+    return true;
+  }
+  bool VisitCXXOperatorCallExpr(CXXOperatorCallExpr* op) {
+    if (op->isAssignmentOp() || op->getOperator() == OO_PlusPlus || op->getOperator() == OO_MinusMinus) Check(op->getArg(0), op->getExprLoc());
+    return true;
+  }
+};
+
 std::string StructName(const std::string& chunk) {
   static const std::regex decl(R"(^struct (\w+) \{)");
   std::smatch m;
@@ -1233,6 +1254,13 @@ bool ComposeFromTranslationUnit(ASTContext& ctx, Reporter& reporter, ClassModel&
         printer.EmitComposedMethod(md);
       }
       if (printer.Functions().empty()) continue;
+      for (auto* fn : printer.helpers) {
+        ComposedWriteFinder finder;
+        finder.TraverseStmt(fn->getBody());
+        for (auto& [field, loc] : finder.writes)
+          reporter.Error(loc, "composed code writes member '" + field->getNameAsString() + "' of " + comp.implName +
+                         ", whose GPU copy is never read back", "members of a composed implementation are read-only in kernels: compute into a local variable");
+      }
       // The implementation's data: its std::vector members become buffers, plain members join
       // the class data, all reached through the holder on the host.
       std::vector<std::string> vectors;

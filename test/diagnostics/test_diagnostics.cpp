@@ -309,6 +309,15 @@ void Tracer::kernel1D_Run(int n, float* out)
     REQUIRE(r.output.find("Tracer.h:16:22: error: member 'm_hidden' of Spheres is read on the GPU through composition") != std::string::npos);
     REQUIRE(r.output.find("hint: declare it public") != std::string::npos);
   }
+  SECTION("the implementation writes its own member")
+  {
+    writeSpheres("float Spheres::Distance(LiteMath::float3 p)\n{\n  m_spheres[0].w += 1.0f;\n  return LiteMath::length(p) - m_spheres[0].w;\n}\n");
+    CommandResult r = RunCrossrt(base + spheres + " --compose IShape=Spheres" + args);
+    INFO(r.output);
+    REQUIRE(r.exitCode == 1);
+    REQUIRE(r.output.find("Spheres.cpp:4:18: error: composed code writes member 'm_spheres' of Spheres, whose GPU copy is never read back") != std::string::npos);
+    REQUIRE(r.output.find("hint: members of a composed implementation are read-only in kernels") != std::string::npos);
+  }
   SECTION("a malformed composition is a usage error")
   {
     CommandResult r = RunCrossrt(base + " --compose IShape" + args);
