@@ -545,8 +545,6 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     hs.TraverseStmt(helper->getBody());
     markVectorWrites(hs);
   }
-  k.glslStructs = printer.PreludeTypes();
-  k.glslHelpers = printer.PreludeFunctions();
   k.structList = printer.Structs();
   k.constantList = printer.Constants();
   k.functionList = printer.Functions();
@@ -1250,7 +1248,6 @@ bool ComposeFromTranslationUnit(ASTContext& ctx, Reporter& reporter, ClassModel&
         if (holder != comp.holder) continue;
         const FunctionDecl* def = nullptr;
         auto* md = ImplementationOf(impl, method, def);
-        comp.sourceFile = BaseName(FileOf(ctx, def->getLocation()));
         printer.EmitComposedMethod(md);
       }
       if (printer.Functions().empty()) continue;
@@ -1324,12 +1321,9 @@ bool ComposeFromTranslationUnit(ASTContext& ctx, Reporter& reporter, ClassModel&
       for (auto& line : k.constantList)
         if (std::find(constants.begin(), constants.end(), line) == constants.end()) constants.push_back(line);
       functions.insert(functions.end(), k.functionList.begin(), k.functionList.end());
-      k.glslStructs.clear();
-      for (auto& x : structs) k.glslStructs += x + "\n";
-      k.glslHelpers.clear();
-      for (auto& x : constants) k.glslHelpers += x;
-      if (!constants.empty()) k.glslHelpers += "\n";
-      for (auto& x : functions) k.glslHelpers += x + "\n";
+      k.structList = structs;
+      k.constantList = constants;
+      k.functionList = functions;
       for (auto& v : vectors)
         if (std::find(k.memberVectors.begin(), k.memberVectors.end(), v) == k.memberVectors.end()) k.memberVectors.push_back(v);
       std::sort(k.memberVectors.begin(), k.memberVectors.end());

@@ -169,7 +169,9 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   d.set("groupZ", std::to_string(Shape(k).z));
   d.set("groupSize", std::to_string(shape.x * shape.y * shape.z));
   d.set("classStructs", model.glslClassStructs);
-  d.set("kernelStructs", k.glslStructs);
+  std::string structs;
+  for (auto& x : k.structList) structs += x + "\n";
+  d.set("kernelStructs", structs);
   Data buffers = List();
   unsigned binding = 1;
   bool scalarAny = false;  // any buffer that needs GL_EXT_scalar_block_layout
@@ -241,7 +243,11 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
     push.push_back(s);
   }
   d.set("pushConstants", push);
-  d.set("helpers", k.glslHelpers);
+  std::string helpers;
+  for (auto& x : k.constantList) helpers += x;
+  if (!k.constantList.empty()) helpers += "\n";
+  for (auto& x : k.functionList) helpers += x + "\n";
+  d.set("helpers", helpers);
   d.set("body", k.glslBody);
   d.set("dim1", k.dims == 1);
   // Arguments of the thread function: each thread id in the type its parameter or loop variable has.

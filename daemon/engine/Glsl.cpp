@@ -248,14 +248,6 @@ std::string GlslPrinter::PreludeTypes() const {
   return out;
 }
 
-std::string GlslPrinter::PreludeFunctions() const {
-  std::string out;
-  for (auto& c : m_constants) out += c;
-  if (!m_constants.empty()) out += "\n";
-  for (auto& f : m_functions) out += f + "\n";
-  return out;
-}
-
 std::string GlslPrinter::Literal(const clang::Expr* e) {
   if (auto* il = dyn_cast<IntegerLiteral>(e)) {
     bool isUnsigned = il->getType()->isUnsignedIntegerType();

@@ -69,10 +69,9 @@ public:
   std::optional<std::string> Type(clang::QualType t, clang::SourceLocation loc);
   std::string Declare(clang::QualType t, const std::string& name, clang::SourceLocation loc);
 
-  // Structs the code needs (above the buffer blocks), then constants and helper functions (below).
+  // Structs the code needs (above the buffer blocks), then constants and helper functions (below),
+  // one by one so that composed code can be merged ahead of a kernel's; PreludeTypes joins the structs.
   std::string PreludeTypes() const;
-  std::string PreludeFunctions() const;
-  // The same pieces one by one, for merging the preludes of composed code with a kernel's.
   const std::vector<std::string>& Structs() const { return m_structs; }
   const std::vector<std::string>& Constants() const { return m_constants; }
   const std::vector<std::string>& Functions() const { return m_functions; }

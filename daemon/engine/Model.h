@@ -72,13 +72,12 @@ struct Kernel {
   std::vector<Loop> loops;            // IPV: outermost first
   std::vector<Reduction> reductions;
   std::vector<std::string> memberVectors;   // member vectors the kernel reaches (incl. helpers)
-  std::string glslStructs;            // structs it needs beyond the class's
-  std::string glslHelpers;            // constants and helper functions it needs
   std::string glslBody;               // the thread's code, as a GLSL function body
   std::string cpuLoopNest;            // IPV, CPU backend: the loop nest with reductions renamed
   std::string cpuPreamble;            // IPV, CPU backend: statements before the loops
   std::string sourceFile;             // where the kernel is defined (for comments)
-  // The GLSL prelude in pieces, so composed code can be merged in ahead of the kernel's own.
+  // The GLSL prelude: structs it needs beyond the class's, constants and helper functions, in an
+  // order GLSL accepts (composed code is merged in ahead of the kernel's own).
   std::vector<std::string> structList, constantList, functionList;
   std::set<std::pair<std::string, std::string>> composedCalls;  // (holder member, interface method)
 };
@@ -117,7 +116,6 @@ struct Composition {
   std::string interfaceName;   // ISceneObject
   std::string implName;        // BVHScene
   std::string implHeader;      // file declaring the implementation (included by generated code)
-  std::string sourceFile;      // where the implementation's methods are defined (for comments)
 };
 
 struct ClassModel {

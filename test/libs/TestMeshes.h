@@ -1,12 +1,14 @@
 // Meshes built in code for the ray tracing tests: closed spheres (every edge shared by exactly
 // two triangles, every vertex by several), so rays through edges and vertices are easy to aim.
 #pragma once
+#include "CrossRT.h"
 #include "LiteMath.h"
 #include "MeshIO.h"
 
 #include <cmath>
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -71,3 +73,34 @@ inline TriangleMesh BumpySphere(int levels)
   return mesh;
 }
 
+// The cube [-1, 1]^3: 12 triangles, wound outwards.
+inline TriangleMesh Cube()
+{
+  TriangleMesh cube;
+  cube.positions = {-1, -1, -1, 1, -1, -1, 1, 1, -1, -1, 1, -1, -1, -1, 1, 1, -1, 1, 1, 1, 1, -1, 1, 1};
+  cube.indices = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4, 3, 6, 2, 3, 7, 6, 0, 4, 7, 0, 7, 3, 1, 2, 6, 1, 6, 5};
+  return cube;
+}
+
+// The mesh with `m` applied to its vertices in float, as a scene far away or scaled would be stored.
+inline TriangleMesh Transformed(TriangleMesh mesh, const LiteMath::float4x4& m)
+{
+  for (size_t i = 0; i < mesh.VertexCount(); ++i)
+  {
+    const LiteMath::float3 p = LiteMath::to_float3(m * LiteMath::float4(mesh.positions[3 * i], mesh.positions[3 * i + 1], mesh.positions[3 * i + 2], 1.0f));
+    mesh.positions[3 * i] = p.x, mesh.positions[3 * i + 1] = p.y, mesh.positions[3 * i + 2] = p.z;
+  }
+  return mesh;
+}
+
+// A committed scene of implementation `impl` holding `mesh` once per instance matrix.
+inline std::shared_ptr<ISceneObject> SceneOf(const char* impl, const TriangleMesh& mesh,
+                                             const std::vector<LiteMath::float4x4>& instances = {LiteMath::float4x4()})
+{
+  auto scene = CreateSceneRT(impl);
+  const uint32_t geom = scene->AddGeom_Triangles3f(mesh.positions.data(), mesh.VertexCount(), mesh.indices.data(), mesh.indices.size());
+  for (const LiteMath::float4x4& m : instances)
+    scene->AddInstance(geom, m);
+  scene->CommitScene();
+  return scene;
+}

@@ -23,26 +23,6 @@ namespace {
 
 constexpr uint32_t kMiss = 0xFFFFFFFFu;
 
-std::shared_ptr<ISceneObject> SceneOf(const char* impl, const TriangleMesh& mesh)
-{
-  auto scene = CreateSceneRT(impl);
-  scene->AddInstance(scene->AddGeom_Triangles3f(mesh.positions.data(), mesh.VertexCount(), mesh.indices.data(), mesh.indices.size()),
-                     float4x4());
-  scene->CommitScene();
-  return scene;
-}
-
-// The mesh with `m` applied to its vertices in float, as a scene far away or scaled would be stored.
-TriangleMesh Transformed(TriangleMesh mesh, const float4x4& m)
-{
-  for (size_t i = 0; i < mesh.VertexCount(); ++i)
-  {
-    const float3 p = to_float3(m * float4(mesh.positions[3 * i], mesh.positions[3 * i + 1], mesh.positions[3 * i + 2], 1.0f));
-    mesh.positions[3 * i] = p.x, mesh.positions[3 * i + 1] = p.y, mesh.positions[3 * i + 2] = p.z;
-  }
-  return mesh;
-}
-
 struct Agreement
 {
   size_t rays = 0, hits = 0, samePrim = 0, tOutside = 0;
@@ -183,10 +163,7 @@ TEST_CASE("BVH traversal: axis-parallel rays with +0 and -0 direction components
 {
   const char* impl = GENERATE(as<const char*>{}, "lbvh", "sah", "embree");
   INFO(impl);
-  // The cube [-1, 1]^3, 12 triangles.
-  TriangleMesh cube;
-  cube.positions = {-1, -1, -1, 1, -1, -1, 1, 1, -1, -1, 1, -1, -1, -1, 1, 1, -1, 1, 1, 1, 1, -1, 1, 1};
-  cube.indices = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4, 3, 6, 2, 3, 7, 6, 0, 4, 7, 0, 7, 3, 1, 2, 6, 1, 6, 5};
+  const TriangleMesh cube = Cube();
   auto scene = SceneOf(impl, cube);
   const float coords[] = {-1.5f, -1.0f, -0.5f, 0.0f, 0.25f, 0.5f, 1.0f, 1.5f};
   size_t checked = 0;

@@ -43,16 +43,6 @@ struct Rays
   size_t Size() const { return posAndNear.size(); }
 };
 
-std::shared_ptr<ISceneObject> SceneOf(const char* impl, const TriangleMesh& mesh, const std::vector<float4x4>& instances = {float4x4()})
-{
-  auto scene = CreateSceneRT(impl);
-  const uint32_t geom = scene->AddGeom_Triangles3f(mesh.positions.data(), mesh.VertexCount(), mesh.indices.data(), mesh.indices.size());
-  for (const float4x4& m : instances)
-    scene->AddInstance(geom, m);
-  scene->CommitScene();
-  return scene;
-}
-
 std::vector<CRT_Hit> Cast(PrimaryRays& renderer, const std::shared_ptr<ISceneObject>& scene, const Rays& rays)
 {
   renderer.SetScene(scene, {}, {});
@@ -196,12 +186,7 @@ TEST_CASE("Translated traversal on tiny, huge and far-away scenes, and 1e6 sizes
   for (const Placement& p : placements)
   {
     INFO(p.what);
-    TriangleMesh placed = mesh;
-    for (size_t i = 0; i < placed.VertexCount(); ++i)
-    {
-      const float3 w = to_float3(p.toWorld * float4(placed.positions[3 * i], placed.positions[3 * i + 1], placed.positions[3 * i + 2], 1.0f));
-      placed.positions[3 * i] = w.x, placed.positions[3 * i + 1] = w.y, placed.positions[3 * i + 2] = w.z;
-    }
+    const TriangleMesh placed = Transformed(mesh, p.toWorld);
     std::mt19937 rng(7);
     std::uniform_real_distribution<float> u(-1.0f, 1.0f);
     Rays rays;
@@ -218,9 +203,7 @@ TEST_CASE("Translated traversal on tiny, huge and far-away scenes, and 1e6 sizes
 
 TEST_CASE("Translated traversal: axis-parallel rays with +0 and -0 direction components", "[bvh][composition]")
 {
-  TriangleMesh cube;
-  cube.positions = {-1, -1, -1, 1, -1, -1, 1, 1, -1, -1, 1, -1, -1, -1, 1, 1, -1, 1, 1, 1, 1, -1, 1, 1};
-  cube.indices = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4, 3, 6, 2, 3, 7, 6, 0, 4, 7, 0, 7, 3, 1, 2, 6, 1, 6, 5};
+  const TriangleMesh cube = Cube();
   const float coords[] = {-1.5f, -1.0f, -0.5f, 0.0f, 0.25f, 0.5f, 1.0f, 1.5f};
   Rays rays;
   std::vector<bool> inside;
