@@ -99,7 +99,26 @@ struct Context {
   Reporter& rep;
   ClassModel& model;
   const std::map<std::string, std::string>& compositions;  // interface -> implementation
+  std::set<std::string> appended;  // member vectors some kernel push_backs to
   std::string Text(SourceRange r) const { return engine::Text(ctx, r); }
+};
+
+// `m_v.push_back(x)` on a std::vector member of the class: the member, else null.
+const FieldDecl* AppendTarget(const CXXMemberCallExpr* call) {
+  auto* md = call->getMethodDecl();
+  if (!md || md->getName() != "push_back") return nullptr;
+  auto* f = ThisField(call->getImplicitObjectArgument());
+  return f && IsStdVector(f->getType()) ? f : nullptr;
+}
+
+// The member vectors that kernels of the class append to: kernels that loop to their size are
+// dispatched indirectly, and control functions may not read them before the kernels are done.
+struct AppendFinder : RecursiveASTVisitor<AppendFinder> {
+  std::set<std::string> appended;
+  bool VisitCXXMemberCallExpr(CXXMemberCallExpr* call) {
+    if (auto* f = AppendTarget(call)) appended.insert(f->getNameAsString());
+    return true;
+  }
 };
 
 // ---- members ---------------------------------------------------------------
@@ -271,6 +290,19 @@ struct WriteScanner : RecursiveASTVisitor<WriteScanner> {
   }
   bool VisitUnaryOperator(UnaryOperator* uo) {
     if (uo->isIncrementDecrementOp()) Write(uo->getSubExpr(), uo->getExprLoc(), std::nullopt, {});
+    return true;
+  }
+  // push_back to a member vector: an append through an atomic counter, in the kernel's own body
+  // (the CPU backend serialises the appends there; a helper's body is shared with the original).
+  std::map<const FieldDecl*, SourceLocation> appends;
+  bool VisitCXXMemberCallExpr(CXXMemberCallExpr* call) {
+    auto* f = AppendTarget(call);
+    if (!f) return true;
+    if (helper)
+      c.rep.Error(call->getExprLoc(), "helper function '" + helper->getNameAsString() + "' appends to member '" + f->getNameAsString() +
+                  "' (called from every thread: a data race on the CPU)", "call push_back in the kernel's loop body; the helper can return the value to append");
+    else
+      appends.emplace(f, call->getExprLoc());
     return true;
   }
   // A member passed to a non-const reference parameter may be written by the callee (GLSL inout).
@@ -478,6 +510,21 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
       LoopHeader h;
       if (!ParseLoop(c, fs, h, k.name)) return;
       headers.push_back(h);
+      // `i < m_v.size()` of a vector that kernels append to: its size is only known on the GPU.
+      if (auto* mc = dyn_cast<CXXMemberCallExpr>(h.end->IgnoreParenCasts()); mc && mc->getMethodDecl() && mc->getMethodDecl()->getName() == "size")
+        if (auto* f = ThisField(mc->getImplicitObjectArgument()); f && c.appended.count(f->getNameAsString())) {
+          Expr::EvalResult r;
+          const std::string v = f->getNameAsString();
+          if (k.dims != 1)
+            c.rep.Error(h.end->getBeginLoc(), "kernel '" + k.name + "' loops to the size of '" + v + "', which kernels append to on the GPU, in a " +
+                        std::to_string(k.dims) + "D loop nest", "loop to " + v + ".size() in a kernel1D_ kernel: it is dispatched indirectly, with the count the GPU computed");
+          else if (!(h.start->EvaluateAsInt(r, c.ctx) && r.Val.getInt() == 0) || h.inclusive)
+            c.rep.Error(h.end->getBeginLoc(), "kernel '" + k.name + "' loops over '" + v + "', which kernels append to on the GPU, but not from 0 to " + v + ".size()",
+                        "write 'for (uint32_t i = 0; i < " + v + ".size(); ++i)' and skip elements inside the loop");
+          else
+            k.indirectVector = v;
+          if (auto* m = FindMember(c.model, v)) m->usedByKernels = true;
+        }
       Loop loop;
       loop.var = h.var->getNameAsString();
       loop.glslType = GlslTypeOf(h.var->getType()).value_or("int");
@@ -506,8 +553,20 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
                 "write the loop inside the kernel (kernel1D_" + k.name.substr(std::string("kernel_").size()) + ") so the translator sees the whole reduction");
     return;
   }
+  if (!ws.appends.empty() && k.rtv) {
+    c.rep.Error(ws.appends.begin()->second, "push_back in '" + k.name + "', whose loop is in the control function",
+                "write the loop inside a kernel1D_ kernel so the translator can make the appends safe on every backend");
+    return;
+  }
+  if (!k.indirectVector.empty() && !ws.reductions.empty())
+    c.rep.Error(md->getLocation(), "kernel '" + k.name + "' reduces members and is dispatched indirectly (it loops to " + k.indirectVector + ".size())",
+                "reduce in a kernel with a count the host knows, or append the values and reduce them in a later kernel");
   // In declaration order, so that regeneration is stable.
   for (auto* field : c.cls->fields()) {
+    if (ws.appends.count(field)) {
+      k.appends.push_back(field->getNameAsString());
+      if (auto* m = FindMember(c.model, field->getNameAsString())) m->appendedByKernels = m->writtenByKernels = true;
+    }
     auto found = ws.reductions.find(field);
     if (found == ws.reductions.end()) continue;
     ReduceOp op = found->second;
@@ -545,6 +604,11 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     hs.TraverseStmt(helper->getBody());
     markVectorWrites(hs);
   }
+  // Threads append in any order: a size read in the same kernel would see a partial count.
+  for (auto& [field, loc] : printer.sizeReads)
+    if (ws.appends.count(field))
+      c.rep.Error(loc, "kernel '" + k.name + "' reads the size of '" + field->getNameAsString() + "', which it appends to",
+                  "the final size is known after the kernel: read it in a later kernel, or after the control function returns");
   k.structList = printer.Structs();
   k.constantList = printer.Constants();
   k.functionList = printer.Functions();
@@ -589,9 +653,17 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   // CPU backend: the loop nest as the user wrote it, reduction targets renamed.
   if (!k.rtv) {
     Rewriter rw(c.ctx.getSourceManager(), c.ctx.getLangOpts());
+    // Reduction targets get their per-thread names; appends go through a lock.
     struct Renamer : RecursiveASTVisitor<Renamer> {
       Rewriter& rw; const std::map<const FieldDecl*, ReduceOp>& red;
       Renamer(Rewriter& r, const std::map<const FieldDecl*, ReduceOp>& m) : rw(r), red(m) {}
+      bool VisitCXXMemberCallExpr(CXXMemberCallExpr* call) {
+        if (!AppendTarget(call)) return true;
+        SourceRange object = call->getImplicitObjectArgument()->getSourceRange();
+        rw.InsertTextBefore(object.getBegin(), "crossrt::Locked(");
+        rw.InsertTextAfterToken(object.getEnd(), ")");
+        return true;
+      }
       bool VisitMemberExpr(MemberExpr* me) {
         auto* f = dyn_cast<FieldDecl>(me->getMemberDecl());
         if (f && red.count(f) && me->isImplicitAccess()) rw.ReplaceText(me->getMemberLoc(), f->getName().size(), f->getNameAsString() + "Local");
@@ -656,6 +728,7 @@ public:
         m_gpu(c.ctx.getSourceManager(), c.ctx.getLangOpts()), m_cpu(c.ctx.getSourceManager(), c.ctx.getLangOpts()) {}
 
   void Run() {
+    CheckAppendedUses();
     Visit(m_def->getBody());
     m_ctrl.vulkanCmdBody = CanonicalCode(m_gpu.getRewrittenText(m_def->getBody()->getSourceRange()));
     m_ctrl.cpuBody = CanonicalCode(m_cpu.getRewrittenText(m_def->getBody()->getSourceRange()));
@@ -802,6 +875,49 @@ private:
     SourceLocation end = Lexer::findLocationAfterToken(s->getEndLoc(), tok::semi, m_c.ctx.getSourceManager(), m_c.ctx.getLangOpts(), false);
     if (end.isInvalid()) return;
     m_gpu.InsertTextAfter(end, " UpdateMemberCmd(a_cmd, offsetof(ClassData, " + m->name + "), &" + m->name + ", sizeof(" + m->name + "));");
+  }
+
+  // A vector kernels append to has its size on the GPU while the control function records: its host
+  // copy is stale until the call returns, so host code may only clear it (or reserve room).
+  void CheckAppendedUses() {
+    struct Finder : RecursiveASTVisitor<Finder> {
+      ControlRewriter& rw;
+      explicit Finder(ControlRewriter& r) : rw(r) {}
+      void Check(const Expr* object, const std::string& what, SourceLocation loc) {
+        auto* f = ThisField(object);
+        if (!f || !rw.m_c.appended.count(f->getNameAsString())) return;
+        const std::string v = f->getNameAsString();
+        rw.m_c.rep.Error(loc, "control function '" + rw.m_ctrl.name + "' uses " + what + " of '" + v +
+                         "', which kernels append to: on the GPU its size and contents are known only after the call returns",
+                         "loop to " + v + ".size() inside a kernel1D_ kernel (dispatched indirectly, with no host round trip), or read " + v +
+                         " after the call; here it may only be cleared or reserved");
+      }
+      bool VisitCXXMemberCallExpr(CXXMemberCallExpr* call) {
+        static const std::set<std::string> allowed = {"clear", "reserve", "capacity", "data"};
+        std::string method = call->getMethodDecl() ? call->getMethodDecl()->getNameAsString() : "";
+        if (!allowed.count(method)) Check(call->getImplicitObjectArgument(), method + "()", call->getExprLoc());
+        return true;
+      }
+      bool VisitCXXOperatorCallExpr(CXXOperatorCallExpr* op) {
+        if (op->getOperator() == OO_Subscript) Check(op->getArg(0), "operator[]", op->getExprLoc());
+        return true;
+      }
+    } finder(*this);
+    finder.TraverseStmt(const_cast<Stmt*>(m_def->getBody()));
+  }
+
+  // `m_v.clear();` of a vector kernels append to: the GPU's count restarts at 0 too, in order with
+  // the kernels recorded around it.
+  void RecordClear(const Stmt* s) {
+    auto* call = dyn_cast_or_null<CXXMemberCallExpr>(s);
+    if (!call || !call->getMethodDecl() || call->getMethodDecl()->getName() != "clear") return;
+    auto* f = ThisField(call->getImplicitObjectArgument());
+    if (!f || !m_c.appended.count(f->getNameAsString())) return;
+    SourceLocation end = Lexer::findLocationAfterToken(s->getEndLoc(), tok::semi, m_c.ctx.getSourceManager(), m_c.ctx.getLangOpts(), false);
+    if (end.isInvalid()) return;
+    const std::string size = f->getNameAsString() + "_size";
+    m_gpu.InsertTextAfter(end, " { const uint32_t crt_empty = 0; UpdateMemberCmd(a_cmd, offsetof(ClassData, " + size +
+                                   "), &crt_empty, sizeof(crt_empty)); }");
   }
 
   // Another control function would submit its own work while this one is being recorded.
@@ -1029,7 +1145,10 @@ private:
     if (!s) return;
     // Statement positions where a member may be assigned.
     if (auto* cs = dyn_cast<CompoundStmt>(s))
-      for (auto* child : cs->body()) RecordMemberWrite(child);
+      for (auto* child : cs->body()) {
+        RecordMemberWrite(child);
+        RecordClear(child);
+      }
     if (auto* is = dyn_cast<IfStmt>(s)) {
       RecordMemberWrite(is->getThen());
       RecordMemberWrite(is->getElse());
@@ -1116,12 +1235,23 @@ bool AnalyzeTranslationUnit(ASTContext& ctx, const std::string& className, const
   for (auto* d : ctx.getTranslationUnitDecl()->lookup(&ctx.Idents.get(className)))
     if (auto* rd = dyn_cast<CXXRecordDecl>(d); rd && rd->getDefinition()) cls = rd->getDefinition();
   if (!cls) return false;
-  Context c{ctx, cls, reporter, model, compositions};
+  Context c{ctx, cls, reporter, model, compositions, {}};
   bool first = model.className.empty();
   if (first) {
     model.className = className;
     model.headerFile = FileOf(ctx, cls->getLocation());
     AnalyzeMembers(c);
+  }
+  // Appends decide how other kernels are dispatched: find them all before analysing any kernel.
+  {
+    AppendFinder finder;
+    for (auto* md : cls->methods()) {
+      const FunctionDecl* def = nullptr;
+      if (IsKernelName(md->getName()) && md->hasBody(def) && def) finder.TraverseStmt(def->getBody());
+    }
+    for (auto& m : model.members)
+      if (m.appendedByKernels) finder.appended.insert(m.name);  // found in another source file
+    c.appended = finder.appended;
   }
   auto known = [](const auto& list, const std::string& n) {
     return std::any_of(list.begin(), list.end(), [&](const auto& x) { return x.name == n; });

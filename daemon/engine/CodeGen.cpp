@@ -6,6 +6,7 @@
 #include <kainjow/mustache.hpp>
 
 #include <fstream>
+#include <regex>
 #include <sstream>
 #include <stdexcept>
 
@@ -40,8 +41,27 @@ std::string TidyBlankLines(const std::string& text) {
   return out;
 }
 
+// A line holding only a section tag ({{#x}}, {{^x}}, {{/x}}) renders nothing, not an empty line
+// (mustache's "standalone" rule, which the library does not apply to skipped sections): the tag
+// moves to the start of the next line. Before a blank line it stays, so that the library's own
+// rule removes the tag's line and the blank line is kept (TidyBlankLines merges any doubles).
+std::string JoinStandaloneTags(const std::string& text) {
+  static const std::regex standalone(R"(^[ \t]*(\{\{[#^/][^}]*\}\})[ \t]*$)");
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  std::string out;
+  std::smatch m;
+  for (size_t i = 0; i < lines.size(); ++i) {
+    const bool nextBlank = i + 1 >= lines.size() || lines[i + 1].find_first_not_of(" \t") == std::string::npos;
+    if (std::regex_match(lines[i], m, standalone) && !nextBlank) out += m[1].str();
+    else out += lines[i] + "\n";
+  }
+  return out;
+}
+
 std::string Render(const std::string& templatePath, const Data& data) {
-  kainjow::mustache::mustache tmpl(ReadFile(templatePath));
+  kainjow::mustache::mustache tmpl(JoinStandaloneTags(ReadFile(templatePath)));
   if (!tmpl.is_valid()) throw std::runtime_error(templatePath + ": " + tmpl.error_message());
   tmpl.set_custom_escape([](const std::string& s) { return s; });  // code, not HTML
   std::string out = tmpl.render(data);
@@ -250,6 +270,7 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   d.set("helpers", helpers);
   d.set("body", k.glslBody);
   d.set("dim1", k.dims == 1);
+  d.set("dimN", k.dims != 1);
   // Arguments of the thread function: each thread id in the type its parameter or loop variable has.
   std::vector<std::string> idTypes;
   if (k.rtv) {
@@ -268,6 +289,10 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
     active += (a ? " && " : "") + std::string("gl_GlobalInvocationID.") + GlAxis(a) + " < crt_count" + Axis(a);
   d.set("threadArgs", threadArgs);
   d.set("activeTest", active);
+  // A kernel dispatched indirectly runs to the count the GPU holds (capped at the vector's capacity).
+  const std::string& v = k.indirectVector;
+  d.set("countLimit", v.empty() ? std::string("crt_countX") : "min(" + v + "_size, " + v + "_capacity)");
+  d.set("indirectVector", v);
   return Render(opt.templateDir + "/glsl/kernel.comp.mustache", d);
 }
 
@@ -341,6 +366,8 @@ Data ControlsData(const ClassModel& model) {
       y.set("host", m->hostExpr);
       y.set("control", c.name);
       y.set("elemCppType", m->elemCppType);
+      y.set("appended", m->appendedByKernels);
+      y.set("inPlace", !m->appendedByKernels);  // read back at the size the host knows
       written.push_back(y);
     };
     for (auto& kn : c.kernelsCalled)
@@ -355,8 +382,9 @@ Data ControlsData(const ClassModel& model) {
   return controls;
 }
 
-Data VulkanKernelsData(const ClassModel& model) {
+Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
   Data kernels = List();
+  indirectSlots = 0;
   for (auto& k : model.kernels) {
     Data x;
     x.set("name", k.name);
@@ -398,7 +426,9 @@ Data VulkanKernelsData(const ClassModel& model) {
       } else {
         const Loop& loop = k.loops[k.dims - 1 - a];  // innermost loop is x
         ax.set("startExpr", "int(" + loop.startCpp + ")");
-        ax.set("countExpr", "uint32_t(std::max<int64_t>(0, int64_t(" + loop.countCpp + ")))");
+        // An indirect kernel's count is on the GPU; the host's copy of the vector is stale.
+        ax.set("countExpr", k.indirectVector.empty() ? "uint32_t(std::max<int64_t>(0, int64_t(" + loop.countCpp + ")))"
+                                                     : std::string("0u"));
       }
       axes.push_back(ax);
     }
@@ -406,6 +436,12 @@ Data VulkanKernelsData(const ClassModel& model) {
     std::string empty;
     for (unsigned a = 0; a < k.dims; ++a) empty += (a ? " || " : "") + std::string("crt_count") + Axis(a) + " == 0";
     x.set("emptyTest", empty);
+    // Kernels looping to the size of an appended vector: the GPU computes their groups.
+    x.set("indirect", !k.indirectVector.empty());
+    x.set("direct", k.indirectVector.empty());
+    x.set("indirectVector", k.indirectVector);
+    x.set("indirectSlot", std::to_string(indirectSlots));
+    if (!k.indirectVector.empty()) ++indirectSlots;
     std::string buffers = "m_classDataBuffer.View()";
     unsigned bindings = 1;
     for (auto& p : k.params)
@@ -444,6 +480,7 @@ Data VectorsData(const ClassModel& model) {
     x.set("name", m.name);
     x.set("host", m.hostExpr);
     x.set("elemCppType", m.elemCppType);
+    x.set("appended", m.appendedByKernels);
     vectors.push_back(x);
   }
   return vectors;
@@ -468,7 +505,10 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
   d.set("controls", ControlsData(model));
   d.set("vectors", VectorsData(model));
   if (vulkan) {
-    d.set("kernels", VulkanKernelsData(model));
+    unsigned indirectSlots = 0;
+    d.set("kernels", VulkanKernelsData(model, indirectSlots));
+    d.set("indirectSlots", std::to_string(indirectSlots));
+    d.set("hasIndirect", indirectSlots > 0);
     bool anyReductions = false;
     for (auto& k : model.kernels) anyReductions |= !k.reductions.empty();
     d.set("anyReductions", anyReductions);

@@ -338,6 +338,26 @@ std::string GlslPrinter::Construct(QualType t, const std::vector<const clang::Ex
   return out;
 }
 
+// push_back to a member vector: every thread takes a slot from an atomic counter, the vector's size
+// in the class-data block. A push past the capacity is counted but not stored; the generated class
+// reports it when it reads the size back.
+std::string GlslPrinter::EmitAppend(const FieldDecl* field, const CallExpr* call) {
+  const std::string vector = field->getNameAsString(), name = vector + "_push_back";
+  if (!m_emitted.insert(field).second) return name;
+  QualType element;
+  IsStdVector(field->getType(), &element);
+  std::ostringstream os;
+  os << "// " << vector << ".push_back(value), from any number of threads at once\n"
+     << "void " << name << "(" << Declare(element, "value", call->getBeginLoc()) << ")\n"
+     << "{\n"
+     << "  const uint slot = atomicAdd(" << vector << "_size, 1u);\n"
+     << "  if (slot < " << vector << "_capacity)\n"
+     << "    " << vector << "[slot] = value;\n"
+     << "}\n";
+  m_functions.push_back(os.str());
+  return name;
+}
+
 std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callLoc, bool composedEntry) {
   const FunctionDecl* def = nullptr;
   if (!fd->hasBody(def) || !def) {
@@ -518,11 +538,16 @@ std::string GlslPrinter::Call(const CallExpr* call) {
       auto* field = dyn_cast<FieldDecl>(me->getMemberDecl());
       if (field && isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts())) {
         memberVectors.insert(field);
-        if (name == "size") return composedPrefix + field->getNameAsString() + "_size";
+        if (name == "size") {
+          sizeReads.emplace(field, call->getBeginLoc());
+          return composedPrefix + field->getNameAsString() + "_size";
+        }
         if (name == "capacity") return composedPrefix + field->getNameAsString() + "_capacity";
+        if (name == "push_back" && call->getNumArgs() == 1 && composedPrefix.empty())
+          return EmitAppend(field, call) + "(" + Expr(call->getArg(0)) + ")";
       }
       return Fail(call->getBeginLoc(), "std::vector::" + name + " is not supported in kernels",
-                  "kernels may index member vectors and call size(); push_back inside kernels is not supported yet");
+                  "kernels may index member vectors, call size() and capacity(), and push_back() to a member vector");
     }
     // Member functions of LiteMath types and user structs.
     if (IsSystemDecl(method) || method->getParent()->isInStdNamespace())

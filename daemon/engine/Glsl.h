@@ -46,6 +46,8 @@ public:
   std::map<const clang::ValueDecl*, std::string> renames;
   // Members declared std::vector that the kernel reaches, plain members it reads.
   std::set<const clang::FieldDecl*> memberVectors, plainMembers;
+  // Where the kernel reads a member vector's size (a kernel may not read what it appends to).
+  std::multimap<const clang::FieldDecl*, clang::SourceLocation> sizeReads;
   // Helper functions the kernel reaches (their writes to members matter too).
   std::vector<const clang::FunctionDecl*> helpers;
 
@@ -85,6 +87,7 @@ private:
   std::string Construct(clang::QualType t, const std::vector<const clang::Expr*>& args, clang::SourceLocation loc);
   std::string Literal(const clang::Expr* e);
   std::string Cast(clang::QualType to, const clang::Expr* sub);
+  std::string EmitAppend(const clang::FieldDecl* field, const clang::CallExpr* call);
   std::string EmitHelper(const clang::FunctionDecl* fd, clang::SourceLocation callLoc, bool composedEntry = false);
   std::string ComposedCall(const clang::CXXMemberCallExpr* call);
   void NeedStruct(const clang::RecordDecl* rd);

@@ -29,6 +29,7 @@ struct Member {
   bool scalarLayout = false;    // vector whose element needs GL_EXT_scalar_block_layout to match C++
   bool writtenByKernels = false;
   bool usedByKernels = false;
+  bool appendedByKernels = false;  // vector: kernels push_back to it (its size counts on the GPU)
   bool inClassData = false;     // plain: accessible, and its C++ layout matches std430
   unsigned std430Align = 4;     // plain: alignment in a std430 block
 };
@@ -72,6 +73,10 @@ struct Kernel {
   std::vector<Loop> loops;            // IPV: outermost first
   std::vector<Reduction> reductions;
   std::vector<std::string> memberVectors;   // member vectors the kernel reaches (incl. helpers)
+  std::vector<std::string> appends;         // member vectors it push_backs to
+  // 1D kernel looping to the size of a vector that kernels append to: dispatched indirectly, its
+  // thread count read on the GPU.
+  std::string indirectVector;
   std::string glslBody;               // the thread's code, as a GLSL function body
   std::string cpuLoopNest;            // IPV, CPU backend: the loop nest with reductions renamed
   std::string cpuPreamble;            // IPV, CPU backend: statements before the loops

@@ -1,6 +1,10 @@
-// GPU versions of the library calls control functions may make: scans, copies, fills.
+// GPU versions of the library calls control functions may make (scans, sorts, copies, fills), and
+// the indirect dispatch of kernels that run over what earlier kernels appended.
 #include "crossrt/VulkanRuntime.h"
 
+#include "Internal.h"
+
+#include "indirect_groups.h"
 #include "radix_histogram.h"
 #include "radix_scatter.h"
 #include "scan_add_float.h"
@@ -9,6 +13,8 @@
 #include "scan_blocks_float.h"
 #include "scan_blocks_int.h"
 #include "scan_blocks_uint.h"
+
+#include <algorithm>
 
 namespace crossrt {
 
@@ -124,6 +130,43 @@ void FillCmd(VkCommandBuffer cmd, BufferView dst, VkDeviceSize bytes, uint32_t b
   if (bytes == 0) return;
   vkCmdFillBuffer(cmd, dst.buffer, dst.offset, bytes, bits);
   TransferToComputeBarrier(cmd);
+}
+
+IndirectDispatcher::IndirectDispatcher(std::shared_ptr<VulkanContext> ctx, uint32_t slots)
+    : ctx_(std::move(ctx)), slots_(slots) {
+  // Slots are bound as storage buffers: each starts at the device's storage offset alignment.
+  const VkDeviceSize align = std::max<VkDeviceSize>(16, ctx_->properties.limits.minStorageBufferOffsetAlignment);
+  stride_ = (sizeof(VkDispatchIndirectCommand) + align - 1) / align * align;
+  groups_ = ComputePipeline(ctx_, indirect_groups, sizeof(indirect_groups), 2, 16, "crossrt::indirect_groups");
+  args_ = Buffer(ctx_, stride_ * std::max(1u, slots), VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
+}
+
+void IndirectDispatcher::PrepareCmd(VkCommandBuffer cmd, uint32_t slot, BufferView counts, uint32_t sizeOffset,
+                                    uint32_t capacityOffset, uint32_t groupSize) {
+  if (slot >= slots_) throw Error("IndirectDispatcher: slot " + std::to_string(slot) + " of " + std::to_string(slots_));
+  if (sizeOffset % 4 != 0 || capacityOffset % 4 != 0 || groupSize == 0)
+    throw Error("IndirectDispatcher: counts must be aligned 32-bit words, groups non-empty");
+  // An earlier dispatch of this slot must have read its groups before they are rewritten.
+  auto done = VkInit<VkMemoryBarrier>(VK_STRUCTURE_TYPE_MEMORY_BARRIER);
+  done.srcAccessMask = VK_ACCESS_INDIRECT_COMMAND_READ_BIT;
+  done.dstAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &done, 0,
+                       nullptr, 0, nullptr);
+  const VkDeviceSize at = stride_ * slot;
+  struct { uint32_t sizeWord, capacityWord, groupSize, maxGroupsX; } args{sizeOffset / 4, capacityOffset / 4, groupSize, 65535};
+  groups_.Bind(cmd);
+  groups_.PushBuffers(cmd, {counts, args_.View(at, sizeof(VkDispatchIndirectCommand))});
+  groups_.PushConstants(cmd, &args, sizeof(args));
+  vkCmdDispatch(cmd, 1, 1, 1);
+  auto ready = VkInit<VkMemoryBarrier>(VK_STRUCTURE_TYPE_MEMORY_BARRIER);
+  ready.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+  ready.dstAccessMask = VK_ACCESS_INDIRECT_COMMAND_READ_BIT;
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT, 0, 1, &ready, 0,
+                       nullptr, 0, nullptr);
+}
+
+void IndirectDispatcher::DispatchCmd(VkCommandBuffer cmd, uint32_t slot) const {
+  vkCmdDispatchIndirect(cmd, args_.Handle(), stride_ * slot);
 }
 
 }  // namespace crossrt

@@ -1,4 +1,5 @@
-// The CPU backend's versions of library calls in control functions (header only; OpenMP).
+// The CPU backend's versions of library calls in control functions, and of push_back in kernels
+// (header only; OpenMP).
 #pragma once
 #include "SortKey.h"
 
@@ -7,6 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <utility>
 #include <vector>
 
 namespace crossrt {
@@ -63,6 +65,24 @@ void RadixSort(Iterator first, Iterator last, const SortKey& key) {
   if (n <= 1) return;
   static_assert(sizeof(*first) % 4 == 0, "records of whole 32-bit words");
   RadixSortWords(reinterpret_cast<uint32_t*>(&*first), size_t(n), key);
+}
+
+// `v.push_back(x)` in a kernel whose loop runs on all cores: the generated code calls
+// crossrt::Locked(v).push_back(x), one append at a time. The order of the elements is the order the
+// threads arrive in, as on the GPU.
+template <typename Vector>
+struct LockedAppend {
+  Vector& vector;
+  template <typename T>
+  void push_back(T&& value) {
+#pragma omp critical(crossrt_append)
+    vector.push_back(std::forward<T>(value));
+  }
+};
+
+template <typename Vector>
+LockedAppend<Vector> Locked(Vector& vector) {
+  return LockedAppend<Vector>{vector};
 }
 
 }  // namespace crossrt

@@ -165,6 +165,23 @@ T* RawPointer(T* p) { return p; }
 template <typename Smart>
 auto* RawPointer(const Smart& p) { return p.get(); }
 
+// After kernels appended to a std::vector member on the GPU: reads the count they reached (the
+// uint32_t at sizeOffset of `counts`), gives the host vector that size and the elements. The size
+// stays within the capacity, so the vector is not reallocated. Pushes past the capacity were
+// counted but not stored: that throws, after the stored elements are read.
+template <typename Vector>
+void ReadAppended(const Buffer& counts, size_t sizeOffset, const Buffer& elements, Vector& vector, const char* name) {
+  uint32_t appended = 0;
+  counts.Download(&appended, sizeof(appended), sizeOffset);
+  const size_t stored = appended < vector.capacity() ? appended : vector.capacity();
+  vector.resize(stored);
+  if (stored > 0) elements.Download(vector.data(), sizeof(vector[0]) * stored);
+  if (appended > stored)
+    throw Error(std::string(name) + ": kernels appended " + std::to_string(appended) + " elements, but its capacity is " +
+                std::to_string(vector.capacity()) + "; the GPU keeps only that many. Call reserve(" +
+                std::to_string(appended) + ") or more before the call (the first " + std::to_string(stored) + " were kept)");
+}
+
 // Reallocates b (keeping its extra usage) only when it is empty or smaller than bytes.
 void EnsureSize(std::shared_ptr<VulkanContext> ctx, Buffer& b, VkDeviceSize bytes);
 
@@ -306,6 +323,30 @@ private:
   ComputePipeline histogram_, scatter_;
   Scanner scanner_;
   Buffer recordsTmp_, counts_;
+};
+
+// Dispatch of a 1D kernel whose thread count lives on the GPU: the size of a std::vector member
+// that earlier kernels appended to (push_back), capped at its capacity. One thread turns the count
+// into group counts, vkCmdDispatchIndirect launches them: no host round trip. The groups are
+// spread over y as Dispatch1D spreads them; the kernel tests its ids against the count itself.
+class IndirectDispatcher {
+public:
+  IndirectDispatcher() = default;
+  // One slot of group counts per kernel dispatched indirectly.
+  IndirectDispatcher(std::shared_ptr<VulkanContext> ctx, uint32_t slots);
+  // Records the computation of slot's groups: threads = min(the uint at sizeOffset, the uint at
+  // capacityOffset) of `counts`. Binds its own pipeline: bind the kernel's afterwards.
+  void PrepareCmd(VkCommandBuffer cmd, uint32_t slot, BufferView counts, uint32_t sizeOffset, uint32_t capacityOffset,
+                  uint32_t groupSize);
+  // Launches the bound pipeline with slot's groups.
+  void DispatchCmd(VkCommandBuffer cmd, uint32_t slot) const;
+
+private:
+  std::shared_ptr<VulkanContext> ctx_;
+  ComputePipeline groups_;
+  Buffer args_;  // one VkDispatchIndirectCommand per slot, stride_ bytes apart
+  VkDeviceSize stride_ = 0;
+  uint32_t slots_ = 0;
 };
 
 // A view `bytes` further into a buffer view.

@@ -1,0 +1,45 @@
+// Appends and indirect dispatch: kernels push_back to member vectors, and later kernels loop to
+// those vectors' sizes. On the GPU the appends go through an atomic counter and the later kernels
+// are dispatched indirectly, with no host round trip (test/equivalence/test_append.cpp).
+#pragma once
+#include <cstdint>
+#include <vector>
+
+// A record one kernel appends and the next one reads.
+struct Candidate
+{
+  uint32_t index;
+  float value;
+};
+
+class Appending
+{
+public:
+  // Room for `capacity` appends per vector: the GPU keeps at most the capacity.
+  explicit Appending(int capacity)
+  {
+    m_positive.reserve(capacity);
+    m_large.reserve(capacity);
+    m_negative.reserve(2 * capacity);
+  }
+  virtual ~Appending() = default;
+
+  // Two stages: m_positive gets the indices of the positive values, m_large gets {index, 2 * value}
+  // of those above `threshold`, and out[index] = 2 * value for each of those. The order of the
+  // appended elements is unspecified (threads append as they arrive).
+  virtual void Select(int n, float threshold, [[crossrt::size("n")]] const float* values,
+                      [[crossrt::size("n")]] float* out);
+  // Appends the indices of the negative values to m_negative without clearing it first.
+  virtual void Collect(int n, [[crossrt::size("n")]] const float* values);
+  virtual void CommitDeviceData() {}
+
+  std::vector<uint32_t> m_positive;
+  std::vector<Candidate> m_large;
+  std::vector<uint32_t> m_negative;
+
+protected:
+  void kernel1D_FindPositive(int n, const float* values);
+  void kernel1D_FindLarge(float threshold, const float* values);  // over m_positive
+  void kernel1D_Write(float* out);                                 // over m_large
+  void kernel1D_FindNegative(int n, const float* values);
+};

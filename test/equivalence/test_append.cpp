@@ -1,0 +1,139 @@
+// push_back in kernels and indirect dispatch: the original class, Appending_CPU (appends under a
+// lock on all cores) and Appending_Vulkan (an atomic counter, later kernels dispatched over the
+// count the GPU holds) append the same elements. Threads append in any order, so the vectors are
+// compared sorted; the outputs the indirectly dispatched kernel writes are compared exactly.
+#include "Appending.h"
+#include "Appending_CPU.h"
+#include "Appending_Vulkan.h"
+#include "TestSupport.h"
+
+#include <algorithm>
+#include <random>
+#include <tuple>
+
+namespace
+{
+std::vector<float> RandomValues(int n, unsigned seed)
+{
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<float> values(n);
+  for (auto& v : values) v = u(rng);
+  return values;
+}
+
+std::vector<uint32_t> Sorted(std::vector<uint32_t> v)
+{
+  std::sort(v.begin(), v.end());
+  return v;
+}
+
+std::vector<std::tuple<uint32_t, float>> Sorted(const std::vector<Candidate>& v)
+{
+  std::vector<std::tuple<uint32_t, float>> out;
+  for (auto& c : v) out.emplace_back(c.index, c.value);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+using Impls = std::vector<std::pair<const char*, std::shared_ptr<Appending>>>;
+
+Impls AllBackends(const std::shared_ptr<crossrt::VulkanContext>& ctx, int capacity)
+{
+  Impls impls = {{"original", std::make_shared<Appending>(capacity)}, {"CPU", CreateAppending_CPU(capacity)}};
+  if (ctx) impls.push_back({"Vulkan", CreateAppending_Vulkan(ctx, capacity)});
+  return impls;
+}
+}  // namespace
+
+TEST_CASE("push_back in a kernel, then kernels dispatched over the appended count", "[equivalence][append]")
+{
+  auto ctx = ValidatedContext();
+  for (int n : {0, 1, 1000, 100003})
+  {
+    DYNAMIC_SECTION("n = " << n)
+    {
+      const auto values = RandomValues(n, unsigned(n) + 1);
+      std::vector<uint32_t> positive;
+      std::vector<std::tuple<uint32_t, float>> large;
+      std::vector<float> expectedOut(n, -7.0f);
+      for (int i = 0; i < n; ++i)
+      {
+        if (values[i] > 0.0f) positive.push_back(uint32_t(i));
+        if (values[i] > 0.5f)
+        {
+          large.emplace_back(uint32_t(i), 2.0f * values[i]);
+          expectedOut[i] = 2.0f * values[i];
+        }
+      }
+      if (n >= 1000) REQUIRE(large.size() > size_t(n) / 8);  // the data exercises every stage
+
+      for (auto& [name, impl] : AllBackends(ctx, n))
+      {
+        INFO(name);
+        std::vector<float> out(n, -7.0f);
+        // Twice: the second call clears what the first appended, on the host and on the GPU.
+        for (int call = 0; call < 2; ++call)
+        {
+          impl->Select(n, 0.5f, values.data(), out.data());
+          REQUIRE(Sorted(impl->m_positive) == positive);
+          REQUIRE(Sorted(impl->m_large) == large);
+          REQUIRE(out == expectedOut);
+        }
+        REQUIRE(impl->m_positive.capacity() == size_t(n));  // read back without reallocating
+      }
+    }
+  }
+  RequireNoValidationMessages(ctx);
+}
+
+TEST_CASE("Appends accumulate across calls when the control function does not clear", "[equivalence][append]")
+{
+  auto ctx = ValidatedContext();
+  const int n = 5003;
+  const auto first = RandomValues(n, 11), second = RandomValues(n, 12);
+  std::vector<uint32_t> expected;
+  for (auto* values : {&first, &second})
+    for (int i = 0; i < n; ++i)
+      if ((*values)[i] < 0.0f) expected.push_back(uint32_t(i));
+  std::sort(expected.begin(), expected.end());
+  for (auto& [name, impl] : AllBackends(ctx, n))
+  {
+    INFO(name);
+    impl->Collect(n, first.data());
+    const size_t afterFirst = impl->m_negative.size();
+    impl->Collect(n, second.data());
+    REQUIRE(afterFirst > 0);
+    REQUIRE(Sorted(impl->m_negative) == expected);
+  }
+  RequireNoValidationMessages(ctx);
+}
+
+TEST_CASE("Appending past the capacity: the GPU keeps the capacity and says so", "[equivalence][append]")
+{
+  auto ctx = ValidatedContext();
+  if (!ctx) return;
+  const int n = 1000, capacity = 10;
+  const auto values = RandomValues(n, 5);
+  std::vector<float> out(n, -7.0f);
+  auto gpu = CreateAppending_Vulkan(ctx, capacity);
+  REQUIRE_THROWS_WITH(gpu->Select(n, 0.5f, values.data(), out.data()),
+                      Catch::Contains("Appending::m_positive") && Catch::Contains("capacity is 10") &&
+                          Catch::Contains("reserve("));
+  // What fits is kept: every kept index is one of the positive values.
+  REQUIRE(gpu->m_positive.size() == size_t(capacity));
+  for (uint32_t i : gpu->m_positive) REQUIRE(values[i] > 0.0f);
+  // The original grows the vector instead: it has no capacity limit.
+  Appending original(capacity);
+  original.Select(n, 0.5f, values.data(), out.data());
+  REQUIRE(original.m_positive.size() > size_t(capacity));
+  // After reserving enough, the GPU version agrees again.
+  gpu->m_positive.reserve(n);
+  gpu->m_large.reserve(n);
+  std::vector<float> gpuOut(n, -7.0f), cpuOut(n, -7.0f);
+  gpu->Select(n, 0.5f, values.data(), gpuOut.data());
+  original.Select(n, 0.5f, values.data(), cpuOut.data());
+  REQUIRE(Sorted(gpu->m_positive) == Sorted(original.m_positive));
+  REQUIRE(gpuOut == cpuOut);
+  RequireNoValidationMessages(ctx);
+}
