@@ -327,3 +327,82 @@ void Tracer::kernel1D_Run(int n, float* out)
   }
   REQUIRE(!std::filesystem::exists(tc.dir / "out" / "Tracer_Vulkan.cpp"));
 }
+
+TEST_CASE("Appends that a backend cannot make safe, or whose count the host does not have yet, are reported", "[diagnostics][append]")
+{
+  // Each case: Appender's extra declarations, then Appender.cpp from its line 2 on.
+  struct Case { const char* name; const char* declarations; const char* source; int line; const char* message; const char* hint; };
+  const Case cases[] = {
+      {"push_back in a helper", "  uint32_t Push(uint32_t i);",
+       "void Appender::Run(int n, const float* in) { kernel1D_Find(n, in); }\n"
+       "uint32_t Appender::Push(uint32_t i) { m_hits.push_back(i); return i; }\n"
+       "void Appender::kernel1D_Find(int n, const float* in)\n{\n  for (int i = 0; i < n; i++)\n    if (in[i] > 0.0f) Push(uint32_t(i));\n}\n",
+       3, "helper function 'Push' appends to member 'm_hits' (called from every thread: a data race on the CPU)", "call push_back in the kernel's loop body"},
+      {"push_back in a kernel whose loop is in the control function", "  void kernel_Each(int tid, const float* in);",
+       "void Appender::Run(int n, const float* in) { for (int i = 0; i < n; i++) kernel_Each(i, in); }\n"
+       "void Appender::kernel_Each(int tid, const float* in) { if (in[tid] > 0.0f) m_hits.push_back(uint32_t(tid)); }\n",
+       3, "push_back in 'kernel_Each', whose loop is in the control function", "write the loop inside a kernel1D_ kernel"},
+      {"a kernel reads the size it appends to", "",
+       "void Appender::Run(int n, const float* in) { kernel1D_Find(n, in); }\n"
+       "void Appender::kernel1D_Find(int n, const float* in)\n{\n  for (int i = 0; i < n; i++)\n"
+       "    if (in[i] > float(m_hits.size())) m_hits.push_back(uint32_t(i));\n}\n",
+       6, "kernel 'kernel1D_Find' reads the size of 'm_hits', which it appends to", "the final size is known after the kernel"},
+      {"the control function reads the appended size", "  void kernel1D_Use(int count);",
+       "void Appender::Run(int n, const float* in) { kernel1D_Find(n, in); kernel1D_Use(int(m_hits.size())); }\n"
+       "void Appender::kernel1D_Find(int n, const float* in)\n{\n  for (int i = 0; i < n; i++)\n    if (in[i] > 0.0f) m_hits.push_back(uint32_t(i));\n}\n"
+       "void Appender::kernel1D_Use(int count)\n{\n  for (int i = 0; i < count; i++) m_out[i] = float(m_hits[i]);\n}\n",
+       2, "control function 'Run' uses size() of 'm_hits', which kernels append to: on the GPU its size and contents are known only after the call returns",
+       "loop to m_hits.size() inside a kernel1D_ kernel (dispatched indirectly"},
+      {"a 2D loop nest over an appended vector", "  void kernel2D_Use(int w);",
+       "void Appender::Run(int n, const float* in) { kernel1D_Find(n, in); kernel2D_Use(4); }\n"
+       "void Appender::kernel1D_Find(int n, const float* in)\n{\n  for (int i = 0; i < n; i++)\n    if (in[i] > 0.0f) m_hits.push_back(uint32_t(i));\n}\n"
+       "void Appender::kernel2D_Use(int w)\n{\n  for (uint32_t y = 0; y < m_hits.size(); y++)\n    for (int x = 0; x < w; x++) m_out[y * 4 + x] = 1.0f;\n}\n",
+       10, "kernel 'kernel2D_Use' loops to the size of 'm_hits', which kernels append to on the GPU, in a 2D loop nest",
+       "loop to m_hits.size() in a kernel1D_ kernel"},
+      {"a loop over an appended vector that does not start at 0", "  void kernel1D_Use();",
+       "void Appender::Run(int n, const float* in) { kernel1D_Find(n, in); kernel1D_Use(); }\n"
+       "void Appender::kernel1D_Find(int n, const float* in)\n{\n  for (int i = 0; i < n; i++)\n    if (in[i] > 0.0f) m_hits.push_back(uint32_t(i));\n}\n"
+       "void Appender::kernel1D_Use()\n{\n  for (uint32_t i = 1; i < m_hits.size(); i++) m_out[i] = float(m_hits[i]);\n}\n",
+       10, "kernel 'kernel1D_Use' loops over 'm_hits', which kernels append to on the GPU, but not from 0 to m_hits.size()",
+       "skip elements inside the loop"},
+      {"a reduction in a kernel dispatched indirectly", "  void kernel1D_Use();",
+       "void Appender::Run(int n, const float* in) { kernel1D_Find(n, in); kernel1D_Use(); }\n"
+       "void Appender::kernel1D_Find(int n, const float* in)\n{\n  for (int i = 0; i < n; i++)\n    if (in[i] > 0.0f) m_hits.push_back(uint32_t(i));\n}\n"
+       "void Appender::kernel1D_Use()\n{\n  for (uint32_t i = 0; i < m_hits.size(); i++) m_sum += float(m_hits[i]);\n}\n",
+       -1, "kernel 'kernel1D_Use' reduces members and is dispatched indirectly (it loops to m_hits.size())",
+       "append the values and reduce them in a later kernel"},
+  };
+  for (const Case& c : cases)
+  {
+    SECTION(c.name)
+    {
+      TempClass tc("Appender", std::string(R"(#pragma once
+#include <cstdint>
+#include <vector>
+class Appender
+{
+public:
+  virtual ~Appender() = default;
+  virtual void Run(int n, [[crossrt::size("n")]] const float* in);
+  std::vector<uint32_t> m_hits;
+  std::vector<float> m_out;
+  float m_sum = 0.0f;
+protected:
+  void kernel1D_Find(int n, const float* in);
+)") + c.declarations + "\n};\n",
+                   std::string("#include \"Appender.h\"\n") + c.source);
+      CommandResult r = RunCrossrt("translate --class Appender --backend vulkan --out " + (tc.dir / "out").string() + " --source " +
+                                   tc.Source("Appender") + " --templates " CROSSRT_SOURCE_DIR "/templates");
+      INFO(r.output);
+      REQUIRE_FALSE(r.crashed);
+      REQUIRE(r.exitCode == 1);
+      // The reduction case points at the kernel's declaration in the header.
+      const std::string where = c.line > 0 ? "Appender.cpp:" + std::to_string(c.line) + ":" : std::string("Appender.h:");
+      REQUIRE(r.output.find(where) != std::string::npos);
+      REQUIRE(r.output.find(std::string("error: ") + c.message) != std::string::npos);
+      REQUIRE(r.output.find(std::string("hint: ")) != std::string::npos);
+      REQUIRE(r.output.find(c.hint) != std::string::npos);
+      REQUIRE(!std::filesystem::exists(tc.dir / "out" / "Appender_Vulkan.cpp"));
+    }
+  }
+}
