@@ -444,6 +444,200 @@ void CheckKernelParams(Context& c, const CXXMethodDecl* md, Kernel& k) {
   }
 }
 
+// ---- virtual functions -------------------------------------------------------
+
+// Classes of the translation unit (outside system headers) that implement `interface`: concrete
+// and derived from it, in declaration order.
+void FindImplementations(const DeclContext* dc, const CXXRecordDecl* interface, std::vector<const CXXRecordDecl*>& out) {
+  for (auto* d : dc->decls()) {
+    if (auto* ns = dyn_cast<NamespaceDecl>(d); ns && !ns->isStdNamespace() && !IsSystemDecl(ns)) FindImplementations(ns, interface, out);
+    auto* rd = dyn_cast<CXXRecordDecl>(d);
+    if (!rd || !rd->isThisDeclarationADefinition() || IsSystemDecl(rd) || rd->isAbstract() || rd->isDependentContext()) continue;
+    if (rd->isDerivedFrom(interface)) out.push_back(rd);
+    FindImplementations(rd, interface, out);  // nested classes
+  }
+}
+
+// The data of an object, base classes first, as the GPU mirror holds it.
+void CollectObjectFields(Context& c, const CXXRecordDecl* rd, const CXXRecordDecl* impl, std::vector<const FieldDecl*>& out) {
+  for (auto& base : rd->bases())
+    if (auto* b = base.getType()->getAsCXXRecordDecl(); b && b->hasDefinition()) CollectObjectFields(c, b->getDefinition(), impl, out);
+  for (auto* f : rd->fields()) out.push_back(f);
+}
+
+// Offsets of a struct with these fields, in order, laid out by C++ (natural alignment) or by a GLSL
+// layout; nullopt when a field has no GLSL layout.
+std::optional<std::vector<uint64_t>> MirrorOffsets(ASTContext& ctx, const std::vector<const FieldDecl*>& fields, int layout /* 0 C++, 1 std430, 2 scalar */) {
+  std::vector<uint64_t> offsets;
+  uint64_t offset = 0, align = 1;
+  for (auto* f : fields) {
+    uint64_t a, size;
+    if (layout == 0) {
+      a = ctx.getTypeAlignInChars(f->getType()).getQuantity();
+      size = ctx.getTypeSizeInChars(f->getType()).getQuantity();
+    } else {
+      auto l = Std430Layout(ctx, f->getType(), layout == 2);
+      if (!l) return std::nullopt;
+      a = l->align;
+      size = l->size;
+    }
+    offset = (offset + a - 1) / a * a;
+    offsets.push_back(offset);
+    offset += size;
+    align = std::max(align, a);
+  }
+  offsets.push_back((offset + align - 1) / align * align);  // the array stride
+  return offsets;
+}
+
+// The implementation of `method` the GPU runs for objects of `impl`: its GLSL name, or "" (reported).
+std::string ImplementationMethod(Context& c, GlslPrinter& printer, const CXXRecordDecl* impl, const CXXMethodDecl* method, SourceLocation callLoc) {
+  const CXXMethodDecl* overrider = method->getCorrespondingMethodInClass(impl);
+  const FunctionDecl* def = nullptr;
+  if (!overrider || overrider->isPureVirtual() || !overrider->hasBody(def) || !def) {
+    c.rep.Error(callLoc, "the GPU needs the body of " + impl->getNameAsString() + "'s " + method->getNameAsString() +
+                " (kernels call it through virtual functions), but this translation unit does not define it",
+                "define it in the header that declares " + impl->getNameAsString() + ", or in the class's source file");
+    return "";
+  }
+  return printer.EmitComposedMethod(overrider);
+}
+
+// Kernel calls `m_objects[i]->Method(...)`: for every implementation of the interface, its data as
+// a GLSL struct in a buffer of its own (reached by a buffer reference), its methods printed with
+// `self`, and per method a dispatcher that switches over the object's class.
+void AnalyzeVirtualCalls(Context& c, Kernel& k, GlslPrinter& kernelPrinter) {
+  std::map<const FieldDecl*, std::vector<const CXXMethodDecl*>> calls;
+  for (auto& [field, method] : kernelPrinter.virtualCalls) calls[field].push_back(method);
+  std::vector<std::string> structs, functions;
+  for (auto& [field, methods] : calls) {
+    QualType element;
+    IsStdVector(field->getType(), &element);
+    const CXXRecordDecl* interface = PolymorphicPointee(element);
+    const std::string member = field->getNameAsString();
+    if (field->getAccess() == AS_private)
+      c.rep.Error(field->getLocation(), "member '" + member + "' is private, but the generated class derives from '" + c.cls->getNameAsString() + "' and must reach it",
+                  "declare it protected");
+    std::vector<const CXXRecordDecl*> impls;
+    FindImplementations(c.ctx.getTranslationUnitDecl(), interface, impls);
+    if (impls.empty()) {
+      c.rep.Error(field->getLocation(), "kernels call " + interface->getNameAsString() + " through '" + member + "', but no class that implements it is defined here",
+                  "define the implementations (classes derived from " + interface->getNameAsString() + ") in a header the class's source includes");
+      continue;
+    }
+    auto known = std::find_if(c.model.virtuals.begin(), c.model.virtuals.end(), [&](const VirtualMember& v) { return v.member == member; });
+    if (known == c.model.virtuals.end()) {
+      VirtualMember vm;
+      vm.member = member;
+      vm.interfaceName = interface->getNameAsString();
+      for (auto* impl : impls) {
+        VirtualImpl vi;
+        vi.name = impl->getNameAsString();
+        vi.header = FileOf(c.ctx, impl->getLocation());
+        std::vector<const FieldDecl*> fields;
+        CollectObjectFields(c, impl, impl, fields);
+        bool ok = true;
+        for (auto* f : fields) {
+          auto g = GlslTypeOf(f->getType());
+          if (!g || f->getType()->isPointerType() || IsStdVector(f->getType()) || f->isBitField()) {
+            c.rep.Error(f->getLocation(), "member '" + f->getNameAsString() + "' of " + vi.name + " cannot be copied to the GPU (kernels call " + vm.interfaceName +
+                        " through '" + member + "')", "objects called through virtual functions hold plain data: scalars, LiteMath types and structs of them");
+            ok = false;
+            continue;
+          }
+          if (f->getAccess() != AS_public) {
+            c.rep.Error(f->getLocation(), "member '" + f->getNameAsString() + "' of " + vi.name + " is copied to the GPU (kernels call " + vm.interfaceName +
+                        " through '" + member + "'), but the generated class cannot read it", "declare it public");
+            ok = false;
+            continue;
+          }
+          QualType base = f->getType();
+          while (auto* arr = dyn_cast<ConstantArrayType>(base.getCanonicalType().getTypePtr())) base = arr->getElementType();
+          vi.fields.push_back({f->getNameAsString(), CppTypeName(c.ctx, base.getCanonicalType()), *g, 4, "", ""});
+        }
+        if (!ok) continue;
+        auto cpp = MirrorOffsets(c.ctx, fields, 0), std430 = MirrorOffsets(c.ctx, fields, 1), scalar = MirrorOffsets(c.ctx, fields, 2);
+        if (std430 && *std430 == *cpp) vi.scalarLayout = false;
+        else if (scalar && *scalar == *cpp) vi.scalarLayout = true;
+        else {
+          c.rep.Error(impl->getLocation(), "the data of " + vi.name + " cannot be laid out on the GPU as C++ lays it out",
+                      "use 32-bit scalars and LiteMath vectors; put 16-byte types (float4) first");
+          continue;
+        }
+        vm.impls.push_back(vi);
+      }
+      c.model.virtuals.push_back(vm);
+      known = c.model.virtuals.end() - 1;
+    }
+    const VirtualMember& vm = *known;
+    k.bufferReferences = true;
+    // Data structs and buffer references, then each implementation's methods.
+    structs.push_back("layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer " + member +
+                      "_Tags { uvec2 tags[]; };  // per element of " + member + ": (class, index among its objects)\n");
+    std::map<std::string, std::string> implFunction;  // (impl, method) -> GLSL name
+    for (auto* impl : impls) {
+      auto vi = std::find_if(vm.impls.begin(), vm.impls.end(), [&](const VirtualImpl& x) { return x.name == impl->getNameAsString(); });
+      if (vi == vm.impls.end()) continue;
+      GlslPrinter printer(c.ctx, impl, c.rep);
+      printer.selfClass = impl;
+      printer.composedPrefix = vi->name + "_";
+      for (auto& sn : ClassStructNames(c.model)) printer.predeclaredStructs.insert(sn);
+      std::ostringstream data;
+      data << "struct " << vi->name << "_Data {  // the data members of " << vi->name << "\n";
+      std::vector<const FieldDecl*> fields;
+      CollectObjectFields(c, impl, impl, fields);
+      for (auto* f : fields) data << "  " << printer.Declare(f->getType(), GlslPrinter::SafeName(f->getNameAsString()), f->getLocation()) << ";\n";
+      data << "};\n";
+      for (auto* m : methods) implFunction[vi->name + "::" + m->getNameAsString()] = ImplementationMethod(c, printer, impl, m, field->getLocation());
+      for (auto& x : printer.Structs()) structs.push_back(x);
+      structs.push_back(data.str());
+      structs.push_back(std::string("layout(buffer_reference, ") + (vi->scalarLayout ? "scalar" : "std430") + ", buffer_reference_align = 4) readonly buffer " +
+                        member + "_" + vi->name + "Objects { " + vi->name + "_Data objects[]; };\n");
+      k.scalarReferences |= vi->scalarLayout;
+      for (auto& x : printer.Constants())
+        if (std::find(k.constantList.begin(), k.constantList.end(), x) == k.constantList.end()) k.constantList.push_back(x);
+      for (auto& x : printer.Functions()) functions.push_back(x);
+    }
+    for (auto* m : methods) {
+      std::ostringstream os;
+      auto ret = kernelPrinter.Type(m->getReturnType(), m->getLocation());
+      const std::string retType = ret ? *ret : "void";
+      os << "// " << member << "[index]->" << m->getNameAsString() << (m->getNumParams() ? "(...)" : "()") << ": the object's class picks the implementation\n";
+      os << retType << " " << member << "_" << m->getNameAsString() << "(uint index";
+      // The interface's parameter names (it may leave them unnamed).
+      std::vector<std::string> names;
+      for (auto* p : m->parameters())
+        names.push_back(p->getName().empty() ? "arg" + std::to_string(names.size()) : GlslPrinter::SafeName(p->getNameAsString()));
+      for (unsigned i = 0; i < m->getNumParams(); ++i) {
+        QualType pt = m->getParamDecl(i)->getType();
+        std::string qualifier = pt->isReferenceType() && !pt.getNonReferenceType().isConstQualified() ? "inout " : "";
+        os << ", " << qualifier << kernelPrinter.Declare(pt, names[i], m->getParamDecl(i)->getLocation());
+      }
+      os << ")\n{\n  const uvec2 tag = " << member << "_Tags(" << member << "_tags).tags[index];\n  switch (tag.x)\n  {\n";
+      for (size_t t = 0; t < vm.impls.size(); ++t) {
+        const auto& vi = vm.impls[t];
+        std::string args = member + "_" + vi.name + "Objects(" + member + "_" + vi.name + ").objects[tag.y]";
+        for (auto& n : names) args += ", " + n;
+        const std::string call = implFunction[vi.name + "::" + m->getNameAsString()] + "(" + args + ")";
+        os << "    case " << t << "u: " << (retType == "void" ? call + "; return;" : "return " + call + ";") << "\n";
+      }
+      os << "  }\n";
+      if (retType != "void") os << "  " << retType << " none;  // not reached: every element holds one of these classes\n  return none;\n";
+      os << "}\n";
+      functions.push_back(os.str());
+    }
+  }
+  // Ahead of the kernel's own code, which calls the dispatchers.
+  for (auto& x : structs)
+    if (std::find(k.structList.begin(), k.structList.end(), x) == k.structList.end()) k.structList.push_back(x);
+  // Free functions both print are the same text: keep the first.
+  std::vector<std::string> merged;
+  for (auto* list : {&functions, &k.functionList})
+    for (auto& x : *list)
+      if (std::find(merged.begin(), merged.end(), x) == merged.end()) merged.push_back(x);
+  k.functionList = merged;
+}
+
 void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def) {
   Kernel k;
   k.name = md->getNameAsString();
@@ -612,6 +806,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   k.structList = printer.Structs();
   k.constantList = printer.Constants();
   k.functionList = printer.Functions();
+  if (!printer.virtualCalls.empty()) AnalyzeVirtualCalls(c, k, printer);
   k.composedCalls = printer.composedCalls;
   for (auto& [holder, method] : printer.composedCalls) {
     if (std::any_of(c.model.compositions.begin(), c.model.compositions.end(), [&](const Composition& x) { return x.holder == holder; }))
@@ -1468,14 +1663,20 @@ void FinishModel(ClassModel& model) {
   std::vector<BlockField> fields;
   for (auto& m : model.members)
     if (m.kind == MemberKind::Plain && m.inClassData && (m.usedByKernels || m.hostExpr == m.name))
-      fields.push_back({m.name, m.cppType, m.glslType, m.std430Align, m.hostExpr});
+      fields.push_back({m.name, m.cppType, m.glslType, m.std430Align, m.hostExpr, ""});
   for (auto& m : model.members) {
     if (!m.usedByKernels || m.kind != MemberKind::Vector) continue;
-    fields.push_back({m.name + "_size", "uint32_t", "uint", 4, ""});
-    fields.push_back({m.name + "_capacity", "uint32_t", "uint", 4, ""});
+    fields.push_back({m.name + "_size", "uint32_t", "uint", 4, "", ""});
+    fields.push_back({m.name + "_capacity", "uint32_t", "uint", 4, "", ""});
+  }
+  // Virtual functions: where each vector's tags and each implementation's objects are on the device.
+  for (auto& v : model.virtuals) {
+    fields.push_back({v.member + "_tags", "uint64_t", "uvec2", 8, "", "m_virtual." + v.member + "_tags.Address()"});
+    for (auto& impl : v.impls)
+      fields.push_back({v.member + "_" + impl.name, "uint64_t", "uvec2", 8, "", "m_virtual." + v.member + "_" + impl.name + ".Address()"});
   }
   std::stable_sort(fields.begin(), fields.end(), [](const BlockField& a, const BlockField& b) { return a.std430Align > b.std430Align; });
-  if (fields.empty()) fields.push_back({"dummy", "uint32_t", "uint", 4, ""});  // a block needs a member
+  if (fields.empty()) fields.push_back({"dummy", "uint32_t", "uint", 4, "", ""});  // a block needs a member
   model.classData = fields;
 }
 

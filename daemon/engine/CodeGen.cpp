@@ -132,6 +132,8 @@ Data ClassDataList(const ClassModel& model) {
     d.set("decl", base + " " + f.name + dims);
     auto* m = FindMember(model, f.name);
     d.set("isPlain", m != nullptr);
+    d.set("computed", !f.assignExpr.empty());
+    d.set("assignExpr", f.assignExpr);
     d.set("written", m != nullptr && m->writtenByKernels);
     list.push_back(d);
   }
@@ -174,6 +176,48 @@ Data Common(const ClassModel& model, const GenerateOptions& opt) {
     comps.push_back(x);
   }
   d.set("compositions", comps);
+  // Virtual functions: the implementations' data mirrors and the regrouping of the objects.
+  Data virtuals = List(), implIncludes = List();
+  std::set<std::string> headers;
+  for (auto& v : model.virtuals) {
+    Data x;
+    x.set("member", v.member);
+    x.set("interface", v.interfaceName);
+    std::string names;
+    Data impls = List();
+    for (size_t t = 0; t < v.impls.size(); ++t) {
+      const VirtualImpl& vi = v.impls[t];
+      names += (t ? ", " : "") + vi.name;
+      Data y;
+      y.set("impl", vi.name);
+      y.set("member", v.member);
+      y.set("typeIndex", std::to_string(t));
+      y.set("first", t == 0);
+      Data fields = List();
+      for (auto& f : vi.fields) {
+        Data z;
+        z.set("name", f.name);
+        z.set("cppType", f.cppType);
+        z.set("arraySuffix", SplitArray(f.glslType).second);
+        fields.push_back(z);
+      }
+      y.set("fields", fields);
+      y.set("layout", vi.scalarLayout ? "scalar" : "std430");
+      impls.push_back(y);
+      if (vi.header != model.headerFile && headers.insert(vi.header).second) {
+        Data h;
+        h.set("include", opt.includeSpelling ? opt.includeSpelling(vi.header) : vi.header);
+        h.set("interface", v.interfaceName);
+        implIncludes.push_back(h);
+      }
+    }
+    x.set("impls", impls);
+    x.set("implNames", names);
+    virtuals.push_back(x);
+  }
+  d.set("virtuals", virtuals);
+  d.set("hasVirtuals", !model.virtuals.empty());
+  d.set("virtualIncludes", implIncludes);
   return d;
 }
 
@@ -240,7 +284,8 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
     x.set("subgroupOp", r.op == ReduceOp::Min ? "subgroupMin" : r.op == ReduceOp::Max ? "subgroupMax" : "subgroupAdd");
     reductions.push_back(x);
   }
-  d.set("scalarLayout", scalarAny);
+  d.set("scalarLayout", scalarAny || k.scalarReferences);
+  d.set("bufferReferences", k.bufferReferences);
   d.set("buffers", buffers);
   d.set("reductions", reductions);
   d.set("hasReductions", !k.reductions.empty());
@@ -292,6 +337,7 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   // A kernel dispatched indirectly runs to the count the GPU holds (capped at the vector's capacity).
   const std::string& v = k.indirectVector;
   d.set("countLimit", v.empty() ? std::string("crt_countX") : "min(" + v + "_size, " + v + "_capacity)");
+  d.set("indirect", !v.empty());
   d.set("indirectVector", v);
   return Render(opt.templateDir + "/glsl/kernel.comp.mustache", d);
 }

@@ -365,7 +365,8 @@ std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callL
                 "define it in a header or in one of the class's source files");
   }
   // Composed code keeps its names under the holder's prefix: no clash with the kernel's helpers.
-  std::string name = composedPrefix + fd->getNameAsString();
+  // Methods printed for an object (virtual calls) are per class; free functions are shared.
+  std::string name = (selfClass && !isa<CXXMethodDecl>(fd) ? "" : composedPrefix) + fd->getNameAsString();
   if (m_inProgress.count(def))
     return Fail(callLoc, "recursive call to '" + fd->getQualifiedNameAsString() + "' in a kernel",
                 "GPUs have no call stack: rewrite the recursion as a loop with an explicit stack array");
@@ -376,12 +377,14 @@ std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callL
   std::ostringstream os;
   auto ret = Type(def->getReturnType(), def->getLocation());
   os << "// from " << def->getQualifiedNameAsString() << "\n" << (ret ? *ret : "void") << " " << name << "(";
+  const bool withSelf = selfClass && isa<CXXMethodDecl>(def) && !cast<CXXMethodDecl>(def)->isStatic();
+  if (withSelf) os << selfClass->getNameAsString() << "_Data self";
   for (unsigned i = 0; i < def->getNumParams(); ++i) {
     auto* p = def->getParamDecl(i);
     QualType pt = p->getType();
     std::string qualifier;
     if (pt->isReferenceType() && !pt.getNonReferenceType().isConstQualified()) qualifier = "inout ";
-    os << (i ? ", " : "") << qualifier << Declare(pt, p->getNameAsString(), p->getLocation());
+    os << (i || withSelf ? ", " : "") << qualifier << Declare(pt, p->getNameAsString(), p->getLocation());
   }
   os << ")\n";
   int savedDepth = m_loopDepth;
@@ -432,6 +435,42 @@ std::string GlslPrinter::ComposedCall(const CXXMemberCallExpr* mc) {
   std::string s = holder + "_" + method + "(";
   for (size_t i = 0; i < args.size(); ++i) s += (i ? ", " : "") + args[i];
   return s + ")";
+}
+
+// `m_objects[i]->Method(args)` where m_objects is a std::vector of shared_ptr, unique_ptr or plain
+// pointers to a polymorphic class: `m_objects_Method(uint(i), args)`, the dispatcher that the
+// analysis writes for the implementations it finds; "" when the call is not of that form.
+std::string GlslPrinter::VirtualCall(const CXXMemberCallExpr* mc) {
+  const clang::Expr* obj = mc->getImplicitObjectArgument()->IgnoreParenImpCasts();
+  if (auto* op = dyn_cast<CXXOperatorCallExpr>(obj); op && op->getOperator() == OO_Arrow) obj = op->getArg(0)->IgnoreParenImpCasts();
+  auto* subscript = dyn_cast<CXXOperatorCallExpr>(obj);
+  if (!subscript || subscript->getOperator() != OO_Subscript) return "";
+  auto* me = dyn_cast<MemberExpr>(subscript->getArg(0)->IgnoreParenImpCasts());
+  auto* field = me ? dyn_cast<FieldDecl>(me->getMemberDecl()) : nullptr;
+  QualType element;
+  if (!field || !isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts()) || !IsStdVector(field->getType(), &element)) return "";
+  if (!PolymorphicPointee(element)) return "";
+  auto* method = mc->getMethodDecl();
+  if (!method->isVirtual())
+    return Fail(mc->getBeginLoc(), "call of the non-virtual " + method->getQualifiedNameAsString() + " through '" + field->getNameAsString() + "' in a kernel",
+                "the GPU picks the implementation by the object's type: make the method virtual in the interface");
+  std::vector<std::string> args = {"uint(" + Expr(subscript->getArg(1)) + ")"};
+  for (auto* arg : mc->arguments()) args.push_back(Expr(arg));
+  Type(mc->getType(), mc->getBeginLoc());  // declares a returned struct
+  virtualCalls.insert({field, method->getCanonicalDecl()});
+  std::string s = field->getNameAsString() + "_" + method->getNameAsString() + "(";
+  for (size_t i = 0; i < args.size(); ++i) s += (i ? ", " : "") + args[i];
+  return s + ")";
+}
+
+const CXXRecordDecl* PolymorphicPointee(QualType t) {
+  t = t.getCanonicalType();
+  const CXXRecordDecl* pointee = nullptr;
+  if (t->isPointerType()) pointee = t->getPointeeType()->getAsCXXRecordDecl();
+  else if (auto* spec = dyn_cast_or_null<ClassTemplateSpecializationDecl>(t->getAsCXXRecordDecl());
+           spec && spec->isInStdNamespace() && (spec->getName() == "shared_ptr" || spec->getName() == "unique_ptr"))
+    pointee = spec->getTemplateArgs()[0].getAsType()->getAsCXXRecordDecl();
+  return pointee && pointee->hasDefinition() && pointee->isPolymorphic() ? pointee->getDefinition() : nullptr;
 }
 
 namespace {
@@ -524,6 +563,16 @@ std::string GlslPrinter::Call(const CallExpr* call) {
       if (StringRef(name).starts_with("kernel"))
         return Fail(call->getBeginLoc(), "kernel '" + name + "' is called from inside a kernel", "call kernels only from control functions");
       std::vector<std::string> args;
+      if (selfClass) {
+        args.push_back("self");
+        // The object's exact class is known: a virtual call on it is static.
+        if (auto* overrider = method->getCorrespondingMethodInClass(selfClass); overrider && method->isVirtual()) {
+          for (auto* arg : call->arguments()) args.push_back(Expr(arg));
+          std::string s = EmitHelper(overrider, call->getBeginLoc(), true) + "(";
+          for (size_t i = 0; i < args.size(); ++i) s += (i ? ", " : "") + args[i];
+          return s + ")";
+        }
+      }
       for (auto* arg : call->arguments()) args.push_back(Expr(arg));
       std::string callee = EmitHelper(method, call->getBeginLoc());
       std::string s = callee + "(";
@@ -533,6 +582,9 @@ std::string GlslPrinter::Call(const CallExpr* call) {
     // Calls through a member holding an interface: composition.
     std::string composed = ComposedCall(mc);
     if (!composed.empty()) return composed;
+    // Calls through an element of a vector of objects: dynamic dispatch.
+    std::string dispatched = VirtualCall(mc);
+    if (!dispatched.empty()) return dispatched;
     // Calls on a std::vector member.
     if (auto* me = dyn_cast<MemberExpr>(obj); me && IsStdVector(me->getType())) {
       auto* field = dyn_cast<FieldDecl>(me->getMemberDecl());
@@ -637,6 +689,12 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
     if (isa<CXXThisExpr>(base)) {
       if (auto it = renames.find(me->getMemberDecl()); it != renames.end()) return it->second;
       if (!field) return Fail(e->getBeginLoc(), "member '" + me->getMemberDecl()->getNameAsString() + "' cannot be used here", "");
+      if (selfClass) {  // a method of an object the kernel reached through a virtual call: its data is `self`
+        if (!GlslTypeOf(field->getType()) || IsStdVector(field->getType()) || field->getType()->isPointerType())
+          return Fail(e->getBeginLoc(), "member '" + field->getNameAsString() + "' of " + selfClass->getNameAsString() + " cannot be copied to the GPU",
+                      "objects called through virtual functions hold plain data: scalars, LiteMath types and structs of them");
+        return "self." + SafeName(field->getNameAsString());
+      }
       if (IsStdVector(field->getType())) {
         memberVectors.insert(field);
         return composedPrefix + field->getNameAsString();

@@ -36,6 +36,9 @@ std::optional<LayoutInfo> Std430Layout(clang::ASTContext& ctx, clang::QualType t
 // True when an array of `type` in the given layout has the C++ stride and field offsets.
 bool LayoutMatchesCpp(clang::ASTContext& ctx, clang::QualType type, bool scalar);
 
+// The polymorphic class a shared_ptr, unique_ptr or plain pointer type points to, or null.
+const clang::CXXRecordDecl* PolymorphicPointee(clang::QualType type);
+
 // Prints the code one kernel reaches. One instance per kernel; it collects the helper functions,
 // structs and constants the kernel needs, in an order GLSL accepts (callees before callers).
 class GlslPrinter {
@@ -61,6 +64,13 @@ public:
   std::string composedPrefix;
   // Prints the implementation of an interface method, called from kernels as <prefix><name>.
   std::string EmitComposedMethod(const clang::CXXMethodDecl* method);
+
+  // Virtual functions (paper 3.9). In a kernel's printer: calls `m_objects[i]->Method(...)` through
+  // a std::vector of pointers to a polymorphic class, as (vector member, interface method).
+  std::set<std::pair<const clang::FieldDecl*, const clang::CXXMethodDecl*>> virtualCalls;
+  // In an implementation's printer ("object mode"): the class whose methods are printed; its members
+  // read from the parameter `self` of type <Class>_Data, and its methods take `self` first.
+  const clang::CXXRecordDecl* selfClass = nullptr;
 
   std::string Expr(const clang::Expr* e);
   std::string Stmt(const clang::Stmt* s, int indent);
@@ -90,6 +100,7 @@ private:
   std::string EmitAppend(const clang::FieldDecl* field, const clang::CallExpr* call);
   std::string EmitHelper(const clang::FunctionDecl* fd, clang::SourceLocation callLoc, bool composedEntry = false);
   std::string ComposedCall(const clang::CXXMemberCallExpr* call);
+  std::string VirtualCall(const clang::CXXMemberCallExpr* call);
   void NeedStruct(const clang::RecordDecl* rd);
   void NeedConstant(const clang::VarDecl* vd);
   std::string Fail(clang::SourceLocation loc, const std::string& message, const std::string& hint);

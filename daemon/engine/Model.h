@@ -14,6 +14,7 @@ struct BlockField {
   std::string glslType;  // GLSL type, may end with an array suffix "[N]"
   unsigned std430Align = 4;
   std::string hostExpr;  // how the generated class reaches the value (plain members)
+  std::string assignExpr;  // values the generated class computes (device addresses)
 };
 
 enum class MemberKind { Plain, Vector };
@@ -85,6 +86,8 @@ struct Kernel {
   // order GLSL accepts (composed code is merged in ahead of the kernel's own).
   std::vector<std::string> structList, constantList, functionList;
   std::set<std::pair<std::string, std::string>> composedCalls;  // (holder member, interface method)
+  bool bufferReferences = false;      // reaches objects through buffer references (virtual calls)
+  bool scalarReferences = false;      // some of them need the scalar layout
 };
 
 struct ControlParam {
@@ -123,6 +126,22 @@ struct Composition {
   std::string implHeader;      // file declaring the implementation (included by generated code)
 };
 
+// Virtual functions (paper 3.9, level 2): a std::vector member holding pointers to an interface.
+// On the GPU each implementation's objects sit in a buffer of their own, and a (class, index) tag
+// per element picks the implementation in a switch.
+struct VirtualImpl {
+  std::string name;                // Lambert
+  std::string header;              // the file that declares it (generated code includes it)
+  std::vector<BlockField> fields;  // its data, base classes' first: the mirror <name>_Data
+  bool scalarLayout = false;       // the mirror matches C++ only with GL_EXT_scalar_block_layout
+};
+
+struct VirtualMember {
+  std::string member;         // m_materials
+  std::string interfaceName;  // IMaterial
+  std::vector<VirtualImpl> impls;  // every class of the translation unit that implements it
+};
+
 struct ClassModel {
   std::string className;
   std::string headerFile;      // header declaring the class (as included by generated code)
@@ -137,6 +156,7 @@ struct ClassModel {
   std::vector<std::string> sourceIncludes;  // #include lines of the sources (quoted ones made absolute)
   std::vector<std::string> usingDecls; // top-level using-directives of the sources: copied bodies need them
   std::vector<Composition> compositions;   // holders kernels call through, in declaration order
+  std::vector<VirtualMember> virtuals;     // vectors of objects kernels call virtual functions of
 };
 
 // The member named `name`, or null (works on a const and a mutable model).

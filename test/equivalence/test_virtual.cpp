@@ -1,0 +1,145 @@
+// Virtual functions in kernels: MaterialShading calls IMaterial through a std::vector of
+// shared_ptr. The original, MaterialShading_CPU and MaterialShading_Vulkan (each class's objects in
+// a buffer of their own, reached by buffer references, a switch over the object's class) shade the
+// same points. The GPU may contract a*b+c to fma and pow differs by an ulp or so, hence 1e-5.
+#include "MaterialShading.h"
+#include "MaterialShading_CPU.h"
+#include "MaterialShading_Vulkan.h"
+#include "TestSupport.h"
+
+#include <random>
+
+namespace
+{
+// An implementation the translator never saw (it is defined here, not where MaterialShading is).
+struct Glass : IMaterial
+{
+  float3 Shade(float3, float3) const override { return float3(0.0f); }
+};
+
+std::vector<std::shared_ptr<IMaterial>> Palette()
+{
+  auto lambert = [](float r, float g, float b) {
+    auto m = std::make_shared<Lambert>();
+    m->albedo = float3(r, g, b);
+    return m;
+  };
+  auto phong = [](float shininess, float3 specular) {
+    auto m = std::make_shared<Phong>();
+    m->shininess = shininess;
+    m->specular = specular;
+    return m;
+  };
+  auto checker = [](int axis, float scale, float opacity) {
+    auto m = std::make_shared<Checker>();
+    m->axis = axis;
+    m->scale = scale;
+    m->opacity = opacity;
+    return m;
+  };
+  // Classes interleaved, so that an element's index differs from its index among its class.
+  return {lambert(0.9f, 0.1f, 0.1f), phong(8.0f, float3(0.3f)), checker(0, 4.0f, 0.25f), lambert(0.1f, 0.8f, 0.2f),
+          phong(64.0f, float3(0.9f, 0.8f, 0.7f)), checker(2, 7.0f, 0.75f), phong(2.0f, float3(0.1f))};
+}
+
+struct Scene
+{
+  std::vector<float4> normals;
+  std::vector<uint32_t> ids;
+};
+
+Scene RandomScene(int n, uint32_t materials, unsigned seed)
+{
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> g;
+  Scene s;
+  for (int i = 0; i < n; ++i)
+  {
+    const float3 v = LiteMath::normalize(float3(g(rng), g(rng), g(rng)));
+    s.normals.push_back(float4(v.x, v.y, v.z, 0.0f));
+    s.ids.push_back(uint32_t(rng() % materials));
+  }
+  return s;
+}
+
+std::vector<float4> ShadeWith(MaterialShading& shading, const Scene& s)
+{
+  std::vector<float4> colors(s.normals.size(), float4(-1.0f));
+  shading.Shade(int(s.normals.size()), s.normals.data(), s.ids.data(), colors.data());
+  return colors;
+}
+
+size_t Differing(const std::vector<float4>& a, const std::vector<float4>& b, float tolerance)
+{
+  size_t bad = 0;
+  for (size_t i = 0; i < a.size(); ++i)
+    for (int c = 0; c < 4; ++c)
+      if (!Close(a[i][c], b[i][c], tolerance))
+      {
+        ++bad;
+        break;
+      }
+  return bad;
+}
+}  // namespace
+
+TEST_CASE("Virtual functions: three implementations of different sizes, picked per element", "[equivalence][virtual]")
+{
+  auto ctx = ValidatedContext();
+  const auto palette = Palette();
+  const Scene scene = RandomScene(20011, uint32_t(palette.size()), 3);
+
+  MaterialShading original;
+  original.m_materials = palette;
+  const auto expected = ShadeWith(original, scene);
+  // Every element was shaded, and both opacities (1 from the interface, the checkers' own) occur.
+  size_t opaque = 0, translucent = 0;
+  for (auto& c : expected) (c.w == 1.0f ? opaque : translucent) += 1;
+  REQUIRE(opaque > expected.size() / 2);
+  REQUIRE(translucent > expected.size() / 10);
+  for (auto& c : expected) REQUIRE((c.w == 1.0f || c.w == 0.25f || c.w == 0.75f));
+
+  auto cpu = CreateMaterialShading_CPU();
+  cpu->m_materials = palette;
+  REQUIRE(Differing(ShadeWith(*cpu, scene), expected, 0.0f) == 0);  // the same compiled C++ on all cores
+
+  if (!ctx) return;
+  auto gpu = CreateMaterialShading_Vulkan(ctx);
+  gpu->m_materials = palette;
+  REQUIRE(Differing(ShadeWith(*gpu, scene), expected, 1e-5f) == 0);
+
+  SECTION("objects changed in place are seen after CommitDeviceData()")
+  {
+    auto changed = Palette();
+    static_cast<Lambert&>(*changed[0]).albedo = float3(0.0f, 0.0f, 1.0f);
+    static_cast<Checker&>(*changed[5]).opacity = 0.125f;
+    changed[1] = changed[3];  // an element now holds another class: the tags change
+    original.m_materials = changed;
+    gpu->m_materials = changed;
+    gpu->CommitDeviceData();
+    const auto expectedChanged = ShadeWith(original, scene);
+    REQUIRE(Differing(expectedChanged, expected, 0.0f) > 0);
+    REQUIRE(Differing(ShadeWith(*gpu, scene), expectedChanged, 1e-5f) == 0);
+  }
+  SECTION("added objects are seen without CommitDeviceData()")
+  {
+    auto more = Palette();
+    for (auto& m : Palette()) more.push_back(m);
+    auto extra = std::make_shared<Checker>();
+    extra->axis = 1;
+    more.push_back(extra);
+    const Scene wide = RandomScene(3001, uint32_t(more.size()), 4);
+    original.m_materials = more;
+    gpu->m_materials = more;
+    REQUIRE(Differing(ShadeWith(*gpu, wide), ShadeWith(original, wide), 1e-5f) == 0);
+  }
+  SECTION("an element without an object, or of a class the translator never saw, is a clear error")
+  {
+    gpu->m_materials[2] = nullptr;
+    REQUIRE_THROWS_WITH(gpu->CommitDeviceData(), Catch::Contains("m_materials[2] holds no object"));
+    gpu->m_materials[2] = std::make_shared<Glass>();
+    REQUIRE_THROWS_WITH(gpu->CommitDeviceData(), Catch::Contains("m_materials[2] holds a") && Catch::Contains("Glass") &&
+                                                     Catch::Contains("it knows Lambert, Phong, Checker"));
+  }
+  RequireNoValidationMessages(ctx);
+}
