@@ -406,3 +406,62 @@ protected:
     }
   }
 }
+
+TEST_CASE("Virtual calls whose implementations the GPU cannot run are reported", "[diagnostics][virtual]")
+{
+  struct Case { const char* name; const char* impls; const char* call; const char* file; const char* message; const char* hint; };
+  const Case cases[] = {
+      {"a private member", "struct Square : IShape { float Area() const override { return side * side; } private: float side = 1.0f; };\n",
+       "Area()", "Areas.h:", "member 'side' of Square is copied to the GPU (kernels call IShape through 'm_shapes'), but the generated class cannot read it",
+       "declare it public"},
+      {"a member that is not plain data", "struct Polygon : IShape { std::vector<float> xs; float Area() const override { return 0.0f; } };\n",
+       "Area()", "Areas.h:", "member 'xs' of Polygon cannot be copied to the GPU", "objects called through virtual functions hold plain data"},
+      {"no implementation", "", "Area()", "Areas.h:", "kernels call IShape through 'm_shapes', but no class that implements it is defined here",
+       "define the implementations"},
+      {"a non-virtual method", "struct Square : IShape { float side = 1.0f; float Area() const override { return side * side; } };\n",
+       "Scale()", "Areas.cpp:", "call of the non-virtual IShape::Scale through 'm_shapes' in a kernel", "make the method virtual"},
+      {"a body the translator cannot see", "struct Square : IShape { float side = 1.0f; float Area() const override; };\n",
+       "Area()", "Areas.h:", "the GPU needs the body of Square's Area", "define it in the header that declares Square"},
+  };
+  for (const Case& c : cases)
+  {
+    SECTION(c.name)
+    {
+      TempClass tc("Areas", std::string(R"(#pragma once
+#include <memory>
+#include <vector>
+struct IShape
+{
+  virtual ~IShape() = default;
+  virtual float Area() const = 0;
+  float Scale() const { return 1.0f; }
+};
+)") + c.impls + R"(class Areas
+{
+public:
+  virtual ~Areas() = default;
+  virtual void Run(int n, [[crossrt::size("n")]] float* out);
+  std::vector<std::shared_ptr<IShape>> m_shapes;
+protected:
+  void kernel1D_Run(int n, float* out);
+};
+)",
+                   std::string(R"(#include "Areas.h"
+void Areas::Run(int n, float* out) { kernel1D_Run(n, out); }
+void Areas::kernel1D_Run(int n, float* out)
+{
+  for (int i = 0; i < n; i++)
+    out[i] = m_shapes[i]->)") + c.call + ";\n}\n");
+      CommandResult r = RunCrossrt("translate --class Areas --backend vulkan --out " + (tc.dir / "out").string() + " --source " +
+                                   tc.Source("Areas") + " --templates " CROSSRT_SOURCE_DIR "/templates");
+      INFO(r.output);
+      REQUIRE_FALSE(r.crashed);
+      REQUIRE(r.exitCode == 1);
+      REQUIRE(std::regex_search(r.output, std::regex(std::string(c.file) + R"(\d+:\d+: error: )")));
+      REQUIRE(r.output.find(std::string("error: ") + c.message) != std::string::npos);
+      REQUIRE(r.output.find(std::string("hint: ")) != std::string::npos);
+      REQUIRE(r.output.find(c.hint) != std::string::npos);
+      REQUIRE(!std::filesystem::exists(tc.dir / "out" / "Areas_Vulkan.cpp"));
+    }
+  }
+}
