@@ -459,9 +459,9 @@ void FindImplementations(const DeclContext* dc, const CXXRecordDecl* interface, 
 }
 
 // The data of an object, base classes first, as the GPU mirror holds it.
-void CollectObjectFields(Context& c, const CXXRecordDecl* rd, const CXXRecordDecl* impl, std::vector<const FieldDecl*>& out) {
+void CollectObjectFields(const CXXRecordDecl* rd, std::vector<const FieldDecl*>& out) {
   for (auto& base : rd->bases())
-    if (auto* b = base.getType()->getAsCXXRecordDecl(); b && b->hasDefinition()) CollectObjectFields(c, b->getDefinition(), impl, out);
+    if (auto* b = base.getType()->getAsCXXRecordDecl(); b && b->hasDefinition()) CollectObjectFields(b->getDefinition(), out);
   for (auto* f : rd->fields()) out.push_back(f);
 }
 
@@ -535,7 +535,7 @@ void AnalyzeVirtualCalls(Context& c, Kernel& k, GlslPrinter& kernelPrinter) {
         vi.name = impl->getNameAsString();
         vi.header = FileOf(c.ctx, impl->getLocation());
         std::vector<const FieldDecl*> fields;
-        CollectObjectFields(c, impl, impl, fields);
+        CollectObjectFields(impl, fields);
         bool ok = true;
         for (auto* f : fields) {
           auto g = GlslTypeOf(f->getType());
@@ -585,7 +585,7 @@ void AnalyzeVirtualCalls(Context& c, Kernel& k, GlslPrinter& kernelPrinter) {
       std::ostringstream data;
       data << "struct " << vi->name << "_Data {  // the data members of " << vi->name << "\n";
       std::vector<const FieldDecl*> fields;
-      CollectObjectFields(c, impl, impl, fields);
+      CollectObjectFields(impl, fields);
       for (auto* f : fields) data << "  " << printer.Declare(f->getType(), GlslPrinter::SafeName(f->getNameAsString()), f->getLocation()) << ";\n";
       data << "};\n";
       for (auto* m : methods) implFunction[vi->name + "::" + m->getNameAsString()] = ImplementationMethod(c, printer, impl, m, field->getLocation());
@@ -757,10 +757,8 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
                 "reduce in a kernel with a count the host knows, or append the values and reduce them in a later kernel");
   // In declaration order, so that regeneration is stable.
   for (auto* field : c.cls->fields()) {
-    if (ws.appends.count(field)) {
-      k.appends.push_back(field->getNameAsString());
+    if (ws.appends.count(field))
       if (auto* m = FindMember(c.model, field->getNameAsString())) m->appendedByKernels = m->writtenByKernels = true;
-    }
     auto found = ws.reductions.find(field);
     if (found == ws.reductions.end()) continue;
     ReduceOp op = found->second;

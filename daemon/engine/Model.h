@@ -74,7 +74,6 @@ struct Kernel {
   std::vector<Loop> loops;            // IPV: outermost first
   std::vector<Reduction> reductions;
   std::vector<std::string> memberVectors;   // member vectors the kernel reaches (incl. helpers)
-  std::vector<std::string> appends;         // member vectors it push_backs to
   // 1D kernel looping to the size of a vector that kernels append to: dispatched indirectly, its
   // thread count read on the GPU.
   std::string indirectVector;
