@@ -28,6 +28,7 @@ std::string OptionsKey(const engine::TranslateRequest& r) {
   for (auto& s : r.sources) text += "\nsrc " + s;
   for (auto& a : r.compileArgs) text += "\narg " + a;
   for (auto& c : r.compositions) text += "\ncompose " + c;
+  text += "\nvirtual-level " + std::to_string(r.virtualLevel);
   return Hex(XXH64(text.data(), text.size(), 0));
 }
 

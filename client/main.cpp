@@ -32,7 +32,7 @@ namespace {
 
 const char* kUsage =
     "usage: crossrt translate --class NAME --backend vulkan|cpu --out DIR --source FILE [--source FILE...]\n"
-    "                         [--compose INTERFACE=IMPL...] [--templates DIR]\n"
+    "                         [--compose INTERFACE=IMPL...] [--virtual-level 1|2] [--templates DIR]\n"
     "                         [--depfile FILE --depfile-target FILE]\n"
     "                         [--build-dir DIR | --no-daemon] [-- COMPILE_ARGS...]\n"
     "       crossrt daemon status [--build-dir DIR] [--json]\n"
@@ -160,6 +160,10 @@ int main(int argc, char** argv) {
       if (v.find('=') == std::string::npos || v.front() == '=' || v.back() == '=')
         return Usage("--compose takes Interface=Implementation, e.g. ISceneObject=BVHScene, not '" + v + "'");
       request.compositions.push_back(v);
+    }
+    else if (a == "--virtual-level") {
+      if (v != "1" && v != "2") return Usage("--virtual-level takes 1 (one array of equal slots) or 2 (a buffer per class), not '" + v + "'");
+      request.virtualLevel = std::stoi(v);
     }
     else if (a == "--depfile") depfile = v;
     else if (a == "--depfile-target") depfileTarget = v;

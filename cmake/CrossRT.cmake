@@ -1,5 +1,5 @@
 # crossrt_add_class(<target> <Class> BACKEND vulkan|cpu [SOURCES file...]
-#                   [COMPOSE Interface=Implementation...])
+#                   [COMPOSE Interface=Implementation...] [VIRTUAL_LEVEL 1|2])
 #
 # Translates class <Class> into <Class>_Vulkan (or <Class>_CPU), in the build tree, and adds the
 # generated sources, their include path and the runtime to <target>. SOURCES are the files that
@@ -11,6 +11,10 @@
 # unique_ptr or pointer) run Implementation's code on the GPU, and its data is uploaded with the
 # class's. Implementation's source files are added to SOURCES when it was registered with
 # crossrt_register_implementation() (litert's BVHScene is); otherwise list them in SOURCES.
+#
+# VIRTUAL_LEVEL (paper 3.9): how kernels' virtual calls through a std::vector of pointers reach the
+# objects on the GPU: 1 = every element in one array of equal slots, 2 (default) = each class's
+# objects in a buffer of their own. The class's code is the same for both.
 #
 # The translation goes through the build tree's daemon (crossrtd, started on demand, exits when
 # idle), which keeps parsed headers warm; set CROSSRT_NO_DAEMON=1 to translate in-process.
@@ -31,7 +35,7 @@ function(crossrt_register_implementation impl)
 endfunction()
 
 function(crossrt_add_class target class)
-  cmake_parse_arguments(ARG "" "BACKEND" "SOURCES;COMPOSE" ${ARGN})
+  cmake_parse_arguments(ARG "" "BACKEND;VIRTUAL_LEVEL" "SOURCES;COMPOSE" ${ARGN})
   if(NOT ARG_BACKEND)
     set(ARG_BACKEND vulkan)
   endif()
@@ -57,7 +61,7 @@ function(crossrt_add_class target class)
       set(sources ${target_sources})
     endif()
   endif()
-  set(compose_args "")
+  set(option_args "")
   foreach(c IN LISTS ARG_COMPOSE)
     if(NOT c MATCHES "^[A-Za-z_][A-Za-z0-9_]*=[A-Za-z_][A-Za-z0-9_]*$")
       message(FATAL_ERROR "crossrt_add_class(${target} ${class}): COMPOSE takes Interface=Implementation (e.g. ISceneObject=BVHScene), not '${c}'")
@@ -65,8 +69,14 @@ function(crossrt_add_class target class)
     string(REGEX REPLACE "^.*=" "" impl "${c}")
     get_property(impl_sources GLOBAL PROPERTY CROSSRT_IMPLEMENTATION_SOURCES_${impl})
     list(APPEND sources ${impl_sources})
-    list(APPEND compose_args --compose "${c}")
+    list(APPEND option_args --compose "${c}")
   endforeach()
+  if(ARG_VIRTUAL_LEVEL)
+    if(NOT ARG_VIRTUAL_LEVEL MATCHES "^[12]$")
+      message(FATAL_ERROR "crossrt_add_class(${target} ${class}): VIRTUAL_LEVEL is 1 (one array of equal slots) or 2 (a buffer per class), not '${ARG_VIRTUAL_LEVEL}'")
+    endif()
+    list(APPEND option_args --virtual-level ${ARG_VIRTUAL_LEVEL})
+  endif()
   set(abs_sources "")
   set(source_args "")
   foreach(s IN LISTS sources)
@@ -111,7 +121,7 @@ function(crossrt_add_class target class)
     OUTPUT ${outputs}
     COMMAND ${translator} translate
             --class ${class} --backend ${backend} --out ${out_dir}
-            ${source_args} ${compose_args}
+            ${source_args} ${option_args}
             --templates ${CROSSRT_TEMPLATE_DIR}
             --depfile ${out_dir}/${class}_${suffix}.d --depfile-target ${first_output}
             --build-dir ${CMAKE_BINARY_DIR}

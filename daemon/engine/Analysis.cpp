@@ -557,6 +557,7 @@ void AnalyzeVirtualCalls(Context& c, Kernel& k, GlslPrinter& kernelPrinter) {
         }
         if (!ok) continue;
         auto cpp = MirrorOffsets(c.ctx, fields, 0), std430 = MirrorOffsets(c.ctx, fields, 1), scalar = MirrorOffsets(c.ctx, fields, 2);
+        vi.size = unsigned(cpp->back());
         if (std430 && *std430 == *cpp) vi.scalarLayout = false;
         else if (scalar && *scalar == *cpp) vi.scalarLayout = true;
         else {
@@ -566,14 +567,18 @@ void AnalyzeVirtualCalls(Context& c, Kernel& k, GlslPrinter& kernelPrinter) {
         }
         vm.impls.push_back(vi);
       }
+      if (c.model.virtualLevel == 1) {  // one slot size for all: the largest class's data, in 16-byte steps
+        for (auto& vi : vm.impls) vm.slotBytes = std::max(vm.slotBytes, (vi.size + 15) / 16 * 16);
+        for (auto& vi : vm.impls) vi.paddingWords = (vm.slotBytes - vi.size) / 4;
+      }
       c.model.virtuals.push_back(vm);
       known = c.model.virtuals.end() - 1;
     }
     const VirtualMember& vm = *known;
     k.bufferReferences = true;
     // Data structs and buffer references, then each implementation's methods.
-    structs.push_back("layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer " + member +
-                      "_Tags { uvec2 tags[]; };  // per element of " + member + ": (class, index among its objects)\n");
+    structs.push_back("layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer " + member + "_Tags { uvec2 tags[]; };  // per element of " +
+                      member + ": (class, " + (c.model.virtualLevel == 1 ? "its slot" : "index among its class's objects") + ")\n");
     std::map<std::string, std::string> implFunction;  // (impl, method) -> GLSL name
     for (auto* impl : impls) {
       auto vi = std::find_if(vm.impls.begin(), vm.impls.end(), [&](const VirtualImpl& x) { return x.name == impl->getNameAsString(); });
@@ -587,6 +592,8 @@ void AnalyzeVirtualCalls(Context& c, Kernel& k, GlslPrinter& kernelPrinter) {
       std::vector<const FieldDecl*> fields;
       CollectObjectFields(impl, fields);
       for (auto* f : fields) data << "  " << printer.Declare(f->getType(), GlslPrinter::SafeName(f->getNameAsString()), f->getLocation()) << ";\n";
+      if (vi->paddingWords > 0)
+        data << "  uint crt_padding[" << vi->paddingWords << "];  // every element of " << member << " has a slot of " << vm.slotBytes << " bytes\n";
       data << "};\n";
       for (auto* m : methods) implFunction[vi->name + "::" + m->getNameAsString()] = ImplementationMethod(c, printer, impl, m, field->getLocation());
       for (auto& x : printer.Structs()) structs.push_back(x);
@@ -616,7 +623,9 @@ void AnalyzeVirtualCalls(Context& c, Kernel& k, GlslPrinter& kernelPrinter) {
       os << ")\n{\n  const uvec2 tag = " << member << "_Tags(" << member << "_tags).tags[index];\n  switch (tag.x)\n  {\n";
       for (size_t t = 0; t < vm.impls.size(); ++t) {
         const auto& vi = vm.impls[t];
-        std::string args = member + "_" + vi.name + "Objects(" + member + "_" + vi.name + ").objects[tag.y]";
+        // Level 1: all elements in one array of equal slots; level 2: each class's objects apart.
+        const std::string address = member + (c.model.virtualLevel == 1 ? std::string("_objects") : "_" + vi.name);
+        std::string args = member + "_" + vi.name + "Objects(" + address + ").objects[tag.y]";
         for (auto& n : names) args += ", " + n;
         const std::string call = implFunction[vi.name + "::" + m->getNameAsString()] + "(" + args + ")";
         os << "    case " << t << "u: " << (retType == "void" ? call + "; return;" : "return " + call + ";") << "\n";
@@ -1670,8 +1679,10 @@ void FinishModel(ClassModel& model) {
   // Virtual functions: where each vector's tags and each implementation's objects are on the device.
   for (auto& v : model.virtuals) {
     fields.push_back({v.member + "_tags", "uint64_t", "uvec2", 8, "", "m_virtual." + v.member + "_tags.Address()"});
+    if (model.virtualLevel == 1) fields.push_back({v.member + "_objects", "uint64_t", "uvec2", 8, "", "m_virtual." + v.member + "_objects.Address()"});
     for (auto& impl : v.impls)
-      fields.push_back({v.member + "_" + impl.name, "uint64_t", "uvec2", 8, "", "m_virtual." + v.member + "_" + impl.name + ".Address()"});
+      if (model.virtualLevel == 2)
+        fields.push_back({v.member + "_" + impl.name, "uint64_t", "uvec2", 8, "", "m_virtual." + v.member + "_" + impl.name + ".Address()"});
   }
   std::stable_sort(fields.begin(), fields.end(), [](const BlockField& a, const BlockField& b) { return a.std430Align > b.std430Align; });
   if (fields.empty()) fields.push_back({"dummy", "uint32_t", "uint", 4, "", ""});  // a block needs a member

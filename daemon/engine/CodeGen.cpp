@@ -213,6 +213,9 @@ Data Common(const ClassModel& model, const GenerateOptions& opt) {
     }
     x.set("impls", impls);
     x.set("implNames", names);
+    x.set("level1", model.virtualLevel == 1);
+    x.set("level2", model.virtualLevel == 2);
+    x.set("slotBytes", std::to_string(v.slotBytes));
     virtuals.push_back(x);
   }
   d.set("virtuals", virtuals);

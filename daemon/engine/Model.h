@@ -133,12 +133,15 @@ struct VirtualImpl {
   std::string header;              // the file that declares it (generated code includes it)
   std::vector<BlockField> fields;  // its data, base classes' first: the mirror <name>_Data
   bool scalarLayout = false;       // the mirror matches C++ only with GL_EXT_scalar_block_layout
+  unsigned size = 0;               // bytes of the mirror
+  unsigned paddingWords = 0;       // level 1: words after the data, so that every class's slot has one size
 };
 
 struct VirtualMember {
   std::string member;         // m_materials
   std::string interfaceName;  // IMaterial
   std::vector<VirtualImpl> impls;  // every class of the translation unit that implements it
+  unsigned slotBytes = 0;          // level 1: the size of every element's slot
 };
 
 struct ClassModel {
@@ -156,6 +159,7 @@ struct ClassModel {
   std::vector<std::string> usingDecls; // top-level using-directives of the sources: copied bodies need them
   std::vector<Composition> compositions;   // holders kernels call through, in declaration order
   std::vector<VirtualMember> virtuals;     // vectors of objects kernels call virtual functions of
+  int virtualLevel = 2;                    // 1: one array of equal slots; 2: a buffer per class
 };
 
 // The member named `name`, or null (works on a const and a mutable model).

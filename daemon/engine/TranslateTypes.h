@@ -22,6 +22,9 @@ struct TranslateRequest {
   // call a member of type shared_ptr<Interface> get Implementation's code and data merged in; the
   // implementation's source files are among `sources`.
   std::vector<std::string> compositions;
+  // Virtual functions (paper 3.9): 1 = every element in one array of equal slots, 2 = each class's
+  // objects in a buffer of their own.
+  int virtualLevel = 2;
 };
 
 struct TranslateResult {

@@ -45,7 +45,8 @@ nlohmann::json ToJson(const engine::TranslateRequest& r) {
           {"compileArgs", r.compileArgs},
           {"outputDir", r.outputDir},
           {"templateDir", r.templateDir},
-          {"compositions", r.compositions}};
+          {"compositions", r.compositions},
+          {"virtualLevel", r.virtualLevel}};
 }
 
 engine::TranslateRequest RequestFromJson(const nlohmann::json& j) {
@@ -59,6 +60,8 @@ engine::TranslateRequest RequestFromJson(const nlohmann::json& j) {
   r.outputDir = j.at("outputDir").get<std::string>();
   r.templateDir = j.at("templateDir").get<std::string>();
   if (j.contains("compositions")) r.compositions = j.at("compositions").get<std::vector<std::string>>();
+  if (j.contains("virtualLevel")) r.virtualLevel = j.at("virtualLevel").get<int>();
+  if (r.virtualLevel != 1 && r.virtualLevel != 2) throw std::runtime_error("virtualLevel must be 1 or 2");
   if (r.className.empty() || r.sources.empty()) throw std::runtime_error("className and sources must not be empty");
   return r;
 }

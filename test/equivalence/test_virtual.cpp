@@ -1,12 +1,18 @@
-// Virtual functions in kernels: MaterialShading calls IMaterial through a std::vector of
-// shared_ptr. The original, MaterialShading_CPU and MaterialShading_Vulkan (each class's objects in
-// a buffer of their own, reached by buffer references, a switch over the object's class) shade the
-// same points. The GPU may contract a*b+c to fma and pow differs by an ulp or so, hence 1e-5.
+// Virtual functions in kernels: MaterialShading and FlatShading call IMaterial through a
+// std::vector of shared_ptr. The original, _CPU and _Vulkan shade the same points, at both levels:
+// MaterialShading_Vulkan keeps each class's objects in a buffer of their own (level 2),
+// FlatShading_Vulkan every element in one array of equal slots (level 1); a switch over the
+// object's class picks the code. The GPU may contract a*b+c to fma, and pow differs by an ulp or
+// so, hence 1e-5.
+#include "FlatShading.h"
+#include "FlatShading_CPU.h"
+#include "FlatShading_Vulkan.h"
 #include "MaterialShading.h"
 #include "MaterialShading_CPU.h"
 #include "MaterialShading_Vulkan.h"
 #include "TestSupport.h"
 
+#include <functional>
 #include <random>
 
 namespace
@@ -62,7 +68,8 @@ Scene RandomScene(int n, uint32_t materials, unsigned seed)
   return s;
 }
 
-std::vector<float4> ShadeWith(MaterialShading& shading, const Scene& s)
+template <typename Shading>
+std::vector<float4> ShadeWith(Shading& shading, const Scene& s)
 {
   std::vector<float4> colors(s.normals.size(), float4(-1.0f));
   shading.Shade(int(s.normals.size()), s.normals.data(), s.ids.data(), colors.data());
@@ -83,13 +90,15 @@ size_t Differing(const std::vector<float4>& a, const std::vector<float4>& b, flo
 }
 }  // namespace
 
-TEST_CASE("Virtual functions: three implementations of different sizes, picked per element", "[equivalence][virtual]")
+// Both translations of the same kernel, against the original of their class.
+template <typename Shading>
+void CheckVirtualCalls(std::shared_ptr<Shading> cpu, std::function<std::shared_ptr<Shading>()> createGpu)
 {
   auto ctx = ValidatedContext();
   const auto palette = Palette();
   const Scene scene = RandomScene(20011, uint32_t(palette.size()), 3);
 
-  MaterialShading original;
+  Shading original;
   original.m_materials = palette;
   const auto expected = ShadeWith(original, scene);
   // Every element was shaded, and both opacities (1 from the interface, the checkers' own) occur.
@@ -99,12 +108,11 @@ TEST_CASE("Virtual functions: three implementations of different sizes, picked p
   REQUIRE(translucent > expected.size() / 10);
   for (auto& c : expected) REQUIRE((c.w == 1.0f || c.w == 0.25f || c.w == 0.75f));
 
-  auto cpu = CreateMaterialShading_CPU();
   cpu->m_materials = palette;
   REQUIRE(Differing(ShadeWith(*cpu, scene), expected, 0.0f) == 0);  // the same compiled C++ on all cores
 
   if (!ctx) return;
-  auto gpu = CreateMaterialShading_Vulkan(ctx);
+  auto gpu = createGpu();
   gpu->m_materials = palette;
   REQUIRE(Differing(ShadeWith(*gpu, scene), expected, 1e-5f) == 0);
 
@@ -142,4 +150,14 @@ TEST_CASE("Virtual functions: three implementations of different sizes, picked p
                                                      Catch::Contains("it knows Lambert, Phong, Checker"));
   }
   RequireNoValidationMessages(ctx);
+}
+
+TEST_CASE("Virtual functions, level 2: three implementations of different sizes, each in a buffer of its own", "[equivalence][virtual]")
+{
+  CheckVirtualCalls<MaterialShading>(CreateMaterialShading_CPU(), [] { return CreateMaterialShading_Vulkan(ValidatedContext()); });
+}
+
+TEST_CASE("Virtual functions, level 1: the same kernel with every element in one array of equal slots", "[equivalence][virtual]")
+{
+  CheckVirtualCalls<FlatShading>(CreateFlatShading_CPU(), [] { return CreateFlatShading_Vulkan(ValidatedContext()); });
 }
