@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <memory>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,16 @@ inline std::shared_ptr<crossrt::VulkanContext> ValidatedContext()
   }();
   if (!ctx) WARN("skipping the Vulkan part: no Vulkan driver on this machine (install mesa-vulkan-drivers)");
   return ctx;
+}
+
+// n floats uniform in [lo, hi), the same for a given seed.
+inline std::vector<float> RandomFloats(int n, unsigned seed, float lo, float hi)
+{
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(lo, hi);
+  std::vector<float> v(n);
+  for (auto& x : v) x = u(rng);
+  return v;
 }
 
 // Any validation message fails the test.

@@ -13,15 +13,6 @@
 
 namespace
 {
-std::vector<float> RandomValues(int n, unsigned seed)
-{
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
-  std::vector<float> values(n);
-  for (auto& v : values) v = u(rng);
-  return values;
-}
-
 std::vector<uint32_t> Sorted(std::vector<uint32_t> v)
 {
   std::sort(v.begin(), v.end());
@@ -53,7 +44,7 @@ TEST_CASE("push_back in a kernel, then kernels dispatched over the appended coun
   {
     DYNAMIC_SECTION("n = " << n)
     {
-      const auto values = RandomValues(n, unsigned(n) + 1);
+      const auto values = RandomFloats(n, unsigned(n) + 1, -1.0f, 1.0f);
       std::vector<uint32_t> positive;
       std::vector<std::tuple<uint32_t, float>> large;
       std::vector<float> expectedOut(n, -7.0f);
@@ -91,7 +82,7 @@ TEST_CASE("Appends accumulate across calls when the control function does not cl
 {
   auto ctx = ValidatedContext();
   const int n = 5003;
-  const auto first = RandomValues(n, 11), second = RandomValues(n, 12);
+  const auto first = RandomFloats(n, 11, -1.0f, 1.0f), second = RandomFloats(n, 12, -1.0f, 1.0f);
   std::vector<uint32_t> expected;
   for (auto* values : {&first, &second})
     for (int i = 0; i < n; ++i)
@@ -114,7 +105,7 @@ TEST_CASE("Appending past the capacity: the GPU keeps the capacity and says so",
   auto ctx = ValidatedContext();
   if (!ctx) return;
   const int n = 1000, capacity = 10;
-  const auto values = RandomValues(n, 5);
+  const auto values = RandomFloats(n, 5, -1.0f, 1.0f);
   std::vector<float> out(n, -7.0f);
   auto gpu = CreateAppending_Vulkan(ctx, capacity);
   REQUIRE_THROWS_WITH(gpu->Select(n, 0.5f, values.data(), out.data()),

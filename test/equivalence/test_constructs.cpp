@@ -23,14 +23,6 @@ struct Impls
   }
 };
 
-std::vector<float> RandomFloats(int n, unsigned seed)
-{
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> u(-2.0f, 2.0f);
-  std::vector<float> v(n);
-  for (auto& x : v) x = u(rng);
-  return v;
-}
 
 }  // namespace
 
@@ -38,16 +30,16 @@ TEST_CASE("IPV 1D kernel with helpers, loops, switch and continue", "[equivalenc
 {
   const int n = 100003;  // not a multiple of the workgroup size
   Impls impls(37);
-  const auto x = RandomFloats(n, 1);
+  const auto x = RandomFloats(n, 1, -2.0f, 2.0f);
   std::vector<std::vector<float>> results;
   for (auto& [name, impl] : impls.list)
   {
-    auto y = RandomFloats(n, 2);
+    auto y = RandomFloats(n, 2, -2.0f, 2.0f);
     impl->CommitDeviceData();
     impl->Saxpy(n, 1.5f, x.data(), y.data());
     results.push_back(y);
   }
-  const auto untouched = RandomFloats(n, 2);
+  const auto untouched = RandomFloats(n, 2, -2.0f, 2.0f);
   REQUIRE(results[0][3] == untouched[3]);  // 'continue' left element 3 alone
   REQUIRE(results[0][0] != untouched[0]);
   for (size_t k = 1; k < results.size(); ++k)
@@ -62,9 +54,9 @@ TEST_CASE("Member reductions: +=, -=, min, max on float, int, uint and float3", 
 {
   const int n = 70001;
   Impls impls(5);
-  const auto values = RandomFloats(n, 3);
+  const auto values = RandomFloats(n, 3, -2.0f, 2.0f);
   std::vector<float3> points(n);
-  const auto coords = RandomFloats(3 * n, 4);
+  const auto coords = RandomFloats(3 * n, 4, -2.0f, 2.0f);
   for (int i = 0; i < n; ++i) points[i] = float3(coords[3 * i], coords[3 * i + 1] * 10.0f, coords[3 * i + 2] - 5.0f);
   // An independent expectation, in double precision.
   double sum = 0.0;
@@ -94,7 +86,7 @@ TEST_CASE("Arrays of user structs with float3 fields", "[equivalence]")
   const int n = 1000;
   Impls impls(5);
   std::vector<Particle> in(n);
-  const auto r = RandomFloats(8 * n, 5);
+  const auto r = RandomFloats(8 * n, 5, -2.0f, 2.0f);
   for (int i = 0; i < n; ++i)
     in[i] = {float4(r[8 * i], r[8 * i + 1], r[8 * i + 2], 1.0f), float3(r[8 * i + 3], r[8 * i + 4], r[8 * i + 5]), r[8 * i + 6] + 3.0f};
   std::vector<std::vector<float>> flat;
@@ -201,7 +193,7 @@ TEST_CASE("Users keep data on the GPU: SetVulkanInOutFor_ and ...Cmd into their 
   auto ctx = ValidatedContext();
   if (!ctx) return;
   const int n = 4099;
-  auto x = RandomFloats(n, 11), y = RandomFloats(n, 12);
+  auto x = RandomFloats(n, 11, -2.0f, 2.0f), y = RandomFloats(n, 12, -2.0f, 2.0f);
   Constructs reference(37);
   std::vector<float> expected = y;
   reference.Saxpy(n, 2.0f, x.data(), expected.data());
