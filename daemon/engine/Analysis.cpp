@@ -821,13 +821,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     Composition comp;
     comp.holder = holder;
     for (auto* f : c.cls->fields())
-      if (f->getNameAsString() == holder) {
-        QualType t = f->getType().getCanonicalType();
-        const CXXRecordDecl* rd = t->isPointerType() ? t->getPointeeType()->getAsCXXRecordDecl() : nullptr;
-        if (auto* spec = dyn_cast_or_null<ClassTemplateSpecializationDecl>(t->getAsCXXRecordDecl()))
-          rd = spec->getTemplateArgs()[0].getAsType()->getAsCXXRecordDecl();
-        if (rd) comp.interfaceName = rd->getNameAsString();
-      }
+      if (auto* rd = f->getNameAsString() == holder ? PolymorphicPointee(f->getType()) : nullptr) comp.interfaceName = rd->getNameAsString();
     comp.implName = c.compositions.count(comp.interfaceName) ? c.compositions.at(comp.interfaceName) : "";
     c.model.compositions.push_back(comp);
   }
@@ -1062,8 +1056,10 @@ private:
   }
 
   // `m_x = v;` in a control function runs on the host while recording; the kernels recorded
-  // around it must see it in order, so the ...Cmd also records an update of the GPU copy.
+  // around it must see it in order, so the ...Cmd also records an update of the GPU copy (and
+  // likewise for the count of a cleared vector that kernels append to).
   void RecordMemberWrite(const Stmt* s) {
+    RecordClear(s);
     if (auto* ewc = dyn_cast_or_null<ExprWithCleanups>(s)) s = ewc->getSubExpr();
     const Expr* lhs = nullptr;
     if (auto* bo = dyn_cast_or_null<BinaryOperator>(s); bo && bo->isAssignmentOp()) lhs = bo->getLHS();
@@ -1109,7 +1105,8 @@ private:
   }
 
   // `m_v.clear();` of a vector kernels append to: the GPU's count restarts at 0 too, in order with
-  // the kernels recorded around it.
+  // the kernels recorded around it. Both go in one block, so a clear that is the body of an `if`
+  // or a loop stays one statement.
   void RecordClear(const Stmt* s) {
     auto* call = dyn_cast_or_null<CXXMemberCallExpr>(s);
     if (!call || !call->getMethodDecl() || call->getMethodDecl()->getName() != "clear") return;
@@ -1118,7 +1115,8 @@ private:
     SourceLocation end = Lexer::findLocationAfterToken(s->getEndLoc(), tok::semi, m_c.ctx.getSourceManager(), m_c.ctx.getLangOpts(), false);
     if (end.isInvalid()) return;
     const std::string size = f->getNameAsString() + "_size";
-    m_gpu.InsertTextAfter(end, " { const uint32_t crt_empty = 0; UpdateMemberCmd(a_cmd, offsetof(ClassData, " + size +
+    m_gpu.InsertTextBefore(s->getBeginLoc(), "{ ");
+    m_gpu.InsertTextAfter(end, " const uint32_t crt_empty = 0; UpdateMemberCmd(a_cmd, offsetof(ClassData, " + size +
                                    "), &crt_empty, sizeof(crt_empty)); }");
   }
 
@@ -1347,10 +1345,7 @@ private:
     if (!s) return;
     // Statement positions where a member may be assigned.
     if (auto* cs = dyn_cast<CompoundStmt>(s))
-      for (auto* child : cs->body()) {
-        RecordMemberWrite(child);
-        RecordClear(child);
-      }
+      for (auto* child : cs->body()) RecordMemberWrite(child);
     if (auto* is = dyn_cast<IfStmt>(s)) {
       RecordMemberWrite(is->getThen());
       RecordMemberWrite(is->getElse());

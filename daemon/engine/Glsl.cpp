@@ -414,13 +414,8 @@ std::string GlslPrinter::ComposedCall(const CXXMemberCallExpr* mc) {
   auto* me = dyn_cast<MemberExpr>(obj);
   auto* field = me ? dyn_cast<FieldDecl>(me->getMemberDecl()) : nullptr;
   if (!field || !isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts())) return "";
-  QualType t = field->getType().getCanonicalType();
-  const CXXRecordDecl* pointee = nullptr;
-  if (t->isPointerType()) pointee = t->getPointeeType()->getAsCXXRecordDecl();
-  else if (auto* spec = dyn_cast_or_null<ClassTemplateSpecializationDecl>(t->getAsCXXRecordDecl());
-           spec && spec->isInStdNamespace() && (spec->getName() == "shared_ptr" || spec->getName() == "unique_ptr"))
-    pointee = spec->getTemplateArgs()[0].getAsType()->getAsCXXRecordDecl();
-  if (!pointee || !pointee->hasDefinition() || !pointee->isPolymorphic()) return "";
+  const CXXRecordDecl* pointee = PolymorphicPointee(field->getType());
+  if (!pointee) return "";
   const std::string interface = pointee->getNameAsString(), method = mc->getMethodDecl()->getNameAsString();
   const std::string holder = field->getNameAsString();
   if (!compositions.count(interface))
