@@ -7,17 +7,8 @@
 #include <utility>
 
 namespace crossrt {
-namespace {
+// ---- allocation helpers shared with Image.cpp (declared in Internal.h) ----
 
-// A buffer + its memory; the building block for Buffer and for temporary staging buffers.
-struct Allocation {
-  VkBuffer buffer = VK_NULL_HANDLE;
-  VkDeviceMemory memory = VK_NULL_HANDLE;
-  VkMemoryPropertyFlags flags = 0;
-};
-
-// Tries the memory property sets in order; falls back to the next one when a heap is full
-// (e.g. the 256 MiB BAR window on GPUs without resizable BAR).
 Allocation Allocate(const VulkanContext& ctx, VkDeviceSize size, VkBufferUsageFlags usage,
                     std::initializer_list<VkMemoryPropertyFlags> preferences) {
   Allocation a;
@@ -60,30 +51,22 @@ Allocation Allocate(const VulkanContext& ctx, VkDeviceSize size, VkBufferUsageFl
   return a;
 }
 
-constexpr VkMemoryPropertyFlags kHostCoherent = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+Staging::Staging(const VulkanContext& c, VkDeviceSize size, VkBufferUsageFlags usage) : ctx(c) {
+  // Cached memory first: downloads read it with the CPU.
+  a = Allocate(ctx, size, usage, {kHostCoherent | VK_MEMORY_PROPERTY_HOST_CACHED_BIT, kHostCoherent});
+  VkResult r = vkMapMemory(ctx.device, a.memory, 0, VK_WHOLE_SIZE, 0, &mapped);
+  if (r != VK_SUCCESS) {
+    Free();
+    Check(r, "vkMapMemory (staging)");
+  }
+}
 
-// Host-visible, coherent, mapped temporary buffer for the non-mappable path.
-struct Staging {
-  const VulkanContext& ctx;
-  Allocation a;
-  void* mapped = nullptr;
-  Staging(const VulkanContext& c, VkDeviceSize size, VkBufferUsageFlags usage) : ctx(c) {
-    // Cached memory first: downloads read it with the CPU.
-    a = Allocate(ctx, size, usage, {kHostCoherent | VK_MEMORY_PROPERTY_HOST_CACHED_BIT, kHostCoherent});
-    VkResult r = vkMapMemory(ctx.device, a.memory, 0, VK_WHOLE_SIZE, 0, &mapped);
-    if (r != VK_SUCCESS) {
-      Free();
-      Check(r, "vkMapMemory (staging)");
-    }
-  }
-  ~Staging() { Free(); }
-  void Free() {
-    vkDestroyBuffer(ctx.device, a.buffer, nullptr);
-    vkFreeMemory(ctx.device, a.memory, nullptr);
-  }
-  Staging(const Staging&) = delete;
-  Staging& operator=(const Staging&) = delete;
-};
+void Staging::Free() {
+  vkDestroyBuffer(ctx.device, a.buffer, nullptr);
+  vkFreeMemory(ctx.device, a.memory, nullptr);
+}
+
+namespace {
 
 void CheckRange(const Buffer& b, size_t bytes, size_t offset, const char* what) {
   if (b.Empty()) throw Error(std::string(what) + ": the buffer is empty (default-constructed or moved-from)");

@@ -3,6 +3,8 @@
 
 #include <vulkan/vulkan.h>
 
+#include <initializer_list>
+
 namespace crossrt {
 
 // A zeroed Vulkan struct with its sType set: avoids partial aggregate initialization
@@ -13,5 +15,33 @@ T VkInit(VkStructureType sType) {
   t.sType = sType;
   return t;
 }
+
+class VulkanContext;
+
+// A buffer and its memory: the building block of Buffer and of temporary staging buffers.
+struct Allocation {
+  VkBuffer buffer = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  VkMemoryPropertyFlags flags = 0;
+};
+
+// Tries the memory property sets in order; falls back to the next one when a heap is full
+// (e.g. the 256 MiB BAR window on GPUs without resizable BAR).
+Allocation Allocate(const VulkanContext& ctx, VkDeviceSize size, VkBufferUsageFlags usage,
+                    std::initializer_list<VkMemoryPropertyFlags> preferences);
+
+constexpr VkMemoryPropertyFlags kHostCoherent = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+
+// Host-visible, coherent, mapped temporary buffer, freed on destruction.
+struct Staging {
+  const VulkanContext& ctx;
+  Allocation a;
+  void* mapped = nullptr;
+  Staging(const VulkanContext& c, VkDeviceSize size, VkBufferUsageFlags usage);
+  ~Staging() { Free(); }
+  void Free();
+  Staging(const Staging&) = delete;
+  Staging& operator=(const Staging&) = delete;
+};
 
 }  // namespace crossrt

@@ -9,7 +9,13 @@ namespace crossrt {
 
 ComputePipeline::ComputePipeline(std::shared_ptr<VulkanContext> ctx, const uint32_t* spirv, size_t spirvBytes,
                                  uint32_t storageBufferBindings, uint32_t pushConstantBytes, const char* debugName)
-    : ctx_(std::move(ctx)), bindings_(storageBufferBindings), pushConstantBytes_(pushConstantBytes),
+    : ComputePipeline(std::move(ctx), spirv, spirvBytes,
+                      std::vector<VkDescriptorType>(storageBufferBindings, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER), pushConstantBytes,
+                      debugName) {}
+
+ComputePipeline::ComputePipeline(std::shared_ptr<VulkanContext> ctx, const uint32_t* spirv, size_t spirvBytes,
+                                 std::vector<VkDescriptorType> bindingTypes, uint32_t pushConstantBytes, const char* debugName)
+    : ctx_(std::move(ctx)), types_(std::move(bindingTypes)), pushConstantBytes_(pushConstantBytes),
       name_(debugName ? debugName : "") {
   if (!ctx_) throw Error("ComputePipeline '" + name_ + "': null VulkanContext");
   if (!spirv || spirvBytes == 0 || spirvBytes % 4 != 0)
@@ -21,13 +27,13 @@ ComputePipeline::ComputePipeline(std::shared_ptr<VulkanContext> ctx, const uint3
 
   VkDevice dev = ctx_->device;
   try {
-    if (bindings_ > 0) {
-      std::vector<VkDescriptorSetLayoutBinding> b(bindings_);
-      for (uint32_t i = 0; i < bindings_; ++i)
-        b[i] = VkDescriptorSetLayoutBinding{i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+    if (!types_.empty()) {
+      const uint32_t count = static_cast<uint32_t>(types_.size());
+      std::vector<VkDescriptorSetLayoutBinding> b(count);
+      for (uint32_t i = 0; i < count; ++i) b[i] = VkDescriptorSetLayoutBinding{i, types_[i], 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
       auto setInfo = VkInit<VkDescriptorSetLayoutCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO);
       setInfo.flags = VK_DESCRIPTOR_SET_LAYOUT_CREATE_PUSH_DESCRIPTOR_BIT_KHR;
-      setInfo.bindingCount = bindings_;
+      setInfo.bindingCount = count;
       setInfo.pBindings = b.data();
       Check(vkCreateDescriptorSetLayout(dev, &setInfo, nullptr, &setLayout_), "vkCreateDescriptorSetLayout");
     }
@@ -71,7 +77,7 @@ ComputePipeline& ComputePipeline::operator=(ComputePipeline&& other) noexcept {
     setLayout_ = std::exchange(other.setLayout_, VK_NULL_HANDLE);
     layout_ = std::exchange(other.layout_, VK_NULL_HANDLE);
     pipeline_ = std::exchange(other.pipeline_, VK_NULL_HANDLE);
-    bindings_ = std::exchange(other.bindings_, 0);
+    types_ = std::move(other.types_);
     pushConstantBytes_ = std::exchange(other.pushConstantBytes_, 0);
     name_ = std::move(other.name_);
   }
@@ -97,33 +103,52 @@ void ComputePipeline::Bind(VkCommandBuffer cmd) const {
 }
 
 void ComputePipeline::PushBuffers(VkCommandBuffer cmd, std::initializer_list<BufferView> buffers) const {
-  if (buffers.size() != bindings_)
-    throw Error("ComputePipeline '" + name_ + "': PushBuffers got " + std::to_string(buffers.size()) +
-                " buffers for " + std::to_string(bindings_) + " bindings");
-  if (bindings_ == 0) return;
-  std::vector<VkDescriptorBufferInfo> infos;
-  infos.reserve(bindings_);
-  for (const BufferView& v : buffers) {
-    if (!v.buffer)
-      throw Error("ComputePipeline '" + name_ + "': binding " + std::to_string(infos.size()) + " has no buffer");
-    // e.g. `vec.data() + k` with k elements not a multiple of the device's offset alignment
-    const VkDeviceSize align = ctx_->properties.limits.minStorageBufferOffsetAlignment;
-    if (align > 1 && v.offset % align != 0)
-      throw Error("ComputePipeline '" + name_ + "': binding " + std::to_string(infos.size()) + " starts at byte offset " +
-                  std::to_string(v.offset) + ", which this device cannot bind (offsets must be multiples of " +
-                  std::to_string(align) + " bytes): use element offsets that keep that alignment");
-    infos.push_back(VkDescriptorBufferInfo{v.buffer, v.offset, v.range});
-  }
-  // One write per binding: binding i gets the i-th view.
-  std::vector<VkWriteDescriptorSet> writes(bindings_);
-  for (uint32_t i = 0; i < bindings_; ++i) {
+  std::vector<Binding> bindings(buffers.begin(), buffers.end());
+  Push(cmd, bindings);
+}
+
+void ComputePipeline::PushBindings(VkCommandBuffer cmd, std::initializer_list<Binding> bindings) const {
+  Push(cmd, std::vector<Binding>(bindings));
+}
+
+void ComputePipeline::Push(VkCommandBuffer cmd, const std::vector<Binding>& bindings) const {
+  const uint32_t count = static_cast<uint32_t>(types_.size());
+  if (bindings.size() != count)
+    throw Error("ComputePipeline '" + name_ + "': got " + std::to_string(bindings.size()) + " resources for " +
+                std::to_string(count) + " bindings");
+  if (count == 0) return;
+  // Reserved up front: the writes point into these vectors.
+  std::vector<VkDescriptorBufferInfo> bufferInfos;
+  std::vector<VkDescriptorImageInfo> imageInfos;
+  bufferInfos.reserve(count);
+  imageInfos.reserve(count);
+  std::vector<VkWriteDescriptorSet> writes(count);
+  for (uint32_t i = 0; i < count; ++i) {
+    const Binding& r = bindings[i];
+    const std::string where = "ComputePipeline '" + name_ + "': binding " + std::to_string(i);
+    if (r.type != types_[i]) throw Error(where + " got a resource of another descriptor type than its layout's");
     writes[i] = VkInit<VkWriteDescriptorSet>(VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET);
     writes[i].dstBinding = i;
     writes[i].descriptorCount = 1;
-    writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    writes[i].pBufferInfo = &infos[i];
+    writes[i].descriptorType = r.type;
+    if (r.type == VK_DESCRIPTOR_TYPE_STORAGE_BUFFER) {
+      const BufferView& v = r.buffer;
+      if (!v.buffer) throw Error(where + " has no buffer");
+      // e.g. `vec.data() + k` with k elements not a multiple of the device's offset alignment
+      const VkDeviceSize align = ctx_->properties.limits.minStorageBufferOffsetAlignment;
+      if (align > 1 && v.offset % align != 0)
+        throw Error(where + " starts at byte offset " + std::to_string(v.offset) +
+                    ", which this device cannot bind (offsets must be multiples of " + std::to_string(align) +
+                    " bytes): use element offsets that keep that alignment");
+      bufferInfos.push_back(VkDescriptorBufferInfo{v.buffer, v.offset, v.range});
+      writes[i].pBufferInfo = &bufferInfos.back();
+    } else {
+      if (r.type == VK_DESCRIPTOR_TYPE_SAMPLER ? !r.sampler : !r.view) throw Error(where + " has no image or sampler");
+      imageInfos.push_back(VkDescriptorImageInfo{r.sampler, r.view, VK_IMAGE_LAYOUT_GENERAL});
+      writes[i].pImageInfo = &imageInfos.back();
+    }
   }
-  ctx_->vkCmdPushDescriptorSetKHR(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, bindings_, writes.data());
+  ctx_->vkCmdPushDescriptorSetKHR(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, count, writes.data());
 }
 
 void ComputePipeline::PushConstants(VkCommandBuffer cmd, const void* data, uint32_t bytes) const {

@@ -159,6 +159,129 @@ private:
   VkBufferUsageFlags extraUsage_ = 0;
 };
 
+// RAII 2D image with one mip level, move-only: what Image2D<T> members become. It stays in
+// VK_IMAGE_LAYOUT_GENERAL, so kernels can load, store and sample it without layout transitions.
+// Usage: STORAGE | SAMPLED | TRANSFER_SRC | TRANSFER_DST.
+class Image {
+public:
+  Image() = default;
+  // width and height of 0 become 1 (Vulkan has no empty images).
+  Image(std::shared_ptr<VulkanContext> ctx, uint32_t width, uint32_t height, VkFormat format, const char* debugName);
+  Image(Image&& other) noexcept;
+  Image& operator=(Image&& other) noexcept;
+  Image(const Image&) = delete;
+  Image& operator=(const Image&) = delete;
+  ~Image();
+
+  bool Empty() const { return image_ == VK_NULL_HANDLE; }
+  uint32_t Width() const { return width_; }
+  uint32_t Height() const { return height_; }
+  VkFormat Format() const { return format_; }
+  VkImage Handle() const { return image_; }
+  VkImageView View() const { return view_; }
+  // Whole-image copies of tightly packed rows (synchronous, through a staging buffer). Upload
+  // ends with a barrier, so later kernels see the texels.
+  void Upload(const void* texels, size_t bytes);
+  void Download(void* texels, size_t bytes) const;
+
+private:
+  void Release() noexcept;
+  size_t Bytes() const;
+
+  std::shared_ptr<VulkanContext> ctx_;
+  VkImage image_ = VK_NULL_HANDLE;
+  VkDeviceMemory memory_ = VK_NULL_HANDLE;
+  VkImageView view_ = VK_NULL_HANDLE;
+  uint32_t width_ = 0, height_ = 0;
+  VkFormat format_ = VK_FORMAT_UNDEFINED;
+};
+
+// Reallocates img when it is empty or has another size or format.
+void EnsureImage(std::shared_ptr<VulkanContext> ctx, Image& img, uint32_t width, uint32_t height, VkFormat format,
+                 const char* debugName);
+
+// What a LiteImage::Sampler asks of the GPU. Vulkan samplers know three border colours: a border
+// colour other than (0,0,0,0), (0,0,0,1) or (1,1,1,1) is an error when the sampler is created.
+struct SamplerDesc {
+  bool linear = false;
+  VkSamplerAddressMode addressU = VK_SAMPLER_ADDRESS_MODE_REPEAT, addressV = VK_SAMPLER_ADDRESS_MODE_REPEAT;
+  float border[4] = {0, 0, 0, 0};
+  bool operator==(const SamplerDesc& o) const {
+    return linear == o.linear && addressU == o.addressU && addressV == o.addressV && border[0] == o.border[0] &&
+           border[1] == o.border[1] && border[2] == o.border[2] && border[3] == o.border[3];
+  }
+  bool operator!=(const SamplerDesc& o) const { return !(*this == o); }
+};
+
+// The SamplerDesc of a LiteImage::Sampler (any type with its fields and enums: the runtime does
+// not depend on LiteImage).
+template <typename Mode>
+VkSamplerAddressMode AddressModeOf(Mode m) {
+  switch (m) {
+    case Mode::MIRROR: return VK_SAMPLER_ADDRESS_MODE_MIRRORED_REPEAT;
+    case Mode::CLAMP: return VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+    case Mode::BORDER: return VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_BORDER;
+    default: return VK_SAMPLER_ADDRESS_MODE_REPEAT;
+  }
+}
+template <typename LiteSampler>
+SamplerDesc DescribeSampler(const LiteSampler& s) {
+  SamplerDesc d;
+  d.linear = s.filter == LiteSampler::Filter::LINEAR;
+  d.addressU = AddressModeOf(s.addressU);
+  d.addressV = AddressModeOf(s.addressV);
+  d.border[0] = s.borderColor.x;
+  d.border[1] = s.borderColor.y;
+  d.border[2] = s.borderColor.z;
+  d.border[3] = s.borderColor.w;
+  return d;
+}
+
+// RAII sampler, move-only: what LiteImage::Sampler members become. Nearest or linear filtering,
+// one mip level, normalized coordinates (texel centres at (i + 0.5) / size, as on the CPU).
+class Sampler {
+public:
+  Sampler() = default;
+  Sampler(std::shared_ptr<VulkanContext> ctx, const SamplerDesc& desc, const char* debugName);
+  Sampler(Sampler&& other) noexcept;
+  Sampler& operator=(Sampler&& other) noexcept;
+  Sampler(const Sampler&) = delete;
+  Sampler& operator=(const Sampler&) = delete;
+  ~Sampler();
+
+  bool Empty() const { return sampler_ == VK_NULL_HANDLE; }
+  VkSampler Handle() const { return sampler_; }
+  const SamplerDesc& Desc() const { return desc_; }
+
+private:
+  void Release() noexcept;
+  std::shared_ptr<VulkanContext> ctx_;
+  VkSampler sampler_ = VK_NULL_HANDLE;
+  SamplerDesc desc_;
+};
+
+// Recreates s when it is empty or describes another sampler.
+void EnsureSampler(std::shared_ptr<VulkanContext> ctx, Sampler& s, const SamplerDesc& desc, const char* debugName);
+// Throws when a kernel samples img with linear filtering that its format cannot filter.
+void CheckFilterable(const VulkanContext& ctx, const Image& img, const Sampler& s, const char* what);
+
+// One descriptor of a kernel's push-descriptor set: a storage buffer (converts from BufferView),
+// a storage image, a sampled image or a sampler.
+struct Binding {
+  Binding(BufferView b) : type(VK_DESCRIPTOR_TYPE_STORAGE_BUFFER), buffer(b) {}
+  static Binding StorageImage(const Image& img) { return Binding(VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, img.View(), VK_NULL_HANDLE); }
+  static Binding SampledImage(const Image& img) { return Binding(VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, img.View(), VK_NULL_HANDLE); }
+  static Binding SamplerOf(const Sampler& s) { return Binding(VK_DESCRIPTOR_TYPE_SAMPLER, VK_NULL_HANDLE, s.Handle()); }
+
+  VkDescriptorType type;
+  BufferView buffer;
+  VkImageView view = VK_NULL_HANDLE;
+  VkSampler sampler = VK_NULL_HANDLE;
+
+private:
+  Binding(VkDescriptorType t, VkImageView v, VkSampler s) : type(t), view(v), sampler(s) {}
+};
+
 // The object a composed member (shared_ptr, unique_ptr or plain pointer) holds, or null.
 template <typename T>
 T* RawPointer(T* p) { return p; }
@@ -185,13 +308,16 @@ void ReadAppended(const Buffer& counts, size_t sizeOffset, const Buffer& element
 // Reallocates b (keeping its extra usage) only when it is empty or smaller than bytes.
 void EnsureSize(std::shared_ptr<VulkanContext> ctx, Buffer& b, VkDeviceSize bytes);
 
-// RAII compute pipeline, move-only. Set 0 is a push-descriptor set of storage buffers.
+// RAII compute pipeline, move-only. Set 0 is a push-descriptor set.
 class ComputePipeline {
 public:
   ComputePipeline() = default;
   // storageBufferBindings: bindings 0..n-1 in set 0; pushConstantBytes may be 0.
   ComputePipeline(std::shared_ptr<VulkanContext> ctx, const uint32_t* spirv, size_t spirvBytes,
                   uint32_t storageBufferBindings, uint32_t pushConstantBytes, const char* debugName);
+  // Binding i of set 0 has bindingTypes[i] (storage buffers, storage images, sampled images, samplers).
+  ComputePipeline(std::shared_ptr<VulkanContext> ctx, const uint32_t* spirv, size_t spirvBytes,
+                  std::vector<VkDescriptorType> bindingTypes, uint32_t pushConstantBytes, const char* debugName);
   ComputePipeline(ComputePipeline&& other) noexcept;
   ComputePipeline& operator=(ComputePipeline&& other) noexcept;
   ComputePipeline(const ComputePipeline&) = delete;
@@ -201,18 +327,21 @@ public:
   void Bind(VkCommandBuffer cmd) const;
   // Binding i = i-th view, via vkCmdPushDescriptorSetKHR. The count must equal the binding count.
   void PushBuffers(VkCommandBuffer cmd, std::initializer_list<BufferView> buffers) const;
+  // Binding i = i-th entry, whose type must be the layout's.
+  void PushBindings(VkCommandBuffer cmd, std::initializer_list<Binding> bindings) const;
   void PushConstants(VkCommandBuffer cmd, const void* data, uint32_t bytes) const;
   VkPipeline Handle() const { return pipeline_; }
   VkPipelineLayout Layout() const { return layout_; }
 
 private:
   void Release() noexcept;
+  void Push(VkCommandBuffer cmd, const std::vector<Binding>& bindings) const;
 
   std::shared_ptr<VulkanContext> ctx_;
   VkDescriptorSetLayout setLayout_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
   VkPipeline pipeline_ = VK_NULL_HANDLE;
-  uint32_t bindings_ = 0;
+  std::vector<VkDescriptorType> types_;
   uint32_t pushConstantBytes_ = 0;
   std::string name_;
 };
