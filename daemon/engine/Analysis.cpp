@@ -139,7 +139,20 @@ void AnalyzeMembers(Context& c) {
     m.name = f->getNameAsString();
     m.hostExpr = m.name;
     QualType elem;
-    if (IsStdVector(f->getType(), &elem)) {
+    if (IsImage2D(f->getType(), &elem)) {
+      auto format = ImageFormatOf(elem);
+      if (!format) continue;  // reported if a kernel uses it
+      m.kind = MemberKind::Image;
+      m.glslType = format->texel;
+      m.imageFormat = format->glslFormat;
+      m.vkFormat = format->vkFormat;
+      m.imagePrefix = format->prefix;
+      m.elemCppType = CppTypeName(c.ctx, elem);
+      m.cppType = CppTypeName(c.ctx, f->getType());
+    } else if (IsImageSampler(f->getType())) {
+      m.kind = MemberKind::Sampler;
+      m.cppType = CppTypeName(c.ctx, f->getType());
+    } else if (IsStdVector(f->getType(), &elem)) {
       auto g = GlslTypeOf(elem);
       if (!g) continue;  // reported if a kernel uses it
       m.kind = MemberKind::Vector;
@@ -232,6 +245,15 @@ struct WriteScanner : RecursiveASTVisitor<WriteScanner> {
     const FieldDecl* root = RootField(lhs);
     if (!root) return;
     if (IsStdVector(root->getType())) { vectorWrites.insert(root); return; }
+    if (IsImage2D(root->getType())) {
+      // m_img[p] = v and m_img.at(x, y) = v print as imageStore; a part of a texel cannot be stored.
+      auto* op = dyn_cast<CXXOperatorCallExpr>(lhs->IgnoreParenImpCasts());
+      if (!(op && op->getOperator() == OO_Subscript && ThisField(op->getArg(0)) == root))
+        c.rep.Error(loc, "kernel writes part of a texel of Image2D member '" + root->getNameAsString() + "'",
+                    "GPU images store whole texels: read the texel into a variable, change it, and write it back with " +
+                    root->getNameAsString() + "[p] = value");
+      return;
+    }
     auto* direct = AsThisMember(lhs);
     if (helper) {
       c.rep.Error(loc, "helper function '" + helper->getNameAsString() + "' writes class member '" + root->getNameAsString() + "' (called from every thread: a data race)",
@@ -833,6 +855,24 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
                   "declare it protected");
   }
   std::sort(k.memberVectors.begin(), k.memberVectors.end());
+  // Images and samplers, in declaration order so that bindings stay stable across regenerations.
+  for (auto* f : c.cls->fields()) {
+    const bool loaded = printer.loadedImages.count(f), stored = printer.storedImages.count(f);
+    const bool sampled = printer.sampledImages.count(f), sampler = printer.samplers.count(f);
+    if (!(loaded || stored || sampled || sampler || printer.sizedImages.count(f))) continue;
+    if (f->getAccess() == AS_private)
+      c.rep.Error(f->getLocation(), "member '" + f->getNameAsString() + "' is private, but the generated class derives from '" + c.cls->getNameAsString() + "' and must reach it",
+                  "declare it protected");
+    auto* m = FindMember(c.model, f->getNameAsString());
+    if (!m) continue;
+    m->usedByKernels = true;
+    m->writtenByKernels = m->writtenByKernels || stored;
+    if (loaded || stored) k.images.push_back({m->name, ImageUse::Storage, loaded, stored});
+    if (sampled) k.images.push_back({m->name, ImageUse::Texture, true, false});
+    if (sampler) k.images.push_back({m->name, ImageUse::Sampler, false, false});
+  }
+  for (auto& [image, sampler] : printer.samplePairs) k.samplePairs.push_back({image->getNameAsString(), sampler->getNameAsString()});
+  std::sort(k.samplePairs.begin(), k.samplePairs.end());
   for (auto* f : printer.plainMembers) {
     auto* m = FindMember(c.model, f->getNameAsString());
     if (m) m->usedByKernels = true;
@@ -1670,6 +1710,11 @@ void FinishModel(ClassModel& model) {
     if (!m.usedByKernels || m.kind != MemberKind::Vector) continue;
     fields.push_back({m.name + "_size", "uint32_t", "uint", 4, "", ""});
     fields.push_back({m.name + "_capacity", "uint32_t", "uint", 4, "", ""});
+  }
+  for (auto& m : model.members) {
+    if (!m.usedByKernels || m.kind != MemberKind::Image) continue;
+    fields.push_back({m.name + "_width", "uint32_t", "uint", 4, "", m.hostExpr + ".width()"});
+    fields.push_back({m.name + "_height", "uint32_t", "uint", 4, "", m.hostExpr + ".height()"});
   }
   // Virtual functions: where each vector's tags and each implementation's objects are on the device.
   for (auto& v : model.virtuals) {

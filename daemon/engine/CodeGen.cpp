@@ -287,6 +287,26 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
     x.set("subgroupOp", r.op == ReduceOp::Min ? "subgroupMin" : r.op == ReduceOp::Max ? "subgroupMax" : "subgroupAdd");
     reductions.push_back(x);
   }
+  // Images and samplers follow the buffers (the host pushes them in this order).
+  Data images = List();
+  for (auto& ib : k.images) {
+    auto* m = FindMember(model, ib.member);
+    Data x;
+    x.set("binding", std::to_string(binding++));
+    if (ib.use == ImageUse::Storage) {
+      std::string access = !ib.stored ? "readonly " : !ib.loaded ? "writeonly " : "";
+      x.set("decl", "layout(binding = " + std::to_string(binding - 1) + ", " + m->imageFormat + ") uniform " + access + m->imagePrefix + "image2D " + ib.member);
+      x.set("comment", "member Image2D " + ib.member + ": texels " + (ib.loaded && ib.stored ? "loaded and stored" : ib.loaded ? "loaded" : "stored"));
+    } else if (ib.use == ImageUse::Texture) {
+      x.set("decl", "layout(binding = " + std::to_string(binding - 1) + ") uniform " + m->imagePrefix + "texture2D " + ib.member + "_texture");
+      x.set("comment", "member Image2D " + ib.member + ": sampled");
+    } else {
+      x.set("decl", "layout(binding = " + std::to_string(binding - 1) + ") uniform sampler " + ib.member);
+      x.set("comment", "member LiteImage::Sampler " + ib.member);
+    }
+    images.push_back(x);
+  }
+  d.set("images", images);
   d.set("scalarLayout", scalarAny || k.scalarReferences);
   d.set("bufferReferences", k.bufferReferences);
   d.set("buffers", buffers);
@@ -426,6 +446,23 @@ Data ControlsData(const ClassModel& model) {
             if (auto* m = FindMember(model, v); m && m->writtenByKernels) addWritten(v);
     for (auto& v : c.vectorsWritten) addWritten(v);  // by scans, fills, copies
     x.set("writtenVectors", written);
+    // Image2D members stored by its kernels are read back after it, whole.
+    Data writtenImages = List();
+    std::set<std::string> seenImages;
+    for (auto& kn : c.kernelsCalled)
+      for (auto& k : model.kernels)
+        if (k.name == kn)
+          for (auto& ib : k.images)
+            if (ib.stored && seenImages.insert(ib.member).second) {
+              auto* m = FindMember(model, ib.member);
+              Data y;
+              y.set("name", ib.member);
+              y.set("host", m->hostExpr);
+              y.set("control", c.name);
+              y.set("texelCpp", m->elemCppType);
+              writtenImages.push_back(y);
+            }
+    x.set("writtenImages", writtenImages);
     controls.push_back(x);
   }
   return controls;
@@ -509,6 +546,20 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
       y.set("groupCountExpr", GroupCountExpr(k));
       reds.push_back(y);
     }
+    // Images and samplers after the buffers, as the GLSL declares them.
+    std::string types;
+    for (unsigned i = 0; i < bindings; ++i) types += std::string(i ? ", " : "") + "VK_DESCRIPTOR_TYPE_STORAGE_BUFFER";
+    for (auto& ib : k.images) {
+      const char* type = ib.use == ImageUse::Storage ? "VK_DESCRIPTOR_TYPE_STORAGE_IMAGE"
+                         : ib.use == ImageUse::Texture ? "VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE" : "VK_DESCRIPTOR_TYPE_SAMPLER";
+      types += std::string(", ") + type;
+      buffers += std::string(", crossrt::Binding::") +
+                 (ib.use == ImageUse::Storage ? "StorageImage" : ib.use == ImageUse::Texture ? "SampledImage" : "SamplerOf") + "(m_images." +
+                 ib.member + ")";
+    }
+    x.set("pushBindings", !k.images.empty());  // typed bindings
+    x.set("pushBuffers", k.images.empty());    // buffers only
+    x.set("bindingTypes", types);
     x.set("bufferList", buffers);
     x.set("bindingCount", std::to_string(bindings));
     x.set("reduceBindingCount", std::to_string(1 + k.reductions.size()));
@@ -519,6 +570,33 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
     kernels.push_back(x);
   }
   return kernels;
+}
+
+// Image2D and LiteImage::Sampler members kernels use, and the (image, sampler) pairs they sample.
+Data ImagesData(const ClassModel& model, MemberKind kind) {
+  Data images = List();
+  for (auto& m : model.members) {
+    if (m.kind != kind || !m.usedByKernels) continue;
+    Data x;
+    x.set("name", m.name);
+    x.set("host", m.hostExpr);
+    x.set("texelCpp", m.elemCppType);
+    x.set("vkFormat", m.vkFormat);
+    std::set<std::string> samplers;
+    for (auto& k : model.kernels)
+      for (auto& [image, sampler] : k.samplePairs)
+        if (image == m.name) samplers.insert(sampler);
+    Data pairs = List();
+    for (auto& sampler : samplers) {
+      Data y;
+      y.set("image", m.name);
+      y.set("sampler", sampler);
+      pairs.push_back(y);
+    }
+    x.set("samplePairs", pairs);
+    images.push_back(x);
+  }
+  return images;
 }
 
 Data VectorsData(const ClassModel& model) {
@@ -554,6 +632,12 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
   d.set("controls", ControlsData(model));
   d.set("vectors", VectorsData(model));
   if (vulkan) {
+    Data images = ImagesData(model, MemberKind::Image), samplers = ImagesData(model, MemberKind::Sampler);
+    d.set("images", images);
+    d.set("samplers", samplers);
+    d.set("hasImages", std::any_of(model.members.begin(), model.members.end(), [](const Member& m) {
+      return m.usedByKernels && (m.kind == MemberKind::Image || m.kind == MemberKind::Sampler);
+    }));
     unsigned indirectSlots = 0;
     d.set("kernels", VulkanKernelsData(model, indirectSlots));
     d.set("indirectSlots", std::to_string(indirectSlots));

@@ -65,6 +65,26 @@ bool IsStdVector(QualType type, QualType* element) {
   return true;
 }
 
+bool IsImage2D(QualType type, QualType* texel) {
+  auto* spec = dyn_cast_or_null<ClassTemplateSpecializationDecl>(type.getNonReferenceType().getCanonicalType()->getAsCXXRecordDecl());
+  if (!spec || spec->getName() != "Image2D" || spec->getTemplateArgs().size() != 1) return false;
+  if (texel) *texel = spec->getTemplateArgs()[0].getAsType();
+  return true;
+}
+
+bool IsImageSampler(QualType type) {
+  auto* rd = type.getNonReferenceType().getCanonicalType()->getAsCXXRecordDecl();
+  return rd && rd->getName() == "Sampler" && InNamespace(rd, "LiteImage");
+}
+
+std::optional<ImageFormat> ImageFormatOf(QualType texel) {
+  texel = texel.getCanonicalType().getUnqualifiedType();
+  if (IsLiteMathType(texel, "float4")) return ImageFormat{"rgba32f", "VK_FORMAT_R32G32B32A32_SFLOAT", "vec4", ""};
+  if (texel->isSpecificBuiltinType(BuiltinType::Float)) return ImageFormat{"r32f", "VK_FORMAT_R32_SFLOAT", "float", ""};
+  if (texel->isSpecificBuiltinType(BuiltinType::UInt)) return ImageFormat{"r32ui", "VK_FORMAT_R32_UINT", "uint", "u"};
+  return std::nullopt;
+}
+
 std::optional<std::string> GlslTypeOf(QualType type) {
   type = type.getNonReferenceType().getCanonicalType().getUnqualifiedType();
   if (auto* arr = dyn_cast<ConstantArrayType>(type.getTypePtr())) {
@@ -544,6 +564,97 @@ std::string GlslPrinter::Builtin(const FunctionDecl* fd, const std::vector<std::
   return "";
 }
 
+// ---- Image2D members: storage images (texels loaded and stored) and textures (sampled) ----
+
+namespace {
+const FieldDecl* ThisMemberField(const clang::Expr* e) {
+  auto* me = dyn_cast<MemberExpr>(e->IgnoreParenImpCasts());
+  if (!me || !isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts())) return nullptr;
+  return dyn_cast<FieldDecl>(me->getMemberDecl());
+}
+
+// How a texel of the image's type becomes the C++ value: images hold 4 channels on the GPU.
+std::string TexelOf(const ImageFormat& f, const std::string& load) { return f.texel == "vec4" ? load : load + ".x"; }
+}  // namespace
+
+const FieldDecl* GlslPrinter::ImageTexel(const clang::Expr* e, std::string& coord) {
+  e = e->IgnoreParenImpCasts();
+  if (auto* op = dyn_cast<CXXOperatorCallExpr>(e); op && op->getOperator() == OO_Subscript) {
+    auto* f = ThisMemberField(op->getArg(0));
+    if (!f || !IsImage2D(f->getType())) return nullptr;
+    // int2 is ivec2 already; uint2 and friends are converted.
+    const bool ivec = GlslTypeOf(op->getArg(1)->getType()).value_or("") == "ivec2";
+    coord = ivec ? Expr(op->getArg(1)) : "ivec2(" + Expr(op->getArg(1)) + ")";
+    return f;
+  }
+  if (auto* mc = dyn_cast<CXXMemberCallExpr>(e); mc && mc->getMethodDecl() && mc->getMethodDecl()->getName() == "at" && mc->getNumArgs() == 2) {
+    auto* f = ThisMemberField(mc->getImplicitObjectArgument());
+    if (!f || !IsImage2D(f->getType())) return nullptr;
+    coord = "ivec2(" + Expr(mc->getArg(0)) + ", " + Expr(mc->getArg(1)) + ")";
+    return f;
+  }
+  return nullptr;
+}
+
+std::string GlslPrinter::ImageStore(const clang::Expr* lhs, const std::string& value, const clang::Expr* whole) {
+  std::string coord;
+  const FieldDecl* f = ImageTexel(lhs, coord);
+  QualType texel;
+  IsImage2D(f->getType(), &texel);
+  auto format = ImageFormatOf(texel);
+  if (!format) return Fail(whole->getBeginLoc(), "Image2D member '" + f->getNameAsString() + "' has a texel type the GPU cannot store", "use Image2D<float4>, Image2D<float> or Image2D<uint32_t>");
+  if (!composedPrefix.empty() || selfClass)
+    return Fail(whole->getBeginLoc(), "Image2D member '" + f->getNameAsString() + "' written outside the class's own kernels", "write images only in kernels and helpers of the translated class");
+  storedImages.insert(f);
+  const std::string channels = format->prefix + "vec4";
+  return "imageStore(" + f->getNameAsString() + ", " + coord + ", " + (format->texel == "vec4" ? value : channels + "(" + value + ")") + ")";
+}
+
+std::string GlslPrinter::ImageCall(const FieldDecl* image, const CXXMemberCallExpr* call) {
+  const std::string name = image->getNameAsString();
+  const std::string method = call->getMethodDecl()->getNameAsString();
+  QualType texel;
+  IsImage2D(image->getType(), &texel);
+  auto format = ImageFormatOf(texel);
+  if (!format)
+    return Fail(call->getBeginLoc(), "Image2D member '" + name + "' has texels of type '" + texel.getAsString(m_ctx.getPrintingPolicy()) + "', which GPU images cannot hold",
+                "use Image2D<float4>, Image2D<float> or Image2D<uint32_t>");
+  if (!composedPrefix.empty() || selfClass)
+    return Fail(call->getBeginLoc(), "Image2D member '" + name + "' used outside the class's own kernels", "use images only in kernels and helpers of the translated class");
+  if (method == "width" || method == "height") {
+    sizedImages.insert(image);
+    return name + "_" + method;
+  }
+  if (method == "at") {
+    std::string coord;
+    ImageTexel(call, coord);
+    loadedImages.insert(image);
+    return TexelOf(*format, "imageLoad(" + name + ", " + coord + ")");
+  }
+  if (method == "set" && call->getNumArgs() == 3) {
+    storedImages.insert(image);
+    const std::string value = Expr(call->getArg(2));
+    return "imageStore(" + name + ", ivec2(" + Expr(call->getArg(0)) + ", " + Expr(call->getArg(1)) + "), " +
+           (format->texel == "vec4" ? value : format->prefix + "vec4(" + value + ")") + ")";
+  }
+  if (method == "sample" && call->getNumArgs() == 2) {
+    if (format->texel == "uint")
+      return Fail(call->getBeginLoc(), "sample() of Image2D<uint32_t> member '" + name + "' (GPU samplers filter only float images)",
+                  "read texels with " + name + "[int2(x, y)], or store the image as Image2D<float> or Image2D<float4>");
+    const FieldDecl* sampler = ThisMemberField(call->getArg(0));
+    if (!sampler || !IsImageSampler(sampler->getType()))
+      return Fail(call->getArg(0)->getBeginLoc(), "the sampler of " + name + ".sample() is not a member of the class",
+                  "declare the LiteImage::Sampler as a member, so it is created on the GPU with the image");
+    sampledImages.insert(image);
+    samplers.insert(sampler);
+    samplePairs.insert({image, sampler});
+    // Compute shaders have no derivatives: sample the one mip level explicitly.
+    return TexelOf(*format, "textureLod(sampler2D(" + name + "_texture, " + sampler->getNameAsString() + "), " + Expr(call->getArg(1)) + ", 0.0)");
+  }
+  return Fail(call->getBeginLoc(), "Image2D::" + method + " is not supported in kernels",
+              "kernels read texels (" + name + "[p], at(x, y), sample(sampler, uv)), write them (" + name + "[p] = v, set(x, y, v)) and read width() and height()");
+}
+
 std::string GlslPrinter::Call(const CallExpr* call) {
   const FunctionDecl* fd = call->getDirectCallee();
   if (!fd) return Fail(call->getBeginLoc(), "indirect call in a kernel", "call functions directly; lambdas and function pointers are not supported");
@@ -574,6 +685,8 @@ std::string GlslPrinter::Call(const CallExpr* call) {
       for (size_t i = 0; i < args.size(); ++i) s += (i ? ", " : "") + args[i];
       return s + ")";
     }
+    // Calls on an Image2D member: texel loads and stores, samples, its size.
+    if (auto* image = ThisMemberField(obj); image && IsImage2D(image->getType())) return ImageCall(image, mc);
     // Calls through a member holding an interface: composition.
     std::string composed = ComposedCall(mc);
     if (!composed.empty()) return composed;
@@ -694,6 +807,13 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
         memberVectors.insert(field);
         return composedPrefix + field->getNameAsString();
       }
+      if (IsImage2D(field->getType()))
+        return Fail(e->getBeginLoc(), "Image2D member '" + field->getNameAsString() + "' used as a value in a kernel",
+                    "use its texels where the image is a member: " + field->getNameAsString() + "[p], at(x, y), sample(sampler, uv), " +
+                    field->getNameAsString() + "[p] = v, set(x, y, v), width(), height()");
+      if (IsImageSampler(field->getType()))
+        return Fail(e->getBeginLoc(), "sampler member '" + field->getNameAsString() + "' used as a value in a kernel",
+                    "pass it straight to an Image2D member's sample(" + field->getNameAsString() + ", uv)");
       if (field->getType()->isPointerType() || !GlslTypeOf(field->getType()))
         return Fail(e->getBeginLoc(), "member '" + field->getNameAsString() + "' of type '" + field->getType().getAsString(m_ctx.getPrintingPolicy()) +
                     "' cannot be used in a kernel", "kernels may use plain data members and std::vector members");
@@ -707,7 +827,26 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
   if (auto* as = dyn_cast<ArraySubscriptExpr>(e)) return Expr(as->getBase()) + "[" + Expr(as->getIdx()) + "]";
   if (auto* op = dyn_cast<CXXOperatorCallExpr>(e)) {
     auto kind = op->getOperator();
+    std::string coord;
+    if (kind == OO_Subscript)
+      if (auto* image = ImageTexel(op, coord)) {
+        QualType texel;
+        IsImage2D(image->getType(), &texel);
+        auto format = ImageFormatOf(texel);
+        if (!format)
+          return Fail(e->getBeginLoc(), "Image2D member '" + image->getNameAsString() + "' has a texel type GPU images cannot hold",
+                      "use Image2D<float4>, Image2D<float> or Image2D<uint32_t>");
+        loadedImages.insert(image);
+        return TexelOf(*format, "imageLoad(" + image->getNameAsString() + ", " + coord + ")");
+      }
     if (kind == OO_Subscript) return Expr(op->getArg(0)) + "[" + Expr(op->getArg(1)) + "]";
+    if (op->isAssignmentOp() && op->getNumArgs() == 2 && ImageTexel(op->getArg(0), coord)) {
+      if (kind == OO_Equal) return ImageStore(op->getArg(0), Expr(op->getArg(1)), e);
+      if (op->getArg(0)->HasSideEffects(m_ctx, /*IncludePossibleEffects=*/false))  // it is printed twice
+        return Fail(e->getBeginLoc(), "compound assignment to a texel whose coordinate has side effects", "compute the coordinate into a variable first");
+      std::string spelling = getOperatorSpelling(kind);
+      return ImageStore(op->getArg(0), Expr(op->getArg(0)) + " " + spelling.substr(0, spelling.size() - 1) + " (" + Expr(op->getArg(1)) + ")", e);
+    }
     if (kind == OO_Call) return Fail(e->getBeginLoc(), "call of a function object in a kernel", "call a plain function instead");
     if (kind == OO_LessLess || kind == OO_GreaterGreater) {
       if (IsSystemDecl(op->getDirectCallee() ? (const Decl*)op->getDirectCallee() : (const Decl*)m_class))
@@ -721,6 +860,14 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
     return Fail(e->getBeginLoc(), "operator not supported in kernels", "");
   }
   if (auto* bo = dyn_cast<BinaryOperator>(e)) {
+    std::string coord;
+    if (bo->isAssignmentOp() && ImageTexel(bo->getLHS(), coord)) {  // a texel of a float or uint image
+      if (bo->getOpcode() == BO_Assign) return ImageStore(bo->getLHS(), Expr(bo->getRHS()), e);
+      if (bo->getLHS()->HasSideEffects(m_ctx, /*IncludePossibleEffects=*/false))  // it is printed twice
+        return Fail(e->getBeginLoc(), "compound assignment to a texel whose coordinate has side effects", "compute the coordinate into a variable first");
+      std::string spelling = BinaryOperator::getOpcodeStr(BinaryOperator::getOpForCompoundAssignment(bo->getOpcode())).str();
+      return ImageStore(bo->getLHS(), Expr(bo->getLHS()) + " " + spelling + " (" + Expr(bo->getRHS()) + ")", e);
+    }
     // C++ gives the remainder the dividend's sign; GLSL's % is undefined for negative operands.
     if ((bo->getOpcode() == BO_Rem || bo->getOpcode() == BO_RemAssign) && bo->getType()->isSignedIntegerType()) {
       std::string a = Expr(bo->getLHS()), b = "(" + Expr(bo->getRHS()) + ")";

@@ -24,6 +24,14 @@ std::pair<std::string, std::string> SplitArray(const std::string& glslType);
 
 bool IsLiteMathType(clang::QualType type, const char* name = nullptr);
 bool IsStdVector(clang::QualType type, clang::QualType* element = nullptr);
+// Image2D<T> (any namespace, as the paper's LiteImage names it) and its texel type.
+bool IsImage2D(clang::QualType type, clang::QualType* texel = nullptr);
+// LiteImage::Sampler: filtering and address modes of image samples.
+bool IsImageSampler(clang::QualType type);
+// GPU image format of an Image2D<T>: GLSL format qualifier, Vulkan format, texel GLSL type,
+// image/texture type prefix ("" or "u"); nullopt for texel types the GPU cannot hold.
+struct ImageFormat { std::string glslFormat, vkFormat, texel, prefix; };
+std::optional<ImageFormat> ImageFormatOf(clang::QualType texel);
 bool IsSystemDecl(const clang::Decl* decl);
 
 // std430 array stride of a scalar or vector GLSL type: "vec3" and "vec4" 16, "vec2" 8, scalars 4.
@@ -51,6 +59,11 @@ public:
   std::set<const clang::FieldDecl*> memberVectors, plainMembers;
   // Where the kernel reads a member vector's size (a kernel may not read what it appends to).
   std::multimap<const clang::FieldDecl*, clang::SourceLocation> sizeReads;
+  // Image2D members the kernel loads or stores texels of (storage images), samples (textures),
+  // and the Sampler members it samples with.
+  std::set<const clang::FieldDecl*> loadedImages, storedImages, sampledImages, samplers;
+  std::set<const clang::FieldDecl*> sizedImages;  // whose width() or height() it reads
+  std::set<std::pair<const clang::FieldDecl*, const clang::FieldDecl*>> samplePairs;  // (image, sampler)
   // Helper functions the kernel reaches (their writes to members matter too).
   std::vector<const clang::FunctionDecl*> helpers;
 
@@ -97,6 +110,11 @@ private:
   std::string Construct(clang::QualType t, const std::vector<const clang::Expr*>& args, clang::SourceLocation loc);
   std::string Literal(const clang::Expr* e);
   std::string Cast(clang::QualType to, const clang::Expr* sub);
+  // Image2D members: a texel expression (m_img[p], m_img.at(x, y)) as its image and coordinate;
+  // loads, stores and the image's other calls.
+  const clang::FieldDecl* ImageTexel(const clang::Expr* e, std::string& coord);
+  std::string ImageStore(const clang::Expr* lhs, const std::string& value, const clang::Expr* whole);
+  std::string ImageCall(const clang::FieldDecl* image, const clang::CXXMemberCallExpr* call);
   std::string EmitAppend(const clang::FieldDecl* field, const clang::CallExpr* call);
   std::string EmitHelper(const clang::FunctionDecl* fd, clang::SourceLocation callLoc, bool composedEntry = false);
   std::string ComposedCall(const clang::CXXMemberCallExpr* call);

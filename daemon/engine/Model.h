@@ -17,7 +17,7 @@ struct BlockField {
   std::string assignExpr;  // values the generated class computes (device addresses)
 };
 
-enum class MemberKind { Plain, Vector };
+enum class MemberKind { Plain, Vector, Image, Sampler };
 
 struct Member {
   std::string name;             // as GLSL and the generated mirrors name it
@@ -26,7 +26,10 @@ struct Member {
   MemberKind kind = MemberKind::Plain;
   std::string cppType;          // full C++ type spelling
   std::string glslType;         // plain: the GLSL type; vector: the element's GLSL type
-  std::string elemCppType;      // vector only
+  std::string elemCppType;      // vector: the element's C++ type; image: the texel's
+  std::string imageFormat;      // image: GLSL format qualifier (rgba32f, r32f, r32ui)
+  std::string vkFormat;         // image: VK_FORMAT_...
+  std::string imagePrefix;      // image: "u" for unsigned texels (uimage2D, utexture2D), else ""
   bool scalarLayout = false;    // vector whose element needs GL_EXT_scalar_block_layout to match C++
   bool writtenByKernels = false;
   bool usedByKernels = false;
@@ -57,6 +60,15 @@ struct KernelParam {
   unsigned std430Align = 4;  // by-value parameters: alignment in the push-constant block
 };
 
+// An image or sampler a kernel binds: an Image2D member as a storage image (texels loaded and
+// stored) or as a texture (sampled), or a LiteImage::Sampler member.
+enum class ImageUse { Storage, Texture, Sampler };
+struct ImageBinding {
+  std::string member;
+  ImageUse use = ImageUse::Storage;
+  bool loaded = false, stored = false;  // storage: what the kernel does with its texels
+};
+
 struct Loop {                // one parallel dimension of an IPV kernel
   std::string var;
   std::string glslType;      // the loop variable's GLSL type
@@ -74,6 +86,8 @@ struct Kernel {
   std::vector<Loop> loops;            // IPV: outermost first
   std::vector<Reduction> reductions;
   std::vector<std::string> memberVectors;   // member vectors the kernel reaches (incl. helpers)
+  std::vector<ImageBinding> images;         // bound after the buffers, in member declaration order
+  std::vector<std::pair<std::string, std::string>> samplePairs;  // (image, sampler) it samples with
   // 1D kernel looping to the size of a vector that kernels append to: dispatched indirectly, its
   // thread count read on the GPU.
   std::string indirectVector;

@@ -1,6 +1,6 @@
 // Image and Sampler: what Image2D<T> and LiteImage::Sampler members of a translated class become.
-// Images live in device-local memory in VK_IMAGE_LAYOUT_GENERAL for their whole life: kernels
-// load, store and sample them, and copies use the same layout, so no transitions are recorded.
+// Images live in device-local memory in VK_IMAGE_LAYOUT_GENERAL: kernels load, store and sample
+// them there, so kernels record no transitions. Only the host's copies leave it for a moment.
 #include "crossrt/VulkanRuntime.h"
 #include "Internal.h"
 
@@ -20,13 +20,20 @@ uint32_t TexelBytes(VkFormat format) {
   }
 }
 
-// Every access before and after: copies and kernels of earlier and later submissions see each other's texels.
-void FullBarrier(VkCommandBuffer cmd) {
-  auto b = VkInit<VkMemoryBarrier>(VK_STRUCTURE_TYPE_MEMORY_BARRIER);
+// A layout change that orders every access before it with every access after it: copies and
+// kernels of earlier and later submissions see each other's texels. Copies run in the
+// TRANSFER_*_OPTIMAL layouts, which drivers prefer; everything else in GENERAL.
+void Transition(VkCommandBuffer cmd, VkImage image, VkImageLayout from, VkImageLayout to) {
+  auto b = VkInit<VkImageMemoryBarrier>(VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER);
   b.srcAccessMask = VK_ACCESS_MEMORY_WRITE_BIT;
   b.dstAccessMask = VK_ACCESS_MEMORY_READ_BIT | VK_ACCESS_MEMORY_WRITE_BIT;
-  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 1, &b, 0, nullptr, 0,
-                       nullptr);
+  b.oldLayout = from;
+  b.newLayout = to;
+  b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  b.image = image;
+  b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, 0, 0, nullptr, 0, nullptr, 1,
+                       &b);
 }
 
 VkBufferImageCopy WholeImage(uint32_t width, uint32_t height) {
@@ -137,10 +144,10 @@ void Image::Upload(const void* texels, size_t bytes) {
   Staging staging(*ctx_, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
   std::memcpy(staging.mapped, texels, bytes);
   VkCommandBuffer cmd = ctx_->BeginOneShot();
-  FullBarrier(cmd);  // kernels of earlier submissions are done with the texels
+  Transition(cmd, image_, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);  // earlier kernels are done
   const VkBufferImageCopy region = WholeImage(width_, height_);
-  vkCmdCopyBufferToImage(cmd, staging.a.buffer, image_, VK_IMAGE_LAYOUT_GENERAL, 1, &region);
-  FullBarrier(cmd);  // later kernels see the new texels
+  vkCmdCopyBufferToImage(cmd, staging.a.buffer, image_, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+  Transition(cmd, image_, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL);  // later kernels see the texels
   ctx_->SubmitAndWait(cmd);
 }
 
@@ -150,9 +157,10 @@ void Image::Download(void* texels, size_t bytes) const {
     throw Error("Image::Download: " + std::to_string(bytes) + " bytes for an image of " + std::to_string(Bytes()) + " bytes");
   Staging staging(*ctx_, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
   VkCommandBuffer cmd = ctx_->BeginOneShot();
-  FullBarrier(cmd);
+  Transition(cmd, image_, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);  // kernels are done
   const VkBufferImageCopy region = WholeImage(width_, height_);
-  vkCmdCopyImageToBuffer(cmd, image_, VK_IMAGE_LAYOUT_GENERAL, staging.a.buffer, 1, &region);
+  vkCmdCopyImageToBuffer(cmd, image_, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, staging.a.buffer, 1, &region);
+  Transition(cmd, image_, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_IMAGE_LAYOUT_GENERAL);
   ctx_->SubmitAndWait(cmd);  // ends with a transfer -> host barrier
   std::memcpy(texels, staging.mapped, bytes);
 }

@@ -159,8 +159,9 @@ private:
   VkBufferUsageFlags extraUsage_ = 0;
 };
 
-// RAII 2D image with one mip level, move-only: what Image2D<T> members become. It stays in
-// VK_IMAGE_LAYOUT_GENERAL, so kernels can load, store and sample it without layout transitions.
+// RAII 2D image with one mip level, move-only: what Image2D<T> members become. Kernels find it in
+// VK_IMAGE_LAYOUT_GENERAL and load, store and sample it there; only Upload and Download leave it
+// (for the transfer layouts) and return.
 // Usage: STORAGE | SAMPLED | TRANSFER_SRC | TRANSFER_DST.
 class Image {
 public:
