@@ -474,3 +474,62 @@ void Areas::kernel1D_Run(int n, float* out)
     REQUIRE(r.output.find("--virtual-level takes 1 (one array of equal slots) or 2 (a buffer per class), not '3'") != std::string::npos);
   }
 }
+
+TEST_CASE("Image uses the GPU cannot make are reported", "[diagnostics][images]")
+{
+  struct Case { const char* name; const char* body; const char* message; const char* hint; };
+  const Case cases[] = {
+      {"a part of a texel written", "m_image[LiteMath::int2(i, 0)].x = 1.0f;", "kernel writes part of a texel of Image2D member 'm_image'",
+       "GPU images store whole texels"},
+      {"a compound store whose coordinate has side effects", "int k = i; m_ids[LiteMath::int2(k++, 0)] += 1u;",
+       "compound assignment to a texel whose coordinate has side effects", "compute the coordinate into a variable first"},
+      {"a sampler that is not a member", "LiteImage::Sampler local; out[i] = m_image.sample(local, LiteMath::float2(0.5f)).x;",
+       "the sampler of m_image.sample() is not a member of the class", "declare the LiteImage::Sampler as a member"},
+      {"an image passed as a value", "out[i] = Red(m_image, i);", "Image2D member 'm_image' used as a value in a kernel",
+       "use its texels where the image is a member"},
+      {"an image resized in a kernel", "m_image.resize(2, 2);", "Image2D::resize is not supported in kernels",
+       "kernels read texels"},
+      {"a texel type images cannot hold", "out[i] = m_uv[LiteMath::int2(i, 0)].x;", "Image2D member 'm_uv' has a texel type GPU images cannot hold",
+       "use Image2D<float4>, Image2D<float> or Image2D<uint32_t>"},
+  };
+  for (const Case& c : cases)
+  {
+    SECTION(c.name)
+    {
+      TempClass tc("Images", R"(#pragma once
+#include "Image2D.h"
+#include <cstdint>
+inline float Red(const LiteImage::Image2D<LiteMath::float4>& image, int i) { return image[LiteMath::int2(i, 0)].x; }
+class Images
+{
+public:
+  virtual ~Images() = default;
+  virtual void Run(int n, [[crossrt::size("n")]] float* out);
+  LiteImage::Image2D<LiteMath::float4> m_image;
+  LiteImage::Image2D<uint32_t> m_ids;
+  LiteImage::Image2D<LiteMath::float2> m_uv;
+  LiteImage::Sampler m_sampler;
+protected:
+  void kernel1D_Run(int n, float* out);
+};
+)",
+                   std::string(R"(#include "Images.h"
+void Images::Run(int n, float* out) { kernel1D_Run(n, out); }
+void Images::kernel1D_Run(int n, float* out)
+{
+  for (int i = 0; i < n; i++)
+  {
+    )") + c.body + "\n  }\n}\n");
+      CommandResult r = RunCrossrt("translate --class Images --backend vulkan --out " + (tc.dir / "out").string() + " --source " +
+                                   tc.Source("Images") + " --templates " CROSSRT_SOURCE_DIR "/templates -- -I" CROSSRT_SOURCE_DIR
+                                   "/libs/litemath -I" CROSSRT_SOURCE_DIR "/libs/liteimage");
+      INFO(r.output);
+      REQUIRE_FALSE(r.crashed);
+      REQUIRE(r.exitCode == 1);
+      REQUIRE(std::regex_search(r.output, std::regex(R"(Images\.cpp:\d+:\d+: error: )")));
+      REQUIRE(r.output.find(std::string("error: ") + c.message) != std::string::npos);
+      REQUIRE(r.output.find(c.hint) != std::string::npos);
+      REQUIRE(!std::filesystem::exists(tc.dir / "out" / "Images_Vulkan.cpp"));
+    }
+  }
+}
