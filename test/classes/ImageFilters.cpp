@@ -15,6 +15,19 @@ void ImageFilters::Sample(int n, const float2* uv, float4* nearest, float4* line
 
 void ImageFilters::Accumulate(float weight) { kernel2D_Accumulate(weight); }
 
+void ImageFilters::Double()
+{
+  for (int y = 0; y < int(m_accumulated.height()); ++y)
+    for (int x = 0; x < int(m_accumulated.width()); ++x)
+      kernel_Double(x, y);
+}
+
+void ImageFilters::kernel_Double(int tidX, int tidY)
+{
+  const float2 centre = float2((float(tidX) + 0.5f) / float(m_accumulated.width()), (float(tidY) + 0.5f) / float(m_accumulated.height()));
+  m_accumulated[int2(tidX, tidY)] = 2.0f * m_accumulated.sample(m_nearest, centre);
+}
+
 float4 ImageFilters::SourceTexel(int x, int y) const
 {
   const int cx = std::min(std::max(x, 0), int(m_source.width()) - 1);

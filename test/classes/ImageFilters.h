@@ -22,6 +22,9 @@ public:
                       [[crossrt::size("n")]] LiteMath::float4* linear, [[crossrt::size("n")]] float* heights);
   // m_accumulated += weight * m_source, texel by texel; m_counts += 1.
   virtual void Accumulate(float weight);
+  // m_accumulated *= 2, by thread functions called from the control function's loops, which
+  // sample the image they store (each thread its own texel, at its centre).
+  virtual void Double();
   virtual void CommitDeviceData() {}
 
   LiteImage::Image2D<LiteMath::float4> m_source, m_blurred, m_accumulated;
@@ -33,6 +36,7 @@ protected:
   void kernel2D_Blur(float threshold);
   void kernel1D_Sample(int n, const LiteMath::float2* uv, LiteMath::float4* nearest, LiteMath::float4* linear, float* heights);
   void kernel2D_Accumulate(float weight);
+  void kernel_Double(int tidX, int tidY);
   // A helper reaching images too: the clamped texel of m_source.
   LiteMath::float4 SourceTexel(int x, int y) const;
 };

@@ -59,7 +59,7 @@ float EdgeDistance(float u, uint32_t size)
 }
 }  // namespace
 
-TEST_CASE("Image2D members: texels loaded and stored by kernels, in helpers too", "[equivalence][images]")
+TEST_CASE("Image2D members: texels loaded and stored by kernels, in helpers and thread functions too", "[equivalence][images]")
 {
   auto ctx = ValidatedContext();
   const uint32_t w = 37, h = 23;  // not powers of two, not multiples of the group size
@@ -68,6 +68,7 @@ TEST_CASE("Image2D members: texels loaded and stored by kernels, in helpers too"
   reference.Blur(0.5f);
   reference.Accumulate(0.5f);
   reference.Accumulate(2.0f);
+  reference.Double();
   uint32_t above = 0;
   for (uint32_t i = 0; i < w * h; ++i) above += reference.m_labels.data()[i];
   REQUIRE(above > 0);  // the threshold splits the image
@@ -79,6 +80,7 @@ TEST_CASE("Image2D members: texels loaded and stored by kernels, in helpers too"
     impl->Blur(0.5f);
     impl->Accumulate(0.5f);
     impl->Accumulate(2.0f);
+    impl->Double();
     REQUIRE(impl->m_blurred.width() == w);
     for (uint32_t i = 0; i < w * h; ++i)
     {
