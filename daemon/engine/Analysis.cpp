@@ -868,7 +868,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     m->usedByKernels = true;
     m->writtenByKernels = m->writtenByKernels || stored;
     if (loaded || stored) k.images.push_back({m->name, ImageUse::Storage, loaded, stored});
-    if (sampled) k.images.push_back({m->name, ImageUse::Texture, true, false});
+    if (sampled) k.images.push_back({m->name, ImageUse::Texture, false, false});
     if (sampler) k.images.push_back({m->name, ImageUse::Sampler, false, false});
   }
   for (auto& [image, sampler] : printer.samplePairs) k.samplePairs.push_back({image->getNameAsString(), sampler->getNameAsString()});

@@ -291,17 +291,17 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   Data images = List();
   for (auto& ib : k.images) {
     auto* m = FindMember(model, ib.member);
+    const std::string at = "layout(binding = " + std::to_string(binding++);
     Data x;
-    x.set("binding", std::to_string(binding++));
     if (ib.use == ImageUse::Storage) {
       std::string access = !ib.stored ? "readonly " : !ib.loaded ? "writeonly " : "";
-      x.set("decl", "layout(binding = " + std::to_string(binding - 1) + ", " + m->imageFormat + ") uniform " + access + m->imagePrefix + "image2D " + ib.member);
+      x.set("decl", at + ", " + m->imageFormat + ") uniform " + access + m->imagePrefix + "image2D " + ib.member);
       x.set("comment", "member Image2D " + ib.member + ": texels " + (ib.loaded && ib.stored ? "loaded and stored" : ib.loaded ? "loaded" : "stored"));
     } else if (ib.use == ImageUse::Texture) {
-      x.set("decl", "layout(binding = " + std::to_string(binding - 1) + ") uniform " + m->imagePrefix + "texture2D " + ib.member + "_texture");
+      x.set("decl", at + ") uniform " + m->imagePrefix + "texture2D " + ib.member + "_texture");
       x.set("comment", "member Image2D " + ib.member + ": sampled");
     } else {
-      x.set("decl", "layout(binding = " + std::to_string(binding - 1) + ") uniform sampler " + ib.member);
+      x.set("decl", at + ") uniform sampler " + ib.member);
       x.set("comment", "member LiteImage::Sampler " + ib.member);
     }
     images.push_back(x);

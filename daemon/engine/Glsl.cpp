@@ -596,15 +596,26 @@ const FieldDecl* GlslPrinter::ImageTexel(const clang::Expr* e, std::string& coor
   return nullptr;
 }
 
+std::optional<ImageFormat> GlslPrinter::UsableImage(const FieldDecl* image, SourceLocation use) {
+  QualType texel;
+  IsImage2D(image->getType(), &texel);
+  auto format = ImageFormatOf(texel);
+  if (!format)
+    Fail(use, "Image2D member '" + image->getNameAsString() + "' has a texel type GPU images cannot hold ('" +
+         texel.getAsString(m_ctx.getPrintingPolicy()) + "')", "use Image2D<float4>, Image2D<float> or Image2D<uint32_t>");
+  else if (!composedPrefix.empty() || selfClass)
+    Fail(use, "Image2D member '" + image->getNameAsString() + "' used outside the class's own kernels",
+         "use images only in kernels and helpers of the translated class");
+  else
+    return format;
+  return std::nullopt;
+}
+
 std::string GlslPrinter::ImageStore(const clang::Expr* lhs, const std::string& value, const clang::Expr* whole) {
   std::string coord;
   const FieldDecl* f = ImageTexel(lhs, coord);
-  QualType texel;
-  IsImage2D(f->getType(), &texel);
-  auto format = ImageFormatOf(texel);
-  if (!format) return Fail(whole->getBeginLoc(), "Image2D member '" + f->getNameAsString() + "' has a texel type the GPU cannot store", "use Image2D<float4>, Image2D<float> or Image2D<uint32_t>");
-  if (!composedPrefix.empty() || selfClass)
-    return Fail(whole->getBeginLoc(), "Image2D member '" + f->getNameAsString() + "' written outside the class's own kernels", "write images only in kernels and helpers of the translated class");
+  auto format = UsableImage(f, whole->getBeginLoc());
+  if (!format) return "/*error*/";
   storedImages.insert(f);
   const std::string channels = format->prefix + "vec4";
   return "imageStore(" + f->getNameAsString() + ", " + coord + ", " + (format->texel == "vec4" ? value : channels + "(" + value + ")") + ")";
@@ -613,14 +624,8 @@ std::string GlslPrinter::ImageStore(const clang::Expr* lhs, const std::string& v
 std::string GlslPrinter::ImageCall(const FieldDecl* image, const CXXMemberCallExpr* call) {
   const std::string name = image->getNameAsString();
   const std::string method = call->getMethodDecl()->getNameAsString();
-  QualType texel;
-  IsImage2D(image->getType(), &texel);
-  auto format = ImageFormatOf(texel);
-  if (!format)
-    return Fail(call->getBeginLoc(), "Image2D member '" + name + "' has texels of type '" + texel.getAsString(m_ctx.getPrintingPolicy()) + "', which GPU images cannot hold",
-                "use Image2D<float4>, Image2D<float> or Image2D<uint32_t>");
-  if (!composedPrefix.empty() || selfClass)
-    return Fail(call->getBeginLoc(), "Image2D member '" + name + "' used outside the class's own kernels", "use images only in kernels and helpers of the translated class");
+  auto format = UsableImage(image, call->getBeginLoc());
+  if (!format) return "/*error*/";
   if (method == "width" || method == "height") {
     sizedImages.insert(image);
     return name + "_" + method;
@@ -830,12 +835,8 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
     std::string coord;
     if (kind == OO_Subscript)
       if (auto* image = ImageTexel(op, coord)) {
-        QualType texel;
-        IsImage2D(image->getType(), &texel);
-        auto format = ImageFormatOf(texel);
-        if (!format)
-          return Fail(e->getBeginLoc(), "Image2D member '" + image->getNameAsString() + "' has a texel type GPU images cannot hold",
-                      "use Image2D<float4>, Image2D<float> or Image2D<uint32_t>");
+        auto format = UsableImage(image, e->getBeginLoc());
+        if (!format) return "/*error*/";
         loadedImages.insert(image);
         return TexelOf(*format, "imageLoad(" + image->getNameAsString() + ", " + coord + ")");
       }

@@ -113,6 +113,7 @@ private:
   // Image2D members: a texel expression (m_img[p], m_img.at(x, y)) as its image and coordinate;
   // loads, stores and the image's other calls.
   const clang::FieldDecl* ImageTexel(const clang::Expr* e, std::string& coord);
+  std::optional<ImageFormat> UsableImage(const clang::FieldDecl* image, clang::SourceLocation use);  // reports why not
   std::string ImageStore(const clang::Expr* lhs, const std::string& value, const clang::Expr* whole);
   std::string ImageCall(const clang::FieldDecl* image, const clang::CXXMemberCallExpr* call);
   std::string EmitAppend(const clang::FieldDecl* field, const clang::CallExpr* call);

@@ -66,7 +66,7 @@ enum class ImageUse { Storage, Texture, Sampler };
 struct ImageBinding {
   std::string member;
   ImageUse use = ImageUse::Storage;
-  bool loaded = false, stored = false;  // storage: what the kernel does with its texels
+  bool loaded = false, stored = false;  // storage images: what the kernel does with the texels
 };
 
 struct Loop {                // one parallel dimension of an IPV kernel
