@@ -577,20 +577,22 @@ const FieldDecl* ThisMemberField(const clang::Expr* e) {
 std::string TexelOf(const ImageFormat& f, const std::string& load) { return f.texel == "vec4" ? load : load + ".x"; }
 }  // namespace
 
-const FieldDecl* GlslPrinter::ImageTexel(const clang::Expr* e, std::string& coord) {
+// The image of a texel expression (m_img[p], m_img.at(x, y)), or null; prints the coordinate
+// into `coord` when given.
+const FieldDecl* GlslPrinter::ImageTexel(const clang::Expr* e, std::string* coord) {
   e = e->IgnoreParenImpCasts();
   if (auto* op = dyn_cast<CXXOperatorCallExpr>(e); op && op->getOperator() == OO_Subscript) {
     auto* f = ThisMemberField(op->getArg(0));
     if (!f || !IsImage2D(f->getType())) return nullptr;
     // int2 is ivec2 already; uint2 and friends are converted.
     const bool ivec = GlslTypeOf(op->getArg(1)->getType()).value_or("") == "ivec2";
-    coord = ivec ? Expr(op->getArg(1)) : "ivec2(" + Expr(op->getArg(1)) + ")";
+    if (coord) *coord = ivec ? Expr(op->getArg(1)) : "ivec2(" + Expr(op->getArg(1)) + ")";
     return f;
   }
   if (auto* mc = dyn_cast<CXXMemberCallExpr>(e); mc && mc->getMethodDecl() && mc->getMethodDecl()->getName() == "at" && mc->getNumArgs() == 2) {
     auto* f = ThisMemberField(mc->getImplicitObjectArgument());
     if (!f || !IsImage2D(f->getType())) return nullptr;
-    coord = "ivec2(" + Expr(mc->getArg(0)) + ", " + Expr(mc->getArg(1)) + ")";
+    if (coord) *coord = "ivec2(" + Expr(mc->getArg(0)) + ", " + Expr(mc->getArg(1)) + ")";
     return f;
   }
   return nullptr;
@@ -613,7 +615,7 @@ std::optional<ImageFormat> GlslPrinter::UsableImage(const FieldDecl* image, Sour
 
 std::string GlslPrinter::ImageStore(const clang::Expr* lhs, const std::string& value, const clang::Expr* whole) {
   std::string coord;
-  const FieldDecl* f = ImageTexel(lhs, coord);
+  const FieldDecl* f = ImageTexel(lhs, &coord);
   auto format = UsableImage(f, whole->getBeginLoc());
   if (!format) return "/*error*/";
   storedImages.insert(f);
@@ -632,7 +634,7 @@ std::string GlslPrinter::ImageCall(const FieldDecl* image, const CXXMemberCallEx
   }
   if (method == "at") {
     std::string coord;
-    ImageTexel(call, coord);
+    ImageTexel(call, &coord);
     loadedImages.insert(image);
     return TexelOf(*format, "imageLoad(" + name + ", " + coord + ")");
   }
@@ -834,14 +836,14 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
     auto kind = op->getOperator();
     std::string coord;
     if (kind == OO_Subscript)
-      if (auto* image = ImageTexel(op, coord)) {
+      if (auto* image = ImageTexel(op, &coord)) {
         auto format = UsableImage(image, e->getBeginLoc());
         if (!format) return "/*error*/";
         loadedImages.insert(image);
         return TexelOf(*format, "imageLoad(" + image->getNameAsString() + ", " + coord + ")");
       }
     if (kind == OO_Subscript) return Expr(op->getArg(0)) + "[" + Expr(op->getArg(1)) + "]";
-    if (op->isAssignmentOp() && op->getNumArgs() == 2 && ImageTexel(op->getArg(0), coord)) {
+    if (op->isAssignmentOp() && op->getNumArgs() == 2 && ImageTexel(op->getArg(0))) {
       if (kind == OO_Equal) return ImageStore(op->getArg(0), Expr(op->getArg(1)), e);
       if (op->getArg(0)->HasSideEffects(m_ctx, /*IncludePossibleEffects=*/false))  // it is printed twice
         return Fail(e->getBeginLoc(), "compound assignment to a texel whose coordinate has side effects", "compute the coordinate into a variable first");
@@ -861,8 +863,7 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
     return Fail(e->getBeginLoc(), "operator not supported in kernels", "");
   }
   if (auto* bo = dyn_cast<BinaryOperator>(e)) {
-    std::string coord;
-    if (bo->isAssignmentOp() && ImageTexel(bo->getLHS(), coord)) {  // a texel of a float or uint image
+    if (bo->isAssignmentOp() && ImageTexel(bo->getLHS())) {  // a texel of a float or uint image
       if (bo->getOpcode() == BO_Assign) return ImageStore(bo->getLHS(), Expr(bo->getRHS()), e);
       if (bo->getLHS()->HasSideEffects(m_ctx, /*IncludePossibleEffects=*/false))  // it is printed twice
         return Fail(e->getBeginLoc(), "compound assignment to a texel whose coordinate has side effects", "compute the coordinate into a variable first");

@@ -110,9 +110,9 @@ private:
   std::string Construct(clang::QualType t, const std::vector<const clang::Expr*>& args, clang::SourceLocation loc);
   std::string Literal(const clang::Expr* e);
   std::string Cast(clang::QualType to, const clang::Expr* sub);
-  // Image2D members: a texel expression (m_img[p], m_img.at(x, y)) as its image and coordinate;
+  // Image2D members: a texel expression (m_img[p], m_img.at(x, y)) as its image (and coordinate);
   // loads, stores and the image's other calls.
-  const clang::FieldDecl* ImageTexel(const clang::Expr* e, std::string& coord);
+  const clang::FieldDecl* ImageTexel(const clang::Expr* e, std::string* coord = nullptr);
   std::optional<ImageFormat> UsableImage(const clang::FieldDecl* image, clang::SourceLocation use);  // reports why not
   std::string ImageStore(const clang::Expr* lhs, const std::string& value, const clang::Expr* whole);
   std::string ImageCall(const clang::FieldDecl* image, const clang::CXXMemberCallExpr* call);
