@@ -855,6 +855,8 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
                   "declare it protected");
   }
   std::sort(k.memberVectors.begin(), k.memberVectors.end());
+  k.ownFunctionList = k.functionList;
+  k.ownMemberVectors = k.memberVectors;
   // Images and samplers, in declaration order so that bindings stay stable across regenerations.
   for (auto* f : c.cls->fields()) {
     const bool loaded = printer.loadedImages.count(f), stored = printer.storedImages.count(f);
@@ -1694,6 +1696,11 @@ bool ComposeFromTranslationUnit(ASTContext& ctx, Reporter& reporter, ClassModel&
       for (auto& v : vectors)
         if (std::find(k.memberVectors.begin(), k.memberVectors.end(), v) == k.memberVectors.end()) k.memberVectors.push_back(v);
       std::sort(k.memberVectors.begin(), k.memberVectors.end());
+      // Ray queries on ISceneObject alone can also run on ray tracing hardware (a second shader).
+      const bool onlyRayQueries = std::all_of(k.composedCalls.begin(), k.composedCalls.end(), [&](const auto& call) {
+        return call.first == comp.holder && (call.second == "RayQuery_NearestHit" || call.second == "RayQuery_AnyHit");
+      });
+      if (comp.interfaceName == "ISceneObject" && onlyRayQueries) k.rayQueryHolder = comp.holder;
     }
   }
   return any;

@@ -5,6 +5,7 @@
 
 #include <kainjow/mustache.hpp>
 
+#include <cctype>
 #include <fstream>
 #include <regex>
 #include <sstream>
@@ -176,6 +177,18 @@ Data Common(const ClassModel& model, const GenerateOptions& opt) {
     comps.push_back(x);
   }
   d.set("compositions", comps);
+  // ISceneObject members whose ray queries kernels may also answer on ray tracing hardware.
+  Data rayQueryScenes = List();
+  for (auto& c : model.compositions) {
+    const bool traced = std::any_of(model.kernels.begin(), model.kernels.end(), [&](const Kernel& k) { return k.rayQueryHolder == c.holder; });
+    if (c.implHeader.empty() || !traced) continue;
+    Data x;
+    x.set("holder", c.holder);
+    x.set("impl", c.implName);
+    rayQueryScenes.push_back(x);
+  }
+  d.set("rayQueryScenes", rayQueryScenes);
+  d.set("hasRayQuery", !rayQueryScenes.is_empty_list());
   // Virtual functions: the implementations' data mirrors and the regrouping of the objects.
   Data virtuals = List(), implIncludes = List();
   std::set<std::string> headers;
@@ -226,7 +239,94 @@ Data Common(const ClassModel& model, const GenerateOptions& opt) {
 
 // ---- GLSL ------------------------------------------------------------------
 
-std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateOptions& opt) {
+// ISceneObject's ray queries through `holder` on ray tracing hardware: what the <kernel>_RayQuery
+// shader has in place of the composed implementation's traversal. The results follow the interface
+// (CrossRT.h): a miss has ids 0xFFFFFFFF and t = tmax, barycentrics as Embree defines them (Vulkan's
+// are the same), both sides of a triangle hit. Rays the interface says miss (non-finite, a zero
+// direction, an empty interval) do so before any query, since Vulkan leaves such rays undefined.
+std::string RayQueryFunctions(const std::string& holder, const std::set<std::pair<std::string, std::string>>& calls) {
+  const std::string scene = holder + "_scene";
+  std::string out = "// The interval a ray queries, or false when the interface says it misses.\n"
+                    "bool " + holder + "_RayInterval(vec4 posAndNear, vec4 dirAndFar, out float tnear, out float tfar)\n"
+                    "{\n"
+                    "  tnear = max(posAndNear.w, 0.0);\n"
+                    "  tfar = dirAndFar.w;\n"
+                    "  const bool finite = !any(isnan(posAndNear)) && !any(isinf(posAndNear)) && !any(isnan(dirAndFar.xyz)) && !any(isinf(dirAndFar.xyz));\n"
+                    "  return finite && any(notEqual(dirAndFar.xyz, vec3(0.0))) && tnear < tfar;\n"
+                    "}\n";
+  if (calls.count({holder, "RayQuery_NearestHit"}))
+    out += "\n// ISceneObject::RayQuery_NearestHit through " + holder + ", on the ray tracing hardware.\n"
+           "CRT_Hit " + holder + "_RayQuery_NearestHit(vec4 posAndNear, vec4 dirAndFar)\n"
+           "{\n"
+           "  CRT_Hit hit;\n"
+           "  hit.t = dirAndFar.w;\n"
+           "  hit.primId = 0xFFFFFFFFu;\n"
+           "  hit.instId = 0xFFFFFFFFu;\n"
+           "  hit.geomId = 0xFFFFFFFFu;\n"
+           "  hit.coords = float[4](0.0, 0.0, 0.0, 0.0);\n"
+           "  float tnear, tfar;\n"
+           "  if (!" + holder + "_RayInterval(posAndNear, dirAndFar, tnear, tfar))\n"
+           "    return hit;\n"
+           "  rayQueryEXT query;\n"
+           "  rayQueryInitializeEXT(query, " + scene + ", gl_RayFlagsOpaqueEXT, 0xFF, posAndNear.xyz, tnear, dirAndFar.xyz, tfar);\n"
+           "  while (rayQueryProceedEXT(query))\n"
+           "    ;\n"
+           "  if (rayQueryGetIntersectionTypeEXT(query, true) == gl_RayQueryCommittedIntersectionTriangleEXT)\n"
+           "  {\n"
+           "    const vec2 uv = rayQueryGetIntersectionBarycentricsEXT(query, true);\n"
+           "    hit.t = rayQueryGetIntersectionTEXT(query, true);\n"
+           "    hit.primId = uint(rayQueryGetIntersectionPrimitiveIndexEXT(query, true));\n"
+           "    hit.instId = uint(rayQueryGetIntersectionInstanceIdEXT(query, true));\n"
+           "    hit.geomId = uint(rayQueryGetIntersectionInstanceCustomIndexEXT(query, true));  // the runtime stores the mesh id there\n"
+           "    hit.coords[0] = uv.x;\n"
+           "    hit.coords[1] = uv.y;\n"
+           "  }\n"
+           "  return hit;\n"
+           "}\n";
+  if (calls.count({holder, "RayQuery_AnyHit"}))
+    out += "\n// ISceneObject::RayQuery_AnyHit through " + holder + ", on the ray tracing hardware.\n"
+           "bool " + holder + "_RayQuery_AnyHit(vec4 posAndNear, vec4 dirAndFar)\n"
+           "{\n"
+           "  float tnear, tfar;\n"
+           "  if (!" + holder + "_RayInterval(posAndNear, dirAndFar, tnear, tfar))\n"
+           "    return false;\n"
+           "  rayQueryEXT query;\n"
+           "  rayQueryInitializeEXT(query, " + scene + ", gl_RayFlagsOpaqueEXT | gl_RayFlagsTerminateOnFirstHitEXT, 0xFF, posAndNear.xyz, tnear, dirAndFar.xyz, tfar);\n"
+           "  while (rayQueryProceedEXT(query))\n"
+           "    ;\n"
+           "  return rayQueryGetIntersectionTypeEXT(query, true) != gl_RayQueryCommittedIntersectionNoneEXT;\n"
+           "}\n";
+  return out;
+}
+
+// Whether `name` occurs as a whole word in `text`.
+bool MentionsWord(const std::string& text, const std::string& name) {
+  for (size_t at = text.find(name); at != std::string::npos; at = text.find(name, at + 1)) {
+    auto word = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; };
+    const size_t end = at + name.size();
+    if ((at == 0 || !word(text[at - 1])) && (end >= text.size() || !word(text[end]))) return true;
+  }
+  return false;
+}
+
+// The structs and constants of `chunks` that `used` (code kept) mentions, directly or through a
+// kept chunk; order is kept. Chunks come dependencies first, so one pass from the back suffices.
+std::vector<std::string> KeepMentioned(const std::vector<std::string>& chunks, std::string used, const std::regex& nameOf) {
+  std::vector<bool> keep(chunks.size(), false);
+  for (size_t i = chunks.size(); i-- > 0;) {
+    std::smatch m;
+    if (!std::regex_search(chunks[i], m, nameOf) || !MentionsWord(used, m[1].str())) continue;
+    keep[i] = true;
+    used += chunks[i];
+  }
+  std::vector<std::string> kept;
+  for (size_t i = 0; i < chunks.size(); ++i)
+    if (keep[i]) kept.push_back(chunks[i]);
+  return kept;
+}
+
+// `hardwareRayQuery`: the kernel's <kernel>_RayQuery variant (Kernel::rayQueryHolder).
+std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateOptions& opt, bool hardwareRayQuery = false) {
   Data d = Common(model, opt);
   d.set("kernel", k.name);
   d.set("sourceFile", k.sourceFile);
@@ -236,8 +336,27 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   d.set("groupZ", std::to_string(Shape(k).z));
   d.set("groupSize", std::to_string(shape.x * shape.y * shape.z));
   d.set("classStructs", model.glslClassStructs);
+  d.set("rayQuery", hardwareRayQuery);
+  d.set("variant", hardwareRayQuery ? ": the variant for ray tracing hardware (GL_EXT_ray_query)" : "");
+  // The ray query variant drops the composed implementation: its functions, buffers, and the
+  // structs and constants only they used.
+  const std::vector<std::string>& memberVectors = hardwareRayQuery ? k.ownMemberVectors : k.memberVectors;
+  std::vector<std::string> functionList = k.functionList, structList = k.structList, constantList = k.constantList;
+  if (hardwareRayQuery) {
+    functionList = k.ownFunctionList;
+    functionList.insert(functionList.begin(), RayQueryFunctions(k.rayQueryHolder, k.composedCalls));
+    std::string used = k.glslBody;
+    for (auto& f : functionList) used += f;
+    for (auto& p : k.params) used += " " + p.glslType;
+    for (auto& v : memberVectors)
+      if (auto* m = FindMember(model, v)) used += " " + m->glslType;
+    static const std::regex structName(R"(^struct (\w+))"), constantName(R"(^const \w+ (\w+))");
+    constantList = KeepMentioned(k.constantList, used, constantName);
+    for (auto& c : constantList) used += c;
+    structList = KeepMentioned(k.structList, used, structName);
+  }
   std::string structs;
-  for (auto& x : k.structList) structs += x + "\n";
+  for (auto& x : structList) structs += x + "\n";
   d.set("kernelStructs", structs);
   Data buffers = List();
   unsigned binding = 1;
@@ -255,7 +374,7 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
     b.set("comment", "parameter '" + p.name + "'");
     buffers.push_back(b);
   }
-  for (auto& v : k.memberVectors) {
+  for (auto& v : memberVectors) {
     auto* m = FindMember(model, v);
     Data b;
     b.set("layout", m && m->scalarLayout ? "scalar" : "std430");
@@ -306,6 +425,12 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
     }
     images.push_back(x);
   }
+  if (hardwareRayQuery) {
+    Data x;
+    x.set("decl", "layout(binding = " + std::to_string(binding++) + ") uniform accelerationStructureEXT " + k.rayQueryHolder + "_scene");
+    x.set("comment", "the scene " + k.rayQueryHolder + " holds, built for the ray tracing hardware");
+    images.push_back(x);
+  }
   d.set("images", images);
   d.set("scalarLayout", scalarAny || k.scalarReferences);
   d.set("bufferReferences", k.bufferReferences);
@@ -332,9 +457,9 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   }
   d.set("pushConstants", push);
   std::string helpers;
-  for (auto& x : k.constantList) helpers += x;
-  if (!k.constantList.empty()) helpers += "\n";
-  for (auto& x : k.functionList) helpers += x + "\n";
+  for (auto& x : constantList) helpers += x;
+  if (!constantList.empty()) helpers += "\n";
+  for (auto& x : functionList) helpers += x + "\n";
   d.set("helpers", helpers);
   d.set("body", k.glslBody);
   d.set("dim1", k.dims == 1);
@@ -528,15 +653,46 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
     x.set("indirectVector", k.indirectVector);
     x.set("indirectSlot", std::to_string(indirectSlots));
     if (!k.indirectVector.empty()) ++indirectSlots;
-    std::string buffers = "m_classDataBuffer.View()";
-    unsigned bindings = 1;
-    for (auto& p : k.params)
-      if (p.isPointer) { buffers += ", " + p.name; ++bindings; }
-    for (auto& v : k.memberVectors) { buffers += ", m_vdata." + v + ".View()"; ++bindings; }
+    // What the kernel binds, in the order its GLSL declares it: the class data, pointer arguments,
+    // member vectors, reduction partials (storage buffers), then images and samplers. The ray
+    // query variant binds its own member vectors only, and the scene last.
+    auto bindingList = [&](const std::vector<std::string>& memberVectors, bool scene, std::string& types) {
+      std::string list = "m_classDataBuffer.View()";
+      unsigned buffers = 1;
+      for (auto& p : k.params)
+        if (p.isPointer) { list += ", " + p.name; ++buffers; }
+      for (auto& v : memberVectors) { list += ", m_vdata." + v + ".View()"; ++buffers; }
+      for (auto& r : k.reductions) { list += ", m_partials." + k.name + "_" + r.member + ".View()"; ++buffers; }
+      types.clear();
+      for (unsigned i = 0; i < buffers; ++i) types += std::string(i ? ", " : "") + "VK_DESCRIPTOR_TYPE_STORAGE_BUFFER";
+      for (auto& ib : k.images) {
+        const char* type = ib.use == ImageUse::Storage ? "VK_DESCRIPTOR_TYPE_STORAGE_IMAGE"
+                           : ib.use == ImageUse::Texture ? "VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE" : "VK_DESCRIPTOR_TYPE_SAMPLER";
+        types += std::string(", ") + type;
+        list += std::string(", crossrt::Binding::") +
+                (ib.use == ImageUse::Storage ? "StorageImage" : ib.use == ImageUse::Texture ? "SampledImage" : "SamplerOf") + "(m_images." +
+                ib.member + ")";
+      }
+      if (scene) {
+        types += ", VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR";
+        list += ", crossrt::Binding::SceneOf(m_scenes." + k.rayQueryHolder + ")";
+      }
+      return list;
+    };
+    std::string types, rayQueryTypes;
+    const std::string buffers = bindingList(k.memberVectors, false, types);
+    const unsigned bindings = unsigned(1 + std::count_if(k.params.begin(), k.params.end(), [](const KernelParam& p) { return p.isPointer; }) +
+                                       k.memberVectors.size() + k.reductions.size());
+    const bool rayQuery = !k.rayQueryHolder.empty();
+    x.set("rayQuery", rayQuery);
+    x.set("softwareOnly", !rayQuery);
+    x.set("holder", k.rayQueryHolder);
+    if (rayQuery) {
+      x.set("rayQueryBindingList", bindingList(k.ownMemberVectors, true, rayQueryTypes));
+      x.set("rayQueryBindingTypes", rayQueryTypes);
+    }
     Data reds = List();
     for (auto& r : k.reductions) {
-      buffers += ", m_partials." + k.name + "_" + r.member + ".View()";
-      ++bindings;
       Data y;
       y.set("kernel", k.name);
       y.set("member", r.member);
@@ -546,19 +702,9 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
       y.set("groupCountExpr", GroupCountExpr(k));
       reds.push_back(y);
     }
-    // Images and samplers after the buffers, as the GLSL declares them.
-    std::string types;
-    for (unsigned i = 0; i < bindings; ++i) types += std::string(i ? ", " : "") + "VK_DESCRIPTOR_TYPE_STORAGE_BUFFER";
-    for (auto& ib : k.images) {
-      const char* type = ib.use == ImageUse::Storage ? "VK_DESCRIPTOR_TYPE_STORAGE_IMAGE"
-                         : ib.use == ImageUse::Texture ? "VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE" : "VK_DESCRIPTOR_TYPE_SAMPLER";
-      types += std::string(", ") + type;
-      buffers += std::string(", crossrt::Binding::") +
-                 (ib.use == ImageUse::Storage ? "StorageImage" : ib.use == ImageUse::Texture ? "SampledImage" : "SamplerOf") + "(m_images." +
-                 ib.member + ")";
-    }
     x.set("pushBindings", !k.images.empty());  // typed bindings
     x.set("pushBuffers", k.images.empty());    // buffers only
+    x.set("pushCall", k.images.empty() ? "PushBuffers" : "PushBindings");
     x.set("bindingTypes", types);
     x.set("bufferList", buffers);
     x.set("bindingCount", std::to_string(bindings));
@@ -621,6 +767,7 @@ std::vector<ShaderSource> GenerateShaders(const ClassModel& model, const Generat
   std::vector<ShaderSource> shaders;
   for (auto& k : model.kernels) {
     shaders.push_back({k.name, KernelGlsl(model, k, opt)});
+    if (!k.rayQueryHolder.empty()) shaders.push_back({k.name + "_RayQuery", KernelGlsl(model, k, opt, true)});
     if (!k.reductions.empty()) shaders.push_back({k.name + "_Reduce", ReduceGlsl(model, k, opt)});
   }
   return shaders;

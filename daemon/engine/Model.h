@@ -99,6 +99,13 @@ struct Kernel {
   // order GLSL accepts (composed code is merged in ahead of the kernel's own).
   std::vector<std::string> structList, constantList, functionList;
   std::set<std::pair<std::string, std::string>> composedCalls;  // (holder member, interface method)
+  // Hardware ray tracing (paper 3.5): when the kernel's only composed calls are ISceneObject's
+  // RayQuery_NearestHit / RayQuery_AnyHit through one member, a second shader, <kernel>_RayQuery,
+  // answers them with GL_EXT_ray_query against that member's acceleration structure. It leaves out
+  // the composed implementation's code and buffers; the host picks it where the device has ray queries.
+  std::string rayQueryHolder;
+  std::vector<std::string> ownFunctionList;   // functionList before composition merged its code in
+  std::vector<std::string> ownMemberVectors;  // memberVectors likewise
   bool bufferReferences = false;      // reaches objects through buffer references (virtual calls)
   bool scalarReferences = false;      // some of them need the scalar layout
 };

@@ -342,6 +342,37 @@ void BVHScene::CommitScene(uint32_t)
   }
 }
 
+bool BVHScene::ExportScene(CRT_SceneExport& out) const
+{
+  static_assert(sizeof(BVHTriangle) == 9 * sizeof(float), "a triangle is copied as 9 floats");
+  out = CRT_SceneExport{};
+  out.meshTriangles.resize(m_meshes.size());
+  for (size_t g = 0; g < m_meshes.size(); ++g)
+  {
+    // Back from leaf order to the order AddGeom received (the primIds hits report).
+    const Mesh& mesh = m_meshes[g];
+    uint32_t count = 0;
+    for (uint32_t id : mesh.tree.primIndices)
+      count = std::max(count, id + 1);
+    std::vector<float>& soup = out.meshTriangles[g];
+    soup.assign(size_t(9) * count, 0.0f);
+    for (size_t k = 0; k < mesh.triangles.size(); ++k)
+      std::memcpy(&soup[size_t(9) * mesh.tree.primIndices[k]], &mesh.triangles[k], 9 * sizeof(float));
+  }
+  if (m_nodes.empty())
+    return true;  // not committed, or nothing to hit: every query misses
+  for (const Instance& placed : m_placed)
+  {
+    CRT_SceneExport::Instance inst;
+    inst.geomId = placed.geomId;
+    for (int row = 0; row < 3; ++row)
+      for (int col = 0; col < 4; ++col)
+        inst.toWorldRows[4 * row + col] = placed.toWorld(row, col);
+    out.instances.push_back(inst);
+  }
+  return true;
+}
+
 // ---- traversal: plain C++ in the translator's conventions (composed into GPU kernels) ----
 
 // Visits the leaves of the mesh tree at `root` that the ray may reach, nearest box first, and

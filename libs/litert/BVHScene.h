@@ -58,6 +58,7 @@ public:
   void CommitScene(uint32_t options = BUILD_HIGH) override;
   CRT_Hit RayQuery_NearestHit(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar) override;
   bool RayQuery_AnyHit(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar) override;
+  bool ExportScene(CRT_SceneExport& out) const override;
 
   // The tree of mesh geomId (for SAH cost and statistics).
   const BVHTree& MeshTree(uint32_t geomId) const { return m_meshes.at(geomId).tree; }

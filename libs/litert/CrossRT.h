@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 // Result of RayQuery_NearestHit. A miss has primId == instId == geomId == 0xFFFFFFFF and t set to
 // the ray's tmax.
@@ -26,6 +27,21 @@ enum BuildOptions
   BUILD_MEDIUM = 1,
   BUILD_HIGH   = 2,
   BUILD_REFIT  = 4,
+};
+
+// A committed scene as plain arrays: what a backend that builds its own acceleration structures
+// needs (a translated class tracing on ray tracing hardware builds them from this).
+struct CRT_SceneExport
+{
+  // Mesh g (the id AddGeom_Triangles3f returned): 9 floats per triangle, corners v0, v1, v2,
+  // triangle i (the primId a hit reports) at [9 i, 9 i + 9).
+  std::vector<std::vector<float>> meshTriangles;
+  struct Instance
+  {
+    uint32_t geomId;
+    float toWorldRows[12];  // rows 0-2 of the object-to-world matrix
+  };
+  std::vector<Instance> instances;  // instance i is the id AddInstance returned
 };
 
 struct ISceneObject
@@ -60,6 +76,15 @@ struct ISceneObject
   // Rays with NaN/inf components, a zero direction or tmin >= tmax miss.
   virtual CRT_Hit RayQuery_NearestHit(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar) = 0;
   virtual bool    RayQuery_AnyHit(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar) = 0;
+
+  // The scene as last committed (no instances before the first CommitScene or after a change
+  // without a new one, so that every query misses, as RayQuery_* do). Implementations that do not
+  // keep their input return false; the default does.
+  virtual bool ExportScene(CRT_SceneExport& out) const
+  {
+    (void)out;
+    return false;
+  }
 };
 
 // Creates a scene implementation by name ("embree"; case-insensitive). Throws std::invalid_argument

@@ -120,8 +120,10 @@ void ComputePipeline::Push(VkCommandBuffer cmd, const std::vector<Binding>& bind
   // Reserved up front: the writes point into these vectors.
   std::vector<VkDescriptorBufferInfo> bufferInfos;
   std::vector<VkDescriptorImageInfo> imageInfos;
+  std::vector<VkWriteDescriptorSetAccelerationStructureKHR> sceneInfos;
   bufferInfos.reserve(count);
   imageInfos.reserve(count);
+  sceneInfos.reserve(count);
   std::vector<VkWriteDescriptorSet> writes(count);
   for (uint32_t i = 0; i < count; ++i) {
     const Binding& r = bindings[i];
@@ -142,6 +144,13 @@ void ComputePipeline::Push(VkCommandBuffer cmd, const std::vector<Binding>& bind
                     " bytes): use element offsets that keep that alignment");
       bufferInfos.push_back(VkDescriptorBufferInfo{v.buffer, v.offset, v.range});
       writes[i].pBufferInfo = &bufferInfos.back();
+    } else if (r.type == VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR) {
+      if (!r.accelerationStructure) throw Error(where + " has no acceleration structure (the scene was not built)");
+      auto info = VkInit<VkWriteDescriptorSetAccelerationStructureKHR>(VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET_ACCELERATION_STRUCTURE_KHR);
+      info.accelerationStructureCount = 1;
+      info.pAccelerationStructures = &r.accelerationStructure;
+      sceneInfos.push_back(info);
+      writes[i].pNext = &sceneInfos.back();
     } else {
       if (r.type == VK_DESCRIPTOR_TYPE_SAMPLER ? !r.sampler : !r.view) throw Error(where + " has no image or sampler");
       imageInfos.push_back(VkDescriptorImageInfo{r.sampler, r.view, VK_IMAGE_LAYOUT_GENERAL});

@@ -80,30 +80,14 @@ struct Outcome
   bool hasVulkan = false;
 };
 
-// Traces the rays with BVHScene as written, PrimaryRays_CPU and PrimaryRays_Vulkan (validation on),
-// and checks the agreement stated at the top of this file.
-// `mesh`, when given, is the scene's only geometry with one identity instance: ties are checked on it.
-Outcome TraceEverywhere(const std::shared_ptr<ISceneObject>& scene, const Rays& rays, float sceneSize,
-                        const TriangleMesh* mesh = nullptr)
+// The agreement stated at the top of this file, of `gpu` hits with the original's.
+void RequireAgreement(const char* what, const std::vector<CRT_Hit>& original, const std::vector<CRT_Hit>& gpu, const Rays& rays,
+                      float sceneSize, const TriangleMesh* mesh)
 {
-  Outcome out;
-  for (size_t i = 0; i < rays.Size(); ++i)
-    out.original.push_back(scene->RayQuery_NearestHit(rays.posAndNear[i], rays.dirAndFar[i]));
-  auto cpu = CreatePrimaryRays_CPU(1, 1);
-  out.cpu = Cast(*cpu, scene, rays);
-  REQUIRE(std::memcmp(out.cpu.data(), out.original.data(), sizeof(CRT_Hit) * rays.Size()) == 0);
-
-  auto ctx = ValidatedContext();
-  if (!ctx)
-    return out;
-  auto vulkan = CreatePrimaryRays_Vulkan(ctx, 1, 1);
-  out.vulkan = Cast(*vulkan, scene, rays);
-  out.hasVulkan = true;
-  RequireNoValidationMessages(ctx);
   size_t samePrim = 0, ties = 0, tOutside = 0, idsDiffer = 0;
   for (size_t i = 0; i < rays.Size(); ++i)
   {
-    const CRT_Hit &o = out.original[i], &v = out.vulkan[i];
+    const CRT_Hit &o = original[i], &v = gpu[i];
     samePrim += o.primId == v.primId;
     idsDiffer += o.primId == v.primId && (o.instId != v.instId || o.geomId != v.geomId);
     const float3 org = to_float3(rays.posAndNear[i]), dir = to_float3(rays.dirAndFar[i]);
@@ -120,11 +104,43 @@ Outcome TraceEverywhere(const std::shared_ptr<ISceneObject>& scene, const Rays& 
                                  Vertex(*mesh, mesh->indices[3 * o.primId + 2])) <= tolerance * length(dir);
     }
   }
-  INFO(samePrim << " of " << rays.Size() << " rays on the original's primId, " << ties << " more on another triangle at the same point; "
-                << tOutside << " t outside the tolerance");
+  INFO(what << ": " << samePrim << " of " << rays.Size() << " rays on the original's primId, " << ties
+            << " more on another triangle at the same point; " << tOutside << " t outside the tolerance");
   REQUIRE(double(samePrim + ties) >= 0.9999 * double(rays.Size()));
   REQUIRE(tOutside == 0);
   REQUIRE(idsDiffer == 0);
+}
+
+// Traces the rays with BVHScene as written, PrimaryRays_CPU and PrimaryRays_Vulkan (validation on)
+// running BVHScene's translated traversal, and on a device with ray queries also on its ray
+// tracing hardware; checks the agreement stated at the top of this file.
+// `mesh`, when given, is the scene's only geometry with one identity instance: ties are checked on it.
+Outcome TraceEverywhere(const std::shared_ptr<ISceneObject>& scene, const Rays& rays, float sceneSize,
+                        const TriangleMesh* mesh = nullptr)
+{
+  Outcome out;
+  for (size_t i = 0; i < rays.Size(); ++i)
+    out.original.push_back(scene->RayQuery_NearestHit(rays.posAndNear[i], rays.dirAndFar[i]));
+  auto cpu = CreatePrimaryRays_CPU(1, 1);
+  out.cpu = Cast(*cpu, scene, rays);
+  REQUIRE(std::memcmp(out.cpu.data(), out.original.data(), sizeof(CRT_Hit) * rays.Size()) == 0);
+
+  auto ctx = ValidatedContext();
+  if (!ctx)
+    return out;
+  auto vulkan = std::make_shared<PrimaryRays_Vulkan>(ctx, 1, 1);
+  vulkan->UseRayTracingHardware(false);
+  out.vulkan = Cast(*vulkan, scene, rays);
+  out.hasVulkan = true;
+  RequireNoValidationMessages(ctx);
+  RequireAgreement("translated traversal", out.original, out.vulkan, rays, sceneSize, mesh);
+  if (ctx->hasRayQuery)
+  {
+    vulkan->UseRayTracingHardware(true);
+    const std::vector<CRT_Hit> hardware = Cast(*vulkan, scene, rays);
+    RequireNoValidationMessages(ctx);
+    RequireAgreement("ray tracing hardware", out.original, hardware, rays, sceneSize, mesh);
+  }
   return out;
 }
 
@@ -354,11 +370,82 @@ TEST_CASE("PrimaryRays renders the same image as written, on _CPU and on _Vulkan
   auto ctx = ValidatedContext();
   if (!ctx)
     return;
-  const std::vector<uint32_t> gpu = render(*CreatePrimaryRays_Vulkan(ctx, 96, 64));
-  RequireNoValidationMessages(ctx);
-  size_t differing = 0;
-  for (size_t i = 0; i < gpu.size(); ++i)
-    differing += gpu[i] != expected[i];
-  // Only an occlusion ray grazing an edge may go the other way.
-  REQUIRE(differing <= gpu.size() / 200);
+  PrimaryRays_Vulkan vulkan(ctx, 96, 64);
+  // Where the device has ray queries, the hardware traces by default; elsewhere asking for it throws.
+  REQUIRE(vulkan.UsesRayTracingHardware() == ctx->hasRayQuery);
+  if (!ctx->hasRayQuery)
+    REQUIRE_THROWS_WITH(vulkan.UseRayTracingHardware(true), Catch::Contains("has no ray queries"));
+  for (bool hardware : {false, true})
+  {
+    if (hardware && !ctx->hasRayQuery)
+      continue;
+    vulkan.UseRayTracingHardware(hardware);
+    const std::vector<uint32_t> gpu = render(vulkan);
+    RequireNoValidationMessages(ctx);
+    size_t differing = 0;
+    for (size_t i = 0; i < gpu.size(); ++i)
+      differing += gpu[i] != expected[i];
+    // Only an occlusion ray grazing an edge may go the other way.
+    INFO((hardware ? "ray tracing hardware: " : "translated traversal: ") << differing << " pixels differ");
+    REQUIRE(differing <= gpu.size() / 200);
+  }
+}
+
+TEST_CASE("BVHScene exports the committed scene that hardware acceleration structures are built from", "[composition]")
+{
+  // Two meshes, three instances, one of an empty mesh; the export rebuilt as a second BVHScene must
+  // give the very same hits: primIds in the order added, instance ids and matrices kept.
+  const TriangleMesh sphere = BumpySphere(3), box = Cube();
+  auto scene = CreateSceneRT("lbvh");
+  const uint32_t sphereId = scene->AddGeom_Triangles3f(sphere.positions.data(), sphere.positions.size() / 3, sphere.indices.data(), sphere.indices.size());
+  const uint32_t emptyId = scene->AddGeom_Triangles3f(sphere.positions.data(), sphere.positions.size() / 3, nullptr, 0);
+  const uint32_t boxId = scene->AddGeom_Triangles3f(box.positions.data(), box.positions.size() / 3, box.indices.data(), box.indices.size());
+  scene->AddInstance(sphereId, translate4x4(float3(-1.5f, 0.0f, 0.0f)));
+  scene->AddInstance(emptyId, float4x4());
+  scene->AddInstance(boxId, translate4x4(float3(1.5f, 0.0f, 0.0f)) * rotate4x4Y(0.5f) * scale4x4(float3(1.0f, 2.0f, 1.0f)));
+
+  CRT_SceneExport uncommitted;
+  REQUIRE(scene->ExportScene(uncommitted));
+  REQUIRE(uncommitted.instances.empty());  // queries miss before CommitScene: so must the hardware
+  scene->CommitScene();
+  CRT_SceneExport exported;
+  REQUIRE(scene->ExportScene(exported));
+  REQUIRE(exported.meshTriangles.size() == 3);
+  REQUIRE(exported.meshTriangles[sphereId].size() == 9 * sphere.indices.size() / 3);
+  REQUIRE(exported.meshTriangles[emptyId].empty());
+  REQUIRE(exported.instances.size() == 3);
+  REQUIRE(exported.instances[2].geomId == boxId);
+  for (size_t t = 0; t < sphere.indices.size() / 3; t += 37)
+    for (int corner = 0; corner < 3; ++corner)
+      for (int axis = 0; axis < 3; ++axis)
+        REQUIRE(exported.meshTriangles[sphereId][9 * t + 3 * corner + axis] == sphere.positions[3 * sphere.indices[3 * t + corner] + axis]);
+
+  auto rebuilt = CreateSceneRT("lbvh");
+  for (const auto& triangles : exported.meshTriangles)
+  {
+    std::vector<uint32_t> indices(triangles.size() / 3);
+    for (uint32_t i = 0; i < indices.size(); ++i)
+      indices[i] = i;
+    rebuilt->AddGeom_Triangles3f(triangles.data(), triangles.size() / 3, indices.data(), indices.size());
+  }
+  for (const auto& inst : exported.instances)
+  {
+    float4x4 m;
+    for (int row = 0; row < 3; ++row)
+      for (int col = 0; col < 4; ++col)
+        m(row, col) = inst.toWorldRows[4 * row + col];
+    rebuilt->AddInstance(inst.geomId, m);
+  }
+  rebuilt->CommitScene();
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  size_t hits = 0;
+  for (int i = 0; i < 4000; ++i)
+  {
+    const float4 org(3.0f * u(rng), 3.0f * u(rng), 4.0f, 0.0f), dir(0.3f * u(rng), 0.3f * u(rng), -1.0f, 100.0f);
+    const CRT_Hit a = scene->RayQuery_NearestHit(org, dir), b = rebuilt->RayQuery_NearestHit(org, dir);
+    REQUIRE(std::memcmp(&a, &b, sizeof(CRT_Hit)) == 0);
+    hits += a.primId != kMiss;
+  }
+  REQUIRE(hits > 400);  // both instances are hit often
 }

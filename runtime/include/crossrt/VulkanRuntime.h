@@ -39,7 +39,10 @@ const char* ResultName(VkResult r);
 struct ContextOptions {
   std::string device;        // "" = automatic; else a device index ("1") or a case-insensitive substring of the name
   bool validation = false;   // enable VK_LAYER_KHRONOS_validation + VK_EXT_debug_utils messenger
-  std::vector<const char*> optionalDeviceExtensions;  // enabled when present
+  // Enabled when present: by default what ray queries need (hasRayQuery tells whether they are on).
+  std::vector<const char*> optionalDeviceExtensions = {VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME,
+                                                       VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME,
+                                                       VK_KHR_RAY_QUERY_EXTENSION_NAME};
   // Testing aid: never map device buffers, so Upload/Download take the staging path that GPUs
   // without host-visible VRAM need (lavapipe's memory is always host-visible).
   bool forceStaging = false;
@@ -266,18 +269,69 @@ void EnsureSampler(std::shared_ptr<VulkanContext> ctx, Sampler& s, const Sampler
 // Throws when a kernel samples img with linear filtering that its format cannot filter.
 void CheckFilterable(const VulkanContext& ctx, const Image& img, const Sampler& s, const char* what);
 
+// Acceleration structures for ray queries (VK_KHR_acceleration_structure), move-only: what an
+// ISceneObject member becomes for the shaders that trace on ray tracing hardware. One bottom level
+// per triangle mesh, one top level over the instances, both built on the device by Build.
+// In a hit, the instance index is the instance's position in `instances` and the custom index its
+// mesh; the primitive index is the triangle's position in its mesh.
+class RayTracingScene {
+public:
+  struct Mesh {
+    const float* triangles = nullptr;  // 9 floats per triangle: corners v0, v1, v2
+    size_t triangleCount = 0;
+  };
+  struct Instance {
+    uint32_t mesh = 0;            // index into the meshes given to Build
+    float toWorldRows[12] = {};   // rows 0-2 of the object-to-world matrix, row-major
+  };
+
+  RayTracingScene() = default;
+  // Throws unless the device has ray queries (VulkanContext::hasRayQuery).
+  explicit RayTracingScene(std::shared_ptr<VulkanContext> ctx);
+  RayTracingScene(RayTracingScene&& other) noexcept;
+  RayTracingScene& operator=(RayTracingScene&& other) noexcept;
+  RayTracingScene(const RayTracingScene&) = delete;
+  RayTracingScene& operator=(const RayTracingScene&) = delete;
+  ~RayTracingScene();
+
+  // Replaces what was built (synchronous). Instances of empty meshes are kept but never hit, so
+  // instance indices stay; an empty scene is a top level that every ray misses.
+  void Build(const std::vector<Mesh>& meshes, const std::vector<Instance>& instances);
+  bool Empty() const { return topLevel_ == VK_NULL_HANDLE; }
+  VkAccelerationStructureKHR TopLevel() const { return topLevel_; }
+
+private:
+  struct Level {
+    VkAccelerationStructureKHR handle = VK_NULL_HANDLE;
+    Buffer storage;
+  };
+  Level Create(VkAccelerationStructureTypeKHR type, VkDeviceSize bytes);
+  void Release() noexcept;
+
+  std::shared_ptr<VulkanContext> ctx_;
+  std::vector<Level> bottomLevels_;  // one per non-empty mesh
+  Level top_;
+  VkAccelerationStructureKHR topLevel_ = VK_NULL_HANDLE;
+};
+
 // One descriptor of a kernel's push-descriptor set: a storage buffer (converts from BufferView),
-// a storage image, a sampled image or a sampler.
+// a storage image, a sampled image, a sampler or a top-level acceleration structure.
 struct Binding {
   Binding(BufferView b) : type(VK_DESCRIPTOR_TYPE_STORAGE_BUFFER), buffer(b) {}
   static Binding StorageImage(const Image& img) { return Binding(VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, img.View(), VK_NULL_HANDLE); }
   static Binding SampledImage(const Image& img) { return Binding(VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, img.View(), VK_NULL_HANDLE); }
   static Binding SamplerOf(const Sampler& s) { return Binding(VK_DESCRIPTOR_TYPE_SAMPLER, VK_NULL_HANDLE, s.Handle()); }
+  static Binding SceneOf(const RayTracingScene& scene) {
+    Binding b(VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, VK_NULL_HANDLE, VK_NULL_HANDLE);
+    b.accelerationStructure = scene.TopLevel();
+    return b;
+  }
 
   VkDescriptorType type;
   BufferView buffer;
   VkImageView view = VK_NULL_HANDLE;
   VkSampler sampler = VK_NULL_HANDLE;
+  VkAccelerationStructureKHR accelerationStructure = VK_NULL_HANDLE;
 
 private:
   Binding(VkDescriptorType t, VkImageView v, VkSampler s) : type(t), view(v), sampler(s) {}

@@ -1,0 +1,218 @@
+// RayTracingScene: bottom- and top-level acceleration structures for shaders that trace with
+// GL_EXT_ray_query. Lavapipe has no ray queries, so this runs only on GPUs that have them.
+#include "crossrt/VulkanRuntime.h"
+
+#include "Internal.h"
+
+#include <cstring>
+#include <utility>
+
+namespace crossrt {
+namespace {
+
+// VK_KHR_acceleration_structure's commands are not exported by the loader: look them up per device.
+struct AccelerationFunctions {
+  PFN_vkGetAccelerationStructureBuildSizesKHR getBuildSizes = nullptr;
+  PFN_vkCreateAccelerationStructureKHR create = nullptr;
+  PFN_vkDestroyAccelerationStructureKHR destroy = nullptr;
+  PFN_vkCmdBuildAccelerationStructuresKHR cmdBuild = nullptr;
+  PFN_vkGetAccelerationStructureDeviceAddressKHR getAddress = nullptr;
+};
+
+AccelerationFunctions Functions(const VulkanContext& ctx) {
+  AccelerationFunctions f;
+  auto get = [&](const char* name) {
+    PFN_vkVoidFunction p = vkGetDeviceProcAddr(ctx.device, name);
+    if (!p) throw Error(std::string("crossrt::RayTracingScene: ") + name + " is missing although ray queries are enabled");
+    return p;
+  };
+  f.getBuildSizes = reinterpret_cast<PFN_vkGetAccelerationStructureBuildSizesKHR>(get("vkGetAccelerationStructureBuildSizesKHR"));
+  f.create = reinterpret_cast<PFN_vkCreateAccelerationStructureKHR>(get("vkCreateAccelerationStructureKHR"));
+  f.destroy = reinterpret_cast<PFN_vkDestroyAccelerationStructureKHR>(get("vkDestroyAccelerationStructureKHR"));
+  f.cmdBuild = reinterpret_cast<PFN_vkCmdBuildAccelerationStructuresKHR>(get("vkCmdBuildAccelerationStructuresKHR"));
+  f.getAddress = reinterpret_cast<PFN_vkGetAccelerationStructureDeviceAddressKHR>(get("vkGetAccelerationStructureDeviceAddressKHR"));
+  return f;
+}
+
+VkDeviceSize AlignUp(VkDeviceSize x, VkDeviceSize a) { return a > 1 ? (x + a - 1) / a * a : x; }
+
+// Builds write acceleration structures; later builds and shaders read them.
+void BuildBarrier(VkCommandBuffer cmd, VkPipelineStageFlags dstStages, VkAccessFlags dstAccess) {
+  auto barrier = VkInit<VkMemoryBarrier>(VK_STRUCTURE_TYPE_MEMORY_BARRIER);
+  barrier.srcAccessMask = VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_KHR;
+  barrier.dstAccessMask = dstAccess;
+  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR, dstStages, 0, 1, &barrier, 0, nullptr, 0,
+                       nullptr);
+}
+
+}  // namespace
+
+RayTracingScene::RayTracingScene(std::shared_ptr<VulkanContext> ctx) : ctx_(std::move(ctx)) {
+  if (!ctx_) throw Error("crossrt::RayTracingScene: null VulkanContext");
+  if (!ctx_->hasRayQuery)
+    throw Error("crossrt::RayTracingScene: device '" + std::string(ctx_->properties.deviceName) +
+                "' has no ray queries (VK_KHR_ray_query with acceleration structures)");
+}
+
+RayTracingScene::RayTracingScene(RayTracingScene&& other) noexcept { *this = std::move(other); }
+
+RayTracingScene& RayTracingScene::operator=(RayTracingScene&& other) noexcept {
+  if (this != &other) {
+    Release();
+    ctx_ = std::move(other.ctx_);
+    bottomLevels_ = std::move(other.bottomLevels_);
+    top_ = std::move(other.top_);
+    topLevel_ = std::exchange(other.topLevel_, VK_NULL_HANDLE);
+    other.top_.handle = VK_NULL_HANDLE;
+  }
+  return *this;
+}
+
+RayTracingScene::~RayTracingScene() { Release(); }
+
+void RayTracingScene::Release() noexcept {
+  if (!ctx_) return;
+  auto destroy = reinterpret_cast<PFN_vkDestroyAccelerationStructureKHR>(vkGetDeviceProcAddr(ctx_->device, "vkDestroyAccelerationStructureKHR"));
+  if (!destroy) return;
+  if (top_.handle) destroy(ctx_->device, top_.handle, nullptr);
+  for (auto& level : bottomLevels_)
+    if (level.handle) destroy(ctx_->device, level.handle, nullptr);
+  top_ = Level{};
+  bottomLevels_.clear();
+  topLevel_ = VK_NULL_HANDLE;
+}
+
+RayTracingScene::Level RayTracingScene::Create(VkAccelerationStructureTypeKHR type, VkDeviceSize bytes) {
+  Level level;
+  level.storage = Buffer(ctx_, bytes, VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR);
+  auto info = VkInit<VkAccelerationStructureCreateInfoKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_CREATE_INFO_KHR);
+  info.buffer = level.storage.Handle();
+  info.size = bytes;
+  info.type = type;
+  Check(Functions(*ctx_).create(ctx_->device, &info, nullptr, &level.handle), "vkCreateAccelerationStructureKHR");
+  return level;
+}
+
+void RayTracingScene::Build(const std::vector<Mesh>& meshes, const std::vector<Instance>& instances) {
+  if (!ctx_) throw Error("crossrt::RayTracingScene::Build on a scene without a context");
+  Release();
+  const AccelerationFunctions fn = Functions(*ctx_);
+  auto accelProps = VkInit<VkPhysicalDeviceAccelerationStructurePropertiesKHR>(
+      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR);
+  auto props2 = VkInit<VkPhysicalDeviceProperties2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2);
+  props2.pNext = &accelProps;
+  vkGetPhysicalDeviceProperties2(ctx_->physicalDevice, &props2);
+  const VkDeviceSize scratchAlign = accelProps.minAccelerationStructureScratchOffsetAlignment;
+  const VkBufferUsageFlags input = VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR;
+
+  // Bottom levels: each non-empty mesh's triangles as a vertex soup (no index buffer).
+  struct Pending {
+    Buffer vertices;
+    VkAccelerationStructureGeometryKHR geometry{};
+    VkAccelerationStructureBuildGeometryInfoKHR build{};
+    VkAccelerationStructureBuildRangeInfoKHR range{};
+    VkDeviceSize scratchOffset = 0;
+  };
+  std::vector<Pending> pending;
+  pending.reserve(meshes.size());
+  std::vector<int> levelOfMesh(meshes.size(), -1);
+  VkDeviceSize scratchBytes = 0;
+  for (size_t m = 0; m < meshes.size(); ++m) {
+    const Mesh& mesh = meshes[m];
+    if (mesh.triangleCount == 0) continue;
+    if (mesh.triangleCount > 0x7FFFFFFFu / 3) throw Error("crossrt::RayTracingScene: mesh " + std::to_string(m) + " has too many triangles");
+    Pending p;
+    const size_t bytes = sizeof(float) * 9 * mesh.triangleCount;
+    p.vertices = Buffer(ctx_, bytes, input);
+    p.vertices.Upload(mesh.triangles, bytes);
+    p.geometry = VkInit<VkAccelerationStructureGeometryKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR);
+    p.geometry.geometryType = VK_GEOMETRY_TYPE_TRIANGLES_KHR;
+    p.geometry.flags = VK_GEOMETRY_OPAQUE_BIT_KHR;
+    auto& tri = p.geometry.geometry.triangles;
+    tri = VkInit<VkAccelerationStructureGeometryTrianglesDataKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_TRIANGLES_DATA_KHR);
+    tri.vertexFormat = VK_FORMAT_R32G32B32_SFLOAT;
+    tri.vertexData.deviceAddress = p.vertices.Address();
+    tri.vertexStride = 3 * sizeof(float);
+    tri.maxVertex = static_cast<uint32_t>(3 * mesh.triangleCount - 1);
+    tri.indexType = VK_INDEX_TYPE_NONE_KHR;
+    p.build = VkInit<VkAccelerationStructureBuildGeometryInfoKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR);
+    p.build.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
+    p.build.flags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
+    p.build.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
+    p.build.geometryCount = 1;
+    p.range.primitiveCount = static_cast<uint32_t>(mesh.triangleCount);
+    auto sizes = VkInit<VkAccelerationStructureBuildSizesInfoKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_SIZES_INFO_KHR);
+    p.build.pGeometries = &p.geometry;
+    fn.getBuildSizes(ctx_->device, VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, &p.build, &p.range.primitiveCount, &sizes);
+    Level level = Create(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, sizes.accelerationStructureSize);
+    p.build.dstAccelerationStructure = level.handle;
+    p.scratchOffset = scratchBytes;
+    scratchBytes = AlignUp(scratchBytes + sizes.buildScratchSize, scratchAlign);
+    levelOfMesh[m] = static_cast<int>(bottomLevels_.size());
+    bottomLevels_.push_back(std::move(level));
+    pending.push_back(std::move(p));
+  }
+
+  // The top level: one instance per entry, in order; an instance of an empty mesh references no
+  // bottom level, which Vulkan treats as inactive.
+  std::vector<VkAccelerationStructureInstanceKHR> records(instances.size());
+  for (size_t i = 0; i < instances.size(); ++i) {
+    const Instance& in = instances[i];
+    if (in.mesh >= meshes.size())
+      throw Error("crossrt::RayTracingScene: instance " + std::to_string(i) + " places mesh " + std::to_string(in.mesh) + " of " +
+                  std::to_string(meshes.size()));
+    if (in.mesh >= (1u << 24)) throw Error("crossrt::RayTracingScene: mesh ids must fit the 24-bit custom index");
+    VkAccelerationStructureInstanceKHR& r = records[i];
+    std::memcpy(r.transform.matrix, in.toWorldRows, sizeof(r.transform.matrix));
+    r.instanceCustomIndex = in.mesh;
+    r.mask = 0xFF;
+    r.instanceShaderBindingTableRecordOffset = 0;
+    r.flags = VK_GEOMETRY_INSTANCE_TRIANGLE_FACING_CULL_DISABLE_BIT_KHR;
+    if (levelOfMesh[in.mesh] >= 0) {
+      auto addressInfo = VkInit<VkAccelerationStructureDeviceAddressInfoKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_DEVICE_ADDRESS_INFO_KHR);
+      addressInfo.accelerationStructure = bottomLevels_[size_t(levelOfMesh[in.mesh])].handle;
+      r.accelerationStructureReference = fn.getAddress(ctx_->device, &addressInfo);
+    }
+  }
+  Buffer instanceBuffer(ctx_, sizeof(VkAccelerationStructureInstanceKHR) * std::max<size_t>(1, records.size()), input);
+  if (!records.empty()) instanceBuffer.Upload(records.data(), sizeof(records[0]) * records.size());
+  auto topGeometry = VkInit<VkAccelerationStructureGeometryKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR);
+  topGeometry.geometryType = VK_GEOMETRY_TYPE_INSTANCES_KHR;
+  topGeometry.geometry.instances = VkInit<VkAccelerationStructureGeometryInstancesDataKHR>(
+      VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_INSTANCES_DATA_KHR);
+  topGeometry.geometry.instances.data.deviceAddress = instanceBuffer.Address();
+  auto topBuild = VkInit<VkAccelerationStructureBuildGeometryInfoKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR);
+  topBuild.type = VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR;
+  topBuild.flags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
+  topBuild.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
+  topBuild.geometryCount = 1;
+  topBuild.pGeometries = &topGeometry;
+  VkAccelerationStructureBuildRangeInfoKHR topRange{};
+  topRange.primitiveCount = static_cast<uint32_t>(records.size());
+  auto topSizes = VkInit<VkAccelerationStructureBuildSizesInfoKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_SIZES_INFO_KHR);
+  fn.getBuildSizes(ctx_->device, VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, &topBuild, &topRange.primitiveCount, &topSizes);
+  top_ = Create(VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR, topSizes.accelerationStructureSize);
+  topBuild.dstAccelerationStructure = top_.handle;
+
+  // One scratch buffer: the bottom levels' regions side by side, then reused by the top level.
+  Buffer scratch(ctx_, std::max(scratchBytes, topSizes.buildScratchSize) + scratchAlign);
+  const VkDeviceAddress scratchBase = AlignUp(scratch.Address(), scratchAlign);
+  VkCommandBuffer cmd = ctx_->BeginOneShot();
+  for (auto& p : pending) {
+    p.build.pGeometries = &p.geometry;  // the vector moved the geometry
+    p.build.scratchData.deviceAddress = scratchBase + p.scratchOffset;
+    const VkAccelerationStructureBuildRangeInfoKHR* ranges = &p.range;
+    fn.cmdBuild(cmd, 1, &p.build, &ranges);
+  }
+  if (!pending.empty())
+    BuildBarrier(cmd, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR,
+                 VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR | VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_KHR);
+  topBuild.scratchData.deviceAddress = scratchBase;
+  const VkAccelerationStructureBuildRangeInfoKHR* topRanges = &topRange;
+  fn.cmdBuild(cmd, 1, &topBuild, &topRanges);
+  BuildBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR | VK_ACCESS_SHADER_READ_BIT);
+  ctx_->SubmitAndWait(cmd);
+  topLevel_ = top_.handle;
+}
+
+}  // namespace crossrt

@@ -1,0 +1,41 @@
+#!/bin/bash
+# Compiles every shader variant generated for ray tracing hardware (*_RayQuery.comp) under a build
+# tree with glslangValidator and validates the SPIR-V with spirv-val. Lavapipe cannot run these
+# shaders, so this is what a machine without ray tracing can check of them.
+# Usage: validate_ray_query.sh <glslangValidator> <spirv-val> <spirv-dis> <build dir> <expected shader>...
+# Each expected shader (a path ending, e.g. PrimaryRays_Vulkan/shaders/kernel1D_CastRays_RayQuery.comp)
+# must be among those found, so a generator that stopped writing them fails here.
+set -u
+glslang=$1 spirvval=$2 spirvdis=$3 build=$4
+shift 4
+mapfile -t shaders < <(find "$build" -name '*_RayQuery.comp' -path '*/shaders/*' | sort)
+status=0
+for expected in "$@"; do
+  if ! printf '%s\n' "${shaders[@]}" | grep -q -- "/$expected\$"; then
+    echo "FAIL: no generated shader ends with $expected"
+    status=1
+  fi
+done
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+checked=0
+for shader in "${shaders[@]}"; do
+  spv="$work/$(basename "$shader").spv"
+  if ! "$glslang" -V --target-env vulkan1.2 -o "$spv" "$shader" > "$work/log" 2>&1; then
+    echo "FAIL: $shader does not compile:"; cat "$work/log"; status=1; continue
+  fi
+  if ! "$spirvdis" "$spv" 2>/dev/null | grep -q 'OpCapability RayQueryKHR'; then
+    echo "FAIL: $shader compiled without the RayQueryKHR capability"; status=1; continue
+  fi
+  if ! "$spirvval" --target-env vulkan1.2 "$spv" > "$work/log" 2>&1; then
+    echo "FAIL: spirv-val rejects $shader:"; cat "$work/log"; status=1; continue
+  fi
+  echo "valid: $shader"
+  checked=$((checked + 1))
+done
+if [ "$status" -eq 0 ] && [ "$checked" -gt 0 ]; then
+  echo "OK: $checked ray query shaders valid"
+else
+  echo "FAIL: $checked of ${#shaders[@]} ray query shaders valid"
+  exit 1
+fi
