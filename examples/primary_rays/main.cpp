@@ -1,7 +1,7 @@
 // Primary rays with ambient occlusion through ISceneObject: the class as written on Embree and on
 // CrossRT's BVH, PrimaryRays_CPU (all cores) and PrimaryRays_Vulkan (the BVH traversal composed
-// into the shader). Prints a table of times and of pixels that differ from the original on the
-// same BVH, and writes the Vulkan image.
+// into the shader, and on devices with ray queries also the ray tracing hardware). Prints a table
+// of times and of pixels that differ from the original on the same BVH, and writes the last image.
 //   primary_rays [mesh file] [output image] [--size N] [--ao SAMPLES] [--bvh lbvh|sah]
 // Without a mesh (or with "") it renders a built-in scene: a bumpy sphere on a floor.
 #include "MeshIO.h"
@@ -138,8 +138,19 @@ int main(int argc, char** argv)
     runs.back().renderer->SetScene(bvhScene, mesh.positions, mesh.indices);
     try
     {
-      runs.push_back({"PrimaryRays_Vulkan, " + bvh, CreatePrimaryRays_Vulkan(size, size), {}});
+      // The translated traversal, and where the device has ray queries its ray tracing hardware.
+      auto ctx = crossrt::VulkanContext::CreateDefault();
+      auto software = std::make_shared<PrimaryRays_Vulkan>(ctx, size, size);
+      software->UseRayTracingHardware(false);
+      runs.push_back({"PrimaryRays_Vulkan, " + bvh, software, {}});
       runs.back().renderer->SetScene(bvhScene, mesh.positions, mesh.indices);
+      if (ctx->hasRayQuery)
+      {
+        runs.push_back({"PrimaryRays_Vulkan, ray queries", std::make_shared<PrimaryRays_Vulkan>(ctx, size, size), {}});
+        runs.back().renderer->SetScene(bvhScene, mesh.positions, mesh.indices);
+      }
+      else
+        std::printf("%s has no ray queries: PrimaryRays_Vulkan traces with the translated traversal only\n", ctx->DeviceName().c_str());
     }
     catch (const std::exception& e)
     {

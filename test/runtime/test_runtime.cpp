@@ -440,3 +440,89 @@ TEST_CASE("The pipeline cache is saved when the context is destroyed", "[runtime
   else
     unsetenv("CROSSRT_PIPELINE_CACHE_DIR");
 }
+
+// Rays straight down (-z) at given x, y from z = 5; the shader writes t, primitive index, instance
+// index and custom index of the committed hit (t = -1 and ids ~0u for a miss).
+static const char* kRayQueryProbe = R"(#version 460
+#extension GL_EXT_ray_query : require
+layout(local_size_x = 64) in;
+layout(binding = 0) readonly buffer Rays { vec2 xy[]; };
+layout(binding = 1) buffer Hits { vec4 hits[]; };
+layout(binding = 2) uniform accelerationStructureEXT scene;
+layout(push_constant) uniform Args { uint n; };
+void main() {
+  const uint i = gl_GlobalInvocationID.x;
+  if (i >= n) return;
+  rayQueryEXT q;
+  rayQueryInitializeEXT(q, scene, gl_RayFlagsOpaqueEXT, 0xFF, vec3(xy[i], 5.0), 0.0, vec3(0.0, 0.0, -1.0), 100.0);
+  while (rayQueryProceedEXT(q)) {}
+  if (rayQueryGetIntersectionTypeEXT(q, true) == gl_RayQueryCommittedIntersectionNoneEXT)
+    hits[i] = vec4(-1.0, uintBitsToFloat(~0u), uintBitsToFloat(~0u), uintBitsToFloat(~0u));
+  else
+    hits[i] = vec4(rayQueryGetIntersectionTEXT(q, true), uintBitsToFloat(uint(rayQueryGetIntersectionPrimitiveIndexEXT(q, true))),
+                   uintBitsToFloat(uint(rayQueryGetIntersectionInstanceIdEXT(q, true))),
+                   uintBitsToFloat(uint(rayQueryGetIntersectionInstanceCustomIndexEXT(q, true))));
+}
+)";
+
+TEST_CASE("RayTracingScene: instances of meshes traced with ray queries, or a clear error without them", "[runtime]") {
+  auto ctx = MakeContext();
+  if (!ctx) return;
+  if (!ctx->hasRayQuery) {
+    INFO(ctx->DeviceName() << " has no ray queries: only the error is checked");
+    REQUIRE_THROWS_WITH(RayTracingScene(ctx), Catch::Contains("has no ray queries"));
+    return;
+  }
+  // Mesh 0: two triangles covering [0,1]^2 at z = 0; mesh 1: empty; mesh 2: one triangle at z = 1.
+  const std::vector<float> square = {0, 0, 0, 1, 0, 0, 1, 1, 0, /**/ 0, 0, 0, 1, 1, 0, 0, 1, 0};
+  const std::vector<float> single = {0, 0, 1, 1, 0, 1, 0, 1, 1};
+  std::vector<RayTracingScene::Mesh> meshes = {{square.data(), 2}, {nullptr, 0}, {single.data(), 1}};
+  auto placed = [](uint32_t mesh, float dx) {
+    RayTracingScene::Instance in;
+    in.mesh = mesh;
+    const float rows[12] = {1, 0, 0, dx, 0, 1, 0, 0, 0, 0, 1, 0};
+    std::memcpy(in.toWorldRows, rows, sizeof(rows));
+    return in;
+  };
+  // Instance 0: the square; 1: the empty mesh (never hit); 2: the single triangle moved to x + 10.
+  std::vector<RayTracingScene::Instance> instances = {placed(0, 0.0f), placed(1, 0.0f), placed(2, 10.0f)};
+  RayTracingScene scene(ctx);
+  scene.Build(meshes, instances);
+  REQUIRE_FALSE(scene.Empty());
+
+  const std::vector<float> xy = {0.75f, 0.25f, /**/ 0.25f, 0.75f, /**/ 10.25f, 0.25f, /**/ 5.0f, 5.0f};
+  const uint32_t n = 4;
+  Buffer rays(ctx, sizeof(float) * xy.size()), hits(ctx, sizeof(float) * 4 * n);
+  rays.Upload(xy.data(), sizeof(float) * xy.size());
+  auto spirv = CompileGlsl(kRayQueryProbe);
+  ComputePipeline pipe(ctx, spirv.data(), spirv.size() * 4,
+                       {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR},
+                       sizeof(uint32_t), "ray_query_probe");
+  VkCommandBuffer cmd = ctx->BeginOneShot();
+  pipe.Bind(cmd);
+  pipe.PushBindings(cmd, {rays.View(), hits.View(), Binding::SceneOf(scene)});
+  pipe.PushConstants(cmd, &n, sizeof(n));
+  Dispatch1D(cmd, n, 64);
+  ctx->SubmitAndWait(cmd);
+  std::vector<float> out(4 * n);
+  hits.Download(out.data(), sizeof(float) * out.size());
+  auto id = [&](size_t i) {
+    uint32_t u;
+    std::memcpy(&u, &out[i], 4);
+    return u;
+  };
+  CHECK(out[0] == Approx(5.0f));  // the square's first triangle
+  CHECK(id(1) == 0u);
+  CHECK(id(2) == 0u);
+  CHECK(id(3) == 0u);
+  CHECK(id(5) == 1u);  // its second triangle
+  CHECK(out[8] == Approx(4.0f));  // the moved triangle at z = 1
+  CHECK(id(9) == 0u);
+  CHECK(id(10) == 2u);  // instance index = position among the instances, the empty one counted
+  CHECK(id(11) == 2u);  // custom index = mesh
+  CHECK(out[12] == -1.0f);  // nothing at (5, 5)
+  RequireNoValidationMessages(*ctx);
+
+  scene.Build({}, {});  // an empty scene: a top level every ray misses
+  REQUIRE_FALSE(scene.Empty());
+}
