@@ -754,6 +754,16 @@ Data VectorsData(const ClassModel& model) {
     x.set("host", m.hostExpr);
     x.set("elemCppType", m.elemCppType);
     x.set("appended", m.appendedByKernels);
+    // Composed data that only the translated traversal binds (ray query variants leave it out) is
+    // not uploaded while the ray tracing hardware traces.
+    const bool boundWithHardware = std::any_of(model.kernels.begin(), model.kernels.end(), [&](const Kernel& k) {
+      const auto& bound = k.rayQueryHolder.empty() ? k.memberVectors : k.ownMemberVectors;
+      return std::find(bound.begin(), bound.end(), m.name) != bound.end();
+    });
+    const bool traversalData = !m.composedFrom.empty() && !boundWithHardware &&
+                               std::any_of(model.kernels.begin(), model.kernels.end(), [](const Kernel& k) { return !k.rayQueryHolder.empty(); });
+    x.set("traversalData", traversalData);
+    x.set("alwaysUploaded", !traversalData);
     vectors.push_back(x);
   }
   return vectors;
