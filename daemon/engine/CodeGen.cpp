@@ -244,59 +244,13 @@ Data Common(const ClassModel& model, const GenerateOptions& opt) {
 // (CrossRT.h): a miss has ids 0xFFFFFFFF and t = tmax, barycentrics as Embree defines them (Vulkan's
 // are the same), both sides of a triangle hit. Rays the interface says miss (non-finite, a zero
 // direction, an empty interval) do so before any query, since Vulkan leaves such rays undefined.
-std::string RayQueryFunctions(const std::string& holder, const std::set<std::pair<std::string, std::string>>& calls) {
-  const std::string scene = holder + "_scene";
-  std::string out = "// The interval a ray queries, or false when the interface says it misses.\n"
-                    "bool " + holder + "_RayInterval(vec4 posAndNear, vec4 dirAndFar, out float tnear, out float tfar)\n"
-                    "{\n"
-                    "  tnear = max(posAndNear.w, 0.0);\n"
-                    "  tfar = dirAndFar.w;\n"
-                    "  const bool finite = !any(isnan(posAndNear)) && !any(isinf(posAndNear)) && !any(isnan(dirAndFar.xyz)) && !any(isinf(dirAndFar.xyz));\n"
-                    "  return finite && any(notEqual(dirAndFar.xyz, vec3(0.0))) && tnear < tfar;\n"
-                    "}\n";
-  if (calls.count({holder, "RayQuery_NearestHit"}))
-    out += "\n// ISceneObject::RayQuery_NearestHit through " + holder + ", on the ray tracing hardware.\n"
-           "CRT_Hit " + holder + "_RayQuery_NearestHit(vec4 posAndNear, vec4 dirAndFar)\n"
-           "{\n"
-           "  CRT_Hit hit;\n"
-           "  hit.t = dirAndFar.w;\n"
-           "  hit.primId = 0xFFFFFFFFu;\n"
-           "  hit.instId = 0xFFFFFFFFu;\n"
-           "  hit.geomId = 0xFFFFFFFFu;\n"
-           "  hit.coords = float[4](0.0, 0.0, 0.0, 0.0);\n"
-           "  float tnear, tfar;\n"
-           "  if (!" + holder + "_RayInterval(posAndNear, dirAndFar, tnear, tfar))\n"
-           "    return hit;\n"
-           "  rayQueryEXT query;\n"
-           "  rayQueryInitializeEXT(query, " + scene + ", gl_RayFlagsOpaqueEXT, 0xFF, posAndNear.xyz, tnear, dirAndFar.xyz, tfar);\n"
-           "  while (rayQueryProceedEXT(query))\n"
-           "    ;\n"
-           "  if (rayQueryGetIntersectionTypeEXT(query, true) == gl_RayQueryCommittedIntersectionTriangleEXT)\n"
-           "  {\n"
-           "    const vec2 uv = rayQueryGetIntersectionBarycentricsEXT(query, true);\n"
-           "    hit.t = rayQueryGetIntersectionTEXT(query, true);\n"
-           "    hit.primId = uint(rayQueryGetIntersectionPrimitiveIndexEXT(query, true));\n"
-           "    hit.instId = uint(rayQueryGetIntersectionInstanceIdEXT(query, true));\n"
-           "    hit.geomId = uint(rayQueryGetIntersectionInstanceCustomIndexEXT(query, true));  // the runtime stores the mesh id there\n"
-           "    hit.coords[0] = uv.x;\n"
-           "    hit.coords[1] = uv.y;\n"
-           "  }\n"
-           "  return hit;\n"
-           "}\n";
-  if (calls.count({holder, "RayQuery_AnyHit"}))
-    out += "\n// ISceneObject::RayQuery_AnyHit through " + holder + ", on the ray tracing hardware.\n"
-           "bool " + holder + "_RayQuery_AnyHit(vec4 posAndNear, vec4 dirAndFar)\n"
-           "{\n"
-           "  float tnear, tfar;\n"
-           "  if (!" + holder + "_RayInterval(posAndNear, dirAndFar, tnear, tfar))\n"
-           "    return false;\n"
-           "  rayQueryEXT query;\n"
-           "  rayQueryInitializeEXT(query, " + scene + ", gl_RayFlagsOpaqueEXT | gl_RayFlagsTerminateOnFirstHitEXT, 0xFF, posAndNear.xyz, tnear, dirAndFar.xyz, tfar);\n"
-           "  while (rayQueryProceedEXT(query))\n"
-           "    ;\n"
-           "  return rayQueryGetIntersectionTypeEXT(query, true) != gl_RayQueryCommittedIntersectionNoneEXT;\n"
-           "}\n";
-  return out;
+std::string RayQueryFunctions(const std::string& holder, const std::set<std::pair<std::string, std::string>>& calls,
+                              const GenerateOptions& opt) {
+  Data d;
+  d.set("holder", holder);
+  d.set("nearestHit", calls.count({holder, "RayQuery_NearestHit"}) > 0);
+  d.set("anyHit", calls.count({holder, "RayQuery_AnyHit"}) > 0);
+  return Render(opt.templateDir + "/glsl/ray_query.glsl.mustache", d);
 }
 
 // Whether `name` occurs as a whole word in `text`.
@@ -344,7 +298,7 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   std::vector<std::string> functionList = k.functionList, structList = k.structList, constantList = k.constantList;
   if (hardwareRayQuery) {
     functionList = k.ownFunctionList;
-    functionList.insert(functionList.begin(), RayQueryFunctions(k.rayQueryHolder, k.composedCalls));
+    functionList.insert(functionList.begin(), RayQueryFunctions(k.rayQueryHolder, k.composedCalls, opt));
     std::string used = k.glslBody;
     for (auto& f : functionList) used += f;
     for (auto& p : k.params) used += " " + p.glslType;
