@@ -154,7 +154,7 @@ void RayTracingScene::Build(const std::vector<Mesh>& meshes, const std::vector<I
   }
 
   // The top level: one instance per entry, in order; an instance of an empty mesh references no
-  // bottom level, which Vulkan treats as inactive.
+  // bottom level (Vulkan treats it as inactive) and has mask 0 (no ray's cull mask matches it).
   std::vector<VkAccelerationStructureInstanceKHR> records(instances.size());
   for (size_t i = 0; i < instances.size(); ++i) {
     const Instance& in = instances[i];
@@ -165,7 +165,7 @@ void RayTracingScene::Build(const std::vector<Mesh>& meshes, const std::vector<I
     VkAccelerationStructureInstanceKHR& r = records[i];
     std::memcpy(r.transform.matrix, in.toWorldRows, sizeof(r.transform.matrix));
     r.instanceCustomIndex = in.mesh;
-    r.mask = 0xFF;
+    r.mask = levelOfMesh[in.mesh] >= 0 ? 0xFF : 0x00;
     r.instanceShaderBindingTableRecordOffset = 0;
     r.flags = VK_GEOMETRY_INSTANCE_TRIANGLE_FACING_CULL_DISABLE_BIT_KHR;
     if (levelOfMesh[in.mesh] >= 0) {
