@@ -198,3 +198,41 @@ TEST_CASE("Target compile options: meaning-changing flags are kept, GCC-only one
   INFO(a.diagnostics);
   CHECK(a.ok);
 }
+
+TEST_CASE("Ray queries through ISceneObject get a variant for ray tracing hardware without the composed traversal", "[engine][composition]")
+{
+  // The real example: PrimaryRays composing BVHScene (both from the source tree).
+  TranslateRequest r;
+  r.className = "PrimaryRays";
+  r.sources = {CROSSRT_SOURCE_DIR "/examples/primary_rays/PrimaryRays.cpp", CROSSRT_SOURCE_DIR "/libs/litert/BVHScene.cpp"};
+  r.compileArgs = {"-std=c++17", "-I" CROSSRT_SOURCE_DIR "/libs/litemath", "-I" CROSSRT_SOURCE_DIR "/libs/litert",
+                   "-I" CROSSRT_SOURCE_DIR "/libs/litebvh", "-I" CROSSRT_SOURCE_DIR "/examples/primary_rays"};
+  r.templateDir = CROSSRT_SOURCE_DIR "/templates";
+  r.outputDir = (fs::temp_directory_path() / "crossrt-test-rayquery").string();
+  r.compositions = {"ISceneObject=BVHScene"};
+  const TranslateResult result = Translate(r);
+  INFO(result.diagnostics);
+  REQUIRE(result.ok);
+  const std::string& software = result.files.at("shaders/kernel2D_Render.comp");
+  const std::string& hardware = result.files.at("shaders/kernel2D_Render_RayQuery.comp");
+  // The software variant runs BVHScene's traversal over its buffers; the hardware one has none of it.
+  CHECK(software.find("m_pAccelStruct_m_nodes[]") != std::string::npos);
+  CHECK(software.find("GL_EXT_ray_query") == std::string::npos);
+  CHECK(hardware.find("#extension GL_EXT_ray_query : require") != std::string::npos);
+  CHECK(hardware.find("uniform accelerationStructureEXT m_pAccelStruct_scene;") != std::string::npos);
+  CHECK(hardware.find("CRT_Hit m_pAccelStruct_RayQuery_NearestHit(vec4 posAndNear, vec4 dirAndFar)") != std::string::npos);
+  CHECK(hardware.find("bool m_pAccelStruct_RayQuery_AnyHit(vec4 posAndNear, vec4 dirAndFar)") != std::string::npos);
+  for (const char* gone : {"m_pAccelStruct_m_nodes[]", "m_pAccelStruct_m_triangles[]", "m_pAccelStruct_Trace(", "struct BVHNode", "m_pAccelStruct_kLeafFlag"})
+  {
+    INFO(gone);
+    CHECK(hardware.find(gone) == std::string::npos);
+  }
+  // The class's own data and helpers stay: the kernel body is the same text in both.
+  CHECK(hardware.find("m_vertices[]") != std::string::npos);
+  const auto body = [](const std::string& glsl) { return glsl.substr(glsl.find("void kernel2D_Render(")); };
+  CHECK(body(hardware) == body(software));
+  // The host binds the variant where the device has ray queries.
+  const std::string& host = result.files.at("PrimaryRays_Vulkan.cpp");
+  CHECK(host.find("crossrt::Binding::SceneOf(m_scenes.m_pAccelStruct)") != std::string::npos);
+  CHECK(host.find("m_useRayTracingHardware = m_ctx->hasRayQuery;") != std::string::npos);
+}
