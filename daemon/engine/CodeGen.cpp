@@ -610,9 +610,9 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
     // What the kernel binds, in the order its GLSL declares it: the class data, pointer arguments,
     // member vectors, reduction partials (storage buffers), then images and samplers. The ray
     // query variant binds its own member vectors only, and the scene last.
-    auto bindingList = [&](const std::vector<std::string>& memberVectors, bool scene, std::string& types) {
+    auto bindingList = [&](const std::vector<std::string>& memberVectors, bool scene, std::string& types, unsigned& buffers) {
       std::string list = "m_classDataBuffer.View()";
-      unsigned buffers = 1;
+      buffers = 1;
       for (auto& p : k.params)
         if (p.isPointer) { list += ", " + p.name; ++buffers; }
       for (auto& v : memberVectors) { list += ", m_vdata." + v + ".View()"; ++buffers; }
@@ -634,15 +634,14 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
       return list;
     };
     std::string types, rayQueryTypes;
-    const std::string buffers = bindingList(k.memberVectors, false, types);
-    const unsigned bindings = unsigned(1 + std::count_if(k.params.begin(), k.params.end(), [](const KernelParam& p) { return p.isPointer; }) +
-                                       k.memberVectors.size() + k.reductions.size());
+    unsigned bindings = 0, rayQueryBuffers = 0;  // storage buffers (the buffer-only pipeline's binding count)
+    const std::string buffers = bindingList(k.memberVectors, false, types, bindings);
     const bool rayQuery = !k.rayQueryHolder.empty();
     x.set("rayQuery", rayQuery);
     x.set("softwareOnly", !rayQuery);
     x.set("holder", k.rayQueryHolder);
     if (rayQuery) {
-      x.set("rayQueryBindingList", bindingList(k.ownMemberVectors, true, rayQueryTypes));
+      x.set("rayQueryBindingList", bindingList(k.ownMemberVectors, true, rayQueryTypes, rayQueryBuffers));
       x.set("rayQueryBindingTypes", rayQueryTypes);
     }
     Data reds = List();

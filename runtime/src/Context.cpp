@@ -409,6 +409,26 @@ void VulkanContext::CreateDevice(const ContextOptions& options) {
   vkCmdPushDescriptorSetKHR = reinterpret_cast<PFN_vkCmdPushDescriptorSetKHR>(
       vkGetDeviceProcAddr(device, "vkCmdPushDescriptorSetKHR"));
   if (!vkCmdPushDescriptorSetKHR) throw Error("vkCmdPushDescriptorSetKHR is missing although VK_KHR_push_descriptor is enabled");
+  if (hasRayQuery) {
+    auto load = [&](const char* name) {
+      PFN_vkVoidFunction f = vkGetDeviceProcAddr(device, name);
+      if (!f) throw Error(std::string(name) + " is missing although VK_KHR_acceleration_structure is enabled");
+      return f;
+    };
+    vkGetAccelerationStructureBuildSizesKHR =
+        reinterpret_cast<PFN_vkGetAccelerationStructureBuildSizesKHR>(load("vkGetAccelerationStructureBuildSizesKHR"));
+    vkCreateAccelerationStructureKHR = reinterpret_cast<PFN_vkCreateAccelerationStructureKHR>(load("vkCreateAccelerationStructureKHR"));
+    vkDestroyAccelerationStructureKHR = reinterpret_cast<PFN_vkDestroyAccelerationStructureKHR>(load("vkDestroyAccelerationStructureKHR"));
+    vkCmdBuildAccelerationStructuresKHR = reinterpret_cast<PFN_vkCmdBuildAccelerationStructuresKHR>(load("vkCmdBuildAccelerationStructuresKHR"));
+    vkGetAccelerationStructureDeviceAddressKHR =
+        reinterpret_cast<PFN_vkGetAccelerationStructureDeviceAddressKHR>(load("vkGetAccelerationStructureDeviceAddressKHR"));
+    auto accelLimits = VkInit<VkPhysicalDeviceAccelerationStructurePropertiesKHR>(
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR);
+    auto accelProps = VkInit<VkPhysicalDeviceProperties2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2);
+    accelProps.pNext = &accelLimits;
+    vkGetPhysicalDeviceProperties2(physicalDevice, &accelProps);
+    accelerationScratchAlignment = std::max<VkDeviceSize>(1, accelLimits.minAccelerationStructureScratchOffsetAlignment);
+  }
 }
 
 VulkanContext::~VulkanContext() {

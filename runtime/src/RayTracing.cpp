@@ -10,30 +10,6 @@
 namespace crossrt {
 namespace {
 
-// VK_KHR_acceleration_structure's commands are not exported by the loader: look them up per device.
-struct AccelerationFunctions {
-  PFN_vkGetAccelerationStructureBuildSizesKHR getBuildSizes = nullptr;
-  PFN_vkCreateAccelerationStructureKHR create = nullptr;
-  PFN_vkDestroyAccelerationStructureKHR destroy = nullptr;
-  PFN_vkCmdBuildAccelerationStructuresKHR cmdBuild = nullptr;
-  PFN_vkGetAccelerationStructureDeviceAddressKHR getAddress = nullptr;
-};
-
-AccelerationFunctions Functions(const VulkanContext& ctx) {
-  AccelerationFunctions f;
-  auto get = [&](const char* name) {
-    PFN_vkVoidFunction p = vkGetDeviceProcAddr(ctx.device, name);
-    if (!p) throw Error(std::string("crossrt::RayTracingScene: ") + name + " is missing although ray queries are enabled");
-    return p;
-  };
-  f.getBuildSizes = reinterpret_cast<PFN_vkGetAccelerationStructureBuildSizesKHR>(get("vkGetAccelerationStructureBuildSizesKHR"));
-  f.create = reinterpret_cast<PFN_vkCreateAccelerationStructureKHR>(get("vkCreateAccelerationStructureKHR"));
-  f.destroy = reinterpret_cast<PFN_vkDestroyAccelerationStructureKHR>(get("vkDestroyAccelerationStructureKHR"));
-  f.cmdBuild = reinterpret_cast<PFN_vkCmdBuildAccelerationStructuresKHR>(get("vkCmdBuildAccelerationStructuresKHR"));
-  f.getAddress = reinterpret_cast<PFN_vkGetAccelerationStructureDeviceAddressKHR>(get("vkGetAccelerationStructureDeviceAddressKHR"));
-  return f;
-}
-
 VkDeviceSize AlignUp(VkDeviceSize x, VkDeviceSize a) { return a > 1 ? (x + a - 1) / a * a : x; }
 
 // Builds write acceleration structures; later builds and shaders read them.
@@ -72,11 +48,9 @@ RayTracingScene::~RayTracingScene() { Release(); }
 
 void RayTracingScene::Release() noexcept {
   if (!ctx_) return;
-  auto destroy = reinterpret_cast<PFN_vkDestroyAccelerationStructureKHR>(vkGetDeviceProcAddr(ctx_->device, "vkDestroyAccelerationStructureKHR"));
-  if (!destroy) return;
-  if (top_.handle) destroy(ctx_->device, top_.handle, nullptr);
+  if (top_.handle) ctx_->vkDestroyAccelerationStructureKHR(ctx_->device, top_.handle, nullptr);
   for (auto& level : bottomLevels_)
-    if (level.handle) destroy(ctx_->device, level.handle, nullptr);
+    if (level.handle) ctx_->vkDestroyAccelerationStructureKHR(ctx_->device, level.handle, nullptr);
   top_ = Level{};
   bottomLevels_.clear();
   topLevel_ = VK_NULL_HANDLE;
@@ -89,20 +63,15 @@ RayTracingScene::Level RayTracingScene::Create(VkAccelerationStructureTypeKHR ty
   info.buffer = level.storage.Handle();
   info.size = bytes;
   info.type = type;
-  Check(Functions(*ctx_).create(ctx_->device, &info, nullptr, &level.handle), "vkCreateAccelerationStructureKHR");
+  Check(ctx_->vkCreateAccelerationStructureKHR(ctx_->device, &info, nullptr, &level.handle), "vkCreateAccelerationStructureKHR");
   return level;
 }
 
 void RayTracingScene::Build(const std::vector<Mesh>& meshes, const std::vector<Instance>& instances) {
   if (!ctx_) throw Error("crossrt::RayTracingScene::Build on a scene without a context");
   Release();
-  const AccelerationFunctions fn = Functions(*ctx_);
-  auto accelProps = VkInit<VkPhysicalDeviceAccelerationStructurePropertiesKHR>(
-      VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR);
-  auto props2 = VkInit<VkPhysicalDeviceProperties2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2);
-  props2.pNext = &accelProps;
-  vkGetPhysicalDeviceProperties2(ctx_->physicalDevice, &props2);
-  const VkDeviceSize scratchAlign = accelProps.minAccelerationStructureScratchOffsetAlignment;
+  const VulkanContext& vk = *ctx_;
+  const VkDeviceSize scratchAlign = vk.accelerationScratchAlignment;
   const VkBufferUsageFlags input = VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR;
 
   // Bottom levels: each non-empty mesh's triangles as a vertex soup (no index buffer).
@@ -143,7 +112,7 @@ void RayTracingScene::Build(const std::vector<Mesh>& meshes, const std::vector<I
     p.range.primitiveCount = static_cast<uint32_t>(mesh.triangleCount);
     auto sizes = VkInit<VkAccelerationStructureBuildSizesInfoKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_SIZES_INFO_KHR);
     p.build.pGeometries = &p.geometry;
-    fn.getBuildSizes(ctx_->device, VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, &p.build, &p.range.primitiveCount, &sizes);
+    vk.vkGetAccelerationStructureBuildSizesKHR(vk.device, VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, &p.build, &p.range.primitiveCount, &sizes);
     Level level = Create(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, sizes.accelerationStructureSize);
     p.build.dstAccelerationStructure = level.handle;
     p.scratchOffset = scratchBytes;
@@ -171,7 +140,7 @@ void RayTracingScene::Build(const std::vector<Mesh>& meshes, const std::vector<I
     if (levelOfMesh[in.mesh] >= 0) {
       auto addressInfo = VkInit<VkAccelerationStructureDeviceAddressInfoKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_DEVICE_ADDRESS_INFO_KHR);
       addressInfo.accelerationStructure = bottomLevels_[size_t(levelOfMesh[in.mesh])].handle;
-      r.accelerationStructureReference = fn.getAddress(ctx_->device, &addressInfo);
+      r.accelerationStructureReference = vk.vkGetAccelerationStructureDeviceAddressKHR(vk.device, &addressInfo);
     }
   }
   Buffer instanceBuffer(ctx_, sizeof(VkAccelerationStructureInstanceKHR) * std::max<size_t>(1, records.size()), input);
@@ -190,7 +159,7 @@ void RayTracingScene::Build(const std::vector<Mesh>& meshes, const std::vector<I
   VkAccelerationStructureBuildRangeInfoKHR topRange{};
   topRange.primitiveCount = static_cast<uint32_t>(records.size());
   auto topSizes = VkInit<VkAccelerationStructureBuildSizesInfoKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_SIZES_INFO_KHR);
-  fn.getBuildSizes(ctx_->device, VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, &topBuild, &topRange.primitiveCount, &topSizes);
+  vk.vkGetAccelerationStructureBuildSizesKHR(vk.device, VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, &topBuild, &topRange.primitiveCount, &topSizes);
   top_ = Create(VK_ACCELERATION_STRUCTURE_TYPE_TOP_LEVEL_KHR, topSizes.accelerationStructureSize);
   topBuild.dstAccelerationStructure = top_.handle;
 
@@ -202,14 +171,14 @@ void RayTracingScene::Build(const std::vector<Mesh>& meshes, const std::vector<I
     p.build.pGeometries = &p.geometry;  // the vector moved the geometry
     p.build.scratchData.deviceAddress = scratchBase + p.scratchOffset;
     const VkAccelerationStructureBuildRangeInfoKHR* ranges = &p.range;
-    fn.cmdBuild(cmd, 1, &p.build, &ranges);
+    vk.vkCmdBuildAccelerationStructuresKHR(cmd, 1, &p.build, &ranges);
   }
   if (!pending.empty())
     BuildBarrier(cmd, VK_PIPELINE_STAGE_ACCELERATION_STRUCTURE_BUILD_BIT_KHR,
                  VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR | VK_ACCESS_ACCELERATION_STRUCTURE_WRITE_BIT_KHR);
   topBuild.scratchData.deviceAddress = scratchBase;
   const VkAccelerationStructureBuildRangeInfoKHR* topRanges = &topRange;
-  fn.cmdBuild(cmd, 1, &topBuild, &topRanges);
+  vk.vkCmdBuildAccelerationStructuresKHR(cmd, 1, &topBuild, &topRanges);
   BuildBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR | VK_ACCESS_SHADER_READ_BIT);
   ctx_->SubmitAndWait(cmd);
   topLevel_ = top_.handle;

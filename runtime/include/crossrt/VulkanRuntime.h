@@ -81,6 +81,13 @@ public:
   void ClearValidationMessages();
 
   PFN_vkCmdPushDescriptorSetKHR vkCmdPushDescriptorSetKHR = nullptr;
+  // VK_KHR_acceleration_structure (not exported by the loader), loaded when hasRayQuery.
+  PFN_vkGetAccelerationStructureBuildSizesKHR vkGetAccelerationStructureBuildSizesKHR = nullptr;
+  PFN_vkCreateAccelerationStructureKHR vkCreateAccelerationStructureKHR = nullptr;
+  PFN_vkDestroyAccelerationStructureKHR vkDestroyAccelerationStructureKHR = nullptr;
+  PFN_vkCmdBuildAccelerationStructuresKHR vkCmdBuildAccelerationStructuresKHR = nullptr;
+  PFN_vkGetAccelerationStructureDeviceAddressKHR vkGetAccelerationStructureDeviceAddressKHR = nullptr;
+  VkDeviceSize accelerationScratchAlignment = 1;  // minAccelerationStructureScratchOffsetAlignment
 
   // One-shot command buffers come from the shared commandPool: allocation, submission and freeing
   // are locked, but Vulkan pools allow recording from only one thread at a time.
