@@ -32,7 +32,8 @@ namespace {
 
 const char* kUsage =
     "usage: crossrt translate --class NAME --backend vulkan|cpu --out DIR --source FILE [--source FILE...]\n"
-    "                         [--compose INTERFACE=IMPL...] [--virtual-level 1|2] [--templates DIR]\n"
+    "                         [--compose INTERFACE=IMPL...] [--virtual-level 1|2] [--execution-mode wavefront|megakernel]\n"
+    "                         [--templates DIR]\n"
     "                         [--depfile FILE --depfile-target FILE]\n"
     "                         [--build-dir DIR | --no-daemon] [-- COMPILE_ARGS...]\n"
     "       crossrt daemon status [--build-dir DIR] [--json]\n"
@@ -164,6 +165,11 @@ int main(int argc, char** argv) {
     else if (a == "--virtual-level") {
       if (v != "1" && v != "2") return Usage("--virtual-level takes 1 (one array of equal slots) or 2 (a buffer per class), not '" + v + "'");
       request.virtualLevel = std::stoi(v);
+    }
+    else if (a == "--execution-mode") {
+      if (v != "megakernel" && v != "wavefront")
+        return Usage("--execution-mode takes megakernel (one shader per thread loop) or wavefront (one dispatch per kernel call), not '" + v + "'");
+      request.megakernel = v == "megakernel";
     }
     else if (a == "--depfile") depfile = v;
     else if (a == "--depfile-target") depfileTarget = v;

@@ -1,5 +1,6 @@
 # crossrt_add_class(<target> <Class> BACKEND vulkan|cpu [SOURCES file...]
-#                   [COMPOSE Interface=Implementation...] [VIRTUAL_LEVEL 1|2])
+#                   [COMPOSE Interface=Implementation...] [VIRTUAL_LEVEL 1|2]
+#                   [EXECUTION_MODE wavefront|megakernel])
 #
 # Translates class <Class> into <Class>_Vulkan (or <Class>_CPU), in the build tree, and adds the
 # generated sources, their include path and the runtime to <target>. SOURCES are the files that
@@ -15,6 +16,12 @@
 # VIRTUAL_LEVEL (paper 3.9): how kernels' virtual calls through a std::vector of pointers reach the
 # objects on the GPU: 1 = every element in one array of equal slots, 2 (default) = each class's
 # objects in a buffer of their own. The class's code is the same for both.
+#
+# EXECUTION_MODE (paper 3.4): how a control function's thread loop that calls several kernels
+# (for (y) for (x) { float4 ray; kernel_A(x, y, &ray); kernel_B(x, y, &ray); }) runs on the GPU:
+# wavefront (default) = one dispatch per kernel call, per-thread locals kept in buffers between
+# them; megakernel = the whole loop body in one shader, locals in registers. Both are generated;
+# this picks the one the class starts with, and SetExecutionMode() switches at run time.
 #
 # The translation goes through the build tree's daemon (crossrtd, started on demand, exits when
 # idle), which keeps parsed headers warm; set CROSSRT_NO_DAEMON=1 to translate in-process.
@@ -35,7 +42,7 @@ function(crossrt_register_implementation impl)
 endfunction()
 
 function(crossrt_add_class target class)
-  cmake_parse_arguments(ARG "" "BACKEND;VIRTUAL_LEVEL" "SOURCES;COMPOSE" ${ARGN})
+  cmake_parse_arguments(ARG "" "BACKEND;VIRTUAL_LEVEL;EXECUTION_MODE" "SOURCES;COMPOSE" ${ARGN})
   if(NOT ARG_BACKEND)
     set(ARG_BACKEND vulkan)
   endif()
@@ -76,6 +83,12 @@ function(crossrt_add_class target class)
       message(FATAL_ERROR "crossrt_add_class(${target} ${class}): VIRTUAL_LEVEL is 1 (one array of equal slots) or 2 (a buffer per class), not '${ARG_VIRTUAL_LEVEL}'")
     endif()
     list(APPEND option_args --virtual-level ${ARG_VIRTUAL_LEVEL})
+  endif()
+  if(ARG_EXECUTION_MODE)
+    if(NOT ARG_EXECUTION_MODE MATCHES "^(wavefront|megakernel)$")
+      message(FATAL_ERROR "crossrt_add_class(${target} ${class}): EXECUTION_MODE is wavefront (one dispatch per kernel call) or megakernel (one shader per thread loop), not '${ARG_EXECUTION_MODE}'")
+    endif()
+    list(APPEND option_args --execution-mode ${ARG_EXECUTION_MODE})
   endif()
   set(abs_sources "")
   set(source_args "")

@@ -100,6 +100,8 @@ struct Context {
   ClassModel& model;
   const std::map<std::string, std::string>& compositions;  // interface -> implementation
   std::set<std::string> appended;  // member vectors some kernel push_backs to
+  // (kernel, parameter) pairs a control function's thread loop passes a local's address to.
+  std::set<std::pair<std::string, std::string>> threadState;
   std::string Text(SourceRange r) const { return engine::Text(ctx, r); }
 };
 
@@ -425,6 +427,7 @@ void CheckKernelParams(Context& c, const CXXMethodDecl* md, Kernel& k) {
     if (t->isPointerType()) {
       QualType pointee = t->getPointeeType();
       kp.isPointer = true;
+      kp.threadState = k.rtv && c.threadState.count({k.name, kp.name});
       kp.isConstPointee = pointee.isConstQualified();
       auto g = GlslTypeOf(pointee);
       if (!g || pointee->isPointerType()) {
@@ -697,12 +700,20 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   std::vector<std::pair<std::string, std::string>> threadParams;  // (glsl type, name)
 
   if (k.rtv) {
-    for (auto& p : k.params)
+    // The thread function takes the thread ids, the per-thread values and the by-value arguments,
+    // so that a megakernel can call it as well as this kernel's own main().
+    for (unsigned i = 0; i < k.params.size(); ++i) {
+      const KernelParam& p = k.params[i];
       if (p.isThreadId) {
         k.dims = std::max(k.dims, ThreadAxis(p.name) + 1);
         k.threadAxes.push_back(ThreadAxis(p.name));
-        threadParams.push_back({p.glslType, p.glslName});
       }
+      if (p.threadState) printer.valueParams.insert(def->getParamDecl(i));  // the body refers to the definition's
+      if (p.isPointer && !p.threadState) continue;
+      auto [base, dims] = SplitArray(p.glslType);
+      std::string qualifier = p.threadState && !p.isConstPointee ? "inout " : "";
+      threadParams.push_back({qualifier + base, p.glslName + dims});
+    }
     if (k.dims == 0) {
       c.rep.Error(md->getLocation(), "kernel '" + k.name + "' has no thread id parameter",
                   "name the thread index parameter 'tid' (or tidX, tidY, tidZ), or name the kernel kernel1D_/kernel2D_ with loops inside");
@@ -1017,6 +1028,353 @@ private:
     std::string n = call->getMethodDecl()->getNameAsString();
     if (std::find(m_ctrl.kernelsCalled.begin(), m_ctrl.kernelsCalled.end(), n) == m_ctrl.kernelsCalled.end())
       m_ctrl.kernelsCalled.push_back(n);
+  }
+
+  // ---- thread loops: for (y) for (x) { locals; kernel_A(x, y, &local); for (host) kernel_B(...); } ----
+  // Several kernels per thread, sharing per-thread locals (paper 3.4). Both execution modes are
+  // recorded: the megakernel (one shader runs the whole body) and wavefront (one dispatch per kernel
+  // call, the locals kept in buffers between them); the generated class picks one at run time.
+
+  struct ThreadLoop {
+    std::vector<LoopHeader> loops;                 // outermost first
+    std::map<const VarDecl*, unsigned> axisOf;     // loop variable -> thread axis
+    std::vector<std::pair<const VarDecl*, std::string>> stateBuffers;  // per-thread local -> its wavefront buffer
+    std::vector<std::string> bufferArgs;           // host BufferView of each megakernel parameter so far
+    std::set<const VarDecl*> locals;               // every local of the body (per-thread)
+    std::vector<const VarDecl*> outer;             // control-function variables the body reads, first read first
+    Kernel mega;                                   // the megakernel, without its kernels' code yet
+    std::string hostArgs;                          // ...Cmd arguments of the megakernel after the counts
+    std::string counts;                            // ", (w), (h)": threads per axis, x first
+    bool ok = true;
+  };
+
+  // Variables passed as thread ids to RTV kernels anywhere inside `s`.
+  std::set<const VarDecl*> ThreadIdVars(const Stmt* s) {
+    struct Finder : RecursiveASTVisitor<Finder> {
+      std::set<const VarDecl*> vars;
+      bool VisitCXXMemberCallExpr(CXXMemberCallExpr* call) {
+        auto* md = call->getMethodDecl();
+        if (!md || !IsKernelName(md->getName()) || IpvDims(md->getName())) return true;
+        for (unsigned i = 0; i < call->getNumArgs() && i < md->getNumParams(); ++i)
+          if (IsThreadIdName(md->getParamDecl(i)->getName()))
+            if (auto* dr = dyn_cast<DeclRefExpr>(call->getArg(i)->IgnoreCasts()->IgnoreParens()))
+              if (auto* vd = dyn_cast<VarDecl>(dr->getDecl())) vars.insert(vd);
+        return true;
+      }
+    } finder;
+    finder.TraverseStmt(const_cast<Stmt*>(s));
+    return finder.vars;
+  }
+
+  bool TryThreadLoop(const ForStmt* outerLoop) {
+    const std::set<const VarDecl*> idVars = ThreadIdVars(outerLoop);
+    ThreadLoop tl;
+    const Stmt* body = outerLoop;
+    while (auto* fs = dyn_cast_or_null<ForStmt>(body)) {
+      LoopHeader h;
+      if (!QuietParseLoop(fs, h) || !idVars.count(h.var)) break;
+      tl.loops.push_back(h);
+      body = SingleStatement(fs->getBody());
+    }
+    if (tl.loops.empty()) return false;
+    if (auto* e = dyn_cast_or_null<Expr>(body); e && isa<CXXMemberCallExpr>(e->IgnoreImplicit())) return false;  // one kernel: an RTV nest
+    for (auto& h : tl.loops) {
+      Expr::EvalResult r;
+      if (!(h.start->EvaluateAsInt(r, m_c.ctx) && r.Val.getInt() == 0))
+        Error(tl, h.start->getBeginLoc(), "a thread loop of '" + m_ctrl.name + "' must start at 0", "start at 0 and add the offset inside the kernels");
+    }
+    // Locals first: kernel calls and host loops are checked against them.
+    struct LocalFinder : RecursiveASTVisitor<LocalFinder> {
+      std::set<const VarDecl*>& out;
+      explicit LocalFinder(std::set<const VarDecl*>& o) : out(o) {}
+      bool VisitVarDecl(VarDecl* vd) { out.insert(vd); return true; }
+    } localFinder(tl.locals);
+    localFinder.TraverseStmt(const_cast<Stmt*>(body));
+
+    const unsigned index = ++m_threadLoops;
+    tl.mega.name = m_ctrl.name + "_Megakernel" + (index > 1 ? std::to_string(index) : "");
+    tl.mega.rtv = true;
+    tl.mega.megakernelOf = m_ctrl.name;
+    tl.mega.sourceFile = m_ctrl.sourceFile;
+    tl.mega.dims = unsigned(tl.loops.size());
+    GlslPrinter printer(m_c.ctx, m_c.cls, m_c.rep);
+    for (auto& s : ClassStructNames(m_c.model)) printer.predeclaredStructs.insert(s);
+    std::string glsl = ThreadBodyGlsl(tl, printer, body, 1);
+    if (!tl.ok) return true;
+    for (auto* f : printer.plainMembers)
+      if (auto* m = FindMember(m_c.model, f->getNameAsString())) m->usedByKernels = true;
+    if (!printer.memberVectors.empty() || !printer.helpers.empty())
+      Error(tl, outerLoop->getBeginLoc(), "the host code of a thread loop of '" + m_ctrl.name + "' uses member vectors or calls functions",
+            "count host loops with plain members, parameters or constants; move other work into a kernel");
+    if (tl.axisOf.size() != tl.loops.size()) return true;  // reported by ThreadBodyGlsl
+
+    // The megakernel's signature: thread ids (x first), then the control function's variables it reads.
+    std::vector<const VarDecl*> byAxis(tl.loops.size());
+    for (auto& [var, axis] : tl.axisOf) byAxis[axis] = var;
+    std::string signature;
+    for (unsigned a = 0; a < byAxis.size(); ++a) {
+      KernelParam id;
+      id.name = byAxis[a]->getNameAsString();
+      id.glslName = GlslPrinter::SafeName(id.name);
+      id.glslType = GlslTypeOf(byAxis[a]->getType()).value_or("int");
+      id.isThreadId = true;
+      tl.mega.params.push_back(id);
+      tl.mega.threadAxes.push_back(a);
+      signature += (a ? ", " : "") + id.glslType + " " + id.glslName;
+      for (auto& h : tl.loops)
+        if (h.var == byAxis[a]) tl.counts += ", " + CountExpr(m_c, h);
+    }
+    std::vector<KernelParam> values;
+    for (auto* vd : tl.outer) {  // in declaration order: stable text
+      QualType t = vd->getType().getNonReferenceType().getUnqualifiedType();
+      auto g = GlslTypeOf(t);
+      auto layout = Std430Layout(m_c.ctx, t, false);
+      if (!g || t->isPointerType() || !layout || !FitsClassData(m_c.ctx, t)) {
+        Error(tl, vd->getLocation(), "'" + vd->getNameAsString() + "' is read by the thread loop of '" + m_ctrl.name + "', but its type cannot be passed to the GPU",
+              "use int, uint, float or LiteMath types for values the thread loop reads");
+        continue;
+      }
+      KernelParam v;
+      v.name = vd->getNameAsString();
+      v.glslName = GlslPrinter::SafeName(v.name);
+      v.glslType = *g;
+      v.valueCppType = v.cppType = CppTypeName(m_c.ctx, t);
+      v.std430Align = unsigned(layout->align);
+      values.push_back(v);
+      auto [base, dims] = SplitArray(v.glslType);
+      signature += ", " + base + " " + v.glslName + dims;
+      tl.hostArgs += ", " + v.name;
+    }
+    for (auto& v : values) tl.mega.params.push_back(v);
+    if (!tl.ok) return true;
+    const std::string wavefront = ThreadBodyCpp(tl, body);  // after the counts
+    tl.mega.glslBody = "// from " + m_c.cls->getNameAsString() + "::" + m_ctrl.name + " (" + m_ctrl.sourceFile +
+                       "): the body of its thread loop, each kernel call a function call\nvoid " + tl.mega.name + "(" + signature + ")\n{\n" + glsl + "}\n";
+    m_c.model.megakernels.push_back(tl.mega);
+
+    // Vulkan: both modes, picked when recording.
+    std::string states;
+    for (auto& [local, buffer] : tl.stateBuffers) {
+      std::string cppType = CppTypeName(m_c.ctx, local->getType().getUnqualifiedType());
+      m_ctrl.threadStates.push_back({buffer, cppType, local->getNameAsString()});
+      states += "crossrt::EnsureSize(m_ctx, m_threadState." + buffer + ", sizeof(" + cppType + ") * std::max<size_t>(1, crt_threads));\n"
+                "crossrt::FillCmd(a_cmd, m_threadState." + buffer + ".View(), sizeof(" + cppType + ") * crt_threads, 0);  // " +
+                local->getNameAsString() + " starts at zero\n";
+    }
+    std::string threads;
+    for (auto& h : tl.loops) threads += (threads.empty() ? "" : " * ") + std::string("size_t(") + CountExpr(m_c, h) + ")";
+    std::string text =
+        "if (m_executionMode == crossrt::ExecutionMode::Megakernel)  // the whole loop body in one shader\n" + tl.mega.name + "Cmd(a_cmd" + tl.counts + tl.hostArgs +
+        ");\nelse  // wavefront: one dispatch per kernel call, each thread's locals in buffers between them\n{\nconst size_t crt_threads = " + threads + ";\n" + states +
+        wavefront + "}\n";
+    SourceLocation end = Lexer::findLocationAfterToken(outerLoop->getEndLoc(), tok::semi, m_c.ctx.getSourceManager(), m_c.ctx.getLangOpts(), false);
+    CharSourceRange range = end.isValid() ? CharSourceRange::getCharRange(outerLoop->getBeginLoc(), end) : CharSourceRange::getTokenRange(outerLoop->getSourceRange());
+    m_gpu.ReplaceText(range, text);
+    // CPU: the loop as written, its threads on all cores (the locals are private to each iteration).
+    unsigned col = m_c.ctx.getSourceManager().getExpansionColumnNumber(outerLoop->getBeginLoc());
+    std::string pragma = "#pragma omp parallel for schedule(dynamic, 16)";
+    if (tl.loops.size() > 1) pragma += " collapse(" + std::to_string(tl.loops.size()) + ")";
+    m_cpu.InsertTextBefore(outerLoop->getBeginLoc(), pragma + "\n" + std::string(col > 0 ? col - 1 : 0, ' '));
+    return true;
+  }
+
+  static std::string StateBuffer(const ThreadLoop& tl, const VarDecl* vd) {
+    for (auto& [local, buffer] : tl.stateBuffers)
+      if (local == vd) return buffer;
+    return "";
+  }
+
+  void Error(ThreadLoop& tl, SourceLocation loc, const std::string& message, const std::string& hint) {
+    m_c.rep.Error(loc, message, hint);
+    tl.ok = false;
+  }
+
+  // Checks that `e` does not depend on the thread (host code and by-value kernel arguments run once
+  // for all threads in wavefront mode) and collects the control function's variables it reads.
+  void CheckUniform(ThreadLoop& tl, const Expr* e, const std::string& where, bool readOnGpu = true) {
+    struct Finder : RecursiveASTVisitor<Finder> {
+      std::vector<const DeclRefExpr*> refs;
+      bool VisitDeclRefExpr(DeclRefExpr* dr) { refs.push_back(dr); return true; }
+    } finder;
+    finder.TraverseStmt(const_cast<Expr*>(e));
+    for (auto* dr : finder.refs) {
+      auto* vd = dyn_cast<VarDecl>(dr->getDecl());
+      if (!vd || (vd->hasGlobalStorage() && !vd->isStaticLocal())) continue;
+      bool isLoopVar = std::any_of(tl.loops.begin(), tl.loops.end(), [&](const LoopHeader& h) { return h.var == vd; });
+      if (isLoopVar || !StateBuffer(tl, vd).empty() || (tl.locals.count(vd) && !m_hostLoopVars.count(vd)))
+        Error(tl, dr->getBeginLoc(), "'" + vd->getNameAsString() + "' differs from thread to thread, but " + where + " in the thread loop of '" + m_ctrl.name +
+              "' runs once for all threads in wavefront mode", "pass per-thread values to kernels by address (&" + vd->getNameAsString() + ") and branch inside the kernels");
+      else if (readOnGpu && !tl.locals.count(vd) && std::find(tl.outer.begin(), tl.outer.end(), vd) == tl.outer.end())
+        tl.outer.push_back(vd);
+    }
+  }
+
+  // The GLSL of the thread loop's body (the megakernel) and, alongside, the checks of what may be in it.
+  std::string ThreadBodyGlsl(ThreadLoop& tl, GlslPrinter& printer, const Stmt* s, int indent) {
+    const std::string pad(2 * indent, ' ');
+    if (auto* cs = dyn_cast<CompoundStmt>(s)) {
+      std::string out;
+      for (auto* child : cs->body()) out += ThreadBodyGlsl(tl, printer, child, indent);
+      return out;
+    }
+    if (isa<NullStmt>(s)) return "";
+    if (auto* ds = dyn_cast<DeclStmt>(s)) {
+      std::string out;
+      for (auto* d : ds->decls()) {
+        auto* vd = dyn_cast<VarDecl>(d);
+        if (!vd) continue;
+        const Expr* init = vd->getInit();
+        auto* construct = init ? dyn_cast<CXXConstructExpr>(init->IgnoreImplicit()) : nullptr;
+        if (init && !(construct && construct->getNumArgs() == 0)) {
+          Error(tl, vd->getLocation(), "per-thread local '" + vd->getNameAsString() + "' of the thread loop of '" + m_ctrl.name + "' has an initializer",
+                "declare it without one (it starts at zero on the GPU, as LiteMath types do) and set it in the first kernel");
+          continue;
+        }
+        auto g = GlslTypeOf(vd->getType());
+        if (!g || vd->getType()->isArrayType() || vd->getType()->isPointerType()) {
+          Error(tl, vd->getLocation(), "per-thread local '" + vd->getNameAsString() + "' of type '" + vd->getType().getAsString(m_c.ctx.getPrintingPolicy()) +
+                "' has no GPU equivalent", "use int, uint, float, LiteMath types or plain structs of those; keep arrays in a struct");
+          continue;
+        }
+        tl.stateBuffers.push_back({vd, m_ctrl.name + (m_threadLoops > 1 ? std::to_string(m_threadLoops) : "") + "_" + vd->getNameAsString()});
+        static const std::regex zeroable(R"(^(float|int|uint|[iu]?vec[234]|mat[234])$)");
+        std::string name = GlslPrinter::SafeName(vd->getNameAsString());
+        out += pad + *g + " " + name + (std::regex_match(*g, zeroable) ? " = " + *g + "(0)" : "") + ";\n";
+      }
+      return out;
+    }
+    if (auto* fs = dyn_cast<ForStmt>(s)) {
+      auto* ds = dyn_cast_or_null<DeclStmt>(fs->getInit());
+      auto* var = ds && ds->isSingleDecl() ? dyn_cast<VarDecl>(ds->getSingleDecl()) : nullptr;
+      if (!var || !var->getInit() || !fs->getCond() || !fs->getInc()) {
+        Error(tl, fs->getBeginLoc(), "a loop in the thread loop of '" + m_ctrl.name + "' must declare one counter and have a condition and a step",
+              "write for (int i = 0; i < n; i++)");
+        return "";
+      }
+      m_hostLoopVars.insert(var);
+      CheckUniform(tl, var->getInit(), "the loop's start");
+      CheckUniform(tl, fs->getCond(), "the loop's condition");
+      CheckUniform(tl, fs->getInc(), "the loop's step");
+      std::string header = "for (" + *GlslTypeOf(var->getType()) + " " + GlslPrinter::SafeName(var->getNameAsString()) + " = " + printer.Expr(var->getInit()) + "; " +
+                           printer.Expr(fs->getCond()) + "; " + printer.Expr(fs->getInc()) + ")";
+      return pad + header + "\n" + pad + "{\n" + ThreadBodyGlsl(tl, printer, fs->getBody(), indent + 1) + pad + "}\n";
+    }
+    auto* call = dyn_cast<CXXMemberCallExpr>(s);
+    auto* md = call ? call->getMethodDecl() : nullptr;
+    if (!md || !IsKernelName(md->getName()) || IpvDims(md->getName()) || !isa<CXXThisExpr>(call->getImplicitObjectArgument()->IgnoreParenImpCasts())) {
+      Error(tl, s->getBeginLoc(), "the thread loop of '" + m_ctrl.name + "' may hold only per-thread local declarations, kernel_ calls and counted loops around them",
+            "move this code into a kernel: the loop's body runs once per thread, on the GPU");
+      return "";
+    }
+    Note(call);
+    auto& calls = tl.mega.megakernelCalls;
+    if (std::find(calls.begin(), calls.end(), md->getNameAsString()) == calls.end()) calls.push_back(md->getNameAsString());
+    std::string args;
+    std::set<unsigned> axes;
+    for (unsigned i = 0; i < call->getNumArgs() && i < md->getNumParams(); ++i) {
+      auto* p = md->getParamDecl(i);
+      const Expr* arg = call->getArg(i);
+      std::string a;
+      if (IsThreadIdName(p->getName())) {
+        auto* dr = dyn_cast<DeclRefExpr>(arg->IgnoreCasts()->IgnoreParens());
+        auto* vd = dr ? dyn_cast<VarDecl>(dr->getDecl()) : nullptr;
+        bool isLoopVar = vd && std::any_of(tl.loops.begin(), tl.loops.end(), [&](const LoopHeader& h) { return h.var == vd; });
+        if (!isLoopVar) {
+          Error(tl, arg->getBeginLoc(), "thread id argument of '" + md->getNameAsString() + "' must be a variable of the thread loop around it",
+                "pass the loop variables themselves, e.g. " + md->getNameAsString() + "(x, y, ...)");
+          continue;
+        }
+        const unsigned axis = ThreadAxis(p->getName());
+        auto [it, inserted] = tl.axisOf.insert({vd, axis});
+        if (!inserted && it->second != axis)
+          Error(tl, arg->getBeginLoc(), "'" + vd->getNameAsString() + "' is passed as thread id " + p->getNameAsString() + " here, but as another axis elsewhere in the thread loop",
+                "pass each loop variable as the same thread id (tidX, tidY, tidZ) to every kernel");
+        axes.insert(axis);
+        std::string type = GlslTypeOf(p->getType()).value_or("uint"), varType = GlslTypeOf(vd->getType()).value_or("int");
+        std::string name = GlslPrinter::SafeName(vd->getNameAsString());
+        a = type == varType ? name : type + "(" + name + ")";
+      } else if (p->getType()->isPointerType()) {
+        auto* uo = dyn_cast<UnaryOperator>(arg->IgnoreParenImpCasts());
+        auto* dr = uo && uo->getOpcode() == UO_AddrOf ? dyn_cast<DeclRefExpr>(uo->getSubExpr()->IgnoreParens()) : nullptr;
+        auto* vd = dr ? dyn_cast<VarDecl>(dr->getDecl()) : nullptr;
+        if (vd && !StateBuffer(tl, vd).empty()) {
+          a = GlslPrinter::SafeName(vd->getNameAsString());
+        } else if (vd) {
+          Error(tl, arg->getBeginLoc(), "'&" + vd->getNameAsString() + "' passed to '" + md->getNameAsString() + "' is not a per-thread local declared in the thread loop",
+                "declare the variable inside the thread loop's body");
+          continue;
+        } else {
+          CheckUniform(tl, arg, "a buffer argument", false);  // bound by the host
+          AddMegakernelBuffer(tl, md, p, BufferArg(arg), arg->getBeginLoc());
+          continue;  // a global buffer of the megakernel, named as the kernel names it
+        }
+      } else {
+        CheckUniform(tl, arg, "the by-value argument '" + p->getNameAsString() + "'");
+        a = printer.Expr(arg);
+      }
+      args += (args.empty() ? "" : ", ") + a;
+    }
+    if (axes.size() != tl.loops.size())
+      Error(tl, call->getBeginLoc(), "'" + md->getNameAsString() + "' takes " + std::to_string(axes.size()) + " thread ids, but the thread loop around it has " +
+            std::to_string(tl.loops.size()) + " loops", "give every kernel of a thread loop one thread id parameter (tidX, tidY, ...) per loop");
+    return pad + md->getNameAsString() + "(" + args + ");\n";
+  }
+
+  // A pointer argument of a kernel in a thread loop: in the megakernel, a buffer named as the
+  // kernel's parameter (its code refers to that name). Two kernels naming different buffers alike
+  // would collide there.
+  void AddMegakernelBuffer(ThreadLoop& tl, const CXXMethodDecl* md, const ParmVarDecl* p, const std::string& hostArg, SourceLocation loc) {
+    const KernelParam* kp = nullptr;
+    for (auto& k : m_c.model.kernels)
+      if (k.name == md->getNameAsString())
+        for (auto& x : k.params)
+          if (x.name == p->getNameAsString()) kp = &x;
+    if (!kp) return;  // the kernel failed analysis (reported there)
+    for (unsigned i = 0; i < tl.mega.params.size(); ++i) {
+      KernelParam& have = tl.mega.params[i];
+      if (have.name != kp->glslName) continue;
+      if (tl.bufferArgs[i] != hostArg || have.glslType != kp->glslType)
+        Error(tl, loc, "parameter '" + p->getNameAsString() + "' of '" + md->getNameAsString() + "' is given another buffer than a parameter of the same name of another kernel in the thread loop",
+              "rename one of them: the megakernel binds each kernel's buffers under the parameter's name");
+      have.isConstPointee = have.isConstPointee && kp->isConstPointee;
+      return;
+    }
+    KernelParam b = *kp;
+    b.name = kp->glslName;
+    tl.mega.params.push_back(b);
+    tl.bufferArgs.push_back(hostArg);
+    tl.hostArgs += ", " + hostArg;
+  }
+
+  // The wavefront version of the thread loop's body: host loops as written, each kernel call a
+  // dispatch over all threads, per-thread locals bound as their buffers.
+  std::string ThreadBodyCpp(ThreadLoop& tl, const Stmt* s) {
+    if (auto* cs = dyn_cast<CompoundStmt>(s)) {
+      std::string out;
+      for (auto* child : cs->body()) out += ThreadBodyCpp(tl, child);
+      return out;
+    }
+    if (auto* fs = dyn_cast<ForStmt>(s))
+      return m_c.Text(SourceRange(fs->getBeginLoc(), fs->getRParenLoc())) + "\n{\n" + ThreadBodyCpp(tl, fs->getBody()) + "}\n";
+    auto* call = dyn_cast<CXXMemberCallExpr>(s);
+    auto* md = call ? call->getMethodDecl() : nullptr;
+    if (!md || !IsKernelName(md->getName())) return "";  // declarations (their buffers are set up before), or reported
+    std::string args;
+    for (unsigned i = 0; i < call->getNumArgs() && i < md->getNumParams(); ++i) {
+      auto* p = md->getParamDecl(i);
+      const Expr* arg = call->getArg(i);
+      if (IsThreadIdName(p->getName()) || isa<CXXDefaultArgExpr>(arg)) continue;
+      if (!p->getType()->isPointerType()) {
+        args += ", " + m_c.Text(arg->getSourceRange());
+        continue;
+      }
+      auto* uo = dyn_cast<UnaryOperator>(arg->IgnoreParenImpCasts());
+      auto* dr = uo && uo->getOpcode() == UO_AddrOf ? dyn_cast<DeclRefExpr>(uo->getSubExpr()->IgnoreParens()) : nullptr;
+      auto* vd = dr ? dyn_cast<VarDecl>(dr->getDecl()) : nullptr;
+      std::string buffer = vd ? StateBuffer(tl, vd) : "";
+      args += ", " + (buffer.empty() ? BufferArg(arg) : "m_threadState." + buffer + ".View()");
+    }
+    return md->getNameAsString() + "Cmd(a_cmd" + tl.counts + args + ");\n";
   }
 
   // for (...) for (...) kernel_X(tidX, tidY, ...): one dispatch of the whole nest.
@@ -1397,7 +1755,7 @@ private:
     if (auto* ds = dyn_cast<DoStmt>(s)) RecordMemberWrite(ds->getBody());
     if (auto* mc = dyn_cast<CXXMemberCallExpr>(s)) CheckNestedControl(mc);
     if (auto* call = dyn_cast<CallExpr>(s); call && !isa<CXXMemberCallExpr>(s) && TryLibraryCall(call)) return;
-    if (auto* fs = dyn_cast<ForStmt>(s); fs && TryRtvNest(fs)) return;
+    if (auto* fs = dyn_cast<ForStmt>(s); fs && (TryThreadLoop(fs) || TryRtvNest(fs))) return;
     if (auto* call = dyn_cast<CXXMemberCallExpr>(s)) {
       auto* md = call->getMethodDecl();
       if (md && IsKernelName(md->getName()) && isa<CXXThisExpr>(call->getImplicitObjectArgument()->IgnoreParenImpCasts())) {
@@ -1419,6 +1777,8 @@ private:
   const FunctionDecl* m_def;
   Control& m_ctrl;
   Rewriter m_gpu, m_cpu;
+  unsigned m_threadLoops = 0;                  // thread loops seen so far (names the megakernels)
+  std::set<const VarDecl*> m_hostLoopVars;     // counters of loops inside thread loops: the same for all threads
 };
 
 void AnalyzeControl(Context& c, const CXXMethodDecl* md, const FunctionDecl* def) {
@@ -1474,12 +1834,35 @@ bool AnalyzeTranslationUnit(ASTContext& ctx, const std::string& className, const
   for (auto* d : ctx.getTranslationUnitDecl()->lookup(&ctx.Idents.get(className)))
     if (auto* rd = dyn_cast<CXXRecordDecl>(d); rd && rd->getDefinition()) cls = rd->getDefinition();
   if (!cls) return false;
-  Context c{ctx, cls, reporter, model, compositions, {}};
+  Context c{ctx, cls, reporter, model, compositions, {}, {}};
   bool first = model.className.empty();
   if (first) {
     model.className = className;
     model.headerFile = FileOf(ctx, cls->getLocation());
     AnalyzeMembers(c);
+  }
+  // Locals a control function passes to kernels by address are per-thread values on the GPU: find
+  // them before analysing the kernels, whose GLSL signatures they change.
+  {
+    struct LocalAddressFinder : RecursiveASTVisitor<LocalAddressFinder> {
+      std::set<std::pair<std::string, std::string>>& out;
+      explicit LocalAddressFinder(std::set<std::pair<std::string, std::string>>& o) : out(o) {}
+      bool VisitCXXMemberCallExpr(CXXMemberCallExpr* call) {
+        auto* md = call->getMethodDecl();
+        if (!md || !IsKernelName(md->getName()) || IpvDims(md->getName())) return true;
+        for (unsigned i = 0; i < call->getNumArgs() && i < md->getNumParams(); ++i) {
+          auto* uo = dyn_cast<UnaryOperator>(call->getArg(i)->IgnoreParenImpCasts());
+          auto* dr = uo && uo->getOpcode() == UO_AddrOf ? dyn_cast<DeclRefExpr>(uo->getSubExpr()->IgnoreParens()) : nullptr;
+          auto* vd = dr ? dyn_cast<VarDecl>(dr->getDecl()) : nullptr;
+          if (vd && vd->hasLocalStorage() && !isa<ParmVarDecl>(vd)) out.insert({md->getNameAsString(), md->getParamDecl(i)->getNameAsString()});
+        }
+        return true;
+      }
+    } finder(c.threadState);
+    for (auto* md : cls->methods()) {
+      const FunctionDecl* def = nullptr;
+      if (!IsKernelName(md->getName()) && md->hasBody(def) && def) finder.TraverseStmt(def->getBody());
+    }
   }
   // Appends decide how other kernels are dispatched: find them all before analysing any kernel.
   {
@@ -1706,7 +2089,42 @@ bool ComposeFromTranslationUnit(ASTContext& ctx, Reporter& reporter, ClassModel&
   return any;
 }
 
+// A megakernel runs its kernels' thread functions: it needs their structs, constants, helpers
+// (composed code included, so after composition), buffers and images.
+static void MergeMegakernelCode(ClassModel& model) {
+  for (auto& mk : model.megakernels) {
+    std::vector<std::string> functions;
+    auto addUnique = [](std::vector<std::string>& list, const std::string& x) {
+      if (std::find(list.begin(), list.end(), x) == list.end()) list.push_back(x);
+    };
+    for (auto& name : mk.megakernelCalls) {
+      auto k = std::find_if(model.kernels.begin(), model.kernels.end(), [&](const Kernel& x) { return x.name == name; });
+      if (k == model.kernels.end()) continue;
+      for (auto& chunk : k->structList)
+        if (std::none_of(mk.structList.begin(), mk.structList.end(), [&](const std::string& x) { return StructName(x) == StructName(chunk); }))
+          mk.structList.push_back(chunk);
+      for (auto& x : k->constantList) addUnique(mk.constantList, x);
+      for (auto& x : k->functionList) addUnique(functions, x);
+      addUnique(functions, k->glslBody);
+      for (auto& v : k->memberVectors) addUnique(mk.memberVectors, v);
+      for (auto& ib : k->images) {
+        auto same = std::find_if(mk.images.begin(), mk.images.end(), [&](const ImageBinding& x) { return x.member == ib.member && x.use == ib.use; });
+        if (same == mk.images.end()) mk.images.push_back(ib);
+        else { same->loaded |= ib.loaded; same->stored |= ib.stored; }
+      }
+      for (auto& pair : k->samplePairs)
+        if (std::find(mk.samplePairs.begin(), mk.samplePairs.end(), pair) == mk.samplePairs.end()) mk.samplePairs.push_back(pair);
+      mk.composedCalls.insert(k->composedCalls.begin(), k->composedCalls.end());
+      mk.bufferReferences |= k->bufferReferences;
+      mk.scalarReferences |= k->scalarReferences;
+    }
+    std::sort(mk.memberVectors.begin(), mk.memberVectors.end());
+    mk.functionList = functions;
+  }
+}
+
 void FinishModel(ClassModel& model) {
+  MergeMegakernelCode(model);
   // The class-data block: plain members kernels use, then sizes of member vectors.
   // Ordered by alignment so that the C++ mirror with alignas() has the std430 offsets.
   std::vector<BlockField> fields;

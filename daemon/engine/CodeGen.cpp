@@ -86,6 +86,14 @@ const char* GlAxis(unsigned a) { return a == 0 ? "x" : a == 1 ? "y" : "z"; }
 
 // Workgroup shape by dimension count: 256 threads each, so reductions see the same group size.
 struct GroupShape { unsigned x, y, z; };
+// What the Vulkan class dispatches: the kernels, then the megakernels of thread loops.
+std::vector<const Kernel*> VulkanKernels(const ClassModel& model) {
+  std::vector<const Kernel*> all;
+  for (auto& k : model.kernels) all.push_back(&k);
+  for (auto& k : model.megakernels) all.push_back(&k);
+  return all;
+}
+
 GroupShape Shape(const Kernel& k) {
   static const GroupShape shapes[3] = {{256, 1, 1}, {16, 16, 1}, {8, 8, 4}};
   return shapes[k.dims - 1];
@@ -166,6 +174,8 @@ Data Common(const ClassModel& model, const GenerateOptions& opt) {
   for (auto& u : model.usingDecls) usings += u + "\n";
   d.set("usingDecls", usings);
   d.set("hasUsingDecls", !usings.empty());
+  d.set("hasMegakernels", !model.megakernels.empty());
+  d.set("defaultExecutionMode", model.megakernelByDefault ? "Megakernel" : "Wavefront");
   Data comps = List();
   for (auto& c : model.compositions) {
     if (c.implHeader.empty()) continue;
@@ -292,6 +302,10 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   d.set("classStructs", model.glslClassStructs);
   d.set("rayQuery", hardwareRayQuery);
   d.set("variant", hardwareRayQuery ? ": the variant for ray tracing hardware (GL_EXT_ray_query)" : "");
+  std::string calls;
+  for (auto& c : k.megakernelCalls) calls += (calls.empty() ? "" : ", ") + c;
+  d.set("origin", k.megakernelOf.empty() ? model.className + "::" + k.name
+                                         : "the thread loop of " + model.className + "::" + k.megakernelOf + ", as one megakernel running " + calls);
   // The ray query variant drops the composed implementation: its functions, buffers, and the
   // structs and constants only they used.
   const std::vector<std::string>& memberVectors = hardwareRayQuery ? k.ownMemberVectors : k.memberVectors;
@@ -322,10 +336,13 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
     scalarAny |= p.scalarLayout;
     b.set("binding", std::to_string(binding++));
     b.set("access", p.isConstPointee ? "readonly " : "");
-    b.set("blockName", p.glslName + "Buffer");
+    // A per-thread value: main() loads this thread's element, passes it, and stores it back.
+    const std::string name = p.threadState ? p.glslName + "PerThread" : p.glslName;
+    b.set("blockName", name + "Buffer");
     b.set("type", p.glslType);
-    b.set("name", p.glslName);
-    b.set("comment", "parameter '" + p.name + "'");
+    b.set("name", name);
+    b.set("comment", p.threadState ? "parameter '" + p.name + "': one value per thread, kept between the kernels of a thread loop"
+                                   : k.megakernelOf.empty() ? "parameter '" + p.name + "'" : "parameter '" + p.name + "' of the kernels that name it so");
     buffers.push_back(b);
   }
   for (auto& v : memberVectors) {
@@ -426,12 +443,49 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   } else {
     for (unsigned a = 0; a < k.dims; ++a) idTypes.push_back(k.loops[k.dims - 1 - a].glslType);  // x is the innermost loop
   }
+  // RTV thread functions also take the per-thread values and the by-value arguments (push constants).
   std::string threadArgs, active;
+  Data stateLoads = List(), stateStores = List();
+  bool threadState = false;
+  std::vector<std::string> ids;
   for (size_t i = 0; i < k.threadAxes.size(); ++i) {
     unsigned a = k.threadAxes[i];
-    std::string id = k.dims == 1 ? "int(threadId)" : std::string("int(gl_GlobalInvocationID.") + GlAxis(a) + ")";
-    threadArgs += (i ? ", " : "") + idTypes[i] + "(crt_start" + Axis(a) + " + " + id + ")";
+    std::string gid = k.dims == 1 ? "int(threadId)" : std::string("int(gl_GlobalInvocationID.") + GlAxis(a) + ")";
+    ids.push_back(idTypes[i] + "(crt_start" + Axis(a) + " + " + gid + ")");
   }
+  if (!k.rtv)
+    for (auto& id : ids) threadArgs += (threadArgs.empty() ? "" : ", ") + id;
+  for (size_t i = 0, id = 0; k.rtv && i < k.params.size(); ++i) {
+    std::string arg;
+    if (k.params[i].isThreadId) {
+      arg = ids[id++];
+    } else if (k.params[i].threadState) {
+      const KernelParam& p = k.params[i];
+      arg = p.glslName;
+      Data load;
+      load.set("text", p.glslType + " " + p.glslName + " = " + p.glslName + "PerThread[threadIndex];");
+      stateLoads.push_back(load);
+      threadState = true;
+      if (!p.isConstPointee) {
+        Data store;
+        store.set("text", p.glslName + "PerThread[threadIndex] = " + p.glslName + ";");
+        stateStores.push_back(store);
+      }
+    } else if (!k.params[i].isPointer) {
+      arg = k.params[i].glslName;
+    } else {
+      continue;
+    }
+    threadArgs += (threadArgs.empty() ? "" : ", ") + arg;
+  }
+  d.set("hasThreadState", threadState);
+  d.set("noThreadState", !threadState);
+  d.set("stateLoads", stateLoads);
+  d.set("stateStores", stateStores);
+  // The thread's element of per-thread buffers: threads in x, then rows, then slices.
+  d.set("threadIndex", k.dims == 1 ? std::string("threadId")
+                       : k.dims == 2 ? std::string("gl_GlobalInvocationID.x + crt_countX * gl_GlobalInvocationID.y")
+                                     : std::string("gl_GlobalInvocationID.x + crt_countX * (gl_GlobalInvocationID.y + crt_countY * gl_GlobalInvocationID.z)"));
   for (unsigned a = 0; a < k.dims; ++a)
     active += (a ? " && " : "") + std::string("gl_GlobalInvocationID.") + GlAxis(a) + " < crt_count" + Axis(a);
   d.set("threadArgs", threadArgs);
@@ -542,6 +596,16 @@ Data ControlsData(const ClassModel& model) {
               writtenImages.push_back(y);
             }
     x.set("writtenImages", writtenImages);
+    Data states = List();
+    for (auto& s : c.threadStates) {
+      Data y;
+      y.set("buffer", s.buffer);
+      y.set("cppType", s.cppType);
+      y.set("local", s.local);
+      y.set("control", c.name);
+      states.push_back(y);
+    }
+    x.set("threadStates", states);
     controls.push_back(x);
   }
   return controls;
@@ -550,10 +614,12 @@ Data ControlsData(const ClassModel& model) {
 Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
   Data kernels = List();
   indirectSlots = 0;
-  for (auto& k : model.kernels) {
+  for (const Kernel* kernel : VulkanKernels(model)) {
+    const Kernel& k = *kernel;
     Data x;
     x.set("name", k.name);
     x.set("sourceFile", k.sourceFile);
+    x.set("origin", k.megakernelOf.empty() ? model.className + "::" + k.name : "the thread loop of " + model.className + "::" + k.megakernelOf);
     std::string cmdParams;
     for (unsigned a = 0; k.rtv && a < k.dims; ++a) cmdParams += std::string(", uint32_t a_threads") + Axis(a);
     for (auto& p : k.params) {
@@ -682,8 +748,8 @@ Data ImagesData(const ClassModel& model, MemberKind kind) {
     x.set("texelCpp", m.elemCppType);
     x.set("vkFormat", m.vkFormat);
     std::set<std::string> samplers;
-    for (auto& k : model.kernels)
-      for (auto& [image, sampler] : k.samplePairs)
+    for (const Kernel* k : VulkanKernels(model))
+      for (auto& [image, sampler] : k->samplePairs)
         if (image == m.name) samplers.insert(sampler);
     Data pairs = List();
     for (auto& sampler : samplers) {
@@ -709,8 +775,9 @@ Data VectorsData(const ClassModel& model) {
     x.set("appended", m.appendedByKernels);
     // Composed data that only the translated traversal binds (ray query variants leave it out) is
     // not uploaded while the ray tracing hardware traces.
-    const bool boundWithHardware = std::any_of(model.kernels.begin(), model.kernels.end(), [&](const Kernel& k) {
-      const auto& bound = k.rayQueryHolder.empty() ? k.memberVectors : k.ownMemberVectors;
+    const auto kernels = VulkanKernels(model);  // megakernels bind the traversal's data in either case
+    const bool boundWithHardware = std::any_of(kernels.begin(), kernels.end(), [&](const Kernel* k) {
+      const auto& bound = k->rayQueryHolder.empty() ? k->memberVectors : k->ownMemberVectors;
       return std::find(bound.begin(), bound.end(), m.name) != bound.end();
     });
     const bool traversalData = !m.composedFrom.empty() && !boundWithHardware &&
@@ -728,7 +795,8 @@ std::string ScalarOmpOp(ReduceOp op) { return op == ReduceOp::Min ? "min" : op =
 
 std::vector<ShaderSource> GenerateShaders(const ClassModel& model, const GenerateOptions& opt) {
   std::vector<ShaderSource> shaders;
-  for (auto& k : model.kernels) {
+  for (const Kernel* kernel : VulkanKernels(model)) {
+    const Kernel& k = *kernel;
     shaders.push_back({k.name, KernelGlsl(model, k, opt)});
     if (!k.rayQueryHolder.empty()) shaders.push_back({k.name + "_RayQuery", KernelGlsl(model, k, opt, true)});
     if (!k.reductions.empty()) shaders.push_back({k.name + "_Reduce", ReduceGlsl(model, k, opt)});

@@ -745,6 +745,20 @@ std::string GlslPrinter::Call(const CallExpr* call) {
   return s + ")";
 }
 
+const ValueDecl* GlslPrinter::ValueParamOf(const clang::Expr* e, bool pointerItself) const {
+  e = e->IgnoreParenImpCasts();
+  if (pointerItself) {
+    auto* dr = dyn_cast<DeclRefExpr>(e);
+    return dr && valueParams.count(dr->getDecl()) ? dr->getDecl() : nullptr;
+  }
+  if (auto* uo = dyn_cast<UnaryOperator>(e); uo && uo->getOpcode() == UO_Deref) return ValueParamOf(uo->getSubExpr(), true);
+  if (auto* as = dyn_cast<ArraySubscriptExpr>(e)) {
+    clang::Expr::EvalResult r;
+    if (as->getIdx()->EvaluateAsInt(r, m_ctx) && r.Val.getInt() == 0) return ValueParamOf(as->getBase(), true);
+  }
+  return nullptr;
+}
+
 std::string GlslPrinter::Expr(const clang::Expr* e) {
   if (!e) return "";
   if (auto* p = dyn_cast<ParenExpr>(e)) return "(" + Expr(p->getSubExpr()) + ")";
@@ -782,6 +796,9 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
   if (auto* dr = dyn_cast<DeclRefExpr>(e)) {
     const ValueDecl* d = dr->getDecl();
     if (auto it = renames.find(d); it != renames.end()) return it->second;
+    if (valueParams.count(d))
+      return Fail(e->getBeginLoc(), "'" + d->getNameAsString() + "' holds one value per thread (a local of the control function's thread loop), used here as a pointer",
+                  "read and write it as *" + d->getNameAsString() + " or " + d->getNameAsString() + "->field");
     if (auto* ec = dyn_cast<EnumConstantDecl>(d)) return std::to_string(ec->getInitVal().getSExtValue());
     if (auto* vd = dyn_cast<VarDecl>(d)) {
       if (vd->hasGlobalStorage() && !vd->isStaticLocal()) {
@@ -798,6 +815,9 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
     }
     return Fail(e->getBeginLoc(), "'" + d->getNameAsString() + "' cannot be used in a kernel", "");
   }
+  if (const ValueDecl* param = ValueParamOf(e)) return SafeName(param->getNameAsString());
+  if (auto* me = dyn_cast<MemberExpr>(e); me && me->isArrow() && ValueParamOf(me->getBase(), true))
+    return SafeName(ValueParamOf(me->getBase(), true)->getNameAsString()) + "." + me->getMemberDecl()->getNameAsString();
   if (auto* me = dyn_cast<MemberExpr>(e)) {
     const clang::Expr* base = me->getBase()->IgnoreParenImpCasts();
     auto* field = dyn_cast<FieldDecl>(me->getMemberDecl());
@@ -1020,6 +1040,8 @@ std::string GlslPrinter::Stmt(const clang::Stmt* s, int indent) {
   if (auto* cs = dyn_cast<CaseStmt>(s)) return pad + "case " + Expr(cs->getLHS()) + ":\n" + Stmt(cs->getSubStmt(), indent + 1);
   if (auto* ds = dyn_cast<DefaultStmt>(s)) return pad + "default:\n" + Stmt(ds->getSubStmt(), indent + 1);
   if (isa<NullStmt>(s)) return pad + ";\n";
+  // `(void)unused;` only quiets a C++ warning: nothing to run.
+  if (auto* cast = dyn_cast<CStyleCastExpr>(s); cast && cast->getType()->isVoidType() && !cast->getSubExpr()->HasSideEffects(m_ctx)) return "";
   if (auto* e = dyn_cast<clang::Expr>(s)) return pad + Expr(e) + ";\n";
   return Fail(s->getBeginLoc(), std::string("statement '") + s->getStmtClassName() + "' is not supported in kernels",
               "kernels may use declarations, if, for, while, do, switch, return, break and continue"), "";

@@ -55,6 +55,9 @@ public:
 
   // Names that print differently: reduction members -> their per-thread accumulator, pointer params.
   std::map<const clang::ValueDecl*, std::string> renames;
+  // Pointer parameters that hold one value per thread (a local of a control function's thread
+  // loop passed as &local): the GPU passes the value itself, so *p, p->f and p[0] print as p, p.f.
+  std::set<const clang::ValueDecl*> valueParams;
   // Members declared std::vector that the kernel reaches, plain members it reads.
   std::set<const clang::FieldDecl*> memberVectors, plainMembers;
   // Where the kernel reads a member vector's size (a kernel may not read what it appends to).
@@ -105,6 +108,8 @@ public:
   static std::string SafeName(const std::string& name);  // renames GLSL keywords
 
 private:
+  // The per-thread value parameter `e` reads (*p, p[0]; with pointerItself, p), or null.
+  const clang::ValueDecl* ValueParamOf(const clang::Expr* e, bool pointerItself = false) const;
   std::string Call(const clang::CallExpr* call);
   std::string Builtin(const clang::FunctionDecl* fd, const std::vector<std::string>& args, const clang::CallExpr* call);
   std::string Construct(clang::QualType t, const std::vector<const clang::Expr*>& args, clang::SourceLocation loc);

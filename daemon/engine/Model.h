@@ -57,6 +57,9 @@ struct KernelParam {
   bool isConstPointee = false;
   bool scalarLayout = false;
   bool isThreadId = false;  // RTV kernels: tid, tidX, tidY, tidZ
+  // RTV kernels: a pointer that a control function's thread loop passes a local to (&local). On the
+  // GPU it is one value per thread: a function parameter, kept in a buffer between wavefront dispatches.
+  bool threadState = false;
   unsigned std430Align = 4;  // by-value parameters: alignment in the push-constant block
 };
 
@@ -106,6 +109,11 @@ struct Kernel {
   std::string rayQueryHolder;
   std::vector<std::string> ownFunctionList;   // functionList before composition merged its code in
   std::vector<std::string> ownMemberVectors;  // memberVectors likewise
+  // Megakernel (paper 3.4): the whole body of a thread loop of control function `megakernelOf` in one
+  // shader. Its pointer parameters are the buffers its kernels bind (named as those kernels name
+  // them), its by-value parameters the control function's variables the body reads.
+  std::string megakernelOf;
+  std::vector<std::string> megakernelCalls;  // the kernels it runs, whose code it merges
   bool bufferReferences = false;      // reaches objects through buffer references (virtual calls)
   bool scalarReferences = false;      // some of them need the scalar layout
 };
@@ -129,6 +137,9 @@ struct Control {
   std::string cpuBody;              // body with RTV loops parallelised
   std::vector<std::string> kernelsCalled;
   std::vector<std::string> vectorsWritten;  // member vectors its library calls (scan, fill, memcpy) write
+  // Thread loops calling several kernels: the per-thread locals wavefront mode keeps in buffers.
+  struct ThreadState { std::string buffer, cppType, local; };
+  std::vector<ThreadState> threadStates;
   std::string sourceFile;
 };
 
@@ -181,6 +192,10 @@ struct ClassModel {
   std::vector<Composition> compositions;   // holders kernels call through, in declaration order
   std::vector<VirtualMember> virtuals;     // vectors of objects kernels call virtual functions of
   int virtualLevel = 2;                    // 1: one array of equal slots; 2: a buffer per class
+  // Thread loops that call several kernels run as one shader each (megakernels) or one dispatch per
+  // kernel call (wavefront). Both are generated; this picks the default.
+  std::vector<Kernel> megakernels;
+  bool megakernelByDefault = false;
 };
 
 // The member named `name`, or null (works on a const and a mutable model).

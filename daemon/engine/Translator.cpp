@@ -230,6 +230,7 @@ AnalyzeResult Analyze(const TranslateRequest& request, AstCache* sharedCache) {
   }
   ClassModel& model = result.model;
   model.virtualLevel = request.virtualLevel;
+  model.megakernelByDefault = request.megakernel;
   unsigned errors = 0;
   // Runs one analysis step per AST with its diagnostics printed against that AST's sources.
   auto forEachAst = [&](auto&& step) {

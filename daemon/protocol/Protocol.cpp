@@ -46,7 +46,8 @@ nlohmann::json ToJson(const engine::TranslateRequest& r) {
           {"outputDir", r.outputDir},
           {"templateDir", r.templateDir},
           {"compositions", r.compositions},
-          {"virtualLevel", r.virtualLevel}};
+          {"virtualLevel", r.virtualLevel},
+          {"executionMode", r.megakernel ? "megakernel" : "wavefront"}};
 }
 
 engine::TranslateRequest RequestFromJson(const nlohmann::json& j) {
@@ -62,6 +63,11 @@ engine::TranslateRequest RequestFromJson(const nlohmann::json& j) {
   if (j.contains("compositions")) r.compositions = j.at("compositions").get<std::vector<std::string>>();
   if (j.contains("virtualLevel")) r.virtualLevel = j.at("virtualLevel").get<int>();
   if (r.virtualLevel != 1 && r.virtualLevel != 2) throw std::runtime_error("virtualLevel must be 1 or 2");
+  if (j.contains("executionMode")) {
+    std::string mode = j.at("executionMode").get<std::string>();
+    if (mode != "megakernel" && mode != "wavefront") throw std::runtime_error("executionMode must be megakernel or wavefront, not '" + mode + "'");
+    r.megakernel = mode == "megakernel";
+  }
   if (r.className.empty() || r.sources.empty()) throw std::runtime_error("className and sources must not be empty");
   return r;
 }

@@ -31,6 +31,11 @@ struct NoDeviceError : Error {
   using Error::Error;
 };
 
+// How a generated class runs a control function's thread loop that calls several kernels:
+// one dispatch per kernel call, each thread's locals kept in buffers between them (Wavefront), or
+// the whole loop body as one shader, locals in registers (Megakernel).
+enum class ExecutionMode { Wavefront, Megakernel };
+
 // Throws Error("<what> failed: VK_ERROR_... (code)") unless r == VK_SUCCESS.
 void Check(VkResult r, const char* what);
 // Name of a VkResult, e.g. "VK_ERROR_DEVICE_LOST".
