@@ -1,13 +1,18 @@
 // Benchmark: each example class as the original single-threaded C++, as <Class>_CPU (OpenMP on
 // all cores) and as <Class>_Vulkan on the default device. Every figure comes from this one run;
 // ratios are against the original. Each time is the median of the repeats after a warm-up.
-//   bench_examples [particles] [bloom side]
+// SpherePaths runs on Vulkan in both execution modes: wavefront (one dispatch per kernel call) and
+// megakernel (its thread loop as one shader).
+//   bench_examples [particles] [bloom side] [paths side]
 #include "Bloom.h"
 #include "Bloom_CPU.h"
 #include "Bloom_Vulkan.h"
 #include "Particles.h"
 #include "Particles_CPU.h"
 #include "Particles_Vulkan.h"
+#include "SpherePaths.h"
+#include "SpherePaths_CPU.h"
+#include "SpherePaths_Vulkan.h"
 
 #include <algorithm>
 #include <chrono>
@@ -51,6 +56,8 @@ int main(int argc, char** argv)
 {
   const int particles = argc > 1 ? std::atoi(argv[1]) : 1 << 20;
   const int side = argc > 2 ? std::atoi(argv[2]) : 1024;
+  const int pathSide = argc > 3 ? std::atoi(argv[3]) : 256;
+  const int pathSamples = 8;
   std::shared_ptr<crossrt::VulkanContext> ctx;
   try { ctx = crossrt::VulkanContext::CreateDefault(); }
   catch (const std::exception& e) { std::fprintf(stderr, "no Vulkan device, the _Vulkan rows are skipped: %s\n", e.what()); }
@@ -94,7 +101,34 @@ int main(int argc, char** argv)
       Row("bloom", name, ms, base, ctx && std::string(name) == "Bloom_Vulkan" ? t[0] : 0.0);
     }
   }
-  std::printf("\nparticles: %d particles per step; bloom: %dx%d image, radius 12.\n", particles, side, side);
+  {  // paths: a 2D thread loop of four kernels, 8 samples x 4 bounces = 65 kernel calls per pixel
+    const uint32_t w = uint32_t(pathSide);
+    std::vector<float4> out(size_t(w) * w);
+    std::vector<std::pair<const char*, std::shared_ptr<SpherePaths>>> impls = {{"original", std::make_shared<SpherePaths>()}, {"SpherePaths_CPU", CreateSpherePaths_CPU()}};
+    if (ctx)
+    {
+      auto wavefront = std::make_shared<SpherePaths_Vulkan>(ctx), megakernel = std::make_shared<SpherePaths_Vulkan>(ctx);
+      wavefront->SetExecutionMode(crossrt::ExecutionMode::Wavefront);
+      megakernel->SetExecutionMode(crossrt::ExecutionMode::Megakernel);
+      impls.push_back({"Vulkan wavefront", wavefront});
+      impls.push_back({"Vulkan megakernel", megakernel});
+    }
+    double base = 0.0, wavefrontMs = 0.0;
+    for (auto& [name, p] : impls)
+    {
+      p->CommitDeviceData();
+      const double ms = MedianMs(5, [&] { p->Render(w, w, pathSamples, out.data()); });
+      float t[4];
+      p->GetExecutionTime("Render", t);
+      if (base == 0.0) base = ms;
+      const bool gpu = std::string(name).rfind("Vulkan", 0) == 0;
+      Row("paths", name, ms, base, gpu ? t[0] : 0.0);
+      if (std::string(name) == "Vulkan wavefront") wavefrontMs = ms;
+      if (std::string(name) == "Vulkan megakernel") std::printf("| %-10s | %-18s | %10s | %8.2fx | %12s |\n", "paths", "mega vs wavefront", "", wavefrontMs / ms, "");
+    }
+  }
+  std::printf("\nparticles: %d particles per step; bloom: %dx%d image, radius 12; paths: %dx%d pixels, %d paths per pixel, 4 bounces.\n", particles, side,
+              side, pathSide, pathSide, pathSamples);
   std::printf("_Vulkan ms/call includes copying the arguments in and out; 'GPU ms' is the timestamp-measured kernel time.\n");
   return 0;
 }

@@ -533,3 +533,66 @@ void Images::kernel1D_Run(int n, float* out)
     }
   }
 }
+
+TEST_CASE("Thread loops of several kernels that the GPU cannot run per thread are reported", "[diagnostics][modes]")
+{
+  // Each case: Looper's extra declarations, Run's body from Looper.cpp's line 4 on (the thread loop
+  // starts there), and extra definitions.
+  struct Case { const char* name; const char* declarations; const char* body; const char* definitions; int line; const char* message; const char* hint; };
+  const Case cases[] = {
+      {"a branch in the loop body", "", "    float v;\n    kernel_Init(i, &v);\n    if (n > 2) kernel_Step(i, &v);\n    kernel_Store(i, &v, out);\n", "", 7,
+       "the thread loop of 'Run' may hold only per-thread local declarations, kernel_ calls and counted loops around them", "move this code into a kernel"},
+      {"a local with an initializer", "", "    float v = 1.0f;\n    kernel_Step(i, &v);\n    kernel_Store(i, &v, out);\n", "", 5,
+       "per-thread local 'v' of the thread loop of 'Run' has an initializer", "declare it without one"},
+      {"a loop bound that differs per thread", "", "    float v;\n    kernel_Init(i, &v);\n    for (int s = 0; s < i; s++) kernel_Step(i, &v);\n    kernel_Store(i, &v, out);\n", "", 7,
+       "'i' differs from thread to thread, but the loop's condition in the thread loop of 'Run' runs once for all threads in wavefront mode",
+       "branch inside the kernels"},
+      {"a per-thread value passed by value", "  void kernel_Scale(uint32_t tid, float factor, float* value);",
+       "    float v;\n    kernel_Init(i, &v);\n    kernel_Scale(i, v, &v);\n    kernel_Store(i, &v, out);\n",
+       "void Looper::kernel_Scale(uint32_t tid, float factor, float* value) { (void)tid; *value *= factor; }\n", 7,
+       "'v' differs from thread to thread, but the by-value argument 'factor' in the thread loop of 'Run' runs once for all threads in wavefront mode",
+       "pass per-thread values to kernels by address (&v)"},
+      {"a per-thread value indexed as an array", "  void kernel_Spread(uint32_t tid, float* value);",
+       "    float v;\n    kernel_Init(i, &v);\n    kernel_Step(i, &v);\n    kernel_Spread(i, &v);\n    kernel_Store(i, &v, out);\n",
+       "void Looper::kernel_Spread(uint32_t tid, float* value) { (void)tid; value[1] = 0.0f; }\n", 15,
+       "'value' holds one value per thread (a local of the control function's thread loop), used here as a pointer", "read and write it as *value"},
+      {"two kernels naming different buffers alike", "  void kernel_Keep(uint32_t tid, const float* value, float* out);\n  std::vector<float> m_kept;",
+       "    float v;\n    kernel_Init(i, &v);\n    kernel_Store(i, &v, out);\n    kernel_Keep(i, &v, m_kept.data());\n",
+       "void Looper::kernel_Keep(uint32_t tid, const float* value, float* out) { out[tid] = 2.0f * *value; }\n", 8,
+       "parameter 'out' of 'kernel_Keep' is given another buffer than a parameter of the same name of another kernel in the thread loop",
+       "rename one of them"},
+  };
+  for (const Case& c : cases)
+  {
+    SECTION(c.name)
+    {
+      TempClass tc("Looper", std::string(R"(#pragma once
+#include <cstdint>
+#include <vector>
+class Looper
+{
+public:
+  virtual ~Looper() = default;
+  virtual void Run(int n, [[crossrt::size("n")]] float* out);
+protected:
+  void kernel_Init(uint32_t tid, float* value);
+  void kernel_Step(uint32_t tid, float* value);
+  void kernel_Store(uint32_t tid, const float* value, float* out);
+)") + c.declarations + "\n};\n",
+                   std::string("#include \"Looper.h\"\nvoid Looper::Run(int n, float* out)\n{\n  for (int i = 0; i < n; i++) {\n") + c.body + "  }\n}\n" +
+                       "void Looper::kernel_Init(uint32_t tid, float* value) { *value = float(tid); }\n"
+                       "void Looper::kernel_Step(uint32_t tid, float* value) { (void)tid; *value = *value * 0.5f + 1.0f; }\n"
+                       "void Looper::kernel_Store(uint32_t tid, const float* value, float* out) { out[tid] = *value; }\n" +
+                       c.definitions);
+      CommandResult r = RunCrossrt("translate --class Looper --backend vulkan --out " + (tc.dir / "out").string() + " --source " +
+                                   tc.Source("Looper") + " --templates " CROSSRT_SOURCE_DIR "/templates");
+      INFO(r.output);
+      REQUIRE_FALSE(r.crashed);
+      REQUIRE(r.exitCode == 1);
+      REQUIRE(r.output.find("Looper.cpp:" + std::to_string(c.line) + ":") != std::string::npos);
+      REQUIRE(r.output.find(std::string("error: ") + c.message) != std::string::npos);
+      REQUIRE(r.output.find(c.hint) != std::string::npos);
+      REQUIRE(!std::filesystem::exists(tc.dir / "out" / "Looper_Vulkan.cpp"));
+    }
+  }
+}
