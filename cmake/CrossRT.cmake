@@ -17,7 +17,7 @@
 # objects on the GPU: 1 = every element in one array of equal slots, 2 (default) = each class's
 # objects in a buffer of their own. The class's code is the same for both.
 #
-# EXECUTION_MODE (paper 3.4): how a control function's thread loop that calls several kernels
+# EXECUTION_MODE (paper 2.1 and 4.4): how a control function's thread loop that calls several kernels
 # (for (y) for (x) { float4 ray; kernel_A(x, y, &ray); kernel_B(x, y, &ray); }) runs on the GPU:
 # wavefront (default) = one dispatch per kernel call, per-thread locals kept in buffers between
 # them; megakernel = the whole loop body in one shader, locals in registers. Both are generated;

@@ -1019,9 +1019,19 @@ private:
       if (skipThreadIds && IsThreadIdName(p->getName())) continue;
       const Expr* arg = call->getArg(i);
       if (isa<CXXDefaultArgExpr>(arg)) continue;
+      if (p->getType()->isPointerType()) CheckNotThreadState(md, p, arg);
       out += ", " + (p->getType()->isPointerType() ? BufferArg(arg) : m_c.Text(arg->getSourceRange()));
     }
     return out;
+  }
+
+  // A parameter that some thread loop passes a local's address to holds one value per thread on the
+  // GPU; a buffer passed to it elsewhere would be read one element per thread, not as C++ reads it.
+  void CheckNotThreadState(const CXXMethodDecl* md, const ParmVarDecl* p, const Expr* arg) {
+    if (!m_c.threadState.count({md->getNameAsString(), p->getNameAsString()})) return;
+    m_c.rep.Error(arg->getBeginLoc(), "parameter '" + p->getNameAsString() + "' of '" + md->getNameAsString() +
+                  "' gets a local's address in a thread loop, so on the GPU it holds one value per thread, but here it is given a buffer",
+                  "pass the address of a local declared in the thread loop everywhere, or give the kernel a separate buffer parameter");
   }
 
   void Note(const CXXMemberCallExpr* call) {
@@ -1031,7 +1041,7 @@ private:
   }
 
   // ---- thread loops: for (y) for (x) { locals; kernel_A(x, y, &local); for (host) kernel_B(...); } ----
-  // Several kernels per thread, sharing per-thread locals (paper 3.4). Both execution modes are
+  // Several kernels per thread, sharing per-thread locals (paper 2.1 and 4.4). Both execution modes are
   // recorded: the megakernel (one shader runs the whole body) and wavefront (one dispatch per kernel
   // call, the locals kept in buffers between them); the generated class picks one at run time.
 
@@ -1304,6 +1314,7 @@ private:
                 "declare the variable inside the thread loop's body");
           continue;
         } else {
+          CheckNotThreadState(md, p, arg);
           CheckUniform(tl, arg, "a buffer argument", false);  // bound by the host
           AddMegakernelBuffer(tl, md, p, BufferArg(arg), arg->getBeginLoc());
           continue;  // a global buffer of the megakernel, named as the kernel names it

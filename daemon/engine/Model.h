@@ -109,7 +109,7 @@ struct Kernel {
   std::string rayQueryHolder;
   std::vector<std::string> ownFunctionList;   // functionList before composition merged its code in
   std::vector<std::string> ownMemberVectors;  // memberVectors likewise
-  // Megakernel (paper 3.4): the whole body of a thread loop of control function `megakernelOf` in one
+  // Megakernel (paper 2.1 and 4.4): the whole body of a thread loop of control function `megakernelOf` in one
   // shader. Its pointer parameters are the buffers its kernels bind (named as those kernels name
   // them), its by-value parameters the control function's variables the body reads.
   std::string megakernelOf;

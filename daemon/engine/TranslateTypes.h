@@ -25,7 +25,7 @@ struct TranslateRequest {
   // Virtual functions (paper 3.9): 1 = every element in one array of equal slots, 2 = each class's
   // objects in a buffer of their own.
   int virtualLevel = 2;
-  // Execution modes (paper 3.4) of thread loops that call several kernels: both are generated, this
+  // Execution modes (paper 2.1 and 4.4) of thread loops that call several kernels: both are generated, this
   // is the one the generated class starts in.
   bool megakernel = false;
 };

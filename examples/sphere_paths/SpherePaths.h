@@ -1,4 +1,4 @@
-// A plain C++ path tracer over spheres, written the way the paper's path tracers are (section 3.4):
+// A plain C++ path tracer over spheres, written the way the paper's path tracers are (section 4.4):
 // the control function Render loops over pixels, and per pixel calls several kernels that pass the
 // path's state along in local variables. CrossRT runs that loop on the GPU either as one megakernel
 // or as one dispatch per kernel call (wavefront), from this same class.

@@ -561,6 +561,11 @@ TEST_CASE("Thread loops of several kernels that the GPU cannot run per thread ar
        "void Looper::kernel_Keep(uint32_t tid, const float* value, float* out) { out[tid] = 2.0f * *value; }\n", 8,
        "parameter 'out' of 'kernel_Keep' is given another buffer than a parameter of the same name of another kernel in the thread loop",
        "rename one of them"},
+      {"a per-thread parameter given a buffer elsewhere", "  virtual void Other(int n, [[crossrt::size(\"n\")]] float* out);",
+       "    float v;\n    kernel_Init(i, &v);\n    kernel_Step(i, &v);\n    kernel_Store(i, &v, out);\n",
+       "void Looper::Other(int n, float* out) { for (int i = 0; i < n; i++) kernel_Step(i, out); }\n", 14,
+       "parameter 'value' of 'kernel_Step' gets a local's address in a thread loop, so on the GPU it holds one value per thread, but here it is given a buffer",
+       "give the kernel a separate buffer parameter"},
   };
   for (const Case& c : cases)
   {

@@ -1,4 +1,4 @@
-// Execution modes (paper 3.4): a control function whose thread loop calls several kernels, passing
+// Execution modes (paper 2.1 and 4.4): a control function whose thread loop calls several kernels, passing
 // per-thread locals between them, runs on the GPU as one megakernel or as one dispatch per kernel
 // call (wavefront, the locals kept in buffers). The original, _CPU and _Vulkan in both modes must
 // agree. SpherePaths (the sphere_paths example) is a 2D loop of path-tracing kernels; Walkers a 1D
