@@ -1116,7 +1116,14 @@ private:
     if (!printer.memberVectors.empty() || !printer.helpers.empty())
       Error(tl, outerLoop->getBeginLoc(), "the host code of a thread loop of '" + m_ctrl.name + "' uses member vectors or calls functions",
             "count host loops with plain members, parameters or constants; move other work into a kernel");
-    if (tl.axisOf.size() != tl.loops.size()) return true;  // reported by ThreadBodyGlsl
+    const bool axesCovered = tl.axisOf.size() == tl.loops.size() &&
+                             std::all_of(tl.axisOf.begin(), tl.axisOf.end(), [&](const auto& x) { return x.second < tl.loops.size(); });
+    if (!axesCovered) {
+      if (tl.ok)
+        Error(tl, outerLoop->getBeginLoc(), "the loops of a thread loop of '" + m_ctrl.name + "' do not match the thread ids of its kernels",
+              "with one loop pass it as tid (or tidX), with two as tidX and tidY, with three as tidX, tidY and tidZ");
+      return true;
+    }
 
     // The megakernel's signature: thread ids (x first), then the control function's variables it reads.
     std::vector<const VarDecl*> byAxis(tl.loops.size());
@@ -1135,7 +1142,7 @@ private:
         if (h.var == byAxis[a]) tl.counts += ", " + CountExpr(m_c, h);
     }
     std::vector<KernelParam> values;
-    for (auto* vd : tl.outer) {  // in declaration order: stable text
+    for (auto* vd : tl.outer) {  // in the order the body first reads them: stable text
       QualType t = vd->getType().getNonReferenceType().getUnqualifiedType();
       auto g = GlslTypeOf(t);
       auto layout = Std430Layout(m_c.ctx, t, false);

@@ -84,8 +84,6 @@ std::string IndentTail(const std::string& text, const std::string& pad) {
 const char* Axis(unsigned a) { return a == 0 ? "X" : a == 1 ? "Y" : "Z"; }
 const char* GlAxis(unsigned a) { return a == 0 ? "x" : a == 1 ? "y" : "z"; }
 
-// Workgroup shape by dimension count: 256 threads each, so reductions see the same group size.
-struct GroupShape { unsigned x, y, z; };
 // What the Vulkan class dispatches: the kernels, then the megakernels of thread loops.
 std::vector<const Kernel*> VulkanKernels(const ClassModel& model) {
   std::vector<const Kernel*> all;
@@ -94,6 +92,8 @@ std::vector<const Kernel*> VulkanKernels(const ClassModel& model) {
   return all;
 }
 
+// Workgroup shape by dimension count: 256 threads each, so reductions see the same group size.
+struct GroupShape { unsigned x, y, z; };
 GroupShape Shape(const Kernel& k) {
   static const GroupShape shapes[3] = {{256, 1, 1}, {16, 16, 1}, {8, 8, 4}};
   return shapes[k.dims - 1];

@@ -236,3 +236,62 @@ TEST_CASE("Ray queries through ISceneObject get a variant for ray tracing hardwa
   CHECK(host.find("crossrt::Binding::SceneOf(m_scenes.m_pAccelStruct)") != std::string::npos);
   CHECK(host.find("m_useRayTracingHardware = m_ctx->hasRayQuery;") != std::string::npos);
 }
+
+TEST_CASE("A thread loop whose kernels trace through a composed ISceneObject gets a megakernel with the traversal merged in", "[engine][modes]")
+{
+  TempClass tc("Tracer", R"(#pragma once
+#include "CrossRT.h"
+#include <cstdint>
+#include <memory>
+using LiteMath::float4;
+class Tracer
+{
+public:
+  virtual ~Tracer() = default;
+  virtual void Trace(uint32_t n, [[crossrt::size("2 * n")]] const float4* rays, [[crossrt::size("n")]] float* depth);
+  std::shared_ptr<ISceneObject> m_pAccelStruct;
+protected:
+  void kernel_Hit(uint32_t tid, const float4* rays, CRT_Hit* hit);
+  void kernel_Depth(uint32_t tid, const CRT_Hit* hit, float* depth);
+};
+)",
+               R"(#include "Tracer.h"
+void Tracer::Trace(uint32_t n, const float4* rays, float* depth)
+{
+  for (uint32_t i = 0; i < n; i++)
+  {
+    CRT_Hit hit;
+    kernel_Hit(i, rays, &hit);
+    kernel_Depth(i, &hit, depth);
+  }
+}
+void Tracer::kernel_Hit(uint32_t tid, const float4* rays, CRT_Hit* hit) { *hit = m_pAccelStruct->RayQuery_NearestHit(rays[2 * tid], rays[2 * tid + 1]); }
+void Tracer::kernel_Depth(uint32_t tid, const CRT_Hit* hit, float* depth) { depth[tid] = hit->primId == 0xFFFFFFFFu ? -1.0f : hit->t; }
+)");
+  TranslateRequest r = MakeRequest(tc, "Tracer");
+  r.sources.push_back(CROSSRT_SOURCE_DIR "/libs/litert/BVHScene.cpp");
+  r.compileArgs.insert(r.compileArgs.end(), {"-std=c++17", "-I" CROSSRT_SOURCE_DIR "/libs/litert", "-I" CROSSRT_SOURCE_DIR "/libs/litebvh"});
+  r.compositions = {"ISceneObject=BVHScene"};
+  const TranslateResult result = Translate(r);  // every shader is compiled by glslang on the way
+  INFO(result.diagnostics);
+  REQUIRE(result.ok);
+  const std::string& mega = result.files.at("shaders/Trace_Megakernel.comp");
+  // The megakernel holds the traversal, both kernels' thread functions, and the hit as a local.
+  CHECK(mega.find("m_pAccelStruct_m_nodes[]") != std::string::npos);
+  CHECK(mega.find("CRT_Hit m_pAccelStruct_RayQuery_NearestHit(") != std::string::npos);
+  CHECK(mega.find("void kernel_Hit(uint tid, inout CRT_Hit hit)") != std::string::npos);
+  CHECK(mega.find("void kernel_Depth(uint tid, CRT_Hit hit)") != std::string::npos);
+  CHECK(mega.find("  CRT_Hit hit;\n  kernel_Hit(i, hit);\n  kernel_Depth(i, hit);\n") != std::string::npos);
+  CHECK(mega.find("readonly buffer raysBuffer") != std::string::npos);
+  // Wavefront: kernel_Hit keeps the hit of each thread in a buffer; only it may use the hardware.
+  const std::string& hit = result.files.at("shaders/kernel_Hit.comp");
+  CHECK(hit.find("buffer hitPerThreadBuffer { CRT_Hit hitPerThread[]; }") != std::string::npos);
+  CHECK(hit.find("hitPerThread[threadIndex] = hit;") != std::string::npos);
+  CHECK(result.files.count("shaders/kernel_Hit_RayQuery.comp") == 1);
+  const std::string& host = result.files.at("Tracer_Vulkan.cpp");
+  CHECK(host.find("Trace_MegakernelCmd(a_cmd, (n), m_inOut_Trace.rays, m_inOut_Trace.depth);") != std::string::npos);
+  CHECK(host.find("kernel_HitCmd(a_cmd, (n), m_inOut_Trace.rays, m_threadState.Trace_hit.View());") != std::string::npos);
+  // The megakernel reads the traversal's buffers even while kernel_Hit uses the hardware: they stay uploaded.
+  CHECK(host.find("m_vdata.m_pAccelStruct_m_nodes.Upload(") != std::string::npos);
+  CHECK(host.find("only the translated traversal reads it") == std::string::npos);
+}
