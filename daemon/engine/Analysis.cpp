@@ -1051,6 +1051,7 @@ private:
     std::vector<std::pair<const VarDecl*, std::string>> stateBuffers;  // per-thread local -> its wavefront buffer
     std::vector<std::string> bufferArgs;           // host BufferView of each megakernel parameter so far
     std::set<const VarDecl*> locals;               // every local of the body (per-thread)
+    std::set<const VarDecl*> passed;               // locals some kernel call gets the address of
     std::vector<const VarDecl*> outer;             // control-function variables the body reads, first read first
     Kernel mega;                                   // the megakernel, without its kernels' code yet
     std::string hostArgs;                          // ...Cmd arguments of the megakernel after the counts
@@ -1172,6 +1173,7 @@ private:
     // Vulkan: both modes, picked when recording.
     std::string states;
     for (auto& [local, buffer] : tl.stateBuffers) {
+      if (!tl.passed.count(local)) continue;  // no kernel sees it: nothing to keep between dispatches
       std::string cppType = CppTypeName(m_c.ctx, local->getType().getUnqualifiedType());
       m_ctrl.threadStates.push_back({buffer, cppType, local->getNameAsString()});
       states += "crossrt::EnsureSize(m_ctx, m_threadState." + buffer + ", sizeof(" + cppType + ") * std::max<size_t>(1, crt_threads));\n"
@@ -1315,6 +1317,7 @@ private:
         auto* dr = uo && uo->getOpcode() == UO_AddrOf ? dyn_cast<DeclRefExpr>(uo->getSubExpr()->IgnoreParens()) : nullptr;
         auto* vd = dr ? dyn_cast<VarDecl>(dr->getDecl()) : nullptr;
         if (vd && !StateBuffer(tl, vd).empty()) {
+          tl.passed.insert(vd);
           a = GlslPrinter::SafeName(vd->getNameAsString());
         } else if (vd) {
           Error(tl, arg->getBeginLoc(), "'&" + vd->getNameAsString() + "' passed to '" + md->getNameAsString() + "' is not a per-thread local declared in the thread loop",

@@ -566,6 +566,13 @@ TEST_CASE("Thread loops of several kernels that the GPU cannot run per thread ar
        "void Looper::Other(int n, float* out) { for (int i = 0; i < n; i++) kernel_Step(i, out); }\n", 14,
        "parameter 'value' of 'kernel_Step' gets a local's address in a thread loop, so on the GPU it holds one value per thread, but here it is given a buffer",
        "give the kernel a separate buffer parameter"},
+      {"thread ids that do not match the loops", "  void kernel_Row(uint32_t tidY, float* value);",
+       "    float v;\n    kernel_Row(i, &v);\n    kernel_Row(i, &v);\n",
+       "void Looper::kernel_Row(uint32_t tidY, float* value) { *value = float(tidY); }\n", 4,
+       "the loops of a thread loop of 'Run' do not match the thread ids of its kernels", "with one loop pass it as tid (or tidX)"},
+      {"a local of a type the GPU has no equivalent of", "",
+       "    double d;\n    float v;\n    kernel_Init(i, &v);\n    kernel_Store(i, &v, out);\n", "", 5,
+       "per-thread local 'd' of type 'double' has no GPU equivalent", "use int, uint, float, LiteMath types"},
   };
   for (const Case& c : cases)
   {
