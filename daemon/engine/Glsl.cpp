@@ -497,11 +497,41 @@ bool IsIoFunction(const std::string& n) {
 bool IsHeapFunction(const std::string& n) {
   return n == "malloc" || n == "calloc" || n == "realloc" || n == "free" || n == "aligned_alloc";
 }
+
+// std::numeric_limits<float, int or uint>::infinity(), max() and the like as GLSL constant
+// expressions, which global constants need. GLSL has no literal for infinity and NaN; glslang
+// folds 1.0 / 0.0 to +inf and 0.0 / 0.0 to NaN. Empty for anything else.
+std::string NumericLimit(const FunctionDecl* fd) {
+  auto* spec = dyn_cast_or_null<ClassTemplateSpecializationDecl>(fd->getDeclContext());
+  if (!spec || spec->getName() != "numeric_limits" || !spec->isInStdNamespace() || spec->getTemplateArgs().size() != 1)
+    return "";
+  const QualType t = spec->getTemplateArgs()[0].getAsType().getCanonicalType();
+  const std::string n = fd->getNameAsString();
+  if (t->isSpecificBuiltinType(BuiltinType::Float)) {
+    // Nine significant digits: each literal rounds to exactly the float it names.
+    static const std::map<std::string, std::string> values = {
+        {"infinity", "(1.0 / 0.0)"},      {"quiet_NaN", "(0.0 / 0.0)"},  {"max", "3.40282347e+38"},
+        {"lowest", "-3.40282347e+38"},    {"min", "1.17549435e-38"},    {"epsilon", "1.1920929e-07"},
+        {"denorm_min", "1.40129846e-45"}};
+    auto it = values.find(n);
+    return it == values.end() ? "" : it->second;
+  }
+  if (t->isSpecificBuiltinType(BuiltinType::Int)) {
+    if (n == "max") return "0x7FFFFFFF";
+    if (n == "min" || n == "lowest") return "(-2147483647 - 1)";
+  }
+  if (t->isSpecificBuiltinType(BuiltinType::UInt)) {
+    if (n == "max") return "0xFFFFFFFFu";
+    if (n == "min" || n == "lowest") return "0u";
+  }
+  return "";
+}
 }  // namespace
 
-// Library functions with a GLSL counterpart: LiteMath, <cmath>, std::min/max.
+// Library functions with a GLSL counterpart: LiteMath, <cmath>, std::min/max, std::numeric_limits.
 std::string GlslPrinter::Builtin(const FunctionDecl* fd, const std::vector<std::string>& a, const CallExpr* call) {
   std::string n = fd->getNameAsString();
+  if (std::string limit = NumericLimit(fd); !limit.empty()) return limit;
   auto join = [&](const std::string& f) {
     std::string s = f + "(";
     for (size_t i = 0; i < a.size(); ++i) s += (i ? ", " : "") + a[i];

@@ -12,6 +12,7 @@ using LiteMath::Box4f;
 using LiteMath::float3;
 using LiteMath::float4;
 using LiteMath::float4x4;
+using LiteMath::uint4;
 
 namespace {
 
@@ -24,7 +25,8 @@ constexpr float kWiden = 1.00000036f;
 static_assert(kWiden == 1.0f + 2.0f * (3.0f * std::numeric_limits<float>::epsilon() * 0.5f) /
                                    (1.0f - 3.0f * std::numeric_limits<float>::epsilon() * 0.5f),
               "kWiden is 1 + 2 gamma(3)");
-constexpr float kMissed = -1.0f;  // SlabEntry's answer for a box the ray misses (entries are >= 0)
+constexpr float kMissed = -1.0f;  // an exit before every entry (entries are >= 0): a missed box
+constexpr float kNever = std::numeric_limits<float>::infinity();  // the entry of a lane not entered
 
 BVHTraceRay Prepare(float3 org, float3 dir, float tnear)
 {
@@ -52,43 +54,94 @@ BVHTraceRay Prepare(float3 org, float3 dir, float tnear)
   return r;
 }
 
-// SlabEntry for rays with a zero direction component (rare): per axis. Such a ray is inside that
-// slab when its origin is, boundaries included.
-[[gnu::noinline]] float SlabEntryParallelAxes(const BVHTraceRay& r, const float3& lo, const float3& hi, float tfar)
+// The entry and exit distances of the ray into the four boxes of `n`, within [tnear, tfar]: a
+// lane whose entry is beyond its exit is missed (so is an empty lane). For rays with a zero
+// direction component (rare): per lane and axis. Such a ray is inside a slab when its origin is,
+// boundaries included.
+[[gnu::noinline]] float4 SlabEntriesParallelAxes(const BVHTraceRay& r, const BVH4Node& n, float tfar, float4& exits)
 {
-  float tmin = r.tnear;
-  float tmax = tfar;
-  for (int a = 0; a < 3; ++a)
+  float4 entries = float4(0.0f);
+  exits = float4(kMissed);
+  for (int lane = 0; lane < 4; ++lane)
   {
-    if (r.invDir[a] == 0.0f)
+    const float3 lo = float3(n.minX[lane], n.minY[lane], n.minZ[lane]);
+    const float3 hi = float3(n.maxX[lane], n.maxY[lane], n.maxZ[lane]);
+    float tmin = r.tnear;
+    float tmax = tfar;
+    bool inside = lo.x <= hi.x;  // an empty lane is never entered
+    for (int a = 0; a < 3; ++a)
     {
-      if (r.org[a] < lo[a] || r.org[a] > hi[a])
-        return kMissed;
-      continue;
+      if (r.invDir[a] == 0.0f)
+      {
+        inside = inside && r.org[a] >= lo[a] && r.org[a] <= hi[a];
+        continue;
+      }
+      const float t0 = (lo[a] - r.org[a]) * r.invDir[a];
+      const float t1 = (hi[a] - r.org[a]) * r.invDir[a];
+      tmin = std::max(tmin, std::min(t0, t1));
+      tmax = std::min(tmax, std::max(t0, t1) * kWiden);
     }
-    const float t0 = (lo[a] - r.org[a]) * r.invDir[a];
-    const float t1 = (hi[a] - r.org[a]) * r.invDir[a];
-    tmin = std::max(tmin, std::min(t0, t1));
-    tmax = std::min(tmax, std::max(t0, t1) * kWiden);
+    if (inside)
+    {
+      entries[lane] = tmin;
+      exits[lane] = tmax;
+    }
   }
-  return tmin <= tmax ? tmin : kMissed;
+  return entries;
 }
 
-// The entry distance into [lo, hi] along the ray within [tnear, tfar], or kMissed. Inlined into
-// the traversal loop: it runs twice per step.
-[[gnu::always_inline]] inline float SlabEntry(const BVHTraceRay& r, const float3& lo, const float3& hi, float tfar)
+// SlabEntriesParallelAxes for every other ray, four boxes at once: each axis' near plane is the
+// box side the ray faces, so an empty lane (+inf, -inf) enters at +inf and exits at -inf.
+[[gnu::always_inline]] inline float4 SlabEntries(const BVHTraceRay& r, const BVH4Node& n, float tfar, float4& exits)
 {
   if (r.anyZeroAxis)
-    return SlabEntryParallelAxes(r, lo, hi, tfar);
-  const float x0 = (lo.x - r.org.x) * r.invDir.x;
-  const float x1 = (hi.x - r.org.x) * r.invDir.x;
-  const float y0 = (lo.y - r.org.y) * r.invDir.y;
-  const float y1 = (hi.y - r.org.y) * r.invDir.y;
-  const float z0 = (lo.z - r.org.z) * r.invDir.z;
-  const float z1 = (hi.z - r.org.z) * r.invDir.z;
-  const float tmin = std::max(std::max(std::min(x0, x1), std::min(y0, y1)), std::max(std::min(z0, z1), r.tnear));
-  const float tmax = std::min(std::min(std::min(std::max(x0, x1), std::max(y0, y1)), std::max(z0, z1)) * kWiden, tfar);
-  return tmin <= tmax ? tmin : kMissed;
+    return SlabEntriesParallelAxes(r, n, tfar, exits);
+  const float4 nearX = ((r.invDir.x < 0.0f ? n.maxX : n.minX) - r.org.x) * r.invDir.x;
+  const float4 farX = ((r.invDir.x < 0.0f ? n.minX : n.maxX) - r.org.x) * r.invDir.x;
+  const float4 nearY = ((r.invDir.y < 0.0f ? n.maxY : n.minY) - r.org.y) * r.invDir.y;
+  const float4 farY = ((r.invDir.y < 0.0f ? n.minY : n.maxY) - r.org.y) * r.invDir.y;
+  const float4 nearZ = ((r.invDir.z < 0.0f ? n.maxZ : n.minZ) - r.org.z) * r.invDir.z;
+  const float4 farZ = ((r.invDir.z < 0.0f ? n.minZ : n.maxZ) - r.org.z) * r.invDir.z;
+  exits = min(min(min(farX, farY), farZ) * kWiden, float4(tfar));
+  return max(max(nearX, nearY), max(nearZ, float4(r.tnear)));
+}
+
+// Puts lanes i < j of (entries, children) in order of entry.
+inline void OrderLanes(float4& entries, uint4& children, int i, int j)
+{
+  if (entries[j] < entries[i])
+  {
+    const float e = entries[i];
+    entries[i] = entries[j];
+    entries[j] = e;
+    const uint32_t c = children[i];
+    children[i] = children[j];
+    children[j] = c;
+  }
+}
+
+// The lanes of `n` the ray enters within [tnear, tfar], nearest first: their entry distances and
+// children, and how many there are (the lanes missed come after them).
+inline int EnteredLanes(const BVHTraceRay& r, const BVH4Node& n, float tfar, float4& entries, uint4& children)
+{
+  float4 exits;
+  entries = SlabEntries(r, n, tfar, exits);
+  children = n.child;
+  int entered = 0;
+  for (int lane = 0; lane < 4; ++lane)
+  {
+    if (entries[lane] <= exits[lane])
+      entered = entered + 1;
+    else
+      entries[lane] = kNever;  // missed (NaN compares false too): sorts last
+  }
+  // A sorting network of five compare-exchanges, without branches on the GPU.
+  OrderLanes(entries, children, 0, 1);
+  OrderLanes(entries, children, 2, 3);
+  OrderLanes(entries, children, 0, 2);
+  OrderLanes(entries, children, 1, 3);
+  OrderLanes(entries, children, 1, 2);
+  return entered;
 }
 
 // a * b - c * d within 1.5 ulp (Kahan's algorithm): its sign is exact, which decides on which side
@@ -154,52 +207,189 @@ float3 ToObjectVector(const BVHInstance& inst, float3 d)
 
 // ---- host side ----
 
-// The same tree with every pair of children side by side, in depth-first order: one cache line
-// holds both boxes a traversal step tests (the LBVH places siblings far apart).
-BVHTree WithSiblingsAdjacent(const BVHTree& tree)
+constexpr uint32_t kMergeSize = 4;  // subtrees of up to this many primitives become one leaf
+
+uint32_t LeafRef(uint32_t first, uint32_t count) { return kLeafFlag | first << 3 | (count - 1); }
+
+// Collapses a binary tree into BVH4Nodes: each node takes its two children, then opens the child
+// with the largest surface area (an inner node, or a leaf of more than kMaxLeafSize primitives,
+// which is halved) until it has four or nothing is left to open.
+class Collapse
 {
-  if (tree.nodes.size() <= 1)
-    return tree;
-  BVHTree out;
-  out.primIndices = tree.primIndices;
-  out.nodes.reserve(tree.nodes.size());
-  out.nodes.push_back(tree.nodes[0]);
-  std::vector<std::pair<uint32_t, uint32_t>> todo = {{0u, 0u}};  // (old index, new index)
-  while (!todo.empty())
+public:
+  // primBox(k): the box of primitive tree.primIndices[k].
+  Collapse(const BVHTree& tree, std::function<Box4f(uint32_t)> primBox) : m_tree(tree), m_primBox(std::move(primBox))
   {
-    const auto [from, to] = todo.back();
-    todo.pop_back();
-    const BVHNode& n = tree.nodes[from];
-    if (n.left & kLeafFlag)
-      continue;
-    const uint32_t children = uint32_t(out.nodes.size());
-    out.nodes.push_back(tree.nodes[n.left]);
-    out.nodes.push_back(tree.nodes[n.right]);
-    out.nodes[to].left = children;
-    out.nodes[to].right = children + 1;
-    todo.push_back({n.right, children + 1});
-    todo.push_back({n.left, children});
+    m_first.resize(tree.nodes.size());
+    m_count.resize(tree.nodes.size());
+    Measure(0);
   }
-  return out;
+
+  // Node 0 is the root. stackNeed: the most entries TraceMesh's stack holds on this tree.
+  std::vector<BVH4Node> Run(int& stackNeed)
+  {
+    m_nodes.clear();
+    Emit(FromBinary(0), stackNeed);
+    return std::move(m_nodes);
+  }
+
+private:
+  // A subtree to place in a lane: a binary inner node, or a range of primitives.
+  struct Part
+  {
+    uint32_t node;  // kNoChild for a range
+    uint32_t first, count;
+    Box4f box;
+  };
+
+  // The primitive range under each binary node (count 0: not contiguous).
+  void Measure(uint32_t index)
+  {
+    const BVHNode& n = m_tree.nodes[index];
+    if (n.left & kLeafFlag)
+    {
+      m_first[index] = n.left & ~kLeafFlag;
+      m_count[index] = n.right;
+      return;
+    }
+    Measure(n.left);
+    Measure(n.right);
+    const uint32_t l = n.left, r = n.right;
+    const bool contiguous = m_count[l] > 0 && m_count[r] > 0 && m_first[l] + m_count[l] == m_first[r];
+    m_first[index] = m_first[l];
+    m_count[index] = contiguous ? m_count[l] + m_count[r] : 0;
+  }
+
+  Part FromBinary(uint32_t index) const
+  {
+    const BVHNode& n = m_tree.nodes[index];
+    const Box4f box(float4(n.boxMin, 0.0f), float4(n.boxMax, 0.0f));
+    // A small subtree over consecutive primitives becomes one leaf: testing its few triangles
+    // costs less than a step over their boxes.
+    if ((n.left & kLeafFlag) || (m_count[index] > 0 && m_count[index] <= kMergeSize))
+      return {kNoChild, m_first[index], m_count[index], box};
+    return {index, 0, 0, box};
+  }
+
+  Part Range(uint32_t first, uint32_t count) const
+  {
+    Part part{kNoChild, first, count, Box4f()};
+    for (uint32_t k = first; k < first + count; ++k)
+      part.box.include(m_primBox(k));
+    return part;
+  }
+
+  static bool Openable(const Part& p) { return p.node != kNoChild || p.count > kMaxLeafSize; }
+
+  void Open(const Part& p, Part& a, Part& b) const
+  {
+    if (p.node != kNoChild)
+    {
+      a = FromBinary(m_tree.nodes[p.node].left);
+      b = FromBinary(m_tree.nodes[p.node].right);
+      return;
+    }
+    const uint32_t half = p.count / 2;
+    a = Range(p.first, half);
+    b = Range(p.first + half, p.count - half);
+  }
+
+  uint32_t Emit(const Part& part, int& stackNeed)
+  {
+    std::vector<Part> lanes;
+    if (Openable(part))
+    {
+      lanes.resize(2);
+      Open(part, lanes[0], lanes[1]);
+    }
+    else
+      lanes.push_back(part);  // a root that is one small leaf
+    while (lanes.size() < 4)
+    {
+      int widest = -1;
+      for (int i = 0; i < int(lanes.size()); ++i)
+        if (Openable(lanes[i]) && (widest < 0 || lanes[i].box.surfaceArea() > lanes[widest].box.surfaceArea()))
+          widest = i;
+      if (widest < 0)
+        break;
+      Part a, b;
+      Open(lanes[widest], a, b);
+      lanes[widest] = a;
+      lanes.push_back(b);
+    }
+    const uint32_t index = uint32_t(m_nodes.size());
+    m_nodes.emplace_back();
+    BVH4Node n;
+    n.minX = n.minY = n.minZ = float4(LiteMath::INF_POSITIVE);
+    n.maxX = n.maxY = n.maxZ = float4(LiteMath::INF_NEGATIVE);
+    n.child = LiteMath::uint4(kNoChild);
+    n.unused = LiteMath::uint4(0u);
+    int deepest = 0;  // the stack the lanes' subtrees need
+    for (int i = 0; i < int(lanes.size()); ++i)
+    {
+      const Part& lane = lanes[i];
+      n.minX[i] = lane.box.boxMin.x, n.minY[i] = lane.box.boxMin.y, n.minZ[i] = lane.box.boxMin.z;
+      n.maxX[i] = lane.box.boxMax.x, n.maxY[i] = lane.box.boxMax.y, n.maxZ[i] = lane.box.boxMax.z;
+      if (Openable(lane))
+      {
+        int need = 0;
+        n.child[i] = Emit(lane, need);
+        deepest = std::max(deepest, need);
+      }
+      else
+        n.child[i] = LeafRef(lane.first, lane.count);
+    }
+    m_nodes[index] = n;
+    // A step pushes every lane it enters and pops the nearest, leaving the others below it.
+    stackNeed = std::max(int(lanes.size()), int(lanes.size()) - 1 + deepest);
+    return index;
+  }
+
+  const BVHTree& m_tree;
+  std::function<Box4f(uint32_t)> m_primBox;
+  std::vector<uint32_t> m_first, m_count;
+  std::vector<BVH4Node> m_nodes;
+};
+
+std::vector<BVH4Node> CollapseTree(const BVHTree& tree, std::function<Box4f(uint32_t)> primBox)
+{
+  int stackNeed = 0;
+  std::vector<BVH4Node> nodes = Collapse(tree, std::move(primBox)).Run(stackNeed);
+  if (stackNeed > kStackSize)
+    throw std::length_error("BVHScene: the tree is too deep for the traversal's stack (" + std::to_string(stackNeed) + " entries, " +
+                            std::to_string(kStackSize) + " available)");
+  return nodes;
 }
 
 // Appends `tree` to `nodes` with child indices moved by the append position and leaf ranges
 // moved by firstPrim. Returns the root's index.
-uint32_t AppendTree(std::vector<BVHNode>& nodes, const BVHTree& tree, uint32_t firstPrim)
+uint32_t AppendTree(std::vector<BVH4Node>& nodes, const std::vector<BVH4Node>& tree, uint32_t firstPrim)
 {
   const uint32_t base = uint32_t(nodes.size());
-  for (BVHNode n : tree.nodes)
+  for (BVH4Node n : tree)
   {
-    if (n.left & kLeafFlag)
-      n.left = kLeafFlag | ((n.left & ~kLeafFlag) + firstPrim);
-    else
+    for (int i = 0; i < 4; ++i)
     {
-      n.left += base;
-      n.right += base;
+      const uint32_t c = n.child[i];
+      if (c == kNoChild)
+        continue;
+      const uint32_t first = ((c & ~kLeafFlag) >> 3) + firstPrim;
+      if ((c & kLeafFlag) && first >= (1u << 28))
+        throw std::length_error("BVHScene: more than 2^28 triangles in a scene");
+      n.child[i] = (c & kLeafFlag) ? LeafRef(first, (c & 7u) + 1) : c + base;
     }
     nodes.push_back(n);
   }
   return base;
+}
+
+bool IsIdentity(const float4x4& m)
+{
+  for (int row = 0; row < 4; ++row)
+    for (int col = 0; col < 4; ++col)
+      if (m(row, col) != (row == col ? 1.0f : 0.0f))
+        return false;
+  return true;
 }
 
 float3 TransformPoint(const float4x4& m, float3 p) { return to_float3(m * float4(p.x, p.y, p.z, 1.0f)); }
@@ -241,10 +431,13 @@ void BVHScene::SetMesh(Mesh& mesh, const float* vpos3f, size_t vertNum, const ui
     const float3 lo = min(tris[i].v0, min(tris[i].v1, tris[i].v2)), hi = max(tris[i].v0, max(tris[i].v1, tris[i].v2));
     boxes[i] = Box4f(float4(lo.x, lo.y, lo.z, 0.0f), float4(hi.x, hi.y, hi.z, 0.0f));
   }
-  mesh.tree = triCount > 0 ? WithSiblingsAdjacent(m_builder(boxes.data(), triCount)) : BVHTree{};
+  mesh.tree = triCount > 0 ? m_builder(boxes.data(), triCount) : BVHTree{};
   mesh.triangles.resize(mesh.tree.primIndices.size());
   for (size_t k = 0; k < mesh.tree.primIndices.size(); ++k)
     mesh.triangles[k] = tris[mesh.tree.primIndices[k]];
+  mesh.wide.clear();
+  if (triCount > 0)
+    mesh.wide = CollapseTree(mesh.tree, [&](uint32_t k) { return boxes[mesh.tree.primIndices[k]]; });
   ClearDeviceData();
 }
 
@@ -316,14 +509,14 @@ void BVHScene::CommitScene(uint32_t)
   const BVHTree top = m_builder(boxes.data(), int(boxes.size()));
 
   // Device data: the top tree first, so its root is node 0, then each mesh that has triangles.
-  AppendTree(m_nodes, top, 0);
+  AppendTree(m_nodes, CollapseTree(top, [&](uint32_t k) { return boxes[top.primIndices[k]]; }), 0);
   std::vector<uint32_t> meshRoot(m_meshes.size(), kNoId);
   for (uint32_t g = 0; g < m_meshes.size(); ++g)
   {
     const Mesh& mesh = m_meshes[g];
-    if (mesh.tree.nodes.empty())
+    if (mesh.wide.empty())
       continue;
-    meshRoot[g] = AppendTree(m_nodes, mesh.tree, uint32_t(m_triangles.size()));
+    meshRoot[g] = AppendTree(m_nodes, mesh.wide, uint32_t(m_triangles.size()));
     m_triangles.insert(m_triangles.end(), mesh.triangles.begin(), mesh.triangles.end());
     m_primIds.insert(m_primIds.end(), mesh.tree.primIndices.begin(), mesh.tree.primIndices.end());
   }
@@ -337,7 +530,7 @@ void BVHScene::CommitScene(uint32_t)
     inst.instId = ids[k];
     inst.geomId = placed.geomId;
     inst.root = meshRoot[placed.geomId];
-    inst.unused = 0;
+    inst.identity = IsIdentity(placed.toObject) ? 1u : 0u;
     m_instances.push_back(inst);
   }
 }
@@ -380,20 +573,18 @@ bool BVHScene::ExportScene(CRT_SceneExport& out) const
 // barycentrics, and returns true (at the first hit when anyHit).
 bool BVHScene::TraceMesh(const BVHTraceRay& ray, uint32_t root, bool anyHit, float& tfar, CRT_Hit& hit) const
 {
-  if (SlabEntry(ray, m_nodes[root].boxMin, m_nodes[root].boxMax, tfar) < 0.0f)
-    return false;
-  uint32_t stack[kStackSize];
-  float stackEntry[kStackSize];  // entry distances, to skip subtrees beyond a hit found since
+  uint32_t stack[kStackSize];    // node indices and leaf references
+  float stackEntry[kStackSize];  // their entry distances, to skip those beyond a hit found since
   int top = 0;
   uint32_t node = root;
   bool found = false;
   while (true)
   {
-    const BVHNode& n = m_nodes[node];
-    if ((n.left & kLeafFlag) != 0)
+    if ((node & kLeafFlag) != 0)
     {
-      const uint32_t first = n.left & ~kLeafFlag;
-      for (uint32_t j = first; j < first + n.right; ++j)
+      const uint32_t first = (node & ~kLeafFlag) >> 3;
+      const uint32_t last = first + (node & 7u);
+      for (uint32_t j = first; j <= last; ++j)
       {
         float t = 0.0f;
         float u = 0.0f;
@@ -412,24 +603,19 @@ bool BVHScene::TraceMesh(const BVHTraceRay& ray, uint32_t root, bool anyHit, flo
     }
     else
     {
-      const BVHNode& l = m_nodes[n.left];
-      const BVHNode& r = m_nodes[n.right];
-      const float tl = SlabEntry(ray, l.boxMin, l.boxMax, tfar);
-      const float tr = SlabEntry(ray, r.boxMin, r.boxMax, tfar);
-      const bool hitL = tl >= 0.0f;
-      const bool hitR = tr >= 0.0f;
-      if (hitL && hitR)
+      // Go on with the nearest lane entered; the others wait on the stack, the farthest lowest.
+      float4 entries;
+      uint4 children;
+      const int entered = EnteredLanes(ray, m_nodes[node], tfar, entries, children);
+      if (entered > 0)
       {
-        const bool leftFirst = tl <= tr;
-        stackEntry[top] = leftFirst ? tr : tl;
-        stack[top] = leftFirst ? n.right : n.left;
-        top = top + 1;
-        node = leftFirst ? n.left : n.right;
-        continue;
-      }
-      if (hitL || hitR)
-      {
-        node = hitL ? n.left : n.right;
+        for (int lane = entered - 1; lane > 0; --lane)
+        {
+          stack[top] = children[lane];
+          stackEntry[top] = entries[lane];
+          top = top + 1;
+        }
+        node = children[0];
         continue;
       }
     }
@@ -444,21 +630,35 @@ bool BVHScene::TraceMesh(const BVHTraceRay& ray, uint32_t root, bool anyHit, flo
   }
 }
 
-// The top tree's leaves hold instances: each is traced in its mesh's tree, in object space
-// (affine maps keep t: the object-space ray is not renormalized). This loop and TraceMesh's walk
-// the stack alike; a shared step function would take the stack arrays as GLSL inout parameters,
-// which copy them on every call.
+// Traces instance m_instances[k] in object space (affine maps keep t: the object-space ray is not
+// renormalized). On a hit nearer than tfar, sets the hit's ids too.
+bool BVHScene::TraceInstance(uint32_t k, const BVHTraceRay& worldRay, bool anyHit, float& tfar, CRT_Hit& hit) const
+{
+  const BVHInstance& inst = m_instances[k];
+  const bool found = inst.identity != 0u
+                         ? TraceMesh(worldRay, inst.root, anyHit, tfar, hit)
+                         : TraceMesh(Prepare(ToObjectPoint(inst, worldRay.org), ToObjectVector(inst, worldRay.dir), worldRay.tnear),
+                                     inst.root, anyHit, tfar, hit);
+  if (found)
+  {
+    hit.instId = inst.instId;
+    hit.geomId = inst.geomId;
+  }
+  return found;
+}
+
+// The top tree's leaves hold instances. This loop and TraceMesh's walk the stack alike; a shared
+// step function would take the stack arrays as GLSL inout parameters, which copy them on every
+// call.
 bool BVHScene::Trace(float4 posAndNear, float4 dirAndFar, bool anyHit, CRT_Hit& hit) const
 {
   float tnear = 0.0f;
   float tfar = 0.0f;
   if (m_nodes.size() == 0 || !litert_detail::RayInterval(posAndNear, dirAndFar, tnear, tfar))
     return false;
-  const float3 org = to_float3(posAndNear);
-  const float3 dir = to_float3(dirAndFar);
-  const BVHTraceRay worldRay = Prepare(org, dir, tnear);
-  if (SlabEntry(worldRay, m_nodes[0].boxMin, m_nodes[0].boxMax, tfar) < 0.0f)
-    return false;
+  const BVHTraceRay worldRay = Prepare(to_float3(posAndNear), to_float3(dirAndFar), tnear);
+  if (m_instances.size() == 1)
+    return TraceInstance(0, worldRay, anyHit, tfar, hit);  // no top tree to walk: its root tests the same box
   uint32_t stack[kStackSize];
   float stackEntry[kStackSize];
   int top = 0;
@@ -466,43 +666,34 @@ bool BVHScene::Trace(float4 posAndNear, float4 dirAndFar, bool anyHit, CRT_Hit& 
   bool found = false;
   while (true)
   {
-    const BVHNode& n = m_nodes[node];
-    if ((n.left & kLeafFlag) != 0)
+    if ((node & kLeafFlag) != 0)
     {
-      const uint32_t first = n.left & ~kLeafFlag;
-      for (uint32_t k = first; k < first + n.right; ++k)
+      const uint32_t first = (node & ~kLeafFlag) >> 3;
+      const uint32_t last = first + (node & 7u);
+      for (uint32_t k = first; k <= last; ++k)
       {
-        const BVHInstance& inst = m_instances[k];
-        const BVHTraceRay ray = Prepare(ToObjectPoint(inst, org), ToObjectVector(inst, dir), tnear);
-        if (!TraceMesh(ray, inst.root, anyHit, tfar, hit))
+        if (!TraceInstance(k, worldRay, anyHit, tfar, hit))
           continue;
         found = true;
-        hit.instId = inst.instId;
-        hit.geomId = inst.geomId;
         if (anyHit)
           return true;
       }
     }
     else
     {
-      const BVHNode& l = m_nodes[n.left];
-      const BVHNode& r = m_nodes[n.right];
-      const float tl = SlabEntry(worldRay, l.boxMin, l.boxMax, tfar);
-      const float tr = SlabEntry(worldRay, r.boxMin, r.boxMax, tfar);
-      const bool hitL = tl >= 0.0f;
-      const bool hitR = tr >= 0.0f;
-      if (hitL && hitR)
+      // Go on with the nearest lane entered; the others wait on the stack, the farthest lowest.
+      float4 entries;
+      uint4 children;
+      const int entered = EnteredLanes(worldRay, m_nodes[node], tfar, entries, children);
+      if (entered > 0)
       {
-        const bool leftFirst = tl <= tr;
-        stackEntry[top] = leftFirst ? tr : tl;
-        stack[top] = leftFirst ? n.right : n.left;
-        top = top + 1;
-        node = leftFirst ? n.left : n.right;
-        continue;
-      }
-      if (hitL || hitR)
-      {
-        node = hitL ? n.left : n.right;
+        for (int lane = entered - 1; lane > 0; --lane)
+        {
+          stack[top] = children[lane];
+          stackEntry[top] = entries[lane];
+          top = top + 1;
+        }
+        node = children[0];
         continue;
       }
     }

@@ -14,6 +14,20 @@
 #include <string>
 #include <vector>
 
+// The traversal's node: four children side by side, their boxes one lane each (so one step tests
+// four boxes with float4 arithmetic, and a tree has half the levels of a binary one). 128 bytes,
+// std430 as in C++. CommitScene collapses every builder's binary tree into these.
+struct BVH4Node
+{
+  LiteMath::float4 minX, maxX, minY, maxY, minZ, maxZ;  // an empty lane is the empty box (+inf, -inf)
+  LiteMath::uint4 child;  // an inner child's node index, or BVH4Leaf(first, count), or kNoChild
+  LiteMath::uint4 unused;
+};
+
+// A leaf lane holds up to 8 primitives: kLeafFlag | first << 3 | (count - 1).
+constexpr uint32_t kMaxLeafSize = 8;
+constexpr uint32_t kNoChild = 0xFFFFFFFFu;  // an empty lane (its box is never entered)
+
 // A triangle's corners (36 bytes; a scalar-layout buffer on the GPU).
 struct BVHTriangle
 {
@@ -25,7 +39,8 @@ struct BVHTriangle
 struct BVHInstance
 {
   LiteMath::float4 toObjectRow0, toObjectRow1, toObjectRow2;
-  uint32_t instId, geomId, root, unused;
+  uint32_t instId, geomId, root;
+  uint32_t identity;  // 1 when toObject is the identity: the world ray is the object ray
 };
 
 // A ray prepared for one tree: slab test reciprocals (0 for a zero or denormal direction
@@ -65,7 +80,7 @@ public:
 
   // ---- Device data: what the traversal reads, rebuilt by CommitScene and empty until then. ----
   // Public because a class composing BVHScene uploads them to the GPU.
-  std::vector<BVHNode> m_nodes;          // the top tree (root 0, leaves index m_instances), then every mesh's
+  std::vector<BVH4Node> m_nodes;         // the top tree (root 0, leaves index m_instances), then every mesh's
   std::vector<BVHInstance> m_instances;  // in the top tree's leaf order
   std::vector<BVHTriangle> m_triangles;  // every mesh's triangles in its leaf order (leaves index here)
   std::vector<uint32_t> m_primIds;       // m_triangles[k] is triangle m_primIds[k] of its mesh
@@ -73,7 +88,8 @@ public:
 private:
   struct Mesh
   {
-    BVHTree tree;
+    BVHTree tree;                        // as the builder made it
+    std::vector<BVH4Node> wide;          // the same tree collapsed for the traversal (empty without triangles)
     std::vector<BVHTriangle> triangles;  // triangles[k] is triangle tree.primIndices[k]
   };
   struct Instance
@@ -86,6 +102,7 @@ private:
 
   // The traversal (translated for the GPU when composed).
   bool Trace(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar, bool anyHit, CRT_Hit& hit) const;
+  bool TraceInstance(uint32_t k, const BVHTraceRay& worldRay, bool anyHit, float& tfar, CRT_Hit& hit) const;
   bool TraceMesh(const BVHTraceRay& ray, uint32_t root, bool anyHit, float& tfar, CRT_Hit& hit) const;
 
   std::string m_name;
