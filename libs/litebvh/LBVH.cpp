@@ -46,10 +46,10 @@ void LBVH::Build(int count, const Box4f* boxes)
   kernel1D_MakeLeaves(count, boxes);
   // (4) the hierarchy over the leaves
   kernel1D_Karras12(count);
-  // (5) refit from the leaves up, one level per pass. Leaf codes are unique 30-bit values, so the
-  // common prefix (clz of two codes' xor, 2..31) grows from parent to child: at most 30 levels of
-  // inner nodes, so 30 passes reach the root.
-  for (int pass = 0; pass < 15; pass++)
+  // (5) refit from the leaves up. Leaf codes are unique 30-bit values, so the common prefix (clz of
+  // two codes' xor, 2..31) grows from parent to child: at most 30 levels of inner nodes. A pass
+  // finishes every node whose children or grandchildren were done before it: 15 passes reach the root.
+  for (int pass = 0; pass < 8; pass++)
   {
     kernel1D_RefitPass(count, m_readyA.data(), m_readyB.data());
     kernel1D_RefitPass(count, m_readyB.data(), m_readyA.data());
@@ -187,11 +187,33 @@ void LBVH::kernel1D_RefitPass(int count, const uint32_t* readyBefore, uint32_t* 
     uint32_t ready = readyBefore[i];
     if (ready == 0u)  // most nodes are done after the first passes: test that before loading the node
     {
-      const uint32_t left = m_nodes[i].left, right = m_nodes[i].right;
-      if (readyBefore[left] != 0u && readyBefore[right] != 0u)
+      // Each child's box: its own when it was done before this pass, else the union of its
+      // children's when they were (it finishes in this pass too, from the same boxes). Only boxes
+      // finished in earlier passes are read, so no thread reads what another is writing.
+      float3 boxMin = float3(+1e30f), boxMax = float3(-1e30f);
+      bool done = true;
+      for (int side = 0; side < 2; side++)
       {
-        m_nodes[i].boxMin = min(m_nodes[left].boxMin, m_nodes[right].boxMin);
-        m_nodes[i].boxMax = max(m_nodes[left].boxMax, m_nodes[right].boxMax);
+        const uint32_t child = side == 0 ? m_nodes[i].left : m_nodes[i].right;
+        if (readyBefore[child] != 0u)
+        {
+          boxMin = min(boxMin, m_nodes[child].boxMin);
+          boxMax = max(boxMax, m_nodes[child].boxMax);
+          continue;
+        }
+        const uint32_t a = m_nodes[child].left, b = m_nodes[child].right;  // not ready: an inner node
+        if (readyBefore[a] != 0u && readyBefore[b] != 0u)
+        {
+          boxMin = min(boxMin, min(m_nodes[a].boxMin, m_nodes[b].boxMin));
+          boxMax = max(boxMax, max(m_nodes[a].boxMax, m_nodes[b].boxMax));
+        }
+        else
+          done = false;
+      }
+      if (done)
+      {
+        m_nodes[i].boxMin = boxMin;
+        m_nodes[i].boxMax = boxMax;
         ready = 1u;
       }
     }

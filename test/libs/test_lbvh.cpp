@@ -91,6 +91,49 @@ BVHTree BuildWith(LBVH& builder, const std::vector<Box4f>& boxes)
 
 }  // namespace
 
+// Centers whose Morton codes are 0, 1, 2, 4, ..., 2^29 and 2^30 - 1: each code shares one more
+// leading bit with the next, so the tree is a chain 30 inner nodes deep, the most a 30-bit code
+// allows, and the refit needs every one of its passes.
+TEST_CASE("LBVH: the deepest tree 30-bit codes allow is refit to the root on every backend", "[lbvh][equivalence]")
+{
+  auto ctx = ValidatedContext();
+  std::vector<Box4f> boxes;
+  auto add = [&](float x, float y, float z) { boxes.push_back(Box4f(float4(x, y, z, 0.0f) - 0.25f, float4(x, y, z, 0.0f) + 0.25f)); };
+  add(0.0f, 0.0f, 0.0f);
+  add(1023.0f, 1023.0f, 1023.0f);  // the scene's extent: 1023 cells of size 1 per axis
+  for (int k = 0; k < 30; ++k)  // bit k of a code is axis 2 - k % 3's bit k / 3 (z is the lowest)
+  {
+    const float cell = float(1 << (k / 3));
+    add(k % 3 == 2 ? cell : 0.0f, k % 3 == 1 ? cell : 0.0f, k % 3 == 0 ? cell : 0.0f);
+  }
+  auto depth = [](const BVHTree& tree) {
+    int deepest = 0;
+    std::vector<std::pair<uint32_t, int>> todo = {{0u, 0}};
+    while (!todo.empty())
+    {
+      const auto [n, d] = todo.back();
+      todo.pop_back();
+      deepest = std::max(deepest, d);
+      if (!(tree.nodes[n].left & kLeafFlag))
+        todo.insert(todo.end(), {{tree.nodes[n].left, d + 1}, {tree.nodes[n].right, d + 1}});
+    }
+    return deepest;
+  };
+  LBVH original;
+  const BVHTree expected = BuildWith(original, boxes);
+  REQUIRE(original.m_leafCount == 32u);
+  CHECK(depth(expected) >= 30);  // 31 levels of inner nodes above the deepest leaf pair
+  REQUIRE(CheckTree(expected, boxes) == "");
+  std::vector<std::pair<const char*, std::shared_ptr<LBVH>>> translated = {{"CPU", CreateLBVH_CPU()}};
+  if (ctx) translated.push_back({"Vulkan", CreateLBVH_Vulkan(ctx)});
+  for (auto& [name, impl] : translated)
+  {
+    INFO(name);
+    REQUIRE(CheckTree(BuildWith(*impl, boxes), boxes) == "");
+  }
+  RequireNoValidationMessages(ctx);
+}
+
 TEST_CASE("LBVH: the original, LBVH_CPU and LBVH_Vulkan build the same valid tree", "[lbvh][equivalence]")
 {
   auto ctx = ValidatedContext();
