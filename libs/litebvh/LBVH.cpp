@@ -48,8 +48,8 @@ void LBVH::Build(int count, const Box4f* boxes)
   kernel1D_Karras12(count);
   // (5) refit from the leaves up. Leaf codes are unique 30-bit values, so the common prefix (clz of
   // two codes' xor, 2..31) grows from parent to child: at most 30 levels of inner nodes. A pass
-  // finishes every node whose children or grandchildren were done before it: 15 passes reach the root.
-  for (int pass = 0; pass < 8; pass++)
+  // finishes every node with done nodes up to three levels below it: 10 passes reach the root.
+  for (int pass = 0; pass < 5; pass++)
   {
     kernel1D_RefitPass(count, m_readyA.data(), m_readyB.data());
     kernel1D_RefitPass(count, m_readyB.data(), m_readyA.data());
@@ -187,12 +187,13 @@ void LBVH::kernel1D_RefitPass(int count, const uint32_t* readyBefore, uint32_t* 
     uint32_t ready = readyBefore[i];
     if (ready == 0u)  // most nodes are done after the first passes: test that before loading the node
     {
-      // Each child's box: its own when it was done before this pass, else the union of its
-      // children's when they were (it finishes in this pass too, from the same boxes). Only boxes
-      // finished in earlier passes are read, so no thread reads what another is writing.
+      // The box from those of nodes done before this pass, up to three levels down: each child's
+      // own, else its children's, else theirs. (Those in between finish in this pass too, from the
+      // same boxes.) Only boxes finished in earlier passes are read, so no thread reads what another
+      // is writing.
       float3 boxMin = float3(+1e30f), boxMax = float3(-1e30f);
       bool done = true;
-      for (int side = 0; side < 2; side++)
+      for (int side = 0; side < 2 && done; side++)
       {
         const uint32_t child = side == 0 ? m_nodes[i].left : m_nodes[i].right;
         if (readyBefore[child] != 0u)
@@ -201,14 +202,23 @@ void LBVH::kernel1D_RefitPass(int count, const uint32_t* readyBefore, uint32_t* 
           boxMax = max(boxMax, m_nodes[child].boxMax);
           continue;
         }
-        const uint32_t a = m_nodes[child].left, b = m_nodes[child].right;  // not ready: an inner node
-        if (readyBefore[a] != 0u && readyBefore[b] != 0u)
+        for (int side2 = 0; side2 < 2 && done; side2++)  // not ready: an inner node
         {
-          boxMin = min(boxMin, min(m_nodes[a].boxMin, m_nodes[b].boxMin));
-          boxMax = max(boxMax, max(m_nodes[a].boxMax, m_nodes[b].boxMax));
+          const uint32_t grandchild = side2 == 0 ? m_nodes[child].left : m_nodes[child].right;
+          if (readyBefore[grandchild] != 0u)
+          {
+            boxMin = min(boxMin, m_nodes[grandchild].boxMin);
+            boxMax = max(boxMax, m_nodes[grandchild].boxMax);
+            continue;
+          }
+          const uint32_t a = m_nodes[grandchild].left, b = m_nodes[grandchild].right;
+          done = readyBefore[a] != 0u && readyBefore[b] != 0u;
+          if (done)
+          {
+            boxMin = min(boxMin, min(m_nodes[a].boxMin, m_nodes[b].boxMin));
+            boxMax = max(boxMax, max(m_nodes[a].boxMax, m_nodes[b].boxMax));
+          }
         }
-        else
-          done = false;
       }
       if (done)
       {
