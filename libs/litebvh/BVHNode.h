@@ -1,4 +1,5 @@
-// The node format every CrossRT BVH builder writes and every traversal reads.
+// The node format every CrossRT BVH builder writes (BVHScene collapses it into 4-wide nodes for its
+// traversal: BVH4Node in libs/litert/BVHScene.h).
 #pragma once
 #include "LiteMath.h"
 
