@@ -5,6 +5,9 @@
 #include "LiteMath.h"
 
 #include <cstddef>
+#include <cstring>
+#include <limits>
+#include <utility>
 #include <random>
 #include <type_traits>
 
@@ -156,6 +159,35 @@ TEST_CASE("LiteMath min/max coexist with std", "[litemath]")
   CHECK(abs(int2(-4, 4)).x == 4);
   CHECK(abs(-2.5f) == 2.5f);
   CHECK(sqrt(16.0f) == 4.0f);
+}
+
+// float4 runs on SSE in compiled C++ (LITEMATH_FLOAT4_SSE): each lane must give the same bits as the
+// scalar std::min/std::max and operators, including the operand order that decides NaN and +-0.
+TEST_CASE("LiteMath float4 arithmetic and min/max match the scalar definitions bit for bit", "[litemath]")
+{
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  const float4 a(nan, 0.0f, -0.0f, 1.5f), b(1.0f, -0.0f, 0.0f, nan);
+  const float4 c(-inf, 3.0f, 1e-40f, -2.0f), d(inf, -7.25f, 3.0f, 0.0f);
+  auto bits = [](float f) {
+    uint32_t u;
+    std::memcpy(&u, &f, 4);
+    return u;
+  };
+  for (const auto& [x, y] : {std::pair{a, b}, std::pair{b, a}, std::pair{c, d}, std::pair{d, c}})
+  {
+    const float4 lo = min(x, y), hi = max(x, y), sum = x + y, diff = x - y, prod = x * y, quot = x / y, scaled = x * 3.0f;
+    for (int i = 0; i < 4; ++i)
+    {
+      INFO("lane " << i << ": " << x[i] << ", " << y[i]);
+      CHECK(bits(lo[i]) == bits(std::min(x[i], y[i])));
+      CHECK(bits(hi[i]) == bits(std::max(x[i], y[i])));
+      CHECK(bits(sum[i]) == bits(x[i] + y[i]));
+      CHECK(bits(diff[i]) == bits(x[i] - y[i]));
+      CHECK(bits(prod[i]) == bits(x[i] * y[i]));
+      CHECK(bits(quot[i]) == bits(x[i] / y[i]));
+      CHECK(bits(scaled[i]) == bits(x[i] * 3.0f));
+    }
+  }
 }
 
 TEST_CASE("LiteMath scalar and componentwise functions", "[litemath]")
