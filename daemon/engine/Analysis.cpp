@@ -236,6 +236,7 @@ struct WriteScanner : RecursiveASTVisitor<WriteScanner> {
   std::map<const FieldDecl*, ReduceOp> reductions;
   std::set<const MemberExpr*> reductionUses;  // member references that belong to a reduction statement
   std::set<const FieldDecl*> vectorWrites;
+  std::set<const FieldDecl*> atomicMembers;  // plain data members written by crossrt::Atomic*
   const FunctionDecl* helper = nullptr;  // scanning a helper's body: reductions are not allowed there
   explicit WriteScanner(Context& ctx) : c(ctx) {}
 
@@ -332,6 +333,11 @@ struct WriteScanner : RecursiveASTVisitor<WriteScanner> {
   // A member passed to a non-const reference parameter may be written by the callee (GLSL inout).
   bool VisitCallExpr(CallExpr* call) {
     auto* fd = call->getDirectCallee();
+    // An atomic's target may be written by every thread, in a helper too: no race, no reduction.
+    if (IsCrossrtAtomic(fd) && call->getNumArgs() > 0) {
+      if (auto* root = RootField(call->getArg(0))) (IsStdVector(root->getType()) ? vectorWrites : atomicMembers).insert(root);
+      return true;
+    }
     if (!fd || IsSystemDecl(fd) || isa<CXXOperatorCallExpr>(call)) return true;
     for (unsigned i = 0; i < call->getNumArgs() && i < fd->getNumParams(); ++i) {
       QualType t = fd->getParamDecl(i)->getType();
@@ -814,8 +820,9 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   }
   // After printing, the printer knows the helpers the kernel reaches: their writes count too.
   auto markVectorWrites = [&](const WriteScanner& scanner) {
-    for (auto* f : scanner.vectorWrites)
-      if (auto* m = FindMember(c.model, f->getNameAsString())) m->writtenByKernels = true;
+    for (auto* set : {&scanner.vectorWrites, &scanner.atomicMembers})
+      for (auto* f : *set)
+        if (auto* m = FindMember(c.model, f->getNameAsString())) m->writtenByKernels = true;
   };
   markVectorWrites(ws);
 
@@ -846,6 +853,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   k.structList = printer.Structs();
   k.constantList = printer.Constants();
   k.functionList = printer.Functions();
+  k.atomics = printer.usesAtomics;
   if (!printer.virtualCalls.empty()) AnalyzeVirtualCalls(c, k, printer);
   k.composedCalls = printer.composedCalls;
   for (auto& [holder, method] : printer.composedCalls) {
@@ -1979,6 +1987,10 @@ struct ComposedWriteFinder : RecursiveASTVisitor<ComposedWriteFinder> {
     if (uo->isIncrementDecrementOp()) Check(uo->getSubExpr(), uo->getExprLoc());
     return true;
   }
+  bool VisitCallExpr(CallExpr* call) {
+    if (IsCrossrtAtomic(call->getDirectCallee()) && call->getNumArgs() > 0) Check(call->getArg(0), call->getExprLoc());
+    return true;
+  }
   bool VisitCXXOperatorCallExpr(CXXOperatorCallExpr* op) {
     if (op->isAssignmentOp() || op->getOperator() == OO_PlusPlus || op->getOperator() == OO_MinusMinus) Check(op->getArg(0), op->getExprLoc());
     return true;
@@ -2137,6 +2149,7 @@ static void MergeMegakernelCode(ClassModel& model) {
         if (std::find(mk.samplePairs.begin(), mk.samplePairs.end(), pair) == mk.samplePairs.end()) mk.samplePairs.push_back(pair);
       mk.composedCalls.insert(k->composedCalls.begin(), k->composedCalls.end());
       mk.bufferReferences |= k->bufferReferences;
+      mk.atomics |= k->atomics;
       mk.scalarReferences |= k->scalarReferences;
     }
     std::sort(mk.memberVectors.begin(), mk.memberVectors.end());

@@ -15,11 +15,25 @@
 
 namespace crossrt::engine {
 
+namespace {
+// Counts the errors it prints, in a count only Get() resets. The consumer's own count does not
+// survive the parse: an error in a header (the preamble) would read as a clean parse.
+class ErrorCountingPrinter : public clang::TextDiagnosticPrinter {
+public:
+  using TextDiagnosticPrinter::TextDiagnosticPrinter;
+  void HandleDiagnostic(clang::DiagnosticsEngine::Level level, const clang::Diagnostic& info) override {
+    if (level >= clang::DiagnosticsEngine::Error) ++errors;
+    TextDiagnosticPrinter::HandleDiagnostic(level, info);
+  }
+  unsigned errors = 0;
+};
+}  // namespace
+
 struct AstCache::Handle::Entry {
   std::mutex inUse;  // one translation at a time per AST
   std::string diagText;
   llvm::raw_string_ostream diagStream{diagText};
-  std::unique_ptr<clang::TextDiagnosticPrinter> printer;
+  std::unique_ptr<ErrorCountingPrinter> printer;
   clang::IntrusiveRefCntPtr<clang::DiagnosticsEngine> diags;
   std::unique_ptr<clang::ASTUnit> ast;
   bool failed = false;
@@ -68,20 +82,24 @@ AstCache::Handle AstCache::Get(const std::string& file, const std::vector<std::s
   Handle handle(entry);  // waits while another translation uses this AST
   entry->diagStream.flush();
   entry->diagText.clear();
-  if (entry->ast) {  // decided under the entry's lock: another request may have parsed it meanwhile
+  // Decided under the entry's lock: another request may have parsed it meanwhile. A parse that
+  // failed is not reparsed: its preamble keeps header errors without reporting them again.
+  if (entry->ast && !entry->failed) {
     // Reparse() reuses the preamble when the headers it covers are unchanged.
     entry->printer->clear();
+    entry->printer->errors = 0;
     entry->diags->Reset(/*soft=*/true);
     auto pch = std::make_shared<clang::PCHContainerOperations>();
-    entry->failed = entry->ast->Reparse(pch) || entry->printer->getNumErrors() > 0;
+    entry->failed = entry->ast->Reparse(pch) || entry->printer->errors > 0;
     std::lock_guard<std::mutex> guard(m_mutex);
     ++m_reparses;
     return handle;
   }
 
+  entry->ast.reset();
   auto* options = new clang::DiagnosticOptions();
   options->ShowColors = false;
-  entry->printer = std::make_unique<clang::TextDiagnosticPrinter>(entry->diagStream, options);
+  entry->printer = std::make_unique<ErrorCountingPrinter>(entry->diagStream, options);
   entry->diags = clang::CompilerInstance::createDiagnostics(options, entry->printer.get(), /*ShouldOwnClient=*/false);
   std::vector<const char*> argv = {"clang++"};
   for (auto& a : args) argv.push_back(a.c_str());
@@ -91,7 +109,7 @@ AstCache::Handle AstCache::Get(const std::string& file, const std::vector<std::s
       CROSSRT_CLANG_RESOURCE_DIR, /*StorePreamblesInMemory=*/true, /*PreambleStoragePath=*/"",
       /*OnlyLocalDecls=*/false, clang::CaptureDiagsKind::None, /*RemappedFiles=*/{},
       /*RemappedFilesKeepOriginalName=*/true, /*PrecompilePreambleAfterNParses=*/1);
-  entry->failed = !entry->ast || entry->printer->getNumErrors() > 0;
+  entry->failed = !entry->ast || entry->printer->errors > 0;
   std::lock_guard<std::mutex> guard(m_mutex);
   ++m_parses;
   return handle;

@@ -326,6 +326,12 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   std::string structs;
   for (auto& x : structList) structs += x + "\n";
   d.set("kernelStructs", structs);
+  // Atomics order the kernel's other writes for other threads (Atomics.h): the buffers it may
+  // write are coherent, so that those writes are not held in a cache another thread misses.
+  const std::string coherent = k.atomics ? "coherent " : "";
+  d.set("atomics", k.atomics);
+  d.set("fenceConstantId", "1700");  // crossrt::kFenceAtomicsConstantId (VulkanRuntime.h)
+  d.set("classDataAccess", coherent);
   Data buffers = List();
   unsigned binding = 1;
   bool scalarAny = false;  // any buffer that needs GL_EXT_scalar_block_layout
@@ -335,7 +341,7 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
     b.set("layout", p.scalarLayout ? "scalar" : "std430");
     scalarAny |= p.scalarLayout;
     b.set("binding", std::to_string(binding++));
-    b.set("access", p.isConstPointee ? "readonly " : "");
+    b.set("access", p.isConstPointee ? "readonly " : coherent);
     // A per-thread value: main() loads this thread's element, passes it, and stores it back.
     const std::string name = p.threadState ? p.glslName + "PerThread" : p.glslName;
     b.set("blockName", name + "Buffer");
@@ -351,7 +357,7 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
     b.set("layout", m && m->scalarLayout ? "scalar" : "std430");
     scalarAny |= m && m->scalarLayout;
     b.set("binding", std::to_string(binding++));
-    b.set("access", "");
+    b.set("access", coherent);
     b.set("blockName", v + "Buffer");
     b.set("type", m ? m->glslType : "float");
     b.set("name", v);

@@ -594,6 +594,85 @@ std::string GlslPrinter::Builtin(const FunctionDecl* fd, const std::vector<std::
   return "";
 }
 
+// ---- crossrt::Atomic* (Atomics.h): GLSL atomics with device scope and acquire-release order ----
+
+bool IsCrossrtAtomic(const FunctionDecl* fd) {
+  static const std::set<std::string> names = {"AtomicAdd", "AtomicAnd", "AtomicOr", "AtomicXor", "AtomicExchange",
+                                              "AtomicMin", "AtomicMax", "AtomicCompareExchange"};
+  return fd && InNamespace(fd, "crossrt") && names.count(fd->getNameAsString()) > 0;
+}
+
+// GLSL atomics take a buffer (or shared) variable itself, never a copy: the target must be a
+// path of indexing and field selection from a buffer the kernel binds. Empty when it is.
+std::string GlslPrinter::AtomicTargetProblem(const clang::Expr* e) const {
+  while (true) {
+    e = e->IgnoreParenImpCasts();
+    if (auto* me = dyn_cast<MemberExpr>(e)) {
+      const clang::Expr* base = me->getBase()->IgnoreParenImpCasts();
+      if (isa<CXXThisExpr>(base)) {
+        if (selfClass) return "it is a member of an object reached through a virtual call, which kernels only read";
+        if (IsImage2D(me->getType())) return "it is a texel of an image";
+        return "";  // a data member (the class-data block) or an element of a member vector
+      }
+      if (me->isArrow()) {  // p->field: p must be a kernel's pointer parameter
+        e = base;
+        break;
+      }
+      e = base;
+      continue;
+    }
+    if (auto* op = dyn_cast<CXXOperatorCallExpr>(e); op && op->getOperator() == OO_Subscript) {
+      if (!IsStdVector(op->getArg(0)->getType())) return "it is an element of a container kernels cannot index atomically";
+      e = op->getArg(0);
+      continue;
+    }
+    if (auto* as = dyn_cast<ArraySubscriptExpr>(e)) {
+      const clang::Expr* base = as->getBase()->IgnoreParenImpCasts();
+      if (base->getType()->isPointerType()) {
+        e = base;
+        break;
+      }
+      e = base;  // a fixed-size array inside an element
+      continue;
+    }
+    if (auto* uo = dyn_cast<UnaryOperator>(e); uo && uo->getOpcode() == UO_Deref) {
+      e = uo->getSubExpr()->IgnoreParenImpCasts();
+      break;
+    }
+    break;
+  }
+  // What remains names the root: a pointer parameter of the kernel is a buffer, anything else a copy.
+  auto* dr = dyn_cast<DeclRefExpr>(e);
+  auto* param = dr ? dyn_cast<ParmVarDecl>(dr->getDecl()) : nullptr;
+  if (param && param->getType()->isPointerType()) {
+    if (valueParams.count(param)) return "parameter '" + param->getNameAsString() + "' holds one value per thread (a local of the control function's thread loop)";
+    return "";
+  }
+  if (param && param->getType()->isReferenceType())
+    return "reference parameter '" + param->getNameAsString() + "' is a copy on the GPU (GLSL passes it in and out)";
+  if (dr) return "'" + dr->getDecl()->getNameAsString() + "' is a local variable, private to each GPU thread";
+  return "it is not a variable in device memory";
+}
+
+std::string GlslPrinter::AtomicCall(const FunctionDecl* fd, const CallExpr* call) {
+  const std::string name = fd->getNameAsString();
+  if (std::string problem = AtomicTargetProblem(call->getArg(0)); !problem.empty())
+    return Fail(call->getArg(0)->getExprLoc(), "the target of crossrt::" + name + " is not in device memory: " + problem,
+                "make the target an element of a std::vector member, a data member, or an element of a kernel's pointer parameter");
+  usesAtomics = true;
+  std::vector<std::string> args;
+  for (auto* arg : call->arguments()) args.push_back(Expr(arg));
+  // The fences of acquire-release order (the kernel template defines crt_release/crt_acquire):
+  // the last argument passes a release fence before the atomic runs, the result an acquire fence
+  // after. crossrt::AtomicCompareExchange is atomicCompSwap; the others keep their name.
+  std::string s = "crt_acquire(" + (name == "AtomicCompareExchange" ? std::string("atomicCompSwap") : "atomic" + name.substr(6)) + "(";
+  for (size_t i = 0; i < args.size(); ++i) {
+    s += i ? ", " : "";
+    s += i + 1 == args.size() ? "crt_release(" + args[i] + ")" : args[i];
+  }
+  return s + "))";
+}
+
 // ---- Image2D members: storage images (texels loaded and stored) and textures (sampled) ----
 
 namespace {
@@ -761,6 +840,7 @@ std::string GlslPrinter::Call(const CallExpr* call) {
     return Fail(call->getBeginLoc(), "I/O ('" + name + "') in a kernel",
                 "kernels cannot do I/O: write results to an output buffer and print them in the control function");
 
+  if (IsCrossrtAtomic(fd)) return AtomicCall(fd, call);
   std::vector<std::string> args;
   for (auto* arg : call->arguments()) args.push_back(Expr(arg));
   std::string b = Builtin(fd, args, call);

@@ -33,6 +33,8 @@ bool IsImageSampler(clang::QualType type);
 struct ImageFormat { std::string glslFormat, vkFormat, texel, prefix; };
 std::optional<ImageFormat> ImageFormatOf(clang::QualType texel);
 bool IsSystemDecl(const clang::Decl* decl);
+// crossrt::AtomicAdd and the other read-modify-write operations of Atomics.h.
+bool IsCrossrtAtomic(const clang::FunctionDecl* fd);
 
 // std430 array stride of a scalar or vector GLSL type: "vec3" and "vec4" 16, "vec2" 8, scalars 4.
 unsigned Std430VectorStride(const std::string& glslType);
@@ -88,6 +90,9 @@ public:
   // read from the parameter `self` of type <Class>_Data, and its methods take `self` first.
   const clang::CXXRecordDecl* selfClass = nullptr;
 
+  // The kernel calls crossrt::Atomic*: its buffers must be coherent (GL_KHR_memory_scope_semantics).
+  bool usesAtomics = false;
+
   std::string Expr(const clang::Expr* e);
   std::string Stmt(const clang::Stmt* s, int indent);
   // The thread's function body: `continue` at loop depth 0 ends the thread (becomes `return`).
@@ -121,6 +126,8 @@ private:
   std::optional<ImageFormat> UsableImage(const clang::FieldDecl* image, clang::SourceLocation use);  // reports why not
   std::string ImageStore(const clang::Expr* lhs, const std::string& value, const clang::Expr* whole);
   std::string ImageCall(const clang::FieldDecl* image, const clang::CXXMemberCallExpr* call);
+  std::string AtomicCall(const clang::FunctionDecl* fd, const clang::CallExpr* call);
+  std::string AtomicTargetProblem(const clang::Expr* target) const;
   std::string EmitAppend(const clang::FieldDecl* field, const clang::CallExpr* call);
   std::string EmitHelper(const clang::FunctionDecl* fd, clang::SourceLocation callLoc, bool composedEntry = false);
   std::string ComposedCall(const clang::CXXMemberCallExpr* call);

@@ -116,6 +116,7 @@ struct Kernel {
   std::vector<std::string> megakernelCalls;  // the kernels it runs, whose code it merges
   bool bufferReferences = false;      // reaches objects through buffer references (virtual calls)
   bool scalarReferences = false;      // some of them need the scalar layout
+  bool atomics = false;               // calls crossrt::Atomic*: coherent buffers, memory scope semantics
 };
 
 struct ControlParam {

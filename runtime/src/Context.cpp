@@ -397,7 +397,10 @@ void VulkanContext::CreateDevice(const ContextOptions& options) {
   VkPhysicalDeviceProperties2 props2{};
   props2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
   props2.pNext = &subgroup;
+  auto driver = VkInit<VkPhysicalDeviceDriverProperties>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES);
+  if (vk12) subgroup.pNext = &driver;
   vkGetPhysicalDeviceProperties2(physicalDevice, &props2);
+  fenceAtomics = !(vk12 && driver.driverID == VK_DRIVER_ID_MESA_LLVMPIPE);
   subgroupSize = subgroup.subgroupSize;
   hasSubgroupArithmetic = (subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) &&
                           (subgroup.supportedOperations & VK_SUBGROUP_FEATURE_ARITHMETIC_BIT);

@@ -22,6 +22,7 @@ std::string Header(const Case& c)
 {
   return std::string(R"(#pragma once
 #include "LiteMath.h"
+#include "Atomics.h"
 #include <vector>
 #include <cstdio>
 #include <cstdlib>
@@ -66,6 +67,11 @@ const Case kCases[] = {
     {"helper writes member", "    x = Touch(x);", "  float Touch(float v);", "float Bad::Touch(float v) { m_value = v; return v; }\n",
      "helper function 'Touch' writes class member 'm_value'", "return the value", 12},
     {"return in loop", "    if (x > 0.0f) return;", "", "", "'return' inside a parallel kernel loop would end all later iterations", "'continue'", 8},
+    {"atomic on a local", "    uint32_t hits = 0; crossrt::AtomicAdd(hits, 1u); x += float(hits);", "", "",
+     "the target of crossrt::AtomicAdd is not in device memory: 'hits' is a local variable", "element of a std::vector member", 8},
+    {"atomic through a helper's reference", "    Count(m_counts[i]);", "  std::vector<uint32_t> m_counts;\n  void Count(uint32_t& c);",
+     "void Bad::Count(uint32_t& c) { crossrt::AtomicAdd(c, 1u); }\n",
+     "reference parameter 'c' is a copy on the GPU", "element of a std::vector member", 12},
     {"nested control", "", "  virtual void Outer(int n, [[crossrt::size(\"n\")]] float* data);", "void Bad::Outer(int n, float* data) { kernel1D_Bad(n, data); Run(n, data); }\n",
      "control function 'Outer' calls control function 'Run'", "one submission", 12},
 };

@@ -1,4 +1,5 @@
 // What the analysis finds in small input classes parsed with the real standard library.
+#include "AstCache.h"
 #include "EngineSupport.h"
 
 using namespace crossrt::engine;
@@ -334,4 +335,40 @@ void Tracer::kernel_Depth(uint32_t tid, const CRT_Hit* hit, float* depth) { dept
   // The megakernel reads the traversal's buffers even while kernel_Hit uses the hardware: they stay uploaded.
   CHECK(host.find("m_vdata.m_pAccelStruct_m_nodes.Upload(") != std::string::npos);
   CHECK(host.find("only the translated traversal reads it") == std::string::npos);
+}
+
+TEST_CASE("An error in the class's header fails the translation, on the first parse and on every reparse", "[engine]")
+{
+  // The header is parsed into the preamble, whose errors must count like the main file's.
+  const std::string bad = R"(#pragma once
+class Broken
+{
+public:
+  virtual ~Broken() = default;
+  virtual void Run(int n, [[crossrt::size("n")]] float* out);
+  undeclared_type m_oops;
+protected:
+  void kernel1D_Fill(int n, float* out);
+};
+)";
+  TempClass tc("Broken", bad, R"(#include "Broken.h"
+void Broken::Run(int n, float* out) { kernel1D_Fill(n, out); }
+void Broken::kernel1D_Fill(int n, float* out) { for (int i = 0; i < n; i++) out[i] = 1.0f; }
+)");
+  AstCache cache;
+  for (int parse = 0; parse < 2; ++parse)
+  {
+    INFO("parse " << parse);
+    TranslateResult r = Translate(MakeRequest(tc, "Broken"), &cache);
+    INFO(r.diagnostics);
+    REQUIRE_FALSE(r.ok);
+    REQUIRE(r.diagnostics.find("Broken.h:7:3: error: unknown type name 'undeclared_type'") != std::string::npos);
+  }
+  // Fixed, the same cache entry translates.
+  std::string fixed = bad;
+  fixed.replace(fixed.find("undeclared_type"), std::string("undeclared_type").size(), "float");
+  std::ofstream(tc.Header("Broken")) << fixed;
+  TranslateResult r = Translate(MakeRequest(tc, "Broken"), &cache);
+  INFO(r.diagnostics);
+  REQUIRE(r.ok);
 }

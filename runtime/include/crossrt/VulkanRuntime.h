@@ -21,6 +21,9 @@
 
 namespace crossrt {
 
+// The specialization constant id of the generated kernels' crt_fenceAtomics (VulkanContext::fenceAtomics).
+constexpr uint32_t kFenceAtomicsConstantId = 1700;
+
 struct Error : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
@@ -77,6 +80,11 @@ public:
   uint32_t subgroupSize = 0;
   bool hasSubgroupArithmetic = false;
   bool forceStaging = false;  // see ContextOptions::forceStaging
+  // Kernels that call crossrt atomics fence them (memoryBarrierBuffer) for acquire-release order,
+  // under the specialization constant kFenceAtomicsConstantId, which every compute pipeline gets
+  // from here. Off on llvmpipe: its atomics are sequentially consistent already, and its memory
+  // barriers inside loops that threads leave at different times give wrong results (Mesa 22.3).
+  bool fenceAtomics = true;
 
   std::string DeviceName() const;
 
