@@ -25,6 +25,7 @@
 #include <mutex>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -212,11 +213,19 @@ AnalyzeResult Analyze(const TranslateRequest& request, AstCache* sharedCache) {
   result.timingsMs["parse"] = MsSince(t0);
   t0 = std::chrono::steady_clock::now();
 
-  // Every file the ASTs read is an input of the translation (for depfiles and cache keys).
+  // Every file the ASTs read is an input of the translation (for depfiles and cache keys), by
+  // its real path: Clang reaches the GCC headers as /../lib/gcc/<triple>/12/../../../../include,
+  // which a build tool shortens without following /lib -> /usr/lib to a file that does not
+  // exist, and then rebuilds on every run.
   std::set<std::string> inputs;
   for (auto* ast : asts) {
     auto& sm = ast->getSourceManager();
-    for (auto it = sm.fileinfo_begin(); it != sm.fileinfo_end(); ++it) inputs.insert(it->first.getName().str());
+    for (auto it = sm.fileinfo_begin(); it != sm.fileinfo_end(); ++it) {
+      std::error_code ec;
+      const std::string name = it->first.getName().str();
+      const std::filesystem::path real = std::filesystem::weakly_canonical(name, ec);
+      inputs.insert(ec ? name : real.string());
+    }
   }
 
   std::map<std::string, std::string> compositions;

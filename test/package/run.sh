@@ -16,4 +16,10 @@ else
   cmake -S "$here" -B "$work/build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCROSSRT_SOURCE_DIR="$crossrt"
 fi
 cmake --build "$work/build"
+# Built once, the project is up to date: no translation reruns (every input in the depfiles exists).
+if ninja -C "$work/build" -n | grep -q "CrossRT: translating"; then
+  echo "a second build translates again:" >&2
+  ninja -C "$work/build" -d explain -n 2>&1 | head -5 >&2
+  exit 1
+fi
 "$work/build/app"
