@@ -24,8 +24,8 @@ void LBVH::Reserve(int maxBoxes)
   m_groupOf.resize(n);
   m_leafFirst.resize(n);
   m_leafCode.resize(n);
-  m_readyA.resize(2 * n - 1);
-  m_readyB.resize(2 * n - 1);
+  m_parent.resize(2 * n - 1);
+  m_arrivals.resize(n);
 }
 
 void LBVH::Build(int count, const Box4f* boxes)
@@ -46,14 +46,8 @@ void LBVH::Build(int count, const Box4f* boxes)
   kernel1D_MakeLeaves(count, boxes);
   // (4) the hierarchy over the leaves
   kernel1D_Karras12(count);
-  // (5) refit from the leaves up. Leaf codes are unique 30-bit values, so the common prefix (clz of
-  // two codes' xor, 2..31) grows from parent to child: at most 30 levels of inner nodes. A pass
-  // finishes every node with done nodes up to three levels below it: 10 passes reach the root.
-  for (int pass = 0; pass < 5; pass++)
-  {
-    kernel1D_RefitPass(count, m_readyA.data(), m_readyB.data());
-    kernel1D_RefitPass(count, m_readyB.data(), m_readyA.data());
-  }
+  // (5) the boxes of the inner nodes, from the leaves up
+  kernel1D_Refit(count);
 }
 
 BVHTree LBVH::Tree(int count) const
@@ -134,8 +128,6 @@ void LBVH::kernel1D_MakeLeaves(int count, const Box4f* boxes)
     m_nodes[node].boxMax = boxMax;
     m_nodes[node].left = kLeafFlag | first;
     m_nodes[node].right = last - first;
-    m_readyA[node] = 1u;
-    m_readyB[node] = 1u;
   }
 }
 
@@ -171,63 +163,36 @@ void LBVH::kernel1D_Karras12(int count)
     }
     const int gamma = i + split * d + std::min(d, 0);
     const int first = std::min(i, j), last = std::max(i, j);
-    m_nodes[i].left = uint32_t(first == gamma ? leaves - 1 + gamma : gamma);
-    m_nodes[i].right = uint32_t(last == gamma + 1 ? leaves + gamma : gamma + 1);
-    m_readyA[i] = 0u;
-    m_readyB[i] = 0u;
+    const uint32_t left = uint32_t(first == gamma ? leaves - 1 + gamma : gamma);
+    const uint32_t right = uint32_t(last == gamma + 1 ? leaves + gamma : gamma + 1);
+    m_nodes[i].left = left;
+    m_nodes[i].right = right;
+    m_parent[left] = uint32_t(i);
+    m_parent[right] = uint32_t(i);
+    m_arrivals[i] = 0u;
   }
 }
 
-void LBVH::kernel1D_RefitPass(int count, const uint32_t* readyBefore, uint32_t* readyAfter)
+void LBVH::kernel1D_Refit(int count)
 {
-  for (int i = 0; i < count; i++)
+  for (int leaf = 0; leaf < count; leaf++)
   {
-    if (i >= int(m_leafCount) - 1)
-      continue;  // leaves are ready from the start
-    uint32_t ready = readyBefore[i];
-    if (ready == 0u)  // most nodes are done after the first passes: test that before loading the node
+    if (uint32_t(leaf) >= m_leafCount)
+      continue;
+    uint32_t node = m_leafCount - 1 + uint32_t(leaf);
+    while (node != 0u)  // the root is node 0
     {
-      // The box from those of nodes done before this pass, up to three levels down: each child's
-      // own, else its children's, else theirs. (Those in between finish in this pass too, from the
-      // same boxes.) Only boxes finished in earlier passes are read, so no thread reads what another
-      // is writing.
-      float3 boxMin = float3(+1e30f), boxMax = float3(-1e30f);
-      bool done = true;
-      for (int side = 0; side < 2 && done; side++)
-      {
-        const uint32_t child = side == 0 ? m_nodes[i].left : m_nodes[i].right;
-        if (readyBefore[child] != 0u)
-        {
-          boxMin = min(boxMin, m_nodes[child].boxMin);
-          boxMax = max(boxMax, m_nodes[child].boxMax);
-          continue;
-        }
-        for (int side2 = 0; side2 < 2 && done; side2++)  // not ready: an inner node
-        {
-          const uint32_t grandchild = side2 == 0 ? m_nodes[child].left : m_nodes[child].right;
-          if (readyBefore[grandchild] != 0u)
-          {
-            boxMin = min(boxMin, m_nodes[grandchild].boxMin);
-            boxMax = max(boxMax, m_nodes[grandchild].boxMax);
-            continue;
-          }
-          const uint32_t a = m_nodes[grandchild].left, b = m_nodes[grandchild].right;
-          done = readyBefore[a] != 0u && readyBefore[b] != 0u;
-          if (done)
-          {
-            boxMin = min(boxMin, min(m_nodes[a].boxMin, m_nodes[b].boxMin));
-            boxMax = max(boxMax, max(m_nodes[a].boxMax, m_nodes[b].boxMax));
-          }
-        }
-      }
-      if (done)
-      {
-        m_nodes[i].boxMin = boxMin;
-        m_nodes[i].boxMax = boxMax;
-        ready = 1u;
-      }
+      const uint32_t parent = m_parent[node];
+      // The first child to arrive stops: its sibling's box may not be there yet. The second one
+      // reads both (the first wrote its box before its atomic) and carries on with the parent.
+      if (crossrt::AtomicAdd(m_arrivals[parent], 1u) == 0u)
+        break;
+      const BVHNode left = m_nodes[m_nodes[parent].left];
+      const BVHNode right = m_nodes[m_nodes[parent].right];
+      m_nodes[parent].boxMin = min(left.boxMin, right.boxMin);
+      m_nodes[parent].boxMax = max(left.boxMax, right.boxMax);
+      node = parent;
     }
-    readyAfter[i] = ready;
   }
 }
 

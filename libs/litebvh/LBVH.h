@@ -2,8 +2,9 @@
 // conventions, so that the same class runs as written, translated to all CPU cores (LBVH_CPU) and
 // translated to Vulkan (LBVH_Vulkan). The steps follow the paper's listing 3: a reduction for the
 // bounds, Morton codes, a sort, grouping of equal codes into leaves with a scan, the Karras
-// hierarchy, and a bottom-up refit in passes.
+// hierarchy, and a bottom-up refit in one pass (the second child to reach a node finishes it).
 #pragma once
+#include "Atomics.h"
 #include "BVHNode.h"
 #include "LiteMath.h"
 
@@ -55,10 +56,10 @@ protected:
   void kernel1D_AppendComplete(int count);
   // leaves get their boxes and primitive ranges
   void kernel1D_MakeLeaves(int count, const LiteMath::Box4f* boxes);
-  // (4) the inner nodes' children from the leaves' codes
+  // (4) the inner nodes' children from the leaves' codes, and each node's parent
   void kernel1D_Karras12(int count);
-  // (5) one refit pass: an inner node whose children were ready after the last pass gets its box
-  void kernel1D_RefitPass(int count, const uint32_t* readyBefore, uint32_t* readyAfter);
+  // (5) from each leaf up: the second child to reach an inner node gives it its box and goes on
+  void kernel1D_Refit(int count);
   // Length of the common prefix of leaf codes i and j; -1 when j is outside the leaves.
   int Delta(int i, int j) const;
 
@@ -68,7 +69,8 @@ protected:
   std::vector<uint32_t> m_groupOf;       // leaf of each sorted box (exclusive scan of m_newGroup)
   std::vector<uint32_t> m_leafFirst;     // first sorted box of each leaf
   std::vector<uint32_t> m_leafCode;      // Morton code of each leaf, strictly increasing
-  std::vector<uint32_t> m_readyA, m_readyB;  // per node: box final (ping-pong between passes)
+  std::vector<uint32_t> m_parent;        // per node: its parent (the root's is unused)
+  std::vector<uint32_t> m_arrivals;      // per inner node: children that reached it in the refit
 };
 
 // Builds with `builder` (the class as written or a translated one) over boxes[0, count), reserving

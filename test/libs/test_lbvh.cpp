@@ -93,7 +93,7 @@ BVHTree BuildWith(LBVH& builder, const std::vector<Box4f>& boxes)
 
 // Centers whose Morton codes are 0, 1, 2, 4, ..., 2^29 and 2^30 - 1: each code shares one more
 // leading bit with the next, so the tree is a chain 30 inner nodes deep, the most a 30-bit code
-// allows, and the refit needs every one of its passes.
+// allows: the refit climbs all of it, one thread reaching the root through every level.
 TEST_CASE("LBVH: the deepest tree 30-bit codes allow is refit to the root on every backend", "[lbvh][equivalence]")
 {
   auto ctx = ValidatedContext();
