@@ -7,13 +7,6 @@ using LiteMath::Box4f;
 using LiteMath::float3;
 using LiteMath::uint2;
 
-int LBVH::Delta(int i, int j) const
-{
-  if (j < 0 || j >= int(m_leafCount))
-    return -1;
-  return __builtin_clz(m_leafCode[i] ^ m_leafCode[j]);
-}
-
 void LBVH::Reserve(int maxBoxes)
 {
   const size_t n = size_t(std::max(maxBoxes, 1));
@@ -43,11 +36,10 @@ void LBVH::Build(int count, const Box4f* boxes)
   std::exclusive_scan(m_newGroup.begin(), m_newGroup.begin() + count, m_groupOf.begin(), 0u);
   m_leafCount = 0;
   kernel1D_AppendComplete(count);
-  kernel1D_MakeLeaves(count, boxes);
   // (4) the hierarchy over the leaves
   kernel1D_Karras12(count);
-  // (5) the boxes of the inner nodes, from the leaves up
-  kernel1D_Refit(count);
+  // (5) the leaves from their boxes, then the inner nodes from the leaves up
+  kernel1D_Refit(count, boxes);
 }
 
 BVHTree LBVH::Tree(int count) const
@@ -108,29 +100,6 @@ void LBVH::kernel1D_AppendComplete(int count)
   }
 }
 
-void LBVH::kernel1D_MakeLeaves(int count, const Box4f* boxes)
-{
-  for (int leaf = 0; leaf < count; leaf++)
-  {
-    if (uint32_t(leaf) >= m_leafCount)
-      continue;
-    const uint32_t first = m_leafFirst[leaf];
-    const uint32_t last = uint32_t(leaf) + 1 < m_leafCount ? m_leafFirst[leaf + 1] : uint32_t(count);
-    float3 boxMin = float3(+1e30f), boxMax = float3(-1e30f);
-    for (uint32_t k = first; k < last; k++)
-    {
-      const Box4f box = boxes[m_primIndices[k]];
-      boxMin = min(boxMin, to_float3(box.boxMin));
-      boxMax = max(boxMax, to_float3(box.boxMax));
-    }
-    const uint32_t node = m_leafCount - 1 + uint32_t(leaf);  // leaves follow the leafCount - 1 inner nodes
-    m_nodes[node].boxMin = boxMin;
-    m_nodes[node].boxMax = boxMax;
-    m_nodes[node].left = kLeafFlag | first;
-    m_nodes[node].right = last - first;
-  }
-}
-
 void LBVH::kernel1D_Karras12(int count)
 {
   for (int i = 0; i < count; i++)
@@ -173,13 +142,26 @@ void LBVH::kernel1D_Karras12(int count)
   }
 }
 
-void LBVH::kernel1D_Refit(int count)
+void LBVH::kernel1D_Refit(int count, const Box4f* boxes)
 {
   for (int leaf = 0; leaf < count; leaf++)
   {
     if (uint32_t(leaf) >= m_leafCount)
       continue;
-    uint32_t node = m_leafCount - 1 + uint32_t(leaf);
+    const uint32_t first = m_leafFirst[leaf];
+    const uint32_t last = uint32_t(leaf) + 1 < m_leafCount ? m_leafFirst[leaf + 1] : uint32_t(count);
+    float3 boxMin = float3(+1e30f), boxMax = float3(-1e30f);
+    for (uint32_t k = first; k < last; k++)
+    {
+      const Box4f box = boxes[m_primIndices[k]];
+      boxMin = min(boxMin, to_float3(box.boxMin));
+      boxMax = max(boxMax, to_float3(box.boxMax));
+    }
+    uint32_t node = m_leafCount - 1 + uint32_t(leaf);  // leaves follow the leafCount - 1 inner nodes
+    m_nodes[node].boxMin = boxMin;
+    m_nodes[node].boxMax = boxMax;
+    m_nodes[node].left = kLeafFlag | first;
+    m_nodes[node].right = last - first;
     while (node != 0u)  // the root is node 0
     {
       const uint32_t parent = m_parent[node];

@@ -54,14 +54,19 @@ protected:
   void kernel1D_AppendInit(int count);
   // (3) after the scan: the first sorted box and the code of every leaf
   void kernel1D_AppendComplete(int count);
-  // leaves get their boxes and primitive ranges
-  void kernel1D_MakeLeaves(int count, const LiteMath::Box4f* boxes);
   // (4) the inner nodes' children from the leaves' codes, and each node's parent
   void kernel1D_Karras12(int count);
-  // (5) from each leaf up: the second child to reach an inner node gives it its box and goes on
-  void kernel1D_Refit(int count);
-  // Length of the common prefix of leaf codes i and j; -1 when j is outside the leaves.
-  int Delta(int i, int j) const;
+  // (5) each leaf gets its box and primitive range; from there up, the second child to reach an
+  // inner node gives it its box and goes on
+  void kernel1D_Refit(int count, const LiteMath::Box4f* boxes);
+  // Length of the common prefix of leaf codes i and j; -1 when j is outside the leaves. Defined
+  // here so that the translated CPU class, compiled apart, can inline it into Karras12's searches.
+  int Delta(int i, int j) const
+  {
+    if (j < 0 || j >= int(m_leafCount))
+      return -1;
+    return __builtin_clz(m_leafCode[i] ^ m_leafCode[j]);
+  }
 
   LiteMath::float3 m_centerMin, m_centerMax;
   std::vector<LiteMath::uint2> m_codes;  // (Morton code, box index)
