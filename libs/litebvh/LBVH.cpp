@@ -169,10 +169,12 @@ void LBVH::kernel1D_Refit(int count, const Box4f* boxes)
       // reads both (the first wrote its box before its atomic) and carries on with the parent.
       if (crossrt::AtomicAdd(m_arrivals[parent], 1u) == 0u)
         break;
-      const BVHNode left = m_nodes[m_nodes[parent].left];
-      const BVHNode right = m_nodes[m_nodes[parent].right];
-      m_nodes[parent].boxMin = min(left.boxMin, right.boxMin);
-      m_nodes[parent].boxMax = max(left.boxMax, right.boxMax);
+      // This thread's box is at hand: only the sibling's is read.
+      const uint32_t sibling = m_nodes[parent].left == node ? m_nodes[parent].right : m_nodes[parent].left;
+      boxMin = min(boxMin, m_nodes[sibling].boxMin);
+      boxMax = max(boxMax, m_nodes[sibling].boxMax);
+      m_nodes[parent].boxMin = boxMin;
+      m_nodes[parent].boxMax = boxMax;
       node = parent;
     }
   }
