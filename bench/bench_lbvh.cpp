@@ -3,7 +3,8 @@
 // default device, binned SAH), SAH cost of each tree, and traversal of 1024x1024 primary rays
 // (Embree rtcIntersect1 and rtcIntersect16, CrossRT's traversal over the LBVH and SAH trees as
 // written, and translated: PrimaryRays_CPU and PrimaryRays_Vulkan, which compose BVHScene's
-// traversal), with ratios against Embree. Every figure is measured in this run: medians of 3 after a warm-up.
+// traversal), with ratios against Embree. Every figure is measured in this run: medians of 3 after a warm-up,
+// and for the CPU builders medians of 7 rounds that run them in turn.
 // Then the speed-against-quality trade of LBVH against binned SAH, as a table and as a PNG.
 //
 //   bench_lbvh [mesh dir (default build/data/meshes)] [plot.png (default out/bvh_tradeoff.png)]
@@ -52,6 +53,37 @@ double MedianMs(const std::function<void()>& work)
   }
   std::sort(ms.begin(), ms.end());
   return ms[1];
+}
+
+// Wall times of several works measured in rounds, each round running every work once after a
+// warm-up round: a burst of load on this shared machine then slows them alike, and the ratio of
+// two works taken round by round keeps its meaning. Returns each work's times.
+std::vector<std::vector<double>> InterleavedMs(const std::vector<std::function<void()>>& works, int rounds)
+{
+  for (auto& work : works) work();
+  std::vector<std::vector<double>> ms(works.size());
+  for (int r = 0; r < rounds; ++r)
+    for (size_t w = 0; w < works.size(); ++w)
+    {
+      auto t0 = std::chrono::steady_clock::now();
+      works[w]();
+      ms[w].push_back(Ms(std::chrono::steady_clock::now() - t0));
+    }
+  return ms;
+}
+
+double Median(std::vector<double> v)
+{
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+// Median over the rounds of a[r] / b[r].
+double PairedRatio(const std::vector<double>& a, const std::vector<double>& b)
+{
+  std::vector<double> r;
+  for (size_t i = 0; i < a.size(); ++i) r.push_back(a[i] / b[i]);
+  return Median(r);
 }
 
 struct Camera
@@ -169,7 +201,8 @@ int main(int argc, char** argv)
   catch (const std::exception& e) { std::printf("no Vulkan device (%s): the _Vulkan column is left out\n", e.what()); }
   std::printf("CPU threads: %d; Vulkan device: %s\n", omp_get_max_threads(), ctx ? ctx->DeviceName().c_str() : "none");
 
-  std::printf("\nBuild time, ms (ratio = time / Embree LOW; Vulkan: wall time with copies, [GPU time])\n");
+  std::printf("\nBuild time, ms (ratio = time / Embree LOW; the CPU builders' medians of 7 interleaved rounds, their ratios\n"
+              "medians of the rounds' ratios; Vulkan: wall time with copies, [GPU time])\n");
   std::printf("| %-22s | %9s | %10s | %12s | %15s | %15s | %23s | %15s |\n", "mesh", "triangles", "Embree LOW", "Embree MEDIUM",
               "LBVH original", "LBVH_CPU", "LBVH_Vulkan", "binned SAH");
   std::printf("|%s|\n", std::string(146, '-').c_str());
@@ -189,15 +222,18 @@ int main(int argc, char** argv)
     const std::vector<Box4f> boxes = TriangleBoxes(row.mesh);
     const int n = int(boxes.size());
     EmbreeMesh embree;
-    const double low = MedianMs([&] { embree.Build(row.mesh, RTC_BUILD_QUALITY_LOW); });
-    const double medium = MedianMs([&] { embree.Build(row.mesh, RTC_BUILD_QUALITY_MEDIUM); });
     LBVH original;
     original.Reserve(n);
     lbvhCpu->Reserve(n);
     lbvhCpu->CommitDeviceData();
-    const double originalMs = MedianMs([&] { original.Build(n, boxes.data()); });
+    // The CPU builders in 7 interleaved rounds; ratios to Embree LOW are medians of per-round ratios.
+    const auto cpuMs = InterleavedMs({[&] { embree.Build(row.mesh, RTC_BUILD_QUALITY_LOW); },
+                                      [&] { embree.Build(row.mesh, RTC_BUILD_QUALITY_MEDIUM); },
+                                      [&] { original.Build(n, boxes.data()); }, [&] { lbvhCpu->Build(n, boxes.data()); }},
+                                     7);
+    const double low = Median(cpuMs[0]), medium = Median(cpuMs[1]), originalMs = Median(cpuMs[2]);
     row.lbvh = original.Tree(n);
-    row.lbvhCpuMs = MedianMs([&] { lbvhCpu->Build(n, boxes.data()); });
+    row.lbvhCpuMs = Median(cpuMs[3]);
     char gpu[64] = "n/a";
     if (lbvhGpu)
     {
@@ -210,7 +246,8 @@ int main(int argc, char** argv)
     }
     row.sahMs = MedianMs([&] { row.sah = BuildBinnedSAH(boxes.data(), n); });
     std::printf("| %-22s | %9d | %10.1f | %6.1f (%4.2fx) | %7.1f (%5.2fx) | %7.1f (%5.2fx) | %23s | %7.1f (%5.2fx) |\n", name, n, low,
-                medium, medium / low, originalMs, originalMs / low, row.lbvhCpuMs, row.lbvhCpuMs / low, gpu, row.sahMs, row.sahMs / low);
+                medium, PairedRatio(cpuMs[1], cpuMs[0]), originalMs, PairedRatio(cpuMs[2], cpuMs[0]), row.lbvhCpuMs,
+                PairedRatio(cpuMs[3], cpuMs[0]), gpu, row.sahMs, row.sahMs / low);
     rows.push_back(std::move(row));
   }
 
