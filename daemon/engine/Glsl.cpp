@@ -594,7 +594,7 @@ std::string GlslPrinter::Builtin(const FunctionDecl* fd, const std::vector<std::
   return "";
 }
 
-// ---- crossrt::Atomic* (Atomics.h): GLSL atomics with device scope and acquire-release order ----
+// ---- crossrt::Atomic* (Atomics.h): GLSL atomics between buffer memory barriers ----
 
 bool IsCrossrtAtomic(const FunctionDecl* fd) {
   static const std::set<std::string> names = {"AtomicAdd", "AtomicAnd", "AtomicOr", "AtomicXor", "AtomicExchange",
