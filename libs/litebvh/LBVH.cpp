@@ -38,8 +38,11 @@ void LBVH::Build(int count, const Box4f* boxes)
   kernel1D_AppendComplete(count);
   // (4) the hierarchy over the leaves
   kernel1D_Karras12(count);
-  // (5) the leaves from their boxes, then the inner nodes from the leaves up
-  kernel1D_Refit(count, boxes);
+  // (5) the leaves from their triangles' boxes
+  kernel1D_MakeLeaves(count, boxes);
+  // (6) the inner nodes from the leaves up. With the leaves done, only a node whose children are
+  // both inner needs an atomic, a third of them or so (making the leaves here, every node did).
+  kernel1D_Refit(count);
 }
 
 BVHTree LBVH::Tree(int count) const
@@ -142,7 +145,7 @@ void LBVH::kernel1D_Karras12(int count)
   }
 }
 
-void LBVH::kernel1D_Refit(int count, const Box4f* boxes)
+void LBVH::kernel1D_MakeLeaves(int count, const Box4f* boxes)
 {
   for (int leaf = 0; leaf < count; leaf++)
   {
@@ -157,20 +160,37 @@ void LBVH::kernel1D_Refit(int count, const Box4f* boxes)
       boxMin = min(boxMin, to_float3(box.boxMin));
       boxMax = max(boxMax, to_float3(box.boxMax));
     }
-    uint32_t node = m_leafCount - 1 + uint32_t(leaf);  // leaves follow the leafCount - 1 inner nodes
+    const uint32_t node = m_leafCount - 1 + uint32_t(leaf);  // leaves follow the leafCount - 1 inner nodes
     m_nodes[node].boxMin = boxMin;
     m_nodes[node].boxMax = boxMax;
     m_nodes[node].left = kLeafFlag | first;
     m_nodes[node].right = last - first;
-    while (node != 0u)  // the root is node 0
+  }
+}
+
+void LBVH::kernel1D_Refit(int count)
+{
+  for (int leaf = 0; leaf < count; leaf++)
+  {
+    if (uint32_t(leaf) >= m_leafCount)
+      continue;
+    const uint32_t firstLeaf = m_leafCount - 1;
+    uint32_t node = firstLeaf + uint32_t(leaf);
+    float3 boxMin = m_nodes[node].boxMin, boxMax = m_nodes[node].boxMax;
+    while (node != 0u)
     {
       const uint32_t parent = m_parent[node];
-      // The first child to arrive stops: its sibling's box may not be there yet. The second one
-      // reads both (the first wrote its box before its atomic) and carries on with the parent.
-      if (crossrt::AtomicAdd(m_arrivals[parent], 1u) == 0u)
+      const uint32_t left = m_nodes[parent].left, right = m_nodes[parent].right;
+      const uint32_t sibling = left == node ? right : left;
+      if (sibling >= firstLeaf)  // a leaf, done: of two leaves, the left one's thread goes on
+      {
+        if (node >= firstLeaf && node == right)
+          break;
+      }
+      else if (node >= firstLeaf)  // the inner sibling's thread will find this leaf done
         break;
-      // This thread's box is at hand: only the sibling's is read.
-      const uint32_t sibling = m_nodes[parent].left == node ? m_nodes[parent].right : m_nodes[parent].left;
+      else if (crossrt::AtomicAdd(m_arrivals[parent], 1u) == 0u)  // two inner children: the second goes on
+        break;
       boxMin = min(boxMin, m_nodes[sibling].boxMin);
       boxMax = max(boxMax, m_nodes[sibling].boxMax);
       m_nodes[parent].boxMin = boxMin;

@@ -56,9 +56,12 @@ protected:
   void kernel1D_AppendComplete(int count);
   // (4) the inner nodes' children from the leaves' codes, and each node's parent
   void kernel1D_Karras12(int count);
-  // (5) each leaf gets its box and primitive range; from there up, the second child to reach an
-  // inner node gives it its box and goes on
-  void kernel1D_Refit(int count, const LiteMath::Box4f* boxes);
+  // (5) each leaf gets its box and primitive range
+  void kernel1D_MakeLeaves(int count, const LiteMath::Box4f* boxes);
+  // (6) from the leaves up, one thread per leaf: a node is finished by the thread coming from its
+  // left leaf when both children are leaves, from its inner child when one is, and from the second
+  // to arrive (crossrt::AtomicAdd) when both are inner; the others stop
+  void kernel1D_Refit(int count);
   // Length of the common prefix of leaf codes i and j; -1 when j is outside the leaves. Defined
   // here so that the translated CPU class, compiled apart, can inline it into Karras12's searches.
   int Delta(int i, int j) const
