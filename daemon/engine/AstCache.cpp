@@ -96,7 +96,9 @@ AstCache::Handle AstCache::Get(const std::string& file, const std::vector<std::s
     return handle;
   }
 
+  // A failed parse's objects go in dependency order: the AST uses the engine, which uses the printer.
   entry->ast.reset();
+  entry->diags.reset();
   auto* options = new clang::DiagnosticOptions();
   options->ShowColors = false;
   entry->printer = std::make_unique<ErrorCountingPrinter>(entry->diagStream, options);

@@ -81,6 +81,10 @@ std::string IndentTail(const std::string& text, const std::string& pad) {
   return out;
 }
 
+// The specialization constant that switches the fences of crossrt atomics (crt_fenceAtomics). The
+// runtime names it crossrt::kFenceAtomicsConstantId; generated host code static_asserts they agree.
+const char* const kFenceAtomicsConstantId = "1700";
+
 const char* Axis(unsigned a) { return a == 0 ? "X" : a == 1 ? "Y" : "Z"; }
 const char* GlAxis(unsigned a) { return a == 0 ? "x" : a == 1 ? "y" : "z"; }
 
@@ -330,7 +334,7 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   // write are coherent, so that those writes are not held in a cache another thread misses.
   const std::string coherent = k.atomics ? "coherent " : "";
   d.set("atomics", k.atomics);
-  d.set("fenceConstantId", "1700");  // crossrt::kFenceAtomicsConstantId (VulkanRuntime.h)
+  d.set("fenceConstantId", kFenceAtomicsConstantId);
   d.set("classDataAccess", coherent);
   Data buffers = List();
   unsigned binding = 1;
@@ -829,6 +833,8 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
     bool anyReductions = false;
     for (auto& k : model.kernels) anyReductions |= !k.reductions.empty();
     d.set("anyReductions", anyReductions);
+    d.set("anyAtomics", std::any_of(model.kernels.begin(), model.kernels.end(), [](const Kernel& k) { return k.atomics; }));
+    d.set("fenceConstantId", kFenceAtomicsConstantId);
     files[model.className + "_Vulkan.h"] = Render(opt.templateDir + "/vulkan/class.h.mustache", d);
     files[model.className + "_Vulkan.cpp"] = Render(opt.templateDir + "/vulkan/class.cpp.mustache", d);
     return files;

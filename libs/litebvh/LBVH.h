@@ -2,7 +2,8 @@
 // conventions, so that the same class runs as written, translated to all CPU cores (LBVH_CPU) and
 // translated to Vulkan (LBVH_Vulkan). The steps follow the paper's listing 3: a reduction for the
 // bounds, Morton codes, a sort, grouping of equal codes into leaves with a scan, the Karras
-// hierarchy, and a bottom-up refit in one pass (the second child to reach a node finishes it).
+// hierarchy, and a bottom-up refit in one pass (a thread climbs from each leaf; at a node with two
+// inner children, the second to arrive finishes it).
 #pragma once
 #include "Atomics.h"
 #include "BVHNode.h"

@@ -21,7 +21,8 @@
 
 namespace crossrt {
 
-// The specialization constant id of the generated kernels' crt_fenceAtomics (VulkanContext::fenceAtomics).
+// The specialization constant id of the generated kernels' crt_fenceAtomics (VulkanContext::fenceAtomics);
+// the translator writes it into the shaders, and generated classes static_assert that it matches.
 constexpr uint32_t kFenceAtomicsConstantId = 1700;
 
 struct Error : std::runtime_error {
