@@ -3,8 +3,9 @@
 // default device, binned SAH), SAH cost of each tree, and traversal of 1024x1024 primary rays
 // (Embree rtcIntersect1 and rtcIntersect16, CrossRT's traversal over the LBVH and SAH trees as
 // written, and translated: PrimaryRays_CPU and PrimaryRays_Vulkan, which compose BVHScene's
-// traversal), with ratios against Embree. Every figure is measured in this run: medians of 3 after a warm-up,
-// and for the CPU builders medians of 7 rounds that run them in turn.
+// traversal), with ratios against Embree. Every figure is measured in this run: the CPU builders and
+// the CPU tracers in rounds that run each in turn (7 and 5), with ratios as medians of the rounds'
+// ratios; the Vulkan figures as medians of 3 after a warm-up.
 // Then the speed-against-quality trade of LBVH against binned SAH, as a table and as a PNG.
 //
 //   bench_lbvh [mesh dir (default build/data/meshes)] [plot.png (default out/bvh_tradeoff.png)]
@@ -37,6 +38,7 @@ using LiteImage::Image2D;
 namespace {
 
 constexpr int kImageSize = 1024;
+constexpr int kTraceRounds = 5;  // interleaved rounds of the CPU tracers
 
 double Ms(std::chrono::steady_clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); }
 
@@ -251,8 +253,9 @@ int main(int argc, char** argv)
     rows.push_back(std::move(row));
   }
 
-  std::printf("\nTraversal of %dx%d primary rays, Mrays/s, all %d threads (ratio against Embree rtcIntersect1); SAH cost of the trees\n",
-              kImageSize, kImageSize, omp_get_max_threads());
+  std::printf("\nTraversal of %dx%d primary rays, Mrays/s, all %d threads but 1T (ratio against Embree rtcIntersect1 on all\n"
+              "threads: medians of %d interleaved rounds' ratios); SAH cost of the trees\n",
+              kImageSize, kImageSize, omp_get_max_threads(), kTraceRounds);
   std::printf("| %-22s | %9s | %9s | %15s | %15s | %15s | %15s | %23s | %9s | %9s | %8s |\n", "mesh", "Embree 1", "Embree 16",
               "CrossRT LBVH", "CrossRT LBVH 1T", "LBVH _CPU", "CrossRT SAH", "LBVH _Vulkan [GPU]", "SAH cost L", "SAH cost S", "same hit");
   std::printf("|%s|\n", std::string(188, '-').c_str());
@@ -275,7 +278,7 @@ int main(int argc, char** argv)
     EmbreeMesh embree;
     embree.Build(row.mesh, RTC_BUILD_QUALITY_MEDIUM);
     std::vector<uint32_t> embreePrim(pixels), ourPrim(pixels);
-    const double embree1 = MedianMs([&] {
+    auto embreeSingle = [&] {
 #pragma omp parallel for schedule(dynamic, 16)
       for (int y = 0; y < kImageSize; ++y)
       {
@@ -293,8 +296,8 @@ int main(int argc, char** argv)
           embreePrim[y * kImageSize + x] = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? 0xFFFFFFFFu : rh.hit.primID;
         }
       }
-    });
-    const double embree16 = MedianMs([&] {
+    };
+    auto embreePacket = [&] {
 #pragma omp parallel for schedule(dynamic, 4)
       for (int ty = 0; ty < kImageSize / 4; ++ty)
       {
@@ -316,14 +319,14 @@ int main(int argc, char** argv)
           rtcIntersect16(valid, embree.scene, &context, &rh);
         }
       }
-    });
-    auto traceWith = [&](ISceneObject& scene, int threads) {
-      return MedianMs([&] {
+    };
+    auto traceWith = [&](ISceneObject& scene, int threads, std::vector<uint32_t>& prims) {
+      return [&scene, threads, &prims, &cam] {
 #pragma omp parallel for schedule(dynamic, 16) num_threads(threads)
         for (int y = 0; y < kImageSize; ++y)
           for (int x = 0; x < kImageSize; ++x)
-            ourPrim[y * kImageSize + x] = scene.RayQuery_NearestHit(float4(cam.eye.x, cam.eye.y, cam.eye.z, 0.0f), cam.Ray(x, y)).primId;
-      });
+            prims[y * kImageSize + x] = scene.RayQuery_NearestHit(float4(cam.eye.x, cam.eye.y, cam.eye.z, 0.0f), cam.Ray(x, y)).primId;
+      };
     };
     const BVHTree lbvhTree = row.lbvh, sahTree = row.sah;
     // Scenes over the trees built above; their one-instance top level gets a tree of its own.
@@ -339,16 +342,21 @@ int main(int argc, char** argv)
       s->CommitScene();
     }
     const int threads = omp_get_max_threads();
-    const double sahMs = traceWith(sahScene, threads);
-    const double lbvh1T = traceWith(lbvhScene, 1);
-    const double lbvhMs = traceWith(lbvhScene, threads);  // last: ourPrim holds the LBVH's hits
     auto mrays = [&](double ms) { return pixels / ms / 1e3; };
     std::vector<float4> rayPos(pixels, float4(cam.eye.x, cam.eye.y, cam.eye.z, 0.0f)), rayDir(pixels);
     for (int i = 0; i < pixels; ++i) rayDir[i] = cam.Ray(i % kImageSize, i / kImageSize);
     std::vector<CRT_Hit> castHits(pixels);
     std::shared_ptr<ISceneObject> lbvhShared(&lbvhScene, [](ISceneObject*) {});  // lives on this stack frame
     castCpu->SetScene(lbvhShared, {}, {});
-    const double castCpuMs = MedianMs([&] { castCpu->CastRays(rayPos.data(), rayDir.data(), castHits.data(), pixels); });
+    // The CPU tracers in interleaved rounds, as the builders above: ratios are medians of per-round ratios.
+    std::vector<uint32_t> sahPrim(pixels), lbvh1TPrim(pixels);
+    const auto traceMs = InterleavedMs({embreeSingle, embreePacket, traceWith(lbvhScene, threads, ourPrim), traceWith(lbvhScene, 1, lbvh1TPrim),
+                                        [&] { castCpu->CastRays(rayPos.data(), rayDir.data(), castHits.data(), pixels); },
+                                        traceWith(sahScene, threads, sahPrim)},
+                                       kTraceRounds);
+    const double embree1 = Median(traceMs[0]), embree16 = Median(traceMs[1]), lbvhMs = Median(traceMs[2]), lbvh1T = Median(traceMs[3]),
+                 castCpuMs = Median(traceMs[4]), sahMs = Median(traceMs[5]);
+    auto againstEmbree1 = [&](int work) { return PairedRatio(traceMs[0], traceMs[work]); };  // throughput ratio
     size_t translatedDiffer = 0;
     for (int i = 0; i < pixels; ++i) translatedDiffer += castHits[i].primId != ourPrim[i];
     char gpuCast[48] = "no device";
@@ -369,8 +377,8 @@ int main(int argc, char** argv)
     size_t same = 0;
     for (int i = 0; i < pixels; ++i) same += ourPrim[i] == embreePrim[i];
     std::printf("| %-22s | %9.2f | %9.2f | %6.2f (%5.2fx) | %6.2f (%5.2fx) | %6.2f (%5.2fx) | %6.2f (%5.2fx) | %23s | %9.1f | %9.1f | %7.4f%% |\n",
-                row.name.c_str(), mrays(embree1), mrays(embree16), mrays(lbvhMs), embree1 / lbvhMs, mrays(lbvh1T), embree1 / lbvh1T,
-                mrays(castCpuMs), embree1 / castCpuMs, mrays(sahMs), embree1 / sahMs, gpuCast, SAHCost(row.lbvh), SAHCost(row.sah),
+                row.name.c_str(), mrays(embree1), mrays(embree16), mrays(lbvhMs), againstEmbree1(2), mrays(lbvh1T), againstEmbree1(3),
+                mrays(castCpuMs), againstEmbree1(4), mrays(sahMs), againstEmbree1(5), gpuCast, SAHCost(row.lbvh), SAHCost(row.sah),
                 100.0 * same / pixels);
     trade.push_back({row.name, row.lbvhCpuMs, mrays(lbvhMs), row.sahMs, mrays(sahMs)});
   }

@@ -585,6 +585,9 @@ std::string GlslPrinter::Builtin(const FunctionDecl* fd, const std::vector<std::
     if (t.back() == '4') r = std::string(f) + "(" + r + ", " + v + ".w)";
     return r;
   }
+  // The lanes' bits as the sum of their weights: one compare of four lanes, each argument read once.
+  if (n == "lane_mask_le")
+    return "uint(dot(vec4(lessThanEqual(" + a[0] + ", " + a[1] + ")), vec4(1.0, 2.0, 4.0, 8.0)))";
   if (n == "mul4x3") return "(" + a[0] + " * vec4(" + a[1] + ", 1.0)).xyz";
   if (n == "mul3x3") return "(mat3(" + a[0] + ") * " + a[1] + ")";
   if (n == "fmod" || n == "fmodf") return "(" + a[0] + " - " + a[1] + " * trunc(" + a[0] + " / " + a[1] + "))";

@@ -347,6 +347,17 @@ inline float hmax(const float3& a) { return std::max(a.x, std::max(a.y, a.z)); }
 inline float hmin(const float4& a) { return std::min(std::min(a.x, a.y), std::min(a.z, a.w)); }
 inline float hmax(const float4& a) { return std::max(std::max(a.x, a.y), std::max(a.z, a.w)); }
 
+// Bit i set where a[i] <= b[i] (a NaN on either side compares false): one SIMD compare on the
+// CPU, and lessThanEqual on the GPU. For branching on which of four lanes pass a test.
+#if LITEMATH_FLOAT4_SSE
+inline uint lane_mask_le(const float4& a, const float4& b) { return uint(_mm_movemask_ps(_mm_cmple_ps(lm_load(a), lm_load(b)))); }
+#else
+inline uint lane_mask_le(const float4& a, const float4& b)
+{
+  return (a.x <= b.x ? 1u : 0u) | (a.y <= b.y ? 2u : 0u) | (a.z <= b.z ? 4u : 0u) | (a.w <= b.w ? 8u : 0u);
+}
+#endif
+
 // ---------------------------------------------------------------- conversions
 inline float2 to_float2(const float3& v) { return float2(v.x, v.y); }
 inline float2 to_float2(const float4& v) { return float2(v.x, v.y); }

@@ -121,27 +121,43 @@ inline void OrderLanes(float4& entries, uint4& children, int i, int j)
 }
 
 // The lanes of `n` the ray enters within [tnear, tfar], nearest first: their entry distances and
-// children, and how many there are (the lanes missed come after them).
+// children in entries/children[0, count), and count. Coherent rays mostly enter one or two lanes,
+// so each count has its own path: no compare for one lane, one for two, a network for more.
 inline int EnteredLanes(const BVHTraceRay& r, const BVH4Node& n, float tfar, float4& entries, uint4& children)
 {
   float4 exits;
-  entries = SlabEntries(r, n, tfar, exits);
-  children = n.child;
-  int entered = 0;
-  for (int lane = 0; lane < 4; ++lane)
-  {
-    if (entries[lane] <= exits[lane])
-      entered = entered + 1;
-    else
-      entries[lane] = kNever;  // missed (NaN compares false too): sorts last
-  }
-  // A sorting network of five compare-exchanges, without branches on the GPU.
+  const float4 laneEntries = SlabEntries(r, n, tfar, exits);
+  uint32_t mask = lane_mask_le(laneEntries, exits);  // a NaN entry or exit compares false: missed
+  if (mask == 0u)
+    return 0;
+  const int first = __builtin_ctz(mask);
+  entries[0] = laneEntries[first];
+  children[0] = n.child[first];
+  mask = mask & (mask - 1u);
+  if (mask == 0u)
+    return 1;
+  const int second = __builtin_ctz(mask);
+  entries[1] = laneEntries[second];
+  children[1] = n.child[second];
   OrderLanes(entries, children, 0, 1);
-  OrderLanes(entries, children, 2, 3);
-  OrderLanes(entries, children, 0, 2);
-  OrderLanes(entries, children, 1, 3);
+  mask = mask & (mask - 1u);
+  if (mask == 0u)
+    return 2;
+  // Three or four: insert each into the ordered front.
+  const int third = __builtin_ctz(mask);
+  entries[2] = laneEntries[third];
+  children[2] = n.child[third];
   OrderLanes(entries, children, 1, 2);
-  return entered;
+  OrderLanes(entries, children, 0, 1);
+  mask = mask & (mask - 1u);
+  if (mask == 0u)
+    return 3;
+  entries[3] = laneEntries[3];  // the fourth entered lane can only be lane 3
+  children[3] = n.child[3];
+  OrderLanes(entries, children, 2, 3);
+  OrderLanes(entries, children, 1, 2);
+  OrderLanes(entries, children, 0, 1);
+  return 4;
 }
 
 // a * b - c * d within 1.5 ulp (Kahan's algorithm): its sign is exact, which decides on which side
