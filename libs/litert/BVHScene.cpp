@@ -169,44 +169,47 @@ float DifferenceOfProducts(float a, float b, float c, float d)
   return std::fma(a, b, -cd) + error;
 }
 
-// Watertight ray/triangle test, both sides. On a hit in [tnear, tfar] sets t and Embree-style
-// barycentrics (u weights v1, v weights v2).
-bool IntersectTriangle(const BVHTraceRay& r, const BVHTriangle& tri, float tfar, float& t, float& u, float& v)
+// Watertight ray/triangle test (Woop, Benthin and Wald 2013), both sides, of the four triangles of
+// `g` at once. Returns the lanes hit within [tnear, tfar] as bits, with their distances t and
+// Embree-style barycentrics (u weights corner 1, v corner 2).
+uint32_t IntersectTriangles4(const BVHTraceRay& r, const BVHTriangle4& g, float tfar, float4& t, float4& u, float4& v)
 {
-  const float3 a = tri.v0 - r.org;
-  const float3 b = tri.v1 - r.org;
-  const float3 c = tri.v2 - r.org;
-  const float ax = a[r.kx] - r.sx * a[r.kz];
-  const float ay = a[r.ky] - r.sy * a[r.kz];
-  const float bx = b[r.kx] - r.sx * b[r.kz];
-  const float by = b[r.ky] - r.sy * b[r.kz];
-  const float cx = c[r.kx] - r.sx * c[r.kz];
-  const float cy = c[r.ky] - r.sy * c[r.kz];
-  float eu = cx * by - cy * bx;
-  float ev = ax * cy - ay * cx;
-  float ew = bx * ay - by * ax;
-  if (eu == 0.0f || ev == 0.0f || ew == 0.0f)
+  // The corners relative to the origin, sheared so that the ray runs along +z from (0, 0).
+  const float ox = r.org[r.kx];
+  const float oy = r.org[r.ky];
+  const float oz = r.org[r.kz];
+  const float4 az = g.coord[r.kz] - oz;
+  const float4 bz = g.coord[3 + r.kz] - oz;
+  const float4 cz = g.coord[6 + r.kz] - oz;
+  const float4 ax = (g.coord[r.kx] - ox) - r.sx * az;
+  const float4 ay = (g.coord[r.ky] - oy) - r.sy * az;
+  const float4 bx = (g.coord[3 + r.kx] - ox) - r.sx * bz;
+  const float4 by = (g.coord[3 + r.ky] - oy) - r.sy * bz;
+  const float4 cx = (g.coord[6 + r.kx] - ox) - r.sx * cz;
+  const float4 cy = (g.coord[6 + r.ky] - oy) - r.sy * cz;
+  float4 eu = cx * by - cy * bx;
+  float4 ev = ax * cy - ay * cx;
+  float4 ew = bx * ay - by * ax;
+  const float4 zero = float4(0.0f);
+  uint32_t onEdge = lane_mask_le(min(min(abs(eu), abs(ev)), abs(ew)), zero);
+  while (onEdge != 0u)
   {
     // On an edge in float: decide exactly, so that neighbouring triangles agree.
-    eu = DifferenceOfProducts(cx, by, cy, bx);
-    ev = DifferenceOfProducts(ax, cy, ay, cx);
-    ew = DifferenceOfProducts(bx, ay, by, ax);
+    const int lane = __builtin_ctz(onEdge);
+    onEdge = onEdge & (onEdge - 1u);
+    eu[lane] = DifferenceOfProducts(cx[lane], by[lane], cy[lane], bx[lane]);
+    ev[lane] = DifferenceOfProducts(ax[lane], cy[lane], ay[lane], cx[lane]);
+    ew[lane] = DifferenceOfProducts(bx[lane], ay[lane], by[lane], ax[lane]);
   }
-  if ((eu < 0.0f || ev < 0.0f || ew < 0.0f) && (eu > 0.0f || ev > 0.0f || ew > 0.0f))
-    return false;
-  const float det = eu + ev + ew;
-  if (det == 0.0f)
-    return false;  // edge-on or degenerate
-  const float az = r.sz * a[r.kz];
-  const float bz = r.sz * b[r.kz];
-  const float cz = r.sz * c[r.kz];
-  const float distance = (eu * az + ev * bz + ew * cz) / det;
-  if (!(distance >= r.tnear && distance <= tfar))
-    return false;
-  t = distance;
+  // Inside when the three edge functions share a sign (zeros count as either).
+  uint32_t hits = lane_mask_le(zero, min(min(eu, ev), ew)) | lane_mask_le(max(max(eu, ev), ew), zero);
+  const float4 det = eu + ev + ew;
+  hits = hits & ~(lane_mask_le(det, zero) & lane_mask_le(zero, det));  // edge-on or degenerate
+  t = (eu * (r.sz * az) + ev * (r.sz * bz) + ew * (r.sz * cz)) / det;
+  hits = hits & lane_mask_le(float4(r.tnear), t) & lane_mask_le(t, float4(tfar));  // NaN (an empty lane) fails
   u = ev / det;
   v = ew / det;
-  return true;
+  return hits;
 }
 
 float3 ToObjectPoint(const BVHInstance& inst, float3 p)
@@ -367,6 +370,46 @@ private:
   std::vector<BVH4Node> m_nodes;
 };
 
+// Packs the triangles of each leaf of `wide` (triangles[k] is triangle primIndices[k]) into groups
+// of four, in the order the leaves appear, and points the leaves at their groups.
+void GroupLeaves(std::vector<BVH4Node>& wide, const std::vector<BVHTriangle>& triangles, const std::vector<uint32_t>& primIndices,
+                 std::vector<BVHTriangle4>& groups, std::vector<uint32_t>& groupPrims)
+{
+  groups.clear();
+  groupPrims.clear();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (BVH4Node& n : wide)
+    for (int lane = 0; lane < 4; ++lane)
+    {
+      const uint32_t c = n.child[lane];
+      if (c == kNoChild || (c & kLeafFlag) == 0)
+        continue;
+      const uint32_t first = (c & ~kLeafFlag) >> 3, count = (c & 7u) + 1;
+      const uint32_t firstGroup = uint32_t(groups.size()), groupCount = (count + 3) / 4;
+      for (uint32_t k = 0; k < 4 * groupCount; ++k)
+      {
+        if (k % 4 == 0)
+        {
+          groups.emplace_back();
+          for (float4& c4 : groups.back().coord) c4 = float4(nan);
+        }
+        BVHTriangle4& group = groups.back();
+        if (k >= count)
+        {
+          groupPrims.push_back(kNoId);
+          continue;
+        }
+        const BVHTriangle& tri = triangles[first + k];
+        const float3 corners[3] = {tri.v0, tri.v1, tri.v2};
+        for (int corner = 0; corner < 3; ++corner)
+          for (int axis = 0; axis < 3; ++axis)
+            group.coord[3 * corner + axis][k % 4] = corners[corner][axis];
+        groupPrims.push_back(primIndices[first + k]);
+      }
+      n.child[lane] = LeafRef(firstGroup, groupCount);
+    }
+}
+
 std::vector<BVH4Node> CollapseTree(const BVHTree& tree, std::function<Box4f(uint32_t)> primBox)
 {
   int stackNeed = 0;
@@ -378,7 +421,7 @@ std::vector<BVH4Node> CollapseTree(const BVHTree& tree, std::function<Box4f(uint
 }
 
 // Appends `tree` to `nodes` with child indices moved by the append position and leaf ranges
-// moved by firstPrim. Returns the root's index.
+// (primitives or groups) moved by firstPrim. Returns the root's index.
 uint32_t AppendTree(std::vector<BVH4Node>& nodes, const std::vector<BVH4Node>& tree, uint32_t firstPrim)
 {
   const uint32_t base = uint32_t(nodes.size());
@@ -391,7 +434,7 @@ uint32_t AppendTree(std::vector<BVH4Node>& nodes, const std::vector<BVH4Node>& t
         continue;
       const uint32_t first = ((c & ~kLeafFlag) >> 3) + firstPrim;
       if ((c & kLeafFlag) && first >= (1u << 28))
-        throw std::length_error("BVHScene: more than 2^28 triangles in a scene");
+        throw std::length_error("BVHScene: more than 2^28 groups of triangles in a scene");
       n.child[i] = (c & kLeafFlag) ? LeafRef(first, (c & 7u) + 1) : c + base;
     }
     nodes.push_back(n);
@@ -454,6 +497,7 @@ void BVHScene::SetMesh(Mesh& mesh, const float* vpos3f, size_t vertNum, const ui
   mesh.wide.clear();
   if (triCount > 0)
     mesh.wide = CollapseTree(mesh.tree, [&](uint32_t k) { return boxes[mesh.tree.primIndices[k]]; });
+  GroupLeaves(mesh.wide, mesh.triangles, mesh.tree.primIndices, mesh.groups, mesh.groupPrims);
   ClearDeviceData();
 }
 
@@ -533,8 +577,8 @@ void BVHScene::CommitScene(uint32_t)
     if (mesh.wide.empty())
       continue;
     meshRoot[g] = AppendTree(m_nodes, mesh.wide, uint32_t(m_triangles.size()));
-    m_triangles.insert(m_triangles.end(), mesh.triangles.begin(), mesh.triangles.end());
-    m_primIds.insert(m_primIds.end(), mesh.tree.primIndices.begin(), mesh.tree.primIndices.end());
+    m_triangles.insert(m_triangles.end(), mesh.groups.begin(), mesh.groups.end());
+    m_primIds.insert(m_primIds.end(), mesh.groupPrims.begin(), mesh.groupPrims.end());
   }
   for (uint32_t k : top.primIndices)
   {
@@ -600,21 +644,27 @@ bool BVHScene::TraceMesh(const BVHTraceRay& ray, uint32_t root, bool anyHit, flo
     {
       const uint32_t first = (node & ~kLeafFlag) >> 3;
       const uint32_t last = first + (node & 7u);
-      for (uint32_t j = first; j <= last; ++j)
+      for (uint32_t g = first; g <= last; ++g)
       {
-        float t = 0.0f;
-        float u = 0.0f;
-        float v = 0.0f;
-        if (!IntersectTriangle(ray, m_triangles[j], tfar, t, u, v))
-          continue;
-        found = true;
-        tfar = t;
-        hit.t = t;
-        hit.primId = m_primIds[j];
-        hit.coords[0] = u;
-        hit.coords[1] = v;
-        if (anyHit)
-          return true;
+        float4 t;
+        float4 u;
+        float4 v;
+        uint32_t hits = IntersectTriangles4(ray, m_triangles[g], tfar, t, u, v);
+        while (hits != 0u)
+        {
+          const int lane = __builtin_ctz(hits);
+          hits = hits & (hits - 1u);
+          if (t[lane] > tfar)
+            continue;  // behind a lane of this group taken before it
+          found = true;
+          tfar = t[lane];
+          hit.t = t[lane];
+          hit.primId = m_primIds[4 * g + lane];
+          hit.coords[0] = u[lane];
+          hit.coords[1] = v[lane];
+          if (anyHit)
+            return true;
+        }
       }
     }
     else

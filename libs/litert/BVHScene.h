@@ -24,14 +24,24 @@ struct BVH4Node
   LiteMath::uint4 unused;
 };
 
-// A leaf lane holds up to 8 primitives: kLeafFlag | first << 3 | (count - 1).
+// A leaf lane of a mesh tree holds up to 8 primitives, in groups of four (BVHTriangle4):
+// kLeafFlag | first group << 3 | (groups - 1). A leaf of the top tree holds up to 8 instances:
+// kLeafFlag | first << 3 | (count - 1).
 constexpr uint32_t kMaxLeafSize = 8;
 constexpr uint32_t kNoChild = 0xFFFFFFFFu;  // an empty lane (its box is never entered)
 
-// A triangle's corners (36 bytes; a scalar-layout buffer on the GPU).
+// A triangle's corners.
 struct BVHTriangle
 {
   LiteMath::float3 v0, v1, v2;
+};
+
+// Four triangles side by side, one lane each, so that one test covers four with float4
+// arithmetic: coord[3 * corner + axis] holds that coordinate of the four. A lane without a
+// triangle holds NaN, which no ray hits. 144 bytes, std430 as in C++.
+struct BVHTriangle4
+{
+  LiteMath::float4 coord[9];
 };
 
 // An instance as the traversal reads it: rows 0-2 of its world-to-object matrix, the ids a hit
@@ -82,8 +92,8 @@ public:
   // Public because a class composing BVHScene uploads them to the GPU.
   std::vector<BVH4Node> m_nodes;         // the top tree (root 0, leaves index m_instances), then every mesh's
   std::vector<BVHInstance> m_instances;  // in the top tree's leaf order
-  std::vector<BVHTriangle> m_triangles;  // every mesh's triangles in its leaf order (leaves index here)
-  std::vector<uint32_t> m_primIds;       // m_triangles[k] is triangle m_primIds[k] of its mesh
+  std::vector<BVHTriangle4> m_triangles;  // every mesh's triangles in leaf order, four per group (leaves index here)
+  std::vector<uint32_t> m_primIds;        // lane l of m_triangles[g] is triangle m_primIds[4 * g + l] of its mesh
 
 private:
   struct Mesh
@@ -91,6 +101,8 @@ private:
     BVHTree tree;                        // as the builder made it
     std::vector<BVH4Node> wide;          // the same tree collapsed for the traversal (empty without triangles)
     std::vector<BVHTriangle> triangles;  // triangles[k] is triangle tree.primIndices[k]
+    std::vector<BVHTriangle4> groups;    // what wide's leaves index: each leaf's triangles, four per group
+    std::vector<uint32_t> groupPrims;    // lane l of groups[g] is triangle groupPrims[4 * g + l] (or none)
   };
   struct Instance
   {
