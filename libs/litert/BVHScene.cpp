@@ -169,47 +169,10 @@ float DifferenceOfProducts(float a, float b, float c, float d)
   return std::fma(a, b, -cd) + error;
 }
 
-// Watertight ray/triangle test (Woop, Benthin and Wald 2013), both sides, of the four triangles of
-// `g` at once. Returns the lanes hit within [tnear, tfar] as bits, with their distances t and
-// Embree-style barycentrics (u weights corner 1, v corner 2).
-uint32_t IntersectTriangles4(const BVHTraceRay& r, const BVHTriangle4& g, float tfar, float4& t, float4& u, float4& v)
+float4 DifferenceOfProducts(float4 a, float4 b, float4 c, float4 d)
 {
-  // The corners relative to the origin, sheared so that the ray runs along +z from (0, 0).
-  const float ox = r.org[r.kx];
-  const float oy = r.org[r.ky];
-  const float oz = r.org[r.kz];
-  const float4 az = g.coord[r.kz] - oz;
-  const float4 bz = g.coord[3 + r.kz] - oz;
-  const float4 cz = g.coord[6 + r.kz] - oz;
-  const float4 ax = (g.coord[r.kx] - ox) - r.sx * az;
-  const float4 ay = (g.coord[r.ky] - oy) - r.sy * az;
-  const float4 bx = (g.coord[3 + r.kx] - ox) - r.sx * bz;
-  const float4 by = (g.coord[3 + r.ky] - oy) - r.sy * bz;
-  const float4 cx = (g.coord[6 + r.kx] - ox) - r.sx * cz;
-  const float4 cy = (g.coord[6 + r.ky] - oy) - r.sy * cz;
-  float4 eu = cx * by - cy * bx;
-  float4 ev = ax * cy - ay * cx;
-  float4 ew = bx * ay - by * ax;
-  const float4 zero = float4(0.0f);
-  uint32_t onEdge = lane_mask_le(min(min(abs(eu), abs(ev)), abs(ew)), zero);
-  while (onEdge != 0u)
-  {
-    // On an edge in float: decide exactly, so that neighbouring triangles agree.
-    const int lane = __builtin_ctz(onEdge);
-    onEdge = onEdge & (onEdge - 1u);
-    eu[lane] = DifferenceOfProducts(cx[lane], by[lane], cy[lane], bx[lane]);
-    ev[lane] = DifferenceOfProducts(ax[lane], cy[lane], ay[lane], cx[lane]);
-    ew[lane] = DifferenceOfProducts(bx[lane], ay[lane], by[lane], ax[lane]);
-  }
-  // Inside when the three edge functions share a sign (zeros count as either).
-  uint32_t hits = lane_mask_le(zero, min(min(eu, ev), ew)) | lane_mask_le(max(max(eu, ev), ew), zero);
-  const float4 det = eu + ev + ew;
-  hits = hits & ~(lane_mask_le(det, zero) & lane_mask_le(zero, det));  // edge-on or degenerate
-  t = (eu * (r.sz * az) + ev * (r.sz * bz) + ew * (r.sz * cz)) / det;
-  hits = hits & lane_mask_le(float4(r.tnear), t) & lane_mask_le(t, float4(tfar));  // NaN (an empty lane) fails
-  u = ev / det;
-  v = ew / det;
-  return hits;
+  return float4(DifferenceOfProducts(a.x, b.x, c.x, d.x), DifferenceOfProducts(a.y, b.y, c.y, d.y),
+                DifferenceOfProducts(a.z, b.z, c.z, d.z), DifferenceOfProducts(a.w, b.w, c.w, d.w));
 }
 
 float3 ToObjectPoint(const BVHInstance& inst, float3 p)
@@ -628,6 +591,50 @@ bool BVHScene::ExportScene(CRT_SceneExport& out) const
 
 // ---- traversal: plain C++ in the translator's conventions (composed into GPU kernels) ----
 
+// Watertight ray/triangle test (Woop, Benthin and Wald 2013), both sides, of the four triangles of
+// m_triangles[group] at once. Returns the lanes hit within [tnear, tfar] as bits, with their distances t and
+// Embree-style barycentrics (u weights corner 1, v corner 2).
+uint32_t BVHScene::IntersectGroup(const BVHTraceRay& r, uint32_t group, float tfar, float4& t, float4& u, float4& v) const
+{
+  // The corners relative to the origin, sheared so that the ray runs along +z from (0, 0). Each
+  // coordinate is read from m_triangles where it is used: a copy of the group would be a local
+  // array, which GPU compilers index in scratch memory.
+  const float ox = r.org[r.kx];
+  const float oy = r.org[r.ky];
+  const float oz = r.org[r.kz];
+  const float4 az = m_triangles[group].coord[r.kz] - oz;
+  const float4 bz = m_triangles[group].coord[3 + r.kz] - oz;
+  const float4 cz = m_triangles[group].coord[6 + r.kz] - oz;
+  const float4 ax = (m_triangles[group].coord[r.kx] - ox) - r.sx * az;
+  const float4 ay = (m_triangles[group].coord[r.ky] - oy) - r.sy * az;
+  const float4 bx = (m_triangles[group].coord[3 + r.kx] - ox) - r.sx * bz;
+  const float4 by = (m_triangles[group].coord[3 + r.ky] - oy) - r.sy * bz;
+  const float4 cx = (m_triangles[group].coord[6 + r.kx] - ox) - r.sx * cz;
+  const float4 cy = (m_triangles[group].coord[6 + r.ky] - oy) - r.sy * cz;
+  float4 eu = cx * by - cy * bx;
+  float4 ev = ax * cy - ay * cx;
+  float4 ew = bx * ay - by * ax;
+  const float4 zero = float4(0.0f);
+  if (lane_mask_le(min(min(abs(eu), abs(ev)), abs(ew)), zero) != 0u)
+  {
+    // A lane on an edge in float: decide exactly, so that neighbouring triangles agree. (Rounding
+    // never flips the sign of a product difference, only zeroes it, so the other lanes keep theirs.)
+    eu = DifferenceOfProducts(cx, by, cy, bx);
+    ev = DifferenceOfProducts(ax, cy, ay, cx);
+    ew = DifferenceOfProducts(bx, ay, by, ax);
+  }
+  // Inside when the three edge functions share a sign (zeros count as either).
+  uint32_t hits = lane_mask_le(zero, min(min(eu, ev), ew)) | lane_mask_le(max(max(eu, ev), ew), zero);
+  const float4 det = eu + ev + ew;
+  hits = hits & ~(lane_mask_le(det, zero) & lane_mask_le(zero, det));  // edge-on or degenerate
+  t = (eu * (r.sz * az) + ev * (r.sz * bz) + ew * (r.sz * cz)) / det;
+  hits = hits & lane_mask_le(float4(r.tnear), t) & lane_mask_le(t, float4(tfar));  // NaN (an empty lane) fails
+  u = ev / det;
+  v = ew / det;
+  return hits;
+}
+
+
 // Visits the leaves of the mesh tree at `root` that the ray may reach, nearest box first, and
 // tests their triangles. On a hit nearer than tfar: sets tfar and the hit's t, primId and
 // barycentrics, and returns true (at the first hit when anyHit).
@@ -649,7 +656,7 @@ bool BVHScene::TraceMesh(const BVHTraceRay& ray, uint32_t root, bool anyHit, flo
         float4 t;
         float4 u;
         float4 v;
-        uint32_t hits = IntersectTriangles4(ray, m_triangles[g], tfar, t, u, v);
+        uint32_t hits = IntersectGroup(ray, g, tfar, t, u, v);
         while (hits != 0u)
         {
           const int lane = __builtin_ctz(hits);

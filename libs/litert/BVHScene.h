@@ -116,6 +116,8 @@ private:
   bool Trace(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar, bool anyHit, CRT_Hit& hit) const;
   bool TraceInstance(uint32_t k, const BVHTraceRay& worldRay, bool anyHit, float& tfar, CRT_Hit& hit) const;
   bool TraceMesh(const BVHTraceRay& ray, uint32_t root, bool anyHit, float& tfar, CRT_Hit& hit) const;
+  uint32_t IntersectGroup(const BVHTraceRay& r, uint32_t group, float tfar, LiteMath::float4& t, LiteMath::float4& u,
+                          LiteMath::float4& v) const;
 
   std::string m_name;
   Builder m_builder;
