@@ -163,7 +163,7 @@ TEST_CASE("LiteMath min/max coexist with std", "[litemath]")
 
 // float4 runs on SSE in compiled C++ (LITEMATH_FLOAT4_SSE): each lane must give the same bits as the
 // scalar std::min/std::max and operators, including the operand order that decides NaN and +-0.
-TEST_CASE("LiteMath float4 arithmetic and min/max match the scalar definitions bit for bit", "[litemath]")
+TEST_CASE("LiteMath float4 arithmetic, min/max and lane_mask_le match the scalar definitions bit for bit", "[litemath]")
 {
   const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
   const float4 a(nan, 0.0f, -0.0f, 1.5f), b(1.0f, -0.0f, 0.0f, nan);
@@ -187,7 +187,13 @@ TEST_CASE("LiteMath float4 arithmetic and min/max match the scalar definitions b
       CHECK(bits(quot[i]) == bits(x[i] / y[i]));
       CHECK(bits(scaled[i]) == bits(x[i] * 3.0f));
     }
+    // lane_mask_le: bit i is x[i] <= y[i] as C++ compares floats (NaN false, -0 == +0).
+    uint32_t expected = 0;
+    for (int i = 0; i < 4; ++i) expected |= (x[i] <= y[i] ? 1u : 0u) << i;
+    CHECK(lane_mask_le(x, y) == expected);
   }
+  CHECK(lane_mask_le(float4(1, 2, 3, 4), float4(1, 2, 3, 4)) == 15u);
+  CHECK(lane_mask_le(float4(1, 5, 3, 7), float4(2, 4, 3, 6)) == 5u);  // lanes 0 and 2
 }
 
 TEST_CASE("LiteMath scalar and componentwise functions", "[litemath]")
