@@ -123,7 +123,9 @@ function(crossrt_add_class target class)
 
   if(TARGET crossrt OR CROSSRT_TRANSLATOR_IN_TREE)  # in-tree: the target may be defined later
     set(translator $<TARGET_FILE:crossrt>)
-    set(translator_dep crossrt)
+    # The engine lives in the daemon and the in-process module, not in the client: a change to it
+    # must translate again too.
+    set(translator_dep crossrt crossrtd crossrt_engine_plugin)
   else()
     set(translator $<TARGET_FILE:crossrt::crossrt>)
     set(translator_dep crossrt::crossrt)

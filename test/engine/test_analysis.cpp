@@ -202,7 +202,7 @@ TEST_CASE("The CPU backend parallelises kernels with OpenMP", "[engine]")
   INFO(r.diagnostics);
   REQUIRE(r.ok);
   const std::string& cpp = r.files.at("Finder_CPU.cpp");
-  CHECK(cpp.find("#pragma omp parallel for schedule(static) reduction(+:m_totalLocal) reduction(crossrt_min_vec3:m_loLocal)") != std::string::npos);
+  CHECK(cpp.find("#pragma omp parallel for schedule(dynamic, 1024) reduction(+:m_totalLocal) reduction(crossrt_min_vec3:m_loLocal)") != std::string::npos);
   CHECK(cpp.find("m_totalLocal += out[i];") != std::string::npos);
 }
 
