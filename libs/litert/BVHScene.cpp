@@ -26,7 +26,6 @@ static_assert(kWiden == 1.0f + 2.0f * (3.0f * std::numeric_limits<float>::epsilo
                                    (1.0f - 3.0f * std::numeric_limits<float>::epsilon() * 0.5f),
               "kWiden is 1 + 2 gamma(3)");
 constexpr float kMissed = -1.0f;  // an exit before every entry (entries are >= 0): a missed box
-constexpr float kNever = std::numeric_limits<float>::infinity();  // the entry of a lane not entered
 
 BVHTraceRay Prepare(float3 org, float3 dir, float tnear)
 {
@@ -617,8 +616,9 @@ uint32_t BVHScene::IntersectGroup(const BVHTraceRay& r, uint32_t group, float tf
   const float4 zero = float4(0.0f);
   if (lane_mask_le(min(min(abs(eu), abs(ev)), abs(ew)), zero) != 0u)
   {
-    // A lane on an edge in float: decide exactly, so that neighbouring triangles agree. (Rounding
-    // never flips the sign of a product difference, only zeroes it, so the other lanes keep theirs.)
+    // A lane on an edge in float: decide exactly, so that neighbouring triangles agree. (Unfused
+    // rounding never flips the sign of a product difference, only zeroes it: the other lanes keep
+    // their signs.)
     eu = DifferenceOfProducts(cx, by, cy, bx);
     ev = DifferenceOfProducts(ax, cy, ay, cx);
     ew = DifferenceOfProducts(bx, ay, by, ax);
@@ -633,7 +633,6 @@ uint32_t BVHScene::IntersectGroup(const BVHTraceRay& r, uint32_t group, float tf
   v = ew / det;
   return hits;
 }
-
 
 // Visits the leaves of the mesh tree at `root` that the ray may reach, nearest box first, and
 // tests their triangles. On a hit nearer than tfar: sets tfar and the hit's t, primId and
