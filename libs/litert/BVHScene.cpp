@@ -681,10 +681,8 @@ bool BVHScene::TraceMesh(const BVHTraceRay& ray, uint32_t root, bool anyHit, flo
       const int entered = EnteredLanes(ray, m_nodes[node], tfar, entries, children);
       if (entered > 0)
       {
-        for (int lane = 3; lane > 0; --lane)
+        for (int lane = entered - 1; lane > 0; --lane)
         {
-          if (lane >= entered)
-            continue;
           stack[top] = children[lane];
           stackEntry[top] = entries[lane];
           top = top + 1;
@@ -761,10 +759,8 @@ bool BVHScene::Trace(float4 posAndNear, float4 dirAndFar, bool anyHit, CRT_Hit& 
       const int entered = EnteredLanes(worldRay, m_nodes[node], tfar, entries, children);
       if (entered > 0)
       {
-        for (int lane = 3; lane > 0; --lane)
+        for (int lane = entered - 1; lane > 0; --lane)
         {
-          if (lane >= entered)
-            continue;
           stack[top] = children[lane];
           stackEntry[top] = entries[lane];
           top = top + 1;
