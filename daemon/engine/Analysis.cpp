@@ -113,15 +113,47 @@ const FieldDecl* AppendTarget(const CXXMemberCallExpr* call) {
   return f && IsStdVector(f->getType()) ? f : nullptr;
 }
 
-// The member vectors that kernels of the class append to: kernels that loop to their size are
-// dispatched indirectly, and control functions may not read them before the kernels are done.
+// The class's own member function a call `this->f(...)` reaches, defined, else null.
+const FunctionDecl* ThisMethodDef(const CXXMemberCallExpr* call, const CXXRecordDecl* cls) {
+  auto* md = call->getMethodDecl();
+  const FunctionDecl* def = nullptr;
+  if (!md || md->isStatic() || md->getParent() != cls || !isa<CXXThisExpr>(call->getImplicitObjectArgument()->IgnoreParenImpCasts()))
+    return nullptr;
+  return md->hasBody(def) ? def : nullptr;
+}
+
+// The member vectors that kernels of the class append to, in their bodies or in the member
+// functions they call: kernels that loop to their size are dispatched indirectly, and control
+// functions may not read them before the kernels are done.
 struct AppendFinder : RecursiveASTVisitor<AppendFinder> {
+  const CXXRecordDecl* cls;
   std::set<std::string> appended;
+  std::set<const FunctionDecl*> visited;
+  explicit AppendFinder(const CXXRecordDecl* c) : cls(c) {}
   bool VisitCXXMemberCallExpr(CXXMemberCallExpr* call) {
     if (auto* f = AppendTarget(call)) appended.insert(f->getNameAsString());
+    auto* md = call->getMethodDecl();
+    if (auto* def = ThisMethodDef(call, cls); def && !IsKernelName(md->getName()) && visited.insert(def).second) TraverseStmt(def->getBody());
     return true;
   }
 };
+
+// Whether `fn` appends to a member vector, itself or through the class's member functions it calls.
+bool AppendsThroughCalls(const FunctionDecl* fn, const CXXRecordDecl* cls, std::map<const FunctionDecl*, bool>& memo) {
+  if (auto it = memo.find(fn); it != memo.end()) return it->second;
+  memo[fn] = false;  // a recursive call adds nothing (and is a diagnostic of its own)
+  struct Finder : RecursiveASTVisitor<Finder> {
+    const CXXRecordDecl* cls; std::map<const FunctionDecl*, bool>& memo; bool found = false;
+    Finder(const CXXRecordDecl* c, std::map<const FunctionDecl*, bool>& m) : cls(c), memo(m) {}
+    bool VisitCXXMemberCallExpr(CXXMemberCallExpr* call) {
+      if (AppendTarget(call)) found = true;
+      else if (auto* def = ThisMethodDef(call, cls)) found = found || AppendsThroughCalls(def, cls, memo);
+      return !found;
+    }
+  } finder(cls, memo);
+  finder.TraverseStmt(fn->getBody());
+  return memo[fn] = finder.found;
+}
 
 // ---- members ---------------------------------------------------------------
 
@@ -317,17 +349,11 @@ struct WriteScanner : RecursiveASTVisitor<WriteScanner> {
     if (uo->isIncrementDecrementOp()) Write(uo->getSubExpr(), uo->getExprLoc(), std::nullopt, {});
     return true;
   }
-  // push_back to a member vector: an append through an atomic counter, in the kernel's own body
-  // (the CPU backend serialises the appends there; a helper's body is shared with the original).
+  // push_back to a member vector: an append through an atomic counter on the GPU; on the CPU a
+  // lock, in the kernel's loop and in copies of the helpers on the way (LockedCopy).
   std::map<const FieldDecl*, SourceLocation> appends;
   bool VisitCXXMemberCallExpr(CXXMemberCallExpr* call) {
-    auto* f = AppendTarget(call);
-    if (!f) return true;
-    if (helper)
-      c.rep.Error(call->getExprLoc(), "helper function '" + helper->getNameAsString() + "' appends to member '" + f->getNameAsString() +
-                  "' (called from every thread: a data race on the CPU)", "call push_back in the kernel's loop body; the helper can return the value to append");
-    else
-      appends.emplace(f, call->getExprLoc());
+    if (auto* f = AppendTarget(call)) appends.emplace(f, call->getExprLoc());
     return true;
   }
   // A member passed to a non-const reference parameter may be written by the callee (GLSL inout).
@@ -678,6 +704,76 @@ void AnalyzeVirtualCalls(Context& c, Kernel& k, GlslPrinter& kernelPrinter) {
   k.functionList = merged;
 }
 
+// `v.push_back(x)` -> `crossrt::Locked(v).push_back(x)` for the class's member vectors in `body`.
+void LockAppends(Rewriter& rw, const Stmt* body) {
+  struct Locker : RecursiveASTVisitor<Locker> {
+    Rewriter& rw;
+    explicit Locker(Rewriter& r) : rw(r) {}
+    bool VisitCXXMemberCallExpr(CXXMemberCallExpr* call) {
+      if (!AppendTarget(call)) return true;
+      SourceRange object = call->getImplicitObjectArgument()->getSourceRange();
+      rw.InsertTextBefore(object.getBegin(), "crossrt::Locked(");
+      rw.InsertTextAfterToken(object.getEnd(), ")");
+      return true;
+    }
+  } locker(rw);
+  locker.TraverseStmt(const_cast<Stmt*>(body));
+}
+
+// The member functions a kernel's threads run that append, themselves or through calls: the CPU
+// backend gets copies of them whose appends take a lock (see LockedCopy).
+void AddLockedCopies(Context& c, const std::vector<const FunctionDecl*>& reached) {
+  std::map<const FunctionDecl*, bool> memo;
+  for (auto* fn : reached) {
+    auto* md = dyn_cast<CXXMethodDecl>(fn);
+    if (!md || md->getParent() != c.cls || md->isStatic() || !AppendsThroughCalls(fn, c.cls, memo)) continue;
+    const std::string name = md->getNameAsString();
+    if (std::any_of(c.model.lockedCopies.begin(), c.model.lockedCopies.end(), [&](const LockedCopy& x) { return x.name == name; }))
+      continue;
+    // The copy lives in the derived class: what it names must be reachable from there.
+    struct PrivateUses : RecursiveASTVisitor<PrivateUses> {
+      Context& c; const std::string& fn; std::set<const Decl*> reported;
+      PrivateUses(Context& ctx, const std::string& f) : c(ctx), fn(f) {}
+      bool VisitMemberExpr(MemberExpr* me) {
+        auto* d = me->getMemberDecl();
+        if (d->getAccess() != AS_private || d->getDeclContext() != c.cls || !reported.insert(d).second) return true;
+        c.rep.Error(me->getMemberLoc(), "'" + fn + "' appends to a member vector, so the CPU backend copies it into the derived class, but it uses private member '" +
+                    d->getNameAsString() + "'", "declare '" + d->getNameAsString() + "' protected");
+        return true;
+      }
+    } privateUses(c, name);
+    privateUses.TraverseStmt(fn->getBody());
+    CheckCopiedBody(c, fn->getBody(), "'" + name + "', which appends,");
+
+    const CXXMethodDecl* decl = cast<CXXMethodDecl>(md->getCanonicalDecl());
+    LockedCopy copy;
+    copy.name = name;
+    copy.sourceFile = BaseName(FileOf(c.ctx, fn->getLocation()));
+    std::string params, defParams;
+    for (unsigned i = 0; i < decl->getNumParams(); ++i) {
+      auto* p = decl->getParamDecl(i);
+      params += (i ? ", " : "") + ParamDecl(c.ctx, p, i);
+      if (p->hasDefaultArg() && !p->hasUninstantiatedDefaultArg() && !p->hasUnparsedDefaultArg())
+        params += " = " + c.Text(p->getDefaultArgRange());
+      defParams += (i ? ", " : "") + ParamDecl(c.ctx, md->getParamDecl(i), i);
+    }
+    const std::string ret = c.Text(decl->getReturnTypeSourceRange()), cv = md->isConst() ? " const" : "";
+    copy.declaration = ret + " " + name + "(" + params + ")" + cv + (md->isVirtual() ? " override" : "");
+    // Outside the class body a leading return type is looked up at namespace scope: a type
+    // declared in the class goes after the name, where the class's scope applies.
+    QualType rt = md->getReturnType();
+    const NamedDecl* named = rt->getAsTagDecl();
+    if (auto* td = rt->getAs<TypedefType>()) named = td->getDecl();
+    const bool nested = named && named->getDeclContext() == c.cls;
+    const std::string qualified = c.cls->getNameAsString() + "_CPU::" + name + "(" + defParams + ")" + cv;
+    copy.definitionHead = nested ? "auto " + qualified + " -> " + ret : ret + " " + qualified;
+    Rewriter rw(c.ctx.getSourceManager(), c.ctx.getLangOpts());
+    LockAppends(rw, fn->getBody());
+    copy.body = CanonicalCode(rw.getRewrittenText(fn->getBody()->getSourceRange()));
+    c.model.lockedCopies.push_back(copy);
+  }
+}
+
 void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def) {
   Kernel k;
   k.name = md->getNameAsString();
@@ -795,18 +891,11 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
                 "write the loop inside the kernel (kernel1D_" + k.name.substr(std::string("kernel_").size()) + ") so the translator sees the whole reduction");
     return;
   }
-  if (!ws.appends.empty() && k.rtv) {
-    c.rep.Error(ws.appends.begin()->second, "push_back in '" + k.name + "', whose loop is in the control function",
-                "write the loop inside a kernel1D_ kernel so the translator can make the appends safe on every backend");
-    return;
-  }
   if (!k.indirectVector.empty() && !ws.reductions.empty())
     c.rep.Error(md->getLocation(), "kernel '" + k.name + "' reduces members and is dispatched indirectly (it loops to " + k.indirectVector + ".size())",
                 "reduce in a kernel with a count the host knows, or append the values and reduce them in a later kernel");
   // In declaration order, so that regeneration is stable.
   for (auto* field : c.cls->fields()) {
-    if (ws.appends.count(field))
-      if (auto* m = FindMember(c.model, field->getNameAsString())) m->appendedByKernels = m->writtenByKernels = true;
     auto found = ws.reductions.find(field);
     if (found == ws.reductions.end()) continue;
     ReduceOp op = found->second;
@@ -839,15 +928,25 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     os << printer.ThreadBody(threadBody, 1, !k.rtv);
   os << "}\n";
   k.glslBody = os.str();
+  std::map<const FieldDecl*, SourceLocation> appends = ws.appends;
   for (auto* helper : printer.helpers) {
     WriteScanner hs(c);
     hs.helper = helper;
     hs.TraverseStmt(helper->getBody());
     markVectorWrites(hs);
+    appends.insert(hs.appends.begin(), hs.appends.end());
   }
+  for (auto& [field, loc] : appends)
+    if (auto* m = FindMember(c.model, field->getNameAsString())) m->appendedByKernels = m->writtenByKernels = true;
+  // On the CPU the threads run the original bodies of kernel_ functions (their loop is in the
+  // control function) and of helpers: those that append get copies with a lock.
+  std::vector<const FunctionDecl*> reached;
+  if (k.rtv) reached.push_back(def);
+  reached.insert(reached.end(), printer.helpers.begin(), printer.helpers.end());
+  AddLockedCopies(c, reached);
   // Threads append in any order: a size read in the same kernel would see a partial count.
   for (auto& [field, loc] : printer.sizeReads)
-    if (ws.appends.count(field))
+    if (appends.count(field))
       c.rep.Error(loc, "kernel '" + k.name + "' reads the size of '" + field->getNameAsString() + "', which it appends to",
                   "the final size is known after the kernel: read it in a later kernel, or after the control function returns");
   k.structList = printer.Structs();
@@ -914,13 +1013,6 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     struct Renamer : RecursiveASTVisitor<Renamer> {
       Rewriter& rw; const std::map<const FieldDecl*, ReduceOp>& red;
       Renamer(Rewriter& r, const std::map<const FieldDecl*, ReduceOp>& m) : rw(r), red(m) {}
-      bool VisitCXXMemberCallExpr(CXXMemberCallExpr* call) {
-        if (!AppendTarget(call)) return true;
-        SourceRange object = call->getImplicitObjectArgument()->getSourceRange();
-        rw.InsertTextBefore(object.getBegin(), "crossrt::Locked(");
-        rw.InsertTextAfterToken(object.getEnd(), ")");
-        return true;
-      }
       bool VisitMemberExpr(MemberExpr* me) {
         auto* f = dyn_cast<FieldDecl>(me->getMemberDecl());
         if (f && red.count(f) && me->isImplicitAccess()) rw.ReplaceText(me->getMemberLoc(), f->getName().size(), f->getNameAsString() + "Local");
@@ -932,6 +1024,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     for (auto* s : body->body())
       if ((outer = dyn_cast<ForStmt>(s))) break;
     renamer.TraverseStmt(const_cast<ForStmt*>(outer));
+    LockAppends(rw, outer);
     // A loop whose body is a bare statement ends before its ';': take the ';' too.
     SourceLocation end = Lexer::findLocationAfterToken(outer->getEndLoc(), tok::semi, c.ctx.getSourceManager(), c.ctx.getLangOpts(), false);
     k.cpuLoopNest = CanonicalCode(end.isValid() ? rw.getRewrittenText(CharSourceRange::getCharRange(outer->getBeginLoc(), end))
@@ -1895,7 +1988,7 @@ bool AnalyzeTranslationUnit(ASTContext& ctx, const std::string& className, const
   }
   // Appends decide how other kernels are dispatched: find them all before analysing any kernel.
   {
-    AppendFinder finder;
+    AppendFinder finder(cls);
     for (auto* md : cls->methods()) {
       const FunctionDecl* def = nullptr;
       if (IsKernelName(md->getName()) && md->hasBody(def) && def) finder.TraverseStmt(def->getBody());

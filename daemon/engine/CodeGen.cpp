@@ -885,6 +885,18 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
   }
   d.set("kernels", kernels);
   d.set("ompReductions", ompReductions);
+  Data copies = List();
+  for (auto& lc : model.lockedCopies) {
+    Data x;
+    x.set("name", lc.name);
+    x.set("sourceFile", lc.sourceFile);
+    x.set("declaration", lc.declaration);
+    x.set("definitionHead", lc.definitionHead);
+    x.set("body", lc.body);
+    copies.push_back(x);
+  }
+  d.set("lockedCopies", copies);
+  d.set("hasLockedCopies", !model.lockedCopies.empty());
   files[model.className + "_CPU.h"] = Render(opt.templateDir + "/cpu/class.h.mustache", d);
   files[model.className + "_CPU.cpp"] = Render(opt.templateDir + "/cpu/class.cpp.mustache", d);
   return files;

@@ -177,6 +177,17 @@ struct VirtualMember {
   unsigned slotBytes = 0;          // level 1: the size of every element's slot
 };
 
+// A member function that appends to a member vector, reached from a kernel's threads: the CPU
+// backend hides it with a copy whose push_backs take a lock (crossrt::Locked), as it does in the
+// kernels' own loops. Callers on the way from the kernel are copied too, so that they call the copy.
+struct LockedCopy {
+  std::string name;        // AddHit
+  std::string declaration;     // in the class: void AddHit(const Hit& a_hit, int a_n = 1)
+  std::string definitionHead;  // void Render_CPU::AddHit(const Hit& a_hit, int a_n)
+  std::string sourceFile;      // where the original is defined
+  std::string body;        // its body, push_backs rewritten
+};
+
 struct ClassModel {
   std::string className;
   std::string headerFile;      // header declaring the class (as included by generated code)
@@ -197,6 +208,7 @@ struct ClassModel {
   // kernel call (wavefront). Both are generated; this picks the default.
   std::vector<Kernel> megakernels;
   bool megakernelByDefault = false;
+  std::vector<LockedCopy> lockedCopies;  // in the order the kernels reach them
 };
 
 // The member named `name`, or null (works on a const and a mutable model).

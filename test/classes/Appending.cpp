@@ -1,5 +1,7 @@
 #include "Appending.h"
 
+#include <cmath>
+
 void Appending::Select(int n, float threshold, const float* values, float* out)
 {
   m_positive.clear();
@@ -12,6 +14,15 @@ void Appending::Select(int n, float threshold, const float* values, float* out)
 void Appending::Collect(int n, const float* values)
 {
   kernel1D_FindNegative(n, values);
+}
+
+void Appending::Classify(int n, const float* values)
+{
+  m_small.clear();
+  m_tagged.clear();
+  kernel1D_FindSmall(n, values);
+  for (int i = 0; i < n; ++i)
+    kernel_Tag(i, values);
 }
 
 void Appending::kernel1D_FindPositive(int n, const float* values)
@@ -42,4 +53,24 @@ void Appending::kernel1D_FindNegative(int n, const float* values)
   for (int i = 0; i < n; ++i)
     if (values[i] < 0.0f)
       m_negative.push_back(uint32_t(i));
+}
+
+void Appending::kernel1D_FindSmall(int n, const float* values)
+{
+  for (int i = 0; i < n; ++i)
+    NoteSmall(uint32_t(i), values[i]);
+}
+
+uint32_t Appending::NoteSmall(uint32_t i, float value, float limit)
+{
+  if (std::abs(value) >= limit)
+    return 0;
+  Append(i);
+  return 1;
+}
+
+void Appending::kernel_Tag(int tid, const float* values)
+{
+  if (values[tid] > 0.9f)
+    m_tagged.push_back(Candidate{uint32_t(tid), values[tid]});
 }

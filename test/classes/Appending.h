@@ -21,6 +21,8 @@ public:
     m_positive.reserve(capacity);
     m_large.reserve(capacity);
     m_negative.reserve(2 * capacity);
+    m_small.reserve(capacity);
+    m_tagged.reserve(capacity);
   }
   virtual ~Appending() = default;
 
@@ -31,15 +33,27 @@ public:
                       [[crossrt::size("n")]] float* out);
   // Appends the indices of the negative values to m_negative without clearing it first.
   virtual void Collect(int n, [[crossrt::size("n")]] const float* values);
+  // Appends made away from the kernel's loop: m_small gets the indices of the values with
+  // |value| < 0.1 through two helpers, m_tagged gets {index, value} of those above 0.9 from a
+  // kernel_ function whose loop is here, in the control function.
+  virtual void Classify(int n, [[crossrt::size("n")]] const float* values);
   virtual void CommitDeviceData() {}
 
   std::vector<uint32_t> m_positive;
   std::vector<Candidate> m_large;
   std::vector<uint32_t> m_negative;
+  std::vector<uint32_t> m_small;
+  std::vector<Candidate> m_tagged;
 
 protected:
   void kernel1D_FindPositive(int n, const float* values);
   void kernel1D_FindLarge(float threshold, const float* values);  // over m_positive
   void kernel1D_Write(float* out);                                 // over m_large
   void kernel1D_FindNegative(int n, const float* values);
+  void kernel1D_FindSmall(int n, const float* values);
+  virtual void kernel_Tag(int tid, const float* values);
+
+  // 1 if it appended i. The default argument and the helper it calls are part of the test.
+  uint32_t NoteSmall(uint32_t i, float value, float limit = 0.1f);
+  void Append(uint32_t i) { m_small.push_back(i); }
 };

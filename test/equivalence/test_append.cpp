@@ -8,6 +8,7 @@
 #include "TestSupport.h"
 
 #include <algorithm>
+#include <cmath>
 #include <random>
 #include <tuple>
 
@@ -96,6 +97,37 @@ TEST_CASE("Appends accumulate across calls when the control function does not cl
     impl->Collect(n, second.data());
     REQUIRE(afterFirst > 0);
     REQUIRE(Sorted(impl->m_negative) == expected);
+  }
+  RequireNoValidationMessages(ctx);
+}
+
+TEST_CASE("push_back in helpers and in a kernel_ function whose loop is in the control function", "[equivalence][append]")
+{
+  auto ctx = ValidatedContext();
+  for (int n : {0, 1, 20011})
+  {
+    DYNAMIC_SECTION("n = " << n)
+    {
+      const auto values = RandomFloats(n, unsigned(n) + 3, -1.0f, 1.0f);
+      std::vector<uint32_t> small;
+      std::vector<std::tuple<uint32_t, float>> tagged;
+      for (int i = 0; i < n; ++i)
+      {
+        if (std::abs(values[i]) < 0.1f) small.push_back(uint32_t(i));
+        if (values[i] > 0.9f) tagged.emplace_back(uint32_t(i), values[i]);
+      }
+      if (n > 1000) REQUIRE((small.size() > size_t(n) / 20 && tagged.size() > size_t(n) / 40));
+      for (auto& [name, impl] : AllBackends(ctx, n))
+      {
+        INFO(name);
+        for (int call = 0; call < 2; ++call)
+        {
+          impl->Classify(n, values.data());
+          REQUIRE(Sorted(impl->m_small) == small);
+          REQUIRE(Sorted(impl->m_tagged) == tagged);
+        }
+      }
+    }
   }
   RequireNoValidationMessages(ctx);
 }
