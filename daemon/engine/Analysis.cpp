@@ -1597,12 +1597,32 @@ private:
     m_gpu.InsertTextAfter(end, " UpdateMemberCmd(a_cmd, offsetof(ClassData, " + m->name + "), &" + m->name + ", sizeof(" + m->name + "));");
   }
 
+  // `std::sort(m_v.begin(), m_v.end(), ...)`: the whole of one member vector.
+  static bool IsWholeVector(const CallExpr* call) {
+    auto* first = dyn_cast<CXXMemberCallExpr>(call->getArg(0)->IgnoreParenImpCasts());
+    auto* last = dyn_cast<CXXMemberCallExpr>(call->getArg(1)->IgnoreParenImpCasts());
+    if (!first || !last || !first->getMethodDecl() || !last->getMethodDecl()) return false;
+    auto* f = ThisField(first->getImplicitObjectArgument());
+    return f && f == ThisField(last->getImplicitObjectArgument()) && first->getMethodDecl()->getName() == "begin" &&
+           last->getMethodDecl()->getName() == "end";
+  }
+
   // A vector kernels append to has its size on the GPU while the control function records: its host
-  // copy is stale until the call returns, so host code may only clear it (or reserve room).
+  // copy is stale until the call returns, so host code may only clear it (or reserve room) and sort
+  // all of it, which the GPU does with the count it has.
   void CheckAppendedUses() {
     struct Finder : RecursiveASTVisitor<Finder> {
       ControlRewriter& rw;
+      std::set<const Expr*> sortBounds;  // begin() and end() of whole-vector std::sort calls
       explicit Finder(ControlRewriter& r) : rw(r) {}
+      bool VisitCallExpr(CallExpr* call) {
+        auto* fd = call->getDirectCallee();
+        if (fd && fd->isInStdNamespace() && fd->getName() == "sort" && call->getNumArgs() >= 2 && IsWholeVector(call)) {
+          sortBounds.insert(call->getArg(0)->IgnoreParenImpCasts());
+          sortBounds.insert(call->getArg(1)->IgnoreParenImpCasts());
+        }
+        return true;
+      }
       void Check(const Expr* object, const std::string& what, SourceLocation loc) {
         auto* f = ThisField(object);
         if (!f || !rw.m_c.appended.count(f->getNameAsString())) return;
@@ -1610,12 +1630,12 @@ private:
         rw.m_c.rep.Error(loc, "control function '" + rw.m_ctrl.name + "' uses " + what + " of '" + v +
                          "', which kernels append to: on the GPU its size and contents are known only after the call returns",
                          "loop to " + v + ".size() inside a kernel1D_ kernel (dispatched indirectly, with no host round trip), or read " + v +
-                         " after the call; here it may only be cleared or reserved");
+                         " after the call; here it may only be cleared, reserved, or sorted whole with std::sort(" + v + ".begin(), " + v + ".end(), ...)");
       }
       bool VisitCXXMemberCallExpr(CXXMemberCallExpr* call) {
         static const std::set<std::string> allowed = {"clear", "reserve", "capacity", "data"};
         std::string method = call->getMethodDecl() ? call->getMethodDecl()->getNameAsString() : "";
-        if (!allowed.count(method)) Check(call->getImplicitObjectArgument(), method + "()", call->getExprLoc());
+        if (!allowed.count(method) && !sortBounds.count(call)) Check(call->getImplicitObjectArgument(), method + "()", call->getExprLoc());
         return true;
       }
       bool VisitCXXOperatorCallExpr(CXXOperatorCallExpr* op) {
@@ -1829,6 +1849,13 @@ private:
       const std::string key = "crossrt::SortKey{" + std::to_string(words) + ", " + std::to_string(order->keyWord) +
                               ", crossrt::ElementType::" + order->type + ", " + (order->descending ? "true" : "false") + "}";
       replacement = "m_sorter.RecordCmd(a_cmd, " + ViewAt(*first) + ", uint32_t" + *count + ", " + key + ")";
+      // A vector that kernels append to has its size on the GPU: the sort reads it there.
+      if (first->vector && m_c.appended.count(first->vector->name)) {
+        if (!IsWholeVector(call)) return bad("'" + first->vector->name + "' is appended to by kernels, so its size is known only on the GPU: sort all of it, from begin() to end()");
+        const std::string v = first->vector->name;
+        replacement = "m_sorter.RecordCmd(a_cmd, " + first->view + ", uint32_t(m_vdata." + v + "Capacity), " + key +
+                      ", m_classDataBuffer.View(), offsetof(ClassData, " + v + "_size))";
+      }
       // The CPU backend sorts on all cores too, with the same radix sort.
       m_cpu.ReplaceText(call->getSourceRange(), "crossrt::RadixSort(" + m_c.Text(call->getArg(0)->getSourceRange()) + ", " +
                                                     m_c.Text(call->getArg(1)->getSourceRange()) + ", " + key + ")");

@@ -6,6 +6,7 @@
 layout(local_size_x = 256) in;
 layout(std430, binding = 0) readonly buffer Records { uint records[]; };
 layout(std430, binding = 1) writeonly buffer Counts { uint counts[]; };
+layout(std430, binding = 2) readonly buffer Count { uint countWords[]; };
 #include "radix_key.glsl"
 
 shared uint histogram[256];
@@ -14,12 +15,13 @@ void main()
 {
   const uint tile = gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x;
   const uint t = gl_LocalInvocationIndex;
+  const uint count = RecordCount();
   histogram[t] = 0u;
   barrier();
   for (uint r = 0u; r < 4u; ++r)
   {
     const uint i = tile * 1024u + r * 256u + t;
-    if (i < n)
+    if (i < count)
       atomicAdd(histogram[(SortableKey(records[i * stride + keyWord]) >> shift) & 255u], 1u);
   }
   barrier();

@@ -8,6 +8,7 @@ layout(local_size_x = 256) in;
 layout(std430, binding = 0) readonly buffer RecordsIn { uint recordsIn[]; };
 layout(std430, binding = 1) writeonly buffer RecordsOut { uint recordsOut[]; };
 layout(std430, binding = 2) readonly buffer Offsets { uint offsets[]; };  // scanned counts
+layout(std430, binding = 3) readonly buffer Count { uint countWords[]; };
 #include "radix_key.glsl"
 
 shared uint masks[256][8];   // per digit: which threads of this round hold it
@@ -17,6 +18,7 @@ void main()
 {
   const uint tile = gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x;
   const uint t = gl_LocalInvocationIndex;
+  const uint count = RecordCount();
   placed[t] = offsets[t * tiles + tile];
   for (uint w = 0u; w < 8u; ++w)
     masks[t][w] = 0u;
@@ -24,7 +26,7 @@ void main()
   for (uint r = 0u; r < 4u; ++r)
   {
     const uint i = tile * 1024u + r * 256u + t;
-    const bool valid = i < n;
+    const bool valid = i < count;
     const uint digit = valid ? (SortableKey(recordsIn[i * stride + keyWord]) >> shift) & 255u : 0u;
     if (valid)
       atomicOr(masks[digit][t / 32u], 1u << (t % 32u));

@@ -176,4 +176,11 @@ void EnsureSize(std::shared_ptr<VulkanContext> ctx, Buffer& b, VkDeviceSize byte
   b = Buffer(std::move(ctx), bytes, b.ExtraUsage());
 }
 
+void GrowScratch(std::shared_ptr<VulkanContext> ctx, Buffer& b, VkDeviceSize bytes, std::vector<Buffer>& retired) {
+  if (!b.Empty() && b.Size() >= bytes) return;
+  const VkBufferUsageFlags usage = b.ExtraUsage();
+  if (!b.Empty()) retired.push_back(std::move(b));
+  b = Buffer(std::move(ctx), bytes, usage);
+}
+
 }  // namespace crossrt

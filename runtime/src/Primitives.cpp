@@ -55,7 +55,7 @@ void Scanner::RecordCmd(VkCommandBuffer cmd, BufferView in, BufferView out, uint
   }
   if (levels_.size() < counts.size()) levels_.resize(counts.size());
   for (size_t l = 0; l < counts.size(); ++l)
-    EnsureSize(ctx_, levels_[l].sums, 4ull * ((counts[l] + kBlock - 1) / kBlock));
+    GrowScratch(ctx_, levels_[l].sums, 4ull * ((counts[l] + kBlock - 1) / kBlock), retired_);
 
   // Down: scan each level's blocks, collecting block totals into the next level.
   for (size_t l = 0; l < counts.size(); ++l) {
@@ -88,31 +88,40 @@ void Scanner::RecordCmd(VkCommandBuffer cmd, BufferView in, BufferView out, uint
 RadixSorter::RadixSorter(std::shared_ptr<VulkanContext> ctx) : ctx_(ctx), scanner_(ctx) {}
 
 void RadixSorter::RecordCmd(VkCommandBuffer cmd, BufferView records, uint32_t n, SortKey key) {
+  RecordCmd(cmd, records, n, key, {}, 0);
+}
+
+void RadixSorter::RecordCmd(VkCommandBuffer cmd, BufferView records, uint32_t n, SortKey key, BufferView counts,
+                            uint32_t countOffset) {
   if (n <= 1) return;
   if (key.strideWords == 0 || key.keyWord >= key.strideWords)
     throw Error("RadixSorter: key word " + std::to_string(key.keyWord) + " outside records of " +
                 std::to_string(key.strideWords) + " words");
+  if (countOffset % 4 != 0) throw Error("RadixSorter: the count must be an aligned 32-bit word");
   if (histogram_.Handle() == VK_NULL_HANDLE) {  // pipelines are made on first use
-    histogram_ = ComputePipeline(ctx_, radix_histogram, sizeof(radix_histogram), 2, 24, "crossrt::radix_histogram");
-    scatter_ = ComputePipeline(ctx_, radix_scatter, sizeof(radix_scatter), 3, 24, "crossrt::radix_scatter");
+    histogram_ = ComputePipeline(ctx_, radix_histogram, sizeof(radix_histogram), 3, 28, "crossrt::radix_histogram");
+    scatter_ = ComputePipeline(ctx_, radix_scatter, sizeof(radix_scatter), 4, 28, "crossrt::radix_scatter");
   }
   const uint32_t tiles = (n + kBlock - 1) / kBlock;
-  EnsureSize(ctx_, recordsTmp_, 4ull * key.strideWords * n);
-  EnsureSize(ctx_, counts_, 4ull * 256 * tiles);
-  const uint32_t keyMode = uint32_t(key.type) | (key.descending ? 4u : 0u);
+  GrowScratch(ctx_, recordsTmp_, 4ull * key.strideWords * n, retired_);
+  GrowScratch(ctx_, counts_, 4ull * 256 * tiles, retired_);
+  const bool countOnGpu = counts.buffer != VK_NULL_HANDLE;
+  const uint32_t keyMode = uint32_t(key.type) | (key.descending ? 4u : 0u) | (countOnGpu ? 8u : 0u);
+  const BufferView count = countOnGpu ? counts : counts_.View();  // not read without the flag
   // Four passes ping-pong between the caller's buffer and scratch, ending in the caller's.
   BufferView r[2] = {records, recordsTmp_.View()};
   for (uint32_t pass = 0; pass < 4; ++pass) {
     const uint32_t src = pass % 2, dst = 1 - src;
-    struct { uint32_t n, shift, tiles, stride, keyWord, keyMode; } args{n, 8 * pass, tiles, key.strideWords, key.keyWord, keyMode};
+    struct { uint32_t n, shift, tiles, stride, keyWord, keyMode, countWord; } args{
+        n, 8 * pass, tiles, key.strideWords, key.keyWord, keyMode, countOffset / 4};
     histogram_.Bind(cmd);
-    histogram_.PushBuffers(cmd, {r[src], counts_.View()});
+    histogram_.PushBuffers(cmd, {r[src], counts_.View(), count});
     histogram_.PushConstants(cmd, &args, sizeof(args));
     DispatchBlocks(cmd, tiles);
     ComputeBarrier(cmd);
     scanner_.RecordCmd(cmd, counts_.View(), counts_.View(), 256 * tiles, false, ElementType::Uint);
     scatter_.Bind(cmd);
-    scatter_.PushBuffers(cmd, {r[src], r[dst], counts_.View()});
+    scatter_.PushBuffers(cmd, {r[src], r[dst], counts_.View(), count});
     scatter_.PushConstants(cmd, &args, sizeof(args));
     DispatchBlocks(cmd, tiles);
     ComputeBarrier(cmd);

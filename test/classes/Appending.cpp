@@ -1,6 +1,8 @@
 #include "Appending.h"
 
+#include <algorithm>
 #include <cmath>
+#include <functional>
 
 void Appending::Select(int n, float threshold, const float* values, float* out)
 {
@@ -9,6 +11,17 @@ void Appending::Select(int n, float threshold, const float* values, float* out)
   kernel1D_FindPositive(n, values);
   kernel1D_FindLarge(threshold, values);
   kernel1D_Write(out);
+}
+
+void Appending::SelectSorted(int n, float threshold, const float* values, float* ranks)
+{
+  m_positive.clear();
+  m_large.clear();
+  kernel1D_FindPositive(n, values);
+  std::sort(m_positive.begin(), m_positive.end(), std::greater<uint32_t>());
+  kernel1D_FindLarge(threshold, values);
+  std::sort(m_large.begin(), m_large.end(), [](const Candidate& a, const Candidate& b) { return a.value < b.value; });
+  kernel1D_Rank(ranks);
 }
 
 void Appending::Collect(int n, const float* values)
@@ -46,6 +59,12 @@ void Appending::kernel1D_Write(float* out)
 {
   for (uint32_t i = 0; i < m_large.size(); ++i)
     out[m_large[i].index] = m_large[i].value;
+}
+
+void Appending::kernel1D_Rank(float* ranks)
+{
+  for (uint32_t i = 0; i < m_large.size(); ++i)
+    ranks[m_large[i].index] = float(i);
 }
 
 void Appending::kernel1D_FindNegative(int n, const float* values)

@@ -31,6 +31,10 @@ public:
   // appended elements is unspecified (threads append as they arrive).
   virtual void Select(int n, float threshold, [[crossrt::size("n")]] const float* values,
                       [[crossrt::size("n")]] float* out);
+  // Select, then each appended vector sorted in the same call: m_positive descending, m_large by
+  // value. ranks[index] = the position of index in the sorted m_large (unchanged elsewhere).
+  virtual void SelectSorted(int n, float threshold, [[crossrt::size("n")]] const float* values,
+                            [[crossrt::size("n")]] float* ranks);
   // Appends the indices of the negative values to m_negative without clearing it first.
   virtual void Collect(int n, [[crossrt::size("n")]] const float* values);
   // Appends made away from the kernel's loop: m_small gets the indices of the values with
@@ -49,6 +53,7 @@ protected:
   void kernel1D_FindPositive(int n, const float* values);
   void kernel1D_FindLarge(float threshold, const float* values);  // over m_positive
   void kernel1D_Write(float* out);                                 // over m_large
+  void kernel1D_Rank(float* ranks);                                // over m_large
   void kernel1D_FindNegative(int n, const float* values);
   void kernel1D_FindSmall(int n, const float* values);
   virtual void kernel_Tag(int tid, const float* values);

@@ -345,6 +345,12 @@ TEST_CASE("Appends that a backend cannot make safe, or whose count the host does
        "void Appender::kernel1D_Find(int n, const float* in)\n{\n  for (int i = 0; i < n; i++)\n    if (in[i] > 0.0f) Push(uint32_t(i));\n}\n",
        3, "'Push' appends to a member vector, so the CPU backend copies it into the derived class, but it uses private member 'Twice'",
        "declare 'Twice' protected"},
+      {"sorting part of an appended vector", "",
+       "#include <algorithm>\n"
+       "void Appender::Run(int n, const float* in) { kernel1D_Find(n, in); std::sort(m_hits.begin() + 1, m_hits.end()); }\n"
+       "void Appender::kernel1D_Find(int n, const float* in)\n{\n  for (int i = 0; i < n; i++)\n    if (in[i] > 0.0f) m_hits.push_back(uint32_t(i));\n}\n",
+       3, "'std::sort' on device data: 'm_hits' is appended to by kernels, so its size is known only on the GPU: sort all of it, from begin() to end()",
+       "use member std::vector begin()/end()/data()"},
       {"a kernel reads the size it appends to", "",
        "void Appender::Run(int n, const float* in) { kernel1D_Find(n, in); }\n"
        "void Appender::kernel1D_Find(int n, const float* in)\n{\n  for (int i = 0; i < n; i++)\n"

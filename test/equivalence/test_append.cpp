@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <random>
 #include <tuple>
 
@@ -97,6 +98,55 @@ TEST_CASE("Appends accumulate across calls when the control function does not cl
     impl->Collect(n, second.data());
     REQUIRE(afterFirst > 0);
     REQUIRE(Sorted(impl->m_negative) == expected);
+  }
+  RequireNoValidationMessages(ctx);
+}
+
+TEST_CASE("Sorting appended vectors in the control function that appends to them", "[equivalence][append][sort]")
+{
+  auto ctx = ValidatedContext();
+  for (int n : {0, 1, 1000, 100003})
+  {
+    DYNAMIC_SECTION("n = " << n)
+    {
+      // Distinct values in random places, so that every backend must give one order: random
+      // floats repeat at this many draws.
+      std::vector<float> values(n);
+      std::vector<int> places(n);
+      std::iota(places.begin(), places.end(), 0);
+      std::shuffle(places.begin(), places.end(), std::mt19937(unsigned(n) + 7));
+      for (int i = 0; i < n; ++i) values[places[i]] = -1.0f + 2.0f * (float(i) + 0.5f) / float(n);
+      std::vector<uint32_t> positive;
+      std::vector<std::pair<float, uint32_t>> large;  // (2 * value, index)
+      for (int i = 0; i < n; ++i)
+      {
+        if (values[i] > 0.0f) positive.push_back(uint32_t(i));
+        if (values[i] > 0.5f) large.emplace_back(2.0f * values[i], uint32_t(i));
+      }
+      std::sort(positive.rbegin(), positive.rend());
+      std::sort(large.begin(), large.end());
+      REQUIRE(std::adjacent_find(large.begin(), large.end(), [](auto& a, auto& b) { return a.first == b.first; }) == large.end());
+      std::vector<float> expectedRanks(n, -1.0f);
+      for (size_t r = 0; r < large.size(); ++r) expectedRanks[large[r].second] = float(r);
+
+      for (auto& [name, impl] : AllBackends(ctx, n))
+      {
+        INFO(name);
+        for (int call = 0; call < 2; ++call)
+        {
+          std::vector<float> ranks(n, -1.0f);
+          impl->SelectSorted(n, 0.5f, values.data(), ranks.data());
+          REQUIRE(impl->m_positive == positive);
+          REQUIRE(impl->m_large.size() == large.size());
+          for (size_t r = 0; r < large.size(); ++r)
+          {
+            REQUIRE(impl->m_large[r].value == large[r].first);
+            REQUIRE(impl->m_large[r].index == large[r].second);
+          }
+          REQUIRE(ranks == expectedRanks);
+        }
+      }
+    }
   }
   RequireNoValidationMessages(ctx);
 }

@@ -383,6 +383,9 @@ void ReadAppended(const Buffer& counts, size_t sizeOffset, const Buffer& element
 
 // Reallocates b (keeping its extra usage) only when it is empty or smaller than bytes.
 void EnsureSize(std::shared_ptr<VulkanContext> ctx, Buffer& b, VkDeviceSize bytes);
+// EnsureSize for scratch that commands already recorded may use: a replaced buffer moves to
+// `retired` instead of being destroyed.
+void GrowScratch(std::shared_ptr<VulkanContext> ctx, Buffer& b, VkDeviceSize bytes, std::vector<Buffer>& retired);
 
 // RAII compute pipeline, move-only. Set 0 is a push-descriptor set.
 class ComputePipeline {
@@ -499,10 +502,13 @@ public:
   Scanner() = default;
   explicit Scanner(std::shared_ptr<VulkanContext> ctx);
   // out[i] = init + in[0] + ... + in[i-1] (exclusive) or ... + in[i] (inclusive), i < n.
-  // `in` may be `out`. Ends with a barrier. Scratch buffers grow as needed and are kept: do not
-  // record scans of growing sizes into one command buffer before submitting it.
+  // `in` may be `out`. Ends with a barrier. Scratch buffers grow as needed and are kept; the
+  // ones they replace stay alive, since commands recorded earlier may still use them, until
+  // ReleaseRetired().
   void RecordCmd(VkCommandBuffer cmd, BufferView in, BufferView out, uint32_t n, bool inclusive, ElementType type,
                  uint32_t initBits = 0);
+  // Frees replaced scratch: call when every command buffer recorded so far has completed.
+  void ReleaseRetired() { retired_.clear(); }
 
 private:
   struct Level { Buffer sums; };
@@ -510,6 +516,7 @@ private:
   std::shared_ptr<VulkanContext> ctx_;
   ComputePipeline blocks_[3], add_[3];
   std::vector<Level> levels_;
+  std::vector<Buffer> retired_;
 };
 
 // std::sort on the GPU: a stable LSD radix sort, 4 passes of 8 bits (tile histograms, an
@@ -522,12 +529,22 @@ public:
   // Sorts records[0..n) in place. Ends with a barrier. Scratch grows as needed (see
   // Scanner::RecordCmd).
   void RecordCmd(VkCommandBuffer cmd, BufferView records, uint32_t n, SortKey key = {});
+  // Sorts records[0..min(n, count)) where count is the uint `countOffset` bytes into `counts`,
+  // known only on the GPU (the size of a vector that kernels appended to; n is its capacity).
+  // The work is that of sorting n records.
+  void RecordCmd(VkCommandBuffer cmd, BufferView records, uint32_t n, SortKey key, BufferView counts, uint32_t countOffset);
+  // See Scanner::ReleaseRetired.
+  void ReleaseRetired() {
+    retired_.clear();
+    scanner_.ReleaseRetired();
+  }
 
 private:
   std::shared_ptr<VulkanContext> ctx_;
   ComputePipeline histogram_, scatter_;
   Scanner scanner_;
   Buffer recordsTmp_, counts_;
+  std::vector<Buffer> retired_;
 };
 
 // Dispatch of a 1D kernel whose thread count lives on the GPU: the size of a std::vector member
