@@ -728,8 +728,6 @@ void AddLockedCopies(Context& c, const std::vector<const FunctionDecl*>& reached
     auto* md = dyn_cast<CXXMethodDecl>(fn);
     if (!md || md->getParent() != c.cls || md->isStatic() || !AppendsThroughCalls(fn, c.cls, memo)) continue;
     const std::string name = md->getNameAsString();
-    if (std::any_of(c.model.lockedCopies.begin(), c.model.lockedCopies.end(), [&](const LockedCopy& x) { return x.name == name; }))
-      continue;
     // The copy lives in the derived class: what it names must be reachable from there.
     struct PrivateUses : RecursiveASTVisitor<PrivateUses> {
       Context& c; const std::string& fn; std::set<const Decl*> reported;
@@ -759,6 +757,11 @@ void AddLockedCopies(Context& c, const std::vector<const FunctionDecl*>& reached
     }
     const std::string ret = c.Text(decl->getReturnTypeSourceRange()), cv = md->isConst() ? " const" : "";
     copy.declaration = ret + " " + name + "(" + params + ")" + cv + (md->isVirtual() ? " override" : "");
+    if (std::any_of(c.model.lockedCopies.begin(), c.model.lockedCopies.end(), [&](const LockedCopy& x) { return x.declaration == copy.declaration; }))
+      continue;  // another kernel reached it first
+    // The copy hides every overload of its name: the others stay reachable through a using-declaration.
+    auto overloads = c.cls->lookup(md->getDeclName());
+    copy.keepOverloads = std::distance(overloads.begin(), overloads.end()) > 1 && decl->getAccess() != AS_private;
     // Outside the class body a leading return type is looked up at namespace scope: a type
     // declared in the class goes after the name, where the class's scope applies.
     QualType rt = md->getReturnType();

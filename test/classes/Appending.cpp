@@ -82,7 +82,7 @@ void Appending::kernel1D_FindSmall(int n, const float* values)
 
 uint32_t Appending::NoteSmall(uint32_t i, float value, float limit)
 {
-  if (std::abs(value) >= limit)
+  if (!NoteSmall(value, limit))
     return 0;
   Append(i);
   return 1;

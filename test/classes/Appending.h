@@ -2,6 +2,7 @@
 // those vectors' sizes. On the GPU the appends go through an atomic counter and the later kernels
 // are dispatched indirectly, with no host round trip (test/equivalence/test_append.cpp).
 #pragma once
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -58,7 +59,9 @@ protected:
   void kernel1D_FindSmall(int n, const float* values);
   virtual void kernel_Tag(int tid, const float* values);
 
-  // 1 if it appended i. The default argument and the helper it calls are part of the test.
+  // 1 if it appended i. The default argument, the overload and the helper it calls are part of
+  // the test: the CPU backend copies this one, and the copy must still call the other overload.
   uint32_t NoteSmall(uint32_t i, float value, float limit = 0.1f);
+  static bool NoteSmall(float value, float limit) { return std::abs(value) < limit; }
   void Append(uint32_t i) { m_small.push_back(i); }
 };
