@@ -3,10 +3,12 @@
 #                   [EXECUTION_MODE wavefront|megakernel])
 #
 # Translates class <Class> into <Class>_Vulkan (or <Class>_CPU), in the build tree, and adds the
-# generated sources, their include path and the runtime to <target>. SOURCES are the files that
-# define <Class>'s member functions (default: <Class>.cpp next to the calling CMakeLists.txt, else
-# every .cpp source of <target>). The translation re-runs when any file it read changes (depfile),
-# and writes only files whose contents changed, so an unchanged class recompiles nothing.
+# generated sources, their include path and the runtime to <target>. A class in a namespace is
+# named with it (demo::Render); its generated classes are declared in the same namespace. SOURCES
+# are the files that define <Class>'s member functions (default: <Class>.cpp next to the calling
+# CMakeLists.txt, else every .cpp source of <target>). The translation re-runs when any file it
+# read changes (depfile), and writes only files whose contents changed, so an unchanged class
+# recompiles nothing.
 #
 # COMPOSE (paper 3.6): kernels that call Interface's methods through a member (a shared_ptr,
 # unique_ptr or pointer) run Implementation's code on the GPU, and its data is uploaded with the
@@ -57,11 +59,14 @@ function(crossrt_add_class target class)
   if(NOT TARGET ${target})
     message(FATAL_ERROR "crossrt_add_class: '${target}' is not a target")
   endif()
+  # A class in a namespace (demo::Render) is translated by that name; files, folders and targets
+  # take the class's own name (Render_Vulkan), and the generated class joins the namespace.
+  string(REGEX REPLACE "^.*::" "" name "${class}")
 
   set(sources ${ARG_SOURCES})
   if(NOT sources)
-    if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/${class}.cpp)
-      set(sources ${class}.cpp)
+    if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/${name}.cpp)
+      set(sources ${name}.cpp)
     else()
       get_target_property(target_sources ${target} SOURCES)
       list(FILTER target_sources INCLUDE REGEX "\\.(cpp|cc|cxx)$")
@@ -98,10 +103,10 @@ function(crossrt_add_class target class)
     list(APPEND source_args --source "${a}")
   endforeach()
 
-  set(out_dir ${CMAKE_CURRENT_BINARY_DIR}/crossrt/${class}_${suffix})
-  set(outputs ${out_dir}/${class}_${suffix}.h ${out_dir}/${class}_${suffix}.cpp)
+  set(out_dir ${CMAKE_CURRENT_BINARY_DIR}/crossrt/${name}_${suffix})
+  set(outputs ${out_dir}/${name}_${suffix}.h ${out_dir}/${name}_${suffix}.cpp)
   if(suffix STREQUAL "Vulkan")
-    list(APPEND outputs ${out_dir}/${class}_Vulkan_shaders.cpp)
+    list(APPEND outputs ${out_dir}/${name}_Vulkan_shaders.cpp)
   endif()
 
   # Parse the class as the target compiles it: its include paths, definitions and standard, plus
@@ -138,12 +143,12 @@ function(crossrt_add_class target class)
             --class ${class} --backend ${backend} --out ${out_dir}
             ${source_args} ${option_args}
             --templates ${CROSSRT_TEMPLATE_DIR}
-            --depfile ${out_dir}/${class}_${suffix}.d --depfile-target ${first_output}
+            --depfile ${out_dir}/${name}_${suffix}.d --depfile-target ${first_output}
             --build-dir ${CMAKE_BINARY_DIR}
             -- ${compile_args}
     DEPENDS ${abs_sources} ${translator_dep}
-    DEPFILE ${out_dir}/${class}_${suffix}.d
-    COMMENT "CrossRT: translating ${class} -> ${class}_${suffix}"
+    DEPFILE ${out_dir}/${name}_${suffix}.d
+    COMMENT "CrossRT: translating ${class} -> ${name}_${suffix}"
     COMMAND_EXPAND_LISTS
     VERBATIM)
 
@@ -151,8 +156,8 @@ function(crossrt_add_class target class)
   if(NOT TARGET crossrt_generate)
     add_custom_target(crossrt_generate)
   endif()
-  add_custom_target(crossrt_generate_${target}_${class}_${suffix} DEPENDS ${outputs})
-  add_dependencies(crossrt_generate crossrt_generate_${target}_${class}_${suffix})
+  add_custom_target(crossrt_generate_${target}_${name}_${suffix} DEPENDS ${outputs})
+  add_dependencies(crossrt_generate crossrt_generate_${target}_${name}_${suffix})
 
   target_sources(${target} PRIVATE ${outputs})
   target_include_directories(${target} PRIVATE ${out_dir})

@@ -1980,16 +1980,32 @@ void AnalyzeControl(Context& c, const CXXMethodDecl* md, const FunctionDecl* def
 
 bool AnalyzeTranslationUnit(ASTContext& ctx, const std::string& className, const std::map<std::string, std::string>& compositions,
                             Reporter& reporter, ClassModel& model) {
-  // A name lookup in the translation unit: walking every declaration of the standard library
-  // would cost more than the rest of the analysis.
+  // Name lookups, namespace by namespace ("demo::Render"): walking every declaration of the
+  // standard library would cost more than the rest of the analysis.
+  std::vector<std::string> path;
+  for (size_t start = 0;;) {
+    const size_t colons = className.find("::", start);
+    path.push_back(className.substr(start, colons == std::string::npos ? std::string::npos : colons - start));
+    if (colons == std::string::npos) break;
+    start = colons + 2;
+  }
+  const DeclContext* scope = ctx.getTranslationUnitDecl();
+  for (size_t i = 0; i + 1 < path.size() && scope; ++i) {
+    const DeclContext* inner = nullptr;
+    for (auto* d : scope->lookup(&ctx.Idents.get(path[i])))
+      if (auto* ns = dyn_cast<NamespaceDecl>(d)) inner = ns;
+    scope = inner;
+  }
   const CXXRecordDecl* cls = nullptr;
-  for (auto* d : ctx.getTranslationUnitDecl()->lookup(&ctx.Idents.get(className)))
-    if (auto* rd = dyn_cast<CXXRecordDecl>(d); rd && rd->getDefinition()) cls = rd->getDefinition();
+  if (scope && !path.back().empty())
+    for (auto* d : scope->lookup(&ctx.Idents.get(path.back())))
+      if (auto* rd = dyn_cast<CXXRecordDecl>(d); rd && rd->getDefinition()) cls = rd->getDefinition();
   if (!cls) return false;
   Context c{ctx, cls, reporter, model, compositions, {}, {}};
   bool first = model.className.empty();
   if (first) {
-    model.className = className;
+    model.className = path.back();
+    for (size_t i = 0; i + 1 < path.size(); ++i) model.namespaceName += (i ? "::" : "") + path[i];
     model.headerFile = FileOf(ctx, cls->getLocation());
     AnalyzeMembers(c);
   }

@@ -156,6 +156,8 @@ Data ClassDataList(const ClassModel& model) {
 Data Common(const ClassModel& model, const GenerateOptions& opt) {
   Data d;
   d.set("className", model.className);
+  d.set("namespaceName", model.namespaceName);
+  d.set("hasNamespace", !model.namespaceName.empty());
   d.set("headerName", opt.headerName);
   d.set("headerInclude", opt.headerInclude);
   d.set("commitOverride", model.declaresCommitDeviceData ? " override" : "");

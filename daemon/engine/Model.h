@@ -190,7 +190,8 @@ struct LockedCopy {
 };
 
 struct ClassModel {
-  std::string className;
+  std::string className;       // Render
+  std::string namespaceName;   // demo (or a::b) where the class is declared: the generated classes join it
   std::string headerFile;      // header declaring the class (as included by generated code)
   std::vector<Member> members;
   std::vector<Kernel> kernels;

@@ -270,7 +270,7 @@ AnalyzeResult Analyze(const TranslateRequest& request, AstCache* sharedCache) {
   }
   if (model.className.empty()) {
     result.diagnostics = diagText + "error: class '" + request.className + "' is not defined in " + sources.front() +
-                         " or the headers it includes\nnote: hint: the class must be defined in the global namespace; check the name given to crossrt_add_class\n";
+                         " or the headers it includes\nnote: hint: check the name given to crossrt_add_class; name a class in a namespace with it (demo::Render)\n";
     return result;
   }
   if (model.kernels.empty() && errors == 0) {

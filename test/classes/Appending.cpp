@@ -4,6 +4,9 @@
 #include <cmath>
 #include <functional>
 
+namespace demo::appends
+{
+
 void Appending::Select(int n, float threshold, const float* values, float* out)
 {
   m_positive.clear();
@@ -93,3 +96,4 @@ void Appending::kernel_Tag(int tid, const float* values)
   if (values[tid] > 0.9f)
     m_tagged.push_back(Candidate{uint32_t(tid), values[tid]});
 }
+}  // namespace demo::appends

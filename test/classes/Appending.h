@@ -1,11 +1,14 @@
 // Appends and indirect dispatch: kernels push_back to member vectors, and later kernels loop to
 // those vectors' sizes. On the GPU the appends go through an atomic counter and the later kernels
-// are dispatched indirectly, with no host round trip (test/equivalence/test_append.cpp).
+// are dispatched indirectly, with no host round trip (test/equivalence/test_append.cpp). The class
+// sits in a nested namespace, as users' classes do: the generated classes join it.
 #pragma once
 #include <cmath>
 #include <cstdint>
 #include <vector>
 
+namespace demo::appends
+{
 // A record one kernel appends and the next one reads.
 struct Candidate
 {
@@ -65,3 +68,4 @@ protected:
   static bool NoteSmall(float value, float limit) { return std::abs(value) < limit; }
   void Append(uint32_t i) { m_small.push_back(i); }
 };
+}  // namespace demo::appends

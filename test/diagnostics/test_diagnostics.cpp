@@ -3,6 +3,8 @@
 // command runs on each case: it must exit with status 1, never crash, and write no output files.
 #include "EngineSupport.h"
 
+#include <fstream>
+#include <iterator>
 #include <regex>
 
 namespace {
@@ -616,4 +618,52 @@ protected:
       REQUIRE(!std::filesystem::exists(tc.dir / "out" / "Looper_Vulkan.cpp"));
     }
   }
+}
+
+TEST_CASE("A class in a namespace is found by its qualified name, and only by it", "[diagnostics][namespace]")
+{
+  TempClass tc("Scaler", R"(#pragma once
+namespace demo
+{
+class Scaler
+{
+public:
+  virtual ~Scaler() = default;
+  virtual void Run(int n, [[crossrt::size("n")]] float* data);
+protected:
+  void kernel1D_Scale(int n, float* data);
+};
+}  // namespace demo
+)",
+               R"(#include "Scaler.h"
+namespace demo
+{
+void Scaler::Run(int n, float* data) { kernel1D_Scale(n, data); }
+void Scaler::kernel1D_Scale(int n, float* data)
+{
+  for (int i = 0; i < n; i++) data[i] *= 2.0f;
+}
+}  // namespace demo
+)");
+  auto translate = [&](const std::string& name) {
+    return RunCrossrt("translate --class " + name + " --backend cpu --out " + (tc.dir / "out").string() + " --source " +
+                      tc.Source("Scaler") + " --templates " CROSSRT_SOURCE_DIR "/templates");
+  };
+  for (const char* wrong : {"Scaler", "other::Scaler", "demo::", "demo::Scaler::Run"})
+  {
+    INFO(wrong);
+    CommandResult r = translate(wrong);
+    INFO(r.output);
+    REQUIRE_FALSE(r.crashed);
+    REQUIRE(r.exitCode == 1);
+    REQUIRE(r.output.find(std::string("error: class '") + wrong + "' is not defined in") != std::string::npos);
+    REQUIRE(r.output.find("hint: check the name given to crossrt_add_class; name a class in a namespace with it") != std::string::npos);
+    REQUIRE(!std::filesystem::exists(tc.dir / "out" / "Scaler_CPU.h"));
+  }
+  CommandResult r = translate("demo::Scaler");
+  INFO(r.output);
+  REQUIRE(r.exitCode == 0);
+  std::ifstream header(tc.dir / "out" / "Scaler_CPU.h");
+  const std::string text((std::istreambuf_iterator<char>(header)), std::istreambuf_iterator<char>());
+  REQUIRE(text.find("namespace demo\n{\nclass Scaler_CPU : public Scaler") != std::string::npos);
 }

@@ -13,6 +13,9 @@
 #include <random>
 #include <tuple>
 
+using demo::appends::Appending;
+using demo::appends::Candidate;
+
 namespace
 {
 std::vector<uint32_t> Sorted(std::vector<uint32_t> v)
@@ -33,8 +36,8 @@ using Impls = std::vector<std::pair<const char*, std::shared_ptr<Appending>>>;
 
 Impls AllBackends(const std::shared_ptr<crossrt::VulkanContext>& ctx, int capacity)
 {
-  Impls impls = {{"original", std::make_shared<Appending>(capacity)}, {"CPU", CreateAppending_CPU(capacity)}};
-  if (ctx) impls.push_back({"Vulkan", CreateAppending_Vulkan(ctx, capacity)});
+  Impls impls = {{"original", std::make_shared<Appending>(capacity)}, {"CPU", demo::appends::CreateAppending_CPU(capacity)}};
+  if (ctx) impls.push_back({"Vulkan", demo::appends::CreateAppending_Vulkan(ctx, capacity)});
   return impls;
 }
 }  // namespace
@@ -189,7 +192,7 @@ TEST_CASE("Appending past the capacity: the GPU keeps the capacity and says so",
   const int n = 1000, capacity = 10;
   const auto values = RandomFloats(n, 5, -1.0f, 1.0f);
   std::vector<float> out(n, -7.0f);
-  auto gpu = CreateAppending_Vulkan(ctx, capacity);
+  auto gpu = demo::appends::CreateAppending_Vulkan(ctx, capacity);
   REQUIRE_THROWS_WITH(gpu->Select(n, 0.5f, values.data(), out.data()),
                       Catch::Contains("Appending::m_positive") && Catch::Contains("capacity is 10") &&
                           Catch::Contains("reserve("));
