@@ -181,11 +181,11 @@ struct VirtualMember {
 // backend hides it with a copy whose push_backs take a lock (crossrt::Locked), as it does in the
 // kernels' own loops. Callers on the way from the kernel are copied too, so that they call the copy.
 struct LockedCopy {
-  std::string name;        // AddHit
+  std::string name;            // AddHit
   std::string declaration;     // in the class: void AddHit(const Hit& a_hit, int a_n = 1)
   std::string definitionHead;  // void Render_CPU::AddHit(const Hit& a_hit, int a_n)
   std::string sourceFile;      // where the original is defined
-  std::string body;        // its body, push_backs rewritten
+  std::string body;            // its body, push_backs rewritten
   bool keepOverloads = false;  // the class has other functions of this name: `using` them
 };
 
