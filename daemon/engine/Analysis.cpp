@@ -113,6 +113,13 @@ const FieldDecl* AppendTarget(const CXXMemberCallExpr* call) {
   return f && IsStdVector(f->getType()) ? f : nullptr;
 }
 
+// The variable `v` of an argument written `&v`, else null.
+const VarDecl* AddressedVar(const Expr* arg) {
+  auto* uo = dyn_cast<UnaryOperator>(arg->IgnoreParenImpCasts());
+  auto* dr = uo && uo->getOpcode() == UO_AddrOf ? dyn_cast<DeclRefExpr>(uo->getSubExpr()->IgnoreParens()) : nullptr;
+  return dr ? dyn_cast<VarDecl>(dr->getDecl()) : nullptr;
+}
+
 // The class's own member function a call `this->f(...)` reaches, defined, else null.
 const FunctionDecl* ThisMethodDef(const CXXMemberCallExpr* call, const CXXRecordDecl* cls) {
   auto* md = call->getMethodDecl();
@@ -759,9 +766,11 @@ void AddLockedCopies(Context& c, const std::vector<const FunctionDecl*>& reached
     copy.declaration = ret + " " + name + "(" + params + ")" + cv + (md->isVirtual() ? " override" : "");
     if (std::any_of(c.model.lockedCopies.begin(), c.model.lockedCopies.end(), [&](const LockedCopy& x) { return x.declaration == copy.declaration; }))
       continue;  // another kernel reached it first
-    // The copy hides every overload of its name: the others stay reachable through a using-declaration.
+    // The copy hides every overload of its name: the others stay reachable through one
+    // using-declaration, with the first copy of the name.
     auto overloads = c.cls->lookup(md->getDeclName());
-    copy.keepOverloads = std::distance(overloads.begin(), overloads.end()) > 1 && decl->getAccess() != AS_private;
+    copy.keepOverloads = std::distance(overloads.begin(), overloads.end()) > 1 && decl->getAccess() != AS_private &&
+                         std::none_of(c.model.lockedCopies.begin(), c.model.lockedCopies.end(), [&](const LockedCopy& x) { return x.name == name; });
     // Outside the class body a leading return type is looked up at namespace scope: a type
     // declared in the class goes after the name, where the class's scope applies.
     QualType rt = md->getReturnType();
@@ -1417,9 +1426,7 @@ private:
         std::string name = GlslPrinter::SafeName(vd->getNameAsString());
         a = type == varType ? name : type + "(" + name + ")";
       } else if (p->getType()->isPointerType()) {
-        auto* uo = dyn_cast<UnaryOperator>(arg->IgnoreParenImpCasts());
-        auto* dr = uo && uo->getOpcode() == UO_AddrOf ? dyn_cast<DeclRefExpr>(uo->getSubExpr()->IgnoreParens()) : nullptr;
-        auto* vd = dr ? dyn_cast<VarDecl>(dr->getDecl()) : nullptr;
+        auto* vd = AddressedVar(arg);
         if (vd && !StateBuffer(tl, vd).empty()) {
           tl.passed.insert(vd);
           a = GlslPrinter::SafeName(vd->getNameAsString());
@@ -1493,9 +1500,7 @@ private:
         args += ", " + m_c.Text(arg->getSourceRange());
         continue;
       }
-      auto* uo = dyn_cast<UnaryOperator>(arg->IgnoreParenImpCasts());
-      auto* dr = uo && uo->getOpcode() == UO_AddrOf ? dyn_cast<DeclRefExpr>(uo->getSubExpr()->IgnoreParens()) : nullptr;
-      auto* vd = dr ? dyn_cast<VarDecl>(dr->getDecl()) : nullptr;
+      auto* vd = AddressedVar(arg);
       std::string buffer = vd ? StateBuffer(tl, vd) : "";
       args += ", " + (buffer.empty() ? BufferArg(arg) : "m_threadState." + buffer + ".View()");
     }
@@ -2019,9 +2024,7 @@ bool AnalyzeTranslationUnit(ASTContext& ctx, const std::string& className, const
         auto* md = call->getMethodDecl();
         if (!md || !IsKernelName(md->getName()) || IpvDims(md->getName())) return true;
         for (unsigned i = 0; i < call->getNumArgs() && i < md->getNumParams(); ++i) {
-          auto* uo = dyn_cast<UnaryOperator>(call->getArg(i)->IgnoreParenImpCasts());
-          auto* dr = uo && uo->getOpcode() == UO_AddrOf ? dyn_cast<DeclRefExpr>(uo->getSubExpr()->IgnoreParens()) : nullptr;
-          auto* vd = dr ? dyn_cast<VarDecl>(dr->getDecl()) : nullptr;
+          auto* vd = AddressedVar(call->getArg(i));
           if (vd && vd->hasLocalStorage() && !isa<ParmVarDecl>(vd)) out.insert({md->getNameAsString(), md->getParamDecl(i)->getNameAsString()});
         }
         return true;
@@ -2266,7 +2269,7 @@ bool ComposeFromTranslationUnit(ASTContext& ctx, Reporter& reporter, ClassModel&
 static void MergeMegakernelCode(ClassModel& model) {
   for (auto& mk : model.megakernels) {
     std::vector<std::string> functions;
-    auto addUnique = [](std::vector<std::string>& list, const std::string& x) {
+    auto addUnique = [](auto& list, const auto& x) {
       if (std::find(list.begin(), list.end(), x) == list.end()) list.push_back(x);
     };
     for (auto& name : mk.megakernelCalls) {
@@ -2284,8 +2287,7 @@ static void MergeMegakernelCode(ClassModel& model) {
         if (same == mk.images.end()) mk.images.push_back(ib);
         else { same->loaded |= ib.loaded; same->stored |= ib.stored; }
       }
-      for (auto& pair : k->samplePairs)
-        if (std::find(mk.samplePairs.begin(), mk.samplePairs.end(), pair) == mk.samplePairs.end()) mk.samplePairs.push_back(pair);
+      for (auto& pair : k->samplePairs) addUnique(mk.samplePairs, pair);
       mk.composedCalls.insert(k->composedCalls.begin(), k->composedCalls.end());
       mk.bufferReferences |= k->bufferReferences;
       mk.atomics |= k->atomics;

@@ -895,10 +895,7 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
     x.set("declaration", lc.declaration);
     x.set("definitionHead", lc.definitionHead);
     x.set("body", lc.body);
-    // One using-declaration per overloaded name.
-    const bool firstOfName = std::none_of(model.lockedCopies.begin(), model.lockedCopies.begin() + (&lc - model.lockedCopies.data()),
-                                          [&](const LockedCopy& y) { return y.name == lc.name; });
-    x.set("keepOverloads", lc.keepOverloads && firstOfName);
+    x.set("keepOverloads", lc.keepOverloads);
     copies.push_back(x);
   }
   d.set("lockedCopies", copies);

@@ -186,7 +186,7 @@ struct LockedCopy {
   std::string definitionHead;  // void Render_CPU::AddHit(const Hit& a_hit, int a_n)
   std::string sourceFile;      // where the original is defined
   std::string body;            // its body, push_backs rewritten
-  bool keepOverloads = false;  // the class has other functions of this name: `using` them
+  bool keepOverloads = false;  // the first copy of a name the class overloads: `using` the others
 };
 
 struct ClassModel {
