@@ -180,7 +180,15 @@ void AnalyzeMembers(Context& c) {
     m.name = f->getNameAsString();
     m.hostExpr = m.name;
     QualType elem;
-    if (IsImage2D(f->getType(), &elem)) {
+    if (IsTextureArray(f->getType(), &elem)) {
+      auto format = ImageFormatOf(elem);
+      if (!format || format->texel == "uint") continue;  // reported if a kernel uses it
+      m.kind = MemberKind::TextureArray;
+      m.glslType = format->texel;
+      m.vkFormat = format->vkFormat;
+      m.elemCppType = CppTypeName(c.ctx, elem);
+      m.cppType = CppTypeName(c.ctx, f->getType());
+    } else if (IsImage2D(f->getType(), &elem)) {
       auto format = ImageFormatOf(elem);
       if (!format) continue;  // reported if a kernel uses it
       m.kind = MemberKind::Image;
@@ -1004,6 +1012,16 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     if (sampler) k.images.push_back({m->name, ImageUse::Sampler, false, false});
   }
   for (auto& [image, sampler] : printer.samplePairs) k.samplePairs.push_back({image->getNameAsString(), sampler->getNameAsString()});
+  for (auto* f : c.cls->fields()) {
+    if (!printer.textureArrays.count(f)) continue;
+    if (f->getAccess() == AS_private)
+      c.rep.Error(f->getLocation(), "member '" + f->getNameAsString() + "' is private, but the generated class derives from '" + c.cls->getNameAsString() + "' and must reach it",
+                  "declare it protected");
+    if (auto* m = FindMember(c.model, f->getNameAsString())) {
+      m->usedByKernels = true;
+      k.textureArrays.push_back(m->name);
+    }
+  }
   std::sort(k.samplePairs.begin(), k.samplePairs.end());
   for (auto* f : printer.plainMembers) {
     auto* m = FindMember(c.model, f->getNameAsString());
@@ -2288,6 +2306,7 @@ static void MergeMegakernelCode(ClassModel& model) {
         else { same->loaded |= ib.loaded; same->stored |= ib.stored; }
       }
       for (auto& pair : k->samplePairs) addUnique(mk.samplePairs, pair);
+      for (auto& array : k->textureArrays) addUnique(mk.textureArrays, array);
       mk.composedCalls.insert(k->composedCalls.begin(), k->composedCalls.end());
       mk.bufferReferences |= k->bufferReferences;
       mk.atomics |= k->atomics;
@@ -2316,6 +2335,8 @@ void FinishModel(ClassModel& model) {
     fields.push_back({m.name + "_width", "uint32_t", "uint", 4, "", m.hostExpr + ".width()"});
     fields.push_back({m.name + "_height", "uint32_t", "uint", 4, "", m.hostExpr + ".height()"});
   }
+  for (auto& m : model.members)
+    if (m.usedByKernels && m.kind == MemberKind::TextureArray) fields.push_back({m.name + "_size", "uint32_t", "uint", 4, "", "uint32_t(" + m.hostExpr + ".size())"});
   // Virtual functions: where each vector's tags and each implementation's objects are on the device.
   for (auto& v : model.virtuals) {
     fields.push_back({v.member + "_tags", "uint64_t", "uvec2", 8, "", "m_virtual." + v.member + "_tags.Address()"});

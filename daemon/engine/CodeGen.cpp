@@ -18,6 +18,21 @@ using Data = kainjow::mustache::data;
 
 Data List() { return Data(Data::type::list); }
 
+// The shaders of a kernel, most specific first (the order the host tries them in): the variants for
+// ray tracing hardware and for arrays of textures on the GPU's samplers, and the one every device runs.
+struct KernelVariant {
+  std::string suffix;  // "_RayQuery_Textures", "_RayQuery", "_Textures" or ""
+  bool rayQuery = false, textures = false;
+};
+std::vector<KernelVariant> Variants(const Kernel& k) {
+  std::vector<KernelVariant> variants;
+  for (bool rayQuery : {true, false})
+    for (bool textures : {true, false})
+      if ((!rayQuery || !k.rayQueryHolder.empty()) && (!textures || !k.textureArrays.empty()))
+        variants.push_back({std::string(rayQuery ? "_RayQuery" : "") + (textures ? "_Textures" : ""), rayQuery, textures});
+  return variants;
+}
+
 std::string ReadFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error("cannot read template '" + path + "'");
@@ -295,8 +310,24 @@ std::vector<std::string> KeepMentioned(const std::vector<std::string>& chunks, s
   return kept;
 }
 
-// `hardwareRayQuery`: the kernel's <kernel>_RayQuery variant (Kernel::rayQueryHolder).
-std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateOptions& opt, bool hardwareRayQuery = false) {
+// The functions kernels call on an array of textures (<array>_sample, ...): with the GPU's
+// samplers (hardware) or over buffers, as LiteImage samples (the helpers they share come once).
+std::string TextureArrayFunctions(const Member& array, bool hardware, bool first, const GenerateOptions& opt) {
+  Data d;
+  d.set("member", array.name);
+  d.set("texel", array.glslType);
+  d.set("border", array.glslType == "vec4" ? "t.border" : "t.border.x");
+  d.set("channel", array.glslType == "vec4" ? "" : ".x");
+  d.set("hardware", hardware);
+  d.set("software", !hardware);
+  d.set("common", !hardware && first);
+  return Render(opt.templateDir + "/glsl/texture_array.glsl.mustache", d);
+}
+
+// A shader of a kernel: `hardwareRayQuery` the variant that traces with ray queries
+// (Kernel::rayQueryHolder), `hardwareTextures` the one that samples arrays of textures with the
+// GPU's samplers (Kernel::textureArrays).
+std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateOptions& opt, bool hardwareRayQuery, bool hardwareTextures) {
   Data d = Common(model, opt);
   d.set("kernel", k.name);
   d.set("sourceFile", k.sourceFile);
@@ -307,7 +338,12 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   d.set("groupSize", std::to_string(shape.x * shape.y * shape.z));
   d.set("classStructs", model.glslClassStructs);
   d.set("rayQuery", hardwareRayQuery);
-  d.set("variant", hardwareRayQuery ? ": the variant for ray tracing hardware (GL_EXT_ray_query)" : "");
+  d.set("textureHardware", hardwareTextures);
+  std::string variant;
+  if (hardwareRayQuery) variant = ": the variant for ray tracing hardware (GL_EXT_ray_query)";
+  if (hardwareTextures) variant += std::string(variant.empty() ? ": the variant" : ",") + " for arrays of textures on the GPU's samplers (descriptor indexing)";
+  else if (!k.textureArrays.empty()) variant += std::string(variant.empty() ? ": the variant" : ",") + " sampling arrays of textures from buffers, on any device";
+  d.set("variant", variant);
   std::string calls;
   for (auto& c : k.megakernelCalls) calls += (calls.empty() ? "" : ", ") + c;
   d.set("origin", k.megakernelOf.empty() ? model.className + "::" + k.name
@@ -331,7 +367,14 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   }
   std::string structs;
   for (auto& x : structList) structs += x + "\n";
+  if (!k.textureArrays.empty())
+    structs += "// A texture of an array as the host describes it (crossrt::TextureInfo): its texels' place in the\n"
+               "// texel buffer, its size, its sampler's address modes and filter, its border colour.\n"
+               "struct crt_TextureInfo\n{\n  uint offset;\n  uint width;\n  uint height;\n  uint mode;  // addressU | addressV << 2 | linear << 4\n"
+               "  vec4 border;\n};\n\n";
   d.set("kernelStructs", structs);
+  for (size_t i = k.textureArrays.size(); i-- > 0;)
+    if (auto* m = FindMember(model, k.textureArrays[i])) functionList.insert(functionList.begin(), TextureArrayFunctions(*m, hardwareTextures, i == 0, opt));
   // Atomics order the kernel's other writes for other threads (Atomics.h): the buffers it may
   // write are coherent, so that those writes are not held in a cache another thread misses.
   const std::string coherent = k.atomics ? "coherent " : "";
@@ -407,6 +450,25 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
       x.set("comment", "member LiteImage::Sampler " + ib.member);
     }
     images.push_back(x);
+  }
+  // Arrays of textures: each texture's size and sampler, and either its texels or its descriptor.
+  for (size_t i = 0; i < k.textureArrays.size(); ++i) {
+    auto* m = FindMember(model, k.textureArrays[i]);
+    const std::string& a = k.textureArrays[i];
+    const std::string cppType = "std::vector<LiteImage::Texture2D<" + (m ? m->elemCppType : std::string("?")) + ">>";
+    Data x;
+    x.set("decl", "layout(std430, binding = " + std::to_string(binding++) + ") readonly buffer " + a + "InfoBuffer { crt_TextureInfo " + a + "_info[]; }");
+    x.set("comment", "member " + cppType + " " + a + ": its textures' sizes and samplers");
+    images.push_back(x);
+    Data y;
+    if (hardwareTextures) {
+      y.set("decl", "layout(set = " + std::to_string(1 + i) + ", binding = 0) uniform sampler2D " + a + "[]");
+      y.set("comment", "its textures, with their samplers");
+    } else {
+      y.set("decl", "layout(std430, binding = " + std::to_string(binding++) + ") readonly buffer " + a + "TexelBuffer { " + (m ? m->glslType : "vec4") + " " + a + "_texels[]; }");
+      y.set("comment", "their texels, one texture after the other");
+    }
+    images.push_back(y);
   }
   if (hardwareRayQuery) {
     Data x;
@@ -685,18 +747,26 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
     x.set("indirectVector", k.indirectVector);
     x.set("indirectSlot", std::to_string(indirectSlots));
     if (!k.indirectVector.empty()) ++indirectSlots;
-    // What the kernel binds, in the order its GLSL declares it: the class data, pointer arguments,
-    // member vectors, reduction partials (storage buffers), then images and samplers. The ray
-    // query variant binds its own member vectors only, and the scene last.
-    auto bindingList = [&](const std::vector<std::string>& memberVectors, bool scene, std::string& types, unsigned& buffers) {
-      std::string list = "m_classDataBuffer.View()";
-      buffers = 1;
+    // What each variant binds, in the order its GLSL declares it: the class data, pointer arguments,
+    // member vectors, reduction partials (storage buffers), images and samplers, then per array of
+    // textures its infos and (sampled from buffers) its texels. The ray query variants bind their
+    // own member vectors only, and the scene last; the texture variants bind the arrays' sets.
+    Data variants = List();
+    const std::vector<KernelVariant> kinds = Variants(k);
+    for (size_t vi = 0; vi < kinds.size(); ++vi) {
+      const KernelVariant& kind = kinds[vi];
+      std::string list = "m_classDataBuffer.View()", types = "VK_DESCRIPTOR_TYPE_STORAGE_BUFFER";
+      unsigned buffers = 1;
+      auto buffer = [&](const std::string& view) {
+        list += ", " + view;
+        types += ", VK_DESCRIPTOR_TYPE_STORAGE_BUFFER";
+        ++buffers;
+      };
       for (auto& p : k.params)
-        if (p.isPointer) { list += ", " + p.name; ++buffers; }
-      for (auto& v : memberVectors) { list += ", m_vdata." + v + ".View()"; ++buffers; }
-      for (auto& r : k.reductions) { list += ", m_partials." + k.name + "_" + r.member + ".View()"; ++buffers; }
-      types.clear();
-      for (unsigned i = 0; i < buffers; ++i) types += std::string(i ? ", " : "") + "VK_DESCRIPTOR_TYPE_STORAGE_BUFFER";
+        if (p.isPointer) buffer(p.name);
+      for (auto& v : kind.rayQuery ? k.ownMemberVectors : k.memberVectors) buffer("m_vdata." + v + ".View()");
+      for (auto& r : k.reductions) buffer("m_partials." + k.name + "_" + r.member + ".View()");
+      bool typed = false;  // bindings other than storage buffers
       for (auto& ib : k.images) {
         const char* type = ib.use == ImageUse::Storage ? "VK_DESCRIPTOR_TYPE_STORAGE_IMAGE"
                            : ib.use == ImageUse::Texture ? "VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE" : "VK_DESCRIPTOR_TYPE_SAMPLER";
@@ -704,24 +774,56 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
         list += std::string(", crossrt::Binding::") +
                 (ib.use == ImageUse::Storage ? "StorageImage" : ib.use == ImageUse::Texture ? "SampledImage" : "SamplerOf") + "(m_images." +
                 ib.member + ")";
+        typed = true;
       }
-      if (scene) {
+      std::string sets;
+      for (auto& a : k.textureArrays) {
+        buffer("m_textures." + a + "_info.View()");
+        if (kind.textures) sets += (sets.empty() ? "&m_textures." : ", &m_textures.") + a;
+        else buffer("m_textures." + a + "_texels.View()");
+      }
+      if (kind.rayQuery) {
         types += ", VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR";
         list += ", crossrt::Binding::SceneOf(m_scenes." + k.rayQueryHolder + ")";
+        typed = true;
       }
-      return list;
-    };
-    std::string types, rayQueryTypes;
-    unsigned bindings = 0, rayQueryBuffers = 0;  // storage buffers (the buffer-only pipeline's binding count)
-    const std::string buffers = bindingList(k.memberVectors, false, types, bindings);
-    const bool rayQuery = !k.rayQueryHolder.empty();
-    x.set("rayQuery", rayQuery);
-    x.set("softwareOnly", !rayQuery);
-    x.set("holder", k.rayQueryHolder);
-    if (rayQuery) {
-      x.set("rayQueryBindingList", bindingList(k.ownMemberVectors, true, rayQueryTypes, rayQueryBuffers));
-      x.set("rayQueryBindingTypes", rayQueryTypes);
+      Data y;
+      y.set("kernel", k.name);
+      y.set("pipeline", k.name + kind.suffix);
+      y.set("bindingList", list);
+      y.set("bindingTypes", types);
+      y.set("bindingCount", std::to_string(buffers));
+      y.set("pushBuffers", !typed && !kind.textures);  // storage buffers only: the simple constructor
+      y.set("pushBindings", typed || kind.textures);
+      y.set("pushCall", typed ? "PushBindings" : "PushBuffers");
+      y.set("textureSets", sets);
+      y.set("hasTextureSets", !sets.empty());
+      y.set("textureSetCount", std::to_string(k.textureArrays.size()));
+      // Which devices can create it, and when the host records it.
+      std::string needs, use, why;
+      if (kind.rayQuery) {
+        needs = "m_ctx->hasRayQuery";
+        use = "m_useRayTracingHardware";
+        why = k.rayQueryHolder + "'s ray queries on the ray tracing hardware";
+      }
+      if (kind.textures) {
+        needs += (needs.empty() ? "" : " && ") + std::string("m_ctx->hasTextureArrays");
+        use += (use.empty() ? "" : " && ") + std::string("m_useTextureHardware");
+        why += (why.empty() ? "" : ", ") + std::string("textures on the GPU's samplers");
+      }
+      y.set("conditional", !needs.empty());
+      y.set("indentCreate", needs.empty() ? "" : "  ");
+      y.set("needs", needs);
+      y.set("why", why);
+      y.set("comment", why.empty() ? "" : "  // " + why);
+      // The host tries the variants in order; the last (every device's) is the `else`.
+      const bool choice = kinds.size() > 1;
+      y.set("choice", choice);
+      y.set("head", !choice ? "" : vi == 0 ? "if (" + use + ")  // " + why : vi + 1 < kinds.size() ? "else if (" + use + ")  // " + why : "else");
+      y.set("indent", choice ? "  " : "");
+      variants.push_back(y);
     }
+    x.set("variants", variants);
     Data reds = List();
     for (auto& r : k.reductions) {
       Data y;
@@ -733,12 +835,6 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
       y.set("groupCountExpr", GroupCountExpr(k));
       reds.push_back(y);
     }
-    x.set("pushBindings", !k.images.empty());  // typed bindings
-    x.set("pushBuffers", k.images.empty());    // buffers only
-    x.set("pushCall", k.images.empty() ? "PushBuffers" : "PushBindings");
-    x.set("bindingTypes", types);
-    x.set("bufferList", buffers);
-    x.set("bindingCount", std::to_string(bindings));
     x.set("reduceBindingCount", std::to_string(1 + k.reductions.size()));
     x.set("reductions", reds);
     x.set("hasReductions", !k.reductions.empty());
@@ -809,8 +905,7 @@ std::vector<ShaderSource> GenerateShaders(const ClassModel& model, const Generat
   std::vector<ShaderSource> shaders;
   for (const Kernel* kernel : VulkanKernels(model)) {
     const Kernel& k = *kernel;
-    shaders.push_back({k.name, KernelGlsl(model, k, opt)});
-    if (!k.rayQueryHolder.empty()) shaders.push_back({k.name + "_RayQuery", KernelGlsl(model, k, opt, true)});
+    for (const KernelVariant& v : Variants(k)) shaders.push_back({k.name + v.suffix, KernelGlsl(model, k, opt, v.rayQuery, v.textures)});
     if (!k.reductions.empty()) shaders.push_back({k.name + "_Reduce", ReduceGlsl(model, k, opt)});
   }
   return shaders;
@@ -825,6 +920,17 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
     Data images = ImagesData(model, MemberKind::Image), samplers = ImagesData(model, MemberKind::Sampler);
     d.set("images", images);
     d.set("samplers", samplers);
+    Data textureArrays = List();
+    for (auto& m : model.members) {
+      if (m.kind != MemberKind::TextureArray || !m.usedByKernels) continue;
+      Data x;
+      x.set("name", m.name);
+      x.set("host", m.hostExpr);
+      x.set("vkFormat", m.vkFormat);
+      textureArrays.push_back(x);
+    }
+    d.set("hasTextureArrays", !textureArrays.is_empty_list());
+    d.set("textureArrays", textureArrays);
     d.set("hasImages", std::any_of(model.members.begin(), model.members.end(), [](const Member& m) {
       return m.usedByKernels && (m.kind == MemberKind::Image || m.kind == MemberKind::Sampler);
     }));

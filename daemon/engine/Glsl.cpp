@@ -77,6 +77,15 @@ bool IsImageSampler(QualType type) {
   return rd && rd->getName() == "Sampler" && InNamespace(rd, "LiteImage");
 }
 
+bool IsTextureArray(QualType type, QualType* texel) {
+  QualType elem;
+  if (!IsStdVector(type.getNonReferenceType(), &elem)) return false;
+  auto* spec = dyn_cast_or_null<ClassTemplateSpecializationDecl>(elem.getCanonicalType()->getAsCXXRecordDecl());
+  if (!spec || spec->getName() != "Texture2D" || spec->getTemplateArgs().size() != 1 || !InNamespace(spec, "LiteImage")) return false;
+  if (texel) *texel = spec->getTemplateArgs()[0].getAsType();
+  return true;
+}
+
 std::optional<ImageFormat> ImageFormatOf(QualType texel) {
   texel = texel.getCanonicalType().getUnqualifiedType();
   if (IsLiteMathType(texel, "float4")) return ImageFormat{"rgba32f", "VK_FORMAT_R32G32B32A32_SFLOAT", "vec4", ""};
@@ -774,6 +783,60 @@ std::string GlslPrinter::ImageCall(const FieldDecl* image, const CXXMemberCallEx
               "kernels read texels (" + name + "[p], at(x, y), sample(sampler, uv)), write them (" + name + "[p] = v, set(x, y, v)) and read width() and height()");
 }
 
+// ---- arrays of textures: std::vector<LiteImage::Texture2D<T>> members ----
+// Kernels call <array>_sample, _texel, _width and _height (templates/glsl/texture_array.glsl), which
+// each variant of the shader defines its own way: GPU samplers, or buffers and LiteImage's sampling.
+
+const FieldDecl* GlslPrinter::TextureElement(const clang::Expr* e, const clang::Expr** index) {
+  auto* op = dyn_cast<CXXOperatorCallExpr>(e->IgnoreParenImpCasts());
+  if (!op || op->getOperator() != OO_Subscript) return nullptr;
+  auto* f = ThisMemberField(op->getArg(0));
+  if (!f || !IsTextureArray(f->getType())) return nullptr;
+  if (index) *index = op->getArg(1);
+  return f;
+}
+
+bool GlslPrinter::UsableTextures(const FieldDecl* array, SourceLocation use) {
+  QualType texel;
+  IsTextureArray(array->getType(), &texel);
+  auto format = ImageFormatOf(texel);
+  if (!format || format->texel == "uint")
+    Fail(use, "array of textures '" + array->getNameAsString() + "' has a texel type GPU samplers cannot filter ('" +
+         texel.getAsString(m_ctx.getPrintingPolicy()) + "')", "use LiteImage::Texture2D<float4> or Texture2D<float>");
+  else if (!composedPrefix.empty() || selfClass)
+    Fail(use, "array of textures '" + array->getNameAsString() + "' used outside the class's own kernels",
+         "use textures only in kernels and helpers of the translated class; pass a texture index to the object instead");
+  else {
+    textureArrays.insert(array);
+    return true;
+  }
+  return false;
+}
+
+namespace {
+// A texture index as the generated functions take it (uint).
+std::string TextureIndex(const clang::Expr* index, const std::string& printed) {
+  return index->getType()->isUnsignedIntegerType() ? printed : "uint(" + printed + ")";
+}
+}  // namespace
+
+std::string GlslPrinter::TextureCall(const FieldDecl* array, const clang::Expr* index, const CXXMemberCallExpr* call) {
+  const std::string name = array->getNameAsString();
+  const std::string method = call->getMethodDecl()->getNameAsString();
+  if (!UsableTextures(array, call->getBeginLoc())) return "/*error*/";
+  const std::string i = TextureIndex(index, Expr(index));
+  if (method == "sample" && call->getNumArgs() == 1) return name + "_sample(" + i + ", " + Expr(call->getArg(0)) + ")";
+  if ((method == "width" || method == "height") && call->getNumArgs() == 0) return name + "_" + method + "(" + i + ")";
+  return Fail(call->getBeginLoc(), "Texture2D::" + method + " is not supported in kernels",
+              "kernels sample textures of an array (" + name + "[i].sample(uv)), read texels (" + name + "[i][p]) and read width() and height()");
+}
+
+std::string GlslPrinter::TextureTexel(const FieldDecl* array, const clang::Expr* index, const clang::Expr* coord, SourceLocation loc) {
+  if (!UsableTextures(array, loc)) return "/*error*/";
+  const bool ivec = GlslTypeOf(coord->getType()).value_or("") == "ivec2";
+  return array->getNameAsString() + "_texel(" + TextureIndex(index, Expr(index)) + ", " + (ivec ? Expr(coord) : "ivec2(" + Expr(coord) + ")") + ")";
+}
+
 std::string GlslPrinter::Call(const CallExpr* call) {
   const FunctionDecl* fd = call->getDirectCallee();
   if (!fd) return Fail(call->getBeginLoc(), "indirect call in a kernel", "call functions directly; lambdas and function pointers are not supported");
@@ -806,6 +869,9 @@ std::string GlslPrinter::Call(const CallExpr* call) {
     }
     // Calls on an Image2D member: texel loads and stores, samples, its size.
     if (auto* image = ThisMemberField(obj); image && IsImage2D(image->getType())) return ImageCall(image, mc);
+    // Calls on a texture of an array of textures.
+    const clang::Expr* textureIndex = nullptr;
+    if (auto* array = TextureElement(obj, &textureIndex)) return TextureCall(array, textureIndex, mc);
     // Calls through a member holding an interface: composition.
     std::string composed = ComposedCall(mc);
     if (!composed.empty()) return composed;
@@ -815,6 +881,11 @@ std::string GlslPrinter::Call(const CallExpr* call) {
     // Calls on a std::vector member.
     if (auto* me = dyn_cast<MemberExpr>(obj); me && IsStdVector(me->getType())) {
       auto* field = dyn_cast<FieldDecl>(me->getMemberDecl());
+      if (field && isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts()) && IsTextureArray(field->getType())) {
+        if (name == "size" && UsableTextures(field, call->getBeginLoc())) return field->getNameAsString() + "_size";
+        return Fail(call->getBeginLoc(), "std::vector::" + name + " of an array of textures in a kernel",
+                    "kernels read its size() and use its textures: " + field->getNameAsString() + "[i].sample(uv)");
+      }
       if (field && isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts())) {
         memberVectors.insert(field);
         if (name == "size") {
@@ -943,6 +1014,10 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
                       "objects called through virtual functions hold plain data: scalars, LiteMath types and structs of them");
         return "self." + SafeName(field->getNameAsString());
       }
+      if (IsTextureArray(field->getType()))
+        return Fail(e->getBeginLoc(), "array of textures '" + field->getNameAsString() + "' used as a value in a kernel",
+                    "call its textures where the array is a member: " + field->getNameAsString() + "[i].sample(uv), " +
+                    field->getNameAsString() + "[i][p], " + field->getNameAsString() + "[i].width(), " + field->getNameAsString() + ".size()");
       if (IsStdVector(field->getType())) {
         memberVectors.insert(field);
         return composedPrefix + field->getNameAsString();
@@ -975,6 +1050,9 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
         loadedImages.insert(image);
         return TexelOf(*format, "imageLoad(" + image->getNameAsString() + ", " + coord + ")");
       }
+    const clang::Expr* textureIndex = nullptr;
+    if (kind == OO_Subscript)
+      if (auto* array = TextureElement(op->getArg(0), &textureIndex)) return TextureTexel(array, textureIndex, op->getArg(1), e->getBeginLoc());
     if (kind == OO_Subscript) return Expr(op->getArg(0)) + "[" + Expr(op->getArg(1)) + "]";
     if (op->isAssignmentOp() && op->getNumArgs() == 2 && ImageTexel(op->getArg(0))) {
       if (kind == OO_Equal) return ImageStore(op->getArg(0), Expr(op->getArg(1)), e);

@@ -28,6 +28,8 @@ bool IsStdVector(clang::QualType type, clang::QualType* element = nullptr);
 bool IsImage2D(clang::QualType type, clang::QualType* texel = nullptr);
 // LiteImage::Sampler: filtering and address modes of image samples.
 bool IsImageSampler(clang::QualType type);
+// std::vector<LiteImage::Texture2D<T>>: an array of textures (combined image samplers), and T.
+bool IsTextureArray(clang::QualType type, clang::QualType* texel = nullptr);
 // GPU image format of an Image2D<T>: GLSL format qualifier, Vulkan format, texel GLSL type,
 // image/texture type prefix ("" or "u"); nullopt for texel types the GPU cannot hold.
 struct ImageFormat { std::string glslFormat, vkFormat, texel, prefix; };
@@ -69,6 +71,8 @@ public:
   std::set<const clang::FieldDecl*> loadedImages, storedImages, sampledImages, samplers;
   std::set<const clang::FieldDecl*> sizedImages;  // whose width() or height() it reads
   std::set<std::pair<const clang::FieldDecl*, const clang::FieldDecl*>> samplePairs;  // (image, sampler)
+  // Arrays of textures (std::vector<LiteImage::Texture2D<T>> members) the kernel samples or reads.
+  std::set<const clang::FieldDecl*> textureArrays;
   // Helper functions the kernel reaches (their writes to members matter too).
   std::vector<const clang::FunctionDecl*> helpers;
 
@@ -126,6 +130,12 @@ private:
   std::optional<ImageFormat> UsableImage(const clang::FieldDecl* image, clang::SourceLocation use);  // reports why not
   std::string ImageStore(const clang::Expr* lhs, const std::string& value, const clang::Expr* whole);
   std::string ImageCall(const clang::FieldDecl* image, const clang::CXXMemberCallExpr* call);
+  // Arrays of textures: the array of an element expression (m_textures[i]) and its index; calls on
+  // an element (sample, width, height) and texel reads (m_textures[i][p]).
+  const clang::FieldDecl* TextureElement(const clang::Expr* e, const clang::Expr** index = nullptr);
+  std::string TextureCall(const clang::FieldDecl* array, const clang::Expr* index, const clang::CXXMemberCallExpr* call);
+  std::string TextureTexel(const clang::FieldDecl* array, const clang::Expr* index, const clang::Expr* coord, clang::SourceLocation loc);
+  bool UsableTextures(const clang::FieldDecl* array, clang::SourceLocation use);  // reports why not
   std::string AtomicCall(const clang::FunctionDecl* fd, const clang::CallExpr* call);
   std::string AtomicTargetProblem(const clang::Expr* target) const;
   std::string EmitAppend(const clang::FieldDecl* field, const clang::CallExpr* call);

@@ -17,7 +17,8 @@ struct BlockField {
   std::string assignExpr;  // values the generated class computes (device addresses)
 };
 
-enum class MemberKind { Plain, Vector, Image, Sampler };
+// TextureArray: std::vector<LiteImage::Texture2D<T>>, an array of combined image samplers.
+enum class MemberKind { Plain, Vector, Image, Sampler, TextureArray };
 
 struct Member {
   std::string name;             // as GLSL and the generated mirrors name it
@@ -25,8 +26,8 @@ struct Member {
   std::string composedFrom;     // composed: "BVHScene::m_nodes through m_pAccelStruct" (for comments)
   MemberKind kind = MemberKind::Plain;
   std::string cppType;          // full C++ type spelling
-  std::string glslType;         // plain: the GLSL type; vector: the element's GLSL type
-  std::string elemCppType;      // vector: the element's C++ type; image: the texel's
+  std::string glslType;         // plain: the GLSL type; vector: the element's GLSL type; image, texture array: the texel's
+  std::string elemCppType;      // vector: the element's C++ type; image, texture array: the texel's
   std::string imageFormat;      // image: GLSL format qualifier (rgba32f, r32f, r32ui)
   std::string vkFormat;         // image: VK_FORMAT_...
   std::string imagePrefix;      // image: "u" for unsigned texels (uimage2D, utexture2D), else ""
@@ -91,6 +92,10 @@ struct Kernel {
   std::vector<std::string> memberVectors;   // member vectors the kernel reaches (incl. helpers)
   std::vector<ImageBinding> images;         // bound after the buffers, in member declaration order
   std::vector<std::pair<std::string, std::string>> samplePairs;  // (image, sampler) it samples with
+  // Arrays of textures it samples, in member declaration order. Each shader has a variant that
+  // samples them with the GPU's samplers (<kernel>_Textures: a descriptor set each, from set 1 on)
+  // and one that samples them from buffers as LiteImage does (any device).
+  std::vector<std::string> textureArrays;
   // 1D kernel looping to the size of a vector that kernels append to: dispatched indirectly, its
   // thread count read on the GPU.
   std::string indirectVector;

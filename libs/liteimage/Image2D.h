@@ -4,6 +4,7 @@
 #include "LiteMath.h"
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace LiteImage
@@ -156,6 +157,34 @@ T Image2D<T>::sample(const Sampler& a_sampler, float2 a_uv) const
   const T bottom = t01 * (1.0f - tx) + t11 * tx;
   return top * (1.0f - ty) + bottom * ty;
 }
+
+// An image with the sampler it is read through: what Vulkan calls a combined image sampler.
+// A std::vector<Texture2D<T>> member (a material's textures, one sampler each) becomes an array of
+// textures on the GPU, indexed per thread: m_textures[id].sample(uv). T is float4 or float.
+template <typename T>
+class Texture2D
+{
+public:
+  Texture2D() = default;
+  explicit Texture2D(Image2D<T> a_image, const Sampler& a_sampler = Sampler())
+      : m_image(std::move(a_image)), m_sampler(a_sampler)
+  {
+  }
+
+  T        sample(float2 a_uv) const { return m_image.sample(m_sampler, a_uv); }
+  uint32_t width() const { return m_image.width(); }
+  uint32_t height() const { return m_image.height(); }
+  const T& operator[](const int2& p) const { return m_image[p]; }  // a texel, as Image2D's
+
+  Image2D<T>&       image() { return m_image; }
+  const Image2D<T>& image() const { return m_image; }
+  Sampler&          sampler() { return m_sampler; }
+  const Sampler&    sampler() const { return m_sampler; }
+
+private:
+  Image2D<T> m_image;
+  Sampler    m_sampler;
+};
 
 // ---- image file IO (OpenImageIO) ----
 // Float data is written as-is to float formats (.exr, .hdr, .pfm, .tif/.tiff). Other formats

@@ -366,6 +366,12 @@ void VulkanContext::CreateDevice(const ContextOptions& options) {
   if (vk12) {
     enable12.scalarBlockLayout = supported12.scalarBlockLayout;
     enable12.bufferDeviceAddress = supported12.bufferDeviceAddress;
+    // Arrays of textures indexed per thread (TextureArray): all four or none.
+    if (supported12.runtimeDescriptorArray && supported12.shaderSampledImageArrayNonUniformIndexing &&
+        supported12.descriptorBindingPartiallyBound && supported12.descriptorBindingVariableDescriptorCount) {
+      enable12.runtimeDescriptorArray = enable12.shaderSampledImageArrayNonUniformIndexing = VK_TRUE;
+      enable12.descriptorBindingPartiallyBound = enable12.descriptorBindingVariableDescriptorCount = VK_TRUE;
+    }
     *tail = &enable12; tail = &enable12.pNext;
   }
   if (rayQuery && supportedRq.rayQuery && supportedAs.accelerationStructure && enable12.bufferDeviceAddress) {
@@ -408,6 +414,27 @@ void VulkanContext::CreateDevice(const ContextOptions& options) {
   hasScalarBlockLayout = enable12.scalarBlockLayout == VK_TRUE;
   hasBufferDeviceAddress = enable12.bufferDeviceAddress == VK_TRUE;
   hasRayQuery = enableRq.rayQuery == VK_TRUE;
+  if (enable12.runtimeDescriptorArray) {
+    // A kernel may sample a few arrays besides its own images: each array gets a quarter of what
+    // one stage may bind, and at most 65536 textures.
+    const VkPhysicalDeviceLimits& l = properties.limits;
+    const uint32_t stageLimit = std::min({l.maxPerStageDescriptorSamplers, l.maxPerStageDescriptorSampledImages,
+                                          l.maxDescriptorSetSamplers, l.maxDescriptorSetSampledImages});
+    maxTextureArraySize = std::min<uint32_t>(65536, stageLimit > 64 ? (stageLimit - 32) / 4 : 0);
+    if (maxTextureArraySize > 0) {
+      const VkDescriptorBindingFlags flags = VK_DESCRIPTOR_BINDING_PARTIALLY_BOUND_BIT | VK_DESCRIPTOR_BINDING_VARIABLE_DESCRIPTOR_COUNT_BIT;
+      auto bindingFlags = VkInit<VkDescriptorSetLayoutBindingFlagsCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_BINDING_FLAGS_CREATE_INFO);
+      bindingFlags.bindingCount = 1;
+      bindingFlags.pBindingFlags = &flags;
+      const VkDescriptorSetLayoutBinding binding{0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, maxTextureArraySize, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+      auto setInfo = VkInit<VkDescriptorSetLayoutCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO);
+      setInfo.pNext = &bindingFlags;
+      setInfo.bindingCount = 1;
+      setInfo.pBindings = &binding;
+      Check(vkCreateDescriptorSetLayout(device, &setInfo, nullptr, &textureArrayLayout), "vkCreateDescriptorSetLayout (arrays of textures)");
+      hasTextureArrays = true;
+    }
+  }
 
   vkCmdPushDescriptorSetKHR = reinterpret_cast<PFN_vkCmdPushDescriptorSetKHR>(
       vkGetDeviceProcAddr(device, "vkCmdPushDescriptorSetKHR"));
@@ -440,6 +467,7 @@ VulkanContext::~VulkanContext() {
     SavePipelineCache();
     if (pipelineCache) vkDestroyPipelineCache(device, pipelineCache, nullptr);
     if (commandPool) vkDestroyCommandPool(device, commandPool, nullptr);
+    if (textureArrayLayout) vkDestroyDescriptorSetLayout(device, textureArrayLayout, nullptr);
     vkDestroyDevice(device, nullptr);
   }
   if (instance) {

@@ -14,10 +14,13 @@ ComputePipeline::ComputePipeline(std::shared_ptr<VulkanContext> ctx, const uint3
                       debugName) {}
 
 ComputePipeline::ComputePipeline(std::shared_ptr<VulkanContext> ctx, const uint32_t* spirv, size_t spirvBytes,
-                                 std::vector<VkDescriptorType> bindingTypes, uint32_t pushConstantBytes, const char* debugName)
-    : ctx_(std::move(ctx)), types_(std::move(bindingTypes)), pushConstantBytes_(pushConstantBytes),
+                                 std::vector<VkDescriptorType> bindingTypes, uint32_t pushConstantBytes, const char* debugName,
+                                 uint32_t textureArraySets)
+    : ctx_(std::move(ctx)), types_(std::move(bindingTypes)), textureArraySets_(textureArraySets), pushConstantBytes_(pushConstantBytes),
       name_(debugName ? debugName : "") {
   if (!ctx_) throw Error("ComputePipeline '" + name_ + "': null VulkanContext");
+  if (textureArraySets_ > 0 && !ctx_->hasTextureArrays)
+    throw Error("ComputePipeline '" + name_ + "': device '" + ctx_->DeviceName() + "' has no arrays of textures (descriptor indexing)");
   if (!spirv || spirvBytes == 0 || spirvBytes % 4 != 0)
     throw Error("ComputePipeline '" + name_ + "': SPIR-V must be a non-empty multiple of 4 bytes");
   if (pushConstantBytes > ctx_->properties.limits.maxPushConstantsSize || pushConstantBytes % 4 != 0)
@@ -39,9 +42,18 @@ ComputePipeline::ComputePipeline(std::shared_ptr<VulkanContext> ctx, const uint3
     }
 
     VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, pushConstantBytes_};
+    // Set 0 exists whenever later sets do: an empty push-descriptor layout stands in for it.
+    if (!setLayout_ && textureArraySets_ > 0) {
+      auto setInfo = VkInit<VkDescriptorSetLayoutCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO);
+      setInfo.flags = VK_DESCRIPTOR_SET_LAYOUT_CREATE_PUSH_DESCRIPTOR_BIT_KHR;
+      Check(vkCreateDescriptorSetLayout(dev, &setInfo, nullptr, &setLayout_), "vkCreateDescriptorSetLayout");
+    }
+    std::vector<VkDescriptorSetLayout> sets;
+    if (setLayout_) sets.push_back(setLayout_);
+    for (uint32_t i = 0; i < textureArraySets_; ++i) sets.push_back(ctx_->textureArrayLayout);
     auto layoutInfo = VkInit<VkPipelineLayoutCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO);
-    layoutInfo.setLayoutCount = setLayout_ ? 1 : 0;
-    layoutInfo.pSetLayouts = setLayout_ ? &setLayout_ : nullptr;
+    layoutInfo.setLayoutCount = static_cast<uint32_t>(sets.size());
+    layoutInfo.pSetLayouts = sets.empty() ? nullptr : sets.data();
     layoutInfo.pushConstantRangeCount = pushConstantBytes_ ? 1 : 0;
     layoutInfo.pPushConstantRanges = pushConstantBytes_ ? &range : nullptr;
     Check(vkCreatePipelineLayout(dev, &layoutInfo, nullptr, &layout_), "vkCreatePipelineLayout");
@@ -83,6 +95,7 @@ ComputePipeline& ComputePipeline::operator=(ComputePipeline&& other) noexcept {
     layout_ = std::exchange(other.layout_, VK_NULL_HANDLE);
     pipeline_ = std::exchange(other.pipeline_, VK_NULL_HANDLE);
     types_ = std::move(other.types_);
+    textureArraySets_ = std::exchange(other.textureArraySets_, 0);
     pushConstantBytes_ = std::exchange(other.pushConstantBytes_, 0);
     name_ = std::move(other.name_);
   }
@@ -163,6 +176,19 @@ void ComputePipeline::Push(VkCommandBuffer cmd, const std::vector<Binding>& bind
     }
   }
   ctx_->vkCmdPushDescriptorSetKHR(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, count, writes.data());
+}
+
+void ComputePipeline::BindTextureArrays(VkCommandBuffer cmd, std::initializer_list<const TextureArray*> arrays) const {
+  if (arrays.size() != textureArraySets_)
+    throw Error("ComputePipeline '" + name_ + "': got " + std::to_string(arrays.size()) + " arrays of textures for " +
+                std::to_string(textureArraySets_) + " sets");
+  std::vector<VkDescriptorSet> sets;
+  for (const TextureArray* a : arrays) {
+    if (!a || !a->Set()) throw Error("ComputePipeline '" + name_ + "': an array of textures was not assigned");
+    sets.push_back(a->Set());
+  }
+  if (!sets.empty())
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 1, static_cast<uint32_t>(sets.size()), sets.data(), 0, nullptr);
 }
 
 void ComputePipeline::PushConstants(VkCommandBuffer cmd, const void* data, uint32_t bytes) const {

@@ -16,6 +16,7 @@
 #include <mutex>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <unordered_map>
 #include <vector>
 
@@ -77,6 +78,12 @@ public:
   VkPhysicalDeviceProperties properties{};  // limits, name, timestampPeriod
   bool hasScalarBlockLayout = false, hasBufferDeviceAddress = false, hasRayQuery = false,
        hasShaderFloat64 = false, hasShaderInt64 = false;
+  // Arrays of combined image samplers indexed per thread (descriptor indexing: runtime arrays,
+  // non-uniform indexing, partially bound sets of variable size). Then textureArrayLayout is the
+  // set layout of one such array, of up to maxTextureArraySize textures.
+  bool hasTextureArrays = false;
+  uint32_t maxTextureArraySize = 0;
+  VkDescriptorSetLayout textureArrayLayout = VK_NULL_HANDLE;
   // Subgroups of compute shaders: generated reductions need arithmetic ops and >= 4 lanes.
   uint32_t subgroupSize = 0;
   bool hasSubgroupArithmetic = false;
@@ -387,16 +394,116 @@ void EnsureSize(std::shared_ptr<VulkanContext> ctx, Buffer& b, VkDeviceSize byte
 // `retired` instead of being destroyed.
 void GrowScratch(std::shared_ptr<VulkanContext> ctx, Buffer& b, VkDeviceSize bytes, std::vector<Buffer>& retired);
 
-// RAII compute pipeline, move-only. Set 0 is a push-descriptor set.
+// ---- arrays of textures: std::vector<LiteImage::Texture2D<T>> members --------------------------
+// Kernels sample them by a per-thread index. Two ways, chosen at run time:
+// - TextureArray: an image and a sampler per texture in a descriptor set, for devices with
+//   descriptor indexing (VulkanContext::hasTextureArrays); the GPU's samplers filter.
+// - TextureBuffers: every texel in one storage buffer and a TextureInfo per texture; the kernels'
+//   own sampler (generated GLSL) filters as LiteImage::Image2D::sample does, on any device.
+
+// One texture as the generated sampler reads it (std430, 32 bytes; GLSL struct crt_TextureInfo).
+struct TextureInfo {
+  uint32_t offset = 0;  // its first texel in the texel buffer
+  uint32_t width = 0, height = 0;
+  uint32_t mode = 0;    // addressU | addressV << 2 | linear << 4; address modes numbered as LiteImage's
+  float border[4] = {0, 0, 0, 0};
+};
+
+// The TextureInfo of a LiteImage::Texture2D (any type with its members: the runtime does not depend on LiteImage).
+template <typename Texture>
+TextureInfo DescribeTexture(const Texture& t, uint32_t offset) {
+  using Filter = typename std::decay_t<decltype(t.sampler())>::Filter;
+  TextureInfo info;
+  info.offset = offset;
+  info.width = t.width();
+  info.height = t.height();
+  info.mode = uint32_t(t.sampler().addressU) | uint32_t(t.sampler().addressV) << 2 | uint32_t(t.sampler().filter == Filter::LINEAR) << 4;
+  info.border[0] = t.sampler().borderColor.x;
+  info.border[1] = t.sampler().borderColor.y;
+  info.border[2] = t.sampler().borderColor.z;
+  info.border[3] = t.sampler().borderColor.w;
+  return info;
+}
+
+// Uploads the TextureInfos of `textures` to `infos` and, unless `texels` is null, their texels one
+// after the other to *texels, for the generated sampler. Buffers grow as needed and hold at least
+// one element.
+template <typename Textures>
+void CommitTextureBuffers(std::shared_ptr<VulkanContext> ctx, const Textures& textures, Buffer& infos, Buffer* texels) {
+  using Texel = std::remove_const_t<std::remove_pointer_t<decltype(textures[0].image().data())>>;
+  std::vector<TextureInfo> table(textures.size() == 0 ? 1 : textures.size());
+  size_t total = 0;
+  for (size_t i = 0; i < textures.size(); ++i) {
+    const size_t texelCount = size_t(textures[i].width()) * textures[i].height();
+    if (total + texelCount > UINT32_MAX) throw Error("CommitTextureBuffers: the textures hold more than 2^32 texels");
+    table[i] = DescribeTexture(textures[i], uint32_t(total));
+    total += texelCount;
+  }
+  EnsureSize(ctx, infos, sizeof(TextureInfo) * table.size());
+  infos.Upload(table.data(), sizeof(TextureInfo) * table.size());
+  if (!texels) return;
+  EnsureSize(ctx, *texels, sizeof(Texel) * (total == 0 ? 1 : total));
+  for (size_t i = 0; i < textures.size(); ++i)
+    if (textures[i].width() > 0 && textures[i].height() > 0)
+      texels->Upload(textures[i].image().data(), sizeof(Texel) * textures[i].width() * textures[i].height(), sizeof(Texel) * table[i].offset);
+}
+
+// The descriptor set of an array of combined image samplers: one GPU image per texture (1 x 1
+// while empty) and one sampler per distinct LiteImage::Sampler. Move-only.
+class TextureArray {
+public:
+  struct Texture {
+    const void* texels = nullptr;  // tightly packed rows of the array's format
+    uint32_t width = 0, height = 0;
+    SamplerDesc sampler;
+  };
+  TextureArray() = default;
+  // Throws unless ctx->hasTextureArrays.
+  TextureArray(std::shared_ptr<VulkanContext> ctx, const char* debugName);
+  TextureArray(TextureArray&& other) noexcept;
+  TextureArray& operator=(TextureArray&& other) noexcept;
+  TextureArray(const TextureArray&) = delete;
+  TextureArray& operator=(const TextureArray&) = delete;
+  ~TextureArray();
+
+  // Replaces the textures (synchronous uploads) and rewrites the set. Throws for more textures
+  // than maxTextureArraySize, and for linear filtering of a format the device cannot filter.
+  void Assign(VkFormat format, const std::vector<Texture>& textures);
+  VkDescriptorSet Set() const { return set_; }
+  size_t Size() const { return images_.size(); }
+
+private:
+  void Release() noexcept;
+  std::shared_ptr<VulkanContext> ctx_;
+  std::string name_;
+  std::vector<Image> images_;
+  std::vector<Sampler> samplers_;
+  VkDescriptorPool pool_ = VK_NULL_HANDLE;
+  VkDescriptorSet set_ = VK_NULL_HANDLE;
+};
+
+// TextureArray::Assign from a vector of LiteImage::Texture2D.
+template <typename Textures>
+void AssignTextures(TextureArray& array, VkFormat format, const Textures& textures) {
+  std::vector<TextureArray::Texture> list(textures.size());
+  for (size_t i = 0; i < textures.size(); ++i)
+    list[i] = {textures[i].image().data(), textures[i].width(), textures[i].height(), DescribeSampler(textures[i].sampler())};
+  array.Assign(format, list);
+}
+
+// RAII compute pipeline, move-only. Set 0 is a push-descriptor set; sets 1, 2, ... may be
+// arrays of textures (VulkanContext::textureArrayLayout).
 class ComputePipeline {
 public:
   ComputePipeline() = default;
   // storageBufferBindings: bindings 0..n-1 in set 0; pushConstantBytes may be 0.
   ComputePipeline(std::shared_ptr<VulkanContext> ctx, const uint32_t* spirv, size_t spirvBytes,
                   uint32_t storageBufferBindings, uint32_t pushConstantBytes, const char* debugName);
-  // Binding i of set 0 has bindingTypes[i] (storage buffers, storage images, sampled images, samplers).
+  // Binding i of set 0 has bindingTypes[i] (storage buffers, storage images, sampled images, samplers);
+  // sets 1..textureArraySets are arrays of textures (throws unless ctx->hasTextureArrays).
   ComputePipeline(std::shared_ptr<VulkanContext> ctx, const uint32_t* spirv, size_t spirvBytes,
-                  std::vector<VkDescriptorType> bindingTypes, uint32_t pushConstantBytes, const char* debugName);
+                  std::vector<VkDescriptorType> bindingTypes, uint32_t pushConstantBytes, const char* debugName,
+                  uint32_t textureArraySets = 0);
   ComputePipeline(ComputePipeline&& other) noexcept;
   ComputePipeline& operator=(ComputePipeline&& other) noexcept;
   ComputePipeline(const ComputePipeline&) = delete;
@@ -409,6 +516,8 @@ public:
   // Binding i = i-th entry, whose type must be the layout's.
   void PushBindings(VkCommandBuffer cmd, std::initializer_list<Binding> bindings) const;
   void PushConstants(VkCommandBuffer cmd, const void* data, uint32_t bytes) const;
+  // Binds the arrays as sets 1, 2, ...; their number must be the pipeline's textureArraySets.
+  void BindTextureArrays(VkCommandBuffer cmd, std::initializer_list<const TextureArray*> arrays) const;
   VkPipeline Handle() const { return pipeline_; }
   VkPipelineLayout Layout() const { return layout_; }
 
@@ -421,6 +530,7 @@ private:
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
   VkPipeline pipeline_ = VK_NULL_HANDLE;
   std::vector<VkDescriptorType> types_;
+  uint32_t textureArraySets_ = 0;
   uint32_t pushConstantBytes_ = 0;
   std::string name_;
 };

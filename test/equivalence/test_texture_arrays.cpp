@@ -1,0 +1,218 @@
+// Arrays of textures: the original TexturedMaterials, TexturedMaterials_CPU and
+// TexturedMaterials_Vulkan give the same samples. Each texture has its own size, address modes
+// and filter; threads pick textures by index. Where the device has no descriptor indexing (lavapipe)
+// the kernels sample from buffers exactly as LiteImage does, so the results are bit for bit the
+// CPU's; with the GPU's samplers bilinear weights have its sub-texel precision.
+#include "TexturedMaterials.h"
+#include "TexturedMaterials_CPU.h"
+#include "TexturedMaterials_Vulkan.h"
+#include "TestSupport.h"
+
+#include <cmath>
+#include <limits>
+
+using LiteImage::Image2D;
+using LiteImage::Sampler;
+using LiteImage::Texture2D;
+using LiteMath::float2;
+using LiteMath::float4;
+
+namespace
+{
+using Mode = Sampler::AddressMode;
+
+Sampler MakeSampler(Mode u, Mode v, bool linear, float4 border = float4(0.0f))
+{
+  Sampler s;
+  s.addressU = u;
+  s.addressV = v;
+  s.filter = linear ? Sampler::Filter::LINEAR : Sampler::Filter::NEAREST;
+  s.borderColor = border;
+  return s;
+}
+
+Image2D<float4> RandomImage(uint32_t w, uint32_t h, unsigned seed)
+{
+  const auto v = RandomFloats(int(4 * w * h), seed, 0.0f, 1.0f);
+  Image2D<float4> img(w, h);
+  for (uint32_t i = 0; i < w * h; ++i) img.data()[i] = float4(v[4 * i], v[4 * i + 1], v[4 * i + 2], v[4 * i + 3]);
+  return img;
+}
+
+// Five albedo textures: sizes that are not powers of two, one empty, every address mode, both filters.
+void Fill(TexturedMaterials& m)
+{
+  m.m_albedo.clear();
+  m.m_albedo.emplace_back(RandomImage(7, 5, 1), MakeSampler(Mode::WRAP, Mode::WRAP, false));
+  m.m_albedo.emplace_back(RandomImage(16, 9, 2), MakeSampler(Mode::MIRROR, Mode::MIRROR, true));
+  m.m_albedo.emplace_back(RandomImage(3, 1, 3), MakeSampler(Mode::BORDER, Mode::BORDER, true, float4(0.0f, 0.0f, 0.0f, 1.0f)));
+  m.m_albedo.emplace_back(Image2D<float4>(), MakeSampler(Mode::WRAP, Mode::WRAP, true));
+  m.m_albedo.emplace_back(RandomImage(5, 4, 4), MakeSampler(Mode::CLAMP, Mode::WRAP, true));
+  const auto a = RandomFloats(11 * 3, 5, -2.0f, 2.0f), b = RandomFloats(4 * 4, 6, -2.0f, 2.0f);
+  m.m_bumps.clear();
+  m.m_bumps.emplace_back(Image2D<float>(11, 3, a.data()), MakeSampler(Mode::CLAMP, Mode::CLAMP, true));
+  m.m_bumps.emplace_back(Image2D<float>(4, 4, b.data()), MakeSampler(Mode::MIRROR, Mode::BORDER, false, float4(1.0f)));
+}
+
+struct Hits
+{
+  std::vector<uint32_t> ids;
+  std::vector<float2> uvs;
+};
+
+// Random texture ids and coordinates in and around [0, 1], and a few extremes: huge, infinite and NaN.
+Hits RandomHits(int n)
+{
+  Hits h;
+  const auto c = RandomFloats(3 * n, 11, -1.5f, 2.5f);
+  for (int i = 0; i < n; ++i)
+  {
+    h.ids.push_back(uint32_t(c[3 * i] * 1000.0f + 2000.0f));
+    h.uvs.push_back(float2(c[3 * i + 1], c[3 * i + 2]));
+  }
+  const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+  const float2 extremes[] = {float2(1.0e9f, -1.0e9f), float2(inf, 0.5f), float2(0.5f, -inf), float2(nan, 0.25f), float2(0.0f, 1.0f)};
+  for (int i = 0; i < n && i < 5 * 5; ++i) h.uvs[i] = extremes[i % 5];  // ids i % 5 cover every texture with each
+  for (int i = 0; i < n && i < 5 * 5; ++i) h.ids[i] = uint32_t(i / 5);
+  return h;
+}
+
+struct Shaded
+{
+  std::vector<float4> colors, texels;
+  std::vector<float> heights;
+};
+
+Shaded Shade(TexturedMaterials& m, const Hits& h)
+{
+  const int n = int(h.ids.size());
+  Shaded s{std::vector<float4>(n, float4(-7.0f)), std::vector<float4>(n, float4(-7.0f)), std::vector<float>(n, -7.0f)};
+  m.Shade(n, h.ids.data(), h.uvs.data(), s.colors.data(), s.heights.data(), s.texels.data());
+  return s;
+}
+
+bool Same(const float4& a, const float4& b) { return a.x == b.x && a.y == b.y && a.z == b.z && a.w == b.w; }
+
+float MaxDifference(const float4& a, const float4& b)
+{
+  return std::max(std::max(std::fabs(a.x - b.x), std::fabs(a.y - b.y)), std::max(std::fabs(a.z - b.z), std::fabs(a.w - b.w)));
+}
+}  // namespace
+
+TEST_CASE("Arrays of textures: each its own size, address modes and filter, picked per thread", "[equivalence][textures]")
+{
+  auto ctx = ValidatedContext();
+  const Hits hits = RandomHits(4001);
+  TexturedMaterials reference;
+  Fill(reference);
+  const Shaded expected = Shade(reference, hits);
+
+  // The original itself, against what the test computes: nearest WRAP texels of texture 0, the
+  // empty texture's zeros, and every texture picked.
+  std::vector<int> picked(5, 0);
+  for (size_t i = 0; i < hits.ids.size(); ++i)
+  {
+    const uint32_t id = hits.ids[i] % 5;
+    ++picked[id];
+    if (id == 3) REQUIRE(Same(expected.colors[i], float4(0.0f)));
+    if (id == 0 && i >= 25)
+    {
+      const auto& t = reference.m_albedo[0];
+      const int x = int(std::floor(hits.uvs[i].x * 7.0f)), y = int(std::floor(hits.uvs[i].y * 5.0f));
+      REQUIRE(Same(expected.colors[i], t.image().at(((x % 7) + 7) % 7, ((y % 5) + 5) % 5)));
+    }
+  }
+  for (int count : picked) REQUIRE(count > 400);
+
+  std::vector<std::pair<const char*, std::shared_ptr<TexturedMaterials>>> impls = {{"CPU", CreateTexturedMaterials_CPU()}};
+  if (ctx) impls.push_back({"Vulkan", CreateTexturedMaterials_Vulkan(ctx)});
+  for (auto& [name, impl] : impls)
+  {
+    INFO(name);
+    Fill(*impl);
+    const Shaded got = Shade(*impl, hits);
+    auto* vulkan = dynamic_cast<TexturedMaterials_Vulkan*>(impl.get());
+    const bool exact = !vulkan || !vulkan->UsesTextureHardware();
+    size_t near = 0;
+    for (size_t i = 0; i < hits.ids.size(); ++i)
+    {
+      INFO("hit " << i << ": texture " << hits.ids[i] % 5 << " at uv " << hits.uvs[i].x << ", " << hits.uvs[i].y);
+      REQUIRE(Same(got.texels[i], expected.texels[i]));
+      if (exact)
+      {
+        REQUIRE(Same(got.colors[i], expected.colors[i]));
+        REQUIRE(got.heights[i] == expected.heights[i]);
+      }
+      else  // the GPU's sampler: 8 bits of sub-texel precision, nearest may pick the other texel at an edge
+        near += MaxDifference(got.colors[i], expected.colors[i]) <= 4.0f / 512.0f && std::fabs(got.heights[i] - expected.heights[i]) <= 16.0f / 512.0f;
+    }
+    if (!exact) CHECK(near >= hits.ids.size() * 98 / 100);
+  }
+  RequireNoValidationMessages(ctx);
+}
+
+TEST_CASE("Arrays of textures: changed, added and emptied textures reach the GPU", "[equivalence][textures]")
+{
+  auto ctx = ValidatedContext();
+  if (!ctx) return;
+  auto gpu = CreateTexturedMaterials_Vulkan(ctx);
+  TexturedMaterials cpu;
+  Fill(*gpu);
+  Fill(cpu);
+  const Hits hits = RandomHits(501);
+  auto agree = [&] {
+    const Shaded a = Shade(cpu, hits), b = Shade(*gpu, hits);
+    size_t same = 0;
+    for (size_t i = 0; i < hits.ids.size(); ++i)
+      same += MaxDifference(a.colors[i], b.colors[i]) <= 4.0f / 512.0f && std::fabs(a.heights[i] - b.heights[i]) <= 16.0f / 512.0f;
+    return same >= hits.ids.size() * 98 / 100;
+  };
+  REQUIRE(agree());
+  // New texels and a new sampler, same sizes: CommitDeviceData() sends them.
+  for (auto* m : {static_cast<TexturedMaterials*>(gpu.get()), &cpu})
+  {
+    m->m_albedo[1].image() = RandomImage(16, 9, 21);
+    m->m_albedo[1].sampler() = MakeSampler(Mode::CLAMP, Mode::WRAP, false);
+    m->CommitDeviceData();
+  }
+  REQUIRE(agree());
+  // One more texture: the next call commits by itself.
+  for (auto* m : {static_cast<TexturedMaterials*>(gpu.get()), &cpu})
+    m->m_albedo.emplace_back(RandomImage(2, 3, 22), MakeSampler(Mode::MIRROR, Mode::CLAMP, true));
+  REQUIRE(agree());
+  // One texture only, and an empty bump map.
+  for (auto* m : {static_cast<TexturedMaterials*>(gpu.get()), &cpu})
+  {
+    m->m_albedo.resize(1);
+    m->m_bumps[0] = Texture2D<float>();
+  }
+  REQUIRE(agree());
+  RequireNoValidationMessages(ctx);
+}
+
+TEST_CASE("Arrays of textures: the GPU's samplers only where the device has descriptor indexing", "[equivalence][textures]")
+{
+  auto ctx = ValidatedContext();
+  if (!ctx) return;
+  auto gpu = std::dynamic_pointer_cast<TexturedMaterials_Vulkan>(CreateTexturedMaterials_Vulkan(ctx));
+  REQUIRE(gpu);
+  CHECK(gpu->UsesTextureHardware() == ctx->hasTextureArrays);
+  if (ctx->hasTextureArrays)
+  {
+    CHECK(ctx->maxTextureArraySize > 0);
+    gpu->UseTextureHardware(false);  // and back: both ways work
+    CHECK_FALSE(gpu->UsesTextureHardware());
+    gpu->UseTextureHardware(true);
+  }
+  else
+  {
+    try {
+      gpu->UseTextureHardware(true);
+      FAIL("UseTextureHardware(true) did not throw on a device without descriptor indexing");
+    } catch (const crossrt::Error& e) {
+      CHECK(std::string(e.what()).find("no arrays of textures (descriptor indexing)") != std::string::npos);
+    }
+    CHECK_FALSE(gpu->UsesTextureHardware());
+  }
+  RequireNoValidationMessages(ctx);
+}

@@ -1,0 +1,52 @@
+#!/bin/bash
+# Compiles every shader variant generated for GPU hardware that lavapipe lacks under a build tree
+# with glslangValidator, checks that it asks for that hardware, and validates the SPIR-V with
+# spirv-val. Lavapipe cannot run these shaders, so this is what a machine without them can check.
+#   *_RayQuery*.comp: ray queries (GL_EXT_ray_query), capability RayQueryKHR;
+#   *_Textures.comp: arrays of textures indexed per thread (descriptor indexing), capabilities
+#   RuntimeDescriptorArray and SampledImageArrayNonUniformIndexing.
+# Usage: validate_hardware_variants.sh <glslangValidator> <spirv-val> <spirv-dis> <build dir> <expected shader>...
+# Each expected shader (a path ending, e.g. PrimaryRays_Vulkan/shaders/kernel1D_CastRays_RayQuery.comp)
+# must be among those found, so a generator that stopped writing them fails here.
+set -u
+glslang=$1 spirvval=$2 spirvdis=$3 build=$4
+shift 4
+mapfile -t shaders < <(find "$build" \( -name '*_RayQuery.comp' -o -name '*_RayQuery_Textures.comp' -o -name '*_Textures.comp' \) -path '*/shaders/*' | sort -u)
+status=0
+for expected in "$@"; do
+  if ! printf '%s\n' "${shaders[@]}" | grep -q -- "/$expected\$"; then
+    echo "FAIL: no generated shader ends with $expected"
+    status=1
+  fi
+done
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+checked=0
+for shader in "${shaders[@]}"; do
+  spv="$work/$(basename "$shader").spv"
+  if ! "$glslang" -V --target-env vulkan1.2 -o "$spv" "$shader" > "$work/log" 2>&1; then
+    echo "FAIL: $shader does not compile:"; cat "$work/log"; status=1; continue
+  fi
+  needed=()
+  case "$shader" in *_RayQuery*) needed+=(RayQueryKHR) ;; esac
+  case "$shader" in *_Textures.comp) needed+=(RuntimeDescriptorArray SampledImageArrayNonUniformIndexing) ;; esac
+  "$spirvdis" "$spv" > "$work/dis" 2>/dev/null
+  missing=""
+  for capability in "${needed[@]}"; do
+    grep -q "OpCapability $capability\$" "$work/dis" || missing+=" $capability"
+  done
+  if [ -n "$missing" ]; then
+    echo "FAIL: $shader compiled without the capabilities$missing"; status=1; continue
+  fi
+  if ! "$spirvval" --target-env vulkan1.2 "$spv" > "$work/log" 2>&1; then
+    echo "FAIL: spirv-val rejects $shader:"; cat "$work/log"; status=1; continue
+  fi
+  echo "valid: $shader (${needed[*]})"
+  checked=$((checked + 1))
+done
+if [ "$status" -eq 0 ] && [ "$checked" -gt 0 ]; then
+  echo "OK: $checked hardware variant shaders valid"
+else
+  echo "FAIL: $checked of ${#shaders[@]} hardware variant shaders valid"
+  exit 1
+fi
