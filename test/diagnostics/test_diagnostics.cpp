@@ -502,6 +502,15 @@ TEST_CASE("Image uses the GPU cannot make are reported", "[diagnostics][images]"
        "kernels read texels"},
       {"a texel type images cannot hold", "out[i] = m_uv[LiteMath::int2(i, 0)].x;", "Image2D member 'm_uv' has a texel type GPU images cannot hold",
        "use Image2D<float4>, Image2D<float> or Image2D<uint32_t>"},
+      // Arrays of textures (std::vector<LiteImage::Texture2D<T>>).
+      {"a texture of an array kept in a local", "const auto& t = m_textures[i]; out[i] = t.sample(LiteMath::float2(0.5f)).x;",
+       "array of textures 'm_textures' used as a value in a kernel", "call its textures where the array is a member: m_textures[i].sample(uv)"},
+      {"an array of textures changed in a kernel", "m_textures.pop_back();", "std::vector::pop_back of an array of textures in a kernel",
+       "kernels read its size() and use its textures"},
+      {"a texture's image reached in a kernel", "out[i] = m_textures[i].image()[LiteMath::int2(0, 0)].x;", "Texture2D::image is not supported in kernels",
+       "kernels sample textures of an array (m_textures[i].sample(uv))"},
+      {"an array of textures of uint texels", "out[i] = float(m_idTextures[i][LiteMath::int2(0, 0)]);",
+       "array of textures 'm_idTextures' has a texel type GPU samplers cannot filter ('unsigned int')", "use LiteImage::Texture2D<float4> or Texture2D<float>"},
   };
   for (const Case& c : cases)
   {
@@ -510,6 +519,7 @@ TEST_CASE("Image uses the GPU cannot make are reported", "[diagnostics][images]"
       TempClass tc("Images", R"(#pragma once
 #include "Image2D.h"
 #include <cstdint>
+#include <vector>
 inline float Red(const LiteImage::Image2D<LiteMath::float4>& image, int i) { return image[LiteMath::int2(i, 0)].x; }
 class Images
 {
@@ -520,6 +530,8 @@ public:
   LiteImage::Image2D<uint32_t> m_ids;
   LiteImage::Image2D<LiteMath::float2> m_uv;
   LiteImage::Sampler m_sampler;
+  std::vector<LiteImage::Texture2D<LiteMath::float4>> m_textures;
+  std::vector<LiteImage::Texture2D<uint32_t>> m_idTextures;
 protected:
   void kernel1D_Run(int n, float* out);
 };
