@@ -5,6 +5,7 @@
 #include "ImageFilters.h"
 #include "ImageFilters_CPU.h"
 #include "ImageFilters_Vulkan.h"
+#include "ImageSupport.h"
 #include "TestSupport.h"
 
 #include <cmath>
@@ -16,14 +17,6 @@ using LiteMath::float4;
 
 namespace
 {
-Image2D<float4> RandomImage(uint32_t w, uint32_t h, unsigned seed)
-{
-  const auto v = RandomFloats(int(4 * w * h), seed, 0.0f, 1.0f);
-  Image2D<float4> img(w, h);
-  for (uint32_t i = 0; i < w * h; ++i) img.data()[i] = float4(v[4 * i], v[4 * i + 1], v[4 * i + 2], v[4 * i + 3]);
-  return img;
-}
-
 void Fill(ImageFilters& f, uint32_t w, uint32_t h)
 {
   f.m_source = RandomImage(w, h, 7);
@@ -43,11 +36,6 @@ Impls AllBackends(const std::shared_ptr<crossrt::VulkanContext>& ctx)
   Impls impls = {{"original", std::make_shared<ImageFilters>()}, {"CPU", CreateImageFilters_CPU()}};
   if (ctx) impls.push_back({"Vulkan", CreateImageFilters_Vulkan(ctx)});
   return impls;
-}
-
-float MaxDifference(const float4& a, const float4& b)
-{
-  return std::max(std::max(std::fabs(a.x - b.x), std::fabs(a.y - b.y)), std::max(std::fabs(a.z - b.z), std::fabs(a.w - b.w)));
 }
 
 // Distance of a coordinate from the nearest texel edge, in texels: nearest sampling may pick

@@ -9,6 +9,7 @@
 #include "TexturedHits.h"
 #include "TexturedHits_CPU.h"
 #include "TexturedHits_Vulkan.h"
+#include "ImageSupport.h"
 #include "TestSupport.h"
 
 #include <cmath>
@@ -32,14 +33,6 @@ Sampler MakeSampler(Mode u, Mode v, bool linear, float4 border = float4(0.0f))
   s.filter = linear ? Sampler::Filter::LINEAR : Sampler::Filter::NEAREST;
   s.borderColor = border;
   return s;
-}
-
-Image2D<float4> RandomImage(uint32_t w, uint32_t h, unsigned seed)
-{
-  const auto v = RandomFloats(int(4 * w * h), seed, 0.0f, 1.0f);
-  Image2D<float4> img(w, h);
-  for (uint32_t i = 0; i < w * h; ++i) img.data()[i] = float4(v[4 * i], v[4 * i + 1], v[4 * i + 2], v[4 * i + 3]);
-  return img;
 }
 
 // Five albedo textures: sizes that are not powers of two, one empty, every address mode, both filters.
@@ -95,11 +88,6 @@ Shaded Shade(TexturedMaterials& m, const Hits& h)
 }
 
 bool Same(const float4& a, const float4& b) { return a.x == b.x && a.y == b.y && a.z == b.z && a.w == b.w; }
-
-float MaxDifference(const float4& a, const float4& b)
-{
-  return std::max(std::max(std::fabs(a.x - b.x), std::fabs(a.y - b.y)), std::max(std::fabs(a.z - b.z), std::fabs(a.w - b.w)));
-}
 }  // namespace
 
 TEST_CASE("Arrays of textures: each its own size, address modes and filter, picked per thread", "[equivalence][textures]")
