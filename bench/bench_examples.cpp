@@ -4,6 +4,7 @@
 // SpherePaths runs on Vulkan in both execution modes: wavefront (one dispatch per kernel call) and
 // megakernel (its thread loop as one shader).
 //   bench_examples [particles] [bloom side] [paths side]
+#include "BenchSupport.h"
 #include "Bloom.h"
 #include "Bloom_CPU.h"
 #include "Bloom_Vulkan.h"
@@ -28,20 +29,6 @@
 using LiteMath::float4;
 
 namespace {
-
-double MedianMs(int repeats, const std::function<void()>& f)
-{
-  f();  // warm-up: first-use costs (pipeline JIT, page faults) are not the steady state
-  std::vector<double> ms;
-  for (int i = 0; i < repeats; ++i)
-  {
-    const auto t0 = std::chrono::steady_clock::now();
-    f();
-    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-  }
-  std::sort(ms.begin(), ms.end());
-  return ms[ms.size() / 2];
-}
 
 void Row(const char* example, const char* impl, double ms, double baseMs, double gpuMs)
 {

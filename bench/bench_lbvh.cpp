@@ -9,6 +9,7 @@
 // Then the speed-against-quality trade of LBVH against binned SAH, as a table and as a PNG.
 //
 //   bench_lbvh [mesh dir (default build/data/meshes)] [plot.png (default out/bvh_tradeoff.png)]
+#include "BenchSupport.h"
 #include "BVHScene.h"
 #include "CrossRT.h"
 #include "Image2D.h"
@@ -41,21 +42,6 @@ constexpr int kImageSize = 1024;
 constexpr int kTraceRounds = 5;  // interleaved rounds of the CPU tracers
 
 double Ms(std::chrono::steady_clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); }
-
-// Median wall time of 3 runs of `work` after one warm-up run.
-double MedianMs(const std::function<void()>& work)
-{
-  work();
-  std::vector<double> ms;
-  for (int i = 0; i < 3; ++i)
-  {
-    auto t0 = std::chrono::steady_clock::now();
-    work();
-    ms.push_back(Ms(std::chrono::steady_clock::now() - t0));
-  }
-  std::sort(ms.begin(), ms.end());
-  return ms[1];
-}
 
 // Wall times of several works measured in rounds, each round running every work once after a
 // warm-up round: a burst of load on this shared machine then slows them alike, and the ratio of
@@ -241,12 +227,12 @@ int main(int argc, char** argv)
     {
       lbvhGpu->Reserve(n);
       lbvhGpu->CommitDeviceData();
-      const double wall = MedianMs([&] { lbvhGpu->Build(n, boxes.data()); });
+      const double wall = MedianMs(3, [&] { lbvhGpu->Build(n, boxes.data()); });
       float times[4];
       lbvhGpu->GetExecutionTime("Build", times);
       std::snprintf(gpu, sizeof(gpu), "%7.1f (%4.2fx) [%6.1f]", wall, wall / low, times[0]);
     }
-    row.sahMs = MedianMs([&] { row.sah = BuildBinnedSAH(boxes.data(), n); });
+    row.sahMs = MedianMs(3, [&] { row.sah = BuildBinnedSAH(boxes.data(), n); });
     std::printf("| %-22s | %9d | %10.1f | %6.1f (%4.2fx) | %7.1f (%5.2fx) | %7.1f (%5.2fx) | %23s | %7.1f (%5.2fx) |\n", name, n, low,
                 medium, PairedRatio(cpuMs[1], cpuMs[0]), originalMs, PairedRatio(cpuMs[2], cpuMs[0]), row.lbvhCpuMs,
                 PairedRatio(cpuMs[3], cpuMs[0]), gpu, row.sahMs, row.sahMs / low);
@@ -364,7 +350,7 @@ int main(int argc, char** argv)
     {
       castGpu->SetScene(lbvhShared, {}, {});
       castGpu->CommitDeviceData();
-      const double wall = MedianMs([&] { castGpu->CastRays(rayPos.data(), rayDir.data(), castHits.data(), pixels); });
+      const double wall = MedianMs(3, [&] { castGpu->CastRays(rayPos.data(), rayDir.data(), castHits.data(), pixels); });
       float times[4];
       castGpu->GetExecutionTime("CastRays", times);
       for (int i = 0; i < pixels; ++i) translatedDiffer += castHits[i].primId != ourPrim[i];

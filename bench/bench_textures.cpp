@@ -5,6 +5,7 @@
 // descriptor indexing). Speed against accuracy: each row prints its largest difference from the
 // original. Times are medians of the repeats after a warm-up, all from this one run.
 //   bench_textures [hits] [textures] [texture side]
+#include "BenchSupport.h"
 #include "TexturedMaterials.h"
 #include "TexturedMaterials_CPU.h"
 #include "TexturedMaterials_Vulkan.h"
@@ -25,20 +26,6 @@ using LiteMath::float2;
 using LiteMath::float4;
 
 namespace {
-
-double MedianMs(int repeats, const std::function<void()>& f)
-{
-  f();  // warm-up: pipeline creation, uploads, page faults
-  std::vector<double> ms;
-  for (int i = 0; i < repeats; ++i)
-  {
-    const auto t0 = std::chrono::steady_clock::now();
-    f();
-    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-  }
-  std::sort(ms.begin(), ms.end());
-  return ms[ms.size() / 2];
-}
 
 // Textures of every address mode, half nearest, half bilinear; bump maps a quarter the size.
 void Fill(TexturedMaterials& m, int textures, uint32_t side)

@@ -54,10 +54,7 @@ void TextureArray::Assign(VkFormat format, const std::vector<Texture>& textures)
     const Texture t = textures.empty() ? Texture{} : textures[i];
     const std::string name = name_ + "[" + std::to_string(i) + "]";
     images_.emplace_back(ctx_, t.width, t.height, format, name.c_str());
-    if (t.width > 0 && t.height > 0) {
-      VkDeviceSize texelBytes = format == VK_FORMAT_R32G32B32A32_SFLOAT ? 16 : 4;
-      images_.back().Upload(t.texels, size_t(texelBytes) * t.width * t.height);
-    }
+    if (t.width > 0 && t.height > 0) images_.back().Upload(t.texels, images_.back().Bytes());
     size_t s = 0;
     while (s < samplers_.size() && samplers_[s].Desc() != t.sampler) ++s;
     if (s == samplers_.size()) samplers_.emplace_back(ctx_, t.sampler, (name + " sampler").c_str());

@@ -211,6 +211,7 @@ public:
   VkFormat Format() const { return format_; }
   VkImage Handle() const { return image_; }
   VkImageView View() const { return view_; }
+  size_t Bytes() const;  // of its texels, tightly packed
   // Whole-image copies of tightly packed rows (synchronous, through a staging buffer). Upload
   // ends with a barrier, so later kernels see the texels.
   void Upload(const void* texels, size_t bytes);
@@ -218,7 +219,6 @@ public:
 
 private:
   void Release() noexcept;
-  size_t Bytes() const;
 
   std::shared_ptr<VulkanContext> ctx_;
   VkImage image_ = VK_NULL_HANDLE;
