@@ -459,6 +459,11 @@ std::string CountExpr(Context& c, const LoopHeader& h) {
   return h.inclusive ? count + " + 1" : count;
 }
 
+// A kernel's Image2D reference parameter (by value it is an error the kernel's analysis reports).
+bool IsImageParam(const ParmVarDecl* p) {
+  return p->getType()->isReferenceType() && IsImage2D(p->getType().getNonReferenceType().getUnqualifiedType());
+}
+
 void CheckKernelParams(Context& c, const CXXMethodDecl* md, Kernel& k) {
   for (unsigned i = 0; i < md->getNumParams(); ++i) {
     auto* p = md->getParamDecl(i);
@@ -471,6 +476,28 @@ void CheckKernelParams(Context& c, const CXXMethodDecl* md, Kernel& k) {
     kp.glslName = GlslPrinter::SafeName(kp.name);
     QualType t = p->getType();
     kp.isThreadId = k.rtv && IsThreadIdName(kp.name);
+    QualType texel;
+    if (IsImage2D(t.getNonReferenceType().getUnqualifiedType(), &texel)) {
+      auto format = ImageFormatOf(texel);
+      if (!t->isReferenceType()) {
+        c.rep.Error(p->getLocation(), "kernel parameter '" + kp.name + "' takes an Image2D by value",
+                    "take it by reference: 'const Image2D<T>& " + kp.name + "' to read it, 'Image2D<T>& " + kp.name + "' to write it");
+        continue;
+      }
+      if (!format) {
+        c.rep.Error(p->getLocation(), "kernel parameter '" + kp.name + "' is an Image2D of '" + texel.getAsString(c.ctx.getPrintingPolicy()) + "', which GPU images cannot hold",
+                    "use Image2D<float4>, Image2D<float> or Image2D<uint32_t>");
+        continue;
+      }
+      kp.isImage = true;
+      kp.isConstPointee = t.getNonReferenceType().isConstQualified();
+      kp.glslType = format->texel;
+      kp.imageFormat = format->glslFormat;
+      kp.vkFormat = format->vkFormat;
+      kp.imagePrefix = format->prefix;
+      k.params.push_back(kp);
+      continue;
+    }
     if (t->isPointerType()) {
       QualType pointee = t->getPointeeType();
       kp.isPointer = true;
@@ -810,8 +837,10 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   printer.compositions = c.compositions;
   for (auto& s : ClassStructNames(c.model)) printer.predeclaredStructs.insert(s);
   // Structs the parameters' buffers hold are declared even when the body names no variable of them.
-  for (auto* p : def->parameters())
+  for (auto* p : def->parameters()) {
     if (p->getType()->isPointerType()) printer.Type(p->getType()->getPointeeType(), p->getLocation());
+    if (IsImageParam(p)) printer.imageParams.insert(p);
+  }
   auto* body = dyn_cast<CompoundStmt>(def->getBody());
   if (!body) {
     c.rep.Error(md->getLocation(), "kernel '" + k.name + "' has a function-try-block", "GPU code has no exceptions: remove the try/catch");
@@ -831,7 +860,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
         k.threadAxes.push_back(ThreadAxis(p.name));
       }
       if (p.threadState) printer.valueParams.insert(def->getParamDecl(i));  // the body refers to the definition's
-      if (p.isPointer && !p.threadState) continue;
+      if ((p.isPointer && !p.threadState) || p.isImage) continue;
       auto [base, dims] = SplitArray(p.glslType);
       std::string qualifier = p.threadState && !p.isConstPointee ? "inout " : "";
       threadParams.push_back({qualifier + base, p.glslName + dims});
@@ -1011,7 +1040,15 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     if (sampled) k.images.push_back({m->name, ImageUse::Texture, false, false});
     if (sampler) k.images.push_back({m->name, ImageUse::Sampler, false, false});
   }
-  for (auto& [image, sampler] : printer.samplePairs) k.samplePairs.push_back({image->getNameAsString(), sampler->getNameAsString()});
+  // Image parameters after the members, in parameter order.
+  for (auto* p : def->parameters()) {
+    if (!printer.imageParams.count(p)) continue;
+    const bool loaded = printer.loadedImages.count(p), stored = printer.storedImages.count(p);
+    if (loaded || stored) k.images.push_back({p->getNameAsString(), ImageUse::Storage, loaded, stored, true});
+    if (printer.sampledImages.count(p)) k.images.push_back({p->getNameAsString(), ImageUse::Texture, false, false, true});
+  }
+  for (auto& [image, sampler] : printer.samplePairs)
+    (isa<FieldDecl>(image) ? k.samplePairs : k.paramSamplePairs).push_back({image->getNameAsString(), sampler->getNameAsString()});
   for (auto* f : c.cls->fields()) {
     if (!printer.textureArrays.count(f)) continue;
     if (f->getAccess() == AS_private)
@@ -1101,6 +1138,33 @@ const Stmt* SingleStatement(const Stmt* s) {
   return s;
 }
 
+// The generated control function copies its Image2D parameters to the GPU before its body runs
+// and back after: host code of the body that changes one (resize, texel writes) would be lost.
+void CheckImageParamsUnchanged(Context& c, const FunctionDecl* def, const std::string& control) {
+  struct Finder : RecursiveASTVisitor<Finder> {
+    Context& c;
+    const FunctionDecl* def;
+    const std::string& control;
+    Finder(Context& cc, const FunctionDecl* d, const std::string& n) : c(cc), def(d), control(n) {}
+    void Check(const CXXMethodDecl* md, const Expr* object, SourceLocation loc) {
+      auto* dr = object ? dyn_cast<DeclRefExpr>(object->IgnoreParenImpCasts()) : nullptr;
+      auto* p = dr ? dyn_cast<ParmVarDecl>(dr->getDecl()) : nullptr;
+      if (!p || p->getDeclContext() != def || !md || md->isConst() || !IsImage2D(p->getType().getNonReferenceType().getUnqualifiedType())) return;
+      c.rep.Error(loc, "control function '" + control + "' changes Image2D parameter '" + p->getNameAsString() + "' on the host ('" + md->getNameAsString() + "')",
+                  "its GPU copy is made before the body runs: size and fill the image before calling '" + control + "', and write its texels in a kernel");
+    }
+    bool VisitCXXMemberCallExpr(CXXMemberCallExpr* call) {
+      Check(call->getMethodDecl(), call->getImplicitObjectArgument(), call->getBeginLoc());
+      return true;
+    }
+    bool VisitCXXOperatorCallExpr(CXXOperatorCallExpr* op) {
+      if (op->getNumArgs() > 0) Check(dyn_cast_or_null<CXXMethodDecl>(op->getDirectCallee()), op->getArg(0), op->getBeginLoc());
+      return true;
+    }
+  } finder(c, def, control);
+  finder.TraverseStmt(def->getBody());
+}
+
 class ControlRewriter {
 public:
   ControlRewriter(Context& c, const CXXMethodDecl* md, const FunctionDecl* def, Control& ctrl)
@@ -1142,6 +1206,33 @@ private:
     return "{}";
   }
 
+  // An Image2D argument of a kernel call, as the crossrt::ImageView the generated code binds: the
+  // device copy of a parameter of the control function, or of a member.
+  std::string ImageArg(const ParmVarDecl* p, const Expr* arg) {
+    const Expr* e = arg->IgnoreParenImpCasts();
+    if (auto* dr = dyn_cast<DeclRefExpr>(e))
+      if (auto* cp = dyn_cast<ParmVarDecl>(dr->getDecl()); cp && cp->getDeclContext() == m_def)
+        return "m_inOut_" + m_ctrl.name + "." + cp->getNameAsString();
+    if (auto* f = ThisField(e); f && IsImage2D(f->getType())) {
+      const std::string name = f->getNameAsString();
+      if (f->getAccess() == AS_private)
+        m_c.rep.Error(f->getLocation(), "member '" + name + "' is private, but the generated class derives from '" + m_c.cls->getNameAsString() + "' and must reach it",
+                      "declare it protected");
+      if (auto* m = FindMember(m_c.model, name)) {
+        m->usedByKernels = true;
+        const bool written = !p->getType().getNonReferenceType().isConstQualified();
+        m->writtenByKernels = m->writtenByKernels || written;
+        auto& list = m_ctrl.imagesWritten;
+        if (written && std::find(list.begin(), list.end(), name) == list.end()) list.push_back(name);
+      }
+      return "crossrt::ImageView(m_images." + name + ", m_images." + name + "Width, m_images." + name + "Height)";
+    }
+    m_c.rep.Error(arg->getBeginLoc(), "Image2D argument of a kernel call must be an Image2D parameter of '" + m_ctrl.name + "' or an Image2D member",
+                  "an image local to '" + m_ctrl.name + "' has no GPU copy: make it a member (its GPU copy is kept between calls) or a parameter of '" +
+                      m_ctrl.name + "'");
+    return "{}";
+  }
+
   std::string Args(const CXXMemberCallExpr* call, bool skipThreadIds) {
     std::string out;
     auto* md = call->getMethodDecl();
@@ -1151,7 +1242,8 @@ private:
       const Expr* arg = call->getArg(i);
       if (isa<CXXDefaultArgExpr>(arg)) continue;
       if (p->getType()->isPointerType()) CheckNotThreadState(md, p, arg);
-      out += ", " + (p->getType()->isPointerType() ? BufferArg(arg) : m_c.Text(arg->getSourceRange()));
+      if (IsImageParam(p)) out += ", " + ImageArg(p, arg);
+      else out += ", " + (p->getType()->isPointerType() ? BufferArg(arg) : m_c.Text(arg->getSourceRange()));
     }
     return out;
   }
@@ -1443,6 +1535,10 @@ private:
         std::string type = GlslTypeOf(p->getType()).value_or("uint"), varType = GlslTypeOf(vd->getType()).value_or("int");
         std::string name = GlslPrinter::SafeName(vd->getNameAsString());
         a = type == varType ? name : type + "(" + name + ")";
+      } else if (IsImageParam(p)) {
+        Error(tl, arg->getBeginLoc(), "Image2D argument of '" + md->getNameAsString() + "' in a thread loop that calls several kernels",
+              "the megakernel binds members only: make the image a member of the class, or give the kernel a thread loop of its own");
+        continue;
       } else if (p->getType()->isPointerType()) {
         auto* vd = AddressedVar(arg);
         if (vd && !StateBuffer(tl, vd).empty()) {
@@ -1991,8 +2087,18 @@ void AnalyzeControl(Context& c, const CXXMethodDecl* md, const FunctionDecl* def
                     "annotate it with its element count, e.g. '[[crossrt::size(\"n\")]] const float* " + cp.name +
                     "' or 'const float* " + cp.name + " __attribute__((size(\"n\")))'");
     }
+    QualType texel;
+    if (IsImage2D(p->getType().getNonReferenceType().getUnqualifiedType(), &texel)) {
+      cp.isImage = true;
+      cp.isConst = !p->getType()->isReferenceType() || p->getType().getNonReferenceType().isConstQualified();
+      cp.pointeeCpp = CppTypeName(c.ctx, texel);
+      if (auto format = ImageFormatOf(texel)) cp.vkFormat = format->vkFormat;
+      else c.rep.Error(p->getLocation(), "parameter '" + cp.name + "' of control function '" + ctrl.name + "' is an Image2D of '" +
+                       texel.getAsString(c.ctx.getPrintingPolicy()) + "', which GPU images cannot hold", "use Image2D<float4>, Image2D<float> or Image2D<uint32_t>");
+    }
     ctrl.params.push_back(cp);
   }
+  CheckImageParamsUnchanged(c, def, ctrl.name);
   CheckCopiedBody(c, def->getBody(), "control function '" + ctrl.name + "'");
   ControlRewriter rw(c, md, def, ctrl);
   rw.Run();

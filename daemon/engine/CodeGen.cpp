@@ -435,16 +435,28 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   // Images and samplers follow the buffers (the host pushes them in this order).
   Data images = List();
   for (auto& ib : k.images) {
-    auto* m = FindMember(model, ib.member);
+    // A member's format, or a parameter's (named as the kernel's GLSL names it).
+    std::string format, prefix, name = ib.member;
+    if (auto* m = ib.parameter ? nullptr : FindMember(model, ib.member)) {
+      format = m->imageFormat;
+      prefix = m->imagePrefix;
+    }
+    for (auto& p : k.params)
+      if (ib.parameter && p.isImage && p.name == ib.member) {
+        format = p.imageFormat;
+        prefix = p.imagePrefix;
+        name = p.glslName;
+      }
+    const std::string what = (ib.parameter ? "parameter Image2D " : "member Image2D ") + ib.member;
     const std::string at = "layout(binding = " + std::to_string(binding++);
     Data x;
     if (ib.use == ImageUse::Storage) {
       std::string access = !ib.stored ? "readonly " : !ib.loaded ? "writeonly " : "";
-      x.set("decl", at + ", " + m->imageFormat + ") uniform " + access + m->imagePrefix + "image2D " + ib.member);
-      x.set("comment", "member Image2D " + ib.member + ": texels " + (ib.loaded && ib.stored ? "loaded and stored" : ib.loaded ? "loaded" : "stored"));
+      x.set("decl", at + ", " + format + ") uniform " + access + prefix + "image2D " + name);
+      x.set("comment", what + ": texels " + (ib.loaded && ib.stored ? "loaded and stored" : ib.loaded ? "loaded" : "stored"));
     } else if (ib.use == ImageUse::Texture) {
-      x.set("decl", at + ") uniform " + m->imagePrefix + "texture2D " + ib.member + "_texture");
-      x.set("comment", "member Image2D " + ib.member + ": sampled");
+      x.set("decl", at + ") uniform " + prefix + "texture2D " + ib.member + "_texture");
+      x.set("comment", what + ": sampled");
     } else {
       x.set("decl", at + ") uniform sampler " + ib.member);
       x.set("comment", "member LiteImage::Sampler " + ib.member);
@@ -495,8 +507,15 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   }
   for (auto& p : k.params) {
     if (p.isPointer || p.isThreadId) continue;
-    auto [base, dims] = SplitArray(p.glslType);
     Data s;
+    if (p.isImage) {  // its size, as the host image has it (an empty image's device copy has one texel)
+      s.set("decl", "uint " + p.name + "_width");
+      push.push_back(s);
+      s.set("decl", "uint " + p.name + "_height");
+      push.push_back(s);
+      continue;
+    }
+    auto [base, dims] = SplitArray(p.glslType);
     s.set("decl", base + " " + p.glslName + dims);
     push.push_back(s);
   }
@@ -545,7 +564,7 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
         store.set("text", p.glslName + "PerThread[threadIndex] = " + p.glslName + ";");
         stateStores.push_back(store);
       }
-    } else if (!k.params[i].isPointer) {
+    } else if (!k.params[i].isPointer && !k.params[i].isImage) {
       arg = k.params[i].glslName;
     } else {
       continue;
@@ -623,12 +642,28 @@ Data ControlsData(const ClassModel& model) {
       bindDecl += (bindDecl.empty() ? "" : ", ") + std::string("crossrt::BufferView a_") + p.name;
       bindArgs += (bindArgs.empty() ? "" : ", ") + std::string("crt_self->m_args.") + c.name + "_" + p.name + ".View()";
     }
+    Data images = List(), outImages = List();
+    for (auto& p : c.params) {
+      if (!p.isImage) continue;
+      Data y;
+      y.set("name", p.name);
+      y.set("control", c.name);
+      y.set("texelCpp", p.pointeeCpp);
+      y.set("vkFormat", p.vkFormat);
+      images.push_back(y);
+      if (!p.isConst) outImages.push_back(y);
+      bindDecl += (bindDecl.empty() ? "" : ", ") + std::string("crossrt::ImageView a_") + p.name;
+      bindArgs += (bindArgs.empty() ? "" : ", ") + std::string("crossrt::ImageView(crt_self->m_args.") + c.name + "_" + p.name + ", " + p.name +
+                  ".width(), " + p.name + ".height())";
+    }
     x.set("pointerParams", ptrs);
     x.set("outputParams", outs);
+    x.set("imageParams", images);
+    x.set("outputImages", outImages);
     x.set("bindParamsDecl", bindDecl);
     // In ...Cmd the kernels use the bound buffers, so host pointers may go unused.
     std::string cmdDecl;
-    for (auto& p : c.params) cmdDecl += (cmdDecl.empty() ? "" : ", ") + std::string(p.isPointer ? "[[maybe_unused]] " : "") + p.declText;
+    for (auto& p : c.params) cmdDecl += (cmdDecl.empty() ? "" : ", ") + std::string(p.isPointer || p.isImage ? "[[maybe_unused]] " : "") + p.declText;
     x.set("cmdParamsDefinition", cmdDecl);
     x.set("bindArgs", bindArgs);
     // Member vectors written by any kernel this function calls are read back after it.
@@ -653,22 +688,26 @@ Data ControlsData(const ClassModel& model) {
             if (auto* m = FindMember(model, v); m && m->writtenByKernels) addWritten(v);
     for (auto& v : c.vectorsWritten) addWritten(v);  // by scans, fills, copies
     x.set("writtenVectors", written);
-    // Image2D members stored by its kernels are read back after it, whole.
+    // Image2D members stored by its kernels, or given to their non-const image parameters, are read
+    // back after it, whole.
     Data writtenImages = List();
     std::set<std::string> seenImages;
+    auto addImage = [&](const std::string& name) {
+      auto* m = FindMember(model, name);
+      if (!m || !seenImages.insert(name).second) return;
+      Data y;
+      y.set("name", name);
+      y.set("host", m->hostExpr);
+      y.set("control", c.name);
+      y.set("texelCpp", m->elemCppType);
+      writtenImages.push_back(y);
+    };
     for (auto& kn : c.kernelsCalled)
       for (auto& k : model.kernels)
         if (k.name == kn)
           for (auto& ib : k.images)
-            if (ib.stored && seenImages.insert(ib.member).second) {
-              auto* m = FindMember(model, ib.member);
-              Data y;
-              y.set("name", ib.member);
-              y.set("host", m->hostExpr);
-              y.set("control", c.name);
-              y.set("texelCpp", m->elemCppType);
-              writtenImages.push_back(y);
-            }
+            if (ib.stored && !ib.parameter) addImage(ib.member);
+    for (auto& name : c.imagesWritten) addImage(name);
     x.set("writtenImages", writtenImages);
     Data states = List();
     for (auto& s : c.threadStates) {
@@ -698,7 +737,7 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
     for (unsigned a = 0; k.rtv && a < k.dims; ++a) cmdParams += std::string(", uint32_t a_threads") + Axis(a);
     for (auto& p : k.params) {
       if (p.isThreadId) continue;
-      cmdParams += ", " + (p.isPointer ? std::string("crossrt::BufferView") : p.cppType) + " " + p.name;
+      cmdParams += ", " + (p.isPointer ? std::string("crossrt::BufferView") : p.isImage ? std::string("crossrt::ImageView") : p.cppType) + " " + p.name;
     }
     x.set("cmdParamsDecl", cmdParams);
     // Push constants: starts, counts, then scalar arguments (same order as the GLSL block).
@@ -718,9 +757,23 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
     for (unsigned a = 0; a < k.dims; ++a) field("4", "uint32_t", std::string("crt_count") + Axis(a), std::string("crt_count") + Axis(a));
     for (auto& p : k.params) {
       if (p.isPointer || p.isThreadId) continue;
+      if (p.isImage) {
+        field("4", "uint32_t", p.name + "_width", p.name + ".width()");
+        field("4", "uint32_t", p.name + "_height", p.name + ".height()");
+        continue;
+      }
       field(std::to_string(p.std430Align), p.valueCppType, GlslPrinter::SafeName(p.name), p.name);
     }
     x.set("pushFields", fields);
+    // Image parameters it samples linearly: their format must allow it on this device.
+    Data filterChecks = List();
+    for (auto& [image, sampler] : k.paramSamplePairs) {
+      Data f;
+      f.set("image", image);
+      f.set("sampler", sampler);
+      filterChecks.push_back(f);
+    }
+    x.set("filterChecks", filterChecks);
     x.set("pushAssign", assign);
     for (unsigned a = 0; a < k.dims; ++a) {
       Data ax;
@@ -772,8 +825,8 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
                            : ib.use == ImageUse::Texture ? "VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE" : "VK_DESCRIPTOR_TYPE_SAMPLER";
         types += std::string(", ") + type;
         list += std::string(", crossrt::Binding::") +
-                (ib.use == ImageUse::Storage ? "StorageImage" : ib.use == ImageUse::Texture ? "SampledImage" : "SamplerOf") + "(m_images." +
-                ib.member + ")";
+                (ib.use == ImageUse::Storage ? "StorageImage" : ib.use == ImageUse::Texture ? "SampledImage" : "SamplerOf") + "(" +
+                (ib.parameter ? "" : "m_images.") + ib.member + ")";
         typed = true;
       }
       std::string sets;

@@ -413,6 +413,9 @@ std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callL
     QualType pt = p->getType();
     std::string qualifier;
     if (pt->isReferenceType() && !pt.getNonReferenceType().isConstQualified()) qualifier = "inout ";
+    if (IsImage2D(pt.getNonReferenceType()))
+      Fail(p->getLocation(), "helper '" + fd->getNameAsString() + "' takes an Image2D parameter; on the GPU only kernels take images",
+           "read the texels in the kernel and pass them to the helper, or make the image a member, which helpers reach directly");
     os << (i || withSelf ? ", " : "") << qualifier << Declare(pt, p->getNameAsString(), p->getLocation());
   }
   os << ")\n";
@@ -685,7 +688,7 @@ std::string GlslPrinter::AtomicCall(const FunctionDecl* fd, const CallExpr* call
   return s + "))";
 }
 
-// ---- Image2D members: storage images (texels loaded and stored) and textures (sampled) ----
+// ---- Image2D members and parameters: storage images (texels loaded and stored) and textures (sampled) ----
 
 namespace {
 const FieldDecl* ThisMemberField(const clang::Expr* e) {
@@ -698,37 +701,53 @@ const FieldDecl* ThisMemberField(const clang::Expr* e) {
 std::string TexelOf(const ImageFormat& f, const std::string& load) { return f.texel == "vec4" ? load : load + ".x"; }
 }  // namespace
 
-// The image of a texel expression (m_img[p], m_img.at(x, y)), or null; prints the coordinate
-// into `coord` when given.
-const FieldDecl* GlslPrinter::ImageTexel(const clang::Expr* e, std::string* coord) {
+namespace {
+// How GLSL names an image's storage image: a member by its name, a parameter by its name made safe
+// for GLSL. Its texture and size add "_texture", "_width", "_height" to the name as written.
+std::string ImageName(const ValueDecl* image) {
+  return isa<FieldDecl>(image) ? image->getNameAsString() : GlslPrinter::SafeName(image->getNameAsString());
+}
+std::string Described(const ValueDecl* image) {
+  return std::string(isa<FieldDecl>(image) ? "Image2D member '" : "Image2D parameter '") + image->getNameAsString() + "'";
+}
+}  // namespace
+
+const ValueDecl* GlslPrinter::ImageOf(const clang::Expr* e) const {
+  if (auto* f = ThisMemberField(e); f && IsImage2D(f->getType())) return f;
+  if (auto* dr = dyn_cast<DeclRefExpr>(e->IgnoreParenImpCasts()); dr && imageParams.count(dr->getDecl())) return dr->getDecl();
+  return nullptr;
+}
+
+// The image of a texel expression (img[p], img.at(x, y)), or null; prints the coordinate into
+// `coord` when given.
+const ValueDecl* GlslPrinter::ImageTexel(const clang::Expr* e, std::string* coord) {
   e = e->IgnoreParenImpCasts();
   if (auto* op = dyn_cast<CXXOperatorCallExpr>(e); op && op->getOperator() == OO_Subscript) {
-    auto* f = ThisMemberField(op->getArg(0));
-    if (!f || !IsImage2D(f->getType())) return nullptr;
+    auto* image = ImageOf(op->getArg(0));
+    if (!image) return nullptr;
     // int2 is ivec2 already; uint2 and friends are converted.
     const bool ivec = GlslTypeOf(op->getArg(1)->getType()).value_or("") == "ivec2";
     if (coord) *coord = ivec ? Expr(op->getArg(1)) : "ivec2(" + Expr(op->getArg(1)) + ")";
-    return f;
+    return image;
   }
   if (auto* mc = dyn_cast<CXXMemberCallExpr>(e); mc && mc->getMethodDecl() && mc->getMethodDecl()->getName() == "at" && mc->getNumArgs() == 2) {
-    auto* f = ThisMemberField(mc->getImplicitObjectArgument());
-    if (!f || !IsImage2D(f->getType())) return nullptr;
+    auto* image = ImageOf(mc->getImplicitObjectArgument());
+    if (!image) return nullptr;
     if (coord) *coord = "ivec2(" + Expr(mc->getArg(0)) + ", " + Expr(mc->getArg(1)) + ")";
-    return f;
+    return image;
   }
   return nullptr;
 }
 
-std::optional<ImageFormat> GlslPrinter::UsableImage(const FieldDecl* image, SourceLocation use) {
+std::optional<ImageFormat> GlslPrinter::UsableImage(const ValueDecl* image, SourceLocation use) {
   QualType texel;
-  IsImage2D(image->getType(), &texel);
+  IsImage2D(image->getType().getNonReferenceType(), &texel);
   auto format = ImageFormatOf(texel);
   if (!format)
-    Fail(use, "Image2D member '" + image->getNameAsString() + "' has a texel type GPU images cannot hold ('" +
-         texel.getAsString(m_ctx.getPrintingPolicy()) + "')", "use Image2D<float4>, Image2D<float> or Image2D<uint32_t>");
+    Fail(use, Described(image) + " has a texel type GPU images cannot hold ('" + texel.getAsString(m_ctx.getPrintingPolicy()) + "')",
+         "use Image2D<float4>, Image2D<float> or Image2D<uint32_t>");
   else if (!composedPrefix.empty() || selfClass)
-    Fail(use, "Image2D member '" + image->getNameAsString() + "' used outside the class's own kernels",
-         "use images only in kernels and helpers of the translated class");
+    Fail(use, Described(image) + " used outside the class's own kernels", "use images only in kernels and helpers of the translated class");
   else
     return format;
   return std::nullopt;
@@ -736,22 +755,24 @@ std::optional<ImageFormat> GlslPrinter::UsableImage(const FieldDecl* image, Sour
 
 std::string GlslPrinter::ImageStore(const clang::Expr* lhs, const std::string& value, const clang::Expr* whole) {
   std::string coord;
-  const FieldDecl* f = ImageTexel(lhs, &coord);
-  auto format = UsableImage(f, whole->getBeginLoc());
+  const ValueDecl* image = ImageTexel(lhs, &coord);
+  auto format = UsableImage(image, whole->getBeginLoc());
   if (!format) return "/*error*/";
-  storedImages.insert(f);
+  if (!isa<FieldDecl>(image) && image->getType().getNonReferenceType().isConstQualified())
+    return Fail(whole->getBeginLoc(), "kernel writes a texel of const " + Described(image), "take the image as a non-const reference to write it");
+  storedImages.insert(image);
   const std::string channels = format->prefix + "vec4";
-  return "imageStore(" + f->getNameAsString() + ", " + coord + ", " + (format->texel == "vec4" ? value : channels + "(" + value + ")") + ")";
+  return "imageStore(" + ImageName(image) + ", " + coord + ", " + (format->texel == "vec4" ? value : channels + "(" + value + ")") + ")";
 }
 
-std::string GlslPrinter::ImageCall(const FieldDecl* image, const CXXMemberCallExpr* call) {
-  const std::string name = image->getNameAsString();
+std::string GlslPrinter::ImageCall(const ValueDecl* image, const CXXMemberCallExpr* call) {
+  const std::string name = ImageName(image);
   const std::string method = call->getMethodDecl()->getNameAsString();
   auto format = UsableImage(image, call->getBeginLoc());
   if (!format) return "/*error*/";
   if (method == "width" || method == "height") {
     sizedImages.insert(image);
-    return name + "_" + method;
+    return image->getNameAsString() + "_" + method;
   }
   if (method == "at") {
     std::string coord;
@@ -760,6 +781,8 @@ std::string GlslPrinter::ImageCall(const FieldDecl* image, const CXXMemberCallEx
     return TexelOf(*format, "imageLoad(" + name + ", " + coord + ")");
   }
   if (method == "set" && call->getNumArgs() == 3) {
+    if (!isa<FieldDecl>(image) && image->getType().getNonReferenceType().isConstQualified())
+      return Fail(call->getBeginLoc(), "kernel writes a texel of const " + Described(image), "take the image as a non-const reference to write it");
     storedImages.insert(image);
     const std::string value = Expr(call->getArg(2));
     return "imageStore(" + name + ", ivec2(" + Expr(call->getArg(0)) + ", " + Expr(call->getArg(1)) + "), " +
@@ -767,20 +790,22 @@ std::string GlslPrinter::ImageCall(const FieldDecl* image, const CXXMemberCallEx
   }
   if (method == "sample" && call->getNumArgs() == 2) {
     if (format->texel == "uint")
-      return Fail(call->getBeginLoc(), "sample() of Image2D<uint32_t> member '" + name + "' (GPU samplers filter only float images)",
-                  "read texels with " + name + "[int2(x, y)], or store the image as Image2D<float> or Image2D<float4>");
+      return Fail(call->getBeginLoc(), "sample() of Image2D<uint32_t> " + std::string(isa<FieldDecl>(image) ? "member" : "parameter") + " '" +
+                  image->getNameAsString() + "' (GPU samplers filter only float images)",
+                  "read texels with " + image->getNameAsString() + "[int2(x, y)], or store the image as Image2D<float> or Image2D<float4>");
     const FieldDecl* sampler = ThisMemberField(call->getArg(0));
     if (!sampler || !IsImageSampler(sampler->getType()))
-      return Fail(call->getArg(0)->getBeginLoc(), "the sampler of " + name + ".sample() is not a member of the class",
+      return Fail(call->getArg(0)->getBeginLoc(), "the sampler of " + image->getNameAsString() + ".sample() is not a member of the class",
                   "declare the LiteImage::Sampler as a member, so it is created on the GPU with the image");
     sampledImages.insert(image);
     samplers.insert(sampler);
     samplePairs.insert({image, sampler});
     // Compute shaders have no derivatives: sample the one mip level explicitly.
-    return TexelOf(*format, "textureLod(sampler2D(" + name + "_texture, " + sampler->getNameAsString() + "), " + Expr(call->getArg(1)) + ", 0.0)");
+    return TexelOf(*format, "textureLod(sampler2D(" + image->getNameAsString() + "_texture, " + sampler->getNameAsString() + "), " + Expr(call->getArg(1)) + ", 0.0)");
   }
   return Fail(call->getBeginLoc(), "Image2D::" + method + " is not supported in kernels",
-              "kernels read texels (" + name + "[p], at(x, y), sample(sampler, uv)), write them (" + name + "[p] = v, set(x, y, v)) and read width() and height()");
+              "kernels read texels (" + image->getNameAsString() + "[p], at(x, y), sample(sampler, uv)), write them (" + image->getNameAsString() +
+              "[p] = v, set(x, y, v)) and read width() and height()");
 }
 
 // ---- arrays of textures: std::vector<LiteImage::Texture2D<T>> members ----
@@ -867,8 +892,8 @@ std::string GlslPrinter::Call(const CallExpr* call) {
       for (size_t i = 0; i < args.size(); ++i) s += (i ? ", " : "") + args[i];
       return s + ")";
     }
-    // Calls on an Image2D member: texel loads and stores, samples, its size.
-    if (auto* image = ThisMemberField(obj); image && IsImage2D(image->getType())) return ImageCall(image, mc);
+    // Calls on an Image2D member or parameter: texel loads and stores, samples, its size.
+    if (auto* image = ImageOf(obj)) return ImageCall(image, mc);
     // Calls on a texture of an array of textures.
     const clang::Expr* textureIndex = nullptr;
     if (auto* array = TextureElement(obj, &textureIndex)) return TextureCall(array, textureIndex, mc);
@@ -980,6 +1005,11 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
   if (auto* dr = dyn_cast<DeclRefExpr>(e)) {
     const ValueDecl* d = dr->getDecl();
     if (auto it = renames.find(d); it != renames.end()) return it->second;
+    if (IsImage2D(d->getType().getNonReferenceType()))
+      return Fail(e->getBeginLoc(), (imageParams.count(d) ? Described(d) : "Image2D '" + d->getNameAsString() + "'") + " used as a value in a kernel",
+                  imageParams.count(d) ? "use its texels in the kernel itself: " + d->getNameAsString() + "[p], at(x, y), sample(sampler, uv), " +
+                                             d->getNameAsString() + "[p] = v, set(x, y, v), width(), height()"
+                                       : "kernels reach images that are members of the class or Image2D reference parameters of the kernel");
     if (valueParams.count(d))
       return Fail(e->getBeginLoc(), "'" + d->getNameAsString() + "' holds one value per thread (a local of the control function's thread loop), used here as a pointer",
                   "read and write it as *" + d->getNameAsString() + " or " + d->getNameAsString() + "->field");
@@ -1048,7 +1078,7 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
         auto format = UsableImage(image, e->getBeginLoc());
         if (!format) return "/*error*/";
         loadedImages.insert(image);
-        return TexelOf(*format, "imageLoad(" + image->getNameAsString() + ", " + coord + ")");
+        return TexelOf(*format, "imageLoad(" + ImageName(image) + ", " + coord + ")");
       }
     const clang::Expr* textureIndex = nullptr;
     if (kind == OO_Subscript)
@@ -1074,6 +1104,15 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
     return Fail(e->getBeginLoc(), "operator not supported in kernels", "");
   }
   if (auto* bo = dyn_cast<BinaryOperator>(e)) {
+    if (bo->isAssignmentOp()) {  // m_img[p].x = v: the analysis reports it for members; parameters here
+      const clang::Expr* part = bo->getLHS()->IgnoreParenImpCasts();
+      while (auto* me = dyn_cast<MemberExpr>(part)) part = me->getBase()->IgnoreParenImpCasts();
+      if (part != bo->getLHS()->IgnoreParenImpCasts())
+        if (auto* image = ImageTexel(part); image && !isa<FieldDecl>(image))
+          return Fail(e->getBeginLoc(), "kernel writes part of a texel of " + Described(image),
+                      "GPU images store whole texels: read the texel into a variable, change it, and write it back with " +
+                          image->getNameAsString() + "[p] = value");
+    }
     if (bo->isAssignmentOp() && ImageTexel(bo->getLHS())) {  // a texel of a float or uint image
       if (bo->getOpcode() == BO_Assign) return ImageStore(bo->getLHS(), Expr(bo->getRHS()), e);
       if (bo->getLHS()->HasSideEffects(m_ctx, /*IncludePossibleEffects=*/false))  // it is printed twice

@@ -66,11 +66,15 @@ public:
   std::set<const clang::FieldDecl*> memberVectors, plainMembers;
   // Where the kernel reads a member vector's size (a kernel may not read what it appends to).
   std::multimap<const clang::FieldDecl*, clang::SourceLocation> sizeReads;
-  // Image2D members the kernel loads or stores texels of (storage images), samples (textures),
-  // and the Sampler members it samples with.
-  std::set<const clang::FieldDecl*> loadedImages, storedImages, sampledImages, samplers;
-  std::set<const clang::FieldDecl*> sizedImages;  // whose width() or height() it reads
-  std::set<std::pair<const clang::FieldDecl*, const clang::FieldDecl*>> samplePairs;  // (image, sampler)
+  // The kernel's Image2D reference parameters (the definition's): images bound per call, used in
+  // the kernel's own body as member images are.
+  std::set<const clang::ValueDecl*> imageParams;
+  // Image2D members and parameters the kernel loads or stores texels of (storage images), samples
+  // (textures), and the Sampler members it samples with.
+  std::set<const clang::ValueDecl*> loadedImages, storedImages, sampledImages;
+  std::set<const clang::FieldDecl*> samplers;
+  std::set<const clang::ValueDecl*> sizedImages;  // whose width() or height() it reads
+  std::set<std::pair<const clang::ValueDecl*, const clang::FieldDecl*>> samplePairs;  // (image, sampler)
   // Arrays of textures (std::vector<LiteImage::Texture2D<T>> members) the kernel samples or reads.
   std::set<const clang::FieldDecl*> textureArrays;
   // Helper functions the kernel reaches (their writes to members matter too).
@@ -124,12 +128,14 @@ private:
   std::string Construct(clang::QualType t, const std::vector<const clang::Expr*>& args, clang::SourceLocation loc);
   std::string Literal(const clang::Expr* e);
   std::string Cast(clang::QualType to, const clang::Expr* sub);
-  // Image2D members: a texel expression (m_img[p], m_img.at(x, y)) as its image (and coordinate);
+  // Image2D members and parameters: the image an expression names (m_img, or a kernel's image
+  // parameter), or null; a texel expression (img[p], img.at(x, y)) as its image (and coordinate);
   // loads, stores and the image's other calls.
-  const clang::FieldDecl* ImageTexel(const clang::Expr* e, std::string* coord = nullptr);
-  std::optional<ImageFormat> UsableImage(const clang::FieldDecl* image, clang::SourceLocation use);  // reports why not
+  const clang::ValueDecl* ImageOf(const clang::Expr* e) const;
+  const clang::ValueDecl* ImageTexel(const clang::Expr* e, std::string* coord = nullptr);
+  std::optional<ImageFormat> UsableImage(const clang::ValueDecl* image, clang::SourceLocation use);  // reports why not
   std::string ImageStore(const clang::Expr* lhs, const std::string& value, const clang::Expr* whole);
-  std::string ImageCall(const clang::FieldDecl* image, const clang::CXXMemberCallExpr* call);
+  std::string ImageCall(const clang::ValueDecl* image, const clang::CXXMemberCallExpr* call);
   // Arrays of textures: the array of an element expression (m_textures[i]) and its index; calls on
   // an element (sample, width, height) and texel reads (m_textures[i][p]).
   const clang::FieldDecl* TextureElement(const clang::Expr* e, const clang::Expr** index = nullptr);

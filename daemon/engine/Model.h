@@ -58,6 +58,10 @@ struct KernelParam {
   bool isConstPointee = false;
   bool scalarLayout = false;
   bool isThreadId = false;  // RTV kernels: tid, tidX, tidY, tidZ
+  // An Image2D reference: an image bound per call (glslType is the texel's), its size in push
+  // constants <name>_width and _height. isConstPointee: a const reference.
+  bool isImage = false;
+  std::string imageFormat, vkFormat, imagePrefix;  // as Member's
   // RTV kernels: a pointer that a control function's thread loop passes a local to (&local). On the
   // GPU it is one value per thread: a function parameter, kept in a buffer between wavefront dispatches.
   bool threadState = false;
@@ -68,9 +72,10 @@ struct KernelParam {
 // stored) or as a texture (sampled), or a LiteImage::Sampler member.
 enum class ImageUse { Storage, Texture, Sampler };
 struct ImageBinding {
-  std::string member;
+  std::string member;  // or parameter
   ImageUse use = ImageUse::Storage;
   bool loaded = false, stored = false;  // storage images: what the kernel does with the texels
+  bool parameter = false;  // an Image2D parameter of the kernel (after the members)
 };
 
 struct Loop {                // one parallel dimension of an IPV kernel
@@ -91,7 +96,8 @@ struct Kernel {
   std::vector<Reduction> reductions;
   std::vector<std::string> memberVectors;   // member vectors the kernel reaches (incl. helpers)
   std::vector<ImageBinding> images;         // bound after the buffers, in member declaration order
-  std::vector<std::pair<std::string, std::string>> samplePairs;  // (image, sampler) it samples with
+  std::vector<std::pair<std::string, std::string>> samplePairs;  // (image member, sampler) it samples with
+  std::vector<std::pair<std::string, std::string>> paramSamplePairs;  // (image parameter, sampler)
   // Arrays of textures it samples, in member declaration order. Each shader has a variant that
   // samples them with the GPU's samplers (<kernel>_Textures: a descriptor set each, from set 1 on)
   // and one that samples them from buffers as LiteImage does (any device).
@@ -130,6 +136,10 @@ struct ControlParam {
   bool isConst = false;
   std::string pointeeCpp;    // element type of a pointer
   std::string sizeExpr;      // from [[crossrt::size("...")]]
+  // An Image2D (by reference or value): copied to a device image for the call, and back unless
+  // const or by value. pointeeCpp is its texel type.
+  bool isImage = false;
+  std::string vkFormat;
   std::string declText;      // "const float* in", as written minus attributes
 };
 
@@ -143,6 +153,7 @@ struct Control {
   std::string cpuBody;              // body with RTV loops parallelised
   std::vector<std::string> kernelsCalled;
   std::vector<std::string> vectorsWritten;  // member vectors its library calls (scan, fill, memcpy) write
+  std::vector<std::string> imagesWritten;   // Image2D members it passes to kernels' non-const image parameters
   // Thread loops calling several kernels: the per-thread locals wavefront mode keeps in buffers.
   struct ThreadState { std::string buffer, cppType, local; };
   std::vector<ThreadState> threadStates;

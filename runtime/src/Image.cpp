@@ -227,9 +227,13 @@ void EnsureSampler(std::shared_ptr<VulkanContext> ctx, Sampler& s, const Sampler
 }
 
 void CheckFilterable(const VulkanContext& ctx, const Image& img, const Sampler& s, const char* what) {
+  CheckFilterable(ctx, img.Format(), s, what);
+}
+
+void CheckFilterable(const VulkanContext& ctx, VkFormat format, const Sampler& s, const char* what) {
   if (!s.Desc().linear) return;
   VkFormatProperties props;
-  vkGetPhysicalDeviceFormatProperties(ctx.physicalDevice, img.Format(), &props);
+  vkGetPhysicalDeviceFormatProperties(ctx.physicalDevice, format, &props);
   if (!(props.optimalTilingFeatures & VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT))
     throw Error(std::string(what) + ": device '" + ctx.DeviceName() +
                 "' cannot filter this image's format linearly; sample it with Filter::NEAREST or use another device");

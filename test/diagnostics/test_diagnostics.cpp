@@ -557,6 +557,80 @@ void Images::kernel1D_Run(int n, float* out)
   }
 }
 
+TEST_CASE("Image2D parameters the GPU cannot bind are reported", "[diagnostics][images]")
+{
+  // Each case: Framer's declarations (after `protected:`) and its definitions; the error is in Framer.cpp.
+  struct Case { const char* name; const char* declarations; const char* definitions; const char* message; const char* hint; };
+  const Case cases[] = {
+      {"a kernel taking an image by value", "  void kernel1D_Copy(Image img, int n, float* out);",
+       "void Framer::Run(const Image& img, int n, float* out) { kernel1D_Copy(img, n, out); }\n"
+       "void Framer::kernel1D_Copy(Image img, int n, float* out) { for (int i = 0; i < n; i++) out[i] = img[LiteMath::int2(i, 0)].x; }\n",
+       "kernel parameter 'img' takes an Image2D by value", "take it by reference: 'const Image2D<T>& img' to read it"},
+      {"a local image given to a kernel", "  void kernel1D_Copy(const Image& img, int n, float* out);",
+       "void Framer::Run(const Image& img, int n, float* out) { Image copy = img; kernel1D_Copy(copy, n, out); }\n"
+       "void Framer::kernel1D_Copy(const Image& img, int n, float* out) { for (int i = 0; i < n; i++) out[i] = img[LiteMath::int2(i, 0)].x; }\n",
+       "Image2D argument of a kernel call must be an Image2D parameter of 'Run' or an Image2D member",
+       "an image local to 'Run' has no GPU copy: make it a member"},
+      {"an image given to a helper", "  void kernel1D_Copy(const Image& img, int n, float* out);",
+       "static float Red(const Framer::Image& image, int i) { return image[LiteMath::int2(i, 0)].x; }\n"
+       "void Framer::Run(const Image& img, int n, float* out) { kernel1D_Copy(img, n, out); }\n"
+       "void Framer::kernel1D_Copy(const Image& img, int n, float* out) { for (int i = 0; i < n; i++) out[i] = Red(img, i); }\n",
+       "helper 'Red' takes an Image2D parameter; on the GPU only kernels take images", "read the texels in the kernel and pass them to the helper"},
+      {"an image parameter kept in a local", "  void kernel1D_Copy(const Image& img, int n, float* out);",
+       "void Framer::Run(const Image& img, int n, float* out) { kernel1D_Copy(img, n, out); }\n"
+       "void Framer::kernel1D_Copy(const Image& img, int n, float* out) { for (int i = 0; i < n; i++) { const Image& alias = img; out[i] = alias[LiteMath::int2(i, 0)].x; } }\n",
+       "Image2D parameter 'img' used as a value in a kernel", "use its texels in the kernel itself: img[p]"},
+      {"a part of a texel written", "  void kernel1D_Mark(Image& img, int n);",
+       "void Framer::Run(const Image& img, int n, float* out) { (void)img; (void)out; kernel1D_Mark(m_frame, n); }\n"
+       "void Framer::kernel1D_Mark(Image& img, int n) { for (int i = 0; i < n; i++) img[LiteMath::int2(i, 0)].x = 1.0f; }\n",
+       "kernel writes part of a texel of Image2D parameter 'img'", "GPU images store whole texels"},
+      {"an image parameter resized on the host", "  virtual void Resize(Image& img, int n);\n  void kernel1D_Mark(Image& img, int n);",
+       "void Framer::Run(const Image& img, int n, float* out) { (void)img; (void)out; kernel1D_Mark(m_frame, n); }\n"
+       "void Framer::Resize(Image& img, int n) { img.resize(uint32_t(n), 1); kernel1D_Mark(img, n); }\n"
+       "void Framer::kernel1D_Mark(Image& img, int n) { for (int i = 0; i < n; i++) img[LiteMath::int2(i, 0)] = LiteMath::float4(1.0f); }\n",
+       "control function 'Resize' changes Image2D parameter 'img' on the host ('resize')",
+       "its GPU copy is made before the body runs: size and fill the image before calling 'Resize'"},
+      {"an image parameter of a texel type images cannot hold", "  void kernel1D_Uv(const LiteImage::Image2D<LiteMath::float2>& uv, int n, float* out);",
+       "void Framer::Run(const Image& img, int n, float* out) { (void)img; kernel1D_Uv(LiteImage::Image2D<LiteMath::float2>(), n, out); }\n"
+       "void Framer::kernel1D_Uv(const LiteImage::Image2D<LiteMath::float2>& uv, int n, float* out) { for (int i = 0; i < n; i++) out[i] = uv[LiteMath::int2(i, 0)].x; }\n",
+       "kernel parameter 'uv' is an Image2D of 'LiteMath::float2', which GPU images cannot hold", "use Image2D<float4>, Image2D<float> or Image2D<uint32_t>"},
+      {"an image given to a kernel of a thread loop of several kernels", "  void kernel_Load(uint32_t tid, const Image& img, float* v);\n  void kernel_Store(uint32_t tid, const float* v, float* out);",
+       "void Framer::Run(const Image& img, int n, float* out) { for (int i = 0; i < n; i++) { float v; kernel_Load(i, img, &v); kernel_Store(i, &v, out); } }\n"
+       "void Framer::kernel_Load(uint32_t tid, const Image& img, float* v) { *v = img[LiteMath::int2(int(tid), 0)].x; }\n"
+       "void Framer::kernel_Store(uint32_t tid, const float* v, float* out) { out[tid] = *v; }\n",
+       "Image2D argument of 'kernel_Load' in a thread loop that calls several kernels", "make the image a member of the class, or give the kernel a thread loop of its own"},
+  };
+  for (const Case& c : cases)
+  {
+    SECTION(c.name)
+    {
+      TempClass tc("Framer", std::string(R"(#pragma once
+#include "Image2D.h"
+#include <cstdint>
+class Framer
+{
+public:
+  using Image = LiteImage::Image2D<LiteMath::float4>;
+  virtual ~Framer() = default;
+  virtual void Run(const Image& img, int n, [[crossrt::size("n")]] float* out);
+  Image m_frame;
+protected:
+)") + c.declarations + "\n};\n",
+                   std::string("#include \"Framer.h\"\n") + c.definitions);
+      CommandResult r = RunCrossrt("translate --class Framer --backend vulkan --out " + (tc.dir / "out").string() + " --source " +
+                                   tc.Source("Framer") + " --templates " CROSSRT_SOURCE_DIR "/templates -- -I" CROSSRT_SOURCE_DIR
+                                   "/libs/litemath -I" CROSSRT_SOURCE_DIR "/libs/liteimage");
+      INFO(r.output);
+      REQUIRE_FALSE(r.crashed);
+      REQUIRE(r.exitCode == 1);
+      REQUIRE(std::regex_search(r.output, std::regex(R"(Framer\.(cpp|h):\d+:\d+: error: )")));
+      REQUIRE(r.output.find(std::string("error: ") + c.message) != std::string::npos);
+      REQUIRE(r.output.find(c.hint) != std::string::npos);
+      REQUIRE(!std::filesystem::exists(tc.dir / "out" / "Framer_Vulkan.cpp"));
+    }
+  }
+}
+
 TEST_CASE("Thread loops of several kernels that the GPU cannot run per thread are reported", "[diagnostics][modes]")
 {
   // Each case: Looper's extra declarations, Run's body from Looper.cpp's line 4 on (the thread loop

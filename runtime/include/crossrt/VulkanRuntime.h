@@ -228,6 +228,22 @@ private:
   VkFormat format_ = VK_FORMAT_UNDEFINED;
 };
 
+// The image a kernel's Image2D parameter is given: a device image and the size of the host image
+// it copies (0 x 0 for an empty one, whose device image has one texel). width() and height() are
+// spelled as LiteImage spells them, so that a kernel's thread count written with them compiles in
+// the generated host code too.
+struct ImageView {
+  ImageView() = default;
+  ImageView(const Image& img, uint32_t width, uint32_t height)
+      : view(img.View()), format(img.Format()), imageWidth(width), imageHeight(height) {}
+  uint32_t width() const { return imageWidth; }
+  uint32_t height() const { return imageHeight; }
+
+  VkImageView view = VK_NULL_HANDLE;
+  VkFormat format = VK_FORMAT_UNDEFINED;
+  uint32_t imageWidth = 0, imageHeight = 0;
+};
+
 // Reallocates img when it is empty or has another size or format.
 void EnsureImage(std::shared_ptr<VulkanContext> ctx, Image& img, uint32_t width, uint32_t height, VkFormat format,
                  const char* debugName);
@@ -296,6 +312,7 @@ private:
 void EnsureSampler(std::shared_ptr<VulkanContext> ctx, Sampler& s, const SamplerDesc& desc, const char* debugName);
 // Throws when a kernel samples img with linear filtering that its format cannot filter.
 void CheckFilterable(const VulkanContext& ctx, const Image& img, const Sampler& s, const char* what);
+void CheckFilterable(const VulkanContext& ctx, VkFormat format, const Sampler& s, const char* what);
 
 // Acceleration structures for ray queries (VK_KHR_acceleration_structure), move-only: what an
 // ISceneObject member becomes for the shaders that trace on ray tracing hardware. One bottom level
@@ -348,6 +365,8 @@ struct Binding {
   Binding(BufferView b) : type(VK_DESCRIPTOR_TYPE_STORAGE_BUFFER), buffer(b) {}
   static Binding StorageImage(const Image& img) { return Binding(VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, img.View(), VK_NULL_HANDLE); }
   static Binding SampledImage(const Image& img) { return Binding(VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, img.View(), VK_NULL_HANDLE); }
+  static Binding StorageImage(const ImageView& img) { return Binding(VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, img.view, VK_NULL_HANDLE); }
+  static Binding SampledImage(const ImageView& img) { return Binding(VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE, img.view, VK_NULL_HANDLE); }
   static Binding SamplerOf(const Sampler& s) { return Binding(VK_DESCRIPTOR_TYPE_SAMPLER, VK_NULL_HANDLE, s.Handle()); }
   static Binding SceneOf(const RayTracingScene& scene) {
     Binding b(VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, VK_NULL_HANDLE, VK_NULL_HANDLE);
