@@ -590,11 +590,11 @@ std::optional<std::vector<uint64_t>> MirrorOffsets(ASTContext& ctx, const std::v
 }
 
 // The implementation of `method` the GPU runs for objects of `impl`: its GLSL name, or "" (reported).
-std::string ImplementationMethod(Context& c, GlslPrinter& printer, const CXXRecordDecl* impl, const CXXMethodDecl* method, SourceLocation callLoc) {
+std::string ImplementationMethod(Reporter& rep, GlslPrinter& printer, const CXXRecordDecl* impl, const CXXMethodDecl* method, SourceLocation callLoc) {
   const CXXMethodDecl* overrider = method->getCorrespondingMethodInClass(impl);
   const FunctionDecl* def = nullptr;
   if (!overrider || overrider->isPureVirtual() || !overrider->hasBody(def) || !def) {
-    c.rep.Error(callLoc, "the GPU needs the body of " + impl->getNameAsString() + "'s " + method->getNameAsString() +
+    rep.Error(callLoc, "the GPU needs the body of " + impl->getNameAsString() + "'s " + method->getNameAsString() +
                 " (kernels call it through virtual functions), but this translation unit does not define it",
                 "define it in the header that declares " + impl->getNameAsString() + ", or in the class's source file");
     return "";
@@ -602,90 +602,107 @@ std::string ImplementationMethod(Context& c, GlslPrinter& printer, const CXXReco
   return printer.EmitComposedMethod(overrider);
 }
 
-// Kernel calls `m_objects[i]->Method(...)`: for every implementation of the interface, its data as
+// Where the vectors of objects that code calls virtual functions through live: the translated
+// class (its own members), or a composed implementation (the code of listing 2 of the paper: a
+// traversal calling an intersection function per primitive), whose members the generated class
+// reaches through the holder and whose GLSL names carry the holder's prefix.
+struct VirtualOwner {
+  const CXXRecordDecl* cls;  // the class declaring the vectors
+  std::string prefix;        // "" or "m_scene_"
+  std::string hostPrefix;    // "" or "crt_m_scene()->"
+  std::string holder;        // "" or "m_scene"
+};
+
+// Code calls `m_objects[i]->Method(...)`: for every implementation of the interface, its data as
 // a GLSL struct in a buffer of its own (reached by a buffer reference), its methods printed with
-// `self`, and per method a dispatcher that switches over the object's class.
-void AnalyzeVirtualCalls(Context& c, Kernel& k, GlslPrinter& kernelPrinter) {
+// `self`, and per method a dispatcher that switches over the object's class. The structs and
+// functions to put ahead of the calling code go to `structs` and `functions`.
+void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& k, GlslPrinter& kernelPrinter, const VirtualOwner& owner,
+                     std::vector<std::string>& structs, std::vector<std::string>& functions) {
   std::map<const FieldDecl*, std::vector<const CXXMethodDecl*>> calls;
   for (auto& [field, method] : kernelPrinter.virtualCalls) calls[field].push_back(method);
-  std::vector<std::string> structs, functions;
   for (auto& [field, methods] : calls) {
     QualType element;
     IsStdVector(field->getType(), &element);
     const CXXRecordDecl* interface = PolymorphicPointee(element);
-    const std::string member = field->getNameAsString();
-    if (field->getAccess() == AS_private)
-      c.rep.Error(field->getLocation(), "member '" + member + "' is private, but the generated class derives from '" + c.cls->getNameAsString() + "' and must reach it",
-                  "declare it protected");
+    const std::string member = owner.prefix + field->getNameAsString();
+    if (owner.holder.empty() && field->getAccess() == AS_private)
+      rep.Error(field->getLocation(), "member '" + field->getNameAsString() + "' is private, but the generated class derives from '" + owner.cls->getNameAsString() + "' and must reach it",
+                "declare it protected");
+    if (!owner.holder.empty() && field->getAccess() != AS_public)
+      rep.Error(field->getLocation(), "member '" + field->getNameAsString() + "' of " + owner.cls->getNameAsString() + " is read on the GPU through composition, so the generated class must reach it through a " +
+                owner.cls->getNameAsString() + "*", "declare it public");
     std::vector<const CXXRecordDecl*> impls;
-    FindImplementations(c.ctx.getTranslationUnitDecl(), interface, impls);
+    FindImplementations(ctx.getTranslationUnitDecl(), interface, impls);
     if (impls.empty()) {
-      c.rep.Error(field->getLocation(), "kernels call " + interface->getNameAsString() + " through '" + member + "', but no class that implements it is defined here",
+      rep.Error(field->getLocation(), "kernels call " + interface->getNameAsString() + " through '" + member + "', but no class that implements it is defined here",
                   "define the implementations (classes derived from " + interface->getNameAsString() + ") in a header the class's source includes");
       continue;
     }
-    auto known = std::find_if(c.model.virtuals.begin(), c.model.virtuals.end(), [&](const VirtualMember& v) { return v.member == member; });
-    if (known == c.model.virtuals.end()) {
+    auto known = std::find_if(model.virtuals.begin(), model.virtuals.end(), [&](const VirtualMember& v) { return v.member == member; });
+    if (known == model.virtuals.end()) {
       VirtualMember vm;
       vm.member = member;
+      vm.hostExpr = owner.hostPrefix + field->getNameAsString();
+      vm.display = owner.holder.empty() ? member : owner.holder + "->" + field->getNameAsString();
       vm.interfaceName = interface->getNameAsString();
       for (auto* impl : impls) {
         VirtualImpl vi;
         vi.name = impl->getNameAsString();
-        vi.header = FileOf(c.ctx, impl->getLocation());
+        vi.header = FileOf(ctx, impl->getLocation());
         std::vector<const FieldDecl*> fields;
         CollectObjectFields(impl, fields);
         bool ok = true;
         for (auto* f : fields) {
           auto g = GlslTypeOf(f->getType());
           if (!g || f->getType()->isPointerType() || IsStdVector(f->getType()) || f->isBitField()) {
-            c.rep.Error(f->getLocation(), "member '" + f->getNameAsString() + "' of " + vi.name + " cannot be copied to the GPU (kernels call " + vm.interfaceName +
+            rep.Error(f->getLocation(), "member '" + f->getNameAsString() + "' of " + vi.name + " cannot be copied to the GPU (kernels call " + vm.interfaceName +
                         " through '" + member + "')", "objects called through virtual functions hold plain data: scalars, LiteMath types and structs of them");
             ok = false;
             continue;
           }
           if (f->getAccess() != AS_public) {
-            c.rep.Error(f->getLocation(), "member '" + f->getNameAsString() + "' of " + vi.name + " is copied to the GPU (kernels call " + vm.interfaceName +
+            rep.Error(f->getLocation(), "member '" + f->getNameAsString() + "' of " + vi.name + " is copied to the GPU (kernels call " + vm.interfaceName +
                         " through '" + member + "'), but the generated class cannot read it", "declare it public");
             ok = false;
             continue;
           }
           QualType base = f->getType();
           while (auto* arr = dyn_cast<ConstantArrayType>(base.getCanonicalType().getTypePtr())) base = arr->getElementType();
-          vi.fields.push_back({f->getNameAsString(), CppTypeName(c.ctx, base.getCanonicalType()), *g, 4, "", ""});
+          vi.fields.push_back({f->getNameAsString(), CppTypeName(ctx, base.getCanonicalType()), *g, 4, "", ""});
         }
         if (!ok) continue;
-        auto cpp = MirrorOffsets(c.ctx, fields, 0), std430 = MirrorOffsets(c.ctx, fields, 1), scalar = MirrorOffsets(c.ctx, fields, 2);
+        auto cpp = MirrorOffsets(ctx, fields, 0), std430 = MirrorOffsets(ctx, fields, 1), scalar = MirrorOffsets(ctx, fields, 2);
         vi.size = unsigned(cpp->back());
         if (std430 && *std430 == *cpp) vi.scalarLayout = false;
         else if (scalar && *scalar == *cpp) vi.scalarLayout = true;
         else {
-          c.rep.Error(impl->getLocation(), "the data of " + vi.name + " cannot be laid out on the GPU as C++ lays it out",
+          rep.Error(impl->getLocation(), "the data of " + vi.name + " cannot be laid out on the GPU as C++ lays it out",
                       "use 32-bit scalars and LiteMath vectors; put 16-byte types (float4) first");
           continue;
         }
         vm.impls.push_back(vi);
       }
-      if (c.model.virtualLevel == 1) {  // one slot size for all: the largest class's data, in 16-byte steps
+      if (model.virtualLevel == 1) {  // one slot size for all: the largest class's data, in 16-byte steps
         for (auto& vi : vm.impls) vm.slotBytes = std::max(vm.slotBytes, (vi.size + 15) / 16 * 16);
         for (auto& vi : vm.impls) vi.paddingWords = (vm.slotBytes - vi.size) / 4;
       }
-      c.model.virtuals.push_back(vm);
-      known = c.model.virtuals.end() - 1;
+      model.virtuals.push_back(vm);
+      known = model.virtuals.end() - 1;
     }
     const VirtualMember& vm = *known;
     k.bufferReferences = true;
     // Data structs and buffer references, then each implementation's methods.
     structs.push_back("layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer " + member + "_Tags { uvec2 tags[]; };  // per element of " +
-                      member + ": (class, " + (c.model.virtualLevel == 1 ? "its slot" : "index among its class's objects") + ")\n");
+                      vm.display + ": (class, " + (model.virtualLevel == 1 ? "its slot" : "index among its class's objects") + ")\n");
     std::map<std::string, std::string> implFunction;  // (impl, method) -> GLSL name
     for (auto* impl : impls) {
       auto vi = std::find_if(vm.impls.begin(), vm.impls.end(), [&](const VirtualImpl& x) { return x.name == impl->getNameAsString(); });
       if (vi == vm.impls.end()) continue;
-      GlslPrinter printer(c.ctx, impl, c.rep);
+      GlslPrinter printer(ctx, impl, rep);
       printer.selfClass = impl;
       printer.composedPrefix = vi->name + "_";
-      for (auto& sn : ClassStructNames(c.model)) printer.predeclaredStructs.insert(sn);
+      for (auto& sn : ClassStructNames(model)) printer.predeclaredStructs.insert(sn);
       std::ostringstream data;
       data << "struct " << vi->name << "_Data {  // the data members of " << vi->name << "\n";
       std::vector<const FieldDecl*> fields;
@@ -694,7 +711,7 @@ void AnalyzeVirtualCalls(Context& c, Kernel& k, GlslPrinter& kernelPrinter) {
       if (vi->paddingWords > 0)
         data << "  uint crt_padding[" << vi->paddingWords << "];  // every element of " << member << " has a slot of " << vm.slotBytes << " bytes\n";
       data << "};\n";
-      for (auto* m : methods) implFunction[vi->name + "::" + m->getNameAsString()] = ImplementationMethod(c, printer, impl, m, field->getLocation());
+      for (auto* m : methods) implFunction[vi->name + "::" + m->getNameAsString()] = ImplementationMethod(rep, printer, impl, m, field->getLocation());
       for (auto& x : printer.Structs()) structs.push_back(x);
       structs.push_back(data.str());
       structs.push_back(std::string("layout(buffer_reference, ") + (vi->scalarLayout ? "scalar" : "std430") + ", buffer_reference_align = 4) readonly buffer " +
@@ -708,7 +725,7 @@ void AnalyzeVirtualCalls(Context& c, Kernel& k, GlslPrinter& kernelPrinter) {
       std::ostringstream os;
       auto ret = kernelPrinter.Type(m->getReturnType(), m->getLocation());
       const std::string retType = ret ? *ret : "void";
-      os << "// " << member << "[index]->" << m->getNameAsString() << (m->getNumParams() ? "(...)" : "()") << ": the object's class picks the implementation\n";
+      os << "// " << vm.display << "[index]->" << m->getNameAsString() << (m->getNumParams() ? "(...)" : "()") << ": the object's class picks the implementation\n";
       os << retType << " " << member << "_" << m->getNameAsString() << "(uint index";
       // The interface's parameter names (it may leave them unnamed).
       std::vector<std::string> names;
@@ -723,7 +740,7 @@ void AnalyzeVirtualCalls(Context& c, Kernel& k, GlslPrinter& kernelPrinter) {
       for (size_t t = 0; t < vm.impls.size(); ++t) {
         const auto& vi = vm.impls[t];
         // Level 1: all elements in one array of equal slots; level 2: each class's objects apart.
-        const std::string address = member + (c.model.virtualLevel == 1 ? std::string("_objects") : "_" + vi.name);
+        const std::string address = member + (model.virtualLevel == 1 ? std::string("_objects") : "_" + vi.name);
         std::string args = member + "_" + vi.name + "Objects(" + address + ").objects[tag.y]";
         for (auto& n : names) args += ", " + n;
         const std::string call = implFunction[vi.name + "::" + m->getNameAsString()] + "(" + args + ")";
@@ -735,6 +752,12 @@ void AnalyzeVirtualCalls(Context& c, Kernel& k, GlslPrinter& kernelPrinter) {
       functions.push_back(os.str());
     }
   }
+}
+
+// The kernel's own code calls virtual functions through the class's vectors of objects.
+void AnalyzeVirtualCalls(Context& c, Kernel& k, GlslPrinter& kernelPrinter) {
+  std::vector<std::string> structs, functions;
+  VirtualCallCode(c.ctx, c.rep, c.model, k, kernelPrinter, VirtualOwner{c.cls, "", "", ""}, structs, functions);
   // Ahead of the kernel's own code, which calls the dispatchers.
   for (auto& x : structs)
     if (std::find(k.structList.begin(), k.structList.end(), x) == k.structList.end()) k.structList.push_back(x);
@@ -2302,6 +2325,12 @@ bool ComposeFromTranslationUnit(ASTContext& ctx, Reporter& reporter, ClassModel&
         printer.EmitComposedMethod(md);
       }
       if (printer.Functions().empty()) continue;
+      // Virtual calls in the composed code (listing 2: an intersection function per primitive):
+      // their dispatchers and the implementations' code go ahead of it.
+      std::vector<std::string> virtualStructs, virtualFunctions;
+      if (!printer.virtualCalls.empty())
+        VirtualCallCode(ctx, reporter, model, k, printer, VirtualOwner{impl, holderPrefix, "crt_" + comp.holder + "()->", comp.holder}, virtualStructs,
+                        virtualFunctions);
       for (auto* fn : printer.helpers) {
         ComposedWriteFinder finder;
         finder.TraverseStmt(fn->getBody());
@@ -2364,11 +2393,18 @@ bool ComposeFromTranslationUnit(ASTContext& ctx, Reporter& reporter, ClassModel&
         model.members.push_back(m);
       }
       // Composed code first: the kernel's own code calls it and may use its structs.
-      std::vector<std::string> structs = printer.Structs(), constants = printer.Constants(), functions = printer.Functions();
-      for (auto& chunk : k.structList) {
-        auto same = std::find_if(structs.begin(), structs.end(), [&](const std::string& x) { return StructName(x) == StructName(chunk); });
-        if (same == structs.end()) structs.push_back(chunk);
-      }
+      std::vector<std::string> structs = printer.Structs(), constants = printer.Constants(), functions;
+      std::vector<std::string> own = printer.Functions();
+      for (auto* list : {&virtualFunctions, &own})  // free functions several print are the same text: once
+        for (auto& x : *list)
+          if (std::find(functions.begin(), functions.end(), x) == functions.end()) functions.push_back(x);
+      for (auto* list : {&virtualStructs, &k.structList})
+        for (auto& chunk : *list) {
+          auto same = std::find_if(structs.begin(), structs.end(), [&](const std::string& x) {
+            return StructName(x) == StructName(chunk) && (!StructName(x).empty() || x == chunk);
+          });
+          if (same == structs.end()) structs.push_back(chunk);
+        }
       for (auto& line : k.constantList)
         if (std::find(constants.begin(), constants.end(), line) == constants.end()) constants.push_back(line);
       functions.insert(functions.end(), k.functionList.begin(), k.functionList.end());
@@ -2382,7 +2418,9 @@ bool ComposeFromTranslationUnit(ASTContext& ctx, Reporter& reporter, ClassModel&
       const bool onlyRayQueries = std::all_of(k.composedCalls.begin(), k.composedCalls.end(), [&](const auto& call) {
         return call.first == comp.holder && (call.second == "RayQuery_NearestHit" || call.second == "RayQuery_AnyHit");
       });
-      if (comp.interfaceName == "ISceneObject" && onlyRayQueries) k.rayQueryHolder = comp.holder;
+      // Not when the traversal calls virtual intersection functions: the hardware would need them as
+      // intersection shaders, which are not generated yet.
+      if (comp.interfaceName == "ISceneObject" && onlyRayQueries && printer.virtualCalls.empty()) k.rayQueryHolder = comp.holder;
     }
   }
   return any;

@@ -226,6 +226,8 @@ Data Common(const ClassModel& model, const GenerateOptions& opt) {
   for (auto& v : model.virtuals) {
     Data x;
     x.set("member", v.member);
+    x.set("host", v.hostExpr);
+    x.set("display", v.display);
     x.set("interface", v.interfaceName);
     std::string names;
     Data impls = List();

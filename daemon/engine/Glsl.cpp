@@ -485,7 +485,7 @@ std::string GlslPrinter::VirtualCall(const CXXMemberCallExpr* mc) {
   for (auto* arg : mc->arguments()) args.push_back(Expr(arg));
   Type(mc->getType(), mc->getBeginLoc());  // declares a returned struct
   virtualCalls.insert({field, method->getCanonicalDecl()});
-  std::string s = field->getNameAsString() + "_" + method->getNameAsString() + "(";
+  std::string s = composedPrefix + field->getNameAsString() + "_" + method->getNameAsString() + "(";
   for (size_t i = 0; i < args.size(); ++i) s += (i ? ", " : "") + args[i];
   return s + ")";
 }

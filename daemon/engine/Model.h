@@ -187,7 +187,9 @@ struct VirtualImpl {
 };
 
 struct VirtualMember {
-  std::string member;         // m_materials
+  std::string member;         // m_materials; composed: m_scene_m_shapes (holder prefix)
+  std::string hostExpr;       // how the generated class reaches it: m_materials, crt_m_scene()->m_shapes
+  std::string display;        // for messages: m_materials, m_scene->m_shapes
   std::string interfaceName;  // IMaterial
   std::vector<VirtualImpl> impls;  // every class of the translation unit that implements it
   unsigned slotBytes = 0;          // level 1: the size of every element's slot
