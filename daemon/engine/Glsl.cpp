@@ -758,8 +758,6 @@ std::string GlslPrinter::ImageStore(const clang::Expr* lhs, const std::string& v
   const ValueDecl* image = ImageTexel(lhs, &coord);
   auto format = UsableImage(image, whole->getBeginLoc());
   if (!format) return "/*error*/";
-  if (!isa<FieldDecl>(image) && image->getType().getNonReferenceType().isConstQualified())
-    return Fail(whole->getBeginLoc(), "kernel writes a texel of const " + Described(image), "take the image as a non-const reference to write it");
   storedImages.insert(image);
   const std::string channels = format->prefix + "vec4";
   return "imageStore(" + ImageName(image) + ", " + coord + ", " + (format->texel == "vec4" ? value : channels + "(" + value + ")") + ")";
@@ -781,8 +779,6 @@ std::string GlslPrinter::ImageCall(const ValueDecl* image, const CXXMemberCallEx
     return TexelOf(*format, "imageLoad(" + name + ", " + coord + ")");
   }
   if (method == "set" && call->getNumArgs() == 3) {
-    if (!isa<FieldDecl>(image) && image->getType().getNonReferenceType().isConstQualified())
-      return Fail(call->getBeginLoc(), "kernel writes a texel of const " + Described(image), "take the image as a non-const reference to write it");
     storedImages.insert(image);
     const std::string value = Expr(call->getArg(2));
     return "imageStore(" + name + ", ivec2(" + Expr(call->getArg(0)) + ", " + Expr(call->getArg(1)) + "), " +

@@ -22,12 +22,20 @@ void Record(float t, float4 posAndNear, uint32_t shapeId, float3 n, ShapeHit& hi
   }
 }
 
-// Whether the ray meets the box [lo, hi] within [near, far] (the slab test).
-bool HitsBox(float4 posAndNear, float4 dirAndFar, float far, float4 lo, float4 hi)
+// Where the ray enters (tmin) and leaves (tmax) the slabs of the box [lo, hi], per axis.
+void SlabTimes(float4 posAndNear, float4 dirAndFar, float4 lo, float4 hi, float3& tmin, float3& tmax)
 {
   const float3 inv = float3(1.0f / dirAndFar.x, 1.0f / dirAndFar.y, 1.0f / dirAndFar.z);
   const float3 t0 = (Xyz(lo) - Xyz(posAndNear)) * inv, t1 = (Xyz(hi) - Xyz(posAndNear)) * inv;
-  const float3 tmin = LiteMath::min(t0, t1), tmax = LiteMath::max(t0, t1);
+  tmin = LiteMath::min(t0, t1);
+  tmax = LiteMath::max(t0, t1);
+}
+
+// Whether the ray meets the box [lo, hi] within [near, far] (the slab test).
+bool HitsBox(float4 posAndNear, float4 dirAndFar, float far, float4 lo, float4 hi)
+{
+  float3 tmin, tmax;
+  SlabTimes(posAndNear, dirAndFar, lo, hi, tmin, tmax);
   const float enter = std::max(std::max(tmin.x, tmin.y), std::max(tmin.z, posAndNear.w));
   const float leave = std::min(std::min(tmax.x, tmax.y), std::min(tmax.z, far));
   return enter <= leave;
@@ -52,9 +60,8 @@ float4 Sphere::BoxMax() const { return centerAndRadius + float4(centerAndRadius.
 
 void Box::Intersect(float4 posAndNear, float4 dirAndFar, uint32_t shapeId, ShapeHit& hit) const
 {
-  const float3 inv = float3(1.0f / dirAndFar.x, 1.0f / dirAndFar.y, 1.0f / dirAndFar.z);
-  const float3 t0 = (Xyz(boxMin) - Xyz(posAndNear)) * inv, t1 = (Xyz(boxMax) - Xyz(posAndNear)) * inv;
-  const float3 tmin = LiteMath::min(t0, t1), tmax = LiteMath::max(t0, t1);
+  float3 tmin, tmax;
+  SlabTimes(posAndNear, dirAndFar, boxMin, boxMax, tmin, tmax);
   const float enter = std::max(std::max(tmin.x, tmin.y), tmin.z), leave = std::min(std::min(tmax.x, tmax.y), tmax.z);
   if (enter > leave)
     return;
