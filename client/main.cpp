@@ -32,7 +32,7 @@ namespace {
 
 const char* kUsage =
     "usage: crossrt translate --class NAME --backend vulkan|cpu --out DIR --source FILE [--source FILE...]\n"
-    "                         [--compose INTERFACE=IMPL...] [--virtual-level 1|2] [--execution-mode wavefront|megakernel]\n"
+    "                         [--compose INTERFACE=IMPL...] [--virtual-level 1|2|3] [--execution-mode wavefront|megakernel]\n"
     "                         [--templates DIR]\n"
     "                         [--depfile FILE --depfile-target FILE]\n"
     "                         [--build-dir DIR | --no-daemon] [-- COMPILE_ARGS...]\n"
@@ -163,7 +163,8 @@ int main(int argc, char** argv) {
       request.compositions.push_back(v);
     }
     else if (a == "--virtual-level") {
-      if (v != "1" && v != "2") return Usage("--virtual-level takes 1 (one array of equal slots) or 2 (a buffer per class), not '" + v + "'");
+      if (v != "1" && v != "2" && v != "3")
+        return Usage("--virtual-level takes 1 (one array of equal slots), 2 (a buffer per class) or 3 (2, plus callable shaders), not '" + v + "'");
       request.virtualLevel = std::stoi(v);
     }
     else if (a == "--execution-mode") {

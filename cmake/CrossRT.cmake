@@ -1,5 +1,5 @@
 # crossrt_add_class(<target> <Class> BACKEND vulkan|cpu [SOURCES file...]
-#                   [COMPOSE Interface=Implementation...] [VIRTUAL_LEVEL 1|2]
+#                   [COMPOSE Interface=Implementation...] [VIRTUAL_LEVEL 1|2|3]
 #                   [EXECUTION_MODE wavefront|megakernel])
 #
 # Translates class <Class> into <Class>_Vulkan (or <Class>_CPU), in the build tree, and adds the
@@ -17,7 +17,9 @@
 #
 # VIRTUAL_LEVEL (paper 3.9): how kernels' virtual calls through a std::vector of pointers reach the
 # objects on the GPU: 1 = every element in one array of equal slots, 2 (default) = each class's
-# objects in a buffer of their own. The class's code is the same for both.
+# objects in a buffer of their own, 3 = as 2, and where the device has ray tracing pipelines, kernels
+# run as ray generation shaders whose virtual calls execute a callable shader per class. The class's
+# code is the same for all three.
 #
 # EXECUTION_MODE (paper 2.1 and 4.4): how a control function's thread loop that calls several kernels
 # (for (y) for (x) { float4 ray; kernel_A(x, y, &ray); kernel_B(x, y, &ray); }) runs on the GPU:
@@ -84,8 +86,8 @@ function(crossrt_add_class target class)
     list(APPEND option_args --compose "${c}")
   endforeach()
   if(ARG_VIRTUAL_LEVEL)
-    if(NOT ARG_VIRTUAL_LEVEL MATCHES "^[12]$")
-      message(FATAL_ERROR "crossrt_add_class(${target} ${class}): VIRTUAL_LEVEL is 1 (one array of equal slots) or 2 (a buffer per class), not '${ARG_VIRTUAL_LEVEL}'")
+    if(NOT ARG_VIRTUAL_LEVEL MATCHES "^[123]$")
+      message(FATAL_ERROR "crossrt_add_class(${target} ${class}): VIRTUAL_LEVEL is 1 (one array of equal slots), 2 (a buffer per class) or 3 (2, plus callable shaders), not '${ARG_VIRTUAL_LEVEL}'")
     endif()
     list(APPEND option_args --virtual-level ${ARG_VIRTUAL_LEVEL})
   endif()

@@ -613,12 +613,120 @@ struct VirtualOwner {
   std::string holder;        // "" or "m_scene"
 };
 
+// The GLSL name of a virtual method's parameter i: the interface's (it may leave it unnamed).
+std::string CallArgumentName(const CXXMethodDecl* m, unsigned i) {
+  const ParmVarDecl* p = m->getParamDecl(i);
+  return p->getName().empty() ? "arg" + std::to_string(i) : GlslPrinter::SafeName(p->getNameAsString());
+}
+
+// A non-const reference parameter of a virtual method: its value comes back to the caller.
+bool WrittenBack(const CXXMethodDecl* m, unsigned i) {
+  QualType pt = m->getParamDecl(i)->getType();
+  return pt->isReferenceType() && !pt.getNonReferenceType().isConstQualified();
+}
+
+// ", vec3 normal, inout float weight": a dispatcher's parameters after the element's index.
+std::string DispatcherParams(GlslPrinter& printer, const CXXMethodDecl* m) {
+  std::string out;
+  for (unsigned i = 0; i < m->getNumParams(); ++i)
+    out += std::string(", ") + (WrittenBack(m, i) ? "inout " : "") +
+           printer.Declare(m->getParamDecl(i)->getType(), CallArgumentName(m, i), m->getParamDecl(i)->getLocation());
+  return out;
+}
+
+// Level 3: what a kernel's ray generation shader has instead of the switches.
+struct CallableCode {
+  std::vector<std::string> structs;    // the calls' payloads and the variables passed to executeCallableEXT
+  std::vector<std::string> functions;  // per method, a dispatcher that executes the callable shader of the object's class
+};
+
+// Level 3: `vm`'s implementation `vi` (an object of class `impl`) of `method` as a callable shader,
+// named <member>_<class>_<method>, added to the model unless another kernel added it.
+void AddCallableShader(ASTContext& ctx, Reporter& rep, ClassModel& model, const VirtualMember& vm, const VirtualImpl& vi,
+                       const CXXRecordDecl* impl, const CXXMethodDecl* method, SourceLocation callLoc, const std::string& dataStruct,
+                       const std::string& objectsReference, const std::string& payload) {
+  const std::string name = vm.member + "_" + vi.name + "_" + method->getNameAsString();
+  if (std::any_of(model.callables.begin(), model.callables.end(), [&](const CallableShader& c) { return c.name == name; })) return;
+  GlslPrinter printer(ctx, impl, rep);
+  printer.selfClass = impl;
+  printer.composedPrefix = vi.name + "_";
+  for (auto& sn : ClassStructNames(model)) printer.predeclaredStructs.insert(sn);
+  const std::string function = ImplementationMethod(rep, printer, impl, method, callLoc);
+  if (function.empty()) return;
+  CallableShader c;
+  c.name = name;
+  c.origin = vi.name + "::" + method->getNameAsString();
+  c.call = vm.display + "[index]->" + method->getNameAsString() + (method->getNumParams() ? "(...)" : "()");
+  c.scalarLayout = vi.scalarLayout;
+  for (auto& x : printer.Constants()) c.constants += x;
+  for (auto& x : printer.Structs()) c.structs += x + "\n";
+  c.structs += dataStruct + "\n" + objectsReference + "\n" + payload + "layout(location = 0) callableDataInEXT " + vm.member + "_" + method->getNameAsString() +
+               "_Call call;\n";
+  for (auto& x : printer.Functions()) c.functions += x + "\n";
+  std::string args = "self";
+  for (unsigned i = 0; i < method->getNumParams(); ++i) args += ", call." + CallArgumentName(method, i);
+  const std::string invoke = function + "(" + args + ")";
+  c.mainBody = "  const " + vi.name + "_Data self = " + vm.member + "_" + vi.name + "Objects(call.crt_objects).objects[call.crt_index];\n  " +
+               (method->getReturnType()->isVoidType() ? invoke : "call.crt_result = " + invoke) + ";\n";
+  model.callables.push_back(c);
+}
+
+// Level 3: `m` called through `vm` from a kernel's ray generation shader. Its payload, and a
+// dispatcher that fills it and executes the callable shader of the object's class (numbered after
+// the kernel's callables so far); each implementation's callable shader joins the model.
+void CallableDispatcher(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& k, GlslPrinter& kernelPrinter, const VirtualMember& vm,
+                        const std::vector<const CXXRecordDecl*>& impls, const CXXMethodDecl* m, SourceLocation callLoc,
+                        const std::map<std::string, std::pair<std::string, std::string>>& implData, CallableCode& out) {
+  const std::string method = m->getNameAsString(), callName = vm.member + "_" + method, variable = callName + "_call";
+  const std::string display = vm.display + "[index]->" + method + (m->getNumParams() ? "(...)" : "()");
+  auto ret = kernelPrinter.Type(m->getReturnType(), m->getLocation());
+  const std::string retType = ret ? *ret : "void";
+  std::ostringstream payload;
+  payload << "// " << display << ": its arguments and result, passed to the callable shader of the object's class\n";
+  payload << "struct " << callName << "_Call\n{\n  uvec2 crt_objects;  // the objects of its class (a buffer reference)\n"
+          << "  uint crt_index;     // the object's index among them\n";
+  for (unsigned i = 0; i < m->getNumParams(); ++i) {
+    const ParmVarDecl* p = m->getParamDecl(i);
+    payload << "  " << kernelPrinter.Declare(p->getType().getNonReferenceType().getUnqualifiedType(), CallArgumentName(m, i), p->getLocation()) << ";\n";
+  }
+  if (retType != "void") payload << "  " << retType << " crt_result;\n";
+  payload << "};\n";
+  const size_t location = out.structs.size(), first = k.callables.size();
+  out.structs.push_back(payload.str() + "layout(location = " + std::to_string(location) + ") callableDataEXT " + callName + "_Call " + variable + ";\n");
+
+  std::string names;
+  for (const VirtualImpl& vi : vm.impls) {
+    auto impl = std::find_if(impls.begin(), impls.end(), [&](const CXXRecordDecl* r) { return r->getNameAsString() == vi.name; });
+    const auto& [dataStruct, objectsReference] = implData.at(vi.name);
+    AddCallableShader(ctx, rep, model, vm, vi, *impl, m, callLoc, dataStruct, objectsReference, payload.str());
+    k.callables.push_back(vm.member + "_" + vi.name + "_" + method);
+    names += (names.empty() ? "" : ", ") + k.callables.back();
+  }
+  std::ostringstream os;
+  os << "// " << display << ": the callable shader of the object's class runs its implementation\n";
+  os << retType << " " << callName << "(uint index" << DispatcherParams(kernelPrinter, m) << ")\n{\n";
+  os << "  const uvec2 tag = " << vm.member << "_Tags(" << vm.member << "_tags).tags[index];\n";
+  os << "  switch (tag.x)  // the objects of its class\n  {\n";
+  for (size_t t = 0; t < vm.impls.size(); ++t)
+    os << "    case " << t << "u: " << variable << ".crt_objects = " << vm.member << "_" << vm.impls[t].name << "; break;\n";
+  os << "  }\n  " << variable << ".crt_index = tag.y;\n";
+  for (unsigned i = 0; i < m->getNumParams(); ++i) os << "  " << variable << "." << CallArgumentName(m, i) << " = " << CallArgumentName(m, i) << ";\n";
+  os << "  executeCallableEXT(" << first << "u + tag.x, " << location << ");  // " << names << "\n";
+  for (unsigned i = 0; i < m->getNumParams(); ++i)
+    if (WrittenBack(m, i)) os << "  " << CallArgumentName(m, i) << " = " << variable << "." << CallArgumentName(m, i) << ";\n";
+  if (retType != "void") os << "  return " << variable << ".crt_result;\n";
+  os << "}\n";
+  out.functions.push_back(os.str());
+}
+
 // Code calls `m_objects[i]->Method(...)`: for every implementation of the interface, its data as
 // a GLSL struct in a buffer of its own (reached by a buffer reference), its methods printed with
 // `self`, and per method a dispatcher that switches over the object's class. The structs and
-// functions to put ahead of the calling code go to `structs` and `functions`.
+// functions to put ahead of the calling code go to `structs` and `functions`; at level 3, with
+// `callable` given, also the callable shaders of the implementations and what the ray generation
+// shader calls them with.
 void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& k, GlslPrinter& kernelPrinter, const VirtualOwner& owner,
-                     std::vector<std::string>& structs, std::vector<std::string>& functions) {
+                     std::vector<std::string>& structs, std::vector<std::string>& functions, CallableCode* callable = nullptr) {
   std::map<const FieldDecl*, std::vector<const CXXMethodDecl*>> calls;
   for (auto& [field, method] : kernelPrinter.virtualCalls) calls[field].push_back(method);
   for (auto& [field, methods] : calls) {
@@ -696,6 +804,7 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
     structs.push_back("layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer " + member + "_Tags { uvec2 tags[]; };  // per element of " +
                       vm.display + ": (class, " + (model.virtualLevel == 1 ? "its slot" : "index among its class's objects") + ")\n");
     std::map<std::string, std::string> implFunction;  // (impl, method) -> GLSL name
+    std::map<std::string, std::pair<std::string, std::string>> implData;  // impl -> (data struct, buffer reference to its objects)
     for (auto* impl : impls) {
       auto vi = std::find_if(vm.impls.begin(), vm.impls.end(), [&](const VirtualImpl& x) { return x.name == impl->getNameAsString(); });
       if (vi == vm.impls.end()) continue;
@@ -713,9 +822,12 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
       data << "};\n";
       for (auto* m : methods) implFunction[vi->name + "::" + m->getNameAsString()] = ImplementationMethod(rep, printer, impl, m, field->getLocation());
       for (auto& x : printer.Structs()) structs.push_back(x);
+      const std::string objectsReference = std::string("layout(buffer_reference, ") + (vi->scalarLayout ? "scalar" : "std430") +
+                                           ", buffer_reference_align = 4) readonly buffer " + member + "_" + vi->name + "Objects { " + vi->name +
+                                           "_Data objects[]; };\n";
       structs.push_back(data.str());
-      structs.push_back(std::string("layout(buffer_reference, ") + (vi->scalarLayout ? "scalar" : "std430") + ", buffer_reference_align = 4) readonly buffer " +
-                        member + "_" + vi->name + "Objects { " + vi->name + "_Data objects[]; };\n");
+      structs.push_back(objectsReference);
+      implData[vi->name] = {data.str(), objectsReference};
       k.scalarReferences |= vi->scalarLayout;
       for (auto& x : printer.Constants())
         if (std::find(k.constantList.begin(), k.constantList.end(), x) == k.constantList.end()) k.constantList.push_back(x);
@@ -726,23 +838,13 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
       auto ret = kernelPrinter.Type(m->getReturnType(), m->getLocation());
       const std::string retType = ret ? *ret : "void";
       os << "// " << vm.display << "[index]->" << m->getNameAsString() << (m->getNumParams() ? "(...)" : "()") << ": the object's class picks the implementation\n";
-      os << retType << " " << member << "_" << m->getNameAsString() << "(uint index";
-      // The interface's parameter names (it may leave them unnamed).
-      std::vector<std::string> names;
-      for (auto* p : m->parameters())
-        names.push_back(p->getName().empty() ? "arg" + std::to_string(names.size()) : GlslPrinter::SafeName(p->getNameAsString()));
-      for (unsigned i = 0; i < m->getNumParams(); ++i) {
-        QualType pt = m->getParamDecl(i)->getType();
-        std::string qualifier = pt->isReferenceType() && !pt.getNonReferenceType().isConstQualified() ? "inout " : "";
-        os << ", " << qualifier << kernelPrinter.Declare(pt, names[i], m->getParamDecl(i)->getLocation());
-      }
-      os << ")\n{\n  const uvec2 tag = " << member << "_Tags(" << member << "_tags).tags[index];\n  switch (tag.x)\n  {\n";
+      os << retType << " " << member << "_" << m->getNameAsString() << "(uint index" << DispatcherParams(kernelPrinter, m) << ")\n{\n  const uvec2 tag = " << member << "_Tags(" << member << "_tags).tags[index];\n  switch (tag.x)\n  {\n";
       for (size_t t = 0; t < vm.impls.size(); ++t) {
         const auto& vi = vm.impls[t];
         // Level 1: all elements in one array of equal slots; level 2: each class's objects apart.
         const std::string address = member + (model.virtualLevel == 1 ? std::string("_objects") : "_" + vi.name);
         std::string args = member + "_" + vi.name + "Objects(" + address + ").objects[tag.y]";
-        for (auto& n : names) args += ", " + n;
+        for (unsigned i = 0; i < m->getNumParams(); ++i) args += ", " + CallArgumentName(m, i);
         const std::string call = implFunction[vi.name + "::" + m->getNameAsString()] + "(" + args + ")";
         os << "    case " << t << "u: " << (retType == "void" ? call + "; return;" : "return " + call + ";") << "\n";
       }
@@ -750,6 +852,7 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
       if (retType != "void") os << "  " << retType << " none;  // not reached: every element holds one of these classes\n  return none;\n";
       os << "}\n";
       functions.push_back(os.str());
+      if (callable) CallableDispatcher(ctx, rep, model, k, kernelPrinter, vm, impls, m, field->getLocation(), implData, *callable);
     }
   }
 }
@@ -757,7 +860,18 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
 // The kernel's own code calls virtual functions through the class's vectors of objects.
 void AnalyzeVirtualCalls(Context& c, Kernel& k, GlslPrinter& kernelPrinter) {
   std::vector<std::string> structs, functions;
-  VirtualCallCode(c.ctx, c.rep, c.model, k, kernelPrinter, VirtualOwner{c.cls, "", "", ""}, structs, functions);
+  CallableCode callable;
+  VirtualCallCode(c.ctx, c.rep, c.model, k, kernelPrinter, VirtualOwner{c.cls, "", "", ""}, structs, functions,
+                  c.model.virtualLevel == 3 ? &callable : nullptr);
+  if (c.model.virtualLevel == 3) {
+    // The ray generation shader needs the tags, not the implementations' code or data.
+    k.callableStructList = k.structList;
+    for (auto& x : structs)
+      if (x.find("_Tags {") != std::string::npos) k.callableStructList.push_back(x);
+    for (auto& x : callable.structs) k.callableStructList.push_back(x);
+    k.callableFunctionList = callable.functions;
+    for (auto& x : k.functionList) k.callableFunctionList.push_back(x);
+  }
   // Ahead of the kernel's own code, which calls the dispatchers.
   for (auto& x : structs)
     if (std::find(k.structList.begin(), k.structList.end(), x) == k.structList.end()) k.structList.push_back(x);
@@ -2486,7 +2600,7 @@ void FinishModel(ClassModel& model) {
     fields.push_back({v.member + "_tags", "uint64_t", "uvec2", 8, "", "m_virtual." + v.member + "_tags.Address()"});
     if (model.virtualLevel == 1) fields.push_back({v.member + "_objects", "uint64_t", "uvec2", 8, "", "m_virtual." + v.member + "_objects.Address()"});
     for (auto& impl : v.impls)
-      if (model.virtualLevel == 2)
+      if (model.virtualLevel >= 2)
         fields.push_back({v.member + "_" + impl.name, "uint64_t", "uvec2", 8, "", "m_virtual." + v.member + "_" + impl.name + ".Address()"});
   }
   std::stable_sort(fields.begin(), fields.end(), [](const BlockField& a, const BlockField& b) { return a.std430Align > b.std430Align; });

@@ -8,6 +8,7 @@
 #include <cctype>
 #include <fstream>
 #include <regex>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -21,11 +22,21 @@ Data List() { return Data(Data::type::list); }
 // The shaders of a kernel, most specific first (the order the host tries them in): the variants for
 // ray tracing hardware and for arrays of textures on the GPU's samplers, and the one every device runs.
 struct KernelVariant {
-  std::string suffix;  // "_RayQuery_Textures", "_RayQuery", "_Textures" or ""
-  bool rayQuery = false, textures = false;
+  std::string suffix;  // "_Callables", "_RayQuery_Textures", "_RayQuery", "_Textures" or ""
+  bool rayQuery = false, textures = false, callables = false;
 };
+// Virtual functions, level 3: a kernel whose virtual calls run as callable shaders, in a ray
+// generation shader of its own. Not for kernels that need what only compute shaders have (shared
+// memory for reductions, indirect dispatch) or other hardware variants, nor for megakernels and
+// composed code: those keep the level-2 switch.
+bool RunsCallables(const Kernel& k) {
+  return !k.callables.empty() && k.reductions.empty() && k.indirectVector.empty() && k.textureArrays.empty() && k.rayQueryHolder.empty() &&
+         k.composedCalls.empty() && k.megakernelOf.empty();
+}
+
 std::vector<KernelVariant> Variants(const Kernel& k) {
   std::vector<KernelVariant> variants;
+  if (RunsCallables(k)) variants.push_back({"_Callables", false, false, true});
   for (bool rayQuery : {true, false})
     for (bool textures : {true, false})
       if ((!rayQuery || !k.rayQueryHolder.empty()) && (!textures || !k.textureArrays.empty()))
@@ -141,6 +152,13 @@ std::string DispatchExpr(const Kernel& k) {
   return "crossrt::Dispatch3D(a_cmd, crt_countX, crt_countY, crt_countZ, " + std::to_string(s.x) + ", " + std::to_string(s.y) + ", " + std::to_string(s.z) + ")";
 }
 
+// The launch of a kernel's ray generation variant: a thread per kernel thread. 1D counts go in
+// rows of 65536, within every device's launch width (maxComputeWorkGroupCount[0] x group size).
+std::string LaunchSize(const Kernel& k) {
+  if (k.dims == 1) return "std::min<uint32_t>(crt_countX, 65536u), (crt_countX + 65535u) / 65536u, 1";
+  if (k.dims == 2) return "crt_countX, crt_countY, 1";
+  return "crt_countX, crt_countY, crt_countZ";
+}
 
 std::string ReductionCppType(const ClassModel& model, const Reduction& r) {
   auto* m = FindMember(model, r.member);
@@ -260,7 +278,7 @@ Data Common(const ClassModel& model, const GenerateOptions& opt) {
     x.set("impls", impls);
     x.set("implNames", names);
     x.set("level1", model.virtualLevel == 1);
-    x.set("level2", model.virtualLevel == 2);
+    x.set("level2", model.virtualLevel >= 2);  // level 3 keeps the objects as level 2 does
     x.set("slotBytes", std::to_string(v.slotBytes));
     virtuals.push_back(x);
   }
@@ -328,8 +346,10 @@ std::string TextureArrayFunctions(const Member& array, bool hardware, bool first
 
 // A shader of a kernel: `hardwareRayQuery` the variant that traces with ray queries
 // (Kernel::rayQueryHolder), `hardwareTextures` the one that samples arrays of textures with the
-// GPU's samplers (Kernel::textureArrays).
-std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateOptions& opt, bool hardwareRayQuery, bool hardwareTextures) {
+// GPU's samplers (Kernel::textureArrays), `callables` the ray generation shader whose virtual calls
+// execute callable shaders (Kernel::callables).
+std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateOptions& opt, bool hardwareRayQuery, bool hardwareTextures,
+                       bool callables) {
   Data d = Common(model, opt);
   d.set("kernel", k.name);
   d.set("sourceFile", k.sourceFile);
@@ -341,7 +361,10 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   d.set("classStructs", model.glslClassStructs);
   d.set("rayQuery", hardwareRayQuery);
   d.set("textureHardware", hardwareTextures);
+  d.set("callables", callables);
+  d.set("compute", !callables);
   std::string variant;
+  if (callables) variant = ": the variant for ray tracing pipelines, whose virtual calls execute a callable shader per class";
   if (hardwareRayQuery) variant = ": the variant for ray tracing hardware (GL_EXT_ray_query)";
   if (hardwareTextures) variant += std::string(variant.empty() ? ": the variant" : ",") + " for arrays of textures on the GPU's samplers (descriptor indexing)";
   else if (!k.textureArrays.empty()) variant += std::string(variant.empty() ? ": the variant" : ",") + " sampling arrays of textures from buffers, on any device";
@@ -354,6 +377,10 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   // structs and constants only they used.
   const std::vector<std::string>& memberVectors = hardwareRayQuery ? k.ownMemberVectors : k.memberVectors;
   std::vector<std::string> functionList = k.functionList, structList = k.structList, constantList = k.constantList;
+  if (callables) {
+    functionList = k.callableFunctionList;
+    structList = k.callableStructList;
+  }
   if (hardwareRayQuery) {
     functionList = k.ownFunctionList;
     functionList.insert(functionList.begin(), RayQueryFunctions(k.rayQueryHolder, k.composedCalls, opt));
@@ -590,7 +617,26 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   d.set("countLimit", v.empty() ? std::string("crt_countX") : "min(" + v + "_size, " + v + "_capacity)");
   d.set("indirect", !v.empty());
   d.set("indirectVector", v);
-  return Render(opt.templateDir + "/glsl/kernel.comp.mustache", d);
+  std::string glsl = Render(opt.templateDir + "/glsl/kernel.comp.mustache", d);
+  // A ray generation thread's id is its launch id: the launch spans the thread counts exactly.
+  if (callables) glsl = std::regex_replace(glsl, std::regex("gl_GlobalInvocationID"), "gl_LaunchIDEXT");
+  return glsl;
+}
+
+// Virtual functions, level 3: one class's implementation of a method as a callable shader.
+std::string CallableGlsl(const ClassModel& model, const CallableShader& c, const GenerateOptions& opt) {
+  Data d = Common(model, opt);
+  d.set("name", c.name);
+  d.set("origin", c.origin);
+  d.set("implName", c.origin.substr(0, c.origin.find("::")));
+  d.set("call", c.call);
+  d.set("scalarLayout", c.scalarLayout);
+  d.set("classStructs", model.glslClassStructs);
+  d.set("constants", c.constants);
+  d.set("structs", c.structs);
+  d.set("functions", c.functions);
+  d.set("mainBody", c.mainBody);
+  return Render(opt.templateDir + "/glsl/callable.rcall.mustache", d);
 }
 
 std::string ReduceGlsl(const ClassModel& model, const Kernel& k, const GenerateOptions& opt) {
@@ -848,14 +894,32 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
       y.set("bindingList", list);
       y.set("bindingTypes", types);
       y.set("bindingCount", std::to_string(buffers));
-      y.set("pushBuffers", !typed && !kind.textures);  // storage buffers only: the simple constructor
-      y.set("pushBindings", typed || kind.textures);
+      y.set("pushBuffers", !kind.callables && !typed && !kind.textures);  // storage buffers only: the simple constructor
+      y.set("pushBindings", !kind.callables && (typed || kind.textures));
+      y.set("callablePipeline", kind.callables);
+      y.set("pipelineType", kind.callables ? "crossrt::CallablePipeline" : "crossrt::ComputePipeline");
+      std::string callableList;
+      for (auto& c : k.callables)
+        callableList += "\n          {" + model.className + "_" + c + "_spv, " + model.className + "_" + c + "_spvBytes},";
+      y.set("callableList", callableList);
+      const std::string code = model.className + "_" + k.name + kind.suffix;
+      y.set("rayGenerationCode", "{" + code + "_spv, " + code + "_spvBytes}");
+      // A kernel with callables records its launch in each branch: a trace or a dispatch.
+      std::string launch;
+      if (kind.callables) launch = "m_pipelines." + k.name + kind.suffix + ".TraceCmd(a_cmd, " + LaunchSize(k) + ")";
+      else if (RunsCallables(k)) launch = DispatchExpr(k);
+      y.set("launch", launch);
       y.set("pushCall", typed ? "PushBindings" : "PushBuffers");
       y.set("textureSets", sets);
       y.set("hasTextureSets", !sets.empty());
       y.set("textureSetCount", std::to_string(k.textureArrays.size()));
       // Which devices can create it, and when the host records it.
       std::string needs, use, why;
+      if (kind.callables) {
+        needs = "m_ctx->hasRayTracingPipeline";
+        use = "m_useCallableShaders";
+        why = "virtual calls as callable shaders, in a ray tracing pipeline";
+      }
       if (kind.rayQuery) {
         needs = "m_ctx->hasRayQuery";
         use = "m_useRayTracingHardware";
@@ -895,6 +959,7 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
     x.set("hasReductions", !k.reductions.empty());
     x.set("groupCountExpr", GroupCountExpr(k));
     x.set("dispatch", DispatchExpr(k));
+    x.set("sharedDispatch", k.indirectVector.empty() && !RunsCallables(k));
     kernels.push_back(x);
   }
   return kernels;
@@ -960,9 +1025,16 @@ std::vector<ShaderSource> GenerateShaders(const ClassModel& model, const Generat
   std::vector<ShaderSource> shaders;
   for (const Kernel* kernel : VulkanKernels(model)) {
     const Kernel& k = *kernel;
-    for (const KernelVariant& v : Variants(k)) shaders.push_back({k.name + v.suffix, KernelGlsl(model, k, opt, v.rayQuery, v.textures)});
+    for (const KernelVariant& v : Variants(k))
+      shaders.push_back({k.name + v.suffix, KernelGlsl(model, k, opt, v.rayQuery, v.textures, v.callables), v.callables ? "rgen" : "comp"});
     if (!k.reductions.empty()) shaders.push_back({k.name + "_Reduce", ReduceGlsl(model, k, opt)});
   }
+  // Level 3: the callable shaders of the kernels that run them.
+  std::set<std::string> executed;
+  for (const Kernel* k : VulkanKernels(model))
+    if (RunsCallables(*k)) executed.insert(k->callables.begin(), k->callables.end());
+  for (const CallableShader& c : model.callables)
+    if (executed.count(c.name)) shaders.push_back({c.name, CallableGlsl(model, c, opt), "rcall"});
   return shaders;
 }
 
@@ -989,6 +1061,19 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
     d.set("hasImages", std::any_of(model.members.begin(), model.members.end(), [](const Member& m) {
       return m.usedByKernels && (m.kind == MemberKind::Image || m.kind == MemberKind::Sampler);
     }));
+    // Level 3: the callable shaders that kernels' ray generation variants execute.
+    Data callableShaders = List();
+    std::set<std::string> executed;
+    for (const Kernel* k : VulkanKernels(model))
+      if (RunsCallables(*k))
+        for (auto& c : k->callables)
+          if (executed.insert(c).second) {
+            Data x;
+            x.set("name", c);
+            callableShaders.push_back(x);
+          }
+    d.set("callableShaders", callableShaders);
+    d.set("hasCallables", !executed.empty());
     unsigned indirectSlots = 0;
     d.set("kernels", VulkanKernelsData(model, indirectSlots));
     d.set("indirectSlots", std::to_string(indirectSlots));

@@ -17,8 +17,9 @@ struct GenerateOptions {
 };
 
 struct ShaderSource {
-  std::string name;  // kernel name, or kernel + "_Reduce"
+  std::string name;  // kernel name, or kernel + "_Reduce", "_RayQuery", ...; a callable shader's name
   std::string glsl;
+  std::string stage = "comp";  // the file's extension, which names the stage: comp, rgen or rcall
 };
 
 std::vector<ShaderSource> GenerateShaders(const ClassModel& model, const GenerateOptions& options);

@@ -127,6 +127,12 @@ struct Kernel {
   std::vector<std::string> megakernelCalls;  // the kernels it runs, whose code it merges
   bool bufferReferences = false;      // reaches objects through buffer references (virtual calls)
   bool scalarReferences = false;      // some of them need the scalar layout
+  // Virtual functions, level 3: the callable shaders (ClassModel::callables) its virtual calls
+  // execute, in executeCallableEXT's numbering, and the prelude of its <kernel>_Callables ray
+  // generation shader: the kernel's own structs and functions, the calls' payloads, and dispatchers
+  // that execute the object's class's callable shader instead of switching over implementations.
+  std::vector<std::string> callables;
+  std::vector<std::string> callableStructList, callableFunctionList;
   bool atomics = false;               // calls crossrt::Atomic*: coherent buffers, memory scope semantics
 };
 
@@ -195,6 +201,18 @@ struct VirtualMember {
   unsigned slotBytes = 0;          // level 1: the size of every element's slot
 };
 
+// Virtual functions, level 3 (paper 3.9): one class's implementation of a method called through a
+// vector of objects, as a callable shader of a ray tracing pipeline. It receives the call's
+// payload (the objects of the class, the object's index, the arguments, room for the result).
+struct CallableShader {
+  std::string name;                   // m_materials_Lambert_Shade: the .rcall file and its SPIR-V
+  std::string origin;                 // Lambert::Shade
+  std::string call;                   // m_materials[index]->Shade(...)
+  bool scalarLayout = false;          // the class's objects need GL_EXT_scalar_block_layout
+  std::string constants, structs, functions;  // the implementation's code and the payload, in GLSL order
+  std::string mainBody;               // loads the object, calls the implementation, stores the result
+};
+
 // A member function that appends to a member vector, reached from a kernel's threads: the CPU
 // backend hides it with a copy whose push_backs take a lock (crossrt::Locked), as it does in the
 // kernels' own loops. Callers on the way from the kernel are copied too, so that they call the copy.
@@ -223,7 +241,10 @@ struct ClassModel {
   std::vector<std::string> usingDecls; // top-level using-directives of the sources: copied bodies need them
   std::vector<Composition> compositions;   // holders kernels call through, in declaration order
   std::vector<VirtualMember> virtuals;     // vectors of objects kernels call virtual functions of
-  int virtualLevel = 2;                    // 1: one array of equal slots; 2: a buffer per class
+  // 1: one array of equal slots; 2: a buffer per class; 3: as 2, plus callable shaders for kernels
+  // whose ray generation variant a device with ray tracing pipelines runs.
+  int virtualLevel = 2;
+  std::vector<CallableShader> callables;   // level 3, by name
   // Thread loops that call several kernels run as one shader each (megakernels) or one dispatch per
   // kernel call (wavefront). Both are generated; this picks the default.
   std::vector<Kernel> megakernels;

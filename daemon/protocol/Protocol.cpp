@@ -62,7 +62,7 @@ engine::TranslateRequest RequestFromJson(const nlohmann::json& j) {
   r.templateDir = j.at("templateDir").get<std::string>();
   if (j.contains("compositions")) r.compositions = j.at("compositions").get<std::vector<std::string>>();
   if (j.contains("virtualLevel")) r.virtualLevel = j.at("virtualLevel").get<int>();
-  if (r.virtualLevel != 1 && r.virtualLevel != 2) throw std::runtime_error("virtualLevel must be 1 or 2");
+  if (r.virtualLevel < 1 || r.virtualLevel > 3) throw std::runtime_error("virtualLevel must be 1, 2 or 3");
   if (j.contains("executionMode")) {
     std::string mode = j.at("executionMode").get<std::string>();
     if (mode != "megakernel" && mode != "wavefront") throw std::runtime_error("executionMode must be megakernel or wavefront, not '" + mode + "'");

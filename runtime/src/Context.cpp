@@ -334,10 +334,12 @@ void VulkanContext::CreateDevice(const ContextOptions& options) {
   bool deferredOps = wanted(VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME);
   bool accel = deferredOps && wanted(VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME);
   bool rayQuery = accel && wanted(VK_KHR_RAY_QUERY_EXTENSION_NAME);
+  bool rayPipeline = accel && wanted(VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME);
   for (const char* e : options.optionalDeviceExtensions) {
     if (!e || !HasExtension(available, e) || std::strcmp(e, VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME) == 0) continue;
     if (std::strcmp(e, VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME) == 0 && !accel) continue;
     if (std::strcmp(e, VK_KHR_RAY_QUERY_EXTENSION_NAME) == 0 && !rayQuery) continue;
+    if (std::strcmp(e, VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME) == 0 && !rayPipeline) continue;
     bool dup = std::any_of(extensions.begin(), extensions.end(), [&](const char* x) { return std::strcmp(x, e) == 0; });
     if (!dup) extensions.push_back(e);
   }
@@ -347,18 +349,19 @@ void VulkanContext::CreateDevice(const ContextOptions& options) {
   auto supported12 = VkInit<VkPhysicalDeviceVulkan12Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES);
   auto supportedAs = VkInit<VkPhysicalDeviceAccelerationStructureFeaturesKHR>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR);
   auto supportedRq = VkInit<VkPhysicalDeviceRayQueryFeaturesKHR>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR);
+  auto supportedRt = VkInit<VkPhysicalDeviceRayTracingPipelineFeaturesKHR>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR);
   auto supported = VkInit<VkPhysicalDeviceFeatures2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2);
   void** tail = &supported.pNext;
   if (vk12) { *tail = &supported12; tail = &supported12.pNext; }
-  if (rayQuery) {
-    *tail = &supportedAs; tail = &supportedAs.pNext;
-    *tail = &supportedRq; tail = &supportedRq.pNext;
-  }
+  if (rayQuery || rayPipeline) { *tail = &supportedAs; tail = &supportedAs.pNext; }
+  if (rayQuery) { *tail = &supportedRq; tail = &supportedRq.pNext; }
+  if (rayPipeline) { *tail = &supportedRt; tail = &supportedRt.pNext; }
   vkGetPhysicalDeviceFeatures2(physicalDevice, &supported);
 
   auto enable12 = VkInit<VkPhysicalDeviceVulkan12Features>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES);
   auto enableAs = VkInit<VkPhysicalDeviceAccelerationStructureFeaturesKHR>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR);
   auto enableRq = VkInit<VkPhysicalDeviceRayQueryFeaturesKHR>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR);
+  auto enableRt = VkInit<VkPhysicalDeviceRayTracingPipelineFeaturesKHR>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR);
   auto enable = VkInit<VkPhysicalDeviceFeatures2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2);
   enable.features.shaderInt64 = supported.features.shaderInt64;
   enable.features.shaderFloat64 = supported.features.shaderFloat64;
@@ -374,11 +377,19 @@ void VulkanContext::CreateDevice(const ContextOptions& options) {
     }
     *tail = &enable12; tail = &enable12.pNext;
   }
-  if (rayQuery && supportedRq.rayQuery && supportedAs.accelerationStructure && enable12.bufferDeviceAddress) {
+  // Acceleration structures come with either; the pipeline's shader binding table needs device addresses.
+  const bool accelOk = supportedAs.accelerationStructure && enable12.bufferDeviceAddress;
+  if (accelOk && ((rayQuery && supportedRq.rayQuery) || (rayPipeline && supportedRt.rayTracingPipeline))) {
     enableAs.accelerationStructure = VK_TRUE;
-    enableRq.rayQuery = VK_TRUE;
     *tail = &enableAs; tail = &enableAs.pNext;
+  }
+  if (accelOk && rayQuery && supportedRq.rayQuery) {
+    enableRq.rayQuery = VK_TRUE;
     *tail = &enableRq; tail = &enableRq.pNext;
+  }
+  if (accelOk && rayPipeline && supportedRt.rayTracingPipeline) {
+    enableRt.rayTracingPipeline = VK_TRUE;
+    *tail = &enableRt; tail = &enableRt.pNext;
   }
 
   float priority = 1.0f;
@@ -414,6 +425,7 @@ void VulkanContext::CreateDevice(const ContextOptions& options) {
   hasScalarBlockLayout = enable12.scalarBlockLayout == VK_TRUE;
   hasBufferDeviceAddress = enable12.bufferDeviceAddress == VK_TRUE;
   hasRayQuery = enableRq.rayQuery == VK_TRUE;
+  hasRayTracingPipeline = enableRt.rayTracingPipeline == VK_TRUE;
   if (enable12.runtimeDescriptorArray) {
     // A kernel may sample a few arrays besides its own images: each array gets a quarter of what
     // one stage may bind, and at most 65536 textures.
@@ -458,6 +470,25 @@ void VulkanContext::CreateDevice(const ContextOptions& options) {
     accelProps.pNext = &accelLimits;
     vkGetPhysicalDeviceProperties2(physicalDevice, &accelProps);
     accelerationScratchAlignment = std::max<VkDeviceSize>(1, accelLimits.minAccelerationStructureScratchOffsetAlignment);
+  }
+  if (hasRayTracingPipeline) {
+    auto load = [&](const char* name) {
+      PFN_vkVoidFunction f = vkGetDeviceProcAddr(device, name);
+      if (!f) throw Error(std::string(name) + " is missing although VK_KHR_ray_tracing_pipeline is enabled");
+      return f;
+    };
+    vkCreateRayTracingPipelinesKHR = reinterpret_cast<PFN_vkCreateRayTracingPipelinesKHR>(load("vkCreateRayTracingPipelinesKHR"));
+    vkGetRayTracingShaderGroupHandlesKHR =
+        reinterpret_cast<PFN_vkGetRayTracingShaderGroupHandlesKHR>(load("vkGetRayTracingShaderGroupHandlesKHR"));
+    vkCmdTraceRaysKHR = reinterpret_cast<PFN_vkCmdTraceRaysKHR>(load("vkCmdTraceRaysKHR"));
+    auto pipelineLimits = VkInit<VkPhysicalDeviceRayTracingPipelinePropertiesKHR>(
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_PROPERTIES_KHR);
+    auto pipelineProps = VkInit<VkPhysicalDeviceProperties2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2);
+    pipelineProps.pNext = &pipelineLimits;
+    vkGetPhysicalDeviceProperties2(physicalDevice, &pipelineProps);
+    shaderGroupHandleSize = pipelineLimits.shaderGroupHandleSize;
+    shaderGroupHandleAlignment = std::max(1u, pipelineLimits.shaderGroupHandleAlignment);
+    shaderGroupBaseAlignment = std::max(1u, pipelineLimits.shaderGroupBaseAlignment);
   }
 }
 

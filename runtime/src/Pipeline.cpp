@@ -1,5 +1,5 @@
-// ComputePipeline (push-descriptor set 0 of storage buffers + push constants), dispatch helpers
-// and the barriers generated code puts between dispatches.
+// Pipeline (push-descriptor set 0, arrays of textures, push constants), ComputePipeline, dispatch
+// helpers and the barriers generated code puts between dispatches. CallablePipeline: CallablePipeline.cpp.
 #include "crossrt/VulkanRuntime.h"
 #include "Internal.h"
 
@@ -7,41 +7,29 @@
 
 namespace crossrt {
 
-ComputePipeline::ComputePipeline(std::shared_ptr<VulkanContext> ctx, const uint32_t* spirv, size_t spirvBytes,
-                                 uint32_t storageBufferBindings, uint32_t pushConstantBytes, const char* debugName)
-    : ComputePipeline(std::move(ctx), spirv, spirvBytes,
-                      std::vector<VkDescriptorType>(storageBufferBindings, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER), pushConstantBytes,
-                      debugName) {}
-
-ComputePipeline::ComputePipeline(std::shared_ptr<VulkanContext> ctx, const uint32_t* spirv, size_t spirvBytes,
-                                 std::vector<VkDescriptorType> bindingTypes, uint32_t pushConstantBytes, const char* debugName,
-                                 uint32_t textureArraySets)
-    : ctx_(std::move(ctx)), types_(std::move(bindingTypes)), textureArraySets_(textureArraySets), pushConstantBytes_(pushConstantBytes),
-      name_(debugName ? debugName : "") {
-  if (!ctx_) throw Error("ComputePipeline '" + name_ + "': null VulkanContext");
+Pipeline::Pipeline(const char* kind, VkPipelineBindPoint bindPoint, VkShaderStageFlags stages, std::shared_ptr<VulkanContext> ctx,
+                   std::vector<VkDescriptorType> bindingTypes, uint32_t pushConstantBytes, const char* debugName, uint32_t textureArraySets)
+    : ctx_(std::move(ctx)), name_(debugName ? debugName : ""), kind_(kind), bindPoint_(bindPoint), stages_(stages),
+      types_(std::move(bindingTypes)), textureArraySets_(textureArraySets), pushConstantBytes_(pushConstantBytes) {
+  if (!ctx_) throw Error(Where() + ": null VulkanContext");
   if (textureArraySets_ > 0 && !ctx_->hasTextureArrays)
-    throw Error("ComputePipeline '" + name_ + "': device '" + ctx_->DeviceName() + "' has no arrays of textures (descriptor indexing)");
-  if (!spirv || spirvBytes == 0 || spirvBytes % 4 != 0)
-    throw Error("ComputePipeline '" + name_ + "': SPIR-V must be a non-empty multiple of 4 bytes");
+    throw Error(Where() + ": device '" + ctx_->DeviceName() + "' has no arrays of textures (descriptor indexing)");
   if (pushConstantBytes > ctx_->properties.limits.maxPushConstantsSize || pushConstantBytes % 4 != 0)
-    throw Error("ComputePipeline '" + name_ + "': " + std::to_string(pushConstantBytes) +
-                " bytes of push constants (must be a multiple of 4 and at most " +
+    throw Error(Where() + ": " + std::to_string(pushConstantBytes) + " bytes of push constants (must be a multiple of 4 and at most " +
                 std::to_string(ctx_->properties.limits.maxPushConstantsSize) + " on this device)");
-
   VkDevice dev = ctx_->device;
   try {
     if (!types_.empty()) {
       const uint32_t count = static_cast<uint32_t>(types_.size());
       std::vector<VkDescriptorSetLayoutBinding> b(count);
-      for (uint32_t i = 0; i < count; ++i) b[i] = VkDescriptorSetLayoutBinding{i, types_[i], 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+      for (uint32_t i = 0; i < count; ++i) b[i] = VkDescriptorSetLayoutBinding{i, types_[i], 1, stages_, nullptr};
       auto setInfo = VkInit<VkDescriptorSetLayoutCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO);
       setInfo.flags = VK_DESCRIPTOR_SET_LAYOUT_CREATE_PUSH_DESCRIPTOR_BIT_KHR;
       setInfo.bindingCount = count;
       setInfo.pBindings = b.data();
       Check(vkCreateDescriptorSetLayout(dev, &setInfo, nullptr, &setLayout_), "vkCreateDescriptorSetLayout");
     }
-
-    VkPushConstantRange range{VK_SHADER_STAGE_COMPUTE_BIT, 0, pushConstantBytes_};
+    VkPushConstantRange range{stages_, 0, pushConstantBytes_};
     // Set 0 exists whenever later sets do: an empty push-descriptor layout stands in for it.
     if (!setLayout_ && textureArraySets_ > 0) {
       auto setInfo = VkInit<VkDescriptorSetLayoutCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO);
@@ -57,54 +45,45 @@ ComputePipeline::ComputePipeline(std::shared_ptr<VulkanContext> ctx, const uint3
     layoutInfo.pushConstantRangeCount = pushConstantBytes_ ? 1 : 0;
     layoutInfo.pPushConstantRanges = pushConstantBytes_ ? &range : nullptr;
     Check(vkCreatePipelineLayout(dev, &layoutInfo, nullptr, &layout_), "vkCreatePipelineLayout");
-
-    auto moduleInfo = VkInit<VkShaderModuleCreateInfo>(VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO);
-    moduleInfo.codeSize = spirvBytes;
-    moduleInfo.pCode = spirv;
-    VkShaderModule module = VK_NULL_HANDLE;
-    Check(vkCreateShaderModule(dev, &moduleInfo, nullptr, &module), "vkCreateShaderModule");
-
-    auto info = VkInit<VkComputePipelineCreateInfo>(VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO);
-    info.stage = VkInit<VkPipelineShaderStageCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO);
-    info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-    info.stage.module = module;
-    info.stage.pName = "main";
-    // Shaders without this constant ignore it.
-    const VkBool32 fenceAtomics = ctx_->fenceAtomics ? VK_TRUE : VK_FALSE;
-    const VkSpecializationMapEntry fenceEntry{kFenceAtomicsConstantId, 0, sizeof(VkBool32)};
-    const VkSpecializationInfo specialization{1, &fenceEntry, sizeof(VkBool32), &fenceAtomics};
-    info.stage.pSpecializationInfo = &specialization;
-    info.layout = layout_;
-    VkResult r = vkCreateComputePipelines(dev, ctx_->pipelineCache, 1, &info, nullptr, &pipeline_);
-    vkDestroyShaderModule(dev, module, nullptr);  // the pipeline keeps what it needs
-    Check(r, ("vkCreateComputePipelines '" + name_ + "'").c_str());
-    ctx_->SetObjectName(VK_OBJECT_TYPE_PIPELINE, reinterpret_cast<uint64_t>(pipeline_), name_.c_str());
   } catch (...) {
     Release();
     throw;
   }
 }
 
-ComputePipeline::ComputePipeline(ComputePipeline&& other) noexcept { *this = std::move(other); }
+VkShaderModule Pipeline::CreateModule(const uint32_t* spirv, size_t spirvBytes) const {
+  if (!spirv || spirvBytes == 0 || spirvBytes % 4 != 0) throw Error(Where() + ": SPIR-V must be a non-empty multiple of 4 bytes");
+  auto moduleInfo = VkInit<VkShaderModuleCreateInfo>(VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO);
+  moduleInfo.codeSize = spirvBytes;
+  moduleInfo.pCode = spirv;
+  VkShaderModule module = VK_NULL_HANDLE;
+  Check(vkCreateShaderModule(ctx_->device, &moduleInfo, nullptr, &module), "vkCreateShaderModule");
+  return module;
+}
 
-ComputePipeline& ComputePipeline::operator=(ComputePipeline&& other) noexcept {
+Pipeline::Pipeline(Pipeline&& other) noexcept { *this = std::move(other); }
+
+Pipeline& Pipeline::operator=(Pipeline&& other) noexcept {
   if (this != &other) {
     Release();
     ctx_ = std::move(other.ctx_);
-    setLayout_ = std::exchange(other.setLayout_, VK_NULL_HANDLE);
     layout_ = std::exchange(other.layout_, VK_NULL_HANDLE);
     pipeline_ = std::exchange(other.pipeline_, VK_NULL_HANDLE);
+    name_ = std::move(other.name_);
+    kind_ = other.kind_;
+    bindPoint_ = other.bindPoint_;
+    stages_ = other.stages_;
+    setLayout_ = std::exchange(other.setLayout_, VK_NULL_HANDLE);
     types_ = std::move(other.types_);
     textureArraySets_ = std::exchange(other.textureArraySets_, 0);
     pushConstantBytes_ = std::exchange(other.pushConstantBytes_, 0);
-    name_ = std::move(other.name_);
   }
   return *this;
 }
 
-ComputePipeline::~ComputePipeline() { Release(); }
+Pipeline::~Pipeline() { Release(); }
 
-void ComputePipeline::Release() noexcept {
+void Pipeline::Release() noexcept {
   if (ctx_) {
     if (pipeline_) vkDestroyPipeline(ctx_->device, pipeline_, nullptr);
     if (layout_) vkDestroyPipelineLayout(ctx_->device, layout_, nullptr);
@@ -116,24 +95,21 @@ void ComputePipeline::Release() noexcept {
   ctx_.reset();
 }
 
-void ComputePipeline::Bind(VkCommandBuffer cmd) const {
-  vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
-}
+void Pipeline::Bind(VkCommandBuffer cmd) const { vkCmdBindPipeline(cmd, bindPoint_, pipeline_); }
 
-void ComputePipeline::PushBuffers(VkCommandBuffer cmd, std::initializer_list<BufferView> buffers) const {
+void Pipeline::PushBuffers(VkCommandBuffer cmd, std::initializer_list<BufferView> buffers) const {
   std::vector<Binding> bindings(buffers.begin(), buffers.end());
   Push(cmd, bindings);
 }
 
-void ComputePipeline::PushBindings(VkCommandBuffer cmd, std::initializer_list<Binding> bindings) const {
+void Pipeline::PushBindings(VkCommandBuffer cmd, std::initializer_list<Binding> bindings) const {
   Push(cmd, std::vector<Binding>(bindings));
 }
 
-void ComputePipeline::Push(VkCommandBuffer cmd, const std::vector<Binding>& bindings) const {
+void Pipeline::Push(VkCommandBuffer cmd, const std::vector<Binding>& bindings) const {
   const uint32_t count = static_cast<uint32_t>(types_.size());
   if (bindings.size() != count)
-    throw Error("ComputePipeline '" + name_ + "': got " + std::to_string(bindings.size()) + " resources for " +
-                std::to_string(count) + " bindings");
+    throw Error(Where() + ": got " + std::to_string(bindings.size()) + " resources for " + std::to_string(count) + " bindings");
   if (count == 0) return;
   // Reserved up front: the writes point into these vectors.
   std::vector<VkDescriptorBufferInfo> bufferInfos;
@@ -145,7 +121,7 @@ void ComputePipeline::Push(VkCommandBuffer cmd, const std::vector<Binding>& bind
   std::vector<VkWriteDescriptorSet> writes(count);
   for (uint32_t i = 0; i < count; ++i) {
     const Binding& r = bindings[i];
-    const std::string where = "ComputePipeline '" + name_ + "': binding " + std::to_string(i);
+    const std::string where = Where() + ": binding " + std::to_string(i);
     if (r.type != types_[i]) throw Error(where + " got a resource of another descriptor type than its layout's");
     writes[i] = VkInit<VkWriteDescriptorSet>(VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET);
     writes[i].dstBinding = i;
@@ -175,28 +151,62 @@ void ComputePipeline::Push(VkCommandBuffer cmd, const std::vector<Binding>& bind
       writes[i].pImageInfo = &imageInfos.back();
     }
   }
-  ctx_->vkCmdPushDescriptorSetKHR(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 0, count, writes.data());
+  ctx_->vkCmdPushDescriptorSetKHR(cmd, bindPoint_, layout_, 0, count, writes.data());
 }
 
-void ComputePipeline::BindTextureArrays(VkCommandBuffer cmd, std::initializer_list<const TextureArray*> arrays) const {
+void Pipeline::BindTextureArrays(VkCommandBuffer cmd, std::initializer_list<const TextureArray*> arrays) const {
   if (arrays.size() != textureArraySets_)
-    throw Error("ComputePipeline '" + name_ + "': got " + std::to_string(arrays.size()) + " arrays of textures for " +
-                std::to_string(textureArraySets_) + " sets");
+    throw Error(Where() + ": got " + std::to_string(arrays.size()) + " arrays of textures for " + std::to_string(textureArraySets_) + " sets");
   std::vector<VkDescriptorSet> sets;
   for (const TextureArray* a : arrays) {
-    if (!a || !a->Set()) throw Error("ComputePipeline '" + name_ + "': an array of textures was not assigned");
+    if (!a || !a->Set()) throw Error(Where() + ": an array of textures was not assigned");
     sets.push_back(a->Set());
   }
   if (!sets.empty())
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout_, 1, static_cast<uint32_t>(sets.size()), sets.data(), 0, nullptr);
+    vkCmdBindDescriptorSets(cmd, bindPoint_, layout_, 1, static_cast<uint32_t>(sets.size()), sets.data(), 0, nullptr);
 }
 
-void ComputePipeline::PushConstants(VkCommandBuffer cmd, const void* data, uint32_t bytes) const {
+void Pipeline::PushConstants(VkCommandBuffer cmd, const void* data, uint32_t bytes) const {
   if (bytes > pushConstantBytes_)
-    throw Error("ComputePipeline '" + name_ + "': " + std::to_string(bytes) + " bytes of push constants, layout has " +
-                std::to_string(pushConstantBytes_));
+    throw Error(Where() + ": " + std::to_string(bytes) + " bytes of push constants, layout has " + std::to_string(pushConstantBytes_));
   if (bytes == 0) return;
-  vkCmdPushConstants(cmd, layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, bytes, data);
+  vkCmdPushConstants(cmd, layout_, stages_, 0, bytes, data);
+}
+
+// ---- compute pipelines ---------------------------------------------------------------------------
+
+ComputePipeline::ComputePipeline(std::shared_ptr<VulkanContext> ctx, const uint32_t* spirv, size_t spirvBytes,
+                                 uint32_t storageBufferBindings, uint32_t pushConstantBytes, const char* debugName)
+    : ComputePipeline(std::move(ctx), spirv, spirvBytes,
+                      std::vector<VkDescriptorType>(storageBufferBindings, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER), pushConstantBytes,
+                      debugName) {}
+
+ComputePipeline::ComputePipeline(std::shared_ptr<VulkanContext> ctx, const uint32_t* spirv, size_t spirvBytes,
+                                 std::vector<VkDescriptorType> bindingTypes, uint32_t pushConstantBytes, const char* debugName,
+                                 uint32_t textureArraySets)
+    : Pipeline("ComputePipeline", VK_PIPELINE_BIND_POINT_COMPUTE, VK_SHADER_STAGE_COMPUTE_BIT, std::move(ctx), std::move(bindingTypes),
+               pushConstantBytes, debugName, textureArraySets) {
+  try {
+    VkShaderModule module = CreateModule(spirv, spirvBytes);
+    auto info = VkInit<VkComputePipelineCreateInfo>(VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO);
+    info.stage = VkInit<VkPipelineShaderStageCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO);
+    info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    info.stage.module = module;
+    info.stage.pName = "main";
+    // Shaders without this constant ignore it.
+    const VkBool32 fenceAtomics = ctx_->fenceAtomics ? VK_TRUE : VK_FALSE;
+    const VkSpecializationMapEntry fenceEntry{kFenceAtomicsConstantId, 0, sizeof(VkBool32)};
+    const VkSpecializationInfo specialization{1, &fenceEntry, sizeof(VkBool32), &fenceAtomics};
+    info.stage.pSpecializationInfo = &specialization;
+    info.layout = layout_;
+    VkResult r = vkCreateComputePipelines(ctx_->device, ctx_->pipelineCache, 1, &info, nullptr, &pipeline_);
+    vkDestroyShaderModule(ctx_->device, module, nullptr);  // the pipeline keeps what it needs
+    Check(r, ("vkCreateComputePipelines '" + name_ + "'").c_str());
+    ctx_->SetObjectName(VK_OBJECT_TYPE_PIPELINE, reinterpret_cast<uint64_t>(pipeline_), name_.c_str());
+  } catch (...) {
+    Release();
+    throw;
+  }
 }
 
 // ---- dispatch ------------------------------------------------------------------------------------

@@ -18,6 +18,8 @@ struct IMaterial
   // Reflected colour for a unit normal and a unit direction to the light.
   virtual float3 Shade(float3 normal, float3 toLight) const = 0;
   virtual float Opacity() const { return 1.0f; }
+  // Dims `color` with the distance it travelled (CallableShading calls it: a result through a reference).
+  virtual void Attenuate(float3& color, float distance) const { color = color / (1.0f + distance * distance); }
 };
 
 inline float Lit(float3 normal, float3 toLight) { return LiteMath::max(LiteMath::dot(normal, toLight), 0.0f); }
@@ -58,6 +60,7 @@ struct Checker : IMaterial
     return ((cell & 1) == 0 ? even : odd) * Lit(normal, toLight);
   }
   float Opacity() const override { return opacity; }
+  void Attenuate(float3& color, float distance) const override { color = color * LiteMath::max(1.0f - distance * opacity, 0.0f); }
 };
 
 class MaterialShading

@@ -479,10 +479,11 @@ void Areas::kernel1D_Run(int n, float* out)
   {
     TempClass tc("Areas", "#pragma once\nclass Areas {};\n", "#include \"Areas.h\"\n");
     CommandResult r = RunCrossrt("translate --class Areas --backend vulkan --out " + (tc.dir / "out").string() + " --source " +
-                                 tc.Source("Areas") + " --virtual-level 3 --templates " CROSSRT_SOURCE_DIR "/templates");
+                                 tc.Source("Areas") + " --virtual-level 4 --templates " CROSSRT_SOURCE_DIR "/templates");
     INFO(r.output);
     REQUIRE(r.exitCode == 2);
-    REQUIRE(r.output.find("--virtual-level takes 1 (one array of equal slots) or 2 (a buffer per class), not '3'") != std::string::npos);
+    REQUIRE(r.output.find("--virtual-level takes 1 (one array of equal slots), 2 (a buffer per class) or 3 (2, plus callable shaders), not '4'") !=
+            std::string::npos);
   }
 }
 

@@ -1,9 +1,13 @@
-// Virtual functions in kernels: MaterialShading and FlatShading call IMaterial through a
-// std::vector of shared_ptr. The original, _CPU and _Vulkan shade the same points, at both levels:
-// MaterialShading_Vulkan keeps each class's objects in a buffer of their own (level 2),
-// FlatShading_Vulkan every element in one array of equal slots (level 1); a switch over the
-// object's class picks the code. The GPU may contract a*b+c to fma, and pow differs by an ulp or
-// so, hence 1e-5.
+// Virtual functions in kernels: MaterialShading, FlatShading and CallableShading call IMaterial
+// through a std::vector of shared_ptr. The original, _CPU and _Vulkan shade the same points, at
+// all three levels: MaterialShading_Vulkan keeps each class's objects in a buffer of their own
+// (level 2), FlatShading_Vulkan every element in one array of equal slots (level 1); a switch over
+// the object's class picks the code. CallableShading_Vulkan (level 3) runs a callable shader per
+// class where the device has ray tracing pipelines, the level-2 switch elsewhere. The GPU may
+// contract a*b+c to fma, and pow differs by an ulp or so, hence 1e-5.
+#include "CallableShading.h"
+#include "CallableShading_CPU.h"
+#include "CallableShading_Vulkan.h"
 #include "FlatShading.h"
 #include "FlatShading_CPU.h"
 #include "FlatShading_Vulkan.h"
@@ -160,4 +164,55 @@ TEST_CASE("Virtual functions, level 2: three implementations of different sizes,
 TEST_CASE("Virtual functions, level 1: the same kernel with every element in one array of equal slots", "[equivalence][virtual]")
 {
   CheckVirtualCalls<FlatShading>(CreateFlatShading_CPU(), [] { return CreateFlatShading_Vulkan(ValidatedContext()); });
+}
+
+TEST_CASE("Virtual functions, level 3: callable shaders on ray tracing pipelines, else the level-2 switch", "[equivalence][virtual]")
+{
+  auto ctx = ValidatedContext();
+  const auto palette = Palette();
+  const int width = 61, height = 47;  // not multiples of a workgroup's side
+  const Scene scene = RandomScene(width * height, uint32_t(palette.size()), 5);
+  auto render = [&](CallableShading& shading) {
+    std::vector<float4> colors(scene.normals.size(), float4(-1.0f));
+    shading.Render(width, height, scene.normals.data(), scene.ids.data(), colors.data());
+    return colors;
+  };
+
+  CallableShading original;
+  original.m_materials = palette;
+  const auto expected = render(original);
+  // Attenuate (through a reference) dims what MaterialShading's kernel shades, more with x + y; the
+  // opacity stays.
+  MaterialShading plain;
+  plain.m_materials = palette;
+  const auto unattenuated = ShadeWith(plain, scene);
+  REQUIRE(Differing(expected, unattenuated, 1e-3f) > expected.size() / 2);
+  for (size_t i = 0; i < expected.size(); ++i)
+  {
+    for (int c = 0; c < 3; ++c) REQUIRE(expected[i][c] <= unattenuated[i][c] + 1e-6f);
+    REQUIRE(expected[i].w == unattenuated[i].w);
+  }
+
+  auto cpu = CreateCallableShading_CPU();
+  cpu->m_materials = palette;
+  REQUIRE(Differing(render(*cpu), expected, 0.0f) == 0);
+
+  if (!ctx) return;
+  auto gpu = CreateCallableShading_Vulkan(ctx);
+  auto& vulkan = dynamic_cast<CallableShading_Vulkan&>(*gpu);
+  gpu->m_materials = palette;
+  // Callable shaders by default wherever the device can run them.
+  REQUIRE(vulkan.UsesCallableShaders() == ctx->hasRayTracingPipeline);
+  REQUIRE(Differing(render(*gpu), expected, 1e-5f) == 0);
+  if (ctx->hasRayTracingPipeline)
+  {
+    vulkan.UseCallableShaders(false);  // the same kernel as a compute shader with the switch
+    REQUIRE(Differing(render(*gpu), expected, 1e-5f) == 0);
+  }
+  else
+  {
+    REQUIRE_THROWS_WITH(vulkan.UseCallableShaders(true), Catch::Contains("has no ray tracing pipelines"));
+    REQUIRE_FALSE(vulkan.UsesCallableShaders());
+  }
+  RequireNoValidationMessages(ctx);
 }

@@ -49,10 +49,12 @@ const char* ResultName(VkResult r);
 struct ContextOptions {
   std::string device;        // "" = automatic; else a device index ("1") or a case-insensitive substring of the name
   bool validation = false;   // enable VK_LAYER_KHRONOS_validation + VK_EXT_debug_utils messenger
-  // Enabled when present: by default what ray queries need (hasRayQuery tells whether they are on).
+  // Enabled when present: by default what ray queries and ray tracing pipelines need
+  // (hasRayQuery and hasRayTracingPipeline tell whether they are on).
   std::vector<const char*> optionalDeviceExtensions = {VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME,
                                                        VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME,
-                                                       VK_KHR_RAY_QUERY_EXTENSION_NAME};
+                                                       VK_KHR_RAY_QUERY_EXTENSION_NAME,
+                                                       VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME};
   // Testing aid: never map device buffers, so Upload/Download take the staging path that GPUs
   // without host-visible VRAM need (lavapipe's memory is always host-visible).
   bool forceStaging = false;
@@ -78,6 +80,11 @@ public:
   VkPhysicalDeviceProperties properties{};  // limits, name, timestampPeriod
   bool hasScalarBlockLayout = false, hasBufferDeviceAddress = false, hasRayQuery = false,
        hasShaderFloat64 = false, hasShaderInt64 = false;
+  // Ray tracing pipelines (VK_KHR_ray_tracing_pipeline) with buffer device addresses: what
+  // CallablePipeline needs, the pipeline virtual functions run in at level 3. Then the shader
+  // group handle limits follow.
+  bool hasRayTracingPipeline = false;
+  uint32_t shaderGroupHandleSize = 0, shaderGroupHandleAlignment = 1, shaderGroupBaseAlignment = 1;
   // Arrays of combined image samplers indexed per thread (descriptor indexing: runtime arrays,
   // non-uniform indexing, partially bound sets of variable size). Then textureArrayLayout is the
   // set layout of one such array, of up to maxTextureArraySize textures.
@@ -109,6 +116,10 @@ public:
   PFN_vkCmdBuildAccelerationStructuresKHR vkCmdBuildAccelerationStructuresKHR = nullptr;
   PFN_vkGetAccelerationStructureDeviceAddressKHR vkGetAccelerationStructureDeviceAddressKHR = nullptr;
   VkDeviceSize accelerationScratchAlignment = 1;  // minAccelerationStructureScratchOffsetAlignment
+  // VK_KHR_ray_tracing_pipeline, loaded when hasRayTracingPipeline.
+  PFN_vkCreateRayTracingPipelinesKHR vkCreateRayTracingPipelinesKHR = nullptr;
+  PFN_vkGetRayTracingShaderGroupHandlesKHR vkGetRayTracingShaderGroupHandlesKHR = nullptr;
+  PFN_vkCmdTraceRaysKHR vkCmdTraceRaysKHR = nullptr;
 
   // One-shot command buffers come from the shared commandPool: allocation, submission and freeing
   // are locked, but Vulkan pools allow recording from only one thread at a time.
@@ -510,25 +521,10 @@ void AssignTextures(TextureArray& array, VkFormat format, const Textures& textur
   array.Assign(format, list);
 }
 
-// RAII compute pipeline, move-only. Set 0 is a push-descriptor set; sets 1, 2, ... may be
-// arrays of textures (VulkanContext::textureArrayLayout).
-class ComputePipeline {
+// What compute and ray tracing pipelines share, move-only: the layout (set 0 a push-descriptor set,
+// sets 1, 2, ... arrays of textures, push constants), binding resources and push constants.
+class Pipeline {
 public:
-  ComputePipeline() = default;
-  // storageBufferBindings: bindings 0..n-1 in set 0; pushConstantBytes may be 0.
-  ComputePipeline(std::shared_ptr<VulkanContext> ctx, const uint32_t* spirv, size_t spirvBytes,
-                  uint32_t storageBufferBindings, uint32_t pushConstantBytes, const char* debugName);
-  // Binding i of set 0 has bindingTypes[i] (storage buffers, storage images, sampled images, samplers);
-  // sets 1..textureArraySets are arrays of textures (throws unless ctx->hasTextureArrays).
-  ComputePipeline(std::shared_ptr<VulkanContext> ctx, const uint32_t* spirv, size_t spirvBytes,
-                  std::vector<VkDescriptorType> bindingTypes, uint32_t pushConstantBytes, const char* debugName,
-                  uint32_t textureArraySets = 0);
-  ComputePipeline(ComputePipeline&& other) noexcept;
-  ComputePipeline& operator=(ComputePipeline&& other) noexcept;
-  ComputePipeline(const ComputePipeline&) = delete;
-  ComputePipeline& operator=(const ComputePipeline&) = delete;
-  ~ComputePipeline();
-
   void Bind(VkCommandBuffer cmd) const;
   // Binding i = i-th view, via vkCmdPushDescriptorSetKHR. The count must equal the binding count.
   void PushBuffers(VkCommandBuffer cmd, std::initializer_list<BufferView> buffers) const;
@@ -540,18 +536,72 @@ public:
   VkPipeline Handle() const { return pipeline_; }
   VkPipelineLayout Layout() const { return layout_; }
 
-private:
+protected:
+  Pipeline() = default;
+  // Checks the arguments and creates the layout, for shaders of `stages`; `kind` names the class in errors.
+  Pipeline(const char* kind, VkPipelineBindPoint bindPoint, VkShaderStageFlags stages, std::shared_ptr<VulkanContext> ctx,
+           std::vector<VkDescriptorType> bindingTypes, uint32_t pushConstantBytes, const char* debugName, uint32_t textureArraySets);
+  Pipeline(Pipeline&& other) noexcept;
+  Pipeline& operator=(Pipeline&& other) noexcept;
+  Pipeline(const Pipeline&) = delete;
+  Pipeline& operator=(const Pipeline&) = delete;
+  ~Pipeline();
   void Release() noexcept;
-  void Push(VkCommandBuffer cmd, const std::vector<Binding>& bindings) const;
+  std::string Where() const { return std::string(kind_) + " '" + name_ + "'"; }  // for errors
+  VkShaderModule CreateModule(const uint32_t* spirv, size_t spirvBytes) const;  // throws on bad SPIR-V
 
   std::shared_ptr<VulkanContext> ctx_;
-  VkDescriptorSetLayout setLayout_ = VK_NULL_HANDLE;
   VkPipelineLayout layout_ = VK_NULL_HANDLE;
   VkPipeline pipeline_ = VK_NULL_HANDLE;
+  std::string name_;
+
+private:
+  void Push(VkCommandBuffer cmd, const std::vector<Binding>& bindings) const;
+
+  const char* kind_ = "Pipeline";
+  VkPipelineBindPoint bindPoint_ = VK_PIPELINE_BIND_POINT_COMPUTE;
+  VkShaderStageFlags stages_ = 0;
+  VkDescriptorSetLayout setLayout_ = VK_NULL_HANDLE;
   std::vector<VkDescriptorType> types_;
   uint32_t textureArraySets_ = 0;
   uint32_t pushConstantBytes_ = 0;
-  std::string name_;
+};
+
+// RAII compute pipeline, move-only.
+class ComputePipeline : public Pipeline {
+public:
+  ComputePipeline() = default;
+  // storageBufferBindings: bindings 0..n-1 in set 0; pushConstantBytes may be 0.
+  ComputePipeline(std::shared_ptr<VulkanContext> ctx, const uint32_t* spirv, size_t spirvBytes,
+                  uint32_t storageBufferBindings, uint32_t pushConstantBytes, const char* debugName);
+  // Binding i of set 0 has bindingTypes[i] (storage buffers, storage images, sampled images, samplers);
+  // sets 1..textureArraySets are arrays of textures (throws unless ctx->hasTextureArrays).
+  ComputePipeline(std::shared_ptr<VulkanContext> ctx, const uint32_t* spirv, size_t spirvBytes,
+                  std::vector<VkDescriptorType> bindingTypes, uint32_t pushConstantBytes, const char* debugName,
+                  uint32_t textureArraySets = 0);
+};
+
+// SPIR-V code of one shader: a pointer into the generated arrays, and its size in bytes.
+struct ShaderCode {
+  const uint32_t* spirv = nullptr;
+  size_t bytes = 0;
+};
+
+// RAII ray tracing pipeline of one ray generation shader and callable shaders, move-only: a kernel
+// whose virtual calls run as callable shaders (virtual functions, level 3). executeCallableEXT(i, ...)
+// in the shaders runs callables[i]. Throws unless ctx->hasRayTracingPipeline.
+class CallablePipeline : public Pipeline {
+public:
+  CallablePipeline() = default;
+  CallablePipeline(std::shared_ptr<VulkanContext> ctx, ShaderCode rayGeneration, const std::vector<ShaderCode>& callables,
+                   std::vector<VkDescriptorType> bindingTypes, uint32_t pushConstantBytes, const char* debugName);
+  // Launches width x height x depth ray generation threads (gl_LaunchIDEXT), behind and ahead of
+  // barriers to and from the compute and transfer stages the other commands use.
+  void TraceCmd(VkCommandBuffer cmd, uint32_t width, uint32_t height, uint32_t depth) const;
+
+private:
+  Buffer table_;  // the shader binding table: the ray generation record, then the callables'
+  VkStridedDeviceAddressRegionKHR rayGenRegion_{}, callableRegion_{};
 };
 
 // Dispatch `threads` threads in groups of `groupSize` (1D). Above 65535 groups (the minimum
