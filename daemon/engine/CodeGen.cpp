@@ -29,10 +29,17 @@ struct KernelVariant {
 // generation shader of its own. Not for kernels that need what only compute shaders have (shared
 // memory for reductions, indirect dispatch) or other hardware variants, nor for megakernels and
 // composed code: those keep the level-2 switch.
-bool RunsCallables(const Kernel& k) {
-  return !k.callables.empty() && k.reductions.empty() && k.indirectVector.empty() && k.textureArrays.empty() && k.rayQueryHolder.empty() &&
-         k.composedCalls.empty() && k.megakernelOf.empty();
+// Why a kernel with virtual calls at level 3 has no such variant ("" when it has one).
+std::string WhyNoCallables(const Kernel& k) {
+  if (!k.reductions.empty()) return "its reductions need a compute shader's shared memory";
+  if (!k.indirectVector.empty()) return "it is dispatched indirectly, which ray tracing pipelines are not here";
+  if (!k.textureArrays.empty() || !k.rayQueryHolder.empty()) return "it has other hardware variants (arrays of textures or ray queries)";
+  if (!k.composedCalls.empty()) return "it calls composed code";
+  if (!k.megakernelOf.empty()) return "it is a megakernel";
+  return "";
 }
+
+bool RunsCallables(const Kernel& k) { return !k.callables.empty() && WhyNoCallables(k).empty(); }
 
 std::vector<KernelVariant> Variants(const Kernel& k) {
   std::vector<KernelVariant> variants;
@@ -960,6 +967,7 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
     x.set("groupCountExpr", GroupCountExpr(k));
     x.set("dispatch", DispatchExpr(k));
     x.set("sharedDispatch", k.indirectVector.empty() && !RunsCallables(k));
+    x.set("whyNoCallables", k.callables.empty() ? "" : WhyNoCallables(k));
     kernels.push_back(x);
   }
   return kernels;
