@@ -50,13 +50,13 @@ const fs::path& TempDir() {
   return dir.path;
 }
 
-std::vector<uint32_t> CompileGlsl(const std::string& source) {
+std::vector<uint32_t> CompileGlsl(const std::string& source, const char* stage = "comp") {
   static int counter = 0;
   const fs::path spv = TempDir() / ("shader" + std::to_string(counter) + ".spv");
   const fs::path log = TempDir() / ("shader" + std::to_string(counter) + ".log");
   ++counter;
   const std::string cmd = std::string("\"") + CROSSRT_GLSLANG_VALIDATOR +
-                          "\" -V --target-env vulkan1.2 --stdin -S comp -o \"" + spv.string() + "\" > \"" +
+                          "\" -V --target-env vulkan1.2 --stdin -S " + stage + " -o \"" + spv.string() + "\" > \"" +
                           log.string() + "\" 2>&1";
   FILE* pipe = popen(cmd.c_str(), "w");
   REQUIRE(pipe != nullptr);
@@ -526,6 +526,69 @@ TEST_CASE("RayTracingScene: instances of meshes traced with ray queries, or a cl
 
   scene.Build({}, {});  // an empty scene: a top level every ray misses
   REQUIRE_FALSE(scene.Empty());
+}
+
+// A ray generation shader executing one of two callable shaders per thread (the shape of level-3
+// virtual calls), in rows of the launch as generated 1D kernels use.
+const char* kCallableProbeRayGen = R"(#version 460
+#extension GL_EXT_ray_tracing : require
+layout(std430, binding = 0) buffer Out { uint values[]; };
+layout(push_constant) uniform Args { uint count; };
+struct Call { uint argument; uint result; };
+layout(location = 0) callableDataEXT Call call;
+void main() {
+  const uint i = gl_LaunchIDEXT.x + gl_LaunchIDEXT.y * gl_LaunchSizeEXT.x;
+  if (i >= count) return;
+  call.argument = i;
+  executeCallableEXT(i % 2u, 0);
+  values[i] = call.result;
+}
+)";
+const char* kCallableDouble = R"(#version 460
+#extension GL_EXT_ray_tracing : require
+struct Call { uint argument; uint result; };
+layout(location = 0) callableDataInEXT Call call;
+void main() { call.result = call.argument * 2u; }
+)";
+const char* kCallableOffset = R"(#version 460
+#extension GL_EXT_ray_tracing : require
+struct Call { uint argument; uint result; };
+layout(location = 0) callableDataInEXT Call call;
+void main() { call.result = call.argument + 1000u; }
+)";
+
+TEST_CASE("CallablePipeline: callable shaders chosen per thread, or a clear error without ray tracing pipelines", "[runtime]") {
+  auto ctx = MakeContext();
+  if (!ctx) return;
+  const auto rayGen = CompileGlsl(kCallableProbeRayGen, "rgen");
+  const auto doubled = CompileGlsl(kCallableDouble, "rcall"), offset = CompileGlsl(kCallableOffset, "rcall");
+  auto create = [&] {
+    return CallablePipeline(ctx, {rayGen.data(), rayGen.size() * 4}, {{doubled.data(), doubled.size() * 4}, {offset.data(), offset.size() * 4}},
+                            {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}, sizeof(uint32_t), "callable_probe");
+  };
+  if (!ctx->hasRayTracingPipeline) {
+    INFO(ctx->DeviceName() << " has no ray tracing pipelines: only the error is checked");
+    REQUIRE_THROWS_WITH(create(), Catch::Contains("has no ray tracing pipelines"));
+    RequireNoValidationMessages(*ctx);
+    return;
+  }
+  CallablePipeline pipe = create();
+  const uint32_t n = 70001;  // more than one row of 65536
+  Buffer out(ctx, n * sizeof(uint32_t));
+  out.Fill(0xffffffffu);
+  VkCommandBuffer cmd = ctx->BeginOneShot();
+  pipe.Bind(cmd);
+  pipe.PushBuffers(cmd, {out.View()});
+  pipe.PushConstants(cmd, &n, sizeof(n));
+  pipe.TraceCmd(cmd, std::min<uint32_t>(n, 65536u), (n + 65535u) / 65536u, 1);
+  ctx->SubmitAndWait(cmd);
+  std::vector<uint32_t> values(n);
+  out.Download(values.data(), n * sizeof(uint32_t));
+  size_t wrong = 0;
+  for (uint32_t i = 0; i < n; ++i)
+    if (values[i] != (i % 2 == 0 ? 2 * i : i + 1000) && wrong++ < 5) UNSCOPED_INFO("i=" << i << " got " << values[i]);
+  REQUIRE(wrong == 0);
+  RequireNoValidationMessages(*ctx);
 }
 
 // The CPU backend's radix sort takes one to three passes of 11 bits, skipping a pass whose digit
