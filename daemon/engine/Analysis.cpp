@@ -636,8 +636,9 @@ std::string DispatcherParams(GlslPrinter& printer, const CXXMethodDecl* m) {
 
 // Level 3: what a kernel's ray generation shader has instead of the switches.
 struct CallableCode {
-  std::vector<std::string> structs;    // the calls' payloads and the variables passed to executeCallableEXT
+  std::vector<std::string> structs;    // the vectors' tags, the calls' payloads and the variables passed to executeCallableEXT
   std::vector<std::string> functions;  // per method, a dispatcher that executes the callable shader of the object's class
+  unsigned payloads = 0;               // callableDataEXT variables so far: the next one's location
 };
 
 // Level 3: `vm`'s implementation `vi` (an object of class `impl`) of `method` as a callable shader,
@@ -691,7 +692,7 @@ void CallableDispatcher(ASTContext& ctx, Reporter& rep, ClassModel& model, Kerne
   }
   if (retType != "void") payload << "  " << retType << " crt_result;\n";
   payload << "};\n";
-  const size_t location = out.structs.size(), first = k.callables.size();
+  const size_t location = out.payloads++, first = k.callables.size();
   out.structs.push_back(payload.str() + "layout(location = " + std::to_string(location) + ") callableDataEXT " + callName + "_Call " + variable + ";\n");
 
   std::string names;
@@ -801,8 +802,11 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
     const VirtualMember& vm = *known;
     k.bufferReferences = true;
     // Data structs and buffer references, then each implementation's methods.
-    structs.push_back("layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer " + member + "_Tags { uvec2 tags[]; };  // per element of " +
-                      vm.display + ": (class, " + (model.virtualLevel == 1 ? "its slot" : "index among its class's objects") + ")\n");
+    const std::string tags = "layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer " + member +
+                             "_Tags { uvec2 tags[]; };  // per element of " + vm.display + ": (class, " +
+                             (model.virtualLevel == 1 ? "its slot" : "index among its class's objects") + ")\n";
+    structs.push_back(tags);
+    if (callable) callable->structs.push_back(tags);
     std::map<std::string, std::string> implFunction;  // (impl, method) -> GLSL name
     std::map<std::string, std::pair<std::string, std::string>> implData;  // impl -> (data struct, buffer reference to its objects)
     for (auto* impl : impls) {
@@ -838,7 +842,8 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
       auto ret = kernelPrinter.Type(m->getReturnType(), m->getLocation());
       const std::string retType = ret ? *ret : "void";
       os << "// " << vm.display << "[index]->" << m->getNameAsString() << (m->getNumParams() ? "(...)" : "()") << ": the object's class picks the implementation\n";
-      os << retType << " " << member << "_" << m->getNameAsString() << "(uint index" << DispatcherParams(kernelPrinter, m) << ")\n{\n  const uvec2 tag = " << member << "_Tags(" << member << "_tags).tags[index];\n  switch (tag.x)\n  {\n";
+      os << retType << " " << member << "_" << m->getNameAsString() << "(uint index" << DispatcherParams(kernelPrinter, m) << ")\n{\n";
+      os << "  const uvec2 tag = " << member << "_Tags(" << member << "_tags).tags[index];\n  switch (tag.x)\n  {\n";
       for (size_t t = 0; t < vm.impls.size(); ++t) {
         const auto& vi = vm.impls[t];
         // Level 1: all elements in one array of equal slots; level 2: each class's objects apart.
@@ -866,8 +871,6 @@ void AnalyzeVirtualCalls(Context& c, Kernel& k, GlslPrinter& kernelPrinter) {
   if (c.model.virtualLevel == 3) {
     // The ray generation shader needs the tags, not the implementations' code or data.
     k.callableStructList = k.structList;
-    for (auto& x : structs)
-      if (x.find("_Tags {") != std::string::npos) k.callableStructList.push_back(x);
     for (auto& x : callable.structs) k.callableStructList.push_back(x);
     k.callableFunctionList = callable.functions;
     for (auto& x : k.functionList) k.callableFunctionList.push_back(x);

@@ -41,6 +41,17 @@ std::string WhyNoCallables(const Kernel& k) {
 
 bool RunsCallables(const Kernel& k) { return !k.callables.empty() && WhyNoCallables(k).empty(); }
 
+// The callable shaders that kernels' ray generation variants execute, in the model's order.
+std::vector<const CallableShader*> ExecutedCallables(const ClassModel& model) {
+  std::set<std::string> executed;
+  for (const Kernel& k : model.kernels)
+    if (RunsCallables(k)) executed.insert(k.callables.begin(), k.callables.end());
+  std::vector<const CallableShader*> out;
+  for (const CallableShader& c : model.callables)
+    if (executed.count(c.name)) out.push_back(&c);
+  return out;
+}
+
 std::vector<KernelVariant> Variants(const Kernel& k) {
   std::vector<KernelVariant> variants;
   if (RunsCallables(k)) variants.push_back({"_Callables", false, false, true});
@@ -1037,12 +1048,7 @@ std::vector<ShaderSource> GenerateShaders(const ClassModel& model, const Generat
       shaders.push_back({k.name + v.suffix, KernelGlsl(model, k, opt, v.rayQuery, v.textures, v.callables), v.callables ? "rgen" : "comp"});
     if (!k.reductions.empty()) shaders.push_back({k.name + "_Reduce", ReduceGlsl(model, k, opt)});
   }
-  // Level 3: the callable shaders of the kernels that run them.
-  std::set<std::string> executed;
-  for (const Kernel* k : VulkanKernels(model))
-    if (RunsCallables(*k)) executed.insert(k->callables.begin(), k->callables.end());
-  for (const CallableShader& c : model.callables)
-    if (executed.count(c.name)) shaders.push_back({c.name, CallableGlsl(model, c, opt), "rcall"});
+  for (const CallableShader* c : ExecutedCallables(model)) shaders.push_back({c->name, CallableGlsl(model, *c, opt), "rcall"});
   return shaders;
 }
 
@@ -1069,19 +1075,14 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
     d.set("hasImages", std::any_of(model.members.begin(), model.members.end(), [](const Member& m) {
       return m.usedByKernels && (m.kind == MemberKind::Image || m.kind == MemberKind::Sampler);
     }));
-    // Level 3: the callable shaders that kernels' ray generation variants execute.
     Data callableShaders = List();
-    std::set<std::string> executed;
-    for (const Kernel* k : VulkanKernels(model))
-      if (RunsCallables(*k))
-        for (auto& c : k->callables)
-          if (executed.insert(c).second) {
-            Data x;
-            x.set("name", c);
-            callableShaders.push_back(x);
-          }
+    for (const CallableShader* c : ExecutedCallables(model)) {
+      Data x;
+      x.set("name", c->name);
+      callableShaders.push_back(x);
+    }
     d.set("callableShaders", callableShaders);
-    d.set("hasCallables", !executed.empty());
+    d.set("hasCallables", !callableShaders.is_empty_list());
     unsigned indirectSlots = 0;
     d.set("kernels", VulkanKernelsData(model, indirectSlots));
     d.set("indirectSlots", std::to_string(indirectSlots));

@@ -354,8 +354,9 @@ TranslateResult Translate(const TranslateRequest& request, AstCache* cache, Spir
     return result;
   }
   // Templates are inputs too: editing one regenerates.
-  for (const char* t : {"glsl/kernel.comp.mustache", "glsl/reduce.comp.mustache", "glsl/ray_query.glsl.mustache", "glsl/texture_array.glsl.mustache", "glsl/callable.rcall.mustache", "vulkan/class.h.mustache",
-                        "vulkan/class.cpp.mustache", "cpu/class.h.mustache", "cpu/class.cpp.mustache"})
+  for (const char* t : {"glsl/kernel.comp.mustache", "glsl/reduce.comp.mustache", "glsl/ray_query.glsl.mustache", "glsl/texture_array.glsl.mustache",
+                        "glsl/callable.rcall.mustache", "vulkan/class.h.mustache", "vulkan/class.cpp.mustache", "cpu/class.h.mustache",
+                        "cpu/class.cpp.mustache"})
     inputs.insert(request.templateDir + "/" + t);
   result.inputs.assign(inputs.begin(), inputs.end());
   result.diagnostics = diagText;  // warnings, if any
