@@ -15,11 +15,8 @@
 #include "SpherePaths_CPU.h"
 #include "SpherePaths_Vulkan.h"
 
-#include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
-#include <functional>
 #include <memory>
 #include <random>
 #include <string>

@@ -493,7 +493,6 @@ void CheckKernelParams(Context& c, const CXXMethodDecl* md, Kernel& k) {
       kp.isConstPointee = t.getNonReferenceType().isConstQualified();
       kp.glslType = format->texel;
       kp.imageFormat = format->glslFormat;
-      kp.vkFormat = format->vkFormat;
       kp.imagePrefix = format->prefix;
       k.params.push_back(kp);
       continue;
@@ -612,6 +611,13 @@ struct VirtualOwner {
   std::string hostPrefix;    // "" or "crt_m_scene()->"
   std::string holder;        // "" or "m_scene"
 };
+
+// The generated class derives from `cls` and names member `f`: a private one is an error.
+void RequireReachable(Reporter& rep, const FieldDecl* f, const CXXRecordDecl* cls) {
+  if (f->getAccess() == AS_private)
+    rep.Error(f->getLocation(), "member '" + f->getNameAsString() + "' is private, but the generated class derives from '" + cls->getNameAsString() + "' and must reach it",
+              "declare it protected");
+}
 
 // The GLSL name of a virtual method's parameter i: the interface's (it may leave it unnamed).
 std::string CallArgumentName(const CXXMethodDecl* m, unsigned i) {
@@ -735,9 +741,7 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
     IsStdVector(field->getType(), &element);
     const CXXRecordDecl* interface = PolymorphicPointee(element);
     const std::string member = owner.prefix + field->getNameAsString();
-    if (owner.holder.empty() && field->getAccess() == AS_private)
-      rep.Error(field->getLocation(), "member '" + field->getNameAsString() + "' is private, but the generated class derives from '" + owner.cls->getNameAsString() + "' and must reach it",
-                "declare it protected");
+    if (owner.holder.empty()) RequireReachable(rep, field, owner.cls);
     if (!owner.holder.empty() && field->getAccess() != AS_public)
       rep.Error(field->getLocation(), "member '" + field->getNameAsString() + "' of " + owner.cls->getNameAsString() + " is read on the GPU through composition, so the generated class must reach it through a " +
                 owner.cls->getNameAsString() + "*", "declare it public");
@@ -910,21 +914,6 @@ void AddLockedCopies(Context& c, const std::vector<const FunctionDecl*>& reached
     auto* md = dyn_cast<CXXMethodDecl>(fn);
     if (!md || md->getParent() != c.cls || md->isStatic() || !AppendsThroughCalls(fn, c.cls, memo)) continue;
     const std::string name = md->getNameAsString();
-    // The copy lives in the derived class: what it names must be reachable from there.
-    struct PrivateUses : RecursiveASTVisitor<PrivateUses> {
-      Context& c; const std::string& fn; std::set<const Decl*> reported;
-      PrivateUses(Context& ctx, const std::string& f) : c(ctx), fn(f) {}
-      bool VisitMemberExpr(MemberExpr* me) {
-        auto* d = me->getMemberDecl();
-        if (d->getAccess() != AS_private || d->getDeclContext() != c.cls || !reported.insert(d).second) return true;
-        c.rep.Error(me->getMemberLoc(), "'" + fn + "' appends to a member vector, so the CPU backend copies it into the derived class, but it uses private member '" +
-                    d->getNameAsString() + "'", "declare '" + d->getNameAsString() + "' protected");
-        return true;
-      }
-    } privateUses(c, name);
-    privateUses.TraverseStmt(fn->getBody());
-    CheckCopiedBody(c, fn->getBody(), "'" + name + "', which appends,");
-
     const CXXMethodDecl* decl = cast<CXXMethodDecl>(md->getCanonicalDecl());
     LockedCopy copy;
     copy.name = name;
@@ -941,6 +930,20 @@ void AddLockedCopies(Context& c, const std::vector<const FunctionDecl*>& reached
     copy.declaration = ret + " " + name + "(" + params + ")" + cv + (md->isVirtual() ? " override" : "");
     if (std::any_of(c.model.lockedCopies.begin(), c.model.lockedCopies.end(), [&](const LockedCopy& x) { return x.declaration == copy.declaration; }))
       continue;  // another kernel reached it first
+    // The copy lives in the derived class: what it names must be reachable from there.
+    struct PrivateUses : RecursiveASTVisitor<PrivateUses> {
+      Context& c; const std::string& fn; std::set<const Decl*> reported;
+      PrivateUses(Context& ctx, const std::string& f) : c(ctx), fn(f) {}
+      bool VisitMemberExpr(MemberExpr* me) {
+        auto* d = me->getMemberDecl();
+        if (d->getAccess() != AS_private || d->getDeclContext() != c.cls || !reported.insert(d).second) return true;
+        c.rep.Error(me->getMemberLoc(), "'" + fn + "' appends to a member vector, so the CPU backend copies it into the derived class, but it uses private member '" +
+                    d->getNameAsString() + "'", "declare '" + d->getNameAsString() + "' protected");
+        return true;
+      }
+    } privateUses(c, name);
+    privateUses.TraverseStmt(fn->getBody());
+    CheckCopiedBody(c, fn->getBody(), "'" + name + "', which appends,");
     // The copy hides every overload of its name: the others stay reachable through one
     // using-declaration, with the first copy of the name.
     auto overloads = c.cls->lookup(md->getDeclName());
@@ -1157,9 +1160,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   for (auto* f : printer.memberVectors) {
     k.memberVectors.push_back(f->getNameAsString());
     if (auto* m = FindMember(c.model, f->getNameAsString())) m->usedByKernels = true;
-    if (f->getAccess() == AS_private)
-      c.rep.Error(f->getLocation(), "member '" + f->getNameAsString() + "' is private, but the generated class derives from '" + c.cls->getNameAsString() + "' and must reach it",
-                  "declare it protected");
+    RequireReachable(c.rep, f, c.cls);
   }
   std::sort(k.memberVectors.begin(), k.memberVectors.end());
   k.ownFunctionList = k.functionList;
@@ -1169,9 +1170,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     const bool loaded = printer.loadedImages.count(f), stored = printer.storedImages.count(f);
     const bool sampled = printer.sampledImages.count(f), sampler = printer.samplers.count(f);
     if (!(loaded || stored || sampled || sampler || printer.sizedImages.count(f))) continue;
-    if (f->getAccess() == AS_private)
-      c.rep.Error(f->getLocation(), "member '" + f->getNameAsString() + "' is private, but the generated class derives from '" + c.cls->getNameAsString() + "' and must reach it",
-                  "declare it protected");
+    RequireReachable(c.rep, f, c.cls);
     auto* m = FindMember(c.model, f->getNameAsString());
     if (!m) continue;
     m->usedByKernels = true;
@@ -1191,9 +1190,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     (isa<FieldDecl>(image) ? k.samplePairs : k.paramSamplePairs).push_back({image->getNameAsString(), sampler->getNameAsString()});
   for (auto* f : c.cls->fields()) {
     if (!printer.textureArrays.count(f)) continue;
-    if (f->getAccess() == AS_private)
-      c.rep.Error(f->getLocation(), "member '" + f->getNameAsString() + "' is private, but the generated class derives from '" + c.cls->getNameAsString() + "' and must reach it",
-                  "declare it protected");
+    RequireReachable(c.rep, f, c.cls);
     if (auto* m = FindMember(c.model, f->getNameAsString())) {
       m->usedByKernels = true;
       k.textureArrays.push_back(m->name);
@@ -1206,9 +1203,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     if (m && !m->inClassData && f->getAccess() != AS_private)
       c.rep.Error(f->getLocation(), "member '" + f->getNameAsString() + "' of type '" + f->getType().getAsString(c.ctx.getPrintingPolicy()) + "' has a C++ layout that a GPU buffer cannot reproduce",
                   "use int instead of bool, float4x4 instead of float3x3, or reorder struct fields so 16-byte types come first");
-    if (f->getAccess() == AS_private)
-      c.rep.Error(f->getLocation(), "member '" + f->getNameAsString() + "' is private, but the generated class derives from '" + c.cls->getNameAsString() + "' and must reach it",
-                  "declare it protected");
+    RequireReachable(c.rep, f, c.cls);
   }
   for (auto& r : k.reductions)
     if (auto* m = FindMember(c.model, r.member)) { m->usedByKernels = true; m->writtenByKernels = true; }
@@ -1355,9 +1350,7 @@ private:
         return "m_inOut_" + m_ctrl.name + "." + cp->getNameAsString();
     if (auto* f = ThisField(e); f && IsImage2D(f->getType())) {
       const std::string name = f->getNameAsString();
-      if (f->getAccess() == AS_private)
-        m_c.rep.Error(f->getLocation(), "member '" + name + "' is private, but the generated class derives from '" + m_c.cls->getNameAsString() + "' and must reach it",
-                      "declare it protected");
+      RequireReachable(m_c.rep, f, m_c.cls);
       if (auto* m = FindMember(m_c.model, name)) {
         m->usedByKernels = true;
         const bool written = !p->getType().getNonReferenceType().isConstQualified();

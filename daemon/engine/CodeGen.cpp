@@ -35,8 +35,7 @@ std::string WhyNoCallables(const Kernel& k) {
   if (!k.indirectVector.empty()) return "it is dispatched indirectly, which ray tracing pipelines are not here";
   if (!k.textureArrays.empty() || !k.rayQueryHolder.empty()) return "it has other hardware variants (arrays of textures or ray queries)";
   if (!k.composedCalls.empty()) return "it calls composed code";
-  if (!k.megakernelOf.empty()) return "it is a megakernel";
-  return "";
+  return "";  // megakernels have no callables of their own: MergeMegakernelCode keeps the kernels' switches
 }
 
 bool RunsCallables(const Kernel& k) { return !k.callables.empty() && WhyNoCallables(k).empty(); }
@@ -588,9 +587,11 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   Data stateLoads = List(), stateStores = List();
   bool threadState = false;
   std::vector<std::string> ids;
+  // A ray generation thread's id is its launch id: the launch spans the thread counts exactly.
+  const std::string invocation = callables ? "gl_LaunchIDEXT" : "gl_GlobalInvocationID";
   for (size_t i = 0; i < k.threadAxes.size(); ++i) {
     unsigned a = k.threadAxes[i];
-    std::string gid = k.dims == 1 ? "int(threadId)" : std::string("int(gl_GlobalInvocationID.") + GlAxis(a) + ")";
+    std::string gid = k.dims == 1 ? "int(threadId)" : "int(" + invocation + "." + GlAxis(a) + ")";
     ids.push_back(idTypes[i] + "(crt_start" + Axis(a) + " + " + gid + ")");
   }
   if (!k.rtv)
@@ -623,11 +624,12 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   d.set("stateLoads", stateLoads);
   d.set("stateStores", stateStores);
   // The thread's element of per-thread buffers: threads in x, then rows, then slices.
-  d.set("threadIndex", k.dims == 1 ? std::string("threadId")
-                       : k.dims == 2 ? std::string("gl_GlobalInvocationID.x + crt_countX * gl_GlobalInvocationID.y")
-                                     : std::string("gl_GlobalInvocationID.x + crt_countX * (gl_GlobalInvocationID.y + crt_countY * gl_GlobalInvocationID.z)"));
+  const std::string& g = invocation;
+  d.set("threadIndex", k.dims == 1 ? "threadId"
+                       : k.dims == 2 ? g + ".x + crt_countX * " + g + ".y"
+                                     : g + ".x + crt_countX * (" + g + ".y + crt_countY * " + g + ".z)");
   for (unsigned a = 0; a < k.dims; ++a)
-    active += (a ? " && " : "") + std::string("gl_GlobalInvocationID.") + GlAxis(a) + " < crt_count" + Axis(a);
+    active += (a ? " && " : "") + invocation + "." + GlAxis(a) + " < crt_count" + Axis(a);
   d.set("threadArgs", threadArgs);
   d.set("activeTest", active);
   // A kernel dispatched indirectly runs to the count the GPU holds (capped at the vector's capacity).
@@ -635,10 +637,7 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   d.set("countLimit", v.empty() ? std::string("crt_countX") : "min(" + v + "_size, " + v + "_capacity)");
   d.set("indirect", !v.empty());
   d.set("indirectVector", v);
-  std::string glsl = Render(opt.templateDir + "/glsl/kernel.comp.mustache", d);
-  // A ray generation thread's id is its launch id: the launch spans the thread counts exactly.
-  if (callables) glsl = std::regex_replace(glsl, std::regex("gl_GlobalInvocationID"), "gl_LaunchIDEXT");
-  return glsl;
+  return Render(opt.templateDir + "/glsl/kernel.comp.mustache", d);
 }
 
 // Virtual functions, level 3: one class's implementation of a method as a callable shader.

@@ -61,7 +61,7 @@ struct KernelParam {
   // An Image2D reference: an image bound per call (glslType is the texel's), its size in push
   // constants <name>_width and _height. isConstPointee: a const reference.
   bool isImage = false;
-  std::string imageFormat, vkFormat, imagePrefix;  // as Member's
+  std::string imageFormat, imagePrefix;  // as Member's
   // RTV kernels: a pointer that a control function's thread loop passes a local to (&local). On the
   // GPU it is one value per thread: a function parameter, kept in a buffer between wavefront dispatches.
   bool threadState = false;

@@ -32,12 +32,14 @@ CallablePipeline::CallablePipeline(std::shared_ptr<VulkanContext> ctx, ShaderCod
     // Stage 0 and group 0: the ray generation shader; stage and group i: callables[i - 1].
     std::vector<VkPipelineShaderStageCreateInfo> stages;
     std::vector<VkRayTracingShaderGroupCreateInfoKHR> groups;
+    const FenceSpecialization specialization(ctx_->fenceAtomics);  // kernels with atomics read it
     auto add = [&](ShaderCode code, VkShaderStageFlagBits stage) {
       modules.push_back(CreateModule(code.spirv, code.bytes));
       auto s = VkInit<VkPipelineShaderStageCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO);
       s.stage = stage;
       s.module = modules.back();
       s.pName = "main";
+      s.pSpecializationInfo = &specialization.info;
       stages.push_back(s);
       auto g = VkInit<VkRayTracingShaderGroupCreateInfoKHR>(VK_STRUCTURE_TYPE_RAY_TRACING_SHADER_GROUP_CREATE_INFO_KHR);
       g.type = VK_RAY_TRACING_SHADER_GROUP_TYPE_GENERAL_KHR;

@@ -451,19 +451,21 @@ void VulkanContext::CreateDevice(const ContextOptions& options) {
   vkCmdPushDescriptorSetKHR = reinterpret_cast<PFN_vkCmdPushDescriptorSetKHR>(
       vkGetDeviceProcAddr(device, "vkCmdPushDescriptorSetKHR"));
   if (!vkCmdPushDescriptorSetKHR) throw Error("vkCmdPushDescriptorSetKHR is missing although VK_KHR_push_descriptor is enabled");
+  // Entry points of enabled extensions, which the loader does not export.
+  auto load = [&](const char* name, const char* extension) {
+    PFN_vkVoidFunction f = vkGetDeviceProcAddr(device, name);
+    if (!f) throw Error(std::string(name) + " is missing although " + extension + " is enabled");
+    return f;
+  };
   if (hasRayQuery) {
-    auto load = [&](const char* name) {
-      PFN_vkVoidFunction f = vkGetDeviceProcAddr(device, name);
-      if (!f) throw Error(std::string(name) + " is missing although VK_KHR_acceleration_structure is enabled");
-      return f;
-    };
+    const char* as = VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME;
     vkGetAccelerationStructureBuildSizesKHR =
-        reinterpret_cast<PFN_vkGetAccelerationStructureBuildSizesKHR>(load("vkGetAccelerationStructureBuildSizesKHR"));
-    vkCreateAccelerationStructureKHR = reinterpret_cast<PFN_vkCreateAccelerationStructureKHR>(load("vkCreateAccelerationStructureKHR"));
-    vkDestroyAccelerationStructureKHR = reinterpret_cast<PFN_vkDestroyAccelerationStructureKHR>(load("vkDestroyAccelerationStructureKHR"));
-    vkCmdBuildAccelerationStructuresKHR = reinterpret_cast<PFN_vkCmdBuildAccelerationStructuresKHR>(load("vkCmdBuildAccelerationStructuresKHR"));
+        reinterpret_cast<PFN_vkGetAccelerationStructureBuildSizesKHR>(load("vkGetAccelerationStructureBuildSizesKHR", as));
+    vkCreateAccelerationStructureKHR = reinterpret_cast<PFN_vkCreateAccelerationStructureKHR>(load("vkCreateAccelerationStructureKHR", as));
+    vkDestroyAccelerationStructureKHR = reinterpret_cast<PFN_vkDestroyAccelerationStructureKHR>(load("vkDestroyAccelerationStructureKHR", as));
+    vkCmdBuildAccelerationStructuresKHR = reinterpret_cast<PFN_vkCmdBuildAccelerationStructuresKHR>(load("vkCmdBuildAccelerationStructuresKHR", as));
     vkGetAccelerationStructureDeviceAddressKHR =
-        reinterpret_cast<PFN_vkGetAccelerationStructureDeviceAddressKHR>(load("vkGetAccelerationStructureDeviceAddressKHR"));
+        reinterpret_cast<PFN_vkGetAccelerationStructureDeviceAddressKHR>(load("vkGetAccelerationStructureDeviceAddressKHR", as));
     auto accelLimits = VkInit<VkPhysicalDeviceAccelerationStructurePropertiesKHR>(
         VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR);
     auto accelProps = VkInit<VkPhysicalDeviceProperties2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2);
@@ -472,15 +474,11 @@ void VulkanContext::CreateDevice(const ContextOptions& options) {
     accelerationScratchAlignment = std::max<VkDeviceSize>(1, accelLimits.minAccelerationStructureScratchOffsetAlignment);
   }
   if (hasRayTracingPipeline) {
-    auto load = [&](const char* name) {
-      PFN_vkVoidFunction f = vkGetDeviceProcAddr(device, name);
-      if (!f) throw Error(std::string(name) + " is missing although VK_KHR_ray_tracing_pipeline is enabled");
-      return f;
-    };
-    vkCreateRayTracingPipelinesKHR = reinterpret_cast<PFN_vkCreateRayTracingPipelinesKHR>(load("vkCreateRayTracingPipelinesKHR"));
+    const char* rt = VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME;
+    vkCreateRayTracingPipelinesKHR = reinterpret_cast<PFN_vkCreateRayTracingPipelinesKHR>(load("vkCreateRayTracingPipelinesKHR", rt));
     vkGetRayTracingShaderGroupHandlesKHR =
-        reinterpret_cast<PFN_vkGetRayTracingShaderGroupHandlesKHR>(load("vkGetRayTracingShaderGroupHandlesKHR"));
-    vkCmdTraceRaysKHR = reinterpret_cast<PFN_vkCmdTraceRaysKHR>(load("vkCmdTraceRaysKHR"));
+        reinterpret_cast<PFN_vkGetRayTracingShaderGroupHandlesKHR>(load("vkGetRayTracingShaderGroupHandlesKHR", rt));
+    vkCmdTraceRaysKHR = reinterpret_cast<PFN_vkCmdTraceRaysKHR>(load("vkCmdTraceRaysKHR", rt));
     auto pipelineLimits = VkInit<VkPhysicalDeviceRayTracingPipelinePropertiesKHR>(
         VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_PROPERTIES_KHR);
     auto pipelineProps = VkInit<VkPhysicalDeviceProperties2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2);

@@ -227,11 +227,11 @@ void EnsureSampler(std::shared_ptr<VulkanContext> ctx, Sampler& s, const Sampler
 }
 
 void CheckFilterable(const VulkanContext& ctx, const Image& img, const Sampler& s, const char* what) {
-  CheckFilterable(ctx, img.Format(), s, what);
+  CheckFilterable(ctx, img.Format(), s.Desc(), what);
 }
 
-void CheckFilterable(const VulkanContext& ctx, VkFormat format, const Sampler& s, const char* what) {
-  if (!s.Desc().linear) return;
+void CheckFilterable(const VulkanContext& ctx, VkFormat format, const SamplerDesc& s, const char* what) {
+  if (!s.linear) return;
   VkFormatProperties props;
   vkGetPhysicalDeviceFormatProperties(ctx.physicalDevice, format, &props);
   if (!(props.optimalTilingFeatures & VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT))

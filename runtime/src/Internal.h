@@ -1,6 +1,8 @@
 // Helpers shared by the runtime's source files (not installed).
 #pragma once
 
+#include "crossrt/VulkanRuntime.h"
+
 #include <vulkan/vulkan.h>
 
 #include <initializer_list>
@@ -16,7 +18,17 @@ T VkInit(VkStructureType sType) {
   return t;
 }
 
-class VulkanContext;
+// The specialization every pipeline's shaders get: crt_fenceAtomics (kFenceAtomicsConstantId)
+// from the context; shaders without the constant ignore it. `info` points into the object, which
+// therefore stays where it was made while the pipeline is created.
+struct FenceSpecialization {
+  VkBool32 fence;
+  VkSpecializationMapEntry entry{kFenceAtomicsConstantId, 0, sizeof(VkBool32)};
+  VkSpecializationInfo info;
+  explicit FenceSpecialization(bool on) : fence(on ? VK_TRUE : VK_FALSE), info{1, &entry, sizeof(VkBool32), &fence} {}
+  FenceSpecialization(const FenceSpecialization&) = delete;
+  FenceSpecialization& operator=(const FenceSpecialization&) = delete;
+};
 
 // A buffer and its memory: the building block of Buffer and of temporary staging buffers.
 struct Allocation {

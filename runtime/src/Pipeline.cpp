@@ -193,11 +193,8 @@ ComputePipeline::ComputePipeline(std::shared_ptr<VulkanContext> ctx, const uint3
     info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
     info.stage.module = module;
     info.stage.pName = "main";
-    // Shaders without this constant ignore it.
-    const VkBool32 fenceAtomics = ctx_->fenceAtomics ? VK_TRUE : VK_FALSE;
-    const VkSpecializationMapEntry fenceEntry{kFenceAtomicsConstantId, 0, sizeof(VkBool32)};
-    const VkSpecializationInfo specialization{1, &fenceEntry, sizeof(VkBool32), &fenceAtomics};
-    info.stage.pSpecializationInfo = &specialization;
+    const FenceSpecialization specialization(ctx_->fenceAtomics);
+    info.stage.pSpecializationInfo = &specialization.info;
     info.layout = layout_;
     VkResult r = vkCreateComputePipelines(ctx_->device, ctx_->pipelineCache, 1, &info, nullptr, &pipeline_);
     vkDestroyShaderModule(ctx_->device, module, nullptr);  // the pipeline keeps what it needs

@@ -44,6 +44,12 @@ void TextureArray::Assign(VkFormat format, const std::vector<Texture>& textures)
   if (textures.size() > ctx_->maxTextureArraySize)
     throw Error(name_ + ": " + std::to_string(textures.size()) + " textures, but device '" + ctx_->DeviceName() + "' binds at most " +
                 std::to_string(ctx_->maxTextureArraySize) + " in an array");
+  // One format for all: checked once, before the old set goes.
+  for (size_t i = 0; i < textures.size(); ++i)
+    if (textures[i].sampler.linear) {
+      CheckFilterable(*ctx_, format, textures[i].sampler, (name_ + "[" + std::to_string(i) + "]").c_str());
+      break;
+    }
   // Kernels may still sample the old set: let them finish before it goes.
   vkDeviceWaitIdle(ctx_->device);
   Release();
@@ -59,7 +65,6 @@ void TextureArray::Assign(VkFormat format, const std::vector<Texture>& textures)
     while (s < samplers_.size() && samplers_[s].Desc() != t.sampler) ++s;
     if (s == samplers_.size()) samplers_.emplace_back(ctx_, t.sampler, (name + " sampler").c_str());
     samplerOf[i] = static_cast<uint32_t>(s);
-    CheckFilterable(*ctx_, images_.back(), samplers_[s], name.c_str());
   }
 
   const VkDescriptorPoolSize size{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, count};

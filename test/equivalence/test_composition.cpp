@@ -115,7 +115,7 @@ TEST_CASE("Composition: virtual intersection functions called from the composed 
   auto ctx = ValidatedContext();
   auto cpu = CreateShapeTracer_CPU();
   std::shared_ptr<ShapeTracer> gpu = ctx ? CreateShapeTracer_Vulkan(ctx) : nullptr;
-  for (ShapeTracer* t : {static_cast<ShapeTracer*>(cpu.get()), static_cast<ShapeTracer*>(gpu.get())})
+  for (ShapeTracer* t : {cpu.get(), gpu.get()})
   {
     if (!t) continue;
     INFO((t == cpu.get() ? "CPU" : "Vulkan"));

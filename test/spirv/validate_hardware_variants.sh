@@ -13,7 +13,7 @@
 set -u
 glslang=$1 spirvval=$2 spirvdis=$3 build=$4
 shift 4
-mapfile -t shaders < <(find "$build" \( -name '*_RayQuery.comp' -o -name '*_RayQuery_Textures.comp' -o -name '*_Textures.comp' -o -name '*_Callables.rgen' -o -name '*.rcall' \) -path '*/shaders/*' | sort -u)
+mapfile -t shaders < <(find "$build" \( -name '*_RayQuery.comp' -o -name '*_Textures.comp' -o -name '*_Callables.rgen' -o -name '*.rcall' \) -path '*/shaders/*' | sort -u)
 status=0
 for expected in "$@"; do
   if ! printf '%s\n' "${shaders[@]}" | grep -q -- "/$expected\$"; then

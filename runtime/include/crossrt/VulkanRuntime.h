@@ -96,7 +96,7 @@ public:
   bool hasSubgroupArithmetic = false;
   bool forceStaging = false;  // see ContextOptions::forceStaging
   // Kernels that call crossrt atomics fence them (memoryBarrierBuffer) for acquire-release order,
-  // under the specialization constant kFenceAtomicsConstantId, which every compute pipeline gets
+  // under the specialization constant kFenceAtomicsConstantId, which every pipeline's shaders get
   // from here. Off on llvmpipe: its atomics are sequentially consistent already, and its memory
   // barriers inside loops that threads leave at different times give wrong results (Mesa 22.3).
   bool fenceAtomics = true;
@@ -323,7 +323,7 @@ private:
 void EnsureSampler(std::shared_ptr<VulkanContext> ctx, Sampler& s, const SamplerDesc& desc, const char* debugName);
 // Throws when a kernel samples img with linear filtering that its format cannot filter.
 void CheckFilterable(const VulkanContext& ctx, const Image& img, const Sampler& s, const char* what);
-void CheckFilterable(const VulkanContext& ctx, VkFormat format, const Sampler& s, const char* what);
+void CheckFilterable(const VulkanContext& ctx, VkFormat format, const SamplerDesc& s, const char* what);
 
 // Acceleration structures for ray queries (VK_KHR_acceleration_structure), move-only: what an
 // ISceneObject member becomes for the shaders that trace on ray tracing hardware. One bottom level
@@ -500,7 +500,6 @@ public:
   // than maxTextureArraySize, and for linear filtering of a format the device cannot filter.
   void Assign(VkFormat format, const std::vector<Texture>& textures);
   VkDescriptorSet Set() const { return set_; }
-  size_t Size() const { return images_.size(); }
 
 private:
   void Release() noexcept;
