@@ -3,6 +3,7 @@
 #include "Canonical.h"
 #include "Glsl.h"
 
+#include <clang/AST/ParentMapContext.h>
 #include <clang/AST/RecursiveASTVisitor.h>
 #include <clang/Basic/SourceManager.h>
 #include <clang/Lex/Lexer.h>
@@ -640,6 +641,31 @@ std::string DispatcherParams(GlslPrinter& printer, const CXXMethodDecl* m) {
   return out;
 }
 
+// The buffer reference to a vector's tags: per element, its class and where its object is.
+std::string TagsReference(const ClassModel& model, const VirtualMember& vm) {
+  return "layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer " + vm.member + "_Tags { uvec2 tags[]; };  // per element of " +
+         vm.display + ": (class, " + (model.virtualLevel == 1 ? "its slot" : "index among its class's objects") + ")\n";
+}
+
+// The GLSL mirror of the data of an implementation's objects (printed by its object-mode printer).
+std::string ImplDataStruct(GlslPrinter& printer, const CXXRecordDecl* impl, const VirtualMember& vm, const VirtualImpl& vi) {
+  std::ostringstream data;
+  data << "struct " << vi.name << "_Data {  // the data members of " << vi.name << "\n";
+  std::vector<const FieldDecl*> fields;
+  CollectObjectFields(impl, fields);
+  for (auto* f : fields) data << "  " << printer.Declare(f->getType(), GlslPrinter::SafeName(f->getNameAsString()), f->getLocation()) << ";\n";
+  if (vi.paddingWords > 0)
+    data << "  uint crt_padding[" << vi.paddingWords << "];  // every element of " << vm.member << " has a slot of " << vm.slotBytes << " bytes\n";
+  data << "};\n";
+  return data.str();
+}
+
+// The buffer reference to the objects of one implementation (level 2 and 3).
+std::string ObjectsReference(const VirtualMember& vm, const VirtualImpl& vi) {
+  return std::string("layout(buffer_reference, ") + (vi.scalarLayout ? "scalar" : "std430") + ", buffer_reference_align = 4) readonly buffer " +
+         vm.member + "_" + vi.name + "Objects { " + vi.name + "_Data objects[]; };\n";
+}
+
 // Level 3: what a kernel's ray generation shader has instead of the switches.
 struct CallableCode {
   std::vector<std::string> structs;    // the vectors' tags, the calls' payloads and the variables passed to executeCallableEXT
@@ -653,17 +679,20 @@ void AddCallableShader(ASTContext& ctx, Reporter& rep, ClassModel& model, const 
                        const CXXRecordDecl* impl, const CXXMethodDecl* method, SourceLocation callLoc, const std::string& dataStruct,
                        const std::string& objectsReference, const std::string& payload) {
   const std::string name = vm.member + "_" + vi.name + "_" + method->getNameAsString();
-  if (std::any_of(model.callables.begin(), model.callables.end(), [&](const CallableShader& c) { return c.name == name; })) return;
+  if (std::any_of(model.callables.begin(), model.callables.end(), [&](const StageShader& c) { return c.name == name; })) return;
   GlslPrinter printer(ctx, impl, rep);
   printer.selfClass = impl;
   printer.composedPrefix = vi.name + "_";
   for (auto& sn : ClassStructNames(model)) printer.predeclaredStructs.insert(sn);
   const std::string function = ImplementationMethod(rep, printer, impl, method, callLoc);
   if (function.empty()) return;
-  CallableShader c;
+  StageShader c;
   c.name = name;
+  c.stage = "rcall";
   c.origin = vi.name + "::" + method->getNameAsString();
-  c.call = vm.display + "[index]->" + method->getNameAsString() + (method->getNumParams() ? "(...)" : "()");
+  c.description = "what " + vm.display + "[index]->" + method->getNameAsString() + (method->getNumParams() ? "(...)" : "()") +
+                  " runs when the object is\n// a " + vi.name +
+                  ", as a callable shader of the ray tracing pipelines of the kernels calling it (virtual functions, level 3)";
   c.scalarLayout = vi.scalarLayout;
   for (auto& x : printer.Constants()) c.constants += x;
   for (auto& x : printer.Structs()) c.structs += x + "\n";
@@ -806,9 +835,7 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
     const VirtualMember& vm = *known;
     k.bufferReferences = true;
     // Data structs and buffer references, then each implementation's methods.
-    const std::string tags = "layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer " + member +
-                             "_Tags { uvec2 tags[]; };  // per element of " + vm.display + ": (class, " +
-                             (model.virtualLevel == 1 ? "its slot" : "index among its class's objects") + ")\n";
+    const std::string tags = TagsReference(model, vm);
     structs.push_back(tags);
     if (callable) callable->structs.push_back(tags);
     std::map<std::string, std::string> implFunction;  // (impl, method) -> GLSL name
@@ -820,22 +847,13 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
       printer.selfClass = impl;
       printer.composedPrefix = vi->name + "_";
       for (auto& sn : ClassStructNames(model)) printer.predeclaredStructs.insert(sn);
-      std::ostringstream data;
-      data << "struct " << vi->name << "_Data {  // the data members of " << vi->name << "\n";
-      std::vector<const FieldDecl*> fields;
-      CollectObjectFields(impl, fields);
-      for (auto* f : fields) data << "  " << printer.Declare(f->getType(), GlslPrinter::SafeName(f->getNameAsString()), f->getLocation()) << ";\n";
-      if (vi->paddingWords > 0)
-        data << "  uint crt_padding[" << vi->paddingWords << "];  // every element of " << member << " has a slot of " << vm.slotBytes << " bytes\n";
-      data << "};\n";
+      const std::string data = ImplDataStruct(printer, impl, vm, *vi);
       for (auto* m : methods) implFunction[vi->name + "::" + m->getNameAsString()] = ImplementationMethod(rep, printer, impl, m, field->getLocation());
       for (auto& x : printer.Structs()) structs.push_back(x);
-      const std::string objectsReference = std::string("layout(buffer_reference, ") + (vi->scalarLayout ? "scalar" : "std430") +
-                                           ", buffer_reference_align = 4) readonly buffer " + member + "_" + vi->name + "Objects { " + vi->name +
-                                           "_Data objects[]; };\n";
-      structs.push_back(data.str());
+      const std::string objectsReference = ObjectsReference(vm, *vi);
+      structs.push_back(data);
       structs.push_back(objectsReference);
-      implData[vi->name] = {data.str(), objectsReference};
+      implData[vi->name] = {data, objectsReference};
       k.scalarReferences |= vi->scalarLayout;
       for (auto& x : printer.Constants())
         if (std::find(k.constantList.begin(), k.constantList.end(), x) == k.constantList.end()) k.constantList.push_back(x);
@@ -2396,6 +2414,332 @@ struct ComposedWriteFinder : RecursiveASTVisitor<ComposedWriteFinder> {
   }
 };
 
+// ---- virtual functions, level 3, in composed code: intersection shaders (paper 3.10) ----
+
+// The variable an expression names (through parentheses, implicit casts and copies), or null.
+const VarDecl* NamedVar(const clang::Expr* e) {
+  for (;;) {
+    e = e->IgnoreImplicit()->IgnoreParenImpCasts();
+    auto* copy = dyn_cast<CXXConstructExpr>(e);
+    if (!copy || copy->getNumArgs() != 1 || !copy->getConstructor()->isCopyOrMoveConstructor()) break;
+    e = copy->getArg(0);
+  }
+  auto* ref = dyn_cast<DeclRefExpr>(e);
+  return ref ? dyn_cast<VarDecl>(ref->getDecl()) : nullptr;
+}
+
+// The variable at the root of a written expression: v in v, v.f, v[i], v.f[i].g; else null.
+const VarDecl* WrittenVar(const clang::Expr* e) {
+  for (;;) {
+    e = e->IgnoreParenImpCasts();
+    if (auto* me = dyn_cast<MemberExpr>(e)) e = me->getBase();
+    else if (auto* sub = dyn_cast<ArraySubscriptExpr>(e)) e = sub->getBase();
+    else if (auto* op = dyn_cast<CXXOperatorCallExpr>(e); op && op->getOperator() == OO_Subscript) e = op->getArg(0);
+    else return NamedVar(e);
+  }
+}
+
+// Where a leaf call sits: the function whose body holds it, and the statement of that body that
+// holds it (the leaves' loop).
+struct LeafSite {
+  const FunctionDecl* fn = nullptr;
+  const clang::Stmt* loop = nullptr;
+};
+
+LeafSite FindLeafSite(ASTContext& ctx, const clang::Stmt* call) {
+  const clang::Stmt *child = call, *below = nullptr;
+  DynTypedNode node = DynTypedNode::create(*call);
+  for (;;) {
+    auto parents = ctx.getParents(node);
+    if (parents.empty()) return {};
+    node = parents[0];
+    if (auto* fn = node.get<FunctionDecl>()) return fn->getBody() == child && below ? LeafSite{fn, below} : LeafSite{};
+    const clang::Stmt* s = node.get<clang::Stmt>();
+    if (!s) return {};
+    below = child;
+    child = s;
+  }
+}
+
+// What the leaves' loop does besides the leaf call that the hardware's trace would not: writes to
+// variables declared before it, returns, breaks out of it. The first such place and why, or "".
+struct LoopEffects : RecursiveASTVisitor<LoopEffects> {
+  ASTContext& ctx;
+  const clang::Stmt* loop;
+  const CXXMemberCallExpr* leafCall;
+  std::set<const VarDecl*> inner;  // declared inside the loop
+  std::string problem;
+  SourceLocation where;
+
+  LoopEffects(ASTContext& c, const clang::Stmt* l, const CXXMemberCallExpr* call) : ctx(c), loop(l), leafCall(call) {}
+  void Note(SourceLocation loc, const std::string& what) {
+    if (problem.empty()) { problem = what; where = loc; }
+  }
+  void Written(const clang::Expr* target, SourceLocation loc) {
+    const VarDecl* vd = WrittenVar(target);
+    if (vd && !inner.count(vd)) Note(loc, "it writes '" + vd->getNameAsString() + "', declared before the loop");
+  }
+  bool VisitVarDecl(VarDecl* vd) { inner.insert(vd); return true; }
+  bool VisitBinaryOperator(BinaryOperator* bo) {
+    if (bo->isAssignmentOp()) Written(bo->getLHS(), bo->getExprLoc());
+    return true;
+  }
+  bool VisitUnaryOperator(UnaryOperator* uo) {
+    if (uo->isIncrementDecrementOp()) Written(uo->getSubExpr(), uo->getExprLoc());
+    return true;
+  }
+  bool VisitCallExpr(CallExpr* call) {
+    if (call == leafCall) return true;
+    if (auto* op = dyn_cast<CXXOperatorCallExpr>(call); op && (op->isAssignmentOp() || op->getOperator() == OO_PlusPlus || op->getOperator() == OO_MinusMinus))
+      Written(op->getArg(0), op->getExprLoc());
+    const FunctionDecl* fd = call->getDirectCallee();
+    const unsigned shift = isa<CXXOperatorCallExpr>(call) && isa_and_nonnull<CXXMethodDecl>(fd) ? 1 : 0;  // argument 0 is the object
+    for (unsigned i = 0; fd && i + shift < call->getNumArgs() && i < fd->getNumParams(); ++i) {
+      QualType pt = fd->getParamDecl(i)->getType();
+      if (pt->isReferenceType() && !pt.getNonReferenceType().isConstQualified()) Written(call->getArg(i + shift), call->getArg(i + shift)->getExprLoc());
+    }
+    return true;
+  }
+  bool VisitReturnStmt(ReturnStmt* r) {
+    Note(r->getBeginLoc(), "it returns from inside the loop");
+    return true;
+  }
+  bool VisitBreakStmt(BreakStmt* b) {
+    // A break of the leaves' loop itself stops visiting leaves; one of an inner loop does not.
+    DynTypedNode node = DynTypedNode::create(*b);
+    for (;;) {
+      auto parents = ctx.getParents(node);
+      if (parents.empty()) return true;
+      node = parents[0];
+      const clang::Stmt* s = node.get<clang::Stmt>();
+      if (!s) return true;
+      if (isa<ForStmt, WhileStmt, DoStmt, CXXForRangeStmt, SwitchStmt>(s)) {
+        if (s == loop) Note(b->getBeginLoc(), "it breaks out of the loop");
+        return true;
+      }
+    }
+  }
+};
+
+// GLSL zero of a hit struct's field type (scalars, vectors and arrays of them), or "".
+std::string ZeroOf(QualType t) {
+  t = t.getCanonicalType();
+  if (auto* arr = dyn_cast<ConstantArrayType>(t.getTypePtr())) {
+    const std::string element = ZeroOf(arr->getElementType());
+    auto g = GlslTypeOf(arr->getElementType());
+    if (element.empty() || !g) return "";
+    std::string out = *g + "[" + std::to_string(arr->getSize().getZExtValue()) + "](";
+    for (uint64_t i = 0; i < arr->getSize().getZExtValue(); ++i) out += (i ? ", " : "") + element;
+    return out + ")";
+  }
+  if (t->isRecordType() && !IsLiteMathType(t)) return "";
+  auto g = GlslTypeOf(t);
+  return g ? *g + "(0)" : "";
+}
+
+// The interface method that gives a leaf's box corner on the host: `name() const`, no parameters,
+// returning a LiteMath float3 or float4. Null when there is none.
+const CXXMethodDecl* BoxCorner(const CXXRecordDecl* interface, const std::string& name) {
+  for (auto* d : interface->lookup(&interface->getASTContext().Idents.get(name)))
+    if (auto* md = dyn_cast<CXXMethodDecl>(d); md && md->isConst() && md->getNumParams() == 0) {
+      auto g = GlslTypeOf(md->getReturnType().getNonReferenceType().getUnqualifiedType());
+      if (g && (*g == "vec3" || *g == "vec4")) return md;
+    }
+  return nullptr;
+}
+
+// Virtual functions, level 3, in composed code. The composed traversal `printer` printed for kernel
+// `k` calls an intersection function per leaf (listing 2 of the paper):
+//   for (...) if (<box test>) m_shapes[i]->Intersect(posAndNear, dirAndFar, i, hit);
+// The ray tracing hardware can run that loop when the call has the fixed form the paper gives
+// Intersect: the ray (two float4: origin and near, direction and far) first, the hit last (a struct
+// whose first field is its distance, updated when the leaf is nearer), and between them only the
+// leaf's index or constants. Then the kernel gets a ray generation variant whose traversal traces
+// a ray where the loop was, with an intersection shader per class of leaf. Otherwise the reason
+// goes to k.whyNoLeafShaders and the kernel keeps the switch.
+void AnalyzeLeafTraversal(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& k, const Composition& comp, const CXXRecordDecl* implClass,
+                          const std::string& holderPrefix, const GlslPrinter& printer) {
+  auto skip = [&](const std::string& why) { k.whyNoLeafShaders = why; };
+  SourceManager& sm = ctx.getSourceManager();
+  auto at = [&](SourceLocation loc) {
+    PresumedLoc p = sm.getPresumedLoc(sm.getFileLoc(loc));
+    return p.isValid() ? BaseName(p.getFilename()) + ":" + std::to_string(p.getLine()) : std::string("?");
+  };
+  if (std::any_of(k.composedCalls.begin(), k.composedCalls.end(), [&](const auto& c) { return c.first != comp.holder; }))
+    return skip("it calls code composed through more than one member");
+  if (printer.virtualCallSites.size() != 1) return skip("its composed code makes more than one virtual call");
+  const CXXMemberCallExpr* call = printer.virtualCallSites[0];
+  const clang::Expr* indexExpr = nullptr;
+  const FieldDecl* field = VirtualCallTarget(call, &indexExpr);
+  const CXXMethodDecl* method = call->getMethodDecl();
+  const std::string member = holderPrefix + field->getNameAsString(), site = at(call->getBeginLoc());
+  auto vm = std::find_if(model.virtuals.begin(), model.virtuals.end(), [&](const VirtualMember& v) { return v.member == member; });
+  if (vm == model.virtuals.end() || vm->impls.empty()) return;  // reported by VirtualCallCode
+  const std::string callText = vm->display + "[...]->" + method->getNameAsString();
+  const LeafSite leaf = FindLeafSite(ctx, call);
+  if (!leaf.fn || !isa<ForStmt, WhileStmt, DoStmt, CXXForRangeStmt>(leaf.loop))
+    return skip("the leaf call " + callText + " (" + site + ") is not inside a loop of the traversal's body");
+  LoopEffects effects(ctx, leaf.loop, call);
+  effects.TraverseStmt(const_cast<clang::Stmt*>(leaf.loop));
+  if (!effects.problem.empty())
+    return skip("the loop calling " + callText + " does more than visit leaves: " + effects.problem + " (" + at(effects.where) + ")");
+
+  // The call's form: (float4 ray origin and near, float4 direction and far, leaf index or constants..., Hit& hit).
+  const unsigned n = method->getNumParams();
+  auto isFloat4 = [](QualType t) { return GlslTypeOf(t.getNonReferenceType().getUnqualifiedType()).value_or("") == "vec4"; };
+  const QualType hitParam = n ? method->getParamDecl(n - 1)->getType() : QualType();
+  const auto* hitRecord = n ? hitParam.getNonReferenceType()->getAsCXXRecordDecl() : nullptr;
+  const std::string form = "(float4 posAndNear, float4 dirAndFar, [leaf index or constants,] Hit& hit)";
+  if (n < 3 || !isFloat4(method->getParamDecl(0)->getType()) || !isFloat4(method->getParamDecl(1)->getType()) || !WrittenBack(method, n - 1) ||
+      !hitRecord || hitRecord->isPolymorphic() || !method->getReturnType()->isVoidType())
+    return skip(callText + " does not have the form of an intersection function, void " + method->getNameAsString() + form);
+  const FieldDecl* distance = hitRecord->field_empty() ? nullptr : *hitRecord->field_begin();
+  if (!distance || !distance->getType()->isSpecificBuiltinType(BuiltinType::Float))
+    return skip("the hit " + hitRecord->getNameAsString() + " does not start with its distance (a float)");
+  const uint64_t hitBytes = ctx.getTypeSize(hitParam.getNonReferenceType()) / 8;
+  if (hitBytes > 32)
+    return skip("the hit " + hitRecord->getNameAsString() + " takes " + std::to_string(hitBytes) +
+                " bytes; intersection shaders report at most 32 (Vulkan's guaranteed hit attribute size)");
+  std::string zeroHit;
+  for (auto* f : hitRecord->fields()) {
+    const std::string zero = ZeroOf(f->getType());
+    if (zero.empty()) return skip("the hit " + hitRecord->getNameAsString() + " has a field, '" + f->getNameAsString() + "', that is not a scalar, vector or array of them");
+    zeroHit += "  hit." + GlslPrinter::SafeName(f->getNameAsString()) + " = " + zero + ";\n";
+  }
+  // Arguments: the ray and the hit as the traversal has them before the loop; the index as the leaf.
+  const VarDecl* index = NamedVar(indexExpr);
+  if (!index || !effects.inner.count(index))
+    return skip(callText + " picks its object with an expression, not a variable of the loop: the hardware names a leaf by its element's position");
+  auto outer = [&](const clang::Expr* e) {
+    const VarDecl* vd = NamedVar(e);
+    return vd && vd->isLocalVarDeclOrParm() && !effects.inner.count(vd) ? vd : nullptr;
+  };
+  const VarDecl *pos = outer(call->getArg(0)), *dir = outer(call->getArg(1)), *hit = outer(call->getArg(n - 1));
+  if (!pos || !dir || !hit)
+    return skip("the ray and the hit " + callText + " takes must be variables of the traversal declared before the loop");
+  // In the intersection shader, the leaf's index is its instance's: one instance per element, in order.
+  GlslPrinter literals(ctx, implClass, rep);
+  auto hardwareLiteral = [&](const clang::Expr* e) { return literals.Expr(e); };
+  std::vector<std::string> leafArgs;
+  for (unsigned i = 2; i + 1 < n; ++i) {
+    const clang::Expr* arg = call->getArg(i)->IgnoreParenImpCasts();
+    auto type = GlslTypeOf(method->getParamDecl(i)->getType().getNonReferenceType().getUnqualifiedType());
+    if (NamedVar(arg) == index && type) leafArgs.push_back(*type + "(gl_InstanceID)");
+    else if (isa<IntegerLiteral, FloatingLiteral, CXXBoolLiteralExpr>(arg) && type) leafArgs.push_back(*type + "(" + hardwareLiteral(arg) + ")");
+    else return skip("argument " + std::to_string(i + 1) + " of " + callText + " is neither the leaf's index nor a constant");
+  }
+  const CXXRecordDecl* interface = method->getParent();
+  const CXXMethodDecl *boxMin = BoxCorner(interface, "BoxMin"), *boxMax = BoxCorner(interface, "BoxMax");
+  if (!boxMin || !boxMax)
+    return skip(interface->getNameAsString() + " declares no BoxMin() const and BoxMax() const (float3 or float4): the hardware needs each leaf's box");
+
+  // The traversal again, with the loop replaced by a trace (the leaves' code is left out).
+  LeafTraversal lt;
+  lt.member = member;
+  lt.hostExpr = vm->hostExpr;
+  lt.display = vm->display;
+  lt.interfaceName = interface->getNameAsString();
+  lt.traversal = comp.implName + "::" + leaf.fn->getNameAsString();
+  const std::string methodName = method->getNameAsString(), payload = member + "_" + methodName + "_hit", scene = member + "_leaves";
+  GlslPrinter hardware(ctx, implClass, rep);
+  hardware.composedPrefix = holderPrefix;
+  for (auto& sn : ClassStructNames(model)) hardware.predeclaredStructs.insert(sn);
+  const std::string p = hardware.Expr(call->getArg(0)), d = hardware.Expr(call->getArg(1)), h = hardware.Expr(call->getArg(n - 1));
+  const std::string t = h + "." + GlslPrinter::SafeName(distance->getNameAsString());
+  std::ostringstream trace;
+  trace << "// The loop of " << lt.traversal << " calling " << callText << " (" << site << ") runs on the ray tracing\n"
+        << "// hardware: it finds the leaves whose boxes the ray meets, and the intersection shader of each\n"
+        << "// leaf's class calls its " << methodName << " (virtual functions, level 3).\n"
+        << "{\n  const float crt_near = max(" << p << ".w, 0.0);  // rays start at a distance >= 0 on the hardware\n"
+        << "  const bool crt_finite = !any(isnan(" << p << ".xyz)) && !any(isinf(" << p << ".xyz)) && !any(isnan(" << d << ".xyz)) && !any(isinf(" << d << ".xyz));\n"
+        << "  " << payload << " = " << h << ";\n"
+        << "  if (crt_finite && crt_near < " << t << ")\n"
+        << "    traceRayEXT(" << scene << ", gl_RayFlagsNoneEXT, 0xFF, 0, 0, 0, " << p << ".xyz, crt_near, " << d << ".xyz, " << t << ", 0);\n"
+        << "  " << h << " = " << payload << ";\n}\n";
+  hardware.replacedStatements[leaf.loop] = trace.str();
+  for (auto& [holder, name] : k.composedCalls) {
+    const FunctionDecl* def = nullptr;
+    if (auto* md = ImplementationOf(implClass, name, def)) hardware.EmitComposedMethod(md);
+  }
+  // Structs: the kernel's (composition merged them in) and the payload; functions: the traversal's
+  // without the leaves' code, then the kernel's own.
+  k.leafStructList = k.structList;
+  for (auto& x : hardware.Structs())
+    if (std::find(k.leafStructList.begin(), k.leafStructList.end(), x) == k.leafStructList.end()) k.leafStructList.push_back(x);
+  const std::string hitType = *hardware.Type(hitParam.getNonReferenceType().getUnqualifiedType(), call->getBeginLoc());
+  k.leafStructList.push_back("// The hit the leaves' intersection shaders report to (" + callText + "'s last argument)\nlayout(location = 0) rayPayloadEXT " +
+                             hitType + " " + payload + ";\n");
+  k.leafFunctionList = hardware.Functions();
+  for (auto& x : k.ownFunctionList)
+    if (std::find(k.leafFunctionList.begin(), k.leafFunctionList.end(), x) == k.leafFunctionList.end()) k.leafFunctionList.push_back(x);
+
+  // Per class, an intersection shader: the leaf's object, its method on the hardware's ray, and the
+  // hit reported when it is nearer than the nearest so far (the ray's end).
+  std::vector<const CXXRecordDecl*> impls;
+  FindImplementations(ctx.getTranslationUnitDecl(), interface, impls);
+  for (const VirtualImpl& vi : vm->impls) {
+    auto impl = std::find_if(impls.begin(), impls.end(), [&](const CXXRecordDecl* r) { return r->getNameAsString() == vi.name; });
+    if (impl == impls.end()) return;
+    const std::string name = member + "_" + vi.name + "_" + methodName;
+    lt.intersectionShaders.push_back(name);
+    if (std::any_of(model.leafShaders.begin(), model.leafShaders.end(), [&](const StageShader& s) { return s.name == name; })) continue;
+    GlslPrinter object(ctx, *impl, rep);
+    object.selfClass = *impl;
+    object.composedPrefix = vi.name + "_";
+    for (auto& sn : ClassStructNames(model)) object.predeclaredStructs.insert(sn);
+    const std::string function = ImplementationMethod(rep, object, *impl, method, call->getBeginLoc());
+    if (function.empty()) return;
+    object.Type(hitParam.getNonReferenceType().getUnqualifiedType(), call->getBeginLoc());
+    StageShader s;
+    s.name = name;
+    s.stage = "rint";
+    s.origin = vi.name + "::" + methodName;
+    s.description = "what " + callText + " runs for a leaf that is a " + vi.name + ",\n// as the intersection shader of the ray tracing pipelines tracing " +
+                    lt.traversal + "'s leaves (virtual functions, level 3)";
+    s.scalarLayout = vi.scalarLayout;
+    s.classData = true;
+    for (auto& x : object.Constants()) s.constants += x;
+    for (auto& x : object.Structs()) s.structs += x + "\n";
+    s.structs += TagsReference(model, *vm) + "\n" + ImplDataStruct(object, *impl, *vm, vi) + "\n" + ObjectsReference(*vm, vi) + "\n" +
+                 "hitAttributeEXT " + hitType + " crt_hit;  // what the closest-hit shader receives\n";
+    for (auto& x : object.Functions()) s.functions += x + "\n";
+    std::string args = "self, vec4(gl_WorldRayOriginEXT, gl_RayTminEXT), vec4(gl_WorldRayDirectionEXT, gl_RayTmaxEXT)";
+    for (auto& a : leafArgs) args += ", " + a;
+    s.mainBody = "  // The leaf is element gl_InstanceID of " + vm->display + " (one instance per element, in order).\n"
+                 "  const uvec2 tag = " + member + "_Tags(" + member + "_tags).tags[gl_InstanceID];\n"
+                 "  const " + vi.name + "_Data self = " + member + "_" + vi.name + "Objects(" + member + "_" + vi.name + ").objects[tag.y];\n"
+                 "  // Nearer than the ray's end (the nearest hit so far) or nothing: the other fields start at zero.\n"
+                 "  " + hitType + " hit;\n" + zeroHit + "  hit." + GlslPrinter::SafeName(distance->getNameAsString()) + " = gl_RayTmaxEXT;\n"
+                 "  " + function + "(" + args + ", hit);\n"
+                 "  if (hit." + GlslPrinter::SafeName(distance->getNameAsString()) + " < gl_RayTmaxEXT)\n  {\n    crt_hit = hit;\n"
+                 "    reportIntersectionEXT(hit." + GlslPrinter::SafeName(distance->getNameAsString()) + ", 0u);\n  }\n";
+    model.leafShaders.push_back(s);
+  }
+  // The closest-hit shader hands the nearest leaf's hit to the trace; the miss shader leaves it.
+  lt.closestHitShader = member + "_" + methodName + "_Hit";
+  lt.missShader = member + "_" + methodName + "_Miss";
+  if (std::none_of(model.leafShaders.begin(), model.leafShaders.end(), [&](const StageShader& s) { return s.name == lt.closestHitShader; })) {
+    std::string hitStructs;
+    for (auto& x : hardware.Structs()) hitStructs += x + "\n";
+    StageShader chit;
+    chit.name = lt.closestHitShader;
+    chit.stage = "rchit";
+    chit.origin = callText;
+    chit.description = "the nearest leaf's hit, handed to the trace of " + lt.traversal + " (virtual functions, level 3)";
+    chit.structs = hitStructs + "hitAttributeEXT " + hitType + " crt_hit;  // from the leaf's intersection shader\n" +
+                   "layout(location = 0) rayPayloadInEXT " + hitType + " hit;\n";
+    chit.mainBody = "  hit = crt_hit;\n";
+    model.leafShaders.push_back(chit);
+    StageShader miss;
+    miss.name = lt.missShader;
+    miss.stage = "rmiss";
+    miss.origin = callText;
+    miss.description = "a ray of " + lt.traversal + " that meets no leaf keeps the hit it had (virtual functions, level 3)";
+    model.leafShaders.push_back(miss);
+  }
+  k.leaves = lt;
+}
+
 std::string StructName(const std::string& chunk) {
   static const std::regex decl(R"(^struct (\w+) \{)");
   std::smatch m;
@@ -2528,9 +2872,12 @@ bool ComposeFromTranslationUnit(ASTContext& ctx, Reporter& reporter, ClassModel&
       const bool onlyRayQueries = std::all_of(k.composedCalls.begin(), k.composedCalls.end(), [&](const auto& call) {
         return call.first == comp.holder && (call.second == "RayQuery_NearestHit" || call.second == "RayQuery_AnyHit");
       });
-      // Not when the traversal calls virtual intersection functions: the hardware would need them as
-      // intersection shaders, which are not generated yet.
+      // Not when the traversal calls virtual intersection functions: those become intersection shaders
+      // of a ray tracing pipeline instead (AnalyzeLeafTraversal).
       if (comp.interfaceName == "ISceneObject" && onlyRayQueries && printer.virtualCalls.empty()) k.rayQueryHolder = comp.holder;
+      // Virtual intersection functions called per leaf can run as intersection shaders (level 3).
+      if (model.virtualLevel == 3 && !printer.virtualCalls.empty() && reporter.Errors() == 0)
+        AnalyzeLeafTraversal(ctx, reporter, model, k, comp, impl, holderPrefix, printer);
     }
   }
   return any;

@@ -22,38 +22,66 @@ Data List() { return Data(Data::type::list); }
 // The shaders of a kernel, most specific first (the order the host tries them in): the variants for
 // ray tracing hardware and for arrays of textures on the GPU's samplers, and the one every device runs.
 struct KernelVariant {
-  std::string suffix;  // "_Callables", "_RayQuery_Textures", "_RayQuery", "_Textures" or ""
-  bool rayQuery = false, textures = false, callables = false;
+  std::string suffix;  // "_Callables", "_Intersections", "_RayQuery_Textures", "_RayQuery", "_Textures" or ""
+  bool rayQuery = false, textures = false, callables = false, leaves = false;
+  bool RayGeneration() const { return callables || leaves; }  // a ray generation shader, not a compute shader
 };
-// Virtual functions, level 3: a kernel whose virtual calls run as callable shaders, in a ray
-// generation shader of its own. Not for kernels that need what only compute shaders have (shared
-// memory for reductions, indirect dispatch) or other hardware variants, nor for megakernels and
-// composed code: those keep the level-2 switch.
-// Why a kernel with virtual calls at level 3 has no such variant ("" when it has one).
-std::string WhyNoCallables(const Kernel& k) {
+// Virtual functions, level 3: a kernel whose virtual calls run as callable shaders, or whose composed
+// traversal's leaves the ray tracing hardware finds, in a ray generation shader of its own. Not for
+// kernels that need what only compute shaders have (shared memory for reductions, indirect dispatch)
+// or other hardware variants, nor for megakernels: those keep the level-2 switch.
+// Why a kernel cannot be a ray generation shader ("" when it can).
+std::string WhyNoRayGeneration(const Kernel& k) {
   if (!k.reductions.empty()) return "its reductions need a compute shader's shared memory";
   if (!k.indirectVector.empty()) return "it is dispatched indirectly, which ray tracing pipelines are not here";
   if (!k.textureArrays.empty() || !k.rayQueryHolder.empty()) return "it has other hardware variants (arrays of textures or ray queries)";
-  if (!k.composedCalls.empty()) return "it calls composed code";
-  return "";  // megakernels have no callables of their own: MergeMegakernelCode keeps the kernels' switches
+  return "";  // megakernels have no callables or leaves of their own: MergeMegakernelCode keeps the kernels' switches
+}
+
+// Why a kernel with virtual calls at level 3 has no callables variant ("" when it has one).
+std::string WhyNoCallables(const Kernel& k) {
+  const std::string why = WhyNoRayGeneration(k);
+  return !why.empty() || k.composedCalls.empty() ? why : "it calls composed code";
 }
 
 bool RunsCallables(const Kernel& k) { return !k.callables.empty() && WhyNoCallables(k).empty(); }
+bool RunsLeafShaders(const Kernel& k) { return !k.leaves.member.empty() && WhyNoRayGeneration(k).empty(); }
+
+// Why a kernel whose composed traversal calls a virtual function per leaf keeps that loop in software.
+std::string WhyNoLeafShaders(const Kernel& k) {
+  return !k.whyNoLeafShaders.empty() ? k.whyNoLeafShaders : k.leaves.member.empty() ? "" : WhyNoRayGeneration(k);
+}
 
 // The callable shaders that kernels' ray generation variants execute, in the model's order.
-std::vector<const CallableShader*> ExecutedCallables(const ClassModel& model) {
+std::vector<const StageShader*> ExecutedCallables(const ClassModel& model) {
   std::set<std::string> executed;
   for (const Kernel& k : model.kernels)
     if (RunsCallables(k)) executed.insert(k.callables.begin(), k.callables.end());
-  std::vector<const CallableShader*> out;
-  for (const CallableShader& c : model.callables)
+  std::vector<const StageShader*> out;
+  for (const StageShader& c : model.callables)
+    if (executed.count(c.name)) out.push_back(&c);
+  return out;
+}
+
+// The intersection, closest-hit and miss shaders of the kernels that trace leaves, in the model's order.
+std::vector<const StageShader*> ExecutedLeafShaders(const ClassModel& model) {
+  std::set<std::string> executed;
+  for (const Kernel& k : model.kernels)
+    if (RunsLeafShaders(k)) {
+      executed.insert(k.leaves.intersectionShaders.begin(), k.leaves.intersectionShaders.end());
+      executed.insert(k.leaves.closestHitShader);
+      executed.insert(k.leaves.missShader);
+    }
+  std::vector<const StageShader*> out;
+  for (const StageShader& c : model.leafShaders)
     if (executed.count(c.name)) out.push_back(&c);
   return out;
 }
 
 std::vector<KernelVariant> Variants(const Kernel& k) {
   std::vector<KernelVariant> variants;
-  if (RunsCallables(k)) variants.push_back({"_Callables", false, false, true});
+  if (RunsCallables(k)) variants.push_back({"_Callables", false, false, true, false});
+  if (RunsLeafShaders(k)) variants.push_back({"_Intersections", false, false, false, true});
   for (bool rayQuery : {true, false})
     for (bool textures : {true, false})
       if ((!rayQuery || !k.rayQueryHolder.empty()) && (!textures || !k.textureArrays.empty()))
@@ -361,12 +389,12 @@ std::string TextureArrayFunctions(const Member& array, bool hardware, bool first
   return Render(opt.templateDir + "/glsl/texture_array.glsl.mustache", d);
 }
 
-// A shader of a kernel: `hardwareRayQuery` the variant that traces with ray queries
-// (Kernel::rayQueryHolder), `hardwareTextures` the one that samples arrays of textures with the
-// GPU's samplers (Kernel::textureArrays), `callables` the ray generation shader whose virtual calls
-// execute callable shaders (Kernel::callables).
-std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateOptions& opt, bool hardwareRayQuery, bool hardwareTextures,
-                       bool callables) {
+// A shader of a kernel, in variant `v`: rayQuery traces with ray queries (Kernel::rayQueryHolder),
+// textures samples arrays of textures with the GPU's samplers (Kernel::textureArrays), callables is
+// the ray generation shader whose virtual calls execute callable shaders (Kernel::callables), and
+// leaves the one whose composed traversal traces its leaves on the hardware (Kernel::leaves).
+std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateOptions& opt, const KernelVariant& kind) {
+  const bool hardwareRayQuery = kind.rayQuery, hardwareTextures = kind.textures, callables = kind.callables, rayGeneration = kind.RayGeneration();
   Data d = Common(model, opt);
   d.set("kernel", k.name);
   d.set("sourceFile", k.sourceFile);
@@ -378,10 +406,13 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   d.set("classStructs", model.glslClassStructs);
   d.set("rayQuery", hardwareRayQuery);
   d.set("textureHardware", hardwareTextures);
-  d.set("callables", callables);
-  d.set("compute", !callables);
+  d.set("rayGeneration", rayGeneration);
+  d.set("compute", !rayGeneration);
   std::string variant;
   if (callables) variant = ": the variant for ray tracing pipelines, whose virtual calls execute a callable shader per class";
+  if (kind.leaves)
+    variant = ": the variant for ray tracing pipelines, in which the hardware finds the leaves of " + k.leaves.traversal +
+              "\n// and an intersection shader per class of " + k.leaves.display + " intersects them";
   if (hardwareRayQuery) variant = ": the variant for ray tracing hardware (GL_EXT_ray_query)";
   if (hardwareTextures) variant += std::string(variant.empty() ? ": the variant" : ",") + " for arrays of textures on the GPU's samplers (descriptor indexing)";
   else if (!k.textureArrays.empty()) variant += std::string(variant.empty() ? ": the variant" : ",") + " sampling arrays of textures from buffers, on any device";
@@ -397,6 +428,10 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   if (callables) {
     functionList = k.callableFunctionList;
     structList = k.callableStructList;
+  }
+  if (kind.leaves) {
+    functionList = k.leafFunctionList;
+    structList = k.leafStructList;
   }
   if (hardwareRayQuery) {
     functionList = k.ownFunctionList;
@@ -534,6 +569,12 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
     x.set("comment", "the scene " + k.rayQueryHolder + " holds, built for the ray tracing hardware");
     images.push_back(x);
   }
+  if (kind.leaves) {
+    Data x;
+    x.set("decl", "layout(binding = " + std::to_string(binding++) + ") uniform accelerationStructureEXT " + k.leaves.member + "_leaves");
+    x.set("comment", "a box per element of " + k.leaves.display + ", for the ray tracing hardware");
+    images.push_back(x);
+  }
   d.set("images", images);
   d.set("scalarLayout", scalarAny || k.scalarReferences);
   d.set("bufferReferences", k.bufferReferences);
@@ -588,7 +629,7 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   bool threadState = false;
   std::vector<std::string> ids;
   // A ray generation thread's id is its launch id: the launch spans the thread counts exactly.
-  const std::string invocation = callables ? "gl_LaunchIDEXT" : "gl_GlobalInvocationID";
+  const std::string invocation = rayGeneration ? "gl_LaunchIDEXT" : "gl_GlobalInvocationID";
   for (size_t i = 0; i < k.threadAxes.size(); ++i) {
     unsigned a = k.threadAxes[i];
     std::string gid = k.dims == 1 ? "int(threadId)" : "int(" + invocation + "." + GlAxis(a) + ")";
@@ -640,20 +681,22 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   return Render(opt.templateDir + "/glsl/kernel.comp.mustache", d);
 }
 
-// Virtual functions, level 3: one class's implementation of a method as a callable shader.
-std::string CallableGlsl(const ClassModel& model, const CallableShader& c, const GenerateOptions& opt) {
+// Virtual functions, level 3: a shader of a ray tracing pipeline other than the ray generation
+// shader (a callable, intersection, closest-hit or miss shader).
+std::string StageGlsl(const ClassModel& model, const StageShader& c, const GenerateOptions& opt) {
   Data d = Common(model, opt);
   d.set("name", c.name);
   d.set("origin", c.origin);
-  d.set("implName", c.origin.substr(0, c.origin.find("::")));
-  d.set("call", c.call);
+  d.set("description", c.description);
   d.set("scalarLayout", c.scalarLayout);
-  d.set("classStructs", model.glslClassStructs);
+  d.set("bufferReferences", c.stage == "rcall" || c.stage == "rint");  // they reach the objects through them
+  d.set("classStructs", c.stage == "rmiss" ? std::string() : model.glslClassStructs);
+  d.set("hasClassData", c.classData);
   d.set("constants", c.constants);
   d.set("structs", c.structs);
   d.set("functions", c.functions);
   d.set("mainBody", c.mainBody);
-  return Render(opt.templateDir + "/glsl/callable.rcall.mustache", d);
+  return Render(opt.templateDir + "/glsl/stage.glsl.mustache", d);
 }
 
 std::string ReduceGlsl(const ClassModel& model, const Kernel& k, const GenerateOptions& opt) {
@@ -900,9 +943,9 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
         if (kind.textures) sets += (sets.empty() ? "&m_textures." : ", &m_textures.") + a;
         else buffer("m_textures." + a + "_texels.View()");
       }
-      if (kind.rayQuery) {
+      if (kind.rayQuery || kind.leaves) {
         types += ", VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR";
-        list += ", crossrt::Binding::SceneOf(m_scenes." + k.rayQueryHolder + ")";
+        list += ", crossrt::Binding::SceneOf(m_scenes." + (kind.leaves ? k.leaves.member + "_leaves" : k.rayQueryHolder) + ")";
         typed = true;
       }
       Data y;
@@ -911,20 +954,34 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
       y.set("bindingList", list);
       y.set("bindingTypes", types);
       y.set("bindingCount", std::to_string(buffers));
-      y.set("pushBuffers", !kind.callables && !typed && !kind.textures);  // storage buffers only: the simple constructor
-      y.set("pushBindings", !kind.callables && (typed || kind.textures));
-      y.set("callablePipeline", kind.callables);
-      y.set("pipelineType", kind.callables ? "crossrt::CallablePipeline" : "crossrt::ComputePipeline");
-      std::string callableList;
-      for (auto& c : k.callables)
-        callableList += "\n          {" + model.className + "_" + c + "_spv, " + model.className + "_" + c + "_spvBytes},";
-      y.set("callableList", callableList);
-      const std::string code = model.className + "_" + k.name + kind.suffix;
-      y.set("rayGenerationCode", "{" + code + "_spv, " + code + "_spvBytes}");
-      // A kernel with callables records its launch in each branch: a trace or a dispatch.
+      const bool rayGeneration = kind.RayGeneration();
+      y.set("pushBuffers", !rayGeneration && !typed && !kind.textures);  // storage buffers only: the simple constructor
+      y.set("pushBindings", !rayGeneration && (typed || kind.textures));
+      y.set("rayTracingPipeline", rayGeneration);
+      y.set("pipelineType", rayGeneration ? "crossrt::RayTracingPipeline" : "crossrt::ComputePipeline");
+      // The pipeline's shaders (crossrt::RayTracingShaders): ray generation, miss shaders, hit
+      // groups (intersection and closest hit), callables in executeCallableEXT's numbering.
+      auto code = [&](const std::string& shader) { return "{" + model.className + "_" + shader + "_spv, " + model.className + "_" + shader + "_spvBytes}"; };
+      std::string shaders;
+      if (rayGeneration) {
+        const std::string pad = "\n          ";
+        shaders = "{" + code(k.name + kind.suffix) + ",";
+        if (kind.leaves) {
+          shaders += pad + "{" + code(k.leaves.missShader) + "},  // a ray that meets no leaf" + pad + "{  // hit group i: the leaves of class i";
+          for (auto& c : k.leaves.intersectionShaders) shaders += pad + "  {" + code(c) + ", " + code(k.leaves.closestHitShader) + "},";
+          shaders += pad + "}," + pad + "{}}";
+        } else {
+          shaders += pad + "{}," + pad + "{}," + pad + "{  // executeCallableEXT's numbering";
+          for (auto& c : k.callables) shaders += pad + "  " + code(c) + ",";
+          shaders += pad + "}}";
+        }
+      }
+      y.set("rayTracingShaders", shaders);
+      // A kernel with a ray generation variant records its launch in each branch: a trace or a dispatch.
+      const bool traces = RunsCallables(k) || RunsLeafShaders(k);
       std::string launch;
-      if (kind.callables) launch = "m_pipelines." + k.name + kind.suffix + ".TraceCmd(a_cmd, " + LaunchSize(k) + ")";
-      else if (RunsCallables(k)) launch = DispatchExpr(k);
+      if (rayGeneration) launch = "m_pipelines." + k.name + kind.suffix + ".TraceCmd(a_cmd, " + LaunchSize(k) + ")";
+      else if (traces) launch = DispatchExpr(k);
       y.set("launch", launch);
       y.set("pushCall", typed ? "PushBindings" : "PushBuffers");
       y.set("textureSets", sets);
@@ -932,10 +989,11 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
       y.set("textureSetCount", std::to_string(k.textureArrays.size()));
       // Which devices can create it, and when the host records it.
       std::string needs, use, why;
-      if (kind.callables) {
+      if (rayGeneration) {
         needs = "m_ctx->hasRayTracingPipeline";
-        use = "m_useCallableShaders";
-        why = "virtual calls as callable shaders, in a ray tracing pipeline";
+        use = "m_useRayTracingPipelines";
+        why = kind.callables ? "virtual calls as callable shaders, in a ray tracing pipeline"
+                             : k.leaves.display + "'s leaves as intersection shaders, in a ray tracing pipeline";
       }
       if (kind.rayQuery) {
         needs = "m_ctx->hasRayQuery";
@@ -976,8 +1034,10 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
     x.set("hasReductions", !k.reductions.empty());
     x.set("groupCountExpr", GroupCountExpr(k));
     x.set("dispatch", DispatchExpr(k));
-    x.set("sharedDispatch", k.indirectVector.empty() && !RunsCallables(k));
-    x.set("whyNoCallables", k.callables.empty() ? "" : WhyNoCallables(k));
+    x.set("sharedDispatch", k.indirectVector.empty() && !RunsCallables(k) && !RunsLeafShaders(k));
+    // Set only when there is a reason: an empty string still opens a section.
+    if (const std::string why = k.callables.empty() ? "" : WhyNoCallables(k); !why.empty()) x.set("whyNoCallables", why);
+    if (const std::string why = WhyNoLeafShaders(k); !why.empty()) x.set("whyNoLeafShaders", why);
     kernels.push_back(x);
   }
   return kernels;
@@ -1044,10 +1104,11 @@ std::vector<ShaderSource> GenerateShaders(const ClassModel& model, const Generat
   for (const Kernel* kernel : VulkanKernels(model)) {
     const Kernel& k = *kernel;
     for (const KernelVariant& v : Variants(k))
-      shaders.push_back({k.name + v.suffix, KernelGlsl(model, k, opt, v.rayQuery, v.textures, v.callables), v.callables ? "rgen" : "comp"});
+      shaders.push_back({k.name + v.suffix, KernelGlsl(model, k, opt, v), v.RayGeneration() ? "rgen" : "comp"});
     if (!k.reductions.empty()) shaders.push_back({k.name + "_Reduce", ReduceGlsl(model, k, opt)});
   }
-  for (const CallableShader* c : ExecutedCallables(model)) shaders.push_back({c->name, CallableGlsl(model, *c, opt), "rcall"});
+  for (const StageShader* c : ExecutedCallables(model)) shaders.push_back({c->name, StageGlsl(model, *c, opt), c->stage});
+  for (const StageShader* c : ExecutedLeafShaders(model)) shaders.push_back({c->name, StageGlsl(model, *c, opt), c->stage});
   return shaders;
 }
 
@@ -1074,14 +1135,42 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
     d.set("hasImages", std::any_of(model.members.begin(), model.members.end(), [](const Member& m) {
       return m.usedByKernels && (m.kind == MemberKind::Image || m.kind == MemberKind::Sampler);
     }));
-    Data callableShaders = List();
-    for (const CallableShader* c : ExecutedCallables(model)) {
+    // The shaders of ray tracing pipelines besides the kernels' (virtual functions, level 3).
+    Data stageShaders = List();
+    std::vector<const StageShader*> stages = ExecutedCallables(model), leafStages = ExecutedLeafShaders(model);
+    stages.insert(stages.end(), leafStages.begin(), leafStages.end());
+    for (const StageShader* c : stages) {
       Data x;
       x.set("name", c->name);
-      callableShaders.push_back(x);
+      stageShaders.push_back(x);
     }
-    d.set("callableShaders", callableShaders);
-    d.set("hasCallables", !callableShaders.is_empty_list());
+    d.set("stageShaders", stageShaders);
+    d.set("hasRayTracingPipelines", !stages.empty());
+    // Per vector whose elements are leaves of a traversal the hardware runs: its boxes' scene.
+    Data leafScenes = List();
+    std::set<std::string> leafMembers;
+    for (const Kernel& k : model.kernels) {
+      if (!RunsLeafShaders(k) || !leafMembers.insert(k.leaves.member).second) continue;
+      auto vm = std::find_if(model.virtuals.begin(), model.virtuals.end(), [&](const VirtualMember& v) { return v.member == k.leaves.member; });
+      Data x;
+      x.set("member", k.leaves.member);
+      x.set("host", k.leaves.hostExpr);
+      x.set("display", k.leaves.display);
+      x.set("interface", k.leaves.interfaceName);
+      Data impls = List();
+      for (size_t t = 0; vm != model.virtuals.end() && t < vm->impls.size(); ++t) {
+        Data y;
+        y.set("impl", vm->impls[t].name);
+        y.set("typeIndex", std::to_string(t));
+        y.set("first", t == 0);
+        impls.push_back(y);
+      }
+      x.set("impls", impls);
+      leafScenes.push_back(x);
+    }
+    d.set("leafScenes", leafScenes);
+    d.set("hasLeafScenes", !leafScenes.is_empty_list());
+    d.set("hasScenes", !leafScenes.is_empty_list() || std::any_of(model.kernels.begin(), model.kernels.end(), [](const Kernel& k) { return !k.rayQueryHolder.empty(); }));
     unsigned indirectSlots = 0;
     d.set("kernels", VulkanKernelsData(model, indirectSlots));
     d.set("indirectSlots", std::to_string(indirectSlots));

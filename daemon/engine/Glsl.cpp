@@ -467,24 +467,33 @@ std::string GlslPrinter::ComposedCall(const CXXMemberCallExpr* mc) {
 // `m_objects[i]->Method(args)` where m_objects is a std::vector of shared_ptr, unique_ptr or plain
 // pointers to a polymorphic class: `m_objects_Method(uint(i), args)`, the dispatcher that the
 // analysis writes for the implementations it finds; "" when the call is not of that form.
-std::string GlslPrinter::VirtualCall(const CXXMemberCallExpr* mc) {
+const FieldDecl* VirtualCallTarget(const CXXMemberCallExpr* mc, const clang::Expr** index) {
   const clang::Expr* obj = mc->getImplicitObjectArgument()->IgnoreParenImpCasts();
   if (auto* op = dyn_cast<CXXOperatorCallExpr>(obj); op && op->getOperator() == OO_Arrow) obj = op->getArg(0)->IgnoreParenImpCasts();
   auto* subscript = dyn_cast<CXXOperatorCallExpr>(obj);
-  if (!subscript || subscript->getOperator() != OO_Subscript) return "";
+  if (!subscript || subscript->getOperator() != OO_Subscript) return nullptr;
   auto* me = dyn_cast<MemberExpr>(subscript->getArg(0)->IgnoreParenImpCasts());
   auto* field = me ? dyn_cast<FieldDecl>(me->getMemberDecl()) : nullptr;
   QualType element;
-  if (!field || !isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts()) || !IsStdVector(field->getType(), &element)) return "";
-  if (!PolymorphicPointee(element)) return "";
+  if (!field || !isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts()) || !IsStdVector(field->getType(), &element)) return nullptr;
+  if (!PolymorphicPointee(element)) return nullptr;
+  if (index) *index = subscript->getArg(1);
+  return field;
+}
+
+std::string GlslPrinter::VirtualCall(const CXXMemberCallExpr* mc) {
+  const clang::Expr* indexExpr = nullptr;
+  const FieldDecl* field = VirtualCallTarget(mc, &indexExpr);
+  if (!field) return "";
   auto* method = mc->getMethodDecl();
   if (!method->isVirtual())
     return Fail(mc->getBeginLoc(), "call of the non-virtual " + method->getQualifiedNameAsString() + " through '" + field->getNameAsString() + "' in a kernel",
                 "the GPU picks the implementation by the object's type: make the method virtual in the interface");
-  std::vector<std::string> args = {"uint(" + Expr(subscript->getArg(1)) + ")"};
+  std::vector<std::string> args = {"uint(" + Expr(indexExpr) + ")"};
   for (auto* arg : mc->arguments()) args.push_back(Expr(arg));
   Type(mc->getType(), mc->getBeginLoc());  // declares a returned struct
   virtualCalls.insert({field, method->getCanonicalDecl()});
+  virtualCallSites.push_back(mc);
   std::string s = composedPrefix + field->getNameAsString() + "_" + method->getNameAsString() + "(";
   for (size_t i = 0; i < args.size(); ++i) s += (i ? ", " : "") + args[i];
   return s + ")";
@@ -1183,6 +1192,12 @@ std::string GlslPrinter::ThreadBody(const clang::Stmt* body, int indent, bool lo
 std::string GlslPrinter::Stmt(const clang::Stmt* s, int indent) {
   std::string pad(indent * 2, ' ');
   if (!s) return pad + ";\n";
+  if (auto replaced = replacedStatements.find(s); replaced != replacedStatements.end()) {
+    std::string out;
+    std::istringstream lines(replaced->second);
+    for (std::string line; std::getline(lines, line);) out += (line.empty() ? "" : pad) + line + "\n";
+    return out;
+  }
   if (auto* cs = dyn_cast<CompoundStmt>(s)) {
     std::string out = pad + "{\n";
     for (auto* c : cs->body()) out += Stmt(c, indent + 1);

@@ -50,6 +50,9 @@ bool LayoutMatchesCpp(clang::ASTContext& ctx, clang::QualType type, bool scalar)
 
 // The polymorphic class a shared_ptr, unique_ptr or plain pointer type points to, or null.
 const clang::CXXRecordDecl* PolymorphicPointee(clang::QualType type);
+// `m_v[i]->Method(...)` through a member std::vector of pointers to a polymorphic class: the vector
+// (and in `index`, the expression i), or null for other calls.
+const clang::FieldDecl* VirtualCallTarget(const clang::CXXMemberCallExpr* call, const clang::Expr** index = nullptr);
 
 // Prints the code one kernel reaches. One instance per kernel; it collects the helper functions,
 // structs and constants the kernel needs, in an order GLSL accepts (callees before callers).
@@ -94,6 +97,10 @@ public:
   // Virtual functions (paper 3.9). In a kernel's printer: calls `m_objects[i]->Method(...)` through
   // a std::vector of pointers to a polymorphic class, as (vector member, interface method).
   std::set<std::pair<const clang::FieldDecl*, const clang::CXXMethodDecl*>> virtualCalls;
+  std::vector<const clang::CXXMemberCallExpr*> virtualCallSites;  // each such call, in printing order
+  // Statements printed as other text (each line indented as the statement): the leaves' loop of a
+  // traversal that the ray tracing hardware runs instead (virtual functions, level 3).
+  std::map<const clang::Stmt*, std::string> replacedStatements;
   // In an implementation's printer ("object mode"): the class whose methods are printed; its members
   // read from the parameter `self` of type <Class>_Data, and its methods take `self` first.
   const clang::CXXRecordDecl* selfClass = nullptr;

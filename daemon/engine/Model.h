@@ -85,6 +85,21 @@ struct Loop {                // one parallel dimension of an IPV kernel
   std::string countCpp;
 };
 
+// Virtual functions, level 3, in composed code (paper 3.10, listing 2): a traversal whose leaves
+// call a virtual intersection function (ShapeScene::Trace calling m_shapes[i]->Intersect(..., hit)).
+// Its kernel gets a ray generation variant, <kernel>_Intersections, in which the ray tracing
+// hardware finds the leaves a ray meets (one instance per element, its box from the interface's
+// BoxMin() and BoxMax() on the host) and runs the intersection shader of each leaf's class.
+struct LeafTraversal {
+  std::string member;         // the VirtualMember: m_scene_m_shapes
+  std::string hostExpr;       // crt_m_scene()->m_shapes
+  std::string display;        // m_scene->m_shapes
+  std::string interfaceName;  // IShape
+  std::string traversal;      // ShapeScene::Trace
+  std::vector<std::string> intersectionShaders;  // per class, in the tags' order: hit group i is class i
+  std::string closestHitShader, missShader;
+};
+
 struct Kernel {
   std::string name;
   bool rtv = false;                   // kernel_* called from a loop, else kernel1D/2D/3D_* holding loops
@@ -134,6 +149,13 @@ struct Kernel {
   std::vector<std::string> callables;
   std::vector<std::string> callableStructList, callableFunctionList;
   bool atomics = false;               // calls crossrt::Atomic*: coherent buffers, memory scope semantics
+  // Virtual functions, level 3, in composed code: the leaves the ray tracing hardware finds (an empty
+  // member when there are none; whyNoLeafShaders says why a traversal's leaves stay in software),
+  // and the prelude of the <kernel>_Intersections ray generation shader, whose traversal traces a
+  // ray where the leaves' loop was.
+  LeafTraversal leaves;
+  std::string whyNoLeafShaders;
+  std::vector<std::string> leafStructList, leafFunctionList;
 };
 
 struct ControlParam {
@@ -201,17 +223,23 @@ struct VirtualMember {
   unsigned slotBytes = 0;          // level 1: the size of every element's slot
 };
 
-// Virtual functions, level 3 (paper 3.9): one class's implementation of a method called through a
-// vector of objects, as a callable shader of a ray tracing pipeline. It receives the call's
-// payload (the objects of the class, the object's index, the arguments, room for the result).
-struct CallableShader {
-  std::string name;                   // m_materials_Lambert_Shade: the .rcall file and its SPIR-V
+// Virtual functions, level 3: a shader of a ray tracing pipeline other than the ray generation
+// shader. A callable shader (paper 3.9) is one class's implementation of a method called through a
+// vector of objects; it receives the call's payload (the objects of the class, the object's index,
+// the arguments, room for the result). An intersection shader (paper 3.10) is one class's
+// implementation of the intersection function a composed traversal calls per leaf; a closest-hit
+// and a miss shader go with them.
+struct StageShader {
+  std::string name;                   // m_materials_Lambert_Shade: the file (<name>.<stage>) and its SPIR-V
+  std::string stage;                  // rcall, rint, rchit or rmiss
   std::string origin;                 // Lambert::Shade
-  std::string call;                   // m_materials[index]->Shade(...)
+  std::string description;            // what it is, for its header comment
   bool scalarLayout = false;          // the class's objects need GL_EXT_scalar_block_layout
+  bool classData = false;             // it reads the class-data block (binding 0): where the objects are
   std::string constants, structs, functions;  // the implementation's code and the payload, in GLSL order
   std::string mainBody;               // loads the object, calls the implementation, stores the result
 };
+
 
 // A member function that appends to a member vector, reached from a kernel's threads: the CPU
 // backend hides it with a copy whose push_backs take a lock (crossrt::Locked), as it does in the
@@ -244,7 +272,8 @@ struct ClassModel {
   // 1: one array of equal slots; 2: a buffer per class; 3: as 2, plus callable shaders for kernels
   // whose ray generation variant a device with ray tracing pipelines runs.
   int virtualLevel = 2;
-  std::vector<CallableShader> callables;   // level 3, by name
+  std::vector<StageShader> callables;      // level 3, by name
+  std::vector<StageShader> leafShaders;    // level 3: intersection, closest-hit and miss shaders, by name
   // Thread loops that call several kernels run as one shader each (megakernels) or one dispatch per
   // kernel call (wavefront). Both are generated; this picks the default.
   std::vector<Kernel> megakernels;

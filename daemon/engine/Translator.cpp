@@ -64,14 +64,16 @@ std::string IncludeSpelling(const std::string& header, const std::vector<std::st
   return best.empty() ? header : best;
 }
 
-// Compiles one GLSL shader of `stage` (comp, rgen or rcall) to SPIR-V in-process with the glslang
+// Compiles one GLSL shader of `stage` (comp, rgen, rcall, rint, rchit or rmiss) to SPIR-V in-process with the glslang
 // library (as `glslangValidator -V --target-env vulkan1.2` would); returns the words or throws.
 std::vector<uint32_t> CompileGlsl(const std::string& name, const std::string& glsl, const std::string& stage) {
   static std::mutex mutex;  // glslang keeps global state: one compile at a time (a few ms each)
   std::lock_guard<std::mutex> guard(mutex);
   static bool initialized = glslang::InitializeProcess();
   (void)initialized;
-  const EShLanguage language = stage == "rgen" ? EShLangRayGen : stage == "rcall" ? EShLangCallable : EShLangCompute;
+  static const std::map<std::string, EShLanguage> stages = {{"comp", EShLangCompute}, {"rgen", EShLangRayGen}, {"rcall", EShLangCallable},
+                                                            {"rint", EShLangIntersect}, {"rchit", EShLangClosestHit}, {"rmiss", EShLangMiss}};
+  const EShLanguage language = stages.at(stage);
   glslang::TShader shader(language);
   const char* text = glsl.c_str();
   const char* fileName = name.c_str();
@@ -355,7 +357,7 @@ TranslateResult Translate(const TranslateRequest& request, AstCache* cache, Spir
   }
   // Templates are inputs too: editing one regenerates.
   for (const char* t : {"glsl/kernel.comp.mustache", "glsl/reduce.comp.mustache", "glsl/ray_query.glsl.mustache", "glsl/texture_array.glsl.mustache",
-                        "glsl/callable.rcall.mustache", "vulkan/class.h.mustache", "vulkan/class.cpp.mustache", "cpu/class.h.mustache",
+                        "glsl/stage.glsl.mustache", "vulkan/class.h.mustache", "vulkan/class.cpp.mustache", "cpu/class.h.mustache",
                         "cpu/class.cpp.mustache"})
     inputs.insert(request.templateDir + "/" + t);
   result.inputs.assign(inputs.begin(), inputs.end());

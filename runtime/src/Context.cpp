@@ -457,7 +457,7 @@ void VulkanContext::CreateDevice(const ContextOptions& options) {
     if (!f) throw Error(std::string(name) + " is missing although " + extension + " is enabled");
     return f;
   };
-  if (hasRayQuery) {
+  if (hasRayQuery || hasRayTracingPipeline) {  // either comes with acceleration structures
     const char* as = VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME;
     vkGetAccelerationStructureBuildSizesKHR =
         reinterpret_cast<PFN_vkGetAccelerationStructureBuildSizesKHR>(load("vkGetAccelerationStructureBuildSizesKHR", as));

@@ -1,5 +1,5 @@
 // Pipeline (push-descriptor set 0, arrays of textures, push constants), ComputePipeline, dispatch
-// helpers and the barriers generated code puts between dispatches. CallablePipeline: CallablePipeline.cpp.
+// helpers and the barriers generated code puts between dispatches. RayTracingPipeline: RayTracingPipeline.cpp.
 #include "crossrt/VulkanRuntime.h"
 #include "Internal.h"
 

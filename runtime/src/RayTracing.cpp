@@ -1,9 +1,12 @@
 // RayTracingScene: bottom- and top-level acceleration structures for shaders that trace with
-// GL_EXT_ray_query. Lavapipe has no ray queries, so this runs only on GPUs that have them.
+// GL_EXT_ray_query (meshes) or in ray tracing pipelines (leaf boxes). Lavapipe has neither, so this
+// runs only on GPUs that have them.
 #include "crossrt/VulkanRuntime.h"
 
 #include "Internal.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <utility>
 
@@ -25,9 +28,9 @@ void BuildBarrier(VkCommandBuffer cmd, VkPipelineStageFlags dstStages, VkAccessF
 
 RayTracingScene::RayTracingScene(std::shared_ptr<VulkanContext> ctx) : ctx_(std::move(ctx)) {
   if (!ctx_) throw Error("crossrt::RayTracingScene: null VulkanContext");
-  if (!ctx_->hasRayQuery)
+  if (!ctx_->hasRayQuery && !ctx_->hasRayTracingPipeline)
     throw Error("crossrt::RayTracingScene: device '" + std::string(ctx_->properties.deviceName) +
-                "' has no ray queries (VK_KHR_ray_query with acceleration structures)");
+                "' has no acceleration structures (neither VK_KHR_ray_query nor VK_KHR_ray_tracing_pipeline)");
 }
 
 RayTracingScene::RayTracingScene(RayTracingScene&& other) noexcept { *this = std::move(other); }
@@ -67,22 +70,45 @@ RayTracingScene::Level RayTracingScene::Create(VkAccelerationStructureTypeKHR ty
   return level;
 }
 
+// A bottom level created and sized, with the input it is built from.
+struct RayTracingScene::PendingLevel {
+  Buffer input;  // vertices or boxes
+  VkAccelerationStructureGeometryKHR geometry{};
+  VkAccelerationStructureBuildGeometryInfoKHR build{};
+  VkAccelerationStructureBuildRangeInfoKHR range{};
+  VkDeviceSize scratchOffset = 0;
+};
+
+RayTracingScene::PendingLevel RayTracingScene::Prepare(const VkAccelerationStructureGeometryKHR& geometry, uint32_t primitiveCount,
+                                                       VkDeviceSize& scratchBytes) {
+  const VulkanContext& vk = *ctx_;
+  PendingLevel p;
+  p.geometry = geometry;
+  p.build = VkInit<VkAccelerationStructureBuildGeometryInfoKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR);
+  p.build.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
+  p.build.flags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
+  p.build.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
+  p.build.geometryCount = 1;
+  p.build.pGeometries = &p.geometry;
+  p.range.primitiveCount = primitiveCount;
+  auto sizes = VkInit<VkAccelerationStructureBuildSizesInfoKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_SIZES_INFO_KHR);
+  vk.vkGetAccelerationStructureBuildSizesKHR(vk.device, VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, &p.build, &p.range.primitiveCount, &sizes);
+  Level level = Create(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, sizes.accelerationStructureSize);
+  p.build.dstAccelerationStructure = level.handle;
+  p.scratchOffset = scratchBytes;
+  scratchBytes = AlignUp(scratchBytes + sizes.buildScratchSize, vk.accelerationScratchAlignment);
+  bottomLevels_.push_back(std::move(level));
+  return p;
+}
+
 void RayTracingScene::Build(const std::vector<Mesh>& meshes, const std::vector<Instance>& instances) {
   if (!ctx_) throw Error("crossrt::RayTracingScene::Build on a scene without a context");
   Release();
   const VulkanContext& vk = *ctx_;
-  const VkDeviceSize scratchAlign = vk.accelerationScratchAlignment;
   const VkBufferUsageFlags input = VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR;
 
   // Bottom levels: each non-empty mesh's triangles as a vertex soup (no index buffer).
-  struct Pending {
-    Buffer vertices;
-    VkAccelerationStructureGeometryKHR geometry{};
-    VkAccelerationStructureBuildGeometryInfoKHR build{};
-    VkAccelerationStructureBuildRangeInfoKHR range{};
-    VkDeviceSize scratchOffset = 0;
-  };
-  std::vector<Pending> pending;
+  std::vector<PendingLevel> pending;
   pending.reserve(meshes.size());
   std::vector<int> levelOfMesh(meshes.size(), -1);
   VkDeviceSize scratchBytes = 0;
@@ -90,36 +116,22 @@ void RayTracingScene::Build(const std::vector<Mesh>& meshes, const std::vector<I
     const Mesh& mesh = meshes[m];
     if (mesh.triangleCount == 0) continue;
     if (mesh.triangleCount > 0x7FFFFFFFu / 3) throw Error("crossrt::RayTracingScene: mesh " + std::to_string(m) + " has too many triangles");
-    Pending p;
     const size_t bytes = sizeof(float) * 9 * mesh.triangleCount;
-    p.vertices = Buffer(ctx_, bytes, input);
-    p.vertices.Upload(mesh.triangles, bytes);
-    p.geometry = VkInit<VkAccelerationStructureGeometryKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR);
-    p.geometry.geometryType = VK_GEOMETRY_TYPE_TRIANGLES_KHR;
-    p.geometry.flags = VK_GEOMETRY_OPAQUE_BIT_KHR;
-    auto& tri = p.geometry.geometry.triangles;
+    Buffer vertices(ctx_, bytes, input);
+    vertices.Upload(mesh.triangles, bytes);
+    auto geometry = VkInit<VkAccelerationStructureGeometryKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR);
+    geometry.geometryType = VK_GEOMETRY_TYPE_TRIANGLES_KHR;
+    geometry.flags = VK_GEOMETRY_OPAQUE_BIT_KHR;
+    auto& tri = geometry.geometry.triangles;
     tri = VkInit<VkAccelerationStructureGeometryTrianglesDataKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_TRIANGLES_DATA_KHR);
     tri.vertexFormat = VK_FORMAT_R32G32B32_SFLOAT;
-    tri.vertexData.deviceAddress = p.vertices.Address();
+    tri.vertexData.deviceAddress = vertices.Address();
     tri.vertexStride = 3 * sizeof(float);
     tri.maxVertex = static_cast<uint32_t>(3 * mesh.triangleCount - 1);
     tri.indexType = VK_INDEX_TYPE_NONE_KHR;
-    p.build = VkInit<VkAccelerationStructureBuildGeometryInfoKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_GEOMETRY_INFO_KHR);
-    p.build.type = VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR;
-    p.build.flags = VK_BUILD_ACCELERATION_STRUCTURE_PREFER_FAST_TRACE_BIT_KHR;
-    p.build.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
-    p.build.geometryCount = 1;
-    p.range.primitiveCount = static_cast<uint32_t>(mesh.triangleCount);
-    auto sizes = VkInit<VkAccelerationStructureBuildSizesInfoKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_BUILD_SIZES_INFO_KHR);
-    p.build.pGeometries = &p.geometry;
-    vk.vkGetAccelerationStructureBuildSizesKHR(vk.device, VK_ACCELERATION_STRUCTURE_BUILD_TYPE_DEVICE_KHR, &p.build, &p.range.primitiveCount, &sizes);
-    Level level = Create(VK_ACCELERATION_STRUCTURE_TYPE_BOTTOM_LEVEL_KHR, sizes.accelerationStructureSize);
-    p.build.dstAccelerationStructure = level.handle;
-    p.scratchOffset = scratchBytes;
-    scratchBytes = AlignUp(scratchBytes + sizes.buildScratchSize, scratchAlign);
     levelOfMesh[m] = static_cast<int>(bottomLevels_.size());
-    bottomLevels_.push_back(std::move(level));
-    pending.push_back(std::move(p));
+    pending.push_back(Prepare(geometry, static_cast<uint32_t>(mesh.triangleCount), scratchBytes));
+    pending.back().input = std::move(vertices);
   }
 
   // The top level: one instance per entry, in order; an instance of an empty mesh references no
@@ -143,6 +155,69 @@ void RayTracingScene::Build(const std::vector<Mesh>& meshes, const std::vector<I
       r.accelerationStructureReference = vk.vkGetAccelerationStructureDeviceAddressKHR(vk.device, &addressInfo);
     }
   }
+  BuildLevels(pending, scratchBytes, records);
+}
+
+void RayTracingScene::CheckLeafBoxes(const std::vector<LeafBox>& leaves, const std::string& what) {
+  for (size_t i = 0; i < leaves.size(); ++i)
+    for (int a = 0; a < 3; ++a)
+      if (!(leaves[i].min[a] <= leaves[i].max[a]) || !std::isfinite(leaves[i].min[a]) || !std::isfinite(leaves[i].max[a]))
+        throw Error("crossrt::RayTracingScene: the box of " + what + "[" + std::to_string(i) + "] is not a finite box with min <= max (axis " +
+                    std::to_string(a) + ": " + std::to_string(leaves[i].min[a]) + " to " + std::to_string(leaves[i].max[a]) + ")");
+  if (leaves.size() >= (1u << 24)) throw Error("crossrt::RayTracingScene: " + what + " has more leaves than 24-bit instance ids name");
+}
+
+void RayTracingScene::BuildLeaves(const std::vector<LeafBox>& leaves, const std::string& what) {
+  if (!ctx_) throw Error("crossrt::RayTracingScene::BuildLeaves on a scene without a context");
+  CheckLeafBoxes(leaves, what);
+  Release();
+  const VulkanContext& vk = *ctx_;
+  // One bottom level, the unit box; each leaf is an instance scaling it onto the leaf's box.
+  const VkAabbPositionsKHR unit{0.0f, 0.0f, 0.0f, 1.0f, 1.0f, 1.0f};
+  Buffer box(ctx_, sizeof(unit), VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR);
+  box.Upload(&unit, sizeof(unit));
+  auto geometry = VkInit<VkAccelerationStructureGeometryKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR);
+  geometry.geometryType = VK_GEOMETRY_TYPE_AABBS_KHR;
+  geometry.flags = VK_GEOMETRY_OPAQUE_BIT_KHR;  // no any-hit shaders: the intersection shader's report commits
+  geometry.geometry.aabbs = VkInit<VkAccelerationStructureGeometryAabbsDataKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_AABBS_DATA_KHR);
+  geometry.geometry.aabbs.data.deviceAddress = box.Address();
+  geometry.geometry.aabbs.stride = sizeof(VkAabbPositionsKHR);
+  VkDeviceSize scratchBytes = 0;
+  std::vector<PendingLevel> pending;
+  pending.push_back(Prepare(geometry, 1, scratchBytes));
+  pending.back().input = std::move(box);
+  auto addressInfo = VkInit<VkAccelerationStructureDeviceAddressInfoKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_DEVICE_ADDRESS_INFO_KHR);
+  addressInfo.accelerationStructure = bottomLevels_[0].handle;
+  const VkDeviceAddress unitBox = vk.vkGetAccelerationStructureDeviceAddressKHR(vk.device, &addressInfo);
+
+  std::vector<VkAccelerationStructureInstanceKHR> records(leaves.size());
+  for (size_t i = 0; i < leaves.size(); ++i) {
+    const LeafBox& leaf = leaves[i];
+    VkAccelerationStructureInstanceKHR& r = records[i];
+    // A singular transform would leave the hardware no ray in the box's space: a flat box gets
+    // a sliver of thickness, relative to its distance from the origin. Rays meet it a little early
+    // or late; the intersection shader's own test decides the hit.
+    float largest = 1.0f;
+    for (int a = 0; a < 3; ++a) largest = std::max({largest, std::fabs(leaf.min[a]), std::fabs(leaf.max[a])});
+    for (int a = 0; a < 3; ++a) {
+      const float extent = std::max(leaf.max[a] - leaf.min[a], largest * 1e-6f);
+      r.transform.matrix[a][a] = extent;
+      r.transform.matrix[a][3] = leaf.min[a];
+    }
+    r.instanceCustomIndex = static_cast<uint32_t>(i);
+    r.mask = 0xFF;
+    r.instanceShaderBindingTableRecordOffset = leaf.hitGroup;
+    r.flags = VK_GEOMETRY_INSTANCE_FORCE_OPAQUE_BIT_KHR;
+    r.accelerationStructureReference = unitBox;
+  }
+  BuildLevels(pending, scratchBytes, records);
+}
+
+void RayTracingScene::BuildLevels(std::vector<PendingLevel>& pending, VkDeviceSize scratchBytes,
+                                  const std::vector<VkAccelerationStructureInstanceKHR>& records) {
+  const VulkanContext& vk = *ctx_;
+  const VkDeviceSize scratchAlign = vk.accelerationScratchAlignment;
+  const VkBufferUsageFlags input = VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR;
   Buffer instanceBuffer(ctx_, sizeof(VkAccelerationStructureInstanceKHR) * std::max<size_t>(1, records.size()), input);
   if (!records.empty()) instanceBuffer.Upload(records.data(), sizeof(records[0]) * records.size());
   auto topGeometry = VkInit<VkAccelerationStructureGeometryKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR);
@@ -179,7 +254,10 @@ void RayTracingScene::Build(const std::vector<Mesh>& meshes, const std::vector<I
   topBuild.scratchData.deviceAddress = scratchBase;
   const VkAccelerationStructureBuildRangeInfoKHR* topRanges = &topRange;
   vk.vkCmdBuildAccelerationStructuresKHR(cmd, 1, &topBuild, &topRanges);
-  BuildBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR | VK_ACCESS_SHADER_READ_BIT);
+  // Read by compute shaders (ray queries) and by ray tracing pipelines where the device has them.
+  const VkPipelineStageFlags readers =
+      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | (vk.hasRayTracingPipeline ? VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR : VkPipelineStageFlags(0));
+  BuildBarrier(cmd, readers, VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR | VK_ACCESS_SHADER_READ_BIT);
   ctx_->SubmitAndWait(cmd);
   topLevel_ = top_.handle;
 }

@@ -202,17 +202,17 @@ TEST_CASE("Virtual functions, level 3: callable shaders on ray tracing pipelines
   auto& vulkan = dynamic_cast<CallableShading_Vulkan&>(*gpu);
   gpu->m_materials = palette;
   // Callable shaders by default wherever the device can run them.
-  REQUIRE(vulkan.UsesCallableShaders() == ctx->hasRayTracingPipeline);
+  REQUIRE(vulkan.UsesRayTracingPipelines() == ctx->hasRayTracingPipeline);
   REQUIRE(Differing(render(*gpu), expected, 1e-5f) == 0);
   if (ctx->hasRayTracingPipeline)
   {
-    vulkan.UseCallableShaders(false);  // the same kernel as a compute shader with the switch
+    vulkan.UseRayTracingPipelines(false);  // the same kernel as a compute shader with the switch
     REQUIRE(Differing(render(*gpu), expected, 1e-5f) == 0);
   }
   else
   {
-    REQUIRE_THROWS_WITH(vulkan.UseCallableShaders(true), Catch::Contains("has no ray tracing pipelines"));
-    REQUIRE_FALSE(vulkan.UsesCallableShaders());
+    REQUIRE_THROWS_WITH(vulkan.UseRayTracingPipelines(true), Catch::Contains("has no ray tracing pipelines"));
+    REQUIRE_FALSE(vulkan.UsesRayTracingPipelines());
   }
   RequireNoValidationMessages(ctx);
 }

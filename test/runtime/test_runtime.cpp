@@ -557,14 +557,16 @@ layout(location = 0) callableDataInEXT Call call;
 void main() { call.result = call.argument + 1000u; }
 )";
 
-TEST_CASE("CallablePipeline: callable shaders chosen per thread, or a clear error without ray tracing pipelines", "[runtime]") {
+TEST_CASE("RayTracingPipeline: callable shaders chosen per thread, or a clear error without ray tracing pipelines", "[runtime]") {
   auto ctx = MakeContext();
   if (!ctx) return;
   const auto rayGen = CompileGlsl(kCallableProbeRayGen, "rgen");
   const auto doubled = CompileGlsl(kCallableDouble, "rcall"), offset = CompileGlsl(kCallableOffset, "rcall");
   auto create = [&] {
-    return CallablePipeline(ctx, {rayGen.data(), rayGen.size() * 4}, {{doubled.data(), doubled.size() * 4}, {offset.data(), offset.size() * 4}},
-                            {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}, sizeof(uint32_t), "callable_probe");
+    RayTracingShaders shaders;
+    shaders.rayGeneration = {rayGen.data(), rayGen.size() * 4};
+    shaders.callables = {{doubled.data(), doubled.size() * 4}, {offset.data(), offset.size() * 4}};
+    return RayTracingPipeline(ctx, shaders, {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER}, sizeof(uint32_t), "callable_probe");
   };
   if (!ctx->hasRayTracingPipeline) {
     INFO(ctx->DeviceName() << " has no ray tracing pipelines: only the error is checked");
@@ -572,7 +574,7 @@ TEST_CASE("CallablePipeline: callable shaders chosen per thread, or a clear erro
     RequireNoValidationMessages(*ctx);
     return;
   }
-  CallablePipeline pipe = create();
+  RayTracingPipeline pipe = create();
   const uint32_t n = 70001;  // more than one row of 65536
   Buffer out(ctx, n * sizeof(uint32_t));
   out.Fill(0xffffffffu);
@@ -588,6 +590,99 @@ TEST_CASE("CallablePipeline: callable shaders chosen per thread, or a clear erro
   for (uint32_t i = 0; i < n; ++i)
     if (values[i] != (i % 2 == 0 ? 2 * i : i + 1000) && wrong++ < 5) UNSCOPED_INFO("i=" << i << " got " << values[i]);
   REQUIRE(wrong == 0);
+  RequireNoValidationMessages(*ctx);
+}
+
+// Leaves in a ray tracing pipeline: a grid of side x side cells, most holding a box (some flat
+// along z), each box an instance of class (x + y) % 2 whose intersection shader reports
+// 2 * instance + class; one ray per cell, down through its centre.
+const char* kLeafProbeRayGen = R"(#version 460
+#extension GL_EXT_ray_tracing : require
+layout(std430, binding = 0) buffer Out { uint values[]; };
+layout(binding = 1) uniform accelerationStructureEXT leaves;
+layout(push_constant) uniform Args { uint side; };
+layout(location = 0) rayPayloadEXT uint hit;
+void main() {
+  const uint x = gl_LaunchIDEXT.x, y = gl_LaunchIDEXT.y;
+  hit = 0xFFFFFFFFu;
+  traceRayEXT(leaves, gl_RayFlagsNoneEXT, 0xFF, 0, 0, 0, vec3(x + 0.5, y + 0.5, 10.0), 0.0, vec3(0.0, 0.0, -1.0), 100.0, 0);
+  values[y * side + x] = hit;
+}
+)";
+const char* kLeafProbeMiss = R"(#version 460
+#extension GL_EXT_ray_tracing : require
+void main() {}
+)";
+const char* kLeafProbeHit = R"(#version 460
+#extension GL_EXT_ray_tracing : require
+hitAttributeEXT uint reported;
+layout(location = 0) rayPayloadInEXT uint hit;
+void main() { hit = reported; }
+)";
+std::string LeafProbeIntersection(unsigned cls) {
+  return "#version 460\n#extension GL_EXT_ray_tracing : require\nhitAttributeEXT uint reported;\n"
+         "void main() { reported = 2u * uint(gl_InstanceID) + " + std::to_string(cls) + "u; reportIntersectionEXT(5.0, 0u); }\n";
+}
+
+TEST_CASE("RayTracingScene leaves: a box per instance, in order, each class's intersection shader, or a clear error", "[runtime]") {
+  // Boxes are checked before anything is built, on every device.
+  std::vector<RayTracingScene::LeafBox> bad = {{{0, 0, 0}, {1, 1, 1}, 0}, {{0, 2, 0}, {1, 1, 1}, 0}};
+  REQUIRE_THROWS_WITH(RayTracingScene::CheckLeafBoxes(bad, "probe"), Catch::Contains("probe[1]") && Catch::Contains("min <= max (axis 1"));
+  bad[1].max[1] = std::nanf("");
+  REQUIRE_THROWS_WITH(RayTracingScene::CheckLeafBoxes(bad, "probe"), Catch::Contains("probe[1]"));
+  auto ctx = MakeContext();
+  if (!ctx) return;
+  const auto rayGen = CompileGlsl(kLeafProbeRayGen, "rgen"), miss = CompileGlsl(kLeafProbeMiss, "rmiss"), hit = CompileGlsl(kLeafProbeHit, "rchit");
+  const auto isect0 = CompileGlsl(LeafProbeIntersection(0).c_str(), "rint"), isect1 = CompileGlsl(LeafProbeIntersection(1).c_str(), "rint");
+  auto create = [&] {
+    RayTracingShaders shaders;
+    shaders.rayGeneration = {rayGen.data(), rayGen.size() * 4};
+    shaders.misses = {{miss.data(), miss.size() * 4}};
+    shaders.hitGroups = {{{isect0.data(), isect0.size() * 4}, {hit.data(), hit.size() * 4}}, {{isect1.data(), isect1.size() * 4}, {hit.data(), hit.size() * 4}}};
+    return RayTracingPipeline(ctx, shaders, {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR}, sizeof(uint32_t), "leaf_probe");
+  };
+  if (!ctx->hasRayTracingPipeline) {
+    INFO(ctx->DeviceName() << " has no ray tracing pipelines: only the errors are checked");
+    REQUIRE_THROWS_WITH(create(), Catch::Contains("has no ray tracing pipelines"));
+    if (!ctx->hasRayQuery) REQUIRE_THROWS_WITH(RayTracingScene(ctx), Catch::Contains("has no acceleration structures"));
+    RequireNoValidationMessages(*ctx);
+    return;
+  }
+  RayTracingPipeline pipe = create();
+  RayTracingScene scene(ctx);
+  const uint32_t side = 37;
+  std::vector<RayTracingScene::LeafBox> leaves;
+  std::vector<uint32_t> expected(side * side, 0xFFFFFFFFu);
+  for (uint32_t y = 0; y < side; ++y)
+    for (uint32_t x = 0; x < side; ++x) {
+      if ((x + 2 * y) % 7 == 3) continue;  // an empty cell: the ray misses
+      const float top = x % 3 == 0 ? 0.5f : 1.0f;  // every third box is flat along z
+      const uint32_t cls = (x + y) % 2;
+      expected[y * side + x] = 2 * uint32_t(leaves.size()) + cls;
+      leaves.push_back({{float(x), float(y), 0.5f * (x % 3 == 0)}, {float(x + 1), float(y + 1), top}, cls});
+    }
+  Buffer out(ctx, side * side * sizeof(uint32_t));
+  auto trace = [&] {
+    out.Fill(0u);
+    VkCommandBuffer cmd = ctx->BeginOneShot();
+    pipe.Bind(cmd);
+    pipe.PushBindings(cmd, {out.View(), Binding::SceneOf(scene)});
+    pipe.PushConstants(cmd, &side, sizeof(side));
+    pipe.TraceCmd(cmd, side, side, 1);
+    ctx->SubmitAndWait(cmd);
+    std::vector<uint32_t> values(side * side);
+    out.Download(values.data(), values.size() * sizeof(uint32_t));
+    return values;
+  };
+  scene.BuildLeaves(leaves, "probe");
+  std::vector<uint32_t> values = trace();
+  size_t wrong = 0;
+  for (size_t i = 0; i < values.size(); ++i)
+    if (values[i] != expected[i] && wrong++ < 5) UNSCOPED_INFO("cell " << i << " got " << values[i] << ", expected " << expected[i]);
+  REQUIRE(wrong == 0);
+  scene.BuildLeaves({}, "probe");  // no leaves: every ray misses
+  values = trace();
+  REQUIRE(std::count(values.begin(), values.end(), 0xFFFFFFFFu) == long(values.size()));
   RequireNoValidationMessages(*ctx);
 }
 

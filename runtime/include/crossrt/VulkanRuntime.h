@@ -80,9 +80,9 @@ public:
   VkPhysicalDeviceProperties properties{};  // limits, name, timestampPeriod
   bool hasScalarBlockLayout = false, hasBufferDeviceAddress = false, hasRayQuery = false,
        hasShaderFloat64 = false, hasShaderInt64 = false;
-  // Ray tracing pipelines (VK_KHR_ray_tracing_pipeline) with buffer device addresses: what
-  // CallablePipeline needs, the pipeline virtual functions run in at level 3. Then the shader
-  // group handle limits follow.
+  // Ray tracing pipelines (VK_KHR_ray_tracing_pipeline, with acceleration structures and buffer
+  // device addresses): what RayTracingPipeline needs, the pipeline virtual functions run in at
+  // level 3. Then the shader group handle limits follow.
   bool hasRayTracingPipeline = false;
   uint32_t shaderGroupHandleSize = 0, shaderGroupHandleAlignment = 1, shaderGroupBaseAlignment = 1;
   // Arrays of combined image samplers indexed per thread (descriptor indexing: runtime arrays,
@@ -325,9 +325,10 @@ void EnsureSampler(std::shared_ptr<VulkanContext> ctx, Sampler& s, const Sampler
 void CheckFilterable(const VulkanContext& ctx, const Image& img, const Sampler& s, const char* what);
 void CheckFilterable(const VulkanContext& ctx, VkFormat format, const SamplerDesc& s, const char* what);
 
-// Acceleration structures for ray queries (VK_KHR_acceleration_structure), move-only: what an
-// ISceneObject member becomes for the shaders that trace on ray tracing hardware. One bottom level
-// per triangle mesh, one top level over the instances, both built on the device by Build.
+// Acceleration structures (VK_KHR_acceleration_structure), move-only: what an ISceneObject member
+// becomes for the shaders that trace on ray tracing hardware (Build: one bottom level per triangle
+// mesh, one top level over the instances, both built on the device), or the leaves of a composed
+// traversal whose intersection shaders a ray tracing pipeline runs (BuildLeaves).
 // In a hit, the instance index is the instance's position in `instances` and the custom index its
 // mesh; the primitive index is the triangle's position in its mesh.
 class RayTracingScene {
@@ -342,7 +343,7 @@ public:
   };
 
   RayTracingScene() = default;
-  // Throws unless the device has ray queries (VulkanContext::hasRayQuery).
+  // Throws unless the device has acceleration structures (ray queries or ray tracing pipelines).
   explicit RayTracingScene(std::shared_ptr<VulkanContext> ctx);
   RayTracingScene(RayTracingScene&& other) noexcept;
   RayTracingScene& operator=(RayTracingScene&& other) noexcept;
@@ -353,6 +354,17 @@ public:
   // Replaces what was built (synchronous). Instances of empty meshes are kept but never hit, so
   // instance indices stay; an empty scene is a top level that every ray misses.
   void Build(const std::vector<Mesh>& meshes, const std::vector<Instance>& instances);
+
+  // Leaves of a traversal whose intersection shaders the ray tracing pipeline runs: one instance
+  // per box, in order (gl_InstanceID is the box's index), each with the shader binding table offset
+  // of its hit group, over one bottom level holding a unit box. A box that is flat along an axis is
+  // given a sliver of thickness there. Throws on boxes with NaN or min > max, naming `what`.
+  struct LeafBox {
+    float min[3], max[3];
+    uint32_t hitGroup;
+  };
+  void BuildLeaves(const std::vector<LeafBox>& leaves, const std::string& what);
+  static void CheckLeafBoxes(const std::vector<LeafBox>& leaves, const std::string& what);  // BuildLeaves' check, alone
   bool Empty() const { return topLevel_ == VK_NULL_HANDLE; }
   VkAccelerationStructureKHR TopLevel() const { return topLevel_; }
 
@@ -361,7 +373,12 @@ private:
     VkAccelerationStructureKHR handle = VK_NULL_HANDLE;
     Buffer storage;
   };
+  struct PendingLevel;  // a bottom level created, waiting for its build
   Level Create(VkAccelerationStructureTypeKHR type, VkDeviceSize bytes);
+  // Sizes and creates a bottom level for `geometry` (primitiveCount primitives), to build later.
+  PendingLevel Prepare(const VkAccelerationStructureGeometryKHR& geometry, uint32_t primitiveCount, VkDeviceSize& scratchBytes);
+  // Builds the pending bottom levels, then the top level over `records` (synchronous).
+  void BuildLevels(std::vector<PendingLevel>& pending, VkDeviceSize scratchBytes, const std::vector<VkAccelerationStructureInstanceKHR>& records);
   void Release() noexcept;
 
   std::shared_ptr<VulkanContext> ctx_;
@@ -586,21 +603,36 @@ struct ShaderCode {
   size_t bytes = 0;
 };
 
-// RAII ray tracing pipeline of one ray generation shader and callable shaders, move-only: a kernel
-// whose virtual calls run as callable shaders (virtual functions, level 3). executeCallableEXT(i, ...)
-// in the shaders runs callables[i]. Throws unless ctx->hasRayTracingPipeline.
-class CallablePipeline : public Pipeline {
+// The shaders of a ray tracing pipeline. traceRayEXT(..., missIndex, ...) runs misses[missIndex];
+// a leaf whose instance has shader binding table offset i runs hitGroups[i] (procedural geometry: its
+// intersection shader, then the closest-hit shader for the nearest); executeCallableEXT(i, ...) runs
+// callables[i].
+struct RayTracingShaders {
+  struct HitGroup {
+    ShaderCode intersection, closestHit;
+  };
+  ShaderCode rayGeneration;
+  std::vector<ShaderCode> misses;
+  std::vector<HitGroup> hitGroups;
+  std::vector<ShaderCode> callables;
+};
+
+// RAII ray tracing pipeline (virtual functions, level 3), move-only: a kernel as a ray generation
+// shader, whose virtual calls run as callable shaders or whose traversal traces rays against leaves
+// intersected by intersection shaders. Bindings and push constants are visible to every stage.
+// Throws unless ctx->hasRayTracingPipeline.
+class RayTracingPipeline : public Pipeline {
 public:
-  CallablePipeline() = default;
-  CallablePipeline(std::shared_ptr<VulkanContext> ctx, ShaderCode rayGeneration, const std::vector<ShaderCode>& callables,
-                   std::vector<VkDescriptorType> bindingTypes, uint32_t pushConstantBytes, const char* debugName);
+  RayTracingPipeline() = default;
+  RayTracingPipeline(std::shared_ptr<VulkanContext> ctx, const RayTracingShaders& shaders, std::vector<VkDescriptorType> bindingTypes,
+                     uint32_t pushConstantBytes, const char* debugName);
   // Launches width x height x depth ray generation threads (gl_LaunchIDEXT), behind and ahead of
   // barriers to and from the compute and transfer stages the other commands use.
   void TraceCmd(VkCommandBuffer cmd, uint32_t width, uint32_t height, uint32_t depth) const;
 
 private:
-  Buffer table_;  // the shader binding table: the ray generation record, then the callables'
-  VkStridedDeviceAddressRegionKHR rayGenRegion_{}, callableRegion_{};
+  Buffer table_;  // the shader binding table: the ray generation record, then the misses', hit groups' and callables'
+  VkStridedDeviceAddressRegionKHR rayGenRegion_{}, missRegion_{}, hitRegion_{}, callableRegion_{};
 };
 
 // Dispatch `threads` threads in groups of `groupSize` (1D). Above 65535 groups (the minimum
