@@ -114,14 +114,35 @@ TEST_CASE("Composition: virtual intersection functions called from the composed 
 
   auto ctx = ValidatedContext();
   auto cpu = CreateShapeTracer_CPU();
-  std::shared_ptr<ShapeTracer> gpu = ctx ? CreateShapeTracer_Vulkan(ctx) : nullptr;
-  for (ShapeTracer* t : {cpu.get(), gpu.get()})
+  std::shared_ptr<ShapeTracer_Vulkan> gpu = ctx ? std::make_shared<ShapeTracer_Vulkan>(ctx) : nullptr;
+  // Level 3: the leaves are intersection shaders of a ray tracing pipeline where the device has
+  // them (the default there), the switch of level 2 elsewhere.
+  if (gpu)
   {
-    if (!t) continue;
-    INFO((t == cpu.get() ? "CPU" : "Vulkan"));
-    t->SetScene(scene);
+    REQUIRE(gpu->UsesRayTracingPipelines() == ctx->hasRayTracingPipeline);
+    if (!ctx->hasRayTracingPipeline)
+    {
+      INFO(ctx->DeviceName() << " has no ray tracing pipelines: the intersection shaders are only compiled and validated (spirv.hardware_variants)");
+      REQUIRE_THROWS_WITH(gpu->UseRayTracingPipelines(true), Catch::Contains("has no ray tracing pipelines"));
+      REQUIRE_FALSE(gpu->UsesRayTracingPipelines());
+    }
+  }
+  struct Run
+  {
+    const char* name;
+    ShapeTracer* tracer;
+    bool intersectionShaders;
+  };
+  std::vector<Run> runs = {{"CPU", cpu.get(), false}};
+  if (gpu && ctx->hasRayTracingPipeline) runs.push_back({"Vulkan, intersection shaders", gpu.get(), true});
+  if (gpu) runs.push_back({"Vulkan, switch", gpu.get(), false});
+  for (const Run& run : runs)
+  {
+    INFO(run.name);
+    if (run.tracer == gpu.get()) gpu->UseRayTracingPipelines(run.intersectionShaders);
+    run.tracer->SetScene(scene);
     std::vector<ShapeHit> hits(n);
-    t->Trace(n, origins.data(), dirs.data(), far, hits.data());
+    run.tracer->Trace(n, origins.data(), dirs.data(), far, hits.data());
     int sameShape = 0;
     for (int i = 0; i < n; ++i)
     {
@@ -138,10 +159,14 @@ TEST_CASE("Composition: virtual intersection functions called from the composed 
     }
     REQUIRE(sameShape >= n - n / 200);
   }
-  // A shape moved: CommitDeviceData() copies the objects again.
-  if (gpu)
+  // A shape moved: CommitDeviceData() copies the objects (and builds the leaves' boxes) again.
+  for (const Run& run : runs)
   {
+    if (run.tracer != gpu.get()) continue;
+    INFO(run.name);
+    gpu->UseRayTracingPipelines(run.intersectionShaders);
     auto moved = std::make_shared<Sphere>(float3(0.2f, -0.2f, 2.0f), 0.5f);
+    const auto first = scene->m_shapes[0];
     scene->m_shapes[0] = moved;
     scene->m_boxes[0] = moved->BoxMin();
     scene->m_boxes[1] = moved->BoxMax();
@@ -151,6 +176,10 @@ TEST_CASE("Composition: virtual intersection functions called from the composed 
     gpu->Trace(1, &o, &d, far, &h);
     REQUIRE(h.shape == 0u);
     REQUIRE(std::fabs(h.t - 2.5f) < 1e-5f);
+    scene->m_shapes[0] = first;  // back, for the next run
+    scene->m_boxes[0] = first->BoxMin();
+    scene->m_boxes[1] = first->BoxMax();
+    gpu->CommitDeviceData();
   }
   RequireNoValidationMessages(ctx);
 }

@@ -471,7 +471,7 @@ TEST_CASE("RayTracingScene: instances of meshes traced with ray queries, or a cl
   if (!ctx) return;
   if (!ctx->hasRayQuery) {
     INFO(ctx->DeviceName() << " has no ray queries: only the error is checked");
-    REQUIRE_THROWS_WITH(RayTracingScene(ctx), Catch::Contains("has no ray queries"));
+    if (!ctx->hasRayTracingPipeline) REQUIRE_THROWS_WITH(RayTracingScene(ctx), Catch::Contains("has no acceleration structures"));
     return;
   }
   // Mesh 0: two triangles covering [0,1]^2 at z = 0; mesh 1: empty; mesh 2: one triangle at z = 1.
@@ -644,7 +644,6 @@ TEST_CASE("RayTracingScene leaves: a box per instance, in order, each class's in
   if (!ctx->hasRayTracingPipeline) {
     INFO(ctx->DeviceName() << " has no ray tracing pipelines: only the errors are checked");
     REQUIRE_THROWS_WITH(create(), Catch::Contains("has no ray tracing pipelines"));
-    if (!ctx->hasRayQuery) REQUIRE_THROWS_WITH(RayTracingScene(ctx), Catch::Contains("has no acceleration structures"));
     RequireNoValidationMessages(*ctx);
     return;
   }

@@ -6,14 +6,16 @@
 #   *_Textures.comp: arrays of textures indexed per thread (descriptor indexing), capabilities
 #   RuntimeDescriptorArray and SampledImageArrayNonUniformIndexing;
 #   *_Callables.rgen and *.rcall: a kernel as a ray generation shader and the callable shaders its
-#   virtual calls execute (ray tracing pipelines, GL_EXT_ray_tracing), capability RayTracingKHR.
+#   virtual calls execute (ray tracing pipelines, GL_EXT_ray_tracing), capability RayTracingKHR;
+#   *_Intersections.rgen, *.rint, *.rchit and *.rmiss: a kernel whose composed traversal traces its
+#   leaves, with their intersection, closest-hit and miss shaders, capability RayTracingKHR.
 # Usage: validate_hardware_variants.sh <glslangValidator> <spirv-val> <spirv-dis> <build dir> <expected shader>...
 # Each expected shader (a path ending, e.g. PrimaryRays_Vulkan/shaders/kernel1D_CastRays_RayQuery.comp)
 # must be among those found, so a generator that stopped writing them fails here.
 set -u
 glslang=$1 spirvval=$2 spirvdis=$3 build=$4
 shift 4
-mapfile -t shaders < <(find "$build" \( -name '*_RayQuery.comp' -o -name '*_Textures.comp' -o -name '*_Callables.rgen' -o -name '*.rcall' \) -path '*/shaders/*' | sort -u)
+mapfile -t shaders < <(find "$build" \( -name '*_RayQuery.comp' -o -name '*_Textures.comp' -o -name '*.rgen' -o -name '*.rcall' -o -name '*.rint' -o -name '*.rchit' -o -name '*.rmiss' \) -path '*/shaders/*' | sort -u)
 status=0
 for expected in "$@"; do
   if ! printf '%s\n' "${shaders[@]}" | grep -q -- "/$expected\$"; then
@@ -32,7 +34,7 @@ for shader in "${shaders[@]}"; do
   needed=()
   case "$shader" in *_RayQuery*) needed+=(RayQueryKHR) ;; esac
   case "$shader" in *_Textures.comp) needed+=(RuntimeDescriptorArray SampledImageArrayNonUniformIndexing) ;; esac
-  case "$shader" in *.rgen | *.rcall) needed+=(RayTracingKHR) ;; esac
+  case "$shader" in *.rgen | *.rcall | *.rint | *.rchit | *.rmiss) needed+=(RayTracingKHR) ;; esac
   "$spirvdis" "$spv" > "$work/dis" 2>/dev/null
   missing=""
   for capability in "${needed[@]}"; do
