@@ -2602,6 +2602,7 @@ void AnalyzeLeafTraversal(ASTContext& ctx, Reporter& rep, ClassModel& model, Ker
                 " bytes; intersection shaders report at most 32 (Vulkan's guaranteed hit attribute size)");
   std::string zeroHit;
   for (auto* f : hitRecord->fields()) {
+    if (f == distance) continue;  // the ray's end, set after
     const std::string zero = ZeroOf(f->getType());
     if (zero.empty()) return skip("the hit " + hitRecord->getNameAsString() + " has a field, '" + f->getNameAsString() + "', that is not a scalar, vector or array of them");
     zeroHit += "  hit." + GlslPrinter::SafeName(f->getNameAsString()) + " = " + zero + ";\n";
@@ -2647,9 +2648,9 @@ void AnalyzeLeafTraversal(ASTContext& ctx, Reporter& rep, ClassModel& model, Ker
   const std::string p = hardware.Expr(call->getArg(0)), d = hardware.Expr(call->getArg(1)), h = hardware.Expr(call->getArg(n - 1));
   const std::string t = h + "." + GlslPrinter::SafeName(distance->getNameAsString());
   std::ostringstream trace;
-  trace << "// The loop of " << lt.traversal << " calling " << callText << " (" << site << ") runs on the ray tracing\n"
-        << "// hardware: it finds the leaves whose boxes the ray meets, and the intersection shader of each\n"
-        << "// leaf's class calls its " << methodName << " (virtual functions, level 3).\n"
+  trace << "// The loop of " << lt.traversal << " calling " << callText << " (" << site << ")\n"
+        << "// runs on the ray tracing hardware: it finds the leaves whose boxes the ray meets, and the\n"
+        << "// intersection shader of each leaf's class calls its " << methodName << " (virtual functions, level 3).\n"
         << "{\n  const float crt_near = max(" << p << ".w, 0.0);  // rays start at a distance >= 0 on the hardware\n"
         << "  const bool crt_finite = !any(isnan(" << p << ".xyz)) && !any(isinf(" << p << ".xyz)) && !any(isnan(" << d << ".xyz)) && !any(isinf(" << d << ".xyz));\n"
         << "  " << payload << " = " << h << ";\n"

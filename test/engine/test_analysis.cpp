@@ -372,3 +372,113 @@ void Broken::kernel1D_Fill(int n, float* out) { for (int i = 0; i < n; i++) out[
   INFO(r.diagnostics);
   REQUIRE(r.ok);
 }
+
+// Level 3 in composed code (paper 3.10): the traversal's leaf calls become intersection shaders.
+namespace {
+const char* kLeafHeader = R"(#pragma once
+#include "LiteMath.h"
+#include <cstdint>
+#include <memory>
+#include <vector>
+struct Hit { float t; uint32_t id; };
+struct IThing {
+  virtual ~IThing() = default;
+  virtual void Intersect(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar, uint32_t id, Hit& hit) const = 0;
+  virtual LiteMath::float4 BoxMin() const = 0;
+  virtual LiteMath::float4 BoxMax() const = 0;
+};
+struct Ball : IThing {
+  LiteMath::float4 c;
+  void Intersect(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar, uint32_t id, Hit& hit) const override {
+    const float t = c.z - posAndNear.z;
+    if (t >= posAndNear.w && t < hit.t) { hit.t = t; hit.id = id; }
+  }
+  LiteMath::float4 BoxMin() const override { return c; }
+  LiteMath::float4 BoxMax() const override { return c; }
+};
+struct IWorld { virtual ~IWorld() = default; virtual Hit Trace(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar) = 0; };
+struct World : IWorld {
+  std::vector<std::shared_ptr<IThing>> m_things;
+  uint32_t m_count = 0;  // m_things.size(): a vector of objects has no size on the GPU
+  Hit Trace(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar) override;
+};
+class Leaves {
+public:
+  virtual ~Leaves() = default;
+  virtual void Run(int n, [[crossrt::size("n")]] const LiteMath::float4* rays, [[crossrt::size("n")]] Hit* hits);
+  virtual void CommitDeviceData() {}
+protected:
+  void kernel1D_Run(int n, const LiteMath::float4* rays, Hit* hits);
+  std::shared_ptr<IWorld> m_world;
+};
+)";
+
+std::string LeafSource(const std::string& loop) {
+  return "#include \"Leaves.h\"\n"
+         "Hit World::Trace(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar) {\n"
+         "  Hit hit;\n  hit.t = dirAndFar.w;\n  hit.id = ~0u;\n  uint32_t visited = 0;\n" + loop +
+         "  return hit;\n}\n"
+         "void Leaves::Run(int n, const LiteMath::float4* rays, Hit* hits) { kernel1D_Run(n, rays, hits); }\n"
+         "void Leaves::kernel1D_Run(int n, const LiteMath::float4* rays, Hit* hits) {\n"
+         "  for (int i = 0; i < n; ++i) hits[i] = m_world->Trace(rays[i], LiteMath::float4(0.0f, 0.0f, 1.0f, 100.0f));\n}\n";
+}
+}  // namespace
+
+TEST_CASE("Level 3: a composed traversal's leaf calls become intersection shaders, or say why they cannot", "[engine][composition][virtual]")
+{
+  auto translate = [](const std::string& loop, int level) {
+    TempClass tc("Leaves", kLeafHeader, LeafSource(loop));
+    TranslateRequest r = MakeRequest(tc, "Leaves");
+    r.compositions = {"IWorld=World"};
+    r.virtualLevel = level;
+    return Translate(r);
+  };
+  const std::string visitAll = "  for (uint32_t i = 0; i < m_count; ++i)\n    m_things[i]->Intersect(posAndNear, dirAndFar, i, hit);\n";
+  {
+    const TranslateResult result = translate(visitAll, 3);
+    INFO(result.diagnostics);
+    REQUIRE(result.ok);
+    const std::string& rgen = result.files.at("shaders/kernel1D_Run_Intersections.rgen");
+    const std::string& rint = result.files.at("shaders/m_world_m_things_Ball_Intersect.rint");
+    // The loop is a trace from the traversal's ray up to the nearest hit so far; the rest is as written.
+    CHECK(rgen.find("traceRayEXT(m_world_m_things_leaves, gl_RayFlagsNoneEXT, 0xFF, 0, 0, 0, posAndNear.xyz, crt_near, dirAndFar.xyz, hit.t, 0);") != std::string::npos);
+    CHECK(rgen.find("layout(location = 0) rayPayloadEXT Hit m_world_m_things_Intersect_hit;") != std::string::npos);
+    CHECK(rgen.find("hit.id = ~0u;") != std::string::npos);
+    CHECK(rgen.find("m_world_m_things_Intersect(") == std::string::npos);  // no switch over the classes
+    CHECK(result.files.at("shaders/kernel1D_Run.comp").find("m_world_m_things_Intersect(uint(i)") != std::string::npos);
+    // The intersection shader: the leaf's object, Ball's Intersect on the hardware's ray, its index
+    // the instance's, a report when nearer.
+    CHECK(rint.find("objects[tag.y]") != std::string::npos);
+    CHECK(rint.find("Ball_Intersect(self, vec4(gl_WorldRayOriginEXT, gl_RayTminEXT), vec4(gl_WorldRayDirectionEXT, gl_RayTmaxEXT), uint(gl_InstanceID), hit);") != std::string::npos);
+    CHECK(rint.find("reportIntersectionEXT(hit.t, 0u);") != std::string::npos);
+    CHECK(result.files.count("shaders/m_world_m_things_Intersect_Hit.rchit") == 1);
+    CHECK(result.files.count("shaders/m_world_m_things_Intersect_Miss.rmiss") == 1);
+    const std::string& host = result.files.at("Leaves_Vulkan.cpp");
+    CHECK(host.find("m_scenes.m_world_m_things_leaves.BuildLeaves(leaves, \"Leaves::m_world->m_things\");") != std::string::npos);
+    CHECK(host.find("const auto lo = object->BoxMin(), hi = object->BoxMax();") != std::string::npos);
+  }
+  // Level 2 asks for no ray tracing pipeline.
+  {
+    const TranslateResult result = translate(visitAll, 2);
+    REQUIRE(result.ok);
+    CHECK(result.files.count("shaders/kernel1D_Run_Intersections.rgen") == 0);
+  }
+  // Loops that do more than visit leaves keep the switch, and the host says why.
+  const std::pair<std::string, std::string> kept[] = {
+      {"  for (uint32_t i = 0; i < m_count; ++i) {\n    ++visited;\n    m_things[i]->Intersect(posAndNear, dirAndFar, i, hit);\n  }\n",
+       "does more than visit leaves: it writes 'visited', declared before the loop"},
+      {"  for (uint32_t i = 0; i < m_count; ++i) {\n    m_things[i]->Intersect(posAndNear, dirAndFar, i, hit);\n    if (hit.id != ~0u) break;\n  }\n",
+       "does more than visit leaves: it breaks out of the loop"},
+      {"  for (uint32_t i = 0; i < m_count; ++i)\n    m_things[i]->Intersect(posAndNear, dirAndFar, i + 1, hit);\n",
+       "argument 3 of m_world->m_things[...]->Intersect is neither the leaf's index nor a constant"},
+      {"  m_things[0]->Intersect(posAndNear, dirAndFar, 0u, hit);\n", "is not inside a loop of the traversal's body"}};
+  for (const auto& [loop, why] : kept)
+  {
+    INFO(loop);
+    const TranslateResult result = translate(loop, 3);
+    INFO(result.diagnostics);
+    REQUIRE(result.ok);
+    CHECK(result.files.count("shaders/kernel1D_Run_Intersections.rgen") == 0);
+    CHECK(result.files.at("Leaves_Vulkan.cpp").find(why) != std::string::npos);
+  }
+}
