@@ -2461,17 +2461,42 @@ LeafSite FindLeafSite(ASTContext& ctx, const clang::Stmt* call) {
   }
 }
 
+// The variable of a loop over all leaves, `for (T i = 0; i < count; ++i) [if (test)] call;` (braces
+// allowed around one statement), or null when the loop has another shape.
+const VarDecl* LeafLoopVariable(const clang::Stmt* loop, const CXXMemberCallExpr* call) {
+  auto* fs = dyn_cast<ForStmt>(loop);
+  auto* ds = fs ? dyn_cast_or_null<DeclStmt>(fs->getInit()) : nullptr;
+  auto* var = ds && ds->isSingleDecl() ? dyn_cast<VarDecl>(ds->getSingleDecl()) : nullptr;
+  if (!var || !var->getInit() || !var->getType()->isIntegerType()) return nullptr;
+  auto* zero = dyn_cast<IntegerLiteral>(var->getInit()->IgnoreParenImpCasts());
+  auto* cond = dyn_cast_or_null<BinaryOperator>(fs->getCond() ? fs->getCond()->IgnoreImplicit() : nullptr);
+  auto* inc = dyn_cast_or_null<UnaryOperator>(fs->getInc() ? fs->getInc()->IgnoreImplicit() : nullptr);
+  if (!zero || zero->getValue() != 0 || !cond || cond->getOpcode() != BO_LT || NamedVar(cond->getLHS()) != var || !inc || !inc->isIncrementOp() ||
+      NamedVar(inc->getSubExpr()) != var)
+    return nullptr;
+  auto single = [](const clang::Stmt* st) {
+    while (auto* cs = dyn_cast_or_null<CompoundStmt>(st)) {
+      if (cs->size() != 1) return static_cast<const clang::Stmt*>(nullptr);
+      st = cs->body_front();
+    }
+    return st;
+  };
+  const clang::Stmt* body = single(fs->getBody());
+  if (auto* test = dyn_cast_or_null<IfStmt>(body); test && !test->getElse() && !test->getInit() && !test->getConditionVariable()) body = single(test->getThen());
+  auto* expr = dyn_cast_or_null<clang::Expr>(body);
+  return expr && expr->IgnoreImplicit() == call ? var : nullptr;
+}
+
 // What the leaves' loop does besides the leaf call that the hardware's trace would not: writes to
-// variables declared before it, returns, breaks out of it. The first such place and why, or "".
+// variables declared before it (in its test, the only other code LeafLoopVariable lets it have).
+// The first such place and why, or "".
 struct LoopEffects : RecursiveASTVisitor<LoopEffects> {
-  ASTContext& ctx;
-  const clang::Stmt* loop;
   const CXXMemberCallExpr* leafCall;
   std::set<const VarDecl*> inner;  // declared inside the loop
   std::string problem;
   SourceLocation where;
 
-  LoopEffects(ASTContext& c, const clang::Stmt* l, const CXXMemberCallExpr* call) : ctx(c), loop(l), leafCall(call) {}
+  explicit LoopEffects(const CXXMemberCallExpr* call) : leafCall(call) {}
   void Note(SourceLocation loc, const std::string& what) {
     if (problem.empty()) { problem = what; where = loc; }
   }
@@ -2490,6 +2515,8 @@ struct LoopEffects : RecursiveASTVisitor<LoopEffects> {
   }
   bool VisitCallExpr(CallExpr* call) {
     if (call == leafCall) return true;
+    if (auto* mc = dyn_cast<CXXMemberCallExpr>(call); mc && mc->getMethodDecl() && !mc->getMethodDecl()->isConst())
+      Written(mc->getImplicitObjectArgument(), mc->getExprLoc());  // a non-const method changes its object
     if (auto* op = dyn_cast<CXXOperatorCallExpr>(call); op && (op->isAssignmentOp() || op->getOperator() == OO_PlusPlus || op->getOperator() == OO_MinusMinus))
       Written(op->getArg(0), op->getExprLoc());
     const FunctionDecl* fd = call->getDirectCallee();
@@ -2499,25 +2526,6 @@ struct LoopEffects : RecursiveASTVisitor<LoopEffects> {
       if (pt->isReferenceType() && !pt.getNonReferenceType().isConstQualified()) Written(call->getArg(i + shift), call->getArg(i + shift)->getExprLoc());
     }
     return true;
-  }
-  bool VisitReturnStmt(ReturnStmt* r) {
-    Note(r->getBeginLoc(), "it returns from inside the loop");
-    return true;
-  }
-  bool VisitBreakStmt(BreakStmt* b) {
-    // A break of the leaves' loop itself stops visiting leaves; one of an inner loop does not.
-    DynTypedNode node = DynTypedNode::create(*b);
-    for (;;) {
-      auto parents = ctx.getParents(node);
-      if (parents.empty()) return true;
-      node = parents[0];
-      const clang::Stmt* s = node.get<clang::Stmt>();
-      if (!s) return true;
-      if (isa<ForStmt, WhileStmt, DoStmt, CXXForRangeStmt, SwitchStmt>(s)) {
-        if (s == loop) Note(b->getBeginLoc(), "it breaks out of the loop");
-        return true;
-      }
-    }
   }
 };
 
@@ -2537,11 +2545,11 @@ std::string ZeroOf(QualType t) {
   return g ? *g + "(0)" : "";
 }
 
-// The interface method that gives a leaf's box corner on the host: `name() const`, no parameters,
-// returning a LiteMath float3 or float4. Null when there is none.
+// The interface method that gives a leaf's box corner on the host: public `name() const`, no
+// parameters, returning a LiteMath float3 or float4, declared by the interface itself. Else null.
 const CXXMethodDecl* BoxCorner(const CXXRecordDecl* interface, const std::string& name) {
   for (auto* d : interface->lookup(&interface->getASTContext().Idents.get(name)))
-    if (auto* md = dyn_cast<CXXMethodDecl>(d); md && md->isConst() && md->getNumParams() == 0) {
+    if (auto* md = dyn_cast<CXXMethodDecl>(d); md && md->isConst() && md->getNumParams() == 0 && md->getAccess() == AS_public) {
       auto g = GlslTypeOf(md->getReturnType().getNonReferenceType().getUnqualifiedType());
       if (g && (*g == "vec3" || *g == "vec4")) return md;
     }
@@ -2574,12 +2582,18 @@ void AnalyzeLeafTraversal(ASTContext& ctx, Reporter& rep, ClassModel& model, Ker
   const CXXMethodDecl* method = call->getMethodDecl();
   const std::string member = holderPrefix + field->getNameAsString(), site = at(call->getBeginLoc());
   auto vm = std::find_if(model.virtuals.begin(), model.virtuals.end(), [&](const VirtualMember& v) { return v.member == member; });
-  if (vm == model.virtuals.end() || vm->impls.empty()) return;  // reported by VirtualCallCode
+  if (vm == model.virtuals.end() || vm->impls.empty()) return skip("no class that implements it can be copied to the GPU");  // reported
   const std::string callText = vm->display + "[...]->" + method->getNameAsString();
   const LeafSite leaf = FindLeafSite(ctx, call);
   if (!leaf.fn || !isa<ForStmt, WhileStmt, DoStmt, CXXForRangeStmt>(leaf.loop))
     return skip("the leaf call " + callText + " (" + site + ") is not inside a loop of the traversal's body");
-  LoopEffects effects(ctx, leaf.loop, call);
+  // The trace visits every leaf once: the loop must say so, `for (T i = 0; i < count; ++i)` whose
+  // body is the call, perhaps behind a test (the leaf's box test, which the hardware does instead).
+  const VarDecl* loopVar = LeafLoopVariable(cast<clang::Stmt>(leaf.loop), call);
+  if (!loopVar)
+    return skip("the loop calling " + callText + " (" + site + ") is not 'for (i = 0; i < count; ++i) [if (box test)] " +
+                method->getNameAsString() + "(...);', which visits every leaf once as the hardware does");
+  LoopEffects effects(call);
   effects.TraverseStmt(const_cast<clang::Stmt*>(leaf.loop));
   if (!effects.problem.empty())
     return skip("the loop calling " + callText + " does more than visit leaves: " + effects.problem + " (" + at(effects.where) + ")");
@@ -2609,8 +2623,8 @@ void AnalyzeLeafTraversal(ASTContext& ctx, Reporter& rep, ClassModel& model, Ker
   }
   // Arguments: the ray and the hit as the traversal has them before the loop; the index as the leaf.
   const VarDecl* index = NamedVar(indexExpr);
-  if (!index || !effects.inner.count(index))
-    return skip(callText + " picks its object with an expression, not a variable of the loop: the hardware names a leaf by its element's position");
+  if (index != loopVar)
+    return skip(callText + " picks its object with an expression, not the loop's variable: the hardware names a leaf by its element's position");
   auto outer = [&](const clang::Expr* e) {
     const VarDecl* vd = NamedVar(e);
     return vd && vd->isLocalVarDeclOrParm() && !effects.inner.count(vd) ? vd : nullptr;
@@ -2620,13 +2634,12 @@ void AnalyzeLeafTraversal(ASTContext& ctx, Reporter& rep, ClassModel& model, Ker
     return skip("the ray and the hit " + callText + " takes must be variables of the traversal declared before the loop");
   // In the intersection shader, the leaf's index is its instance's: one instance per element, in order.
   GlslPrinter literals(ctx, implClass, rep);
-  auto hardwareLiteral = [&](const clang::Expr* e) { return literals.Expr(e); };
   std::vector<std::string> leafArgs;
   for (unsigned i = 2; i + 1 < n; ++i) {
     const clang::Expr* arg = call->getArg(i)->IgnoreParenImpCasts();
     auto type = GlslTypeOf(method->getParamDecl(i)->getType().getNonReferenceType().getUnqualifiedType());
     if (NamedVar(arg) == index && type) leafArgs.push_back(*type + "(gl_InstanceID)");
-    else if (isa<IntegerLiteral, FloatingLiteral, CXXBoolLiteralExpr>(arg) && type) leafArgs.push_back(*type + "(" + hardwareLiteral(arg) + ")");
+    else if (isa<IntegerLiteral, FloatingLiteral, CXXBoolLiteralExpr>(arg) && type) leafArgs.push_back(*type + "(" + literals.Expr(arg) + ")");
     else return skip("argument " + std::to_string(i + 1) + " of " + callText + " is neither the leaf's index nor a constant");
   }
   const CXXRecordDecl* interface = method->getParent();
@@ -2652,7 +2665,7 @@ void AnalyzeLeafTraversal(ASTContext& ctx, Reporter& rep, ClassModel& model, Ker
         << "// runs on the ray tracing hardware: it finds the leaves whose boxes the ray meets, and the\n"
         << "// intersection shader of each leaf's class calls its " << methodName << " (virtual functions, level 3).\n"
         << "{\n  const float crt_near = max(" << p << ".w, 0.0);  // rays start at a distance >= 0 on the hardware\n"
-        << "  const bool crt_finite = !any(isnan(" << p << ".xyz)) && !any(isinf(" << p << ".xyz)) && !any(isnan(" << d << ".xyz)) && !any(isinf(" << d << ".xyz));\n"
+        << "  const bool crt_finite = !any(isnan(" << p << ")) && !any(isinf(" << p << ".xyz)) && !any(isnan(" << d << ".xyz)) && !any(isinf(" << d << ".xyz));\n"
         << "  " << payload << " = " << h << ";\n"
         << "  if (crt_finite && crt_near < " << t << ")\n"
         << "    traceRayEXT(" << scene << ", gl_RayFlagsNoneEXT, 0xFF, 0, 0, 0, " << p << ".xyz, crt_near, " << d << ".xyz, " << t << ", 0);\n"
@@ -2680,16 +2693,15 @@ void AnalyzeLeafTraversal(ASTContext& ctx, Reporter& rep, ClassModel& model, Ker
   FindImplementations(ctx.getTranslationUnitDecl(), interface, impls);
   for (const VirtualImpl& vi : vm->impls) {
     auto impl = std::find_if(impls.begin(), impls.end(), [&](const CXXRecordDecl* r) { return r->getNameAsString() == vi.name; });
-    if (impl == impls.end()) return;
+    if (impl == impls.end()) return skip(vi.name + " is not defined where the traversal is");
     const std::string name = member + "_" + vi.name + "_" + methodName;
     lt.intersectionShaders.push_back(name);
-    if (std::any_of(model.leafShaders.begin(), model.leafShaders.end(), [&](const StageShader& s) { return s.name == name; })) continue;
     GlslPrinter object(ctx, *impl, rep);
     object.selfClass = *impl;
     object.composedPrefix = vi.name + "_";
     for (auto& sn : ClassStructNames(model)) object.predeclaredStructs.insert(sn);
     const std::string function = ImplementationMethod(rep, object, *impl, method, call->getBeginLoc());
-    if (function.empty()) return;
+    if (function.empty()) return skip("the GPU has no body of " + vi.name + "::" + methodName);  // reported
     object.Type(hitParam.getNonReferenceType().getUnqualifiedType(), call->getBeginLoc());
     StageShader s;
     s.name = name;
@@ -2706,6 +2718,8 @@ void AnalyzeLeafTraversal(ASTContext& ctx, Reporter& rep, ClassModel& model, Ker
     for (auto& x : object.Functions()) s.functions += x + "\n";
     std::string args = "self, vec4(gl_WorldRayOriginEXT, gl_RayTminEXT), vec4(gl_WorldRayDirectionEXT, gl_RayTmaxEXT)";
     for (auto& a : leafArgs) args += ", " + a;
+    // Another kernel's traversal may call the method with other constants: one shader per name.
+    auto same = std::find_if(model.leafShaders.begin(), model.leafShaders.end(), [&](const StageShader& x) { return x.name == name; });
     s.mainBody = "  // The leaf is element gl_InstanceID of " + vm->display + " (one instance per element, in order).\n"
                  "  const uvec2 tag = " + member + "_Tags(" + member + "_tags).tags[gl_InstanceID];\n"
                  "  const " + vi.name + "_Data self = " + member + "_" + vi.name + "Objects(" + member + "_" + vi.name + ").objects[tag.y];\n"
@@ -2714,7 +2728,8 @@ void AnalyzeLeafTraversal(ASTContext& ctx, Reporter& rep, ClassModel& model, Ker
                  "  " + function + "(" + args + ", hit);\n"
                  "  if (hit." + GlslPrinter::SafeName(distance->getNameAsString()) + " < gl_RayTmaxEXT)\n  {\n    crt_hit = hit;\n"
                  "    reportIntersectionEXT(hit." + GlslPrinter::SafeName(distance->getNameAsString()) + ", 0u);\n  }\n";
-    model.leafShaders.push_back(s);
+    if (same == model.leafShaders.end()) model.leafShaders.push_back(s);
+    else if (same->mainBody != s.mainBody) return skip("another traversal calls " + callText + " with other arguments");
   }
   // The closest-hit shader hands the nearest leaf's hit to the trace; the miss shader leaves it.
   lt.closestHitShader = member + "_" + methodName + "_Hit";

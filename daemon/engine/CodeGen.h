@@ -19,7 +19,7 @@ struct GenerateOptions {
 struct ShaderSource {
   std::string name;  // kernel name, or kernel + "_Reduce", "_RayQuery", ...; a callable shader's name
   std::string glsl;
-  std::string stage = "comp";  // the file's extension, which names the stage: comp, rgen or rcall
+  std::string stage = "comp";  // the file's extension, which names the stage: comp, rgen, rcall, rint, rchit or rmiss
 };
 
 std::vector<ShaderSource> GenerateShaders(const ClassModel& model, const GenerateOptions& options);

@@ -269,8 +269,9 @@ struct ClassModel {
   std::vector<std::string> usingDecls; // top-level using-directives of the sources: copied bodies need them
   std::vector<Composition> compositions;   // holders kernels call through, in declaration order
   std::vector<VirtualMember> virtuals;     // vectors of objects kernels call virtual functions of
-  // 1: one array of equal slots; 2: a buffer per class; 3: as 2, plus callable shaders for kernels
-  // whose ray generation variant a device with ray tracing pipelines runs.
+  // 1: one array of equal slots; 2: a buffer per class; 3: as 2, plus callable shaders (the class's
+  // own virtual calls) and intersection shaders (composed traversals' leaves) for kernels whose ray
+  // generation variant a device with ray tracing pipelines runs.
   int virtualLevel = 2;
   std::vector<StageShader> callables;      // level 3, by name
   std::vector<StageShader> leafShaders;    // level 3: intersection, closest-hit and miss shaders, by name

@@ -159,11 +159,14 @@ void RayTracingScene::Build(const std::vector<Mesh>& meshes, const std::vector<I
 }
 
 void RayTracingScene::CheckLeafBoxes(const std::vector<LeafBox>& leaves, const std::string& what) {
-  for (size_t i = 0; i < leaves.size(); ++i)
+  for (size_t i = 0; i < leaves.size(); ++i) {
+    if (leaves[i].hitGroup >= (1u << 24))
+      throw Error("crossrt::RayTracingScene: the hit group of " + what + "[" + std::to_string(i) + "] does not fit the 24-bit record offset");
     for (int a = 0; a < 3; ++a)
-      if (!(leaves[i].min[a] <= leaves[i].max[a]) || !std::isfinite(leaves[i].min[a]) || !std::isfinite(leaves[i].max[a]))
+      if (!(leaves[i].min[a] <= leaves[i].max[a]) || !std::isfinite(leaves[i].max[a] - leaves[i].min[a]))
         throw Error("crossrt::RayTracingScene: the box of " + what + "[" + std::to_string(i) + "] is not a finite box with min <= max (axis " +
                     std::to_string(a) + ": " + std::to_string(leaves[i].min[a]) + " to " + std::to_string(leaves[i].max[a]) + ")");
+  }
   if (leaves.size() >= (1u << 24)) throw Error("crossrt::RayTracingScene: " + what + " has more leaves than 24-bit instance ids name");
 }
 
@@ -254,9 +257,10 @@ void RayTracingScene::BuildLevels(std::vector<PendingLevel>& pending, VkDeviceSi
   topBuild.scratchData.deviceAddress = scratchBase;
   const VkAccelerationStructureBuildRangeInfoKHR* topRanges = &topRange;
   vk.vkCmdBuildAccelerationStructuresKHR(cmd, 1, &topBuild, &topRanges);
-  // Read by compute shaders (ray queries) and by ray tracing pipelines where the device has them.
-  const VkPipelineStageFlags readers =
-      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | (vk.hasRayTracingPipeline ? VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR : VkPipelineStageFlags(0));
+  // Read by compute shaders (ray queries) and ray tracing pipelines, whichever the device has: a
+  // stage that may not read acceleration structures there would be a validation error.
+  const VkPipelineStageFlags readers = (vk.hasRayQuery ? VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT : VkPipelineStageFlags(0)) |
+                                       (vk.hasRayTracingPipeline ? VK_PIPELINE_STAGE_RAY_TRACING_SHADER_BIT_KHR : VkPipelineStageFlags(0));
   BuildBarrier(cmd, readers, VK_ACCESS_ACCELERATION_STRUCTURE_READ_BIT_KHR | VK_ACCESS_SHADER_READ_BIT);
   ctx_->SubmitAndWait(cmd);
   topLevel_ = top_.handle;

@@ -5,6 +5,7 @@
 #include "crossrt/VulkanRuntime.h"
 #include "Internal.h"
 
+#include <algorithm>
 #include <cstring>
 #include <utility>
 
@@ -61,9 +62,12 @@ RayTracingPipeline::RayTracingPipeline(std::shared_ptr<VulkanContext> ctx, const
     };
     group(VK_RAY_TRACING_SHADER_GROUP_TYPE_GENERAL_KHR)->generalShader = stage(shaders.rayGeneration, VK_SHADER_STAGE_RAYGEN_BIT_KHR);
     for (const ShaderCode& c : shaders.misses) group(VK_RAY_TRACING_SHADER_GROUP_TYPE_GENERAL_KHR)->generalShader = stage(c, VK_SHADER_STAGE_MISS_BIT_KHR);
+    std::vector<std::pair<const uint32_t*, uint32_t>> closestHits;  // hit groups often share one: a stage each
     for (const RayTracingShaders::HitGroup& h : shaders.hitGroups) {
       const uint32_t intersection = stage(h.intersection, VK_SHADER_STAGE_INTERSECTION_BIT_KHR);
-      const uint32_t closestHit = stage(h.closestHit, VK_SHADER_STAGE_CLOSEST_HIT_BIT_KHR);
+      auto known = std::find_if(closestHits.begin(), closestHits.end(), [&](const auto& c) { return c.first == h.closestHit.spirv; });
+      const uint32_t closestHit = known != closestHits.end() ? known->second : stage(h.closestHit, VK_SHADER_STAGE_CLOSEST_HIT_BIT_KHR);
+      if (known == closestHits.end()) closestHits.push_back({h.closestHit.spirv, closestHit});
       auto* g = group(VK_RAY_TRACING_SHADER_GROUP_TYPE_PROCEDURAL_HIT_GROUP_KHR);
       g->intersectionShader = intersection;
       g->closestHitShader = closestHit;

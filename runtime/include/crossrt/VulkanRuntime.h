@@ -329,8 +329,9 @@ void CheckFilterable(const VulkanContext& ctx, VkFormat format, const SamplerDes
 // becomes for the shaders that trace on ray tracing hardware (Build: one bottom level per triangle
 // mesh, one top level over the instances, both built on the device), or the leaves of a composed
 // traversal whose intersection shaders a ray tracing pipeline runs (BuildLeaves).
-// In a hit, the instance index is the instance's position in `instances` and the custom index its
-// mesh; the primitive index is the triangle's position in its mesh.
+// In a hit on what Build made, the instance index is the instance's position in `instances` and the
+// custom index its mesh; the primitive index is the triangle's position in its mesh. In BuildLeaves'
+// scene, the instance index and the custom index are the leaf's.
 class RayTracingScene {
 public:
   struct Mesh {
