@@ -2589,7 +2589,7 @@ void AnalyzeLeafTraversal(ASTContext& ctx, Reporter& rep, ClassModel& model, Ker
     return skip("the leaf call " + callText + " (" + site + ") is not inside a loop of the traversal's body");
   // The trace visits every leaf once: the loop must say so, `for (T i = 0; i < count; ++i)` whose
   // body is the call, perhaps behind a test (the leaf's box test, which the hardware does instead).
-  const VarDecl* loopVar = LeafLoopVariable(cast<clang::Stmt>(leaf.loop), call);
+  const VarDecl* loopVar = LeafLoopVariable(leaf.loop, call);
   if (!loopVar)
     return skip("the loop calling " + callText + " (" + site + ") is not 'for (i = 0; i < count; ++i) [if (box test)] " +
                 method->getNameAsString() + "(...);', which visits every leaf once as the hardware does");

@@ -325,6 +325,8 @@ Data Common(const ClassModel& model, const GenerateOptions& opt) {
     x.set("level1", model.virtualLevel == 1);
     x.set("level2", model.virtualLevel >= 2);  // level 3 keeps the objects as level 2 does
     x.set("slotBytes", std::to_string(v.slotBytes));
+    // Its elements are leaves the ray tracing hardware finds: their boxes are committed with it.
+    x.set("leaves", std::any_of(model.kernels.begin(), model.kernels.end(), [&](const Kernel& k) { return RunsLeafShaders(k) && k.leaves.member == v.member; }));
     virtuals.push_back(x);
   }
   d.set("virtuals", virtuals);
@@ -1151,21 +1153,11 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
     std::set<std::string> leafMembers;
     for (const Kernel& k : model.kernels) {
       if (!RunsLeafShaders(k) || !leafMembers.insert(k.leaves.member).second) continue;
-      auto vm = std::find_if(model.virtuals.begin(), model.virtuals.end(), [&](const VirtualMember& v) { return v.member == k.leaves.member; });
       Data x;
       x.set("member", k.leaves.member);
       x.set("host", k.leaves.hostExpr);
       x.set("display", k.leaves.display);
       x.set("interface", k.leaves.interfaceName);
-      Data impls = List();
-      for (size_t t = 0; vm != model.virtuals.end() && t < vm->impls.size(); ++t) {
-        Data y;
-        y.set("impl", vm->impls[t].name);
-        y.set("typeIndex", std::to_string(t));
-        y.set("first", t == 0);
-        impls.push_back(y);
-      }
-      x.set("impls", impls);
       leafScenes.push_back(x);
     }
     d.set("leafScenes", leafScenes);
