@@ -45,11 +45,34 @@ std::string WhyNoCallables(const Kernel& k) {
 }
 
 bool RunsCallables(const Kernel& k) { return !k.callables.empty() && WhyNoCallables(k).empty(); }
-bool RunsLeafShaders(const Kernel& k) { return !k.leaves.member.empty() && WhyNoRayGeneration(k).empty(); }
+bool RunsLeafShaders(const Kernel& k) { return !k.leaves.empty() && WhyNoRayGeneration(k).empty(); }
 
 // Why a kernel whose composed traversal calls a virtual function per leaf keeps that loop in software.
 std::string WhyNoLeafShaders(const Kernel& k) {
-  return !k.whyNoLeafShaders.empty() ? k.whyNoLeafShaders : k.leaves.member.empty() ? "" : WhyNoRayGeneration(k);
+  return !k.whyNoLeafShaders.empty() ? k.whyNoLeafShaders : k.leaves.empty() ? "" : WhyNoRayGeneration(k);
+}
+
+// The vectors whose leaves a kernel's traces find, once each, in the traces' order: one
+// acceleration structure each.
+std::vector<const LeafTraversal*> LeafScenes(const Kernel& k) {
+  std::vector<const LeafTraversal*> out;
+  for (const LeafTraversal& lt : k.leaves)
+    if (std::none_of(out.begin(), out.end(), [&](const LeafTraversal* x) { return x->member == lt.member; })) out.push_back(&lt);
+  return out;
+}
+
+// "a, b and c"
+std::string Listed(const std::vector<std::string>& items) {
+  std::string out;
+  for (size_t i = 0; i < items.size(); ++i) out += (i == 0 ? "" : i + 1 == items.size() ? " and " : ", ") + items[i];
+  return out;
+}
+
+// The vectors whose leaves a kernel's traces find: "m_scene->m_shapes and m_scene->m_lights".
+std::string LeafDisplays(const Kernel& k) {
+  std::vector<std::string> displays;
+  for (const LeafTraversal* lt : LeafScenes(k)) displays.push_back(lt->display);
+  return Listed(displays);
 }
 
 // The callable shaders that kernels' ray generation variants execute, in the model's order.
@@ -67,11 +90,12 @@ std::vector<const StageShader*> ExecutedCallables(const ClassModel& model) {
 std::vector<const StageShader*> ExecutedLeafShaders(const ClassModel& model) {
   std::set<std::string> executed;
   for (const Kernel& k : model.kernels)
-    if (RunsLeafShaders(k)) {
-      executed.insert(k.leaves.intersectionShaders.begin(), k.leaves.intersectionShaders.end());
-      executed.insert(k.leaves.closestHitShader);
-      executed.insert(k.leaves.missShader);
-    }
+    if (RunsLeafShaders(k))
+      for (const LeafTraversal& lt : k.leaves) {
+        executed.insert(lt.intersectionShaders.begin(), lt.intersectionShaders.end());
+        executed.insert(lt.closestHitShader);
+        executed.insert(lt.missShader);
+      }
   std::vector<const StageShader*> out;
   for (const StageShader& c : model.leafShaders)
     if (executed.count(c.name)) out.push_back(&c);
@@ -285,7 +309,7 @@ Data Common(const ClassModel& model, const GenerateOptions& opt) {
   d.set("hasRayQuery", !rayQueryScenes.is_empty_list());
   // Virtual functions: the implementations' data mirrors and the regrouping of the objects.
   Data virtuals = List(), implIncludes = List();
-  std::set<std::string> headers;
+  std::set<std::string> headers, mirrored;
   for (auto& v : model.virtuals) {
     Data x;
     x.set("member", v.member);
@@ -302,6 +326,7 @@ Data Common(const ClassModel& model, const GenerateOptions& opt) {
       y.set("member", v.member);
       y.set("typeIndex", std::to_string(t));
       y.set("first", t == 0);
+      y.set("mirror", mirrored.insert(vi.name).second);  // one mirror per class, whichever vectors hold it
       Data fields = List();
       for (auto& f : vi.fields) {
         Data z;
@@ -326,7 +351,9 @@ Data Common(const ClassModel& model, const GenerateOptions& opt) {
     x.set("level2", model.virtualLevel >= 2);  // level 3 keeps the objects as level 2 does
     x.set("slotBytes", std::to_string(v.slotBytes));
     // Its elements are leaves the ray tracing hardware finds: their boxes are committed with it.
-    x.set("leaves", std::any_of(model.kernels.begin(), model.kernels.end(), [&](const Kernel& k) { return RunsLeafShaders(k) && k.leaves.member == v.member; }));
+    x.set("leaves", std::any_of(model.kernels.begin(), model.kernels.end(), [&](const Kernel& k) {
+            return RunsLeafShaders(k) && std::any_of(k.leaves.begin(), k.leaves.end(), [&](const LeafTraversal& lt) { return lt.member == v.member; });
+          }));
     virtuals.push_back(x);
   }
   d.set("virtuals", virtuals);
@@ -412,9 +439,13 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   d.set("compute", !rayGeneration);
   std::string variant;
   if (callables) variant = ": the variant for ray tracing pipelines, whose virtual calls execute a callable shader per class";
-  if (kind.leaves)
-    variant = ": the variant for ray tracing pipelines, in which the hardware finds the leaves of " + k.leaves.traversal +
-              "\n// and an intersection shader per class of " + k.leaves.display + " intersects them";
+  if (kind.leaves) {
+    std::vector<std::string> traversals;
+    for (const LeafTraversal& lt : k.leaves)
+      if (std::find(traversals.begin(), traversals.end(), lt.traversal) == traversals.end()) traversals.push_back(lt.traversal);
+    variant = ": the variant for ray tracing pipelines, in which the hardware finds the leaves of " + Listed(traversals) +
+              "\n// and an intersection shader per class of " + LeafDisplays(k) + " intersects them";
+  }
   if (hardwareRayQuery) variant = ": the variant for ray tracing hardware (GL_EXT_ray_query)";
   if (hardwareTextures) variant += std::string(variant.empty() ? ": the variant" : ",") + " for arrays of textures on the GPU's samplers (descriptor indexing)";
   else if (!k.textureArrays.empty()) variant += std::string(variant.empty() ? ": the variant" : ",") + " sampling arrays of textures from buffers, on any device";
@@ -571,12 +602,13 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
     x.set("comment", "the scene " + k.rayQueryHolder + " holds, built for the ray tracing hardware");
     images.push_back(x);
   }
-  if (kind.leaves) {
-    Data x;
-    x.set("decl", "layout(binding = " + std::to_string(binding++) + ") uniform accelerationStructureEXT " + k.leaves.member + "_leaves");
-    x.set("comment", "a box per element of " + k.leaves.display + ", for the ray tracing hardware");
-    images.push_back(x);
-  }
+  if (kind.leaves)
+    for (const LeafTraversal* lt : LeafScenes(k)) {
+      Data x;
+      x.set("decl", "layout(binding = " + std::to_string(binding++) + ") uniform accelerationStructureEXT " + lt->member + "_leaves");
+      x.set("comment", "a box per element of " + lt->display + ", for the ray tracing hardware");
+      images.push_back(x);
+    }
   d.set("images", images);
   d.set("scalarLayout", scalarAny || k.scalarReferences);
   d.set("bufferReferences", k.bufferReferences);
@@ -945,11 +977,17 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
         if (kind.textures) sets += (sets.empty() ? "&m_textures." : ", &m_textures.") + a;
         else buffer("m_textures." + a + "_texels.View()");
       }
-      if (kind.rayQuery || kind.leaves) {
+      if (kind.rayQuery) {
         types += ", VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR";
-        list += ", crossrt::Binding::SceneOf(m_scenes." + (kind.leaves ? k.leaves.member + "_leaves" : k.rayQueryHolder) + ")";
+        list += ", crossrt::Binding::SceneOf(m_scenes." + k.rayQueryHolder + ")";
         typed = true;
       }
+      if (kind.leaves)
+        for (const LeafTraversal* lt : LeafScenes(k)) {
+          types += ", VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR";
+          list += ", crossrt::Binding::SceneOf(m_scenes." + lt->member + "_leaves)";
+          typed = true;
+        }
       Data y;
       y.set("kernel", k.name);
       y.set("pipeline", k.name + kind.suffix);
@@ -969,8 +1007,11 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
         const std::string pad = "\n          ";
         shaders = "{" + code(k.name + kind.suffix) + ",";
         if (kind.leaves) {
-          shaders += pad + "{" + code(k.leaves.missShader) + "},  // a ray that meets no leaf" + pad + "{  // hit group i: the leaves of class i";
-          for (auto& c : k.leaves.intersectionShaders) shaders += pad + "  {" + code(c) + ", " + code(k.leaves.closestHitShader) + "},";
+          shaders += pad + "{  // miss shader i: a ray of the traces of leaf call i that meets no leaf";
+          for (const LeafTraversal& lt : k.leaves) shaders += pad + "  " + code(lt.missShader) + ",";
+          shaders += pad + "}," + pad + "{  // hit groups: per leaf call, one per class of its leaves";
+          for (const LeafTraversal& lt : k.leaves)
+            for (auto& c : lt.intersectionShaders) shaders += pad + "  {" + code(c) + ", " + code(lt.closestHitShader) + "},";
           shaders += pad + "}," + pad + "{}}";
         } else {
           shaders += pad + "{}," + pad + "{}," + pad + "{  // executeCallableEXT's numbering";
@@ -995,7 +1036,7 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
         needs = "m_ctx->hasRayTracingPipeline";
         use = "m_useRayTracingPipelines";
         why = kind.callables ? "virtual calls as callable shaders, in a ray tracing pipeline"
-                             : k.leaves.display + "'s leaves as intersection shaders, in a ray tracing pipeline";
+                             : LeafDisplays(k) + "'s leaves as intersection shaders, in a ray tracing pipeline";
       }
       if (kind.rayQuery) {
         needs = "m_ctx->hasRayQuery";
@@ -1152,13 +1193,16 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
     Data leafScenes = List();
     std::set<std::string> leafMembers;
     for (const Kernel& k : model.kernels) {
-      if (!RunsLeafShaders(k) || !leafMembers.insert(k.leaves.member).second) continue;
-      Data x;
-      x.set("member", k.leaves.member);
-      x.set("host", k.leaves.hostExpr);
-      x.set("display", k.leaves.display);
-      x.set("interface", k.leaves.interfaceName);
-      leafScenes.push_back(x);
+      if (!RunsLeafShaders(k)) continue;
+      for (const LeafTraversal* lt : LeafScenes(k)) {
+        if (!leafMembers.insert(lt->member).second) continue;
+        Data x;
+        x.set("member", lt->member);
+        x.set("host", lt->hostExpr);
+        x.set("display", lt->display);
+        x.set("interface", lt->interfaceName);
+        leafScenes.push_back(x);
+      }
     }
     d.set("leafScenes", leafScenes);
     d.set("hasLeafScenes", !leafScenes.is_empty_list());

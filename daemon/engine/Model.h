@@ -90,14 +90,18 @@ struct Loop {                // one parallel dimension of an IPV kernel
 // Its kernel gets a ray generation variant, <kernel>_Intersections, in which the ray tracing
 // hardware finds the leaves a ray meets (one instance per element, its box from the interface's
 // BoxMin() and BoxMax() on the host) and runs the intersection shader of each leaf's class.
+// One LeafTraversal per leaf call (vector and method) of the kernel's composed code.
 struct LeafTraversal {
   std::string member;         // the VirtualMember: m_scene_m_shapes
   std::string hostExpr;       // crt_m_scene()->m_shapes
   std::string display;        // m_scene->m_shapes
   std::string interfaceName;  // IShape
+  std::string method;         // Intersect
   std::string traversal;      // ShapeScene::Trace
-  std::vector<std::string> intersectionShaders;  // per class, in the tags' order: hit group i is class i
+  std::vector<std::string> intersectionShaders;  // per class, in the tags' order: hit group firstHitGroup + i is class i
   std::string closestHitShader, missShader;
+  unsigned firstHitGroup = 0;  // its traces' SBT record offset
+  unsigned missIndex = 0;      // its traces' miss shader, and their payload's location
 };
 
 struct Kernel {
@@ -149,11 +153,11 @@ struct Kernel {
   std::vector<std::string> callables;
   std::vector<std::string> callableStructList, callableFunctionList;
   bool atomics = false;               // calls crossrt::Atomic*: coherent buffers, memory scope semantics
-  // Virtual functions, level 3, in composed code: the leaves the ray tracing hardware finds (an empty
-  // member when there are none; whyNoLeafShaders says why a traversal's leaves stay in software),
-  // and the prelude of the <kernel>_Intersections ray generation shader, whose traversal traces a
-  // ray where the leaves' loop was.
-  LeafTraversal leaves;
+  // Virtual functions, level 3, in composed code: the leaf calls the ray tracing hardware runs, in
+  // the traces' numbering (none when the traversal has none; whyNoLeafShaders says why a traversal's
+  // leaves stay in software), and the shader code of the variant whose traversal traces a ray where
+  // each leaves' loop was.
+  std::vector<LeafTraversal> leaves;
   std::string whyNoLeafShaders;
   std::vector<std::string> leafStructList, leafFunctionList;
 };

@@ -99,6 +99,13 @@ void ShapeScene::Add(std::shared_ptr<IShape> shape)
   m_shapes.push_back(std::move(shape));
 }
 
+void ShapeScene::AddLight(std::shared_ptr<IShape> light)
+{
+  m_lightBoxes.push_back(light->BoxMin());
+  m_lightBoxes.push_back(light->BoxMax());
+  m_lights.push_back(std::move(light));
+}
+
 ShapeHit ShapeScene::Trace(float4 posAndNear, float4 dirAndFar)
 {
   ShapeHit hit;
@@ -110,6 +117,18 @@ ShapeHit ShapeScene::Trace(float4 posAndNear, float4 dirAndFar)
   for (uint32_t i = 0; i < count; ++i)
     if (HitsBox(posAndNear, dirAndFar, hit.t, m_boxes[2 * i], m_boxes[2 * i + 1]))  // a leaf: its primitive's own test
       m_shapes[i]->Intersect(posAndNear, dirAndFar, i, hit);
+  // The lights, nearer than the nearest shape, into a hit of their own.
+  ShapeHit light = hit;
+  light.shape = ~0u;
+  const uint32_t lightCount = uint32_t(m_lightBoxes.size() / 2);
+  for (uint32_t i = 0; i < lightCount; ++i)
+    if (HitsBox(posAndNear, dirAndFar, light.t, m_lightBoxes[2 * i], m_lightBoxes[2 * i + 1]))
+      m_lights[i]->Intersect(posAndNear, dirAndFar, i, light);
+  if (light.shape != ~0u)
+  {
+    hit = light;
+    hit.shape = kLightHit + light.shape;
+  }
   return hit;
 }
 

@@ -1,7 +1,8 @@
 // Intersection functions inside composed code (paper 3.10, listing 2): ShapeTracer holds an IScene,
 // composed on the GPU with ShapeScene, whose traversal calls a virtual Intersect for each primitive
-// it reaches. Three shape classes with data of different sizes implement it; on the GPU the call
-// becomes a switch over the shape's class (test/equivalence/test_composition.cpp).
+// it reaches, in two vectors (shapes and lights). Three shape classes with data of different sizes
+// implement it; on the GPU the call becomes a switch over the shape's class, or at level 3 an
+// intersection shader per class (test/equivalence/test_composition.cpp).
 #pragma once
 #include "LiteMath.h"
 
@@ -65,15 +66,19 @@ struct IScene
   virtual ShapeHit Trace(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar) = 0;
 };
 
-// The leaves of a scene: one box per shape (min, max), tested before the shape's Intersect.
+// The leaves of a scene: one box per shape (min, max), tested before the shape's Intersect. Lights
+// are shapes too, kept apart (a renderer samples them): a ray that meets one nearest reports it
+// as kLightHit + its index.
 class ShapeScene : public IScene
 {
 public:
+  static constexpr uint32_t kLightHit = 0x80000000u;
   void Add(std::shared_ptr<IShape> shape);
+  void AddLight(std::shared_ptr<IShape> light);
   ShapeHit Trace(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar) override;
 
-  std::vector<std::shared_ptr<IShape>> m_shapes;
-  std::vector<LiteMath::float4> m_boxes;  // 2 per shape
+  std::vector<std::shared_ptr<IShape>> m_shapes, m_lights;
+  std::vector<LiteMath::float4> m_boxes, m_lightBoxes;  // 2 per shape, 2 per light
 };
 
 class ShapeTracer

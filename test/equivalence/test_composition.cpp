@@ -80,6 +80,10 @@ TEST_CASE("Composition: virtual intersection functions called from the composed 
   scene->Add(std::make_shared<Sphere>(float3(1.4f, 1.3f, -0.3f), 0.5f));
   scene->Add(std::make_shared<Box>(float3(-2.2f, -2.0f, -1.0f), float3(-0.8f, -0.9f, 0.2f)));
   scene->Add(std::make_shared<Disc>(float3(0.2f, -0.2f, 1.0f), float3(0.0f, 0.0f, 1.0f), 0.3f));  // in front of the first sphere
+  // Lights, a second vector of leaves: one half behind the first sphere.
+  scene->AddLight(std::make_shared<Sphere>(float3(-0.3f, 1.9f, 0.5f), 0.35f));
+  scene->AddLight(std::make_shared<Disc>(float3(1.9f, 0.6f, 1.5f), float3(0.0f, 0.0f, 1.0f), 0.4f));
+  scene->AddLight(std::make_shared<Box>(float3(-1.0f, -0.4f, -3.0f), float3(-0.2f, 0.4f, -2.5f)));
   std::mt19937 rng(17);
   std::uniform_real_distribution<float> u(-1.0f, 1.0f);
   const int n = 3001;
@@ -105,11 +109,14 @@ TEST_CASE("Composition: virtual intersection functions called from the composed 
     REQUIRE(std::fabs(h.t - 4.0f) < 1e-5f);
     REQUIRE(h.nz == 1.0f);
   }
-  std::vector<int> perShape(6, 0);
+  std::vector<int> perShape(6, 0), perLight(3, 0);
   int misses = 0;
   for (auto& h : expected)
-    if (h.shape == ~0u) ++misses; else ++perShape.at(h.shape);
+    if (h.shape == ~0u) ++misses;
+    else if (h.shape >= ShapeScene::kLightHit) ++perLight.at(h.shape - ShapeScene::kLightHit);
+    else ++perShape.at(h.shape);
   for (int s = 0; s < 6; ++s) REQUIRE(perShape[s] > 10);
+  for (int s = 0; s < 3; ++s) REQUIRE(perLight[s] > 10);
   REQUIRE(misses > n / 4);
 
   auto ctx = ValidatedContext();
@@ -176,9 +183,22 @@ TEST_CASE("Composition: virtual intersection functions called from the composed 
     gpu->Trace(1, &o, &d, far, &h);
     REQUIRE(h.shape == 0u);
     REQUIRE(std::fabs(h.t - 2.5f) < 1e-5f);
+    // A light moved in front of it: the second vector's leaves are committed too.
+    auto movedLight = std::make_shared<Sphere>(float3(0.2f, -0.2f, 3.5f), 0.25f);
+    const auto firstLight = scene->m_lights[0];
+    scene->m_lights[0] = movedLight;
+    scene->m_lightBoxes[0] = movedLight->BoxMin();
+    scene->m_lightBoxes[1] = movedLight->BoxMax();
+    gpu->CommitDeviceData();
+    gpu->Trace(1, &o, &d, far, &h);
+    REQUIRE(h.shape == ShapeScene::kLightHit + 0u);
+    REQUIRE(std::fabs(h.t - 1.25f) < 1e-5f);
     scene->m_shapes[0] = first;  // back, for the next run
     scene->m_boxes[0] = first->BoxMin();
     scene->m_boxes[1] = first->BoxMax();
+    scene->m_lights[0] = firstLight;
+    scene->m_lightBoxes[0] = firstLight->BoxMin();
+    scene->m_lightBoxes[1] = firstLight->BoxMax();
     gpu->CommitDeviceData();
   }
   RequireNoValidationMessages(ctx);
