@@ -164,7 +164,7 @@ int main(int argc, char** argv) {
     }
     else if (a == "--virtual-level") {
       if (v != "1" && v != "2" && v != "3")
-        return Usage("--virtual-level takes 1 (one array of equal slots), 2 (a buffer per class) or 3 (2, plus callable shaders), not '" + v + "'");
+        return Usage("--virtual-level takes 1 (one array of equal slots), 2 (a buffer per class) or 3 (2, plus callable and intersection shaders), not '" + v + "'");
       request.virtualLevel = std::stoi(v);
     }
     else if (a == "--execution-mode") {

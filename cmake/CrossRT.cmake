@@ -18,8 +18,9 @@
 # VIRTUAL_LEVEL (paper 3.9): how kernels' virtual calls through a std::vector of pointers reach the
 # objects on the GPU: 1 = every element in one array of equal slots, 2 (default) = each class's
 # objects in a buffer of their own, 3 = as 2, and where the device has ray tracing pipelines, kernels
-# run as ray generation shaders whose virtual calls execute a callable shader per class. The class's
-# code is the same for all three.
+# run as ray generation shaders whose virtual calls execute a callable shader per class, and whose
+# composed traversals' leaf calls are intersection shaders (paper 3.10). The class's code is the
+# same for all three.
 #
 # EXECUTION_MODE (paper 2.1 and 4.4): how a control function's thread loop that calls several kernels
 # (for (y) for (x) { float4 ray; kernel_A(x, y, &ray); kernel_B(x, y, &ray); }) runs on the GPU:
@@ -87,7 +88,7 @@ function(crossrt_add_class target class)
   endforeach()
   if(ARG_VIRTUAL_LEVEL)
     if(NOT ARG_VIRTUAL_LEVEL MATCHES "^[123]$")
-      message(FATAL_ERROR "crossrt_add_class(${target} ${class}): VIRTUAL_LEVEL is 1 (one array of equal slots), 2 (a buffer per class) or 3 (2, plus callable shaders), not '${ARG_VIRTUAL_LEVEL}'")
+      message(FATAL_ERROR "crossrt_add_class(${target} ${class}): VIRTUAL_LEVEL is 1 (one array of equal slots), 2 (a buffer per class) or 3 (2, plus callable and intersection shaders), not '${ARG_VIRTUAL_LEVEL}'")
     endif()
     list(APPEND option_args --virtual-level ${ARG_VIRTUAL_LEVEL})
   endif()

@@ -884,6 +884,15 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
   }
 }
 
+// The size of a vector of objects is in the class data next to the vector's tags, which exist for
+// vectors the kernel calls through.
+void CheckObjectSizeReads(Reporter& rep, const GlslPrinter& printer) {
+  for (auto& [field, loc] : printer.objectSizeReads)
+    if (std::none_of(printer.virtualCalls.begin(), printer.virtualCalls.end(), [&](const auto& call) { return call.first == field; }))
+      rep.Error(loc, "the kernel reads the size of '" + field->getNameAsString() + "', a vector of objects it calls no virtual function through",
+                "keep the count in a plain member, or read the size where the kernel also calls through the vector");
+}
+
 // The kernel's own code calls virtual functions through the class's vectors of objects.
 void AnalyzeVirtualCalls(Context& c, Kernel& k, GlslPrinter& kernelPrinter) {
   std::vector<std::string> structs, functions;
@@ -1155,6 +1164,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   reached.insert(reached.end(), printer.helpers.begin(), printer.helpers.end());
   AddLockedCopies(c, reached);
   // Threads append in any order: a size read in the same kernel would see a partial count.
+  CheckObjectSizeReads(c.rep, printer);
   for (auto& [field, loc] : printer.sizeReads)
     if (appends.count(field))
       c.rep.Error(loc, "kernel '" + k.name + "' reads the size of '" + field->getNameAsString() + "', which it appends to",
@@ -2842,6 +2852,7 @@ bool ComposeFromTranslationUnit(ASTContext& ctx, Reporter& reporter, ClassModel&
       if (!printer.virtualCalls.empty())
         VirtualCallCode(ctx, reporter, model, k, printer, VirtualOwner{impl, holderPrefix, "crt_" + comp.holder + "()->", comp.holder}, virtualStructs,
                         virtualFunctions);
+      CheckObjectSizeReads(reporter, printer);
       for (auto* fn : printer.helpers) {
         ComposedWriteFinder finder;
         finder.TraverseStmt(fn->getBody());
@@ -2998,6 +3009,7 @@ void FinishModel(ClassModel& model) {
   // Virtual functions: where each vector's tags and each implementation's objects are on the device.
   for (auto& v : model.virtuals) {
     fields.push_back({v.member + "_tags", "uint64_t", "uvec2", 8, "", "m_virtual." + v.member + "_tags.Address()"});
+    fields.push_back({v.member + "_size", "uint32_t", "uint", 4, "", "uint32_t(" + v.hostExpr + ".size())"});
     if (model.virtualLevel == 1) fields.push_back({v.member + "_objects", "uint64_t", "uvec2", 8, "", "m_virtual." + v.member + "_objects.Address()"});
     for (auto& impl : v.impls)
       if (model.virtualLevel >= 2)

@@ -916,6 +916,12 @@ std::string GlslPrinter::Call(const CallExpr* call) {
         return Fail(call->getBeginLoc(), "std::vector::" + name + " of an array of textures in a kernel",
                     "kernels read its size() and use its textures: " + field->getNameAsString() + "[i].sample(uv)");
       }
+      QualType element;
+      if (field && isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts()) && name == "size" && IsStdVector(field->getType(), &element) &&
+          PolymorphicPointee(element)) {
+        objectSizeReads.emplace(field, call->getBeginLoc());
+        return composedPrefix + field->getNameAsString() + "_size";
+      }
       if (field && isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts())) {
         memberVectors.insert(field);
         if (name == "size") {

@@ -69,6 +69,9 @@ public:
   std::set<const clang::FieldDecl*> memberVectors, plainMembers;
   // Where the kernel reads a member vector's size (a kernel may not read what it appends to).
   std::multimap<const clang::FieldDecl*, clang::SourceLocation> sizeReads;
+  // Where the kernel reads the size of a vector of objects (the class data holds it with the
+  // vector's tags, so the kernel must also call through it).
+  std::multimap<const clang::FieldDecl*, clang::SourceLocation> objectSizeReads;
   // The kernel's Image2D reference parameters (the definition's): images bound per call, used in
   // the kernel's own body as member images are.
   std::set<const clang::ValueDecl*> imageParams;

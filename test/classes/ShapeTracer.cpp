@@ -120,8 +120,7 @@ ShapeHit ShapeScene::Trace(float4 posAndNear, float4 dirAndFar)
   // The lights, nearer than the nearest shape, into a hit of their own.
   ShapeHit light = hit;
   light.shape = ~0u;
-  const uint32_t lightCount = uint32_t(m_lightBoxes.size() / 2);
-  for (uint32_t i = 0; i < lightCount; ++i)
+  for (uint32_t i = 0; i < m_lights.size(); ++i)
     if (HitsBox(posAndNear, dirAndFar, light.t, m_lightBoxes[2 * i], m_lightBoxes[2 * i + 1]))
       m_lights[i]->Intersect(posAndNear, dirAndFar, i, light);
   if (light.shape != ~0u)

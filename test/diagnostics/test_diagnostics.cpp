@@ -475,6 +475,34 @@ void Areas::kernel1D_Run(int n, float* out)
       REQUIRE(!std::filesystem::exists(tc.dir / "out" / "Areas_Vulkan.cpp"));
     }
   }
+  SECTION("the size of a vector of objects read without calling through it")
+  {
+    TempClass tc("Counts", R"(#pragma once
+#include <memory>
+#include <vector>
+struct IShape { virtual ~IShape() = default; virtual float Area() const = 0; };
+struct Square : IShape { float side = 1.0f; float Area() const override { return side * side; } };
+class Counts
+{
+public:
+  virtual ~Counts() = default;
+  virtual void Run(int n, [[crossrt::size("n")]] float* out);
+  std::vector<std::shared_ptr<IShape>> m_shapes;
+protected:
+  void kernel1D_Run(int n, float* out);
+};
+)",
+                 "#include \"Counts.h\"\nvoid Counts::Run(int n, float* out) { kernel1D_Run(n, out); }\n"
+                 "void Counts::kernel1D_Run(int n, float* out)\n{\n  for (int i = 0; i < n; i++)\n    out[i] = float(m_shapes.size());\n}\n");
+    CommandResult r = RunCrossrt("translate --class Counts --backend vulkan --out " + (tc.dir / "out").string() + " --source " +
+                                 tc.Source("Counts") + " --templates " CROSSRT_SOURCE_DIR "/templates");
+    INFO(r.output);
+    REQUIRE_FALSE(r.crashed);
+    REQUIRE(r.exitCode == 1);
+    REQUIRE(r.output.find("Counts.cpp:6:20: error: the kernel reads the size of 'm_shapes', a vector of objects it calls no virtual function through") !=
+            std::string::npos);
+    REQUIRE(r.output.find("hint: keep the count in a plain member") != std::string::npos);
+  }
   SECTION("a level that does not exist is a usage error")
   {
     TempClass tc("Areas", "#pragma once\nclass Areas {};\n", "#include \"Areas.h\"\n");
@@ -482,7 +510,7 @@ void Areas::kernel1D_Run(int n, float* out)
                                  tc.Source("Areas") + " --virtual-level 4 --templates " CROSSRT_SOURCE_DIR "/templates");
     INFO(r.output);
     REQUIRE(r.exitCode == 2);
-    REQUIRE(r.output.find("--virtual-level takes 1 (one array of equal slots), 2 (a buffer per class) or 3 (2, plus callable shaders), not '4'") !=
+    REQUIRE(r.output.find("--virtual-level takes 1 (one array of equal slots), 2 (a buffer per class) or 3 (2, plus callable and intersection shaders), not '4'") !=
             std::string::npos);
   }
 }

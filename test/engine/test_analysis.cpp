@@ -399,7 +399,6 @@ struct Ball : IThing {
 struct IWorld { virtual ~IWorld() = default; virtual Hit Trace(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar) = 0; };
 struct World : IWorld {
   std::vector<std::shared_ptr<IThing>> m_things, m_lamps;
-  uint32_t m_count = 0, m_lampCount = 0;  // the sizes: a vector of objects has no size on the GPU
   Hit Trace(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar) override;
 };
 class Leaves {
@@ -433,7 +432,7 @@ TEST_CASE("Level 3: a composed traversal's leaf calls become intersection shader
     r.virtualLevel = level;
     return Translate(r);
   };
-  const std::string visitAll = "  for (uint32_t i = 0; i < m_count; ++i)\n    m_things[i]->Intersect(posAndNear, dirAndFar, i, hit);\n";
+  const std::string visitAll = "  for (uint32_t i = 0; i < m_things.size(); ++i)\n    m_things[i]->Intersect(posAndNear, dirAndFar, i, hit);\n";
   {
     const TranslateResult result = translate(visitAll, 3);
     INFO(result.diagnostics);
@@ -461,7 +460,7 @@ TEST_CASE("Level 3: a composed traversal's leaf calls become intersection shader
   // payload and range of hit groups each.
   {
     const TranslateResult result = translate(visitAll + "  Hit lamp = hit;\n  lamp.id = ~0u;\n"
-                                             "  for (uint32_t j = 0; j < m_lampCount; ++j)\n    m_lamps[j]->Intersect(posAndNear, dirAndFar, j, lamp);\n"
+                                             "  for (uint32_t j = 0; j < m_lamps.size(); ++j)\n    m_lamps[j]->Intersect(posAndNear, dirAndFar, j, lamp);\n"
                                              "  if (lamp.id != ~0u) { hit = lamp; hit.id += 1000u; }\n", 3);
     INFO(result.diagnostics);
     REQUIRE(result.ok);
@@ -486,7 +485,7 @@ TEST_CASE("Level 3: a composed traversal's leaf calls become intersection shader
   // Two loops over the same vector with the same method share their payload, miss shader and hit groups.
   {
     const TranslateResult result = translate(visitAll + "  Hit again = hit;\n"
-                                             "  for (uint32_t j = 0; j < m_count; ++j)\n    m_things[j]->Intersect(posAndNear, dirAndFar, j, again);\n", 3);
+                                             "  for (uint32_t j = 0; j < m_things.size(); ++j)\n    m_things[j]->Intersect(posAndNear, dirAndFar, j, again);\n", 3);
     INFO(result.diagnostics);
     REQUIRE(result.ok);
     const std::string& rgen = result.files.at("shaders/kernel1D_Run_Intersections.rgen");
@@ -501,13 +500,13 @@ TEST_CASE("Level 3: a composed traversal's leaf calls become intersection shader
   }
   // Loops that do more than visit every leaf once keep the switch, and the host says why.
   const std::pair<std::string, std::string> kept[] = {
-      {"  for (uint32_t i = 0; i < m_count; ++i)\n    if (++visited > 0u) m_things[i]->Intersect(posAndNear, dirAndFar, i, hit);\n",
+      {"  for (uint32_t i = 0; i < m_things.size(); ++i)\n    if (++visited > 0u) m_things[i]->Intersect(posAndNear, dirAndFar, i, hit);\n",
        "does more than visit leaves: it writes 'visited', declared before the loop"},
-      {"  for (uint32_t i = 0; i < m_count; ++i) {\n    m_things[i]->Intersect(posAndNear, dirAndFar, i, hit);\n    if (hit.id != ~0u) break;\n  }\n",
+      {"  for (uint32_t i = 0; i < m_things.size(); ++i) {\n    m_things[i]->Intersect(posAndNear, dirAndFar, i, hit);\n    if (hit.id != ~0u) break;\n  }\n",
        "which visits every leaf once as the hardware does"},
-      {"  for (uint32_t i = 1; i < m_count; ++i)\n    m_things[i]->Intersect(posAndNear, dirAndFar, i, hit);\n",
+      {"  for (uint32_t i = 1; i < m_things.size(); ++i)\n    m_things[i]->Intersect(posAndNear, dirAndFar, i, hit);\n",
        "is not 'for (i = 0; i < count; ++i) [if (box test)] Intersect(...);'"},
-      {"  for (uint32_t i = 0; i < m_count; ++i)\n    m_things[i]->Intersect(posAndNear, dirAndFar, i + 1, hit);\n",
+      {"  for (uint32_t i = 0; i < m_things.size(); ++i)\n    m_things[i]->Intersect(posAndNear, dirAndFar, i + 1, hit);\n",
        "argument 3 of m_world->m_things[...]->Intersect is neither the leaf's index nor a constant"},
       {"  m_things[0]->Intersect(posAndNear, dirAndFar, 0u, hit);\n", "is not inside a loop of the traversal's body"},
       // One loop the hardware could run is not enough: every leaf call must be one.
