@@ -2556,13 +2556,19 @@ std::string ZeroOf(QualType t) {
 }
 
 // The interface method that gives a leaf's box corner on the host: public `name() const`, no
-// parameters, returning a LiteMath float3 or float4, declared by the interface itself. Else null.
+// parameters, returning a LiteMath float3 or float4, declared by the interface or a public base of
+// it. Else null.
 const CXXMethodDecl* BoxCorner(const CXXRecordDecl* interface, const std::string& name) {
-  for (auto* d : interface->lookup(&interface->getASTContext().Idents.get(name)))
+  auto found = interface->lookup(&interface->getASTContext().Idents.get(name));
+  for (auto* d : found)
     if (auto* md = dyn_cast<CXXMethodDecl>(d); md && md->isConst() && md->getNumParams() == 0 && md->getAccess() == AS_public) {
       auto g = GlslTypeOf(md->getReturnType().getNonReferenceType().getUnqualifiedType());
       if (g && (*g == "vec3" || *g == "vec4")) return md;
     }
+  if (!found.empty()) return nullptr;  // the interface's own declarations hide its bases'
+  for (auto& base : interface->bases())
+    if (auto* rd = base.getType()->getAsCXXRecordDecl(); rd && rd->hasDefinition() && base.getAccessSpecifier() == AS_public)
+      if (auto* md = BoxCorner(rd->getDefinition(), name)) return md;
   return nullptr;
 }
 
@@ -2647,7 +2653,7 @@ std::string TraceLeafCall(ASTContext& ctx, Reporter& rep, const ClassModel& mode
   const CXXRecordDecl* interface = method->getParent();
   const CXXMethodDecl *boxMin = BoxCorner(interface, "BoxMin"), *boxMax = BoxCorner(interface, "BoxMax");
   if (!boxMin || !boxMax)
-    return interface->getNameAsString() + " declares no BoxMin() const and BoxMax() const (float3 or float4): the hardware needs each leaf's box";
+    return interface->getNameAsString() + " declares no public BoxMin() const and BoxMax() const (float3 or float4), nor inherits them: the hardware needs each leaf's box";
 
   // The site: a vector and a method. Its traces start their hit groups after the earlier sites' (the
   // SBT record offset, of which traceRayEXT uses 4 bits) and have its miss shader and payload.

@@ -425,8 +425,8 @@ std::string LeafSource(const std::string& loop) {
 
 TEST_CASE("Level 3: a composed traversal's leaf calls become intersection shaders, or say why they cannot", "[engine][composition][virtual]")
 {
-  auto translate = [](const std::string& loop, int level) {
-    TempClass tc("Leaves", kLeafHeader, LeafSource(loop));
+  auto translate = [](const std::string& loop, int level, const std::string& header = kLeafHeader) {
+    TempClass tc("Leaves", header, LeafSource(loop));
     TranslateRequest r = MakeRequest(tc, "Leaves");
     r.compositions = {"IWorld=World"};
     r.virtualLevel = level;
@@ -491,6 +491,24 @@ TEST_CASE("Level 3: a composed traversal's leaf calls become intersection shader
     const std::string& rgen = result.files.at("shaders/kernel1D_Run_Intersections.rgen");
     CHECK(rgen.find("traceRayEXT(m_world_m_things_leaves, gl_RayFlagsNoneEXT, 0xFF, 0, 0, 0, posAndNear.xyz, crt_near, dirAndFar.xyz, again.t, 0);") != std::string::npos);
     CHECK(rgen.find("rayPayloadEXT") == rgen.rfind("rayPayloadEXT"));
+  }
+  // The boxes may come from a public base of the interface, not from a private one.
+  for (const std::string access : {"", "private "})
+  {
+    std::string header = kLeafHeader;
+    const std::string boxes = "  virtual LiteMath::float4 BoxMin() const = 0;\n  virtual LiteMath::float4 BoxMax() const = 0;\n";
+    REQUIRE(header.find(boxes) != std::string::npos);
+    header.replace(header.find(boxes), boxes.size(), "");
+    header.replace(header.find("struct IThing {"), std::string("struct IThing {").size(),
+                   "struct IBounded {\n  virtual ~IBounded() = default;\n" + boxes + "};\nstruct IThing : " + access + "IBounded {");
+    INFO(header);
+    const TranslateResult result = translate(visitAll, 3, header);
+    INFO(result.diagnostics);
+    REQUIRE(result.ok);
+    CHECK(result.files.count("shaders/kernel1D_Run_Intersections.rgen") == (access.empty() ? 1u : 0u));
+    if (!access.empty())
+      CHECK(result.files.at("Leaves_Vulkan.cpp").find("IThing declares no public BoxMin() const and BoxMax() const (float3 or float4), nor inherits them") !=
+            std::string::npos);
   }
   // Level 2 asks for no ray tracing pipeline.
   {
