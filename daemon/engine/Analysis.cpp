@@ -655,7 +655,8 @@ std::string ImplDataStruct(GlslPrinter& printer, const CXXRecordDecl* impl, cons
   CollectObjectFields(impl, fields);
   for (auto* f : fields) data << "  " << printer.Declare(f->getType(), GlslPrinter::SafeName(f->getNameAsString()), f->getLocation()) << ";\n";
   if (vi.paddingWords > 0)
-    data << "  uint crt_padding[" << vi.paddingWords << "];  // every element of " << vm.member << " has a slot of " << vm.slotBytes << " bytes\n";
+    data << "  uint crt_padding[" << vi.paddingWords << "];  // every element of a vector of " << vm.interfaceName << " has a slot of " << vm.slotBytes
+         << " bytes\n";
   data << "};\n";
   return data.str();
 }
@@ -763,8 +764,18 @@ void CallableDispatcher(ASTContext& ctx, Reporter& rep, ClassModel& model, Kerne
 // shader calls them with.
 void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& k, GlslPrinter& kernelPrinter, const VirtualOwner& owner,
                      std::vector<std::string>& structs, std::vector<std::string>& functions, CallableCode* callable = nullptr) {
-  std::map<const FieldDecl*, std::vector<const CXXMethodDecl*>> calls;
-  for (auto& [field, method] : kernelPrinter.virtualCalls) calls[field].push_back(method);
+  // Vectors and methods in source order: the generated code must not depend on where the AST
+  // happens to sit in memory (the daemon reparses).
+  SourceManager& sm = ctx.getSourceManager();
+  auto before = [&](const Decl* a, const Decl* b) { return sm.isBeforeInTranslationUnit(a->getLocation(), b->getLocation()); };
+  std::vector<std::pair<const FieldDecl*, std::vector<const CXXMethodDecl*>>> calls;
+  for (auto& [field, method] : kernelPrinter.virtualCalls) {
+    auto same = std::find_if(calls.begin(), calls.end(), [&, f = field](const auto& c) { return c.first == f; });
+    if (same == calls.end()) same = calls.insert(calls.end(), {field, {}});
+    same->second.push_back(method);
+  }
+  std::sort(calls.begin(), calls.end(), [&](const auto& a, const auto& b) { return before(a.first, b.first); });
+  for (auto& c : calls) std::sort(c.second.begin(), c.second.end(), before);
   for (auto& [field, methods] : calls) {
     QualType element;
     IsStdVector(field->getType(), &element);
@@ -828,6 +839,15 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
       if (model.virtualLevel == 1) {  // one slot size for all: the largest class's data, in 16-byte steps
         for (auto& vi : vm.impls) vm.slotBytes = std::max(vm.slotBytes, (vi.size + 15) / 16 * 16);
         for (auto& vi : vm.impls) vi.paddingWords = (vm.slotBytes - vi.size) / 4;
+        // The GPU has one <Impl>_Data per class: vectors of two interfaces that share a class
+        // must give it the same slot.
+        for (auto& other : model.virtuals)
+          for (auto& theirs : other.impls)
+            for (auto& vi : vm.impls)
+              if (theirs.name == vi.name && theirs.paddingWords != vi.paddingWords)
+                rep.Error(field->getLocation(), "at virtual-function level 1, " + vi.name + " takes a " + std::to_string(vm.slotBytes) + "-byte slot in '" + member +
+                          "' but a " + std::to_string(other.slotBytes) + "-byte slot in '" + other.member + "'",
+                          "use level 2 (a buffer per class), where a class's objects need no slot");
       }
       model.virtuals.push_back(vm);
       known = model.virtuals.end() - 1;
@@ -2650,7 +2670,9 @@ std::string TraceLeafCall(ASTContext& ctx, Reporter& rep, const ClassModel& mode
     else if (isa<IntegerLiteral, FloatingLiteral, CXXBoolLiteralExpr>(arg) && type) leafArgs.push_back(*type + "(" + literals.Expr(arg) + ")");
     else return "argument " + std::to_string(i + 1) + " of " + callText + " is neither the leaf's index nor a constant";
   }
-  const CXXRecordDecl* interface = method->getParent();
+  QualType element;
+  IsStdVector(field->getType(), &element);
+  const CXXRecordDecl* interface = PolymorphicPointee(element);  // the elements' (the method may be a base's)
   const CXXMethodDecl *boxMin = BoxCorner(interface, "BoxMin"), *boxMax = BoxCorner(interface, "BoxMax");
   if (!boxMin || !boxMax)
     return interface->getNameAsString() + " declares no public BoxMin() const and BoxMax() const (float3 or float4), nor inherits them: the hardware needs each leaf's box";

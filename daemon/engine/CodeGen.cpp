@@ -1036,7 +1036,7 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
         needs = "m_ctx->hasRayTracingPipeline";
         use = "m_useRayTracingPipelines";
         why = kind.callables ? "virtual calls as callable shaders, in a ray tracing pipeline"
-                             : LeafDisplays(k) + "'s leaves as intersection shaders, in a ray tracing pipeline";
+                             : "the leaves of " + LeafDisplays(k) + " as intersection shaders, in a ray tracing pipeline";
       }
       if (kind.rayQuery) {
         needs = "m_ctx->hasRayQuery";

@@ -2,27 +2,33 @@
 #pragma once
 #include <clang/Basic/Diagnostic.h>
 #include <clang/Basic/SourceLocation.h>
+#include <cstdint>
+#include <set>
 #include <string>
+#include <utility>
 
 namespace crossrt::engine {
 
 class Reporter {
 public:
   explicit Reporter(clang::DiagnosticsEngine& diags) : m_diags(diags) {}
+  // Each error once: code several kernels share (a helper, a composed traversal) is checked for each.
   void Error(clang::SourceLocation loc, const std::string& message, const std::string& hint = {}) {
+    ++m_errors;
+    if (!m_reported.insert({loc.getRawEncoding(), message}).second) return;
     unsigned id = m_diags.getCustomDiagID(clang::DiagnosticsEngine::Error, "%0");
     m_diags.Report(loc, id) << message;
     if (!hint.empty()) {
       unsigned noteId = m_diags.getCustomDiagID(clang::DiagnosticsEngine::Note, "hint: %0");
       m_diags.Report(loc, noteId) << hint;
     }
-    ++m_errors;
   }
   unsigned Errors() const { return m_errors; }
 
 private:
   clang::DiagnosticsEngine& m_diags;
   unsigned m_errors = 0;
+  std::set<std::pair<uint64_t, std::string>> m_reported;  // (location, message)
 };
 
 }  // namespace crossrt::engine

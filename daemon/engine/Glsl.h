@@ -101,8 +101,8 @@ public:
   // a std::vector of pointers to a polymorphic class, as (vector member, interface method).
   std::set<std::pair<const clang::FieldDecl*, const clang::CXXMethodDecl*>> virtualCalls;
   std::vector<const clang::CXXMemberCallExpr*> virtualCallSites;  // each such call, in printing order
-  // Statements printed as other text (each line indented as the statement): the leaves' loop of a
-  // traversal that the ray tracing hardware runs instead (virtual functions, level 3).
+  // Statements printed as other text (each line indented as the statement): the loops over leaves
+  // of a traversal that the ray tracing hardware runs instead (virtual functions, level 3).
   std::map<const clang::Stmt*, std::string> replacedStatements;
   // In an implementation's printer ("object mode"): the class whose methods are printed; its members
   // read from the parameter `self` of type <Class>_Data, and its methods take `self` first.

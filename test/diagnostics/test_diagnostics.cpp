@@ -503,6 +503,40 @@ protected:
             std::string::npos);
     REQUIRE(r.output.find("hint: keep the count in a plain member") != std::string::npos);
   }
+  SECTION("a class in two vectors whose slots differ at level 1")
+  {
+    TempClass tc("Slots", R"(#pragma once
+#include <memory>
+#include <vector>
+struct IArea { virtual ~IArea() = default; virtual float Area() const = 0; };
+struct IMass { virtual ~IMass() = default; virtual float Mass() const = 0; };
+struct Dot : IArea, IMass { float r = 1.0f; float Area() const override { return r; } float Mass() const override { return r; } };
+struct Quad : IArea { float a = 1.0f, b = 1.0f, c, d, e, f, g, h; float Area() const override { return a * b; } };
+class Slots
+{
+public:
+  virtual ~Slots() = default;
+  virtual void Run(int n, [[crossrt::size("n")]] float* out);
+  std::vector<std::shared_ptr<IArea>> m_areas;
+  std::vector<std::shared_ptr<IMass>> m_masses;
+protected:
+  void kernel1D_Run(int n, float* out);
+};
+)",
+                 "#include \"Slots.h\"\nvoid Slots::Run(int n, float* out) { kernel1D_Run(n, out); }\n"
+                 "void Slots::kernel1D_Run(int n, float* out)\n{\n  for (int i = 0; i < n; i++)\n    out[i] = m_areas[i]->Area() + m_masses[i]->Mass();\n}\n");
+    CommandResult r = RunCrossrt("translate --class Slots --backend vulkan --out " + (tc.dir / "out").string() + " --source " +
+                                 tc.Source("Slots") + " --virtual-level 1 --templates " CROSSRT_SOURCE_DIR "/templates");
+    INFO(r.output);
+    REQUIRE_FALSE(r.crashed);
+    REQUIRE(r.exitCode == 1);
+    REQUIRE(r.output.find("error: at virtual-function level 1, Dot takes a 16-byte slot in 'm_masses' but a 32-byte slot in 'm_areas'") != std::string::npos);
+    REQUIRE(r.output.find("hint: use level 2") != std::string::npos);
+    // Level 2 has no slots: the same class translates.
+    r = RunCrossrt("translate --class Slots --backend vulkan --out " + (tc.dir / "out").string() + " --source " + tc.Source("Slots") +
+                   " --virtual-level 2 --templates " CROSSRT_SOURCE_DIR "/templates");
+    REQUIRE(r.exitCode == 0);
+  }
   SECTION("a level that does not exist is a usage error")
   {
     TempClass tc("Areas", "#pragma once\nclass Areas {};\n", "#include \"Areas.h\"\n");

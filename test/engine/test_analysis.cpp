@@ -1,6 +1,7 @@
 // What the analysis finds in small input classes parsed with the real standard library.
 #include "AstCache.h"
 #include "EngineSupport.h"
+#include <algorithm>
 
 using namespace crossrt::engine;
 
@@ -396,6 +397,14 @@ struct Ball : IThing {
   LiteMath::float4 BoxMin() const override { return c; }
   LiteMath::float4 BoxMax() const override { return c; }
 };
+struct Plate : IThing {
+  float z = 0.0f, pad = 0.0f;
+  void Intersect(LiteMath::float4 posAndNear, LiteMath::float4, uint32_t id, Hit& hit) const override {
+    if (z - posAndNear.z < hit.t) { hit.t = z - posAndNear.z; hit.id = id; }
+  }
+  LiteMath::float4 BoxMin() const override { return LiteMath::float4(-1.0f, -1.0f, z, 0.0f); }
+  LiteMath::float4 BoxMax() const override { return LiteMath::float4(1.0f, 1.0f, z, 0.0f); }
+};
 struct IWorld { virtual ~IWorld() = default; virtual Hit Trace(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar) = 0; };
 struct World : IWorld {
   std::vector<std::shared_ptr<IThing>> m_things, m_lamps;
@@ -466,21 +475,29 @@ TEST_CASE("Level 3: a composed traversal's leaf calls become intersection shader
     REQUIRE(result.ok);
     const std::string& rgen = result.files.at("shaders/kernel1D_Run_Intersections.rgen");
     CHECK(rgen.find("traceRayEXT(m_world_m_things_leaves, gl_RayFlagsNoneEXT, 0xFF, 0, 0, 0, posAndNear.xyz, crt_near, dirAndFar.xyz, hit.t, 0);") != std::string::npos);
-    CHECK(rgen.find("traceRayEXT(m_world_m_lamps_leaves, gl_RayFlagsNoneEXT, 0xFF, 1, 0, 1, posAndNear.xyz, crt_near, dirAndFar.xyz, lamp.t, 1);") != std::string::npos);
+    // The lamps' hit groups follow the things' two (Ball, Plate).
+    CHECK(rgen.find("traceRayEXT(m_world_m_lamps_leaves, gl_RayFlagsNoneEXT, 0xFF, 2, 0, 1, posAndNear.xyz, crt_near, dirAndFar.xyz, lamp.t, 1);") != std::string::npos);
     CHECK(rgen.find("layout(location = 1) rayPayloadEXT Hit m_world_m_lamps_Intersect_hit;") != std::string::npos);
     CHECK(rgen.find("uniform accelerationStructureEXT m_world_m_things_leaves;") != std::string::npos);
     CHECK(rgen.find("uniform accelerationStructureEXT m_world_m_lamps_leaves;") != std::string::npos);
     CHECK(rgen.find("hit.id += 1000u;") != std::string::npos);  // the code after the loops is as written
     CHECK(result.files.count("shaders/m_world_m_lamps_Ball_Intersect.rint") == 1);
     CHECK(result.files.count("shaders/m_world_m_lamps_Intersect_Miss.rmiss") == 1);
-    // The host: both vectors' boxes, and miss shader 1 and hit group 1 are the lamps'.
+    // The host: both vectors' boxes; in the pipeline's shaders, miss shader 1 and hit groups 2 and
+    // 3 are the lamps'.
     const std::string& host = result.files.at("Leaves_Vulkan.cpp");
     CHECK(host.find("m_scenes.m_world_m_lamps_leaves.BuildLeaves(leaves, \"Leaves::m_world->m_lamps\");") != std::string::npos);
-    const size_t things = host.find("Leaves_m_world_m_things_Intersect_Miss_spv"), lamps = host.find("Leaves_m_world_m_lamps_Intersect_Miss_spv");
-    REQUIRE(things != std::string::npos);
-    REQUIRE(lamps != std::string::npos);
-    CHECK(things < lamps);
-    CHECK(host.find("Leaves_m_world_m_things_Ball_Intersect_spv") < host.find("Leaves_m_world_m_lamps_Ball_Intersect_spv"));
+    const size_t shaders = host.find("crossrt::RayTracingShaders{");
+    REQUIRE(shaders != std::string::npos);
+    std::vector<size_t> order;
+    for (const char* shader : {"m_things_Intersect_Miss", "m_lamps_Intersect_Miss", "m_things_Ball_Intersect", "m_things_Plate_Intersect",
+                               "m_lamps_Ball_Intersect", "m_lamps_Plate_Intersect"})
+    {
+      order.push_back(host.find(std::string("{Leaves_m_world_") + shader + "_spv", shaders));
+      INFO(shader);
+      REQUIRE(order.back() != std::string::npos);
+    }
+    CHECK(std::is_sorted(order.begin(), order.end()));
   }
   // Two loops over the same vector with the same method share their payload, miss shader and hit groups.
   {
@@ -489,8 +506,18 @@ TEST_CASE("Level 3: a composed traversal's leaf calls become intersection shader
     INFO(result.diagnostics);
     REQUIRE(result.ok);
     const std::string& rgen = result.files.at("shaders/kernel1D_Run_Intersections.rgen");
+    CHECK(rgen.find("traceRayEXT(m_world_m_things_leaves, gl_RayFlagsNoneEXT, 0xFF, 0, 0, 0, posAndNear.xyz, crt_near, dirAndFar.xyz, hit.t, 0);") != std::string::npos);
     CHECK(rgen.find("traceRayEXT(m_world_m_things_leaves, gl_RayFlagsNoneEXT, 0xFF, 0, 0, 0, posAndNear.xyz, crt_near, dirAndFar.xyz, again.t, 0);") != std::string::npos);
+    REQUIRE(rgen.find("rayPayloadEXT") != std::string::npos);
     CHECK(rgen.find("rayPayloadEXT") == rgen.rfind("rayPayloadEXT"));
+    const std::string& host = result.files.at("Leaves_Vulkan.cpp");
+    const size_t shaders = host.find("crossrt::RayTracingShaders{");
+    REQUIRE(shaders != std::string::npos);
+    const std::string miss = "{Leaves_m_world_m_things_Intersect_Miss_spv", ball = "{Leaves_m_world_m_things_Ball_Intersect_spv";
+    REQUIRE(host.find(miss, shaders) != std::string::npos);
+    CHECK(host.find(miss, host.find(miss, shaders) + 1) == std::string::npos);  // one miss shader, one run of hit groups
+    REQUIRE(host.find(ball, shaders) != std::string::npos);
+    CHECK(host.find(ball, host.find(ball, shaders) + 1) == std::string::npos);
   }
   // The boxes may come from a public base of the interface, not from a private one.
   for (const std::string access : {"", "private "})
