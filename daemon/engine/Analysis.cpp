@@ -620,6 +620,14 @@ void RequireReachable(Reporter& rep, const FieldDecl* f, const CXXRecordDecl* cl
               "declare it protected");
 }
 
+// The generated class reaches member `f` of a composed implementation through an `implName`*: a
+// member the GPU reads must be public. `how` names the composition, "" or " (IScene=ShapeScene)".
+void RequirePublicForComposition(Reporter& rep, const FieldDecl* f, const std::string& implName, const std::string& how) {
+  if (f->getAccess() != AS_public)
+    rep.Error(f->getLocation(), "member '" + f->getNameAsString() + "' of " + implName + " is read on the GPU through composition" + how +
+              ", so the generated class must reach it through a " + implName + "*", "declare it public");
+}
+
 // The GLSL name of a virtual method's parameter i: the interface's (it may leave it unnamed).
 std::string CallArgumentName(const CXXMethodDecl* m, unsigned i) {
   const ParmVarDecl* p = m->getParamDecl(i);
@@ -782,9 +790,7 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
     const CXXRecordDecl* interface = PolymorphicPointee(element);
     const std::string member = owner.prefix + field->getNameAsString();
     if (owner.holder.empty()) RequireReachable(rep, field, owner.cls);
-    if (!owner.holder.empty() && field->getAccess() != AS_public)
-      rep.Error(field->getLocation(), "member '" + field->getNameAsString() + "' of " + owner.cls->getNameAsString() + " is read on the GPU through composition, so the generated class must reach it through a " +
-                owner.cls->getNameAsString() + "*", "declare it public");
+    else RequirePublicForComposition(rep, field, owner.cls->getNameAsString(), "");
     std::vector<const CXXRecordDecl*> impls;
     FindImplementations(ctx.getTranslationUnitDecl(), interface, impls);
     if (impls.empty()) {
@@ -2419,27 +2425,34 @@ const CXXMethodDecl* ImplementationOf(const CXXRecordDecl* impl, const std::stri
   return nullptr;
 }
 
-// Writes to members of `this` in composed code: the GPU copy of an implementation's data is never
-// read back, so such a write would be lost silently.
-struct ComposedWriteFinder : RecursiveASTVisitor<ComposedWriteFinder> {
-  std::vector<std::pair<const FieldDecl*, SourceLocation>> writes;
-  void Check(const Expr* lhs, SourceLocation loc) {
-    if (auto* f = RootField(lhs)) writes.push_back({f, loc});
-  }
+// The writes the finders below share: assignments, increments and decrements, built in or
+// overloaded. Derived::Written(target, loc) decides what each write means to it.
+template <class Derived>
+struct WriteVisitor : RecursiveASTVisitor<Derived> {
   bool VisitBinaryOperator(BinaryOperator* bo) {
-    if (bo->isAssignmentOp()) Check(bo->getLHS(), bo->getExprLoc());
+    if (bo->isAssignmentOp()) Self().Written(bo->getLHS(), bo->getExprLoc());
     return true;
   }
   bool VisitUnaryOperator(UnaryOperator* uo) {
-    if (uo->isIncrementDecrementOp()) Check(uo->getSubExpr(), uo->getExprLoc());
-    return true;
-  }
-  bool VisitCallExpr(CallExpr* call) {
-    if (IsCrossrtAtomic(call->getDirectCallee()) && call->getNumArgs() > 0) Check(call->getArg(0), call->getExprLoc());
+    if (uo->isIncrementDecrementOp()) Self().Written(uo->getSubExpr(), uo->getExprLoc());
     return true;
   }
   bool VisitCXXOperatorCallExpr(CXXOperatorCallExpr* op) {
-    if (op->isAssignmentOp() || op->getOperator() == OO_PlusPlus || op->getOperator() == OO_MinusMinus) Check(op->getArg(0), op->getExprLoc());
+    if (op->isAssignmentOp() || op->getOperator() == OO_PlusPlus || op->getOperator() == OO_MinusMinus) Self().Written(op->getArg(0), op->getExprLoc());
+    return true;
+  }
+  Derived& Self() { return static_cast<Derived&>(*this); }
+};
+
+// Writes to members of `this` in composed code: the GPU copy of an implementation's data is never
+// read back, so such a write would be lost silently.
+struct ComposedWriteFinder : WriteVisitor<ComposedWriteFinder> {
+  std::vector<std::pair<const FieldDecl*, SourceLocation>> writes;
+  void Written(const Expr* target, SourceLocation loc) {
+    if (auto* f = RootField(target)) writes.push_back({f, loc});
+  }
+  bool VisitCallExpr(CallExpr* call) {
+    if (IsCrossrtAtomic(call->getDirectCallee()) && call->getNumArgs() > 0) Written(call->getArg(0), call->getExprLoc());
     return true;
   }
 };
@@ -2520,7 +2533,7 @@ const VarDecl* LeafLoopVariable(const clang::Stmt* loop, const CXXMemberCallExpr
 // What the leaves' loop does besides the leaf call that the hardware's trace would not: writes to
 // variables declared before it (in its test, the only other code LeafLoopVariable lets it have).
 // The first such place and why, or "".
-struct LoopEffects : RecursiveASTVisitor<LoopEffects> {
+struct LoopEffects : WriteVisitor<LoopEffects> {
   const CXXMemberCallExpr* leafCall;
   std::set<const VarDecl*> inner;  // declared inside the loop
   std::string problem;
@@ -2535,20 +2548,11 @@ struct LoopEffects : RecursiveASTVisitor<LoopEffects> {
     if (vd && !inner.count(vd)) Note(loc, "it writes '" + vd->getNameAsString() + "', declared before the loop");
   }
   bool VisitVarDecl(VarDecl* vd) { inner.insert(vd); return true; }
-  bool VisitBinaryOperator(BinaryOperator* bo) {
-    if (bo->isAssignmentOp()) Written(bo->getLHS(), bo->getExprLoc());
-    return true;
-  }
-  bool VisitUnaryOperator(UnaryOperator* uo) {
-    if (uo->isIncrementDecrementOp()) Written(uo->getSubExpr(), uo->getExprLoc());
-    return true;
-  }
+  // Besides WriteVisitor's: non-const methods and non-const reference arguments.
   bool VisitCallExpr(CallExpr* call) {
     if (call == leafCall) return true;
     if (auto* mc = dyn_cast<CXXMemberCallExpr>(call); mc && mc->getMethodDecl() && !mc->getMethodDecl()->isConst())
       Written(mc->getImplicitObjectArgument(), mc->getExprLoc());  // a non-const method changes its object
-    if (auto* op = dyn_cast<CXXOperatorCallExpr>(call); op && (op->isAssignmentOp() || op->getOperator() == OO_PlusPlus || op->getOperator() == OO_MinusMinus))
-      Written(op->getArg(0), op->getExprLoc());
     const FunctionDecl* fd = call->getDirectCallee();
     const unsigned shift = isa<CXXOperatorCallExpr>(call) && isa_and_nonnull<CXXMethodDecl>(fd) ? 1 : 0;  // argument 0 is the object
     for (unsigned i = 0; fd && i + shift < call->getNumArgs() && i < fd->getNumParams(); ++i) {
@@ -2897,10 +2901,7 @@ bool ComposeFromTranslationUnit(ASTContext& ctx, Reporter& reporter, ClassModel&
         printer.Type(elem, f->getLocation());
       }
       auto requirePublic = [&](const FieldDecl* f) {
-        if (f->getAccess() != AS_public)
-          reporter.Error(f->getLocation(), "member '" + f->getNameAsString() + "' of " + comp.implName + " is read on the GPU through composition (" +
-                         comp.interfaceName + "=" + comp.implName + "), so the generated class must reach it through a " + comp.implName + "*",
-                         "declare it public");
+        RequirePublicForComposition(reporter, f, comp.implName, " (" + comp.interfaceName + "=" + comp.implName + ")");
       };
       for (auto* f : printer.memberVectors) {
         requirePublic(f);

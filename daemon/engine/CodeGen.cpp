@@ -75,30 +75,23 @@ std::string LeafDisplays(const Kernel& k) {
   return Listed(displays);
 }
 
-// The callable shaders that kernels' ray generation variants execute, in the model's order.
-std::vector<const StageShader*> ExecutedCallables(const ClassModel& model) {
+// The shaders of ray tracing pipelines besides the kernels' that some kernel's ray generation
+// variant executes: callables, then intersection, closest-hit and miss shaders, in the model's order.
+std::vector<const StageShader*> ExecutedStageShaders(const ClassModel& model) {
   std::set<std::string> executed;
-  for (const Kernel& k : model.kernels)
+  for (const Kernel& k : model.kernels) {
     if (RunsCallables(k)) executed.insert(k.callables.begin(), k.callables.end());
-  std::vector<const StageShader*> out;
-  for (const StageShader& c : model.callables)
-    if (executed.count(c.name)) out.push_back(&c);
-  return out;
-}
-
-// The intersection, closest-hit and miss shaders of the kernels that trace leaves, in the model's order.
-std::vector<const StageShader*> ExecutedLeafShaders(const ClassModel& model) {
-  std::set<std::string> executed;
-  for (const Kernel& k : model.kernels)
     if (RunsLeafShaders(k))
       for (const LeafTraversal& lt : k.leaves) {
         executed.insert(lt.intersectionShaders.begin(), lt.intersectionShaders.end());
         executed.insert(lt.closestHitShader);
         executed.insert(lt.missShader);
       }
+  }
   std::vector<const StageShader*> out;
-  for (const StageShader& c : model.leafShaders)
-    if (executed.count(c.name)) out.push_back(&c);
+  for (const std::vector<StageShader>* list : {&model.callables, &model.leafShaders})
+    for (const StageShader& c : *list)
+      if (executed.count(c.name)) out.push_back(&c);
   return out;
 }
 
@@ -1150,8 +1143,7 @@ std::vector<ShaderSource> GenerateShaders(const ClassModel& model, const Generat
       shaders.push_back({k.name + v.suffix, KernelGlsl(model, k, opt, v), v.RayGeneration() ? "rgen" : "comp"});
     if (!k.reductions.empty()) shaders.push_back({k.name + "_Reduce", ReduceGlsl(model, k, opt)});
   }
-  for (const StageShader* c : ExecutedCallables(model)) shaders.push_back({c->name, StageGlsl(model, *c, opt), c->stage});
-  for (const StageShader* c : ExecutedLeafShaders(model)) shaders.push_back({c->name, StageGlsl(model, *c, opt), c->stage});
+  for (const StageShader* c : ExecutedStageShaders(model)) shaders.push_back({c->name, StageGlsl(model, *c, opt), c->stage});
   return shaders;
 }
 
@@ -1180,8 +1172,7 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
     }));
     // The shaders of ray tracing pipelines besides the kernels' (virtual functions, level 3).
     Data stageShaders = List();
-    std::vector<const StageShader*> stages = ExecutedCallables(model), leafStages = ExecutedLeafShaders(model);
-    stages.insert(stages.end(), leafStages.begin(), leafStages.end());
+    const std::vector<const StageShader*> stages = ExecutedStageShaders(model);
     for (const StageShader* c : stages) {
       Data x;
       x.set("name", c->name);

@@ -30,6 +30,9 @@ struct FenceSpecialization {
   FenceSpecialization& operator=(const FenceSpecialization&) = delete;
 };
 
+// x rounded up to a multiple of a (a Vulkan alignment; 0 and 1 leave x as it is).
+inline VkDeviceSize AlignUp(VkDeviceSize x, VkDeviceSize a) { return a > 1 ? (x + a - 1) / a * a : x; }
+
 // A buffer and its memory: the building block of Buffer and of temporary staging buffers.
 struct Allocation {
   VkBuffer buffer = VK_NULL_HANDLE;

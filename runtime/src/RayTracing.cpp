@@ -13,8 +13,6 @@
 namespace crossrt {
 namespace {
 
-VkDeviceSize AlignUp(VkDeviceSize x, VkDeviceSize a) { return a > 1 ? (x + a - 1) / a * a : x; }
-
 // Builds write acceleration structures; later builds and shaders read them.
 void BuildBarrier(VkCommandBuffer cmd, VkPipelineStageFlags dstStages, VkAccessFlags dstAccess) {
   auto barrier = VkInit<VkMemoryBarrier>(VK_STRUCTURE_TYPE_MEMORY_BARRIER);

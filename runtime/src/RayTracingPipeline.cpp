@@ -12,8 +12,6 @@
 namespace crossrt {
 
 namespace {
-VkDeviceSize AlignUp(VkDeviceSize x, VkDeviceSize a) { return (x + a - 1) / a * a; }
-
 // The stages a pipeline of these shaders has: its layout makes the bindings visible to all of them.
 VkShaderStageFlags StagesOf(const RayTracingShaders& shaders) {
   VkShaderStageFlags stages = VK_SHADER_STAGE_RAYGEN_BIT_KHR;
