@@ -3,6 +3,7 @@
 //   crossrt translate --class NAME --backend vulkan|cpu --out DIR --source FILE... [options] [-- ARGS]
 //   crossrt daemon status [--build-dir DIR] [--json]
 //   crossrt daemon stop [--build-dir DIR]
+//   crossrt --help | --version
 //
 // translate: when the recorded translation key is unchanged it writes nothing and returns at
 // once. Otherwise it asks the build tree's daemon (starting it when absent) and, when the daemon
@@ -13,6 +14,7 @@
 #include "Manifest.h"
 #include "Outputs.h"
 #include "Protocol.h"
+#include "SourceFinder.h"
 #include "TranslateTypes.h"
 
 #include <cstdio>
@@ -32,13 +34,28 @@ namespace {
 
 const char* kUsage =
     "usage: crossrt translate --class NAME --backend vulkan|cpu --out DIR --source FILE [--source FILE...]\n"
-    "                         [--compose INTERFACE=IMPL...] [--virtual-level 1|2|3] [--execution-mode wavefront|megakernel]\n"
-    "                         [--templates DIR]\n"
+    "                         [--find-sources [--source-dir DIR]] [--compose INTERFACE=IMPL...] [--virtual-level 1|2|3]\n"
+    "                         [--execution-mode wavefront|megakernel] [--templates DIR]\n"
     "                         [--depfile FILE --depfile-target FILE]\n"
     "                         [--build-dir DIR | --no-daemon] [-- COMPILE_ARGS...]\n"
     "       crossrt daemon status [--build-dir DIR] [--json]\n"
     "       crossrt daemon stop [--build-dir DIR]\n"
-    "       crossrt --version\n";
+    "       crossrt --help | --version\n";
+
+const char* kHelp =
+    "crossrt: translates a C++ class into a class that runs its kernels on Vulkan (NAME_Vulkan) or on\n"
+    "all CPU cores (NAME_CPU). crossrt_add_class() in CMake runs it; you rarely call it by hand.\n"
+    "\n"
+    "translate      translates class NAME, whose member functions the --source files define, into DIR.\n"
+    "               With --find-sources the --source files are only candidates (a target's sources):\n"
+    "               those that define NAME's member functions are kept, whatever their names (relative\n"
+    "               ones are found from --source-dir).\n"
+    "               Compile arguments (-I, -D, -std=...) follow '--'. The build tree's daemon (crossrtd)\n"
+    "               translates, and is started when absent; --no-daemon (or CROSSRT_NO_DAEMON=1)\n"
+    "               translates in this process. An unchanged class writes nothing.\n"
+    "daemon status  prints what the build tree's daemon holds (--json for a machine).\n"
+    "daemon stop    stops it; the next translation starts another.\n"
+    "\n";
 
 int Usage(const std::string& message) {
   std::cerr << "crossrt: error: " << message << "\n" << kUsage;
@@ -129,6 +146,10 @@ int DaemonCommand(const std::vector<std::string>& args) {
 int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
   if (args.empty()) return Usage("no command given");
+  if (args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
+    std::cout << kHelp << kUsage;
+    return 0;
+  }
   if (args[0] == "--version") {
     std::cout << "crossrt " << engine::kTranslatorVersion << "\n";
     return 0;
@@ -138,8 +159,8 @@ int main(int argc, char** argv) {
 
   engine::TranslateRequest request;
   request.templateDir = CROSSRT_DEFAULT_TEMPLATE_DIR;
-  std::string depfile, depfileTarget, backend, buildDir;
-  bool useDaemon = std::getenv("CROSSRT_NO_DAEMON") == nullptr;
+  std::string depfile, depfileTarget, backend, buildDir, sourceDir;
+  bool useDaemon = std::getenv("CROSSRT_NO_DAEMON") == nullptr, findSources = false;
   for (size_t i = 1; i < args.size(); ++i) {
     const std::string& a = args[i];
     if (a == "--") {
@@ -150,12 +171,21 @@ int main(int argc, char** argv) {
       useDaemon = false;
       continue;
     }
+    if (a == "--find-sources") {
+      findSources = true;
+      continue;
+    }
+    if (a == "--help" || a == "-h") {
+      std::cout << kHelp << kUsage;
+      return 0;
+    }
     if (i + 1 >= args.size()) return Usage("option '" + a + "' needs a value");
     const std::string& v = args[++i];
     if (a == "--class") request.className = v;
     else if (a == "--backend") backend = v;
     else if (a == "--out") request.outputDir = v;
     else if (a == "--source") request.sources.push_back(v);
+    else if (a == "--source-dir") sourceDir = v;
     else if (a == "--templates") request.templateDir = v;
     else if (a == "--compose") {
       if (v.find('=') == std::string::npos || v.front() == '=' || v.back() == '=')
@@ -179,10 +209,27 @@ int main(int argc, char** argv) {
   }
   if (request.className.empty()) return Usage("--class is required");
   if (request.outputDir.empty()) return Usage("--out is required");
-  if (request.sources.empty()) return Usage("at least one --source is required");
+  if (request.sources.empty() && !findSources) return Usage("at least one --source is required");
   if (backend == "vulkan") request.backend = engine::Backend::Vulkan;
   else if (backend == "cpu") request.backend = engine::Backend::Cpu;
   else return Usage("--backend must be 'vulkan' or 'cpu', not '" + backend + "'");
+  if (findSources) {
+    std::vector<std::string> includeDirs;
+    for (size_t i = 0; i < request.compileArgs.size(); ++i) {
+      const std::string& a = request.compileArgs[i];
+      if ((a == "-I" || a == "-iquote") && i + 1 < request.compileArgs.size()) includeDirs.push_back(request.compileArgs[i + 1]);
+      else if (a.rfind("-I", 0) == 0 && a.size() > 2) includeDirs.push_back(a.substr(2));
+    }
+    // Relative candidates are the target's sources, named from its source folder.
+    for (auto& s : request.sources)
+      if (!s.empty() && s[0] != '/' && !sourceDir.empty()) s = sourceDir + "/" + s;
+    auto found = crossrt::client::FindClassSources(request.className, request.sources, includeDirs);
+    if (found.sources.empty()) {
+      std::cerr << "crossrt: error: " << found.error << "\n";
+      return 1;
+    }
+    request.sources = found.sources;
+  }
 
   // Unchanged key: nothing to translate, nothing to write.
   if (crossrt::client::UpToDate(request)) return 0;

@@ -5,9 +5,10 @@
 # Translates class <Class> into <Class>_Vulkan (or <Class>_CPU), in the build tree, and adds the
 # generated sources, their include path and the runtime to <target>. A class in a namespace is
 # named with it (demo::Render); its generated classes are declared in the same namespace. SOURCES
-# are the files that define <Class>'s member functions (default: <Class>.cpp next to the calling
-# CMakeLists.txt, else every .cpp source of <target>). The translation re-runs when any file it
-# read changes (depfile), and writes only files whose contents changed, so an unchanged class
+# are the files that define <Class>'s member functions; without it, the sources of <target> that
+# define them are found, whatever their names (a class whose members are all defined in its header
+# is found through the headers they include). The translation re-runs when any file it read
+# changes (depfile), and writes only files whose contents changed, so an unchanged class
 # recompiles nothing.
 #
 # COMPOSE (paper 3.6): kernels that call Interface's methods through a member (a shared_ptr,
@@ -67,13 +68,19 @@ function(crossrt_add_class target class)
   string(REGEX REPLACE "^.*::" "" name "${class}")
 
   set(sources ${ARG_SOURCES})
+  set(candidates "")
+  set(candidate_args "")
   if(NOT sources)
+    # The target's C++ sources as the build has them (also those added after this call), less the
+    # files CrossRT generates: the client keeps the ones that define the class's member functions,
+    # whatever their names, and never parses one (main.cpp) only because it is in the target.
+    set(all_sources "$<TARGET_PROPERTY:${target},SOURCES>")
+    set(cpp_sources "$<FILTER:${all_sources},INCLUDE,\\.(cpp|cc|cxx|C|c\\+\\+)$>")
+    set(candidates "$<FILTER:${cpp_sources},EXCLUDE,/crossrt/[^/]+_(Vulkan|CPU|ISPC)/>")
+    set(candidate_args --find-sources --source-dir "$<TARGET_PROPERTY:${target},SOURCE_DIR>"
+        "$<$<BOOL:${candidates}>:--source$<SEMICOLON>$<JOIN:${candidates},$<SEMICOLON>--source$<SEMICOLON>>>")
     if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/${name}.cpp)
-      set(sources ${name}.cpp)
-    else()
-      get_target_property(target_sources ${target} SOURCES)
-      list(FILTER target_sources INCLUDE REGEX "\\.(cpp|cc|cxx)$")
-      set(sources ${target_sources})
+      list(APPEND candidate_args --source ${CMAKE_CURRENT_SOURCE_DIR}/${name}.cpp)
     endif()
   endif()
   set(option_args "")
@@ -144,12 +151,12 @@ function(crossrt_add_class target class)
     OUTPUT ${outputs}
     COMMAND ${translator} translate
             --class ${class} --backend ${backend} --out ${out_dir}
-            ${source_args} ${option_args}
+            ${source_args} ${candidate_args} ${option_args}
             --templates ${CROSSRT_TEMPLATE_DIR}
             --depfile ${out_dir}/${name}_${suffix}.d --depfile-target ${first_output}
             --build-dir ${CMAKE_BINARY_DIR}
             -- ${compile_args}
-    DEPENDS ${abs_sources} ${translator_dep}
+    DEPENDS ${abs_sources} ${candidates} ${translator_dep}
     DEPFILE ${out_dir}/${name}_${suffix}.d
     COMMENT "CrossRT: translating ${class} -> ${name}_${suffix}"
     COMMAND_EXPAND_LISTS

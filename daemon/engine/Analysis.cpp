@@ -174,6 +174,14 @@ bool FitsClassData(ASTContext& ctx, QualType t) {
   return LayoutMatchesCpp(ctx, t, false);
 }
 
+// A destructor Clang has not declared yet (an implicit one) is virtual when a base's is.
+bool HasVirtualDestructor(const CXXRecordDecl* rd) {
+  if (auto* dtor = rd->getDestructor()) return dtor->isVirtual();
+  for (auto& base : rd->bases())
+    if (auto* b = base.getType()->getAsCXXRecordDecl(); b && b->hasDefinition() && HasVirtualDestructor(b->getDefinition())) return true;
+  return false;
+}
+
 void AnalyzeMembers(Context& c) {
   GlslPrinter structs(c.ctx, c.cls, c.rep);
   for (auto* f : c.cls->fields()) {
@@ -237,6 +245,7 @@ void AnalyzeMembers(Context& c) {
     c.model.constructors.push_back(k);
   }
   if (c.model.constructors.empty()) c.model.constructors.push_back({});
+  c.model.virtualDestructor = HasVirtualDestructor(c.cls);
   for (auto* md : c.cls->methods()) {
     if (md->getName() == "CommitDeviceData" && md->isVirtual()) c.model.declaresCommitDeviceData = true;
     if (md->getName() == "GetExecutionTime" && md->isVirtual()) c.model.declaresGetExecutionTime = true;
@@ -2244,11 +2253,12 @@ void AnalyzeControl(Context& c, const CXXMethodDecl* md, const FunctionDecl* def
   ctrl.name = md->getNameAsString();
   ctrl.sourceFile = BaseName(FileOf(c.ctx, def->getLocation()));
   ctrl.isConst = md->isConst();
-  if (!md->isVirtual()) {
-    c.rep.Error(md->getLocation(), "control function '" + ctrl.name + "' calls kernels but is not virtual",
-                "declare it 'virtual' so the generated class can override it and run it on the GPU");
-    return;
-  }
+  ctrl.isVirtual = md->isVirtual();
+  if (!ctrl.isVirtual)
+    c.rep.Warning(md->getLocation(), "control function '" + ctrl.name + "' is not virtual: called through a pointer to " + c.cls->getNameAsString() +
+                  " (as the factories return it) it runs " + c.cls->getNameAsString() + "::" + ctrl.name + " as written, on one CPU core",
+                  "declare it 'virtual' in " + c.cls->getNameAsString() + " so that the generated classes override it; until then only a pointer to the "
+                  "generated class (or its " + ctrl.name + "Cmd) runs it translated");
   if (!md->getReturnType()->isVoidType()) {
     c.rep.Error(md->getLocation(), "control function '" + ctrl.name + "' returns a value",
                 "return results through size-annotated pointer parameters or members; control functions return void");

@@ -257,6 +257,8 @@ Data Common(const ClassModel& model, const GenerateOptions& opt) {
   d.set("headerInclude", opt.headerInclude);
   d.set("commitOverride", model.declaresCommitDeviceData ? " override" : "");
   d.set("timeOverride", model.declaresGetExecutionTime ? " override" : "");
+  d.set("virtualDestructor", model.virtualDestructor);
+  d.set("plainDestructor", !model.virtualDestructor);
   Data ctors = List();
   for (auto& c : model.constructors) {
     Data x;
@@ -760,6 +762,7 @@ Data ControlsData(const ClassModel& model) {
     x.set("hasParams", !c.paramsDecl.empty());
     x.set("argsForward", c.argsForward);
     x.set("constQualifier", c.isConst ? " const" : "");
+    x.set("notVirtual", !c.isVirtual);
     x.set("cmdBody", IndentTail(c.vulkanCmdBody, ""));
     x.set("cpuBody", IndentTail(c.cpuBody, "  "));
     x.set("sourceFile", c.sourceFile);

@@ -23,6 +23,22 @@ public:
       m_diags.Report(loc, noteId) << hint;
     }
   }
+  // Translates, but the user should know: e.g. a control function the generated class cannot override.
+  void Warning(clang::SourceLocation loc, const std::string& message, const std::string& hint = {}) {
+    if (!m_reported.insert({loc.getRawEncoding(), message}).second) return;
+    unsigned id = m_diags.getCustomDiagID(clang::DiagnosticsEngine::Warning, "%0");
+    m_diags.Report(loc, id) << message;
+    if (!hint.empty()) {
+      unsigned noteId = m_diags.getCustomDiagID(clang::DiagnosticsEngine::Note, "hint: %0");
+      m_diags.Report(loc, noteId) << hint;
+    }
+  }
+  // A fact about the translation worth a line, e.g. a type that changes width on the GPU.
+  void Note(clang::SourceLocation loc, const std::string& message) {
+    if (!m_reported.insert({loc.getRawEncoding(), message}).second) return;
+    unsigned id = m_diags.getCustomDiagID(clang::DiagnosticsEngine::Note, "%0");
+    m_diags.Report(loc, id) << message;
+  }
   unsigned Errors() const { return m_errors; }
 
 private:

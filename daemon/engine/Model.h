@@ -180,6 +180,7 @@ struct Control {
   std::string paramsDecl;           // "int n, const float* in"
   std::string argsForward;          // "n, in"
   bool isConst = false;
+  bool isVirtual = true;            // else the generated one hides it, and calls through the base run the original
   std::vector<ControlParam> params;
   std::string vulkanCmdBody;        // body with kernel calls turned into ...Cmd calls
   std::string cpuBody;              // body with RTV loops parallelised
@@ -267,6 +268,7 @@ struct ClassModel {
   std::vector<Constructor> constructors;
   bool declaresCommitDeviceData = false;
   bool declaresGetExecutionTime = false;
+  bool virtualDestructor = false;      // the class's destructor is virtual: the generated ones override it
   std::vector<BlockField> classData;   // plain members + vector sizes, in block order
   std::string glslClassStructs;        // structs the class-data block and member vectors need
   std::vector<std::string> sourceIncludes;  // #include lines of the sources (quoted ones made absolute)

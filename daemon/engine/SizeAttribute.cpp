@@ -1,24 +1,66 @@
-// Teaches Clang the size annotation of control-function pointer parameters, in both spellings:
-//   const float* in __attribute__((size("n")))      [[crossrt::size("n")]] const float* in
-// The element-count expression is kept on the parameter as an AnnotateAttr "crossrt.size=<expr>".
+// Teaches Clang the size annotation of control-function pointer parameters, in every spelling:
+//   const float* in __attribute__((size("n")))    [[size("n")]] const float* in    [[crossrt::size("n")]] const float* in
+// Several strings multiply (size("w", "h") is w * h elements, as in kernel_slicer). The count is
+// kept on the parameter as an AnnotateAttr "crossrt.size=<expr>".
 #include <clang/AST/ASTContext.h>
 #include <clang/AST/Attr.h>
 #include <clang/Basic/SourceManager.h>
 #include <clang/Sema/ParsedAttr.h>
 #include <clang/Sema/Sema.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cstring>
 #include <string>
+#include <vector>
 
 using namespace clang;
 
 namespace {
 
+// The count a size annotation gives: its strings multiplied, as kernel_slicer reads them
+// (size("w", "h", "4") is w * h * 4 elements). Each string is an expression of the parameters.
+std::string SizeProduct(const std::vector<std::string>& factors) {
+  auto simple = [](const std::string& f) {
+    for (char c : f)
+      if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.')) return false;
+    return true;
+  };
+  if (factors.size() == 1) return factors[0];
+  std::string product;
+  for (auto& f : factors) product += (product.empty() ? "" : " * ") + (simple(f) ? f : "(" + f + ")");
+  return product;
+}
+
+// The string literals between the attribute's parentheses, read from the source text: Clang does
+// not parse the arguments of C++11 plugin attributes. Empty when there are none.
+std::vector<std::string> QuotedArguments(Sema& sema, const ParsedAttr& attr) {
+  const char* text = sema.getSourceManager().getCharacterData(attr.getLoc());
+  std::string rest(text, strnlen(text, 4096));
+  std::vector<std::string> args;
+  size_t i = rest.find('(');
+  if (i == std::string::npos || rest.find_first_of(";{]", 0) < i) return args;
+  int depth = 0;
+  for (; i < rest.size(); ++i) {
+    if (rest[i] == '(') ++depth;
+    else if (rest[i] == ')' && --depth == 0) break;
+    else if (rest[i] == '"') {
+      size_t end = i + 1;
+      while (end < rest.size() && rest[end] != '"') end += rest[end] == '\\' ? 2 : 1;
+      args.push_back(rest.substr(i + 1, end - i - 1));
+      i = end;
+    }
+  }
+  return args;
+}
+
 struct SizeAttrInfo : ParsedAttrInfo {
   SizeAttrInfo() {
-    static constexpr Spelling spellings[] = {{ParsedAttr::AS_GNU, "size"}, {ParsedAttr::AS_CXX11, "crossrt::size"}};
+    // __attribute__((size("n"))) and [[size("n")]] as the paper and kernel_slicer write them;
+    // [[crossrt::size("n")]], which GCC can be told to ignore quietly.
+    static constexpr Spelling spellings[] = {{ParsedAttr::AS_GNU, "size"}, {ParsedAttr::AS_CXX11, "size"}, {ParsedAttr::AS_CXX11, "crossrt::size"}};
     Spellings = spellings;
-    OptArgs = 1;
+    OptArgs = 15;
   }
   bool diagAppertainsToDecl(Sema& sema, const ParsedAttr& attr, const Decl* decl) const override {
     if (isa<ParmVarDecl>(decl)) return true;
@@ -26,23 +68,21 @@ struct SizeAttrInfo : ParsedAttrInfo {
     return false;
   }
   AttrHandling handleDeclAttribute(Sema& sema, Decl* decl, const ParsedAttr& attr) const override {
-    std::string expr;
-    if (attr.getNumArgs() == 1)
-      if (auto* str = dyn_cast<StringLiteral>(attr.getArgAsExpr(0)->IgnoreParenCasts())) expr = str->getString().str();
-    if (expr.empty()) {
-      // Clang does not parse the arguments of scoped plugin attributes: read the quoted text.
-      const char* text = sema.getSourceManager().getCharacterData(attr.getLoc());
-      std::string rest(text, strnlen(text, 1024));
-      auto q1 = rest.find('"'), q2 = q1 == std::string::npos ? q1 : rest.find('"', q1 + 1), close = rest.find(')');
-      if (q2 == std::string::npos || q2 > rest.find(']') || q1 > close) {
-        unsigned id = sema.getDiagnostics().getCustomDiagID(DiagnosticsEngine::Error,
-            "size annotation needs the element count as a string, e.g. [[crossrt::size(\"n\")]]");
-        sema.Diag(attr.getLoc(), id);
-        return AttributeNotApplied;
-      }
-      expr = rest.substr(q1 + 1, q2 - q1 - 1);
+    std::vector<std::string> factors;
+    for (unsigned i = 0; i < attr.getNumArgs(); ++i)
+      if (auto* e = attr.isArgExpr(i) ? attr.getArgAsExpr(i) : nullptr)
+        if (auto* str = dyn_cast<StringLiteral>(e->IgnoreParenCasts())) factors.push_back(str->getString().str());
+    if (factors.empty()) factors = QuotedArguments(sema, attr);
+    factors.erase(std::remove_if(factors.begin(), factors.end(), [](const std::string& f) {
+                    return f.find_first_not_of(" \t") == std::string::npos;
+                  }), factors.end());
+    if (factors.empty()) {
+      unsigned id = sema.getDiagnostics().getCustomDiagID(DiagnosticsEngine::Error,
+          "size annotation needs the element count as a string, e.g. [[crossrt::size(\"n\")]] or __attribute__((size(\"w\", \"h\")))");
+      sema.Diag(attr.getLoc(), id);
+      return AttributeNotApplied;
     }
-    decl->addAttr(AnnotateAttr::Create(sema.Context, "crossrt.size=" + expr, nullptr, 0, attr.getRange()));
+    decl->addAttr(AnnotateAttr::Create(sema.Context, "crossrt.size=" + SizeProduct(factors), nullptr, 0, attr.getRange()));
     return AttributeApplied;
   }
 };

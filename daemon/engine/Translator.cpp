@@ -24,6 +24,7 @@
 #include <cstdlib>
 #include <mutex>
 #include <chrono>
+#include <regex>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -162,6 +163,33 @@ std::vector<std::string> FilterFlags(const std::vector<std::string>& in) {
   return out;
 }
 
+// A source that includes a header the translation generates (PointStats_Vulkan.h), which does not
+// exist yet: main.cpp, say, listed by mistake. Parsing it would bury the user in errors that follow
+// from the missing header, so name the problem instead. Empty when there is none.
+std::string GeneratedIncludeProblem(const std::string& source, const std::vector<std::string>& args) {
+  static const std::regex generated(R"(^[ \t]*#[ \t]*include[ \t]*[<"](([^>"]*/)?\w+_(Vulkan|CPU|ISPC)\.h)[>"])");
+  std::vector<std::string> dirs = {llvm::sys::path::parent_path(source).str()};
+  for (size_t i = 0; i < args.size(); ++i) {
+    if (args[i] == "-I" && i + 1 < args.size()) dirs.push_back(args[i + 1]);
+    else if (args[i].rfind("-I", 0) == 0 && args[i].size() > 2) dirs.push_back(args[i].substr(2));
+  }
+  std::ifstream in(source);
+  unsigned lineNo = 0;
+  for (std::string line; std::getline(in, line);) {
+    ++lineNo;
+    std::smatch m;
+    if (!std::regex_search(line, m, generated)) continue;
+    const std::string name = m[1].str();
+    if (std::any_of(dirs.begin(), dirs.end(), [&](const std::string& d) { return llvm::sys::fs::exists(d + "/" + name); })) continue;
+    const std::string file = llvm::sys::path::filename(source).str();
+    return source + ":" + std::to_string(lineNo) + ":" + std::to_string(m.position(1) + 1) + ": error: " + file + " includes '" + name +
+           "', a header that translations generate, so it cannot be parsed to translate a class\n"
+           "note: hint: list only the files that define the class's member functions in SOURCES, or leave SOURCES out and "
+           "crossrt_add_class finds them\n";
+  }
+  return "";
+}
+
 }  // namespace
 
 std::vector<std::string> ParseArguments(const TranslateRequest& request) {
@@ -198,6 +226,11 @@ AnalyzeResult Analyze(const TranslateRequest& request, AstCache* sharedCache) {
   AstCache localCache(sources.size());
   AstCache& cache = sharedCache ? *sharedCache : localCache;
   const std::vector<std::string> args = ParseArguments(request);
+  for (auto& s : sources)
+    if (std::string problem = GeneratedIncludeProblem(s, args); !problem.empty()) {
+      result.diagnostics = problem;
+      return result;
+    }
   auto t0 = std::chrono::steady_clock::now();
   std::vector<AstCache::Handle> handles;
   std::string diagText;

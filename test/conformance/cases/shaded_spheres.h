@@ -1,0 +1,39 @@
+// Virtual calls through a std::vector of pointers to an interface, one implementation per material.
+#pragma once
+#include "LiteMath.h"
+#include <cstdint>
+#include <memory>
+#include <vector>
+using namespace LiteMath;
+
+struct IMaterial
+{
+  virtual ~IMaterial() = default;
+  virtual float3 Shade(float3 n, float3 l) const = 0;
+};
+
+struct Lambert : public IMaterial
+{
+  float3 albedo;
+  float3 Shade(float3 n, float3 l) const override { return albedo * std::max(dot(n, l), 0.0f); }
+};
+
+struct Mirror : public IMaterial
+{
+  float3 tint;
+  float power = 8.0f;
+  float3 Shade(float3 n, float3 l) const override { return tint * std::pow(std::max(n.z * l.z, 0.0f), power); }
+};
+
+class ShadedSpheres
+{
+public:
+  ShadedSpheres();
+  virtual void Shade(uint32_t n, const float4* a_normals [[size("n")]], float4* a_out [[size("n")]]);
+  virtual void CommitDeviceData() {}
+  std::vector<std::shared_ptr<IMaterial>> m_materials;
+
+protected:
+  void kernel1D_Shade(uint32_t n, const float4* a_normals, float4* a_out);
+  float3 m_light;
+};

@@ -1,0 +1,113 @@
+// Cases about the paper's LiteMath API in kernels: matrices, conversions and constants, half4,
+// complex, InterlockedAdd, the ReduceAdd family, and a user's own function named like a LiteMath one.
+#include "Conformance.h"
+
+#include "AccumGrid_CPU.h"
+#include "AccumGrid_Vulkan.h"
+#include "Conversions_CPU.h"
+#include "Conversions_Vulkan.h"
+#include "HalfPack_CPU.h"
+#include "HalfPack_Vulkan.h"
+#include "Histogram_CPU.h"
+#include "Histogram_Vulkan.h"
+#include "Projector_CPU.h"
+#include "Projector_Vulkan.h"
+#include "ThinFilm_CPU.h"
+#include "ThinFilm_Vulkan.h"
+#include "Transforms_CPU.h"
+#include "Transforms_Vulkan.h"
+
+using namespace conformance;
+using LiteMath::float4;
+
+namespace {
+
+std::vector<float4> Points(int n) {
+  std::vector<float4> v(n);
+  for (int i = 0; i < n; i++) v[i] = float4(std::sin(0.1f * float(i)) * 3.0f, float(i % 11) - 5.0f, 0.05f * float(i), 1.0f + 0.01f * float(i));
+  return v;
+}
+
+Outputs Flatten(const std::vector<float4>& v) {
+  Outputs r;
+  for (auto& p : v) Append(r, std::vector<float>{p.x, p.y, p.z, p.w});
+  return r;
+}
+
+Register transforms(MakeCase<Transforms>(
+    "mul4x4x4, make_float4x4_from_rows/cols, rotate3x3X/Y/Z, float3x3 * float3", "transforms.h/.cpp", 1e-5, CONFORMANCE_MAKERS(Transforms),
+    [](Transforms& t) {
+      std::vector<float4> in = Points(200), out(200);
+      t.Apply(200, in.data(), out.data());
+      return Flatten(out);
+    }));
+
+Register conversions(MakeCase<Conversions>(
+    "to_int4(int3, w), int2(float2), to_float3, mod, cross3, M_TWOPI, INV_PI", "conversions.h/.cpp", 1e-5, CONFORMANCE_MAKERS(Conversions),
+    [](Conversions& c) {
+      std::vector<float4> in = Points(150), out(150);
+      std::vector<LiteMath::int4> ints(150);
+      c.Run(150, in.data(), out.data(), ints.data());
+      Outputs r = Flatten(out);
+      for (auto& v : ints) r.insert(r.end(), {double(v.x), double(v.y), double(v.z), double(v.w)});
+      return r;
+    }));
+
+Register halfPack(MakeCase<HalfPack>(
+    "half4: a member vector of 16-bit floats, packed and unpacked in kernels", "half_pack.h/.cpp", 1e-3, CONFORMANCE_MAKERS(HalfPack),
+    [](HalfPack& h) {
+      h.m_packed.resize(128);
+      h.CommitDeviceData();
+      std::vector<float4> in = Points(128), out(128);
+      h.Pack(128, in.data());
+      h.Unpack(128, out.data());
+      return Flatten(out);
+    }));
+
+Register thinFilm(MakeCase<ThinFilm>(
+    "LiteMath::complex: constructors, + - * /, float * complex, complex_norm", "thin_film.h/.cpp", 1e-4, CONFORMANCE_MAKERS(ThinFilm),
+    [](ThinFilm& f) {
+      std::vector<float> cosTheta(256), out(256);
+      for (int i = 0; i < 256; i++) cosTheta[i] = 0.05f + 0.95f * float(i) / 255.0f;
+      f.Reflectance(256, cosTheta.data(), out.data());
+      Outputs r;
+      Append(r, out);
+      return r;
+    }));
+
+Register histogram(MakeCase<Histogram>(
+    "InterlockedAdd on a member vector's and an output pointer's elements", "histogram.h/.cpp", 0.0, CONFORMANCE_MAKERS(Histogram),
+    [](Histogram& h) {
+      std::vector<float> values(4000);
+      for (int i = 0; i < 4000; i++) values[i] = float((i * 7) % 1000) / 1000.0f;
+      int sums[4] = {0, 0, 0, 0};
+      h.CommitDeviceData();
+      h.Count(4000, values.data(), sums);
+      Outputs r;
+      Append(r, h.m_bins);
+      Append(r, std::vector<int>(sums, sums + 4));
+      return r;
+    }));
+
+Register accumGrid(MakeCase<AccumGrid>(
+    "ReduceAddInit / ReduceAdd<float, uint32_t> / ReduceAddComplete", "accum_grid.h/.cpp", 1e-5, CONFORMANCE_MAKERS(AccumGrid),
+    [](AccumGrid& a) {
+      std::vector<float> values(3000);
+      for (int i = 0; i < 3000; i++) values[i] = 0.25f * float(i % 9);
+      a.CommitDeviceData();
+      a.Accumulate(3000, values.data());
+      Outputs r;
+      Append(r, a.m_accum);
+      return r;
+    }));
+
+Register projector(MakeCase<Projector>(
+    "a user's own perspectiveMatrix beside using namespace LiteMath", "projector.h/.cpp", 1e-5, CONFORMANCE_MAKERS(Projector),
+    [](Projector& p) {
+      std::vector<float4> in = Points(100), out(100);
+      for (auto& q : in) q.z -= 20.0f;
+      p.Project(100, in.data(), out.data());
+      return Flatten(out);
+    }));
+
+}  // namespace

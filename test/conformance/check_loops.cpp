@@ -1,0 +1,89 @@
+// Cases about kernels' loops: statements before and after the loop nest (reductions set up, one-thread
+// epilogues), loop bounds, members every thread sets alike.
+#include "Conformance.h"
+
+#include "ArraySum_CPU.h"
+#include "ArraySum_Vulkan.h"
+#include "HalfSum_CPU.h"
+#include "HalfSum_Vulkan.h"
+#include "KeepPositive_CPU.h"
+#include "KeepPositive_Vulkan.h"
+#include "PointStats_CPU.h"
+#include "PointStats_Vulkan.h"
+#include "ThresholdFlag_CPU.h"
+#include "ThresholdFlag_Vulkan.h"
+
+#include <algorithm>
+
+using namespace conformance;
+using LiteMath::float4;
+
+namespace {
+
+std::vector<int> Ints(int n) {
+  std::vector<int> v(n);
+  for (int i = 0; i < n; i++) v[i] = (i * 7919) % 201 - 100;
+  return v;
+}
+
+Register pointStats(MakeCase<PointStats>(
+    "statements before and after the loop nest: reductions set up, results written after", "point_stats.h/.cpp", 1e-5,
+    CONFORMANCE_MAKERS(PointStats), [](PointStats& s) {
+      const uint32_t n = 3000;
+      std::vector<float4> points(n);
+      for (uint32_t i = 0; i < n; i++) points[i] = float4(float(i % 97) - 40.0f, float((i * 31) % 89), -float(i % 13), 1.0f);
+      std::vector<float4> summary(3, float4(-7.0f));
+      s.m_sumX = 1234.0f;  // the kernel sets it up itself
+      s.Compute(n, points.data(), summary.data());
+      Outputs r;
+      for (auto& p : summary) Append(r, std::vector<float>{p.x, p.y, p.z, p.w});
+      Append(r, std::vector<float>{s.m_boxMin.x, s.m_boxMax.y, s.m_sumX});
+      return r;
+    }));
+
+Register halfSum(MakeCase<HalfSum>(
+    "a loop from n / 2 to <= n - 1 after the reduction is set up", "half_sum.h/.cpp", 0.0, CONFORMANCE_MAKERS(HalfSum), [](HalfSum& s) {
+      std::vector<int> data = Ints(2049);
+      s.m_summ = 99;
+      s.Sum(data.data(), unsigned(data.size()));
+      return Outputs{double(s.m_summ)};
+    }));
+
+Register keepPositive(MakeCase<KeepPositive>(
+    "an append kernel that empties its vector first and writes its size after", "keep_positive.h/.cpp", 0.0, CONFORMANCE_MAKERS(KeepPositive),
+    [](KeepPositive& k) {
+      const uint32_t n = 2000;
+      std::vector<float> values(n);
+      for (uint32_t i = 0; i < n; i++) values[i] = float((i * 13) % 17) - 8.0f;
+      uint32_t count = 0;
+      k.m_kept.push_back({7u, 7.0f});  // emptied by the kernel
+      k.Filter(n, values.data(), &count);
+      std::vector<Kept> kept = k.m_kept;
+      std::sort(kept.begin(), kept.end(), [](const Kept& a, const Kept& b) { return a.index < b.index; });  // appends come in any order
+      Outputs r{double(count), double(kept.size())};
+      for (auto& x : kept) r.insert(r.end(), {double(x.index), double(x.value)});
+      return r;
+    }));
+
+Register thresholdFlag(MakeCase<ThresholdFlag>(
+    "a member every thread may set to the same constant (m_flag = 1)", "threshold_flag.h/.cpp", 0.0, CONFORMANCE_MAKERS(ThresholdFlag),
+    [](ThresholdFlag& t) {
+      std::vector<float> values(500);
+      for (int i = 0; i < 500; i++) values[i] = float(i % 50);
+      Outputs r;
+      t.Check(500, values.data(), 48.5f);
+      r.push_back(t.m_flag);
+      t.Check(500, values.data(), 60.0f);
+      r.push_back(t.m_flag);
+      r.push_back(7.0);  // a flag of 0 is a result too
+      return r;
+    }));
+
+Register arraySum(MakeCase<ArraySum>(
+    "size_t kernel parameters (32-bit on the GPU, with a note)", "array_sum.h/.cpp", 0.0, CONFORMANCE_MAKERS(ArraySum), [](ArraySum& a) {
+      std::vector<int> data = Ints(5000);
+      a.CalcArraySum(data.data(), unsigned(data.size()));
+      return Outputs{double(a.m_sum)};
+    }));
+
+}  // namespace

@@ -1,0 +1,98 @@
+// Cases about pointers in kernels and helpers: a generator's state by pointer, out parameters,
+// p->field, row pointers, data() in kernels, and locals whose addresses a per-thread function
+// passes to kernels (kernel_slicer's RTV form).
+#include "Conformance.h"
+
+#include "Gather_CPU.h"
+#include "Gather_Vulkan.h"
+#include "MinMaxPair_CPU.h"
+#include "MinMaxPair_Vulkan.h"
+#include "NoisyFill_CPU.h"
+#include "NoisyFill_Vulkan.h"
+#include "ParticleStep_CPU.h"
+#include "ParticleStep_Vulkan.h"
+#include "RowSums_CPU.h"
+#include "RowSums_Vulkan.h"
+#include "SaxpyBlock_CPU.h"
+#include "SaxpyBlock_Vulkan.h"
+
+using namespace conformance;
+using LiteMath::float4;
+
+namespace {
+
+std::vector<float> Wave(int n, float phase) {
+  std::vector<float> v(n);
+  for (int i = 0; i < n; i++) v[i] = std::sin(0.37f * float(i) + phase) * 10.0f;
+  return v;
+}
+
+Register noisyFill(MakeCase<NoisyFill>(
+    "RandomGen* passed to helpers that advance it (gen->state)", "random_gen.h/.cpp", 1e-6, CONFORMANCE_MAKERS(NoisyFill, 512u),
+    [](NoisyFill& f) {
+      std::vector<float> out(512, 0.0f);
+      f.CommitDeviceData();
+      f.Fill(512, out.data(), 5);
+      Outputs r;
+      Append(r, out);
+      for (auto& g : f.m_gens) r.insert(r.end(), {double(g.state.x), double(g.state.y)});
+      return r;
+    }));
+
+Register minMaxPair(MakeCase<MinMaxPair>(
+    "&local passed to a helper's out parameters (*lo = ..., hi[0] = ...)", "min_max_pair.h/.cpp", 0.0, CONFORMANCE_MAKERS(MinMaxPair),
+    [](MinMaxPair& m) {
+      const int n = 700;
+      std::vector<float> a = Wave(n, 0.0f), b = Wave(n, 1.0f), lo(n), hi(n);
+      m.Run(n, a.data(), b.data(), lo.data(), hi.data());
+      Outputs r;
+      Append(r, lo);
+      Append(r, hi);
+      return r;
+    }));
+
+Register particles(MakeCase<ParticleStep>(
+    "&m_vec[i] passed to a static member helper that writes p->field", "particles.h/.cpp", 1e-5, CONFORMANCE_MAKERS(ParticleStep),
+    [](ParticleStep& p) {
+      p.m_particles.resize(256);
+      for (int i = 0; i < 256; i++) p.m_particles[i] = {float4(float(i % 16), 5.0f + float(i % 7), 0.0f, 1.0f), float4(1.0f, float(i % 5), 0.5f, 0.0f)};
+      p.CommitDeviceData();
+      p.Step(0.01f, 40);
+      Outputs r;
+      for (auto& q : p.m_particles) Append(r, std::vector<float>{q.pos.x, q.pos.y, q.pos.z, q.vel.y});
+      return r;
+    }));
+
+Register rowSums(MakeCase<RowSums>(
+    "a row pointer into a buffer: const float* row = a_in + y * w; row[x], *row", "row_sums.h/.cpp", 1e-5, CONFORMANCE_MAKERS(RowSums),
+    [](RowSums& s) {
+      const int w = 33, h = 40;
+      std::vector<float> in = Wave(w * h, 0.5f), sums(h);
+      s.Sum(w, h, in.data(), sums.data());
+      Outputs r;
+      Append(r, sums);
+      return r;
+    }));
+
+Register gather(MakeCase<Gather>(
+    "m_vec.data() in a kernel, and data() + 2 handed to a static helper", "gather.h/.cpp", 0.0, CONFORMANCE_MAKERS(Gather), [](Gather& g) {
+      g.CommitDeviceData();
+      std::vector<float> out(300);
+      g.Run(300, out.data());
+      Outputs r;
+      Append(r, out);
+      return r;
+    }));
+
+Register saxpyBlock(MakeCase<SaxpyBlock>(
+    "a per-thread function passing &local to kernels, run by a ...Block loop (RTV)", "saxpy_block.h/.cpp", 1e-6, CONFORMANCE_MAKERS(SaxpyBlock),
+    [](SaxpyBlock& s) {
+      const uint32_t n = 1500;
+      std::vector<float> x = Wave(n, 0.2f), y = Wave(n, 2.0f), out(n);
+      s.RunBlock(n, 0.75f, x.data(), y.data(), out.data());
+      Outputs r;
+      Append(r, out);
+      return r;
+    }));
+
+}  // namespace

@@ -1,0 +1,127 @@
+// Cases about types and functions: helpers that live only in the .cpp, copysign, scans with an
+// operator and an initial value, double on the CPU, kernels returning bool, local arrays of
+// vectors, structs by value, data of a base class.
+#include "Conformance.h"
+
+#include "BounceLoop_CPU.h"
+#include "BounceLoop_Vulkan.h"
+#include "DerivedBlend_CPU.h"
+#include "DerivedBlend_Vulkan.h"
+#include "DoubleSum_CPU.h"
+#include "FillVariable_CPU.h"
+#include "FillVariable_Vulkan.h"
+#include "PrefixSums_CPU.h"
+#include "PrefixSums_Vulkan.h"
+#include "SignFlip_CPU.h"
+#include "SignFlip_Vulkan.h"
+#include "Smooth4_CPU.h"
+#include "Smooth4_Vulkan.h"
+#include "Tonemap_CPU.h"
+#include "Tonemap_Vulkan.h"
+
+#include <limits>
+
+using namespace conformance;
+using LiteMath::float2;
+using LiteMath::float4;
+
+namespace {
+
+Register tonemap(MakeCase<Tonemap>(
+    "helpers only in the .cpp: static, free, static member, constexpr", "tonemap.h/.cpp", 1e-5, CONFORMANCE_MAKERS(Tonemap),
+    [](Tonemap& t) {
+      const int w = 31, h = 19;
+      std::vector<float4> hdr(w * h), ldr(w * h);
+      for (int i = 0; i < w * h; i++) hdr[i] = float4(0.01f * float(i % 301), 0.02f * float(i % 97), 0.5f, 1.0f);
+      t.Apply(w, h, hdr.data(), ldr.data());
+      Outputs r;
+      for (auto& p : ldr) Append(r, std::vector<float>{p.x, p.y, p.z, p.w});
+      return r;
+    }));
+
+Register signFlip(MakeCase<SignFlip>(
+    "std::copysign and copysignf (signed zeros, infinities)", "sign_flip.h/.cpp", 0.0, CONFORMANCE_MAKERS(SignFlip), [](SignFlip& s) {
+      const float inf = std::numeric_limits<float>::infinity();
+      std::vector<float> mag = {1.0f, -2.0f, 0.0f, -0.0f, inf, 3.5f, -inf, 7.0f};
+      std::vector<float> sign = {-1.0f, 1.0f, -0.0f, 0.0f, -5.0f, -0.0f, 2.0f, inf};
+      std::vector<float> out(mag.size());
+      s.Run(int(mag.size()), mag.data(), sign.data(), out.data());
+      Outputs r;
+      for (float v : out) r.insert(r.end(), {double(v), double(std::signbit(v))});
+      return r;
+    }));
+
+Register prefixSums(MakeCase<PrefixSums>(
+    "std::inclusive_scan(first, last, out, std::plus<int>(), init) and exclusive_scan", "prefix_sums.h/.cpp", 0.0, CONFORMANCE_MAKERS(PrefixSums),
+    [](PrefixSums& p) {
+      std::vector<int> data(777), exc(777), inc(777);
+      for (int i = 0; i < 777; i++) data[i] = (i * 31) % 17 - 5;
+      p.Scan(data.data(), 777, exc.data(), inc.data());
+      Outputs r;
+      Append(r, exc);
+      Append(r, inc);
+      return r;
+    }));
+
+Register doubleSum([] {
+  Case c = MakeCase<DoubleSum>("double in a kernel (the CPU backend has none of the GPU's limits)", "double_sum.h/.cpp", 1e-12,
+                               [] { return std::make_shared<DoubleSum>(); }, [] { return CreateDoubleSum_CPU(); }, nullptr, [](DoubleSum& d) {
+                                 std::vector<double> data(4001);
+                                 for (int i = 0; i < 4001; i++) data[i] = 1e-3 * double(i % 37) - 0.01;
+                                 d.Sum(data.data(), data.size());
+                                 return Outputs{d.m_summ};
+                               });
+  c.className = "DoubleSum";
+  c.vulkanRefusal = "type 'double' is not supported";
+  return c;
+}());
+
+Register bounceLoop(MakeCase<BounceLoop>(
+    "a kernel returning bool that ends a thread's loop: if (!kernel_X(...)) break;", "bounce_loop.h/.cpp", 1e-6, CONFORMANCE_MAKERS(BounceLoop),
+    [](BounceLoop& b) {
+      const uint32_t n = 400;
+      std::vector<float> energy(n);
+      for (uint32_t i = 0; i < n; i++) energy[i] = 0.05f * float(i % 40);
+      std::vector<float4> out(n);
+      b.Trace(n, energy.data(), out.data());
+      Outputs r;
+      for (auto& p : out) Append(r, std::vector<float>{p.x, p.y});
+      return r;
+    }));
+
+Register smooth4(MakeCase<Smooth4>(
+    "a local array of vectors (float2 taps[4]) and an initialised float array", "smooth4.h/.cpp", 1e-5, CONFORMANCE_MAKERS(Smooth4),
+    [](Smooth4& s) {
+      std::vector<float2> in(100), out(100);
+      for (int i = 0; i < 100; i++) in[i] = float2(float(i), float(100 - i));
+      s.Run(100, in.data(), out.data());
+      Outputs r;
+      for (auto& p : out) Append(r, std::vector<float>{p.x, p.y});
+      return r;
+    }));
+
+Register fillVariable(MakeCase<FillVariable>(
+    "a struct passed by value to kernels, and a struct-making helper", "fill_variable.h/.cpp", 0.0, CONFORMANCE_MAKERS(FillVariable),
+    [](FillVariable& f) {
+      std::vector<float> data(100, -1.0f);
+      std::vector<BoxHit> hits(60);
+      f.Fill(data.data(), 100, hits.data(), 60);
+      Outputs r;
+      Append(r, data);
+      for (auto& h : hits) r.insert(r.end(), {double(h.id), double(h.t)});
+      return r;
+    }));
+
+Register derivedBlend(MakeCase<DerivedBlend>(
+    "a derived class's kernel reading its base's data and vector; the control function in the base", "inherited_data.h/.cpp", 1e-6,
+    CONFORMANCE_MAKERS(DerivedBlend), [](DerivedBlend& d) {
+      d.Init();
+      d.CommitDeviceData();
+      std::vector<float> data(64, 0.0f);
+      d.Test(data.data(), 64);
+      Outputs r;
+      Append(r, data);
+      return r;
+    }));
+
+}  // namespace

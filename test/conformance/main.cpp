@@ -1,0 +1,151 @@
+// Runs every conformance case on the three backends and prints which constructs pass:
+//   crossrt_conformance [--csv FILE]
+// Exit status 0 only when every case agrees with the class as written on every backend, and every
+// refusal by design is the diagnostic the case expects.
+#include "Conformance.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sys/wait.h>
+
+namespace conformance {
+
+std::vector<Case>& Registry() {
+  static std::vector<Case> cases;
+  return cases;
+}
+
+std::shared_ptr<crossrt::VulkanContext> Context() {
+  static std::shared_ptr<crossrt::VulkanContext> ctx = [] {
+    crossrt::ContextOptions options;
+    options.validation = true;
+    const char* device = std::getenv("CROSSRT_DEVICE");
+    options.device = device ? device : "";
+    try {
+      return crossrt::VulkanContext::Create(options);
+    } catch (const crossrt::NoDeviceError&) {
+      return std::shared_ptr<crossrt::VulkanContext>();
+    }
+  }();
+  return ctx;
+}
+
+}  // namespace conformance
+
+namespace {
+
+using conformance::Case;
+using conformance::Run;
+
+struct Verdict {
+  bool pass = false;
+  std::string text;
+};
+
+// A translated run against the original's outputs.
+Verdict Compare(const Run& original, const Run& translated, double tolerance) {
+  if (!translated.ran) return {false, "threw: " + translated.error};
+  if (translated.outputs.size() != original.outputs.size())
+    return {false, "gave " + std::to_string(translated.outputs.size()) + " values, not " + std::to_string(original.outputs.size())};
+  double worst = 0.0;
+  size_t at = 0;
+  for (size_t i = 0; i < original.outputs.size(); ++i) {
+    const double a = original.outputs[i], b = translated.outputs[i];
+    const double d = std::isnan(a) && std::isnan(b) ? 0.0 : std::fabs(a - b) / std::max(1.0, std::fabs(a));
+    if (!(d <= worst)) {
+      worst = d;
+      at = i;
+    }
+  }
+  char buf[96];
+  if (worst <= tolerance) {
+    std::snprintf(buf, sizeof buf, "ok (%.1e)", worst);
+    return {true, buf};
+  }
+  std::snprintf(buf, sizeof buf, "differs: %.3g at [%zu]", worst, at);
+  return {false, buf};
+}
+
+// Translates the class for Vulkan with the real crossrt command and checks that it refuses it with
+// the expected diagnostic.
+Verdict CheckRefusal(const Case& c) {
+  namespace fs = std::filesystem;
+  const std::string source = std::string(CONFORMANCE_CASES_DIR) + "/" + c.files.substr(0, c.files.find('.')) + ".cpp";
+  const fs::path out = fs::temp_directory_path() / ("crossrt-conformance-" + std::to_string(::getpid()));
+  const std::string command = std::string(CROSSRT_CLIENT) + " translate --no-daemon --backend vulkan --find-sources --class " +
+                              c.className + " --out " + out.string() + " --source " + source +
+                              " --templates " CROSSRT_TEMPLATE_DIR " -- -I" CONFORMANCE_CASES_DIR " " CONFORMANCE_INCLUDES " 2>&1";
+  std::string output;
+  if (FILE* p = ::popen(command.c_str(), "r")) {
+    char buf[4096];
+    for (size_t got; (got = std::fread(buf, 1, sizeof buf, p)) > 0;) output.append(buf, got);
+    const int status = ::pclose(p);
+    std::error_code ec;
+    const bool wroteNothing = !fs::exists(out, ec) || fs::is_empty(out, ec);
+    fs::remove_all(out, ec);
+    if (WIFEXITED(status) && WEXITSTATUS(status) == 1 && wroteNothing && output.find(c.vulkanRefusal) != std::string::npos)
+      return {true, "refused: " + c.vulkanRefusal};
+  }
+  return {false, "expected refusal '" + c.vulkanRefusal + "', got: " + output.substr(0, 300)};
+}
+
+std::string Cell(const std::string& s, size_t width) { return s.size() > width ? s.substr(0, width - 3) + "..." : s + std::string(width - s.size(), ' '); }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string csvPath;
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--csv") == 0 && i + 1 < argc) csvPath = argv[++i];
+    else {
+      std::printf("usage: crossrt_conformance [--csv FILE]\n"
+                  "Runs the conformance classes (test/conformance/cases) as written, as _CPU and as _Vulkan, and prints\n"
+                  "which constructs translate, run and agree. CROSSRT_DEVICE picks the Vulkan device.\n");
+      return std::strcmp(argv[i], "--help") == 0 ? 0 : 2;
+    }
+  }
+  auto& cases = conformance::Registry();
+  std::sort(cases.begin(), cases.end(), [](const Case& a, const Case& b) { return a.files < b.files; });
+  auto ctx = conformance::Context();
+  std::printf("CrossRT conformance: %zu classes on the CPU and on Vulkan (%s, validation on)\n\n", cases.size(),
+              ctx ? ctx->DeviceName().c_str() : "no Vulkan driver: Vulkan column skipped");
+  const size_t w0 = 62, w1 = 26, w2 = 22;
+  std::printf("%s | %s | %s | %s\n", Cell("construct", w0).c_str(), Cell("class (cases/)", w1).c_str(), Cell("_CPU", w2).c_str(), "_Vulkan");
+  std::printf("%s-+-%s-+-%s-+-%s\n", std::string(w0, '-').c_str(), std::string(w1, '-').c_str(), std::string(w2, '-').c_str(), std::string(w2, '-').c_str());
+  std::ofstream csv;
+  if (!csvPath.empty()) {
+    csv.open(csvPath);
+    csv << "construct,files,cpu,vulkan\n";
+  }
+  int failures = 0, passes = 0;
+  for (const Case& c : cases) {
+    const Run original = c.original();
+    Verdict cpu, vulkan;
+    if (!original.ran) {
+      cpu = vulkan = {false, "original threw: " + original.error};
+    } else if (std::all_of(original.outputs.begin(), original.outputs.end(), [](double v) { return v == 0.0; })) {
+      cpu = vulkan = {false, "the original computed nothing"};  // a check that cannot fail
+    } else {
+      cpu = Compare(original, c.cpu(), c.tolerance);
+      if (!c.vulkanRefusal.empty()) vulkan = CheckRefusal(c);
+      else if (!ctx) vulkan = {true, "skipped: no Vulkan driver"};
+      else {
+        vulkan = Compare(original, c.vulkan(), c.tolerance);
+        for (auto& m : ctx->ValidationMessages()) vulkan = {false, "validation: " + m};
+        ctx->ClearValidationMessages();
+      }
+    }
+    const bool pass = cpu.pass && vulkan.pass;
+    (pass ? passes : failures)++;
+    std::printf("%s | %s | %s | %s%s\n", Cell(c.construct, w0).c_str(), Cell(c.files, w1).c_str(), Cell(cpu.text, w2).c_str(),
+                vulkan.text.c_str(), pass ? "" : "   <-- FAIL");
+    if (csv) csv << '"' << c.construct << "\",\"" << c.files << "\",\"" << cpu.text << "\",\"" << vulkan.text << "\"\n";
+  }
+  std::printf("\n%d of %zu constructs translate, run and agree on both backends%s\n", passes, cases.size(),
+              failures ? "" : " (OK)");
+  return failures == 0 ? 0 : 1;
+}
