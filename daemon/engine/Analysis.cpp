@@ -94,6 +94,48 @@ unsigned IpvDims(StringRef n) {
 bool IsThreadIdName(StringRef n) { return n == "tid" || n == "tidX" || n == "tidY" || n == "tidZ"; }
 unsigned ThreadAxis(StringRef n) { return n == "tidY" ? 1 : n == "tidZ" ? 2 : 0; }
 
+// The variable an expression names (through parentheses, implicit casts and copies), or null.
+const VarDecl* NamedVar(const clang::Expr* e) {
+  for (;;) {
+    e = e->IgnoreImplicit()->IgnoreParenImpCasts();
+    auto* copy = dyn_cast<CXXConstructExpr>(e);
+    if (!copy || copy->getNumArgs() != 1 || !copy->getConstructor()->isCopyOrMoveConstructor()) break;
+    e = copy->getArg(0);
+  }
+  auto* ref = dyn_cast<DeclRefExpr>(e);
+  return ref ? dyn_cast<VarDecl>(ref->getDecl()) : nullptr;
+}
+
+// The variable at the root of a written expression: v in v, v.f, v[i], v.f[i].g; else null.
+const VarDecl* WrittenVar(const clang::Expr* e) {
+  for (;;) {
+    e = e->IgnoreParenImpCasts();
+    if (auto* me = dyn_cast<MemberExpr>(e)) e = me->getBase();
+    else if (auto* sub = dyn_cast<ArraySubscriptExpr>(e)) e = sub->getBase();
+    else if (auto* op = dyn_cast<CXXOperatorCallExpr>(e); op && op->getOperator() == OO_Subscript) e = op->getArg(0);
+    else return NamedVar(e);
+  }
+}
+
+// Calls Derived::Written(target, loc) for every assignment, increment and overloaded assignment operator.
+template <class Derived>
+struct WriteVisitor : RecursiveASTVisitor<Derived> {
+  bool VisitBinaryOperator(BinaryOperator* bo) {
+    if (bo->isAssignmentOp()) Self().Written(bo->getLHS(), bo->getExprLoc());
+    return true;
+  }
+  bool VisitUnaryOperator(UnaryOperator* uo) {
+    if (uo->isIncrementDecrementOp()) Self().Written(uo->getSubExpr(), uo->getExprLoc());
+    return true;
+  }
+  bool VisitCXXOperatorCallExpr(CXXOperatorCallExpr* op) {
+    if (op->isAssignmentOp() || op->getOperator() == OO_PlusPlus || op->getOperator() == OO_MinusMinus) Self().Written(op->getArg(0), op->getExprLoc());
+    return true;
+  }
+  Derived& Self() { return static_cast<Derived&>(*this); }
+};
+
+
 struct Context {
   ASTContext& ctx;
   const CXXRecordDecl* cls;
@@ -264,28 +306,89 @@ std::set<std::string> ClassStructNames(const ClassModel& model) {
 
 // ---- kernels ---------------------------------------------------------------
 
-// Bodies copied into generated files see only the class's header (and the sources' using-
-// directives): a name declared in the .cpp file itself would not compile there.
-void CheckCopiedBody(Context& c, const Stmt* body, const std::string& what) {
-  struct Finder : RecursiveASTVisitor<Finder> {
-    Context& c; const std::string& what; std::set<const Decl*> reported;
-    Finder(Context& ctx, const std::string& w) : c(ctx), what(w) {}
-    void Check(const NamedDecl* d, SourceLocation use) {
-      if (!d || d->isLocalExternDecl() || reported.count(d)) return;
-      if (auto* vd = dyn_cast<VarDecl>(d); vd && (vd->isLocalVarDeclOrParm())) return;
-      if (isa<FieldDecl, CXXMethodDecl, ParmVarDecl>(d) || d->getDeclContext()->isFunctionOrMethod()) return;
-      auto& sm = c.ctx.getSourceManager();
-      if (!sm.isInMainFile(sm.getExpansionLoc(d->getLocation()))) return;
-      reported.insert(d);
-      c.rep.Error(use, "'" + d->getNameAsString() + "' is declared in the source file, but " + what +
-                  " is copied into generated code that only sees the class's header",
-                  "declare it in the header (or in a header it includes)");
-    }
-    bool VisitDeclRefExpr(DeclRefExpr* e) { Check(e->getDecl(), e->getLocation()); return true; }
-  } finder(c, what);
-  finder.TraverseStmt(const_cast<Stmt*>(body));
+// Bodies copied into generated files (control functions, the CPU's loop nests) see the class's
+// header, the sources' includes and using-directives, and what this collects: the declarations of
+// the source file itself that they use (static and free helpers, constants, types), and those these
+// use in turn. Functions and constants private to the file (static, inline, an anonymous namespace,
+// const) are copied whole; a function the file exports is declared, so that calls link to it.
+// A declaration's source text with its ';' where it has one (`struct S {...};`, `const int k = 2;`).
+std::string DeclText(Context& c, const Decl* d) {
+  auto& sm = c.ctx.getSourceManager();
+  SourceLocation end = Lexer::findLocationAfterToken(d->getEndLoc(), tok::semi, sm, c.ctx.getLangOpts(), false);
+  if (end.isValid()) return Lexer::getSourceText(CharSourceRange::getCharRange(sm.getExpansionLoc(d->getBeginLoc()), end), sm, c.ctx.getLangOpts()).str();
+  return c.Text(d->getSourceRange());
 }
 
+void CopySourceDeclarations(Context& c, const Stmt* body, const std::string& what) {
+  auto& sm = c.ctx.getSourceManager();
+  struct Finder : RecursiveASTVisitor<Finder> {
+    Context& c; SourceManager& sm; const std::string& what;
+    std::set<const Decl*> found;
+    std::vector<const Decl*> pending;
+    Finder(Context& ctx, SourceManager& m, const std::string& w) : c(ctx), sm(m), what(w) {}
+    // The declaration of the main file a use refers to, at namespace scope, or null.
+    const Decl* FileLevel(const Decl* d) {
+      if (!d || isa<ParmVarDecl, FieldDecl, CXXMethodDecl>(d) || d->getDeclContext()->isFunctionOrMethod() || d->getDeclContext()->isRecord()) return nullptr;
+      if (auto* vd = dyn_cast<VarDecl>(d); vd && vd->isLocalVarDeclOrParm()) return nullptr;
+      if (auto* fd = dyn_cast<FunctionDecl>(d)) {
+        if (auto* pattern = fd->getTemplateInstantiationPattern()) fd = pattern;
+        const FunctionDecl* def = nullptr;
+        d = fd->hasBody(def) && def ? def : fd;
+        if (auto* tmpl = cast<FunctionDecl>(d)->getDescribedFunctionTemplate()) d = tmpl;
+      }
+      return sm.isInMainFile(sm.getExpansionLoc(d->getLocation())) ? d : nullptr;
+    }
+    void Use(const Decl* d) {
+      d = FileLevel(d);
+      if (d && found.insert(d).second) pending.push_back(d);
+    }
+    bool VisitDeclRefExpr(DeclRefExpr* e) { Use(e->getDecl()); return true; }
+    bool VisitCallExpr(CallExpr* call) { Use(call->getCalleeDecl()); return true; }
+    bool VisitTypeLoc(TypeLoc tl) {
+      if (auto* tag = tl.getType()->getAsTagDecl()) Use(tag);
+      if (auto* td = tl.getType()->getAs<TypedefType>()) Use(td->getDecl());
+      return true;
+    }
+  } finder(c, sm, what);
+  finder.TraverseStmt(const_cast<Stmt*>(body));
+  while (!finder.pending.empty()) {  // what the collected declarations use, in turn
+    const Decl* d = finder.pending.back();
+    finder.pending.pop_back();
+    finder.TraverseDecl(const_cast<Decl*>(d));
+  }
+  // In the order of the source file, each in its namespaces.
+  std::vector<const Decl*> decls(finder.found.begin(), finder.found.end());
+  std::sort(decls.begin(), decls.end(), [&](const Decl* a, const Decl* b) {
+    return sm.isBeforeInTranslationUnit(sm.getExpansionLoc(a->getBeginLoc()), sm.getExpansionLoc(b->getBeginLoc()));
+  });
+  const std::string file = BaseName(FileOf(c.ctx, body->getBeginLoc()));
+  for (const Decl* d : decls) {
+    std::string text;
+    const auto* fd = dyn_cast<FunctionDecl>(d);
+    if (auto* tmpl = dyn_cast<FunctionTemplateDecl>(d)) fd = tmpl->getTemplatedDecl();
+    if (fd && !isa<FunctionTemplateDecl>(d) && fd->isExternallyVisible() && !fd->isInlined() && fd->hasBody()) {
+      // Exported by the source file: a declaration links to it (a copy would be defined twice).
+      text = c.Text(SourceRange(fd->getBeginLoc(), fd->getBody()->getBeginLoc().getLocWithOffset(-1))) + ";";
+    } else if (auto* vd = dyn_cast<VarDecl>(d); vd && !vd->getType().isConstQualified()) {
+      if (!vd->isExternallyVisible()) {
+        c.rep.Error(vd->getLocation(), "'" + vd->getNameAsString() + "' is a variable private to " + file + ", which " + what +
+                    " uses; the generated class's copy of it would have a variable of its own", "make it const (or constexpr), or a member of the class");
+        continue;
+      }
+      text = "extern " + c.Text(SourceRange(vd->getBeginLoc(), vd->getLocation())) + ";";
+    } else {
+      text = DeclText(c, d);
+    }
+    std::string open, close;
+    for (auto* dc = d->getDeclContext(); dc && !dc->isTranslationUnit(); dc = dc->getParent())
+      if (auto* ns = dyn_cast<NamespaceDecl>(dc)) {
+        open = "namespace " + (ns->isAnonymousNamespace() ? std::string() : ns->getNameAsString() + " ") + "{ " + open;
+        close += " }";
+      }
+    const std::string copy = "// from " + file + "\n" + CanonicalCode(open + text + close);
+    if (std::find(c.model.sourceDecls.begin(), c.model.sourceDecls.end(), copy) == c.model.sourceDecls.end()) c.model.sourceDecls.push_back(copy);
+  }
+}
 
 // Collects the reductions (m += x, m = min(m, x), ...) and member writes of a thread body.
 struct WriteScanner : RecursiveASTVisitor<WriteScanner> {
@@ -295,6 +398,10 @@ struct WriteScanner : RecursiveASTVisitor<WriteScanner> {
   std::set<const FieldDecl*> vectorWrites;
   std::set<const FieldDecl*> atomicMembers;  // plain data members written by crossrt::Atomic*
   const FunctionDecl* helper = nullptr;  // scanning a helper's body: reductions are not allowed there
+  // Scanning statements one thread runs (before or after a kernel's loop nest): members are written
+  // as on the CPU, no race and no reduction.
+  bool singleThread = false;
+  std::set<const FieldDecl*> memberWrites;  // plain members written that way
   explicit WriteScanner(Context& ctx) : c(ctx) {}
 
   static const MemberExpr* AsThisMember(const Expr* e) {
@@ -309,12 +416,16 @@ struct WriteScanner : RecursiveASTVisitor<WriteScanner> {
       // m_img[p] = v and m_img.at(x, y) = v print as imageStore; a part of a texel cannot be stored.
       auto* op = dyn_cast<CXXOperatorCallExpr>(lhs->IgnoreParenImpCasts());
       if (!(op && op->getOperator() == OO_Subscript && ThisField(op->getArg(0)) == root))
-        c.rep.Error(loc, "kernel writes part of a texel of Image2D member '" + root->getNameAsString() + "'",
+        c.rep.GpuError(loc, "kernel writes part of a texel of Image2D member '" + root->getNameAsString() + "'",
                     "GPU images store whole texels: read the texel into a variable, change it, and write it back with " +
                     root->getNameAsString() + "[p] = value");
       return;
     }
     auto* direct = AsThisMember(lhs);
+    if (singleThread) {
+      memberWrites.insert(root);
+      return;
+    }
     if (helper) {
       c.rep.Error(loc, "helper function '" + helper->getNameAsString() + "' writes class member '" + root->getNameAsString() + "' (called from every thread: a data race)",
                   "accumulate in the kernel's loop body (m += x, min, max), or return the value from the helper");
@@ -328,7 +439,7 @@ struct WriteScanner : RecursiveASTVisitor<WriteScanner> {
       for (auto* u : uses) reductionUses.insert(u);
       return;
     }
-    c.rep.Error(loc, "kernel writes class member '" + root->getNameAsString() + "' from every thread (a data race on the GPU)",
+    c.rep.Error(loc, "kernel writes class member '" + root->getNameAsString() + "' from every thread (a data race)",
                 "accumulate with 'm += x', 'm = std::min(m, x)' or 'm = std::max(m, x)' (a reduction), or write to an element of a std::vector member");
   }
   std::optional<ReduceOp> MinMax(const Expr* lhs, const Expr* rhs, std::vector<const MemberExpr*>& uses) {
@@ -435,7 +546,7 @@ struct LoopHeader {
 bool ParseLoop(Context& c, const ForStmt* fs, LoopHeader& h, const std::string& kernel) {
   auto bad = [&](const std::string& what) {
     c.rep.Error(fs->getBeginLoc(), "loop of kernel '" + kernel + "' is not a parallel loop: " + what,
-                "write it as 'for (int i = start; i < end; i++)'; each iteration becomes one GPU thread");
+                "write it as 'for (int i = start; i < end; i++)'; each iteration becomes one thread");
     return false;
   };
   auto* ds = dyn_cast_or_null<DeclStmt>(fs->getInit());
@@ -490,12 +601,12 @@ void CheckKernelParams(Context& c, const CXXMethodDecl* md, Kernel& k) {
     if (IsImage2D(t.getNonReferenceType().getUnqualifiedType(), &texel)) {
       auto format = ImageFormatOf(texel);
       if (!t->isReferenceType()) {
-        c.rep.Error(p->getLocation(), "kernel parameter '" + kp.name + "' takes an Image2D by value",
+        c.rep.GpuError(p->getLocation(), "kernel parameter '" + kp.name + "' takes an Image2D by value",
                     "take it by reference: 'const Image2D<T>& " + kp.name + "' to read it, 'Image2D<T>& " + kp.name + "' to write it");
         continue;
       }
       if (!format) {
-        c.rep.Error(p->getLocation(), "kernel parameter '" + kp.name + "' is an Image2D of '" + texel.getAsString(c.ctx.getPrintingPolicy()) + "', which GPU images cannot hold",
+        c.rep.GpuError(p->getLocation(), "kernel parameter '" + kp.name + "' is an Image2D of '" + texel.getAsString(c.ctx.getPrintingPolicy()) + "', which GPU images cannot hold",
                     "use Image2D<float4>, Image2D<float> or Image2D<uint32_t>");
         continue;
       }
@@ -514,30 +625,45 @@ void CheckKernelParams(Context& c, const CXXMethodDecl* md, Kernel& k) {
       kp.isConstPointee = pointee.isConstQualified();
       auto g = GlslTypeOf(pointee);
       if (!g || pointee->isPointerType()) {
-        c.rep.Error(p->getLocation(), "kernel parameter '" + kp.name + "' points to '" + pointee.getAsString(c.ctx.getPrintingPolicy()) + "', which has no GPU equivalent",
+        c.rep.GpuError(p->getLocation(), "kernel parameter '" + kp.name + "' points to '" + pointee.getAsString(c.ctx.getPrintingPolicy()) + "', which has no GPU equivalent",
                     "pass arrays of int, uint, float, LiteMath vectors or plain structs of those");
         continue;
       }
       kp.glslType = *g;
       if (!LayoutMatchesCpp(c.ctx, pointee, false)) {
         if (LayoutMatchesCpp(c.ctx, pointee, true)) kp.scalarLayout = true;
-        else c.rep.Error(p->getLocation(), "the C++ layout of '" + pointee.getAsString(c.ctx.getPrintingPolicy()) + "' cannot be reproduced in a GPU buffer",
+        else c.rep.GpuError(p->getLocation(), "the C++ layout of '" + pointee.getAsString(c.ctx.getPrintingPolicy()) + "' cannot be reproduced in a GPU buffer",
                          "reorder the fields so 16-byte types (float4, float3) come first, or pad them to float4");
       }
     } else if (t->isReferenceType() && !t.getNonReferenceType().isConstQualified()) {
-      c.rep.Error(p->getLocation(), "kernel parameter '" + kp.name + "' is a non-const reference",
+      c.rep.GpuError(p->getLocation(), "kernel parameter '" + kp.name + "' is a non-const reference",
                   "kernels return results through pointer parameters or members");
     } else {
       auto g = GlslTypeOf(t);
       if (!g || (t.getNonReferenceType()->isFloatingType() && !t.getNonReferenceType()->isSpecificBuiltinType(BuiltinType::Float))) {
-        c.rep.Error(p->getLocation(), "kernel parameter '" + kp.name + "' of type '" + t.getAsString(c.ctx.getPrintingPolicy()) + "' has no GPU equivalent",
+        c.rep.GpuError(p->getLocation(), "kernel parameter '" + kp.name + "' of type '" + t.getAsString(c.ctx.getPrintingPolicy()) + "' has no GPU equivalent",
                     "use int, uint, float, LiteMath types, plain structs, or a pointer with a size");
         continue;
       }
       QualType value = t.getNonReferenceType().getUnqualifiedType();
+      // 64-bit integers (size_t, int64_t) are 32-bit in shaders, like loop counters of those types.
+      if (value->isIntegerType() && c.ctx.getTypeSize(value) == 64) {
+        kp.glslType = *g;
+        kp.std430Align = 4;
+        kp.valueCppType = value->isUnsignedIntegerType() ? "uint32_t" : "int32_t";
+        kp.narrowed = true;
+        kp.cppType = ParamDecl(c.ctx, p, i);
+        kp.cppType = kp.cppType.substr(0, kp.cppType.size() - kp.name.size());
+        while (!kp.cppType.empty() && isspace((unsigned char)kp.cppType.back())) kp.cppType.pop_back();
+        if (c.rep.GpuRules())
+          c.rep.Note(p->getLocation(), "kernel parameter '" + kp.name + "' of type '" + t.getAsString(c.ctx.getPrintingPolicy()) +
+                     "' is 32-bit on the GPU: values above " + std::string(value->isUnsignedIntegerType() ? "4294967295" : "2147483647") + " wrap around");
+        k.params.push_back(kp);
+        continue;
+      }
       auto layout = Std430Layout(c.ctx, value, false);
       if (!layout || !FitsClassData(c.ctx, value)) {
-        c.rep.Error(p->getLocation(), "kernel parameter '" + kp.name + "' of type '" + t.getAsString(c.ctx.getPrintingPolicy()) + "' cannot be passed to the GPU as it is laid out in C++",
+        c.rep.GpuError(p->getLocation(), "kernel parameter '" + kp.name + "' of type '" + t.getAsString(c.ctx.getPrintingPolicy()) + "' cannot be passed to the GPU as it is laid out in C++",
                     "use 32-bit int, uint or float, LiteMath vectors, float4x4, or structs whose fields keep the std430 layout (bool is 1 byte in C++, 4 on the GPU: use int)");
         continue;
       }
@@ -603,7 +729,7 @@ std::string ImplementationMethod(Reporter& rep, GlslPrinter& printer, const CXXR
   const CXXMethodDecl* overrider = method->getCorrespondingMethodInClass(impl);
   const FunctionDecl* def = nullptr;
   if (!overrider || overrider->isPureVirtual() || !overrider->hasBody(def) || !def) {
-    rep.Error(callLoc, "the GPU needs the body of " + impl->getNameAsString() + "'s " + method->getNameAsString() +
+    rep.GpuError(callLoc, "the GPU needs the body of " + impl->getNameAsString() + "'s " + method->getNameAsString() +
                 " (kernels call it through virtual functions), but this translation unit does not define it",
                 "define it in the header that declares " + impl->getNameAsString() + ", or in the class's source file");
     return "";
@@ -633,7 +759,7 @@ void RequireReachable(Reporter& rep, const FieldDecl* f, const CXXRecordDecl* cl
 // member the GPU reads must be public. `how` names the composition, "" or " (IScene=ShapeScene)".
 void RequirePublicForComposition(Reporter& rep, const FieldDecl* f, const std::string& implName, const std::string& how) {
   if (f->getAccess() != AS_public)
-    rep.Error(f->getLocation(), "member '" + f->getNameAsString() + "' of " + implName + " is read on the GPU through composition" + how +
+    rep.GpuError(f->getLocation(), "member '" + f->getNameAsString() + "' of " + implName + " is read on the GPU through composition" + how +
               ", so the generated class must reach it through a " + implName + "*", "declare it public");
 }
 
@@ -803,7 +929,7 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
     std::vector<const CXXRecordDecl*> impls;
     FindImplementations(ctx.getTranslationUnitDecl(), interface, impls);
     if (impls.empty()) {
-      rep.Error(field->getLocation(), "kernels call " + interface->getNameAsString() + " through '" + member + "', but no class that implements it is defined here",
+      rep.GpuError(field->getLocation(), "kernels call " + interface->getNameAsString() + " through '" + member + "', but no class that implements it is defined here",
                   "define the implementations (classes derived from " + interface->getNameAsString() + ") in a header the class's source includes");
       continue;
     }
@@ -824,13 +950,13 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
         for (auto* f : fields) {
           auto g = GlslTypeOf(f->getType());
           if (!g || f->getType()->isPointerType() || IsStdVector(f->getType()) || f->isBitField()) {
-            rep.Error(f->getLocation(), "member '" + f->getNameAsString() + "' of " + vi.name + " cannot be copied to the GPU (kernels call " + vm.interfaceName +
+            rep.GpuError(f->getLocation(), "member '" + f->getNameAsString() + "' of " + vi.name + " cannot be copied to the GPU (kernels call " + vm.interfaceName +
                         " through '" + member + "')", "objects called through virtual functions hold plain data: scalars, LiteMath types and structs of them");
             ok = false;
             continue;
           }
           if (f->getAccess() != AS_public) {
-            rep.Error(f->getLocation(), "member '" + f->getNameAsString() + "' of " + vi.name + " is copied to the GPU (kernels call " + vm.interfaceName +
+            rep.GpuError(f->getLocation(), "member '" + f->getNameAsString() + "' of " + vi.name + " is copied to the GPU (kernels call " + vm.interfaceName +
                         " through '" + member + "'), but the generated class cannot read it", "declare it public");
             ok = false;
             continue;
@@ -845,7 +971,7 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
         if (std430 && *std430 == *cpp) vi.scalarLayout = false;
         else if (scalar && *scalar == *cpp) vi.scalarLayout = true;
         else {
-          rep.Error(impl->getLocation(), "the data of " + vi.name + " cannot be laid out on the GPU as C++ lays it out",
+          rep.GpuError(impl->getLocation(), "the data of " + vi.name + " cannot be laid out on the GPU as C++ lays it out",
                       "use 32-bit scalars and LiteMath vectors; put 16-byte types (float4) first");
           continue;
         }
@@ -860,7 +986,7 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
           for (auto& theirs : other.impls)
             for (auto& vi : vm.impls)
               if (theirs.name == vi.name && theirs.paddingWords != vi.paddingWords)
-                rep.Error(field->getLocation(), "at virtual-function level 1, " + vi.name + " takes a " + std::to_string(vm.slotBytes) + "-byte slot in '" + member +
+                rep.GpuError(field->getLocation(), "at virtual-function level 1, " + vi.name + " takes a " + std::to_string(vm.slotBytes) + "-byte slot in '" + member +
                           "' but a " + std::to_string(other.slotBytes) + "-byte slot in '" + other.member + "'",
                           "use level 2 (a buffer per class), where a class's objects need no slot");
       }
@@ -924,7 +1050,7 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
 void CheckObjectSizeReads(Reporter& rep, const GlslPrinter& printer) {
   for (auto& [field, loc] : printer.objectSizeReads)
     if (std::none_of(printer.virtualCalls.begin(), printer.virtualCalls.end(), [&](const auto& call) { return call.first == field; }))
-      rep.Error(loc, "the kernel reads the size of '" + field->getNameAsString() + "', a vector of objects it calls no virtual function through",
+      rep.GpuError(loc, "the kernel reads the size of '" + field->getNameAsString() + "', a vector of objects it calls no virtual function through",
                 "keep the count in a plain member, or read the size where the kernel also calls through the vector");
 }
 
@@ -1005,7 +1131,7 @@ void AddLockedCopies(Context& c, const std::vector<const FunctionDecl*>& reached
       }
     } privateUses(c, name);
     privateUses.TraverseStmt(fn->getBody());
-    CheckCopiedBody(c, fn->getBody(), "'" + name + "', which appends,");
+    CopySourceDeclarations(c, fn->getBody(), "'" + name + "', which appends,");
     // The copy hides every overload of its name: the others stay reachable through one
     // using-declaration, with the first copy of the name.
     auto overloads = c.cls->lookup(md->getDeclName());
@@ -1024,6 +1150,75 @@ void AddLockedCopies(Context& c, const std::vector<const FunctionDecl*>& reached
     copy.body = CanonicalCode(rw.getRewrittenText(fn->getBody()->getSourceRange()));
     c.model.lockedCopies.push_back(copy);
   }
+}
+
+// A statement's source text with its ';' (the AST range of an expression statement ends before it).
+std::string StatementText(Context& c, const Stmt* s) {
+  auto& sm = c.ctx.getSourceManager();
+  SourceLocation end = Lexer::findLocationAfterToken(s->getEndLoc(), tok::semi, sm, c.ctx.getLangOpts(), false);
+  if (end.isValid()) return Lexer::getSourceText(CharSourceRange::getCharRange(sm.getExpansionLoc(s->getBeginLoc()), end), sm, c.ctx.getLangOpts()).str();
+  return c.Text(s->getSourceRange());
+}
+
+// The statements before and after a kernelND_'s loop nest run on one thread, around the threads of
+// the nest: before them (the GPU's <kernel>_Start) and after them (<kernel>_Finish). Every thread
+// evaluates the declarations before the nest for itself, so the statements before it may not change
+// those locals afterwards, and neither may the threads (a race on the CPU too). A 'return' before
+// the nest would skip it on the CPU but not on the GPU.
+bool CheckLoopEnds(Context& c, const std::string& kernel, const std::vector<const Stmt*>& before,
+                   const std::vector<const Stmt*>& after, const Stmt* threadBody) {
+  std::set<const VarDecl*> locals;
+  for (auto* s : before)
+    if (auto* ds = dyn_cast<DeclStmt>(s))
+      for (auto* d : ds->decls())
+        if (auto* vd = dyn_cast<VarDecl>(d)) locals.insert(vd);
+  struct LocalWrites : WriteVisitor<LocalWrites> {
+    const std::set<const VarDecl*>& locals;
+    std::vector<std::pair<const VarDecl*, SourceLocation>> found;
+    explicit LocalWrites(const std::set<const VarDecl*>& l) : locals(l) {}
+    void Written(const Expr* target, SourceLocation loc) {
+      if (auto* vd = WrittenVar(target); vd && locals.count(vd)) found.push_back({vd, loc});
+    }
+    bool VisitUnaryOperator(UnaryOperator* uo) {
+      if (uo->getOpcode() == UO_AddrOf) Written(uo->getSubExpr(), uo->getExprLoc());
+      return WriteVisitor<LocalWrites>::VisitUnaryOperator(uo);
+    }
+  };
+  bool ok = true;
+  for (auto* s : before) {
+    if (isa<DeclStmt>(s)) continue;
+    LocalWrites w(locals);
+    w.TraverseStmt(const_cast<Stmt*>(s));
+    for (auto& [vd, loc] : w.found) {
+      c.rep.Error(loc, "a statement before the loop nest of kernel '" + kernel + "' changes '" + vd->getNameAsString() +
+                  "', which every thread of the nest computes from its declaration",
+                  "give '" + vd->getNameAsString() + "' its final value where it is declared");
+      ok = false;
+    }
+  }
+  LocalWrites inLoop(locals);
+  inLoop.TraverseStmt(const_cast<Stmt*>(threadBody));
+  for (auto& [vd, loc] : inLoop.found) {
+    c.rep.Error(loc, "the loop of kernel '" + kernel + "' writes '" + vd->getNameAsString() + "', declared before the loop: every iteration (a thread) would write one variable",
+                "declare it inside the loop, or accumulate into a member (m += x is a reduction)");
+    ok = false;
+  }
+  struct Returns : RecursiveASTVisitor<Returns> {
+    std::vector<SourceLocation> found;
+    bool VisitReturnStmt(ReturnStmt* r) { found.push_back(r->getReturnLoc()); return true; }
+    bool TraverseLambdaExpr(LambdaExpr*) { return true; }
+  };
+  for (auto* s : before) {
+    Returns r;
+    r.TraverseStmt(const_cast<Stmt*>(s));
+    for (auto loc : r.found) {
+      c.rep.GpuError(loc, "'return' before the loop nest of kernel '" + kernel + "': on the GPU the nest's threads would run anyway",
+                  "test the condition in the control function before calling the kernel, or inside the loop");
+      ok = false;
+    }
+  }
+  (void)after;  // a 'return' after the nest ends the statements after it on both
+  return ok;
 }
 
 void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def) {
@@ -1048,10 +1243,11 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   }
   auto* body = dyn_cast<CompoundStmt>(def->getBody());
   if (!body) {
-    c.rep.Error(md->getLocation(), "kernel '" + k.name + "' has a function-try-block", "GPU code has no exceptions: remove the try/catch");
+    c.rep.GpuError(md->getLocation(), "kernel '" + k.name + "' has a function-try-block", "GPU code has no exceptions: remove the try/catch");
     return;
   }
-  std::vector<const Stmt*> preamble;
+  std::vector<const Stmt*> preamble;      // declarations before the loop nest: every thread evaluates them
+  std::vector<const Stmt*> before, after;  // all statements before and after the loop nest: one thread runs them
   const Stmt* threadBody = body;
   std::vector<std::pair<std::string, std::string>> threadParams;  // (glsl type, name)
 
@@ -1077,15 +1273,17 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     }
   } else {
     // kernelND_: optional declarations, then N perfectly nested loops.
+    // [statements before] N perfectly nested loops [statements after]: the first for loop of the
+    // body is the nest; what comes before and after it (the paper's loop_start and loop_end) runs
+    // on one thread. The declarations before it are also evaluated by every thread.
     const ForStmt* outer = nullptr;
     for (auto* s : body->body()) {
-      if (!outer && isa<DeclStmt>(s)) { preamble.push_back(s); continue; }
-      if (!outer && isa<ForStmt>(s)) { outer = cast<ForStmt>(s); continue; }
       if (isa<NullStmt>(s)) continue;
-      c.rep.Error(s->getBeginLoc(), "kernel '" + k.name + "' must consist of its parallel loop nest (and declarations before it)",
-                  "move this statement into the loop body, or into the control function");
-      return;
+      if (!outer && isa<ForStmt>(s)) outer = cast<ForStmt>(s);
+      else (outer ? after : before).push_back(s);
     }
+    for (auto* s : before)
+      if (isa<DeclStmt>(s)) preamble.push_back(s);
     if (!outer) {
       c.rep.Error(md->getLocation(), "kernel '" + k.name + "' has no loop", "a kernel" + std::to_string(k.dims) + "D_ function holds " + std::to_string(k.dims) + " nested for loops whose iterations become GPU threads");
       return;
@@ -1108,10 +1306,10 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
           Expr::EvalResult r;
           const std::string v = f->getNameAsString();
           if (k.dims != 1)
-            c.rep.Error(h.end->getBeginLoc(), "kernel '" + k.name + "' loops to the size of '" + v + "', which kernels append to on the GPU, in a " +
+            c.rep.GpuError(h.end->getBeginLoc(), "kernel '" + k.name + "' loops to the size of '" + v + "', which kernels append to on the GPU, in a " +
                         std::to_string(k.dims) + "D loop nest", "loop to " + v + ".size() in a kernel1D_ kernel: it is dispatched indirectly, with the count the GPU computed");
           else if (!(h.start->EvaluateAsInt(r, c.ctx) && r.Val.getInt() == 0) || h.inclusive)
-            c.rep.Error(h.end->getBeginLoc(), "kernel '" + k.name + "' loops over '" + v + "', which kernels append to on the GPU, but not from 0 to " + v + ".size()",
+            c.rep.GpuError(h.end->getBeginLoc(), "kernel '" + k.name + "' loops over '" + v + "', which kernels append to on the GPU, but not from 0 to " + v + ".size()",
                         "write 'for (uint32_t i = 0; i < " + v + ".size(); ++i)' and skip elements inside the loop");
           else
             k.indirectVector = v;
@@ -1138,6 +1336,12 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   WriteScanner ws(c);
   ws.TraverseStmt(const_cast<Stmt*>(threadBody));
   for (auto* s : preamble) ws.TraverseStmt(const_cast<Stmt*>(s));
+  WriteScanner ends(c);  // the statements around the loop nest, which one thread runs
+  ends.singleThread = true;
+  for (auto* list : {&before, &after})
+    for (auto* s : *list)
+      if (!isa<DeclStmt>(s)) ends.TraverseStmt(const_cast<Stmt*>(s));
+  if (!CheckLoopEnds(c, k.name, before, after, threadBody)) return;
   ReductionReadScanner rs(c, ws);
   rs.TraverseStmt(const_cast<Stmt*>(threadBody));
   if (k.rtv && !ws.reductions.empty()) {
@@ -1146,7 +1350,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     return;
   }
   if (!k.indirectVector.empty() && !ws.reductions.empty())
-    c.rep.Error(md->getLocation(), "kernel '" + k.name + "' reduces members and is dispatched indirectly (it loops to " + k.indirectVector + ".size())",
+    c.rep.GpuError(md->getLocation(), "kernel '" + k.name + "' reduces members and is dispatched indirectly (it loops to " + k.indirectVector + ".size())",
                 "reduce in a kernel with a count the host knows, or append the values and reduce them in a later kernel");
   // In declaration order, so that regeneration is stable.
   for (auto* field : c.cls->fields()) {
@@ -1163,11 +1367,13 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   }
   // After printing, the printer knows the helpers the kernel reaches: their writes count too.
   auto markVectorWrites = [&](const WriteScanner& scanner) {
-    for (auto* set : {&scanner.vectorWrites, &scanner.atomicMembers})
+    for (auto* set : {&scanner.vectorWrites, &scanner.atomicMembers, &scanner.memberWrites})
       for (auto* f : *set)
         if (auto* m = FindMember(c.model, f->getNameAsString())) m->writtenByKernels = true;
   };
   markVectorWrites(ws);
+  markVectorWrites(ends);
+  for (auto& [field, loc] : ends.appends) ws.appends.emplace(field, loc);
 
   // GLSL: the thread function.
   std::ostringstream os;
@@ -1182,6 +1388,34 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     os << printer.ThreadBody(threadBody, 1, !k.rtv);
   os << "}\n";
   k.glslBody = os.str();
+  // The statements around the loop nest, as functions one thread runs before and after the others.
+  if (std::any_of(before.begin(), before.end(), [](const Stmt* s) { return !isa<DeclStmt>(s); }) || !after.empty()) {
+    const auto sizeReadsInLoop = printer.sizeReads;  // after the loop a vector's final size is known
+    const auto renames = printer.renames;
+    for (auto& r : k.reductions)
+      for (auto* f : c.cls->fields())
+        if (f->getNameAsString() == r.member) printer.renames.erase(f);  // the member itself, not a thread's part
+    printer.singleThread = true;
+    const std::string from = "// from " + c.cls->getNameAsString() + "::" + k.name + " (" + k.sourceFile + "): ";
+    if (std::any_of(before.begin(), before.end(), [](const Stmt* s) { return !isa<DeclStmt>(s); })) {
+      k.glslStart = from + "the statements before its loop nest, run by one thread before the others\nvoid " + k.name + "_Start()\n{\n";
+      for (auto* s : before) k.glslStart += printer.Stmt(s, 1);
+      k.glslStart += "}\n";
+    }
+    if (!after.empty()) {
+      k.glslFinish = from + "the statements after its loop nest, run by one thread after the others\nvoid " + k.name + "_Finish()\n{\n";
+      for (auto* s : preamble) k.glslFinish += printer.Stmt(s, 1);
+      for (auto* s : after) k.glslFinish += printer.Stmt(s, 1);
+      k.glslFinish += "}\n";
+    }
+    printer.singleThread = false;
+    printer.renames = renames;
+    for (auto* f : printer.emptiedVectors)
+      if (!c.appended.count(f->getNameAsString()))
+        c.rep.GpuError(f->getLocation(), "kernel '" + k.name + "' empties '" + f->getNameAsString() + "', which no kernel appends to: on the GPU only an appended vector's size is counted there",
+                    "empty it in the control function (before the kernel), or append to it with push_back in the loop");
+    printer.sizeReads = sizeReadsInLoop;
+  }
   std::map<const FieldDecl*, SourceLocation> appends = ws.appends;
   for (auto* helper : printer.helpers) {
     WriteScanner hs(c);
@@ -1264,7 +1498,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     auto* m = FindMember(c.model, f->getNameAsString());
     if (m) m->usedByKernels = true;
     if (m && !m->inClassData && f->getAccess() != AS_private)
-      c.rep.Error(f->getLocation(), "member '" + f->getNameAsString() + "' of type '" + f->getType().getAsString(c.ctx.getPrintingPolicy()) + "' has a C++ layout that a GPU buffer cannot reproduce",
+      c.rep.GpuError(f->getLocation(), "member '" + f->getNameAsString() + "' of type '" + f->getType().getAsString(c.ctx.getPrintingPolicy()) + "' has a C++ layout that a GPU buffer cannot reproduce",
                   "use int instead of bool, float4x4 instead of float3x3, or reorder struct fields so 16-byte types come first");
     RequireReachable(c.rep, f, c.cls);
   }
@@ -1294,9 +1528,11 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     SourceLocation end = Lexer::findLocationAfterToken(outer->getEndLoc(), tok::semi, c.ctx.getSourceManager(), c.ctx.getLangOpts(), false);
     k.cpuLoopNest = CanonicalCode(end.isValid() ? rw.getRewrittenText(CharSourceRange::getCharRange(outer->getBeginLoc(), end))
                                                 : rw.getRewrittenText(outer->getSourceRange()));
-    CheckCopiedBody(c, def->getBody(), "kernel '" + k.name + "'");
-    for (auto* s : preamble) k.cpuPreamble += c.Text(s->getSourceRange()) + "\n";
+    CopySourceDeclarations(c, def->getBody(), "kernel '" + k.name + "'");
+    for (auto* s : before) k.cpuPreamble += StatementText(c, s) + "\n";
     k.cpuPreamble = CanonicalCode(k.cpuPreamble);
+    for (auto* s : after) k.cpuPostamble += StatementText(c, s) + "\n";
+    k.cpuPostamble = CanonicalCode(k.cpuPostamble);
   }
   c.model.kernels.push_back(k);
 }
@@ -1348,7 +1584,7 @@ void CheckImageParamsUnchanged(Context& c, const FunctionDecl* def, const std::s
       auto* dr = object ? dyn_cast<DeclRefExpr>(object->IgnoreParenImpCasts()) : nullptr;
       auto* p = dr ? dyn_cast<ParmVarDecl>(dr->getDecl()) : nullptr;
       if (!p || p->getDeclContext() != def || !md || md->isConst() || !IsImage2D(p->getType().getNonReferenceType().getUnqualifiedType())) return;
-      c.rep.Error(loc, "control function '" + control + "' changes Image2D parameter '" + p->getNameAsString() + "' on the host ('" + md->getNameAsString() + "')",
+      c.rep.GpuError(loc, "control function '" + control + "' changes Image2D parameter '" + p->getNameAsString() + "' on the host ('" + md->getNameAsString() + "')",
                   "its GPU copy is made before the body runs: size and fill the image before calling '" + control + "', and write its texels in a kernel");
     }
     bool VisitCXXMemberCallExpr(CXXMemberCallExpr* call) {
@@ -1399,7 +1635,7 @@ private:
         return view + ")";
       }
     }
-    m_c.rep.Error(arg->getBeginLoc(), "pointer argument of a kernel call must be a parameter of '" + m_ctrl.name + "' or 'member.data()' (+ offset)",
+    m_c.rep.GpuError(arg->getBeginLoc(), "pointer argument of a kernel call must be a parameter of '" + m_ctrl.name + "' or 'member.data()' (+ offset)",
                   "pass the control function's size-annotated pointer, or a std::vector member's data()");
     return "{}";
   }
@@ -1423,7 +1659,7 @@ private:
       }
       return "crossrt::ImageView(m_images." + name + ", m_images." + name + "Width, m_images." + name + "Height)";
     }
-    m_c.rep.Error(arg->getBeginLoc(), "Image2D argument of a kernel call must be an Image2D parameter of '" + m_ctrl.name + "' or an Image2D member",
+    m_c.rep.GpuError(arg->getBeginLoc(), "Image2D argument of a kernel call must be an Image2D parameter of '" + m_ctrl.name + "' or an Image2D member",
                   "an image local to '" + m_ctrl.name + "' has no GPU copy: make it a member (its GPU copy is kept between calls) or a parameter of '" +
                       m_ctrl.name + "'");
     return "{}";
@@ -1448,7 +1684,7 @@ private:
   // GPU; a buffer passed to it elsewhere would be read one element per thread, not as C++ reads it.
   void CheckNotThreadState(const CXXMethodDecl* md, const ParmVarDecl* p, const Expr* arg) {
     if (!m_c.threadState.count({md->getNameAsString(), p->getNameAsString()})) return;
-    m_c.rep.Error(arg->getBeginLoc(), "parameter '" + p->getNameAsString() + "' of '" + md->getNameAsString() +
+    m_c.rep.GpuError(arg->getBeginLoc(), "parameter '" + p->getNameAsString() + "' of '" + md->getNameAsString() +
                   "' gets a local's address in a thread loop, so on the GPU it holds one value per thread, but here it is given a buffer",
                   "pass the address of a local declared in the thread loop everywhere, or give the kernel a separate buffer parameter");
   }
@@ -1623,7 +1859,7 @@ private:
   }
 
   void Error(ThreadLoop& tl, SourceLocation loc, const std::string& message, const std::string& hint) {
-    m_c.rep.Error(loc, message, hint);
+    m_c.rep.GpuError(loc, message, hint);
     tl.ok = false;
   }
 
@@ -1945,7 +2181,7 @@ private:
         auto* f = ThisField(object);
         if (!f || !rw.m_c.appended.count(f->getNameAsString())) return;
         const std::string v = f->getNameAsString();
-        rw.m_c.rep.Error(loc, "control function '" + rw.m_ctrl.name + "' uses " + what + " of '" + v +
+        rw.m_c.rep.GpuError(loc, "control function '" + rw.m_ctrl.name + "' uses " + what + " of '" + v +
                          "', which kernels append to: on the GPU its size and contents are known only after the call returns",
                          "loop to " + v + ".size() inside a kernel1D_ kernel (dispatched indirectly, with no host round trip), or read " + v +
                          " after the call; here it may only be cleared, reserved, or sorted whole with std::sort(" + v + ".begin(), " + v + ".end(), ...)");
@@ -1988,7 +2224,7 @@ private:
     KernelCallFinder kc;
     kc.TraverseStmt(def->getBody());
     if (kc.calls.empty()) return;
-    m_c.rep.Error(call->getBeginLoc(), "control function '" + m_ctrl.name + "' calls control function '" + md->getNameAsString() + "'",
+    m_c.rep.GpuError(call->getBeginLoc(), "control function '" + m_ctrl.name + "' calls control function '" + md->getNameAsString() + "'",
                   "on the GPU each control function is one submission: call its kernels directly here, or call both from outside the class");
   }
 
@@ -2138,7 +2374,7 @@ private:
     bool inStd = fd->isInStdNamespace() || IsSystemDecl(fd);
     if (!inStd) return false;
     auto bad = [&](const std::string& why) {
-      m_c.rep.Error(call->getBeginLoc(), "'" + fd->getQualifiedNameAsString() + "' on device data: " + why,
+      m_c.rep.GpuError(call->getBeginLoc(), "'" + fd->getQualifiedNameAsString() + "' on device data: " + why,
                     "use member std::vector begin()/end()/data() or size-annotated pointer parameters, with + offsets");
       return true;
     };
@@ -2227,7 +2463,7 @@ private:
       auto* md = call->getMethodDecl();
       if (md && IsKernelName(md->getName()) && isa<CXXThisExpr>(call->getImplicitObjectArgument()->IgnoreParenImpCasts())) {
         if (!IpvDims(md->getName())) {
-          m_c.rep.Error(call->getBeginLoc(), "kernel '" + md->getNameAsString() + "' must be called inside loops over its thread ids",
+          m_c.rep.GpuError(call->getBeginLoc(), "kernel '" + md->getNameAsString() + "' must be called inside loops over its thread ids",
                         "call it as: for (int i = 0; i < n; i++) " + md->getNameAsString() + "(i, ...);");
           return;
         }
@@ -2280,7 +2516,7 @@ void AnalyzeControl(Context& c, const CXXMethodDecl* md, const FunctionDecl* def
       for (auto* a : p->specific_attrs<AnnotateAttr>())
         if (a->getAnnotation().starts_with("crossrt.size=")) cp.sizeExpr = a->getAnnotation().substr(13).str();
       if (cp.sizeExpr.empty())
-        c.rep.Error(p->getLocation(), "pointer parameter '" + cp.name + "' of control function '" + ctrl.name + "' has no size",
+        c.rep.GpuError(p->getLocation(), "pointer parameter '" + cp.name + "' of control function '" + ctrl.name + "' has no size",
                     "annotate it with its element count, e.g. '[[crossrt::size(\"n\")]] const float* " + cp.name +
                     "' or 'const float* " + cp.name + " __attribute__((size(\"n\")))'");
     }
@@ -2290,13 +2526,13 @@ void AnalyzeControl(Context& c, const CXXMethodDecl* md, const FunctionDecl* def
       cp.isConst = !p->getType()->isReferenceType() || p->getType().getNonReferenceType().isConstQualified();
       cp.pointeeCpp = CppTypeName(c.ctx, texel);
       if (auto format = ImageFormatOf(texel)) cp.vkFormat = format->vkFormat;
-      else c.rep.Error(p->getLocation(), "parameter '" + cp.name + "' of control function '" + ctrl.name + "' is an Image2D of '" +
+      else c.rep.GpuError(p->getLocation(), "parameter '" + cp.name + "' of control function '" + ctrl.name + "' is an Image2D of '" +
                        texel.getAsString(c.ctx.getPrintingPolicy()) + "', which GPU images cannot hold", "use Image2D<float4>, Image2D<float> or Image2D<uint32_t>");
     }
     ctrl.params.push_back(cp);
   }
   CheckImageParamsUnchanged(c, def, ctrl.name);
-  CheckCopiedBody(c, def->getBody(), "control function '" + ctrl.name + "'");
+  CopySourceDeclarations(c, def->getBody(), "control function '" + ctrl.name + "'");
   ControlRewriter rw(c, md, def, ctrl);
   rw.Run();
   c.model.controls.push_back(ctrl);
@@ -2437,23 +2673,6 @@ const CXXMethodDecl* ImplementationOf(const CXXRecordDecl* impl, const std::stri
 
 // The writes the finders below share: assignments, increments and decrements, built in or
 // overloaded. Derived::Written(target, loc) decides what each write means to it.
-template <class Derived>
-struct WriteVisitor : RecursiveASTVisitor<Derived> {
-  bool VisitBinaryOperator(BinaryOperator* bo) {
-    if (bo->isAssignmentOp()) Self().Written(bo->getLHS(), bo->getExprLoc());
-    return true;
-  }
-  bool VisitUnaryOperator(UnaryOperator* uo) {
-    if (uo->isIncrementDecrementOp()) Self().Written(uo->getSubExpr(), uo->getExprLoc());
-    return true;
-  }
-  bool VisitCXXOperatorCallExpr(CXXOperatorCallExpr* op) {
-    if (op->isAssignmentOp() || op->getOperator() == OO_PlusPlus || op->getOperator() == OO_MinusMinus) Self().Written(op->getArg(0), op->getExprLoc());
-    return true;
-  }
-  Derived& Self() { return static_cast<Derived&>(*this); }
-};
-
 // Writes to members of `this` in composed code: the GPU copy of an implementation's data is never
 // read back, so such a write would be lost silently.
 struct ComposedWriteFinder : WriteVisitor<ComposedWriteFinder> {
@@ -2468,29 +2687,6 @@ struct ComposedWriteFinder : WriteVisitor<ComposedWriteFinder> {
 };
 
 // ---- virtual functions, level 3, in composed code: intersection shaders (paper 3.10) ----
-
-// The variable an expression names (through parentheses, implicit casts and copies), or null.
-const VarDecl* NamedVar(const clang::Expr* e) {
-  for (;;) {
-    e = e->IgnoreImplicit()->IgnoreParenImpCasts();
-    auto* copy = dyn_cast<CXXConstructExpr>(e);
-    if (!copy || copy->getNumArgs() != 1 || !copy->getConstructor()->isCopyOrMoveConstructor()) break;
-    e = copy->getArg(0);
-  }
-  auto* ref = dyn_cast<DeclRefExpr>(e);
-  return ref ? dyn_cast<VarDecl>(ref->getDecl()) : nullptr;
-}
-
-// The variable at the root of a written expression: v in v, v.f, v[i], v.f[i].g; else null.
-const VarDecl* WrittenVar(const clang::Expr* e) {
-  for (;;) {
-    e = e->IgnoreParenImpCasts();
-    if (auto* me = dyn_cast<MemberExpr>(e)) e = me->getBase();
-    else if (auto* sub = dyn_cast<ArraySubscriptExpr>(e)) e = sub->getBase();
-    else if (auto* op = dyn_cast<CXXOperatorCallExpr>(e); op && op->getOperator() == OO_Subscript) e = op->getArg(0);
-    else return NamedVar(e);
-  }
-}
 
 // Where a leaf call sits: the function whose body holds it, and the statement of that body that
 // holds it (the leaves' loop).
@@ -2899,7 +3095,7 @@ bool ComposeFromTranslationUnit(ASTContext& ctx, Reporter& reporter, ClassModel&
         ComposedWriteFinder finder;
         finder.TraverseStmt(fn->getBody());
         for (auto& [field, loc] : finder.writes)
-          reporter.Error(loc, "composed code writes member '" + field->getNameAsString() + "' of " + comp.implName +
+          reporter.GpuError(loc, "composed code writes member '" + field->getNameAsString() + "' of " + comp.implName +
                          ", whose GPU copy is never read back", "members of a composed implementation are read-only in kernels: compute into a local variable");
       }
       // The implementation's data: its std::vector members become buffers, plain members join
@@ -2930,7 +3126,7 @@ bool ComposeFromTranslationUnit(ASTContext& ctx, Reporter& reporter, ClassModel&
         m.cppType = CppTypeName(ctx, f->getType());
         m.scalarLayout = !LayoutMatchesCpp(ctx, elem, false);
         if (m.scalarLayout && !LayoutMatchesCpp(ctx, elem, true))
-          reporter.Error(f->getLocation(), "the elements of '" + f->getNameAsString() + "' have a C++ layout that a GPU buffer cannot reproduce",
+          reporter.GpuError(f->getLocation(), "the elements of '" + f->getNameAsString() + "' have a C++ layout that a GPU buffer cannot reproduce",
                          "use int instead of bool, and 32-bit scalars and LiteMath vectors in structs");
         m.usedByKernels = true;
         model.members.push_back(m);
@@ -2947,7 +3143,7 @@ bool ComposeFromTranslationUnit(ASTContext& ctx, Reporter& reporter, ClassModel&
         m.inClassData = FitsClassData(ctx, f->getType());
         if (auto layout = Std430Layout(ctx, f->getType(), false)) m.std430Align = unsigned(layout->align);
         if (!m.inClassData)
-          reporter.Error(f->getLocation(), "member '" + f->getNameAsString() + "' of type '" + f->getType().getAsString(ctx.getPrintingPolicy()) +
+          reporter.GpuError(f->getLocation(), "member '" + f->getNameAsString() + "' of type '" + f->getType().getAsString(ctx.getPrintingPolicy()) +
                          "' has a C++ layout that a GPU buffer cannot reproduce",
                          "use int instead of bool, float4x4 instead of float3x3");
         m.usedByKernels = true;

@@ -24,8 +24,19 @@ Data List() { return Data(Data::type::list); }
 struct KernelVariant {
   std::string suffix;  // "_Callables", "_Intersections", "_RayQuery_Textures", "_RayQuery", "_Textures" or ""
   bool rayQuery = false, textures = false, callables = false, leaves = false;
+  // "Start" or "Finish": the one-thread shader of the statements before or after the loop nest,
+  // with the bindings of the variant every device runs.
+  std::string phase;
   bool RayGeneration() const { return callables || leaves; }  // a ray generation shader, not a compute shader
 };
+
+// The one-thread shaders of a kernel's statements before and after its loop nest (loop_start, loop_end).
+std::vector<KernelVariant> Phases(const Kernel& k) {
+  std::vector<KernelVariant> phases;
+  if (!k.glslStart.empty()) phases.push_back({"_Start", false, false, false, false, "Start"});
+  if (!k.glslFinish.empty()) phases.push_back({"_Finish", false, false, false, false, "Finish"});
+  return phases;
+}
 // Virtual functions, level 3: a kernel whose virtual calls run as callable shaders, or whose composed
 // traversal's leaves the ray tracing hardware finds, in a ray generation shader of its own. Not for
 // kernels that need what only compute shaders have (shared memory for reductions, indirect dispatch)
@@ -97,12 +108,12 @@ std::vector<const StageShader*> ExecutedStageShaders(const ClassModel& model) {
 
 std::vector<KernelVariant> Variants(const Kernel& k) {
   std::vector<KernelVariant> variants;
-  if (RunsCallables(k)) variants.push_back({"_Callables", false, false, true, false});
-  if (RunsLeafShaders(k)) variants.push_back({"_Intersections", false, false, false, true});
+  if (RunsCallables(k)) variants.push_back({"_Callables", false, false, true, false, ""});
+  if (RunsLeafShaders(k)) variants.push_back({"_Intersections", false, false, false, true, ""});
   for (bool rayQuery : {true, false})
     for (bool textures : {true, false})
       if ((!rayQuery || !k.rayQueryHolder.empty()) && (!textures || !k.textureArrays.empty()))
-        variants.push_back({std::string(rayQuery ? "_RayQuery" : "") + (textures ? "_Textures" : ""), rayQuery, textures});
+        variants.push_back({std::string(rayQuery ? "_RayQuery" : "") + (textures ? "_Textures" : ""), rayQuery, textures, false, false, ""});
   return variants;
 }
 
@@ -275,6 +286,7 @@ Data Common(const ClassModel& model, const GenerateOptions& opt) {
   std::string usings;
   for (auto& i : model.sourceIncludes) usings += i + "\n";
   for (auto& u : model.usingDecls) usings += u + "\n";
+  for (auto& decl : model.sourceDecls) usings += "\n" + decl + "\n";
   d.set("usingDecls", usings);
   d.set("hasUsingDecls", !usings.empty());
   d.set("hasMegakernels", !model.megakernels.empty());
@@ -422,10 +434,13 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   Data d = Common(model, opt);
   d.set("kernel", k.name);
   d.set("sourceFile", k.sourceFile);
-  const GroupShape shape = Shape(k);
+  const GroupShape shape = kind.phase.empty() ? Shape(k) : GroupShape{1, 1, 1};
   d.set("groupX", std::to_string(shape.x));
-  d.set("groupY", std::to_string(Shape(k).y));
-  d.set("groupZ", std::to_string(Shape(k).z));
+  d.set("groupY", std::to_string(shape.y));
+  d.set("groupZ", std::to_string(shape.z));
+  d.set("shaderName", k.name + kind.suffix);
+  d.set("hasPhase", !kind.phase.empty());
+  d.set("phaseName", kind.phase);
   d.set("groupSize", std::to_string(shape.x * shape.y * shape.z));
   d.set("classStructs", model.glslClassStructs);
   d.set("rayQuery", hardwareRayQuery);
@@ -442,6 +457,9 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
               "\n// and an intersection shader per class of " + LeafDisplays(k) + " intersects them";
   }
   if (hardwareRayQuery) variant = ": the variant for ray tracing hardware (GL_EXT_ray_query)";
+  if (!kind.phase.empty())
+    variant = std::string(":\n// the statements ") + (kind.phase == "Start" ? "before" : "after") + " its loop nest, which one thread runs " +
+              (kind.phase == "Start" ? "before" : "after") + " the nest's threads";
   if (hardwareTextures) variant += std::string(variant.empty() ? ": the variant" : ",") + " for arrays of textures on the GPU's samplers (descriptor indexing)";
   else if (!k.textureArrays.empty()) variant += std::string(variant.empty() ? ": the variant" : ",") + " sampling arrays of textures from buffers, on any device";
   d.set("variant", variant);
@@ -608,8 +626,8 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   d.set("scalarLayout", scalarAny || k.scalarReferences);
   d.set("bufferReferences", k.bufferReferences);
   d.set("buffers", buffers);
-  d.set("reductions", reductions);
-  d.set("hasReductions", !k.reductions.empty());
+  d.set("reductions", kind.phase.empty() ? reductions : List());  // a phase binds the partials, but has no part in them
+  d.set("hasReductions", kind.phase.empty() && !k.reductions.empty());
   Data push = List();
   for (unsigned a = 0; a < k.dims; ++a) {
     Data s;
@@ -641,7 +659,7 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   if (!constantList.empty()) helpers += "\n";
   for (auto& x : functionList) helpers += x + "\n";
   d.set("helpers", helpers);
-  d.set("body", k.glslBody);
+  d.set("body", kind.phase == "Start" ? k.glslStart : kind.phase == "Finish" ? k.glslFinish : k.glslBody);
   d.set("dim1", k.dims == 1);
   d.set("dimN", k.dims != 1);
   // Arguments of the thread function: each thread id in the type its parameter or loop variable has.
@@ -900,7 +918,7 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
         field("4", "uint32_t", p.name + "_height", p.name + ".height()");
         continue;
       }
-      field(std::to_string(p.std430Align), p.valueCppType, GlslPrinter::SafeName(p.name), p.name);
+      field(std::to_string(p.std430Align), p.valueCppType, GlslPrinter::SafeName(p.name), p.narrowed ? p.valueCppType + "(" + p.name + ")" : p.name);
     }
     x.set("pushFields", fields);
     // Image parameters it samples linearly: their format must allow it on this device.
@@ -1057,6 +1075,24 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
       variants.push_back(y);
     }
     x.set("variants", variants);
+    // The one-thread shaders of the statements around the loop nest: the base variant's bindings.
+    Data phases = List();
+    for (const KernelVariant& v : Phases(k)) {
+      Data y = variants.list_value().back();
+      y.set("pipeline", k.name + v.suffix);
+      y.set("conditional", false);
+      y.set("indentCreate", "");
+      y.set("comment", std::string("  // the statements ") + (v.phase == "Start" ? "before" : "after") + " the loop nest, on one thread");
+      y.set("isStart", v.phase == "Start");
+      y.set("isFinish", v.phase == "Finish");
+      phases.push_back(y);
+    }
+    x.set("phases", phases);
+    x.set("hasStart", !k.glslStart.empty());
+    x.set("hasFinish", !k.glslFinish.empty());
+    x.set("hasLoopEnds", !k.glslStart.empty() || !k.glslFinish.empty());
+    x.set("startPipeline", k.name + "_Start");
+    x.set("finishPipeline", k.name + "_Finish");
     Data reds = List();
     for (auto& r : k.reductions) {
       Data y;
@@ -1144,6 +1180,7 @@ std::vector<ShaderSource> GenerateShaders(const ClassModel& model, const Generat
     const Kernel& k = *kernel;
     for (const KernelVariant& v : Variants(k))
       shaders.push_back({k.name + v.suffix, KernelGlsl(model, k, opt, v), v.RayGeneration() ? "rgen" : "comp"});
+    for (const KernelVariant& v : Phases(k)) shaders.push_back({k.name + v.suffix, KernelGlsl(model, k, opt, v), "comp"});
     if (!k.reductions.empty()) shaders.push_back({k.name + "_Reduce", ReduceGlsl(model, k, opt)});
   }
   for (const StageShader* c : ExecutedStageShaders(model)) shaders.push_back({c->name, StageGlsl(model, *c, opt), c->stage});
@@ -1224,6 +1261,8 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
     x.set("paramsDecl", k.cppParamsDecl);
     x.set("preamble", IndentTail(k.cpuPreamble, "  "));
     x.set("hasPreamble", !k.cpuPreamble.empty());
+    x.set("postamble", IndentTail(k.cpuPostamble, "  "));
+    x.set("hasPostamble", !k.cpuPostamble.empty());
     x.set("loopNest", IndentTail(k.cpuLoopNest, "  "));
     // Dynamic chunks: iterations may cost very different amounts (a ray that hits against one that
     // misses). With static halves PrimaryRays_CPU cast the bunny's rays at 0.57-0.63x of Embree,

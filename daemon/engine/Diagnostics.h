@@ -33,17 +33,28 @@ public:
       m_diags.Report(loc, noteId) << hint;
     }
   }
-  // A fact about the translation worth a line, e.g. a type that changes width on the GPU.
+  // A fact about the translation worth a line, e.g. a type that changes width on the GPU. (Clang
+  // drops a note that follows no error or warning, so the reporter prints it itself: Notes().)
   void Note(clang::SourceLocation loc, const std::string& message) {
     if (!m_reported.insert({loc.getRawEncoding(), message}).second) return;
-    unsigned id = m_diags.getCustomDiagID(clang::DiagnosticsEngine::Note, "%0");
-    m_diags.Report(loc, id) << message;
+    m_notes += loc.printToString(m_diags.getSourceManager()) + ": note: " + message + "\n";
   }
+  const std::string& Notes() const { return m_notes; }
   unsigned Errors() const { return m_errors; }
+
+  // A rule of the GPU (what GLSL can express, buffer layouts, images, composition): an error when
+  // translating for Vulkan, nothing for the CPU backend, whose classes run the user's C++ as written.
+  void GpuError(clang::SourceLocation loc, const std::string& message, const std::string& hint = {}) {
+    if (m_gpuRules) Error(loc, message, hint);
+  }
+  void SetGpuRules(bool on) { m_gpuRules = on; }
+  bool GpuRules() const { return m_gpuRules; }
 
 private:
   clang::DiagnosticsEngine& m_diags;
   unsigned m_errors = 0;
+  bool m_gpuRules = true;
+  std::string m_notes;
   std::set<std::pair<uint64_t, std::string>> m_reported;  // (location, message)
 };
 

@@ -210,7 +210,7 @@ std::string GlslPrinter::SafeName(const std::string& name) {
 }
 
 std::string GlslPrinter::Fail(SourceLocation loc, const std::string& message, const std::string& hint) {
-  m_reporter.Error(loc, message, hint);
+  m_reporter.GpuError(loc, message, hint);
   return "/*error*/";
 }
 
@@ -929,6 +929,13 @@ std::string GlslPrinter::Call(const CallExpr* call) {
           return composedPrefix + field->getNameAsString() + "_size";
         }
         if (name == "capacity") return composedPrefix + field->getNameAsString() + "_capacity";
+        // Emptied by the one thread before a loop nest: the appends that follow count from 0.
+        const bool empties = name == "clear" || (name == "resize" && call->getNumArgs() == 1 && call->getArg(0)->isIntegerConstantExpr(m_ctx) &&
+                                                  call->getArg(0)->EvaluateKnownConstInt(m_ctx) == 0);
+        if (empties && singleThread && composedPrefix.empty()) {
+          emptiedVectors.insert(field);
+          return field->getNameAsString() + "_size = 0u";
+        }
         if (name == "push_back" && call->getNumArgs() == 1 && composedPrefix.empty())
           return EmitAppend(field, call) + "(" + Expr(call->getArg(0)) + ")";
       }

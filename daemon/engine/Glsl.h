@@ -110,6 +110,10 @@ public:
 
   // The kernel calls crossrt::Atomic*: its buffers must be coherent (GL_KHR_memory_scope_semantics).
   bool usesAtomics = false;
+  // Printing statements one thread runs (before or after a kernel's loop nest): a member vector that
+  // kernels append to may be emptied there (its count restarts).
+  bool singleThread = false;
+  std::set<const clang::FieldDecl*> emptiedVectors;  // clear() or resize(0) there
 
   std::string Expr(const clang::Expr* e);
   std::string Stmt(const clang::Stmt* s, int indent);

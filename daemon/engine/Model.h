@@ -65,6 +65,7 @@ struct KernelParam {
   // RTV kernels: a pointer that a control function's thread loop passes a local to (&local). On the
   // GPU it is one value per thread: a function parameter, kept in a buffer between wavefront dispatches.
   bool threadState = false;
+  bool narrowed = false;     // a 64-bit integer passed as 32 bits (size_t, int64_t)
   unsigned std430Align = 4;  // by-value parameters: alignment in the push-constant block
 };
 
@@ -127,6 +128,11 @@ struct Kernel {
   std::string glslBody;               // the thread's code, as a GLSL function body
   std::string cpuLoopNest;            // IPV, CPU backend: the loop nest with reductions renamed
   std::string cpuPreamble;            // IPV, CPU backend: statements before the loops
+  std::string cpuPostamble;           // IPV, CPU backend: statements after the loops
+  // IPV: the statements before and after the loop nest (the paper's loop_start and loop_end), as
+  // GLSL functions <kernel>_Start() and <kernel>_Finish() that one thread runs, in shaders of their
+  // own dispatched before and after the kernel's threads (and their reductions). Empty when none.
+  std::string glslStart, glslFinish;
   std::string sourceFile;             // where the kernel is defined (for comments)
   // The GLSL prelude: structs it needs beyond the class's, constants and helper functions, in an
   // order GLSL accepts (composed code is merged in ahead of the kernel's own).
@@ -273,6 +279,9 @@ struct ClassModel {
   std::string glslClassStructs;        // structs the class-data block and member vectors need
   std::vector<std::string> sourceIncludes;  // #include lines of the sources (quoted ones made absolute)
   std::vector<std::string> usingDecls; // top-level using-directives of the sources: copied bodies need them
+  // Declarations of the sources themselves that copied bodies use (static helpers, constants, types;
+  // exported functions only declared), in source order, each "// from <file>\n<code>".
+  std::vector<std::string> sourceDecls;
   std::vector<Composition> compositions;   // holders kernels call through, in declaration order
   std::vector<VirtualMember> virtuals;     // vectors of objects kernels call virtual functions of
   // 1: one array of equal slots; 2: a buffer per class; 3: as 2, plus callable shaders (the class's

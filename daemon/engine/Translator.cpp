@@ -284,17 +284,18 @@ AnalyzeResult Analyze(const TranslateRequest& request, AstCache* sharedCache) {
       size_t before = handle.diagnostics().size();
       handle.printer().BeginSourceFile(ast->getLangOpts(), &ast->getPreprocessor());
       Reporter reporter(ast->getDiagnostics());
+      reporter.SetGpuRules(request.backend == Backend::Vulkan);  // a CPU class runs the user's C++ as written
       step(ast->getASTContext(), reporter);
       errors += reporter.Errors();
       handle.printer().EndSourceFile();
-      diagText += handle.diagnostics().substr(before);
+      diagText += handle.diagnostics().substr(before) + reporter.Notes();
     }
   };
   forEachAst([&](clang::ASTContext& ctx, Reporter& reporter) {
     AnalyzeTranslationUnit(ctx, request.className, compositions, reporter, model);
   });
   // Composed implementations are printed from the AST that defines their methods.
-  if (errors == 0 && !model.compositions.empty()) {
+  if (errors == 0 && !model.compositions.empty() && request.backend == Backend::Vulkan) {  // a CPU class calls the interface as written
     forEachAst([&](clang::ASTContext& ctx, Reporter& reporter) { ComposeFromTranslationUnit(ctx, reporter, model); });
     for (auto& comp : model.compositions)
       if (errors == 0 && comp.implHeader.empty()) {

@@ -3,14 +3,22 @@
 // The translator maps these names one-to-one onto GLSL, so the names and semantics
 // deliberately follow GLSL (float3 <-> vec3, mix, fract, inversesqrt, ...).
 // Matrices are stored column-major (m_col[i] is column i), like GLSL and Vulkan.
+//
+// It has the public API of the paper's LiteMath (msu-graphics-group/LiteMath) that kernels use:
+// its constants (M_PI as a float, M_TWOPI, INV_PI), converting constructors (int2(float2)),
+// mul4x4x4, make_float4x4_from_rows/cols, rotate3x3X/Y/Z, mod, cross3, half4, complex,
+// InterlockedAdd and the ReduceAdd family. One difference remains: m[i] of a matrix is column i
+// here (as in GLSL), row i there.
 #pragma once
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <limits>
+#include <vector>
 
 // float4 arithmetic and min/max on SSE in compiled C++ (compilers do not vectorize the
 // four-field struct themselves). Results are bit-identical to the scalar definitions. The
@@ -23,6 +31,18 @@
 namespace LiteMath
 {
 typedef uint32_t uint;
+
+struct float2;
+struct float3;
+struct float4;
+struct int2;
+struct int3;
+struct int4;
+struct uint2;
+struct uint3;
+struct uint4;
+struct half2;
+struct half4;
 
 // Bring std scalar functions into this namespace so that LiteMath::min(1.0f, 2.0f) works and
 // unqualified calls with `using namespace LiteMath;` see both scalar and vector overloads.
@@ -46,6 +66,17 @@ constexpr float EPSILON      = 1e-6f;
 constexpr float M_PI_F = 3.14159265358979323846f;
 #endif
 constexpr float DEG_TO_RAD = 3.14159265358979323846f / 180.0f;
+// As in the paper's LiteMath, M_PI is a float in the namespace (it replaces <cmath>'s macro).
+#ifdef M_PI
+#undef M_PI
+#endif
+constexpr float M_PI      = 3.14159265358979323846f;
+constexpr float M_TWOPI   = 2.0f * M_PI;
+constexpr float INV_PI    = 1.0f / M_PI;
+constexpr float INV_TWOPI = 1.0f / (2.0f * M_PI);
+#ifndef MAXFLOAT
+#define MAXFLOAT FLT_MAX
+#endif
 
 // ---------------------------------------------------------------- scalar helpers std lacks
 inline float fract(float x) { return x - std::floor(x); }
@@ -73,6 +104,8 @@ struct alignas(8) float2
   float x, y;
   float2() : x(0), y(0) {}
   explicit float2(float a) : x(a), y(a) {}
+  explicit float2(const int2& v);  // componentwise conversion
+  explicit float2(const uint2& v);  // componentwise conversion
   float2(float a_x, float a_y) : x(a_x), y(a_y) {}
   float&       operator[](int i) { return (&x)[i]; }
   const float& operator[](int i) const { return (&x)[i]; }
@@ -83,6 +116,8 @@ struct float3
   float x, y, z;
   float3() : x(0), y(0), z(0) {}
   explicit float3(float a) : x(a), y(a), z(a) {}
+  explicit float3(const int3& v);  // componentwise conversion
+  explicit float3(const uint3& v);  // componentwise conversion
   float3(float a_x, float a_y, float a_z) : x(a_x), y(a_y), z(a_z) {}
   float3(float2 v, float a_z) : x(v.x), y(v.y), z(a_z) {}
   float&       operator[](int i) { return (&x)[i]; }
@@ -94,6 +129,9 @@ struct alignas(16) float4
   float x, y, z, w;
   float4() : x(0), y(0), z(0), w(0) {}
   explicit float4(float a) : x(a), y(a), z(a), w(a) {}
+  explicit float4(const int4& v);  // componentwise conversion
+  explicit float4(const uint4& v);  // componentwise conversion
+  explicit float4(const half4& v);  // componentwise conversion
   float4(float a_x, float a_y, float a_z, float a_w) : x(a_x), y(a_y), z(a_z), w(a_w) {}
   float4(float3 v, float a_w) : x(v.x), y(v.y), z(v.z), w(a_w) {}
   float&       operator[](int i) { return (&x)[i]; }
@@ -105,6 +143,8 @@ struct alignas(8) int2
   int x, y;
   int2() : x(0), y(0) {}
   explicit int2(int a) : x(a), y(a) {}
+  explicit int2(const float2& v);  // componentwise conversion
+  explicit int2(const uint2& v);  // componentwise conversion
   int2(int a_x, int a_y) : x(a_x), y(a_y) {}
   int&       operator[](int i) { return (&x)[i]; }
   const int& operator[](int i) const { return (&x)[i]; }
@@ -115,6 +155,8 @@ struct int3
   int x, y, z;
   int3() : x(0), y(0), z(0) {}
   explicit int3(int a) : x(a), y(a), z(a) {}
+  explicit int3(const float3& v);  // componentwise conversion
+  explicit int3(const uint3& v);  // componentwise conversion
   int3(int a_x, int a_y, int a_z) : x(a_x), y(a_y), z(a_z) {}
   int3(int2 v, int a_z) : x(v.x), y(v.y), z(a_z) {}
   int&       operator[](int i) { return (&x)[i]; }
@@ -126,6 +168,8 @@ struct alignas(16) int4
   int x, y, z, w;
   int4() : x(0), y(0), z(0), w(0) {}
   explicit int4(int a) : x(a), y(a), z(a), w(a) {}
+  explicit int4(const float4& v);  // componentwise conversion
+  explicit int4(const uint4& v);  // componentwise conversion
   int4(int a_x, int a_y, int a_z, int a_w) : x(a_x), y(a_y), z(a_z), w(a_w) {}
   int4(int3 v, int a_w) : x(v.x), y(v.y), z(v.z), w(a_w) {}
   int&       operator[](int i) { return (&x)[i]; }
@@ -137,6 +181,8 @@ struct alignas(8) uint2
   uint x, y;
   uint2() : x(0), y(0) {}
   explicit uint2(uint a) : x(a), y(a) {}
+  explicit uint2(const float2& v);  // componentwise conversion
+  explicit uint2(const int2& v);  // componentwise conversion
   uint2(uint a_x, uint a_y) : x(a_x), y(a_y) {}
   uint&       operator[](int i) { return (&x)[i]; }
   const uint& operator[](int i) const { return (&x)[i]; }
@@ -147,6 +193,8 @@ struct uint3
   uint x, y, z;
   uint3() : x(0), y(0), z(0) {}
   explicit uint3(uint a) : x(a), y(a), z(a) {}
+  explicit uint3(const float3& v);  // componentwise conversion
+  explicit uint3(const int3& v);  // componentwise conversion
   uint3(uint a_x, uint a_y, uint a_z) : x(a_x), y(a_y), z(a_z) {}
   uint3(uint2 v, uint a_z) : x(v.x), y(v.y), z(a_z) {}
   uint&       operator[](int i) { return (&x)[i]; }
@@ -158,6 +206,8 @@ struct alignas(16) uint4
   uint x, y, z, w;
   uint4() : x(0), y(0), z(0), w(0) {}
   explicit uint4(uint a) : x(a), y(a), z(a), w(a) {}
+  explicit uint4(const float4& v);  // componentwise conversion
+  explicit uint4(const int4& v);  // componentwise conversion
   uint4(uint a_x, uint a_y, uint a_z, uint a_w) : x(a_x), y(a_y), z(a_z), w(a_w) {}
   uint4(uint3 v, uint a_w) : x(v.x), y(v.y), z(v.z), w(a_w) {}
   uint&       operator[](int i) { return (&x)[i]; }
@@ -378,6 +428,33 @@ inline uint2  to_uint2(const float2& v) { return uint2(uint(v.x), uint(v.y)); }
 inline uint3  to_uint3(const float3& v) { return uint3(uint(v.x), uint(v.y), uint(v.z)); }
 inline uint4  to_uint4(const float4& v) { return uint4(uint(v.x), uint(v.y), uint(v.z), uint(v.w)); }
 
+// Converting constructors (explicit, as in the paper's LiteMath): C conversions per component, so
+// int2(float2(-1.5f, 2.7f)) is (-1, 2), as GLSL's ivec2(vec2) truncates.
+inline float2::float2(const int2& v) : x(float(v.x)), y(float(v.y)) {}
+inline float2::float2(const uint2& v) : x(float(v.x)), y(float(v.y)) {}
+inline float3::float3(const int3& v) : x(float(v.x)), y(float(v.y)), z(float(v.z)) {}
+inline float3::float3(const uint3& v) : x(float(v.x)), y(float(v.y)), z(float(v.z)) {}
+inline float4::float4(const int4& v) : x(float(v.x)), y(float(v.y)), z(float(v.z)), w(float(v.w)) {}
+inline float4::float4(const uint4& v) : x(float(v.x)), y(float(v.y)), z(float(v.z)), w(float(v.w)) {}
+inline int2::int2(const float2& v) : x(int(v.x)), y(int(v.y)) {}
+inline int2::int2(const uint2& v) : x(int(v.x)), y(int(v.y)) {}
+inline int3::int3(const float3& v) : x(int(v.x)), y(int(v.y)), z(int(v.z)) {}
+inline int3::int3(const uint3& v) : x(int(v.x)), y(int(v.y)), z(int(v.z)) {}
+inline int4::int4(const float4& v) : x(int(v.x)), y(int(v.y)), z(int(v.z)), w(int(v.w)) {}
+inline int4::int4(const uint4& v) : x(int(v.x)), y(int(v.y)), z(int(v.z)), w(int(v.w)) {}
+inline uint2::uint2(const float2& v) : x(uint(v.x)), y(uint(v.y)) {}
+inline uint2::uint2(const int2& v) : x(uint(v.x)), y(uint(v.y)) {}
+inline uint3::uint3(const float3& v) : x(uint(v.x)), y(uint(v.y)), z(uint(v.z)) {}
+inline uint3::uint3(const int3& v) : x(uint(v.x)), y(uint(v.y)), z(uint(v.z)) {}
+inline uint4::uint4(const float4& v) : x(uint(v.x)), y(uint(v.y)), z(uint(v.z)), w(uint(v.w)) {}
+inline uint4::uint4(const int4& v) : x(uint(v.x)), y(uint(v.y)), z(uint(v.z)), w(uint(v.w)) {}
+
+// Width changes as the paper's LiteMath has them: to_int4(int3, w) appends w; to_int3(int4) drops it.
+inline int4  to_int4(const int3& v, int w) { return int4(v.x, v.y, v.z, w); }
+inline uint4 to_uint4(const uint3& v, uint w) { return uint4(v.x, v.y, v.z, w); }
+inline int3  to_int3(const int4& v) { return int3(v.x, v.y, v.z); }
+inline uint3 to_uint3(const uint4& v) { return uint3(v.x, v.y, v.z); }
+
 // ---------------------------------------------------------------- bit casts (memcpy: no aliasing UB)
 inline int as_int(float x) { int r; std::memcpy(&r, &x, sizeof(r)); return r; }
 inline uint as_uint(float x) { uint r; std::memcpy(&r, &x, sizeof(r)); return r; }
@@ -537,12 +614,17 @@ inline float4x4 transpose(const float4x4& m)
   return r;
 }
 
+// Helpers that users' code often defines itself (the paper's samples carry their own copies of
+// mul4x3, mul3x3, lookAt and perspectiveMatrix): templates with a defaulted parameter, so that a
+// user's plain function of the same name and parameters is preferred instead of ambiguous.
+#define LITEMATH_YIELDS_TO_USER template <int LiteMathYieldsToUser = 0>
+
 // Point transform (w = 1) and direction transform (w = 0, translation ignored).
-inline float3 mul4x3(const float4x4& m, const float3& p)
+LITEMATH_YIELDS_TO_USER inline float3 mul4x3(const float4x4& m, const float3& p)
 {
   return to_float3(m.m_col[0] * p.x + m.m_col[1] * p.y + m.m_col[2] * p.z + m.m_col[3]);
 }
-inline float3 mul3x3(const float4x4& m, const float3& d)
+LITEMATH_YIELDS_TO_USER inline float3 mul3x3(const float4x4& m, const float3& d)
 {
   return to_float3(m.m_col[0] * d.x + m.m_col[1] * d.y + m.m_col[2] * d.z);
 }
@@ -667,7 +749,7 @@ inline float4x4 rotate4x4(const float3& axis, float rad)
 }
 
 // OpenGL-style view matrix (right-handed): eye -> origin, camera looks down -Z, up is +Y.
-inline float4x4 lookAt(const float3& eye, const float3& center, const float3& up)
+LITEMATH_YIELDS_TO_USER inline float4x4 lookAt(const float3& eye, const float3& center, const float3& up)
 {
   const float3 f = normalize(center - eye);
   const float3 s = normalize(cross(f, up));
@@ -679,7 +761,7 @@ inline float4x4 lookAt(const float3& eye, const float3& center, const float3& up
 }
 
 // OpenGL-style projection (gluPerspective): view-space z=-zNear -> NDC z=-1, z=-zFar -> +1.
-inline float4x4 perspectiveMatrix(float fovy_degrees, float aspect, float zNear, float zFar)
+LITEMATH_YIELDS_TO_USER inline float4x4 perspectiveMatrix(float fovy_degrees, float aspect, float zNear, float zFar)
 {
   const float f = 1.0f / std::tan(0.5f * fovy_degrees * DEG_TO_RAD);
   return float4x4(f / aspect, 0, 0, 0,
@@ -727,6 +809,321 @@ struct Box4f
   }
 };
 
+
+// ================================================================ the paper's LiteMath API
+// Names and semantics of msu-graphics-group/LiteMath that kernels written for the paper use.
+
+// ---------------------------------------------------------------- scalar and vector helpers
+// GLSL's mod: x - y * floor(x / y), the sign of y (not fmod's, the sign of x).
+inline float mod(float x, float y) { return x - y * std::floor(x / y); }
+inline float2 mod(const float2& x, const float2& y) { return x - y * floor(x / y); }
+inline float3 mod(const float3& x, const float3& y) { return x - y * floor(x / y); }
+inline float4 mod(const float4& x, const float4& y) { return x - y * floor(x / y); }
+inline float rcp(float x) { return 1.0f / x; }
+inline float2 rcp(const float2& v) { return float2(1.0f) / v; }
+inline float3 rcp(const float3& v) { return float3(1.0f) / v; }
+inline float4 rcp(const float4& v) { return float4(1.0f) / v; }
+template <typename T> inline T SQR(T x) { return x * x; }
+inline float3 faceforward(const float3& n, const float3& i, const float3& ng) { return dot(i, ng) < 0.0f ? n : -n; }
+inline float hmin(const float2& a) { return std::min(a.x, a.y); }
+inline float hmax(const float2& a) { return std::max(a.x, a.y); }
+inline float hmin3(const float4& a) { return std::min(a.x, std::min(a.y, a.z)); }
+inline float hmax3(const float4& a) { return std::max(a.x, std::max(a.y, a.z)); }
+
+// float4 as a 3-vector plus w: the xyz part's dot product, length, cross product (w = 0) and
+// normalisation (all four components divided by the xyz length).
+inline float  dot3(const float4& a, const float4& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline float  dot4(const float4& a, const float4& b) { return dot(a, b); }
+inline float  dot3f(const float4& a, const float4& b) { return dot3(a, b); }
+inline float  dot4f(const float4& a, const float4& b) { return dot(a, b); }
+inline float4 dot3v(const float4& a, const float4& b) { return float4(dot3(a, b)); }
+inline float4 dot4v(const float4& a, const float4& b) { return float4(dot(a, b)); }
+inline float  length3(const float4& a) { return std::sqrt(dot3(a, a)); }
+inline float  length3f(const float4& a) { return length3(a); }
+inline float  length4(const float4& a) { return length(a); }
+inline float  length4f(const float4& a) { return length(a); }
+inline float4 length3v(const float4& a) { return float4(length3(a)); }
+inline float4 length4v(const float4& a) { return float4(length(a)); }
+inline float4 normalize3(const float4& a) { return a / length3(a); }
+inline float4 cross3(const float4& a, const float4& b)
+{
+  return float4(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x, 0.0f);
+}
+inline float4 cross(const float4& a, const float4& b) { return cross3(a, b); }
+
+// ---------------------------------------------------------------- matrices
+inline float4 mul4x4x4(const float4x4& m, const float4& v) { return m * v; }
+inline float4 mul(const float4x4& m, const float4& v) { return m * v; }
+// A point: (m * (v, 1)).xyz, without a perspective divide.
+inline float3 operator*(const float4x4& m, const float3& v) { return to_float3(m * float4(v.x, v.y, v.z, 1.0f)); }
+inline float3 mul(const float4x4& m, const float3& v) { return m * v; }
+inline float4x4 mul(const float4x4& a, const float4x4& b) { return a * b; }
+inline float3 mul(const float3x3& m, const float3& v) { return m * v; }
+inline float3x3 mul(const float3x3& a, const float3x3& b) { return a * b; }
+inline float4x4 operator+(const float4x4& a, const float4x4& b)
+{
+  float4x4 r;
+  for (int i = 0; i < 4; i++)
+    r.m_col[i] = a.m_col[i] + b.m_col[i];
+  return r;
+}
+inline float4x4 operator-(const float4x4& a, const float4x4& b)
+{
+  float4x4 r;
+  for (int i = 0; i < 4; i++)
+    r.m_col[i] = a.m_col[i] - b.m_col[i];
+  return r;
+}
+inline float3x3 operator+(const float3x3& a, const float3x3& b)
+{
+  float3x3 r;
+  for (int i = 0; i < 3; i++)
+    r.m_col[i] = a.m_col[i] + b.m_col[i];
+  return r;
+}
+inline float3x3 operator-(const float3x3& a, const float3x3& b)
+{
+  float3x3 r;
+  for (int i = 0; i < 3; i++)
+    r.m_col[i] = a.m_col[i] - b.m_col[i];
+  return r;
+}
+inline float4x4 make_float4x4_from_rows(const float4& a, const float4& b, const float4& c, const float4& d)
+{
+  float4x4 m;
+  m.set_row(0, a);
+  m.set_row(1, b);
+  m.set_row(2, c);
+  m.set_row(3, d);
+  return m;
+}
+inline float4x4 make_float4x4_from_cols(const float4& a, const float4& b, const float4& c, const float4& d)
+{
+  float4x4 m;
+  m.set_col(0, a);
+  m.set_col(1, b);
+  m.set_col(2, c);
+  m.set_col(3, d);
+  return m;
+}
+inline float3x3 make_float3x3_from_rows(const float3& a, const float3& b, const float3& c)
+{
+  float3x3 m;
+  m.set_row(0, a);
+  m.set_row(1, b);
+  m.set_row(2, c);
+  return m;
+}
+inline float3x3 make_float3x3_from_cols(const float3& a, const float3& b, const float3& c)
+{
+  float3x3 m;
+  m.set_col(0, a);
+  m.set_col(1, b);
+  m.set_col(2, c);
+  return m;
+}
+// The paper's older names: make_float3x3 takes rows, make_float3x3_by_columns columns.
+inline float3x3 make_float3x3(const float3& a, const float3& b, const float3& c) { return make_float3x3_from_rows(a, b, c); }
+inline float3x3 make_float3x3_by_columns(const float3& a, const float3& b, const float3& c) { return make_float3x3_from_cols(a, b, c); }
+inline float4x4 outerProduct(const float4& a, const float4& b) { return make_float4x4_from_cols(a * b.x, a * b.y, a * b.z, a * b.w); }
+inline float3x3 outerProduct(const float3& a, const float3& b) { return make_float3x3_from_cols(a * b.x, a * b.y, a * b.z); }
+inline float3x3 inverse3x3(const float3x3& m) { return inverse(m); }
+inline float3x3 scale3x3(const float3& s) { return make_float3x3_from_cols(float3(s.x, 0, 0), float3(0, s.y, 0), float3(0, 0, s.z)); }
+// Right-handed rotations by `rad` radians, the upper 3x3 of rotate4x4X/Y/Z.
+inline float3x3 rotate3x3X(float rad)
+{
+  const float c = std::cos(rad), s = std::sin(rad);
+  return float3x3(1, 0, 0,
+                  0, c, -s,
+                  0, s, c);
+}
+inline float3x3 rotate3x3Y(float rad)
+{
+  const float c = std::cos(rad), s = std::sin(rad);
+  return float3x3(c, 0, s,
+                  0, 1, 0,
+                  -s, 0, c);
+}
+inline float3x3 rotate3x3Z(float rad)
+{
+  const float c = std::cos(rad), s = std::sin(rad);
+  return float3x3(c, -s, 0,
+                  s, c, 0,
+                  0, 0, 1);
+}
+// glOrtho's projection.
+LITEMATH_YIELDS_TO_USER inline float4x4 ortoMatrix(float l, float r, float b, float t, float n, float f)
+{
+  return float4x4(2.0f / (r - l), 0, 0, -(r + l) / (r - l),
+                  0, 2.0f / (t - b), 0, -(t + b) / (t - b),
+                  0, 0, -2.0f / (f - n), -(f + n) / (f - n),
+                  0, 0, 0, 1);
+}
+
+// ---------------------------------------------------------------- half: 16-bit floats for storage
+// half converts to and from float implicitly (round to nearest even, infinities and NaN kept);
+// half2 and half4 hold two and four, for buffers of compact colours and normals. Arithmetic happens
+// in float: to_float4(h), float4(h).
+struct half
+{
+  uint16_t bits = 0;
+  half() = default;
+  half(float f) : bits(FromFloat(f)) {}
+  operator float() const { return ToFloat(bits); }
+
+  static uint16_t FromFloat(float f)
+  {
+    uint32_t x;
+    std::memcpy(&x, &f, 4);
+    const uint32_t sign = (x >> 16) & 0x8000u, absBits = x & 0x7FFFFFFFu;
+    if (absBits >= 0x7F800000u)  // infinity or NaN (a quiet NaN stays a NaN)
+      return uint16_t(sign | 0x7C00u | (absBits > 0x7F800000u ? 0x200u : 0u));
+    if (absBits >= 0x477FF000u)  // rounds to beyond 65504: infinity
+      return uint16_t(sign | 0x7C00u);
+    if (absBits < 0x38800000u)  // a half subnormal (or zero): round the value to a multiple of 2^-24
+    {
+      float a;
+      const uint32_t plain = absBits;
+      std::memcpy(&a, &plain, 4);
+      return uint16_t(sign | uint32_t(std::nearbyint(a * 16777216.0f)));
+    }
+    const uint32_t mantissaOdd = (absBits >> 13) & 1u;  // round to nearest, ties to even
+    return uint16_t(sign | ((absBits + 0xFFFu + mantissaOdd - 0x38000000u) >> 13));
+  }
+  static float ToFloat(uint16_t h)
+  {
+    const uint32_t sign = uint32_t(h & 0x8000u) << 16, exponent = (h >> 10) & 0x1Fu, mantissa = h & 0x3FFu;
+    float f;
+    if (exponent == 0)
+      f = float(mantissa) * (1.0f / 16777216.0f);  // subnormal or zero
+    else if (exponent == 31)
+    {
+      const uint32_t bits = 0x7F800000u | (mantissa << 13);
+      std::memcpy(&f, &bits, 4);
+    }
+    else
+    {
+      const uint32_t bits = ((exponent + 112u) << 23) | (mantissa << 13);
+      std::memcpy(&f, &bits, 4);
+    }
+    uint32_t out;
+    std::memcpy(&out, &f, 4);
+    out |= sign;
+    std::memcpy(&f, &out, 4);
+    return f;
+  }
+};
+
+struct half2
+{
+  half x, y;
+  half2() = default;
+  half2(float a_x, float a_y) : x(a_x), y(a_y) {}
+  explicit half2(float a) : x(a), y(a) {}
+  explicit half2(const float2& v) : x(v.x), y(v.y) {}
+};
+
+struct half4
+{
+  half x, y, z, w;
+  half4() = default;
+  half4(float a_x, float a_y, float a_z, float a_w) : x(a_x), y(a_y), z(a_z), w(a_w) {}
+  explicit half4(float a) : x(a), y(a), z(a), w(a) {}
+  explicit half4(const float a[4]) : x(a[0]), y(a[1]), z(a[2]), w(a[3]) {}
+  explicit half4(const float4& v) : x(v.x), y(v.y), z(v.z), w(v.w) {}
+};
+static_assert(sizeof(half2) == 4 && sizeof(half4) == 8, "half layouts");
+
+inline float4::float4(const half4& v) : x(v.x), y(v.y), z(v.z), w(v.w) {}
+inline float4 to_float4(const half4& v) { return float4(v); }
+inline float2 to_float2(const half2& v) { return float2(v.x, v.y); }
+
+// ---------------------------------------------------------------- complex numbers (float)
+struct complex
+{
+  float re = 0.0f, im = 0.0f;
+  complex() = default;
+  complex(float a_re) : re(a_re), im(0.0f) {}  // implicit, as a real number is a complex one
+  complex(float a_re, float a_im) : re(a_re), im(a_im) {}
+
+  complex operator-() const { return complex(-re, -im); }
+  complex operator+(const complex& b) const { return complex(re + b.re, im + b.im); }
+  complex operator-(const complex& b) const { return complex(re - b.re, im - b.im); }
+  complex operator*(const complex& b) const { return complex(re * b.re - im * b.im, re * b.im + im * b.re); }
+  complex operator/(const complex& b) const
+  {
+    const float d = b.re * b.re + b.im * b.im;
+    return complex((re * b.re + im * b.im) / d, (im * b.re - re * b.im) / d);
+  }
+};
+inline complex operator+(float a, const complex& b) { return complex(a) + b; }
+inline complex operator-(float a, const complex& b) { return complex(a) - b; }
+inline complex operator*(float a, const complex& b) { return complex(a * b.re, a * b.im); }
+inline complex operator/(float a, const complex& b) { return complex(a) / b; }
+inline float real(const complex& c) { return c.re; }
+inline float imag(const complex& c) { return c.im; }
+inline float complex_norm(const complex& c) { return c.re * c.re + c.im * c.im; }  // |c|^2
+inline float complex_abs(const complex& c) { return std::sqrt(complex_norm(c)); }
+// The principal square root (pbrt's algorithm); 0 at 0.
+inline complex complex_sqrt(const complex& z)
+{
+  const float n = complex_abs(z), t1 = std::sqrt(0.5f * (n + std::abs(z.re))), t2 = 0.5f * z.im / t1;
+  if (n == 0.0f)
+    return complex(0.0f);
+  if (z.re >= 0.0f)
+    return complex(t1, t2);
+  return complex(std::abs(t2), std::copysign(t1, z.im));
+}
+
+// ---------------------------------------------------------------- atomics and reductions into arrays
+// InterlockedAdd(mem, v) adds atomically, from any number of threads (the GPU's atomicAdd); the
+// three-argument form also gives the value before the add. These are atomic whether or not the
+// code is compiled with OpenMP.
+inline void InterlockedAdd(int& mem, int data) { __atomic_fetch_add(&mem, data, __ATOMIC_RELAXED); }
+inline void InterlockedAdd(uint& mem, uint data) { __atomic_fetch_add(&mem, data, __ATOMIC_RELAXED); }
+inline void InterlockedAdd(int& mem, int data, int& a_res) { a_res = __atomic_fetch_add(&mem, data, __ATOMIC_RELAXED); }
+inline void InterlockedAdd(uint& mem, uint data, uint& a_res) { a_res = __atomic_fetch_add(&mem, data, __ATOMIC_RELAXED); }
+inline void InterlockedAdd(float& mem, float data, float& a_res)
+{
+  float expected, desired;
+  __atomic_load(&mem, &expected, __ATOMIC_RELAXED);
+  do
+    desired = expected + data;  // a failed exchange updates `expected` to what is there now
+  while (!__atomic_compare_exchange(&mem, &expected, &desired, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED));
+  a_res = expected;
+}
+inline void InterlockedAdd(float& mem, float data)
+{
+  float before;
+  InterlockedAdd(mem, data, before);
+}
+
+// Sums from many threads into the elements of a std::vector (kernel_slicer's 045_reduce_add):
+//   ReduceAddInit(v, n);  kernel1D_X(...) { ... ReduceAdd(v, index, value); ... }  ReduceAddComplete(v);
+// Init sizes and zeroes the vector, ReduceAdd adds a finite value to an element atomically, and
+// Complete finishes (nothing is left to do: each add went to the element itself). The order of
+// the adds varies, so float sums may differ in their last bits from run to run.
+template <typename IndexType> inline IndexType align(IndexType a_size, IndexType a_alignment)
+{
+  return (a_size + a_alignment - 1) / a_alignment * a_alignment;
+}
+template <typename T> inline size_t ReduceAddInit(std::vector<T>& a_vec, size_t a_targetSize)
+{
+  a_vec.assign(a_targetSize, T(0));
+  return align(a_targetSize, size_t(16));
+}
+template <typename T> inline void ReduceAddComplete(std::vector<T>& a_vec) { (void)a_vec; }
+template <typename T, typename IndexType> inline void ReduceAdd(std::vector<T>& a_vec, IndexType offset, T val)
+{
+  if (std::isfinite(float(val)))
+    InterlockedAdd(a_vec[size_t(offset)], val);
+}
+template <typename T, typename IndexType> inline void ReduceAdd(std::vector<T>& a_vec, IndexType offset, IndexType a_sizeAligned, T val)
+{
+  (void)a_sizeAligned;
+  ReduceAdd(a_vec, offset, val);
+}
+
 #undef LM_VEC2_BINOP
 #undef LM_VEC3_BINOP
 #undef LM_VEC4_BINOP
@@ -739,5 +1136,6 @@ struct Box4f
 #undef LM_BINARY4
 #undef LM_MINMAX
 #undef LM_FLOAT_FUNCS
+#undef LITEMATH_YIELDS_TO_USER
 
 } // namespace LiteMath

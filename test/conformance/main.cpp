@@ -145,6 +145,10 @@ int main(int argc, char** argv) {
                 vulkan.text.c_str(), pass ? "" : "   <-- FAIL");
     if (csv) csv << '"' << c.construct << "\",\"" << c.files << "\",\"" << cpu.text << "\",\"" << vulkan.text << "\"\n";
   }
+  if (cases.size() != CONFORMANCE_EXPECTED_CASES) {
+    std::printf("\n%zu cases ran, but the build translated %d classes: a case is missing its check\n", cases.size(), CONFORMANCE_EXPECTED_CASES);
+    ++failures;
+  }
   std::printf("\n%d of %zu constructs translate, run and agree on both backends%s\n", passes, cases.size(),
               failures ? "" : " (OK)");
   return failures == 0 ? 0 : 1;
