@@ -136,6 +136,44 @@ struct WriteVisitor : RecursiveASTVisitor<Derived> {
 };
 
 
+// The data members kernels may use: the bases' first (in declaration order), then the class's own.
+std::vector<const FieldDecl*> ClassFields(const CXXRecordDecl* cls) {
+  std::vector<const FieldDecl*> out;
+  for (auto& base : cls->bases())
+    if (auto* b = base.getType()->getAsCXXRecordDecl(); b && b->hasDefinition() && !base.isVirtual()) {
+      auto inherited = ClassFields(b->getDefinition());
+      out.insert(out.end(), inherited.begin(), inherited.end());
+    }
+  for (auto* f : cls->fields()) out.push_back(f);
+  return out;
+}
+
+// The member functions a translation looks at: the class's own, then those of its bases it does not
+// hide by name (a control function or kernel declared in a base, kernel_slicer's inheritance form).
+std::vector<const CXXMethodDecl*> ClassMethods(const CXXRecordDecl* cls) {
+  std::vector<const CXXMethodDecl*> out;
+  std::set<std::string> names;
+  std::vector<const CXXRecordDecl*> order = {cls};
+  for (size_t i = 0; i < order.size(); ++i)
+    for (auto& base : order[i]->bases())
+      if (auto* b = base.getType()->getAsCXXRecordDecl(); b && b->hasDefinition()) order.push_back(b->getDefinition());
+  for (auto* rd : order) {
+    std::set<std::string> here;
+    for (auto* md : rd->methods()) {
+      if (isa<CXXConstructorDecl, CXXDestructorDecl>(md) || names.count(md->getNameAsString())) continue;
+      out.push_back(md);
+      here.insert(md->getNameAsString());
+    }
+    names.insert(here.begin(), here.end());
+  }
+  return out;
+}
+
+// The class or one of its bases: a member function defined there is one of the class's.
+bool IsClassOrBase(const CXXRecordDecl* rd, const CXXRecordDecl* cls) {
+  return rd && (rd == cls || cls->isDerivedFrom(rd));
+}
+
 struct Context {
   ASTContext& ctx;
   const CXXRecordDecl* cls;
@@ -167,7 +205,7 @@ const VarDecl* AddressedVar(const Expr* arg) {
 const FunctionDecl* ThisMethodDef(const CXXMemberCallExpr* call, const CXXRecordDecl* cls) {
   auto* md = call->getMethodDecl();
   const FunctionDecl* def = nullptr;
-  if (!md || md->isStatic() || md->getParent() != cls || !isa<CXXThisExpr>(call->getImplicitObjectArgument()->IgnoreParenImpCasts()))
+  if (!md || md->isStatic() || !IsClassOrBase(md->getParent(), cls) || !isa<CXXThisExpr>(call->getImplicitObjectArgument()->IgnoreParenImpCasts()))
     return nullptr;
   return md->hasBody(def) ? def : nullptr;
 }
@@ -226,7 +264,7 @@ bool HasVirtualDestructor(const CXXRecordDecl* rd) {
 
 void AnalyzeMembers(Context& c) {
   GlslPrinter structs(c.ctx, c.cls, c.rep);
-  for (auto* f : c.cls->fields()) {
+  for (auto* f : ClassFields(c.cls)) {
     Member m;
     m.name = f->getNameAsString();
     m.hostExpr = m.name;
@@ -288,7 +326,7 @@ void AnalyzeMembers(Context& c) {
   }
   if (c.model.constructors.empty()) c.model.constructors.push_back({});
   c.model.virtualDestructor = HasVirtualDestructor(c.cls);
-  for (auto* md : c.cls->methods()) {
+  for (auto* md : ClassMethods(c.cls)) {
     if (md->getName() == "CommitDeviceData" && md->isVirtual()) c.model.declaresCommitDeviceData = true;
     if (md->getName() == "GetExecutionTime" && md->isVirtual()) c.model.declaresGetExecutionTime = true;
   }
@@ -482,7 +520,15 @@ struct WriteScanner : RecursiveASTVisitor<WriteScanner> {
     return true;
   }
   bool VisitUnaryOperator(UnaryOperator* uo) {
-    if (uo->isIncrementDecrementOp()) Write(uo->getSubExpr(), uo->getExprLoc(), std::nullopt, {});
+    if (!uo->isIncrementDecrementOp()) return true;
+    // m++ and m-- on a member are reductions, as m += 1 and m -= 1 are.
+    std::vector<const MemberExpr*> uses;
+    std::optional<ReduceOp> op;
+    if (auto* me = AsThisMember(uo->getSubExpr()); me && uo->getSubExpr()->getType()->isArithmeticType()) {
+      uses.push_back(me);
+      op = uo->isIncrementOp() ? ReduceOp::Add : ReduceOp::Sub;
+    }
+    Write(uo->getSubExpr(), uo->getExprLoc(), op, uses);
     return true;
   }
   // push_back to a member vector: an append through an atomic counter on the GPU; on the CPU a
@@ -624,6 +670,10 @@ void CheckKernelParams(Context& c, const CXXMethodDecl* md, Kernel& k) {
       kp.threadState = k.rtv && c.threadState.count({k.name, kp.name});
       kp.isConstPointee = pointee.isConstQualified();
       auto g = GlslTypeOf(pointee);
+      if (pointee->isRealFloatingType() && !pointee->isSpecificBuiltinType(BuiltinType::Float)) {
+        c.rep.GpuError(p->getLocation(), DoubleRefusal(pointee.getUnqualifiedType().getAsString(c.ctx.getPrintingPolicy())), DoubleRefusalHint());
+        continue;
+      }
       if (!g || pointee->isPointerType()) {
         c.rep.GpuError(p->getLocation(), "kernel parameter '" + kp.name + "' points to '" + pointee.getAsString(c.ctx.getPrintingPolicy()) + "', which has no GPU equivalent",
                     "pass arrays of int, uint, float, LiteMath vectors or plain structs of those");
@@ -640,7 +690,11 @@ void CheckKernelParams(Context& c, const CXXMethodDecl* md, Kernel& k) {
                   "kernels return results through pointer parameters or members");
     } else {
       auto g = GlslTypeOf(t);
-      if (!g || (t.getNonReferenceType()->isFloatingType() && !t.getNonReferenceType()->isSpecificBuiltinType(BuiltinType::Float))) {
+      if (t.getNonReferenceType()->isRealFloatingType() && !t.getNonReferenceType()->isSpecificBuiltinType(BuiltinType::Float)) {
+        c.rep.GpuError(p->getLocation(), DoubleRefusal(t.getNonReferenceType().getUnqualifiedType().getAsString(c.ctx.getPrintingPolicy())), DoubleRefusalHint());
+        continue;
+      }
+      if (!g) {
         c.rep.GpuError(p->getLocation(), "kernel parameter '" + kp.name + "' of type '" + t.getAsString(c.ctx.getPrintingPolicy()) + "' has no GPU equivalent",
                     "use int, uint, float, LiteMath types, plain structs, or a pointer with a size");
         continue;
@@ -1100,7 +1154,7 @@ void AddLockedCopies(Context& c, const std::vector<const FunctionDecl*>& reached
   std::map<const FunctionDecl*, bool> memo;
   for (auto* fn : reached) {
     auto* md = dyn_cast<CXXMethodDecl>(fn);
-    if (!md || md->getParent() != c.cls || md->isStatic() || !AppendsThroughCalls(fn, c.cls, memo)) continue;
+    if (!md || !IsClassOrBase(md->getParent(), c.cls) || md->isStatic() || !AppendsThroughCalls(fn, c.cls, memo)) continue;
     const std::string name = md->getNameAsString();
     const CXXMethodDecl* decl = cast<CXXMethodDecl>(md->getCanonicalDecl());
     LockedCopy copy;
@@ -1236,9 +1290,12 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   GlslPrinter printer(c.ctx, c.cls, c.rep);
   printer.compositions = c.compositions;
   for (auto& s : ClassStructNames(c.model)) printer.predeclaredStructs.insert(s);
-  // Structs the parameters' buffers hold are declared even when the body names no variable of them.
+  // Structs the parameters hold (buffers, push constants) are declared even when the body names no variable of them.
   for (auto* p : def->parameters()) {
     if (p->getType()->isPointerType()) printer.Type(p->getType()->getPointeeType(), p->getLocation());
+    else if (auto* rd = p->getType().getNonReferenceType()->getAsCXXRecordDecl(); rd && !IsLiteMathType(p->getType().getNonReferenceType()) &&
+             !IsImage2D(p->getType()) && GlslTypeOf(p->getType()))
+      printer.Type(p->getType().getNonReferenceType(), p->getLocation());
     if (IsImageParam(p)) printer.imageParams.insert(p);
   }
   auto* body = dyn_cast<CompoundStmt>(def->getBody());
@@ -1353,7 +1410,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     c.rep.GpuError(md->getLocation(), "kernel '" + k.name + "' reduces members and is dispatched indirectly (it loops to " + k.indirectVector + ".size())",
                 "reduce in a kernel with a count the host knows, or append the values and reduce them in a later kernel");
   // In declaration order, so that regeneration is stable.
-  for (auto* field : c.cls->fields()) {
+  for (auto* field : ClassFields(c.cls)) {
     auto found = ws.reductions.find(field);
     if (found == ws.reductions.end()) continue;
     ReduceOp op = found->second;
@@ -1393,7 +1450,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     const auto sizeReadsInLoop = printer.sizeReads;  // after the loop a vector's final size is known
     const auto renames = printer.renames;
     for (auto& r : k.reductions)
-      for (auto* f : c.cls->fields())
+      for (auto* f : ClassFields(c.cls))
         if (f->getNameAsString() == r.member) printer.renames.erase(f);  // the member itself, not a thread's part
     printer.singleThread = true;
     const std::string from = "// from " + c.cls->getNameAsString() + "::" + k.name + " (" + k.sourceFile + "): ";
@@ -1449,7 +1506,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
       continue;
     Composition comp;
     comp.holder = holder;
-    for (auto* f : c.cls->fields())
+    for (auto* f : ClassFields(c.cls))
       if (auto* rd = f->getNameAsString() == holder ? PolymorphicPointee(f->getType()) : nullptr) comp.interfaceName = rd->getNameAsString();
     comp.implName = c.compositions.count(comp.interfaceName) ? c.compositions.at(comp.interfaceName) : "";
     c.model.compositions.push_back(comp);
@@ -1463,7 +1520,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   k.ownFunctionList = k.functionList;
   k.ownMemberVectors = k.memberVectors;
   // Images and samplers, in declaration order so that bindings stay stable across regenerations.
-  for (auto* f : c.cls->fields()) {
+  for (auto* f : ClassFields(c.cls)) {
     const bool loaded = printer.loadedImages.count(f), stored = printer.storedImages.count(f);
     const bool sampled = printer.sampledImages.count(f), sampler = printer.samplers.count(f);
     if (!(loaded || stored || sampled || sampler || printer.sizedImages.count(f))) continue;
@@ -1485,7 +1542,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   }
   for (auto& [image, sampler] : printer.samplePairs)
     (isa<FieldDecl>(image) ? k.samplePairs : k.paramSamplePairs).push_back({image->getNameAsString(), sampler->getNameAsString()});
-  for (auto* f : c.cls->fields()) {
+  for (auto* f : ClassFields(c.cls)) {
     if (!printer.textureArrays.count(f)) continue;
     RequireReachable(c.rep, f, c.cls);
     if (auto* m = FindMember(c.model, f->getNameAsString())) {
@@ -2220,7 +2277,7 @@ private:
   void CheckNestedControl(const CXXMemberCallExpr* call) {
     auto* md = call->getMethodDecl();
     const FunctionDecl* def = nullptr;
-    if (!md || IsKernelName(md->getName()) || !md->hasBody(def) || !def || md->getParent() != m_md->getParent()) return;
+    if (!md || IsKernelName(md->getName()) || !md->hasBody(def) || !def || !IsClassOrBase(md->getParent(), m_c.cls)) return;
     KernelCallFinder kc;
     kc.TraverseStmt(def->getBody());
     if (kc.calls.empty()) return;
@@ -2587,7 +2644,7 @@ bool AnalyzeTranslationUnit(ASTContext& ctx, const std::string& className, const
         return true;
       }
     } finder(c.threadState);
-    for (auto* md : cls->methods()) {
+    for (auto* md : ClassMethods(cls)) {
       const FunctionDecl* def = nullptr;
       if (!IsKernelName(md->getName()) && md->hasBody(def) && def) finder.TraverseStmt(def->getBody());
     }
@@ -2595,7 +2652,7 @@ bool AnalyzeTranslationUnit(ASTContext& ctx, const std::string& className, const
   // Appends decide how other kernels are dispatched: find them all before analysing any kernel.
   {
     AppendFinder finder(cls);
-    for (auto* md : cls->methods()) {
+    for (auto* md : ClassMethods(cls)) {
       const FunctionDecl* def = nullptr;
       if (IsKernelName(md->getName()) && md->hasBody(def) && def) finder.TraverseStmt(def->getBody());
     }
@@ -2640,7 +2697,7 @@ bool AnalyzeTranslationUnit(ASTContext& ctx, const std::string& className, const
   }
   // Kernels first: control functions refer to them.
   for (int pass = 0; pass < 2; ++pass) {
-    for (auto* md : cls->methods()) {
+    for (auto* md : ClassMethods(cls)) {
       const FunctionDecl* def = nullptr;
       if (!md->hasBody(def) || !def) continue;
       // A method defined in a header is seen by every source file: analyse it once.

@@ -25,6 +25,20 @@ const std::set<std::string>& GlslKeywords() {
   return words;
 }
 
+// GLSL's built-in functions, which a shader may not overload: a helper of the same name is renamed.
+bool IsGlslBuiltinFunction(const std::string& name) {
+  static const std::set<std::string> names = {
+      "radians", "degrees", "sin", "cos", "tan", "asin", "acos", "atan", "sinh", "cosh", "tanh", "asinh", "acosh", "atanh",
+      "pow", "exp", "log", "exp2", "log2", "sqrt", "inversesqrt", "abs", "sign", "floor", "trunc", "round", "roundEven",
+      "ceil", "fract", "mod", "modf", "min", "max", "clamp", "mix", "step", "smoothstep", "isnan", "isinf", "fma", "frexp",
+      "ldexp", "length", "distance", "dot", "cross", "normalize", "faceforward", "reflect", "refract", "matrixCompMult",
+      "outerProduct", "transpose", "determinant", "inverse", "lessThan", "lessThanEqual", "greaterThan", "greaterThanEqual",
+      "equal", "notEqual", "any", "all", "not", "bitCount", "findLSB", "findMSB", "bitfieldExtract", "bitfieldInsert",
+      "bitfieldReverse", "uaddCarry", "usubBorrow", "umulExtended", "imulExtended", "packHalf2x16", "unpackHalf2x16",
+      "floatBitsToInt", "floatBitsToUint", "intBitsToFloat", "uintBitsToFloat", "barrier", "texture", "textureLod"};
+  return names.count(name) > 0;
+}
+
 std::string TrimmedSourceText(const ASTContext& ctx, SourceRange range) {
   auto& sm = ctx.getSourceManager();
   return Lexer::getSourceText(CharSourceRange::getTokenRange(range), sm, ctx.getLangOpts()).str();
@@ -46,6 +60,13 @@ const char* LiteMathGlsl(StringRef name) {
 }
 
 }  // namespace
+
+std::string DoubleRefusal(const std::string& type) {
+  return "type '" + type + "' is not supported in Vulkan kernels: many GPUs have no 64-bit floats, the others run them many times slower";
+}
+std::string DoubleRefusalHint() {
+  return "use float (literals such as 0.5 are fine: they become float), or translate the class with BACKEND cpu, which runs it as written";
+}
 
 bool IsSystemDecl(const Decl* decl) {
   auto& sm = decl->getASTContext().getSourceManager();
@@ -229,8 +250,7 @@ std::optional<std::string> GlslPrinter::Type(QualType t, SourceLocation loc) {
     return std::nullopt;
   }
   if (auto* bt = base->getAs<BuiltinType>(); bt && bt->isFloatingPoint() && bt->getKind() != BuiltinType::Float) {
-    Fail(loc, "type '" + t.getAsString(m_ctx.getPrintingPolicy()) + "' is not supported in kernels (only 32-bit float)",
-         "use float; double-precision literals such as 0.5 are fine and become float");
+    Fail(loc, DoubleRefusal(t.getAsString(m_ctx.getPrintingPolicy())), DoubleRefusalHint());
     return std::nullopt;
   }
   auto g = GlslTypeOf(t);
@@ -346,7 +366,14 @@ std::string GlslPrinter::Construct(QualType t, const std::vector<const clang::Ex
   std::string out = base + dims + "(";
   if (real.empty()) {
     if (matrix) return base + "(1.0)";  // LiteMath matrices start as the identity
-    if (IsLiteMathType(t) || !dims.empty()) return base + dims + "(" + (dims.empty() ? "0" : "") + ")";
+    if (auto* arr = dyn_cast<ConstantArrayType>(t.getCanonicalType().getTypePtr())) {
+      // Every element default-constructed, as C++ does for an array of class type.
+      const std::string element = Construct(arr->getElementType(), {}, loc);
+      std::string list;
+      for (uint64_t i = 0; i < arr->getSize().getZExtValue(); ++i) list += (i ? ", " : "") + element;
+      return base + dims + "(" + list + ")";
+    }
+    if (IsLiteMathType(t)) return base + "(0)";
     auto* rd = t.getCanonicalType()->getAsCXXRecordDecl();
     if (!rd) return base + "(0)";  // a value-initialised scalar
     // Value-initialised struct: default member initialisers, else zero.
@@ -396,6 +423,7 @@ std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callL
   // Composed code keeps its names under the holder's prefix: no clash with the kernel's helpers.
   // Methods printed for an object (virtual calls) are per class; free functions are shared.
   std::string name = (selfClass && !isa<CXXMethodDecl>(fd) ? "" : composedPrefix) + fd->getNameAsString();
+  if (IsGlslBuiltinFunction(name)) name += "_";  // GLSL forbids overloading its built-in functions
   if (m_inProgress.count(def))
     return Fail(callLoc, "recursive call to '" + fd->getQualifiedNameAsString() + "' in a kernel",
                 "GPUs have no call stack: rewrite the recursion as a loop with an explicit stack array");
@@ -576,7 +604,8 @@ std::string GlslPrinter::Builtin(const FunctionDecl* fd, const std::vector<std::
       {"make_int3", "ivec3"}, {"make_int4", "ivec4"}, {"make_uint2", "uvec2"}, {"make_uint3", "uvec3"},
       {"make_uint4", "uvec4"}, {"to_float2", "vec2"}, {"to_int2", "ivec2"}, {"to_int3", "ivec3"},
       {"to_int4", "ivec4"}, {"to_uint2", "uvec2"}, {"to_uint3", "uvec3"}, {"to_uint4", "uvec4"},
-      {"to_float4", "vec4"}};
+      {"to_float4", "vec4"}, {"mod", "mod"}, {"faceforward", "faceforward"}, {"outerProduct", "outerProduct"},
+      {"determinant", "determinant"}, {"inverse3x3", "inverse"}};
   // GCC/Clang bit builtins (C++ leaves clz and ctz of 0 undefined).
   if (fd->getBuiltinID() != 0) {
     if (n == "__builtin_clz") return "(31 - findMSB(uint(" + a[0] + ")))";
@@ -612,6 +641,21 @@ std::string GlslPrinter::Builtin(const FunctionDecl* fd, const std::vector<std::
   if (n == "mul4x3") return "(" + a[0] + " * vec4(" + a[1] + ", 1.0)).xyz";
   if (n == "mul3x3") return "(mat3(" + a[0] + ") * " + a[1] + ")";
   if (n == "fmod" || n == "fmodf") return "(" + a[0] + " - " + a[1] + " * trunc(" + a[0] + " / " + a[1] + "))";
+  // The magnitude of the first and the sign bit of the second, as C++ has it (signed zeros, NaNs too).
+  if (n == "copysign" || n == "copysignf")
+    return "uintBitsToFloat((floatBitsToUint(" + a[0] + ") & 0x7FFFFFFFu) | (floatBitsToUint(" + a[1] + ") & 0x80000000u))";
+  // LiteMath's float4 as a 3-vector and a w: the cross product of the xyz parts, w = 0.
+  if ((n == "cross3" || n == "cross") && arg0Type == "vec4") return "vec4(cross((" + a[0] + ").xyz, (" + a[1] + ").xyz), 0.0)";
+  if (n == "mul4x4x4" || (n == "mul" && call->getNumArgs() == 2 && arg0Type.rfind("mat", 0) == 0)) {
+    const std::string arg1Type = GlslTypeOf(call->getArg(1)->getType()).value_or("");
+    if (arg0Type == "mat4" && arg1Type == "vec3") return "(" + a[0] + " * vec4(" + a[1] + ", 1.0)).xyz";
+    return "(" + a[0] + " * " + a[1] + ")";
+  }
+  if (n == "make_float4x4_from_rows" || n == "make_float3x3_from_rows" || n == "make_float3x3")
+    return std::string("transpose(") + (n == "make_float4x4_from_rows" ? "mat4(" : "mat3(") + a[0] + ", " + a[1] + ", " + a[2] + (a.size() > 3 ? ", " + a[3] : "") + "))";
+  if (n == "make_float4x4_from_cols" || n == "make_float3x3_from_cols" || n == "make_float3x3_by_columns")
+    return std::string(n == "make_float4x4_from_cols" ? "mat4(" : "mat3(") + a[0] + ", " + a[1] + ", " + a[2] + (a.size() > 3 ? ", " + a[3] : "") + ")";
+  if (n == "rcp") return "(1.0 / " + a[0] + ")";
   if (n == "isfinite") return "!(isinf(" + a[0] + ") || isnan(" + a[0] + "))";
   auto it = same.find(n);
   if (it != same.end()) return join(it->second);
@@ -1229,15 +1273,24 @@ std::string GlslPrinter::Stmt(const clang::Stmt* s, int indent) {
       std::string decl = Declare(t, vd->getNameAsString(), vd->getLocation());
       std::string cnst = t.getNonReferenceType().isConstQualified() && !t->isArrayType() ? "const " : "";
       out += pad + cnst + decl;
+      std::string after;
       if (auto* init = vd->getInit()) {
         const clang::Expr* bare = init->IgnoreImplicit();
         bool trivialDefault = false;
-        if (auto* cons = dyn_cast<CXXConstructExpr>(bare); cons && cons->getNumArgs() == 0 &&
-            cons->getConstructor()->isTrivial())
+        auto* cons = dyn_cast<CXXConstructExpr>(bare);
+        if (cons && cons->getNumArgs() == 0 && cons->getConstructor()->isTrivial())
           trivialDefault = true;
-        if (!trivialDefault) out += " = " + Expr(init);
+        auto* arr = dyn_cast<ConstantArrayType>(t.getCanonicalType().getTypePtr());
+        if (!trivialDefault && cons && cons->getNumArgs() == 0 && arr && arr->getSize().getZExtValue() > 8) {
+          // A long array of class type: each element constructed in a loop, not in one long constructor.
+          const std::string n = std::to_string(arr->getSize().getZExtValue()), name = SafeName(vd->getNameAsString());
+          after = pad + "for (int crt_i = 0; crt_i < " + n + "; ++crt_i)  // each element default-constructed, as in C++\n" + pad + "  " +
+                  name + "[crt_i] = " + Construct(arr->getElementType(), {}, vd->getLocation()) + ";\n";
+        } else if (!trivialDefault) {
+          out += " = " + Expr(init);
+        }
       }
-      out += ";\n";
+      out += ";\n" + after;
     }
     return out;
   }

@@ -35,6 +35,9 @@ bool IsTextureArray(clang::QualType type, clang::QualType* texel = nullptr);
 struct ImageFormat { std::string glslFormat, vkFormat, texel, prefix; };
 std::optional<ImageFormat> ImageFormatOf(clang::QualType texel);
 bool IsSystemDecl(const clang::Decl* decl);
+// Why double is refused in Vulkan kernels, and what to do instead (by design: the GPU's limits).
+std::string DoubleRefusal(const std::string& type);
+std::string DoubleRefusalHint();
 // crossrt::AtomicAdd and the other read-modify-write operations of Atomics.h.
 bool IsCrossrtAtomic(const clang::FunctionDecl* fd);
 

@@ -98,7 +98,7 @@ Register doubleSum([] {
                                  return Outputs{d.m_summ};
                                });
   c.className = "DoubleSum";
-  c.vulkanRefusal = "type 'double' is not supported";
+  c.vulkanRefusal = "is not supported in Vulkan kernels: many GPUs have no 64-bit floats";
   return c;
 }());
 #endif

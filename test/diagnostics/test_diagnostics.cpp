@@ -64,7 +64,7 @@ const Case kCases[] = {
     {"iostream", "    std::cout << x;", "", "", "I/O (stream operator) in a kernel", "write results to an output buffer", 8},
     {"library call", "    x += float(std::strlen(\"abc\"));", "", "", "unsupported library call 'strlen' in a kernel", "kernels may call LiteMath", 8},
     {"member race", "    m_value = x;", "", "", "kernel writes class member 'm_value' from every thread", "reduction", 8},
-    {"double", "    double d = x; x = float(d);", "", "", "type 'double' is not supported in kernels", "use float", 8},
+    {"double", "    double d = x; x = float(d);", "", "", "type 'double' is not supported in Vulkan kernels", "use float", 8},
     {"narrow integer", "    short s = short(x); x = float(s);", "", "", "narrower than 32 bits", "use int", 8},
     {"helper writes member", "    x = Touch(x);", "  float Touch(float v);", "float Bad::Touch(float v) { m_value = v; return v; }\n",
      "helper function 'Touch' writes class member 'm_value'", "return the value", 12},

@@ -9,7 +9,7 @@ public:
   ImageScale() {}
   virtual void Scale(int w, int h, const float* a_in __attribute__((size("w", "h"))), float* a_out __attribute__((size("w", "h"))));
   virtual void CommitDeviceData() {}
-  virtual void GetExecutionTime(const char* a_funcName, float a_out[4]) {}
+  virtual void GetExecutionTime(const char*, float[4]) {}
 
 protected:
   virtual void kernel2D_Scale(int w, int h, const float* a_in, float* a_out);

@@ -10,7 +10,7 @@ void SortPairs::MakeAndSort(uint32_t a_seed, uint2* a_out)
 void SortPairs::kernel1D_Make(uint32_t n, uint32_t a_seed)
 {
   for (uint32_t i = 0; i < n; i++)
-    m_pairs[i] = uint2((i * 2654435761u + a_seed) % 997u, i);
+    m_pairs[i] = uint2((i * 7919u + a_seed) % 1009u, i);  // distinct keys: std::sort need not keep ties in order
 }
 
 void SortPairs::kernel1D_Copy(uint32_t n, uint2* a_out)
