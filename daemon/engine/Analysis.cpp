@@ -549,8 +549,16 @@ struct WriteScanner : RecursiveASTVisitor<WriteScanner> {
     if (!fd || IsSystemDecl(fd) || isa<CXXOperatorCallExpr>(call)) return true;
     for (unsigned i = 0; i < call->getNumArgs() && i < fd->getNumParams(); ++i) {
       QualType t = fd->getParamDecl(i)->getType();
+      const Expr* arg = call->getArg(i);
       if (t->isReferenceType() && !t.getNonReferenceType().isConstQualified())
-        Write(call->getArg(i), call->getArg(i)->getExprLoc(), std::nullopt, {});
+        Write(arg, arg->getExprLoc(), std::nullopt, {});
+      // A pointer to non-const: the callee may write what it points at (&m_v[i], m_v.data() + k).
+      if (!t->isPointerType() || t->getPointeeType().isConstQualified()) continue;
+      const Expr* target = arg->IgnoreParenImpCasts();
+      while (auto* bo = dyn_cast<BinaryOperator>(target)) target = (bo->getLHS()->getType()->isPointerType() ? bo->getLHS() : bo->getRHS())->IgnoreParenImpCasts();
+      if (auto* uo = dyn_cast<UnaryOperator>(target); uo && uo->getOpcode() == UO_AddrOf) Write(uo->getSubExpr(), arg->getExprLoc(), std::nullopt, {});
+      if (auto* mc = dyn_cast<CXXMemberCallExpr>(target); mc && mc->getMethodDecl() && mc->getMethodDecl()->getName() == "data")
+        if (auto* f = ThisField(mc->getImplicitObjectArgument()); f && IsStdVector(f->getType())) vectorWrites.insert(f);
     }
     return true;
   }
@@ -1185,7 +1193,7 @@ void AddLockedCopies(Context& c, const std::vector<const FunctionDecl*>& reached
       }
     } privateUses(c, name);
     privateUses.TraverseStmt(fn->getBody());
-    CopySourceDeclarations(c, fn->getBody(), "'" + name + "', which appends,");
+    if (c.model.forCpu) CopySourceDeclarations(c, fn->getBody(), "'" + name + "', which appends,");
     // The copy hides every overload of its name: the others stay reachable through one
     // using-declaration, with the first copy of the name.
     auto overloads = c.cls->lookup(md->getDeclName());
@@ -1585,7 +1593,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     SourceLocation end = Lexer::findLocationAfterToken(outer->getEndLoc(), tok::semi, c.ctx.getSourceManager(), c.ctx.getLangOpts(), false);
     k.cpuLoopNest = CanonicalCode(end.isValid() ? rw.getRewrittenText(CharSourceRange::getCharRange(outer->getBeginLoc(), end))
                                                 : rw.getRewrittenText(outer->getSourceRange()));
-    CopySourceDeclarations(c, def->getBody(), "kernel '" + k.name + "'");
+    if (c.model.forCpu) CopySourceDeclarations(c, def->getBody(), "kernel '" + k.name + "'");  // the CPU class copies the loop nest
     for (auto* s : before) k.cpuPreamble += StatementText(c, s) + "\n";
     k.cpuPreamble = CanonicalCode(k.cpuPreamble);
     for (auto* s : after) k.cpuPostamble += StatementText(c, s) + "\n";

@@ -414,7 +414,8 @@ std::string GlslPrinter::EmitAppend(const FieldDecl* field, const CallExpr* call
   return name;
 }
 
-std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callLoc, bool composedEntry) {
+std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callLoc, bool composedEntry,
+                                    const std::map<unsigned, std::string>& bufferBindings) {
   const FunctionDecl* def = nullptr;
   if (!fd->hasBody(def) || !def) {
     return Fail(callLoc, "function '" + fd->getQualifiedNameAsString() + "' is called from a kernel but its body is not visible",
@@ -424,10 +425,11 @@ std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callL
   // Methods printed for an object (virtual calls) are per class; free functions are shared.
   std::string name = (selfClass && !isa<CXXMethodDecl>(fd) ? "" : composedPrefix) + fd->getNameAsString();
   if (IsGlslBuiltinFunction(name)) name += "_";  // GLSL forbids overloading its built-in functions
+  for (auto& [index, buffer] : bufferBindings) name += "_" + buffer;  // a copy per buffer its pointers index
   if (m_inProgress.count(def))
     return Fail(callLoc, "recursive call to '" + fd->getQualifiedNameAsString() + "' in a kernel",
                 "GPUs have no call stack: rewrite the recursion as a loop with an explicit stack array");
-  if (m_emitted.count(def)) return name;
+  if (bufferBindings.empty() ? m_emitted.count(def) > 0 : !m_emittedCopies.insert(name).second) return name;
   if (!composedEntry && isa<CXXMethodDecl>(def) && cast<CXXMethodDecl>(def)->isVirtual())
     Fail(callLoc, "virtual call to '" + fd->getQualifiedNameAsString() + "' in a kernel", "call a non-virtual helper");
   m_inProgress.insert(def);
@@ -436,6 +438,7 @@ std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callL
   os << "// from " << def->getQualifiedNameAsString() << "\n" << (ret ? *ret : "void") << " " << name << "(";
   const bool withSelf = selfClass && isa<CXXMethodDecl>(def) && !cast<CXXMethodDecl>(def)->isStatic();
   if (withSelf) os << selfClass->getNameAsString() << "_Data self";
+  const auto outerPointers = m_pointers;  // this function's pointer parameters shadow the caller's names
   for (unsigned i = 0; i < def->getNumParams(); ++i) {
     auto* p = def->getParamDecl(i);
     QualType pt = p->getType();
@@ -444,7 +447,24 @@ std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callL
     if (IsImage2D(pt.getNonReferenceType()))
       Fail(p->getLocation(), "helper '" + fd->getNameAsString() + "' takes an Image2D parameter; on the GPU only kernels take images",
            "read the texels in the kernel and pass them to the helper, or make the image a member, which helpers reach directly");
-    os << (i || withSelf ? ", " : "") << qualifier << Declare(pt, p->getNameAsString(), p->getLocation());
+    os << (i || withSelf ? ", " : "");
+    if (pt->isPointerType()) {
+      // A pointer parameter: the element it points at (inout unless const), or the offset into the
+      // buffer this copy of the helper is bound to.
+      PointerTarget t;
+      const std::string name = SafeName(p->getNameAsString());
+      if (auto bound = bufferBindings.find(i); bound != bufferBindings.end()) {
+        t.array = bound->second;
+        t.offset = name + "_offset";
+        os << "uint " << t.offset;
+      } else {
+        t.value = name;
+        os << (pt->getPointeeType().isConstQualified() ? "" : "inout ") << Declare(pt->getPointeeType(), p->getNameAsString(), p->getLocation());
+      }
+      m_pointers[p] = t;
+      continue;
+    }
+    os << qualifier << Declare(pt, p->getNameAsString(), p->getLocation());
   }
   os << ")\n";
   int savedDepth = m_loopDepth;
@@ -455,10 +475,11 @@ std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callL
   m_loopDepth = savedDepth;
   m_inThreadBody = savedThread;
   m_inLoopBody = savedLoopBody;
+  m_pointers = outerPointers;
   m_inProgress.erase(def);
+  if (!m_emitted.count(def)) helpers.push_back(def);
   m_emitted.insert(def);
   m_functions.push_back(os.str());
-  helpers.push_back(def);
   return name;
 }
 
@@ -935,8 +956,9 @@ std::string GlslPrinter::Call(const CallExpr* call) {
           return s + ")";
         }
       }
-      for (auto* arg : call->arguments()) args.push_back(Expr(arg));
-      std::string callee = EmitHelper(method, call->getBeginLoc());
+      std::map<unsigned, std::string> bindings;
+      for (auto& a : HelperArgs(method, call, bindings)) args.push_back(a);
+      std::string callee = EmitHelper(method, call->getBeginLoc(), false, bindings);
       std::string s = callee + "(";
       for (size_t i = 0; i < args.size(); ++i) s += (i ? ", " : "") + args[i];
       return s + ")";
@@ -1003,14 +1025,19 @@ std::string GlslPrinter::Call(const CallExpr* call) {
 
   if (IsCrossrtAtomic(fd)) return AtomicCall(fd, call);
   std::vector<std::string> args;
-  for (auto* arg : call->arguments()) args.push_back(Expr(arg));
+  const bool library = IsSystemDecl(fd) || fd->isInStdNamespace() || InNamespace(fd, "LiteMath");
+  std::map<unsigned, std::string> bindings;
+  if (library)
+    for (auto* arg : call->arguments()) args.push_back(Expr(arg));
+  else
+    args = HelperArgs(fd, call, bindings);
   std::string b = Builtin(fd, args, call);
   if (!b.empty()) return b;
   if (IsSystemDecl(fd) || fd->isInStdNamespace())
     return Fail(call->getBeginLoc(), "unsupported library call '" + qname + "' in a kernel",
                 "kernels may call LiteMath, <cmath> and std::min/max/abs, and your own functions with visible bodies");
   // The user's own free function.
-  std::string callee = EmitHelper(fd, call->getBeginLoc());
+  std::string callee = EmitHelper(fd, call->getBeginLoc(), false, bindings);
   std::string s = callee + "(";
   for (size_t i = 0; i < args.size(); ++i) s += (i ? ", " : "") + args[i];
   return s + ")";
@@ -1127,11 +1154,23 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
       plainMembers.insert(field);
       return composedPrefix + field->getNameAsString();
     }
-    if (me->isArrow()) return Fail(e->getBeginLoc(), "'->' in a kernel", "GLSL has no pointers: use a reference or a value");
     if (!field) return Fail(e->getBeginLoc(), "member function used as a value", "");
+    if (me->isArrow()) {  // p->f: the field of what p points at
+      auto t = Pointer(me->getBase());
+      return t ? Pointee(*t, nullptr, e->getBeginLoc()) + "." + field->getNameAsString() : "/*error*/";
+    }
     return Expr(me->getBase()) + "." + field->getNameAsString();
   }
-  if (auto* as = dyn_cast<ArraySubscriptExpr>(e)) return Expr(as->getBase()) + "[" + Expr(as->getIdx()) + "]";
+  if (auto* as = dyn_cast<ArraySubscriptExpr>(e)) {
+    // p[i] through a pointer (a buffer parameter, a pointer local, data()); an array's own elements as written.
+    auto* decay = dyn_cast<ImplicitCastExpr>(as->getBase()->IgnoreParens());
+    const bool array = decay && decay->getCastKind() == CK_ArrayToPointerDecay;
+    if (!array && as->getBase()->getType()->isPointerType()) {
+      auto t = Pointer(as->getBase());
+      return t ? Pointee(*t, as->getIdx(), e->getBeginLoc()) : "/*error*/";
+    }
+    return Expr(as->getBase()) + "[" + Expr(as->getIdx()) + "]";
+  }
   if (auto* op = dyn_cast<CXXOperatorCallExpr>(e)) {
     auto kind = op->getOperator();
     std::string coord;
@@ -1193,9 +1232,13 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
   }
   if (auto* uo = dyn_cast<UnaryOperator>(e)) {
     auto opc = uo->getOpcode();
-    if (opc == UO_Deref || opc == UO_AddrOf)
-      return Fail(e->getBeginLoc(), std::string(opc == UO_Deref ? "pointer dereference" : "address-of") + " in a kernel",
-                  "GLSL has no pointers: index the array parameter, e.g. a[i]");
+    if (opc == UO_Deref) {  // *p: what p points at
+      auto t = Pointer(uo->getSubExpr());
+      return t ? Pointee(*t, nullptr, e->getBeginLoc()) : "/*error*/";
+    }
+    if (opc == UO_AddrOf)
+      return Fail(e->getBeginLoc(), "address-of used as a value in a kernel",
+                  "pass &x to a helper's pointer parameter, or set a pointer local from it (T* p = &x)");
     std::string sub = Expr(uo->getSubExpr());
     if (uo->isPostfix()) return sub + UnaryOperator::getOpcodeStr(opc).str();
     return UnaryOperator::getOpcodeStr(opc).str() + sub;
@@ -1267,6 +1310,10 @@ std::string GlslPrinter::Stmt(const clang::Stmt* s, int indent) {
       if (!vd) continue;  // local typedefs and such need nothing
       if (vd->isStaticLocal()) { Fail(vd->getLocation(), "static local variable in a kernel", "use a class member or a constant"); continue; }
       QualType t = vd->getType();
+      if (t->isPointerType()) {
+        out += PointerLocal(vd, pad);
+        continue;
+      }
       if (t->isReferenceType() && !t.getNonReferenceType().isConstQualified())
         Fail(vd->getLocation(), "non-const reference variable in a kernel",
              "GLSL has no references: write through the original expression, e.g. arr[i].x = ...");

@@ -162,7 +162,29 @@ private:
   std::string AtomicCall(const clang::FunctionDecl* fd, const clang::CallExpr* call);
   std::string AtomicTargetProblem(const clang::Expr* target) const;
   std::string EmitAppend(const clang::FieldDecl* field, const clang::CallExpr* call);
-  std::string EmitHelper(const clang::FunctionDecl* fd, clang::SourceLocation callLoc, bool composedEntry = false);
+  // A user function as a GLSL function, once; with `bufferBindings` (parameter index -> buffer), a copy
+  // of it whose pointer parameters index those buffers from an offset (see GlslPointers.cpp).
+  std::string EmitHelper(const clang::FunctionDecl* fd, clang::SourceLocation callLoc, bool composedEntry = false,
+                         const std::map<unsigned, std::string>& bufferBindings = {});
+  // ---- pointers (GlslPointers.cpp) ----
+  struct PointerTarget {
+    std::string array;   // the array it points into (as GLSL names it), or "" for one variable
+    std::string offset;  // its element offset in `array` ("" is 0)
+    std::string value;   // one variable: its GLSL lvalue
+    bool local = false;  // the array is a local one (a copy of a helper cannot reach it)
+  };
+  std::optional<PointerTarget> Pointer(const clang::Expr* e);  // what e points at; nullopt (reported) when unknown
+  std::string Pointee(const PointerTarget& t, const clang::Expr* index, clang::SourceLocation loc);  // *p, p[index]
+  std::vector<std::string> HelperArgs(const clang::FunctionDecl* fd, const clang::CallExpr* call, std::map<unsigned, std::string>& bindings);
+  std::string PointerLocal(const clang::VarDecl* vd, const std::string& pad);  // T* p = ...;
+  std::string TextOf(const clang::Expr* e) const;
+  std::map<const clang::ValueDecl*, PointerTarget> m_pointers;  // pointer locals and helper parameters in scope
+  std::set<std::string> m_emittedCopies;                         // helpers bound to buffers, by name
+
+public:
+  bool PointerIsValueOnly(const clang::FunctionDecl* fn, const clang::ParmVarDecl* p);
+
+private:
   std::string ComposedCall(const clang::CXXMemberCallExpr* call);
   std::string VirtualCall(const clang::CXXMemberCallExpr* call);
   void NeedStruct(const clang::RecordDecl* rd);

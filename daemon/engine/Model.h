@@ -265,6 +265,7 @@ struct LockedCopy {
 };
 
 struct ClassModel {
+  bool forCpu = false;         // translated for the CPU backend (else Vulkan)
   std::string className;       // Render
   std::string namespaceName;   // demo (or a::b) where the class is declared: the generated classes join it
   std::string headerFile;      // header declaring the class (as included by generated code)

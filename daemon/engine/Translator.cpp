@@ -274,6 +274,7 @@ AnalyzeResult Analyze(const TranslateRequest& request, AstCache* sharedCache) {
     compositions[c.substr(0, eq)] = c.substr(eq + 1);
   }
   ClassModel& model = result.model;
+  model.forCpu = request.backend == Backend::Cpu;
   model.virtualLevel = request.virtualLevel;
   model.megakernelByDefault = request.megakernel;
   unsigned errors = 0;

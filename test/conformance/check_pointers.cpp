@@ -75,9 +75,13 @@ Register particles(MakeCase<ParticleStep>(
     "&m_vec[i] passed to a static member helper that writes p->field", "particles.h/.cpp", 1e-5, CONFORMANCE_MAKERS(ParticleStep),
     [](ParticleStep& p) {
       p.m_particles.resize(256);
-      for (int i = 0; i < 256; i++) p.m_particles[i] = {float4(float(i % 16), 5.0f + float(i % 7), 0.0f, 1.0f), float4(1.0f, float(i % 5), 0.5f, 0.0f)};
+      // Every seventh particle starts just above the ground, falling: it bounces in the first step
+      // (a bounce decided by rounding would make the backends part ways, so none is close).
+      for (int i = 0; i < 256; i++)
+        p.m_particles[i] = i % 7 == 0 ? Particle{float4(float(i % 16), 0.001f, 0.0f, 1.0f), float4(1.0f, -3.0f, 0.5f, 0.0f)}
+                                      : Particle{float4(float(i % 16), 5.0f + float(i % 7), 0.0f, 1.0f), float4(1.0f, float(i % 5), 0.5f, 0.0f)};
       p.CommitDeviceData();
-      p.Step(0.01f, 40);
+      p.Step(0.01f, 10);
       Outputs r;
       for (auto& q : p.m_particles) Append(r, std::vector<float>{q.pos.x, q.pos.y, q.pos.z, q.vel.y});
       return r;
