@@ -415,7 +415,7 @@ std::string GlslPrinter::EmitAppend(const FieldDecl* field, const CallExpr* call
 }
 
 std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callLoc, bool composedEntry,
-                                    const std::map<unsigned, std::string>& bufferBindings) {
+                                    const std::map<unsigned, std::string>& bufferBindings, const CXXRecordDecl* structSelf) {
   const FunctionDecl* def = nullptr;
   if (!fd->hasBody(def) || !def) {
     return Fail(callLoc, "function '" + fd->getQualifiedNameAsString() + "' is called from a kernel but its body is not visible",
@@ -423,7 +423,7 @@ std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callL
   }
   // Composed code keeps its names under the holder's prefix: no clash with the kernel's helpers.
   // Methods printed for an object (virtual calls) are per class; free functions are shared.
-  std::string name = (selfClass && !isa<CXXMethodDecl>(fd) ? "" : composedPrefix) + fd->getNameAsString();
+  std::string name = (selfClass && !isa<CXXMethodDecl>(fd) ? "" : composedPrefix) + FunctionName(fd, structSelf);
   if (IsGlslBuiltinFunction(name)) name += "_";  // GLSL forbids overloading its built-in functions
   for (auto& [index, buffer] : bufferBindings) name += "_" + buffer;  // a copy per buffer its pointers index
   if (m_inProgress.count(def))
@@ -436,8 +436,9 @@ std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callL
   std::ostringstream os;
   auto ret = Type(def->getReturnType(), def->getLocation());
   os << "// from " << def->getQualifiedNameAsString() << "\n" << (ret ? *ret : "void") << " " << name << "(";
-  const bool withSelf = selfClass && isa<CXXMethodDecl>(def) && !cast<CXXMethodDecl>(def)->isStatic();
-  if (withSelf) os << selfClass->getNameAsString() << "_Data self";
+  const bool withSelf = (selfClass || structSelf) && isa<CXXMethodDecl>(def) && !cast<CXXMethodDecl>(def)->isStatic();
+  if (withSelf && structSelf) os << (cast<CXXMethodDecl>(def)->isConst() ? "" : "inout ") << structSelf->getNameAsString() << " self";
+  else if (withSelf) os << selfClass->getNameAsString() << "_Data self";
   const auto outerPointers = m_pointers;  // this function's pointer parameters shadow the caller's names
   for (unsigned i = 0; i < def->getNumParams(); ++i) {
     auto* p = def->getParamDecl(i);
@@ -469,9 +470,12 @@ std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callL
   os << ")\n";
   int savedDepth = m_loopDepth;
   bool savedThread = m_inThreadBody, savedLoopBody = m_inLoopBody;
+  const CXXRecordDecl* savedSelf = m_structSelf;
+  m_structSelf = structSelf;
   m_loopDepth = 0;
   m_inThreadBody = m_inLoopBody = false;
   os << Stmt(def->getBody(), 0);
+  m_structSelf = savedSelf;
   m_loopDepth = savedDepth;
   m_inThreadBody = savedThread;
   m_inLoopBody = savedLoopBody;
@@ -942,6 +946,13 @@ std::string GlslPrinter::Call(const CallExpr* call) {
   if (auto* mc = dyn_cast<CXXMemberCallExpr>(call)) {
     const clang::Expr* obj = mc->getImplicitObjectArgument()->IgnoreParenImpCasts();
     auto* method = mc->getMethodDecl();
+    if (isa<CXXThisExpr>(obj) && m_structSelf) {  // another member function of the struct being printed
+      std::map<unsigned, std::string> bindings;
+      std::vector<std::string> args = HelperArgs(method, call, bindings);
+      std::string s = EmitHelper(method, call->getBeginLoc(), false, bindings, m_structSelf) + "(self";
+      for (auto& a : args) s += ", " + a;
+      return s + ")";
+    }
     if (isa<CXXThisExpr>(obj)) {
       if (StringRef(name).starts_with("kernel"))
         return Fail(call->getBeginLoc(), "kernel '" + name + "' is called from inside a kernel", "call kernels only from control functions");
@@ -1008,7 +1019,9 @@ std::string GlslPrinter::Call(const CallExpr* call) {
       return Fail(call->getBeginLoc(), "std::vector::" + name + " is not supported in kernels",
                   "kernels may index member vectors, call size() and capacity(), and push_back() to a member vector");
     }
-    // Member functions of LiteMath types and user structs.
+    // Member functions of plain structs (the user's, LiteMath's complex and Box4f) and of matrices.
+    if (IsPlainStruct(method->getParent())) return StructMethodCall(mc);
+    if (IsLiteMathType(obj->getType(), "float4x4") || IsLiteMathType(obj->getType(), "float3x3")) return MatrixMethodCall(mc);
     if (IsSystemDecl(method) || method->getParent()->isInStdNamespace())
       return Fail(call->getBeginLoc(), "call to '" + qname + "' is not supported in a kernel",
                   "kernels may call LiteMath, <cmath> and std::min/max, and your own functions");
@@ -1084,6 +1097,7 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
     const clang::Expr* sub = ec->getSubExpr()->IgnoreImplicit();
     if (auto* cons = dyn_cast<CXXConstructExpr>(sub)) {
       std::vector<const clang::Expr*> args(cons->arg_begin(), cons->arg_end());
+      if (IsUserConstructor(cons->getConstructor())) return ConstructorCall(cons->getConstructor(), args, e->getBeginLoc());
       return Construct(cons->getType(), args, e->getBeginLoc());
     }
     if (ec->getType()->isPointerType())
@@ -1124,6 +1138,10 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
   if (auto* me = dyn_cast<MemberExpr>(e)) {
     const clang::Expr* base = me->getBase()->IgnoreParenImpCasts();
     auto* field = dyn_cast<FieldDecl>(me->getMemberDecl());
+    if (isa<CXXThisExpr>(base) && m_structSelf) {
+      if (!field) return Fail(e->getBeginLoc(), "member function used as a value", "");
+      return "self." + SafeName(field->getNameAsString());
+    }
     if (isa<CXXThisExpr>(base)) {
       if (auto it = renames.find(me->getMemberDecl()); it != renames.end()) return it->second;
       if (!field) return Fail(e->getBeginLoc(), "member '" + me->getMemberDecl()->getNameAsString() + "' cannot be used here", "");
@@ -1172,6 +1190,7 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
     return Expr(as->getBase()) + "[" + Expr(as->getIdx()) + "]";
   }
   if (auto* op = dyn_cast<CXXOperatorCallExpr>(e)) {
+    if (IsStructOperator(op)) return StructOperatorCall(op);  // a struct's own operator: its code
     auto kind = op->getOperator();
     std::string coord;
     if (kind == OO_Subscript)
@@ -1232,6 +1251,7 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
   }
   if (auto* uo = dyn_cast<UnaryOperator>(e)) {
     auto opc = uo->getOpcode();
+    if (opc == UO_Deref && isa<CXXThisExpr>(uo->getSubExpr()->IgnoreParenImpCasts()) && m_structSelf) return "self";  // *this
     if (opc == UO_Deref) {  // *p: what p points at
       auto t = Pointer(uo->getSubExpr());
       return t ? Pointee(*t, nullptr, e->getBeginLoc()) : "/*error*/";
@@ -1246,12 +1266,9 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
   if (auto* co = dyn_cast<ConditionalOperator>(e))
     return Expr(co->getCond()) + " ? " + Expr(co->getTrueExpr()) + " : " + Expr(co->getFalseExpr());
   if (auto* call = dyn_cast<CallExpr>(e)) return Call(call);
-  if (auto* tmp = dyn_cast<CXXTemporaryObjectExpr>(e)) {
-    std::vector<const clang::Expr*> args(tmp->arg_begin(), tmp->arg_end());
-    return Construct(tmp->getType(), args, e->getBeginLoc());
-  }
-  if (auto* cons = dyn_cast<CXXConstructExpr>(e)) {
+  if (auto* cons = dyn_cast<CXXConstructExpr>(e)) {  // also CXXTemporaryObjectExpr
     std::vector<const clang::Expr*> args(cons->arg_begin(), cons->arg_end());
+    if (IsUserConstructor(cons->getConstructor())) return ConstructorCall(cons->getConstructor(), args, e->getBeginLoc());
     return Construct(cons->getType(), args, e->getBeginLoc());
   }
   if (auto* il = dyn_cast<InitListExpr>(e)) {
@@ -1276,6 +1293,7 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
                 "GPU threads cannot allocate: use a fixed-size local array or a std::vector member sized before the call");
   if (isa<CXXThrowExpr>(e)) return Fail(e->getBeginLoc(), "'throw' in a kernel", "GPU code has no exceptions: return an error code in an output buffer");
   if (isa<LambdaExpr>(e)) return Fail(e->getBeginLoc(), "lambda in a kernel", "use a helper member function");
+  if (isa<CXXThisExpr>(e) && m_structSelf) return "self";
   if (isa<CXXThisExpr>(e)) return Fail(e->getBeginLoc(), "'this' used as a value in a kernel", "access members directly");
   return Fail(e->getBeginLoc(), std::string("expression '") + e->getStmtClassName() + "' is not supported in kernels", "");
 }
@@ -1377,6 +1395,7 @@ std::string GlslPrinter::Stmt(const clang::Stmt* s, int indent) {
                   "each iteration is a thread: skip this one with 'continue'"), "";
     if (m_inThreadBody && rs->getRetValue())
       return Fail(s->getBeginLoc(), "kernel returns a value", "kernels return void; write results to an output buffer"), "";
+    if (m_inConstructor) return pad + "return self;\n";
     return pad + "return" + (rs->getRetValue() ? " " + Expr(rs->getRetValue()) : "") + ";\n";
   }
   if (isa<ContinueStmt>(s)) return pad + (m_inThreadBody && m_loopDepth == 0 ? "return;  // 'continue' ends this thread\n" : "continue;\n");

@@ -164,8 +164,20 @@ private:
   std::string EmitAppend(const clang::FieldDecl* field, const clang::CallExpr* call);
   // A user function as a GLSL function, once; with `bufferBindings` (parameter index -> buffer), a copy
   // of it whose pointer parameters index those buffers from an offset (see GlslPointers.cpp).
+  // With `structSelf`, a member function of that plain struct: the object comes first, as `self`.
   std::string EmitHelper(const clang::FunctionDecl* fd, clang::SourceLocation callLoc, bool composedEntry = false,
-                         const std::map<unsigned, std::string>& bufferBindings = {});
+                         const std::map<unsigned, std::string>& bufferBindings = {}, const clang::CXXRecordDecl* structSelf = nullptr);
+  // ---- plain structs' member functions, operators and constructors (GlslStructs.cpp) ----
+  bool IsPlainStruct(const clang::CXXRecordDecl* rd) const;
+  std::string FunctionName(const clang::FunctionDecl* fd, const clang::CXXRecordDecl* structSelf) const;
+  std::string StructMethodCall(const clang::CXXMemberCallExpr* call);
+  std::string StructOperatorCall(const clang::CXXOperatorCallExpr* op);
+  bool IsStructOperator(const clang::CXXOperatorCallExpr* op) const;
+  std::string ConstructorCall(const clang::CXXConstructorDecl* ctor, const std::vector<const clang::Expr*>& args, clang::SourceLocation loc);
+  bool IsUserConstructor(const clang::CXXConstructorDecl* ctor) const;
+  std::string MatrixMethodCall(const clang::CXXMemberCallExpr* call);
+  const clang::CXXRecordDecl* m_structSelf = nullptr;  // printing a member function of this struct: `this` is `self`
+  bool m_inConstructor = false;                         // ... a constructor, which returns `self`
   // ---- pointers (GlslPointers.cpp) ----
   struct PointerTarget {
     std::string array;   // the array it points into (as GLSL names it), or "" for one variable
