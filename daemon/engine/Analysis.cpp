@@ -169,6 +169,12 @@ std::vector<const CXXMethodDecl*> ClassMethods(const CXXRecordDecl* cls) {
   return out;
 }
 
+bool InLiteMath(const Decl* d) {
+  for (auto* dc = d->getDeclContext(); dc; dc = dc->getParent())
+    if (auto* ns = dyn_cast<NamespaceDecl>(dc); ns && ns->getName() == "LiteMath") return true;
+  return false;
+}
+
 // The class or one of its bases: a member function defined there is one of the class's.
 bool IsClassOrBase(const CXXRecordDecl* rd, const CXXRecordDecl* cls) {
   return rd && (rd == cls || cls->isDerivedFrom(rd));
@@ -1507,6 +1513,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   k.constantList = printer.Constants();
   k.functionList = printer.Functions();
   k.atomics = printer.usesAtomics;
+  k.floatAtomics = printer.usesFloatAtomics;
   if (!printer.virtualCalls.empty()) AnalyzeVirtualCalls(c, k, printer);
   k.composedCalls = printer.composedCalls;
   for (auto& [holder, method] : printer.composedCalls) {
@@ -2432,10 +2439,33 @@ private:
     return SortOrder{uint32_t(l->second / 4), lType, descending};
   }
 
+  // LiteMath's ReduceAddInit(v, n) sizes and zeroes v on the host, as written; its device copy, which
+  // kernels' ReduceAdd then add into, is zeroed in order with them.
+  bool ReduceAddInit(const CallExpr* call) {
+    auto* f = call->getNumArgs() == 2 ? ThisField(call->getArg(0)) : nullptr;
+    Member* m = f ? FindMember(m_c.model, f->getNameAsString()) : nullptr;
+    if (!m || m->kind != MemberKind::Vector) {
+      m_c.rep.GpuError(call->getBeginLoc(), "ReduceAddInit of something other than a std::vector member", "pass the member vector kernels add into");
+      return true;
+    }
+    SourceLocation end = Lexer::findLocationAfterToken(call->getEndLoc(), tok::semi, m_c.ctx.getSourceManager(), m_c.ctx.getLangOpts(), false);
+    if (end.isInvalid()) {
+      m_c.rep.GpuError(call->getBeginLoc(), "ReduceAddInit used inside an expression in control function '" + m_ctrl.name + "'",
+                       "call it as a statement of its own: ReduceAddInit(" + m->name + ", n);");
+      return true;
+    }
+    m->usedByKernels = true;
+    WrittenVector({"", m->name, "", {}, m});
+    m_gpu.InsertTextAfter(end, "\ncrossrt::ZeroCmd(a_cmd, m_vdata." + m->name + ", sizeof(" + m->elemCppType + ") * " + m->name + ".size(), \"" +
+                               m_c.cls->getNameAsString() + "::" + m->name + "\");  // its device copy starts at zero too\n");
+    return true;
+  }
+
   bool TryLibraryCall(const CallExpr* call) {
     auto* fd = call->getDirectCallee();
     if (!fd) return false;
     std::string name = fd->getNameAsString();
+    if (name == "ReduceAddInit" && InLiteMath(fd)) return ReduceAddInit(call);
     bool inStd = fd->isInStdNamespace() || IsSystemDecl(fd);
     if (!inStd) return false;
     auto bad = [&](const std::string& why) {

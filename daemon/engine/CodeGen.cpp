@@ -506,6 +506,7 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   // write are coherent, so that those writes are not held in a cache another thread misses.
   const std::string coherent = k.atomics ? "coherent " : "";
   d.set("atomics", k.atomics);
+  d.set("floatAtomics", k.floatAtomics);
   d.set("fenceConstantId", kFenceAtomicsConstantId);
   d.set("classDataAccess", coherent);
   Data buffers = List();
@@ -1246,6 +1247,7 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
     for (auto& k : model.kernels) anyReductions |= !k.reductions.empty();
     d.set("anyReductions", anyReductions);
     d.set("anyAtomics", std::any_of(model.kernels.begin(), model.kernels.end(), [](const Kernel& k) { return k.atomics; }));
+    d.set("anyFloatAtomics", std::any_of(model.kernels.begin(), model.kernels.end(), [](const Kernel& k) { return k.floatAtomics; }));
     d.set("fenceConstantId", kFenceAtomicsConstantId);
     files[model.className + "_Vulkan.h"] = Render(opt.templateDir + "/vulkan/class.h.mustache", d);
     files[model.className + "_Vulkan.cpp"] = Render(opt.templateDir + "/vulkan/class.cpp.mustache", d);

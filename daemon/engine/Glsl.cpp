@@ -54,7 +54,9 @@ const char* LiteMathGlsl(StringRef name) {
   static const std::map<std::string, const char*> table = {
       {"float2", "vec2"},  {"float3", "vec3"},  {"float4", "vec4"},  {"int2", "ivec2"},
       {"int3", "ivec3"},   {"int4", "ivec4"},   {"uint2", "uvec2"},  {"uint3", "uvec3"},
-      {"uint4", "uvec4"},  {"float3x3", "mat3"}, {"float4x4", "mat4"}};
+      {"uint4", "uvec4"},  {"float3x3", "mat3"}, {"float4x4", "mat4"},
+      // 16-bit floats in storage: two per uint (packHalf2x16), converted to float to compute.
+      {"half2", "uint"},   {"half4", "uvec2"}};
   auto it = table.find(name.str());
   return it == table.end() ? nullptr : it->second;
 }
@@ -183,6 +185,8 @@ std::optional<LayoutInfo> Std430Layout(ASTContext& ctx, QualType type, bool scal
     auto name = rd->getName();
     int n = name.ends_with("2") ? 2 : name.ends_with("3") ? 3 : name.ends_with("4") ? 4 : 0;
     if (name == "float3x3") return scalar ? LayoutInfo{36, 4} : LayoutInfo{48, 16};
+    if (name == "half2") return LayoutInfo{4, 4};
+    if (name == "half4") return scalar ? LayoutInfo{8, 4} : LayoutInfo{8, 8};
     if (name == "float4x4") return scalar ? LayoutInfo{64, 4} : LayoutInfo{64, 16};
     if (!LiteMathGlsl(name) || n == 0) return std::nullopt;
     if (scalar) return LayoutInfo{uint64_t(4 * n), 4};
@@ -360,7 +364,10 @@ std::string GlslPrinter::Construct(QualType t, const std::vector<const clang::Ex
   for (auto* a : args)
     if (!isa<CXXDefaultArgExpr>(a)) real.push_back(a);
   // Copies and moves are plain values in GLSL.
-  if (real.size() == 1 && GlslTypeOf(real[0]->getType()) == g) return Expr(real[0]);
+  if (real.size() == 1 && GlslTypeOf(real[0]->getType()) == g && IsLiteMathType(real[0]->getType(), "half4") == IsLiteMathType(t, "half4"))
+    return Expr(real[0]);
+  if (IsLiteMathType(t, "half4") || IsLiteMathType(t, "half2") || (real.size() == 1 && IsLiteMathType(real[0]->getType(), "half4")))
+    return HalfConstruct(t, real, loc);
   auto [base, dims] = SplitArray(*g);
   bool matrix = IsLiteMathType(t, "float4x4") || IsLiteMathType(t, "float3x3");
   std::string out = base + dims + "(";
@@ -392,6 +399,27 @@ std::string GlslPrinter::Construct(QualType t, const std::vector<const clang::Ex
   // LiteMath lists matrix elements row by row; GLSL constructors take them column by column.
   if (matrix && real.size() > 1) return "transpose(" + out + ")";
   return out;
+}
+
+// LiteMath's half2 and half4 hold their 16-bit floats two per uint (packHalf2x16); float4(h) and
+// to_float4(h) unpack them. Their components are reached only through that conversion.
+std::string GlslPrinter::HalfConstruct(QualType t, const std::vector<const clang::Expr*>& args, SourceLocation loc) {
+  auto pair = [](const std::string& a, const std::string& b) { return "packHalf2x16(vec2(" + a + ", " + b + "))"; };
+  if (IsLiteMathType(t, "float4")) {  // float4(half4)
+    const std::string h = Expr(args[0]);
+    return "vec4(unpackHalf2x16((" + h + ").x), unpackHalf2x16((" + h + ").y))";
+  }
+  std::vector<std::string> a;
+  for (auto* arg : args) a.push_back(Expr(arg));
+  const bool four = IsLiteMathType(t, "half4");
+  if (args.empty()) return four ? "uvec2(0u)" : "0u";
+  if (args.size() == 1 && IsLiteMathType(args[0]->getType(), "float4")) return "uvec2(packHalf2x16((" + a[0] + ").xy), packHalf2x16((" + a[0] + ").zw))";
+  if (args.size() == 1 && IsLiteMathType(args[0]->getType(), "float2")) return "packHalf2x16(" + a[0] + ")";
+  if (args.size() == 1 && args[0]->getType()->isArithmeticType()) return four ? "uvec2(" + pair(a[0], a[0]) + ")" : pair(a[0], a[0]);
+  if (four && args.size() == 4) return "uvec2(" + pair(a[0], a[1]) + ", " + pair(a[2], a[3]) + ")";
+  if (!four && args.size() == 2) return pair(a[0], a[1]);
+  return Fail(loc, "this construction of LiteMath::" + t.getUnqualifiedType().getAsString(m_ctx.getPrintingPolicy()) + " is not supported in kernels",
+              "build it from a float4 (half4(v)) or from four floats");
 }
 
 // push_back to a member vector: every thread takes a slot from an atomic counter, the vector's size
@@ -640,6 +668,9 @@ std::string GlslPrinter::Builtin(const FunctionDecl* fd, const std::vector<std::
   bool library = IsSystemDecl(fd) || InNamespace(fd, "LiteMath");
   if (!library) return "";
   const std::string arg0Type = call->getNumArgs() ? GlslTypeOf(call->getArg(0)->getType()).value_or("") : "";
+  if (n == "to_float4" && call->getNumArgs() == 1 && IsLiteMathType(call->getArg(0)->getType(), "half4"))
+    return "vec4(unpackHalf2x16((" + a[0] + ").x), unpackHalf2x16((" + a[0] + ").y))";
+  if (n == "to_float2" && call->getNumArgs() == 1 && IsLiteMathType(call->getArg(0)->getType(), "half2")) return "unpackHalf2x16(" + a[0] + ")";
   if (n == "to_float3" && arg0Type == "vec4") return "(" + a[0] + ").xyz";
   if (n == "to_float3") return "vec3(" + a[0] + ")";  // from int3/uint3: a conversion
   if (n == "to_float2" && (arg0Type == "vec4" || arg0Type == "vec3")) return "(" + a[0] + ").xy";
@@ -1037,6 +1068,7 @@ std::string GlslPrinter::Call(const CallExpr* call) {
                 "kernels cannot do I/O: write results to an output buffer and print them in the control function");
 
   if (IsCrossrtAtomic(fd)) return AtomicCall(fd, call);
+  if (InNamespace(fd, "LiteMath") && (name == "InterlockedAdd" || name == "ReduceAdd")) return InterlockedCall(fd, call);
   std::vector<std::string> args;
   const bool library = IsSystemDecl(fd) || fd->isInStdNamespace() || InNamespace(fd, "LiteMath");
   std::map<unsigned, std::string> bindings;
@@ -1173,6 +1205,9 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
       return composedPrefix + field->getNameAsString();
     }
     if (!field) return Fail(e->getBeginLoc(), "member function used as a value", "");
+    if (IsLiteMathType(me->getBase()->getType(), "half4") || IsLiteMathType(me->getBase()->getType(), "half2"))
+      return Fail(e->getBeginLoc(), "a component of a half2 or half4 in a kernel (GPUs keep them packed, two per 32 bits)",
+                  "convert it first: to_float4(h).x, float4(h)");
     if (me->isArrow()) {  // p->f: the field of what p points at
       auto t = Pointer(me->getBase());
       return t ? Pointee(*t, nullptr, e->getBeginLoc()) + "." + field->getNameAsString() : "/*error*/";
@@ -1418,6 +1453,41 @@ std::string GlslPrinter::Stmt(const clang::Stmt* s, int indent) {
   if (auto* e = dyn_cast<clang::Expr>(s)) return pad + Expr(e) + ";\n";
   return Fail(s->getBeginLoc(), std::string("statement '") + s->getStmtClassName() + "' is not supported in kernels",
               "kernels may use declarations, if, for, while, do, switch, return, break and continue"), "";
+}
+
+// LiteMath's InterlockedAdd(mem, v[, before]) is GLSL's atomicAdd (relaxed, as LiteMath's); its
+// ReduceAdd(vector, index, v) adds a finite v to the element (kernel_slicer's ReduceAdd family),
+// through a function per member vector.
+std::string GlslPrinter::InterlockedCall(const FunctionDecl* fd, const CallExpr* call) {
+  const std::string name = fd->getNameAsString();
+  if (name == "InterlockedAdd") {
+    if (call->getNumArgs() < 2) return Fail(call->getBeginLoc(), "InterlockedAdd needs a target and a value", "");
+    if (std::string problem = AtomicTargetProblem(call->getArg(0)); !problem.empty())
+      return Fail(call->getArg(0)->getExprLoc(), "the target of InterlockedAdd is not in device memory: " + problem,
+                  "make the target an element of a std::vector member, a data member, or an element of a kernel's pointer parameter");
+    usesFloatAtomics |= call->getArg(0)->getType()->isRealFloatingType();
+    const std::string add = "atomicAdd(" + Expr(call->getArg(0)) + ", " + Expr(call->getArg(1)) + ")";
+    return call->getNumArgs() == 3 ? Expr(call->getArg(2)) + " = " + add : add;
+  }
+  const FieldDecl* field = ThisMemberField(call->getArg(0));
+  QualType element;
+  if (!field || !IsStdVector(field->getType(), &element))
+    return Fail(call->getArg(0)->getBeginLoc(), "ReduceAdd in a kernel adds into a std::vector member", "pass the member vector itself");
+  memberVectors.insert(field);
+  const std::string vector = field->getNameAsString(), helper = vector + "_ReduceAdd";
+  const bool isFloat = element->isRealFloatingType();
+  usesFloatAtomics |= isFloat;
+  if (!std::count(m_reduceAddVectors.begin(), m_reduceAddVectors.end(), vector)) {
+    m_reduceAddVectors.push_back(vector);
+    std::ostringstream os;
+    os << "// ReduceAdd(" << vector << ", offset, value) from any number of threads: " << (isFloat ? "a finite value" : "the value")
+       << " added to the element\n"
+       << "void " << helper << "(uint offset, " << Declare(element, "value", call->getBeginLoc()) << ")\n{\n"
+       << (isFloat ? "  if (!(isinf(value) || isnan(value)))\n    " : "  ") << "atomicAdd(" << vector << "[offset], value);\n}\n";
+    m_functions.push_back(os.str());
+  }
+  const clang::Expr* value = call->getArg(call->getNumArgs() - 1);
+  return helper + "(uint(" + Expr(call->getArg(1)) + "), " + Expr(value) + ")";
 }
 
 }  // namespace crossrt::engine

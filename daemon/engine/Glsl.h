@@ -113,6 +113,8 @@ public:
 
   // The kernel calls crossrt::Atomic*: its buffers must be coherent (GL_KHR_memory_scope_semantics).
   bool usesAtomics = false;
+  // It adds floats atomically (LiteMath's InterlockedAdd, ReduceAdd): GL_EXT_shader_atomic_float.
+  bool usesFloatAtomics = false;
   // Printing statements one thread runs (before or after a kernel's loop nest): a member vector that
   // kernels append to may be emptied there (its count restarts).
   bool singleThread = false;
@@ -143,6 +145,7 @@ private:
   std::string Call(const clang::CallExpr* call);
   std::string Builtin(const clang::FunctionDecl* fd, const std::vector<std::string>& args, const clang::CallExpr* call);
   std::string Construct(clang::QualType t, const std::vector<const clang::Expr*>& args, clang::SourceLocation loc);
+  std::string HalfConstruct(clang::QualType t, const std::vector<const clang::Expr*>& args, clang::SourceLocation loc);
   std::string Literal(const clang::Expr* e);
   std::string Cast(clang::QualType to, const clang::Expr* sub);
   // Image2D members and parameters: the image an expression names (m_img, or a kernel's image
@@ -160,6 +163,7 @@ private:
   std::string TextureTexel(const clang::FieldDecl* array, const clang::Expr* index, const clang::Expr* coord, clang::SourceLocation loc);
   bool UsableTextures(const clang::FieldDecl* array, clang::SourceLocation use);  // reports why not
   std::string AtomicCall(const clang::FunctionDecl* fd, const clang::CallExpr* call);
+  std::string InterlockedCall(const clang::FunctionDecl* fd, const clang::CallExpr* call);  // LiteMath's InterlockedAdd, ReduceAdd
   std::string AtomicTargetProblem(const clang::Expr* target) const;
   std::string EmitAppend(const clang::FieldDecl* field, const clang::CallExpr* call);
   // A user function as a GLSL function, once; with `bufferBindings` (parameter index -> buffer), a copy
@@ -192,6 +196,7 @@ private:
   std::string TextOf(const clang::Expr* e) const;
   std::map<const clang::ValueDecl*, PointerTarget> m_pointers;  // pointer locals and helper parameters in scope
   std::set<std::string> m_emittedCopies;                         // helpers bound to buffers, by name
+  std::vector<std::string> m_reduceAddVectors;                   // member vectors with a ReduceAdd function
 
 public:
   bool PointerIsValueOnly(const clang::FunctionDecl* fn, const clang::ParmVarDecl* p);

@@ -159,6 +159,7 @@ struct Kernel {
   std::vector<std::string> callables;
   std::vector<std::string> callableStructList, callableFunctionList;
   bool atomics = false;               // calls crossrt::Atomic*: coherent buffers, memory scope semantics
+  bool floatAtomics = false;          // adds floats atomically (InterlockedAdd, ReduceAdd): GL_EXT_shader_atomic_float
   // Virtual functions, level 3, in composed code: the leaf calls the ray tracing hardware runs, in
   // the traces' numbering (none when the traversal has none; whyNoLeafShaders says why a traversal's
   // leaves stay in software), and the shader code of the variant whose traversal traces a ray where

@@ -350,8 +350,11 @@ void VulkanContext::CreateDevice(const ContextOptions& options) {
   auto supportedAs = VkInit<VkPhysicalDeviceAccelerationStructureFeaturesKHR>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR);
   auto supportedRq = VkInit<VkPhysicalDeviceRayQueryFeaturesKHR>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR);
   auto supportedRt = VkInit<VkPhysicalDeviceRayTracingPipelineFeaturesKHR>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR);
+  auto supportedAf = VkInit<VkPhysicalDeviceShaderAtomicFloatFeaturesEXT>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SHADER_ATOMIC_FLOAT_FEATURES_EXT);
   auto supported = VkInit<VkPhysicalDeviceFeatures2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2);
+  const bool atomicFloat = std::any_of(extensions.begin(), extensions.end(), [](const char* e) { return std::strcmp(e, VK_EXT_SHADER_ATOMIC_FLOAT_EXTENSION_NAME) == 0; });
   void** tail = &supported.pNext;
+  if (atomicFloat) { *tail = &supportedAf; tail = &supportedAf.pNext; }
   if (vk12) { *tail = &supported12; tail = &supported12.pNext; }
   if (rayQuery || rayPipeline) { *tail = &supportedAs; tail = &supportedAs.pNext; }
   if (rayQuery) { *tail = &supportedRq; tail = &supportedRq.pNext; }
@@ -362,6 +365,7 @@ void VulkanContext::CreateDevice(const ContextOptions& options) {
   auto enableAs = VkInit<VkPhysicalDeviceAccelerationStructureFeaturesKHR>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR);
   auto enableRq = VkInit<VkPhysicalDeviceRayQueryFeaturesKHR>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR);
   auto enableRt = VkInit<VkPhysicalDeviceRayTracingPipelineFeaturesKHR>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_TRACING_PIPELINE_FEATURES_KHR);
+  auto enableAf = VkInit<VkPhysicalDeviceShaderAtomicFloatFeaturesEXT>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SHADER_ATOMIC_FLOAT_FEATURES_EXT);
   auto enable = VkInit<VkPhysicalDeviceFeatures2>(VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2);
   enable.features.shaderInt64 = supported.features.shaderInt64;
   enable.features.shaderFloat64 = supported.features.shaderFloat64;
@@ -390,6 +394,10 @@ void VulkanContext::CreateDevice(const ContextOptions& options) {
   if (accelOk && rayPipeline && supportedRt.rayTracingPipeline) {
     enableRt.rayTracingPipeline = VK_TRUE;
     *tail = &enableRt; tail = &enableRt.pNext;
+  }
+  if (atomicFloat && supportedAf.shaderBufferFloat32AtomicAdd) {
+    enableAf.shaderBufferFloat32AtomicAdd = VK_TRUE;
+    *tail = &enableAf; tail = &enableAf.pNext;
   }
 
   float priority = 1.0f;
@@ -425,6 +433,7 @@ void VulkanContext::CreateDevice(const ContextOptions& options) {
   hasScalarBlockLayout = enable12.scalarBlockLayout == VK_TRUE;
   hasBufferDeviceAddress = enable12.bufferDeviceAddress == VK_TRUE;
   hasRayQuery = enableRq.rayQuery == VK_TRUE;
+  hasFloatAtomicAdd = enableAf.shaderBufferFloat32AtomicAdd == VK_TRUE;
   hasRayTracingPipeline = enableRt.rayTracingPipeline == VK_TRUE;
   if (enable12.runtimeDescriptorArray) {
     // A kernel may sample a few arrays besides its own images: each array gets a quarter of what

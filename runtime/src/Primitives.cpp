@@ -141,6 +141,13 @@ void FillCmd(VkCommandBuffer cmd, BufferView dst, VkDeviceSize bytes, uint32_t b
   TransferToComputeBarrier(cmd);
 }
 
+void ZeroCmd(VkCommandBuffer cmd, const Buffer& buffer, VkDeviceSize bytes, const char* what) {
+  if (bytes > buffer.Size())
+    throw Error(std::string(what) + " has grown since CommitDeviceData(): its device copy holds " + std::to_string(buffer.Size()) +
+                " bytes, not " + std::to_string(bytes) + " (call CommitDeviceData() after resizing it)");
+  FillCmd(cmd, buffer.View(), bytes, 0u);
+}
+
 IndirectDispatcher::IndirectDispatcher(std::shared_ptr<VulkanContext> ctx, uint32_t slots)
     : ctx_(std::move(ctx)), slots_(slots) {
   // Slots are bound as storage buffers: each starts at the device's storage offset alignment.

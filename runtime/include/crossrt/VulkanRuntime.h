@@ -51,10 +51,12 @@ struct ContextOptions {
   bool validation = false;   // enable VK_LAYER_KHRONOS_validation + VK_EXT_debug_utils messenger
   // Enabled when present: by default what ray queries and ray tracing pipelines need
   // (hasRayQuery and hasRayTracingPipeline tell whether they are on).
+  // And atomic adds of floats in buffers (hasFloatAtomicAdd), which InterlockedAdd and ReduceAdd of floats need.
   std::vector<const char*> optionalDeviceExtensions = {VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME,
                                                        VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME,
                                                        VK_KHR_RAY_QUERY_EXTENSION_NAME,
-                                                       VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME};
+                                                       VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME,
+                                                       VK_EXT_SHADER_ATOMIC_FLOAT_EXTENSION_NAME};
   // Testing aid: never map device buffers, so Upload/Download take the staging path that GPUs
   // without host-visible VRAM need (lavapipe's memory is always host-visible).
   bool forceStaging = false;
@@ -80,6 +82,7 @@ public:
   VkPhysicalDeviceProperties properties{};  // limits, name, timestampPeriod
   bool hasScalarBlockLayout = false, hasBufferDeviceAddress = false, hasRayQuery = false,
        hasShaderFloat64 = false, hasShaderInt64 = false;
+  bool hasFloatAtomicAdd = false;  // atomicAdd of 32-bit floats in storage buffers (VK_EXT_shader_atomic_float)
   // Ray tracing pipelines (VK_KHR_ray_tracing_pipeline, with acceleration structures and buffer
   // device addresses): what RayTracingPipeline needs, the pipeline virtual functions run in at
   // level 3. Then the shader group handle limits follow.
@@ -791,5 +794,8 @@ inline BufferView Offset(BufferView v, VkDeviceSize bytes) {
 void CopyCmd(VkCommandBuffer cmd, BufferView src, BufferView dst, VkDeviceSize bytes);
 // std::fill of 32-bit elements: fills `bytes` bytes with the pattern.
 void FillCmd(VkCommandBuffer cmd, BufferView dst, VkDeviceSize bytes, uint32_t bits);
+// Zeroes the first `bytes` of a buffer in order with the commands around it (the device copy of a
+// vector that kernels then add into); throws when the buffer is smaller, naming `what`.
+void ZeroCmd(VkCommandBuffer cmd, const Buffer& buffer, VkDeviceSize bytes, const char* what);
 
 }  // namespace crossrt
