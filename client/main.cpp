@@ -34,7 +34,7 @@ namespace {
 
 const char* kUsage =
     "usage: crossrt translate --class NAME --backend vulkan|cpu --out DIR --source FILE [--source FILE...]\n"
-    "                         [--find-sources [--source-dir DIR]] [--compose INTERFACE=IMPL...] [--virtual-level 1|2|3]\n"
+    "                         [--candidate FILE... [--source-dir DIR]] [--compose INTERFACE=IMPL...] [--virtual-level 1|2|3]\n"
     "                         [--execution-mode wavefront|megakernel] [--templates DIR]\n"
     "                         [--depfile FILE --depfile-target FILE]\n"
     "                         [--build-dir DIR | --no-daemon] [-- COMPILE_ARGS...]\n"
@@ -47,9 +47,9 @@ const char* kHelp =
     "all CPU cores (NAME_CPU). crossrt_add_class() in CMake runs it; you rarely call it by hand.\n"
     "\n"
     "translate      translates class NAME, whose member functions the --source files define, into DIR.\n"
-    "               With --find-sources the --source files are only candidates (a target's sources):\n"
-    "               those that define NAME's member functions are kept, whatever their names (relative\n"
-    "               ones are found from --source-dir).\n"
+    "               Of the --candidate files (a target's sources), those that define NAME's member\n"
+    "               functions are parsed too, whatever their names (relative ones are found from\n"
+    "               --source-dir).\n"
     "               Compile arguments (-I, -D, -std=...) follow '--'. The build tree's daemon (crossrtd)\n"
     "               translates, and is started when absent; --no-daemon (or CROSSRT_NO_DAEMON=1)\n"
     "               translates in this process. An unchanged class writes nothing.\n"
@@ -160,7 +160,8 @@ int main(int argc, char** argv) {
   engine::TranslateRequest request;
   request.templateDir = CROSSRT_DEFAULT_TEMPLATE_DIR;
   std::string depfile, depfileTarget, backend, buildDir, sourceDir;
-  bool useDaemon = std::getenv("CROSSRT_NO_DAEMON") == nullptr, findSources = false;
+  bool useDaemon = std::getenv("CROSSRT_NO_DAEMON") == nullptr;
+  std::vector<std::string> candidates;
   for (size_t i = 1; i < args.size(); ++i) {
     const std::string& a = args[i];
     if (a == "--") {
@@ -169,10 +170,6 @@ int main(int argc, char** argv) {
     }
     if (a == "--no-daemon") {
       useDaemon = false;
-      continue;
-    }
-    if (a == "--find-sources") {
-      findSources = true;
       continue;
     }
     if (a == "--help" || a == "-h") {
@@ -186,6 +183,7 @@ int main(int argc, char** argv) {
     else if (a == "--out") request.outputDir = v;
     else if (a == "--source") request.sources.push_back(v);
     else if (a == "--source-dir") sourceDir = v;
+    else if (a == "--candidate") candidates.push_back(v);
     else if (a == "--templates") request.templateDir = v;
     else if (a == "--compose") {
       if (v.find('=') == std::string::npos || v.front() == '=' || v.back() == '=')
@@ -209,11 +207,11 @@ int main(int argc, char** argv) {
   }
   if (request.className.empty()) return Usage("--class is required");
   if (request.outputDir.empty()) return Usage("--out is required");
-  if (request.sources.empty() && !findSources) return Usage("at least one --source is required");
+  if (request.sources.empty() && candidates.empty()) return Usage("at least one --source (or --candidate) is required");
   if (backend == "vulkan") request.backend = engine::Backend::Vulkan;
   else if (backend == "cpu") request.backend = engine::Backend::Cpu;
   else return Usage("--backend must be 'vulkan' or 'cpu', not '" + backend + "'");
-  if (findSources) {
+  if (!candidates.empty()) {
     std::vector<std::string> includeDirs;
     for (size_t i = 0; i < request.compileArgs.size(); ++i) {
       const std::string& a = request.compileArgs[i];
@@ -221,14 +219,14 @@ int main(int argc, char** argv) {
       else if (a.rfind("-I", 0) == 0 && a.size() > 2) includeDirs.push_back(a.substr(2));
     }
     // Relative candidates are the target's sources, named from its source folder.
-    for (auto& s : request.sources)
-      if (!s.empty() && s[0] != '/' && !sourceDir.empty()) s = sourceDir + "/" + s;
-    auto found = crossrt::client::FindClassSources(request.className, request.sources, includeDirs);
+    for (auto& c : candidates)
+      if (!c.empty() && c[0] != '/' && !sourceDir.empty()) c = sourceDir + "/" + c;
+    auto found = crossrt::client::FindClassSources(request.className, candidates, includeDirs);
     if (found.sources.empty()) {
       std::cerr << "crossrt: error: " << found.error << "\n";
       return 1;
     }
-    request.sources = found.sources;
+    request.sources.insert(request.sources.end(), found.sources.begin(), found.sources.end());
   }
 
   // Unchanged key: nothing to translate, nothing to write.

@@ -77,10 +77,10 @@ function(crossrt_add_class target class)
     set(all_sources "$<TARGET_PROPERTY:${target},SOURCES>")
     set(cpp_sources "$<FILTER:${all_sources},INCLUDE,\\.(cpp|cc|cxx|C|c\\+\\+)$>")
     set(candidates "$<FILTER:${cpp_sources},EXCLUDE,/crossrt/[^/]+_(Vulkan|CPU|ISPC)/>")
-    set(candidate_args --find-sources --source-dir "$<TARGET_PROPERTY:${target},SOURCE_DIR>"
-        "$<$<BOOL:${candidates}>:--source$<SEMICOLON>$<JOIN:${candidates},$<SEMICOLON>--source$<SEMICOLON>>>")
+    set(candidate_args --source-dir "$<TARGET_PROPERTY:${target},SOURCE_DIR>"
+        "$<$<BOOL:${candidates}>:--candidate$<SEMICOLON>$<JOIN:${candidates},$<SEMICOLON>--candidate$<SEMICOLON>>>")
     if(EXISTS ${CMAKE_CURRENT_SOURCE_DIR}/${name}.cpp)
-      list(APPEND candidate_args --source ${CMAKE_CURRENT_SOURCE_DIR}/${name}.cpp)
+      list(APPEND candidate_args --candidate ${CMAKE_CURRENT_SOURCE_DIR}/${name}.cpp)
     endif()
   endif()
   set(option_args "")

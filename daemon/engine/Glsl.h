@@ -188,6 +188,7 @@ private:
     std::string offset;  // its element offset in `array` ("" is 0)
     std::string value;   // one variable: its GLSL lvalue
     bool local = false;  // the array is a local one (a copy of a helper cannot reach it)
+    std::string perThread;  // a thread loop's local passed by address (for messages)
   };
   std::optional<PointerTarget> Pointer(const clang::Expr* e);  // what e points at; nullopt (reported) when unknown
   std::string Pointee(const PointerTarget& t, const clang::Expr* index, clang::SourceLocation loc);  // *p, p[index]

@@ -86,12 +86,17 @@ std::optional<GlslPrinter::PointerTarget> GlslPrinter::Pointer(const clang::Expr
     PointerTarget t;
     if (valueParams.count(d)) {  // a local of a thread loop, one value per thread
       t.value = SafeName(d->getNameAsString());
+      t.perThread = d->getNameAsString();
       return t;
     }
     if (isa<ParmVarDecl>(d) && d->getType()->isPointerType()) {  // a kernel's pointer parameter: a buffer
       t.array = SafeName(d->getNameAsString());
       return t;
     }
+  }
+  if (isa<CXXNewExpr>(e)) {  // reported as heap allocation
+    Expr(e);
+    return std::nullopt;
   }
   Fail(e->getBeginLoc(), "pointer '" + TextOf(e) + "' cannot be followed in a kernel",
        "point into a buffer (a kernel's pointer parameter, a member vector's data(), &v[i], + k) or at a variable (&x)");
@@ -100,6 +105,9 @@ std::optional<GlslPrinter::PointerTarget> GlslPrinter::Pointer(const clang::Expr
 
 std::string GlslPrinter::Pointee(const PointerTarget& t, const clang::Expr* index, SourceLocation loc) {
   if (!t.value.empty()) {
+    if (index && !IsZero(index, m_ctx) && !t.perThread.empty())
+      return Fail(loc, "'" + t.perThread + "' holds one value per thread (a local of the control function's thread loop), used here as a pointer",
+                  "read and write it as *" + t.perThread + " or " + t.perThread + "->field");
     if (index && !IsZero(index, m_ctx))
       return Fail(loc, "a pointer to one variable indexed past it in a kernel", "index an array or a buffer instead");
     return t.value;
@@ -196,7 +204,12 @@ std::string GlslPrinter::PointerLocal(const VarDecl* vd, const std::string& pad)
   if (reassigned.found)
     return Fail(vd->getLocation(), "pointer '" + vd->getNameAsString() + "' is moved in a kernel", "keep an index next to the array and change that instead"), "";
   auto t = Pointer(init);
-  if (!t) return "";
+  if (!t) {
+    PointerTarget reported;  // reported once: its uses say nothing more
+    reported.value = "/*error*/";
+    m_pointers[vd] = reported;
+    return "";
+  }
   std::string out;
   if (!t->offset.empty()) {
     const std::string offset = SafeName(vd->getNameAsString()) + "_offset";

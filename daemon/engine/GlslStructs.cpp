@@ -50,6 +50,14 @@ bool GlslPrinter::IsPlainStruct(const CXXRecordDecl* rd) const {
   if (!rd || !rd->hasDefinition() || rd == m_class || rd->isPolymorphic() || rd->isUnion() || rd->getName().empty()) return false;
   QualType t = m_ctx.getRecordType(rd);
   if (IsLiteMathType(t) || IsStdVector(t) || IsImage2D(t) || IsImageSampler(t) || IsSystemDecl(rd)) return false;
+  for (auto* dc = rd->getDeclContext(); dc; dc = dc->getParent())  // LiteImage's images and textures are the GPU's own
+    if (auto* ns = dyn_cast<NamespaceDecl>(dc); ns && ns->getName() == "LiteImage") return false;
+  // Data the GPU can hold: every field of a GLSL type (the struct is then declared in the shader).
+  for (auto* f : rd->fields()) {
+    QualType ft = f->getType();
+    while (auto* arr = dyn_cast<ConstantArrayType>(ft.getCanonicalType().getTypePtr())) ft = arr->getElementType();
+    if (!GlslTypeOf(ft) || ft->isPointerType() || IsStdVector(ft)) return false;
+  }
   return GlslTypeOf(t).has_value();
 }
 

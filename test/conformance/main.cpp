@@ -76,8 +76,8 @@ Verdict CheckRefusal(const Case& c) {
   namespace fs = std::filesystem;
   const std::string source = std::string(CONFORMANCE_CASES_DIR) + "/" + c.files.substr(0, c.files.find('.')) + ".cpp";
   const fs::path out = fs::temp_directory_path() / ("crossrt-conformance-" + std::to_string(::getpid()));
-  const std::string command = std::string(CROSSRT_CLIENT) + " translate --no-daemon --backend vulkan --find-sources --class " +
-                              c.className + " --out " + out.string() + " --source " + source +
+  const std::string command = std::string(CROSSRT_CLIENT) + " translate --no-daemon --backend vulkan --class " +
+                              c.className + " --out " + out.string() + " --candidate " + source +
                               " --templates " CROSSRT_TEMPLATE_DIR " -- -I" CONFORMANCE_CASES_DIR " " CONFORMANCE_INCLUDES " 2>&1";
   std::string output;
   if (FILE* p = ::popen(command.c_str(), "r")) {
