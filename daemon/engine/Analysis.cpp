@@ -500,8 +500,26 @@ struct WriteScanner : RecursiveASTVisitor<WriteScanner> {
       }
     return std::nullopt;
   }
+  // `m = constant;` of a scalar member from the threads (kernel_slicer's flags: m_found = 1): every
+  // thread that stores, stores the same value, so the result is that of the CPU. Stored
+  // atomically on the CPU; the values of each member must agree, and no thread may read it.
+  std::map<const FieldDecl*, std::set<std::string>> constantStores;
+  std::vector<const BinaryOperator*> constantStoreExprs;
+  std::set<const MemberExpr*> constantStoreUses;
+  bool ConstantStore(BinaryOperator* bo) {
+    auto* me = AsThisMember(bo->getLHS());
+    auto* f = me ? dyn_cast<FieldDecl>(me->getMemberDecl()) : nullptr;
+    Expr::EvalResult r;
+    if (!f || bo->getOpcode() != BO_Assign || singleThread || helper || !f->getType()->isScalarType() || f->getType()->isPointerType() ||
+        !bo->getRHS()->EvaluateAsRValue(r, c.ctx))
+      return false;
+    constantStores[f].insert(r.Val.getAsString(c.ctx, bo->getRHS()->getType()));
+    constantStoreExprs.push_back(bo);
+    constantStoreUses.insert(me);
+    return true;
+  }
   bool VisitBinaryOperator(BinaryOperator* bo) {
-    if (!bo->isAssignmentOp()) return true;
+    if (!bo->isAssignmentOp() || ConstantStore(bo)) return true;
     std::vector<const MemberExpr*> uses;
     if (auto* me = AsThisMember(bo->getLHS())) uses.push_back(me);
     std::optional<ReduceOp> op;
@@ -1295,14 +1313,19 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   k.dims = IpvDims(k.name);
   k.rtv = k.dims == 0;
   k.sourceFile = BaseName(FileOf(c.ctx, def->getLocation()));
-  if (!md->getReturnType()->isVoidType()) {
-    c.rep.Error(md->getLocation(), "kernel '" + k.name + "' returns a value", "kernels return void and write results to pointer parameters or members");
+  // A kernel_ function may return bool, for its thread loop to leave a loop: if (!kernel_X(...)) break;
+  k.returnsBool = k.rtv && md->getReturnType()->isBooleanType();
+  if (!md->getReturnType()->isVoidType() && !k.returnsBool) {
+    c.rep.Error(md->getLocation(), "kernel '" + k.name + "' returns a value",
+                k.rtv ? "kernels return void, or bool for their thread loop to leave a loop (if (!" + k.name + "(...)) break;); write other results to pointer parameters"
+                      : "kernels return void and write results to pointer parameters or members");
     return;
   }
   CheckKernelParams(c, md, k);
   for (unsigned i = 0; i < md->getNumParams(); ++i) k.cppParamsDecl += (i ? ", " : "") + ParamDecl(c.ctx, md->getParamDecl(i), i);
   GlslPrinter printer(c.ctx, c.cls, c.rep);
   printer.compositions = c.compositions;
+  printer.threadReturnsValue = k.returnsBool;
   for (auto& s : ClassStructNames(c.model)) printer.predeclaredStructs.insert(s);
   // Structs the parameters hold (buffers, push constants) are declared even when the body names no variable of them.
   for (auto* p : def->parameters()) {
@@ -1415,6 +1438,25 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   if (!CheckLoopEnds(c, k.name, before, after, threadBody)) return;
   ReductionReadScanner rs(c, ws);
   rs.TraverseStmt(const_cast<Stmt*>(threadBody));
+  for (auto& [field, values] : ws.constantStores) {
+    if (values.size() > 1 || ws.reductions.count(field))
+      c.rep.Error(field->getLocation(), "the threads of kernel '" + k.name + "' set member '" + field->getNameAsString() +
+                  "' to " + (values.size() > 1 ? "different values" : "a value and reduce it") + ": the result would depend on which thread comes last",
+                  "set it to one constant (a flag), or reduce it (m = std::max(m, x))");
+    struct Reads : RecursiveASTVisitor<Reads> {
+      const FieldDecl* f; const std::set<const MemberExpr*>& stores; std::vector<SourceLocation> found;
+      Reads(const FieldDecl* ff, const std::set<const MemberExpr*>& st) : f(ff), stores(st) {}
+      bool VisitMemberExpr(MemberExpr* me) {
+        if (me->getMemberDecl() == f && !stores.count(me)) found.push_back(me->getExprLoc());
+        return true;
+      }
+    } reads(field, ws.constantStoreUses);
+    reads.TraverseStmt(const_cast<Stmt*>(threadBody));
+    for (auto loc : reads.found)
+      c.rep.Error(loc, "kernel '" + k.name + "' reads '" + field->getNameAsString() + "', which its threads set",
+                  "read it after the loop nest, or in the control function after the kernel");
+    if (auto* m = FindMember(c.model, field->getNameAsString())) m->writtenByKernels = true;
+  }
   if (k.rtv && !ws.reductions.empty()) {
     c.rep.Error(md->getLocation(), "member reductions are supported in kernel1D_/2D_/3D_ loops, not in '" + k.name + "'",
                 "write the loop inside the kernel (kernel1D_" + k.name.substr(std::string("kernel_").size()) + ") so the translator sees the whole reduction");
@@ -1449,7 +1491,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   // GLSL: the thread function.
   std::ostringstream os;
   os << "// from " << c.cls->getNameAsString() << "::" << k.name << " (" << k.sourceFile << ")\n";
-  os << "void " << k.name << "(";
+  os << (k.returnsBool ? "bool " : "void ") << k.name << "(";
   for (size_t i = 0; i < threadParams.size(); ++i) os << (i ? ", " : "") << threadParams[i].first << " " << threadParams[i].second;
   os << ")\n{\n";
   for (auto* s : preamble) os << printer.Stmt(s, 1);
@@ -1595,6 +1637,13 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     for (auto* s : body->body())
       if ((outer = dyn_cast<ForStmt>(s))) break;
     renamer.TraverseStmt(const_cast<ForStmt*>(outer));
+    // A flag every thread may set: stored atomically, so that the threads do not race on it.
+    for (auto* bo : ws.constantStoreExprs) {
+      SourceLocation end = Lexer::findLocationAfterToken(bo->getEndLoc(), tok::semi, c.ctx.getSourceManager(), c.ctx.getLangOpts(), false);
+      if (end.isInvalid()) continue;
+      rw.InsertTextBefore(bo->getBeginLoc(), "{\n#pragma omp atomic write\n");
+      rw.InsertTextAfter(end, "\n}");
+    }
     LockAppends(rw, outer);
     // A loop whose body is a bare statement ends before its ';': take the ';' too.
     SourceLocation end = Lexer::findLocationAfterToken(outer->getEndLoc(), tok::semi, c.ctx.getSourceManager(), c.ctx.getLangOpts(), false);
@@ -1613,10 +1662,15 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
 
 // Kernel calls, and library calls that work on member vectors (scan, fill, memcpy): either makes
 // a member function a control function.
+bool IsPerThreadFunction(const CXXMethodDecl* md, const CXXRecordDecl* cls);
+
 struct KernelCallFinder : RecursiveASTVisitor<KernelCallFinder> {
+  const CXXRecordDecl* cls;  // a call of its per-thread functions counts too (they call kernels)
   std::vector<const Expr*> calls;
+  explicit KernelCallFinder(const CXXRecordDecl* c) : cls(c) {}
   bool VisitCXXMemberCallExpr(CXXMemberCallExpr* call) {
-    if (auto* md = call->getMethodDecl(); md && IsKernelName(md->getName()) && isa<CXXThisExpr>(call->getImplicitObjectArgument()->IgnoreParenImpCasts()))
+    auto* md = call->getMethodDecl();
+    if (md && (IsKernelName(md->getName()) || IsPerThreadFunction(md, cls)) && isa<CXXThisExpr>(call->getImplicitObjectArgument()->IgnoreParenImpCasts()))
       calls.push_back(call);
     return true;
   }
@@ -1635,6 +1689,29 @@ struct KernelCallFinder : RecursiveASTVisitor<KernelCallFinder> {
     return true;
   }
 };
+
+// kernel_slicer's per-thread function: a member function (not a kernel) that calls kernel_ functions
+// with a parameter of its own as the thread id, `void Run(uint tid, ...) { float t; kernel_A(tid, &t); ... }`.
+// A ...Block control function runs it in a thread loop; it is no control function itself.
+bool IsPerThreadFunction(const CXXMethodDecl* md, const CXXRecordDecl* cls) {
+  const FunctionDecl* def = nullptr;
+  if (!md || IsKernelName(md->getName()) || !md->hasBody(def) || !def || !IsClassOrBase(md->getParent(), cls)) return false;
+  struct Finder : RecursiveASTVisitor<Finder> {
+    const FunctionDecl* def; bool found = false;
+    explicit Finder(const FunctionDecl* d) : def(d) {}
+    bool VisitCXXMemberCallExpr(CXXMemberCallExpr* call) {
+      auto* k = call->getMethodDecl();
+      if (!k || !IsKernelName(k->getName()) || IpvDims(k->getName())) return true;
+      for (unsigned i = 0; i < call->getNumArgs() && i < k->getNumParams(); ++i)
+        if (IsThreadIdName(k->getParamDecl(i)->getName()))
+          if (auto* dr = dyn_cast<DeclRefExpr>(call->getArg(i)->IgnoreCasts()->IgnoreParens()))
+            found |= isa<ParmVarDecl>(dr->getDecl()) && cast<ParmVarDecl>(dr->getDecl())->getDeclContext() == def;
+      return true;
+    }
+  } finder(def);
+  finder.TraverseStmt(def->getBody());
+  return finder.found;
+}
 
 const Stmt* SingleStatement(const Stmt* s) {
   while (auto* cs = dyn_cast_or_null<CompoundStmt>(s)) {
@@ -1679,12 +1756,36 @@ public:
 
   void Run() {
     CheckAppendedUses();
+    RemoveOpenMpPragmas();
     Visit(m_def->getBody());
     m_ctrl.vulkanCmdBody = CanonicalCode(m_gpu.getRewrittenText(m_def->getBody()->getSourceRange()));
     m_ctrl.cpuBody = CanonicalCode(m_cpu.getRewrittenText(m_def->getBody()->getSourceRange()));
   }
 
 private:
+  // The user's `#pragma omp ...` lines go: on the GPU the loops they parallelise become dispatches,
+  // and the CPU class puts its own pragma on each thread loop.
+  void RemoveOpenMpPragmas() {
+    auto& sm = m_c.ctx.getSourceManager();
+    const SourceRange body = m_def->getBody()->getSourceRange();
+    const SourceLocation begin = sm.getExpansionLoc(body.getBegin()), end = sm.getExpansionLoc(body.getEnd());
+    if (sm.getFileID(begin) != sm.getFileID(end)) return;
+    const unsigned from = sm.getFileOffset(begin), to = sm.getFileOffset(end);
+    const StringRef text = sm.getBufferData(sm.getFileID(begin));
+    for (unsigned at = from; at < to;) {
+      const size_t eol = text.find('\n', at);
+      const unsigned lineEnd = eol == StringRef::npos ? unsigned(text.size()) : unsigned(eol);
+      const StringRef line = text.substr(at, lineEnd - at).ltrim();
+      if (line.starts_with("#") && line.drop_front().ltrim().starts_with("pragma") &&
+          line.drop_front().ltrim().drop_front(6).ltrim().starts_with("omp")) {
+        const SourceLocation start = begin.getLocWithOffset(int(at - from));
+        m_gpu.RemoveText(start, lineEnd - at);
+        m_cpu.RemoveText(start, lineEnd - at);
+      }
+      at = lineEnd + 1;
+    }
+  }
+
   // A pointer argument of a kernel call, as the BufferView the generated code binds.
   std::string BufferArg(const Expr* arg) {
     const Expr* e = arg->IgnoreParenImpCasts();
@@ -1783,29 +1884,56 @@ private:
     Kernel mega;                                   // the megakernel, without its kernels' code yet
     std::string hostArgs;                          // ...Cmd arguments of the megakernel after the counts
     std::string counts;                            // ", (w), (h)": threads per axis, x first
+    bool megakernelOnly = false;                   // a kernel's result ends a thread's loop: no wavefront form
     bool ok = true;
   };
+
+  // ---- kernel_slicer's per-thread functions: for (i) Run(i, args) with Run(tid, ...) calling kernels ----
+  // A thread loop whose body calls such a function is the function's body with its parameters bound
+  // to the call's arguments (`m_inlined`): Resolve() reads through them.
+  std::map<const ParmVarDecl*, const Expr*> m_inlined;
+  const Expr* Resolve(const Expr* e) const {
+    auto* dr = dyn_cast<DeclRefExpr>(e->IgnoreCasts()->IgnoreParens());
+    auto* p = dr ? dyn_cast<ParmVarDecl>(dr->getDecl()) : nullptr;
+    auto it = p ? m_inlined.find(p) : m_inlined.end();
+    return it == m_inlined.end() ? e : Resolve(it->second);
+  }
+  // The source text of an argument, read through per-thread functions' parameters.
+  std::string ResolvedText(const Expr* e) { return m_c.Text(Resolve(e)->getSourceRange()); }
 
   // Variables passed as thread ids to RTV kernels anywhere inside `s`.
   std::set<const VarDecl*> ThreadIdVars(const Stmt* s) {
     struct Finder : RecursiveASTVisitor<Finder> {
+      const ControlRewriter& rw;
       std::set<const VarDecl*> vars;
+      explicit Finder(const ControlRewriter& r) : rw(r) {}
       bool VisitCXXMemberCallExpr(CXXMemberCallExpr* call) {
         auto* md = call->getMethodDecl();
         if (!md || !IsKernelName(md->getName()) || IpvDims(md->getName())) return true;
         for (unsigned i = 0; i < call->getNumArgs() && i < md->getNumParams(); ++i)
           if (IsThreadIdName(md->getParamDecl(i)->getName()))
-            if (auto* dr = dyn_cast<DeclRefExpr>(call->getArg(i)->IgnoreCasts()->IgnoreParens()))
+            if (auto* dr = dyn_cast<DeclRefExpr>(rw.Resolve(call->getArg(i))->IgnoreCasts()->IgnoreParens()))
               if (auto* vd = dyn_cast<VarDecl>(dr->getDecl())) vars.insert(vd);
         return true;
       }
-    } finder;
+    } finder(*this);
     finder.TraverseStmt(const_cast<Stmt*>(s));
     return finder.vars;
   }
 
   bool TryThreadLoop(const ForStmt* outerLoop) {
-    const std::set<const VarDecl*> idVars = ThreadIdVars(outerLoop);
+    // The innermost body a call of a per-thread function (kernel_slicer's ...Block form)? Then the
+    // thread loop's body is that function's, its parameters bound to the call's arguments.
+    m_inlined.clear();
+    const Stmt* innermost = outerLoop;
+    while (auto* fs = dyn_cast_or_null<ForStmt>(innermost)) innermost = SingleStatement(fs->getBody());
+    const FunctionDecl* perThread = nullptr;
+    if (auto* e = dyn_cast_or_null<Expr>(innermost))
+      if (auto* call = dyn_cast<CXXMemberCallExpr>(e->IgnoreImplicit()); call && IsPerThreadFunction(call->getMethodDecl(), m_c.cls)) {
+        call->getMethodDecl()->hasBody(perThread);
+        for (unsigned i = 0; i < call->getNumArgs() && i < perThread->getNumParams(); ++i) m_inlined[perThread->getParamDecl(i)] = call->getArg(i);
+      }
+    const std::set<const VarDecl*> idVars = ThreadIdVars(perThread ? perThread->getBody() : outerLoop);
     ThreadLoop tl;
     const Stmt* body = outerLoop;
     while (auto* fs = dyn_cast_or_null<ForStmt>(body)) {
@@ -1814,8 +1942,12 @@ private:
       tl.loops.push_back(h);
       body = SingleStatement(fs->getBody());
     }
-    if (tl.loops.empty()) return false;
-    if (auto* e = dyn_cast_or_null<Expr>(body); e && isa<CXXMemberCallExpr>(e->IgnoreImplicit())) return false;  // one kernel: an RTV nest
+    if (tl.loops.empty()) {
+      m_inlined.clear();
+      return false;
+    }
+    if (perThread && body == innermost) body = perThread->getBody();
+    else if (auto* e = dyn_cast_or_null<Expr>(body); e && isa<CXXMemberCallExpr>(e->IgnoreImplicit())) return false;  // one kernel: an RTV nest
     for (auto& h : tl.loops) {
       Expr::EvalResult r;
       if (!(h.start->EvaluateAsInt(r, m_c.ctx) && r.Val.getInt() == 0))
@@ -1837,6 +1969,7 @@ private:
     tl.mega.dims = unsigned(tl.loops.size());
     GlslPrinter printer(m_c.ctx, m_c.cls, m_c.rep);
     for (auto& s : ClassStructNames(m_c.model)) printer.predeclaredStructs.insert(s);
+    for (auto& [param, arg] : m_inlined) printer.renames[param] = printer.Expr(Resolve(arg));  // read through
     std::string glsl = ThreadBodyGlsl(tl, printer, body, 1);
     if (!tl.ok) return true;
     for (auto* f : printer.plainMembers)
@@ -1913,6 +2046,14 @@ private:
         "if (m_executionMode == crossrt::ExecutionMode::Megakernel)  // the whole loop body in one shader\n" + tl.mega.name + "Cmd(a_cmd" + tl.counts + tl.hostArgs +
         ");\nelse  // wavefront: one dispatch per kernel call, each thread's locals in buffers between them\n{\nconst size_t crt_threads = " + threads + ";\n" + states +
         wavefront + "}\n";
+    if (tl.megakernelOnly) {
+      m_ctrl.threadStates.erase(m_ctrl.threadStates.end() - long(std::count_if(tl.stateBuffers.begin(), tl.stateBuffers.end(),
+                                                                               [&](const auto& x) { return tl.passed.count(x.first) > 0; })),
+                                m_ctrl.threadStates.end());
+      text = "// A kernel's result ends a thread's loop here, at a time of the thread's own: the whole loop\n"
+             "// body runs in one shader (the megakernel) in both execution modes.\n" +
+             tl.mega.name + "Cmd(a_cmd" + tl.counts + tl.hostArgs + ");\n";
+    }
     SourceLocation end = Lexer::findLocationAfterToken(outerLoop->getEndLoc(), tok::semi, m_c.ctx.getSourceManager(), m_c.ctx.getLangOpts(), false);
     CharSourceRange range = end.isValid() ? CharSourceRange::getCharRange(outerLoop->getBeginLoc(), end) : CharSourceRange::getTokenRange(outerLoop->getSourceRange());
     m_gpu.ReplaceText(range, text);
@@ -1921,6 +2062,7 @@ private:
     std::string pragma = "#pragma omp parallel for schedule(dynamic, 16)";
     if (tl.loops.size() > 1) pragma += " collapse(" + std::to_string(tl.loops.size()) + ")";
     m_cpu.InsertTextBefore(outerLoop->getBeginLoc(), pragma + "\n" + std::string(col > 0 ? col - 1 : 0, ' '));
+    m_inlined.clear();
     return true;
   }
 
@@ -1944,6 +2086,10 @@ private:
     } finder;
     finder.TraverseStmt(const_cast<Expr*>(e));
     for (auto* dr : finder.refs) {
+      if (auto* p = dyn_cast<ParmVarDecl>(dr->getDecl()); p && m_inlined.count(p)) {  // a per-thread function's parameter
+        CheckUniform(tl, m_inlined.at(p), where, readOnGpu);
+        continue;
+      }
       auto* vd = dyn_cast<VarDecl>(dr->getDecl());
       if (!vd || (vd->hasGlobalStorage() && !vd->isStaticLocal())) continue;
       bool isLoopVar = std::any_of(tl.loops.begin(), tl.loops.end(), [&](const LoopHeader& h) { return h.var == vd; });
@@ -2003,7 +2149,32 @@ private:
       CheckUniform(tl, fs->getInc(), "the loop's step");
       std::string header = "for (" + *GlslTypeOf(var->getType()) + " " + GlslPrinter::SafeName(var->getNameAsString()) + " = " + printer.Expr(var->getInit()) + "; " +
                            printer.Expr(fs->getCond()) + "; " + printer.Expr(fs->getInc()) + ")";
-      return pad + header + "\n" + pad + "{\n" + ThreadBodyGlsl(tl, printer, fs->getBody(), indent + 1) + pad + "}\n";
+      m_hostLoopDepth++;
+      const std::string loopBody = ThreadBodyGlsl(tl, printer, fs->getBody(), indent + 1);
+      m_hostLoopDepth--;
+      return pad + header + "\n" + pad + "{\n" + loopBody + pad + "}\n";
+    }
+    // `if (!kernel_X(...)) break;`: a kernel returning bool ends this thread's loop (kernel_slicer's
+    // loop-break form). Threads leave at different times, which only the megakernel follows.
+    if (auto* is = dyn_cast<IfStmt>(s)) {
+      const Expr* cond = is->getCond()->IgnoreParenImpCasts();
+      bool negated = false;
+      if (auto* uo = dyn_cast<UnaryOperator>(cond); uo && uo->getOpcode() == UO_LNot) {
+        negated = true;
+        cond = uo->getSubExpr()->IgnoreParenImpCasts();
+      }
+      auto* kernelCall = dyn_cast<CXXMemberCallExpr>(cond);
+      const Stmt* then = SingleStatement(is->getThen());
+      const bool leaves = then && (isa<BreakStmt>(then) || isa<ContinueStmt>(then));
+      if (!kernelCall || !kernelCall->getMethodDecl() || !kernelCall->getMethodDecl()->getReturnType()->isBooleanType() || !leaves ||
+          is->getElse() || m_hostLoopDepth == 0) {
+        Error(tl, s->getBeginLoc(), "the thread loop of '" + m_ctrl.name + "' may branch only on a kernel's bool result, to leave a loop inside it",
+              "write if (!kernel_X(tid, ...)) break; (or continue) in a counted loop of the thread loop, and branch on anything else inside the kernels");
+        return "";
+      }
+      tl.megakernelOnly = true;
+      return pad + "if (" + (negated ? "!" : "") + KernelCallGlsl(tl, printer, kernelCall) + ")\n" + pad + "  " +
+             (isa<BreakStmt>(then) ? "break;\n" : "continue;\n");
     }
     auto* call = dyn_cast<CXXMemberCallExpr>(s);
     auto* md = call ? call->getMethodDecl() : nullptr;
@@ -2012,6 +2183,12 @@ private:
             "move this code into a kernel: the loop's body runs once per thread, on the GPU");
       return "";
     }
+    return pad + KernelCallGlsl(tl, printer, call) + ";\n";
+  }
+
+  // A kernel call in the thread loop's body, as the megakernel calls the kernel's thread function.
+  std::string KernelCallGlsl(ThreadLoop& tl, GlslPrinter& printer, const CXXMemberCallExpr* call) {
+    auto* md = call->getMethodDecl();
     Note(call);
     auto& calls = tl.mega.megakernelCalls;
     if (std::find(calls.begin(), calls.end(), md->getNameAsString()) == calls.end()) calls.push_back(md->getNameAsString());
@@ -2022,7 +2199,7 @@ private:
       const Expr* arg = call->getArg(i);
       std::string a;
       if (IsThreadIdName(p->getName())) {
-        auto* dr = dyn_cast<DeclRefExpr>(arg->IgnoreCasts()->IgnoreParens());
+        auto* dr = dyn_cast<DeclRefExpr>(Resolve(arg)->IgnoreCasts()->IgnoreParens());
         auto* vd = dr ? dyn_cast<VarDecl>(dr->getDecl()) : nullptr;
         bool isLoopVar = vd && std::any_of(tl.loops.begin(), tl.loops.end(), [&](const LoopHeader& h) { return h.var == vd; });
         if (!isLoopVar) {
@@ -2055,19 +2232,19 @@ private:
         } else {
           CheckNotThreadState(md, p, arg);
           CheckUniform(tl, arg, "a buffer argument", false);  // bound by the host
-          AddMegakernelBuffer(tl, md, p, BufferArg(arg), arg->getBeginLoc());
+          AddMegakernelBuffer(tl, md, p, BufferArg(Resolve(arg)), arg->getBeginLoc());
           continue;  // a global buffer of the megakernel, named as the kernel names it
         }
       } else {
         CheckUniform(tl, arg, "the by-value argument '" + p->getNameAsString() + "'");
-        a = printer.Expr(arg);
+        a = printer.Expr(Resolve(arg));
       }
       args += (args.empty() ? "" : ", ") + a;
     }
     if (axes.size() != tl.loops.size())
       Error(tl, call->getBeginLoc(), "'" + md->getNameAsString() + "' takes " + std::to_string(axes.size()) + " thread ids, but the thread loop around it has " +
             std::to_string(tl.loops.size()) + " loops", "give every kernel of a thread loop one thread id parameter (tidX, tidY, ...) per loop");
-    return pad + md->getNameAsString() + "(" + args + ");\n";
+    return md->getNameAsString() + "(" + args + ")";
   }
 
   // A pointer argument of a kernel in a thread loop: in the megakernel, a buffer named as the
@@ -2104,8 +2281,23 @@ private:
       for (auto* child : cs->body()) out += ThreadBodyCpp(tl, child);
       return out;
     }
-    if (auto* fs = dyn_cast<ForStmt>(s))
+    if (auto* fs = dyn_cast<ForStmt>(s)) {
+      // A host loop of a per-thread function runs in the control function: its parameters must be
+      // what the control function passes, under the same names.
+      struct Refs : RecursiveASTVisitor<Refs> {
+        std::vector<const DeclRefExpr*> found;
+        bool VisitDeclRefExpr(DeclRefExpr* dr) { found.push_back(dr); return true; }
+      } refs;
+      for (const Stmt* part : {fs->getInit(), static_cast<const Stmt*>(fs->getCond()), static_cast<const Stmt*>(fs->getInc())})
+        if (part) refs.TraverseStmt(const_cast<Stmt*>(part));
+      for (auto* dr : refs.found)
+        if (auto* p = dyn_cast<ParmVarDecl>(dr->getDecl()); p && m_inlined.count(p) && ResolvedText(dr) != p->getNameAsString())
+          Error(tl, dr->getBeginLoc(), "a loop of '" + cast<FunctionDecl>(p->getDeclContext())->getNameAsString() + "' reads its parameter '" +
+                p->getNameAsString() + "', which '" + m_ctrl.name + "' passes as '" + ResolvedText(dr) + "'",
+                "pass the values its loops read under the same names");
       return m_c.Text(SourceRange(fs->getBeginLoc(), fs->getRParenLoc())) + "\n{\n" + ThreadBodyCpp(tl, fs->getBody()) + "}\n";
+    }
+    if (isa<IfStmt>(s)) return "";  // a loop a kernel's result may end: the megakernel only
     auto* call = dyn_cast<CXXMemberCallExpr>(s);
     auto* md = call ? call->getMethodDecl() : nullptr;
     if (!md || !IsKernelName(md->getName())) return "";  // declarations (their buffers are set up before), or reported
@@ -2115,12 +2307,12 @@ private:
       const Expr* arg = call->getArg(i);
       if (IsThreadIdName(p->getName()) || isa<CXXDefaultArgExpr>(arg)) continue;
       if (!p->getType()->isPointerType()) {
-        args += ", " + m_c.Text(arg->getSourceRange());
+        args += ", " + ResolvedText(arg);
         continue;
       }
       auto* vd = AddressedVar(arg);
       std::string buffer = vd ? StateBuffer(tl, vd) : "";
-      args += ", " + (buffer.empty() ? BufferArg(arg) : "m_threadState." + buffer + ".View()");
+      args += ", " + (buffer.empty() ? BufferArg(Resolve(arg)) : "m_threadState." + buffer + ".View()");
     }
     return md->getNameAsString() + "Cmd(a_cmd" + tl.counts + args + ");\n";
   }
@@ -2292,8 +2484,10 @@ private:
   void CheckNestedControl(const CXXMemberCallExpr* call) {
     auto* md = call->getMethodDecl();
     const FunctionDecl* def = nullptr;
-    if (!md || IsKernelName(md->getName()) || !md->hasBody(def) || !def || !IsClassOrBase(md->getParent(), m_c.cls)) return;
-    KernelCallFinder kc;
+    if (!md || IsKernelName(md->getName()) || !md->hasBody(def) || !def || !IsClassOrBase(md->getParent(), m_c.cls) ||
+        IsPerThreadFunction(md, m_c.cls))
+      return;
+    KernelCallFinder kc(m_c.cls);
     kc.TraverseStmt(def->getBody());
     if (kc.calls.empty()) return;
     m_c.rep.GpuError(call->getBeginLoc(), "control function '" + m_ctrl.name + "' calls control function '" + md->getNameAsString() + "'",
@@ -2461,6 +2655,25 @@ private:
     return true;
   }
 
+  // std::plus<T>(), std::plus<>() or a lambda `[](T a, T b) { return a + b; }`: the scans the GPU runs.
+  static bool IsAddition(const Expr* op) {
+    op = op->IgnoreImplicit()->IgnoreParenImpCasts();
+    if (auto* mt = dyn_cast<MaterializeTemporaryExpr>(op)) op = mt->getSubExpr()->IgnoreImplicit();
+    if (auto* rd = op->getType()->getAsCXXRecordDecl(); rd && rd->isInStdNamespace() && rd->getName() == "plus") return true;
+    auto* lambda = dyn_cast<LambdaExpr>(op);
+    if (!lambda || lambda->getCallOperator()->getNumParams() != 2) return false;
+    auto* body = dyn_cast_or_null<CompoundStmt>(lambda->getCallOperator()->getBody());
+    auto* ret = body && body->size() == 1 ? dyn_cast<ReturnStmt>(body->body_front()) : nullptr;
+    auto* sum = ret && ret->getRetValue() ? dyn_cast<BinaryOperator>(ret->getRetValue()->IgnoreParenImpCasts()) : nullptr;
+    if (!sum || sum->getOpcode() != BO_Add) return false;
+    auto param = [](const Expr* e) {
+      auto* dr = dyn_cast<DeclRefExpr>(e->IgnoreParenImpCasts());
+      return dr ? dyn_cast<ParmVarDecl>(dr->getDecl()) : nullptr;
+    };
+    const ParmVarDecl *a = param(sum->getLHS()), *b = param(sum->getRHS());
+    return a && b && a != b;
+  }
+
   bool TryLibraryCall(const CallExpr* call) {
     auto* fd = call->getDirectCallee();
     if (!fd) return false;
@@ -2474,7 +2687,12 @@ private:
       return true;
     };
     std::string replacement;
-    if ((name == "exclusive_scan" && (call->getNumArgs() == 4)) || (name == "inclusive_scan" && call->getNumArgs() == 3)) {
+    const unsigned nargs = call->getNumArgs();
+    if ((name == "exclusive_scan" && (nargs == 4 || nargs == 5)) || (name == "inclusive_scan" && nargs >= 3 && nargs <= 5)) {
+      // exclusive_scan(first, last, out, init[, op]); inclusive_scan(first, last, out[, op[, init]]).
+      const Expr* op = name == "exclusive_scan" ? (nargs == 5 ? call->getArg(4) : nullptr) : (nargs >= 4 ? call->getArg(3) : nullptr);
+      const Expr* initArg = name == "exclusive_scan" ? call->getArg(3) : (nargs == 5 ? call->getArg(4) : nullptr);
+      if (op && !IsAddition(op)) return bad("scans on the GPU add: the operation must be std::plus or a lambda returning a + b");
       auto first = PositionOf(call->getArg(0)), last = PositionOf(call->getArg(1)), out = PositionOf(call->getArg(2));
       if (!first || !last || !out) return bad("its ranges are not device buffers the translator can name");
       auto count = Count(*first, *last);
@@ -2482,7 +2700,7 @@ private:
       const std::string type = ElementTypeName(first->element);
       if (type.empty()) return bad("scans on the GPU take uint32_t, int or float elements");
       std::string elem = CppTypeName(m_c.ctx, first->element);
-      std::string init = name == "exclusive_scan" ? "crossrt::Bits32(static_cast<" + elem + ">(" + m_c.Text(call->getArg(3)->getSourceRange()) + "))" : "0u";
+      std::string init = initArg ? "crossrt::Bits32(static_cast<" + elem + ">(" + m_c.Text(initArg->getSourceRange()) + "))" : "0u";
       replacement = "m_scanner.RecordCmd(a_cmd, " + ViewAt(*first) + ", " + ViewAt(*out) + ", uint32_t" + *count + ", " +
                     (name == "inclusive_scan" ? "true" : "false") + ", crossrt::ElementType::" + type + ", " + init + ")";
       WrittenVector(*out);
@@ -2531,7 +2749,8 @@ private:
         QualType t = arg->getType();
         bool pointerLike = t->isPointerType() || (t->getAsCXXRecordDecl() && t->getAsCXXRecordDecl()->getName().contains("iterator"));
         if (pointerLike && PositionOf(arg))
-          return bad("only std::sort, std::exclusive_scan, std::inclusive_scan, std::fill and memcpy run on device data so far");
+          return bad("on device data the GPU runs std::sort, std::exclusive_scan and std::inclusive_scan (adding), std::fill, memcpy and "
+                     "LiteMath's ReduceAddInit; this call would run on a stale host copy");
       }
       return false;
     }
@@ -2576,6 +2795,7 @@ private:
   Control& m_ctrl;
   Rewriter m_gpu, m_cpu;
   unsigned m_threadLoops = 0;                  // thread loops seen so far (names the megakernels)
+  int m_hostLoopDepth = 0;                     // counted loops around the statement of a thread loop being printed
   std::set<const VarDecl*> m_hostLoopVars;     // counters of loops inside thread loops: the same for all threads
 };
 
@@ -2742,8 +2962,8 @@ bool AnalyzeTranslationUnit(ASTContext& ctx, const std::string& className, const
       std::string n = md->getNameAsString();
       bool isKernel = IsKernelName(n);
       if (pass == 0 && isKernel && !known(model.kernels, n)) AnalyzeKernel(c, md, def);
-      if (pass == 1 && !isKernel && !known(model.controls, n)) {
-        KernelCallFinder kc;
+      if (pass == 1 && !isKernel && !known(model.controls, n) && !IsPerThreadFunction(md, cls)) {  // those run inside thread loops
+        KernelCallFinder kc(cls);
         kc.TraverseStmt(def->getBody());
         if (!kc.calls.empty()) AnalyzeControl(c, md, def);
       }

@@ -1428,7 +1428,7 @@ std::string GlslPrinter::Stmt(const clang::Stmt* s, int indent) {
     if (m_inThreadBody && m_inLoopBody)
       return Fail(s->getBeginLoc(), "'return' inside a parallel kernel loop would end all later iterations",
                   "each iteration is a thread: skip this one with 'continue'"), "";
-    if (m_inThreadBody && rs->getRetValue())
+    if (m_inThreadBody && rs->getRetValue() && !threadReturnsValue)
       return Fail(s->getBeginLoc(), "kernel returns a value", "kernels return void; write results to an output buffer"), "";
     if (m_inConstructor) return pad + "return self;\n";
     return pad + "return" + (rs->getRetValue() ? " " + Expr(rs->getRetValue()) : "") + ";\n";

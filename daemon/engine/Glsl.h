@@ -118,6 +118,8 @@ public:
   // Printing statements one thread runs (before or after a kernel's loop nest): a member vector that
   // kernels append to may be emptied there (its count restarts).
   bool singleThread = false;
+  // The thread function returns a value (a kernel_ function returning bool).
+  bool threadReturnsValue = false;
   std::set<const clang::FieldDecl*> emptiedVectors;  // clear() or resize(0) there
 
   std::string Expr(const clang::Expr* e);

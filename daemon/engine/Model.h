@@ -108,6 +108,7 @@ struct LeafTraversal {
 struct Kernel {
   std::string name;
   bool rtv = false;                   // kernel_* called from a loop, else kernel1D/2D/3D_* holding loops
+  bool returnsBool = false;           // kernel_* returning bool: its thread loop may leave a loop on it
   unsigned dims = 1;
   std::vector<KernelParam> params;
   std::string cppParamsDecl;          // the parameter list as the user wrote it
