@@ -120,7 +120,7 @@ int main(int argc, char** argv)
   const float3 eye = centre + float3(0.3f, 0.45f, 1.0f) * (radius * 1.9f);
 
   auto makeScene = [&](const char* impl) {
-    auto scene = CreateSceneRT(impl);
+    auto scene = MakeSceneRT(impl);
     scene->AddInstance(scene->AddGeom_Triangles3f(mesh.positions.data(), mesh.VertexCount(), mesh.indices.data(), mesh.indices.size()),
                        float4x4());
     scene->CommitScene();

@@ -9,9 +9,14 @@
 #include <stdexcept>
 
 using LiteMath::Box4f;
+using LiteMath::clamp;
 using LiteMath::float3;
+using LiteMath::float3x3;
 using LiteMath::float4;
 using LiteMath::float4x4;
+using LiteMath::inverse;
+using LiteMath::make_float3x3_from_rows;
+using LiteMath::mix;
 using LiteMath::uint4;
 
 namespace {
@@ -372,6 +377,49 @@ void GroupLeaves(std::vector<BVH4Node>& wide, const std::vector<BVHTriangle>& tr
     }
 }
 
+// Box geometry: packs the boxes of each leaf of `wide` (boxes[k] is box primIndices[k]) into groups
+// of four, laid out as a node's lanes (so that one slab test covers four), a lane's child the
+// primitive its box bounds; points the leaves at their groups.
+void GroupBoxes(std::vector<BVH4Node>& wide, const std::vector<Box4f>& boxes, const std::vector<uint32_t>& primIndices,
+                uint32_t boxesPerPrim, std::vector<BVH4Node>& groups)
+{
+  groups.clear();
+  const float inf = std::numeric_limits<float>::infinity();
+  for (BVH4Node& n : wide)
+    for (int lane = 0; lane < 4; ++lane)
+    {
+      const uint32_t c = n.child[lane];
+      if (c == kNoChild || (c & kLeafFlag) == 0)
+        continue;
+      const uint32_t first = (c & ~kLeafFlag) >> 3, count = (c & 7u) + 1;
+      const uint32_t firstGroup = uint32_t(groups.size()), groupCount = (count + 3) / 4;
+      for (uint32_t k = 0; k < 4 * groupCount; ++k)
+      {
+        if (k % 4 == 0)
+        {
+          groups.emplace_back();
+          BVH4Node& g = groups.back();
+          g.minX = g.minY = g.minZ = float4(inf);
+          g.maxX = g.maxY = g.maxZ = float4(-inf);
+          g.child = uint4(kNoChild);
+          g.unused = uint4(0u);
+        }
+        if (k >= count)
+          continue;
+        BVH4Node& g = groups.back();
+        const Box4f& b = boxes[primIndices[first + k]];
+        g.minX[k % 4] = b.boxMin.x;
+        g.minY[k % 4] = b.boxMin.y;
+        g.minZ[k % 4] = b.boxMin.z;
+        g.maxX[k % 4] = b.boxMax.x;
+        g.maxY[k % 4] = b.boxMax.y;
+        g.maxZ[k % 4] = b.boxMax.z;
+        g.child[k % 4] = primIndices[first + k] / boxesPerPrim;
+      }
+      n.child[lane] = LeafRef(firstGroup, groupCount);
+    }
+}
+
 std::vector<BVH4Node> CollapseTree(const BVHTree& tree, std::function<Box4f(uint32_t)> primBox)
 {
   int stackNeed = 0;
@@ -425,6 +473,8 @@ void BVHScene::ClearDeviceData()
   m_instances.clear();
   m_triangles.clear();
   m_primIds.clear();
+  m_boxes.clear();
+  m_motion.clear();
 }
 
 void BVHScene::ClearGeom()
@@ -486,8 +536,61 @@ void BVHScene::ClearScene()
   ClearDeviceData();
 }
 
+void BVHScene::SetBoxes(Mesh& mesh, const CRT_AABB* boxes, size_t boxNumber, size_t customPrimCount)
+{
+  if (boxNumber > 0 && boxes == nullptr)
+    throw std::invalid_argument(m_name + "::AddGeom_AABB: null boxes");
+  if (customPrimCount > 0 && boxNumber % customPrimCount != 0)
+    throw std::invalid_argument(m_name + "::AddGeom_AABB: " + std::to_string(boxNumber) + " boxes are not a multiple of " +
+                                std::to_string(customPrimCount) + " primitives");
+  std::vector<Box4f> bounds(boxNumber);
+  for (size_t i = 0; i < boxNumber; ++i)
+  {
+    bounds[i] = Box4f(float4(boxes[i].boxMin.x, boxes[i].boxMin.y, boxes[i].boxMin.z, 0.0f),
+                      float4(boxes[i].boxMax.x, boxes[i].boxMax.y, boxes[i].boxMax.z, 0.0f));
+    if (!(bounds[i].boxMin.x <= bounds[i].boxMax.x && bounds[i].boxMin.y <= bounds[i].boxMax.y && bounds[i].boxMin.z <= bounds[i].boxMax.z))
+      throw std::invalid_argument(m_name + "::AddGeom_AABB: box " + std::to_string(i) + " is empty or not finite");
+  }
+  mesh = Mesh{};
+  mesh.boxes = true;
+  mesh.tree = boxNumber > 0 ? m_builder(bounds.data(), int(boxNumber)) : BVHTree{};
+  if (boxNumber > 0)
+  {
+    mesh.wide = CollapseTree(mesh.tree, [&](uint32_t k) { return bounds[mesh.tree.primIndices[k]]; });
+    GroupBoxes(mesh.wide, bounds, mesh.tree.primIndices, customPrimCount > 0 ? uint32_t(boxNumber / customPrimCount) : 1u, mesh.boxGroups);
+  }
+  ClearDeviceData();
+}
+
+uint32_t BVHScene::AddGeom_AABB(uint32_t, const CRT_AABB* boxMinMaxF8, size_t boxNumber, void**, size_t customPrimCount)
+{
+  Mesh mesh;
+  SetBoxes(mesh, boxMinMaxF8, boxNumber, customPrimCount);
+  m_meshes.push_back(std::move(mesh));
+  return uint32_t(m_meshes.size() - 1) | CRT_GEOM_MASK_AABB_BIT;
+}
+
+void BVHScene::UpdateGeom_AABB(uint32_t geomId, uint32_t, const CRT_AABB* boxMinMaxF8, size_t boxNumber, void**, size_t customPrimCount)
+{
+  geomId &= CRT_GEOM_MASK_AABB_BIT_RM;
+  if (geomId >= m_meshes.size() || !m_meshes[geomId].boxes)
+    throw std::out_of_range(m_name + "::UpdateGeom_AABB: " + std::to_string(geomId) + " is no box geometry");
+  SetBoxes(m_meshes[geomId], boxMinMaxF8, boxNumber, customPrimCount);
+}
+
+uint32_t BVHScene::AddInstanceMotion(uint32_t geomId, const float4x4* matrices, uint32_t matrixNumber)
+{
+  if (matrixNumber == 0)
+    throw std::invalid_argument(m_name + "::AddInstanceMotion: no matrices");
+  const uint32_t instId = AddInstance(geomId, matrices[0]);
+  if (matrixNumber > 1)
+    m_placed[instId].motion.assign(matrices, matrices + matrixNumber);
+  return instId;
+}
+
 uint32_t BVHScene::AddInstance(uint32_t geomId, const float4x4& matrix)
 {
+  geomId &= CRT_GEOM_MASK_AABB_BIT_RM;  // box geometry's id may come with its bit
   if (geomId >= m_meshes.size())
     throw std::out_of_range(m_name + "::AddInstance: invalid geomId " + std::to_string(geomId));
   m_placed.push_back({geomId, matrix, LiteMath::inverse4x4(matrix)});
@@ -501,6 +604,7 @@ void BVHScene::UpdateInstance(uint32_t instanceId, const float4x4& matrix)
     throw std::out_of_range(m_name + "::UpdateInstance: invalid instanceId " + std::to_string(instanceId));
   m_placed[instanceId].toWorld = matrix;
   m_placed[instanceId].toObject = LiteMath::inverse4x4(matrix);
+  m_placed[instanceId].motion.clear();
   ClearDeviceData();
 }
 
@@ -515,14 +619,17 @@ void BVHScene::CommitScene(uint32_t)
     const BVHTree& tree = m_meshes[m_placed[i].geomId].tree;
     if (tree.nodes.empty())
       continue;
+    // A moving instance is within the hull of its box at each time step: the matrices interpolate linearly.
     Box4f box;
-    for (int corner = 0; corner < 8; ++corner)
-    {
-      const float3 lo = tree.nodes[0].boxMin, hi = tree.nodes[0].boxMax;
-      const float3 p((corner & 1) ? hi.x : lo.x, (corner & 2) ? hi.y : lo.y, (corner & 4) ? hi.z : lo.z);
-      const float3 w = TransformPoint(m_placed[i].toWorld, p);
-      box.include(float4(w.x, w.y, w.z, 0.0f));
-    }
+    const std::vector<float4x4> still = {m_placed[i].toWorld};
+    for (const float4x4& toWorld : m_placed[i].motion.empty() ? still : m_placed[i].motion)
+      for (int corner = 0; corner < 8; ++corner)
+      {
+        const float3 lo = tree.nodes[0].boxMin, hi = tree.nodes[0].boxMax;
+        const float3 p((corner & 1) ? hi.x : lo.x, (corner & 2) ? hi.y : lo.y, (corner & 4) ? hi.z : lo.z);
+        const float3 w = TransformPoint(toWorld, p);
+        box.include(float4(w.x, w.y, w.z, 0.0f));
+      }
     boxes.push_back(box);
     ids.push_back(i);
   }
@@ -538,6 +645,12 @@ void BVHScene::CommitScene(uint32_t)
     const Mesh& mesh = m_meshes[g];
     if (mesh.wide.empty())
       continue;
+    if (mesh.boxes)
+    {
+      meshRoot[g] = AppendTree(m_nodes, mesh.wide, uint32_t(m_boxes.size()));
+      m_boxes.insert(m_boxes.end(), mesh.boxGroups.begin(), mesh.boxGroups.end());
+      continue;
+    }
     meshRoot[g] = AppendTree(m_nodes, mesh.wide, uint32_t(m_triangles.size()));
     m_triangles.insert(m_triangles.end(), mesh.groups.begin(), mesh.groups.end());
     m_primIds.insert(m_primIds.end(), mesh.groupPrims.begin(), mesh.groupPrims.end());
@@ -549,10 +662,18 @@ void BVHScene::CommitScene(uint32_t)
     inst.toObjectRow0 = placed.toObject.get_row(0);
     inst.toObjectRow1 = placed.toObject.get_row(1);
     inst.toObjectRow2 = placed.toObject.get_row(2);
+    const bool boxes = m_meshes[placed.geomId].boxes;
     inst.instId = ids[k];
-    inst.geomId = placed.geomId;
+    inst.geomId = boxes ? placed.geomId | CRT_GEOM_MASK_AABB_BIT : placed.geomId;
     inst.root = meshRoot[placed.geomId];
-    inst.identity = IsIdentity(placed.toObject) ? 1u : 0u;
+    inst.flags = (IsIdentity(placed.toObject) && placed.motion.empty() ? kInstanceIdentity : 0u) | (boxes ? kInstanceBoxes : 0u) |
+                 (placed.motion.empty() ? 0u : kInstanceMotion);
+    inst.motionFirst = uint32_t(m_motion.size());
+    inst.motionSteps = uint32_t(placed.motion.size());
+    inst.unused0 = inst.unused1 = 0u;
+    for (const float4x4& step : placed.motion)
+      for (int row = 0; row < 3; ++row)
+        m_motion.push_back(step.get_row(row));
     m_instances.push_back(inst);
   }
 }
@@ -561,6 +682,10 @@ bool BVHScene::ExportScene(CRT_SceneExport& out) const
 {
   static_assert(sizeof(BVHTriangle) == 9 * sizeof(float), "a triangle is copied as 9 floats");
   out = CRT_SceneExport{};
+  const bool onlyStillTriangles = std::none_of(m_meshes.begin(), m_meshes.end(), [](const Mesh& m) { return m.boxes; }) &&
+                                  std::all_of(m_placed.begin(), m_placed.end(), [](const Instance& p) { return p.motion.empty(); });
+  if (!onlyStillTriangles)
+    return false;  // the export holds triangles placed still
   out.meshTriangles.resize(m_meshes.size());
   for (size_t g = 0; g < m_meshes.size(); ++g)
   {
@@ -634,10 +759,34 @@ uint32_t BVHScene::IntersectGroup(const BVHTraceRay& r, uint32_t group, float tf
   return hits;
 }
 
+// The four boxes of box geometry's m_boxes[group], as a node's lanes: a ray hits one where it enters
+// it (at tnear from inside). On a hit nearer than tfar: sets tfar and the hit's t and primId.
+bool BVHScene::IntersectBoxes(const BVHTraceRay& r, uint32_t group, float& tfar, CRT_Hit& hit) const
+{
+  float4 exits;
+  const float4 entries = SlabEntries(r, m_boxes[group], tfar, exits);
+  uint32_t hits = lane_mask_le(entries, exits);
+  bool found = false;
+  while (hits != 0u)
+  {
+    const int lane = __builtin_ctz(hits);
+    hits = hits & (hits - 1u);
+    if (entries[lane] > tfar)
+      continue;  // behind a box of this group taken before it
+    found = true;
+    tfar = entries[lane];
+    hit.t = entries[lane];
+    hit.primId = m_boxes[group].child[lane];
+    hit.coords[0] = 0.0f;
+    hit.coords[1] = 0.0f;
+  }
+  return found;
+}
+
 // Visits the leaves of the mesh tree at `root` that the ray may reach, nearest box first, and
-// tests their triangles. On a hit nearer than tfar: sets tfar and the hit's t, primId and
+// tests their triangles (or boxes). On a hit nearer than tfar: sets tfar and the hit's t, primId and
 // barycentrics, and returns true (at the first hit when anyHit).
-bool BVHScene::TraceMesh(const BVHTraceRay& ray, uint32_t root, bool anyHit, float& tfar, CRT_Hit& hit) const
+bool BVHScene::TraceMesh(const BVHTraceRay& ray, uint32_t root, bool boxes, bool anyHit, float& tfar, CRT_Hit& hit) const
 {
   uint32_t stack[kStackSize];    // node indices and leaf references
   float stackEntry[kStackSize];  // their entry distances, to skip those beyond a hit found since
@@ -652,6 +801,16 @@ bool BVHScene::TraceMesh(const BVHTraceRay& ray, uint32_t root, bool anyHit, flo
       const uint32_t last = first + (node & 7u);
       for (uint32_t g = first; g <= last; ++g)
       {
+        if (boxes)
+        {
+          if (IntersectBoxes(ray, g, tfar, hit))
+          {
+            found = true;
+            if (anyHit)
+              return true;
+          }
+          continue;
+        }
         float4 t;
         float4 u;
         float4 v;
@@ -704,13 +863,30 @@ bool BVHScene::TraceMesh(const BVHTraceRay& ray, uint32_t root, bool anyHit, flo
 
 // Traces instance m_instances[k] in object space (affine maps keep t: the object-space ray is not
 // renormalized). On a hit nearer than tfar, sets the hit's ids too.
-bool BVHScene::TraceInstance(uint32_t k, const BVHTraceRay& worldRay, bool anyHit, float& tfar, CRT_Hit& hit) const
+bool BVHScene::TraceInstance(uint32_t k, const BVHTraceRay& worldRay, float time, bool anyHit, float& tfar, CRT_Hit& hit) const
 {
   const BVHInstance& inst = m_instances[k];
-  const bool found = inst.identity != 0u
-                         ? TraceMesh(worldRay, inst.root, anyHit, tfar, hit)
-                         : TraceMesh(Prepare(ToObjectPoint(inst, worldRay.org), ToObjectVector(inst, worldRay.dir), worldRay.tnear),
-                                     inst.root, anyHit, tfar, hit);
+  const bool boxes = (inst.flags & kInstanceBoxes) != 0u;
+  bool found = false;
+  if ((inst.flags & kInstanceMotion) != 0u)
+  {
+    // Its object-to-world matrix at the ray's time, between the two steps around it, inverted.
+    const float f = clamp(time, 0.0f, 1.0f) * float(inst.motionSteps - 1u);
+    const uint32_t step = std::min(uint32_t(f), inst.motionSteps - 2u);
+    const float w = f - float(step);
+    const uint32_t at = inst.motionFirst + 3u * step;
+    const float4 row0 = mix(m_motion[at], m_motion[at + 3u], w);
+    const float4 row1 = mix(m_motion[at + 1u], m_motion[at + 4u], w);
+    const float4 row2 = mix(m_motion[at + 2u], m_motion[at + 5u], w);
+    const float3x3 toObject = inverse(make_float3x3_from_rows(to_float3(row0), to_float3(row1), to_float3(row2)));
+    const float3 org = toObject * (worldRay.org - float3(row0.w, row1.w, row2.w));
+    found = TraceMesh(Prepare(org, toObject * worldRay.dir, worldRay.tnear), inst.root, boxes, anyHit, tfar, hit);
+  }
+  else if ((inst.flags & kInstanceIdentity) != 0u)
+    found = TraceMesh(worldRay, inst.root, boxes, anyHit, tfar, hit);
+  else
+    found = TraceMesh(Prepare(ToObjectPoint(inst, worldRay.org), ToObjectVector(inst, worldRay.dir), worldRay.tnear), inst.root, boxes,
+                      anyHit, tfar, hit);
   if (found)
   {
     hit.instId = inst.instId;
@@ -722,7 +898,7 @@ bool BVHScene::TraceInstance(uint32_t k, const BVHTraceRay& worldRay, bool anyHi
 // The top tree's leaves hold instances. This loop and TraceMesh's walk the stack alike; a shared
 // step function would take the stack arrays as GLSL inout parameters, which copy them on every
 // call.
-bool BVHScene::Trace(float4 posAndNear, float4 dirAndFar, bool anyHit, CRT_Hit& hit) const
+bool BVHScene::Trace(float4 posAndNear, float4 dirAndFar, float time, bool anyHit, CRT_Hit& hit) const
 {
   float tnear = 0.0f;
   float tfar = 0.0f;
@@ -730,7 +906,7 @@ bool BVHScene::Trace(float4 posAndNear, float4 dirAndFar, bool anyHit, CRT_Hit& 
     return false;
   const BVHTraceRay worldRay = Prepare(to_float3(posAndNear), to_float3(dirAndFar), tnear);
   if (m_instances.size() == 1)
-    return TraceInstance(0, worldRay, anyHit, tfar, hit);  // no top tree to walk: its root tests the same box
+    return TraceInstance(0, worldRay, time, anyHit, tfar, hit);  // no top tree to walk: its root tests the same box
   uint32_t stack[kStackSize];
   float stackEntry[kStackSize];
   int top = 0;
@@ -744,7 +920,7 @@ bool BVHScene::Trace(float4 posAndNear, float4 dirAndFar, bool anyHit, CRT_Hit& 
       const uint32_t last = first + (node & 7u);
       for (uint32_t k = first; k <= last; ++k)
       {
-        if (!TraceInstance(k, worldRay, anyHit, tfar, hit))
+        if (!TraceInstance(k, worldRay, time, anyHit, tfar, hit))
           continue;
         found = true;
         if (anyHit)
@@ -779,7 +955,15 @@ bool BVHScene::Trace(float4 posAndNear, float4 dirAndFar, bool anyHit, CRT_Hit& 
   }
 }
 
-CRT_Hit BVHScene::RayQuery_NearestHit(float4 posAndNear, float4 dirAndFar)
+CRT_Hit BVHScene::RayQuery_NearestHit(float4 posAndNear, float4 dirAndFar) { return NearestHit(posAndNear, dirAndFar, 0.0f); }
+
+bool BVHScene::RayQuery_AnyHit(float4 posAndNear, float4 dirAndFar) { return AnyHit(posAndNear, dirAndFar, 0.0f); }
+
+CRT_Hit BVHScene::RayQuery_NearestHitMotion(float4 posAndNear, float4 dirAndFar, float time) { return NearestHit(posAndNear, dirAndFar, time); }
+
+bool BVHScene::RayQuery_AnyHitMotion(float4 posAndNear, float4 dirAndFar, float time) { return AnyHit(posAndNear, dirAndFar, time); }
+
+CRT_Hit BVHScene::NearestHit(float4 posAndNear, float4 dirAndFar, float time) const
 {
   CRT_Hit hit;
   hit.t = dirAndFar.w;
@@ -790,13 +974,13 @@ CRT_Hit BVHScene::RayQuery_NearestHit(float4 posAndNear, float4 dirAndFar)
   hit.coords[1] = 0.0f;
   hit.coords[2] = 0.0f;
   hit.coords[3] = 0.0f;
-  Trace(posAndNear, dirAndFar, false, hit);
+  Trace(posAndNear, dirAndFar, time, false, hit);
   return hit;
 }
 
-bool BVHScene::RayQuery_AnyHit(float4 posAndNear, float4 dirAndFar)
+bool BVHScene::AnyHit(float4 posAndNear, float4 dirAndFar, float time) const
 {
   CRT_Hit unused;
   unused.t = dirAndFar.w;
-  return Trace(posAndNear, dirAndFar, true, unused);
+  return Trace(posAndNear, dirAndFar, time, true, unused);
 }

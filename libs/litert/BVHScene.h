@@ -1,4 +1,5 @@
-// ISceneObject over CrossRT's own BVHs: one tree per mesh, a top-level tree over the instances,
+// ISceneObject over CrossRT's own BVHs: one tree per mesh (of triangles, or of boxes for custom
+// primitives), a top-level tree over the instances (moving ones bounded over their motion),
 // both built by a pluggable builder (the LBVH as written, LBVH_CPU, LBVH_Vulkan, binned SAH), and a
 // stack-based traversal with watertight ray/triangle tests and robust slab tests.
 //
@@ -45,12 +46,18 @@ struct BVHTriangle4
 };
 
 // An instance as the traversal reads it: rows 0-2 of its world-to-object matrix, the ids a hit
-// reports, and the root of its mesh's tree in BVHScene::m_nodes. 64 bytes, std430 as in C++.
+// reports, the root of its mesh's tree in BVHScene::m_nodes, what kind of instance it is, and for a
+// moving one where its object-to-world rows are. 80 bytes, std430 as in C++.
+constexpr uint32_t kInstanceIdentity = 1u;  // toObject is the identity: the world ray is the object ray
+constexpr uint32_t kInstanceBoxes = 2u;     // its geometry is boxes (AddGeom_AABB): leaves index m_boxes
+constexpr uint32_t kInstanceMotion = 4u;    // it moves: toObject comes from m_motion at the ray's time
 struct BVHInstance
 {
   LiteMath::float4 toObjectRow0, toObjectRow1, toObjectRow2;
   uint32_t instId, geomId, root;
-  uint32_t identity;  // 1 when toObject is the identity: the world ray is the object ray
+  uint32_t flags;                     // kInstance*
+  uint32_t motionFirst, motionSteps;  // a moving instance: its object-to-world rows 0-2 per step, at m_motion[motionFirst...]
+  uint32_t unused0, unused1;
 };
 
 // A ray prepared for one tree: slab test reciprocals (0 for a zero or denormal direction
@@ -83,6 +90,15 @@ public:
   void CommitScene(uint32_t options = BUILD_HIGH) override;
   CRT_Hit RayQuery_NearestHit(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar) override;
   bool RayQuery_AnyHit(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar) override;
+  // Box geometry and moving instances (CrossRT.h).
+  uint32_t AddGeom_AABB(uint32_t typeId, const CRT_AABB* boxMinMaxF8, size_t boxNumber, void** customPrimPtrs = nullptr,
+                        size_t customPrimCount = 0) override;
+  void UpdateGeom_AABB(uint32_t geomId, uint32_t typeId, const CRT_AABB* boxMinMaxF8, size_t boxNumber, void** customPrimPtrs = nullptr,
+                       size_t customPrimCount = 0) override;
+  uint32_t AddInstanceMotion(uint32_t geomId, const LiteMath::float4x4* matrices, uint32_t matrixNumber) override;
+  CRT_Hit RayQuery_NearestHitMotion(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar, float time) override;
+  bool RayQuery_AnyHitMotion(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar, float time = 0.0f) override;
+  // Triangle meshes placed still; a scene with boxes or moving instances is not exported (false).
   bool ExportScene(CRT_SceneExport& out) const override;
 
   // The tree of mesh geomId (for SAH cost and statistics).
@@ -94,10 +110,14 @@ public:
   std::vector<BVHInstance> m_instances;  // in the top tree's leaf order
   std::vector<BVHTriangle4> m_triangles;  // every mesh's triangles in leaf order, four per group (leaves index here)
   std::vector<uint32_t> m_primIds;        // lane l of m_triangles[g] is triangle m_primIds[4 * g + l] of its mesh
+  std::vector<BVH4Node> m_boxes;          // box geometry's boxes in leaf order, four per group, a lane's child its primitive
+  std::vector<LiteMath::float4> m_motion; // moving instances' object-to-world rows 0-2, per time step
 
 private:
   struct Mesh
   {
+    bool boxes = false;                  // box geometry (AddGeom_AABB): boxGroups instead of triangles
+    std::vector<BVH4Node> boxGroups;     // what wide's leaves index: each leaf's boxes, four per group
     BVHTree tree;                        // as the builder made it
     std::vector<BVH4Node> wide;          // the same tree collapsed for the traversal (empty without triangles)
     std::vector<BVHTriangle> triangles;  // triangles[k] is triangle tree.primIndices[k]
@@ -108,16 +128,21 @@ private:
   {
     uint32_t geomId;
     LiteMath::float4x4 toWorld, toObject;
+    std::vector<LiteMath::float4x4> motion;  // a moving instance: toWorld at evenly spaced times over [0, 1]
   };
   void SetMesh(Mesh& mesh, const float* vpos3f, size_t vertNum, const uint32_t* triIndices, size_t indNum, size_t vByteStride);
+  void SetBoxes(Mesh& mesh, const CRT_AABB* boxes, size_t boxNumber, size_t customPrimCount);
   void ClearDeviceData();
 
   // The traversal (translated for the GPU when composed).
-  bool Trace(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar, bool anyHit, CRT_Hit& hit) const;
-  bool TraceInstance(uint32_t k, const BVHTraceRay& worldRay, bool anyHit, float& tfar, CRT_Hit& hit) const;
-  bool TraceMesh(const BVHTraceRay& ray, uint32_t root, bool anyHit, float& tfar, CRT_Hit& hit) const;
+  CRT_Hit NearestHit(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar, float time) const;
+  bool AnyHit(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar, float time) const;
+  bool Trace(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar, float time, bool anyHit, CRT_Hit& hit) const;
+  bool TraceInstance(uint32_t k, const BVHTraceRay& worldRay, float time, bool anyHit, float& tfar, CRT_Hit& hit) const;
+  bool TraceMesh(const BVHTraceRay& ray, uint32_t root, bool boxes, bool anyHit, float& tfar, CRT_Hit& hit) const;
   uint32_t IntersectGroup(const BVHTraceRay& r, uint32_t group, float tfar, LiteMath::float4& t, LiteMath::float4& u,
                           LiteMath::float4& v) const;
+  bool IntersectBoxes(const BVHTraceRay& r, uint32_t group, float& tfar, CRT_Hit& hit) const;
 
   std::string m_name;
   Builder m_builder;

@@ -1,5 +1,6 @@
-// CrossRT ray query interface: a two-level scene (meshes + instances) with nearest/any hit
-// queries. Kernels call RayQuery_* on the CPU; the GPU backend maps them to ray queries.
+// CrossRT ray query interface: a two-level scene (meshes, boxes of custom primitives, instances,
+// moving instances) with nearest/any hit queries, as the paper's CrossRT.h declares it. Kernels call
+// RayQuery_* on the CPU; the GPU backend maps them to ray queries.
 #pragma once
 
 #include "LiteMath.h"
@@ -7,10 +8,12 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 // Result of RayQuery_NearestHit. A miss has primId == instId == geomId == 0xFFFFFFFF and t set to
-// the ray's tmax.
+// the ray's tmax. A hit on box geometry has CRT_GEOM_MASK_AABB_BIT in geomId.
 struct CRT_Hit
 {
   float    t;         // ray parameter of the hit
@@ -20,13 +23,41 @@ struct CRT_Hit
   float    coords[4]; // [0], [1]: barycentrics u, v (Embree convention: p = (1-u-v)*v0 + u*v1 + v*v2); [2], [3]: 0
 };
 
-// Build flags: the low two bits select BVH quality; BUILD_REFIT marks geometry that will be updated.
+// Build flags, with the paper's values: a quality, BUILD_REFIT for geometry that will be updated,
+// MOTION_BLUR for scenes with motion instances.
 enum BuildOptions
 {
-  BUILD_LOW    = 0,
-  BUILD_MEDIUM = 1,
-  BUILD_HIGH   = 2,
-  BUILD_REFIT  = 4,
+  NONE                   = 0x00000000,
+  BUILD_LOW              = 0x00000001,
+  BUILD_MEDIUM           = 0x00000002,
+  BUILD_HIGH             = 0x00000004,
+  BUILD_REFIT            = 0x00000008,
+  MOTION_BLUR            = 0x00000010,
+  BUILD_NOW              = 0x00000020,
+  BUILD_OPTIONS_MAX_ENUM = 0x7FFFFFFF,
+};
+
+// Box geometry (custom primitives): AddGeom_AABB returns its id with this bit set, and a hit on it
+// reports that id; the other mask takes the bit off. AddInstance accepts either.
+static constexpr uint32_t CRT_GEOM_MASK_AABB_BIT    = 0x80000000u;
+static constexpr uint32_t CRT_GEOM_MASK_AABB_BIT_RM = 0x7fffffffu;
+
+// An axis-aligned box of a custom primitive (w components unused).
+struct CRT_AABB
+{
+  LiteMath::float4 boxMin;
+  LiteMath::float4 boxMax;
+};
+
+// What a custom primitive's intersection is told about the box a ray reached.
+struct CRT_LeafInfo
+{
+  uint32_t aabbId;  // the box, among its geometry's
+  uint32_t primId;  // the primitive it bounds
+  uint32_t instId;  // the instance
+  uint32_t geomId;  // the geometry (with CRT_GEOM_MASK_AABB_BIT)
+  uint32_t rayxId;  // the ray (e.g. its pixel)
+  uint32_t rayyId;
 };
 
 // A committed scene as plain arrays: what a backend that builds its own acceleration structures
@@ -62,11 +93,38 @@ struct ISceneObject
                                       size_t indNum, uint32_t flags = BUILD_HIGH,
                                       size_t vByteStride = 3 * sizeof(float)) = 0;
 
+  // Boxes as a geometry, for custom primitives (paper 3.10): boxNumber boxes, a primitive per
+  // boxNumber / customPrimCount of them (one each without customPrimPtrs); typeId names the kind of
+  // primitive. Returns the geometry id with CRT_GEOM_MASK_AABB_BIT set. Unless a subclass intersects
+  // the primitives itself, a ray hits a box where it enters it (or at tmin, from inside): the hit's
+  // primId is the primitive, its geomId the id returned, coords are 0. Implementations without box
+  // geometry throw std::runtime_error.
+  virtual uint32_t AddGeom_AABB(uint32_t typeId, const CRT_AABB* boxMinMaxF8, size_t boxNumber, void** customPrimPtrs = nullptr,
+                                size_t customPrimCount = 0)
+  {
+    (void)typeId, (void)boxMinMaxF8, (void)boxNumber, (void)customPrimPtrs, (void)customPrimCount;
+    throw std::runtime_error(std::string(Name()) + ": this ISceneObject has no box geometry (AddGeom_AABB)");
+  }
+  virtual void UpdateGeom_AABB(uint32_t geomId, uint32_t typeId, const CRT_AABB* boxMinMaxF8, size_t boxNumber, void** customPrimPtrs = nullptr,
+                               size_t customPrimCount = 0)
+  {
+    (void)geomId, (void)typeId, (void)boxMinMaxF8, (void)boxNumber, (void)customPrimPtrs, (void)customPrimCount;
+    throw std::runtime_error(std::string(Name()) + ": this ISceneObject has no box geometry (UpdateGeom_AABB)");
+  }
+
   // Removes all instances (meshes stay).
   virtual void ClearScene() = 0;
   // Places mesh geomId with an object-to-world matrix. Returns the instance id (0, 1, 2, ...).
   virtual uint32_t AddInstance(uint32_t geomId, const LiteMath::float4x4& matrix) = 0;
   virtual void     UpdateInstance(uint32_t instanceId, const LiteMath::float4x4& matrix) = 0;
+  // A moving instance: matrixNumber object-to-world matrices at evenly spaced times from 0 to 1,
+  // interpolated linearly between them for a ray's time (RayQuery_*Motion). Implementations without
+  // motion take one matrix and throw std::runtime_error for more.
+  virtual uint32_t AddInstanceMotion(uint32_t geomId, const LiteMath::float4x4* matrices, uint32_t matrixNumber)
+  {
+    if (matrixNumber == 1) return AddInstance(geomId, matrices[0]);
+    throw std::runtime_error(std::string(Name()) + ": this ISceneObject has no motion instances (AddInstanceMotion)");
+  }
   // Builds the top-level structure; queries before the first commit (or after a change without
   // a new commit) miss.
   virtual void CommitScene(uint32_t options = BUILD_HIGH) = 0;
@@ -76,6 +134,23 @@ struct ISceneObject
   // Rays with NaN/inf components, a zero direction or tmin >= tmax miss.
   virtual CRT_Hit RayQuery_NearestHit(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar) = 0;
   virtual bool    RayQuery_AnyHit(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar) = 0;
+  // The same at a time in [0, 1], where motion instances are (a scene without them: the same as above).
+  virtual CRT_Hit RayQuery_NearestHitMotion(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar, float time)
+  {
+    (void)time;
+    return RayQuery_NearestHit(posAndNear, dirAndFar);
+  }
+  virtual bool RayQuery_AnyHitMotion(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar, float time = 0.0f)
+  {
+    (void)time;
+    return RayQuery_AnyHit(posAndNear, dirAndFar);
+  }
+  // The implementation behind a wrapper (the paper's API; this one is its own).
+  virtual ISceneObject* UnderlyingImpl(uint32_t implId)
+  {
+    (void)implId;
+    return this;
+  }
 
   // The scene as last committed (no instances before the first CommitScene or after a change
   // without a new one, so that every query misses, as RayQuery_* do). Implementations that do not
@@ -87,6 +162,18 @@ struct ISceneObject
   }
 };
 
-// Creates a scene implementation by name ("embree"; case-insensitive). Throws std::invalid_argument
-// listing the known names for an unknown one, std::runtime_error if the backend fails to start.
-std::shared_ptr<ISceneObject> CreateSceneRT(const char* name);
+// Creates a scene implementation by name, case-insensitive: "embree" (Embree 3), "lbvh" and "sah"
+// (BVHScene with those builders), and the paper's names for the same ("BVH2Common", "BVH4Common":
+// sah). Throws std::invalid_argument listing the known names for an unknown one, std::runtime_error
+// if the backend fails to start. As in the paper's API, the caller owns the scene and deletes it with
+// DeleteSceneRT: std::shared_ptr<ISceneObject>(CreateSceneRT("sah"), DeleteSceneRT).
+ISceneObject* CreateSceneRT(const char* implName);
+void DeleteSceneRT(ISceneObject* scene);
+// Owned by a shared_ptr: std::shared_ptr<ISceneObject>(CreateSceneRT(implName), DeleteSceneRT).
+inline std::shared_ptr<ISceneObject> MakeSceneRT(const char* implName)
+{
+  return std::shared_ptr<ISceneObject>(CreateSceneRT(implName), DeleteSceneRT);
+}
+// LiteRT's form: implementation, builder ("lbvh", "sah"; others, or "", the implementation's own) and
+// node layout (ignored: BVHScene has one), shared.
+std::shared_ptr<ISceneObject> CreateSceneRT(const char* implName, const char* buildName, const char* layoutName);

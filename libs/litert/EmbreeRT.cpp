@@ -1,7 +1,8 @@
 // Embree 3 implementation of ISceneObject.
 //
-// Layout: one RTCScene per mesh (holding a single triangle geometry with id 0) and a top-level
-// RTCScene whose geometries are INSTANCE geometries referencing the mesh scenes. Instance i is
+// Layout: one RTCScene per mesh (holding a single triangle geometry with id 0, or for box geometry
+// a user geometry of boxes) and a top-level RTCScene whose geometries are INSTANCE geometries
+// referencing the mesh scenes, with a time step per matrix of a moving instance. Instance i is
 // attached with geometry id i, so Embree's instID is directly our instance id.
 #include "CrossRT.h"
 #include "SceneInput.h"
@@ -30,11 +31,89 @@ void embreeErrorCallback(void* /*userPtr*/, RTCError code, const char* str)
 
 RTCBuildQuality qualityFromFlags(uint32_t flags)
 {
-  switch (flags & 3u)
+  if (flags & BUILD_HIGH) return RTC_BUILD_QUALITY_HIGH;
+  if (flags & BUILD_MEDIUM) return RTC_BUILD_QUALITY_MEDIUM;
+  if (flags & BUILD_LOW) return RTC_BUILD_QUALITY_LOW;
+  return RTC_BUILD_QUALITY_MEDIUM;  // NONE
+}
+
+// Box geometry: the boxes of a user geometry; a ray hits a box where it enters it (CrossRT.h).
+struct BoxData
+{
+  std::vector<CRT_AABB> boxes;
+  uint32_t boxesPerPrim = 1;
+};
+
+void boxBounds(const RTCBoundsFunctionArguments* args)
+{
+  const CRT_AABB& b = static_cast<const BoxData*>(args->geometryUserPtr)->boxes[args->primID];
+  args->bounds_o->lower_x = b.boxMin.x;
+  args->bounds_o->lower_y = b.boxMin.y;
+  args->bounds_o->lower_z = b.boxMin.z;
+  args->bounds_o->upper_x = b.boxMax.x;
+  args->bounds_o->upper_y = b.boxMax.y;
+  args->bounds_o->upper_z = b.boxMax.z;
+}
+
+// Where a ray enters the box, in [tnear, tfar] (tnear from inside); false when it misses.
+bool boxEntry(const CRT_AABB& b, const float org[3], const float dir[3], float tnear, float tfar, float& t)
+{
+  const float lo[3] = {b.boxMin.x, b.boxMin.y, b.boxMin.z}, hi[3] = {b.boxMax.x, b.boxMax.y, b.boxMax.z};
+  for (int a = 0; a < 3; a++)
   {
-  case BUILD_LOW: return RTC_BUILD_QUALITY_LOW;
-  case BUILD_MEDIUM: return RTC_BUILD_QUALITY_MEDIUM;
-  default: return RTC_BUILD_QUALITY_HIGH;
+    if (dir[a] == 0.0f)
+    {
+      if (org[a] < lo[a] || org[a] > hi[a])
+        return false;
+      continue;
+    }
+    const float t0 = (lo[a] - org[a]) / dir[a], t1 = (hi[a] - org[a]) / dir[a];
+    tnear = std::max(tnear, std::min(t0, t1));
+    tfar = std::min(tfar, std::max(t0, t1));
+  }
+  t = tnear;
+  return tnear <= tfar;
+}
+
+void boxIntersect(const RTCIntersectFunctionNArguments* args)
+{
+  const BoxData& data = *static_cast<const BoxData*>(args->geometryUserPtr);
+  RTCRayHitN* rayHit = args->rayhit;
+  RTCRayN* ray = RTCRayHitN_RayN(rayHit, args->N);
+  RTCHitN* hit = RTCRayHitN_HitN(rayHit, args->N);
+  for (unsigned i = 0; i < args->N; i++)
+  {
+    if (args->valid[i] == 0)
+      continue;
+    const float org[3] = {RTCRayN_org_x(ray, args->N, i), RTCRayN_org_y(ray, args->N, i), RTCRayN_org_z(ray, args->N, i)};
+    const float dir[3] = {RTCRayN_dir_x(ray, args->N, i), RTCRayN_dir_y(ray, args->N, i), RTCRayN_dir_z(ray, args->N, i)};
+    float t;
+    if (!boxEntry(data.boxes[args->primID], org, dir, RTCRayN_tnear(ray, args->N, i), RTCRayN_tfar(ray, args->N, i), t))
+      continue;
+    RTCRayN_tfar(ray, args->N, i) = t;
+    RTCHitN_u(hit, args->N, i) = 0.0f;
+    RTCHitN_v(hit, args->N, i) = 0.0f;
+    RTCHitN_Ng_x(hit, args->N, i) = 0.0f;
+    RTCHitN_Ng_y(hit, args->N, i) = 0.0f;
+    RTCHitN_Ng_z(hit, args->N, i) = 1.0f;
+    RTCHitN_geomID(hit, args->N, i) = args->geomID;
+    RTCHitN_primID(hit, args->N, i) = args->primID;
+    RTCHitN_instID(hit, args->N, i, 0) = args->context->instID[0];
+  }
+}
+
+void boxOccluded(const RTCOccludedFunctionNArguments* args)
+{
+  const BoxData& data = *static_cast<const BoxData*>(args->geometryUserPtr);
+  for (unsigned i = 0; i < args->N; i++)
+  {
+    if (args->valid[i] == 0)
+      continue;
+    const float org[3] = {RTCRayN_org_x(args->ray, args->N, i), RTCRayN_org_y(args->ray, args->N, i), RTCRayN_org_z(args->ray, args->N, i)};
+    const float dir[3] = {RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i), RTCRayN_dir_z(args->ray, args->N, i)};
+    float t;
+    if (boxEntry(data.boxes[args->primID], org, dir, RTCRayN_tnear(args->ray, args->N, i), RTCRayN_tfar(args->ray, args->N, i), t))
+      RTCRayN_tfar(args->ray, args->N, i) = -std::numeric_limits<float>::infinity();  // Embree's "occluded"
   }
 }
 
@@ -124,6 +203,39 @@ public:
     m_committed = false; // the top level has to be rebuilt around the changed mesh
   }
 
+  uint32_t AddGeom_AABB(uint32_t typeId, const CRT_AABB* boxMinMaxF8, size_t boxNumber, void** customPrimPtrs, size_t customPrimCount) override
+  {
+    Mesh m;
+    m.scene = rtcNewScene(m_device);
+    m_meshes.push_back(m);
+    const uint32_t geomId = uint32_t(m_meshes.size() - 1);
+    setBoxData(m_meshes.back(), typeId, boxMinMaxF8, boxNumber, customPrimPtrs, customPrimCount);
+    return geomId | CRT_GEOM_MASK_AABB_BIT;
+  }
+
+  void UpdateGeom_AABB(uint32_t geomId, uint32_t typeId, const CRT_AABB* boxMinMaxF8, size_t boxNumber, void** customPrimPtrs,
+                       size_t customPrimCount) override
+  {
+    geomId &= CRT_GEOM_MASK_AABB_BIT_RM;
+    if (geomId >= m_meshes.size() || !m_meshes[geomId].boxes)
+      throw std::out_of_range("EmbreeRT::UpdateGeom_AABB: " + std::to_string(geomId) + " is no box geometry");
+    setBoxData(m_meshes[geomId], typeId, boxMinMaxF8, boxNumber, customPrimPtrs, customPrimCount);
+    m_committed = false;
+  }
+
+  uint32_t AddInstanceMotion(uint32_t geomId, const LiteMath::float4x4* matrices, uint32_t matrixNumber) override
+  {
+    if (matrixNumber == 0)
+      throw std::invalid_argument("EmbreeRT::AddInstanceMotion: no matrices");
+    const uint32_t instId = AddInstance(geomId, matrices[0]);
+    RTCGeometry inst = m_instances[instId];
+    rtcSetGeometryTimeStepCount(inst, matrixNumber);  // evenly spaced over [0, 1], interpolated linearly
+    for (uint32_t step = 0; step < matrixNumber; step++)
+      rtcSetGeometryTransform(inst, step, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, &matrices[step].m_col[0].x);
+    rtcCommitGeometry(inst);
+    return instId;
+  }
+
   void ClearScene() override
   {
     for (RTCGeometry inst : m_instances)
@@ -139,6 +251,7 @@ public:
 
   uint32_t AddInstance(uint32_t geomId, const LiteMath::float4x4& matrix) override
   {
+    geomId &= CRT_GEOM_MASK_AABB_BIT_RM;  // box geometry's id may come with its bit
     if (geomId >= m_meshes.size())
       throw std::out_of_range("EmbreeRT::AddInstance: invalid geomId " + std::to_string(geomId));
     const uint32_t instId = uint32_t(m_instances.size());
@@ -178,6 +291,16 @@ public:
 
   CRT_Hit RayQuery_NearestHit(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar) override
   {
+    return RayQuery_NearestHitMotion(posAndNear, dirAndFar, 0.0f);
+  }
+
+  bool RayQuery_AnyHit(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar) override
+  {
+    return RayQuery_AnyHitMotion(posAndNear, dirAndFar, 0.0f);
+  }
+
+  CRT_Hit RayQuery_NearestHitMotion(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar, float time) override
+  {
     CRT_Hit res;
     res.t      = dirAndFar.w;
     res.primId = res.instId = res.geomId = CRT_INVALID_ID;
@@ -189,6 +312,7 @@ public:
 
     RTCRayHit rh;
     rh.ray          = pr.ray;
+    rh.ray.time     = std::min(std::max(time, 0.0f), 1.0f);
     rh.hit.geomID   = RTC_INVALID_GEOMETRY_ID;
     rh.hit.primID   = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
@@ -199,20 +323,23 @@ public:
 
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID || rh.hit.instID[0] == RTC_INVALID_GEOMETRY_ID)
       return res;
+    const uint32_t geomId = m_instGeom[rh.hit.instID[0]];
+    const Mesh& mesh = m_meshes[geomId];
     res.t         = rh.ray.tfar;
-    res.primId    = rh.hit.primID;
+    res.primId    = mesh.boxes ? rh.hit.primID / mesh.boxes->boxesPerPrim : rh.hit.primID;
     res.instId    = rh.hit.instID[0];
-    res.geomId    = m_instGeom[rh.hit.instID[0]];
+    res.geomId    = mesh.boxes ? geomId | CRT_GEOM_MASK_AABB_BIT : geomId;
     res.coords[0] = rh.hit.u;
     res.coords[1] = rh.hit.v;
     return res;
   }
 
-  bool RayQuery_AnyHit(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar) override
+  bool RayQuery_AnyHitMotion(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar, float time) override
   {
     PreparedRay pr = prepareRay(posAndNear, dirAndFar);
     if (!pr.valid || !m_committed)
       return false;
+    pr.ray.time = std::min(std::max(time, 0.0f), 1.0f);
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     rtcOccluded1(m_topScene, &ctx, &pr.ray);
@@ -226,7 +353,40 @@ private:
     RTCGeometry geom    = nullptr; // null for a mesh without triangles
     size_t      vertNum = 0, triNum = 0;
     bool        changed = false;   // updated since the last CommitScene
+    std::shared_ptr<BoxData> boxes; // box geometry: its boxes (Embree keeps a pointer to them)
   };
+
+  void setBoxData(Mesh& m, uint32_t typeId, const CRT_AABB* boxMinMaxF8, size_t boxNumber, void** customPrimPtrs, size_t customPrimCount)
+  {
+    (void)typeId, (void)customPrimPtrs;
+    if (boxNumber > 0 && boxMinMaxF8 == nullptr)
+      throw std::invalid_argument("EmbreeRT::AddGeom_AABB: null boxes");
+    if (customPrimCount > 0 && boxNumber % customPrimCount != 0)
+      throw std::invalid_argument("EmbreeRT::AddGeom_AABB: " + std::to_string(boxNumber) + " boxes are not a multiple of " +
+                                  std::to_string(customPrimCount) + " primitives");
+    if (m.geom != nullptr)
+    {
+      rtcDetachGeometry(m.scene, 0);
+      rtcReleaseGeometry(m.geom);
+      m.geom = nullptr;
+    }
+    m.boxes = std::make_shared<BoxData>();
+    m.boxes->boxes.assign(boxMinMaxF8, boxMinMaxF8 + boxNumber);
+    m.boxes->boxesPerPrim = customPrimCount > 0 ? uint32_t(boxNumber / customPrimCount) : 1u;
+    if (boxNumber > 0)
+    {
+      m.geom = rtcNewGeometry(m_device, RTC_GEOMETRY_TYPE_USER);
+      rtcSetGeometryUserPrimitiveCount(m.geom, unsigned(boxNumber));
+      rtcSetGeometryUserData(m.geom, m.boxes.get());
+      rtcSetGeometryBoundsFunction(m.geom, boxBounds, nullptr);
+      rtcSetGeometryIntersectFunction(m.geom, boxIntersect);
+      rtcSetGeometryOccludedFunction(m.geom, boxOccluded);
+      rtcCommitGeometry(m.geom);
+      rtcAttachGeometryByID(m.scene, m.geom, 0);
+    }
+    m.changed = true;
+    rtcCommitScene(m.scene);
+  }
 
   // (Re)fills the mesh's triangle geometry and commits its scene. Buffers are reused in place when
   // the sizes are unchanged (refit-friendly); otherwise the geometry is replaced.
@@ -303,4 +463,4 @@ private:
 };
 } // namespace
 
-std::shared_ptr<ISceneObject> CreateEmbreeRT() { return std::make_shared<EmbreeRT>(); }
+std::unique_ptr<ISceneObject> CreateEmbreeRT() { return std::make_unique<EmbreeRT>(); }

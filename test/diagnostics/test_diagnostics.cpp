@@ -706,6 +706,8 @@ TEST_CASE("Thread loops of several kernels that the GPU cannot run per thread ar
   struct Case { const char* name; const char* declarations; const char* body; const char* definitions; int line; const char* message; const char* hint; };
   const Case cases[] = {
       {"a branch in the loop body", "", "    float v;\n    kernel_Init(i, &v);\n    if (n > 2) kernel_Step(i, &v);\n    kernel_Store(i, &v, out);\n", "", 7,
+       "the thread loop of 'Run' may branch only on a kernel's bool result, to leave a loop inside it", "branch on anything else inside the kernels"},
+      {"other code in the loop body", "", "    float v;\n    kernel_Init(i, &v);\n    n = n + 1;\n    kernel_Store(i, &v, out);\n", "", 7,
        "the thread loop of 'Run' may hold only per-thread local declarations, kernel_ calls and counted loops around them", "move this code into a kernel"},
       {"a local with an initializer", "", "    float v = 1.0f;\n    kernel_Step(i, &v);\n    kernel_Store(i, &v, out);\n", "", 5,
        "per-thread local 'v' of the thread loop of 'Run' has an initializer", "declare it without one"},

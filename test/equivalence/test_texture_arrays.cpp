@@ -220,7 +220,7 @@ TEST_CASE("Arrays of textures with ray queries in one kernel: the texture of the
   const float triangle[] = {-0.5f, -0.5f, 0.5f, 0.6f, -0.4f, 0.5f, 0.0f, 0.7f, 0.5f};
   const uint32_t triangleIndices[] = {0, 1, 2};
   auto configure = [&](TexturedHits& t) {
-    auto scene = CreateSceneRT("lbvh");
+    auto scene = MakeSceneRT("lbvh");
     scene->AddInstance(scene->AddGeom_Triangles3f(quad, 4, quadIndices, 6), LiteMath::float4x4());
     scene->AddInstance(scene->AddGeom_Triangles3f(triangle, 3, triangleIndices, 3), LiteMath::float4x4());
     scene->CommitScene();

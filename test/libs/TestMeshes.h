@@ -97,7 +97,7 @@ inline TriangleMesh Transformed(TriangleMesh mesh, const LiteMath::float4x4& m)
 inline std::shared_ptr<ISceneObject> SceneOf(const char* impl, const TriangleMesh& mesh,
                                              const std::vector<LiteMath::float4x4>& instances = {LiteMath::float4x4()})
 {
-  auto scene = CreateSceneRT(impl);
+  auto scene = MakeSceneRT(impl);
   const uint32_t geom = scene->AddGeom_Triangles3f(mesh.positions.data(), mesh.VertexCount(), mesh.indices.data(), mesh.indices.size());
   for (const LiteMath::float4x4& m : instances)
     scene->AddInstance(geom, m);

@@ -230,7 +230,7 @@ TEST_CASE("BVH traversal: degenerate triangles, one shared center, and 0, 1 and 
     for (size_t triangles : {0, 1, 2})
     {
       INFO(triangles << " triangles");
-      auto scene = CreateSceneRT(impl);
+      auto scene = MakeSceneRT(impl);
       scene->AddInstance(scene->AddGeom_Triangles3f(vertices, 4, indices, 3 * triangles), float4x4());
       scene->CommitScene();
       const CRT_Hit lower = scene->RayQuery_NearestHit(float4(0.75f, 0.25f, 1.0f, 0.0f), float4(0.0f, 0.0f, -1.0f, 10.0f));

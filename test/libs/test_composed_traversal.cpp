@@ -396,7 +396,7 @@ TEST_CASE("BVHScene exports the committed scene that hardware acceleration struc
   // Two meshes, three instances, one of an empty mesh; the export rebuilt as a second BVHScene must
   // give the very same hits: primIds in the order added, instance ids and matrices kept.
   const TriangleMesh sphere = BumpySphere(3), box = Cube();
-  auto scene = CreateSceneRT("lbvh");
+  auto scene = MakeSceneRT("lbvh");
   const uint32_t sphereId = scene->AddGeom_Triangles3f(sphere.positions.data(), sphere.positions.size() / 3, sphere.indices.data(), sphere.indices.size());
   const uint32_t emptyId = scene->AddGeom_Triangles3f(sphere.positions.data(), sphere.positions.size() / 3, nullptr, 0);
   const uint32_t boxId = scene->AddGeom_Triangles3f(box.positions.data(), box.positions.size() / 3, box.indices.data(), box.indices.size());
@@ -420,7 +420,7 @@ TEST_CASE("BVHScene exports the committed scene that hardware acceleration struc
       for (int axis = 0; axis < 3; ++axis)
         REQUIRE(exported.meshTriangles[sphereId][9 * t + 3 * corner + axis] == sphere.positions[3 * sphere.indices[3 * t + corner] + axis]);
 
-  auto rebuilt = CreateSceneRT("lbvh");
+  auto rebuilt = MakeSceneRT("lbvh");
   for (const auto& triangles : exported.meshTriangles)
   {
     std::vector<uint32_t> indices(triangles.size() / 3);

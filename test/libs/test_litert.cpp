@@ -29,7 +29,7 @@ const char* anyImplementation() { return GENERATE(as<const char*>{}, "embree", "
 
 std::shared_ptr<ISceneObject> makeQuadScene(const char* name)
 {
-  auto scene = CreateSceneRT(name);
+  auto scene = MakeSceneRT(name);
   const uint32_t g = scene->AddGeom_Triangles3f(QUAD_VERTS, 4, QUAD_INDICES, 6);
   REQUIRE(g == 0);
   REQUIRE(scene->AddInstance(g, float4x4()) == 0);
@@ -42,13 +42,13 @@ TEST_CASE("CrossRT factory", "[litert]")
 {
   for (const char* name : {"embree", "lbvh", "sah"})
   {
-    auto scene = CreateSceneRT(name);
+    auto scene = MakeSceneRT(name);
     REQUIRE(scene != nullptr);
     CHECK(std::string(scene->Name()) == name);
   }
-  CHECK(std::string(CreateSceneRT("LBVH")->Name()) == "lbvh");  // names are case-insensitive
-  CHECK_THROWS_AS(CreateSceneRT("nope"), std::invalid_argument);
-  CHECK_THROWS_WITH(CreateSceneRT("nope"), Catch::Contains("nope") && Catch::Contains("embree") && Catch::Contains("lbvh") &&
+  CHECK(std::string(MakeSceneRT("LBVH")->Name()) == "lbvh");  // names are case-insensitive
+  CHECK_THROWS_AS(MakeSceneRT("nope"), std::invalid_argument);
+  CHECK_THROWS_WITH(MakeSceneRT("nope"), Catch::Contains("nope") && Catch::Contains("embree") && Catch::Contains("lbvh") &&
                                                Catch::Contains("sah"));
 }
 
@@ -137,7 +137,7 @@ TEST_CASE("CrossRT instances", "[litert]")
 {
   const char* impl = anyImplementation();
   INFO(impl);
-  auto           scene = CreateSceneRT(impl);
+  auto           scene = MakeSceneRT(impl);
   const uint32_t quad  = scene->AddGeom_Triangles3f(QUAD_VERTS, 4, QUAD_INDICES, 6, BUILD_MEDIUM);
 
   // Second mesh: one triangle with a 4-float vertex stride (the 4th float is padding).
@@ -255,7 +255,7 @@ TEST_CASE("CrossRT queries before commit miss", "[litert]")
 {
   const char* impl = anyImplementation();
   INFO(impl);
-  auto scene = CreateSceneRT(impl);
+  auto scene = MakeSceneRT(impl);
   CHECK(scene->RayQuery_NearestHit(from(0.5f, 0.2f, 1.0f), down()).primId == MISS);
   scene->AddInstance(scene->AddGeom_Triangles3f(QUAD_VERTS, 4, QUAD_INDICES, 6), float4x4());
   CHECK_FALSE(scene->RayQuery_AnyHit(from(0.5f, 0.2f, 1.0f), down()));
@@ -267,7 +267,7 @@ TEST_CASE("CrossRT concurrent queries", "[litert]")
 {
   const char* impl = anyImplementation();
   INFO(impl);
-  auto scene = CreateSceneRT(impl);
+  auto scene = MakeSceneRT(impl);
   const uint32_t g = scene->AddGeom_Triangles3f(QUAD_VERTS, 4, QUAD_INDICES, 6);
   for (int i = 0; i < 16; i++)
     scene->AddInstance(g, translate4x4(float3(2.0f * float(i), 0, -float(i))));

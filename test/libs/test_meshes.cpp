@@ -90,13 +90,13 @@ TEST_CASE("Rays from random points inside the closed bunny all hit it, and leave
     volume += dot(Vertex(mesh, mesh.indices[t]), cross(Vertex(mesh, mesh.indices[t + 1]), Vertex(mesh, mesh.indices[t + 2])));
   const float outward = volume > 0.0 ? 1.0f : -1.0f;
 
-  auto reference = CreateSceneRT("embree");
+  auto reference = MakeSceneRT("embree");
   reference->AddInstance(reference->AddGeom_Triangles3f(mesh.positions.data(), mesh.VertexCount(), mesh.indices.data(), mesh.indices.size()), float4x4());
   reference->CommitScene();
   for (const char* impl : {"lbvh", "sah"})
   {
     INFO(impl);
-    auto scene = CreateSceneRT(impl);
+    auto scene = MakeSceneRT(impl);
     scene->AddInstance(scene->AddGeom_Triangles3f(mesh.positions.data(), mesh.VertexCount(), mesh.indices.data(), mesh.indices.size()), float4x4());
     scene->CommitScene();
     std::mt19937 rng(11);
