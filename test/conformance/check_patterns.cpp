@@ -3,6 +3,8 @@
 #include "Conformance.h"
 
 #include "LiteMath.h"
+#include <cmath>
+#include <stdexcept>
 
 // A case compiles where this build translated its class (CONFORMANCE_CLASSES); main checks that all were.
 #if __has_include("SortPairs_CPU.h")
@@ -16,6 +18,10 @@
 #if __has_include("ShadedSpheres_CPU.h")
 #include "ShadedSpheres_CPU.h"
 #include "ShadedSpheres_Vulkan.h"
+#endif
+#if __has_include("MovingBoxes_CPU.h")
+#include "MovingBoxes_CPU.h"
+#include "MovingBoxes_Vulkan.h"
 #endif
 
 using namespace conformance;
@@ -61,6 +67,40 @@ Register shadedSpheres(MakeCase<ShadedSpheres>(
       s.Shade(300, normals.data(), out.data());
       Outputs r;
       for (auto& p : out) Append(r, std::vector<float>{p.x, p.y, p.z, p.w});
+      return r;
+    }));
+#endif
+
+#if __has_include("MovingBoxes_CPU.h")
+Register movingBoxes(MakeCase<MovingBoxes>(
+    "ISceneObject with AABB geometry and a motion instance, RayQuery_NearestHitMotion", "moving_boxes.h/.cpp", 1e-5,
+    CONFORMANCE_MAKERS(MovingBoxes), [](MovingBoxes& m) {
+      m.CommitDeviceData();
+      // Rays straight down across the row of boxes and the quad's path, and a few sideways.
+      std::vector<float4> org, dir;
+      for (int i = 0; i < 96; i++) {
+        org.push_back(float4(-0.5f + 0.1f * float(i), 0.5f, 10.0f, 0.0f));
+        dir.push_back(float4(0.0f, 0.0f, -1.0f, 100.0f));
+      }
+      for (int i = 0; i < 8; i++) {
+        org.push_back(float4(-5.0f, 0.25f + 0.05f * float(i), 3.0f + 0.1f * float(i), 0.0f));
+        dir.push_back(float4(1.0f, 0.0f, 0.0f, 100.0f));
+      }
+      const uint32_t n = uint32_t(org.size());
+      Outputs r;
+      for (float time : {0.0f, 0.3f, 0.5f, 0.8f, 1.0f}) {
+        std::vector<int> what(n);
+        std::vector<float> dist(n);
+        m.Trace(n, org.data(), dir.data(), what.data(), dist.data(), time);
+        // Known answers, so that agreeing on nothing cannot pass: the first box (primitive 0, at z
+        // in [3, 4] once placed) straight down from z = 10, and the quad alone at x = 8.3 at time 1.
+        if (time == 0.0f && (what[10] != 1000 || std::abs(dist[10] - 6.0f) > 1e-4f))
+          throw std::runtime_error("ray 10 at time 0 should enter box primitive 0 at t = 6");
+        if (time == 1.0f && (what[88] < 0 || what[88] >= 1000 || std::abs(dist[88] - 11.0f) > 1e-4f))
+          throw std::runtime_error("ray 88 at time 1 should hit the quad at t = 11");
+        Append(r, what);
+        Append(r, dist);
+      }
       return r;
     }));
 #endif

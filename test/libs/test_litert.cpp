@@ -295,3 +295,148 @@ TEST_CASE("CrossRT concurrent queries", "[litert]")
     th.join();
   CHECK(errors.load() == 0);
 }
+
+namespace
+{
+CRT_AABB box(float x0, float y0, float z0, float x1, float y1, float z1)
+{
+  return CRT_AABB{float4(x0, y0, z0, 0.0f), float4(x1, y1, z1, 0.0f)};
+}
+} // namespace
+
+TEST_CASE("CrossRT box geometry: a ray hits a box where it enters it", "[litert]")
+{
+  const char* impl = anyImplementation();
+  INFO(impl);
+  auto scene = MakeSceneRT(impl);
+
+  // A quad at z = 0 and, above it, two unit boxes at z in [1, 2]: x in [0, 1] and in [2, 3].
+  const uint32_t quad = scene->AddGeom_Triangles3f(QUAD_VERTS, 4, QUAD_INDICES, 6);
+  const CRT_AABB boxes[] = {box(0, 0, 1, 1, 1, 2), box(2, 0, 1, 3, 1, 2)};
+  const uint32_t boxGeom = scene->AddGeom_AABB(7, boxes, 2);
+  REQUIRE((boxGeom & CRT_GEOM_MASK_AABB_BIT) != 0);
+  REQUIRE((boxGeom & CRT_GEOM_MASK_AABB_BIT_RM) == 1);  // the second geometry
+  REQUIRE(scene->AddInstance(quad, float4x4()) == 0);
+  REQUIRE(scene->AddInstance(boxGeom, float4x4()) == 1);
+  scene->CommitScene();
+
+  // Straight down onto the first box: it enters at z = 2, before the quad.
+  const CRT_Hit a = scene->RayQuery_NearestHit(from(0.5f, 0.5f, 5.0f), down());
+  CHECK(a.t == Approx(3.0f));
+  CHECK(a.geomId == boxGeom);
+  CHECK(a.instId == 1);
+  CHECK(a.primId == 0);
+  CHECK(a.coords[0] == 0.0f);
+
+  // The second box is the second primitive.
+  const CRT_Hit b = scene->RayQuery_NearestHit(from(2.5f, 0.5f, 5.0f), down());
+  CHECK(b.t == Approx(3.0f));
+  CHECK(b.primId == 1);
+  CHECK(b.geomId == boxGeom);
+
+  // Sideways through both boxes: the nearer one, entered through its x = 0 face.
+  const CRT_Hit c = scene->RayQuery_NearestHit(from(-1.0f, 0.5f, 1.5f), float4(1, 0, 0, 100));
+  CHECK(c.t == Approx(1.0f));
+  CHECK(c.primId == 0);
+  // Backwards from past the second box: the second box first.
+  const CRT_Hit d = scene->RayQuery_NearestHit(from(4.0f, 0.5f, 1.5f), float4(-1, 0, 0, 100));
+  CHECK(d.t == Approx(1.0f));
+  CHECK(d.primId == 1);
+
+  // From inside a box the hit is at tmin.
+  const CRT_Hit e = scene->RayQuery_NearestHit(from(0.5f, 0.5f, 1.5f, 0.25f), down());
+  CHECK(e.t == Approx(0.25f));
+  CHECK(e.geomId == boxGeom);
+
+  // Between the boxes the quad's x range ends at 1, so the ray misses everything.
+  const CRT_Hit f = scene->RayQuery_NearestHit(from(1.5f, 0.5f, 5.0f), down());
+  CHECK(f.primId == MISS);
+  CHECK(f.geomId == MISS);
+  CHECK_FALSE(scene->RayQuery_AnyHit(from(1.5f, 0.5f, 5.0f), down()));
+  CHECK(scene->RayQuery_AnyHit(from(2.5f, 0.5f, 5.0f), down()));
+
+  // A ray that stops before the box misses it; one that stops inside hits.
+  CHECK(scene->RayQuery_NearestHit(from(0.5f, 0.5f, 5.0f), down(2.5f)).primId == MISS);
+  CHECK(scene->RayQuery_NearestHit(from(0.5f, 0.5f, 5.0f), down(3.5f)).geomId == boxGeom);
+}
+
+TEST_CASE("CrossRT box geometry: primitives of several boxes, instances and updates", "[litert]")
+{
+  const char* impl = anyImplementation();
+  INFO(impl);
+  auto scene = MakeSceneRT(impl);
+
+  // Four boxes in a row along x, two per custom primitive: boxes 0-1 are primitive 0, 2-3 primitive 1.
+  const CRT_AABB boxes[] = {box(0, 0, 0, 1, 1, 1), box(1, 0, 0, 2, 1, 1), box(2, 0, 0, 3, 1, 1), box(3, 0, 0, 4, 1, 1)};
+  int prims[2] = {0, 1};
+  void* primPtrs[2] = {&prims[0], &prims[1]};
+  const uint32_t g = scene->AddGeom_AABB(3, boxes, 4, primPtrs, 2);
+  REQUIRE(scene->AddInstance(g, float4x4()) == 0);
+  REQUIRE(scene->AddInstance(g, translate4x4(float3(0, 0, -10))) == 1);
+  scene->CommitScene();
+
+  CHECK(scene->RayQuery_NearestHit(from(0.5f, 0.5f, 5.0f), down()).primId == 0);
+  CHECK(scene->RayQuery_NearestHit(from(1.5f, 0.5f, 5.0f), down()).primId == 0);
+  CHECK(scene->RayQuery_NearestHit(from(2.5f, 0.5f, 5.0f), down()).primId == 1);
+  CHECK(scene->RayQuery_NearestHit(from(3.5f, 0.5f, 5.0f), down()).primId == 1);
+
+  // The moved instance: below the first, reached from underneath.
+  const CRT_Hit below = scene->RayQuery_NearestHit(from(3.5f, 0.5f, -20.0f), float4(0, 0, 1, 100));
+  CHECK(below.instId == 1);
+  CHECK(below.t == Approx(10.0f));
+  CHECK(below.primId == 1);
+
+  // Updating the boxes (same count): the row moves up by 10.
+  const CRT_AABB moved[] = {box(0, 0, 10, 1, 1, 11), box(1, 0, 10, 2, 1, 11), box(2, 0, 10, 3, 1, 11), box(3, 0, 10, 4, 1, 11)};
+  scene->UpdateGeom_AABB(g, 3, moved, 4, primPtrs, 2);
+  scene->CommitScene();
+  const CRT_Hit up = scene->RayQuery_NearestHit(from(0.5f, 0.5f, 20.0f), down());
+  CHECK(up.t == Approx(9.0f));
+  CHECK(up.instId == 0);
+  // The old place is empty; the moved instance's copy now sits at z in [0, 1].
+  CHECK(scene->RayQuery_NearestHit(from(0.5f, 0.5f, 5.0f), down(3.5f)).primId == MISS);
+  CHECK(scene->RayQuery_NearestHit(from(0.5f, 0.5f, 5.0f), down()).instId == 1);
+}
+
+TEST_CASE("CrossRT motion instances interpolate their matrices over the ray's time", "[litert]")
+{
+  const char* impl = anyImplementation();
+  INFO(impl);
+  auto scene = MakeSceneRT(impl);
+
+  const uint32_t quad = scene->AddGeom_Triangles3f(QUAD_VERTS, 4, QUAD_INDICES, 6);
+  // Three steps at times 0, 0.5, 1: the quad slides 2 along x, then drops 1 along z.
+  const float4x4 steps[] = {float4x4(), translate4x4(float3(2, 0, 0)), translate4x4(float3(2, 0, -1))};
+  REQUIRE(scene->AddInstanceMotion(quad, steps, 3) == 0);
+  scene->CommitScene(BUILD_HIGH | MOTION_BLUR);
+
+  // At time 0 the quad covers x in [0, 1].
+  CHECK(scene->RayQuery_NearestHitMotion(from(0.5f, 0.25f, 1.0f), down(), 0.0f).t == Approx(1.0f));
+  CHECK(scene->RayQuery_NearestHitMotion(from(2.5f, 0.25f, 1.0f), down(), 0.0f).primId == MISS);
+  // At time 0.25 it has slid by 1: x in [1, 2]; the hit's barycentrics are in the quad's own frame.
+  const CRT_Hit mid = scene->RayQuery_NearestHitMotion(from(1.75f, 0.25f, 1.0f), down(), 0.25f);
+  CHECK(mid.t == Approx(1.0f));
+  CHECK(mid.primId == 0);
+  CHECK(mid.instId == 0);
+  CHECK(mid.coords[0] == Approx(0.5f));
+  CHECK(mid.coords[1] == Approx(0.25f));
+  CHECK(scene->RayQuery_NearestHitMotion(from(0.5f, 0.25f, 1.0f), down(), 0.25f).primId == MISS);
+  // At time 0.75 it is halfway down: z = -0.5.
+  CHECK(scene->RayQuery_NearestHitMotion(from(2.5f, 0.25f, 1.0f), down(), 0.75f).t == Approx(1.5f));
+  // At time 1 it is at z = -1; times past 1 clamp to it.
+  CHECK(scene->RayQuery_NearestHitMotion(from(2.5f, 0.25f, 1.0f), down(), 1.0f).t == Approx(2.0f));
+  CHECK(scene->RayQuery_NearestHitMotion(from(2.5f, 0.25f, 1.0f), down(), 3.0f).t == Approx(2.0f));
+  // Any hit follows the same motion.
+  CHECK(scene->RayQuery_AnyHitMotion(from(1.75f, 0.25f, 1.0f), down(), 0.25f));
+  CHECK_FALSE(scene->RayQuery_AnyHitMotion(from(1.75f, 0.25f, 1.0f), down(), 0.9f));
+  // Queries without a time see time 0.
+  CHECK(scene->RayQuery_NearestHit(from(0.5f, 0.25f, 1.0f), down()).t == Approx(1.0f));
+}
+
+TEST_CASE("CrossRT paper-style ownership: CreateSceneRT and DeleteSceneRT", "[litert]")
+{
+  std::shared_ptr<ISceneObject> scene(CreateSceneRT("sah"), DeleteSceneRT);
+  REQUIRE(scene != nullptr);
+  CHECK(std::string(scene->Name()) == "sah");
+  CHECK_THROWS_AS(CreateSceneRT("nope"), std::invalid_argument);
+}
