@@ -1246,13 +1246,101 @@ std::string StatementText(Context& c, const Stmt* s) {
   return c.Text(s->getSourceRange());
 }
 
+// Locals declared before a kernelND_'s loop nest that its threads reduce, as they reduce members:
+//   float sum = 0.0f;  for (...) { ... sum += x; best = std::max(best, y); }  m_mean = sum / n;
+// Each thread accumulates its part from the identity; after the nest the parts are combined with
+// the local's initial value, where the statements after the loop read it. Any other write, or a
+// read inside the loop, stays an error (CheckLoopEnds, LocalReductionReads).
+struct LocalReductionScanner : RecursiveASTVisitor<LocalReductionScanner> {
+  Context& c;
+  const std::set<const VarDecl*>& locals;
+  std::map<const VarDecl*, ReduceOp> reductions;
+  std::set<const Expr*> targets;         // the written expressions of the reduction statements
+  std::set<const DeclRefExpr*> uses;     // the references to the locals those statements make
+  LocalReductionScanner(Context& ctx, const std::set<const VarDecl*>& l) : c(ctx), locals(l) {}
+
+  const DeclRefExpr* Ref(const Expr* e) const {
+    auto* dr = dyn_cast<DeclRefExpr>(e->IgnoreParenImpCasts());
+    return dr && isa<VarDecl>(dr->getDecl()) && locals.count(cast<VarDecl>(dr->getDecl())) ? dr : nullptr;
+  }
+  // x = min(x, v) / max(v, x) (std::, fmin/fmax, LiteMath's): the operation, and the reference to x among the arguments.
+  std::optional<ReduceOp> MinMax(const DeclRefExpr* target, const Expr* rhs, const DeclRefExpr*& use) const {
+    auto* call = dyn_cast<CallExpr>(rhs->IgnoreImplicit());
+    if (!call || !call->getDirectCallee() || call->getNumArgs() != 2) return std::nullopt;
+    const std::string n = call->getDirectCallee()->getNameAsString();
+    const bool isMin = n == "min" || n == "fmin" || n == "fminf", isMax = n == "max" || n == "fmax" || n == "fmaxf";
+    if (!isMin && !isMax) return std::nullopt;
+    for (auto* arg : call->arguments())
+      if (auto* r = Ref(arg); r && r->getDecl() == target->getDecl()) {
+        use = r;
+        return isMin ? ReduceOp::Min : ReduceOp::Max;
+      }
+    return std::nullopt;
+  }
+  void Found(const Expr* lhs, const DeclRefExpr* target, ReduceOp op, const DeclRefExpr* other, SourceLocation loc) {
+    auto* vd = cast<VarDecl>(target->getDecl());
+    auto [it, fresh] = reductions.emplace(vd, op);
+    if (!fresh && it->second != op)
+      c.rep.Error(loc, "local '" + vd->getNameAsString() + "' is reduced with two different operations in one loop nest",
+                  "use one of +=, -=, min or max per variable");
+    targets.insert(lhs);
+    uses.insert(target);
+    if (other) uses.insert(other);
+  }
+  bool VisitBinaryOperator(BinaryOperator* bo) {
+    auto* target = bo->isAssignmentOp() ? Ref(bo->getLHS()) : nullptr;
+    if (!target || !target->getType()->isArithmeticType()) return true;
+    const DeclRefExpr* other = nullptr;
+    std::optional<ReduceOp> op;
+    if (bo->getOpcode() == BO_AddAssign) op = ReduceOp::Add;
+    else if (bo->getOpcode() == BO_SubAssign) op = ReduceOp::Sub;
+    else if (bo->getOpcode() == BO_Assign) op = MinMax(target, bo->getRHS(), other);
+    if (op) Found(bo->getLHS(), target, *op, other, bo->getExprLoc());
+    return true;
+  }
+  bool VisitCXXOperatorCallExpr(CXXOperatorCallExpr* call) {  // LiteMath vectors: v += x, v = min(v, x)
+    auto k = call->getOperator();
+    auto* target = (k == OO_PlusEqual || k == OO_MinusEqual || k == OO_Equal) ? Ref(call->getArg(0)) : nullptr;
+    if (!target || !GlslTypeOf(target->getType())) return true;
+    const DeclRefExpr* other = nullptr;
+    std::optional<ReduceOp> op;
+    if (k == OO_PlusEqual) op = ReduceOp::Add;
+    else if (k == OO_MinusEqual) op = ReduceOp::Sub;
+    else op = MinMax(target, call->getArg(1), other);
+    if (op) Found(call->getArg(0), target, *op, other, call->getExprLoc());
+    return true;
+  }
+  bool VisitUnaryOperator(UnaryOperator* uo) {  // n++ and n-- count
+    auto* target = uo->isIncrementDecrementOp() ? Ref(uo->getSubExpr()) : nullptr;
+    if (target && target->getType()->isArithmeticType())
+      Found(uo->getSubExpr(), target, uo->isIncrementOp() ? ReduceOp::Add : ReduceOp::Sub, nullptr, uo->getExprLoc());
+    return true;
+  }
+};
+
+// A read of a reduced local inside the loop nest would see one thread's part.
+void LocalReductionReads(Context& c, const std::string& kernel, const LocalReductionScanner& scan, const Stmt* threadBody) {
+  struct Reads : RecursiveASTVisitor<Reads> {
+    Context& c; const std::string& kernel; const LocalReductionScanner& scan;
+    Reads(Context& ctx, const std::string& k, const LocalReductionScanner& s) : c(ctx), kernel(k), scan(s) {}
+    bool VisitDeclRefExpr(DeclRefExpr* e) {
+      auto* vd = dyn_cast<VarDecl>(e->getDecl());
+      if (vd && scan.reductions.count(vd) && !scan.uses.count(e))
+        c.rep.Error(e->getLocation(), "the loop of kernel '" + kernel + "' reads '" + vd->getNameAsString() + "', which its iterations reduce",
+                    "its total is known after the loop: read it in the statements after the loop nest");
+      return true;
+    }
+  } reads(c, kernel, scan);
+  reads.TraverseStmt(const_cast<Stmt*>(threadBody));
+}
+
 // The statements before and after a kernelND_'s loop nest run on one thread, around the threads of
 // the nest: before them (the GPU's <kernel>_Start) and after them (<kernel>_Finish). Every thread
 // evaluates the declarations before the nest for itself, so the statements before it may not change
 // those locals afterwards, and neither may the threads (a race on the CPU too). A 'return' before
 // the nest would skip it on the CPU but not on the GPU.
 bool CheckLoopEnds(Context& c, const std::string& kernel, const std::vector<const Stmt*>& before,
-                   const std::vector<const Stmt*>& after, const Stmt* threadBody) {
+                   const std::vector<const Stmt*>& after, const Stmt* threadBody, const std::set<const Expr*>& reductionTargets) {
   std::set<const VarDecl*> locals;
   for (auto* s : before)
     if (auto* ds = dyn_cast<DeclStmt>(s))
@@ -1261,8 +1349,10 @@ bool CheckLoopEnds(Context& c, const std::string& kernel, const std::vector<cons
   struct LocalWrites : WriteVisitor<LocalWrites> {
     const std::set<const VarDecl*>& locals;
     std::vector<std::pair<const VarDecl*, SourceLocation>> found;
+    const std::set<const Expr*>* skip = nullptr;  // the targets of reductions
     explicit LocalWrites(const std::set<const VarDecl*>& l) : locals(l) {}
     void Written(const Expr* target, SourceLocation loc) {
+      if (skip && skip->count(target)) return;
       if (auto* vd = WrittenVar(target); vd && locals.count(vd)) found.push_back({vd, loc});
     }
     bool VisitUnaryOperator(UnaryOperator* uo) {
@@ -1283,10 +1373,11 @@ bool CheckLoopEnds(Context& c, const std::string& kernel, const std::vector<cons
     }
   }
   LocalWrites inLoop(locals);
+  inLoop.skip = &reductionTargets;
   inLoop.TraverseStmt(const_cast<Stmt*>(threadBody));
   for (auto& [vd, loc] : inLoop.found) {
     c.rep.Error(loc, "the loop of kernel '" + kernel + "' writes '" + vd->getNameAsString() + "', declared before the loop: every iteration (a thread) would write one variable",
-                "declare it inside the loop, or accumulate into a member (m += x is a reduction)");
+                "declare it inside the loop, or reduce it (x += v, x -= v, x = std::min(x, v), x = std::max(x, v))");
     ok = false;
   }
   struct Returns : RecursiveASTVisitor<Returns> {
@@ -1435,7 +1526,14 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   for (auto* list : {&before, &after})
     for (auto* s : *list)
       if (!isa<DeclStmt>(s)) ends.TraverseStmt(const_cast<Stmt*>(s));
-  if (!CheckLoopEnds(c, k.name, before, after, threadBody)) return;
+  std::set<const VarDecl*> beforeLocals;
+  for (auto* s : preamble)
+    for (auto* d : cast<DeclStmt>(s)->decls())
+      if (auto* vd = dyn_cast<VarDecl>(d)) beforeLocals.insert(vd);
+  LocalReductionScanner localReductions(c, beforeLocals);
+  localReductions.TraverseStmt(const_cast<Stmt*>(threadBody));
+  if (!CheckLoopEnds(c, k.name, before, after, threadBody, localReductions.targets)) return;
+  LocalReductionReads(c, k.name, localReductions, threadBody);
   ReductionReadScanner rs(c, ws);
   rs.TraverseStmt(const_cast<Stmt*>(threadBody));
   for (auto& [field, values] : ws.constantStores) {
@@ -1457,6 +1555,29 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
                   "read it after the loop nest, or in the control function after the kernel");
     if (auto* m = FindMember(c.model, field->getNameAsString())) m->writtenByKernels = true;
   }
+  // Reduced locals, in declaration order: a thread's part is <local>Local, as a member's is.
+  std::set<const Stmt*> reductionDecls;  // their declarations, which the threads do not evaluate
+  for (auto* s : preamble)
+    for (auto* d : cast<DeclStmt>(s)->decls()) {
+      auto* vd = dyn_cast<VarDecl>(d);
+      auto found = vd ? localReductions.reductions.find(vd) : localReductions.reductions.end();
+      if (found == localReductions.reductions.end()) continue;
+      if (!cast<DeclStmt>(s)->isSingleDecl()) {
+        c.rep.Error(vd->getLocation(), "'" + vd->getNameAsString() + "', which the loop of kernel '" + k.name + "' reduces, is declared with other variables",
+                    "declare it on its own: float " + vd->getNameAsString() + " = ...;");
+        continue;
+      }
+      reductionDecls.insert(s);
+      Reduction r;
+      r.member = vd->getNameAsString();
+      r.op = found->second;
+      r.glslType = GlslTypeOf(vd->getType()).value_or("float");
+      r.identity = Identity(r.op, r.glslType);
+      r.local = true;
+      r.cppType = vd->getType().getUnqualifiedType().getAsString(c.ctx.getPrintingPolicy());
+      printer.renames[vd] = r.member + "Local";
+      k.reductions.push_back(r);
+    }
   if (k.rtv && !ws.reductions.empty()) {
     c.rep.Error(md->getLocation(), "member reductions are supported in kernel1D_/2D_/3D_ loops, not in '" + k.name + "'",
                 "write the loop inside the kernel (kernel1D_" + k.name.substr(std::string("kernel_").size()) + ") so the translator sees the whole reduction");
@@ -1494,7 +1615,8 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   os << (k.returnsBool ? "bool " : "void ") << k.name << "(";
   for (size_t i = 0; i < threadParams.size(); ++i) os << (i ? ", " : "") << threadParams[i].first << " " << threadParams[i].second;
   os << ")\n{\n";
-  for (auto* s : preamble) os << printer.Stmt(s, 1);
+  for (auto* s : preamble)
+    if (!reductionDecls.count(s)) os << printer.Stmt(s, 1);
   if (auto* cs = dyn_cast<CompoundStmt>(threadBody))
     for (auto* s : cs->body()) os << printer.ThreadBody(s, 1, !k.rtv);
   else
@@ -1508,6 +1630,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     for (auto& r : k.reductions)
       for (auto* f : ClassFields(c.cls))
         if (f->getNameAsString() == r.member) printer.renames.erase(f);  // the member itself, not a thread's part
+    for (auto& [vd, op] : localReductions.reductions) printer.renames.erase(vd);
     printer.singleThread = true;
     const std::string from = "// from " + c.cls->getNameAsString() + "::" + k.name + " (" + k.sourceFile + "): ";
     if (std::any_of(before.begin(), before.end(), [](const Stmt* s) { return !isa<DeclStmt>(s); })) {
@@ -1518,6 +1641,17 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     if (!after.empty()) {
       k.glslFinish = from + "the statements after its loop nest, run by one thread after the others\nvoid " + k.name + "_Finish()\n{\n";
       for (auto* s : preamble) k.glslFinish += printer.Stmt(s, 1);
+      // The reduced locals: their initial values and the threads' total (<kernel>_Reduce left it
+      // in element 0 of the partials; when the nest had no threads there is none).
+      std::string anyThreads;
+      for (unsigned a = 0; a < k.dims; ++a) anyThreads += std::string(a ? " && " : "") + "crt_count" + "XYZ"[a] + " != 0u";
+      for (auto& r : k.reductions)
+        if (r.local) {
+          const std::string total = r.member + "Partials[0]";
+          const std::string combined = r.op == ReduceOp::Min ? "min(" + r.member + ", " + total + ")"
+                                       : r.op == ReduceOp::Max ? "max(" + r.member + ", " + total + ")" : r.member + " + " + total;
+          k.glslFinish += "  if (" + anyThreads + ")\n    " + r.member + " = " + combined + ";  // the threads' total\n";
+        }
       for (auto* s : after) k.glslFinish += printer.Stmt(s, 1);
       k.glslFinish += "}\n";
     }
@@ -1617,7 +1751,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     RequireReachable(c.rep, f, c.cls);
   }
   for (auto& r : k.reductions)
-    if (auto* m = FindMember(c.model, r.member)) { m->usedByKernels = true; m->writtenByKernels = true; }
+    if (auto* m = r.local ? nullptr : FindMember(c.model, r.member)) { m->usedByKernels = true; m->writtenByKernels = true; }
 
   // CPU backend: the loop nest as the user wrote it, reduction targets renamed.
   if (!k.rtv) {

@@ -234,6 +234,7 @@ std::string LaunchSize(const Kernel& k) {
 }
 
 std::string ReductionCppType(const ClassModel& model, const Reduction& r) {
+  if (!r.cppType.empty()) return r.cppType;
   auto* m = FindMember(model, r.member);
   return m ? m->cppType : "float";
 }
@@ -546,11 +547,11 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
     Data b;
     b.set("layout", "std430");
     b.set("binding", std::to_string(binding++));
-    b.set("access", "writeonly ");
+    b.set("access", r.local ? "" : "writeonly ");  // a local's total is read back after the nest
     b.set("blockName", r.member + "PartialsBlock");
     b.set("type", r.glslType);
     b.set("name", r.member + "Partials");
-    b.set("comment", "per-workgroup partial results of the reduction of " + r.member);
+    b.set("comment", "per-workgroup partial results of the reduction of " + std::string(r.local ? "local " : "") + r.member);
     buffers.push_back(b);
     Data x;
     x.set("type", r.glslType);
@@ -764,6 +765,8 @@ std::string ReduceGlsl(const ClassModel& model, const Kernel& k, const GenerateO
     x.set("combineShared", Combine(r.op, r.member + "Shared[local]", r.member + "Shared[local + stride]"));
     x.set("combinePartial", Combine(r.op, r.member + "Local", r.member + "Partials[i]"));
     x.set("combineMember", Combine(r.op, r.member, r.member + "Shared[0]"));
+    x.set("local", r.local);  // its total goes to element 0 of its partials, for <kernel>_Finish
+    x.set("access", r.local ? "" : "readonly ");
     reductions.push_back(x);
   }
   d.set("reductions", reductions);
@@ -1273,19 +1276,23 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
     std::string clauses;
     Data reds = List();
     for (auto& r : k.reductions) {
-      Data y;
-      y.set("member", r.member);
-      reds.push_back(y);
+      // A member is reduced through a local copy (<member>Local); a local is reduced itself.
+      const std::string reduced = r.local ? r.member : r.member + "Local";
+      if (!r.local) {
+        Data y;
+        y.set("member", r.member);
+        reds.push_back(y);
+      }
       std::string cppType = ReductionCppType(model, r);
       bool scalar = r.glslType == "float" || r.glslType == "int" || r.glslType == "uint";
       if (scalar) {
-        clauses += " reduction(" + ScalarOmpOp(r.op) + ":" + r.member + "Local)";
+        clauses += " reduction(" + ScalarOmpOp(r.op) + ":" + reduced + ")";
         continue;
       }
       // LiteMath vectors need a declared reduction.
       std::string opName = std::string(r.op == ReduceOp::Min ? "min" : r.op == ReduceOp::Max ? "max" : "add");
       std::string name = "crossrt_" + opName + "_" + SplitArray(r.glslType).first;
-      clauses += " reduction(" + name + ":" + r.member + "Local)";
+      clauses += " reduction(" + name + ":" + reduced + ")";
       if (declared.insert(name).second) {
         Data o;
         o.set("name", name);

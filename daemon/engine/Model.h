@@ -42,10 +42,14 @@ struct Member {
 enum class ReduceOp { Add, Sub, Min, Max };
 
 struct Reduction {
-  std::string member;
+  std::string member;  // the member reduced, or the local (local)
   ReduceOp op = ReduceOp::Add;
   std::string glslType;
   std::string identity;  // GLSL expression of the identity element
+  // A local declared before the loop nest (float sum = 0; ... sum += x; ... m = sum / n): its total
+  // goes to element 0 of the partials, which <kernel>_Finish adds to the local's initial value.
+  bool local = false;
+  std::string cppType;  // locals: the C++ type (members: the member's)
 };
 
 struct KernelParam {

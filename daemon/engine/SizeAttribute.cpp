@@ -1,6 +1,7 @@
 // Teaches Clang the size annotation of control-function pointer parameters, in every spelling:
 //   const float* in __attribute__((size("n")))    [[size("n")]] const float* in    [[crossrt::size("n")]] const float* in
-// Several strings multiply (size("w", "h") is w * h elements, as in kernel_slicer). The count is
+// Several strings multiply (size("w", "h") is w * h elements, as in kernel_slicer); a number or a
+// name may go without quotes (size(1), size(n)). The count is
 // kept on the parameter as an AnnotateAttr "crossrt.size=<expr>".
 #include <clang/AST/ASTContext.h>
 #include <clang/AST/Attr.h>
@@ -32,24 +33,41 @@ std::string SizeProduct(const std::vector<std::string>& factors) {
   return product;
 }
 
-// The string literals between the attribute's parentheses, read from the source text: Clang does
-// not parse the arguments of C++11 plugin attributes. Empty when there are none.
-std::vector<std::string> QuotedArguments(Sema& sema, const ParsedAttr& attr) {
+// The arguments between the attribute's parentheses, read from the source text (Clang does not
+// parse the arguments of C++11 plugin attributes): each string's contents, or the text of an
+// argument written without quotes (size(1), size(n)). Empty when there are none.
+std::vector<std::string> ArgumentTexts(Sema& sema, const ParsedAttr& attr) {
   const char* text = sema.getSourceManager().getCharacterData(attr.getLoc());
   std::string rest(text, strnlen(text, 4096));
   std::vector<std::string> args;
   size_t i = rest.find('(');
   if (i == std::string::npos || rest.find_first_of(";{]", 0) < i) return args;
+  auto trimmed = [](std::string a) {
+    const size_t b = a.find_first_not_of(" \t\n"), e = a.find_last_not_of(" \t\n");
+    return b == std::string::npos ? std::string() : a.substr(b, e - b + 1);
+  };
   int depth = 0;
+  std::string current;
+  bool quoted = false;
   for (; i < rest.size(); ++i) {
-    if (rest[i] == '(') ++depth;
-    else if (rest[i] == ')' && --depth == 0) break;
-    else if (rest[i] == '"') {
+    const char c = rest[i];
+    if (c == '"') {
       size_t end = i + 1;
       while (end < rest.size() && rest[end] != '"') end += rest[end] == '\\' ? 2 : 1;
-      args.push_back(rest.substr(i + 1, end - i - 1));
+      current = rest.substr(i + 1, end - i - 1);
+      quoted = true;
       i = end;
+      continue;
     }
+    if (c == '(' && depth++ == 0) continue;
+    if ((c == ')' && --depth == 0) || (c == ',' && depth == 1)) {
+      args.push_back(quoted ? current : trimmed(current));
+      current.clear();
+      quoted = false;
+      if (c == ')') break;
+      continue;
+    }
+    if (!quoted) current += c;
   }
   return args;
 }
@@ -69,16 +87,19 @@ struct SizeAttrInfo : ParsedAttrInfo {
   }
   AttrHandling handleDeclAttribute(Sema& sema, Decl* decl, const ParsedAttr& attr) const override {
     std::vector<std::string> factors;
-    for (unsigned i = 0; i < attr.getNumArgs(); ++i)
-      if (auto* e = attr.isArgExpr(i) ? attr.getArgAsExpr(i) : nullptr)
-        if (auto* str = dyn_cast<StringLiteral>(e->IgnoreParenCasts())) factors.push_back(str->getString().str());
-    if (factors.empty()) factors = QuotedArguments(sema, attr);
+    for (unsigned i = 0; i < attr.getNumArgs(); ++i) {
+      auto* e = attr.isArgExpr(i) ? attr.getArgAsExpr(i) : nullptr;
+      if (auto* str = e ? dyn_cast<StringLiteral>(e->IgnoreParenCasts()) : nullptr) factors.push_back(str->getString().str());
+      else if (auto* number = e ? dyn_cast<IntegerLiteral>(e->IgnoreParenCasts()) : nullptr)
+        factors.push_back(std::to_string(number->getValue().getZExtValue()));
+    }
+    if (factors.empty()) factors = ArgumentTexts(sema, attr);
     factors.erase(std::remove_if(factors.begin(), factors.end(), [](const std::string& f) {
                     return f.find_first_not_of(" \t") == std::string::npos;
                   }), factors.end());
     if (factors.empty()) {
       unsigned id = sema.getDiagnostics().getCustomDiagID(DiagnosticsEngine::Error,
-          "size annotation needs the element count as a string, e.g. [[crossrt::size(\"n\")]] or __attribute__((size(\"w\", \"h\")))");
+          "size annotation needs the element count, e.g. [[crossrt::size(\"n\")]] or __attribute__((size(\"w\", \"h\")))");
       sema.Diag(attr.getLoc(), id);
       return AttributeNotApplied;
     }

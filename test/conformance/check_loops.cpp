@@ -25,8 +25,13 @@
 #include "ArraySum_CPU.h"
 #include "ArraySum_Vulkan.h"
 #endif
+#if __has_include("LocalTotals_CPU.h")
+#include "LocalTotals_CPU.h"
+#include "LocalTotals_Vulkan.h"
+#endif
 
 #include <algorithm>
+#include <stdexcept>
 
 using namespace conformance;
 using LiteMath::float4;
@@ -106,6 +111,30 @@ Register arraySum(MakeCase<ArraySum>(
       std::vector<int> data = Ints(5000);
       a.CalcArraySum(data.data(), unsigned(data.size()));
       return Outputs{double(a.m_sum)};
+    }));
+#endif
+
+#if __has_include("LocalTotals_CPU.h")
+Register localTotals(MakeCase<LocalTotals>(
+    "locals reduced in the loop (sum += v, std::min/max, a float4, n++) and read after it", "local_totals.h/.cpp", 1e-5,
+    CONFORMANCE_MAKERS(LocalTotals), [](LocalTotals& t) {
+      t.CommitDeviceData();
+      Outputs r;
+      for (uint32_t n : {5000u, 1u, 0u}) {  // no threads at all: the locals keep their initial values
+        std::vector<float4> values(std::max(n, 1u));
+        for (uint32_t i = 0; i < n; i++) values[i] = float4(float(int(i * 37) % 101) - 30.0f, 0.5f, float(i % 7), -1.0f);
+        std::vector<float> out(8, -7.0f);
+        t.Summarize(n, values.data(), out.data());
+        // Known answers, so that agreeing on nothing cannot pass.
+        if (n == 0 && (out[0] != 0.0f || out[1] != 1e30f || out[3] != 1.0f || out[7] != 0.0f))
+          throw std::runtime_error("with no values the locals should keep their initial values");
+        if (n == 1 && (out[0] != -30.0f || out[1] != -30.0f || out[2] != -30.0f || out[6] != 3.0f || out[7] != 1.0f))
+          throw std::runtime_error("one value: sum, min and max are that value");
+        Append(r, out);
+        r.push_back(t.m_mean);
+        r.push_back(t.m_range);
+      }
+      return r;
     }));
 #endif
 

@@ -157,6 +157,52 @@ void NotVirtual::kernel1D_Fill(int n, float* out) { for (int i = 0; i < n; i++) 
   REQUIRE(text.find("virtual void RunCmd(VkCommandBuffer a_cmd") != std::string::npos);
 }
 
+TEST_CASE("Locals reduced in a loop nest may only be reduced there, one way, and read after it", "[diagnostics]")
+{
+  // Line 8 of Sums.cpp is the loop body's statement.
+  struct LocalCase { const char* name; const char* statement; const char* message; const char* hint; };
+  const LocalCase cases[] = {
+      {"read in the loop", "    sum += data[i]; data[i] = sum;", "the loop of kernel 'kernel1D_Sum' reads 'sum', which its iterations reduce",
+       "read it in the statements after the loop nest"},
+      {"two operations", "    sum += data[i]; sum = std::max(sum, data[i]);", "local 'sum' is reduced with two different operations in one loop nest",
+       "use one of +=, -=, min or max per variable"},
+      {"a plain store", "    sum = data[i];", "the loop of kernel 'kernel1D_Sum' writes 'sum', declared before the loop",
+       "x = std::max(x, v)"},
+  };
+  for (const LocalCase& c : cases)
+  {
+    SECTION(c.name)
+    {
+      TempClass tc("Sums", R"(#pragma once
+class Sums
+{
+public:
+  virtual ~Sums() = default;
+  virtual void Sum(int n, [[crossrt::size("n")]] float* data, [[crossrt::size(1)]] float* total);
+protected:
+  void kernel1D_Sum(int n, float* data, float* total);
+};
+)",
+                   std::string(R"(#include "Sums.h"
+#include <algorithm>
+void Sums::Sum(int n, float* data, float* total) { kernel1D_Sum(n, data, total); }
+void Sums::kernel1D_Sum(int n, float* data, float* total)
+{
+  float sum = 0.0f;
+  for (int i = 0; i < n; i++) {
+)") + c.statement + "\n  }\n  total[0] = sum;\n}\n");
+      CommandResult r = RunCrossrt("translate --class Sums --backend vulkan --out " + (tc.dir / "out").string() + " --source " + tc.Source("Sums") +
+                                   " --templates " CROSSRT_SOURCE_DIR "/templates");
+      INFO(r.output);
+      REQUIRE_FALSE(r.crashed);
+      REQUIRE(r.exitCode == 1);
+      REQUIRE(r.output.find(tc.Source("Sums") + ":8:") != std::string::npos);
+      REQUIRE(r.output.find(c.message) != std::string::npos);
+      REQUIRE(r.output.find(c.hint) != std::string::npos);
+    }
+  }
+}
+
 TEST_CASE("A source that does not parse passes the compiler's diagnostics through", "[diagnostics]")
 {
   TempClass tc("Broken", "#pragma once\nclass Broken { public: virtual void Run(); };\n",
