@@ -12,6 +12,7 @@
 #include <llvm/Support/Path.h>
 
 #include <algorithm>
+#include <cctype>
 #include <map>
 #include <optional>
 #include <regex>
@@ -54,6 +55,16 @@ std::string ParamDecl(const ASTContext& ctx, const ParmVarDecl* p, unsigned inde
   if (name.empty()) return p->getType().getAsString(ctx.getPrintingPolicy()) + " a_unnamed" + std::to_string(index);
   SourceRange range(p->getBeginLoc(), p->getLocation());
   return StripAttributes(Text(ctx, range));
+}
+
+// A parameter as the declaration `p` writes its type (valid where the class is declared), named
+// as the definition `named` names it (its body uses that name).
+std::string ParamDecl(const ASTContext& ctx, const ParmVarDecl* p, const ParmVarDecl* named, unsigned index) {
+  std::string text = ParamDecl(ctx, p, index);
+  const std::string from = p->getName().empty() ? "a_unnamed" + std::to_string(index) : p->getNameAsString(), to = named->getNameAsString();
+  if (!to.empty() && to != from && text.size() >= from.size() && text.compare(text.size() - from.size(), from.size(), from) == 0)
+    text = text.substr(0, text.size() - from.size()) + to;
+  return text;
 }
 
 std::string CppTypeName(const ASTContext& ctx, QualType t) {
@@ -363,6 +374,36 @@ std::string DeclText(Context& c, const Decl* d) {
   return c.Text(d->getSourceRange());
 }
 
+// The #define lines of a file (with their continuation lines) whose names `code` uses, and those
+// the definitions use in turn, in the file's order: (name, definition).
+std::vector<std::pair<std::string, std::string>> UsedMacros(llvm::StringRef file, const std::string& code) {
+  static const std::regex defineLine(R"(^[ \t]*#[ \t]*define[ \t]+([A-Za-z_][A-Za-z0-9_]*))");
+  std::vector<std::pair<std::string, std::string>> defines;  // in the file's order
+  std::istringstream lines(file.str());
+  std::string line;
+  std::smatch m;
+  while (std::getline(lines, line)) {
+    if (!std::regex_search(line, m, defineLine)) continue;
+    std::string definition = line;
+    while (!line.empty() && line.back() == '\\' && std::getline(lines, line)) definition += "\n" + line;
+    defines.push_back({m[1].str(), definition});
+  }
+  static const std::regex identifier(R"([A-Za-z_][A-Za-z0-9_]*)");
+  std::set<std::string> used;
+  std::vector<std::string> pending = {code};
+  while (!pending.empty()) {
+    const std::string text = pending.back();
+    pending.pop_back();
+    for (std::sregex_iterator it(text.begin(), text.end(), identifier), end; it != end; ++it)
+      for (auto& [name, definition] : defines)
+        if (name == it->str() && used.insert(name).second) pending.push_back(definition.substr(definition.find(name) + name.size()));
+  }
+  std::vector<std::pair<std::string, std::string>> out;
+  for (auto& d : defines)
+    if (used.count(d.first)) out.push_back(d);
+  return out;
+}
+
 void CopySourceDeclarations(Context& c, const Stmt* body, const std::string& what) {
   auto& sm = c.ctx.getSourceManager();
   struct Finder : RecursiveASTVisitor<Finder> {
@@ -431,6 +472,17 @@ void CopySourceDeclarations(Context& c, const Stmt* body, const std::string& wha
       }
     const std::string copy = "// from " + file + "\n" + CanonicalCode(open + text + close);
     if (std::find(c.model.sourceDecls.begin(), c.model.sourceDecls.end(), copy) == c.model.sourceDecls.end()) c.model.sourceDecls.push_back(copy);
+  }
+  // The file's macros the copied code expands (#define INCREMENT(a, b) a++; b++), ahead of the copies.
+  std::string copiedText = c.Text(body->getSourceRange());
+  for (const Decl* d : decls) copiedText += "\n" + c.Text(d->getSourceRange());
+  const FileID fid = sm.getFileID(sm.getExpansionLoc(body->getBeginLoc()));
+  size_t at = 0;  // after the macros copied so far
+  while (at < c.model.sourceDecls.size() && c.model.sourceDecls[at].find("\n#define ") != std::string::npos) ++at;
+  for (auto& [name, definition] : UsedMacros(sm.getBufferData(fid), copiedText)) {
+    const std::string copy = "// from " + file + "\n" + definition;
+    if (std::find(c.model.sourceDecls.begin(), c.model.sourceDecls.end(), copy) == c.model.sourceDecls.end())
+      c.model.sourceDecls.insert(c.model.sourceDecls.begin() + at++, copy);
   }
 }
 
@@ -663,11 +715,11 @@ bool IsImageParam(const ParmVarDecl* p) {
   return p->getType()->isReferenceType() && IsImage2D(p->getType().getNonReferenceType().getUnqualifiedType());
 }
 
-void CheckKernelParams(Context& c, const CXXMethodDecl* md, Kernel& k) {
+void CheckKernelParams(Context& c, const CXXMethodDecl* md, const FunctionDecl* def, Kernel& k) {
   for (unsigned i = 0; i < md->getNumParams(); ++i) {
     auto* p = md->getParamDecl(i);
     KernelParam kp;
-    kp.name = p->getNameAsString();
+    kp.name = def->getParamDecl(i)->getNameAsString();  // the name the body uses
     if (kp.name.empty()) {
       c.rep.Error(p->getLocation(), "kernel '" + k.name + "' has a parameter without a name", "name it, or remove it");
       continue;
@@ -1412,8 +1464,9 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
                       : "kernels return void and write results to pointer parameters or members");
     return;
   }
-  CheckKernelParams(c, md, k);
-  for (unsigned i = 0; i < md->getNumParams(); ++i) k.cppParamsDecl += (i ? ", " : "") + ParamDecl(c.ctx, md->getParamDecl(i), i);
+  // The definition's parameter names: its body uses them (a declaration may name them otherwise).
+  CheckKernelParams(c, md, def, k);
+  for (unsigned i = 0; i < def->getNumParams(); ++i) k.cppParamsDecl += (i ? ", " : "") + ParamDecl(c.ctx, md->getParamDecl(i), def->getParamDecl(i), i);
   GlslPrinter printer(c.ctx, c.cls, c.rep);
   printer.compositions = c.compositions;
   printer.threadReturnsValue = k.returnsBool;
@@ -1892,6 +1945,7 @@ public:
     CheckAppendedUses();
     RemoveOpenMpPragmas();
     Visit(m_def->getBody());
+    CheckTemporaryUses();
     m_ctrl.vulkanCmdBody = CanonicalCode(m_gpu.getRewrittenText(m_def->getBody()->getSourceRange()));
     m_ctrl.cpuBody = CanonicalCode(m_cpu.getRewrittenText(m_def->getBody()->getSourceRange()));
   }
@@ -1942,9 +1996,92 @@ private:
         return view + ")";
       }
     }
-    m_c.rep.GpuError(arg->getBeginLoc(), "pointer argument of a kernel call must be a parameter of '" + m_ctrl.name + "' or 'member.data()' (+ offset)",
-                  "pass the control function's size-annotated pointer, or a std::vector member's data()");
+    if (auto* mc = dyn_cast<CXXMemberCallExpr>(e); mc && mc->getMethodDecl()->getName() == "data")
+      if (auto* dr = dyn_cast<DeclRefExpr>(mc->getImplicitObjectArgument()->IgnoreParenImpCasts()))
+        if (auto* vd = dyn_cast<VarDecl>(dr->getDecl()); vd && vd->hasLocalStorage() && IsStdVector(vd->getType())) {
+          auto* t = Temporary(vd);
+          if (!t) return "{}";
+          m_temporaryUses.insert(dr);
+          std::string view = "m_temporaries." + t->buffer + ".View(";
+          if (offset) view += "sizeof(" + t->cppType + ") * size_t(" + m_c.Text(offset->getSourceRange()) + ")";
+          return view + ")";
+        }
+    m_c.rep.GpuError(arg->getBeginLoc(), "pointer argument of a kernel call must be a parameter of '" + m_ctrl.name + "', 'member.data()' or a local std::vector's data() (+ offset)",
+                  "pass the control function's size-annotated pointer, a std::vector member's data(), or a std::vector declared in '" + m_ctrl.name + "'");
     return "{}";
+  }
+
+  // ---- std::vector locals passed to kernels: std::vector<float> temp(n[, value]); kernel1D_A(temp.data(), ...) ----
+  // On the GPU the local gets a device buffer of the generated class (m_temporaries), sized and
+  // filled where the local is declared, as its constructor fills the host's. The host's vector
+  // stays (its size() is the buffer's); its elements are never the GPU's, so the control function
+  // may only pass data() to kernels and ask for size().
+
+  std::map<const VarDecl*, Control::Temporary> m_temporaries;
+  std::set<const DeclRefExpr*> m_temporaryUses;  // the references a kernel argument or size() makes
+
+  const Control::Temporary* Temporary(const VarDecl* vd) {
+    if (auto it = m_temporaries.find(vd); it != m_temporaries.end()) return &it->second;
+    QualType element;
+    IsStdVector(vd->getType(), &element);
+    const std::string local = vd->getNameAsString();
+    // Declared at the top of the control function's body, so that the buffer is sized once per call.
+    const DeclStmt* decl = nullptr;
+    if (auto* body = dyn_cast<CompoundStmt>(m_def->getBody()))
+      for (auto* st : body->body())
+        if (auto* ds = dyn_cast<DeclStmt>(st); ds && ds->isSingleDecl() && ds->getSingleDecl() == vd) decl = ds;
+    auto* ctor = dyn_cast_or_null<CXXConstructExpr>(vd->getInit() ? vd->getInit()->IgnoreImplicit() : nullptr);
+    const unsigned args = ctor ? unsigned(std::count_if(ctor->arg_begin(), ctor->arg_end(), [](const Expr* a) { return !isa<CXXDefaultArgExpr>(a); })) : 0;
+    const bool countCtor = ctor && (args == 1 || args == 2) && ctor->getArg(0)->getType()->isIntegerType();
+    if (!decl || !countCtor) {
+      m_c.rep.GpuError(vd->getLocation(), "std::vector '" + local + "' is passed to a kernel, but the GPU's copy of a local vector is made only from 'std::vector<T> " + local +
+                       "(n)' or '(n, value)' declared on its own at the top of '" + m_ctrl.name + "'",
+                       "declare it as 'std::vector<T> " + local + "(n);' at the top of the function, or make it a member");
+      return nullptr;
+    }
+    const ASTContext& ctx = m_c.ctx;
+    if (args == 2 && ctx.getTypeSize(element) != 32) {
+      m_c.rep.GpuError(ctor->getArg(1)->getBeginLoc(), "the GPU fills a local vector with a value of 32 bits, not of " + std::to_string(ctx.getTypeSize(element)) + " bits",
+                       "declare it as 'std::vector<T> " + local + "(n);' and fill it in a kernel");
+      return nullptr;
+    }
+    Control::Temporary t;
+    t.buffer = m_ctrl.name + "_" + local;
+    t.cppType = CppTypeName(ctx, element);
+    t.local = local;
+    const std::string bytes = "sizeof(" + t.cppType + ") * " + local + ".size()";
+    const std::string bits = args == 2 ? "crossrt::Bits32(" + t.cppType + "(" + m_c.Text(ctor->getArg(1)->getSourceRange()) + "))" : "0u";
+    SourceLocation end = Lexer::findLocationAfterToken(decl->getEndLoc(), tok::semi, ctx.getSourceManager(), ctx.getLangOpts(), false);
+    if (end.isInvalid()) end = decl->getEndLoc().getLocWithOffset(1);
+    m_gpu.InsertTextAfter(end, "\n  // " + local + " on the GPU: a buffer of the class, filled as the constructor fills the vector\n"
+                          "  crossrt::EnsureSize(m_ctx, m_temporaries." + t.buffer + ", " + bytes + ");\n"
+                          "  crossrt::FillCmd(a_cmd, m_temporaries." + t.buffer + ".View(), (" + bytes + " + 3) / 4 * 4, " + bits + ");");
+    m_ctrl.temporaries.push_back(t);
+    return &m_temporaries.emplace(vd, t).first->second;
+  }
+
+  // A temporary's elements live on the GPU: the host's copy is not theirs to read or write.
+  void CheckTemporaryUses() {
+    struct Uses : RecursiveASTVisitor<Uses> {
+      ControlRewriter& rw;
+      explicit Uses(ControlRewriter& r) : rw(r) {}
+      bool VisitCXXMemberCallExpr(CXXMemberCallExpr* mc) {
+        auto* dr = dyn_cast<DeclRefExpr>(mc->getImplicitObjectArgument()->IgnoreParenImpCasts());
+        const std::string n = mc->getMethodDecl() ? mc->getMethodDecl()->getNameAsString() : "";
+        if (dr && (n == "size" || n == "empty")) rw.m_temporaryUses.insert(dr);
+        return true;
+      }
+      bool VisitDeclRefExpr(DeclRefExpr* dr) {
+        auto* vd = dyn_cast<VarDecl>(dr->getDecl());
+        auto it = vd ? rw.m_temporaries.find(vd) : rw.m_temporaries.end();
+        if (it == rw.m_temporaries.end() || rw.m_temporaryUses.count(dr)) return true;
+        rw.m_c.rep.GpuError(dr->getLocation(), "'" + it->second.local + "' is used on the host, but the kernels of '" + rw.m_ctrl.name +
+                            "' read and write its GPU copy", "pass " + it->second.local + ".data() only to kernels; to read the results make it a member "
+                            "(or a size-annotated parameter), which the generated class copies back");
+        return true;
+      }
+    } uses(*this);
+    if (!m_temporaries.empty()) uses.TraverseStmt(const_cast<Stmt*>(m_def->getBody()));
   }
 
   // An Image2D argument of a kernel call, as the crossrt::ImageView the generated code binds: the
@@ -2933,6 +3070,28 @@ private:
   std::set<const VarDecl*> m_hostLoopVars;     // counters of loops inside thread loops: the same for all threads
 };
 
+// `text` with each whole identifier `from` replaced by `to`, for each (from, to) pair.
+std::string RenameIdentifiers(const std::string& text, const std::vector<std::pair<std::string, std::string>>& names) {
+  std::string out;
+  for (size_t i = 0; i < text.size();) {
+    if (!(std::isalpha(static_cast<unsigned char>(text[i])) || text[i] == '_')) {
+      out += text[i++];
+      continue;
+    }
+    size_t end = i;
+    while (end < text.size() && (std::isalnum(static_cast<unsigned char>(text[end])) || text[end] == '_')) ++end;
+    std::string word = text.substr(i, end - i);
+    for (auto& [from, to] : names)
+      if (word == from) {
+        word = to;
+        break;
+      }
+    out += word;
+    i = end;
+  }
+  return out;
+}
+
 void AnalyzeControl(Context& c, const CXXMethodDecl* md, const FunctionDecl* def) {
   Control ctrl;
   ctrl.name = md->getNameAsString();
@@ -2949,12 +3108,19 @@ void AnalyzeControl(Context& c, const CXXMethodDecl* md, const FunctionDecl* def
                 "return results through size-annotated pointer parameters or members; control functions return void");
     return;
   }
+  // The definition's parameter names, which its body uses; a size annotation may be on any
+  // declaration, in terms of that declaration's names.
+  std::vector<std::pair<std::string, std::string>> declaredNames;  // (a declaration's name, the definition's)
+  for (auto* redecl : md->redecls())
+    for (unsigned i = 0; i < redecl->getNumParams() && i < def->getNumParams(); ++i)
+      if (redecl->getParamDecl(i)->getName() != def->getParamDecl(i)->getName() && !redecl->getParamDecl(i)->getName().empty())
+        declaredNames.push_back({redecl->getParamDecl(i)->getNameAsString(), def->getParamDecl(i)->getNameAsString()});
   for (unsigned i = 0; i < md->getNumParams(); ++i) {
     auto* p = md->getParamDecl(i);
     ControlParam cp;
-    cp.name = p->getNameAsString();
+    cp.name = def->getParamDecl(i)->getNameAsString();
     if (cp.name.empty()) cp.name = "a_unnamed" + std::to_string(i);  // as ParamDecl() spells it
-    cp.declText = ParamDecl(c.ctx, p, i);
+    cp.declText = ParamDecl(c.ctx, p, def->getParamDecl(i), i);
     ctrl.paramsDecl += (i ? ", " : "") + cp.declText;
     ctrl.argsForward += (i ? ", " : "") + cp.name;
     if (p->getType()->isPointerType()) {
@@ -2962,8 +3128,10 @@ void AnalyzeControl(Context& c, const CXXMethodDecl* md, const FunctionDecl* def
       QualType pointee = p->getType()->getPointeeType();
       cp.isConst = pointee.isConstQualified();
       cp.pointeeCpp = CppTypeName(c.ctx, pointee);
-      for (auto* a : p->specific_attrs<AnnotateAttr>())
-        if (a->getAnnotation().starts_with("crossrt.size=")) cp.sizeExpr = a->getAnnotation().substr(13).str();
+      for (auto* redecl : md->redecls())
+        for (auto* a : redecl->getParamDecl(i)->specific_attrs<AnnotateAttr>())
+          if (a->getAnnotation().starts_with("crossrt.size=") && cp.sizeExpr.empty())
+            cp.sizeExpr = RenameIdentifiers(a->getAnnotation().substr(13).str(), declaredNames);
       if (cp.sizeExpr.empty())
         c.rep.GpuError(p->getLocation(), "pointer parameter '" + cp.name + "' of control function '" + ctrl.name + "' has no size",
                     "annotate it with its element count, e.g. '[[crossrt::size(\"n\")]] const float* " + cp.name +

@@ -291,6 +291,7 @@ Data Common(const ClassModel& model, const GenerateOptions& opt) {
   d.set("usingDecls", usings);
   d.set("hasUsingDecls", !usings.empty());
   d.set("hasMegakernels", !model.megakernels.empty());
+  d.set("hasTemporaries", std::any_of(model.controls.begin(), model.controls.end(), [](const Control& c) { return !c.temporaries.empty(); }));
   d.set("defaultExecutionMode", model.megakernelByDefault ? "Megakernel" : "Wavefront");
   Data comps = List();
   for (auto& c : model.compositions) {
@@ -879,6 +880,16 @@ Data ControlsData(const ClassModel& model) {
       states.push_back(y);
     }
     x.set("threadStates", states);
+    Data temporaries = List();
+    for (auto& t : c.temporaries) {
+      Data y;
+      y.set("buffer", t.buffer);
+      y.set("cppType", t.cppType);
+      y.set("local", t.local);
+      y.set("control", c.name);
+      temporaries.push_back(y);
+    }
+    x.set("temporaries", temporaries);
     controls.push_back(x);
   }
   return controls;

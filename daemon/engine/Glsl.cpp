@@ -1068,7 +1068,7 @@ std::string GlslPrinter::Call(const CallExpr* call) {
                 "kernels cannot do I/O: write results to an output buffer and print them in the control function");
 
   if (IsCrossrtAtomic(fd)) return AtomicCall(fd, call);
-  if (InNamespace(fd, "LiteMath") && (name == "InterlockedAdd" || name == "ReduceAdd")) return InterlockedCall(fd, call);
+  if (InNamespace(fd, "LiteMath") && (name == "InterlockedAdd" || name == "atomicAdd" || name == "ReduceAdd")) return InterlockedCall(fd, call);
   std::vector<std::string> args;
   const bool library = IsSystemDecl(fd) || fd->isInStdNamespace() || InNamespace(fd, "LiteMath");
   std::map<unsigned, std::string> bindings;
@@ -1208,6 +1208,9 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
     if (IsLiteMathType(me->getBase()->getType(), "half4") || IsLiteMathType(me->getBase()->getType(), "half2"))
       return Fail(e->getBeginLoc(), "a component of a half2 or half4 in a kernel (GPUs keep them packed, two per 32 bits)",
                   "convert it first: to_float4(h).x, float4(h)");
+    // LiteMath's matrices keep their columns in m_col, which GLSL's matrices index directly.
+    if (field->getName() == "m_col" && (IsLiteMathType(me->getBase()->getType(), "float4x4") || IsLiteMathType(me->getBase()->getType(), "float3x3")))
+      return Expr(me->getBase());
     if (me->isArrow()) {  // p->f: the field of what p points at
       auto t = Pointer(me->getBase());
       return t ? Pointee(*t, nullptr, e->getBeginLoc()) + "." + field->getNameAsString() : "/*error*/";
@@ -1238,7 +1241,19 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
     const clang::Expr* textureIndex = nullptr;
     if (kind == OO_Subscript)
       if (auto* array = TextureElement(op->getArg(0), &textureIndex)) return TextureTexel(array, textureIndex, op->getArg(1), e->getBeginLoc());
-    if (kind == OO_Subscript) return Expr(op->getArg(0)) + "[" + Expr(op->getArg(1)) + "]";
+    if (kind == OO_Subscript) {
+      // A LiteMath vector's component by a constant index past its end: undefined in C++, an error in GLSL.
+      clang::Expr::EvalResult index;
+      const auto glsl = GlslTypeOf(op->getArg(0)->getType().getNonReferenceType());
+      if (glsl && glsl->find("vec") != std::string::npos && glsl->find("mat") == std::string::npos &&
+          op->getArg(1)->EvaluateAsInt(index, m_ctx)) {
+        const int64_t n = glsl->back() - '0', i = index.Val.getInt().getExtValue();
+        if (i < 0 || i >= n)
+          return Fail(op->getArg(1)->getBeginLoc(), "index " + std::to_string(i) + " is out of range of a " + std::to_string(n) +
+                      "-component vector (undefined behaviour in C++, rejected by GLSL)", "index components 0 to " + std::to_string(n - 1));
+      }
+      return Expr(op->getArg(0)) + "[" + Expr(op->getArg(1)) + "]";
+    }
     if (op->isAssignmentOp() && op->getNumArgs() == 2 && ImageTexel(op->getArg(0))) {
       if (kind == OO_Equal) return ImageStore(op->getArg(0), Expr(op->getArg(1)), e);
       if (op->getArg(0)->HasSideEffects(m_ctx, /*IncludePossibleEffects=*/false))  // it is printed twice
@@ -1455,15 +1470,16 @@ std::string GlslPrinter::Stmt(const clang::Stmt* s, int indent) {
               "kernels may use declarations, if, for, while, do, switch, return, break and continue"), "";
 }
 
-// LiteMath's InterlockedAdd(mem, v[, before]) is GLSL's atomicAdd (relaxed, as LiteMath's); its
+// LiteMath's InterlockedAdd(mem, v[, before]) and atomicAdd(mem, v) are GLSL's atomicAdd (relaxed,
+// as LiteMath's); its
 // ReduceAdd(vector, index, v) adds a finite v to the element (kernel_slicer's ReduceAdd family),
 // through a function per member vector.
 std::string GlslPrinter::InterlockedCall(const FunctionDecl* fd, const CallExpr* call) {
   const std::string name = fd->getNameAsString();
-  if (name == "InterlockedAdd") {
-    if (call->getNumArgs() < 2) return Fail(call->getBeginLoc(), "InterlockedAdd needs a target and a value", "");
+  if (name == "InterlockedAdd" || name == "atomicAdd") {
+    if (call->getNumArgs() < 2) return Fail(call->getBeginLoc(), name + " needs a target and a value", "");
     if (std::string problem = AtomicTargetProblem(call->getArg(0)); !problem.empty())
-      return Fail(call->getArg(0)->getExprLoc(), "the target of InterlockedAdd is not in device memory: " + problem,
+      return Fail(call->getArg(0)->getExprLoc(), "the target of " + name + " is not in device memory: " + problem,
                   "make the target an element of a std::vector member, a data member, or an element of a kernel's pointer parameter");
     usesFloatAtomics |= call->getArg(0)->getType()->isRealFloatingType();
     const std::string add = "atomicAdd(" + Expr(call->getArg(0)) + ", " + Expr(call->getArg(1)) + ")";

@@ -202,6 +202,10 @@ struct Control {
   // Thread loops calling several kernels: the per-thread locals wavefront mode keeps in buffers.
   struct ThreadState { std::string buffer, cppType, local; };
   std::vector<ThreadState> threadStates;
+  // std::vector locals it passes to kernels (std::vector<float> temp(n); kernel1D_A(temp.data(), n)):
+  // device buffers of the generated class, filled as the local's constructor fills it.
+  struct Temporary { std::string buffer, cppType, local; };
+  std::vector<Temporary> temporaries;
   std::string sourceFile;
 };
 

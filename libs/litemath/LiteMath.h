@@ -74,6 +74,10 @@ constexpr float M_PI      = 3.14159265358979323846f;
 constexpr float M_TWOPI   = 2.0f * M_PI;
 constexpr float INV_PI    = 1.0f / M_PI;
 constexpr float INV_TWOPI = 1.0f / (2.0f * M_PI);
+// OpenCL's address space qualifier, which kernel_slicer's older samples write on pointers.
+#ifndef __global
+#define __global
+#endif
 #ifndef MAXFLOAT
 #define MAXFLOAT FLT_MAX
 #endif
@@ -1096,6 +1100,18 @@ inline void InterlockedAdd(float& mem, float data)
 {
   float before;
   InterlockedAdd(mem, data, before);
+}
+
+// The older names: atomicAdd(mem, v) is InterlockedAdd and gives the value before the add, as
+// GLSL's atomicAdd does; InterlockedAdd3f adds a float3 to three consecutive floats of an array.
+inline int atomicAdd(int& mem, int data) { int before; InterlockedAdd(mem, data, before); return before; }
+inline uint atomicAdd(uint& mem, uint data) { uint before; InterlockedAdd(mem, data, before); return before; }
+inline float atomicAdd(float& mem, float data) { float before; InterlockedAdd(mem, data, before); return before; }
+inline void InterlockedAdd3f(float* arr, int offset, float3 val)
+{
+  InterlockedAdd(arr[offset + 0], val.x);
+  InterlockedAdd(arr[offset + 1], val.y);
+  InterlockedAdd(arr[offset + 2], val.z);
 }
 
 // Sums from many threads into the elements of a std::vector (kernel_slicer's 045_reduce_add):

@@ -19,6 +19,10 @@
 #include "ShadedSpheres_CPU.h"
 #include "ShadedSpheres_Vulkan.h"
 #endif
+#if __has_include("StagedSaxpy_CPU.h")
+#include "StagedSaxpy_CPU.h"
+#include "StagedSaxpy_Vulkan.h"
+#endif
 #if __has_include("MovingBoxes_CPU.h")
 #include "MovingBoxes_CPU.h"
 #include "MovingBoxes_Vulkan.h"
@@ -100,6 +104,27 @@ Register movingBoxes(MakeCase<MovingBoxes>(
           throw std::runtime_error("ray 88 at time 1 should hit the quad at t = 11");
         Append(r, what);
         Append(r, dist);
+      }
+      return r;
+    }));
+#endif
+
+#if __has_include("StagedSaxpy_CPU.h")
+Register stagedSaxpy(MakeCase<StagedSaxpy>(
+    "std::vector locals of a control function between its kernels: (n), (n, value), data() + offset, size()", "staged_saxpy.h/.cpp", 0.0,
+    CONFORMANCE_MAKERS(StagedSaxpy), [](StagedSaxpy& s) {
+      s.CommitDeviceData();
+      Outputs r;
+      for (uint32_t n : {1000u, 4u}) {  // offsets of n floats: the device binds at multiples of 16 bytes
+        std::vector<float> x(n), y(n), out(n, -1.0f);
+        for (uint32_t i = 0; i < n; i++) {
+          x[i] = float(i % 17);
+          y[i] = 0.5f * float(i % 5);
+        }
+        s.Run(x.data(), y.data(), out.data(), n);
+        for (uint32_t i = 0; i < n; i++)  // a known answer: agreeing on garbage cannot pass
+          if (out[i] != x[i] * y[i] + 2.0f) throw std::runtime_error("out[" + std::to_string(i) + "] should be x * y + 2");
+        Append(r, out);
       }
       return r;
     }));
