@@ -384,9 +384,10 @@ std::vector<std::pair<std::string, std::string>> UsedMacros(llvm::StringRef file
   std::smatch m;
   while (std::getline(lines, line)) {
     if (!std::regex_search(line, m, defineLine)) continue;
+    const std::string name = m[1].str();  // before the continuation lines replace `line`
     std::string definition = line;
     while (!line.empty() && line.back() == '\\' && std::getline(lines, line)) definition += "\n" + line;
-    defines.push_back({m[1].str(), definition});
+    defines.push_back({name, definition});
   }
   static const std::regex identifier(R"([A-Za-z_][A-Za-z0-9_]*)");
   std::set<std::string> used;
@@ -3230,17 +3231,29 @@ bool AnalyzeTranslationUnit(ASTContext& ctx, const std::string& className, const
     StringRef buffer = sm.getBufferData(sm.getMainFileID());
     static const std::regex inc(R"(^[ \t]*#[ \t]*include[ \t]*([<"])([^>"]+)[>"])");
     std::string dir = llvm::sys::path::parent_path(FileOf(ctx, sm.getLocForStartOfFile(sm.getMainFileID()))).str();
+    // The file each #include line of the main file brought in, by line.
+    std::map<unsigned, std::string> included;
+    auto note = [&](const SrcMgr::SLocEntry& entry) {
+      if (!entry.isFile()) return;
+      const SourceLocation from = entry.getFile().getIncludeLoc();
+      // The main file, or its copy in the preamble the AST cache loaded (another FileID).
+      if (from.isValid() && (sm.getFileID(from) == sm.getMainFileID() || sm.getFilename(from) == sm.getFilename(sm.getLocForStartOfFile(sm.getMainFileID()))))
+        if (auto file = entry.getFile().getContentCache().OrigEntry)
+          included[sm.getSpellingLineNumber(from)] = file->getName().str();
+    };
+    for (unsigned i = 0; i < sm.local_sloc_entry_size(); ++i) note(sm.getLocalSLocEntry(i));
+    for (unsigned i = 0; i < sm.loaded_sloc_entry_size(); ++i) note(sm.getLoadedSLocEntry(i));  // the preamble's
     std::istringstream lines(buffer.str());
+    unsigned lineNumber = 0;
     for (std::string line; std::getline(lines, line);) {
+      ++lineNumber;
       std::smatch m;
       if (!std::regex_search(line, m, inc)) continue;
       std::string text;
       if (m[1] == "<") text = "#include <" + m[2].str() + ">";
       else {
         std::string path = dir + "/" + m[2].str();
-        if (!llvm::sys::fs::exists(path))  // found through an include directory: take the file Clang read
-          for (auto it = sm.fileinfo_begin(); it != sm.fileinfo_end(); ++it)
-            if (StringRef(it->first.getName()).ends_with("/" + m[2].str())) path = it->first.getName().str();
+        if (!llvm::sys::fs::exists(path) && included.count(lineNumber)) path = included[lineNumber];  // found through an include directory
         if (path == model.headerFile) continue;  // the generated header includes it already
         text = "#include \"" + path + "\"";
       }

@@ -1068,7 +1068,8 @@ std::string GlslPrinter::Call(const CallExpr* call) {
                 "kernels cannot do I/O: write results to an output buffer and print them in the control function");
 
   if (IsCrossrtAtomic(fd)) return AtomicCall(fd, call);
-  if (InNamespace(fd, "LiteMath") && (name == "InterlockedAdd" || name == "atomicAdd" || name == "ReduceAdd")) return InterlockedCall(fd, call);
+  if (InNamespace(fd, "LiteMath") && (name == "InterlockedAdd" || name == "atomicAdd" || name == "InterlockedAdd3f" || name == "ReduceAdd"))
+    return InterlockedCall(fd, call);
   std::vector<std::string> args;
   const bool library = IsSystemDecl(fd) || fd->isInStdNamespace() || InNamespace(fd, "LiteMath");
   std::map<unsigned, std::string> bindings;
@@ -1484,6 +1485,18 @@ std::string GlslPrinter::InterlockedCall(const FunctionDecl* fd, const CallExpr*
     usesFloatAtomics |= call->getArg(0)->getType()->isRealFloatingType();
     const std::string add = "atomicAdd(" + Expr(call->getArg(0)) + ", " + Expr(call->getArg(1)) + ")";
     return call->getNumArgs() == 3 ? Expr(call->getArg(2)) + " = " + add : add;
+  }
+  if (name == "InterlockedAdd3f") {  // (array, offset, float3): three atomic adds to array[offset], [offset + 1], [offset + 2]
+    if (call->getNumArgs() != 3) return Fail(call->getBeginLoc(), "InterlockedAdd3f takes an array, an offset and a float3", "");
+    auto t = Pointer(call->getArg(0));
+    if (!t) return "/*error*/";
+    if (!t->value.empty() || t->local)
+      return Fail(call->getArg(0)->getExprLoc(), "the array of InterlockedAdd3f is not in device memory",
+                  "pass a kernel's pointer parameter or a std::vector member's data()");
+    usesFloatAtomics = true;
+    const std::string at = (t->offset.empty() ? "" : t->offset + " + ") + "(" + Expr(call->getArg(1)) + ")", value = "(" + Expr(call->getArg(2)) + ")";
+    return "atomicAdd(" + t->array + "[" + at + "], " + value + ".x), atomicAdd(" + t->array + "[" + at + " + 1], " + value +
+           ".y), atomicAdd(" + t->array + "[" + at + " + 2], " + value + ".z)";
   }
   const FieldDecl* field = ThisMemberField(call->getArg(0));
   QualType element;

@@ -3,6 +3,7 @@
 #include "Conformance.h"
 
 #include "LiteMath.h"
+#include <stdexcept>
 
 // A case compiles where this build translated its class (CONFORMANCE_CLASSES); main checks that all were.
 #if __has_include("Transforms_CPU.h")
@@ -24,6 +25,10 @@
 #if __has_include("Histogram_CPU.h")
 #include "Histogram_CPU.h"
 #include "Histogram_Vulkan.h"
+#endif
+#if __has_include("OldAtomics_CPU.h")
+#include "OldAtomics_CPU.h"
+#include "OldAtomics_Vulkan.h"
 #endif
 #if __has_include("AccumGrid_CPU.h")
 #include "AccumGrid_CPU.h"
@@ -138,6 +143,29 @@ Register projector(MakeCase<Projector>(
       for (auto& q : in) q.z -= 20.0f;
       p.Project(100, in.data(), out.data());
       return Flatten(out);
+    }));
+#endif
+
+#if __has_include("OldAtomics_CPU.h")
+Register oldAtomics(MakeCase<OldAtomics>(
+    "atomicAdd(a_out[i], v) and InterlockedAdd3f(array, offset, float3), the older spellings", "old_atomics.h/.cpp", 0.0,
+    CONFORMANCE_MAKERS(OldAtomics), [](OldAtomics& a) {
+      a.CommitDeviceData();
+      const uint32_t bins = 10, threads = 6000;
+      std::vector<int32_t> counts(bins, 5);
+      std::vector<float> sums(bins * 4, 0.0f);
+      a.Scatter(threads, counts.data(), sums.data(), bins);
+      // Known answers: 600 threads per bin (7 and 10 are coprime), counts add i % 3 to the 5 there.
+      int32_t total = 0;
+      for (int32_t c : counts) total += c;
+      if (total != int32_t(5 * bins) + 6000 / 3 * (0 + 1 + 2)) throw std::runtime_error("the counts should add up to 6050");
+      for (uint32_t b = 0; b < bins; b++)
+        if (sums[b * 4] != 600.0f || sums[b * 4 + 1] != 300.0f || sums[b * 4 + 3] != 0.0f)
+          throw std::runtime_error("each bin should get 600 adds of (1, 0.5, i % 4) and nothing in its fourth float");
+      Outputs r;
+      Append(r, counts);
+      Append(r, sums);
+      return r;
     }));
 #endif
 
