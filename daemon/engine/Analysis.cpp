@@ -792,7 +792,7 @@ void CheckKernelParams(Context& c, const CXXMethodDecl* md, const FunctionDecl* 
         kp.valueCppType = value->isUnsignedIntegerType() ? "uint32_t" : "int32_t";
         kp.narrowed = true;
         kp.cppType = ParamDecl(c.ctx, p, i);
-        kp.cppType = kp.cppType.substr(0, kp.cppType.size() - kp.name.size());
+        kp.cppType = kp.cppType.substr(0, kp.cppType.size() - p->getName().size());
         while (!kp.cppType.empty() && isspace((unsigned char)kp.cppType.back())) kp.cppType.pop_back();
         if (c.rep.GpuRules())
           c.rep.Note(p->getLocation(), "kernel parameter '" + kp.name + "' of type '" + t.getAsString(c.ctx.getPrintingPolicy()) +
@@ -810,7 +810,7 @@ void CheckKernelParams(Context& c, const CXXMethodDecl* md, const FunctionDecl* 
       kp.glslType = *g;
       kp.valueCppType = CppTypeName(c.ctx, value);
       kp.cppType = ParamDecl(c.ctx, p, i);
-      kp.cppType = kp.cppType.substr(0, kp.cppType.size() - kp.name.size());  // type part only
+      kp.cppType = kp.cppType.substr(0, kp.cppType.size() - p->getName().size());  // type part only
       while (!kp.cppType.empty() && isspace((unsigned char)kp.cppType.back())) kp.cppType.pop_back();
     }
     k.params.push_back(kp);
@@ -3233,8 +3233,10 @@ bool AnalyzeTranslationUnit(ASTContext& ctx, const std::string& className, const
     std::string dir = llvm::sys::path::parent_path(FileOf(ctx, sm.getLocForStartOfFile(sm.getMainFileID()))).str();
     // The file each #include line of the main file brought in, by line.
     std::map<unsigned, std::string> included;
+    std::vector<std::string> read;  // every file Clang read, for an include that was skipped (#pragma once)
     auto note = [&](const SrcMgr::SLocEntry& entry) {
       if (!entry.isFile()) return;
+      if (auto file = entry.getFile().getContentCache().OrigEntry) read.push_back(file->getName().str());
       const SourceLocation from = entry.getFile().getIncludeLoc();
       // The main file, or its copy in the preamble the AST cache loaded (another FileID).
       if (from.isValid() && (sm.getFileID(from) == sm.getMainFileID() || sm.getFilename(from) == sm.getFilename(sm.getLocForStartOfFile(sm.getMainFileID()))))
@@ -3254,6 +3256,9 @@ bool AnalyzeTranslationUnit(ASTContext& ctx, const std::string& className, const
       else {
         std::string path = dir + "/" + m[2].str();
         if (!llvm::sys::fs::exists(path) && included.count(lineNumber)) path = included[lineNumber];  // found through an include directory
+        else if (!llvm::sys::fs::exists(path))  // read before, through another include: the file of that name
+          for (auto& name : read)
+            if (StringRef(name).ends_with("/" + m[2].str())) path = name;
         if (path == model.headerFile) continue;  // the generated header includes it already
         text = "#include \"" + path + "\"";
       }
