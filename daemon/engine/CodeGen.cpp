@@ -489,7 +489,8 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
     for (auto& p : k.params) used += " " + p.glslType;
     for (auto& v : memberVectors)
       if (auto* m = FindMember(model, v)) used += " " + m->glslType;
-    static const std::regex structName(R"(^struct (\w+))"), constantName(R"(^const \w+ (\w+))");
+    // Structs, and the buffer reference types of virtual calls (layout(buffer_reference, ...) buffer T).
+    static const std::regex structName(R"(^(?:struct|layout\(buffer_reference[^)]*\) readonly buffer) (\w+))"), constantName(R"(^const \w+ (\w+))");
     constantList = KeepMentioned(k.constantList, used, constantName);
     for (auto& c : constantList) used += c;
     structList = KeepMentioned(k.structList, used, structName);

@@ -22,6 +22,7 @@ struct Frame
 {
   std::vector<uint32_t> color;
   std::vector<float> depth, sorted;
+  std::vector<uint32_t> rowOffsets;
   uint32_t hits = 0, sortedCount = 0;
   float meanDepth = 0.0f, maxDepth = 0.0f;
 };
@@ -43,6 +44,8 @@ Frame RenderCubes(std::shared_ptr<RayCaster> caster, int w, int h)
   f.sorted.resize(size_t(w) * h);
   caster->Render(f.color.data(), f.depth.data());
   caster->SortedDepths(f.sorted.data(), &f.sortedCount);
+  f.rowOffsets.resize(size_t(h));
+  caster->RowOffsets(f.depth.data(), f.rowOffsets.data());
   f.hits = caster->m_hitCount;
   f.meanDepth = caster->m_meanDepth;
   f.maxDepth = caster->m_maxDepth;
@@ -69,6 +72,19 @@ bool CheckRayCaster()
   check(std::fabs(nearest - 2.5f) < 0.05f, "the nearest depth should be about 2.5");
   check(ref.meanDepth > 2.4f && ref.meanDepth < ref.maxDepth && ref.maxDepth < 4.5f, "depth statistics out of range");
   check(ref.sortedCount == ref.hits && std::is_sorted(ref.sorted.begin(), ref.sorted.begin() + ref.sortedCount), "SortedDepths");
+  // The row offsets, counted here from the depths.
+  uint32_t above = 0;
+  bool offsetsOk = true;
+  for (int y = 0; y < h; ++y)
+  {
+    offsetsOk = offsetsOk && ref.rowOffsets[size_t(y)] == above;
+    for (int x = 0; x < w; ++x) above += ref.depth[size_t(y * w + x)] > 0.0f;
+  }
+  check(offsetsOk && above == ref.hits, "RowOffsets should be the exclusive scan of the rows' hits");
+  // Both shades show: the flat cube's colour and the striped cube's.
+  std::vector<uint32_t> colours(ref.color);
+  std::sort(colours.begin(), colours.end());
+  check(std::unique(colours.begin(), colours.end()) - colours.begin() > 8, "the two shades should give many colours");
   for (const Frame* f : {&cpu, &gpu})
   {
     const bool exact = f == &cpu;
@@ -87,6 +103,9 @@ bool CheckRayCaster()
     check(std::abs(int(f->hits) - int(ref.hits)) <= int(allowed), "hit count differs");
     check(std::fabs(f->meanDepth - ref.meanDepth) < 1e-3f && std::fabs(f->maxDepth - ref.maxDepth) < 1e-4f, "depth statistics differ");
     check(f->sortedCount == f->hits && std::is_sorted(f->sorted.begin(), f->sorted.begin() + f->sortedCount), "sorted depths");
+    int offsetDiff = 0;
+    for (int y = 0; y < h; ++y) offsetDiff = std::max(offsetDiff, std::abs(int(f->rowOffsets[size_t(y)]) - int(ref.rowOffsets[size_t(y)])));
+    check(offsetDiff <= int(allowed), "row offsets differ from the original");
   }
   return ok;
 }

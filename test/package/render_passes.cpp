@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 namespace
 {
@@ -26,6 +27,10 @@ static float3 Palette(uint32_t id)
 RayCaster::RayCaster(int a_width, int a_height) : m_width(a_width), m_height(a_height)
 {
   m_hitDepths.resize(size_t(a_width) * size_t(a_height));
+  m_rowHits.resize(size_t(a_height));
+  m_rowOffsets.resize(size_t(a_height));
+  m_shades.push_back(std::make_shared<FlatShade>());
+  m_shades.push_back(std::make_shared<StripeShade>());
 }
 
 void RayCaster::SetCamera(float3 a_eye, float a_fovDegrees)
@@ -64,8 +69,8 @@ void RayCaster::kernel2D_Render(uint32_t* a_color, float* a_depth, int a_width, 
         a_depth[y * a_width + x] = 0.0f;
         continue;
       }
-      const float shade = 0.3f + 0.7f * std::abs(dir.z);
-      a_color[y * a_width + x] = PackColor(Palette(hit.primId) * shade);
+      const float3 base = m_shades[hit.instId % m_shades.size()]->Color(dir, hit.primId);
+      a_color[y * a_width + x] = PackColor(0.8f * base + 0.2f * Palette(hit.primId));
       a_depth[y * a_width + x] = hit.t;
       m_hitCount += 1;
       depthSum += hit.t;
@@ -94,4 +99,28 @@ void RayCaster::kernel1D_CopySorted(float* a_sorted, uint32_t* a_count)
   for (uint32_t i = 0; i < m_hitDepths.size(); i++)
     a_sorted[i] = m_hitDepths[i];
   a_count[0] = uint32_t(m_hitDepths.size());
+}
+
+void RayCaster::RowOffsets(const float* a_depth, uint32_t* a_offsets)
+{
+  kernel1D_CountRows(a_depth, m_width, m_height);
+  std::exclusive_scan(m_rowHits.begin(), m_rowHits.end(), m_rowOffsets.begin(), 0u);
+  kernel1D_CopyOffsets(a_offsets, m_height);
+}
+
+void RayCaster::kernel1D_CountRows(const float* a_depth, int a_width, int a_height)
+{
+  for (int y = 0; y < a_height; y++)
+  {
+    uint32_t hits = 0;
+    for (int x = 0; x < a_width; x++)
+      hits += a_depth[y * a_width + x] > 0.0f ? 1u : 0u;
+    m_rowHits[y] = hits;
+  }
+}
+
+void RayCaster::kernel1D_CopyOffsets(uint32_t* a_offsets, int a_height)
+{
+  for (int y = 0; y < a_height; y++)
+    a_offsets[y] = m_rowOffsets[y];
 }
