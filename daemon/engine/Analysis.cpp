@@ -2018,10 +2018,10 @@ private:
   // stays (its size() is the buffer's); its elements are never the GPU's, so the control function
   // may only pass data() to kernels and ask for size().
 
-  std::map<const VarDecl*, Control::Temporary> m_temporaries;
+  std::map<const VarDecl*, Control::LocalBuffer> m_temporaries;
   std::set<const DeclRefExpr*> m_temporaryUses;  // the references a kernel argument or size() makes
 
-  const Control::Temporary* Temporary(const VarDecl* vd) {
+  const Control::LocalBuffer* Temporary(const VarDecl* vd) {
     if (auto it = m_temporaries.find(vd); it != m_temporaries.end()) return &it->second;
     QualType element;
     IsStdVector(vd->getType(), &element);
@@ -2046,7 +2046,7 @@ private:
                        "declare it as 'std::vector<T> " + local + "(n);' and fill it in a kernel");
       return nullptr;
     }
-    Control::Temporary t;
+    Control::LocalBuffer t;
     t.buffer = m_ctrl.name + "_" + local;
     t.cppType = CppTypeName(ctx, element);
     t.local = local;

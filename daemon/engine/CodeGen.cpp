@@ -871,26 +871,20 @@ Data ControlsData(const ClassModel& model) {
             if (ib.stored && !ib.parameter) addImage(ib.member);
     for (auto& name : c.imagesWritten) addImage(name);
     x.set("writtenImages", writtenImages);
-    Data states = List();
-    for (auto& s : c.threadStates) {
-      Data y;
-      y.set("buffer", s.buffer);
-      y.set("cppType", s.cppType);
-      y.set("local", s.local);
-      y.set("control", c.name);
-      states.push_back(y);
-    }
-    x.set("threadStates", states);
-    Data temporaries = List();
-    for (auto& t : c.temporaries) {
-      Data y;
-      y.set("buffer", t.buffer);
-      y.set("cppType", t.cppType);
-      y.set("local", t.local);
-      y.set("control", c.name);
-      temporaries.push_back(y);
-    }
-    x.set("temporaries", temporaries);
+    auto localBuffers = [&](const std::vector<Control::LocalBuffer>& buffers) {
+      Data list = List();
+      for (auto& b : buffers) {
+        Data y;
+        y.set("buffer", b.buffer);
+        y.set("cppType", b.cppType);
+        y.set("local", b.local);
+        y.set("control", c.name);
+        list.push_back(y);
+      }
+      return list;
+    };
+    x.set("threadStates", localBuffers(c.threadStates));
+    x.set("temporaries", localBuffers(c.temporaries));
     controls.push_back(x);
   }
   return controls;

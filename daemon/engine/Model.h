@@ -199,13 +199,13 @@ struct Control {
   std::vector<std::string> kernelsCalled;
   std::vector<std::string> vectorsWritten;  // member vectors its library calls (scan, fill, memcpy) write
   std::vector<std::string> imagesWritten;   // Image2D members it passes to kernels' non-const image parameters
+  // A device buffer of the generated class that holds a local of the control function.
+  struct LocalBuffer { std::string buffer, cppType, local; };
   // Thread loops calling several kernels: the per-thread locals wavefront mode keeps in buffers.
-  struct ThreadState { std::string buffer, cppType, local; };
-  std::vector<ThreadState> threadStates;
-  // std::vector locals it passes to kernels (std::vector<float> temp(n); kernel1D_A(temp.data(), n)):
-  // device buffers of the generated class, filled as the local's constructor fills it.
-  struct Temporary { std::string buffer, cppType, local; };
-  std::vector<Temporary> temporaries;
+  std::vector<LocalBuffer> threadStates;
+  // std::vector locals it passes to kernels (std::vector<float> temp(n); kernel1D_A(temp.data(), n)),
+  // filled as the local's constructor fills it.
+  std::vector<LocalBuffer> temporaries;
   std::string sourceFile;
 };
 

@@ -337,44 +337,60 @@ private:
   std::vector<BVH4Node> m_nodes;
 };
 
-// Packs the triangles of each leaf of `wide` (triangles[k] is triangle primIndices[k]) into groups
-// of four, in the order the leaves appear, and points the leaves at their groups.
-void GroupLeaves(std::vector<BVH4Node>& wide, const std::vector<BVHTriangle>& triangles, const std::vector<uint32_t>& primIndices,
-                 std::vector<BVHTriangle4>& groups, std::vector<uint32_t>& groupPrims)
+// Visits the leaves of `wide` in order, their entries in groups of four: open() starts a group
+// and returns its index, fill(lane, k) puts entry k of the leaf's range in a lane of the open
+// group, empty(lane) marks a lane the leaf does not fill; each leaf then points at its groups.
+template <class Open, class Fill, class Empty>
+void PackLeavesByFour(std::vector<BVH4Node>& wide, Open open, Fill fill, Empty empty)
 {
-  groups.clear();
-  groupPrims.clear();
-  const float nan = std::numeric_limits<float>::quiet_NaN();
   for (BVH4Node& n : wide)
     for (int lane = 0; lane < 4; ++lane)
     {
       const uint32_t c = n.child[lane];
       if (c == kNoChild || (c & kLeafFlag) == 0)
         continue;
-      const uint32_t first = (c & ~kLeafFlag) >> 3, count = (c & 7u) + 1;
-      const uint32_t firstGroup = uint32_t(groups.size()), groupCount = (count + 3) / 4;
+      const uint32_t first = (c & ~kLeafFlag) >> 3, count = (c & 7u) + 1, groupCount = (count + 3) / 4;
+      uint32_t firstGroup = 0;
       for (uint32_t k = 0; k < 4 * groupCount; ++k)
       {
         if (k % 4 == 0)
         {
-          groups.emplace_back();
-          for (float4& c4 : groups.back().coord) c4 = float4(nan);
+          const uint32_t g = open();
+          firstGroup = k == 0 ? g : firstGroup;
         }
-        BVHTriangle4& group = groups.back();
-        if (k >= count)
-        {
-          groupPrims.push_back(kNoId);
-          continue;
-        }
-        const BVHTriangle& tri = triangles[first + k];
-        const float3 corners[3] = {tri.v0, tri.v1, tri.v2};
-        for (int corner = 0; corner < 3; ++corner)
-          for (int axis = 0; axis < 3; ++axis)
-            group.coord[3 * corner + axis][k % 4] = corners[corner][axis];
-        groupPrims.push_back(primIndices[first + k]);
+        if (k < count)
+          fill(k % 4, first + k);
+        else
+          empty(k % 4);
       }
       n.child[lane] = LeafRef(firstGroup, groupCount);
     }
+}
+
+// Packs the triangles of each leaf of `wide` (triangles[k] is triangle primIndices[k]) into groups
+// of four, in the order the leaves appear (empty lanes NaN), and points the leaves at their groups.
+void GroupLeaves(std::vector<BVH4Node>& wide, const std::vector<BVHTriangle>& triangles, const std::vector<uint32_t>& primIndices,
+                 std::vector<BVHTriangle4>& groups, std::vector<uint32_t>& groupPrims)
+{
+  groups.clear();
+  groupPrims.clear();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  PackLeavesByFour(
+      wide,
+      [&] {
+        groups.emplace_back();
+        for (float4& c4 : groups.back().coord) c4 = float4(nan);
+        return uint32_t(groups.size() - 1);
+      },
+      [&](int slot, uint32_t k) {
+        const BVHTriangle& tri = triangles[k];
+        const float3 corners[3] = {tri.v0, tri.v1, tri.v2};
+        for (int corner = 0; corner < 3; ++corner)
+          for (int axis = 0; axis < 3; ++axis)
+            groups.back().coord[3 * corner + axis][slot] = corners[corner][axis];
+        groupPrims.push_back(primIndices[k]);
+      },
+      [&](int) { groupPrims.push_back(kNoId); });
 }
 
 // Box geometry: packs the boxes of each leaf of `wide` (boxes[k] is box primIndices[k]) into groups
@@ -385,39 +401,29 @@ void GroupBoxes(std::vector<BVH4Node>& wide, const std::vector<Box4f>& boxes, co
 {
   groups.clear();
   const float inf = std::numeric_limits<float>::infinity();
-  for (BVH4Node& n : wide)
-    for (int lane = 0; lane < 4; ++lane)
-    {
-      const uint32_t c = n.child[lane];
-      if (c == kNoChild || (c & kLeafFlag) == 0)
-        continue;
-      const uint32_t first = (c & ~kLeafFlag) >> 3, count = (c & 7u) + 1;
-      const uint32_t firstGroup = uint32_t(groups.size()), groupCount = (count + 3) / 4;
-      for (uint32_t k = 0; k < 4 * groupCount; ++k)
-      {
-        if (k % 4 == 0)
-        {
-          groups.emplace_back();
-          BVH4Node& g = groups.back();
-          g.minX = g.minY = g.minZ = float4(inf);
-          g.maxX = g.maxY = g.maxZ = float4(-inf);
-          g.child = uint4(kNoChild);
-          g.unused = uint4(0u);
-        }
-        if (k >= count)
-          continue;
+  PackLeavesByFour(
+      wide,
+      [&] {
+        groups.emplace_back();
         BVH4Node& g = groups.back();
-        const Box4f& b = boxes[primIndices[first + k]];
-        g.minX[k % 4] = b.boxMin.x;
-        g.minY[k % 4] = b.boxMin.y;
-        g.minZ[k % 4] = b.boxMin.z;
-        g.maxX[k % 4] = b.boxMax.x;
-        g.maxY[k % 4] = b.boxMax.y;
-        g.maxZ[k % 4] = b.boxMax.z;
-        g.child[k % 4] = primIndices[first + k] / boxesPerPrim;
-      }
-      n.child[lane] = LeafRef(firstGroup, groupCount);
-    }
+        g.minX = g.minY = g.minZ = float4(inf);
+        g.maxX = g.maxY = g.maxZ = float4(-inf);
+        g.child = uint4(kNoChild);
+        g.unused = uint4(0u);
+        return uint32_t(groups.size() - 1);
+      },
+      [&](int slot, uint32_t k) {
+        BVH4Node& g = groups.back();
+        const Box4f& b = boxes[primIndices[k]];
+        g.minX[slot] = b.boxMin.x;
+        g.minY[slot] = b.boxMin.y;
+        g.minZ[slot] = b.boxMin.z;
+        g.maxX[slot] = b.boxMax.x;
+        g.maxY[slot] = b.boxMax.y;
+        g.maxZ[slot] = b.boxMax.z;
+        g.child[slot] = primIndices[k] / boxesPerPrim;
+      },
+      [](int) {});
 }
 
 std::vector<BVH4Node> CollapseTree(const BVHTree& tree, std::function<Box4f(uint32_t)> primBox)
