@@ -1,6 +1,7 @@
 // C++ (Clang AST) to GLSL: types, memory layouts and the statement/expression printer.
 #pragma once
 #include "Diagnostics.h"
+#include "OrderedSet.h"
 
 #include <clang/AST/ASTContext.h>
 #include <clang/AST/DeclCXX.h>
@@ -69,7 +70,7 @@ public:
   // loop passed as &local): the GPU passes the value itself, so *p, p->f and p[0] print as p, p.f.
   std::set<const clang::ValueDecl*> valueParams;
   // Members declared std::vector that the kernel reaches, plain members it reads.
-  std::set<const clang::FieldDecl*> memberVectors, plainMembers;
+  OrderedSet<const clang::FieldDecl*> memberVectors, plainMembers;
   // Where the kernel reads a member vector's size (a kernel may not read what it appends to).
   std::multimap<const clang::FieldDecl*, clang::SourceLocation> sizeReads;
   // Where the kernel reads the size of a vector of objects (the class data holds it with the
@@ -77,15 +78,15 @@ public:
   std::multimap<const clang::FieldDecl*, clang::SourceLocation> objectSizeReads;
   // The kernel's Image2D reference parameters (the definition's): images bound per call, used in
   // the kernel's own body as member images are.
-  std::set<const clang::ValueDecl*> imageParams;
+  OrderedSet<const clang::ValueDecl*> imageParams;
   // Image2D members and parameters the kernel loads or stores texels of (storage images), samples
   // (textures), and the Sampler members it samples with.
-  std::set<const clang::ValueDecl*> loadedImages, storedImages, sampledImages;
-  std::set<const clang::FieldDecl*> samplers;
-  std::set<const clang::ValueDecl*> sizedImages;  // whose width() or height() it reads
-  std::set<std::pair<const clang::ValueDecl*, const clang::FieldDecl*>> samplePairs;  // (image, sampler)
+  OrderedSet<const clang::ValueDecl*> loadedImages, storedImages, sampledImages;
+  OrderedSet<const clang::FieldDecl*> samplers;
+  OrderedSet<const clang::ValueDecl*> sizedImages;  // whose width() or height() it reads
+  OrderedSet<std::pair<const clang::ValueDecl*, const clang::FieldDecl*>> samplePairs;  // (image, sampler)
   // Arrays of textures (std::vector<LiteImage::Texture2D<T>> members) the kernel samples or reads.
-  std::set<const clang::FieldDecl*> textureArrays;
+  OrderedSet<const clang::FieldDecl*> textureArrays;
   // Helper functions the kernel reaches (their writes to members matter too).
   std::vector<const clang::FunctionDecl*> helpers;
 
@@ -102,7 +103,7 @@ public:
 
   // Virtual functions (paper 3.9). In a kernel's printer: calls `m_objects[i]->Method(...)` through
   // a std::vector of pointers to a polymorphic class, as (vector member, interface method).
-  std::set<std::pair<const clang::FieldDecl*, const clang::CXXMethodDecl*>> virtualCalls;
+  OrderedSet<std::pair<const clang::FieldDecl*, const clang::CXXMethodDecl*>> virtualCalls;
   std::vector<const clang::CXXMemberCallExpr*> virtualCallSites;  // each such call, in printing order
   // Statements printed as other text (each line indented as the statement): the loops over leaves
   // of a traversal that the ray tracing hardware runs instead (virtual functions, level 3).
@@ -120,7 +121,7 @@ public:
   bool singleThread = false;
   // The thread function returns a value (a kernel_ function returning bool).
   bool threadReturnsValue = false;
-  std::set<const clang::FieldDecl*> emptiedVectors;  // clear() or resize(0) there
+  OrderedSet<const clang::FieldDecl*> emptiedVectors;  // clear() or resize(0) there
 
   std::string Expr(const clang::Expr* e);
   std::string Stmt(const clang::Stmt* s, int indent);
