@@ -1,0 +1,248 @@
+// The code of virtual calls: per implementation its data struct and methods printed with `self`, per
+// method a dispatcher that switches over the object's class (levels 1-2), or at level 3 a callable
+// shader per implementation and the call that the ray generation shader makes.
+#include "Callables.h"
+
+#include "AstQueries.h"
+#include "Members.h"
+#include "VirtualCalls.h"
+
+#include <llvm/Support/FileSystem.h>
+#include <llvm/Support/Path.h>
+
+#include <algorithm>
+#include <cctype>
+#include <regex>
+#include <sstream>
+
+using namespace clang;
+
+namespace crossrt::engine {
+
+namespace {
+
+// Level 3: `vm`'s implementation `vi` (an object of class `impl`) of `method` as a callable shader,
+// named <member>_<class>_<method>, added to the model unless another kernel added it.
+void AddCallableShader(ASTContext& ctx, Reporter& rep, ClassModel& model, const VirtualMember& vm, const VirtualImpl& vi,
+                       const CXXRecordDecl* impl, const CXXMethodDecl* method, SourceLocation callLoc, const std::string& dataStruct,
+                       const std::string& objectsReference, const std::string& payload) {
+  const std::string name = vm.member + "_" + vi.name + "_" + method->getNameAsString();
+  if (std::any_of(model.callables.begin(), model.callables.end(), [&](const StageShader& c) { return c.name == name; })) return;
+  GlslPrinter printer(ctx, impl, rep);
+  printer.selfClass = impl;
+  printer.composedPrefix = vi.name + "_";
+  for (auto& sn : ClassStructNames(model)) printer.predeclaredStructs.insert(sn);
+  const std::string function = ImplementationMethod(rep, printer, impl, method, callLoc);
+  if (function.empty()) return;
+  StageShader c;
+  c.name = name;
+  c.stage = "rcall";
+  c.origin = vi.name + "::" + method->getNameAsString();
+  c.description = "what " + vm.display + "[index]->" + method->getNameAsString() + (method->getNumParams() ? "(...)" : "()") +
+                  " runs when the object is\n// a " + vi.name +
+                  ", as a callable shader of the ray tracing pipelines of the kernels calling it (virtual functions, level 3)";
+  c.scalarLayout = vi.scalarLayout;
+  for (auto& x : printer.Constants()) c.constants += x;
+  for (auto& x : printer.Structs()) c.structs += x + "\n";
+  c.structs += dataStruct + "\n" + objectsReference + "\n" + payload + "layout(location = 0) callableDataInEXT " + vm.member + "_" + method->getNameAsString() +
+               "_Call call;\n";
+  for (auto& x : printer.Functions()) c.functions += x + "\n";
+  std::string args = "self";
+  for (unsigned i = 0; i < method->getNumParams(); ++i) args += ", call." + CallArgumentName(method, i);
+  const std::string invoke = function + "(" + args + ")";
+  c.mainBody = "  const " + vi.name + "_Data self = " + vm.member + "_" + vi.name + "Objects(call.crt_objects).objects[call.crt_index];\n  " +
+               (method->getReturnType()->isVoidType() ? invoke : "call.crt_result = " + invoke) + ";\n";
+  model.callables.push_back(c);
+}
+
+// Level 3: `m` called through `vm` from a kernel's ray generation shader. Its payload, and a
+// dispatcher that fills it and executes the callable shader of the object's class (numbered after
+// the kernel's callables so far); each implementation's callable shader joins the model.
+void CallableDispatcher(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& k, GlslPrinter& kernelPrinter, const VirtualMember& vm,
+                        const std::vector<const CXXRecordDecl*>& impls, const CXXMethodDecl* m, SourceLocation callLoc,
+                        const std::map<std::string, std::pair<std::string, std::string>>& implData, CallableCode& out) {
+  const std::string method = m->getNameAsString(), callName = vm.member + "_" + method, variable = callName + "_call";
+  const std::string display = vm.display + "[index]->" + method + (m->getNumParams() ? "(...)" : "()");
+  auto ret = kernelPrinter.Type(m->getReturnType(), m->getLocation());
+  const std::string retType = ret ? *ret : "void";
+  std::ostringstream payload;
+  payload << "// " << display << ": its arguments and result, passed to the callable shader of the object's class\n";
+  payload << "struct " << callName << "_Call\n{\n  uvec2 crt_objects;  // the objects of its class (a buffer reference)\n"
+          << "  uint crt_index;     // the object's index among them\n";
+  for (unsigned i = 0; i < m->getNumParams(); ++i) {
+    const ParmVarDecl* p = m->getParamDecl(i);
+    payload << "  " << kernelPrinter.Declare(p->getType().getNonReferenceType().getUnqualifiedType(), CallArgumentName(m, i), p->getLocation()) << ";\n";
+  }
+  if (retType != "void") payload << "  " << retType << " crt_result;\n";
+  payload << "};\n";
+  const size_t location = out.payloads++, first = k.callables.size();
+  out.structs.push_back(payload.str() + "layout(location = " + std::to_string(location) + ") callableDataEXT " + callName + "_Call " + variable + ";\n");
+
+  std::string names;
+  for (const VirtualImpl& vi : vm.impls) {
+    auto impl = std::find_if(impls.begin(), impls.end(), [&](const CXXRecordDecl* r) { return r->getNameAsString() == vi.name; });
+    const auto& [dataStruct, objectsReference] = implData.at(vi.name);
+    AddCallableShader(ctx, rep, model, vm, vi, *impl, m, callLoc, dataStruct, objectsReference, payload.str());
+    k.callables.push_back(vm.member + "_" + vi.name + "_" + method);
+    names += (names.empty() ? "" : ", ") + k.callables.back();
+  }
+  std::ostringstream os;
+  os << "// " << display << ": the callable shader of the object's class runs its implementation\n";
+  os << retType << " " << callName << "(uint index" << DispatcherParams(kernelPrinter, m) << ")\n{\n";
+  os << "  const uvec2 tag = " << vm.member << "_Tags(" << vm.member << "_tags).tags[index];\n";
+  os << "  switch (tag.x)  // the objects of its class\n  {\n";
+  for (size_t t = 0; t < vm.impls.size(); ++t)
+    os << "    case " << t << "u: " << variable << ".crt_objects = " << vm.member << "_" << vm.impls[t].name << "; break;\n";
+  os << "  }\n  " << variable << ".crt_index = tag.y;\n";
+  for (unsigned i = 0; i < m->getNumParams(); ++i) os << "  " << variable << "." << CallArgumentName(m, i) << " = " << CallArgumentName(m, i) << ";\n";
+  os << "  executeCallableEXT(" << first << "u + tag.x, " << location << ");  // " << names << "\n";
+  for (unsigned i = 0; i < m->getNumParams(); ++i)
+    if (WrittenBack(m, i)) os << "  " << CallArgumentName(m, i) << " = " << variable << "." << CallArgumentName(m, i) << ";\n";
+  if (retType != "void") os << "  return " << variable << ".crt_result;\n";
+  os << "}\n";
+  out.functions.push_back(os.str());
+}
+
+}  // namespace
+
+void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& k, GlslPrinter& kernelPrinter, const VirtualOwner& owner,
+                     std::vector<std::string>& structs, std::vector<std::string>& functions, CallableCode* callable) {
+  // Vectors and methods in source order: the generated code must not depend on where the AST
+  // happens to sit in memory (the daemon reparses).
+  SourceManager& sm = ctx.getSourceManager();
+  auto before = [&](const Decl* a, const Decl* b) { return sm.isBeforeInTranslationUnit(a->getLocation(), b->getLocation()); };
+  std::vector<std::pair<const FieldDecl*, std::vector<const CXXMethodDecl*>>> calls;
+  for (auto& [field, method] : kernelPrinter.virtualCalls) {
+    auto same = std::find_if(calls.begin(), calls.end(), [&, f = field](const auto& c) { return c.first == f; });
+    if (same == calls.end()) same = calls.insert(calls.end(), {field, {}});
+    same->second.push_back(method);
+  }
+  std::sort(calls.begin(), calls.end(), [&](const auto& a, const auto& b) { return before(a.first, b.first); });
+  for (auto& c : calls) std::sort(c.second.begin(), c.second.end(), before);
+  for (auto& [field, methods] : calls) {
+    QualType element;
+    IsStdVector(field->getType(), &element);
+    const CXXRecordDecl* interface = PolymorphicPointee(element);
+    const std::string member = owner.prefix + field->getNameAsString();
+    if (owner.holder.empty()) RequireReachable(rep, field, owner.cls);
+    else RequirePublicForComposition(rep, field, owner.cls->getNameAsString(), "");
+    std::vector<const CXXRecordDecl*> impls;
+    FindImplementations(ctx.getTranslationUnitDecl(), interface, impls);
+    if (impls.empty()) {
+      rep.GpuError(field->getLocation(), "kernels call " + interface->getNameAsString() + " through '" + member + "', but no class that implements it is defined here",
+                  "define the implementations (classes derived from " + interface->getNameAsString() + ") in a header the class's source includes");
+      continue;
+    }
+    auto known = std::find_if(model.virtuals.begin(), model.virtuals.end(), [&](const VirtualMember& v) { return v.member == member; });
+    if (known == model.virtuals.end()) {
+      VirtualMember vm;
+      vm.member = member;
+      vm.hostExpr = owner.hostPrefix + field->getNameAsString();
+      vm.display = owner.holder.empty() ? member : owner.holder + "->" + field->getNameAsString();
+      vm.interfaceName = interface->getNameAsString();
+      for (auto* impl : impls) {
+        VirtualImpl vi;
+        vi.name = impl->getNameAsString();
+        vi.header = FileOf(ctx, impl->getLocation());
+        std::vector<const FieldDecl*> fields;
+        CollectObjectFields(impl, fields);
+        bool ok = true;
+        for (auto* f : fields) {
+          auto g = GlslTypeOf(f->getType());
+          if (!g || f->getType()->isPointerType() || IsStdVector(f->getType()) || f->isBitField()) {
+            rep.GpuError(f->getLocation(), "member '" + f->getNameAsString() + "' of " + vi.name + " cannot be copied to the GPU (kernels call " + vm.interfaceName +
+                        " through '" + member + "')", "objects called through virtual functions hold plain data: scalars, LiteMath types and structs of them");
+            ok = false;
+            continue;
+          }
+          if (f->getAccess() != AS_public) {
+            rep.GpuError(f->getLocation(), "member '" + f->getNameAsString() + "' of " + vi.name + " is copied to the GPU (kernels call " + vm.interfaceName +
+                        " through '" + member + "'), but the generated class cannot read it", "declare it public");
+            ok = false;
+            continue;
+          }
+          QualType base = f->getType();
+          while (auto* arr = dyn_cast<ConstantArrayType>(base.getCanonicalType().getTypePtr())) base = arr->getElementType();
+          vi.fields.push_back({f->getNameAsString(), CppTypeName(ctx, base.getCanonicalType()), *g, 4, "", ""});
+        }
+        if (!ok) continue;
+        auto cpp = MirrorOffsets(ctx, fields, 0), std430 = MirrorOffsets(ctx, fields, 1), scalar = MirrorOffsets(ctx, fields, 2);
+        vi.size = unsigned(cpp->back());
+        if (std430 && *std430 == *cpp) vi.scalarLayout = false;
+        else if (scalar && *scalar == *cpp) vi.scalarLayout = true;
+        else {
+          rep.GpuError(impl->getLocation(), "the data of " + vi.name + " cannot be laid out on the GPU as C++ lays it out",
+                      "use 32-bit scalars and LiteMath vectors; put 16-byte types (float4) first");
+          continue;
+        }
+        vm.impls.push_back(vi);
+      }
+      if (model.virtualLevel == 1) {  // one slot size for all: the largest class's data, in 16-byte steps
+        for (auto& vi : vm.impls) vm.slotBytes = std::max(vm.slotBytes, (vi.size + 15) / 16 * 16);
+        for (auto& vi : vm.impls) vi.paddingWords = (vm.slotBytes - vi.size) / 4;
+        // The GPU has one <Impl>_Data per class: vectors of two interfaces that share a class
+        // must give it the same slot.
+        for (auto& other : model.virtuals)
+          for (auto& theirs : other.impls)
+            for (auto& vi : vm.impls)
+              if (theirs.name == vi.name && theirs.paddingWords != vi.paddingWords)
+                rep.GpuError(field->getLocation(), "at virtual-function level 1, " + vi.name + " takes a " + std::to_string(vm.slotBytes) + "-byte slot in '" + member +
+                          "' but a " + std::to_string(other.slotBytes) + "-byte slot in '" + other.member + "'",
+                          "use level 2 (a buffer per class), where a class's objects need no slot");
+      }
+      model.virtuals.push_back(vm);
+      known = model.virtuals.end() - 1;
+    }
+    const VirtualMember& vm = *known;
+    k.bufferReferences = true;
+    // Data structs and buffer references, then each implementation's methods.
+    const std::string tags = TagsReference(model, vm);
+    structs.push_back(tags);
+    if (callable) callable->structs.push_back(tags);
+    std::map<std::string, std::string> implFunction;  // (impl, method) -> GLSL name
+    std::map<std::string, std::pair<std::string, std::string>> implData;  // impl -> (data struct, buffer reference to its objects)
+    for (auto* impl : impls) {
+      auto vi = std::find_if(vm.impls.begin(), vm.impls.end(), [&](const VirtualImpl& x) { return x.name == impl->getNameAsString(); });
+      if (vi == vm.impls.end()) continue;
+      GlslPrinter printer(ctx, impl, rep);
+      printer.selfClass = impl;
+      printer.composedPrefix = vi->name + "_";
+      for (auto& sn : ClassStructNames(model)) printer.predeclaredStructs.insert(sn);
+      const std::string data = ImplDataStruct(printer, impl, vm, *vi);
+      for (auto* m : methods) implFunction[vi->name + "::" + m->getNameAsString()] = ImplementationMethod(rep, printer, impl, m, field->getLocation());
+      for (auto& x : printer.Structs()) structs.push_back(x);
+      const std::string objectsReference = ObjectsReference(vm, *vi);
+      structs.push_back(data);
+      structs.push_back(objectsReference);
+      implData[vi->name] = {data, objectsReference};
+      k.scalarReferences |= vi->scalarLayout;
+      for (auto& x : printer.Constants())
+        if (std::find(k.constantList.begin(), k.constantList.end(), x) == k.constantList.end()) k.constantList.push_back(x);
+      for (auto& x : printer.Functions()) functions.push_back(x);
+    }
+    for (auto* m : methods) {
+      std::ostringstream os;
+      auto ret = kernelPrinter.Type(m->getReturnType(), m->getLocation());
+      const std::string retType = ret ? *ret : "void";
+      os << "// " << vm.display << "[index]->" << m->getNameAsString() << (m->getNumParams() ? "(...)" : "()") << ": the object's class picks the implementation\n";
+      os << retType << " " << member << "_" << m->getNameAsString() << "(uint index" << DispatcherParams(kernelPrinter, m) << ")\n{\n";
+      os << "  const uvec2 tag = " << member << "_Tags(" << member << "_tags).tags[index];\n  switch (tag.x)\n  {\n";
+      for (size_t t = 0; t < vm.impls.size(); ++t) {
+        const auto& vi = vm.impls[t];
+        // Level 1: all elements in one array of equal slots; level 2: each class's objects apart.
+        const std::string address = member + (model.virtualLevel == 1 ? std::string("_objects") : "_" + vi.name);
+        std::string args = member + "_" + vi.name + "Objects(" + address + ").objects[tag.y]";
+        for (unsigned i = 0; i < m->getNumParams(); ++i) args += ", " + CallArgumentName(m, i);
+        const std::string call = implFunction[vi.name + "::" + m->getNameAsString()] + "(" + args + ")";
+        os << "    case " << t << "u: " << (retType == "void" ? call + "; return;" : "return " + call + ";") << "\n";
+      }
+      os << "  }\n";
+      if (retType != "void") os << "  " << retType << " none;  // not reached: every element holds one of these classes\n  return none;\n";
+      os << "}\n";
+      functions.push_back(os.str());
+      if (callable) CallableDispatcher(ctx, rep, model, k, kernelPrinter, vm, impls, m, field->getLocation(), implData, *callable);
+    }
+  }
+}
+
+}  // namespace crossrt::engine

@@ -1,0 +1,423 @@
+// One kernel from start to end: its loop nest, parameters, writes and reductions, the GLSL of its body
+// through the printer, and the CPU copy with its OpenMP pragma. Takes a kernel's method; adds a Kernel
+// to the model.
+#include "Kernels.h"
+
+#include "AnalysisContext.h"
+#include "AstQueries.h"
+#include "CpuCopies.h"
+#include "KernelParams.h"
+#include "LoopShape.h"
+#include "Members.h"
+#include "Naming.h"
+#include "VirtualCalls.h"
+#include "Writes.h"
+
+#include <llvm/Support/FileSystem.h>
+#include <llvm/Support/Path.h>
+
+#include <algorithm>
+#include <cctype>
+#include <regex>
+#include <sstream>
+
+using namespace clang;
+
+namespace crossrt::engine {
+
+void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def) {
+  Kernel k;
+  k.name = md->getNameAsString();
+  k.dims = IpvDims(k.name);
+  k.rtv = k.dims == 0;
+  k.sourceFile = BaseName(FileOf(c.ctx, def->getLocation()));
+  // A kernel_ function may return bool, for its thread loop to leave a loop: if (!kernel_X(...)) break;
+  k.returnsBool = k.rtv && md->getReturnType()->isBooleanType();
+  if (!md->getReturnType()->isVoidType() && !k.returnsBool) {
+    c.rep.Error(md->getLocation(), "kernel '" + k.name + "' returns a value",
+                k.rtv ? "kernels return void, or bool for their thread loop to leave a loop (if (!" + k.name + "(...)) break;); write other results to pointer parameters"
+                      : "kernels return void and write results to pointer parameters or members");
+    return;
+  }
+  // The definition's parameter names: its body uses them (a declaration may name them otherwise).
+  CheckKernelParams(c, md, def, k);
+  for (unsigned i = 0; i < def->getNumParams(); ++i) k.cppParamsDecl += (i ? ", " : "") + ParamDecl(c.ctx, md->getParamDecl(i), def->getParamDecl(i), i);
+  GlslPrinter printer(c.ctx, c.cls, c.rep);
+  printer.compositions = c.compositions;
+  printer.threadReturnsValue = k.returnsBool;
+  for (auto& s : ClassStructNames(c.model)) printer.predeclaredStructs.insert(s);
+  // Structs the parameters hold (buffers, push constants) are declared even when the body names no variable of them.
+  for (auto* p : def->parameters()) {
+    if (p->getType()->isPointerType()) printer.Type(p->getType()->getPointeeType(), p->getLocation());
+    else if (auto* rd = p->getType().getNonReferenceType()->getAsCXXRecordDecl(); rd && !IsLiteMathType(p->getType().getNonReferenceType()) &&
+             !IsImage2D(p->getType()) && GlslTypeOf(p->getType()))
+      printer.Type(p->getType().getNonReferenceType(), p->getLocation());
+    if (IsImageParam(p)) printer.imageParams.insert(p);
+  }
+  auto* body = dyn_cast<CompoundStmt>(def->getBody());
+  if (!body) {
+    c.rep.GpuError(md->getLocation(), "kernel '" + k.name + "' has a function-try-block", "GPU code has no exceptions: remove the try/catch");
+    return;
+  }
+  std::vector<const Stmt*> preamble;      // declarations before the loop nest: every thread evaluates them
+  std::vector<const Stmt*> before, after;  // all statements before and after the loop nest: one thread runs them
+  const Stmt* threadBody = body;
+  std::vector<std::pair<std::string, std::string>> threadParams;  // (glsl type, name)
+
+  if (k.rtv) {
+    // The thread function takes the thread ids, the per-thread values and the by-value arguments,
+    // so that a megakernel can call it as well as this kernel's own main().
+    for (unsigned i = 0; i < k.params.size(); ++i) {
+      const KernelParam& p = k.params[i];
+      if (p.isThreadId) {
+        k.dims = std::max(k.dims, ThreadAxis(p.name) + 1);
+        k.threadAxes.push_back(ThreadAxis(p.name));
+      }
+      if (p.threadState) printer.valueParams.insert(def->getParamDecl(i));  // the body refers to the definition's
+      if ((p.isPointer && !p.threadState) || p.isImage) continue;
+      auto [base, dims] = SplitArray(p.glslType);
+      std::string qualifier = p.threadState && !p.isConstPointee ? "inout " : "";
+      threadParams.push_back({qualifier + base, p.glslName + dims});
+    }
+    if (k.dims == 0) {
+      c.rep.Error(md->getLocation(), "kernel '" + k.name + "' has no thread id parameter",
+                  "name the thread index parameter 'tid' (or tidX, tidY, tidZ), or name the kernel kernel1D_/kernel2D_ with loops inside");
+      return;
+    }
+  } else {
+    // kernelND_: optional declarations, then N perfectly nested loops.
+    // [statements before] N perfectly nested loops [statements after]: the first for loop of the
+    // body is the nest; what comes before and after it (the paper's loop_start and loop_end) runs
+    // on one thread. The declarations before it are also evaluated by every thread.
+    const ForStmt* outer = nullptr;
+    for (auto* s : body->body()) {
+      if (isa<NullStmt>(s)) continue;
+      if (!outer && isa<ForStmt>(s)) outer = cast<ForStmt>(s);
+      else (outer ? after : before).push_back(s);
+    }
+    for (auto* s : before)
+      if (isa<DeclStmt>(s)) preamble.push_back(s);
+    if (!outer) {
+      c.rep.Error(md->getLocation(), "kernel '" + k.name + "' has no loop", "a kernel" + std::to_string(k.dims) + "D_ function holds " + std::to_string(k.dims) + " nested for loops whose iterations become GPU threads");
+      return;
+    }
+    const Stmt* cur = outer;
+    std::vector<LoopHeader> headers;
+    for (unsigned d = 0; d < k.dims; ++d) {
+      auto* fs = dyn_cast<ForStmt>(cur);
+      if (!fs) {
+        c.rep.Error(cur->getBeginLoc(), "kernel '" + k.name + "' needs " + std::to_string(k.dims) + " perfectly nested loops",
+                    "put nothing between the loop headers; move per-row code into the innermost body");
+        return;
+      }
+      LoopHeader h;
+      if (!ParseLoop(c, fs, h, k.name)) return;
+      headers.push_back(h);
+      // `i < m_v.size()` of a vector that kernels append to: its size is only known on the GPU.
+      if (auto* mc = dyn_cast<CXXMemberCallExpr>(h.end->IgnoreParenCasts()); mc && mc->getMethodDecl() && mc->getMethodDecl()->getName() == "size")
+        if (auto* f = ThisField(mc->getImplicitObjectArgument()); f && c.appended.count(f->getNameAsString())) {
+          Expr::EvalResult r;
+          const std::string v = f->getNameAsString();
+          if (k.dims != 1)
+            c.rep.GpuError(h.end->getBeginLoc(), "kernel '" + k.name + "' loops to the size of '" + v + "', which kernels append to on the GPU, in a " +
+                        std::to_string(k.dims) + "D loop nest", "loop to " + v + ".size() in a kernel1D_ kernel: it is dispatched indirectly, with the count the GPU computed");
+          else if (!(h.start->EvaluateAsInt(r, c.ctx) && r.Val.getInt() == 0) || h.inclusive)
+            c.rep.GpuError(h.end->getBeginLoc(), "kernel '" + k.name + "' loops over '" + v + "', which kernels append to on the GPU, but not from 0 to " + v + ".size()",
+                        "write 'for (uint32_t i = 0; i < " + v + ".size(); ++i)' and skip elements inside the loop");
+          else
+            k.indirectVector = v;
+          if (auto* m = FindMember(c.model, v)) m->usedByKernels = true;
+        }
+      Loop loop;
+      loop.var = h.var->getNameAsString();
+      loop.glslType = GlslTypeOf(h.var->getType()).value_or("int");
+      loop.startCpp = c.Text(h.start->getSourceRange());
+      loop.countCpp = CountExpr(c, h);
+      k.loops.push_back(loop);
+      threadParams.push_back({loop.glslType, GlslPrinter::SafeName(loop.var)});
+      cur = fs->getBody();
+      if (d + 1 < k.dims)
+        if (auto* cs = dyn_cast<CompoundStmt>(cur); cs && cs->size() == 1) cur = cs->body_front();
+    }
+    threadBody = cur;
+    // Thread ids are listed innermost first (x), like the dispatch.
+    std::reverse(threadParams.begin(), threadParams.end());
+    for (unsigned d = 0; d < k.dims; ++d) k.threadAxes.push_back(d);
+  }
+
+  // Reductions and member writes.
+  WriteScanner ws(c);
+  ws.TraverseStmt(const_cast<Stmt*>(threadBody));
+  for (auto* s : preamble) ws.TraverseStmt(const_cast<Stmt*>(s));
+  WriteScanner ends(c);  // the statements around the loop nest, which one thread runs
+  ends.singleThread = true;
+  for (auto* list : {&before, &after})
+    for (auto* s : *list)
+      if (!isa<DeclStmt>(s)) ends.TraverseStmt(const_cast<Stmt*>(s));
+  std::set<const VarDecl*> beforeLocals;
+  for (auto* s : preamble)
+    for (auto* d : cast<DeclStmt>(s)->decls())
+      if (auto* vd = dyn_cast<VarDecl>(d)) beforeLocals.insert(vd);
+  LocalReductionScanner localReductions(c, beforeLocals);
+  localReductions.TraverseStmt(const_cast<Stmt*>(threadBody));
+  if (!CheckLoopEnds(c, k.name, before, after, threadBody, localReductions.targets)) return;
+  LocalReductionReads(c, k.name, localReductions, threadBody);
+  ReductionReadScanner rs(c, ws);
+  rs.TraverseStmt(const_cast<Stmt*>(threadBody));
+  for (auto& [field, values] : ws.constantStores) {
+    if (values.size() > 1 || ws.reductions.count(field))
+      c.rep.Error(field->getLocation(), "the threads of kernel '" + k.name + "' set member '" + field->getNameAsString() +
+                  "' to " + (values.size() > 1 ? "different values" : "a value and reduce it") + ": the result would depend on which thread comes last",
+                  "set it to one constant (a flag), or reduce it (m = std::max(m, x))");
+    struct Reads : RecursiveASTVisitor<Reads> {
+      const FieldDecl* f; const std::set<const MemberExpr*>& stores; std::vector<SourceLocation> found;
+      Reads(const FieldDecl* ff, const std::set<const MemberExpr*>& st) : f(ff), stores(st) {}
+      bool VisitMemberExpr(MemberExpr* me) {
+        if (me->getMemberDecl() == f && !stores.count(me)) found.push_back(me->getExprLoc());
+        return true;
+      }
+    } reads(field, ws.constantStoreUses);
+    reads.TraverseStmt(const_cast<Stmt*>(threadBody));
+    for (auto loc : reads.found)
+      c.rep.Error(loc, "kernel '" + k.name + "' reads '" + field->getNameAsString() + "', which its threads set",
+                  "read it after the loop nest, or in the control function after the kernel");
+    if (auto* m = FindMember(c.model, field->getNameAsString())) m->writtenByKernels = true;
+  }
+  // Reduced locals, in declaration order: a thread's part is <local>Local, as a member's is.
+  std::set<const Stmt*> reductionDecls;  // their declarations, which the threads do not evaluate
+  for (auto* s : preamble)
+    for (auto* d : cast<DeclStmt>(s)->decls()) {
+      auto* vd = dyn_cast<VarDecl>(d);
+      auto found = vd ? localReductions.reductions.find(vd) : localReductions.reductions.end();
+      if (found == localReductions.reductions.end()) continue;
+      if (!cast<DeclStmt>(s)->isSingleDecl()) {
+        c.rep.Error(vd->getLocation(), "'" + vd->getNameAsString() + "', which the loop of kernel '" + k.name + "' reduces, is declared with other variables",
+                    "declare it on its own: float " + vd->getNameAsString() + " = ...;");
+        continue;
+      }
+      reductionDecls.insert(s);
+      Reduction r;
+      r.member = vd->getNameAsString();
+      r.op = found->second;
+      r.glslType = GlslTypeOf(vd->getType()).value_or("float");
+      r.identity = Identity(r.op, r.glslType);
+      r.local = true;
+      r.cppType = vd->getType().getUnqualifiedType().getAsString(c.ctx.getPrintingPolicy());
+      printer.renames[vd] = r.member + "Local";
+      k.reductions.push_back(r);
+    }
+  if (k.rtv && !ws.reductions.empty()) {
+    c.rep.Error(md->getLocation(), "member reductions are supported in kernel1D_/2D_/3D_ loops, not in '" + k.name + "'",
+                "write the loop inside the kernel (kernel1D_" + k.name.substr(std::string("kernel_").size()) + ") so the translator sees the whole reduction");
+    return;
+  }
+  if (!k.indirectVector.empty() && !ws.reductions.empty())
+    c.rep.GpuError(md->getLocation(), "kernel '" + k.name + "' reduces members and is dispatched indirectly (it loops to " + k.indirectVector + ".size())",
+                "reduce in a kernel with a count the host knows, or append the values and reduce them in a later kernel");
+  // In declaration order, so that regeneration is stable.
+  for (auto* field : ClassFields(c.cls)) {
+    auto found = ws.reductions.find(field);
+    if (found == ws.reductions.end()) continue;
+    ReduceOp op = found->second;
+    Reduction r;
+    r.member = field->getNameAsString();
+    r.op = op;
+    r.glslType = GlslTypeOf(field->getType()).value_or("float");
+    r.identity = Identity(op, r.glslType);
+    printer.renames[field] = r.member + "Local";
+    k.reductions.push_back(r);
+  }
+  // After printing, the printer knows the helpers the kernel reaches: their writes count too.
+  auto markVectorWrites = [&](const WriteScanner& scanner) {
+    for (auto* set : {&scanner.vectorWrites, &scanner.atomicMembers, &scanner.memberWrites})
+      for (auto* f : *set)
+        if (auto* m = FindMember(c.model, f->getNameAsString())) m->writtenByKernels = true;
+  };
+  markVectorWrites(ws);
+  markVectorWrites(ends);
+  for (auto& [field, loc] : ends.appends) ws.appends.emplace(field, loc);
+
+  // GLSL: the thread function.
+  std::ostringstream os;
+  os << "// from " << c.cls->getNameAsString() << "::" << k.name << " (" << k.sourceFile << ")\n";
+  os << (k.returnsBool ? "bool " : "void ") << k.name << "(";
+  for (size_t i = 0; i < threadParams.size(); ++i) os << (i ? ", " : "") << threadParams[i].first << " " << threadParams[i].second;
+  os << ")\n{\n";
+  for (auto* s : preamble)
+    if (!reductionDecls.count(s)) os << printer.Stmt(s, 1);
+  if (auto* cs = dyn_cast<CompoundStmt>(threadBody))
+    for (auto* s : cs->body()) os << printer.ThreadBody(s, 1, !k.rtv);
+  else
+    os << printer.ThreadBody(threadBody, 1, !k.rtv);
+  os << "}\n";
+  k.glslBody = os.str();
+  // The statements around the loop nest, as functions one thread runs before and after the others.
+  if (std::any_of(before.begin(), before.end(), [](const Stmt* s) { return !isa<DeclStmt>(s); }) || !after.empty()) {
+    const auto sizeReadsInLoop = printer.sizeReads;  // after the loop a vector's final size is known
+    const auto renames = printer.renames;
+    for (auto& r : k.reductions)
+      for (auto* f : ClassFields(c.cls))
+        if (f->getNameAsString() == r.member) printer.renames.erase(f);  // the member itself, not a thread's part
+    for (auto& [vd, op] : localReductions.reductions) printer.renames.erase(vd);
+    printer.singleThread = true;
+    const std::string from = "// from " + c.cls->getNameAsString() + "::" + k.name + " (" + k.sourceFile + "): ";
+    if (std::any_of(before.begin(), before.end(), [](const Stmt* s) { return !isa<DeclStmt>(s); })) {
+      k.glslStart = from + "the statements before its loop nest, run by one thread before the others\nvoid " + k.name + "_Start()\n{\n";
+      for (auto* s : before) k.glslStart += printer.Stmt(s, 1);
+      k.glslStart += "}\n";
+    }
+    if (!after.empty()) {
+      k.glslFinish = from + "the statements after its loop nest, run by one thread after the others\nvoid " + k.name + "_Finish()\n{\n";
+      for (auto* s : preamble) k.glslFinish += printer.Stmt(s, 1);
+      // The reduced locals: their initial values and the threads' total (<kernel>_Reduce left it
+      // in element 0 of the partials; when the nest had no threads there is none).
+      std::string anyThreads;
+      for (unsigned a = 0; a < k.dims; ++a) anyThreads += std::string(a ? " && " : "") + "crt_count" + "XYZ"[a] + " != 0u";
+      for (auto& r : k.reductions)
+        if (r.local) {
+          const std::string total = r.member + "Partials[0]";
+          const std::string combined = r.op == ReduceOp::Min ? "min(" + r.member + ", " + total + ")"
+                                       : r.op == ReduceOp::Max ? "max(" + r.member + ", " + total + ")" : r.member + " + " + total;
+          k.glslFinish += "  if (" + anyThreads + ")\n    " + r.member + " = " + combined + ";  // the threads' total\n";
+        }
+      for (auto* s : after) k.glslFinish += printer.Stmt(s, 1);
+      k.glslFinish += "}\n";
+    }
+    printer.singleThread = false;
+    printer.renames = renames;
+    for (auto* f : printer.emptiedVectors)
+      if (!c.appended.count(f->getNameAsString()))
+        c.rep.GpuError(f->getLocation(), "kernel '" + k.name + "' empties '" + f->getNameAsString() + "', which no kernel appends to: on the GPU only an appended vector's size is counted there",
+                    "empty it in the control function (before the kernel), or append to it with push_back in the loop");
+    printer.sizeReads = sizeReadsInLoop;
+  }
+  std::map<const FieldDecl*, SourceLocation> appends = ws.appends;
+  for (auto* helper : printer.helpers) {
+    WriteScanner hs(c);
+    hs.helper = helper;
+    hs.TraverseStmt(helper->getBody());
+    markVectorWrites(hs);
+    appends.insert(hs.appends.begin(), hs.appends.end());
+  }
+  for (auto& [field, loc] : appends)
+    if (auto* m = FindMember(c.model, field->getNameAsString())) m->appendedByKernels = m->writtenByKernels = true;
+  // On the CPU the threads run the original bodies of kernel_ functions (their loop is in the
+  // control function) and of helpers: those that append get copies with a lock.
+  std::vector<const FunctionDecl*> reached;
+  if (k.rtv) reached.push_back(def);
+  reached.insert(reached.end(), printer.helpers.begin(), printer.helpers.end());
+  AddLockedCopies(c, reached);
+  // Threads append in any order: a size read in the same kernel would see a partial count.
+  CheckObjectSizeReads(c.rep, printer);
+  for (auto& [field, loc] : printer.sizeReads)
+    if (appends.count(field))
+      c.rep.Error(loc, "kernel '" + k.name + "' reads the size of '" + field->getNameAsString() + "', which it appends to",
+                  "the final size is known after the kernel: read it in a later kernel, or after the control function returns");
+  k.structList = printer.Structs();
+  k.constantList = printer.Constants();
+  k.functionList = printer.Functions();
+  k.atomics = printer.usesAtomics;
+  k.floatAtomics = printer.usesFloatAtomics;
+  if (!printer.virtualCalls.empty()) AnalyzeVirtualCalls(c, k, printer);
+  k.composedCalls = printer.composedCalls;
+  for (auto& [holder, method] : printer.composedCalls) {
+    if (std::any_of(c.model.compositions.begin(), c.model.compositions.end(), [&](const Composition& x) { return x.holder == holder; }))
+      continue;
+    Composition comp;
+    comp.holder = holder;
+    for (auto* f : ClassFields(c.cls))
+      if (auto* rd = f->getNameAsString() == holder ? PolymorphicPointee(f->getType()) : nullptr) comp.interfaceName = rd->getNameAsString();
+    comp.implName = c.compositions.count(comp.interfaceName) ? c.compositions.at(comp.interfaceName) : "";
+    c.model.compositions.push_back(comp);
+  }
+  for (auto* f : printer.memberVectors) {
+    k.memberVectors.push_back(f->getNameAsString());
+    if (auto* m = FindMember(c.model, f->getNameAsString())) m->usedByKernels = true;
+    RequireReachable(c.rep, f, c.cls);
+  }
+  std::sort(k.memberVectors.begin(), k.memberVectors.end());
+  k.ownFunctionList = k.functionList;
+  k.ownMemberVectors = k.memberVectors;
+  // Images and samplers, in declaration order so that bindings stay stable across regenerations.
+  for (auto* f : ClassFields(c.cls)) {
+    const bool loaded = printer.loadedImages.count(f), stored = printer.storedImages.count(f);
+    const bool sampled = printer.sampledImages.count(f), sampler = printer.samplers.count(f);
+    if (!(loaded || stored || sampled || sampler || printer.sizedImages.count(f))) continue;
+    RequireReachable(c.rep, f, c.cls);
+    auto* m = FindMember(c.model, f->getNameAsString());
+    if (!m) continue;
+    m->usedByKernels = true;
+    m->writtenByKernels = m->writtenByKernels || stored;
+    if (loaded || stored) k.images.push_back({m->name, ImageUse::Storage, loaded, stored});
+    if (sampled) k.images.push_back({m->name, ImageUse::Texture, false, false});
+    if (sampler) k.images.push_back({m->name, ImageUse::Sampler, false, false});
+  }
+  // Image parameters after the members, in parameter order.
+  for (auto* p : def->parameters()) {
+    if (!printer.imageParams.count(p)) continue;
+    const bool loaded = printer.loadedImages.count(p), stored = printer.storedImages.count(p);
+    if (loaded || stored) k.images.push_back({p->getNameAsString(), ImageUse::Storage, loaded, stored, true});
+    if (printer.sampledImages.count(p)) k.images.push_back({p->getNameAsString(), ImageUse::Texture, false, false, true});
+  }
+  for (auto& [image, sampler] : printer.samplePairs)
+    (isa<FieldDecl>(image) ? k.samplePairs : k.paramSamplePairs).push_back({image->getNameAsString(), sampler->getNameAsString()});
+  for (auto* f : ClassFields(c.cls)) {
+    if (!printer.textureArrays.count(f)) continue;
+    RequireReachable(c.rep, f, c.cls);
+    if (auto* m = FindMember(c.model, f->getNameAsString())) {
+      m->usedByKernels = true;
+      k.textureArrays.push_back(m->name);
+    }
+  }
+  std::sort(k.samplePairs.begin(), k.samplePairs.end());
+  for (auto* f : printer.plainMembers) {
+    auto* m = FindMember(c.model, f->getNameAsString());
+    if (m) m->usedByKernels = true;
+    if (m && !m->inClassData && f->getAccess() != AS_private)
+      c.rep.GpuError(f->getLocation(), "member '" + f->getNameAsString() + "' of type '" + f->getType().getAsString(c.ctx.getPrintingPolicy()) + "' has a C++ layout that a GPU buffer cannot reproduce",
+                  "use int instead of bool, float4x4 instead of float3x3, or reorder struct fields so 16-byte types come first");
+    RequireReachable(c.rep, f, c.cls);
+  }
+  for (auto& r : k.reductions)
+    if (auto* m = r.local ? nullptr : FindMember(c.model, r.member)) { m->usedByKernels = true; m->writtenByKernels = true; }
+
+  // CPU backend: the loop nest as the user wrote it, reduction targets renamed.
+  if (!k.rtv) {
+    Rewriter rw(c.ctx.getSourceManager(), c.ctx.getLangOpts());
+    // Reduction targets get their per-thread names; appends go through a lock.
+    struct Renamer : RecursiveASTVisitor<Renamer> {
+      Rewriter& rw; const std::map<const FieldDecl*, ReduceOp>& red;
+      Renamer(Rewriter& r, const std::map<const FieldDecl*, ReduceOp>& m) : rw(r), red(m) {}
+      bool VisitMemberExpr(MemberExpr* me) {
+        auto* f = dyn_cast<FieldDecl>(me->getMemberDecl());
+        if (f && red.count(f) && me->isImplicitAccess()) rw.ReplaceText(me->getMemberLoc(), f->getName().size(), f->getNameAsString() + "Local");
+        else if (f && red.count(f)) rw.ReplaceText(me->getSourceRange(), f->getNameAsString() + "Local");
+        return true;
+      }
+    } renamer(rw, ws.reductions);
+    const ForStmt* outer = nullptr;
+    for (auto* s : body->body())
+      if ((outer = dyn_cast<ForStmt>(s))) break;
+    renamer.TraverseStmt(const_cast<ForStmt*>(outer));
+    // A flag every thread may set: stored atomically, so that the threads do not race on it.
+    for (auto* bo : ws.constantStoreExprs) {
+      SourceLocation end = Lexer::findLocationAfterToken(bo->getEndLoc(), tok::semi, c.ctx.getSourceManager(), c.ctx.getLangOpts(), false);
+      if (end.isInvalid()) continue;
+      rw.InsertTextBefore(bo->getBeginLoc(), "{\n#pragma omp atomic write\n");
+      rw.InsertTextAfter(end, "\n}");
+    }
+    LockAppends(rw, outer);
+    // A loop whose body is a bare statement ends before its ';': take the ';' too.
+    SourceLocation end = Lexer::findLocationAfterToken(outer->getEndLoc(), tok::semi, c.ctx.getSourceManager(), c.ctx.getLangOpts(), false);
+    k.cpuLoopNest = CanonicalCode(end.isValid() ? rw.getRewrittenText(CharSourceRange::getCharRange(outer->getBeginLoc(), end))
+                                                : rw.getRewrittenText(outer->getSourceRange()));
+    if (c.model.forCpu) CopySourceDeclarations(c, def->getBody(), "kernel '" + k.name + "'");  // the CPU class copies the loop nest
+    for (auto* s : before) k.cpuPreamble += StatementText(c, s) + "\n";
+    k.cpuPreamble = CanonicalCode(k.cpuPreamble);
+    for (auto* s : after) k.cpuPostamble += StatementText(c, s) + "\n";
+    k.cpuPostamble = CanonicalCode(k.cpuPostamble);
+  }
+  c.model.kernels.push_back(k);
+}
+
+}  // namespace crossrt::engine

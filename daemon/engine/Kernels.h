@@ -1,0 +1,11 @@
+// One kernel from start to end: its loop nest, parameters, writes and reductions, the GLSL of its body
+// through the printer, and the CPU copy with its OpenMP pragma. Takes a kernel's method; adds a Kernel
+// to the model.
+#pragma once
+#include "AnalysisContext.h"
+
+namespace crossrt::engine {
+
+void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def);
+
+}  // namespace crossrt::engine

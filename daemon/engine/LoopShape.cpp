@@ -1,0 +1,116 @@
+// The shape of a kernel's loop nest: one parser of `for (int i = begin; i < end; ++i)` headers
+// (ParseLoop, quiet or reporting), their thread counts, and what may stand before and after the nest.
+#include "LoopShape.h"
+
+#include "AnalysisContext.h"
+#include "AstQueries.h"
+#include "WriteVisitor.h"
+
+#include <llvm/Support/FileSystem.h>
+#include <llvm/Support/Path.h>
+
+#include <algorithm>
+#include <cctype>
+#include <regex>
+#include <sstream>
+
+using namespace clang;
+
+namespace crossrt::engine {
+
+bool ParseLoop(Context& c, const ForStmt* fs, LoopHeader& h, const std::string& kernel) {
+  auto bad = [&](const std::string& what) {
+    c.rep.Error(fs->getBeginLoc(), "loop of kernel '" + kernel + "' is not a parallel loop: " + what,
+                "write it as 'for (int i = start; i < end; i++)'; each iteration becomes one thread");
+    return false;
+  };
+  auto* ds = dyn_cast_or_null<DeclStmt>(fs->getInit());
+  if (!ds || !ds->isSingleDecl()) return bad("it must declare one loop variable");
+  h.var = dyn_cast<VarDecl>(ds->getSingleDecl());
+  if (!h.var || !h.var->getInit() || !h.var->getType()->isIntegerType()) return bad("the loop variable must be an initialised integer");
+  h.start = h.var->getInit();
+  auto* cond = dyn_cast_or_null<BinaryOperator>(fs->getCond() ? fs->getCond()->IgnoreImplicit() : nullptr);
+  if (!cond || (cond->getOpcode() != BO_LT && cond->getOpcode() != BO_LE)) return bad("the condition must be 'i < end' or 'i <= end'");
+  auto* lhs = dyn_cast<DeclRefExpr>(cond->getLHS()->IgnoreParenImpCasts());
+  if (!lhs || lhs->getDecl() != h.var) return bad("the condition must compare the loop variable");
+  h.end = cond->getRHS();
+  h.inclusive = cond->getOpcode() == BO_LE;
+  const Expr* inc = fs->getInc() ? fs->getInc()->IgnoreImplicit() : nullptr;
+  bool stepOne = false;
+  if (auto* uo = dyn_cast_or_null<UnaryOperator>(inc)) stepOne = uo->isIncrementOp();
+  if (auto* ca = dyn_cast_or_null<CompoundAssignOperator>(inc)) {
+    Expr::EvalResult r;
+    stepOne = ca->getOpcode() == BO_AddAssign && ca->getRHS()->EvaluateAsInt(r, c.ctx) && r.Val.getInt() == 1;
+  }
+  if (!stepOne) return bad("the step must be ++i, i++ or i += 1");
+  return true;
+}
+
+std::string CountExpr(Context& c, const LoopHeader& h) {
+  std::string end = c.Text(h.end->getSourceRange()), start = c.Text(h.start->getSourceRange());
+  Expr::EvalResult r;
+  bool zeroStart = h.start->EvaluateAsInt(r, c.ctx) && r.Val.getInt() == 0;
+  std::string count = zeroStart ? "(" + end + ")" : "(" + end + ") - (" + start + ")";
+  return h.inclusive ? count + " + 1" : count;
+}
+
+bool CheckLoopEnds(Context& c, const std::string& kernel, const std::vector<const Stmt*>& before,
+                   const std::vector<const Stmt*>& after, const Stmt* threadBody, const std::set<const Expr*>& reductionTargets) {
+  std::set<const VarDecl*> locals;
+  for (auto* s : before)
+    if (auto* ds = dyn_cast<DeclStmt>(s))
+      for (auto* d : ds->decls())
+        if (auto* vd = dyn_cast<VarDecl>(d)) locals.insert(vd);
+  struct LocalWrites : WriteVisitor<LocalWrites> {
+    const std::set<const VarDecl*>& locals;
+    std::vector<std::pair<const VarDecl*, SourceLocation>> found;
+    const std::set<const Expr*>* skip = nullptr;  // the targets of reductions
+    explicit LocalWrites(const std::set<const VarDecl*>& l) : locals(l) {}
+    void Written(const Expr* target, SourceLocation loc) {
+      if (skip && skip->count(target)) return;
+      if (auto* vd = WrittenVar(target); vd && locals.count(vd)) found.push_back({vd, loc});
+    }
+    bool VisitUnaryOperator(UnaryOperator* uo) {
+      if (uo->getOpcode() == UO_AddrOf) Written(uo->getSubExpr(), uo->getExprLoc());
+      return WriteVisitor<LocalWrites>::VisitUnaryOperator(uo);
+    }
+  };
+  bool ok = true;
+  for (auto* s : before) {
+    if (isa<DeclStmt>(s)) continue;
+    LocalWrites w(locals);
+    w.TraverseStmt(const_cast<Stmt*>(s));
+    for (auto& [vd, loc] : w.found) {
+      c.rep.Error(loc, "a statement before the loop nest of kernel '" + kernel + "' changes '" + vd->getNameAsString() +
+                  "', which every thread of the nest computes from its declaration",
+                  "give '" + vd->getNameAsString() + "' its final value where it is declared");
+      ok = false;
+    }
+  }
+  LocalWrites inLoop(locals);
+  inLoop.skip = &reductionTargets;
+  inLoop.TraverseStmt(const_cast<Stmt*>(threadBody));
+  for (auto& [vd, loc] : inLoop.found) {
+    c.rep.Error(loc, "the loop of kernel '" + kernel + "' writes '" + vd->getNameAsString() + "', declared before the loop: every iteration (a thread) would write one variable",
+                "declare it inside the loop, or reduce it (x += v, x -= v, x = std::min(x, v), x = std::max(x, v))");
+    ok = false;
+  }
+  struct Returns : RecursiveASTVisitor<Returns> {
+    std::vector<SourceLocation> found;
+    bool VisitReturnStmt(ReturnStmt* r) { found.push_back(r->getReturnLoc()); return true; }
+    bool TraverseLambdaExpr(LambdaExpr*) { return true; }
+  };
+  for (auto* s : before) {
+    Returns r;
+    r.TraverseStmt(const_cast<Stmt*>(s));
+    for (auto loc : r.found) {
+      c.rep.GpuError(loc, "'return' before the loop nest of kernel '" + kernel + "': on the GPU the nest's threads would run anyway",
+                  "test the condition in the control function before calling the kernel, or inside the loop");
+      ok = false;
+    }
+  }
+  (void)after;  // a 'return' after the nest ends the statements after it on both
+  return ok;
+}
+
+}  // namespace crossrt::engine

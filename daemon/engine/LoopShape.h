@@ -1,0 +1,29 @@
+// The shape of a kernel's loop nest: one parser of `for (int i = begin; i < end; ++i)` headers
+// (ParseLoop, quiet or reporting), their thread counts, and what may stand before and after the nest.
+#pragma once
+#include "AnalysisContext.h"
+
+namespace crossrt::engine {
+
+// The statements before and after a kernelND_'s loop nest run on one thread, around the threads of
+// the nest: before them (the GPU's <kernel>_Start) and after them (<kernel>_Finish). Every thread
+// evaluates the declarations before the nest for itself, so the statements before it may not change
+// those locals afterwards, and neither may the threads (a race on the CPU too). A 'return' before
+// the nest would skip it on the CPU but not on the GPU.
+bool CheckLoopEnds(Context& c, const std::string& kernel, const std::vector<const Stmt*>& before,
+                   const std::vector<const Stmt*>& after, const Stmt* threadBody, const std::set<const Expr*>& reductionTargets);
+
+struct LoopHeader {
+  const VarDecl* var = nullptr;
+  const Expr* start = nullptr;
+  const Expr* end = nullptr;
+  bool inclusive = false;
+};
+
+// Accepts `for (T i = a; i < b; ++i)` (also i++, i += 1, <=). Returns false and reports otherwise.
+bool ParseLoop(Context& c, const ForStmt* fs, LoopHeader& h, const std::string& kernel);
+
+// Casts the host-side C++ count to the loop variable's range: (end) - (start) [+ 1].
+std::string CountExpr(Context& c, const LoopHeader& h);
+
+}  // namespace crossrt::engine

@@ -1,0 +1,118 @@
+// The class's data members: which become buffers (std::vector), class data, images, samplers,
+// textures or vectors of objects, with their C++ and GLSL types. Takes the class; fills model.members
+// and model.constructors.
+#include "Members.h"
+
+#include "AnalysisContext.h"
+#include "AstQueries.h"
+
+#include <llvm/Support/FileSystem.h>
+#include <llvm/Support/Path.h>
+
+#include <algorithm>
+#include <cctype>
+#include <regex>
+#include <sstream>
+
+using namespace clang;
+
+namespace crossrt::engine {
+
+bool FitsClassData(ASTContext& ctx, QualType t) {
+  t = t.getCanonicalType();
+  if (IsLiteMathType(t)) return !IsLiteMathType(t, "float3x3");
+  if (t->isBuiltinType() || t->isEnumeralType()) return Std430Layout(ctx, t, false).has_value();
+  return LayoutMatchesCpp(ctx, t, false);
+}
+
+namespace {
+
+// A destructor Clang has not declared yet (an implicit one) is virtual when a base's is.
+bool HasVirtualDestructor(const CXXRecordDecl* rd) {
+  if (auto* dtor = rd->getDestructor()) return dtor->isVirtual();
+  for (auto& base : rd->bases())
+    if (auto* b = base.getType()->getAsCXXRecordDecl(); b && b->hasDefinition() && HasVirtualDestructor(b->getDefinition())) return true;
+  return false;
+}
+
+}  // namespace
+
+void AnalyzeMembers(Context& c) {
+  GlslPrinter structs(c.ctx, c.cls, c.rep);
+  for (auto* f : ClassFields(c.cls)) {
+    Member m;
+    m.name = f->getNameAsString();
+    m.hostExpr = m.name;
+    QualType elem;
+    if (IsTextureArray(f->getType(), &elem)) {
+      auto format = ImageFormatOf(elem);
+      if (!format || format->texel == "uint") continue;  // reported if a kernel uses it
+      m.kind = MemberKind::TextureArray;
+      m.glslType = format->texel;
+      m.vkFormat = format->vkFormat;
+      m.elemCppType = CppTypeName(c.ctx, elem);
+      m.cppType = CppTypeName(c.ctx, f->getType());
+    } else if (IsImage2D(f->getType(), &elem)) {
+      auto format = ImageFormatOf(elem);
+      if (!format) continue;  // reported if a kernel uses it
+      m.kind = MemberKind::Image;
+      m.glslType = format->texel;
+      m.imageFormat = format->glslFormat;
+      m.vkFormat = format->vkFormat;
+      m.imagePrefix = format->prefix;
+      m.elemCppType = CppTypeName(c.ctx, elem);
+      m.cppType = CppTypeName(c.ctx, f->getType());
+    } else if (IsImageSampler(f->getType())) {
+      m.kind = MemberKind::Sampler;
+      m.cppType = CppTypeName(c.ctx, f->getType());
+    } else if (IsStdVector(f->getType(), &elem)) {
+      auto g = GlslTypeOf(elem);
+      if (!g) continue;  // reported if a kernel uses it
+      m.kind = MemberKind::Vector;
+      m.glslType = *g;
+      m.elemCppType = CppTypeName(c.ctx, elem);
+      m.cppType = CppTypeName(c.ctx, f->getType());
+      m.scalarLayout = !LayoutMatchesCpp(c.ctx, elem, false);
+      if (f->getAccess() != AS_private && (!m.scalarLayout || LayoutMatchesCpp(c.ctx, elem, true))) structs.Type(elem, f->getLocation());
+    } else {
+      auto g = GlslTypeOf(f->getType());
+      if (!g) continue;
+      m.kind = MemberKind::Plain;
+      m.glslType = *g;
+      QualType base = f->getType();
+      while (auto* arr = dyn_cast<ConstantArrayType>(base.getCanonicalType().getTypePtr())) base = arr->getElementType();
+      m.cppType = CppTypeName(c.ctx, base);
+      m.inClassData = f->getAccess() != AS_private && FitsClassData(c.ctx, f->getType());
+      if (auto layout = Std430Layout(c.ctx, f->getType(), false)) m.std430Align = unsigned(layout->align);
+      if (m.inClassData) structs.Type(f->getType(), f->getLocation());
+    }
+    c.model.members.push_back(m);
+  }
+  c.model.glslClassStructs = structs.PreludeTypes();
+  for (auto* ctor : c.cls->ctors()) {
+    if (ctor->isImplicit() || ctor->isCopyOrMoveConstructor() || ctor->isDeleted() || ctor->getAccess() == AS_private) continue;
+    Constructor k;
+    for (unsigned i = 0; i < ctor->getNumParams(); ++i) {
+      k.paramsDecl += (i ? ", " : "") + ParamDecl(c.ctx, ctor->getParamDecl(i), i);
+      std::string n = ctor->getParamDecl(i)->getNameAsString();
+      k.argsForward += (i ? ", " : "") + (n.empty() ? "a_unnamed" + std::to_string(i) : n);
+    }
+    c.model.constructors.push_back(k);
+  }
+  if (c.model.constructors.empty()) c.model.constructors.push_back({});
+  c.model.virtualDestructor = HasVirtualDestructor(c.cls);
+  for (auto* md : ClassMethods(c.cls)) {
+    if (md->getName() == "CommitDeviceData" && md->isVirtual()) c.model.declaresCommitDeviceData = true;
+    if (md->getName() == "GetExecutionTime" && md->isVirtual()) c.model.declaresGetExecutionTime = true;
+  }
+}
+
+std::set<std::string> ClassStructNames(const ClassModel& model) {
+  std::set<std::string> names;
+  static const std::regex decl(R"(struct (\w+) \{)");
+  for (std::sregex_iterator it(model.glslClassStructs.begin(), model.glslClassStructs.end(), decl), end; it != end; ++it)
+    names.insert((*it)[1]);
+  return names;
+}
+
+}  // namespace crossrt::engine

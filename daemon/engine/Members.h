@@ -1,0 +1,18 @@
+// The class's data members: which become buffers (std::vector), class data, images, samplers,
+// textures or vectors of objects, with their C++ and GLSL types. Takes the class; fills model.members
+// and model.constructors.
+#pragma once
+#include "AnalysisContext.h"
+
+namespace crossrt::engine {
+
+// A single member of the class-data block: the C++ mirror declares it with alignas(std430
+// alignment), so a lone float3 matches; float3x3, bool and arrays of float3 do not.
+bool FitsClassData(ASTContext& ctx, QualType t);
+
+void AnalyzeMembers(Context& c);
+
+// Struct names already declared by the class-wide prelude ("struct Foo {  // ...").
+std::set<std::string> ClassStructNames(const ClassModel& model);
+
+}  // namespace crossrt::engine
