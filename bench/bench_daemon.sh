@@ -4,6 +4,11 @@
 # after one translation. Scenarios edit a copy of examples/bloom. Each figure is the median of 5.
 #   bench/bench_daemon.sh [build dir]     (default: build)
 set -euo pipefail
+if [[ "${1:-}" == --help || "${1:-}" == -h ]]; then
+  echo "usage: bench/bench_daemon.sh [BUILD_DIR (default build)]"
+  echo "  Cold against warm translation times of examples/bloom, per edit scenario (medians of 5)."
+  exit 0
+fi
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=$(cd "${1:-$root/build}" && pwd)
 crossrt=$build/bin/crossrt

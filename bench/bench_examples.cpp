@@ -38,6 +38,11 @@ void Row(const char* example, const char* impl, double ms, double baseMs, double
 
 int main(int argc, char** argv)
 {
+  if (argc > 1 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h"))
+  {
+    std::printf("usage: bench_examples [PARTICLES (default 1048576)] [IMAGE_SIDE (default 1024)] [PATH_SIDE (default 256)]\n  Times the examples as written, as _CPU and as _Vulkan, in interleaved rounds, and prints ratios.\n");
+    return 0;
+  }
   const int particles = argc > 1 ? std::atoi(argv[1]) : 1 << 20;
   const int side = argc > 2 ? std::atoi(argv[2]) : 1024;
   const int pathSide = argc > 3 ? std::atoi(argv[3]) : 256;

@@ -6,13 +6,13 @@
 // traversal), with ratios against Embree. Every figure is measured in this run: the CPU builders and
 // the CPU tracers in rounds that run each in turn (7 and 5), with ratios as medians of the rounds'
 // ratios; the Vulkan figures as medians of 3 after a warm-up.
-// Then the speed-against-quality trade of LBVH against binned SAH, as a table and as a PNG.
+// Then the speed-against-quality trade of LBVH against binned SAH, as a table and as CSV, which
+// bench/plot_bvh_tradeoff.py plots with matplotlib.
 //
-//   bench_lbvh [mesh dir (default build/data/meshes)] [plot.png (default out/bvh_tradeoff.png)]
+//   bench_lbvh [MESH_DIR (default build/data/meshes)] [TRADEOFF.csv (default out/bvh_tradeoff.csv)]
 #include "BenchSupport.h"
 #include "BVHScene.h"
 #include "CrossRT.h"
-#include "Image2D.h"
 #include "LBVH.h"
 #include "LBVH_CPU.h"
 #include "LBVH_Vulkan.h"
@@ -34,7 +34,6 @@
 #include <vector>
 
 using namespace LiteMath;
-using LiteImage::Image2D;
 
 namespace {
 
@@ -145,34 +144,19 @@ std::vector<Box4f> TriangleBoxes(const TriangleMesh& mesh)
 
 struct TradeOff { std::string mesh; double lbvhBuildMs, lbvhMrays, sahBuildMs, sahMrays; };
 
-// The trade as a scatter plot: x = build time (log scale, 0.1 ms .. 10 s), y = Mrays/s; one line
-// per mesh from its LBVH point (blue) to its SAH point (orange).
-void Plot(const std::vector<TradeOff>& rows, const std::string& path)
+// The trade as CSV, which bench/plot_bvh_tradeoff.py plots.
+void WriteTradeOffCsv(const std::vector<TradeOff>& rows, const std::string& path)
 {
-  const int w = 800, h = 500, margin = 40;
-  Image2D<float4> img(w, h, float4(1.0f));
-  double maxRays = 1.0;
-  for (auto& r : rows) maxRays = std::max({maxRays, r.lbvhMrays, r.sahMrays});
-  auto px = [&](double ms) { return margin + int((std::log10(std::max(ms, 0.1)) + 1.0) / 5.0 * (w - 2 * margin)); };
-  auto py = [&](double mrays) { return h - margin - int(mrays / (1.1 * maxRays) * (h - 2 * margin)); };
-  auto dot = [&](int x, int y, float4 c, int r) {
-    for (int dy = -r; dy <= r; ++dy)
-      for (int dx = -r; dx <= r; ++dx)
-        if (x + dx >= 0 && x + dx < w && y + dy >= 0 && y + dy < h) img[int2(x + dx, y + dy)] = c;
-  };
-  for (int decade = 0; decade <= 5; ++decade)  // grid lines at 0.1, 1, 10, 100, 1000, 10000 ms
-    for (int y = margin; y < h - margin; ++y) dot(margin + decade * (w - 2 * margin) / 5, y, float4(0.8f, 0.8f, 0.8f, 1), 0);
-  for (int x = margin; x < w - margin; ++x) dot(x, h - margin, float4(0, 0, 0, 1), 0);
-  for (int y = margin; y < h - margin; ++y) dot(margin, y, float4(0, 0, 0, 1), 0);
-  for (auto& r : rows)
+  if (std::filesystem::path(path).has_parent_path()) std::filesystem::create_directories(std::filesystem::path(path).parent_path());
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (!f)
   {
-    const int x0 = px(r.lbvhBuildMs), y0 = py(r.lbvhMrays), x1 = px(r.sahBuildMs), y1 = py(r.sahMrays);
-    for (int s = 0; s <= 200; ++s) dot(x0 + (x1 - x0) * s / 200, y0 + (y1 - y0) * s / 200, float4(0.5f, 0.5f, 0.5f, 1), 0);
-    dot(x0, y0, float4(0.1f, 0.3f, 0.9f, 1), 4);
-    dot(x1, y1, float4(0.95f, 0.5f, 0.1f, 1), 4);
+    std::fprintf(stderr, "bench_lbvh: cannot write %s\n", path.c_str());
+    return;
   }
-  std::filesystem::create_directories(std::filesystem::path(path).parent_path());
-  if (!LiteImage::SaveImage(path.c_str(), img)) std::printf("could not write %s\n", path.c_str());
+  std::fprintf(f, "mesh,lbvh_build_ms,lbvh_mrays_per_s,sah_build_ms,sah_mrays_per_s\n");
+  for (auto& r : rows) std::fprintf(f, "%s,%.3f,%.3f,%.3f,%.3f\n", r.mesh.c_str(), r.lbvhBuildMs, r.lbvhMrays, r.sahBuildMs, r.sahMrays);
+  std::fclose(f);
 }
 
 }  // namespace
@@ -180,8 +164,32 @@ void Plot(const std::vector<TradeOff>& rows, const std::string& path)
 int main(int argc, char** argv)
 {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // tables appear as they are measured
-  const std::string dir = argc > 1 ? argv[1] : "build/data/meshes";
-  const std::string plotPath = argc > 2 ? argv[2] : "out/bvh_tradeoff.png";
+  std::vector<std::string> positional;
+  for (int i = 1; i < argc; ++i)
+  {
+    const std::string a = argv[i];
+    if (a == "--help" || a == "-h")
+    {
+      std::printf("usage: bench_lbvh [MESH_DIR] [TRADEOFF.csv]\n"
+                  "  BVH build and traversal against Embree on the meshes scripts/fetch-meshes.sh cached in MESH_DIR\n"
+                  "  (default build/data/meshes), in the form of the paper's Tables 1 and 3. The speed-against-quality\n"
+                  "  table goes to TRADEOFF.csv too (default out/bvh_tradeoff.csv); bench/plot_bvh_tradeoff.py plots it.\n");
+      return 0;
+    }
+    if (a.size() > 1 && a[0] == '-')
+    {
+      std::fprintf(stderr, "bench_lbvh: unknown option '%s' (see bench_lbvh --help)\n", a.c_str());
+      return 2;
+    }
+    positional.push_back(a);
+  }
+  if (positional.size() > 2)
+  {
+    std::fprintf(stderr, "bench_lbvh: too many arguments (see bench_lbvh --help)\n");
+    return 2;
+  }
+  const std::string dir = positional.size() > 0 ? positional[0] : "build/data/meshes";
+  const std::string csvPath = positional.size() > 1 ? positional[1] : "out/bvh_tradeoff.csv";
   const char* names[] = {"teapot.obj", "dragon_vrip_res4.ply.gz", "dragon_vrip_res3.ply.gz", "armadillo.off", "bunny00.off",
                          "dragon_vrip_res2.ply.gz", "dragon_vrip.ply.gz"};
   std::shared_ptr<crossrt::VulkanContext> ctx;
@@ -385,7 +393,7 @@ int main(int argc, char** argv)
     std::printf("| %-22s | %14.1f | %14.2f | %14.1f | %14.2f | %22s |\n", t.mesh.c_str(), t.lbvhBuildMs, t.lbvhMrays, t.sahBuildMs,
                 t.sahMrays, after);
   }
-  Plot(trade, plotPath);
-  std::printf("plot: %s (x: build ms, log scale 0.1 ms .. 10 s; y: Mrays/s; blue LBVH, orange SAH, one line per mesh)\n", plotPath.c_str());
+  WriteTradeOffCsv(trade, csvPath);
+  std::printf("table: %s (plot it: bench/plot_bvh_tradeoff.py %s out/bvh_tradeoff.png)\n", csvPath.c_str(), csvPath.c_str());
   return 0;
 }

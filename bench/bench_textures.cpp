@@ -51,6 +51,11 @@ void Fill(TexturedMaterials& m, int textures, uint32_t side)
 
 int main(int argc, char** argv)
 {
+  if (argc > 1 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h"))
+  {
+    std::printf("usage: bench_textures [N (default 1048576)] [TEXTURES (default 16)] [SIDE (default 512)]\n  Samples arrays of textures from buffers against the GPU samplers, and prints ratios.\n");
+    return 0;
+  }
   const int n = argc > 1 ? std::atoi(argv[1]) : 1 << 20;
   const int textures = argc > 2 ? std::atoi(argv[2]) : 16;
   const uint32_t side = argc > 3 ? uint32_t(std::atoi(argv[3])) : 512;

@@ -11,6 +11,7 @@ PACKAGES=(
   libassimp-dev zlib1g-dev                                 # mesh files (OFF, PLY, OBJ, gzipped)
   libopenimageio-dev openimageio-tools                     # image IO
   catch2 nlohmann-json3-dev libkainjow-mustache-dev libxxhash-dev
+  python3-matplotlib                                       # plots of the benchmarks' CSV tables
 )
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -1,6 +1,8 @@
-// C++ (Clang AST) to GLSL: types, memory layouts and the statement/expression printer.
+// The GLSL printer: C++ (Clang AST) to GLSL for the code one kernel reaches, collecting the helper
+// functions, structs, members and images it uses. Types and layouts are in GlslTypes.h.
 #pragma once
 #include "Diagnostics.h"
+#include "GlslTypes.h"
 #include "OrderedSet.h"
 
 #include <clang/AST/ASTContext.h>
@@ -17,40 +19,8 @@
 
 namespace crossrt::engine {
 
-// GLSL spelling of a C++ type, or nullopt when it has none (the caller reports).
-// Arrays come back as "float[4]"; use SplitArray() to declare a variable.
-std::optional<std::string> GlslTypeOf(clang::QualType type);
-// "float[4]" -> {"float", "[4]"}
-std::pair<std::string, std::string> SplitArray(const std::string& glslType);
-
-bool IsLiteMathType(clang::QualType type, const char* name = nullptr);
-bool IsStdVector(clang::QualType type, clang::QualType* element = nullptr);
-// Image2D<T> (any namespace, as the paper's LiteImage names it) and its texel type.
-bool IsImage2D(clang::QualType type, clang::QualType* texel = nullptr);
-// LiteImage::Sampler: filtering and address modes of image samples.
-bool IsImageSampler(clang::QualType type);
-// std::vector<LiteImage::Texture2D<T>>: an array of textures (combined image samplers), and T.
-bool IsTextureArray(clang::QualType type, clang::QualType* texel = nullptr);
-// GPU image format of an Image2D<T>: GLSL format qualifier, Vulkan format, texel GLSL type,
-// image/texture type prefix ("" or "u"); nullopt for texel types the GPU cannot hold.
-struct ImageFormat { std::string glslFormat, vkFormat, texel, prefix; };
-std::optional<ImageFormat> ImageFormatOf(clang::QualType texel);
-bool IsSystemDecl(const clang::Decl* decl);
-// Why double is refused in Vulkan kernels, and what to do instead (by design: the GPU's limits).
-std::string DoubleRefusal(const std::string& type);
-std::string DoubleRefusalHint();
 // crossrt::AtomicAdd and the other read-modify-write operations of Atomics.h.
 bool IsCrossrtAtomic(const clang::FunctionDecl* fd);
-
-// std430 array stride of a scalar or vector GLSL type: "vec3" and "vec4" 16, "vec2" 8, scalars 4.
-unsigned Std430VectorStride(const std::string& glslType);
-
-// Memory layouts a GLSL buffer block can use. A C++ type can be shared with the GPU only when one
-// of them gives exactly the C++ offsets and sizes.
-struct LayoutInfo { uint64_t size = 0, align = 0; };
-std::optional<LayoutInfo> Std430Layout(clang::ASTContext& ctx, clang::QualType type, bool scalar);
-// True when an array of `type` in the given layout has the C++ stride and field offsets.
-bool LayoutMatchesCpp(clang::ASTContext& ctx, clang::QualType type, bool scalar);
 
 // The polymorphic class a shared_ptr, unique_ptr or plain pointer type points to, or null.
 const clang::CXXRecordDecl* PolymorphicPointee(clang::QualType type);

@@ -50,7 +50,14 @@ std::string CountExpr(Context& c, const LoopHeader& h) {
   std::string end = c.Text(h.end->getSourceRange()), start = c.Text(h.start->getSourceRange());
   Expr::EvalResult r;
   bool zeroStart = h.start->EvaluateAsInt(r, c.ctx) && r.Val.getInt() == 0;
-  std::string count = zeroStart ? "(" + end + ")" : "(" + end + ") - (" + start + ")";
+  // Operands in parentheses only where an operator inside them needs it: `n`, `(n - 1) - (k)`.
+  auto operand = [](const std::string& e) {
+    std::string bare = e;
+    for (const char* token : {"->", "::"})
+      for (size_t at; (at = bare.find(token)) != std::string::npos;) bare.erase(at, 2);
+    return bare.find_first_of("+-*/%<>=!&|^?, ") == std::string::npos ? e : "(" + e + ")";
+  };
+  std::string count = zeroStart ? operand(end) : operand(end) + " - " + operand(start);
   return h.inclusive ? count + " + 1" : count;
 }
 

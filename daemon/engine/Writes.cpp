@@ -22,9 +22,10 @@ std::string Identity(ReduceOp op, const std::string& glslType) {
                        : glslType[0] == 'i' ? "int" : glslType[0] == 'u' ? "uint" : "float";
   std::string v;
   if (op == ReduceOp::Add || op == ReduceOp::Sub) v = scalar == "float" ? "0.0" : scalar == "uint" ? "0u" : "0";
-  // +-infinity, so that infinite inputs reduce exactly as on the CPU
-  else if (op == ReduceOp::Min) v = scalar == "float" ? "uintBitsToFloat(0x7F800000u)" : scalar == "uint" ? "0xFFFFFFFFu" : "0x7FFFFFFF";
-  else v = scalar == "float" ? "uintBitsToFloat(0xFF800000u)" : scalar == "uint" ? "0u" : "(-2147483647 - 1)";
+  // +-infinity (CRT_INFINITY, defined by the shader templates), so that infinite inputs reduce
+  // exactly as on the CPU
+  else if (op == ReduceOp::Min) v = scalar == "float" ? "CRT_INFINITY" : scalar == "uint" ? "0xFFFFFFFFu" : "0x7FFFFFFF";
+  else v = scalar == "float" ? "-CRT_INFINITY" : scalar == "uint" ? "0u" : "(-2147483647 - 1)";
   return glslType == scalar ? v : glslType + "(" + v + ")";
 }
 

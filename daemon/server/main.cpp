@@ -201,6 +201,12 @@ void Serve(Daemon& d, int fd) {
 
 int main(int argc, char** argv) {
   Daemon d;
+  if (argc > 1 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h")) {
+    std::cout << "usage: crossrtd --build-dir DIR [--log FILE] [--idle-seconds N] [--max-asts N]\n"
+                 "  The translation daemon of one build tree: keeps parsed ASTs warm and answers the crossrt client.\n"
+                 "  crossrt starts it on demand; you rarely run it by hand.\n";
+    return 0;
+  }
   for (int i = 1; i + 1 < argc; i += 2) {
     std::string a = argv[i], v = argv[i + 1];
     if (a == "--build-dir") d.buildDir = v;

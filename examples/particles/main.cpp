@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <string>
 #include <cstdlib>
 #include <memory>
 #include <random>
@@ -24,6 +25,11 @@ struct Run
 
 int main(int argc, char** argv)
 {
+  if (argc > 1 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h"))
+  {
+    std::printf("usage: particles [N (default 1048576)] [STEPS (default 10)]\n  Moves N particles STEPS times with the original class, Particles_CPU and Particles_Vulkan, and prints\n  a table of times. Exits non-zero when their results differ.\n");
+    return 0;
+  }
   const int n = argc > 1 ? std::atoi(argv[1]) : 1 << 20;
   const int steps = argc > 2 ? std::atoi(argv[2]) : 10;
   std::mt19937 rng(7);

@@ -72,6 +72,11 @@ size_t DifferingPixels(const std::vector<uint32_t>& a, const std::vector<uint32_
 
 int main(int argc, char** argv)
 {
+  if (argc > 1 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h"))
+  {
+    std::printf("usage: primary_rays [MESH | \"\"] [OUTPUT.png] [--size N] [--ao SAMPLES] [--bvh lbvh|sah]\n  Renders MESH (OFF, PLY or OBJ, also gzipped; \"\" or none: a built-in scene) with primary rays and\n  ambient occlusion through ISceneObject: Embree, the original class, PrimaryRays_CPU and PrimaryRays_Vulkan.\n");
+    return 0;
+  }
   std::string meshPath, outPath = "primary_rays.png", bvh = "lbvh";
   int size = 512, ao = 4;
   int positional = 0;

@@ -53,6 +53,11 @@ size_t DifferingPixels(const std::vector<float4>& a, const std::vector<float4>& 
 
 int main(int argc, char** argv)
 {
+  if (argc > 1 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h"))
+  {
+    std::printf("usage: sphere_paths [OUTPUT.png] [--size N] [--samples S] [--depth D]\n  Path traces spheres with the original class, SpherePaths_CPU and SpherePaths_Vulkan (megakernel and\n  wavefront); writes OUTPUT.png (default sphere_paths.png). Exits non-zero when they differ.\n");
+    return 0;
+  }
   std::string outPath = "sphere_paths.png";
   int size = 256, samples = 16, depth = 4;
   bool havePath = false;

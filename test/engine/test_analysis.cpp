@@ -92,7 +92,7 @@ TEST_CASE("Analysis finds kernels, control functions, members and reductions", "
   CHECK(scale->dims == 1);
   REQUIRE(scale->loops.size() == 1);
   CHECK(scale->loops[0].var == "i");
-  CHECK(scale->loops[0].countCpp == "(n)");
+  CHECK(scale->loops[0].countCpp == "n");
   REQUIRE(scale->reductions.size() == 2);
   CHECK(scale->reductions[0].member == "m_total");  // in declaration order
   CHECK(scale->reductions[0].op == ReduceOp::Add);
@@ -121,7 +121,7 @@ TEST_CASE("Analysis finds kernels, control functions, members and reductions", "
   CHECK(run.params[2].sizeExpr == "n");
   CHECK_FALSE(run.params[2].isConst);
   CHECK(run.vulkanCmdBody.find("kernel1D_ScaleCmd(a_cmd, n, m_inOut_Run.in, m_inOut_Run.out)") != std::string::npos);
-  CHECK(rtv.vulkanCmdBody.find("kernel_PixelCmd(a_cmd, (w), (h), w, m_inOut_RunRtv.img);") != std::string::npos);
+  CHECK(rtv.vulkanCmdBody.find("kernel_PixelCmd(a_cmd, w, h, w, m_inOut_RunRtv.img);") != std::string::npos);
   CHECK(rtv.cpuBody.find("#pragma omp parallel for") != std::string::npos);
 
   // Members: plain data and vectors; the vector of float3 needs the scalar layout to match C++.
@@ -331,8 +331,8 @@ void Tracer::kernel_Depth(uint32_t tid, const CRT_Hit* hit, float* depth) { dept
   CHECK(hit.find("hitPerThread[threadIndex] = hit;") != std::string::npos);
   CHECK(result.files.count("shaders/kernel_Hit_RayQuery.comp") == 1);
   const std::string& host = result.files.at("Tracer_Vulkan.cpp");
-  CHECK(host.find("Trace_MegakernelCmd(a_cmd, (n), m_inOut_Trace.rays, m_inOut_Trace.depth);") != std::string::npos);
-  CHECK(host.find("kernel_HitCmd(a_cmd, (n), m_inOut_Trace.rays, m_threadState.Trace_hit.View());") != std::string::npos);
+  CHECK(host.find("Trace_MegakernelCmd(a_cmd, n, m_inOut_Trace.rays, m_inOut_Trace.depth);") != std::string::npos);
+  CHECK(host.find("kernel_HitCmd(a_cmd, n, m_inOut_Trace.rays, m_threadState.Trace_hit.View());") != std::string::npos);
   // The megakernel reads the traversal's buffers even while kernel_Hit uses the hardware: they stay uploaded.
   CHECK(host.find("m_vdata.m_pAccelStruct_m_nodes.Upload(") != std::string::npos);
   CHECK(host.find("only the translated traversal reads it") == std::string::npos);

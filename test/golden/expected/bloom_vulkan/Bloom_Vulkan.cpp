@@ -175,9 +175,9 @@ void Bloom_Vulkan::RunCmd(VkCommandBuffer a_cmd, int width, int height, [[maybe_
 void Bloom_Vulkan::kernel2D_ExtractBrightCmd(VkCommandBuffer a_cmd, int width, int height, crossrt::BufferView in, crossrt::BufferView bright)
 {
   const int crt_startX = int(0);
-  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t((width))));
+  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(width)));
   const int crt_startY = int(0);
-  const uint32_t crt_countY = uint32_t(std::max<int64_t>(0, int64_t((height))));
+  const uint32_t crt_countY = uint32_t(std::max<int64_t>(0, int64_t(height)));
   if (crt_countX == 0 || crt_countY == 0)
     return;
   kernel2D_ExtractBrightArgs crt_args{};
@@ -190,7 +190,6 @@ void Bloom_Vulkan::kernel2D_ExtractBrightCmd(VkCommandBuffer a_cmd, int width, i
   m_pipelines.kernel2D_ExtractBright.Bind(a_cmd);
   m_pipelines.kernel2D_ExtractBright.PushBuffers(a_cmd, { m_classDataBuffer.View(), in, bright });
   m_pipelines.kernel2D_ExtractBright.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  ;
   crossrt::Dispatch2D(a_cmd, crt_countX, crt_countY, 16, 16);
   crossrt::ComputeBarrier(a_cmd);
 }
@@ -200,9 +199,9 @@ void Bloom_Vulkan::kernel2D_ExtractBrightCmd(VkCommandBuffer a_cmd, int width, i
 void Bloom_Vulkan::kernel2D_BlurXCmd(VkCommandBuffer a_cmd, int width, int height, crossrt::BufferView src, crossrt::BufferView dst)
 {
   const int crt_startX = int(0);
-  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t((width))));
+  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(width)));
   const int crt_startY = int(0);
-  const uint32_t crt_countY = uint32_t(std::max<int64_t>(0, int64_t((height))));
+  const uint32_t crt_countY = uint32_t(std::max<int64_t>(0, int64_t(height)));
   if (crt_countX == 0 || crt_countY == 0)
     return;
   kernel2D_BlurXArgs crt_args{};
@@ -215,7 +214,6 @@ void Bloom_Vulkan::kernel2D_BlurXCmd(VkCommandBuffer a_cmd, int width, int heigh
   m_pipelines.kernel2D_BlurX.Bind(a_cmd);
   m_pipelines.kernel2D_BlurX.PushBuffers(a_cmd, { m_classDataBuffer.View(), src, dst, m_vdata.m_weights.View() });
   m_pipelines.kernel2D_BlurX.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  ;
   crossrt::Dispatch2D(a_cmd, crt_countX, crt_countY, 16, 16);
   crossrt::ComputeBarrier(a_cmd);
 }
@@ -225,9 +223,9 @@ void Bloom_Vulkan::kernel2D_BlurXCmd(VkCommandBuffer a_cmd, int width, int heigh
 void Bloom_Vulkan::kernel2D_BlurYAndAddCmd(VkCommandBuffer a_cmd, int width, int height, crossrt::BufferView src, crossrt::BufferView in, crossrt::BufferView out)
 {
   const int crt_startX = int(0);
-  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t((width))));
+  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(width)));
   const int crt_startY = int(0);
-  const uint32_t crt_countY = uint32_t(std::max<int64_t>(0, int64_t((height))));
+  const uint32_t crt_countY = uint32_t(std::max<int64_t>(0, int64_t(height)));
   if (crt_countX == 0 || crt_countY == 0)
     return;
   kernel2D_BlurYAndAddArgs crt_args{};
@@ -240,7 +238,6 @@ void Bloom_Vulkan::kernel2D_BlurYAndAddCmd(VkCommandBuffer a_cmd, int width, int
   m_pipelines.kernel2D_BlurYAndAdd.Bind(a_cmd);
   m_pipelines.kernel2D_BlurYAndAdd.PushBuffers(a_cmd, { m_classDataBuffer.View(), src, in, out, m_vdata.m_weights.View() });
   m_pipelines.kernel2D_BlurYAndAdd.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  ;
   crossrt::Dispatch2D(a_cmd, crt_countX, crt_countY, 16, 16);
   crossrt::ComputeBarrier(a_cmd);
 }

@@ -271,9 +271,9 @@ void CallableShading_Vulkan::RenderCmd(VkCommandBuffer a_cmd, int width, int hei
 void CallableShading_Vulkan::kernel2D_RenderCmd(VkCommandBuffer a_cmd, int width, int height, crossrt::BufferView normals, crossrt::BufferView materialIds, crossrt::BufferView colors)
 {
   const int crt_startX = int(0);
-  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t((width))));
+  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(width)));
   const int crt_startY = int(0);
-  const uint32_t crt_countY = uint32_t(std::max<int64_t>(0, int64_t((height))));
+  const uint32_t crt_countY = uint32_t(std::max<int64_t>(0, int64_t(height)));
   if (crt_countX == 0 || crt_countY == 0)
     return;
   kernel2D_RenderArgs crt_args{};

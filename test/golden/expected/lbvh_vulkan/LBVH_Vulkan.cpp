@@ -273,7 +273,7 @@ void LBVH_Vulkan::BuildCmd(VkCommandBuffer a_cmd, int count, [[maybe_unused]] co
 void LBVH_Vulkan::kernel1D_BoundsCmd(VkCommandBuffer a_cmd, int count, crossrt::BufferView boxes)
 {
   const int crt_startX = int(0);
-  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t((count))));
+  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(count)));
   if (crt_countX == 0)
     return;
   kernel1D_BoundsArgs crt_args{};
@@ -285,7 +285,6 @@ void LBVH_Vulkan::kernel1D_BoundsCmd(VkCommandBuffer a_cmd, int count, crossrt::
   m_pipelines.kernel1D_Bounds.Bind(a_cmd);
   m_pipelines.kernel1D_Bounds.PushBuffers(a_cmd, { m_classDataBuffer.View(), boxes, m_partials.kernel1D_Bounds_m_centerMin.View(), m_partials.kernel1D_Bounds_m_centerMax.View() });
   m_pipelines.kernel1D_Bounds.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  ;
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);
   crossrt::ComputeBarrier(a_cmd);
   const uint32_t crt_partialCount = crossrt::GroupCount1D(crt_countX, 256);
@@ -301,7 +300,7 @@ void LBVH_Vulkan::kernel1D_BoundsCmd(VkCommandBuffer a_cmd, int count, crossrt::
 void LBVH_Vulkan::kernel1D_EvalMCCmd(VkCommandBuffer a_cmd, int count, crossrt::BufferView boxes)
 {
   const int crt_startX = int(0);
-  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t((count))));
+  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(count)));
   if (crt_countX == 0)
     return;
   kernel1D_EvalMCArgs crt_args{};
@@ -311,7 +310,6 @@ void LBVH_Vulkan::kernel1D_EvalMCCmd(VkCommandBuffer a_cmd, int count, crossrt::
   m_pipelines.kernel1D_EvalMC.Bind(a_cmd);
   m_pipelines.kernel1D_EvalMC.PushBuffers(a_cmd, { m_classDataBuffer.View(), boxes, m_vdata.m_codes.View() });
   m_pipelines.kernel1D_EvalMC.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  ;
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);
   crossrt::ComputeBarrier(a_cmd);
 }
@@ -321,7 +319,7 @@ void LBVH_Vulkan::kernel1D_EvalMCCmd(VkCommandBuffer a_cmd, int count, crossrt::
 void LBVH_Vulkan::kernel1D_AppendInitCmd(VkCommandBuffer a_cmd, int count)
 {
   const int crt_startX = int(0);
-  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t((count))));
+  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(count)));
   if (crt_countX == 0)
     return;
   kernel1D_AppendInitArgs crt_args{};
@@ -331,7 +329,6 @@ void LBVH_Vulkan::kernel1D_AppendInitCmd(VkCommandBuffer a_cmd, int count)
   m_pipelines.kernel1D_AppendInit.Bind(a_cmd);
   m_pipelines.kernel1D_AppendInit.PushBuffers(a_cmd, { m_classDataBuffer.View(), m_vdata.m_codes.View(), m_vdata.m_newGroup.View(), m_vdata.m_primIndices.View() });
   m_pipelines.kernel1D_AppendInit.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  ;
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);
   crossrt::ComputeBarrier(a_cmd);
 }
@@ -341,7 +338,7 @@ void LBVH_Vulkan::kernel1D_AppendInitCmd(VkCommandBuffer a_cmd, int count)
 void LBVH_Vulkan::kernel1D_AppendCompleteCmd(VkCommandBuffer a_cmd, int count)
 {
   const int crt_startX = int(0);
-  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t((count))));
+  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(count)));
   if (crt_countX == 0)
     return;
   kernel1D_AppendCompleteArgs crt_args{};
@@ -352,7 +349,6 @@ void LBVH_Vulkan::kernel1D_AppendCompleteCmd(VkCommandBuffer a_cmd, int count)
   m_pipelines.kernel1D_AppendComplete.Bind(a_cmd);
   m_pipelines.kernel1D_AppendComplete.PushBuffers(a_cmd, { m_classDataBuffer.View(), m_vdata.m_codes.View(), m_vdata.m_groupOf.View(), m_vdata.m_leafCode.View(), m_vdata.m_leafFirst.View(), m_vdata.m_newGroup.View(), m_partials.kernel1D_AppendComplete_m_leafCount.View() });
   m_pipelines.kernel1D_AppendComplete.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  ;
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);
   crossrt::ComputeBarrier(a_cmd);
   const uint32_t crt_partialCount = crossrt::GroupCount1D(crt_countX, 256);
@@ -368,7 +364,7 @@ void LBVH_Vulkan::kernel1D_AppendCompleteCmd(VkCommandBuffer a_cmd, int count)
 void LBVH_Vulkan::kernel1D_Karras12Cmd(VkCommandBuffer a_cmd, int count)
 {
   const int crt_startX = int(0);
-  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t((count))));
+  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(count)));
   if (crt_countX == 0)
     return;
   kernel1D_Karras12Args crt_args{};
@@ -378,7 +374,6 @@ void LBVH_Vulkan::kernel1D_Karras12Cmd(VkCommandBuffer a_cmd, int count)
   m_pipelines.kernel1D_Karras12.Bind(a_cmd);
   m_pipelines.kernel1D_Karras12.PushBuffers(a_cmd, { m_classDataBuffer.View(), m_vdata.m_arrivals.View(), m_vdata.m_leafCode.View(), m_vdata.m_nodes.View(), m_vdata.m_parent.View() });
   m_pipelines.kernel1D_Karras12.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  ;
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);
   crossrt::ComputeBarrier(a_cmd);
 }
@@ -388,7 +383,7 @@ void LBVH_Vulkan::kernel1D_Karras12Cmd(VkCommandBuffer a_cmd, int count)
 void LBVH_Vulkan::kernel1D_MakeLeavesCmd(VkCommandBuffer a_cmd, int count, crossrt::BufferView boxes)
 {
   const int crt_startX = int(0);
-  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t((count))));
+  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(count)));
   if (crt_countX == 0)
     return;
   kernel1D_MakeLeavesArgs crt_args{};
@@ -398,7 +393,6 @@ void LBVH_Vulkan::kernel1D_MakeLeavesCmd(VkCommandBuffer a_cmd, int count, cross
   m_pipelines.kernel1D_MakeLeaves.Bind(a_cmd);
   m_pipelines.kernel1D_MakeLeaves.PushBuffers(a_cmd, { m_classDataBuffer.View(), boxes, m_vdata.m_leafFirst.View(), m_vdata.m_nodes.View(), m_vdata.m_primIndices.View() });
   m_pipelines.kernel1D_MakeLeaves.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  ;
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);
   crossrt::ComputeBarrier(a_cmd);
 }
@@ -408,7 +402,7 @@ void LBVH_Vulkan::kernel1D_MakeLeavesCmd(VkCommandBuffer a_cmd, int count, cross
 void LBVH_Vulkan::kernel1D_RefitCmd(VkCommandBuffer a_cmd, int count)
 {
   const int crt_startX = int(0);
-  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t((count))));
+  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(count)));
   if (crt_countX == 0)
     return;
   kernel1D_RefitArgs crt_args{};
@@ -418,7 +412,6 @@ void LBVH_Vulkan::kernel1D_RefitCmd(VkCommandBuffer a_cmd, int count)
   m_pipelines.kernel1D_Refit.Bind(a_cmd);
   m_pipelines.kernel1D_Refit.PushBuffers(a_cmd, { m_classDataBuffer.View(), m_vdata.m_arrivals.View(), m_vdata.m_nodes.View(), m_vdata.m_parent.View() });
   m_pipelines.kernel1D_Refit.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  ;
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);
   crossrt::ComputeBarrier(a_cmd);
 }

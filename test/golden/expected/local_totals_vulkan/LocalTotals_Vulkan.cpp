@@ -157,7 +157,7 @@ void LocalTotals_Vulkan::SummarizeCmd(VkCommandBuffer a_cmd, uint32_t n, [[maybe
 void LocalTotals_Vulkan::kernel1D_SummarizeCmd(VkCommandBuffer a_cmd, uint32_t n, crossrt::BufferView a_values, crossrt::BufferView a_out)
 {
   const int crt_startX = int(0);
-  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t((n))));
+  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(n)));
   kernel1D_SummarizeArgs crt_args{};
   crt_args.crt_startX = crt_startX;
   crt_args.crt_countX = crt_countX;
@@ -179,7 +179,6 @@ void LocalTotals_Vulkan::kernel1D_SummarizeCmd(VkCommandBuffer a_cmd, uint32_t n
   m_pipelines.kernel1D_Summarize.Bind(a_cmd);
   m_pipelines.kernel1D_Summarize.PushBuffers(a_cmd, { m_classDataBuffer.View(), a_values, a_out, m_partials.kernel1D_Summarize_sum.View(), m_partials.kernel1D_Summarize_lo.View(), m_partials.kernel1D_Summarize_hi.View(), m_partials.kernel1D_Summarize_total.View(), m_partials.kernel1D_Summarize_negatives.View() });
   m_pipelines.kernel1D_Summarize.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  ;
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);
   crossrt::ComputeBarrier(a_cmd);
   const uint32_t crt_partialCount = crossrt::GroupCount1D(crt_countX, 256);

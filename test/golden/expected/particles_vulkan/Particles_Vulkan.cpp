@@ -186,7 +186,7 @@ void Particles_Vulkan::StepCmd(VkCommandBuffer a_cmd, int n, float dt, [[maybe_u
 void Particles_Vulkan::kernel1D_AdvanceCmd(VkCommandBuffer a_cmd, int n, float dt, crossrt::BufferView positions, crossrt::BufferView velocities)
 {
   const int crt_startX = int(0);
-  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t((n))));
+  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(n)));
   if (crt_countX == 0)
     return;
   kernel1D_AdvanceArgs crt_args{};
@@ -198,7 +198,6 @@ void Particles_Vulkan::kernel1D_AdvanceCmd(VkCommandBuffer a_cmd, int n, float d
   m_pipelines.kernel1D_Advance.Bind(a_cmd);
   m_pipelines.kernel1D_Advance.PushBuffers(a_cmd, { m_classDataBuffer.View(), positions, velocities, m_partials.kernel1D_Advance_m_bounces.View() });
   m_pipelines.kernel1D_Advance.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  ;
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);
   crossrt::ComputeBarrier(a_cmd);
   const uint32_t crt_partialCount = crossrt::GroupCount1D(crt_countX, 256);
@@ -214,7 +213,7 @@ void Particles_Vulkan::kernel1D_AdvanceCmd(VkCommandBuffer a_cmd, int n, float d
 void Particles_Vulkan::kernel1D_MeasureCmd(VkCommandBuffer a_cmd, int n, crossrt::BufferView positions, crossrt::BufferView velocities)
 {
   const int crt_startX = int(0);
-  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t((n))));
+  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(n)));
   if (crt_countX == 0)
     return;
   kernel1D_MeasureArgs crt_args{};
@@ -228,7 +227,6 @@ void Particles_Vulkan::kernel1D_MeasureCmd(VkCommandBuffer a_cmd, int n, crossrt
   m_pipelines.kernel1D_Measure.Bind(a_cmd);
   m_pipelines.kernel1D_Measure.PushBuffers(a_cmd, { m_classDataBuffer.View(), positions, velocities, m_partials.kernel1D_Measure_m_boxMin.View(), m_partials.kernel1D_Measure_m_boxMax.View(), m_partials.kernel1D_Measure_m_momentum.View(), m_partials.kernel1D_Measure_m_kineticEnergy.View() });
   m_pipelines.kernel1D_Measure.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  ;
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);
   crossrt::ComputeBarrier(a_cmd);
   const uint32_t crt_partialCount = crossrt::GroupCount1D(crt_countX, 256);

@@ -342,9 +342,9 @@ void PrimaryRays_Vulkan::CastRaysCmd(VkCommandBuffer a_cmd, [[maybe_unused]] con
 void PrimaryRays_Vulkan::kernel2D_RenderCmd(VkCommandBuffer a_cmd, crossrt::BufferView pixels, int width, int height)
 {
   const int crt_startX = int(0);
-  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t((width))));
+  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(width)));
   const int crt_startY = int(0);
-  const uint32_t crt_countY = uint32_t(std::max<int64_t>(0, int64_t((height))));
+  const uint32_t crt_countY = uint32_t(std::max<int64_t>(0, int64_t(height)));
   if (crt_countX == 0 || crt_countY == 0)
     return;
   kernel2D_RenderArgs crt_args{};
@@ -359,14 +359,12 @@ void PrimaryRays_Vulkan::kernel2D_RenderCmd(VkCommandBuffer a_cmd, crossrt::Buff
     m_pipelines.kernel2D_Render_RayQuery.Bind(a_cmd);
     m_pipelines.kernel2D_Render_RayQuery.PushBindings(a_cmd, { m_classDataBuffer.View(), pixels, m_vdata.m_indices.View(), m_vdata.m_vertices.View(), crossrt::Binding::SceneOf(m_scenes.m_pAccelStruct) });
     m_pipelines.kernel2D_Render_RayQuery.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-    ;
   }
   else
   {
     m_pipelines.kernel2D_Render.Bind(a_cmd);
     m_pipelines.kernel2D_Render.PushBuffers(a_cmd, { m_classDataBuffer.View(), pixels, m_vdata.m_indices.View(), m_vdata.m_pAccelStruct_m_boxes.View(), m_vdata.m_pAccelStruct_m_instances.View(), m_vdata.m_pAccelStruct_m_motion.View(), m_vdata.m_pAccelStruct_m_nodes.View(), m_vdata.m_pAccelStruct_m_primIds.View(), m_vdata.m_pAccelStruct_m_triangles.View(), m_vdata.m_vertices.View() });
     m_pipelines.kernel2D_Render.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-    ;
   }
   crossrt::Dispatch2D(a_cmd, crt_countX, crt_countY, 16, 16);
   crossrt::ComputeBarrier(a_cmd);
@@ -377,7 +375,7 @@ void PrimaryRays_Vulkan::kernel2D_RenderCmd(VkCommandBuffer a_cmd, crossrt::Buff
 void PrimaryRays_Vulkan::kernel1D_CastRaysCmd(VkCommandBuffer a_cmd, crossrt::BufferView posAndNear, crossrt::BufferView dirAndFar, crossrt::BufferView hits, int n)
 {
   const int crt_startX = int(0);
-  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t((n))));
+  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(n)));
   if (crt_countX == 0)
     return;
   kernel1D_CastRaysArgs crt_args{};
@@ -389,14 +387,12 @@ void PrimaryRays_Vulkan::kernel1D_CastRaysCmd(VkCommandBuffer a_cmd, crossrt::Bu
     m_pipelines.kernel1D_CastRays_RayQuery.Bind(a_cmd);
     m_pipelines.kernel1D_CastRays_RayQuery.PushBindings(a_cmd, { m_classDataBuffer.View(), posAndNear, dirAndFar, hits, crossrt::Binding::SceneOf(m_scenes.m_pAccelStruct) });
     m_pipelines.kernel1D_CastRays_RayQuery.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-    ;
   }
   else
   {
     m_pipelines.kernel1D_CastRays.Bind(a_cmd);
     m_pipelines.kernel1D_CastRays.PushBuffers(a_cmd, { m_classDataBuffer.View(), posAndNear, dirAndFar, hits, m_vdata.m_pAccelStruct_m_boxes.View(), m_vdata.m_pAccelStruct_m_instances.View(), m_vdata.m_pAccelStruct_m_motion.View(), m_vdata.m_pAccelStruct_m_nodes.View(), m_vdata.m_pAccelStruct_m_primIds.View(), m_vdata.m_pAccelStruct_m_triangles.View() });
     m_pipelines.kernel1D_CastRays.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-    ;
   }
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);
   crossrt::ComputeBarrier(a_cmd);

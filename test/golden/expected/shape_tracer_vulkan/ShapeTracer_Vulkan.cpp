@@ -405,7 +405,7 @@ void ShapeTracer_Vulkan::TraceCmd(VkCommandBuffer a_cmd, int n, [[maybe_unused]]
 void ShapeTracer_Vulkan::kernel1D_TraceCmd(VkCommandBuffer a_cmd, int n, crossrt::BufferView origins, crossrt::BufferView dirs, float far, crossrt::BufferView hits)
 {
   const int crt_startX = int(0);
-  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t((n))));
+  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(n)));
   if (crt_countX == 0)
     return;
   kernel1D_TraceArgs crt_args{};

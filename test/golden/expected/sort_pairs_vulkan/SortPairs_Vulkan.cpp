@@ -149,7 +149,7 @@ void SortPairs_Vulkan::MakeAndSortCmd(VkCommandBuffer a_cmd, uint32_t a_seed, [[
 void SortPairs_Vulkan::kernel1D_MakeCmd(VkCommandBuffer a_cmd, uint32_t n, uint32_t a_seed)
 {
   const int crt_startX = int(0);
-  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t((n))));
+  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(n)));
   if (crt_countX == 0)
     return;
   kernel1D_MakeArgs crt_args{};
@@ -160,7 +160,6 @@ void SortPairs_Vulkan::kernel1D_MakeCmd(VkCommandBuffer a_cmd, uint32_t n, uint3
   m_pipelines.kernel1D_Make.Bind(a_cmd);
   m_pipelines.kernel1D_Make.PushBuffers(a_cmd, { m_classDataBuffer.View(), m_vdata.m_pairs.View() });
   m_pipelines.kernel1D_Make.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  ;
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);
   crossrt::ComputeBarrier(a_cmd);
 }
@@ -170,7 +169,7 @@ void SortPairs_Vulkan::kernel1D_MakeCmd(VkCommandBuffer a_cmd, uint32_t n, uint3
 void SortPairs_Vulkan::kernel1D_CopyCmd(VkCommandBuffer a_cmd, uint32_t n, crossrt::BufferView a_out)
 {
   const int crt_startX = int(0);
-  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t((n))));
+  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(n)));
   if (crt_countX == 0)
     return;
   kernel1D_CopyArgs crt_args{};
@@ -180,7 +179,6 @@ void SortPairs_Vulkan::kernel1D_CopyCmd(VkCommandBuffer a_cmd, uint32_t n, cross
   m_pipelines.kernel1D_Copy.Bind(a_cmd);
   m_pipelines.kernel1D_Copy.PushBuffers(a_cmd, { m_classDataBuffer.View(), a_out, m_vdata.m_pairs.View() });
   m_pipelines.kernel1D_Copy.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  ;
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);
   crossrt::ComputeBarrier(a_cmd);
 }

@@ -156,10 +156,10 @@ void SpherePaths_Vulkan::RenderCmd(VkCommandBuffer a_cmd, uint32_t width, uint32
 {
   const auto start = std::chrono::steady_clock::now();
   if (m_executionMode == crossrt::ExecutionMode::Megakernel)
-    Render_MegakernelCmd(a_cmd, (width), (height), m_inOut_Render.out_color, samples, width, height);
+    Render_MegakernelCmd(a_cmd, width, height, m_inOut_Render.out_color, samples, width, height);
   else
   {
-    const size_t crt_threads = size_t((height)) * size_t((width));
+    const size_t crt_threads = size_t(height) * size_t(width);
     crossrt::EnsureSize(m_ctx, m_threadState.Render_rayPos,
                         sizeof(float4) * std::max<size_t>(1, crt_threads));
     crossrt::FillCmd(a_cmd, m_threadState.Render_rayPos.View(), sizeof(float4) * crt_threads, 0);
@@ -176,20 +176,19 @@ void SpherePaths_Vulkan::RenderCmd(VkCommandBuffer a_cmd, uint32_t width, uint32
     crossrt::FillCmd(a_cmd, m_threadState.Render_hit.View(), sizeof(SphereHit) * crt_threads, 0);
     for (int sample = 0; sample < samples; sample++)
     {
-      kernel_InitEyeRayCmd(a_cmd, (width), (height), width, height, sample,
-                           m_threadState.Render_rayPos.View(), m_threadState.Render_rayDir.View(),
-                           m_threadState.Render_throughput.View());
+      kernel_InitEyeRayCmd(a_cmd, width, height, width, height, sample, m_threadState.Render_rayPos.View(),
+                           m_threadState.Render_rayDir.View(), m_threadState.Render_throughput.View());
       for (int bounce = 0; bounce < m_maxDepth; bounce++)
       {
-        kernel_RayTraceCmd(a_cmd, (width), (height), m_threadState.Render_rayPos.View(),
+        kernel_RayTraceCmd(a_cmd, width, height, m_threadState.Render_rayPos.View(),
                            m_threadState.Render_rayDir.View(), m_threadState.Render_throughput.View(),
                            m_threadState.Render_hit.View());
-        kernel_NextBounceCmd(a_cmd, (width), (height), width, sample, bounce, m_threadState.Render_hit.View(),
+        kernel_NextBounceCmd(a_cmd, width, height, width, sample, bounce, m_threadState.Render_hit.View(),
                              m_threadState.Render_rayPos.View(), m_threadState.Render_rayDir.View(),
                              m_threadState.Render_throughput.View(), m_threadState.Render_color.View());
       }
     }
-    kernel_ContributeCmd(a_cmd, (width), (height), width, samples, m_threadState.Render_color.View(),
+    kernel_ContributeCmd(a_cmd, width, height, width, samples, m_threadState.Render_color.View(),
                          m_inOut_Render.out_color);
   }
   m_timeMs = std::chrono::duration<float, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -217,7 +216,6 @@ void SpherePaths_Vulkan::kernel_InitEyeRayCmd(VkCommandBuffer a_cmd, uint32_t a_
   m_pipelines.kernel_InitEyeRay.Bind(a_cmd);
   m_pipelines.kernel_InitEyeRay.PushBuffers(a_cmd, { m_classDataBuffer.View(), rayPos, rayDir, throughput });
   m_pipelines.kernel_InitEyeRay.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  ;
   crossrt::Dispatch2D(a_cmd, crt_countX, crt_countY, 16, 16);
   crossrt::ComputeBarrier(a_cmd);
 }
@@ -240,7 +238,6 @@ void SpherePaths_Vulkan::kernel_RayTraceCmd(VkCommandBuffer a_cmd, uint32_t a_th
   m_pipelines.kernel_RayTrace.Bind(a_cmd);
   m_pipelines.kernel_RayTrace.PushBuffers(a_cmd, { m_classDataBuffer.View(), rayPos, rayDir, throughput, hit, m_vdata.m_spheres.View() });
   m_pipelines.kernel_RayTrace.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  ;
   crossrt::Dispatch2D(a_cmd, crt_countX, crt_countY, 16, 16);
   crossrt::ComputeBarrier(a_cmd);
 }
@@ -266,7 +263,6 @@ void SpherePaths_Vulkan::kernel_NextBounceCmd(VkCommandBuffer a_cmd, uint32_t a_
   m_pipelines.kernel_NextBounce.Bind(a_cmd);
   m_pipelines.kernel_NextBounce.PushBuffers(a_cmd, { m_classDataBuffer.View(), hit, rayPos, rayDir, throughput, color, m_vdata.m_spheres.View() });
   m_pipelines.kernel_NextBounce.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  ;
   crossrt::Dispatch2D(a_cmd, crt_countX, crt_countY, 16, 16);
   crossrt::ComputeBarrier(a_cmd);
 }
@@ -291,7 +287,6 @@ void SpherePaths_Vulkan::kernel_ContributeCmd(VkCommandBuffer a_cmd, uint32_t a_
   m_pipelines.kernel_Contribute.Bind(a_cmd);
   m_pipelines.kernel_Contribute.PushBuffers(a_cmd, { m_classDataBuffer.View(), color, out_color });
   m_pipelines.kernel_Contribute.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  ;
   crossrt::Dispatch2D(a_cmd, crt_countX, crt_countY, 16, 16);
   crossrt::ComputeBarrier(a_cmd);
 }
@@ -317,7 +312,6 @@ void SpherePaths_Vulkan::Render_MegakernelCmd(VkCommandBuffer a_cmd, uint32_t a_
   m_pipelines.Render_Megakernel.Bind(a_cmd);
   m_pipelines.Render_Megakernel.PushBuffers(a_cmd, { m_classDataBuffer.View(), out_color, m_vdata.m_spheres.View() });
   m_pipelines.Render_Megakernel.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  ;
   crossrt::Dispatch2D(a_cmd, crt_countX, crt_countY, 16, 16);
   crossrt::ComputeBarrier(a_cmd);
 }

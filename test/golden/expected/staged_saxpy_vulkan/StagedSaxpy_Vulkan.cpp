@@ -161,7 +161,7 @@ void StagedSaxpy_Vulkan::RunCmd(VkCommandBuffer a_cmd, [[maybe_unused]] const fl
 void StagedSaxpy_Vulkan::kernel1D_MultCmd(VkCommandBuffer a_cmd, crossrt::BufferView a_res, crossrt::BufferView a_in1, crossrt::BufferView a_in2, uint32_t a_size)
 {
   const int crt_startX = int(0);
-  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t((a_size))));
+  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(a_size)));
   if (crt_countX == 0)
     return;
   kernel1D_MultArgs crt_args{};
@@ -171,7 +171,6 @@ void StagedSaxpy_Vulkan::kernel1D_MultCmd(VkCommandBuffer a_cmd, crossrt::Buffer
   m_pipelines.kernel1D_Mult.Bind(a_cmd);
   m_pipelines.kernel1D_Mult.PushBuffers(a_cmd, { m_classDataBuffer.View(), a_res, a_in1, a_in2 });
   m_pipelines.kernel1D_Mult.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  ;
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);
   crossrt::ComputeBarrier(a_cmd);
 }
@@ -181,7 +180,7 @@ void StagedSaxpy_Vulkan::kernel1D_MultCmd(VkCommandBuffer a_cmd, crossrt::Buffer
 void StagedSaxpy_Vulkan::kernel1D_AddCmd(VkCommandBuffer a_cmd, crossrt::BufferView a_res, crossrt::BufferView a_in1, crossrt::BufferView a_in2, uint32_t a_size)
 {
   const int crt_startX = int(0);
-  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t((a_size))));
+  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(a_size)));
   if (crt_countX == 0)
     return;
   kernel1D_AddArgs crt_args{};
@@ -191,7 +190,6 @@ void StagedSaxpy_Vulkan::kernel1D_AddCmd(VkCommandBuffer a_cmd, crossrt::BufferV
   m_pipelines.kernel1D_Add.Bind(a_cmd);
   m_pipelines.kernel1D_Add.PushBuffers(a_cmd, { m_classDataBuffer.View(), a_res, a_in1, a_in2 });
   m_pipelines.kernel1D_Add.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  ;
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);
   crossrt::ComputeBarrier(a_cmd);
 }

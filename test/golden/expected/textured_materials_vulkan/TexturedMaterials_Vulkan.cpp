@@ -204,7 +204,7 @@ void TexturedMaterials_Vulkan::ShadeCmd(VkCommandBuffer a_cmd, int n, [[maybe_un
 void TexturedMaterials_Vulkan::kernel1D_ShadeCmd(VkCommandBuffer a_cmd, int n, crossrt::BufferView texIds, crossrt::BufferView uvs, crossrt::BufferView colors, crossrt::BufferView heights, crossrt::BufferView texels)
 {
   const int crt_startX = int(0);
-  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t((n))));
+  const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(n)));
   if (crt_countX == 0)
     return;
   kernel1D_ShadeArgs crt_args{};
@@ -217,14 +217,12 @@ void TexturedMaterials_Vulkan::kernel1D_ShadeCmd(VkCommandBuffer a_cmd, int n, c
     m_pipelines.kernel1D_Shade_Textures.PushBuffers(a_cmd, { m_classDataBuffer.View(), texIds, uvs, colors, heights, texels, m_textures.m_albedo_info.View(), m_textures.m_bumps_info.View() });
     m_pipelines.kernel1D_Shade_Textures.BindTextureArrays(a_cmd, { &m_textures.m_albedo, &m_textures.m_bumps });
     m_pipelines.kernel1D_Shade_Textures.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-    ;
   }
   else
   {
     m_pipelines.kernel1D_Shade.Bind(a_cmd);
     m_pipelines.kernel1D_Shade.PushBuffers(a_cmd, { m_classDataBuffer.View(), texIds, uvs, colors, heights, texels, m_textures.m_albedo_info.View(), m_textures.m_albedo_texels.View(), m_textures.m_bumps_info.View(), m_textures.m_bumps_texels.View() });
     m_pipelines.kernel1D_Shade.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-    ;
   }
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);
   crossrt::ComputeBarrier(a_cmd);

@@ -5,6 +5,7 @@
 // on scheduling.
 
 layout(local_size_x = 256) in;
+#define CRT_INFINITY uintBitsToFloat(0x7F800000u)  // the identity of min over floats (max: -CRT_INFINITY)
 
 struct BVHNode {  // from BVHNode
   vec3 boxMin;
@@ -51,11 +52,11 @@ shared vec3 m_centerMaxShared[256];
 void main()
 {
   const uint local = gl_LocalInvocationIndex;
-  vec3 m_centerMinLocal = vec3(uintBitsToFloat(0x7F800000u));
+  vec3 m_centerMinLocal = vec3(CRT_INFINITY);
   for (uint i = local; i < partialCount; i += 256)
     m_centerMinLocal = min(m_centerMinLocal, m_centerMinPartials[i]);
   m_centerMinShared[local] = m_centerMinLocal;
-  vec3 m_centerMaxLocal = vec3(uintBitsToFloat(0xFF800000u));
+  vec3 m_centerMaxLocal = vec3(-CRT_INFINITY);
   for (uint i = local; i < partialCount; i += 256)
     m_centerMaxLocal = max(m_centerMaxLocal, m_centerMaxPartials[i]);
   m_centerMaxShared[local] = m_centerMaxLocal;

@@ -5,6 +5,7 @@
 // on scheduling.
 
 layout(local_size_x = 256) in;
+#define CRT_INFINITY uintBitsToFloat(0x7F800000u)  // the identity of min over floats (max: -CRT_INFINITY)
 
 layout(std430, binding = 0) buffer LocalTotalsData
 {
@@ -35,11 +36,11 @@ void main()
   for (uint i = local; i < partialCount; i += 256)
     sumLocal = sumLocal + sumPartials[i];
   sumShared[local] = sumLocal;
-  float loLocal = uintBitsToFloat(0x7F800000u);
+  float loLocal = CRT_INFINITY;
   for (uint i = local; i < partialCount; i += 256)
     loLocal = min(loLocal, loPartials[i]);
   loShared[local] = loLocal;
-  float hiLocal = uintBitsToFloat(0xFF800000u);
+  float hiLocal = -CRT_INFINITY;
   for (uint i = local; i < partialCount; i += 256)
     hiLocal = max(hiLocal, hiPartials[i]);
   hiShared[local] = hiLocal;

@@ -5,6 +5,7 @@
 // on scheduling.
 
 layout(local_size_x = 256) in;
+#define CRT_INFINITY uintBitsToFloat(0x7F800000u)  // the identity of min over floats (max: -CRT_INFINITY)
 
 layout(std430, binding = 0) buffer ParticlesData
 {
@@ -35,11 +36,11 @@ shared float m_kineticEnergyShared[256];
 void main()
 {
   const uint local = gl_LocalInvocationIndex;
-  vec4 m_boxMinLocal = vec4(uintBitsToFloat(0x7F800000u));
+  vec4 m_boxMinLocal = vec4(CRT_INFINITY);
   for (uint i = local; i < partialCount; i += 256)
     m_boxMinLocal = min(m_boxMinLocal, m_boxMinPartials[i]);
   m_boxMinShared[local] = m_boxMinLocal;
-  vec4 m_boxMaxLocal = vec4(uintBitsToFloat(0xFF800000u));
+  vec4 m_boxMaxLocal = vec4(-CRT_INFINITY);
   for (uint i = local; i < partialCount; i += 256)
     m_boxMaxLocal = max(m_boxMaxLocal, m_boxMaxPartials[i]);
   m_boxMaxShared[local] = m_boxMaxLocal;

@@ -1,0 +1,158 @@
+// The generated class's header and host source, for the Vulkan class or the CPU class: the entry
+// point that fills the templates of templates/ from the model.
+#include "CodeGenSupport.h"
+#include "VulkanHost.h"
+#include "CodeGen.h"
+#include "Glsl.h"
+
+#include <cctype>
+#include <fstream>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+namespace crossrt::engine {
+
+namespace {
+
+std::string ScalarOmpOp(ReduceOp op) { return op == ReduceOp::Min ? "min" : op == ReduceOp::Max ? "max" : "+"; }
+
+}  // namespace
+
+std::map<std::string, std::string> GenerateHost(const ClassModel& model, const GenerateOptions& opt, bool vulkan) {
+  std::map<std::string, std::string> files;
+  Data d = Common(model, opt);
+  d.set("controls", ControlsData(model));
+  d.set("vectors", VectorsData(model));
+  if (vulkan) {
+    Data images = ImagesData(model, MemberKind::Image), samplers = ImagesData(model, MemberKind::Sampler);
+    d.set("images", images);
+    d.set("samplers", samplers);
+    Data textureArrays = List();
+    for (auto& m : model.members) {
+      if (m.kind != MemberKind::TextureArray || !m.usedByKernels) continue;
+      Data x;
+      x.set("name", m.name);
+      x.set("host", m.hostExpr);
+      x.set("vkFormat", m.vkFormat);
+      textureArrays.push_back(x);
+    }
+    d.set("hasTextureArrays", !textureArrays.is_empty_list());
+    d.set("textureArrays", textureArrays);
+    d.set("hasImages", std::any_of(model.members.begin(), model.members.end(), [](const Member& m) {
+      return m.usedByKernels && (m.kind == MemberKind::Image || m.kind == MemberKind::Sampler);
+    }));
+    // The shaders of ray tracing pipelines besides the kernels' (virtual functions, level 3).
+    Data stageShaders = List();
+    const std::vector<const StageShader*> stages = ExecutedStageShaders(model);
+    for (const StageShader* c : stages) {
+      Data x;
+      x.set("name", c->name);
+      stageShaders.push_back(x);
+    }
+    d.set("stageShaders", stageShaders);
+    d.set("hasRayTracingPipelines", !stages.empty());
+    // Per vector whose elements are leaves of a traversal the hardware runs: its boxes' scene.
+    Data leafScenes = List();
+    std::set<std::string> leafMembers;
+    for (const Kernel& k : model.kernels) {
+      if (!RunsLeafShaders(k)) continue;
+      for (const LeafTraversal* lt : LeafScenes(k)) {
+        if (!leafMembers.insert(lt->member).second) continue;
+        Data x;
+        x.set("member", lt->member);
+        x.set("host", lt->hostExpr);
+        x.set("display", lt->display);
+        x.set("interface", lt->interfaceName);
+        leafScenes.push_back(x);
+      }
+    }
+    d.set("leafScenes", leafScenes);
+    d.set("hasLeafScenes", !leafScenes.is_empty_list());
+    d.set("hasScenes", !leafScenes.is_empty_list() || std::any_of(model.kernels.begin(), model.kernels.end(), [](const Kernel& k) { return !k.rayQueryHolder.empty(); }));
+    unsigned indirectSlots = 0;
+    d.set("kernels", VulkanKernelsData(model, indirectSlots));
+    d.set("indirectSlots", std::to_string(indirectSlots));
+    d.set("hasIndirect", indirectSlots > 0);
+    bool anyReductions = false;
+    for (auto& k : model.kernels) anyReductions |= !k.reductions.empty();
+    d.set("anyReductions", anyReductions);
+    d.set("anyAtomics", std::any_of(model.kernels.begin(), model.kernels.end(), [](const Kernel& k) { return k.atomics; }));
+    d.set("anyFloatAtomics", std::any_of(model.kernels.begin(), model.kernels.end(), [](const Kernel& k) { return k.floatAtomics; }));
+    d.set("fenceConstantId", kFenceAtomicsConstantId);
+    files[model.className + "_Vulkan.h"] = Render(opt.templateDir + "/vulkan/class.h.mustache", d);
+    files[model.className + "_Vulkan.cpp"] = Render(opt.templateDir + "/vulkan/class.cpp.mustache", d);
+    return files;
+  }
+  Data kernels = List(), ompReductions = List();
+  std::set<std::string> declared;
+  for (auto& k : model.kernels) {
+    if (k.rtv) continue;  // kernel_* bodies are inherited; their loops are parallelised in the control function
+    Data x;
+    x.set("name", k.name);
+    x.set("sourceFile", k.sourceFile);
+    x.set("paramsDecl", k.cppParamsDecl);
+    x.set("preamble", IndentTail(k.cpuPreamble, "  "));
+    x.set("hasPreamble", !k.cpuPreamble.empty());
+    x.set("postamble", IndentTail(k.cpuPostamble, "  "));
+    x.set("hasPostamble", !k.cpuPostamble.empty());
+    x.set("loopNest", IndentTail(k.cpuLoopNest, "  "));
+    // Dynamic chunks: iterations may cost very different amounts (a ray that hits against one that
+    // misses). With static halves PrimaryRays_CPU cast the bunny's rays at 0.57-0.63x of Embree,
+    // with chunks of 1024 at 0.71-0.75x (bench_lbvh, 2 threads). 2D kernels hand out rows.
+    x.set("schedule", k.dims == 1 ? "dynamic, 1024" : "dynamic, 1");
+    std::string clauses;
+    Data reds = List();
+    for (auto& r : k.reductions) {
+      // A member is reduced through a local copy (<member>Local); a local is reduced itself.
+      const std::string reduced = r.local ? r.member : r.member + "Local";
+      if (!r.local) {
+        Data y;
+        y.set("member", r.member);
+        reds.push_back(y);
+      }
+      std::string cppType = ReductionCppType(model, r);
+      bool scalar = r.glslType == "float" || r.glslType == "int" || r.glslType == "uint";
+      if (scalar) {
+        clauses += " reduction(" + ScalarOmpOp(r.op) + ":" + reduced + ")";
+        continue;
+      }
+      // LiteMath vectors need a declared reduction.
+      std::string opName = std::string(r.op == ReduceOp::Min ? "min" : r.op == ReduceOp::Max ? "max" : "add");
+      std::string name = "crossrt_" + opName + "_" + SplitArray(r.glslType).first;
+      clauses += " reduction(" + name + ":" + reduced + ")";
+      if (declared.insert(name).second) {
+        Data o;
+        o.set("name", name);
+        o.set("cppType", cppType);
+        o.set("combine", r.op == ReduceOp::Min ? "LiteMath::min(omp_out, omp_in)" : r.op == ReduceOp::Max ? "LiteMath::max(omp_out, omp_in)" : "omp_out + omp_in");
+        o.set("init", r.op == ReduceOp::Min || r.op == ReduceOp::Max ? "omp_orig" : cppType + "()");
+        ompReductions.push_back(o);
+      }
+    }
+    x.set("reductions", reds);
+    x.set("ompClauses", clauses);
+    kernels.push_back(x);
+  }
+  d.set("kernels", kernels);
+  d.set("ompReductions", ompReductions);
+  Data copies = List();
+  for (auto& lc : model.lockedCopies) {
+    Data x;
+    x.set("name", lc.name);
+    x.set("sourceFile", lc.sourceFile);
+    x.set("declaration", lc.declaration);
+    x.set("definitionHead", lc.definitionHead);
+    x.set("body", lc.body);
+    x.set("keepOverloads", lc.keepOverloads);
+    copies.push_back(x);
+  }
+  d.set("lockedCopies", copies);
+  d.set("hasLockedCopies", !model.lockedCopies.empty());
+  files[model.className + "_CPU.h"] = Render(opt.templateDir + "/cpu/class.h.mustache", d);
+  files[model.className + "_CPU.cpp"] = Render(opt.templateDir + "/cpu/class.cpp.mustache", d);
+  return files;
+}
+
+}  // namespace crossrt::engine
