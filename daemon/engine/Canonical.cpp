@@ -7,6 +7,35 @@
 
 namespace crossrt::engine {
 
+namespace {
+
+// clang-format in the layout of generated code: Allman braces, 2-space indents, `float* p`, two
+// spaces before a trailing comment; `wholeFile`: one-line inline functions stay on their line.
+std::string Format(const std::string& code, unsigned columns, bool wholeFile = false) {
+  clang::format::FormatStyle style = clang::format::getLLVMStyle();
+  style.BreakBeforeBraces = clang::format::FormatStyle::BS_Allman;
+  style.IndentWidth = 2;
+  style.ColumnLimit = columns;
+  style.AllowShortFunctionsOnASingleLine = clang::format::FormatStyle::SFS_None;
+  style.AllowShortIfStatementsOnASingleLine = clang::format::FormatStyle::SIS_Never;
+  style.AllowShortLoopsOnASingleLine = false;
+  if (wholeFile) {
+    style.AllowShortFunctionsOnASingleLine = clang::format::FormatStyle::SFS_InlineOnly;
+    style.PointerAlignment = clang::format::FormatStyle::PAS_Left;
+    style.SpacesBeforeTrailingComments = 2;
+    style.AlignEscapedNewlines = clang::format::FormatStyle::ENAS_DontAlign;
+  }
+  auto replacements = clang::format::reformat(style, code, {clang::tooling::Range(0, unsigned(code.size()))});
+  auto formatted = clang::tooling::applyAllReplacements(code, replacements);
+  return formatted ? *formatted : code;
+}
+
+}  // namespace
+
+std::string FormattedGeneratedCode(const std::string& code) {
+  return Format(code, 120, true);
+}
+
 std::string CanonicalCode(const std::string& code) {
   clang::LangOptions lang;
   lang.CPlusPlus = lang.CPlusPlus11 = lang.CPlusPlus14 = lang.CPlusPlus17 = true;
@@ -33,16 +62,7 @@ std::string CanonicalCode(const std::string& code) {
     flat.append(code, begin, tok.getLength());
   }
 
-  clang::format::FormatStyle style = clang::format::getLLVMStyle();
-  style.BreakBeforeBraces = clang::format::FormatStyle::BS_Allman;
-  style.IndentWidth = 2;
-  style.ColumnLimit = 110;
-  style.AllowShortFunctionsOnASingleLine = clang::format::FormatStyle::SFS_None;
-  style.AllowShortIfStatementsOnASingleLine = clang::format::FormatStyle::SIS_Never;
-  style.AllowShortLoopsOnASingleLine = false;
-  auto replacements = clang::format::reformat(style, flat, {clang::tooling::Range(0, flat.size())});
-  auto formatted = clang::tooling::applyAllReplacements(flat, replacements);
-  std::string out = formatted ? *formatted : flat;
+  std::string out = Format(flat, 110);
   size_t first = out.find_first_not_of(" \n");
   if (first == std::string::npos) return "";
   out.erase(0, first);

@@ -24,8 +24,12 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
   std::map<std::string, std::string> files;
   Data d = Common(model, opt);
   d.set("controls", ControlsData(model));
-  d.set("vectors", VectorsData(model));
+  const Data vectors = VectorsData(model);
+  d.set("vectors", vectors);
+  d.set("hasVectors", !vectors.is_empty_list());
   if (vulkan) {
+    d.set("usesScanner", model.usesScanner);
+    d.set("usesSorter", model.usesSorter);
     Data images = ImagesData(model, MemberKind::Image), samplers = ImagesData(model, MemberKind::Sampler);
     d.set("images", images);
     d.set("samplers", samplers);
@@ -43,6 +47,9 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
     d.set("hasImages", std::any_of(model.members.begin(), model.members.end(), [](const Member& m) {
       return m.usedByKernels && (m.kind == MemberKind::Image || m.kind == MemberKind::Sampler);
     }));
+    // Whether anything on the GPU follows a host size (VectorMembersResized has something to compare).
+    d.set("hasResizables", !vectors.is_empty_list() || !images.is_empty_list() || !samplers.is_empty_list() ||
+                               !textureArrays.is_empty_list() || !model.virtuals.empty());
     // The shaders of ray tracing pipelines besides the kernels' (virtual functions, level 3).
     Data stageShaders = List();
     const std::vector<const StageShader*> stages = ExecutedStageShaders(model);

@@ -196,6 +196,7 @@ bool ControlRewriter::TryLibraryCall(const CallExpr* call) {
     if (type.empty()) return bad("scans on the GPU take uint32_t, int or float elements");
     std::string elem = CppTypeName(m_c.ctx, first->element);
     std::string init = initArg ? "crossrt::Bits32(static_cast<" + elem + ">(" + m_c.Text(initArg->getSourceRange()) + "))" : "0u";
+    m_c.model.usesScanner = true;
     replacement = "m_scanner.RecordCmd(a_cmd, " + ViewAt(*first) + ", " + ViewAt(*out) + ", uint32_t" + *count + ", " +
                   (name == "inclusive_scan" ? "true" : "false") + ", crossrt::ElementType::" + type + ", " + init + ")";
     WrittenVector(*out);
@@ -210,11 +211,13 @@ bool ControlRewriter::TryLibraryCall(const CallExpr* call) {
     const uint64_t words = m_c.ctx.getTypeSizeInChars(first->element).getQuantity() / 4;
     const std::string key = "crossrt::SortKey{" + std::to_string(words) + ", " + std::to_string(order->keyWord) +
                             ", crossrt::ElementType::" + order->type + ", " + (order->descending ? "true" : "false") + "}";
+    m_c.model.usesSorter = true;
     replacement = "m_sorter.RecordCmd(a_cmd, " + ViewAt(*first) + ", uint32_t" + *count + ", " + key + ")";
     // A vector that kernels append to has its size on the GPU: the sort reads it there.
     if (first->vector && m_c.appended.count(first->vector->name)) {
       if (!IsWholeVector(call)) return bad("'" + first->vector->name + "' is appended to by kernels, so its size is known only on the GPU: sort all of it, from begin() to end()");
       const std::string v = first->vector->name;
+      m_c.model.usesSorter = true;
       replacement = "m_sorter.RecordCmd(a_cmd, " + first->view + ", uint32_t(m_vdata." + v + "Capacity), " + key +
                     ", m_classDataBuffer.View(), offsetof(ClassData, " + v + "_size))";
     }

@@ -283,6 +283,8 @@ struct ClassModel {
   std::vector<Kernel> kernels;
   std::vector<Control> controls;
   std::vector<Constructor> constructors;
+  bool usesScanner = false;  // control functions scan on the GPU (std::exclusive_scan / inclusive_scan)
+  bool usesSorter = false;   // control functions sort on the GPU (std::sort)
   bool declaresCommitDeviceData = false;
   bool declaresGetExecutionTime = false;
   bool virtualDestructor = false;      // the class's destructor is virtual: the generated ones override it

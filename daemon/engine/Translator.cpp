@@ -2,6 +2,7 @@
 
 #include "Analysis.h"
 #include "AstCache.h"
+#include "Canonical.h"
 #include "CodeGen.h"
 
 #include <glslang/Public/ResourceLimits.h>
@@ -366,9 +367,14 @@ TranslateResult Translate(const TranslateRequest& request, AstCache* cache, Spir
     auto t0 = std::chrono::steady_clock::now();
     bool vulkan = request.backend == Backend::Vulkan;
     result.files = GenerateHost(model, options, vulkan);
+    std::vector<ShaderSource> shaders;
+    if (vulkan) shaders = GenerateShaders(model, options);
+    // Layout: the generated C++ and GLSL as the project's own code looks (clang-format changes
+    // whitespace only, never a token).
+    for (auto& [name, text] : result.files) text = FormattedGeneratedCode(text);
+    for (auto& shader : shaders) shader.glsl = FormattedGeneratedCode(shader.glsl);
+    result.timingsMs["generate"] = MsSince(t0);
     if (vulkan) {
-      auto shaders = GenerateShaders(model, options);
-      result.timingsMs["generate"] = MsSince(t0);
       t0 = std::chrono::steady_clock::now();
       std::vector<std::pair<std::string, std::vector<uint32_t>>> spirv;
       for (auto& shader : shaders) {
@@ -382,8 +388,6 @@ TranslateResult Translate(const TranslateRequest& request, AstCache* cache, Spir
       }
       result.files[model.className + "_Vulkan_shaders.cpp"] = EmbedSpirv(model.className, spirv);
       result.timingsMs["spirv"] = MsSince(t0);
-    } else {
-      result.timingsMs["generate"] = MsSince(t0);
     }
   } catch (const std::exception& e) {
     result.diagnostics = diagText + "error: " + e.what() + "\n";

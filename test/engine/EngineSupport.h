@@ -13,6 +13,22 @@
 
 namespace fs = std::filesystem;
 
+// Text without its whitespace and comment markers. The translator lays generated files out with
+// clang-format, which may break or join lines between any two tokens and rewrap a long comment
+// (adding `//` to its new lines): tests look for the tokens and the comments' words.
+inline std::string Squeezed(const std::string& text)
+{
+  std::string out;
+  for (size_t i = 0; i < text.size(); ++i)
+  {
+    if (text.compare(i, 2, "//") == 0)
+      ++i;
+    else if (text[i] != ' ' && text[i] != '\n' && text[i] != '\t')
+      out += text[i];
+  }
+  return out;
+}
+
 struct TempClass
 {
   fs::path dir;

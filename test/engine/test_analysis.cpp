@@ -145,10 +145,10 @@ TEST_CASE("Generated GLSL keeps the user's names and compiles", "[engine]")
   TranslateResult r = Translate(MakeRequest(tc, "Finder"));
   INFO(r.diagnostics);
   REQUIRE(r.ok);
-  const std::string& glsl = r.files.at("shaders/kernel1D_Scale.comp");
-  CHECK(glsl.find("void kernel1D_Scale(int i)") != std::string::npos);
-  CHECK(glsl.find("out_[i] = in_[2 * i] * m_scale") != std::string::npos);  // 'in'/'out' are GLSL keywords
-  CHECK(glsl.find("layout(scalar, binding") != std::string::npos);          // m_points: float3 array
+  const std::string glsl = Squeezed(r.files.at("shaders/kernel1D_Scale.comp"));
+  CHECK(glsl.find(Squeezed("void kernel1D_Scale(int i)")) != std::string::npos);
+  CHECK(glsl.find(Squeezed("out_[i] = in_[2 * i] * m_scale")) != std::string::npos);  // 'in'/'out' are GLSL keywords
+  CHECK(glsl.find(Squeezed("layout(scalar, binding")) != std::string::npos);          // m_points: float3 array
   CHECK(r.files.count("Finder_Vulkan.h") == 1);
   CHECK(r.files.count("Finder_Vulkan_shaders.cpp") == 1);
   // A translation is deterministic: the same input gives the same bytes.
@@ -187,13 +187,13 @@ void Limits::kernel1D_Fill(int n, float* out, int* ints)
   TranslateResult r = Translate(MakeRequest(tc, "Limits"));
   INFO(r.diagnostics);
   REQUIRE(r.ok);  // the GLSL compiled: a global constant needs a constant expression
-  const std::string& glsl = r.files.at("shaders/kernel1D_Fill.comp");
+  const std::string glsl = Squeezed(r.files.at("shaders/kernel1D_Fill.comp"));
   INFO(glsl);
-  CHECK(glsl.find("const float kFar = (1.0 / 0.0);") != std::string::npos);
-  CHECK(glsl.find("3.40282347e+38") != std::string::npos);
-  CHECK(glsl.find("1.1920929e-07") != std::string::npos);
-  CHECK(glsl.find("(-2147483647 - 1)") != std::string::npos);
-  CHECK(glsl.find("0x7FFFFFFF") != std::string::npos);
+  CHECK(glsl.find(Squeezed("const float kFar = (1.0 / 0.0);")) != std::string::npos);
+  CHECK(glsl.find(Squeezed("3.40282347e+38")) != std::string::npos);
+  CHECK(glsl.find(Squeezed("1.1920929e-07")) != std::string::npos);
+  CHECK(glsl.find(Squeezed("(-2147483647 - 1)")) != std::string::npos);
+  CHECK(glsl.find(Squeezed("0x7FFFFFFF")) != std::string::npos);
 }
 
 TEST_CASE("The CPU backend parallelises kernels with OpenMP", "[engine]")
@@ -202,9 +202,9 @@ TEST_CASE("The CPU backend parallelises kernels with OpenMP", "[engine]")
   TranslateResult r = Translate(MakeRequest(tc, "Finder", Backend::Cpu));
   INFO(r.diagnostics);
   REQUIRE(r.ok);
-  const std::string& cpp = r.files.at("Finder_CPU.cpp");
-  CHECK(cpp.find("#pragma omp parallel for schedule(dynamic, 1024) reduction(+:m_totalLocal) reduction(crossrt_min_vec3:m_loLocal)") != std::string::npos);
-  CHECK(cpp.find("m_totalLocal += out[i];") != std::string::npos);
+  const std::string cpp = Squeezed(r.files.at("Finder_CPU.cpp"));
+  CHECK(cpp.find(Squeezed("#pragma omp parallel for schedule(dynamic, 1024) reduction(+:m_totalLocal) reduction(crossrt_min_vec3:m_loLocal)")) != std::string::npos);
+  CHECK(cpp.find(Squeezed("m_totalLocal += out[i];")) != std::string::npos);
 }
 
 TEST_CASE("Target compile options: meaning-changing flags are kept, GCC-only ones dropped", "[engine]")
@@ -255,28 +255,28 @@ TEST_CASE("Ray queries through ISceneObject get a variant for ray tracing hardwa
   const TranslateResult result = Translate(r);
   INFO(result.diagnostics);
   REQUIRE(result.ok);
-  const std::string& software = result.files.at("shaders/kernel2D_Render.comp");
-  const std::string& hardware = result.files.at("shaders/kernel2D_Render_RayQuery.comp");
+  const std::string software = Squeezed(result.files.at("shaders/kernel2D_Render.comp"));
+  const std::string hardware = Squeezed(result.files.at("shaders/kernel2D_Render_RayQuery.comp"));
   // The software variant runs BVHScene's traversal over its buffers; the hardware one has none of it.
-  CHECK(software.find("m_pAccelStruct_m_nodes[]") != std::string::npos);
-  CHECK(software.find("GL_EXT_ray_query") == std::string::npos);
-  CHECK(hardware.find("#extension GL_EXT_ray_query : require") != std::string::npos);
-  CHECK(hardware.find("uniform accelerationStructureEXT m_pAccelStruct_scene;") != std::string::npos);
-  CHECK(hardware.find("CRT_Hit m_pAccelStruct_RayQuery_NearestHit(vec4 posAndNear, vec4 dirAndFar)") != std::string::npos);
-  CHECK(hardware.find("bool m_pAccelStruct_RayQuery_AnyHit(vec4 posAndNear, vec4 dirAndFar)") != std::string::npos);
+  CHECK(software.find(Squeezed("m_pAccelStruct_m_nodes[]")) != std::string::npos);
+  CHECK(software.find(Squeezed("GL_EXT_ray_query")) == std::string::npos);
+  CHECK(hardware.find(Squeezed("#extension GL_EXT_ray_query : require")) != std::string::npos);
+  CHECK(hardware.find(Squeezed("uniform accelerationStructureEXT m_pAccelStruct_scene;")) != std::string::npos);
+  CHECK(hardware.find(Squeezed("CRT_Hit m_pAccelStruct_RayQuery_NearestHit(vec4 posAndNear, vec4 dirAndFar)")) != std::string::npos);
+  CHECK(hardware.find(Squeezed("bool m_pAccelStruct_RayQuery_AnyHit(vec4 posAndNear, vec4 dirAndFar)")) != std::string::npos);
   for (const char* gone : {"m_pAccelStruct_m_nodes[]", "m_pAccelStruct_m_triangles[]", "m_pAccelStruct_Trace(", "struct BVH4Node", "m_pAccelStruct_kLeafFlag"})
   {
     INFO(gone);
-    CHECK(hardware.find(gone) == std::string::npos);
+    CHECK(hardware.find(Squeezed(gone)) == std::string::npos);
   }
   // The class's own data and helpers stay: the kernel body is the same text in both.
-  CHECK(hardware.find("m_vertices[]") != std::string::npos);
-  const auto body = [](const std::string& glsl) { return glsl.substr(glsl.find("void kernel2D_Render(")); };
+  CHECK(hardware.find(Squeezed("m_vertices[]")) != std::string::npos);
+  const auto body = [](const std::string& glsl) { return glsl.substr(glsl.find(Squeezed("void kernel2D_Render("))); };
   CHECK(body(hardware) == body(software));
   // The host binds the variant where the device has ray queries.
-  const std::string& host = result.files.at("PrimaryRays_Vulkan.cpp");
-  CHECK(host.find("crossrt::Binding::SceneOf(m_scenes.m_pAccelStruct)") != std::string::npos);
-  CHECK(host.find("m_useRayTracingHardware = m_ctx->hasRayQuery;") != std::string::npos);
+  const std::string host = Squeezed(result.files.at("PrimaryRays_Vulkan.cpp"));
+  CHECK(host.find(Squeezed("crossrt::Binding::SceneOf(m_scenes.m_pAccelStruct)")) != std::string::npos);
+  CHECK(host.find(Squeezed("m_useRayTracingHardware = m_ctx->hasRayQuery;")) != std::string::npos);
 }
 
 TEST_CASE("A thread loop whose kernels trace through a composed ISceneObject gets a megakernel with the traversal merged in", "[engine][modes]")
@@ -317,25 +317,25 @@ void Tracer::kernel_Depth(uint32_t tid, const CRT_Hit* hit, float* depth) { dept
   const TranslateResult result = Translate(r);  // every shader is compiled by glslang on the way
   INFO(result.diagnostics);
   REQUIRE(result.ok);
-  const std::string& mega = result.files.at("shaders/Trace_Megakernel.comp");
+  const std::string mega = Squeezed(result.files.at("shaders/Trace_Megakernel.comp"));
   // The megakernel holds the traversal, both kernels' thread functions, and the hit as a local.
-  CHECK(mega.find("m_pAccelStruct_m_nodes[]") != std::string::npos);
-  CHECK(mega.find("CRT_Hit m_pAccelStruct_RayQuery_NearestHit(") != std::string::npos);
-  CHECK(mega.find("void kernel_Hit(uint tid, inout CRT_Hit hit)") != std::string::npos);
-  CHECK(mega.find("void kernel_Depth(uint tid, CRT_Hit hit)") != std::string::npos);
-  CHECK(mega.find("  CRT_Hit hit;\n  kernel_Hit(i, hit);\n  kernel_Depth(i, hit);\n") != std::string::npos);
-  CHECK(mega.find("readonly buffer raysBuffer") != std::string::npos);
+  CHECK(mega.find(Squeezed("m_pAccelStruct_m_nodes[]")) != std::string::npos);
+  CHECK(mega.find(Squeezed("CRT_Hit m_pAccelStruct_RayQuery_NearestHit(")) != std::string::npos);
+  CHECK(mega.find(Squeezed("void kernel_Hit(uint tid, inout CRT_Hit hit)")) != std::string::npos);
+  CHECK(mega.find(Squeezed("void kernel_Depth(uint tid, CRT_Hit hit)")) != std::string::npos);
+  CHECK(mega.find(Squeezed("  CRT_Hit hit;\n  kernel_Hit(i, hit);\n  kernel_Depth(i, hit);\n")) != std::string::npos);
+  CHECK(mega.find(Squeezed("readonly buffer raysBuffer")) != std::string::npos);
   // Wavefront: kernel_Hit keeps the hit of each thread in a buffer; only it may use the hardware.
-  const std::string& hit = result.files.at("shaders/kernel_Hit.comp");
-  CHECK(hit.find("buffer hitPerThreadBuffer { CRT_Hit hitPerThread[]; }") != std::string::npos);
-  CHECK(hit.find("hitPerThread[threadIndex] = hit;") != std::string::npos);
+  const std::string hit = Squeezed(result.files.at("shaders/kernel_Hit.comp"));
+  CHECK(hit.find(Squeezed("buffer hitPerThreadBuffer { CRT_Hit hitPerThread[]; }")) != std::string::npos);
+  CHECK(hit.find(Squeezed("hitPerThread[threadIndex] = hit;")) != std::string::npos);
   CHECK(result.files.count("shaders/kernel_Hit_RayQuery.comp") == 1);
-  const std::string& host = result.files.at("Tracer_Vulkan.cpp");
-  CHECK(host.find("Trace_MegakernelCmd(a_cmd, n, m_inOut_Trace.rays, m_inOut_Trace.depth);") != std::string::npos);
-  CHECK(host.find("kernel_HitCmd(a_cmd, n, m_inOut_Trace.rays, m_threadState.Trace_hit.View());") != std::string::npos);
+  const std::string host = Squeezed(result.files.at("Tracer_Vulkan.cpp"));
+  CHECK(host.find(Squeezed("Trace_MegakernelCmd(a_cmd, n, m_inOut_Trace.rays, m_inOut_Trace.depth);")) != std::string::npos);
+  CHECK(host.find(Squeezed("kernel_HitCmd(a_cmd, n, m_inOut_Trace.rays, m_threadState.Trace_hit.View());")) != std::string::npos);
   // The megakernel reads the traversal's buffers even while kernel_Hit uses the hardware: they stay uploaded.
-  CHECK(host.find("m_vdata.m_pAccelStruct_m_nodes.Upload(") != std::string::npos);
-  CHECK(host.find("only the translated traversal reads it") == std::string::npos);
+  CHECK(host.find(Squeezed("m_vdata.m_pAccelStruct_m_nodes.Upload(")) != std::string::npos);
+  CHECK(host.find(Squeezed("only the translated traversal reads it")) == std::string::npos);
 }
 
 TEST_CASE("An error in the class's header fails the translation, on the first parse and on every reparse", "[engine]")
@@ -446,24 +446,24 @@ TEST_CASE("Level 3: a composed traversal's leaf calls become intersection shader
     const TranslateResult result = translate(visitAll, 3);
     INFO(result.diagnostics);
     REQUIRE(result.ok);
-    const std::string& rgen = result.files.at("shaders/kernel1D_Run_Intersections.rgen");
-    const std::string& rint = result.files.at("shaders/m_world_m_things_Ball_Intersect.rint");
+    const std::string rgen = Squeezed(result.files.at("shaders/kernel1D_Run_Intersections.rgen"));
+    const std::string rint = Squeezed(result.files.at("shaders/m_world_m_things_Ball_Intersect.rint"));
     // The loop is a trace from the traversal's ray up to the nearest hit so far; the rest is as written.
-    CHECK(rgen.find("traceRayEXT(m_world_m_things_leaves, gl_RayFlagsNoneEXT, 0xFF, 0, 0, 0, posAndNear.xyz, crt_near, dirAndFar.xyz, hit.t, 0);") != std::string::npos);
-    CHECK(rgen.find("layout(location = 0) rayPayloadEXT Hit m_world_m_things_Intersect_hit;") != std::string::npos);
-    CHECK(rgen.find("hit.id = ~0u;") != std::string::npos);
-    CHECK(rgen.find("m_world_m_things_Intersect(") == std::string::npos);  // no switch over the classes
-    CHECK(result.files.at("shaders/kernel1D_Run.comp").find("m_world_m_things_Intersect(uint(i)") != std::string::npos);
+    CHECK(rgen.find(Squeezed("traceRayEXT(m_world_m_things_leaves, gl_RayFlagsNoneEXT, 0xFF, 0, 0, 0, posAndNear.xyz, crt_near, dirAndFar.xyz, hit.t, 0);")) != std::string::npos);
+    CHECK(rgen.find(Squeezed("layout(location = 0) rayPayloadEXT Hit m_world_m_things_Intersect_hit;")) != std::string::npos);
+    CHECK(rgen.find(Squeezed("hit.id = ~0u;")) != std::string::npos);
+    CHECK(rgen.find(Squeezed("m_world_m_things_Intersect(")) == std::string::npos);  // no switch over the classes
+    CHECK(Squeezed(result.files.at("shaders/kernel1D_Run.comp")).find(Squeezed("m_world_m_things_Intersect(uint(i)")) != std::string::npos);
     // The intersection shader: the leaf's object, Ball's Intersect on the hardware's ray, its index
     // the instance's, a report when nearer.
-    CHECK(rint.find("objects[tag.y]") != std::string::npos);
-    CHECK(rint.find("Ball_Intersect(self, vec4(gl_WorldRayOriginEXT, gl_RayTminEXT), vec4(gl_WorldRayDirectionEXT, gl_RayTmaxEXT), uint(gl_InstanceID), hit);") != std::string::npos);
-    CHECK(rint.find("reportIntersectionEXT(hit.t, 0u);") != std::string::npos);
+    CHECK(rint.find(Squeezed("objects[tag.y]")) != std::string::npos);
+    CHECK(rint.find(Squeezed("Ball_Intersect(self, vec4(gl_WorldRayOriginEXT, gl_RayTminEXT), vec4(gl_WorldRayDirectionEXT, gl_RayTmaxEXT), uint(gl_InstanceID), hit);")) != std::string::npos);
+    CHECK(rint.find(Squeezed("reportIntersectionEXT(hit.t, 0u);")) != std::string::npos);
     CHECK(result.files.count("shaders/m_world_m_things_Intersect_Hit.rchit") == 1);
     CHECK(result.files.count("shaders/m_world_m_things_Intersect_Miss.rmiss") == 1);
-    const std::string& host = result.files.at("Leaves_Vulkan.cpp");
-    CHECK(host.find("m_scenes.m_world_m_things_leaves.BuildLeaves(leaves, \"Leaves::m_world->m_things\");") != std::string::npos);
-    CHECK(host.find("const auto lo = object->BoxMin(), hi = object->BoxMax();") != std::string::npos);
+    const std::string host = Squeezed(result.files.at("Leaves_Vulkan.cpp"));
+    CHECK(host.find(Squeezed("m_scenes.m_world_m_things_leaves.BuildLeaves(leaves, \"Leaves::m_world->m_things\");")) != std::string::npos);
+    CHECK(host.find(Squeezed("const auto lo = object->BoxMin(), hi = object->BoxMax();")) != std::string::npos);
   }
   // Two vectors of leaves, the second traced into its own hit: a trace each, on a scene, miss shader,
   // payload and range of hit groups each.
@@ -473,27 +473,27 @@ TEST_CASE("Level 3: a composed traversal's leaf calls become intersection shader
                                              "  if (lamp.id != ~0u) { hit = lamp; hit.id += 1000u; }\n", 3);
     INFO(result.diagnostics);
     REQUIRE(result.ok);
-    const std::string& rgen = result.files.at("shaders/kernel1D_Run_Intersections.rgen");
-    CHECK(rgen.find("traceRayEXT(m_world_m_things_leaves, gl_RayFlagsNoneEXT, 0xFF, 0, 0, 0, posAndNear.xyz, crt_near, dirAndFar.xyz, hit.t, 0);") != std::string::npos);
+    const std::string rgen = Squeezed(result.files.at("shaders/kernel1D_Run_Intersections.rgen"));
+    CHECK(rgen.find(Squeezed("traceRayEXT(m_world_m_things_leaves, gl_RayFlagsNoneEXT, 0xFF, 0, 0, 0, posAndNear.xyz, crt_near, dirAndFar.xyz, hit.t, 0);")) != std::string::npos);
     // The lamps' hit groups follow the things' two (Ball, Plate).
-    CHECK(rgen.find("traceRayEXT(m_world_m_lamps_leaves, gl_RayFlagsNoneEXT, 0xFF, 2, 0, 1, posAndNear.xyz, crt_near, dirAndFar.xyz, lamp.t, 1);") != std::string::npos);
-    CHECK(rgen.find("layout(location = 1) rayPayloadEXT Hit m_world_m_lamps_Intersect_hit;") != std::string::npos);
-    CHECK(rgen.find("uniform accelerationStructureEXT m_world_m_things_leaves;") != std::string::npos);
-    CHECK(rgen.find("uniform accelerationStructureEXT m_world_m_lamps_leaves;") != std::string::npos);
-    CHECK(rgen.find("hit.id += 1000u;") != std::string::npos);  // the code after the loops is as written
+    CHECK(rgen.find(Squeezed("traceRayEXT(m_world_m_lamps_leaves, gl_RayFlagsNoneEXT, 0xFF, 2, 0, 1, posAndNear.xyz, crt_near, dirAndFar.xyz, lamp.t, 1);")) != std::string::npos);
+    CHECK(rgen.find(Squeezed("layout(location = 1) rayPayloadEXT Hit m_world_m_lamps_Intersect_hit;")) != std::string::npos);
+    CHECK(rgen.find(Squeezed("uniform accelerationStructureEXT m_world_m_things_leaves;")) != std::string::npos);
+    CHECK(rgen.find(Squeezed("uniform accelerationStructureEXT m_world_m_lamps_leaves;")) != std::string::npos);
+    CHECK(rgen.find(Squeezed("hit.id += 1000u;")) != std::string::npos);  // the code after the loops is as written
     CHECK(result.files.count("shaders/m_world_m_lamps_Ball_Intersect.rint") == 1);
     CHECK(result.files.count("shaders/m_world_m_lamps_Intersect_Miss.rmiss") == 1);
     // The host: both vectors' boxes; in the pipeline's shaders, miss shader 1 and hit groups 2 and
     // 3 are the lamps'.
-    const std::string& host = result.files.at("Leaves_Vulkan.cpp");
-    CHECK(host.find("m_scenes.m_world_m_lamps_leaves.BuildLeaves(leaves, \"Leaves::m_world->m_lamps\");") != std::string::npos);
-    const size_t shaders = host.find("crossrt::RayTracingShaders{");
+    const std::string host = Squeezed(result.files.at("Leaves_Vulkan.cpp"));
+    CHECK(host.find(Squeezed("m_scenes.m_world_m_lamps_leaves.BuildLeaves(leaves, \"Leaves::m_world->m_lamps\");")) != std::string::npos);
+    const size_t shaders = host.find(Squeezed("crossrt::RayTracingShaders{"));
     REQUIRE(shaders != std::string::npos);
     std::vector<size_t> order;
     for (const char* shader : {"m_things_Intersect_Miss", "m_lamps_Intersect_Miss", "m_things_Ball_Intersect", "m_things_Plate_Intersect",
                                "m_lamps_Ball_Intersect", "m_lamps_Plate_Intersect"})
     {
-      order.push_back(host.find(std::string("{Leaves_m_world_") + shader + "_spv", shaders));
+      order.push_back(host.find(Squeezed(std::string("{Leaves_m_world_") + shader + "_spv"), shaders));
       INFO(shader);
       REQUIRE(order.back() != std::string::npos);
     }
@@ -505,19 +505,19 @@ TEST_CASE("Level 3: a composed traversal's leaf calls become intersection shader
                                              "  for (uint32_t j = 0; j < m_things.size(); ++j)\n    m_things[j]->Intersect(posAndNear, dirAndFar, j, again);\n", 3);
     INFO(result.diagnostics);
     REQUIRE(result.ok);
-    const std::string& rgen = result.files.at("shaders/kernel1D_Run_Intersections.rgen");
-    CHECK(rgen.find("traceRayEXT(m_world_m_things_leaves, gl_RayFlagsNoneEXT, 0xFF, 0, 0, 0, posAndNear.xyz, crt_near, dirAndFar.xyz, hit.t, 0);") != std::string::npos);
-    CHECK(rgen.find("traceRayEXT(m_world_m_things_leaves, gl_RayFlagsNoneEXT, 0xFF, 0, 0, 0, posAndNear.xyz, crt_near, dirAndFar.xyz, again.t, 0);") != std::string::npos);
-    REQUIRE(rgen.find("rayPayloadEXT") != std::string::npos);
-    CHECK(rgen.find("rayPayloadEXT") == rgen.rfind("rayPayloadEXT"));
-    const std::string& host = result.files.at("Leaves_Vulkan.cpp");
-    const size_t shaders = host.find("crossrt::RayTracingShaders{");
+    const std::string rgen = Squeezed(result.files.at("shaders/kernel1D_Run_Intersections.rgen"));
+    CHECK(rgen.find(Squeezed("traceRayEXT(m_world_m_things_leaves, gl_RayFlagsNoneEXT, 0xFF, 0, 0, 0, posAndNear.xyz, crt_near, dirAndFar.xyz, hit.t, 0);")) != std::string::npos);
+    CHECK(rgen.find(Squeezed("traceRayEXT(m_world_m_things_leaves, gl_RayFlagsNoneEXT, 0xFF, 0, 0, 0, posAndNear.xyz, crt_near, dirAndFar.xyz, again.t, 0);")) != std::string::npos);
+    REQUIRE(rgen.find(Squeezed("rayPayloadEXT")) != std::string::npos);
+    CHECK(rgen.find(Squeezed("rayPayloadEXT")) == rgen.rfind(Squeezed("rayPayloadEXT")));
+    const std::string host = Squeezed(result.files.at("Leaves_Vulkan.cpp"));
+    const size_t shaders = host.find(Squeezed("crossrt::RayTracingShaders{"));
     REQUIRE(shaders != std::string::npos);
     const std::string miss = "{Leaves_m_world_m_things_Intersect_Miss_spv", ball = "{Leaves_m_world_m_things_Ball_Intersect_spv";
-    REQUIRE(host.find(miss, shaders) != std::string::npos);
-    CHECK(host.find(miss, host.find(miss, shaders) + 1) == std::string::npos);  // one miss shader, one run of hit groups
-    REQUIRE(host.find(ball, shaders) != std::string::npos);
-    CHECK(host.find(ball, host.find(ball, shaders) + 1) == std::string::npos);
+    REQUIRE(host.find(Squeezed(miss), shaders) != std::string::npos);
+    CHECK(host.find(Squeezed(miss), host.find(Squeezed(miss), shaders) + 1) == std::string::npos);  // one miss shader, one run of hit groups
+    REQUIRE(host.find(Squeezed(ball), shaders) != std::string::npos);
+    CHECK(host.find(Squeezed(ball), host.find(Squeezed(ball), shaders) + 1) == std::string::npos);
   }
   // The boxes may come from a public base of the interface, not from a private one.
   for (const std::string access : {"", "private "})
@@ -534,7 +534,7 @@ TEST_CASE("Level 3: a composed traversal's leaf calls become intersection shader
     REQUIRE(result.ok);
     CHECK(result.files.count("shaders/kernel1D_Run_Intersections.rgen") == (access.empty() ? 1u : 0u));
     if (!access.empty())
-      CHECK(result.files.at("Leaves_Vulkan.cpp").find("IThing declares no public BoxMin() const and BoxMax() const (float3 or float4), nor inherits them") !=
+      CHECK(Squeezed(result.files.at("Leaves_Vulkan.cpp")).find(Squeezed("IThing declares no public BoxMin() const and BoxMax() const (float3 or float4), nor inherits them")) !=
             std::string::npos);
   }
   // Level 2 asks for no ray tracing pipeline.
@@ -563,9 +563,9 @@ TEST_CASE("Level 3: a composed traversal's leaf calls become intersection shader
     INFO(result.diagnostics);
     REQUIRE(result.ok);
     CHECK(result.files.count("shaders/kernel1D_Run_Intersections.rgen") == 0);
-    const std::string& host = result.files.at("Leaves_Vulkan.cpp");
-    const size_t said = host.find("still visits its leaves in software");
+    const std::string host = Squeezed(result.files.at("Leaves_Vulkan.cpp"));
+    const size_t said = host.find(Squeezed("still visits its leaves in software"));
     INFO((said == std::string::npos ? std::string("no reason given") : host.substr(said, host.find('\n', said) - said)));
-    CHECK(host.find(why) != std::string::npos);
+    CHECK(host.find(Squeezed(why)) != std::string::npos);
   }
 }

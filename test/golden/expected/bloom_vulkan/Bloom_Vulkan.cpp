@@ -17,13 +17,12 @@ extern const size_t Bloom_kernel2D_BlurX_spvBytes;
 extern const uint32_t Bloom_kernel2D_BlurYAndAdd_spv[];
 extern const size_t Bloom_kernel2D_BlurYAndAdd_spvBytes;
 
-Bloom_Vulkan::Bloom_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx, int width, int height, int radius, float sigma)
-  : Bloom(width, height, radius, sigma), m_ctx(std::move(a_ctx))
+Bloom_Vulkan::Bloom_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx, int width, int height, int radius,
+                           float sigma)
+    : Bloom(width, height, radius, sigma), m_ctx(std::move(a_ctx))
 {
   m_classDataBuffer = crossrt::Buffer(m_ctx, sizeof(ClassData));
   m_gpuTimer = crossrt::GpuTimer(m_ctx);
-  m_scanner = crossrt::Scanner(m_ctx);
-  m_sorter = crossrt::RadixSorter(m_ctx);
   InitPipelines();
 }
 
@@ -32,7 +31,8 @@ std::shared_ptr<Bloom> CreateBloom_Vulkan(int width, int height, int radius, flo
   return std::make_shared<Bloom_Vulkan>(crossrt::VulkanContext::CreateDefault(), width, height, radius, sigma);
 }
 
-std::shared_ptr<Bloom> CreateBloom_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx, int width, int height, int radius, float sigma)
+std::shared_ptr<Bloom> CreateBloom_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx, int width, int height,
+                                          int radius, float sigma)
 {
   return std::make_shared<Bloom_Vulkan>(std::move(a_ctx), width, height, radius, sigma);
 }
@@ -41,9 +41,14 @@ Bloom_Vulkan::~Bloom_Vulkan() = default;
 
 void Bloom_Vulkan::InitPipelines()
 {
-  m_pipelines.kernel2D_ExtractBright = crossrt::ComputePipeline(m_ctx, Bloom_kernel2D_ExtractBright_spv, Bloom_kernel2D_ExtractBright_spvBytes, 3, sizeof(kernel2D_ExtractBrightArgs), "Bloom::kernel2D_ExtractBright");
-  m_pipelines.kernel2D_BlurX = crossrt::ComputePipeline(m_ctx, Bloom_kernel2D_BlurX_spv, Bloom_kernel2D_BlurX_spvBytes, 4, sizeof(kernel2D_BlurXArgs), "Bloom::kernel2D_BlurX");
-  m_pipelines.kernel2D_BlurYAndAdd = crossrt::ComputePipeline(m_ctx, Bloom_kernel2D_BlurYAndAdd_spv, Bloom_kernel2D_BlurYAndAdd_spvBytes, 5, sizeof(kernel2D_BlurYAndAddArgs), "Bloom::kernel2D_BlurYAndAdd");
+  m_pipelines.kernel2D_ExtractBright =
+      crossrt::ComputePipeline(m_ctx, Bloom_kernel2D_ExtractBright_spv, Bloom_kernel2D_ExtractBright_spvBytes, 3,
+                               sizeof(kernel2D_ExtractBrightArgs), "Bloom::kernel2D_ExtractBright");
+  m_pipelines.kernel2D_BlurX = crossrt::ComputePipeline(m_ctx, Bloom_kernel2D_BlurX_spv, Bloom_kernel2D_BlurX_spvBytes,
+                                                        4, sizeof(kernel2D_BlurXArgs), "Bloom::kernel2D_BlurX");
+  m_pipelines.kernel2D_BlurYAndAdd =
+      crossrt::ComputePipeline(m_ctx, Bloom_kernel2D_BlurYAndAdd_spv, Bloom_kernel2D_BlurYAndAdd_spvBytes, 5,
+                               sizeof(kernel2D_BlurYAndAddArgs), "Bloom::kernel2D_BlurYAndAdd");
 }
 
 void Bloom_Vulkan::UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size)
@@ -131,11 +136,11 @@ void Bloom_Vulkan::Run(int width, int height, const float4* in, float4* out)
     crt_self->CommitDeviceData();
 
   crossrt::CpuTimer crt_copyIn;
-  const size_t crt_inBytes = sizeof(float4) * size_t(width*height);
+  const size_t crt_inBytes = sizeof(float4) * size_t(width * height);
   crossrt::EnsureSize(m_ctx, crt_self->m_args.Run_in, crt_inBytes);
   if (crt_inBytes > 0)
     crt_self->m_args.Run_in.Upload(in, crt_inBytes);
-  const size_t crt_outBytes = sizeof(float4) * size_t(width*height);
+  const size_t crt_outBytes = sizeof(float4) * size_t(width * height);
   crossrt::EnsureSize(m_ctx, crt_self->m_args.Run_out, crt_outBytes);
   if (crt_outBytes > 0)
     crt_self->m_args.Run_out.Upload(out, crt_outBytes);
@@ -151,19 +156,19 @@ void Bloom_Vulkan::Run(int width, int height, const float4* in, float4* out)
   crt_self->m_gpuTimer.End(crt_cmd, "Run");
   m_ctx->SubmitAndWait(crt_cmd);
   crt_self->m_gpuTimer.Collect();
-  crt_self->m_scanner.ReleaseRetired();  // scratch that grew while recording
-  crt_self->m_sorter.ReleaseRetired();
 
   crossrt::CpuTimer crt_copyOut;
   crt_self->ReadPlainMembers();
   crt_self->ReadVectorMembers("Run");
   if (crt_outBytes > 0)
     crt_self->m_args.Run_out.Download(out, crt_outBytes);
-  crt_self->m_times["Run"] = {crt_self->m_gpuTimer.LastMs("Run"), crt_copyInMs, crt_copyOut.ElapsedMs(), crt_total.ElapsedMs()};
+  crt_self->m_times["Run"] = {crt_self->m_gpuTimer.LastMs("Run"), crt_copyInMs, crt_copyOut.ElapsedMs(),
+                              crt_total.ElapsedMs()};
 }
 
 // The body of Bloom::Run, with each kernel call turned into its ...Cmd.
-void Bloom_Vulkan::RunCmd(VkCommandBuffer a_cmd, int width, int height, [[maybe_unused]] const float4* in, [[maybe_unused]] float4* out)
+void Bloom_Vulkan::RunCmd(VkCommandBuffer a_cmd, int width, int height, [[maybe_unused]] const float4* in,
+                          [[maybe_unused]] float4* out)
 {
   kernel2D_ExtractBrightCmd(a_cmd, width, height, m_inOut_Run.in, m_vdata.m_bright.View());
   kernel2D_BlurXCmd(a_cmd, width, height, m_vdata.m_bright.View(), m_vdata.m_blurred.View());
@@ -172,7 +177,8 @@ void Bloom_Vulkan::RunCmd(VkCommandBuffer a_cmd, int width, int height, [[maybe_
 
 // ---- kernel2D_ExtractBright (from Bloom::kernel2D_ExtractBright, Bloom.cpp) ----
 
-void Bloom_Vulkan::kernel2D_ExtractBrightCmd(VkCommandBuffer a_cmd, int width, int height, crossrt::BufferView in, crossrt::BufferView bright)
+void Bloom_Vulkan::kernel2D_ExtractBrightCmd(VkCommandBuffer a_cmd, int width, int height, crossrt::BufferView in,
+                                             crossrt::BufferView bright)
 {
   const int crt_startX = int(0);
   const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(width)));
@@ -188,7 +194,7 @@ void Bloom_Vulkan::kernel2D_ExtractBrightCmd(VkCommandBuffer a_cmd, int width, i
   crt_args.width = width;
   crt_args.height = height;
   m_pipelines.kernel2D_ExtractBright.Bind(a_cmd);
-  m_pipelines.kernel2D_ExtractBright.PushBuffers(a_cmd, { m_classDataBuffer.View(), in, bright });
+  m_pipelines.kernel2D_ExtractBright.PushBuffers(a_cmd, {m_classDataBuffer.View(), in, bright});
   m_pipelines.kernel2D_ExtractBright.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   crossrt::Dispatch2D(a_cmd, crt_countX, crt_countY, 16, 16);
   crossrt::ComputeBarrier(a_cmd);
@@ -196,7 +202,8 @@ void Bloom_Vulkan::kernel2D_ExtractBrightCmd(VkCommandBuffer a_cmd, int width, i
 
 // ---- kernel2D_BlurX (from Bloom::kernel2D_BlurX, Bloom.cpp) ----
 
-void Bloom_Vulkan::kernel2D_BlurXCmd(VkCommandBuffer a_cmd, int width, int height, crossrt::BufferView src, crossrt::BufferView dst)
+void Bloom_Vulkan::kernel2D_BlurXCmd(VkCommandBuffer a_cmd, int width, int height, crossrt::BufferView src,
+                                     crossrt::BufferView dst)
 {
   const int crt_startX = int(0);
   const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(width)));
@@ -212,7 +219,7 @@ void Bloom_Vulkan::kernel2D_BlurXCmd(VkCommandBuffer a_cmd, int width, int heigh
   crt_args.width = width;
   crt_args.height = height;
   m_pipelines.kernel2D_BlurX.Bind(a_cmd);
-  m_pipelines.kernel2D_BlurX.PushBuffers(a_cmd, { m_classDataBuffer.View(), src, dst, m_vdata.m_weights.View() });
+  m_pipelines.kernel2D_BlurX.PushBuffers(a_cmd, {m_classDataBuffer.View(), src, dst, m_vdata.m_weights.View()});
   m_pipelines.kernel2D_BlurX.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   crossrt::Dispatch2D(a_cmd, crt_countX, crt_countY, 16, 16);
   crossrt::ComputeBarrier(a_cmd);
@@ -220,7 +227,8 @@ void Bloom_Vulkan::kernel2D_BlurXCmd(VkCommandBuffer a_cmd, int width, int heigh
 
 // ---- kernel2D_BlurYAndAdd (from Bloom::kernel2D_BlurYAndAdd, Bloom.cpp) ----
 
-void Bloom_Vulkan::kernel2D_BlurYAndAddCmd(VkCommandBuffer a_cmd, int width, int height, crossrt::BufferView src, crossrt::BufferView in, crossrt::BufferView out)
+void Bloom_Vulkan::kernel2D_BlurYAndAddCmd(VkCommandBuffer a_cmd, int width, int height, crossrt::BufferView src,
+                                           crossrt::BufferView in, crossrt::BufferView out)
 {
   const int crt_startX = int(0);
   const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(width)));
@@ -236,7 +244,8 @@ void Bloom_Vulkan::kernel2D_BlurYAndAddCmd(VkCommandBuffer a_cmd, int width, int
   crt_args.width = width;
   crt_args.height = height;
   m_pipelines.kernel2D_BlurYAndAdd.Bind(a_cmd);
-  m_pipelines.kernel2D_BlurYAndAdd.PushBuffers(a_cmd, { m_classDataBuffer.View(), src, in, out, m_vdata.m_weights.View() });
+  m_pipelines.kernel2D_BlurYAndAdd.PushBuffers(a_cmd,
+                                               {m_classDataBuffer.View(), src, in, out, m_vdata.m_weights.View()});
   m_pipelines.kernel2D_BlurYAndAdd.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   crossrt::Dispatch2D(a_cmd, crt_countX, crt_countY, 16, 16);
   crossrt::ComputeBarrier(a_cmd);

@@ -28,8 +28,9 @@ public:
   virtual void SetVulkanInOutFor_Run(crossrt::BufferView a_in, crossrt::BufferView a_out);
   virtual void RunCmd(VkCommandBuffer a_cmd, int width, int height, const float4* in, float4* out);
 
-  void CommitDeviceData() override;                                     // uploads members
-  void GetExecutionTime(const char* a_funcName, float a_out[4]) override;  // [0] GPU ms, [1] copy-in ms, [2] copy-out ms, [3] total ms
+  void CommitDeviceData() override;  // uploads members
+  // a_out: [0] GPU ms, [1] copy-in ms, [2] copy-out ms, [3] total ms
+  void GetExecutionTime(const char* a_funcName, float a_out[4]) override;
 
   virtual void UpdatePlainMembers();  // members -> GPU (called before every control function)
   virtual void ReadPlainMembers();    // GPU -> members the kernels write (reductions)
@@ -38,9 +39,12 @@ public:
 
 protected:
   // One per kernel (and megakernel of a thread loop): records its dispatch (and barrier) into a_cmd.
-  virtual void kernel2D_ExtractBrightCmd(VkCommandBuffer a_cmd, int width, int height, crossrt::BufferView in, crossrt::BufferView bright);
-  virtual void kernel2D_BlurXCmd(VkCommandBuffer a_cmd, int width, int height, crossrt::BufferView src, crossrt::BufferView dst);
-  virtual void kernel2D_BlurYAndAddCmd(VkCommandBuffer a_cmd, int width, int height, crossrt::BufferView src, crossrt::BufferView in, crossrt::BufferView out);
+  virtual void kernel2D_ExtractBrightCmd(VkCommandBuffer a_cmd, int width, int height, crossrt::BufferView in,
+                                         crossrt::BufferView bright);
+  virtual void kernel2D_BlurXCmd(VkCommandBuffer a_cmd, int width, int height, crossrt::BufferView src,
+                                 crossrt::BufferView dst);
+  virtual void kernel2D_BlurYAndAddCmd(VkCommandBuffer a_cmd, int width, int height, crossrt::BufferView src,
+                                       crossrt::BufferView in, crossrt::BufferView out);
   virtual void InitPipelines();
   // Records an update of one member's GPU copy, ordered between the kernels around it.
   virtual void UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size);
@@ -128,12 +132,11 @@ protected:
   {
   } m_partials;
 
-  crossrt::Scanner m_scanner;     // std::exclusive_scan / std::inclusive_scan of control functions
-  crossrt::RadixSorter m_sorter;  // std::sort of control functions
   crossrt::GpuTimer m_gpuTimer;
   std::map<std::string, std::array<float, 4>> m_times;
 };
 
 // Runs on the default device: CROSSRT_DEVICE (index or name) if set, else a discrete GPU, else lavapipe.
 std::shared_ptr<Bloom> CreateBloom_Vulkan(int width, int height, int radius, float sigma);
-std::shared_ptr<Bloom> CreateBloom_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx, int width, int height, int radius, float sigma);
+std::shared_ptr<Bloom> CreateBloom_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx, int width, int height,
+                                          int radius, float sigma);

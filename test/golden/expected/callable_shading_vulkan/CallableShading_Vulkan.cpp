@@ -31,12 +31,10 @@ extern const uint32_t CallableShading_m_materials_Checker_Attenuate_spv[];
 extern const size_t CallableShading_m_materials_Checker_Attenuate_spvBytes;
 
 CallableShading_Vulkan::CallableShading_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx)
-  : CallableShading(), m_ctx(std::move(a_ctx))
+    : CallableShading(), m_ctx(std::move(a_ctx))
 {
   m_classDataBuffer = crossrt::Buffer(m_ctx, sizeof(ClassData));
   m_gpuTimer = crossrt::GpuTimer(m_ctx);
-  m_scanner = crossrt::Scanner(m_ctx);
-  m_sorter = crossrt::RadixSorter(m_ctx);
   m_useRayTracingPipelines = m_ctx->hasRayTracingPipeline;
   if (m_ctx->hasRayTracingPipeline)
   {
@@ -60,31 +58,44 @@ void CallableShading_Vulkan::InitPipelines()
 {
   // Virtual functions reach each class's objects through buffer references.
   if (!m_ctx->hasBufferDeviceAddress)
-    throw crossrt::Error("CallableShading_Vulkan: device '" + m_ctx->DeviceName() + "' lacks bufferDeviceAddress, which virtual function calls in kernels need");
-  if (m_ctx->hasRayTracingPipeline)  // virtual calls as callable shaders, in a ray tracing pipeline: the shader needs them even to be created
-    m_pipelines.kernel2D_Render_Callables = crossrt::RayTracingPipeline(m_ctx,
-        crossrt::RayTracingShaders{{CallableShading_kernel2D_Render_Callables_spv, CallableShading_kernel2D_Render_Callables_spvBytes},
-          {},
-          {},
-          {  // executeCallableEXT's numbering
-            {CallableShading_m_materials_Lambert_Shade_spv, CallableShading_m_materials_Lambert_Shade_spvBytes},
-            {CallableShading_m_materials_Phong_Shade_spv, CallableShading_m_materials_Phong_Shade_spvBytes},
-            {CallableShading_m_materials_Checker_Shade_spv, CallableShading_m_materials_Checker_Shade_spvBytes},
-            {CallableShading_m_materials_Lambert_Opacity_spv, CallableShading_m_materials_Lambert_Opacity_spvBytes},
-            {CallableShading_m_materials_Phong_Opacity_spv, CallableShading_m_materials_Phong_Opacity_spvBytes},
-            {CallableShading_m_materials_Checker_Opacity_spv, CallableShading_m_materials_Checker_Opacity_spvBytes},
-            {CallableShading_m_materials_Lambert_Attenuate_spv, CallableShading_m_materials_Lambert_Attenuate_spvBytes},
-            {CallableShading_m_materials_Phong_Attenuate_spv, CallableShading_m_materials_Phong_Attenuate_spvBytes},
-            {CallableShading_m_materials_Checker_Attenuate_spv, CallableShading_m_materials_Checker_Attenuate_spvBytes},
-          }},
-        std::vector<VkDescriptorType>{ VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER }, sizeof(kernel2D_RenderArgs), "CallableShading::kernel2D_Render_Callables");
-  m_pipelines.kernel2D_Render = crossrt::ComputePipeline(m_ctx, CallableShading_kernel2D_Render_spv, CallableShading_kernel2D_Render_spvBytes, 4, sizeof(kernel2D_RenderArgs), "CallableShading::kernel2D_Render");
+    throw crossrt::Error("CallableShading_Vulkan: device '" + m_ctx->DeviceName() +
+                         "' lacks bufferDeviceAddress, which virtual function calls in kernels need");
+  if (m_ctx->hasRayTracingPipeline)  // virtual calls as callable shaders, in a ray tracing pipeline: the shader needs
+                                     // them even to be created
+    m_pipelines.kernel2D_Render_Callables = crossrt::RayTracingPipeline(
+        m_ctx,
+        crossrt::RayTracingShaders{
+            {CallableShading_kernel2D_Render_Callables_spv, CallableShading_kernel2D_Render_Callables_spvBytes},
+            {},
+            {},
+            {
+                // executeCallableEXT's numbering
+                {CallableShading_m_materials_Lambert_Shade_spv, CallableShading_m_materials_Lambert_Shade_spvBytes},
+                {CallableShading_m_materials_Phong_Shade_spv, CallableShading_m_materials_Phong_Shade_spvBytes},
+                {CallableShading_m_materials_Checker_Shade_spv, CallableShading_m_materials_Checker_Shade_spvBytes},
+                {CallableShading_m_materials_Lambert_Opacity_spv, CallableShading_m_materials_Lambert_Opacity_spvBytes},
+                {CallableShading_m_materials_Phong_Opacity_spv, CallableShading_m_materials_Phong_Opacity_spvBytes},
+                {CallableShading_m_materials_Checker_Opacity_spv, CallableShading_m_materials_Checker_Opacity_spvBytes},
+                {CallableShading_m_materials_Lambert_Attenuate_spv,
+                 CallableShading_m_materials_Lambert_Attenuate_spvBytes},
+                {CallableShading_m_materials_Phong_Attenuate_spv, CallableShading_m_materials_Phong_Attenuate_spvBytes},
+                {CallableShading_m_materials_Checker_Attenuate_spv,
+                 CallableShading_m_materials_Checker_Attenuate_spvBytes},
+            }},
+        std::vector<VkDescriptorType>{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                      VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+        sizeof(kernel2D_RenderArgs), "CallableShading::kernel2D_Render_Callables");
+  m_pipelines.kernel2D_Render =
+      crossrt::ComputePipeline(m_ctx, CallableShading_kernel2D_Render_spv, CallableShading_kernel2D_Render_spvBytes, 4,
+                               sizeof(kernel2D_RenderArgs), "CallableShading::kernel2D_Render");
 }
 
 void CallableShading_Vulkan::UseRayTracingPipelines(bool a_use)
 {
   if (a_use && !m_ctx->hasRayTracingPipeline)
-    throw crossrt::Error("CallableShading_Vulkan: device '" + m_ctx->DeviceName() + "' has no ray tracing pipelines (VK_KHR_ray_tracing_pipeline): its kernels switch over the objects' classes in compute shaders");
+    throw crossrt::Error("CallableShading_Vulkan: device '" + m_ctx->DeviceName() +
+                         "' has no ray tracing pipelines (VK_KHR_ray_tracing_pipeline): its kernels switch over the "
+                         "objects' classes in compute shaders");
   m_useRayTracingPipelines = a_use;
 }
 
@@ -139,7 +150,8 @@ std::vector<uint32_t> CallableShading_Vulkan::CommitVirtual_m_materials()
   {
     const IMaterial* object = crossrt::RawPointer(m_materials[i]);
     if (object == nullptr)
-      throw crossrt::Error("CallableShading_Vulkan: m_materials[" + std::to_string(i) + "] holds no object, but kernels call its virtual functions");
+      throw crossrt::Error("CallableShading_Vulkan: m_materials[" + std::to_string(i) +
+                           "] holds no object, but kernels call its virtual functions");
     if (typeid(*object) == typeid(Lambert))
     {
       const auto& from = static_cast<const Lambert&>(*object);
@@ -174,18 +186,23 @@ std::vector<uint32_t> CallableShading_Vulkan::CommitVirtual_m_materials()
       CheckerObjects.push_back(to);
     }
     else
-      throw crossrt::Error(std::string("CallableShading_Vulkan: m_materials[") + std::to_string(i) + "] holds a " + typeid(*object).name() +
-                           ", which the GPU code does not know; it knows Lambert, Phong, Checker (the classes that implement IMaterial where CallableShading is translated)");
+      throw crossrt::Error(std::string("CallableShading_Vulkan: m_materials[") + std::to_string(i) + "] holds a " +
+                           typeid(*object).name() +
+                           ", which the GPU code does not know; it knows Lambert, Phong, Checker (the classes that "
+                           "implement IMaterial where CallableShading is translated)");
   }
   crossrt::EnsureSize(m_ctx, m_virtual.m_materials_tags, sizeof(uint32_t) * tags.size());
   m_virtual.m_materials_tags.Upload(tags.data(), sizeof(uint32_t) * tags.size());
-  crossrt::EnsureSize(m_ctx, m_virtual.m_materials_Lambert, sizeof(Lambert_Data) * std::max<size_t>(1, LambertObjects.size()));
+  crossrt::EnsureSize(m_ctx, m_virtual.m_materials_Lambert,
+                      sizeof(Lambert_Data) * std::max<size_t>(1, LambertObjects.size()));
   if (!LambertObjects.empty())
     m_virtual.m_materials_Lambert.Upload(LambertObjects.data(), sizeof(Lambert_Data) * LambertObjects.size());
-  crossrt::EnsureSize(m_ctx, m_virtual.m_materials_Phong, sizeof(Phong_Data) * std::max<size_t>(1, PhongObjects.size()));
+  crossrt::EnsureSize(m_ctx, m_virtual.m_materials_Phong,
+                      sizeof(Phong_Data) * std::max<size_t>(1, PhongObjects.size()));
   if (!PhongObjects.empty())
     m_virtual.m_materials_Phong.Upload(PhongObjects.data(), sizeof(Phong_Data) * PhongObjects.size());
-  crossrt::EnsureSize(m_ctx, m_virtual.m_materials_Checker, sizeof(Checker_Data) * std::max<size_t>(1, CheckerObjects.size()));
+  crossrt::EnsureSize(m_ctx, m_virtual.m_materials_Checker,
+                      sizeof(Checker_Data) * std::max<size_t>(1, CheckerObjects.size()));
   if (!CheckerObjects.empty())
     m_virtual.m_materials_Checker.Upload(CheckerObjects.data(), sizeof(Checker_Data) * CheckerObjects.size());
   m_virtual.m_materialsSize = m_materials.size();
@@ -206,14 +223,16 @@ void CallableShading_Vulkan::GetExecutionTime(const char* a_funcName, float a_ou
 
 // ---- Render (from CallableShading::Render, CallableShading.cpp) ----
 
-void CallableShading_Vulkan::SetVulkanInOutFor_Render(crossrt::BufferView a_normals, crossrt::BufferView a_materialIds, crossrt::BufferView a_colors)
+void CallableShading_Vulkan::SetVulkanInOutFor_Render(crossrt::BufferView a_normals, crossrt::BufferView a_materialIds,
+                                                      crossrt::BufferView a_colors)
 {
   m_inOut_Render.normals = a_normals;
   m_inOut_Render.materialIds = a_materialIds;
   m_inOut_Render.colors = a_colors;
 }
 
-void CallableShading_Vulkan::Render(int width, int height, const float4* normals, const uint32_t* materialIds, float4* colors)
+void CallableShading_Vulkan::Render(int width, int height, const float4* normals, const uint32_t* materialIds,
+                                    float4* colors)
 {
   auto* crt_self = const_cast<CallableShading_Vulkan*>(this);
   crossrt::CpuTimer crt_total;
@@ -236,7 +255,8 @@ void CallableShading_Vulkan::Render(int width, int height, const float4* normals
   crossrt::EnsureSize(m_ctx, crt_self->m_args.Render_colors, crt_colorsBytes);
   if (crt_colorsBytes > 0)
     crt_self->m_args.Render_colors.Upload(colors, crt_colorsBytes);
-  crt_self->SetVulkanInOutFor_Render(crt_self->m_args.Render_normals.View(), crt_self->m_args.Render_materialIds.View(), crt_self->m_args.Render_colors.View());
+  crt_self->SetVulkanInOutFor_Render(crt_self->m_args.Render_normals.View(), crt_self->m_args.Render_materialIds.View(),
+                                     crt_self->m_args.Render_colors.View());
   const float crt_copyInMs = crt_copyIn.ElapsedMs();
 
   // Members as they are now; host code of Render that changes one records an update in order.
@@ -248,27 +268,29 @@ void CallableShading_Vulkan::Render(int width, int height, const float4* normals
   crt_self->m_gpuTimer.End(crt_cmd, "Render");
   m_ctx->SubmitAndWait(crt_cmd);
   crt_self->m_gpuTimer.Collect();
-  crt_self->m_scanner.ReleaseRetired();  // scratch that grew while recording
-  crt_self->m_sorter.ReleaseRetired();
 
   crossrt::CpuTimer crt_copyOut;
   crt_self->ReadPlainMembers();
   crt_self->ReadVectorMembers("Render");
   if (crt_colorsBytes > 0)
     crt_self->m_args.Render_colors.Download(colors, crt_colorsBytes);
-  crt_self->m_times["Render"] = {crt_self->m_gpuTimer.LastMs("Render"), crt_copyInMs, crt_copyOut.ElapsedMs(), crt_total.ElapsedMs()};
+  crt_self->m_times["Render"] = {crt_self->m_gpuTimer.LastMs("Render"), crt_copyInMs, crt_copyOut.ElapsedMs(),
+                                 crt_total.ElapsedMs()};
 }
 
 // The body of CallableShading::Render, with each kernel call turned into its ...Cmd.
-void CallableShading_Vulkan::RenderCmd(VkCommandBuffer a_cmd, int width, int height, [[maybe_unused]] const float4* normals, [[maybe_unused]] const uint32_t* materialIds, [[maybe_unused]] float4* colors)
+void CallableShading_Vulkan::RenderCmd(VkCommandBuffer a_cmd, int width, int height,
+                                       [[maybe_unused]] const float4* normals,
+                                       [[maybe_unused]] const uint32_t* materialIds, [[maybe_unused]] float4* colors)
 {
-  kernel2D_RenderCmd(a_cmd, width, height, m_inOut_Render.normals, m_inOut_Render.materialIds,
-                     m_inOut_Render.colors);
+  kernel2D_RenderCmd(a_cmd, width, height, m_inOut_Render.normals, m_inOut_Render.materialIds, m_inOut_Render.colors);
 }
 
 // ---- kernel2D_Render (from CallableShading::kernel2D_Render, CallableShading.cpp) ----
 
-void CallableShading_Vulkan::kernel2D_RenderCmd(VkCommandBuffer a_cmd, int width, int height, crossrt::BufferView normals, crossrt::BufferView materialIds, crossrt::BufferView colors)
+void CallableShading_Vulkan::kernel2D_RenderCmd(VkCommandBuffer a_cmd, int width, int height,
+                                                crossrt::BufferView normals, crossrt::BufferView materialIds,
+                                                crossrt::BufferView colors)
 {
   const int crt_startX = int(0);
   const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(width)));
@@ -286,14 +308,14 @@ void CallableShading_Vulkan::kernel2D_RenderCmd(VkCommandBuffer a_cmd, int width
   if (m_useRayTracingPipelines)  // virtual calls as callable shaders, in a ray tracing pipeline
   {
     m_pipelines.kernel2D_Render_Callables.Bind(a_cmd);
-    m_pipelines.kernel2D_Render_Callables.PushBuffers(a_cmd, { m_classDataBuffer.View(), normals, materialIds, colors });
+    m_pipelines.kernel2D_Render_Callables.PushBuffers(a_cmd, {m_classDataBuffer.View(), normals, materialIds, colors});
     m_pipelines.kernel2D_Render_Callables.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
     m_pipelines.kernel2D_Render_Callables.TraceCmd(a_cmd, crt_countX, crt_countY, 1);
   }
   else
   {
     m_pipelines.kernel2D_Render.Bind(a_cmd);
-    m_pipelines.kernel2D_Render.PushBuffers(a_cmd, { m_classDataBuffer.View(), normals, materialIds, colors });
+    m_pipelines.kernel2D_Render.PushBuffers(a_cmd, {m_classDataBuffer.View(), normals, materialIds, colors});
     m_pipelines.kernel2D_Render.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
     crossrt::Dispatch2D(a_cmd, crt_countX, crt_countY, 16, 16);
   }

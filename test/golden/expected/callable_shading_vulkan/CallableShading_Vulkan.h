@@ -26,11 +26,14 @@ public:
   void Render(int width, int height, const float4* normals, const uint32_t* materialIds, float4* colors) override;
 
   // For data that already lives on the GPU: bind your buffers, then record into your command buffer.
-  virtual void SetVulkanInOutFor_Render(crossrt::BufferView a_normals, crossrt::BufferView a_materialIds, crossrt::BufferView a_colors);
-  virtual void RenderCmd(VkCommandBuffer a_cmd, int width, int height, const float4* normals, const uint32_t* materialIds, float4* colors);
+  virtual void SetVulkanInOutFor_Render(crossrt::BufferView a_normals, crossrt::BufferView a_materialIds,
+                                        crossrt::BufferView a_colors);
+  virtual void RenderCmd(VkCommandBuffer a_cmd, int width, int height, const float4* normals,
+                         const uint32_t* materialIds, float4* colors);
 
-  void CommitDeviceData() override;                                     // uploads members
-  void GetExecutionTime(const char* a_funcName, float a_out[4]);  // [0] GPU ms, [1] copy-in ms, [2] copy-out ms, [3] total ms
+  void CommitDeviceData() override;  // uploads members
+  // a_out: [0] GPU ms, [1] copy-in ms, [2] copy-out ms, [3] total ms
+  void GetExecutionTime(const char* a_funcName, float a_out[4]);
 
   virtual void UpdatePlainMembers();  // members -> GPU (called before every control function)
   virtual void ReadPlainMembers();    // GPU -> members the kernels write (reductions)
@@ -46,7 +49,8 @@ public:
 
 protected:
   // One per kernel (and megakernel of a thread loop): records its dispatch (and barrier) into a_cmd.
-  virtual void kernel2D_RenderCmd(VkCommandBuffer a_cmd, int width, int height, crossrt::BufferView normals, crossrt::BufferView materialIds, crossrt::BufferView colors);
+  virtual void kernel2D_RenderCmd(VkCommandBuffer a_cmd, int width, int height, crossrt::BufferView normals,
+                                  crossrt::BufferView materialIds, crossrt::BufferView colors);
   virtual void InitPipelines();
   // Records an update of one member's GPU copy, ordered between the kernels around it.
   virtual void UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size);
@@ -79,9 +83,6 @@ protected:
   crossrt::Buffer m_classDataBuffer;
   bool m_deviceDataCommitted = false;
 
-  struct VectorMembers  // device copies of the std::vector members kernels use
-  {
-  } m_vdata;
   // A std::vector or Image2D member changed size, or a sampler changed, since CommitDeviceData().
   virtual bool VectorMembersResized() const;
 
@@ -106,8 +107,9 @@ protected:
     int axis;
     float opacity;
   };
-  virtual std::vector<uint32_t> CommitVirtual_m_materials();  // returns the tags it uploaded: (class, index) per element
-  struct VirtualObjects  // device copies of the objects kernels call virtual functions of
+  virtual std::vector<uint32_t>
+  CommitVirtual_m_materials();  // returns the tags it uploaded: (class, index) per element
+  struct VirtualObjects         // device copies of the objects kernels call virtual functions of
   {
     crossrt::Buffer m_materials_tags;
     crossrt::Buffer m_materials_Lambert;
@@ -133,7 +135,8 @@ protected:
 
   struct Pipelines
   {
-    crossrt::RayTracingPipeline kernel2D_Render_Callables;  // virtual calls as callable shaders, in a ray tracing pipeline
+    crossrt::RayTracingPipeline
+        kernel2D_Render_Callables;  // virtual calls as callable shaders, in a ray tracing pipeline
     crossrt::ComputePipeline kernel2D_Render;
   } m_pipelines;
 
@@ -141,8 +144,6 @@ protected:
   {
   } m_partials;
 
-  crossrt::Scanner m_scanner;     // std::exclusive_scan / std::inclusive_scan of control functions
-  crossrt::RadixSorter m_sorter;  // std::sort of control functions
   crossrt::GpuTimer m_gpuTimer;
   std::map<std::string, std::array<float, 4>> m_times;
 };

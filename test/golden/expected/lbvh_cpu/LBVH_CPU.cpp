@@ -14,11 +14,12 @@ using LiteMath::Box4f;
 using LiteMath::float3;
 using LiteMath::uint2;
 
-#pragma omp declare reduction(crossrt_min_vec3 : LiteMath::float3 : omp_out = LiteMath::min(omp_out, omp_in)) initializer(omp_priv = omp_orig)
-#pragma omp declare reduction(crossrt_max_vec3 : LiteMath::float3 : omp_out = LiteMath::max(omp_out, omp_in)) initializer(omp_priv = omp_orig)
+#pragma omp declare reduction(crossrt_min_vec3 : LiteMath::float3 : omp_out = LiteMath::min(omp_out, omp_in)) \
+    initializer(omp_priv = omp_orig)
+#pragma omp declare reduction(crossrt_max_vec3 : LiteMath::float3 : omp_out = LiteMath::max(omp_out, omp_in)) \
+    initializer(omp_priv = omp_orig)
 
-LBVH_CPU::LBVH_CPU()
-  : LBVH()
+LBVH_CPU::LBVH_CPU() : LBVH()
 {
 }
 
@@ -64,7 +65,8 @@ void LBVH_CPU::kernel1D_Bounds(int count, const LiteMath::Box4f* boxes)
 {
   auto m_centerMinLocal = m_centerMin;
   auto m_centerMaxLocal = m_centerMax;
-  #pragma omp parallel for schedule(dynamic, 1024) reduction(crossrt_min_vec3:m_centerMinLocal) reduction(crossrt_max_vec3:m_centerMaxLocal)
+#pragma omp parallel for schedule(dynamic, 1024) reduction(crossrt_min_vec3 : m_centerMinLocal) \
+    reduction(crossrt_max_vec3 : m_centerMaxLocal)
   for (int i = 0; i < count; i++)
   {
     const float3 center = 0.5f * (to_float3(boxes[i].boxMin) + to_float3(boxes[i].boxMax));
@@ -78,7 +80,7 @@ void LBVH_CPU::kernel1D_Bounds(int count, const LiteMath::Box4f* boxes)
 // From LBVH::kernel1D_EvalMC (LBVH.cpp): the outer loop runs on all cores.
 void LBVH_CPU::kernel1D_EvalMC(int count, const LiteMath::Box4f* boxes)
 {
-  #pragma omp parallel for schedule(dynamic, 1024)
+#pragma omp parallel for schedule(dynamic, 1024)
   for (int i = 0; i < count; i++)
   {
     const float3 center = 0.5f * (to_float3(boxes[i].boxMin) + to_float3(boxes[i].boxMax));
@@ -87,8 +89,8 @@ void LBVH_CPU::kernel1D_EvalMC(int count, const LiteMath::Box4f* boxes)
         float3(extent.x > 0.0f ? 1023.0f / extent.x : 0.0f, extent.y > 0.0f ? 1023.0f / extent.y : 0.0f,
                extent.z > 0.0f ? 1023.0f / extent.z : 0.0f);
     const float3 cell = clamp((center - m_centerMin) * scale, float3(0.0f), float3(1023.0f));
-    const uint32_t code = (MortonExpandBits(uint32_t(cell.x)) << 2) |
-                          (MortonExpandBits(uint32_t(cell.y)) << 1) | MortonExpandBits(uint32_t(cell.z));
+    const uint32_t code = (MortonExpandBits(uint32_t(cell.x)) << 2) | (MortonExpandBits(uint32_t(cell.y)) << 1) |
+                          MortonExpandBits(uint32_t(cell.z));
     m_codes[i] = uint2(code, uint32_t(i));
   }
 }
@@ -96,7 +98,7 @@ void LBVH_CPU::kernel1D_EvalMC(int count, const LiteMath::Box4f* boxes)
 // From LBVH::kernel1D_AppendInit (LBVH.cpp): the outer loop runs on all cores.
 void LBVH_CPU::kernel1D_AppendInit(int count)
 {
-  #pragma omp parallel for schedule(dynamic, 1024)
+#pragma omp parallel for schedule(dynamic, 1024)
   for (int i = 0; i < count; i++)
   {
     m_newGroup[i] = (i == 0 || m_codes[i].x != m_codes[i - 1].x) ? 1u : 0u;
@@ -108,7 +110,7 @@ void LBVH_CPU::kernel1D_AppendInit(int count)
 void LBVH_CPU::kernel1D_AppendComplete(int count)
 {
   auto m_leafCountLocal = m_leafCount;
-  #pragma omp parallel for schedule(dynamic, 1024) reduction(+:m_leafCountLocal)
+#pragma omp parallel for schedule(dynamic, 1024) reduction(+ : m_leafCountLocal)
   for (int i = 0; i < count; i++)
   {
     if (m_newGroup[i] != 0u)
@@ -125,7 +127,7 @@ void LBVH_CPU::kernel1D_AppendComplete(int count)
 // From LBVH::kernel1D_Karras12 (LBVH.cpp): the outer loop runs on all cores.
 void LBVH_CPU::kernel1D_Karras12(int count)
 {
-  #pragma omp parallel for schedule(dynamic, 1024)
+#pragma omp parallel for schedule(dynamic, 1024)
   for (int i = 0; i < count; i++)
   {
     const int leaves = int(m_leafCount);
@@ -166,7 +168,7 @@ void LBVH_CPU::kernel1D_Karras12(int count)
 // From LBVH::kernel1D_MakeLeaves (LBVH.cpp): the outer loop runs on all cores.
 void LBVH_CPU::kernel1D_MakeLeaves(int count, const LiteMath::Box4f* boxes)
 {
-  #pragma omp parallel for schedule(dynamic, 1024)
+#pragma omp parallel for schedule(dynamic, 1024)
   for (int leaf = 0; leaf < count; leaf++)
   {
     if (uint32_t(leaf) >= m_leafCount)
@@ -191,7 +193,7 @@ void LBVH_CPU::kernel1D_MakeLeaves(int count, const LiteMath::Box4f* boxes)
 // From LBVH::kernel1D_Refit (LBVH.cpp): the outer loop runs on all cores.
 void LBVH_CPU::kernel1D_Refit(int count)
 {
-  #pragma omp parallel for schedule(dynamic, 1024)
+#pragma omp parallel for schedule(dynamic, 1024)
   for (int leaf = 0; leaf < count; leaf++)
   {
     if (uint32_t(leaf) >= m_leafCount)

@@ -32,8 +32,7 @@ extern const size_t LBVH_kernel1D_MakeLeaves_spvBytes;
 extern const uint32_t LBVH_kernel1D_Refit_spv[];
 extern const size_t LBVH_kernel1D_Refit_spvBytes;
 
-LBVH_Vulkan::LBVH_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx)
-  : LBVH(), m_ctx(std::move(a_ctx))
+LBVH_Vulkan::LBVH_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx) : LBVH(), m_ctx(std::move(a_ctx))
 {
   m_classDataBuffer = crossrt::Buffer(m_ctx, sizeof(ClassData));
   m_gpuTimer = crossrt::GpuTimer(m_ctx);
@@ -58,18 +57,35 @@ void LBVH_Vulkan::InitPipelines()
 {
   // Member reductions combine partial results with subgroup arithmetic.
   if (!m_ctx->hasSubgroupArithmetic || m_ctx->subgroupSize < 4)
-    throw crossrt::Error("LBVH_Vulkan: device '" + m_ctx->DeviceName() + "' lacks compute subgroup arithmetic with >= 4 lanes, which member reductions need");
+    throw crossrt::Error("LBVH_Vulkan: device '" + m_ctx->DeviceName() +
+                         "' lacks compute subgroup arithmetic with >= 4 lanes, which member reductions need");
   // Kernels with crossrt atomics take their fence switch from this specialization constant.
-  static_assert(crossrt::kFenceAtomicsConstantId == 1700, "the shaders and the runtime name the fence constant differently");
-  m_pipelines.kernel1D_Bounds = crossrt::ComputePipeline(m_ctx, LBVH_kernel1D_Bounds_spv, LBVH_kernel1D_Bounds_spvBytes, 4, sizeof(kernel1D_BoundsArgs), "LBVH::kernel1D_Bounds");
-  m_pipelines.kernel1D_Bounds_Reduce = crossrt::ComputePipeline(m_ctx, LBVH_kernel1D_Bounds_Reduce_spv, LBVH_kernel1D_Bounds_Reduce_spvBytes, 3, sizeof(uint32_t), "LBVH::kernel1D_Bounds_Reduce");
-  m_pipelines.kernel1D_EvalMC = crossrt::ComputePipeline(m_ctx, LBVH_kernel1D_EvalMC_spv, LBVH_kernel1D_EvalMC_spvBytes, 3, sizeof(kernel1D_EvalMCArgs), "LBVH::kernel1D_EvalMC");
-  m_pipelines.kernel1D_AppendInit = crossrt::ComputePipeline(m_ctx, LBVH_kernel1D_AppendInit_spv, LBVH_kernel1D_AppendInit_spvBytes, 4, sizeof(kernel1D_AppendInitArgs), "LBVH::kernel1D_AppendInit");
-  m_pipelines.kernel1D_AppendComplete = crossrt::ComputePipeline(m_ctx, LBVH_kernel1D_AppendComplete_spv, LBVH_kernel1D_AppendComplete_spvBytes, 7, sizeof(kernel1D_AppendCompleteArgs), "LBVH::kernel1D_AppendComplete");
-  m_pipelines.kernel1D_AppendComplete_Reduce = crossrt::ComputePipeline(m_ctx, LBVH_kernel1D_AppendComplete_Reduce_spv, LBVH_kernel1D_AppendComplete_Reduce_spvBytes, 2, sizeof(uint32_t), "LBVH::kernel1D_AppendComplete_Reduce");
-  m_pipelines.kernel1D_Karras12 = crossrt::ComputePipeline(m_ctx, LBVH_kernel1D_Karras12_spv, LBVH_kernel1D_Karras12_spvBytes, 5, sizeof(kernel1D_Karras12Args), "LBVH::kernel1D_Karras12");
-  m_pipelines.kernel1D_MakeLeaves = crossrt::ComputePipeline(m_ctx, LBVH_kernel1D_MakeLeaves_spv, LBVH_kernel1D_MakeLeaves_spvBytes, 5, sizeof(kernel1D_MakeLeavesArgs), "LBVH::kernel1D_MakeLeaves");
-  m_pipelines.kernel1D_Refit = crossrt::ComputePipeline(m_ctx, LBVH_kernel1D_Refit_spv, LBVH_kernel1D_Refit_spvBytes, 4, sizeof(kernel1D_RefitArgs), "LBVH::kernel1D_Refit");
+  static_assert(crossrt::kFenceAtomicsConstantId == 1700,
+                "the shaders and the runtime name the fence constant differently");
+  m_pipelines.kernel1D_Bounds = crossrt::ComputePipeline(m_ctx, LBVH_kernel1D_Bounds_spv, LBVH_kernel1D_Bounds_spvBytes,
+                                                         4, sizeof(kernel1D_BoundsArgs), "LBVH::kernel1D_Bounds");
+  m_pipelines.kernel1D_Bounds_Reduce =
+      crossrt::ComputePipeline(m_ctx, LBVH_kernel1D_Bounds_Reduce_spv, LBVH_kernel1D_Bounds_Reduce_spvBytes, 3,
+                               sizeof(uint32_t), "LBVH::kernel1D_Bounds_Reduce");
+  m_pipelines.kernel1D_EvalMC = crossrt::ComputePipeline(m_ctx, LBVH_kernel1D_EvalMC_spv, LBVH_kernel1D_EvalMC_spvBytes,
+                                                         3, sizeof(kernel1D_EvalMCArgs), "LBVH::kernel1D_EvalMC");
+  m_pipelines.kernel1D_AppendInit =
+      crossrt::ComputePipeline(m_ctx, LBVH_kernel1D_AppendInit_spv, LBVH_kernel1D_AppendInit_spvBytes, 4,
+                               sizeof(kernel1D_AppendInitArgs), "LBVH::kernel1D_AppendInit");
+  m_pipelines.kernel1D_AppendComplete =
+      crossrt::ComputePipeline(m_ctx, LBVH_kernel1D_AppendComplete_spv, LBVH_kernel1D_AppendComplete_spvBytes, 7,
+                               sizeof(kernel1D_AppendCompleteArgs), "LBVH::kernel1D_AppendComplete");
+  m_pipelines.kernel1D_AppendComplete_Reduce = crossrt::ComputePipeline(
+      m_ctx, LBVH_kernel1D_AppendComplete_Reduce_spv, LBVH_kernel1D_AppendComplete_Reduce_spvBytes, 2, sizeof(uint32_t),
+      "LBVH::kernel1D_AppendComplete_Reduce");
+  m_pipelines.kernel1D_Karras12 =
+      crossrt::ComputePipeline(m_ctx, LBVH_kernel1D_Karras12_spv, LBVH_kernel1D_Karras12_spvBytes, 5,
+                               sizeof(kernel1D_Karras12Args), "LBVH::kernel1D_Karras12");
+  m_pipelines.kernel1D_MakeLeaves =
+      crossrt::ComputePipeline(m_ctx, LBVH_kernel1D_MakeLeaves_spv, LBVH_kernel1D_MakeLeaves_spvBytes, 5,
+                               sizeof(kernel1D_MakeLeavesArgs), "LBVH::kernel1D_MakeLeaves");
+  m_pipelines.kernel1D_Refit = crossrt::ComputePipeline(m_ctx, LBVH_kernel1D_Refit_spv, LBVH_kernel1D_Refit_spvBytes, 4,
+                                                        sizeof(kernel1D_RefitArgs), "LBVH::kernel1D_Refit");
 }
 
 void LBVH_Vulkan::UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size)
@@ -238,12 +254,13 @@ void LBVH_Vulkan::Build(int count, const LiteMath::Box4f* boxes)
   m_ctx->SubmitAndWait(crt_cmd);
   crt_self->m_gpuTimer.Collect();
   crt_self->m_scanner.ReleaseRetired();  // scratch that grew while recording
-  crt_self->m_sorter.ReleaseRetired();
+  crt_self->m_sorter.ReleaseRetired();   // scratch that grew while recording
 
   crossrt::CpuTimer crt_copyOut;
   crt_self->ReadPlainMembers();
   crt_self->ReadVectorMembers("Build");
-  crt_self->m_times["Build"] = {crt_self->m_gpuTimer.LastMs("Build"), crt_copyInMs, crt_copyOut.ElapsedMs(), crt_total.ElapsedMs()};
+  crt_self->m_times["Build"] = {crt_self->m_gpuTimer.LastMs("Build"), crt_copyInMs, crt_copyOut.ElapsedMs(),
+                                crt_total.ElapsedMs()};
 }
 
 // The body of LBVH::Build, with each kernel call turned into its ...Cmd.
@@ -280,16 +297,22 @@ void LBVH_Vulkan::kernel1D_BoundsCmd(VkCommandBuffer a_cmd, int count, crossrt::
   crt_args.crt_startX = crt_startX;
   crt_args.crt_countX = crt_countX;
   crt_args.count = count;
-  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Bounds_m_centerMin, 16 * crossrt::GroupCount1D(crt_countX, 256));  // LiteMath::float3 per workgroup
-  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Bounds_m_centerMax, 16 * crossrt::GroupCount1D(crt_countX, 256));  // LiteMath::float3 per workgroup
+  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Bounds_m_centerMin,
+                      16 * crossrt::GroupCount1D(crt_countX, 256));  // LiteMath::float3 per workgroup
+  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Bounds_m_centerMax,
+                      16 * crossrt::GroupCount1D(crt_countX, 256));  // LiteMath::float3 per workgroup
   m_pipelines.kernel1D_Bounds.Bind(a_cmd);
-  m_pipelines.kernel1D_Bounds.PushBuffers(a_cmd, { m_classDataBuffer.View(), boxes, m_partials.kernel1D_Bounds_m_centerMin.View(), m_partials.kernel1D_Bounds_m_centerMax.View() });
+  m_pipelines.kernel1D_Bounds.PushBuffers(a_cmd, {m_classDataBuffer.View(), boxes,
+                                                  m_partials.kernel1D_Bounds_m_centerMin.View(),
+                                                  m_partials.kernel1D_Bounds_m_centerMax.View()});
   m_pipelines.kernel1D_Bounds.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);
   crossrt::ComputeBarrier(a_cmd);
   const uint32_t crt_partialCount = crossrt::GroupCount1D(crt_countX, 256);
   m_pipelines.kernel1D_Bounds_Reduce.Bind(a_cmd);
-  m_pipelines.kernel1D_Bounds_Reduce.PushBuffers(a_cmd, { m_classDataBuffer.View(), m_partials.kernel1D_Bounds_m_centerMin.View(), m_partials.kernel1D_Bounds_m_centerMax.View() });
+  m_pipelines.kernel1D_Bounds_Reduce.PushBuffers(a_cmd, {m_classDataBuffer.View(),
+                                                         m_partials.kernel1D_Bounds_m_centerMin.View(),
+                                                         m_partials.kernel1D_Bounds_m_centerMax.View()});
   m_pipelines.kernel1D_Bounds_Reduce.PushConstants(a_cmd, &crt_partialCount, sizeof(crt_partialCount));
   vkCmdDispatch(a_cmd, 1, 1, 1);
   crossrt::ComputeBarrier(a_cmd);
@@ -308,7 +331,7 @@ void LBVH_Vulkan::kernel1D_EvalMCCmd(VkCommandBuffer a_cmd, int count, crossrt::
   crt_args.crt_countX = crt_countX;
   crt_args.count = count;
   m_pipelines.kernel1D_EvalMC.Bind(a_cmd);
-  m_pipelines.kernel1D_EvalMC.PushBuffers(a_cmd, { m_classDataBuffer.View(), boxes, m_vdata.m_codes.View() });
+  m_pipelines.kernel1D_EvalMC.PushBuffers(a_cmd, {m_classDataBuffer.View(), boxes, m_vdata.m_codes.View()});
   m_pipelines.kernel1D_EvalMC.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);
   crossrt::ComputeBarrier(a_cmd);
@@ -327,7 +350,8 @@ void LBVH_Vulkan::kernel1D_AppendInitCmd(VkCommandBuffer a_cmd, int count)
   crt_args.crt_countX = crt_countX;
   crt_args.count = count;
   m_pipelines.kernel1D_AppendInit.Bind(a_cmd);
-  m_pipelines.kernel1D_AppendInit.PushBuffers(a_cmd, { m_classDataBuffer.View(), m_vdata.m_codes.View(), m_vdata.m_newGroup.View(), m_vdata.m_primIndices.View() });
+  m_pipelines.kernel1D_AppendInit.PushBuffers(a_cmd, {m_classDataBuffer.View(), m_vdata.m_codes.View(),
+                                                      m_vdata.m_newGroup.View(), m_vdata.m_primIndices.View()});
   m_pipelines.kernel1D_AppendInit.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);
   crossrt::ComputeBarrier(a_cmd);
@@ -345,15 +369,20 @@ void LBVH_Vulkan::kernel1D_AppendCompleteCmd(VkCommandBuffer a_cmd, int count)
   crt_args.crt_startX = crt_startX;
   crt_args.crt_countX = crt_countX;
   crt_args.count = count;
-  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_AppendComplete_m_leafCount, 4 * crossrt::GroupCount1D(crt_countX, 256));  // uint32_t per workgroup
+  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_AppendComplete_m_leafCount,
+                      4 * crossrt::GroupCount1D(crt_countX, 256));  // uint32_t per workgroup
   m_pipelines.kernel1D_AppendComplete.Bind(a_cmd);
-  m_pipelines.kernel1D_AppendComplete.PushBuffers(a_cmd, { m_classDataBuffer.View(), m_vdata.m_codes.View(), m_vdata.m_groupOf.View(), m_vdata.m_leafCode.View(), m_vdata.m_leafFirst.View(), m_vdata.m_newGroup.View(), m_partials.kernel1D_AppendComplete_m_leafCount.View() });
+  m_pipelines.kernel1D_AppendComplete.PushBuffers(a_cmd, {m_classDataBuffer.View(), m_vdata.m_codes.View(),
+                                                          m_vdata.m_groupOf.View(), m_vdata.m_leafCode.View(),
+                                                          m_vdata.m_leafFirst.View(), m_vdata.m_newGroup.View(),
+                                                          m_partials.kernel1D_AppendComplete_m_leafCount.View()});
   m_pipelines.kernel1D_AppendComplete.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);
   crossrt::ComputeBarrier(a_cmd);
   const uint32_t crt_partialCount = crossrt::GroupCount1D(crt_countX, 256);
   m_pipelines.kernel1D_AppendComplete_Reduce.Bind(a_cmd);
-  m_pipelines.kernel1D_AppendComplete_Reduce.PushBuffers(a_cmd, { m_classDataBuffer.View(), m_partials.kernel1D_AppendComplete_m_leafCount.View() });
+  m_pipelines.kernel1D_AppendComplete_Reduce.PushBuffers(
+      a_cmd, {m_classDataBuffer.View(), m_partials.kernel1D_AppendComplete_m_leafCount.View()});
   m_pipelines.kernel1D_AppendComplete_Reduce.PushConstants(a_cmd, &crt_partialCount, sizeof(crt_partialCount));
   vkCmdDispatch(a_cmd, 1, 1, 1);
   crossrt::ComputeBarrier(a_cmd);
@@ -372,7 +401,9 @@ void LBVH_Vulkan::kernel1D_Karras12Cmd(VkCommandBuffer a_cmd, int count)
   crt_args.crt_countX = crt_countX;
   crt_args.count = count;
   m_pipelines.kernel1D_Karras12.Bind(a_cmd);
-  m_pipelines.kernel1D_Karras12.PushBuffers(a_cmd, { m_classDataBuffer.View(), m_vdata.m_arrivals.View(), m_vdata.m_leafCode.View(), m_vdata.m_nodes.View(), m_vdata.m_parent.View() });
+  m_pipelines.kernel1D_Karras12.PushBuffers(a_cmd, {m_classDataBuffer.View(), m_vdata.m_arrivals.View(),
+                                                    m_vdata.m_leafCode.View(), m_vdata.m_nodes.View(),
+                                                    m_vdata.m_parent.View()});
   m_pipelines.kernel1D_Karras12.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);
   crossrt::ComputeBarrier(a_cmd);
@@ -391,7 +422,8 @@ void LBVH_Vulkan::kernel1D_MakeLeavesCmd(VkCommandBuffer a_cmd, int count, cross
   crt_args.crt_countX = crt_countX;
   crt_args.count = count;
   m_pipelines.kernel1D_MakeLeaves.Bind(a_cmd);
-  m_pipelines.kernel1D_MakeLeaves.PushBuffers(a_cmd, { m_classDataBuffer.View(), boxes, m_vdata.m_leafFirst.View(), m_vdata.m_nodes.View(), m_vdata.m_primIndices.View() });
+  m_pipelines.kernel1D_MakeLeaves.PushBuffers(a_cmd, {m_classDataBuffer.View(), boxes, m_vdata.m_leafFirst.View(),
+                                                      m_vdata.m_nodes.View(), m_vdata.m_primIndices.View()});
   m_pipelines.kernel1D_MakeLeaves.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);
   crossrt::ComputeBarrier(a_cmd);
@@ -410,7 +442,8 @@ void LBVH_Vulkan::kernel1D_RefitCmd(VkCommandBuffer a_cmd, int count)
   crt_args.crt_countX = crt_countX;
   crt_args.count = count;
   m_pipelines.kernel1D_Refit.Bind(a_cmd);
-  m_pipelines.kernel1D_Refit.PushBuffers(a_cmd, { m_classDataBuffer.View(), m_vdata.m_arrivals.View(), m_vdata.m_nodes.View(), m_vdata.m_parent.View() });
+  m_pipelines.kernel1D_Refit.PushBuffers(
+      a_cmd, {m_classDataBuffer.View(), m_vdata.m_arrivals.View(), m_vdata.m_nodes.View(), m_vdata.m_parent.View()});
   m_pipelines.kernel1D_Refit.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);
   crossrt::ComputeBarrier(a_cmd);

@@ -17,12 +17,10 @@ extern const uint32_t LocalTotals_kernel1D_Summarize_Reduce_spv[];
 extern const size_t LocalTotals_kernel1D_Summarize_Reduce_spvBytes;
 
 LocalTotals_Vulkan::LocalTotals_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx)
-  : LocalTotals(), m_ctx(std::move(a_ctx))
+    : LocalTotals(), m_ctx(std::move(a_ctx))
 {
   m_classDataBuffer = crossrt::Buffer(m_ctx, sizeof(ClassData));
   m_gpuTimer = crossrt::GpuTimer(m_ctx);
-  m_scanner = crossrt::Scanner(m_ctx);
-  m_sorter = crossrt::RadixSorter(m_ctx);
   InitPipelines();
 }
 
@@ -42,10 +40,17 @@ void LocalTotals_Vulkan::InitPipelines()
 {
   // Member reductions combine partial results with subgroup arithmetic.
   if (!m_ctx->hasSubgroupArithmetic || m_ctx->subgroupSize < 4)
-    throw crossrt::Error("LocalTotals_Vulkan: device '" + m_ctx->DeviceName() + "' lacks compute subgroup arithmetic with >= 4 lanes, which member reductions need");
-  m_pipelines.kernel1D_Summarize = crossrt::ComputePipeline(m_ctx, LocalTotals_kernel1D_Summarize_spv, LocalTotals_kernel1D_Summarize_spvBytes, 8, sizeof(kernel1D_SummarizeArgs), "LocalTotals::kernel1D_Summarize");
-  m_pipelines.kernel1D_Summarize_Finish = crossrt::ComputePipeline(m_ctx, LocalTotals_kernel1D_Summarize_Finish_spv, LocalTotals_kernel1D_Summarize_Finish_spvBytes, 8, sizeof(kernel1D_SummarizeArgs), "LocalTotals::kernel1D_Summarize_Finish");
-  m_pipelines.kernel1D_Summarize_Reduce = crossrt::ComputePipeline(m_ctx, LocalTotals_kernel1D_Summarize_Reduce_spv, LocalTotals_kernel1D_Summarize_Reduce_spvBytes, 6, sizeof(uint32_t), "LocalTotals::kernel1D_Summarize_Reduce");
+    throw crossrt::Error("LocalTotals_Vulkan: device '" + m_ctx->DeviceName() +
+                         "' lacks compute subgroup arithmetic with >= 4 lanes, which member reductions need");
+  m_pipelines.kernel1D_Summarize =
+      crossrt::ComputePipeline(m_ctx, LocalTotals_kernel1D_Summarize_spv, LocalTotals_kernel1D_Summarize_spvBytes, 8,
+                               sizeof(kernel1D_SummarizeArgs), "LocalTotals::kernel1D_Summarize");
+  m_pipelines.kernel1D_Summarize_Finish = crossrt::ComputePipeline(
+      m_ctx, LocalTotals_kernel1D_Summarize_Finish_spv, LocalTotals_kernel1D_Summarize_Finish_spvBytes, 8,
+      sizeof(kernel1D_SummarizeArgs), "LocalTotals::kernel1D_Summarize_Finish");
+  m_pipelines.kernel1D_Summarize_Reduce = crossrt::ComputePipeline(
+      m_ctx, LocalTotals_kernel1D_Summarize_Reduce_spv, LocalTotals_kernel1D_Summarize_Reduce_spvBytes, 6,
+      sizeof(uint32_t), "LocalTotals::kernel1D_Summarize_Reduce");
 }
 
 void LocalTotals_Vulkan::UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size)
@@ -80,8 +85,7 @@ void LocalTotals_Vulkan::CommitDeviceData()
 
 bool LocalTotals_Vulkan::VectorMembersResized() const
 {
-  bool resized = false;
-  return resized;
+  return false;  // no std::vector, Image2D or sampler member of the class is on the GPU
 }
 
 void LocalTotals_Vulkan::ReadVectorMembers(const char* a_funcName)
@@ -123,7 +127,8 @@ void LocalTotals_Vulkan::Summarize(uint32_t n, const float4* a_values, float* a_
   crossrt::EnsureSize(m_ctx, crt_self->m_args.Summarize_a_out, crt_a_outBytes);
   if (crt_a_outBytes > 0)
     crt_self->m_args.Summarize_a_out.Upload(a_out, crt_a_outBytes);
-  crt_self->SetVulkanInOutFor_Summarize(crt_self->m_args.Summarize_a_values.View(), crt_self->m_args.Summarize_a_out.View());
+  crt_self->SetVulkanInOutFor_Summarize(crt_self->m_args.Summarize_a_values.View(),
+                                        crt_self->m_args.Summarize_a_out.View());
   const float crt_copyInMs = crt_copyIn.ElapsedMs();
 
   // Members as they are now; host code of Summarize that changes one records an update in order.
@@ -135,26 +140,27 @@ void LocalTotals_Vulkan::Summarize(uint32_t n, const float4* a_values, float* a_
   crt_self->m_gpuTimer.End(crt_cmd, "Summarize");
   m_ctx->SubmitAndWait(crt_cmd);
   crt_self->m_gpuTimer.Collect();
-  crt_self->m_scanner.ReleaseRetired();  // scratch that grew while recording
-  crt_self->m_sorter.ReleaseRetired();
 
   crossrt::CpuTimer crt_copyOut;
   crt_self->ReadPlainMembers();
   crt_self->ReadVectorMembers("Summarize");
   if (crt_a_outBytes > 0)
     crt_self->m_args.Summarize_a_out.Download(a_out, crt_a_outBytes);
-  crt_self->m_times["Summarize"] = {crt_self->m_gpuTimer.LastMs("Summarize"), crt_copyInMs, crt_copyOut.ElapsedMs(), crt_total.ElapsedMs()};
+  crt_self->m_times["Summarize"] = {crt_self->m_gpuTimer.LastMs("Summarize"), crt_copyInMs, crt_copyOut.ElapsedMs(),
+                                    crt_total.ElapsedMs()};
 }
 
 // The body of LocalTotals::Summarize, with each kernel call turned into its ...Cmd.
-void LocalTotals_Vulkan::SummarizeCmd(VkCommandBuffer a_cmd, uint32_t n, [[maybe_unused]] const float4* a_values, [[maybe_unused]] float* a_out)
+void LocalTotals_Vulkan::SummarizeCmd(VkCommandBuffer a_cmd, uint32_t n, [[maybe_unused]] const float4* a_values,
+                                      [[maybe_unused]] float* a_out)
 {
   kernel1D_SummarizeCmd(a_cmd, n, m_inOut_Summarize.a_values, m_inOut_Summarize.a_out);
 }
 
 // ---- kernel1D_Summarize (from LocalTotals::kernel1D_Summarize, local_totals.cpp) ----
 
-void LocalTotals_Vulkan::kernel1D_SummarizeCmd(VkCommandBuffer a_cmd, uint32_t n, crossrt::BufferView a_values, crossrt::BufferView a_out)
+void LocalTotals_Vulkan::kernel1D_SummarizeCmd(VkCommandBuffer a_cmd, uint32_t n, crossrt::BufferView a_values,
+                                               crossrt::BufferView a_out)
 {
   const int crt_startX = int(0);
   const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(n)));
@@ -162,34 +168,51 @@ void LocalTotals_Vulkan::kernel1D_SummarizeCmd(VkCommandBuffer a_cmd, uint32_t n
   crt_args.crt_startX = crt_startX;
   crt_args.crt_countX = crt_countX;
   crt_args.n = n;
-  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Summarize_sum, 4 * crossrt::GroupCount1D(crt_countX, 256));  // float per workgroup
-  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Summarize_lo, 4 * crossrt::GroupCount1D(crt_countX, 256));  // float per workgroup
-  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Summarize_hi, 4 * crossrt::GroupCount1D(crt_countX, 256));  // float per workgroup
-  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Summarize_total, 16 * crossrt::GroupCount1D(crt_countX, 256));  // float4 per workgroup
-  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Summarize_negatives, 4 * crossrt::GroupCount1D(crt_countX, 256));  // int per workgroup
+  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Summarize_sum,
+                      4 * crossrt::GroupCount1D(crt_countX, 256));  // float per workgroup
+  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Summarize_lo,
+                      4 * crossrt::GroupCount1D(crt_countX, 256));  // float per workgroup
+  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Summarize_hi,
+                      4 * crossrt::GroupCount1D(crt_countX, 256));  // float per workgroup
+  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Summarize_total,
+                      16 * crossrt::GroupCount1D(crt_countX, 256));  // float4 per workgroup
+  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Summarize_negatives,
+                      4 * crossrt::GroupCount1D(crt_countX, 256));  // int per workgroup
   if (crt_countX == 0)  // no threads: only the statements around the loop nest run
   {
     m_pipelines.kernel1D_Summarize_Finish.Bind(a_cmd);
-    m_pipelines.kernel1D_Summarize_Finish.PushBuffers(a_cmd, { m_classDataBuffer.View(), a_values, a_out, m_partials.kernel1D_Summarize_sum.View(), m_partials.kernel1D_Summarize_lo.View(), m_partials.kernel1D_Summarize_hi.View(), m_partials.kernel1D_Summarize_total.View(), m_partials.kernel1D_Summarize_negatives.View() });
+    m_pipelines.kernel1D_Summarize_Finish.PushBuffers(
+        a_cmd, {m_classDataBuffer.View(), a_values, a_out, m_partials.kernel1D_Summarize_sum.View(),
+                m_partials.kernel1D_Summarize_lo.View(), m_partials.kernel1D_Summarize_hi.View(),
+                m_partials.kernel1D_Summarize_total.View(), m_partials.kernel1D_Summarize_negatives.View()});
     m_pipelines.kernel1D_Summarize_Finish.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
     vkCmdDispatch(a_cmd, 1, 1, 1);
     crossrt::ComputeBarrier(a_cmd);
     return;
   }
   m_pipelines.kernel1D_Summarize.Bind(a_cmd);
-  m_pipelines.kernel1D_Summarize.PushBuffers(a_cmd, { m_classDataBuffer.View(), a_values, a_out, m_partials.kernel1D_Summarize_sum.View(), m_partials.kernel1D_Summarize_lo.View(), m_partials.kernel1D_Summarize_hi.View(), m_partials.kernel1D_Summarize_total.View(), m_partials.kernel1D_Summarize_negatives.View() });
+  m_pipelines.kernel1D_Summarize.PushBuffers(
+      a_cmd, {m_classDataBuffer.View(), a_values, a_out, m_partials.kernel1D_Summarize_sum.View(),
+              m_partials.kernel1D_Summarize_lo.View(), m_partials.kernel1D_Summarize_hi.View(),
+              m_partials.kernel1D_Summarize_total.View(), m_partials.kernel1D_Summarize_negatives.View()});
   m_pipelines.kernel1D_Summarize.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);
   crossrt::ComputeBarrier(a_cmd);
   const uint32_t crt_partialCount = crossrt::GroupCount1D(crt_countX, 256);
   m_pipelines.kernel1D_Summarize_Reduce.Bind(a_cmd);
-  m_pipelines.kernel1D_Summarize_Reduce.PushBuffers(a_cmd, { m_classDataBuffer.View(), m_partials.kernel1D_Summarize_sum.View(), m_partials.kernel1D_Summarize_lo.View(), m_partials.kernel1D_Summarize_hi.View(), m_partials.kernel1D_Summarize_total.View(), m_partials.kernel1D_Summarize_negatives.View() });
+  m_pipelines.kernel1D_Summarize_Reduce.PushBuffers(
+      a_cmd, {m_classDataBuffer.View(), m_partials.kernel1D_Summarize_sum.View(),
+              m_partials.kernel1D_Summarize_lo.View(), m_partials.kernel1D_Summarize_hi.View(),
+              m_partials.kernel1D_Summarize_total.View(), m_partials.kernel1D_Summarize_negatives.View()});
   m_pipelines.kernel1D_Summarize_Reduce.PushConstants(a_cmd, &crt_partialCount, sizeof(crt_partialCount));
   vkCmdDispatch(a_cmd, 1, 1, 1);
   crossrt::ComputeBarrier(a_cmd);
   // The statements after the loop nest, on one thread, after the nest's threads and reductions.
   m_pipelines.kernel1D_Summarize_Finish.Bind(a_cmd);
-  m_pipelines.kernel1D_Summarize_Finish.PushBuffers(a_cmd, { m_classDataBuffer.View(), a_values, a_out, m_partials.kernel1D_Summarize_sum.View(), m_partials.kernel1D_Summarize_lo.View(), m_partials.kernel1D_Summarize_hi.View(), m_partials.kernel1D_Summarize_total.View(), m_partials.kernel1D_Summarize_negatives.View() });
+  m_pipelines.kernel1D_Summarize_Finish.PushBuffers(
+      a_cmd, {m_classDataBuffer.View(), a_values, a_out, m_partials.kernel1D_Summarize_sum.View(),
+              m_partials.kernel1D_Summarize_lo.View(), m_partials.kernel1D_Summarize_hi.View(),
+              m_partials.kernel1D_Summarize_total.View(), m_partials.kernel1D_Summarize_negatives.View()});
   m_pipelines.kernel1D_Summarize_Finish.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   vkCmdDispatch(a_cmd, 1, 1, 1);
   crossrt::ComputeBarrier(a_cmd);

@@ -30,8 +30,9 @@ public:
   virtual void SetVulkanInOutFor_Summarize(crossrt::BufferView a_a_values, crossrt::BufferView a_a_out);
   virtual void SummarizeCmd(VkCommandBuffer a_cmd, uint32_t n, const float4* a_values, float* a_out);
 
-  void CommitDeviceData() override;                                     // uploads members
-  void GetExecutionTime(const char* a_funcName, float a_out[4]);  // [0] GPU ms, [1] copy-in ms, [2] copy-out ms, [3] total ms
+  void CommitDeviceData() override;  // uploads members
+  // a_out: [0] GPU ms, [1] copy-in ms, [2] copy-out ms, [3] total ms
+  void GetExecutionTime(const char* a_funcName, float a_out[4]);
 
   virtual void UpdatePlainMembers();  // members -> GPU (called before every control function)
   virtual void ReadPlainMembers();    // GPU -> members the kernels write (reductions)
@@ -40,7 +41,8 @@ public:
 
 protected:
   // One per kernel (and megakernel of a thread loop): records its dispatch (and barrier) into a_cmd.
-  virtual void kernel1D_SummarizeCmd(VkCommandBuffer a_cmd, uint32_t n, crossrt::BufferView a_values, crossrt::BufferView a_out);
+  virtual void kernel1D_SummarizeCmd(VkCommandBuffer a_cmd, uint32_t n, crossrt::BufferView a_values,
+                                     crossrt::BufferView a_out);
   virtual void InitPipelines();
   // Records an update of one member's GPU copy, ordered between the kernels around it.
   virtual void UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size);
@@ -65,9 +67,6 @@ protected:
   crossrt::Buffer m_classDataBuffer;
   bool m_deviceDataCommitted = false;
 
-  struct VectorMembers  // device copies of the std::vector members kernels use
-  {
-  } m_vdata;
   // A std::vector or Image2D member changed size, or a sampler changed, since CommitDeviceData().
   virtual bool VectorMembersResized() const;
 
@@ -99,8 +98,6 @@ protected:
     crossrt::Buffer kernel1D_Summarize_negatives;
   } m_partials;
 
-  crossrt::Scanner m_scanner;     // std::exclusive_scan / std::inclusive_scan of control functions
-  crossrt::RadixSorter m_sorter;  // std::sort of control functions
   crossrt::GpuTimer m_gpuTimer;
   std::map<std::string, std::array<float, 4>> m_times;
 };

@@ -11,12 +11,13 @@
 #include <chrono>
 using namespace LiteMath;
 
-#pragma omp declare reduction(crossrt_min_vec4 : float4 : omp_out = LiteMath::min(omp_out, omp_in)) initializer(omp_priv = omp_orig)
-#pragma omp declare reduction(crossrt_max_vec4 : float4 : omp_out = LiteMath::max(omp_out, omp_in)) initializer(omp_priv = omp_orig)
-#pragma omp declare reduction(crossrt_add_vec4 : float4 : omp_out = omp_out + omp_in) initializer(omp_priv = float4())
+#pragma omp declare reduction(crossrt_min_vec4:float4 : omp_out = LiteMath::min(omp_out, omp_in)) \
+    initializer(omp_priv = omp_orig)
+#pragma omp declare reduction(crossrt_max_vec4:float4 : omp_out = LiteMath::max(omp_out, omp_in)) \
+    initializer(omp_priv = omp_orig)
+#pragma omp declare reduction(crossrt_add_vec4:float4 : omp_out = omp_out + omp_in) initializer(omp_priv = float4())
 
-Particles_CPU::Particles_CPU()
-  : Particles()
+Particles_CPU::Particles_CPU() : Particles()
 {
 }
 
@@ -57,7 +58,7 @@ void Particles_CPU::Step(int n, float dt, float4* positions, float4* velocities)
 void Particles_CPU::kernel1D_Advance(int n, float dt, float4* positions, float4* velocities)
 {
   auto m_bouncesLocal = m_bounces;
-  #pragma omp parallel for schedule(dynamic, 1024) reduction(+:m_bouncesLocal)
+#pragma omp parallel for schedule(dynamic, 1024) reduction(+ : m_bouncesLocal)
   for (int i = 0; i < n; i++)
   {
     float4 v = velocities[i];
@@ -82,7 +83,9 @@ void Particles_CPU::kernel1D_Measure(int n, const float4* positions, const float
   auto m_boxMaxLocal = m_boxMax;
   auto m_momentumLocal = m_momentum;
   auto m_kineticEnergyLocal = m_kineticEnergy;
-  #pragma omp parallel for schedule(dynamic, 1024) reduction(crossrt_min_vec4:m_boxMinLocal) reduction(crossrt_max_vec4:m_boxMaxLocal) reduction(crossrt_add_vec4:m_momentumLocal) reduction(+:m_kineticEnergyLocal)
+#pragma omp parallel for schedule(dynamic, 1024) reduction(crossrt_min_vec4 : m_boxMinLocal) \
+    reduction(crossrt_max_vec4 : m_boxMaxLocal) reduction(crossrt_add_vec4 : m_momentumLocal) \
+    reduction(+ : m_kineticEnergyLocal)
   for (int i = 0; i < n; i++)
   {
     const float4 p = positions[i];

@@ -19,13 +19,10 @@ extern const size_t Particles_kernel1D_Measure_spvBytes;
 extern const uint32_t Particles_kernel1D_Measure_Reduce_spv[];
 extern const size_t Particles_kernel1D_Measure_Reduce_spvBytes;
 
-Particles_Vulkan::Particles_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx)
-  : Particles(), m_ctx(std::move(a_ctx))
+Particles_Vulkan::Particles_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx) : Particles(), m_ctx(std::move(a_ctx))
 {
   m_classDataBuffer = crossrt::Buffer(m_ctx, sizeof(ClassData));
   m_gpuTimer = crossrt::GpuTimer(m_ctx);
-  m_scanner = crossrt::Scanner(m_ctx);
-  m_sorter = crossrt::RadixSorter(m_ctx);
   InitPipelines();
 }
 
@@ -45,11 +42,20 @@ void Particles_Vulkan::InitPipelines()
 {
   // Member reductions combine partial results with subgroup arithmetic.
   if (!m_ctx->hasSubgroupArithmetic || m_ctx->subgroupSize < 4)
-    throw crossrt::Error("Particles_Vulkan: device '" + m_ctx->DeviceName() + "' lacks compute subgroup arithmetic with >= 4 lanes, which member reductions need");
-  m_pipelines.kernel1D_Advance = crossrt::ComputePipeline(m_ctx, Particles_kernel1D_Advance_spv, Particles_kernel1D_Advance_spvBytes, 4, sizeof(kernel1D_AdvanceArgs), "Particles::kernel1D_Advance");
-  m_pipelines.kernel1D_Advance_Reduce = crossrt::ComputePipeline(m_ctx, Particles_kernel1D_Advance_Reduce_spv, Particles_kernel1D_Advance_Reduce_spvBytes, 2, sizeof(uint32_t), "Particles::kernel1D_Advance_Reduce");
-  m_pipelines.kernel1D_Measure = crossrt::ComputePipeline(m_ctx, Particles_kernel1D_Measure_spv, Particles_kernel1D_Measure_spvBytes, 7, sizeof(kernel1D_MeasureArgs), "Particles::kernel1D_Measure");
-  m_pipelines.kernel1D_Measure_Reduce = crossrt::ComputePipeline(m_ctx, Particles_kernel1D_Measure_Reduce_spv, Particles_kernel1D_Measure_Reduce_spvBytes, 5, sizeof(uint32_t), "Particles::kernel1D_Measure_Reduce");
+    throw crossrt::Error("Particles_Vulkan: device '" + m_ctx->DeviceName() +
+                         "' lacks compute subgroup arithmetic with >= 4 lanes, which member reductions need");
+  m_pipelines.kernel1D_Advance =
+      crossrt::ComputePipeline(m_ctx, Particles_kernel1D_Advance_spv, Particles_kernel1D_Advance_spvBytes, 4,
+                               sizeof(kernel1D_AdvanceArgs), "Particles::kernel1D_Advance");
+  m_pipelines.kernel1D_Advance_Reduce =
+      crossrt::ComputePipeline(m_ctx, Particles_kernel1D_Advance_Reduce_spv, Particles_kernel1D_Advance_Reduce_spvBytes,
+                               2, sizeof(uint32_t), "Particles::kernel1D_Advance_Reduce");
+  m_pipelines.kernel1D_Measure =
+      crossrt::ComputePipeline(m_ctx, Particles_kernel1D_Measure_spv, Particles_kernel1D_Measure_spvBytes, 7,
+                               sizeof(kernel1D_MeasureArgs), "Particles::kernel1D_Measure");
+  m_pipelines.kernel1D_Measure_Reduce =
+      crossrt::ComputePipeline(m_ctx, Particles_kernel1D_Measure_Reduce_spv, Particles_kernel1D_Measure_Reduce_spvBytes,
+                               5, sizeof(uint32_t), "Particles::kernel1D_Measure_Reduce");
 }
 
 void Particles_Vulkan::UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size)
@@ -93,8 +99,7 @@ void Particles_Vulkan::CommitDeviceData()
 
 bool Particles_Vulkan::VectorMembersResized() const
 {
-  bool resized = false;
-  return resized;
+  return false;  // no std::vector, Image2D or sampler member of the class is on the GPU
 }
 
 void Particles_Vulkan::ReadVectorMembers(const char* a_funcName)
@@ -148,8 +153,6 @@ void Particles_Vulkan::Step(int n, float dt, float4* positions, float4* velociti
   crt_self->m_gpuTimer.End(crt_cmd, "Step");
   m_ctx->SubmitAndWait(crt_cmd);
   crt_self->m_gpuTimer.Collect();
-  crt_self->m_scanner.ReleaseRetired();  // scratch that grew while recording
-  crt_self->m_sorter.ReleaseRetired();
 
   crossrt::CpuTimer crt_copyOut;
   crt_self->ReadPlainMembers();
@@ -158,11 +161,13 @@ void Particles_Vulkan::Step(int n, float dt, float4* positions, float4* velociti
     crt_self->m_args.Step_positions.Download(positions, crt_positionsBytes);
   if (crt_velocitiesBytes > 0)
     crt_self->m_args.Step_velocities.Download(velocities, crt_velocitiesBytes);
-  crt_self->m_times["Step"] = {crt_self->m_gpuTimer.LastMs("Step"), crt_copyInMs, crt_copyOut.ElapsedMs(), crt_total.ElapsedMs()};
+  crt_self->m_times["Step"] = {crt_self->m_gpuTimer.LastMs("Step"), crt_copyInMs, crt_copyOut.ElapsedMs(),
+                               crt_total.ElapsedMs()};
 }
 
 // The body of Particles::Step, with each kernel call turned into its ...Cmd.
-void Particles_Vulkan::StepCmd(VkCommandBuffer a_cmd, int n, float dt, [[maybe_unused]] float4* positions, [[maybe_unused]] float4* velocities)
+void Particles_Vulkan::StepCmd(VkCommandBuffer a_cmd, int n, float dt, [[maybe_unused]] float4* positions,
+                               [[maybe_unused]] float4* velocities)
 {
   const auto start = std::chrono::steady_clock::now();
   m_boxMin = float4(INF_POSITIVE);
@@ -183,7 +188,8 @@ void Particles_Vulkan::StepCmd(VkCommandBuffer a_cmd, int n, float dt, [[maybe_u
 
 // ---- kernel1D_Advance (from Particles::kernel1D_Advance, Particles.cpp) ----
 
-void Particles_Vulkan::kernel1D_AdvanceCmd(VkCommandBuffer a_cmd, int n, float dt, crossrt::BufferView positions, crossrt::BufferView velocities)
+void Particles_Vulkan::kernel1D_AdvanceCmd(VkCommandBuffer a_cmd, int n, float dt, crossrt::BufferView positions,
+                                           crossrt::BufferView velocities)
 {
   const int crt_startX = int(0);
   const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(n)));
@@ -194,15 +200,18 @@ void Particles_Vulkan::kernel1D_AdvanceCmd(VkCommandBuffer a_cmd, int n, float d
   crt_args.crt_countX = crt_countX;
   crt_args.n = n;
   crt_args.dt = dt;
-  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Advance_m_bounces, 4 * crossrt::GroupCount1D(crt_countX, 256));  // int per workgroup
+  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Advance_m_bounces,
+                      4 * crossrt::GroupCount1D(crt_countX, 256));  // int per workgroup
   m_pipelines.kernel1D_Advance.Bind(a_cmd);
-  m_pipelines.kernel1D_Advance.PushBuffers(a_cmd, { m_classDataBuffer.View(), positions, velocities, m_partials.kernel1D_Advance_m_bounces.View() });
+  m_pipelines.kernel1D_Advance.PushBuffers(
+      a_cmd, {m_classDataBuffer.View(), positions, velocities, m_partials.kernel1D_Advance_m_bounces.View()});
   m_pipelines.kernel1D_Advance.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);
   crossrt::ComputeBarrier(a_cmd);
   const uint32_t crt_partialCount = crossrt::GroupCount1D(crt_countX, 256);
   m_pipelines.kernel1D_Advance_Reduce.Bind(a_cmd);
-  m_pipelines.kernel1D_Advance_Reduce.PushBuffers(a_cmd, { m_classDataBuffer.View(), m_partials.kernel1D_Advance_m_bounces.View() });
+  m_pipelines.kernel1D_Advance_Reduce.PushBuffers(
+      a_cmd, {m_classDataBuffer.View(), m_partials.kernel1D_Advance_m_bounces.View()});
   m_pipelines.kernel1D_Advance_Reduce.PushConstants(a_cmd, &crt_partialCount, sizeof(crt_partialCount));
   vkCmdDispatch(a_cmd, 1, 1, 1);
   crossrt::ComputeBarrier(a_cmd);
@@ -210,7 +219,8 @@ void Particles_Vulkan::kernel1D_AdvanceCmd(VkCommandBuffer a_cmd, int n, float d
 
 // ---- kernel1D_Measure (from Particles::kernel1D_Measure, Particles.cpp) ----
 
-void Particles_Vulkan::kernel1D_MeasureCmd(VkCommandBuffer a_cmd, int n, crossrt::BufferView positions, crossrt::BufferView velocities)
+void Particles_Vulkan::kernel1D_MeasureCmd(VkCommandBuffer a_cmd, int n, crossrt::BufferView positions,
+                                           crossrt::BufferView velocities)
 {
   const int crt_startX = int(0);
   const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(n)));
@@ -220,18 +230,28 @@ void Particles_Vulkan::kernel1D_MeasureCmd(VkCommandBuffer a_cmd, int n, crossrt
   crt_args.crt_startX = crt_startX;
   crt_args.crt_countX = crt_countX;
   crt_args.n = n;
-  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Measure_m_boxMin, 16 * crossrt::GroupCount1D(crt_countX, 256));  // float4 per workgroup
-  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Measure_m_boxMax, 16 * crossrt::GroupCount1D(crt_countX, 256));  // float4 per workgroup
-  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Measure_m_momentum, 16 * crossrt::GroupCount1D(crt_countX, 256));  // float4 per workgroup
-  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Measure_m_kineticEnergy, 4 * crossrt::GroupCount1D(crt_countX, 256));  // float per workgroup
+  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Measure_m_boxMin,
+                      16 * crossrt::GroupCount1D(crt_countX, 256));  // float4 per workgroup
+  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Measure_m_boxMax,
+                      16 * crossrt::GroupCount1D(crt_countX, 256));  // float4 per workgroup
+  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Measure_m_momentum,
+                      16 * crossrt::GroupCount1D(crt_countX, 256));  // float4 per workgroup
+  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Measure_m_kineticEnergy,
+                      4 * crossrt::GroupCount1D(crt_countX, 256));  // float per workgroup
   m_pipelines.kernel1D_Measure.Bind(a_cmd);
-  m_pipelines.kernel1D_Measure.PushBuffers(a_cmd, { m_classDataBuffer.View(), positions, velocities, m_partials.kernel1D_Measure_m_boxMin.View(), m_partials.kernel1D_Measure_m_boxMax.View(), m_partials.kernel1D_Measure_m_momentum.View(), m_partials.kernel1D_Measure_m_kineticEnergy.View() });
+  m_pipelines.kernel1D_Measure.PushBuffers(
+      a_cmd, {m_classDataBuffer.View(), positions, velocities, m_partials.kernel1D_Measure_m_boxMin.View(),
+              m_partials.kernel1D_Measure_m_boxMax.View(), m_partials.kernel1D_Measure_m_momentum.View(),
+              m_partials.kernel1D_Measure_m_kineticEnergy.View()});
   m_pipelines.kernel1D_Measure.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);
   crossrt::ComputeBarrier(a_cmd);
   const uint32_t crt_partialCount = crossrt::GroupCount1D(crt_countX, 256);
   m_pipelines.kernel1D_Measure_Reduce.Bind(a_cmd);
-  m_pipelines.kernel1D_Measure_Reduce.PushBuffers(a_cmd, { m_classDataBuffer.View(), m_partials.kernel1D_Measure_m_boxMin.View(), m_partials.kernel1D_Measure_m_boxMax.View(), m_partials.kernel1D_Measure_m_momentum.View(), m_partials.kernel1D_Measure_m_kineticEnergy.View() });
+  m_pipelines.kernel1D_Measure_Reduce.PushBuffers(
+      a_cmd, {m_classDataBuffer.View(), m_partials.kernel1D_Measure_m_boxMin.View(),
+              m_partials.kernel1D_Measure_m_boxMax.View(), m_partials.kernel1D_Measure_m_momentum.View(),
+              m_partials.kernel1D_Measure_m_kineticEnergy.View()});
   m_pipelines.kernel1D_Measure_Reduce.PushConstants(a_cmd, &crt_partialCount, sizeof(crt_partialCount));
   vkCmdDispatch(a_cmd, 1, 1, 1);
   crossrt::ComputeBarrier(a_cmd);

@@ -28,8 +28,9 @@ public:
   virtual void SetVulkanInOutFor_Step(crossrt::BufferView a_positions, crossrt::BufferView a_velocities);
   virtual void StepCmd(VkCommandBuffer a_cmd, int n, float dt, float4* positions, float4* velocities);
 
-  void CommitDeviceData() override;                                     // uploads members
-  void GetExecutionTime(const char* a_funcName, float a_out[4]) override;  // [0] GPU ms, [1] copy-in ms, [2] copy-out ms, [3] total ms
+  void CommitDeviceData() override;  // uploads members
+  // a_out: [0] GPU ms, [1] copy-in ms, [2] copy-out ms, [3] total ms
+  void GetExecutionTime(const char* a_funcName, float a_out[4]) override;
 
   virtual void UpdatePlainMembers();  // members -> GPU (called before every control function)
   virtual void ReadPlainMembers();    // GPU -> members the kernels write (reductions)
@@ -38,8 +39,10 @@ public:
 
 protected:
   // One per kernel (and megakernel of a thread loop): records its dispatch (and barrier) into a_cmd.
-  virtual void kernel1D_AdvanceCmd(VkCommandBuffer a_cmd, int n, float dt, crossrt::BufferView positions, crossrt::BufferView velocities);
-  virtual void kernel1D_MeasureCmd(VkCommandBuffer a_cmd, int n, crossrt::BufferView positions, crossrt::BufferView velocities);
+  virtual void kernel1D_AdvanceCmd(VkCommandBuffer a_cmd, int n, float dt, crossrt::BufferView positions,
+                                   crossrt::BufferView velocities);
+  virtual void kernel1D_MeasureCmd(VkCommandBuffer a_cmd, int n, crossrt::BufferView positions,
+                                   crossrt::BufferView velocities);
   virtual void InitPipelines();
   // Records an update of one member's GPU copy, ordered between the kernels around it.
   virtual void UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size);
@@ -77,9 +80,6 @@ protected:
   crossrt::Buffer m_classDataBuffer;
   bool m_deviceDataCommitted = false;
 
-  struct VectorMembers  // device copies of the std::vector members kernels use
-  {
-  } m_vdata;
   // A std::vector or Image2D member changed size, or a sampler changed, since CommitDeviceData().
   virtual bool VectorMembersResized() const;
 
@@ -112,8 +112,6 @@ protected:
     crossrt::Buffer kernel1D_Measure_m_kineticEnergy;
   } m_partials;
 
-  crossrt::Scanner m_scanner;     // std::exclusive_scan / std::inclusive_scan of control functions
-  crossrt::RadixSorter m_sorter;  // std::sort of control functions
   crossrt::GpuTimer m_gpuTimer;
   std::map<std::string, std::array<float, 4>> m_times;
 };

@@ -12,8 +12,7 @@
 #include <stdexcept>
 using LiteMath::float4x4;
 
-PrimaryRays_CPU::PrimaryRays_CPU(int width, int height)
-  : PrimaryRays(width, height)
+PrimaryRays_CPU::PrimaryRays_CPU(int width, int height) : PrimaryRays(width, height)
 {
 }
 
@@ -34,10 +33,7 @@ void PrimaryRays_CPU::Render(uint32_t* pixels)
 {
   const auto crt_start = std::chrono::steady_clock::now();
   // The body of PrimaryRays::Render, run as a lambda so that an early 'return' still gets timed.
-  [&]()
-  {
-    kernel2D_Render(pixels, m_width, m_height);
-  }();
+  [&]() { kernel2D_Render(pixels, m_width, m_height); }();
   const float crt_ms = std::chrono::duration<float, std::milli>(std::chrono::steady_clock::now() - crt_start).count();
   const_cast<PrimaryRays_CPU*>(this)->m_times["Render"] = {0.0f, 0.0f, 0.0f, crt_ms};
 }
@@ -47,10 +43,7 @@ void PrimaryRays_CPU::CastRays(const float4* posAndNear, const float4* dirAndFar
 {
   const auto crt_start = std::chrono::steady_clock::now();
   // The body of PrimaryRays::CastRays, run as a lambda so that an early 'return' still gets timed.
-  [&]()
-  {
-    kernel1D_CastRays(posAndNear, dirAndFar, hits, n);
-  }();
+  [&]() { kernel1D_CastRays(posAndNear, dirAndFar, hits, n); }();
   const float crt_ms = std::chrono::duration<float, std::milli>(std::chrono::steady_clock::now() - crt_start).count();
   const_cast<PrimaryRays_CPU*>(this)->m_times["CastRays"] = {0.0f, 0.0f, 0.0f, crt_ms};
 }
@@ -58,7 +51,7 @@ void PrimaryRays_CPU::CastRays(const float4* posAndNear, const float4* dirAndFar
 // From PrimaryRays::kernel2D_Render (PrimaryRays.cpp): the outer loop runs on all cores.
 void PrimaryRays_CPU::kernel2D_Render(uint32_t* pixels, int width, int height)
 {
-  #pragma omp parallel for schedule(dynamic, 1)
+#pragma omp parallel for schedule(dynamic, 1)
   for (int y = 0; y < height; ++y)
   {
     for (int x = 0; x < width; ++x)
@@ -76,7 +69,7 @@ void PrimaryRays_CPU::kernel2D_Render(uint32_t* pixels, int width, int height)
 // From PrimaryRays::kernel1D_CastRays (PrimaryRays.cpp): the outer loop runs on all cores.
 void PrimaryRays_CPU::kernel1D_CastRays(const float4* posAndNear, const float4* dirAndFar, CRT_Hit* hits, int n)
 {
-  #pragma omp parallel for schedule(dynamic, 1024)
+#pragma omp parallel for schedule(dynamic, 1024)
   for (int i = 0; i < n; ++i)
     hits[i] = m_pAccelStruct->RayQuery_NearestHit(posAndNear[i], dirAndFar[i]);
 }

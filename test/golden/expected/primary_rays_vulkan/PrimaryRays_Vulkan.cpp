@@ -21,12 +21,10 @@ extern const uint32_t PrimaryRays_kernel1D_CastRays_spv[];
 extern const size_t PrimaryRays_kernel1D_CastRays_spvBytes;
 
 PrimaryRays_Vulkan::PrimaryRays_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx, int width, int height)
-  : PrimaryRays(width, height), m_ctx(std::move(a_ctx))
+    : PrimaryRays(width, height), m_ctx(std::move(a_ctx))
 {
   m_classDataBuffer = crossrt::Buffer(m_ctx, sizeof(ClassData));
   m_gpuTimer = crossrt::GpuTimer(m_ctx);
-  m_scanner = crossrt::Scanner(m_ctx);
-  m_sorter = crossrt::RadixSorter(m_ctx);
   m_useRayTracingHardware = m_ctx->hasRayQuery;
   if (m_ctx->hasRayQuery)
   {
@@ -40,7 +38,8 @@ std::shared_ptr<PrimaryRays> CreatePrimaryRays_Vulkan(int width, int height)
   return std::make_shared<PrimaryRays_Vulkan>(crossrt::VulkanContext::CreateDefault(), width, height);
 }
 
-std::shared_ptr<PrimaryRays> CreatePrimaryRays_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx, int width, int height)
+std::shared_ptr<PrimaryRays> CreatePrimaryRays_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx, int width,
+                                                      int height)
 {
   return std::make_shared<PrimaryRays_Vulkan>(std::move(a_ctx), width, height);
 }
@@ -49,20 +48,35 @@ PrimaryRays_Vulkan::~PrimaryRays_Vulkan() = default;
 
 void PrimaryRays_Vulkan::InitPipelines()
 {
-  if (m_ctx->hasRayQuery)  // m_pAccelStruct's ray queries on the ray tracing hardware: the shader needs them even to be created
-    m_pipelines.kernel2D_Render_RayQuery = crossrt::ComputePipeline(m_ctx, PrimaryRays_kernel2D_Render_RayQuery_spv, PrimaryRays_kernel2D_Render_RayQuery_spvBytes,
-                                                    std::vector<VkDescriptorType>{ VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR }, sizeof(kernel2D_RenderArgs), "PrimaryRays::kernel2D_Render_RayQuery");
-  m_pipelines.kernel2D_Render = crossrt::ComputePipeline(m_ctx, PrimaryRays_kernel2D_Render_spv, PrimaryRays_kernel2D_Render_spvBytes, 10, sizeof(kernel2D_RenderArgs), "PrimaryRays::kernel2D_Render");
-  if (m_ctx->hasRayQuery)  // m_pAccelStruct's ray queries on the ray tracing hardware: the shader needs them even to be created
-    m_pipelines.kernel1D_CastRays_RayQuery = crossrt::ComputePipeline(m_ctx, PrimaryRays_kernel1D_CastRays_RayQuery_spv, PrimaryRays_kernel1D_CastRays_RayQuery_spvBytes,
-                                                    std::vector<VkDescriptorType>{ VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR }, sizeof(kernel1D_CastRaysArgs), "PrimaryRays::kernel1D_CastRays_RayQuery");
-  m_pipelines.kernel1D_CastRays = crossrt::ComputePipeline(m_ctx, PrimaryRays_kernel1D_CastRays_spv, PrimaryRays_kernel1D_CastRays_spvBytes, 10, sizeof(kernel1D_CastRaysArgs), "PrimaryRays::kernel1D_CastRays");
+  if (m_ctx->hasRayQuery)  // m_pAccelStruct's ray queries on the ray tracing hardware: the shader needs them even to be
+                           // created
+    m_pipelines.kernel2D_Render_RayQuery = crossrt::ComputePipeline(
+        m_ctx, PrimaryRays_kernel2D_Render_RayQuery_spv, PrimaryRays_kernel2D_Render_RayQuery_spvBytes,
+        std::vector<VkDescriptorType>{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                      VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                      VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR},
+        sizeof(kernel2D_RenderArgs), "PrimaryRays::kernel2D_Render_RayQuery");
+  m_pipelines.kernel2D_Render =
+      crossrt::ComputePipeline(m_ctx, PrimaryRays_kernel2D_Render_spv, PrimaryRays_kernel2D_Render_spvBytes, 10,
+                               sizeof(kernel2D_RenderArgs), "PrimaryRays::kernel2D_Render");
+  if (m_ctx->hasRayQuery)  // m_pAccelStruct's ray queries on the ray tracing hardware: the shader needs them even to be
+                           // created
+    m_pipelines.kernel1D_CastRays_RayQuery = crossrt::ComputePipeline(
+        m_ctx, PrimaryRays_kernel1D_CastRays_RayQuery_spv, PrimaryRays_kernel1D_CastRays_RayQuery_spvBytes,
+        std::vector<VkDescriptorType>{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                      VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                      VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR},
+        sizeof(kernel1D_CastRaysArgs), "PrimaryRays::kernel1D_CastRays_RayQuery");
+  m_pipelines.kernel1D_CastRays =
+      crossrt::ComputePipeline(m_ctx, PrimaryRays_kernel1D_CastRays_spv, PrimaryRays_kernel1D_CastRays_spvBytes, 10,
+                               sizeof(kernel1D_CastRaysArgs), "PrimaryRays::kernel1D_CastRays");
 }
 
 void PrimaryRays_Vulkan::UseRayTracingHardware(bool a_use)
 {
   if (a_use && !m_ctx->hasRayQuery)
-    throw crossrt::Error("PrimaryRays_Vulkan: device '" + m_ctx->DeviceName() + "' has no ray queries (VK_KHR_ray_query): its kernels trace with the translated traversal");
+    throw crossrt::Error("PrimaryRays_Vulkan: device '" + m_ctx->DeviceName() +
+                         "' has no ray queries (VK_KHR_ray_query): its kernels trace with the translated traversal");
   if (a_use != m_useRayTracingHardware)
     m_deviceDataCommitted = false;  // the next call commits, building the scene for the hardware
   m_useRayTracingHardware = a_use;
@@ -75,8 +89,11 @@ void PrimaryRays_Vulkan::CommitScene_m_pAccelStruct()
   CRT_SceneExport scene;
   if (!m_pAccelStruct || !m_pAccelStruct->ExportScene(scene))
     throw crossrt::Error(std::string("PrimaryRays_Vulkan: 'm_pAccelStruct' holds ") +
-                         (m_pAccelStruct ? std::string("a scene (") + m_pAccelStruct->Name() + ") that does not export its meshes" : std::string("no scene")) +
-                         ", so the ray tracing hardware cannot trace it; call UseRayTracingHardware(false) to trace with BVHScene's traversal");
+                         (m_pAccelStruct
+                              ? std::string("a scene (") + m_pAccelStruct->Name() + ") that does not export its meshes"
+                              : std::string("no scene")) +
+                         ", so the ray tracing hardware cannot trace it; call UseRayTracingHardware(false) to trace "
+                         "with BVHScene's traversal");
   std::vector<crossrt::RayTracingScene::Mesh> meshes;
   for (const auto& triangles : scene.meshTriangles)
     meshes.push_back({triangles.data(), triangles.size() / 9});
@@ -143,44 +160,56 @@ void PrimaryRays_Vulkan::CommitDeviceData()
   m_vdata.m_indicesSize = m_indices.size();
   if (!m_useRayTracingHardware)  // only the translated traversal reads it
   {
-    crossrt::EnsureSize(m_ctx, m_vdata.m_pAccelStruct_m_nodes, sizeof(BVH4Node) * crt_m_pAccelStruct()->m_nodes.capacity());
+    crossrt::EnsureSize(m_ctx, m_vdata.m_pAccelStruct_m_nodes,
+                        sizeof(BVH4Node) * crt_m_pAccelStruct()->m_nodes.capacity());
     if (!crt_m_pAccelStruct()->m_nodes.empty())
-      m_vdata.m_pAccelStruct_m_nodes.Upload(crt_m_pAccelStruct()->m_nodes.data(), sizeof(BVH4Node) * crt_m_pAccelStruct()->m_nodes.size());
+      m_vdata.m_pAccelStruct_m_nodes.Upload(crt_m_pAccelStruct()->m_nodes.data(),
+                                            sizeof(BVH4Node) * crt_m_pAccelStruct()->m_nodes.size());
   }
   m_vdata.m_pAccelStruct_m_nodesSize = crt_m_pAccelStruct()->m_nodes.size();
   if (!m_useRayTracingHardware)  // only the translated traversal reads it
   {
-    crossrt::EnsureSize(m_ctx, m_vdata.m_pAccelStruct_m_instances, sizeof(BVHInstance) * crt_m_pAccelStruct()->m_instances.capacity());
+    crossrt::EnsureSize(m_ctx, m_vdata.m_pAccelStruct_m_instances,
+                        sizeof(BVHInstance) * crt_m_pAccelStruct()->m_instances.capacity());
     if (!crt_m_pAccelStruct()->m_instances.empty())
-      m_vdata.m_pAccelStruct_m_instances.Upload(crt_m_pAccelStruct()->m_instances.data(), sizeof(BVHInstance) * crt_m_pAccelStruct()->m_instances.size());
+      m_vdata.m_pAccelStruct_m_instances.Upload(crt_m_pAccelStruct()->m_instances.data(),
+                                                sizeof(BVHInstance) * crt_m_pAccelStruct()->m_instances.size());
   }
   m_vdata.m_pAccelStruct_m_instancesSize = crt_m_pAccelStruct()->m_instances.size();
   if (!m_useRayTracingHardware)  // only the translated traversal reads it
   {
-    crossrt::EnsureSize(m_ctx, m_vdata.m_pAccelStruct_m_motion, sizeof(LiteMath::float4) * crt_m_pAccelStruct()->m_motion.capacity());
+    crossrt::EnsureSize(m_ctx, m_vdata.m_pAccelStruct_m_motion,
+                        sizeof(LiteMath::float4) * crt_m_pAccelStruct()->m_motion.capacity());
     if (!crt_m_pAccelStruct()->m_motion.empty())
-      m_vdata.m_pAccelStruct_m_motion.Upload(crt_m_pAccelStruct()->m_motion.data(), sizeof(LiteMath::float4) * crt_m_pAccelStruct()->m_motion.size());
+      m_vdata.m_pAccelStruct_m_motion.Upload(crt_m_pAccelStruct()->m_motion.data(),
+                                             sizeof(LiteMath::float4) * crt_m_pAccelStruct()->m_motion.size());
   }
   m_vdata.m_pAccelStruct_m_motionSize = crt_m_pAccelStruct()->m_motion.size();
   if (!m_useRayTracingHardware)  // only the translated traversal reads it
   {
-    crossrt::EnsureSize(m_ctx, m_vdata.m_pAccelStruct_m_boxes, sizeof(BVH4Node) * crt_m_pAccelStruct()->m_boxes.capacity());
+    crossrt::EnsureSize(m_ctx, m_vdata.m_pAccelStruct_m_boxes,
+                        sizeof(BVH4Node) * crt_m_pAccelStruct()->m_boxes.capacity());
     if (!crt_m_pAccelStruct()->m_boxes.empty())
-      m_vdata.m_pAccelStruct_m_boxes.Upload(crt_m_pAccelStruct()->m_boxes.data(), sizeof(BVH4Node) * crt_m_pAccelStruct()->m_boxes.size());
+      m_vdata.m_pAccelStruct_m_boxes.Upload(crt_m_pAccelStruct()->m_boxes.data(),
+                                            sizeof(BVH4Node) * crt_m_pAccelStruct()->m_boxes.size());
   }
   m_vdata.m_pAccelStruct_m_boxesSize = crt_m_pAccelStruct()->m_boxes.size();
   if (!m_useRayTracingHardware)  // only the translated traversal reads it
   {
-    crossrt::EnsureSize(m_ctx, m_vdata.m_pAccelStruct_m_triangles, sizeof(BVHTriangle4) * crt_m_pAccelStruct()->m_triangles.capacity());
+    crossrt::EnsureSize(m_ctx, m_vdata.m_pAccelStruct_m_triangles,
+                        sizeof(BVHTriangle4) * crt_m_pAccelStruct()->m_triangles.capacity());
     if (!crt_m_pAccelStruct()->m_triangles.empty())
-      m_vdata.m_pAccelStruct_m_triangles.Upload(crt_m_pAccelStruct()->m_triangles.data(), sizeof(BVHTriangle4) * crt_m_pAccelStruct()->m_triangles.size());
+      m_vdata.m_pAccelStruct_m_triangles.Upload(crt_m_pAccelStruct()->m_triangles.data(),
+                                                sizeof(BVHTriangle4) * crt_m_pAccelStruct()->m_triangles.size());
   }
   m_vdata.m_pAccelStruct_m_trianglesSize = crt_m_pAccelStruct()->m_triangles.size();
   if (!m_useRayTracingHardware)  // only the translated traversal reads it
   {
-    crossrt::EnsureSize(m_ctx, m_vdata.m_pAccelStruct_m_primIds, sizeof(unsigned int) * crt_m_pAccelStruct()->m_primIds.capacity());
+    crossrt::EnsureSize(m_ctx, m_vdata.m_pAccelStruct_m_primIds,
+                        sizeof(unsigned int) * crt_m_pAccelStruct()->m_primIds.capacity());
     if (!crt_m_pAccelStruct()->m_primIds.empty())
-      m_vdata.m_pAccelStruct_m_primIds.Upload(crt_m_pAccelStruct()->m_primIds.data(), sizeof(unsigned int) * crt_m_pAccelStruct()->m_primIds.size());
+      m_vdata.m_pAccelStruct_m_primIds.Upload(crt_m_pAccelStruct()->m_primIds.data(),
+                                              sizeof(unsigned int) * crt_m_pAccelStruct()->m_primIds.size());
   }
   m_vdata.m_pAccelStruct_m_primIdsSize = crt_m_pAccelStruct()->m_primIds.size();
   if (m_useRayTracingHardware)
@@ -212,7 +241,8 @@ BVHScene* PrimaryRays_Vulkan::crt_m_pAccelStruct() const
 {
   auto* impl = dynamic_cast<BVHScene*>(crossrt::RawPointer(m_pAccelStruct));
   if (impl == nullptr)
-    throw crossrt::Error(std::string("PrimaryRays_Vulkan: 'm_pAccelStruct' must hold a BVHScene, the ISceneObject composed into the GPU code, but it holds ") +
+    throw crossrt::Error(std::string("PrimaryRays_Vulkan: 'm_pAccelStruct' must hold a BVHScene, the ISceneObject "
+                                     "composed into the GPU code, but it holds ") +
                          (m_pAccelStruct ? "an object of another class" : "nothing"));
   return impl;
 }
@@ -258,15 +288,14 @@ void PrimaryRays_Vulkan::Render(uint32_t* pixels)
   crt_self->m_gpuTimer.End(crt_cmd, "Render");
   m_ctx->SubmitAndWait(crt_cmd);
   crt_self->m_gpuTimer.Collect();
-  crt_self->m_scanner.ReleaseRetired();  // scratch that grew while recording
-  crt_self->m_sorter.ReleaseRetired();
 
   crossrt::CpuTimer crt_copyOut;
   crt_self->ReadPlainMembers();
   crt_self->ReadVectorMembers("Render");
   if (crt_pixelsBytes > 0)
     crt_self->m_args.Render_pixels.Download(pixels, crt_pixelsBytes);
-  crt_self->m_times["Render"] = {crt_self->m_gpuTimer.LastMs("Render"), crt_copyInMs, crt_copyOut.ElapsedMs(), crt_total.ElapsedMs()};
+  crt_self->m_times["Render"] = {crt_self->m_gpuTimer.LastMs("Render"), crt_copyInMs, crt_copyOut.ElapsedMs(),
+                                 crt_total.ElapsedMs()};
 }
 
 // The body of PrimaryRays::Render, with each kernel call turned into its ...Cmd.
@@ -277,7 +306,8 @@ void PrimaryRays_Vulkan::RenderCmd(VkCommandBuffer a_cmd, [[maybe_unused]] uint3
 
 // ---- CastRays (from PrimaryRays::CastRays, PrimaryRays.cpp) ----
 
-void PrimaryRays_Vulkan::SetVulkanInOutFor_CastRays(crossrt::BufferView a_posAndNear, crossrt::BufferView a_dirAndFar, crossrt::BufferView a_hits)
+void PrimaryRays_Vulkan::SetVulkanInOutFor_CastRays(crossrt::BufferView a_posAndNear, crossrt::BufferView a_dirAndFar,
+                                                    crossrt::BufferView a_hits)
 {
   m_inOut_CastRays.posAndNear = a_posAndNear;
   m_inOut_CastRays.dirAndFar = a_dirAndFar;
@@ -307,7 +337,9 @@ void PrimaryRays_Vulkan::CastRays(const float4* posAndNear, const float4* dirAnd
   crossrt::EnsureSize(m_ctx, crt_self->m_args.CastRays_hits, crt_hitsBytes);
   if (crt_hitsBytes > 0)
     crt_self->m_args.CastRays_hits.Upload(hits, crt_hitsBytes);
-  crt_self->SetVulkanInOutFor_CastRays(crt_self->m_args.CastRays_posAndNear.View(), crt_self->m_args.CastRays_dirAndFar.View(), crt_self->m_args.CastRays_hits.View());
+  crt_self->SetVulkanInOutFor_CastRays(crt_self->m_args.CastRays_posAndNear.View(),
+                                       crt_self->m_args.CastRays_dirAndFar.View(),
+                                       crt_self->m_args.CastRays_hits.View());
   const float crt_copyInMs = crt_copyIn.ElapsedMs();
 
   // Members as they are now; host code of CastRays that changes one records an update in order.
@@ -319,22 +351,21 @@ void PrimaryRays_Vulkan::CastRays(const float4* posAndNear, const float4* dirAnd
   crt_self->m_gpuTimer.End(crt_cmd, "CastRays");
   m_ctx->SubmitAndWait(crt_cmd);
   crt_self->m_gpuTimer.Collect();
-  crt_self->m_scanner.ReleaseRetired();  // scratch that grew while recording
-  crt_self->m_sorter.ReleaseRetired();
 
   crossrt::CpuTimer crt_copyOut;
   crt_self->ReadPlainMembers();
   crt_self->ReadVectorMembers("CastRays");
   if (crt_hitsBytes > 0)
     crt_self->m_args.CastRays_hits.Download(hits, crt_hitsBytes);
-  crt_self->m_times["CastRays"] = {crt_self->m_gpuTimer.LastMs("CastRays"), crt_copyInMs, crt_copyOut.ElapsedMs(), crt_total.ElapsedMs()};
+  crt_self->m_times["CastRays"] = {crt_self->m_gpuTimer.LastMs("CastRays"), crt_copyInMs, crt_copyOut.ElapsedMs(),
+                                   crt_total.ElapsedMs()};
 }
 
 // The body of PrimaryRays::CastRays, with each kernel call turned into its ...Cmd.
-void PrimaryRays_Vulkan::CastRaysCmd(VkCommandBuffer a_cmd, [[maybe_unused]] const float4* posAndNear, [[maybe_unused]] const float4* dirAndFar, [[maybe_unused]] CRT_Hit* hits, int n)
+void PrimaryRays_Vulkan::CastRaysCmd(VkCommandBuffer a_cmd, [[maybe_unused]] const float4* posAndNear,
+                                     [[maybe_unused]] const float4* dirAndFar, [[maybe_unused]] CRT_Hit* hits, int n)
 {
-  kernel1D_CastRaysCmd(a_cmd, m_inOut_CastRays.posAndNear, m_inOut_CastRays.dirAndFar, m_inOut_CastRays.hits,
-                       n);
+  kernel1D_CastRaysCmd(a_cmd, m_inOut_CastRays.posAndNear, m_inOut_CastRays.dirAndFar, m_inOut_CastRays.hits, n);
 }
 
 // ---- kernel2D_Render (from PrimaryRays::kernel2D_Render, PrimaryRays.cpp) ----
@@ -357,13 +388,19 @@ void PrimaryRays_Vulkan::kernel2D_RenderCmd(VkCommandBuffer a_cmd, crossrt::Buff
   if (m_useRayTracingHardware)  // m_pAccelStruct's ray queries on the ray tracing hardware
   {
     m_pipelines.kernel2D_Render_RayQuery.Bind(a_cmd);
-    m_pipelines.kernel2D_Render_RayQuery.PushBindings(a_cmd, { m_classDataBuffer.View(), pixels, m_vdata.m_indices.View(), m_vdata.m_vertices.View(), crossrt::Binding::SceneOf(m_scenes.m_pAccelStruct) });
+    m_pipelines.kernel2D_Render_RayQuery.PushBindings(a_cmd, {m_classDataBuffer.View(), pixels,
+                                                              m_vdata.m_indices.View(), m_vdata.m_vertices.View(),
+                                                              crossrt::Binding::SceneOf(m_scenes.m_pAccelStruct)});
     m_pipelines.kernel2D_Render_RayQuery.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   }
   else
   {
     m_pipelines.kernel2D_Render.Bind(a_cmd);
-    m_pipelines.kernel2D_Render.PushBuffers(a_cmd, { m_classDataBuffer.View(), pixels, m_vdata.m_indices.View(), m_vdata.m_pAccelStruct_m_boxes.View(), m_vdata.m_pAccelStruct_m_instances.View(), m_vdata.m_pAccelStruct_m_motion.View(), m_vdata.m_pAccelStruct_m_nodes.View(), m_vdata.m_pAccelStruct_m_primIds.View(), m_vdata.m_pAccelStruct_m_triangles.View(), m_vdata.m_vertices.View() });
+    m_pipelines.kernel2D_Render.PushBuffers(
+        a_cmd, {m_classDataBuffer.View(), pixels, m_vdata.m_indices.View(), m_vdata.m_pAccelStruct_m_boxes.View(),
+                m_vdata.m_pAccelStruct_m_instances.View(), m_vdata.m_pAccelStruct_m_motion.View(),
+                m_vdata.m_pAccelStruct_m_nodes.View(), m_vdata.m_pAccelStruct_m_primIds.View(),
+                m_vdata.m_pAccelStruct_m_triangles.View(), m_vdata.m_vertices.View()});
     m_pipelines.kernel2D_Render.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   }
   crossrt::Dispatch2D(a_cmd, crt_countX, crt_countY, 16, 16);
@@ -372,7 +409,8 @@ void PrimaryRays_Vulkan::kernel2D_RenderCmd(VkCommandBuffer a_cmd, crossrt::Buff
 
 // ---- kernel1D_CastRays (from PrimaryRays::kernel1D_CastRays, PrimaryRays.cpp) ----
 
-void PrimaryRays_Vulkan::kernel1D_CastRaysCmd(VkCommandBuffer a_cmd, crossrt::BufferView posAndNear, crossrt::BufferView dirAndFar, crossrt::BufferView hits, int n)
+void PrimaryRays_Vulkan::kernel1D_CastRaysCmd(VkCommandBuffer a_cmd, crossrt::BufferView posAndNear,
+                                              crossrt::BufferView dirAndFar, crossrt::BufferView hits, int n)
 {
   const int crt_startX = int(0);
   const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(n)));
@@ -385,13 +423,18 @@ void PrimaryRays_Vulkan::kernel1D_CastRaysCmd(VkCommandBuffer a_cmd, crossrt::Bu
   if (m_useRayTracingHardware)  // m_pAccelStruct's ray queries on the ray tracing hardware
   {
     m_pipelines.kernel1D_CastRays_RayQuery.Bind(a_cmd);
-    m_pipelines.kernel1D_CastRays_RayQuery.PushBindings(a_cmd, { m_classDataBuffer.View(), posAndNear, dirAndFar, hits, crossrt::Binding::SceneOf(m_scenes.m_pAccelStruct) });
+    m_pipelines.kernel1D_CastRays_RayQuery.PushBindings(a_cmd, {m_classDataBuffer.View(), posAndNear, dirAndFar, hits,
+                                                                crossrt::Binding::SceneOf(m_scenes.m_pAccelStruct)});
     m_pipelines.kernel1D_CastRays_RayQuery.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   }
   else
   {
     m_pipelines.kernel1D_CastRays.Bind(a_cmd);
-    m_pipelines.kernel1D_CastRays.PushBuffers(a_cmd, { m_classDataBuffer.View(), posAndNear, dirAndFar, hits, m_vdata.m_pAccelStruct_m_boxes.View(), m_vdata.m_pAccelStruct_m_instances.View(), m_vdata.m_pAccelStruct_m_motion.View(), m_vdata.m_pAccelStruct_m_nodes.View(), m_vdata.m_pAccelStruct_m_primIds.View(), m_vdata.m_pAccelStruct_m_triangles.View() });
+    m_pipelines.kernel1D_CastRays.PushBuffers(
+        a_cmd, {m_classDataBuffer.View(), posAndNear, dirAndFar, hits, m_vdata.m_pAccelStruct_m_boxes.View(),
+                m_vdata.m_pAccelStruct_m_instances.View(), m_vdata.m_pAccelStruct_m_motion.View(),
+                m_vdata.m_pAccelStruct_m_nodes.View(), m_vdata.m_pAccelStruct_m_primIds.View(),
+                m_vdata.m_pAccelStruct_m_triangles.View()});
     m_pipelines.kernel1D_CastRays.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   }
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);

@@ -29,11 +29,14 @@ public:
   // For data that already lives on the GPU: bind your buffers, then record into your command buffer.
   virtual void SetVulkanInOutFor_Render(crossrt::BufferView a_pixels);
   virtual void RenderCmd(VkCommandBuffer a_cmd, uint32_t* pixels);
-  virtual void SetVulkanInOutFor_CastRays(crossrt::BufferView a_posAndNear, crossrt::BufferView a_dirAndFar, crossrt::BufferView a_hits);
-  virtual void CastRaysCmd(VkCommandBuffer a_cmd, const float4* posAndNear, const float4* dirAndFar, CRT_Hit* hits, int n);
+  virtual void SetVulkanInOutFor_CastRays(crossrt::BufferView a_posAndNear, crossrt::BufferView a_dirAndFar,
+                                          crossrt::BufferView a_hits);
+  virtual void CastRaysCmd(VkCommandBuffer a_cmd, const float4* posAndNear, const float4* dirAndFar, CRT_Hit* hits,
+                           int n);
 
-  void CommitDeviceData() override;                                     // uploads members
-  void GetExecutionTime(const char* a_funcName, float a_out[4]) override;  // [0] GPU ms, [1] copy-in ms, [2] copy-out ms, [3] total ms
+  void CommitDeviceData() override;  // uploads members
+  // a_out: [0] GPU ms, [1] copy-in ms, [2] copy-out ms, [3] total ms
+  void GetExecutionTime(const char* a_funcName, float a_out[4]) override;
 
   virtual void UpdatePlainMembers();  // members -> GPU (called before every control function)
   virtual void ReadPlainMembers();    // GPU -> members the kernels write (reductions)
@@ -49,7 +52,8 @@ public:
 protected:
   // One per kernel (and megakernel of a thread loop): records its dispatch (and barrier) into a_cmd.
   virtual void kernel2D_RenderCmd(VkCommandBuffer a_cmd, crossrt::BufferView pixels, int width, int height);
-  virtual void kernel1D_CastRaysCmd(VkCommandBuffer a_cmd, crossrt::BufferView posAndNear, crossrt::BufferView dirAndFar, crossrt::BufferView hits, int n);
+  virtual void kernel1D_CastRaysCmd(VkCommandBuffer a_cmd, crossrt::BufferView posAndNear,
+                                    crossrt::BufferView dirAndFar, crossrt::BufferView hits, int n);
   virtual void InitPipelines();
   // Records an update of one member's GPU copy, ordered between the kernels around it.
   virtual void UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size);
@@ -129,7 +133,7 @@ protected:
   // m_pAccelStruct as the BVHScene whose traversal the kernels run and whose data they read; throws
   // when it holds another ISceneObject (or none).
   BVHScene* crt_m_pAccelStruct() const;
-  bool m_useRayTracingHardware = false;   // record the kernels' _RayQuery variants
+  bool m_useRayTracingHardware = false;  // record the kernels' _RayQuery variants
 
   // Acceleration structures for the ray tracing hardware, rebuilt at every CommitDeviceData() while
   // it is in use: the scenes kernels trace with ray queries (from ISceneObject::ExportScene), and a
@@ -171,12 +175,11 @@ protected:
   {
   } m_partials;
 
-  crossrt::Scanner m_scanner;     // std::exclusive_scan / std::inclusive_scan of control functions
-  crossrt::RadixSorter m_sorter;  // std::sort of control functions
   crossrt::GpuTimer m_gpuTimer;
   std::map<std::string, std::array<float, 4>> m_times;
 };
 
 // Runs on the default device: CROSSRT_DEVICE (index or name) if set, else a discrete GPU, else lavapipe.
 std::shared_ptr<PrimaryRays> CreatePrimaryRays_Vulkan(int width, int height);
-std::shared_ptr<PrimaryRays> CreatePrimaryRays_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx, int width, int height);
+std::shared_ptr<PrimaryRays> CreatePrimaryRays_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx, int width,
+                                                      int height);

@@ -39,12 +39,10 @@ extern const uint32_t ShapeTracer_m_scene_m_lights_Intersect_Miss_spv[];
 extern const size_t ShapeTracer_m_scene_m_lights_Intersect_Miss_spvBytes;
 
 ShapeTracer_Vulkan::ShapeTracer_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx)
-  : ShapeTracer(), m_ctx(std::move(a_ctx))
+    : ShapeTracer(), m_ctx(std::move(a_ctx))
 {
   m_classDataBuffer = crossrt::Buffer(m_ctx, sizeof(ClassData));
   m_gpuTimer = crossrt::GpuTimer(m_ctx);
-  m_scanner = crossrt::Scanner(m_ctx);
-  m_sorter = crossrt::RadixSorter(m_ctx);
   m_useRayTracingPipelines = m_ctx->hasRayTracingPipeline;
   if (m_ctx->hasRayTracingPipeline)
   {
@@ -70,31 +68,55 @@ void ShapeTracer_Vulkan::InitPipelines()
 {
   // Virtual functions reach each class's objects through buffer references.
   if (!m_ctx->hasBufferDeviceAddress)
-    throw crossrt::Error("ShapeTracer_Vulkan: device '" + m_ctx->DeviceName() + "' lacks bufferDeviceAddress, which virtual function calls in kernels need");
-  if (m_ctx->hasRayTracingPipeline)  // the leaves of m_scene->m_shapes and m_scene->m_lights as intersection shaders, in a ray tracing pipeline: the shader needs them even to be created
-    m_pipelines.kernel1D_Trace_Intersections = crossrt::RayTracingPipeline(m_ctx,
-        crossrt::RayTracingShaders{{ShapeTracer_kernel1D_Trace_Intersections_spv, ShapeTracer_kernel1D_Trace_Intersections_spvBytes},
-          {  // miss shader i: a ray of the traces of leaf call i that meets no leaf
-            {ShapeTracer_m_scene_m_shapes_Intersect_Miss_spv, ShapeTracer_m_scene_m_shapes_Intersect_Miss_spvBytes},
-            {ShapeTracer_m_scene_m_lights_Intersect_Miss_spv, ShapeTracer_m_scene_m_lights_Intersect_Miss_spvBytes},
-          },
-          {  // hit groups: per leaf call, one per class of its leaves
-            {{ShapeTracer_m_scene_m_shapes_Sphere_Intersect_spv, ShapeTracer_m_scene_m_shapes_Sphere_Intersect_spvBytes}, {ShapeTracer_m_scene_m_shapes_Intersect_Hit_spv, ShapeTracer_m_scene_m_shapes_Intersect_Hit_spvBytes}},
-            {{ShapeTracer_m_scene_m_shapes_Box_Intersect_spv, ShapeTracer_m_scene_m_shapes_Box_Intersect_spvBytes}, {ShapeTracer_m_scene_m_shapes_Intersect_Hit_spv, ShapeTracer_m_scene_m_shapes_Intersect_Hit_spvBytes}},
-            {{ShapeTracer_m_scene_m_shapes_Disc_Intersect_spv, ShapeTracer_m_scene_m_shapes_Disc_Intersect_spvBytes}, {ShapeTracer_m_scene_m_shapes_Intersect_Hit_spv, ShapeTracer_m_scene_m_shapes_Intersect_Hit_spvBytes}},
-            {{ShapeTracer_m_scene_m_lights_Sphere_Intersect_spv, ShapeTracer_m_scene_m_lights_Sphere_Intersect_spvBytes}, {ShapeTracer_m_scene_m_lights_Intersect_Hit_spv, ShapeTracer_m_scene_m_lights_Intersect_Hit_spvBytes}},
-            {{ShapeTracer_m_scene_m_lights_Box_Intersect_spv, ShapeTracer_m_scene_m_lights_Box_Intersect_spvBytes}, {ShapeTracer_m_scene_m_lights_Intersect_Hit_spv, ShapeTracer_m_scene_m_lights_Intersect_Hit_spvBytes}},
-            {{ShapeTracer_m_scene_m_lights_Disc_Intersect_spv, ShapeTracer_m_scene_m_lights_Disc_Intersect_spvBytes}, {ShapeTracer_m_scene_m_lights_Intersect_Hit_spv, ShapeTracer_m_scene_m_lights_Intersect_Hit_spvBytes}},
-          },
-          {}},
-        std::vector<VkDescriptorType>{ VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR }, sizeof(kernel1D_TraceArgs), "ShapeTracer::kernel1D_Trace_Intersections");
-  m_pipelines.kernel1D_Trace = crossrt::ComputePipeline(m_ctx, ShapeTracer_kernel1D_Trace_spv, ShapeTracer_kernel1D_Trace_spvBytes, 6, sizeof(kernel1D_TraceArgs), "ShapeTracer::kernel1D_Trace");
+    throw crossrt::Error("ShapeTracer_Vulkan: device '" + m_ctx->DeviceName() +
+                         "' lacks bufferDeviceAddress, which virtual function calls in kernels need");
+  if (m_ctx->hasRayTracingPipeline)  // the leaves of m_scene->m_shapes and m_scene->m_lights as intersection shaders,
+                                     // in a ray tracing pipeline: the shader needs them even to be created
+    m_pipelines.kernel1D_Trace_Intersections = crossrt::RayTracingPipeline(
+        m_ctx,
+        crossrt::RayTracingShaders{
+            {ShapeTracer_kernel1D_Trace_Intersections_spv, ShapeTracer_kernel1D_Trace_Intersections_spvBytes},
+            {
+                // miss shader i: a ray of the traces of leaf call i that meets no leaf
+                {ShapeTracer_m_scene_m_shapes_Intersect_Miss_spv, ShapeTracer_m_scene_m_shapes_Intersect_Miss_spvBytes},
+                {ShapeTracer_m_scene_m_lights_Intersect_Miss_spv, ShapeTracer_m_scene_m_lights_Intersect_Miss_spvBytes},
+            },
+            {
+                // hit groups: per leaf call, one per class of its leaves
+                {{ShapeTracer_m_scene_m_shapes_Sphere_Intersect_spv,
+                  ShapeTracer_m_scene_m_shapes_Sphere_Intersect_spvBytes},
+                 {ShapeTracer_m_scene_m_shapes_Intersect_Hit_spv, ShapeTracer_m_scene_m_shapes_Intersect_Hit_spvBytes}},
+                {{ShapeTracer_m_scene_m_shapes_Box_Intersect_spv, ShapeTracer_m_scene_m_shapes_Box_Intersect_spvBytes},
+                 {ShapeTracer_m_scene_m_shapes_Intersect_Hit_spv, ShapeTracer_m_scene_m_shapes_Intersect_Hit_spvBytes}},
+                {{ShapeTracer_m_scene_m_shapes_Disc_Intersect_spv,
+                  ShapeTracer_m_scene_m_shapes_Disc_Intersect_spvBytes},
+                 {ShapeTracer_m_scene_m_shapes_Intersect_Hit_spv, ShapeTracer_m_scene_m_shapes_Intersect_Hit_spvBytes}},
+                {{ShapeTracer_m_scene_m_lights_Sphere_Intersect_spv,
+                  ShapeTracer_m_scene_m_lights_Sphere_Intersect_spvBytes},
+                 {ShapeTracer_m_scene_m_lights_Intersect_Hit_spv, ShapeTracer_m_scene_m_lights_Intersect_Hit_spvBytes}},
+                {{ShapeTracer_m_scene_m_lights_Box_Intersect_spv, ShapeTracer_m_scene_m_lights_Box_Intersect_spvBytes},
+                 {ShapeTracer_m_scene_m_lights_Intersect_Hit_spv, ShapeTracer_m_scene_m_lights_Intersect_Hit_spvBytes}},
+                {{ShapeTracer_m_scene_m_lights_Disc_Intersect_spv,
+                  ShapeTracer_m_scene_m_lights_Disc_Intersect_spvBytes},
+                 {ShapeTracer_m_scene_m_lights_Intersect_Hit_spv, ShapeTracer_m_scene_m_lights_Intersect_Hit_spvBytes}},
+            },
+            {}},
+        std::vector<VkDescriptorType>{
+            VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+            VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+            VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR},
+        sizeof(kernel1D_TraceArgs), "ShapeTracer::kernel1D_Trace_Intersections");
+  m_pipelines.kernel1D_Trace =
+      crossrt::ComputePipeline(m_ctx, ShapeTracer_kernel1D_Trace_spv, ShapeTracer_kernel1D_Trace_spvBytes, 6,
+                               sizeof(kernel1D_TraceArgs), "ShapeTracer::kernel1D_Trace");
 }
 
 void ShapeTracer_Vulkan::UseRayTracingPipelines(bool a_use)
 {
   if (a_use && !m_ctx->hasRayTracingPipeline)
-    throw crossrt::Error("ShapeTracer_Vulkan: device '" + m_ctx->DeviceName() + "' has no ray tracing pipelines (VK_KHR_ray_tracing_pipeline): its kernels switch over the objects' classes in compute shaders");
+    throw crossrt::Error("ShapeTracer_Vulkan: device '" + m_ctx->DeviceName() +
+                         "' has no ray tracing pipelines (VK_KHR_ray_tracing_pipeline): its kernels switch over the "
+                         "objects' classes in compute shaders");
   if (a_use != m_useRayTracingPipelines)
     m_deviceDataCommitted = false;  // the next call commits, building the leaves' boxes for the hardware
   m_useRayTracingPipelines = a_use;
@@ -109,7 +131,8 @@ void ShapeTracer_Vulkan::CommitLeaves_m_scene_m_shapes(const std::vector<uint32_
   std::vector<crossrt::RayTracingScene::LeafBox> leaves(crt_m_scene()->m_shapes.size());
   for (size_t i = 0; i < leaves.size(); ++i)
   {
-    const IShape* object = crossrt::RawPointer(crt_m_scene()->m_shapes[i]);  // CommitVirtual_m_scene_m_shapes checked it
+    const IShape* object =
+        crossrt::RawPointer(crt_m_scene()->m_shapes[i]);  // CommitVirtual_m_scene_m_shapes checked it
     const auto lo = object->BoxMin(), hi = object->BoxMax();
     leaves[i] = {{lo.x, lo.y, lo.z}, {hi.x, hi.y, hi.z}, a_tags[2 * i]};
   }
@@ -125,7 +148,8 @@ void ShapeTracer_Vulkan::CommitLeaves_m_scene_m_lights(const std::vector<uint32_
   std::vector<crossrt::RayTracingScene::LeafBox> leaves(crt_m_scene()->m_lights.size());
   for (size_t i = 0; i < leaves.size(); ++i)
   {
-    const IShape* object = crossrt::RawPointer(crt_m_scene()->m_lights[i]);  // CommitVirtual_m_scene_m_lights checked it
+    const IShape* object =
+        crossrt::RawPointer(crt_m_scene()->m_lights[i]);  // CommitVirtual_m_scene_m_lights checked it
     const auto lo = object->BoxMin(), hi = object->BoxMax();
     leaves[i] = {{lo.x, lo.y, lo.z}, {hi.x, hi.y, hi.z}, a_tags[2 * i]};
   }
@@ -168,11 +192,14 @@ void ShapeTracer_Vulkan::CommitDeviceData()
   // std::vector members become buffers of their capacity; kernels see size and capacity.
   crossrt::EnsureSize(m_ctx, m_vdata.m_scene_m_boxes, sizeof(LiteMath::float4) * crt_m_scene()->m_boxes.capacity());
   if (!crt_m_scene()->m_boxes.empty())
-    m_vdata.m_scene_m_boxes.Upload(crt_m_scene()->m_boxes.data(), sizeof(LiteMath::float4) * crt_m_scene()->m_boxes.size());
+    m_vdata.m_scene_m_boxes.Upload(crt_m_scene()->m_boxes.data(),
+                                   sizeof(LiteMath::float4) * crt_m_scene()->m_boxes.size());
   m_vdata.m_scene_m_boxesSize = crt_m_scene()->m_boxes.size();
-  crossrt::EnsureSize(m_ctx, m_vdata.m_scene_m_lightBoxes, sizeof(LiteMath::float4) * crt_m_scene()->m_lightBoxes.capacity());
+  crossrt::EnsureSize(m_ctx, m_vdata.m_scene_m_lightBoxes,
+                      sizeof(LiteMath::float4) * crt_m_scene()->m_lightBoxes.capacity());
   if (!crt_m_scene()->m_lightBoxes.empty())
-    m_vdata.m_scene_m_lightBoxes.Upload(crt_m_scene()->m_lightBoxes.data(), sizeof(LiteMath::float4) * crt_m_scene()->m_lightBoxes.size());
+    m_vdata.m_scene_m_lightBoxes.Upload(crt_m_scene()->m_lightBoxes.data(),
+                                        sizeof(LiteMath::float4) * crt_m_scene()->m_lightBoxes.size());
   m_vdata.m_scene_m_lightBoxesSize = crt_m_scene()->m_lightBoxes.size();
   const std::vector<uint32_t> crt_m_scene_m_shapesTags = CommitVirtual_m_scene_m_shapes();
   if (m_useRayTracingPipelines)
@@ -206,7 +233,8 @@ std::vector<uint32_t> ShapeTracer_Vulkan::CommitVirtual_m_scene_m_shapes()
   {
     const IShape* object = crossrt::RawPointer(crt_m_scene()->m_shapes[i]);
     if (object == nullptr)
-      throw crossrt::Error("ShapeTracer_Vulkan: m_scene->m_shapes[" + std::to_string(i) + "] holds no object, but kernels call its virtual functions");
+      throw crossrt::Error("ShapeTracer_Vulkan: m_scene->m_shapes[" + std::to_string(i) +
+                           "] holds no object, but kernels call its virtual functions");
     if (typeid(*object) == typeid(Sphere))
     {
       const auto& from = static_cast<const Sphere&>(*object);
@@ -238,18 +266,22 @@ std::vector<uint32_t> ShapeTracer_Vulkan::CommitVirtual_m_scene_m_shapes()
       DiscObjects.push_back(to);
     }
     else
-      throw crossrt::Error(std::string("ShapeTracer_Vulkan: m_scene->m_shapes[") + std::to_string(i) + "] holds a " + typeid(*object).name() +
-                           ", which the GPU code does not know; it knows Sphere, Box, Disc (the classes that implement IShape where ShapeTracer is translated)");
+      throw crossrt::Error(std::string("ShapeTracer_Vulkan: m_scene->m_shapes[") + std::to_string(i) + "] holds a " +
+                           typeid(*object).name() +
+                           ", which the GPU code does not know; it knows Sphere, Box, Disc (the classes that implement "
+                           "IShape where ShapeTracer is translated)");
   }
   crossrt::EnsureSize(m_ctx, m_virtual.m_scene_m_shapes_tags, sizeof(uint32_t) * tags.size());
   m_virtual.m_scene_m_shapes_tags.Upload(tags.data(), sizeof(uint32_t) * tags.size());
-  crossrt::EnsureSize(m_ctx, m_virtual.m_scene_m_shapes_Sphere, sizeof(Sphere_Data) * std::max<size_t>(1, SphereObjects.size()));
+  crossrt::EnsureSize(m_ctx, m_virtual.m_scene_m_shapes_Sphere,
+                      sizeof(Sphere_Data) * std::max<size_t>(1, SphereObjects.size()));
   if (!SphereObjects.empty())
     m_virtual.m_scene_m_shapes_Sphere.Upload(SphereObjects.data(), sizeof(Sphere_Data) * SphereObjects.size());
   crossrt::EnsureSize(m_ctx, m_virtual.m_scene_m_shapes_Box, sizeof(Box_Data) * std::max<size_t>(1, BoxObjects.size()));
   if (!BoxObjects.empty())
     m_virtual.m_scene_m_shapes_Box.Upload(BoxObjects.data(), sizeof(Box_Data) * BoxObjects.size());
-  crossrt::EnsureSize(m_ctx, m_virtual.m_scene_m_shapes_Disc, sizeof(Disc_Data) * std::max<size_t>(1, DiscObjects.size()));
+  crossrt::EnsureSize(m_ctx, m_virtual.m_scene_m_shapes_Disc,
+                      sizeof(Disc_Data) * std::max<size_t>(1, DiscObjects.size()));
   if (!DiscObjects.empty())
     m_virtual.m_scene_m_shapes_Disc.Upload(DiscObjects.data(), sizeof(Disc_Data) * DiscObjects.size());
   m_virtual.m_scene_m_shapesSize = crt_m_scene()->m_shapes.size();
@@ -268,7 +300,8 @@ std::vector<uint32_t> ShapeTracer_Vulkan::CommitVirtual_m_scene_m_lights()
   {
     const IShape* object = crossrt::RawPointer(crt_m_scene()->m_lights[i]);
     if (object == nullptr)
-      throw crossrt::Error("ShapeTracer_Vulkan: m_scene->m_lights[" + std::to_string(i) + "] holds no object, but kernels call its virtual functions");
+      throw crossrt::Error("ShapeTracer_Vulkan: m_scene->m_lights[" + std::to_string(i) +
+                           "] holds no object, but kernels call its virtual functions");
     if (typeid(*object) == typeid(Sphere))
     {
       const auto& from = static_cast<const Sphere&>(*object);
@@ -300,18 +333,22 @@ std::vector<uint32_t> ShapeTracer_Vulkan::CommitVirtual_m_scene_m_lights()
       DiscObjects.push_back(to);
     }
     else
-      throw crossrt::Error(std::string("ShapeTracer_Vulkan: m_scene->m_lights[") + std::to_string(i) + "] holds a " + typeid(*object).name() +
-                           ", which the GPU code does not know; it knows Sphere, Box, Disc (the classes that implement IShape where ShapeTracer is translated)");
+      throw crossrt::Error(std::string("ShapeTracer_Vulkan: m_scene->m_lights[") + std::to_string(i) + "] holds a " +
+                           typeid(*object).name() +
+                           ", which the GPU code does not know; it knows Sphere, Box, Disc (the classes that implement "
+                           "IShape where ShapeTracer is translated)");
   }
   crossrt::EnsureSize(m_ctx, m_virtual.m_scene_m_lights_tags, sizeof(uint32_t) * tags.size());
   m_virtual.m_scene_m_lights_tags.Upload(tags.data(), sizeof(uint32_t) * tags.size());
-  crossrt::EnsureSize(m_ctx, m_virtual.m_scene_m_lights_Sphere, sizeof(Sphere_Data) * std::max<size_t>(1, SphereObjects.size()));
+  crossrt::EnsureSize(m_ctx, m_virtual.m_scene_m_lights_Sphere,
+                      sizeof(Sphere_Data) * std::max<size_t>(1, SphereObjects.size()));
   if (!SphereObjects.empty())
     m_virtual.m_scene_m_lights_Sphere.Upload(SphereObjects.data(), sizeof(Sphere_Data) * SphereObjects.size());
   crossrt::EnsureSize(m_ctx, m_virtual.m_scene_m_lights_Box, sizeof(Box_Data) * std::max<size_t>(1, BoxObjects.size()));
   if (!BoxObjects.empty())
     m_virtual.m_scene_m_lights_Box.Upload(BoxObjects.data(), sizeof(Box_Data) * BoxObjects.size());
-  crossrt::EnsureSize(m_ctx, m_virtual.m_scene_m_lights_Disc, sizeof(Disc_Data) * std::max<size_t>(1, DiscObjects.size()));
+  crossrt::EnsureSize(m_ctx, m_virtual.m_scene_m_lights_Disc,
+                      sizeof(Disc_Data) * std::max<size_t>(1, DiscObjects.size()));
   if (!DiscObjects.empty())
     m_virtual.m_scene_m_lights_Disc.Upload(DiscObjects.data(), sizeof(Disc_Data) * DiscObjects.size());
   m_virtual.m_scene_m_lightsSize = crt_m_scene()->m_lights.size();
@@ -327,7 +364,8 @@ ShapeScene* ShapeTracer_Vulkan::crt_m_scene() const
 {
   auto* impl = dynamic_cast<ShapeScene*>(crossrt::RawPointer(m_scene));
   if (impl == nullptr)
-    throw crossrt::Error(std::string("ShapeTracer_Vulkan: 'm_scene' must hold a ShapeScene, the IScene composed into the GPU code, but it holds ") +
+    throw crossrt::Error(std::string("ShapeTracer_Vulkan: 'm_scene' must hold a ShapeScene, the IScene composed into "
+                                     "the GPU code, but it holds ") +
                          (m_scene ? "an object of another class" : "nothing"));
   return impl;
 }
@@ -341,14 +379,16 @@ void ShapeTracer_Vulkan::GetExecutionTime(const char* a_funcName, float a_out[4]
 
 // ---- Trace (from ShapeTracer::Trace, ShapeTracer.cpp) ----
 
-void ShapeTracer_Vulkan::SetVulkanInOutFor_Trace(crossrt::BufferView a_origins, crossrt::BufferView a_dirs, crossrt::BufferView a_hits)
+void ShapeTracer_Vulkan::SetVulkanInOutFor_Trace(crossrt::BufferView a_origins, crossrt::BufferView a_dirs,
+                                                 crossrt::BufferView a_hits)
 {
   m_inOut_Trace.origins = a_origins;
   m_inOut_Trace.dirs = a_dirs;
   m_inOut_Trace.hits = a_hits;
 }
 
-void ShapeTracer_Vulkan::Trace(int n, const LiteMath::float4* origins, const LiteMath::float4* dirs, float far, ShapeHit* hits)
+void ShapeTracer_Vulkan::Trace(int n, const LiteMath::float4* origins, const LiteMath::float4* dirs, float far,
+                               ShapeHit* hits)
 {
   auto* crt_self = const_cast<ShapeTracer_Vulkan*>(this);
   crossrt::CpuTimer crt_total;
@@ -371,7 +411,8 @@ void ShapeTracer_Vulkan::Trace(int n, const LiteMath::float4* origins, const Lit
   crossrt::EnsureSize(m_ctx, crt_self->m_args.Trace_hits, crt_hitsBytes);
   if (crt_hitsBytes > 0)
     crt_self->m_args.Trace_hits.Upload(hits, crt_hitsBytes);
-  crt_self->SetVulkanInOutFor_Trace(crt_self->m_args.Trace_origins.View(), crt_self->m_args.Trace_dirs.View(), crt_self->m_args.Trace_hits.View());
+  crt_self->SetVulkanInOutFor_Trace(crt_self->m_args.Trace_origins.View(), crt_self->m_args.Trace_dirs.View(),
+                                    crt_self->m_args.Trace_hits.View());
   const float crt_copyInMs = crt_copyIn.ElapsedMs();
 
   // Members as they are now; host code of Trace that changes one records an update in order.
@@ -383,26 +424,28 @@ void ShapeTracer_Vulkan::Trace(int n, const LiteMath::float4* origins, const Lit
   crt_self->m_gpuTimer.End(crt_cmd, "Trace");
   m_ctx->SubmitAndWait(crt_cmd);
   crt_self->m_gpuTimer.Collect();
-  crt_self->m_scanner.ReleaseRetired();  // scratch that grew while recording
-  crt_self->m_sorter.ReleaseRetired();
 
   crossrt::CpuTimer crt_copyOut;
   crt_self->ReadPlainMembers();
   crt_self->ReadVectorMembers("Trace");
   if (crt_hitsBytes > 0)
     crt_self->m_args.Trace_hits.Download(hits, crt_hitsBytes);
-  crt_self->m_times["Trace"] = {crt_self->m_gpuTimer.LastMs("Trace"), crt_copyInMs, crt_copyOut.ElapsedMs(), crt_total.ElapsedMs()};
+  crt_self->m_times["Trace"] = {crt_self->m_gpuTimer.LastMs("Trace"), crt_copyInMs, crt_copyOut.ElapsedMs(),
+                                crt_total.ElapsedMs()};
 }
 
 // The body of ShapeTracer::Trace, with each kernel call turned into its ...Cmd.
-void ShapeTracer_Vulkan::TraceCmd(VkCommandBuffer a_cmd, int n, [[maybe_unused]] const LiteMath::float4* origins, [[maybe_unused]] const LiteMath::float4* dirs, float far, [[maybe_unused]] ShapeHit* hits)
+void ShapeTracer_Vulkan::TraceCmd(VkCommandBuffer a_cmd, int n, [[maybe_unused]] const LiteMath::float4* origins,
+                                  [[maybe_unused]] const LiteMath::float4* dirs, float far,
+                                  [[maybe_unused]] ShapeHit* hits)
 {
   kernel1D_TraceCmd(a_cmd, n, m_inOut_Trace.origins, m_inOut_Trace.dirs, far, m_inOut_Trace.hits);
 }
 
 // ---- kernel1D_Trace (from ShapeTracer::kernel1D_Trace, ShapeTracer.cpp) ----
 
-void ShapeTracer_Vulkan::kernel1D_TraceCmd(VkCommandBuffer a_cmd, int n, crossrt::BufferView origins, crossrt::BufferView dirs, float far, crossrt::BufferView hits)
+void ShapeTracer_Vulkan::kernel1D_TraceCmd(VkCommandBuffer a_cmd, int n, crossrt::BufferView origins,
+                                           crossrt::BufferView dirs, float far, crossrt::BufferView hits)
 {
   const int crt_startX = int(0);
   const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(n)));
@@ -413,17 +456,24 @@ void ShapeTracer_Vulkan::kernel1D_TraceCmd(VkCommandBuffer a_cmd, int n, crossrt
   crt_args.crt_countX = crt_countX;
   crt_args.n = n;
   crt_args.far = far;
-  if (m_useRayTracingPipelines)  // the leaves of m_scene->m_shapes and m_scene->m_lights as intersection shaders, in a ray tracing pipeline
+  if (m_useRayTracingPipelines)  // the leaves of m_scene->m_shapes and m_scene->m_lights as intersection shaders, in a
+                                 // ray tracing pipeline
   {
     m_pipelines.kernel1D_Trace_Intersections.Bind(a_cmd);
-    m_pipelines.kernel1D_Trace_Intersections.PushBindings(a_cmd, { m_classDataBuffer.View(), origins, dirs, hits, m_vdata.m_scene_m_boxes.View(), m_vdata.m_scene_m_lightBoxes.View(), crossrt::Binding::SceneOf(m_scenes.m_scene_m_shapes_leaves), crossrt::Binding::SceneOf(m_scenes.m_scene_m_lights_leaves) });
+    m_pipelines.kernel1D_Trace_Intersections.PushBindings(
+        a_cmd, {m_classDataBuffer.View(), origins, dirs, hits, m_vdata.m_scene_m_boxes.View(),
+                m_vdata.m_scene_m_lightBoxes.View(), crossrt::Binding::SceneOf(m_scenes.m_scene_m_shapes_leaves),
+                crossrt::Binding::SceneOf(m_scenes.m_scene_m_lights_leaves)});
     m_pipelines.kernel1D_Trace_Intersections.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-    m_pipelines.kernel1D_Trace_Intersections.TraceCmd(a_cmd, std::min<uint32_t>(crt_countX, 65536u), (crt_countX + 65535u) / 65536u, 1);
+    m_pipelines.kernel1D_Trace_Intersections.TraceCmd(a_cmd, std::min<uint32_t>(crt_countX, 65536u),
+                                                      (crt_countX + 65535u) / 65536u, 1);
   }
   else
   {
     m_pipelines.kernel1D_Trace.Bind(a_cmd);
-    m_pipelines.kernel1D_Trace.PushBuffers(a_cmd, { m_classDataBuffer.View(), origins, dirs, hits, m_vdata.m_scene_m_boxes.View(), m_vdata.m_scene_m_lightBoxes.View() });
+    m_pipelines.kernel1D_Trace.PushBuffers(a_cmd,
+                                           {m_classDataBuffer.View(), origins, dirs, hits,
+                                            m_vdata.m_scene_m_boxes.View(), m_vdata.m_scene_m_lightBoxes.View()});
     m_pipelines.kernel1D_Trace.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
     crossrt::Dispatch1D(a_cmd, crt_countX, 256);
   }

@@ -26,11 +26,14 @@ public:
   void Trace(int n, const LiteMath::float4* origins, const LiteMath::float4* dirs, float far, ShapeHit* hits) override;
 
   // For data that already lives on the GPU: bind your buffers, then record into your command buffer.
-  virtual void SetVulkanInOutFor_Trace(crossrt::BufferView a_origins, crossrt::BufferView a_dirs, crossrt::BufferView a_hits);
-  virtual void TraceCmd(VkCommandBuffer a_cmd, int n, const LiteMath::float4* origins, const LiteMath::float4* dirs, float far, ShapeHit* hits);
+  virtual void SetVulkanInOutFor_Trace(crossrt::BufferView a_origins, crossrt::BufferView a_dirs,
+                                       crossrt::BufferView a_hits);
+  virtual void TraceCmd(VkCommandBuffer a_cmd, int n, const LiteMath::float4* origins, const LiteMath::float4* dirs,
+                        float far, ShapeHit* hits);
 
-  void CommitDeviceData() override;                                     // uploads members
-  void GetExecutionTime(const char* a_funcName, float a_out[4]);  // [0] GPU ms, [1] copy-in ms, [2] copy-out ms, [3] total ms
+  void CommitDeviceData() override;  // uploads members
+  // a_out: [0] GPU ms, [1] copy-in ms, [2] copy-out ms, [3] total ms
+  void GetExecutionTime(const char* a_funcName, float a_out[4]);
 
   virtual void UpdatePlainMembers();  // members -> GPU (called before every control function)
   virtual void ReadPlainMembers();    // GPU -> members the kernels write (reductions)
@@ -46,7 +49,8 @@ public:
 
 protected:
   // One per kernel (and megakernel of a thread loop): records its dispatch (and barrier) into a_cmd.
-  virtual void kernel1D_TraceCmd(VkCommandBuffer a_cmd, int n, crossrt::BufferView origins, crossrt::BufferView dirs, float far, crossrt::BufferView hits);
+  virtual void kernel1D_TraceCmd(VkCommandBuffer a_cmd, int n, crossrt::BufferView origins, crossrt::BufferView dirs,
+                                 float far, crossrt::BufferView hits);
   virtual void InitPipelines();
   // Records an update of one member's GPU copy, ordered between the kernels around it.
   virtual void UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size);
@@ -112,13 +116,15 @@ protected:
     LiteMath::float4 normal;
     float radius;
   };
-  virtual std::vector<uint32_t> CommitVirtual_m_scene_m_shapes();  // returns the tags it uploaded: (class, index) per element
+  virtual std::vector<uint32_t>
+  CommitVirtual_m_scene_m_shapes();  // returns the tags it uploaded: (class, index) per element
 
   // Virtual functions through m_scene->m_lights (level 2): the GPU keeps the objects of each class
   // (Sphere, Box, Disc) in a buffer of their own and a (class, index) tag per element.
   // Call CommitDeviceData() after changing an object; adding or removing elements is noticed by itself.
-  virtual std::vector<uint32_t> CommitVirtual_m_scene_m_lights();  // returns the tags it uploaded: (class, index) per element
-  struct VirtualObjects  // device copies of the objects kernels call virtual functions of
+  virtual std::vector<uint32_t>
+  CommitVirtual_m_scene_m_lights();  // returns the tags it uploaded: (class, index) per element
+  struct VirtualObjects              // device copies of the objects kernels call virtual functions of
   {
     crossrt::Buffer m_scene_m_shapes_tags;
     crossrt::Buffer m_scene_m_shapes_Sphere;
@@ -163,7 +169,8 @@ protected:
 
   struct Pipelines
   {
-    crossrt::RayTracingPipeline kernel1D_Trace_Intersections;  // the leaves of m_scene->m_shapes and m_scene->m_lights as intersection shaders, in a ray tracing pipeline
+    crossrt::RayTracingPipeline kernel1D_Trace_Intersections;  // the leaves of m_scene->m_shapes and m_scene->m_lights
+                                                               // as intersection shaders, in a ray tracing pipeline
     crossrt::ComputePipeline kernel1D_Trace;
   } m_pipelines;
 
@@ -171,8 +178,6 @@ protected:
   {
   } m_partials;
 
-  crossrt::Scanner m_scanner;     // std::exclusive_scan / std::inclusive_scan of control functions
-  crossrt::RadixSorter m_sorter;  // std::sort of control functions
   crossrt::GpuTimer m_gpuTimer;
   std::map<std::string, std::array<float, 4>> m_times;
 };

@@ -11,12 +11,10 @@ extern const size_t SortPairs_kernel1D_Make_spvBytes;
 extern const uint32_t SortPairs_kernel1D_Copy_spv[];
 extern const size_t SortPairs_kernel1D_Copy_spvBytes;
 
-SortPairs_Vulkan::SortPairs_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx)
-  : SortPairs(), m_ctx(std::move(a_ctx))
+SortPairs_Vulkan::SortPairs_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx) : SortPairs(), m_ctx(std::move(a_ctx))
 {
   m_classDataBuffer = crossrt::Buffer(m_ctx, sizeof(ClassData));
   m_gpuTimer = crossrt::GpuTimer(m_ctx);
-  m_scanner = crossrt::Scanner(m_ctx);
   m_sorter = crossrt::RadixSorter(m_ctx);
   InitPipelines();
 }
@@ -35,8 +33,12 @@ SortPairs_Vulkan::~SortPairs_Vulkan() = default;
 
 void SortPairs_Vulkan::InitPipelines()
 {
-  m_pipelines.kernel1D_Make = crossrt::ComputePipeline(m_ctx, SortPairs_kernel1D_Make_spv, SortPairs_kernel1D_Make_spvBytes, 2, sizeof(kernel1D_MakeArgs), "SortPairs::kernel1D_Make");
-  m_pipelines.kernel1D_Copy = crossrt::ComputePipeline(m_ctx, SortPairs_kernel1D_Copy_spv, SortPairs_kernel1D_Copy_spvBytes, 3, sizeof(kernel1D_CopyArgs), "SortPairs::kernel1D_Copy");
+  m_pipelines.kernel1D_Make =
+      crossrt::ComputePipeline(m_ctx, SortPairs_kernel1D_Make_spv, SortPairs_kernel1D_Make_spvBytes, 2,
+                               sizeof(kernel1D_MakeArgs), "SortPairs::kernel1D_Make");
+  m_pipelines.kernel1D_Copy =
+      crossrt::ComputePipeline(m_ctx, SortPairs_kernel1D_Copy_spv, SortPairs_kernel1D_Copy_spvBytes, 3,
+                               sizeof(kernel1D_CopyArgs), "SortPairs::kernel1D_Copy");
 }
 
 void SortPairs_Vulkan::UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size)
@@ -124,15 +126,15 @@ void SortPairs_Vulkan::MakeAndSort(uint32_t a_seed, uint2* a_out)
   crt_self->m_gpuTimer.End(crt_cmd, "MakeAndSort");
   m_ctx->SubmitAndWait(crt_cmd);
   crt_self->m_gpuTimer.Collect();
-  crt_self->m_scanner.ReleaseRetired();  // scratch that grew while recording
-  crt_self->m_sorter.ReleaseRetired();
+  crt_self->m_sorter.ReleaseRetired();  // scratch that grew while recording
 
   crossrt::CpuTimer crt_copyOut;
   crt_self->ReadPlainMembers();
   crt_self->ReadVectorMembers("MakeAndSort");
   if (crt_a_outBytes > 0)
     crt_self->m_args.MakeAndSort_a_out.Download(a_out, crt_a_outBytes);
-  crt_self->m_times["MakeAndSort"] = {crt_self->m_gpuTimer.LastMs("MakeAndSort"), crt_copyInMs, crt_copyOut.ElapsedMs(), crt_total.ElapsedMs()};
+  crt_self->m_times["MakeAndSort"] = {crt_self->m_gpuTimer.LastMs("MakeAndSort"), crt_copyInMs, crt_copyOut.ElapsedMs(),
+                                      crt_total.ElapsedMs()};
 }
 
 // The body of SortPairs::MakeAndSort, with each kernel call turned into its ...Cmd.
@@ -158,7 +160,7 @@ void SortPairs_Vulkan::kernel1D_MakeCmd(VkCommandBuffer a_cmd, uint32_t n, uint3
   crt_args.n = n;
   crt_args.a_seed = a_seed;
   m_pipelines.kernel1D_Make.Bind(a_cmd);
-  m_pipelines.kernel1D_Make.PushBuffers(a_cmd, { m_classDataBuffer.View(), m_vdata.m_pairs.View() });
+  m_pipelines.kernel1D_Make.PushBuffers(a_cmd, {m_classDataBuffer.View(), m_vdata.m_pairs.View()});
   m_pipelines.kernel1D_Make.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);
   crossrt::ComputeBarrier(a_cmd);
@@ -177,7 +179,7 @@ void SortPairs_Vulkan::kernel1D_CopyCmd(VkCommandBuffer a_cmd, uint32_t n, cross
   crt_args.crt_countX = crt_countX;
   crt_args.n = n;
   m_pipelines.kernel1D_Copy.Bind(a_cmd);
-  m_pipelines.kernel1D_Copy.PushBuffers(a_cmd, { m_classDataBuffer.View(), a_out, m_vdata.m_pairs.View() });
+  m_pipelines.kernel1D_Copy.PushBuffers(a_cmd, {m_classDataBuffer.View(), a_out, m_vdata.m_pairs.View()});
   m_pipelines.kernel1D_Copy.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);
   crossrt::ComputeBarrier(a_cmd);

@@ -23,12 +23,10 @@ extern const uint32_t SpherePaths_Render_Megakernel_spv[];
 extern const size_t SpherePaths_Render_Megakernel_spvBytes;
 
 SpherePaths_Vulkan::SpherePaths_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx)
-  : SpherePaths(), m_ctx(std::move(a_ctx))
+    : SpherePaths(), m_ctx(std::move(a_ctx))
 {
   m_classDataBuffer = crossrt::Buffer(m_ctx, sizeof(ClassData));
   m_gpuTimer = crossrt::GpuTimer(m_ctx);
-  m_scanner = crossrt::Scanner(m_ctx);
-  m_sorter = crossrt::RadixSorter(m_ctx);
   InitPipelines();
 }
 
@@ -46,11 +44,21 @@ SpherePaths_Vulkan::~SpherePaths_Vulkan() = default;
 
 void SpherePaths_Vulkan::InitPipelines()
 {
-  m_pipelines.kernel_InitEyeRay = crossrt::ComputePipeline(m_ctx, SpherePaths_kernel_InitEyeRay_spv, SpherePaths_kernel_InitEyeRay_spvBytes, 4, sizeof(kernel_InitEyeRayArgs), "SpherePaths::kernel_InitEyeRay");
-  m_pipelines.kernel_RayTrace = crossrt::ComputePipeline(m_ctx, SpherePaths_kernel_RayTrace_spv, SpherePaths_kernel_RayTrace_spvBytes, 6, sizeof(kernel_RayTraceArgs), "SpherePaths::kernel_RayTrace");
-  m_pipelines.kernel_NextBounce = crossrt::ComputePipeline(m_ctx, SpherePaths_kernel_NextBounce_spv, SpherePaths_kernel_NextBounce_spvBytes, 7, sizeof(kernel_NextBounceArgs), "SpherePaths::kernel_NextBounce");
-  m_pipelines.kernel_Contribute = crossrt::ComputePipeline(m_ctx, SpherePaths_kernel_Contribute_spv, SpherePaths_kernel_Contribute_spvBytes, 3, sizeof(kernel_ContributeArgs), "SpherePaths::kernel_Contribute");
-  m_pipelines.Render_Megakernel = crossrt::ComputePipeline(m_ctx, SpherePaths_Render_Megakernel_spv, SpherePaths_Render_Megakernel_spvBytes, 3, sizeof(Render_MegakernelArgs), "SpherePaths::Render_Megakernel");
+  m_pipelines.kernel_InitEyeRay =
+      crossrt::ComputePipeline(m_ctx, SpherePaths_kernel_InitEyeRay_spv, SpherePaths_kernel_InitEyeRay_spvBytes, 4,
+                               sizeof(kernel_InitEyeRayArgs), "SpherePaths::kernel_InitEyeRay");
+  m_pipelines.kernel_RayTrace =
+      crossrt::ComputePipeline(m_ctx, SpherePaths_kernel_RayTrace_spv, SpherePaths_kernel_RayTrace_spvBytes, 6,
+                               sizeof(kernel_RayTraceArgs), "SpherePaths::kernel_RayTrace");
+  m_pipelines.kernel_NextBounce =
+      crossrt::ComputePipeline(m_ctx, SpherePaths_kernel_NextBounce_spv, SpherePaths_kernel_NextBounce_spvBytes, 7,
+                               sizeof(kernel_NextBounceArgs), "SpherePaths::kernel_NextBounce");
+  m_pipelines.kernel_Contribute =
+      crossrt::ComputePipeline(m_ctx, SpherePaths_kernel_Contribute_spv, SpherePaths_kernel_Contribute_spvBytes, 3,
+                               sizeof(kernel_ContributeArgs), "SpherePaths::kernel_Contribute");
+  m_pipelines.Render_Megakernel =
+      crossrt::ComputePipeline(m_ctx, SpherePaths_Render_Megakernel_spv, SpherePaths_Render_Megakernel_spvBytes, 3,
+                               sizeof(Render_MegakernelArgs), "SpherePaths::Render_Megakernel");
 }
 
 void SpherePaths_Vulkan::UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size)
@@ -140,19 +148,19 @@ void SpherePaths_Vulkan::Render(uint32_t width, uint32_t height, int samples, fl
   crt_self->m_gpuTimer.End(crt_cmd, "Render");
   m_ctx->SubmitAndWait(crt_cmd);
   crt_self->m_gpuTimer.Collect();
-  crt_self->m_scanner.ReleaseRetired();  // scratch that grew while recording
-  crt_self->m_sorter.ReleaseRetired();
 
   crossrt::CpuTimer crt_copyOut;
   crt_self->ReadPlainMembers();
   crt_self->ReadVectorMembers("Render");
   if (crt_out_colorBytes > 0)
     crt_self->m_args.Render_out_color.Download(out_color, crt_out_colorBytes);
-  crt_self->m_times["Render"] = {crt_self->m_gpuTimer.LastMs("Render"), crt_copyInMs, crt_copyOut.ElapsedMs(), crt_total.ElapsedMs()};
+  crt_self->m_times["Render"] = {crt_self->m_gpuTimer.LastMs("Render"), crt_copyInMs, crt_copyOut.ElapsedMs(),
+                                 crt_total.ElapsedMs()};
 }
 
 // The body of SpherePaths::Render, with each kernel call turned into its ...Cmd.
-void SpherePaths_Vulkan::RenderCmd(VkCommandBuffer a_cmd, uint32_t width, uint32_t height, int samples, [[maybe_unused]] float4* out_color)
+void SpherePaths_Vulkan::RenderCmd(VkCommandBuffer a_cmd, uint32_t width, uint32_t height, int samples,
+                                   [[maybe_unused]] float4* out_color)
 {
   const auto start = std::chrono::steady_clock::now();
   if (m_executionMode == crossrt::ExecutionMode::Megakernel)
@@ -160,19 +168,15 @@ void SpherePaths_Vulkan::RenderCmd(VkCommandBuffer a_cmd, uint32_t width, uint32
   else
   {
     const size_t crt_threads = size_t(height) * size_t(width);
-    crossrt::EnsureSize(m_ctx, m_threadState.Render_rayPos,
-                        sizeof(float4) * std::max<size_t>(1, crt_threads));
+    crossrt::EnsureSize(m_ctx, m_threadState.Render_rayPos, sizeof(float4) * std::max<size_t>(1, crt_threads));
     crossrt::FillCmd(a_cmd, m_threadState.Render_rayPos.View(), sizeof(float4) * crt_threads, 0);
-    crossrt::EnsureSize(m_ctx, m_threadState.Render_rayDir,
-                        sizeof(float4) * std::max<size_t>(1, crt_threads));
+    crossrt::EnsureSize(m_ctx, m_threadState.Render_rayDir, sizeof(float4) * std::max<size_t>(1, crt_threads));
     crossrt::FillCmd(a_cmd, m_threadState.Render_rayDir.View(), sizeof(float4) * crt_threads, 0);
-    crossrt::EnsureSize(m_ctx, m_threadState.Render_throughput,
-                        sizeof(float4) * std::max<size_t>(1, crt_threads));
+    crossrt::EnsureSize(m_ctx, m_threadState.Render_throughput, sizeof(float4) * std::max<size_t>(1, crt_threads));
     crossrt::FillCmd(a_cmd, m_threadState.Render_throughput.View(), sizeof(float4) * crt_threads, 0);
     crossrt::EnsureSize(m_ctx, m_threadState.Render_color, sizeof(float4) * std::max<size_t>(1, crt_threads));
     crossrt::FillCmd(a_cmd, m_threadState.Render_color.View(), sizeof(float4) * crt_threads, 0);
-    crossrt::EnsureSize(m_ctx, m_threadState.Render_hit,
-                        sizeof(SphereHit) * std::max<size_t>(1, crt_threads));
+    crossrt::EnsureSize(m_ctx, m_threadState.Render_hit, sizeof(SphereHit) * std::max<size_t>(1, crt_threads));
     crossrt::FillCmd(a_cmd, m_threadState.Render_hit.View(), sizeof(SphereHit) * crt_threads, 0);
     for (int sample = 0; sample < samples; sample++)
     {
@@ -180,9 +184,8 @@ void SpherePaths_Vulkan::RenderCmd(VkCommandBuffer a_cmd, uint32_t width, uint32
                            m_threadState.Render_rayDir.View(), m_threadState.Render_throughput.View());
       for (int bounce = 0; bounce < m_maxDepth; bounce++)
       {
-        kernel_RayTraceCmd(a_cmd, width, height, m_threadState.Render_rayPos.View(),
-                           m_threadState.Render_rayDir.View(), m_threadState.Render_throughput.View(),
-                           m_threadState.Render_hit.View());
+        kernel_RayTraceCmd(a_cmd, width, height, m_threadState.Render_rayPos.View(), m_threadState.Render_rayDir.View(),
+                           m_threadState.Render_throughput.View(), m_threadState.Render_hit.View());
         kernel_NextBounceCmd(a_cmd, width, height, width, sample, bounce, m_threadState.Render_hit.View(),
                              m_threadState.Render_rayPos.View(), m_threadState.Render_rayDir.View(),
                              m_threadState.Render_throughput.View(), m_threadState.Render_color.View());
@@ -197,7 +200,9 @@ void SpherePaths_Vulkan::RenderCmd(VkCommandBuffer a_cmd, uint32_t width, uint32
 
 // ---- kernel_InitEyeRay (from SpherePaths::kernel_InitEyeRay, SpherePaths.cpp) ----
 
-void SpherePaths_Vulkan::kernel_InitEyeRayCmd(VkCommandBuffer a_cmd, uint32_t a_threadsX, uint32_t a_threadsY, uint32_t width, uint32_t height, int sample, crossrt::BufferView rayPos, crossrt::BufferView rayDir, crossrt::BufferView throughput)
+void SpherePaths_Vulkan::kernel_InitEyeRayCmd(VkCommandBuffer a_cmd, uint32_t a_threadsX, uint32_t a_threadsY,
+                                              uint32_t width, uint32_t height, int sample, crossrt::BufferView rayPos,
+                                              crossrt::BufferView rayDir, crossrt::BufferView throughput)
 {
   const int crt_startX = 0;
   const uint32_t crt_countX = a_threadsX;
@@ -214,7 +219,7 @@ void SpherePaths_Vulkan::kernel_InitEyeRayCmd(VkCommandBuffer a_cmd, uint32_t a_
   crt_args.height = height;
   crt_args.sample_ = sample;
   m_pipelines.kernel_InitEyeRay.Bind(a_cmd);
-  m_pipelines.kernel_InitEyeRay.PushBuffers(a_cmd, { m_classDataBuffer.View(), rayPos, rayDir, throughput });
+  m_pipelines.kernel_InitEyeRay.PushBuffers(a_cmd, {m_classDataBuffer.View(), rayPos, rayDir, throughput});
   m_pipelines.kernel_InitEyeRay.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   crossrt::Dispatch2D(a_cmd, crt_countX, crt_countY, 16, 16);
   crossrt::ComputeBarrier(a_cmd);
@@ -222,7 +227,9 @@ void SpherePaths_Vulkan::kernel_InitEyeRayCmd(VkCommandBuffer a_cmd, uint32_t a_
 
 // ---- kernel_RayTrace (from SpherePaths::kernel_RayTrace, SpherePaths.cpp) ----
 
-void SpherePaths_Vulkan::kernel_RayTraceCmd(VkCommandBuffer a_cmd, uint32_t a_threadsX, uint32_t a_threadsY, crossrt::BufferView rayPos, crossrt::BufferView rayDir, crossrt::BufferView throughput, crossrt::BufferView hit)
+void SpherePaths_Vulkan::kernel_RayTraceCmd(VkCommandBuffer a_cmd, uint32_t a_threadsX, uint32_t a_threadsY,
+                                            crossrt::BufferView rayPos, crossrt::BufferView rayDir,
+                                            crossrt::BufferView throughput, crossrt::BufferView hit)
 {
   const int crt_startX = 0;
   const uint32_t crt_countX = a_threadsX;
@@ -236,7 +243,8 @@ void SpherePaths_Vulkan::kernel_RayTraceCmd(VkCommandBuffer a_cmd, uint32_t a_th
   crt_args.crt_countX = crt_countX;
   crt_args.crt_countY = crt_countY;
   m_pipelines.kernel_RayTrace.Bind(a_cmd);
-  m_pipelines.kernel_RayTrace.PushBuffers(a_cmd, { m_classDataBuffer.View(), rayPos, rayDir, throughput, hit, m_vdata.m_spheres.View() });
+  m_pipelines.kernel_RayTrace.PushBuffers(
+      a_cmd, {m_classDataBuffer.View(), rayPos, rayDir, throughput, hit, m_vdata.m_spheres.View()});
   m_pipelines.kernel_RayTrace.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   crossrt::Dispatch2D(a_cmd, crt_countX, crt_countY, 16, 16);
   crossrt::ComputeBarrier(a_cmd);
@@ -244,7 +252,10 @@ void SpherePaths_Vulkan::kernel_RayTraceCmd(VkCommandBuffer a_cmd, uint32_t a_th
 
 // ---- kernel_NextBounce (from SpherePaths::kernel_NextBounce, SpherePaths.cpp) ----
 
-void SpherePaths_Vulkan::kernel_NextBounceCmd(VkCommandBuffer a_cmd, uint32_t a_threadsX, uint32_t a_threadsY, uint32_t width, int sample, int bounce, crossrt::BufferView hit, crossrt::BufferView rayPos, crossrt::BufferView rayDir, crossrt::BufferView throughput, crossrt::BufferView color)
+void SpherePaths_Vulkan::kernel_NextBounceCmd(VkCommandBuffer a_cmd, uint32_t a_threadsX, uint32_t a_threadsY,
+                                              uint32_t width, int sample, int bounce, crossrt::BufferView hit,
+                                              crossrt::BufferView rayPos, crossrt::BufferView rayDir,
+                                              crossrt::BufferView throughput, crossrt::BufferView color)
 {
   const int crt_startX = 0;
   const uint32_t crt_countX = a_threadsX;
@@ -261,7 +272,8 @@ void SpherePaths_Vulkan::kernel_NextBounceCmd(VkCommandBuffer a_cmd, uint32_t a_
   crt_args.sample_ = sample;
   crt_args.bounce = bounce;
   m_pipelines.kernel_NextBounce.Bind(a_cmd);
-  m_pipelines.kernel_NextBounce.PushBuffers(a_cmd, { m_classDataBuffer.View(), hit, rayPos, rayDir, throughput, color, m_vdata.m_spheres.View() });
+  m_pipelines.kernel_NextBounce.PushBuffers(
+      a_cmd, {m_classDataBuffer.View(), hit, rayPos, rayDir, throughput, color, m_vdata.m_spheres.View()});
   m_pipelines.kernel_NextBounce.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   crossrt::Dispatch2D(a_cmd, crt_countX, crt_countY, 16, 16);
   crossrt::ComputeBarrier(a_cmd);
@@ -269,7 +281,9 @@ void SpherePaths_Vulkan::kernel_NextBounceCmd(VkCommandBuffer a_cmd, uint32_t a_
 
 // ---- kernel_Contribute (from SpherePaths::kernel_Contribute, SpherePaths.cpp) ----
 
-void SpherePaths_Vulkan::kernel_ContributeCmd(VkCommandBuffer a_cmd, uint32_t a_threadsX, uint32_t a_threadsY, uint32_t width, int samples, crossrt::BufferView color, crossrt::BufferView out_color)
+void SpherePaths_Vulkan::kernel_ContributeCmd(VkCommandBuffer a_cmd, uint32_t a_threadsX, uint32_t a_threadsY,
+                                              uint32_t width, int samples, crossrt::BufferView color,
+                                              crossrt::BufferView out_color)
 {
   const int crt_startX = 0;
   const uint32_t crt_countX = a_threadsX;
@@ -285,7 +299,7 @@ void SpherePaths_Vulkan::kernel_ContributeCmd(VkCommandBuffer a_cmd, uint32_t a_
   crt_args.width = width;
   crt_args.samples = samples;
   m_pipelines.kernel_Contribute.Bind(a_cmd);
-  m_pipelines.kernel_Contribute.PushBuffers(a_cmd, { m_classDataBuffer.View(), color, out_color });
+  m_pipelines.kernel_Contribute.PushBuffers(a_cmd, {m_classDataBuffer.View(), color, out_color});
   m_pipelines.kernel_Contribute.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   crossrt::Dispatch2D(a_cmd, crt_countX, crt_countY, 16, 16);
   crossrt::ComputeBarrier(a_cmd);
@@ -293,7 +307,9 @@ void SpherePaths_Vulkan::kernel_ContributeCmd(VkCommandBuffer a_cmd, uint32_t a_
 
 // ---- Render_Megakernel (from the thread loop of SpherePaths::Render, SpherePaths.cpp) ----
 
-void SpherePaths_Vulkan::Render_MegakernelCmd(VkCommandBuffer a_cmd, uint32_t a_threadsX, uint32_t a_threadsY, crossrt::BufferView out_color, int samples, uint32_t width, uint32_t height)
+void SpherePaths_Vulkan::Render_MegakernelCmd(VkCommandBuffer a_cmd, uint32_t a_threadsX, uint32_t a_threadsY,
+                                              crossrt::BufferView out_color, int samples, uint32_t width,
+                                              uint32_t height)
 {
   const int crt_startX = 0;
   const uint32_t crt_countX = a_threadsX;
@@ -310,7 +326,7 @@ void SpherePaths_Vulkan::Render_MegakernelCmd(VkCommandBuffer a_cmd, uint32_t a_
   crt_args.width = width;
   crt_args.height = height;
   m_pipelines.Render_Megakernel.Bind(a_cmd);
-  m_pipelines.Render_Megakernel.PushBuffers(a_cmd, { m_classDataBuffer.View(), out_color, m_vdata.m_spheres.View() });
+  m_pipelines.Render_Megakernel.PushBuffers(a_cmd, {m_classDataBuffer.View(), out_color, m_vdata.m_spheres.View()});
   m_pipelines.Render_Megakernel.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   crossrt::Dispatch2D(a_cmd, crt_countX, crt_countY, 16, 16);
   crossrt::ComputeBarrier(a_cmd);

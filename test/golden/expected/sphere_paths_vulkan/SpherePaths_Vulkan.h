@@ -28,8 +28,9 @@ public:
   virtual void SetVulkanInOutFor_Render(crossrt::BufferView a_out_color);
   virtual void RenderCmd(VkCommandBuffer a_cmd, uint32_t width, uint32_t height, int samples, float4* out_color);
 
-  void CommitDeviceData() override;                                     // uploads members
-  void GetExecutionTime(const char* a_funcName, float a_out[4]) override;  // [0] GPU ms, [1] copy-in ms, [2] copy-out ms, [3] total ms
+  void CommitDeviceData() override;  // uploads members
+  // a_out: [0] GPU ms, [1] copy-in ms, [2] copy-out ms, [3] total ms
+  void GetExecutionTime(const char* a_funcName, float a_out[4]) override;
 
   virtual void UpdatePlainMembers();  // members -> GPU (called before every control function)
   virtual void ReadPlainMembers();    // GPU -> members the kernels write (reductions)
@@ -43,11 +44,20 @@ public:
 
 protected:
   // One per kernel (and megakernel of a thread loop): records its dispatch (and barrier) into a_cmd.
-  virtual void kernel_InitEyeRayCmd(VkCommandBuffer a_cmd, uint32_t a_threadsX, uint32_t a_threadsY, uint32_t width, uint32_t height, int sample, crossrt::BufferView rayPos, crossrt::BufferView rayDir, crossrt::BufferView throughput);
-  virtual void kernel_RayTraceCmd(VkCommandBuffer a_cmd, uint32_t a_threadsX, uint32_t a_threadsY, crossrt::BufferView rayPos, crossrt::BufferView rayDir, crossrt::BufferView throughput, crossrt::BufferView hit);
-  virtual void kernel_NextBounceCmd(VkCommandBuffer a_cmd, uint32_t a_threadsX, uint32_t a_threadsY, uint32_t width, int sample, int bounce, crossrt::BufferView hit, crossrt::BufferView rayPos, crossrt::BufferView rayDir, crossrt::BufferView throughput, crossrt::BufferView color);
-  virtual void kernel_ContributeCmd(VkCommandBuffer a_cmd, uint32_t a_threadsX, uint32_t a_threadsY, uint32_t width, int samples, crossrt::BufferView color, crossrt::BufferView out_color);
-  virtual void Render_MegakernelCmd(VkCommandBuffer a_cmd, uint32_t a_threadsX, uint32_t a_threadsY, crossrt::BufferView out_color, int samples, uint32_t width, uint32_t height);
+  virtual void kernel_InitEyeRayCmd(VkCommandBuffer a_cmd, uint32_t a_threadsX, uint32_t a_threadsY, uint32_t width,
+                                    uint32_t height, int sample, crossrt::BufferView rayPos, crossrt::BufferView rayDir,
+                                    crossrt::BufferView throughput);
+  virtual void kernel_RayTraceCmd(VkCommandBuffer a_cmd, uint32_t a_threadsX, uint32_t a_threadsY,
+                                  crossrt::BufferView rayPos, crossrt::BufferView rayDir,
+                                  crossrt::BufferView throughput, crossrt::BufferView hit);
+  virtual void kernel_NextBounceCmd(VkCommandBuffer a_cmd, uint32_t a_threadsX, uint32_t a_threadsY, uint32_t width,
+                                    int sample, int bounce, crossrt::BufferView hit, crossrt::BufferView rayPos,
+                                    crossrt::BufferView rayDir, crossrt::BufferView throughput,
+                                    crossrt::BufferView color);
+  virtual void kernel_ContributeCmd(VkCommandBuffer a_cmd, uint32_t a_threadsX, uint32_t a_threadsY, uint32_t width,
+                                    int samples, crossrt::BufferView color, crossrt::BufferView out_color);
+  virtual void Render_MegakernelCmd(VkCommandBuffer a_cmd, uint32_t a_threadsX, uint32_t a_threadsY,
+                                    crossrt::BufferView out_color, int samples, uint32_t width, uint32_t height);
   virtual void InitPipelines();
   // Records an update of one member's GPU copy, ordered between the kernels around it.
   virtual void UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size);
@@ -132,11 +142,11 @@ protected:
 
   struct ThreadState  // wavefront mode: the per-thread locals of thread loops, one element per thread
   {
-    crossrt::Buffer Render_rayPos;  // float4 rayPos of Render
-    crossrt::Buffer Render_rayDir;  // float4 rayDir of Render
+    crossrt::Buffer Render_rayPos;      // float4 rayPos of Render
+    crossrt::Buffer Render_rayDir;      // float4 rayDir of Render
     crossrt::Buffer Render_throughput;  // float4 throughput of Render
-    crossrt::Buffer Render_color;  // float4 color of Render
-    crossrt::Buffer Render_hit;  // SphereHit hit of Render
+    crossrt::Buffer Render_color;       // float4 color of Render
+    crossrt::Buffer Render_hit;         // SphereHit hit of Render
   } m_threadState;
 
   struct ArgumentBuffers  // device copies of pointer arguments, reused across calls
@@ -157,8 +167,6 @@ protected:
   {
   } m_partials;
 
-  crossrt::Scanner m_scanner;     // std::exclusive_scan / std::inclusive_scan of control functions
-  crossrt::RadixSorter m_sorter;  // std::sort of control functions
   crossrt::GpuTimer m_gpuTimer;
   std::map<std::string, std::array<float, 4>> m_times;
 };

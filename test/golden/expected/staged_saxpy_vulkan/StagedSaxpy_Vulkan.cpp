@@ -12,12 +12,10 @@ extern const uint32_t StagedSaxpy_kernel1D_Add_spv[];
 extern const size_t StagedSaxpy_kernel1D_Add_spvBytes;
 
 StagedSaxpy_Vulkan::StagedSaxpy_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx)
-  : StagedSaxpy(), m_ctx(std::move(a_ctx))
+    : StagedSaxpy(), m_ctx(std::move(a_ctx))
 {
   m_classDataBuffer = crossrt::Buffer(m_ctx, sizeof(ClassData));
   m_gpuTimer = crossrt::GpuTimer(m_ctx);
-  m_scanner = crossrt::Scanner(m_ctx);
-  m_sorter = crossrt::RadixSorter(m_ctx);
   InitPipelines();
 }
 
@@ -35,8 +33,12 @@ StagedSaxpy_Vulkan::~StagedSaxpy_Vulkan() = default;
 
 void StagedSaxpy_Vulkan::InitPipelines()
 {
-  m_pipelines.kernel1D_Mult = crossrt::ComputePipeline(m_ctx, StagedSaxpy_kernel1D_Mult_spv, StagedSaxpy_kernel1D_Mult_spvBytes, 4, sizeof(kernel1D_MultArgs), "StagedSaxpy::kernel1D_Mult");
-  m_pipelines.kernel1D_Add = crossrt::ComputePipeline(m_ctx, StagedSaxpy_kernel1D_Add_spv, StagedSaxpy_kernel1D_Add_spvBytes, 4, sizeof(kernel1D_AddArgs), "StagedSaxpy::kernel1D_Add");
+  m_pipelines.kernel1D_Mult =
+      crossrt::ComputePipeline(m_ctx, StagedSaxpy_kernel1D_Mult_spv, StagedSaxpy_kernel1D_Mult_spvBytes, 4,
+                               sizeof(kernel1D_MultArgs), "StagedSaxpy::kernel1D_Mult");
+  m_pipelines.kernel1D_Add =
+      crossrt::ComputePipeline(m_ctx, StagedSaxpy_kernel1D_Add_spv, StagedSaxpy_kernel1D_Add_spvBytes, 4,
+                               sizeof(kernel1D_AddArgs), "StagedSaxpy::kernel1D_Add");
 }
 
 void StagedSaxpy_Vulkan::UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size)
@@ -65,8 +67,7 @@ void StagedSaxpy_Vulkan::CommitDeviceData()
 
 bool StagedSaxpy_Vulkan::VectorMembersResized() const
 {
-  bool resized = false;
-  return resized;
+  return false;  // no std::vector, Image2D or sampler member of the class is on the GPU
 }
 
 void StagedSaxpy_Vulkan::ReadVectorMembers(const char* a_funcName)
@@ -83,7 +84,8 @@ void StagedSaxpy_Vulkan::GetExecutionTime(const char* a_funcName, float a_out[4]
 
 // ---- Run (from StagedSaxpy::Run, staged_saxpy.cpp) ----
 
-void StagedSaxpy_Vulkan::SetVulkanInOutFor_Run(crossrt::BufferView a_a_x, crossrt::BufferView a_a_y, crossrt::BufferView a_a_out)
+void StagedSaxpy_Vulkan::SetVulkanInOutFor_Run(crossrt::BufferView a_a_x, crossrt::BufferView a_a_y,
+                                               crossrt::BufferView a_a_out)
 {
   m_inOut_Run.a_x = a_a_x;
   m_inOut_Run.a_y = a_a_y;
@@ -113,7 +115,8 @@ void StagedSaxpy_Vulkan::Run(const float* a_x, const float* a_y, float* a_out, u
   crossrt::EnsureSize(m_ctx, crt_self->m_args.Run_a_out, crt_a_outBytes);
   if (crt_a_outBytes > 0)
     crt_self->m_args.Run_a_out.Upload(a_out, crt_a_outBytes);
-  crt_self->SetVulkanInOutFor_Run(crt_self->m_args.Run_a_x.View(), crt_self->m_args.Run_a_y.View(), crt_self->m_args.Run_a_out.View());
+  crt_self->SetVulkanInOutFor_Run(crt_self->m_args.Run_a_x.View(), crt_self->m_args.Run_a_y.View(),
+                                  crt_self->m_args.Run_a_out.View());
   const float crt_copyInMs = crt_copyIn.ElapsedMs();
 
   // Members as they are now; host code of Run that changes one records an update in order.
@@ -125,19 +128,19 @@ void StagedSaxpy_Vulkan::Run(const float* a_x, const float* a_y, float* a_out, u
   crt_self->m_gpuTimer.End(crt_cmd, "Run");
   m_ctx->SubmitAndWait(crt_cmd);
   crt_self->m_gpuTimer.Collect();
-  crt_self->m_scanner.ReleaseRetired();  // scratch that grew while recording
-  crt_self->m_sorter.ReleaseRetired();
 
   crossrt::CpuTimer crt_copyOut;
   crt_self->ReadPlainMembers();
   crt_self->ReadVectorMembers("Run");
   if (crt_a_outBytes > 0)
     crt_self->m_args.Run_a_out.Download(a_out, crt_a_outBytes);
-  crt_self->m_times["Run"] = {crt_self->m_gpuTimer.LastMs("Run"), crt_copyInMs, crt_copyOut.ElapsedMs(), crt_total.ElapsedMs()};
+  crt_self->m_times["Run"] = {crt_self->m_gpuTimer.LastMs("Run"), crt_copyInMs, crt_copyOut.ElapsedMs(),
+                              crt_total.ElapsedMs()};
 }
 
 // The body of StagedSaxpy::Run, with each kernel call turned into its ...Cmd.
-void StagedSaxpy_Vulkan::RunCmd(VkCommandBuffer a_cmd, [[maybe_unused]] const float* a_x, [[maybe_unused]] const float* a_y, [[maybe_unused]] float* a_out, uint32_t n)
+void StagedSaxpy_Vulkan::RunCmd(VkCommandBuffer a_cmd, [[maybe_unused]] const float* a_x,
+                                [[maybe_unused]] const float* a_y, [[maybe_unused]] float* a_out, uint32_t n)
 {
   std::vector<float> product(n);
   crossrt::EnsureSize(m_ctx, m_temporaries.Run_product, sizeof(float) * product.size());
@@ -150,15 +153,16 @@ void StagedSaxpy_Vulkan::RunCmd(VkCommandBuffer a_cmd, [[maybe_unused]] const fl
   crossrt::EnsureSize(m_ctx, m_temporaries.Run_both, sizeof(float) * both.size());
   crossrt::FillCmd(a_cmd, m_temporaries.Run_both.View(), (sizeof(float) * both.size() + 3) / 4 * 4, 0u);
   kernel1D_MultCmd(a_cmd, m_temporaries.Run_product.View(), m_inOut_Run.a_x, m_inOut_Run.a_y, n);
-  kernel1D_AddCmd(a_cmd, m_temporaries.Run_both.View(sizeof(float) * size_t(n)),
-                  m_temporaries.Run_product.View(), m_temporaries.Run_twos.View(), uint32_t(twos.size()));
+  kernel1D_AddCmd(a_cmd, m_temporaries.Run_both.View(sizeof(float) * size_t(n)), m_temporaries.Run_product.View(),
+                  m_temporaries.Run_twos.View(), uint32_t(twos.size()));
   kernel1D_AddCmd(a_cmd, m_inOut_Run.a_out, m_temporaries.Run_both.View(sizeof(float) * size_t(n)),
                   m_temporaries.Run_both.View(), n);
 }
 
 // ---- kernel1D_Mult (from StagedSaxpy::kernel1D_Mult, staged_saxpy.cpp) ----
 
-void StagedSaxpy_Vulkan::kernel1D_MultCmd(VkCommandBuffer a_cmd, crossrt::BufferView a_res, crossrt::BufferView a_in1, crossrt::BufferView a_in2, uint32_t a_size)
+void StagedSaxpy_Vulkan::kernel1D_MultCmd(VkCommandBuffer a_cmd, crossrt::BufferView a_res, crossrt::BufferView a_in1,
+                                          crossrt::BufferView a_in2, uint32_t a_size)
 {
   const int crt_startX = int(0);
   const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(a_size)));
@@ -169,7 +173,7 @@ void StagedSaxpy_Vulkan::kernel1D_MultCmd(VkCommandBuffer a_cmd, crossrt::Buffer
   crt_args.crt_countX = crt_countX;
   crt_args.a_size = a_size;
   m_pipelines.kernel1D_Mult.Bind(a_cmd);
-  m_pipelines.kernel1D_Mult.PushBuffers(a_cmd, { m_classDataBuffer.View(), a_res, a_in1, a_in2 });
+  m_pipelines.kernel1D_Mult.PushBuffers(a_cmd, {m_classDataBuffer.View(), a_res, a_in1, a_in2});
   m_pipelines.kernel1D_Mult.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);
   crossrt::ComputeBarrier(a_cmd);
@@ -177,7 +181,8 @@ void StagedSaxpy_Vulkan::kernel1D_MultCmd(VkCommandBuffer a_cmd, crossrt::Buffer
 
 // ---- kernel1D_Add (from StagedSaxpy::kernel1D_Add, staged_saxpy.cpp) ----
 
-void StagedSaxpy_Vulkan::kernel1D_AddCmd(VkCommandBuffer a_cmd, crossrt::BufferView a_res, crossrt::BufferView a_in1, crossrt::BufferView a_in2, uint32_t a_size)
+void StagedSaxpy_Vulkan::kernel1D_AddCmd(VkCommandBuffer a_cmd, crossrt::BufferView a_res, crossrt::BufferView a_in1,
+                                         crossrt::BufferView a_in2, uint32_t a_size)
 {
   const int crt_startX = int(0);
   const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(a_size)));
@@ -188,7 +193,7 @@ void StagedSaxpy_Vulkan::kernel1D_AddCmd(VkCommandBuffer a_cmd, crossrt::BufferV
   crt_args.crt_countX = crt_countX;
   crt_args.a_size = a_size;
   m_pipelines.kernel1D_Add.Bind(a_cmd);
-  m_pipelines.kernel1D_Add.PushBuffers(a_cmd, { m_classDataBuffer.View(), a_res, a_in1, a_in2 });
+  m_pipelines.kernel1D_Add.PushBuffers(a_cmd, {m_classDataBuffer.View(), a_res, a_in1, a_in2});
   m_pipelines.kernel1D_Add.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);
   crossrt::ComputeBarrier(a_cmd);

@@ -28,8 +28,9 @@ public:
   virtual void SetVulkanInOutFor_Run(crossrt::BufferView a_a_x, crossrt::BufferView a_a_y, crossrt::BufferView a_a_out);
   virtual void RunCmd(VkCommandBuffer a_cmd, const float* a_x, const float* a_y, float* a_out, uint32_t n);
 
-  void CommitDeviceData() override;                                     // uploads members
-  void GetExecutionTime(const char* a_funcName, float a_out[4]);  // [0] GPU ms, [1] copy-in ms, [2] copy-out ms, [3] total ms
+  void CommitDeviceData() override;  // uploads members
+  // a_out: [0] GPU ms, [1] copy-in ms, [2] copy-out ms, [3] total ms
+  void GetExecutionTime(const char* a_funcName, float a_out[4]);
 
   virtual void UpdatePlainMembers();  // members -> GPU (called before every control function)
   virtual void ReadPlainMembers();    // GPU -> members the kernels write (reductions)
@@ -38,8 +39,10 @@ public:
 
 protected:
   // One per kernel (and megakernel of a thread loop): records its dispatch (and barrier) into a_cmd.
-  virtual void kernel1D_MultCmd(VkCommandBuffer a_cmd, crossrt::BufferView a_res, crossrt::BufferView a_in1, crossrt::BufferView a_in2, uint32_t a_size);
-  virtual void kernel1D_AddCmd(VkCommandBuffer a_cmd, crossrt::BufferView a_res, crossrt::BufferView a_in1, crossrt::BufferView a_in2, uint32_t a_size);
+  virtual void kernel1D_MultCmd(VkCommandBuffer a_cmd, crossrt::BufferView a_res, crossrt::BufferView a_in1,
+                                crossrt::BufferView a_in2, uint32_t a_size);
+  virtual void kernel1D_AddCmd(VkCommandBuffer a_cmd, crossrt::BufferView a_res, crossrt::BufferView a_in1,
+                               crossrt::BufferView a_in2, uint32_t a_size);
   virtual void InitPipelines();
   // Records an update of one member's GPU copy, ordered between the kernels around it.
   virtual void UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size);
@@ -69,9 +72,6 @@ protected:
   crossrt::Buffer m_classDataBuffer;
   bool m_deviceDataCommitted = false;
 
-  struct VectorMembers  // device copies of the std::vector members kernels use
-  {
-  } m_vdata;
   // A std::vector or Image2D member changed size, or a sampler changed, since CommitDeviceData().
   virtual bool VectorMembersResized() const;
 
@@ -92,8 +92,8 @@ protected:
   struct Temporaries  // device copies of the std::vector locals control functions pass to kernels
   {
     crossrt::Buffer Run_product;  // std::vector<float> product of Run
-    crossrt::Buffer Run_both;  // std::vector<float> both of Run
-    crossrt::Buffer Run_twos;  // std::vector<float> twos of Run
+    crossrt::Buffer Run_both;     // std::vector<float> both of Run
+    crossrt::Buffer Run_twos;     // std::vector<float> twos of Run
   } m_temporaries;
 
   struct Pipelines
@@ -106,8 +106,6 @@ protected:
   {
   } m_partials;
 
-  crossrt::Scanner m_scanner;     // std::exclusive_scan / std::inclusive_scan of control functions
-  crossrt::RadixSorter m_sorter;  // std::sort of control functions
   crossrt::GpuTimer m_gpuTimer;
   std::map<std::string, std::array<float, 4>> m_times;
 };

@@ -17,12 +17,10 @@ extern const uint32_t TexturedMaterials_kernel1D_Shade_spv[];
 extern const size_t TexturedMaterials_kernel1D_Shade_spvBytes;
 
 TexturedMaterials_Vulkan::TexturedMaterials_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx)
-  : TexturedMaterials(), m_ctx(std::move(a_ctx))
+    : TexturedMaterials(), m_ctx(std::move(a_ctx))
 {
   m_classDataBuffer = crossrt::Buffer(m_ctx, sizeof(ClassData));
   m_gpuTimer = crossrt::GpuTimer(m_ctx);
-  m_scanner = crossrt::Scanner(m_ctx);
-  m_sorter = crossrt::RadixSorter(m_ctx);
   m_useTextureHardware = m_ctx->hasTextureArrays;
   if (m_ctx->hasTextureArrays)
   {
@@ -47,21 +45,30 @@ TexturedMaterials_Vulkan::~TexturedMaterials_Vulkan() = default;
 void TexturedMaterials_Vulkan::InitPipelines()
 {
   if (m_ctx->hasTextureArrays)  // textures on the GPU's samplers: the shader needs them even to be created
-    m_pipelines.kernel1D_Shade_Textures = crossrt::ComputePipeline(m_ctx, TexturedMaterials_kernel1D_Shade_Textures_spv, TexturedMaterials_kernel1D_Shade_Textures_spvBytes,
-                                                    std::vector<VkDescriptorType>{ VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER }, sizeof(kernel1D_ShadeArgs), "TexturedMaterials::kernel1D_Shade_Textures", 2);
-  m_pipelines.kernel1D_Shade = crossrt::ComputePipeline(m_ctx, TexturedMaterials_kernel1D_Shade_spv, TexturedMaterials_kernel1D_Shade_spvBytes, 10, sizeof(kernel1D_ShadeArgs), "TexturedMaterials::kernel1D_Shade");
+    m_pipelines.kernel1D_Shade_Textures = crossrt::ComputePipeline(
+        m_ctx, TexturedMaterials_kernel1D_Shade_Textures_spv, TexturedMaterials_kernel1D_Shade_Textures_spvBytes,
+        std::vector<VkDescriptorType>{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                      VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                      VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                      VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
+        sizeof(kernel1D_ShadeArgs), "TexturedMaterials::kernel1D_Shade_Textures", 2);
+  m_pipelines.kernel1D_Shade =
+      crossrt::ComputePipeline(m_ctx, TexturedMaterials_kernel1D_Shade_spv, TexturedMaterials_kernel1D_Shade_spvBytes,
+                               10, sizeof(kernel1D_ShadeArgs), "TexturedMaterials::kernel1D_Shade");
 }
 
 void TexturedMaterials_Vulkan::UseTextureHardware(bool a_use)
 {
   if (a_use && !m_ctx->hasTextureArrays)
-    throw crossrt::Error("TexturedMaterials_Vulkan: device '" + m_ctx->DeviceName() + "' has no arrays of textures (descriptor indexing): its kernels sample textures from buffers");
+    throw crossrt::Error("TexturedMaterials_Vulkan: device '" + m_ctx->DeviceName() +
+                         "' has no arrays of textures (descriptor indexing): its kernels sample textures from buffers");
   if (a_use != m_useTextureHardware)
     m_deviceDataCommitted = false;  // the next call commits the textures the other way
   m_useTextureHardware = a_use;
 }
 
-void TexturedMaterials_Vulkan::UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size)
+void TexturedMaterials_Vulkan::UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data,
+                                               size_t a_size)
 {
   crossrt::ComputeBarrier(a_cmd);  // kernels recorded before it are done with the class data
   vkCmdUpdateBuffer(a_cmd, m_classDataBuffer.Handle(), a_offset, a_size, a_data);
@@ -86,18 +93,24 @@ void TexturedMaterials_Vulkan::CommitDeviceData()
   // Arrays of textures: for the GPU's samplers an image each, else their texels in a buffer; both
   // ways each texture's size and sampler in another.
   if (m_useTextureHardware && m_albedo.size() > m_ctx->maxTextureArraySize)
-    throw crossrt::Error("TexturedMaterials_Vulkan: m_albedo holds " + std::to_string(m_albedo.size()) + " textures, but device '" + m_ctx->DeviceName() +
-                         "' binds at most " + std::to_string(m_ctx->maxTextureArraySize) + " in an array: call UseTextureHardware(false) to sample them from buffers");
+    throw crossrt::Error("TexturedMaterials_Vulkan: m_albedo holds " + std::to_string(m_albedo.size()) +
+                         " textures, but device '" + m_ctx->DeviceName() + "' binds at most " +
+                         std::to_string(m_ctx->maxTextureArraySize) +
+                         " in an array: call UseTextureHardware(false) to sample them from buffers");
   if (m_useTextureHardware)
     crossrt::AssignTextures(m_textures.m_albedo, VK_FORMAT_R32G32B32A32_SFLOAT, m_albedo);
-  crossrt::CommitTextureBuffers(m_ctx, m_albedo, m_textures.m_albedo_info, m_useTextureHardware ? nullptr : &m_textures.m_albedo_texels);
+  crossrt::CommitTextureBuffers(m_ctx, m_albedo, m_textures.m_albedo_info,
+                                m_useTextureHardware ? nullptr : &m_textures.m_albedo_texels);
   m_textures.m_albedoSize = m_albedo.size();
   if (m_useTextureHardware && m_bumps.size() > m_ctx->maxTextureArraySize)
-    throw crossrt::Error("TexturedMaterials_Vulkan: m_bumps holds " + std::to_string(m_bumps.size()) + " textures, but device '" + m_ctx->DeviceName() +
-                         "' binds at most " + std::to_string(m_ctx->maxTextureArraySize) + " in an array: call UseTextureHardware(false) to sample them from buffers");
+    throw crossrt::Error("TexturedMaterials_Vulkan: m_bumps holds " + std::to_string(m_bumps.size()) +
+                         " textures, but device '" + m_ctx->DeviceName() + "' binds at most " +
+                         std::to_string(m_ctx->maxTextureArraySize) +
+                         " in an array: call UseTextureHardware(false) to sample them from buffers");
   if (m_useTextureHardware)
     crossrt::AssignTextures(m_textures.m_bumps, VK_FORMAT_R32_SFLOAT, m_bumps);
-  crossrt::CommitTextureBuffers(m_ctx, m_bumps, m_textures.m_bumps_info, m_useTextureHardware ? nullptr : &m_textures.m_bumps_texels);
+  crossrt::CommitTextureBuffers(m_ctx, m_bumps, m_textures.m_bumps_info,
+                                m_useTextureHardware ? nullptr : &m_textures.m_bumps_texels);
   m_textures.m_bumpsSize = m_bumps.size();
   UpdatePlainMembers();
   m_deviceDataCommitted = true;
@@ -125,7 +138,9 @@ void TexturedMaterials_Vulkan::GetExecutionTime(const char* a_funcName, float a_
 
 // ---- Shade (from TexturedMaterials::Shade, TexturedMaterials.cpp) ----
 
-void TexturedMaterials_Vulkan::SetVulkanInOutFor_Shade(crossrt::BufferView a_texIds, crossrt::BufferView a_uvs, crossrt::BufferView a_colors, crossrt::BufferView a_heights, crossrt::BufferView a_texels)
+void TexturedMaterials_Vulkan::SetVulkanInOutFor_Shade(crossrt::BufferView a_texIds, crossrt::BufferView a_uvs,
+                                                       crossrt::BufferView a_colors, crossrt::BufferView a_heights,
+                                                       crossrt::BufferView a_texels)
 {
   m_inOut_Shade.texIds = a_texIds;
   m_inOut_Shade.uvs = a_uvs;
@@ -134,7 +149,8 @@ void TexturedMaterials_Vulkan::SetVulkanInOutFor_Shade(crossrt::BufferView a_tex
   m_inOut_Shade.texels = a_texels;
 }
 
-void TexturedMaterials_Vulkan::Shade(int n, const uint32_t* texIds, const LiteMath::float2* uvs, LiteMath::float4* colors, float* heights, LiteMath::float4* texels)
+void TexturedMaterials_Vulkan::Shade(int n, const uint32_t* texIds, const LiteMath::float2* uvs,
+                                     LiteMath::float4* colors, float* heights, LiteMath::float4* texels)
 {
   auto* crt_self = const_cast<TexturedMaterials_Vulkan*>(this);
   crossrt::CpuTimer crt_total;
@@ -165,7 +181,9 @@ void TexturedMaterials_Vulkan::Shade(int n, const uint32_t* texIds, const LiteMa
   crossrt::EnsureSize(m_ctx, crt_self->m_args.Shade_texels, crt_texelsBytes);
   if (crt_texelsBytes > 0)
     crt_self->m_args.Shade_texels.Upload(texels, crt_texelsBytes);
-  crt_self->SetVulkanInOutFor_Shade(crt_self->m_args.Shade_texIds.View(), crt_self->m_args.Shade_uvs.View(), crt_self->m_args.Shade_colors.View(), crt_self->m_args.Shade_heights.View(), crt_self->m_args.Shade_texels.View());
+  crt_self->SetVulkanInOutFor_Shade(crt_self->m_args.Shade_texIds.View(), crt_self->m_args.Shade_uvs.View(),
+                                    crt_self->m_args.Shade_colors.View(), crt_self->m_args.Shade_heights.View(),
+                                    crt_self->m_args.Shade_texels.View());
   const float crt_copyInMs = crt_copyIn.ElapsedMs();
 
   // Members as they are now; host code of Shade that changes one records an update in order.
@@ -177,8 +195,6 @@ void TexturedMaterials_Vulkan::Shade(int n, const uint32_t* texIds, const LiteMa
   crt_self->m_gpuTimer.End(crt_cmd, "Shade");
   m_ctx->SubmitAndWait(crt_cmd);
   crt_self->m_gpuTimer.Collect();
-  crt_self->m_scanner.ReleaseRetired();  // scratch that grew while recording
-  crt_self->m_sorter.ReleaseRetired();
 
   crossrt::CpuTimer crt_copyOut;
   crt_self->ReadPlainMembers();
@@ -189,19 +205,25 @@ void TexturedMaterials_Vulkan::Shade(int n, const uint32_t* texIds, const LiteMa
     crt_self->m_args.Shade_heights.Download(heights, crt_heightsBytes);
   if (crt_texelsBytes > 0)
     crt_self->m_args.Shade_texels.Download(texels, crt_texelsBytes);
-  crt_self->m_times["Shade"] = {crt_self->m_gpuTimer.LastMs("Shade"), crt_copyInMs, crt_copyOut.ElapsedMs(), crt_total.ElapsedMs()};
+  crt_self->m_times["Shade"] = {crt_self->m_gpuTimer.LastMs("Shade"), crt_copyInMs, crt_copyOut.ElapsedMs(),
+                                crt_total.ElapsedMs()};
 }
 
 // The body of TexturedMaterials::Shade, with each kernel call turned into its ...Cmd.
-void TexturedMaterials_Vulkan::ShadeCmd(VkCommandBuffer a_cmd, int n, [[maybe_unused]] const uint32_t* texIds, [[maybe_unused]] const LiteMath::float2* uvs, [[maybe_unused]] LiteMath::float4* colors, [[maybe_unused]] float* heights, [[maybe_unused]] LiteMath::float4* texels)
+void TexturedMaterials_Vulkan::ShadeCmd(VkCommandBuffer a_cmd, int n, [[maybe_unused]] const uint32_t* texIds,
+                                        [[maybe_unused]] const LiteMath::float2* uvs,
+                                        [[maybe_unused]] LiteMath::float4* colors, [[maybe_unused]] float* heights,
+                                        [[maybe_unused]] LiteMath::float4* texels)
 {
-  kernel1D_ShadeCmd(a_cmd, n, m_inOut_Shade.texIds, m_inOut_Shade.uvs, m_inOut_Shade.colors,
-                    m_inOut_Shade.heights, m_inOut_Shade.texels);
+  kernel1D_ShadeCmd(a_cmd, n, m_inOut_Shade.texIds, m_inOut_Shade.uvs, m_inOut_Shade.colors, m_inOut_Shade.heights,
+                    m_inOut_Shade.texels);
 }
 
 // ---- kernel1D_Shade (from TexturedMaterials::kernel1D_Shade, TexturedMaterials.cpp) ----
 
-void TexturedMaterials_Vulkan::kernel1D_ShadeCmd(VkCommandBuffer a_cmd, int n, crossrt::BufferView texIds, crossrt::BufferView uvs, crossrt::BufferView colors, crossrt::BufferView heights, crossrt::BufferView texels)
+void TexturedMaterials_Vulkan::kernel1D_ShadeCmd(VkCommandBuffer a_cmd, int n, crossrt::BufferView texIds,
+                                                 crossrt::BufferView uvs, crossrt::BufferView colors,
+                                                 crossrt::BufferView heights, crossrt::BufferView texels)
 {
   const int crt_startX = int(0);
   const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(n)));
@@ -214,14 +236,18 @@ void TexturedMaterials_Vulkan::kernel1D_ShadeCmd(VkCommandBuffer a_cmd, int n, c
   if (m_useTextureHardware)  // textures on the GPU's samplers
   {
     m_pipelines.kernel1D_Shade_Textures.Bind(a_cmd);
-    m_pipelines.kernel1D_Shade_Textures.PushBuffers(a_cmd, { m_classDataBuffer.View(), texIds, uvs, colors, heights, texels, m_textures.m_albedo_info.View(), m_textures.m_bumps_info.View() });
-    m_pipelines.kernel1D_Shade_Textures.BindTextureArrays(a_cmd, { &m_textures.m_albedo, &m_textures.m_bumps });
+    m_pipelines.kernel1D_Shade_Textures.PushBuffers(a_cmd,
+                                                    {m_classDataBuffer.View(), texIds, uvs, colors, heights, texels,
+                                                     m_textures.m_albedo_info.View(), m_textures.m_bumps_info.View()});
+    m_pipelines.kernel1D_Shade_Textures.BindTextureArrays(a_cmd, {&m_textures.m_albedo, &m_textures.m_bumps});
     m_pipelines.kernel1D_Shade_Textures.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   }
   else
   {
     m_pipelines.kernel1D_Shade.Bind(a_cmd);
-    m_pipelines.kernel1D_Shade.PushBuffers(a_cmd, { m_classDataBuffer.View(), texIds, uvs, colors, heights, texels, m_textures.m_albedo_info.View(), m_textures.m_albedo_texels.View(), m_textures.m_bumps_info.View(), m_textures.m_bumps_texels.View() });
+    m_pipelines.kernel1D_Shade.PushBuffers(a_cmd, {m_classDataBuffer.View(), texIds, uvs, colors, heights, texels,
+                                                   m_textures.m_albedo_info.View(), m_textures.m_albedo_texels.View(),
+                                                   m_textures.m_bumps_info.View(), m_textures.m_bumps_texels.View()});
     m_pipelines.kernel1D_Shade.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   }
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);

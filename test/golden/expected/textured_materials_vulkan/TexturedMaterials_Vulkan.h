@@ -22,14 +22,19 @@ public:
 
   // Control functions: same signatures as in TexturedMaterials; they copy pointer arguments to the
   // device, record the kernels into one command buffer, run it, and copy outputs back.
-  void Shade(int n, const uint32_t* texIds, const LiteMath::float2* uvs, LiteMath::float4* colors, float* heights, LiteMath::float4* texels) override;
+  void Shade(int n, const uint32_t* texIds, const LiteMath::float2* uvs, LiteMath::float4* colors, float* heights,
+             LiteMath::float4* texels) override;
 
   // For data that already lives on the GPU: bind your buffers, then record into your command buffer.
-  virtual void SetVulkanInOutFor_Shade(crossrt::BufferView a_texIds, crossrt::BufferView a_uvs, crossrt::BufferView a_colors, crossrt::BufferView a_heights, crossrt::BufferView a_texels);
-  virtual void ShadeCmd(VkCommandBuffer a_cmd, int n, const uint32_t* texIds, const LiteMath::float2* uvs, LiteMath::float4* colors, float* heights, LiteMath::float4* texels);
+  virtual void SetVulkanInOutFor_Shade(crossrt::BufferView a_texIds, crossrt::BufferView a_uvs,
+                                       crossrt::BufferView a_colors, crossrt::BufferView a_heights,
+                                       crossrt::BufferView a_texels);
+  virtual void ShadeCmd(VkCommandBuffer a_cmd, int n, const uint32_t* texIds, const LiteMath::float2* uvs,
+                        LiteMath::float4* colors, float* heights, LiteMath::float4* texels);
 
-  void CommitDeviceData() override;                                     // uploads members
-  void GetExecutionTime(const char* a_funcName, float a_out[4]);  // [0] GPU ms, [1] copy-in ms, [2] copy-out ms, [3] total ms
+  void CommitDeviceData() override;  // uploads members
+  // a_out: [0] GPU ms, [1] copy-in ms, [2] copy-out ms, [3] total ms
+  void GetExecutionTime(const char* a_funcName, float a_out[4]);
 
   virtual void UpdatePlainMembers();  // members -> GPU (called before every control function)
   virtual void ReadPlainMembers();    // GPU -> members the kernels write (reductions)
@@ -46,7 +51,8 @@ public:
 
 protected:
   // One per kernel (and megakernel of a thread loop): records its dispatch (and barrier) into a_cmd.
-  virtual void kernel1D_ShadeCmd(VkCommandBuffer a_cmd, int n, crossrt::BufferView texIds, crossrt::BufferView uvs, crossrt::BufferView colors, crossrt::BufferView heights, crossrt::BufferView texels);
+  virtual void kernel1D_ShadeCmd(VkCommandBuffer a_cmd, int n, crossrt::BufferView texIds, crossrt::BufferView uvs,
+                                 crossrt::BufferView colors, crossrt::BufferView heights, crossrt::BufferView texels);
   virtual void InitPipelines();
   // Records an update of one member's GPU copy, ordered between the kernels around it.
   virtual void UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size);
@@ -71,9 +77,6 @@ protected:
   crossrt::Buffer m_classDataBuffer;
   bool m_deviceDataCommitted = false;
 
-  struct VectorMembers  // device copies of the std::vector members kernels use
-  {
-  } m_vdata;
   // A std::vector or Image2D member changed size, or a sampler changed, since CommitDeviceData().
   virtual bool VectorMembersResized() const;
 
@@ -81,12 +84,12 @@ protected:
   bool m_useTextureHardware = false;
   struct TextureArrays
   {
-    crossrt::TextureArray m_albedo;                         // for the GPU's samplers
+    crossrt::TextureArray m_albedo;                  // for the GPU's samplers
     crossrt::Buffer m_albedo_info, m_albedo_texels;  // each texture's size and sampler; texels for the shader's sampler
-    size_t m_albedoSize = 0;  // textures at the last CommitDeviceData()
-    crossrt::TextureArray m_bumps;                         // for the GPU's samplers
-    crossrt::Buffer m_bumps_info, m_bumps_texels;  // each texture's size and sampler; texels for the shader's sampler
-    size_t m_bumpsSize = 0;  // textures at the last CommitDeviceData()
+    size_t m_albedoSize = 0;                         // textures at the last CommitDeviceData()
+    crossrt::TextureArray m_bumps;                   // for the GPU's samplers
+    crossrt::Buffer m_bumps_info, m_bumps_texels;    // each texture's size and sampler; texels for the shader's sampler
+    size_t m_bumpsSize = 0;                          // textures at the last CommitDeviceData()
   } m_textures;
 
   struct InOut_Shade  // buffers bound by SetVulkanInOutFor_Shade
@@ -117,8 +120,6 @@ protected:
   {
   } m_partials;
 
-  crossrt::Scanner m_scanner;     // std::exclusive_scan / std::inclusive_scan of control functions
-  crossrt::RadixSorter m_sorter;  // std::sort of control functions
   crossrt::GpuTimer m_gpuTimer;
   std::map<std::string, std::array<float, 4>> m_times;
 };

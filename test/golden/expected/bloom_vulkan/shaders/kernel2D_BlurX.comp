@@ -17,9 +17,18 @@ layout(std430, binding = 0) buffer BloomData
   uint m_blurred_size;
   uint m_blurred_capacity;
 };
-layout(std430, binding = 1) readonly buffer srcBuffer { vec4 src[]; };  // parameter 'src'
-layout(std430, binding = 2) buffer dstBuffer { vec4 dst[]; };  // parameter 'dst'
-layout(std430, binding = 3) buffer m_weightsBuffer { float m_weights[]; };  // member std::vector m_weights
+layout(std430, binding = 1) readonly buffer srcBuffer
+{
+  vec4 src[];
+};  // parameter 'src'
+layout(std430, binding = 2) buffer dstBuffer
+{
+  vec4 dst[];
+};  // parameter 'dst'
+layout(std430, binding = 3) buffer m_weightsBuffer
+{
+  float m_weights[];
+};  // member std::vector m_weights
 
 layout(push_constant) uniform kernel2D_BlurXArgs
 {

@@ -17,10 +17,22 @@ layout(std430, binding = 0) buffer BloomData
   uint m_blurred_size;
   uint m_blurred_capacity;
 };
-layout(std430, binding = 1) readonly buffer srcBuffer { vec4 src[]; };  // parameter 'src'
-layout(std430, binding = 2) readonly buffer in_Buffer { vec4 in_[]; };  // parameter 'in'
-layout(std430, binding = 3) buffer out_Buffer { vec4 out_[]; };  // parameter 'out'
-layout(std430, binding = 4) buffer m_weightsBuffer { float m_weights[]; };  // member std::vector m_weights
+layout(std430, binding = 1) readonly buffer srcBuffer
+{
+  vec4 src[];
+};  // parameter 'src'
+layout(std430, binding = 2) readonly buffer in_Buffer
+{
+  vec4 in_[];
+};  // parameter 'in'
+layout(std430, binding = 3) buffer out_Buffer
+{
+  vec4 out_[];
+};  // parameter 'out'
+layout(std430, binding = 4) buffer m_weightsBuffer
+{
+  float m_weights[];
+};  // member std::vector m_weights
 
 layout(push_constant) uniform kernel2D_BlurYAndAddArgs
 {
@@ -48,5 +60,6 @@ void main()
 {
   const bool inRange = gl_GlobalInvocationID.x < crt_countX && gl_GlobalInvocationID.y < crt_countY;
   if (inRange)
-    kernel2D_BlurYAndAdd(int(crt_startX + int(gl_GlobalInvocationID.x)), int(crt_startY + int(gl_GlobalInvocationID.y)));
+    kernel2D_BlurYAndAdd(int(crt_startX + int(gl_GlobalInvocationID.x)),
+                         int(crt_startY + int(gl_GlobalInvocationID.y)));
 }

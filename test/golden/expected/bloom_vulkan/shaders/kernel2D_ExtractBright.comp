@@ -17,8 +17,14 @@ layout(std430, binding = 0) buffer BloomData
   uint m_blurred_size;
   uint m_blurred_capacity;
 };
-layout(std430, binding = 1) readonly buffer in_Buffer { vec4 in_[]; };  // parameter 'in'
-layout(std430, binding = 2) buffer brightBuffer { vec4 bright[]; };  // parameter 'bright'
+layout(std430, binding = 1) readonly buffer in_Buffer
+{
+  vec4 in_[];
+};  // parameter 'in'
+layout(std430, binding = 2) buffer brightBuffer
+{
+  vec4 bright[];
+};  // parameter 'bright'
 
 layout(push_constant) uniform kernel2D_ExtractBrightArgs
 {
@@ -48,5 +54,6 @@ void main()
 {
   const bool inRange = gl_GlobalInvocationID.x < crt_countX && gl_GlobalInvocationID.y < crt_countY;
   if (inRange)
-    kernel2D_ExtractBright(int(crt_startX + int(gl_GlobalInvocationID.x)), int(crt_startY + int(gl_GlobalInvocationID.y)));
+    kernel2D_ExtractBright(int(crt_startX + int(gl_GlobalInvocationID.x)),
+                           int(crt_startY + int(gl_GlobalInvocationID.y)));
 }

@@ -7,23 +7,35 @@
 
 layout(local_size_x = 16, local_size_y = 16, local_size_z = 1) in;
 
-layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer m_materials_Tags { uvec2 tags[]; };  // per element of m_materials: (class, index among its class's objects)
+layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer m_materials_Tags
+{
+  uvec2 tags[];
+};  // per element of m_materials: (class, index among its class's objects)
 
-struct Lambert_Data {  // the data members of Lambert
+struct Lambert_Data
+{  // the data members of Lambert
   vec3 albedo;
 };
 
-layout(buffer_reference, scalar, buffer_reference_align = 4) readonly buffer m_materials_LambertObjects { Lambert_Data objects[]; };
+layout(buffer_reference, scalar, buffer_reference_align = 4) readonly buffer m_materials_LambertObjects
+{
+  Lambert_Data objects[];
+};
 
-struct Phong_Data {  // the data members of Phong
+struct Phong_Data
+{  // the data members of Phong
   vec3 diffuse;
   vec3 specular;
   float shininess;
 };
 
-layout(buffer_reference, scalar, buffer_reference_align = 4) readonly buffer m_materials_PhongObjects { Phong_Data objects[]; };
+layout(buffer_reference, scalar, buffer_reference_align = 4) readonly buffer m_materials_PhongObjects
+{
+  Phong_Data objects[];
+};
 
-struct Checker_Data {  // the data members of Checker
+struct Checker_Data
+{  // the data members of Checker
   vec3 even;
   vec3 odd;
   float scale;
@@ -31,7 +43,10 @@ struct Checker_Data {  // the data members of Checker
   float opacity;
 };
 
-layout(buffer_reference, scalar, buffer_reference_align = 4) readonly buffer m_materials_CheckerObjects { Checker_Data objects[]; };
+layout(buffer_reference, scalar, buffer_reference_align = 4) readonly buffer m_materials_CheckerObjects
+{
+  Checker_Data objects[];
+};
 
 // Data members of CallableShading, uploaded before every control function call.
 layout(std430, binding = 0) buffer CallableShadingData
@@ -44,9 +59,18 @@ layout(std430, binding = 0) buffer CallableShadingData
   float m_distanceStep;
   uint m_materials_size;
 };
-layout(std430, binding = 1) readonly buffer normalsBuffer { vec4 normals[]; };  // parameter 'normals'
-layout(std430, binding = 2) readonly buffer materialIdsBuffer { uint materialIds[]; };  // parameter 'materialIds'
-layout(std430, binding = 3) buffer colorsBuffer { vec4 colors[]; };  // parameter 'colors'
+layout(std430, binding = 1) readonly buffer normalsBuffer
+{
+  vec4 normals[];
+};  // parameter 'normals'
+layout(std430, binding = 2) readonly buffer materialIdsBuffer
+{
+  uint materialIds[];
+};  // parameter 'materialIds'
+layout(std430, binding = 3) buffer colorsBuffer
+{
+  vec4 colors[];
+};  // parameter 'colors'
 
 layout(push_constant) uniform kernel2D_RenderArgs
 {
@@ -133,9 +157,12 @@ vec3 m_materials_Shade(uint index, vec3 normal, vec3 toLight)
   const uvec2 tag = m_materials_Tags(m_materials_tags).tags[index];
   switch (tag.x)
   {
-    case 0u: return Lambert_Shade(m_materials_LambertObjects(m_materials_Lambert).objects[tag.y], normal, toLight);
-    case 1u: return Phong_Shade(m_materials_PhongObjects(m_materials_Phong).objects[tag.y], normal, toLight);
-    case 2u: return Checker_Shade(m_materials_CheckerObjects(m_materials_Checker).objects[tag.y], normal, toLight);
+  case 0u:
+    return Lambert_Shade(m_materials_LambertObjects(m_materials_Lambert).objects[tag.y], normal, toLight);
+  case 1u:
+    return Phong_Shade(m_materials_PhongObjects(m_materials_Phong).objects[tag.y], normal, toLight);
+  case 2u:
+    return Checker_Shade(m_materials_CheckerObjects(m_materials_Checker).objects[tag.y], normal, toLight);
   }
   vec3 none;  // not reached: every element holds one of these classes
   return none;
@@ -147,9 +174,12 @@ float m_materials_Opacity(uint index)
   const uvec2 tag = m_materials_Tags(m_materials_tags).tags[index];
   switch (tag.x)
   {
-    case 0u: return Lambert_Opacity(m_materials_LambertObjects(m_materials_Lambert).objects[tag.y]);
-    case 1u: return Phong_Opacity(m_materials_PhongObjects(m_materials_Phong).objects[tag.y]);
-    case 2u: return Checker_Opacity(m_materials_CheckerObjects(m_materials_Checker).objects[tag.y]);
+  case 0u:
+    return Lambert_Opacity(m_materials_LambertObjects(m_materials_Lambert).objects[tag.y]);
+  case 1u:
+    return Phong_Opacity(m_materials_PhongObjects(m_materials_Phong).objects[tag.y]);
+  case 2u:
+    return Checker_Opacity(m_materials_CheckerObjects(m_materials_Checker).objects[tag.y]);
   }
   float none;  // not reached: every element holds one of these classes
   return none;
@@ -161,9 +191,15 @@ void m_materials_Attenuate(uint index, inout vec3 color, float distance)
   const uvec2 tag = m_materials_Tags(m_materials_tags).tags[index];
   switch (tag.x)
   {
-    case 0u: Lambert_Attenuate(m_materials_LambertObjects(m_materials_Lambert).objects[tag.y], color, distance); return;
-    case 1u: Phong_Attenuate(m_materials_PhongObjects(m_materials_Phong).objects[tag.y], color, distance); return;
-    case 2u: Checker_Attenuate(m_materials_CheckerObjects(m_materials_Checker).objects[tag.y], color, distance); return;
+  case 0u:
+    Lambert_Attenuate(m_materials_LambertObjects(m_materials_Lambert).objects[tag.y], color, distance);
+    return;
+  case 1u:
+    Phong_Attenuate(m_materials_PhongObjects(m_materials_Phong).objects[tag.y], color, distance);
+    return;
+  case 2u:
+    Checker_Attenuate(m_materials_CheckerObjects(m_materials_Checker).objects[tag.y], color, distance);
+    return;
   }
 }
 

@@ -5,7 +5,8 @@
 
 layout(local_size_x = 256, local_size_y = 1, local_size_z = 1) in;
 
-struct BVHNode {  // from BVHNode
+struct BVHNode
+{  // from BVHNode
   vec3 boxMin;
   uint left;
   vec3 boxMax;
@@ -37,12 +38,30 @@ layout(std430, binding = 0) buffer LBVHData
   uint m_arrivals_size;
   uint m_arrivals_capacity;
 };
-layout(std430, binding = 1) buffer m_codesBuffer { uvec2 m_codes[]; };  // member std::vector m_codes
-layout(std430, binding = 2) buffer m_groupOfBuffer { uint m_groupOf[]; };  // member std::vector m_groupOf
-layout(std430, binding = 3) buffer m_leafCodeBuffer { uint m_leafCode[]; };  // member std::vector m_leafCode
-layout(std430, binding = 4) buffer m_leafFirstBuffer { uint m_leafFirst[]; };  // member std::vector m_leafFirst
-layout(std430, binding = 5) buffer m_newGroupBuffer { uint m_newGroup[]; };  // member std::vector m_newGroup
-layout(std430, binding = 6) writeonly buffer m_leafCountPartialsBlock { uint m_leafCountPartials[]; };  // per-workgroup partial results of the reduction of m_leafCount
+layout(std430, binding = 1) buffer m_codesBuffer
+{
+  uvec2 m_codes[];
+};  // member std::vector m_codes
+layout(std430, binding = 2) buffer m_groupOfBuffer
+{
+  uint m_groupOf[];
+};  // member std::vector m_groupOf
+layout(std430, binding = 3) buffer m_leafCodeBuffer
+{
+  uint m_leafCode[];
+};  // member std::vector m_leafCode
+layout(std430, binding = 4) buffer m_leafFirstBuffer
+{
+  uint m_leafFirst[];
+};  // member std::vector m_leafFirst
+layout(std430, binding = 5) buffer m_newGroupBuffer
+{
+  uint m_newGroup[];
+};  // member std::vector m_newGroup
+layout(std430, binding = 6) writeonly buffer m_leafCountPartialsBlock
+{
+  uint m_leafCountPartials[];
+};  // per-workgroup partial results of the reduction of m_leafCount
 
 layout(push_constant) uniform kernel1D_AppendCompleteArgs
 {
@@ -85,7 +104,8 @@ void main()
   barrier();
   if (gl_LocalInvocationIndex == 0)
   {
-    const uint groupId = gl_WorkGroupID.x + gl_NumWorkGroups.x * (gl_WorkGroupID.y + gl_NumWorkGroups.y * gl_WorkGroupID.z);
+    const uint groupId =
+        gl_WorkGroupID.x + gl_NumWorkGroups.x * (gl_WorkGroupID.y + gl_NumWorkGroups.y * gl_WorkGroupID.z);
     uint m_leafCountGroup = m_leafCountShared[0];
     for (uint s = 1; s < gl_NumSubgroups; ++s)
       m_leafCountGroup = m_leafCountGroup + m_leafCountShared[s];

@@ -6,7 +6,8 @@
 
 layout(local_size_x = 256) in;
 
-struct BVHNode {  // from BVHNode
+struct BVHNode
+{  // from BVHNode
   vec3 boxMin;
   uint left;
   vec3 boxMax;
@@ -37,7 +38,10 @@ layout(std430, binding = 0) buffer LBVHData
   uint m_arrivals_size;
   uint m_arrivals_capacity;
 };
-layout(std430, binding = 1) readonly buffer m_leafCountPartialsBlock { uint m_leafCountPartials[]; };
+layout(std430, binding = 1) readonly buffer m_leafCountPartialsBlock
+{
+  uint m_leafCountPartials[];
+};
 
 layout(push_constant) uniform kernel1D_AppendComplete_ReduceArgs
 {

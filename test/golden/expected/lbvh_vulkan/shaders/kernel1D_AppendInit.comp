@@ -4,7 +4,8 @@
 
 layout(local_size_x = 256, local_size_y = 1, local_size_z = 1) in;
 
-struct BVHNode {  // from BVHNode
+struct BVHNode
+{  // from BVHNode
   vec3 boxMin;
   uint left;
   vec3 boxMax;
@@ -36,9 +37,18 @@ layout(std430, binding = 0) buffer LBVHData
   uint m_arrivals_size;
   uint m_arrivals_capacity;
 };
-layout(std430, binding = 1) buffer m_codesBuffer { uvec2 m_codes[]; };  // member std::vector m_codes
-layout(std430, binding = 2) buffer m_newGroupBuffer { uint m_newGroup[]; };  // member std::vector m_newGroup
-layout(std430, binding = 3) buffer m_primIndicesBuffer { uint m_primIndices[]; };  // member std::vector m_primIndices
+layout(std430, binding = 1) buffer m_codesBuffer
+{
+  uvec2 m_codes[];
+};  // member std::vector m_codes
+layout(std430, binding = 2) buffer m_newGroupBuffer
+{
+  uint m_newGroup[];
+};  // member std::vector m_newGroup
+layout(std430, binding = 3) buffer m_primIndicesBuffer
+{
+  uint m_primIndices[];
+};  // member std::vector m_primIndices
 
 layout(push_constant) uniform kernel1D_AppendInitArgs
 {

@@ -6,14 +6,16 @@
 
 layout(local_size_x = 256, local_size_y = 1, local_size_z = 1) in;
 
-struct BVHNode {  // from BVHNode
+struct BVHNode
+{  // from BVHNode
   vec3 boxMin;
   uint left;
   vec3 boxMax;
   uint right;
 };
 
-struct Box4f {  // from LiteMath::Box4f
+struct Box4f
+{  // from LiteMath::Box4f
   vec4 boxMin;
   vec4 boxMax;
 };
@@ -43,9 +45,18 @@ layout(std430, binding = 0) buffer LBVHData
   uint m_arrivals_size;
   uint m_arrivals_capacity;
 };
-layout(std430, binding = 1) readonly buffer boxesBuffer { Box4f boxes[]; };  // parameter 'boxes'
-layout(std430, binding = 2) writeonly buffer m_centerMinPartialsBlock { vec3 m_centerMinPartials[]; };  // per-workgroup partial results of the reduction of m_centerMin
-layout(std430, binding = 3) writeonly buffer m_centerMaxPartialsBlock { vec3 m_centerMaxPartials[]; };  // per-workgroup partial results of the reduction of m_centerMax
+layout(std430, binding = 1) readonly buffer boxesBuffer
+{
+  Box4f boxes[];
+};  // parameter 'boxes'
+layout(std430, binding = 2) writeonly buffer m_centerMinPartialsBlock
+{
+  vec3 m_centerMinPartials[];
+};  // per-workgroup partial results of the reduction of m_centerMin
+layout(std430, binding = 3) writeonly buffer m_centerMaxPartialsBlock
+{
+  vec3 m_centerMaxPartials[];
+};  // per-workgroup partial results of the reduction of m_centerMax
 
 layout(push_constant) uniform kernel1D_BoundsArgs
 {
@@ -88,7 +99,8 @@ void main()
   barrier();
   if (gl_LocalInvocationIndex == 0)
   {
-    const uint groupId = gl_WorkGroupID.x + gl_NumWorkGroups.x * (gl_WorkGroupID.y + gl_NumWorkGroups.y * gl_WorkGroupID.z);
+    const uint groupId =
+        gl_WorkGroupID.x + gl_NumWorkGroups.x * (gl_WorkGroupID.y + gl_NumWorkGroups.y * gl_WorkGroupID.z);
     vec3 m_centerMinGroup = m_centerMinShared[0];
     for (uint s = 1; s < gl_NumSubgroups; ++s)
       m_centerMinGroup = min(m_centerMinGroup, m_centerMinShared[s]);

@@ -7,7 +7,8 @@
 layout(local_size_x = 256) in;
 #define CRT_INFINITY uintBitsToFloat(0x7F800000u)  // the identity of min over floats (max: -CRT_INFINITY)
 
-struct BVHNode {  // from BVHNode
+struct BVHNode
+{  // from BVHNode
   vec3 boxMin;
   uint left;
   vec3 boxMax;
@@ -38,8 +39,14 @@ layout(std430, binding = 0) buffer LBVHData
   uint m_arrivals_size;
   uint m_arrivals_capacity;
 };
-layout(std430, binding = 1) readonly buffer m_centerMinPartialsBlock { vec3 m_centerMinPartials[]; };
-layout(std430, binding = 2) readonly buffer m_centerMaxPartialsBlock { vec3 m_centerMaxPartials[]; };
+layout(std430, binding = 1) readonly buffer m_centerMinPartialsBlock
+{
+  vec3 m_centerMinPartials[];
+};
+layout(std430, binding = 2) readonly buffer m_centerMaxPartialsBlock
+{
+  vec3 m_centerMaxPartials[];
+};
 
 layout(push_constant) uniform kernel1D_Bounds_ReduceArgs
 {

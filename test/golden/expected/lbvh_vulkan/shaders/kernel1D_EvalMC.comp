@@ -4,14 +4,16 @@
 
 layout(local_size_x = 256, local_size_y = 1, local_size_z = 1) in;
 
-struct BVHNode {  // from BVHNode
+struct BVHNode
+{  // from BVHNode
   vec3 boxMin;
   uint left;
   vec3 boxMax;
   uint right;
 };
 
-struct Box4f {  // from LiteMath::Box4f
+struct Box4f
+{  // from LiteMath::Box4f
   vec4 boxMin;
   vec4 boxMax;
 };
@@ -41,8 +43,14 @@ layout(std430, binding = 0) buffer LBVHData
   uint m_arrivals_size;
   uint m_arrivals_capacity;
 };
-layout(std430, binding = 1) readonly buffer boxesBuffer { Box4f boxes[]; };  // parameter 'boxes'
-layout(std430, binding = 2) buffer m_codesBuffer { uvec2 m_codes[]; };  // member std::vector m_codes
+layout(std430, binding = 1) readonly buffer boxesBuffer
+{
+  Box4f boxes[];
+};  // parameter 'boxes'
+layout(std430, binding = 2) buffer m_codesBuffer
+{
+  uvec2 m_codes[];
+};  // member std::vector m_codes
 
 layout(push_constant) uniform kernel1D_EvalMCArgs
 {
@@ -66,9 +74,11 @@ void kernel1D_EvalMC(int i)
 {
   const vec3 center = 0.5 * ((boxes[i].boxMin).xyz + (boxes[i].boxMax).xyz);
   const vec3 extent = m_centerMax - m_centerMin;
-  const vec3 scale = vec3(extent.x > 0.0 ? 1023.0 / extent.x : 0.0, extent.y > 0.0 ? 1023.0 / extent.y : 0.0, extent.z > 0.0 ? 1023.0 / extent.z : 0.0);
+  const vec3 scale = vec3(extent.x > 0.0 ? 1023.0 / extent.x : 0.0, extent.y > 0.0 ? 1023.0 / extent.y : 0.0,
+                          extent.z > 0.0 ? 1023.0 / extent.z : 0.0);
   const vec3 cell = clamp((center - m_centerMin) * scale, vec3(0.0), vec3(1023.0));
-  const uint code = (MortonExpandBits(uint(cell.x)) << 2) | (MortonExpandBits(uint(cell.y)) << 1) | MortonExpandBits(uint(cell.z));
+  const uint code =
+      (MortonExpandBits(uint(cell.x)) << 2) | (MortonExpandBits(uint(cell.y)) << 1) | MortonExpandBits(uint(cell.z));
   m_codes[uint(i)] = uvec2(code, uint(i));
 }
 

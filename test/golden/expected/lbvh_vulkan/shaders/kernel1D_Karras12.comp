@@ -4,7 +4,8 @@
 
 layout(local_size_x = 256, local_size_y = 1, local_size_z = 1) in;
 
-struct BVHNode {  // from BVHNode
+struct BVHNode
+{  // from BVHNode
   vec3 boxMin;
   uint left;
   vec3 boxMax;
@@ -36,10 +37,22 @@ layout(std430, binding = 0) buffer LBVHData
   uint m_arrivals_size;
   uint m_arrivals_capacity;
 };
-layout(std430, binding = 1) buffer m_arrivalsBuffer { uint m_arrivals[]; };  // member std::vector m_arrivals
-layout(std430, binding = 2) buffer m_leafCodeBuffer { uint m_leafCode[]; };  // member std::vector m_leafCode
-layout(std430, binding = 3) buffer m_nodesBuffer { BVHNode m_nodes[]; };  // member std::vector m_nodes
-layout(std430, binding = 4) buffer m_parentBuffer { uint m_parent[]; };  // member std::vector m_parent
+layout(std430, binding = 1) buffer m_arrivalsBuffer
+{
+  uint m_arrivals[];
+};  // member std::vector m_arrivals
+layout(std430, binding = 2) buffer m_leafCodeBuffer
+{
+  uint m_leafCode[];
+};  // member std::vector m_leafCode
+layout(std430, binding = 3) buffer m_nodesBuffer
+{
+  BVHNode m_nodes[];
+};  // member std::vector m_nodes
+layout(std430, binding = 4) buffer m_parentBuffer
+{
+  uint m_parent[];
+};  // member std::vector m_parent
 
 layout(push_constant) uniform kernel1D_Karras12Args
 {

@@ -4,14 +4,16 @@
 
 layout(local_size_x = 256, local_size_y = 1, local_size_z = 1) in;
 
-struct BVHNode {  // from BVHNode
+struct BVHNode
+{  // from BVHNode
   vec3 boxMin;
   uint left;
   vec3 boxMax;
   uint right;
 };
 
-struct Box4f {  // from LiteMath::Box4f
+struct Box4f
+{  // from LiteMath::Box4f
   vec4 boxMin;
   vec4 boxMax;
 };
@@ -41,10 +43,22 @@ layout(std430, binding = 0) buffer LBVHData
   uint m_arrivals_size;
   uint m_arrivals_capacity;
 };
-layout(std430, binding = 1) readonly buffer boxesBuffer { Box4f boxes[]; };  // parameter 'boxes'
-layout(std430, binding = 2) buffer m_leafFirstBuffer { uint m_leafFirst[]; };  // member std::vector m_leafFirst
-layout(std430, binding = 3) buffer m_nodesBuffer { BVHNode m_nodes[]; };  // member std::vector m_nodes
-layout(std430, binding = 4) buffer m_primIndicesBuffer { uint m_primIndices[]; };  // member std::vector m_primIndices
+layout(std430, binding = 1) readonly buffer boxesBuffer
+{
+  Box4f boxes[];
+};  // parameter 'boxes'
+layout(std430, binding = 2) buffer m_leafFirstBuffer
+{
+  uint m_leafFirst[];
+};  // member std::vector m_leafFirst
+layout(std430, binding = 3) buffer m_nodesBuffer
+{
+  BVHNode m_nodes[];
+};  // member std::vector m_nodes
+layout(std430, binding = 4) buffer m_primIndicesBuffer
+{
+  uint m_primIndices[];
+};  // member std::vector m_primIndices
 
 layout(push_constant) uniform kernel1D_MakeLeavesArgs
 {

@@ -4,7 +4,8 @@
 
 layout(local_size_x = 256, local_size_y = 1, local_size_z = 1) in;
 
-struct BVHNode {  // from BVHNode
+struct BVHNode
+{  // from BVHNode
   vec3 boxMin;
   uint left;
   vec3 boxMax;
@@ -36,9 +37,18 @@ layout(std430, binding = 0) coherent buffer LBVHData
   uint m_arrivals_size;
   uint m_arrivals_capacity;
 };
-layout(std430, binding = 1) coherent buffer m_arrivalsBuffer { uint m_arrivals[]; };  // member std::vector m_arrivals
-layout(std430, binding = 2) coherent buffer m_nodesBuffer { BVHNode m_nodes[]; };  // member std::vector m_nodes
-layout(std430, binding = 3) coherent buffer m_parentBuffer { uint m_parent[]; };  // member std::vector m_parent
+layout(std430, binding = 1) coherent buffer m_arrivalsBuffer
+{
+  uint m_arrivals[];
+};  // member std::vector m_arrivals
+layout(std430, binding = 2) coherent buffer m_nodesBuffer
+{
+  BVHNode m_nodes[];
+};  // member std::vector m_nodes
+layout(std430, binding = 3) coherent buffer m_parentBuffer
+{
+  uint m_parent[];
+};  // member std::vector m_parent
 
 layout(push_constant) uniform kernel1D_RefitArgs
 {
@@ -51,10 +61,30 @@ layout(push_constant) uniform kernel1D_RefitArgs
 // (crt_release, on its last argument) and after it (crt_acquire, on its result), on coherent
 // buffers. The runtime turns the fences off where every atomic is sequentially consistent already.
 layout(constant_id = 1700) const bool crt_fenceAtomics = true;
-uint crt_release(uint value) { if (crt_fenceAtomics) memoryBarrierBuffer(); return value; }
-int crt_release(int value) { if (crt_fenceAtomics) memoryBarrierBuffer(); return value; }
-uint crt_acquire(uint value) { if (crt_fenceAtomics) memoryBarrierBuffer(); return value; }
-int crt_acquire(int value) { if (crt_fenceAtomics) memoryBarrierBuffer(); return value; }
+uint crt_release(uint value)
+{
+  if (crt_fenceAtomics)
+    memoryBarrierBuffer();
+  return value;
+}
+int crt_release(int value)
+{
+  if (crt_fenceAtomics)
+    memoryBarrierBuffer();
+  return value;
+}
+uint crt_acquire(uint value)
+{
+  if (crt_fenceAtomics)
+    memoryBarrierBuffer();
+  return value;
+}
+int crt_acquire(int value)
+{
+  if (crt_fenceAtomics)
+    memoryBarrierBuffer();
+  return value;
+}
 
 // from LBVH::kernel1D_Refit (LBVH.cpp)
 void kernel1D_Refit(int leaf)
@@ -76,12 +106,10 @@ void kernel1D_Refit(int leaf)
       if (node >= firstLeaf && node == right)
         break;
     }
-    else
-      if (node >= firstLeaf)
-        break;
-      else
-        if (crt_acquire(atomicAdd(m_arrivals[parent], crt_release(1u))) == 0u)
-          break;
+    else if (node >= firstLeaf)
+      break;
+    else if (crt_acquire(atomicAdd(m_arrivals[parent], crt_release(1u))) == 0u)
+      break;
     boxMin = min(boxMin, m_nodes[sibling].boxMin);
     boxMax = max(boxMax, m_nodes[sibling].boxMax);
     m_nodes[parent].boxMin = boxMin;

@@ -12,13 +12,34 @@ layout(std430, binding = 0) buffer LocalTotalsData
   float m_mean;
   float m_range;
 };
-layout(std430, binding = 1) readonly buffer a_valuesBuffer { vec4 a_values[]; };  // parameter 'a_values'
-layout(std430, binding = 2) buffer a_outBuffer { float a_out[]; };  // parameter 'a_out'
-layout(std430, binding = 3) buffer sumPartialsBlock { float sumPartials[]; };  // per-workgroup partial results of the reduction of local sum
-layout(std430, binding = 4) buffer loPartialsBlock { float loPartials[]; };  // per-workgroup partial results of the reduction of local lo
-layout(std430, binding = 5) buffer hiPartialsBlock { float hiPartials[]; };  // per-workgroup partial results of the reduction of local hi
-layout(std430, binding = 6) buffer totalPartialsBlock { vec4 totalPartials[]; };  // per-workgroup partial results of the reduction of local total
-layout(std430, binding = 7) buffer negativesPartialsBlock { int negativesPartials[]; };  // per-workgroup partial results of the reduction of local negatives
+layout(std430, binding = 1) readonly buffer a_valuesBuffer
+{
+  vec4 a_values[];
+};  // parameter 'a_values'
+layout(std430, binding = 2) buffer a_outBuffer
+{
+  float a_out[];
+};  // parameter 'a_out'
+layout(std430, binding = 3) buffer sumPartialsBlock
+{
+  float sumPartials[];
+};  // per-workgroup partial results of the reduction of local sum
+layout(std430, binding = 4) buffer loPartialsBlock
+{
+  float loPartials[];
+};  // per-workgroup partial results of the reduction of local lo
+layout(std430, binding = 5) buffer hiPartialsBlock
+{
+  float hiPartials[];
+};  // per-workgroup partial results of the reduction of local hi
+layout(std430, binding = 6) buffer totalPartialsBlock
+{
+  vec4 totalPartials[];
+};  // per-workgroup partial results of the reduction of local total
+layout(std430, binding = 7) buffer negativesPartialsBlock
+{
+  int negativesPartials[];
+};  // per-workgroup partial results of the reduction of local negatives
 
 layout(push_constant) uniform kernel1D_SummarizeArgs
 {
@@ -77,7 +98,8 @@ void main()
   barrier();
   if (gl_LocalInvocationIndex == 0)
   {
-    const uint groupId = gl_WorkGroupID.x + gl_NumWorkGroups.x * (gl_WorkGroupID.y + gl_NumWorkGroups.y * gl_WorkGroupID.z);
+    const uint groupId =
+        gl_WorkGroupID.x + gl_NumWorkGroups.x * (gl_WorkGroupID.y + gl_NumWorkGroups.y * gl_WorkGroupID.z);
     float sumGroup = sumShared[0];
     for (uint s = 1; s < gl_NumSubgroups; ++s)
       sumGroup = sumGroup + sumShared[s];

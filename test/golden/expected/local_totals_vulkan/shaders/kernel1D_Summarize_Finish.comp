@@ -12,13 +12,34 @@ layout(std430, binding = 0) buffer LocalTotalsData
   float m_mean;
   float m_range;
 };
-layout(std430, binding = 1) readonly buffer a_valuesBuffer { vec4 a_values[]; };  // parameter 'a_values'
-layout(std430, binding = 2) buffer a_outBuffer { float a_out[]; };  // parameter 'a_out'
-layout(std430, binding = 3) buffer sumPartialsBlock { float sumPartials[]; };  // per-workgroup partial results of the reduction of local sum
-layout(std430, binding = 4) buffer loPartialsBlock { float loPartials[]; };  // per-workgroup partial results of the reduction of local lo
-layout(std430, binding = 5) buffer hiPartialsBlock { float hiPartials[]; };  // per-workgroup partial results of the reduction of local hi
-layout(std430, binding = 6) buffer totalPartialsBlock { vec4 totalPartials[]; };  // per-workgroup partial results of the reduction of local total
-layout(std430, binding = 7) buffer negativesPartialsBlock { int negativesPartials[]; };  // per-workgroup partial results of the reduction of local negatives
+layout(std430, binding = 1) readonly buffer a_valuesBuffer
+{
+  vec4 a_values[];
+};  // parameter 'a_values'
+layout(std430, binding = 2) buffer a_outBuffer
+{
+  float a_out[];
+};  // parameter 'a_out'
+layout(std430, binding = 3) buffer sumPartialsBlock
+{
+  float sumPartials[];
+};  // per-workgroup partial results of the reduction of local sum
+layout(std430, binding = 4) buffer loPartialsBlock
+{
+  float loPartials[];
+};  // per-workgroup partial results of the reduction of local lo
+layout(std430, binding = 5) buffer hiPartialsBlock
+{
+  float hiPartials[];
+};  // per-workgroup partial results of the reduction of local hi
+layout(std430, binding = 6) buffer totalPartialsBlock
+{
+  vec4 totalPartials[];
+};  // per-workgroup partial results of the reduction of local total
+layout(std430, binding = 7) buffer negativesPartialsBlock
+{
+  int negativesPartials[];
+};  // per-workgroup partial results of the reduction of local negatives
 
 layout(push_constant) uniform kernel1D_SummarizeArgs
 {
@@ -27,7 +48,8 @@ layout(push_constant) uniform kernel1D_SummarizeArgs
   uint n;
 };
 
-// from LocalTotals::kernel1D_Summarize (local_totals.cpp): the statements after its loop nest, run by one thread after the others
+// from LocalTotals::kernel1D_Summarize (local_totals.cpp): the statements after its loop nest, run by one thread after
+// the others
 void kernel1D_Summarize_Finish()
 {
   float sum = 0.0;

@@ -17,9 +17,18 @@ layout(std430, binding = 0) buffer ParticlesData
   float m_restitution;
   float m_timeMs;
 };
-layout(std430, binding = 1) buffer positionsBuffer { vec4 positions[]; };  // parameter 'positions'
-layout(std430, binding = 2) buffer velocitiesBuffer { vec4 velocities[]; };  // parameter 'velocities'
-layout(std430, binding = 3) writeonly buffer m_bouncesPartialsBlock { int m_bouncesPartials[]; };  // per-workgroup partial results of the reduction of m_bounces
+layout(std430, binding = 1) buffer positionsBuffer
+{
+  vec4 positions[];
+};  // parameter 'positions'
+layout(std430, binding = 2) buffer velocitiesBuffer
+{
+  vec4 velocities[];
+};  // parameter 'velocities'
+layout(std430, binding = 3) writeonly buffer m_bouncesPartialsBlock
+{
+  int m_bouncesPartials[];
+};  // per-workgroup partial results of the reduction of m_bounces
 
 layout(push_constant) uniform kernel1D_AdvanceArgs
 {
@@ -67,7 +76,8 @@ void main()
   barrier();
   if (gl_LocalInvocationIndex == 0)
   {
-    const uint groupId = gl_WorkGroupID.x + gl_NumWorkGroups.x * (gl_WorkGroupID.y + gl_NumWorkGroups.y * gl_WorkGroupID.z);
+    const uint groupId =
+        gl_WorkGroupID.x + gl_NumWorkGroups.x * (gl_WorkGroupID.y + gl_NumWorkGroups.y * gl_WorkGroupID.z);
     int m_bouncesGroup = m_bouncesShared[0];
     for (uint s = 1; s < gl_NumSubgroups; ++s)
       m_bouncesGroup = m_bouncesGroup + m_bouncesShared[s];

@@ -17,7 +17,10 @@ layout(std430, binding = 0) buffer ParticlesData
   float m_restitution;
   float m_timeMs;
 };
-layout(std430, binding = 1) readonly buffer m_bouncesPartialsBlock { int m_bouncesPartials[]; };
+layout(std430, binding = 1) readonly buffer m_bouncesPartialsBlock
+{
+  int m_bouncesPartials[];
+};
 
 layout(push_constant) uniform kernel1D_Advance_ReduceArgs
 {

@@ -18,12 +18,30 @@ layout(std430, binding = 0) buffer ParticlesData
   float m_restitution;
   float m_timeMs;
 };
-layout(std430, binding = 1) readonly buffer positionsBuffer { vec4 positions[]; };  // parameter 'positions'
-layout(std430, binding = 2) readonly buffer velocitiesBuffer { vec4 velocities[]; };  // parameter 'velocities'
-layout(std430, binding = 3) writeonly buffer m_boxMinPartialsBlock { vec4 m_boxMinPartials[]; };  // per-workgroup partial results of the reduction of m_boxMin
-layout(std430, binding = 4) writeonly buffer m_boxMaxPartialsBlock { vec4 m_boxMaxPartials[]; };  // per-workgroup partial results of the reduction of m_boxMax
-layout(std430, binding = 5) writeonly buffer m_momentumPartialsBlock { vec4 m_momentumPartials[]; };  // per-workgroup partial results of the reduction of m_momentum
-layout(std430, binding = 6) writeonly buffer m_kineticEnergyPartialsBlock { float m_kineticEnergyPartials[]; };  // per-workgroup partial results of the reduction of m_kineticEnergy
+layout(std430, binding = 1) readonly buffer positionsBuffer
+{
+  vec4 positions[];
+};  // parameter 'positions'
+layout(std430, binding = 2) readonly buffer velocitiesBuffer
+{
+  vec4 velocities[];
+};  // parameter 'velocities'
+layout(std430, binding = 3) writeonly buffer m_boxMinPartialsBlock
+{
+  vec4 m_boxMinPartials[];
+};  // per-workgroup partial results of the reduction of m_boxMin
+layout(std430, binding = 4) writeonly buffer m_boxMaxPartialsBlock
+{
+  vec4 m_boxMaxPartials[];
+};  // per-workgroup partial results of the reduction of m_boxMax
+layout(std430, binding = 5) writeonly buffer m_momentumPartialsBlock
+{
+  vec4 m_momentumPartials[];
+};  // per-workgroup partial results of the reduction of m_momentum
+layout(std430, binding = 6) writeonly buffer m_kineticEnergyPartialsBlock
+{
+  float m_kineticEnergyPartials[];
+};  // per-workgroup partial results of the reduction of m_kineticEnergy
 
 layout(push_constant) uniform kernel1D_MeasureArgs
 {
@@ -77,7 +95,8 @@ void main()
   barrier();
   if (gl_LocalInvocationIndex == 0)
   {
-    const uint groupId = gl_WorkGroupID.x + gl_NumWorkGroups.x * (gl_WorkGroupID.y + gl_NumWorkGroups.y * gl_WorkGroupID.z);
+    const uint groupId =
+        gl_WorkGroupID.x + gl_NumWorkGroups.x * (gl_WorkGroupID.y + gl_NumWorkGroups.y * gl_WorkGroupID.z);
     vec4 m_boxMinGroup = m_boxMinShared[0];
     for (uint s = 1; s < gl_NumSubgroups; ++s)
       m_boxMinGroup = min(m_boxMinGroup, m_boxMinShared[s]);

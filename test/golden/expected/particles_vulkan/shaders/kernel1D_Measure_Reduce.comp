@@ -18,10 +18,22 @@ layout(std430, binding = 0) buffer ParticlesData
   float m_restitution;
   float m_timeMs;
 };
-layout(std430, binding = 1) readonly buffer m_boxMinPartialsBlock { vec4 m_boxMinPartials[]; };
-layout(std430, binding = 2) readonly buffer m_boxMaxPartialsBlock { vec4 m_boxMaxPartials[]; };
-layout(std430, binding = 3) readonly buffer m_momentumPartialsBlock { vec4 m_momentumPartials[]; };
-layout(std430, binding = 4) readonly buffer m_kineticEnergyPartialsBlock { float m_kineticEnergyPartials[]; };
+layout(std430, binding = 1) readonly buffer m_boxMinPartialsBlock
+{
+  vec4 m_boxMinPartials[];
+};
+layout(std430, binding = 2) readonly buffer m_boxMaxPartialsBlock
+{
+  vec4 m_boxMaxPartials[];
+};
+layout(std430, binding = 3) readonly buffer m_momentumPartialsBlock
+{
+  vec4 m_momentumPartials[];
+};
+layout(std430, binding = 4) readonly buffer m_kineticEnergyPartialsBlock
+{
+  float m_kineticEnergyPartials[];
+};
 
 layout(push_constant) uniform kernel1D_Measure_ReduceArgs
 {

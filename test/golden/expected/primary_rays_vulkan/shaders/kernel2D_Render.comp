@@ -4,7 +4,8 @@
 
 layout(local_size_x = 16, local_size_y = 16, local_size_z = 1) in;
 
-struct CRT_Hit {  // from CRT_Hit
+struct CRT_Hit
+{  // from CRT_Hit
   float t;
   uint primId;
   uint instId;
@@ -12,7 +13,8 @@ struct CRT_Hit {  // from CRT_Hit
   float coords[4];
 };
 
-struct BVHTraceRay {  // from BVHTraceRay
+struct BVHTraceRay
+{  // from BVHTraceRay
   vec3 org;
   vec3 dir;
   vec3 invDir;
@@ -26,7 +28,8 @@ struct BVHTraceRay {  // from BVHTraceRay
   bool anyZeroAxis;
 };
 
-struct BVHInstance {  // from BVHInstance
+struct BVHInstance
+{  // from BVHInstance
   vec4 toObjectRow0;
   vec4 toObjectRow1;
   vec4 toObjectRow2;
@@ -40,7 +43,8 @@ struct BVHInstance {  // from BVHInstance
   uint unused1;
 };
 
-struct BVH4Node {  // from BVH4Node
+struct BVH4Node
+{  // from BVH4Node
   vec4 minX;
   vec4 maxX;
   vec4 minY;
@@ -51,7 +55,8 @@ struct BVH4Node {  // from BVH4Node
   uvec4 unused;
 };
 
-struct BVHTriangle4 {  // from BVHTriangle4
+struct BVHTriangle4
+{  // from BVHTriangle4
   vec4 coord[9];
 };
 
@@ -83,15 +88,42 @@ layout(std430, binding = 0) buffer PrimaryRaysData
   uint m_pAccelStruct_m_primIds_size;
   uint m_pAccelStruct_m_primIds_capacity;
 };
-layout(std430, binding = 1) buffer pixelsBuffer { uint pixels[]; };  // parameter 'pixels'
-layout(std430, binding = 2) buffer m_indicesBuffer { uint m_indices[]; };  // member std::vector m_indices
-layout(std430, binding = 3) buffer m_pAccelStruct_m_boxesBuffer { BVH4Node m_pAccelStruct_m_boxes[]; };  // composed: std::vector BVHScene::m_boxes through m_pAccelStruct
-layout(std430, binding = 4) buffer m_pAccelStruct_m_instancesBuffer { BVHInstance m_pAccelStruct_m_instances[]; };  // composed: std::vector BVHScene::m_instances through m_pAccelStruct
-layout(std430, binding = 5) buffer m_pAccelStruct_m_motionBuffer { vec4 m_pAccelStruct_m_motion[]; };  // composed: std::vector BVHScene::m_motion through m_pAccelStruct
-layout(std430, binding = 6) buffer m_pAccelStruct_m_nodesBuffer { BVH4Node m_pAccelStruct_m_nodes[]; };  // composed: std::vector BVHScene::m_nodes through m_pAccelStruct
-layout(std430, binding = 7) buffer m_pAccelStruct_m_primIdsBuffer { uint m_pAccelStruct_m_primIds[]; };  // composed: std::vector BVHScene::m_primIds through m_pAccelStruct
-layout(std430, binding = 8) buffer m_pAccelStruct_m_trianglesBuffer { BVHTriangle4 m_pAccelStruct_m_triangles[]; };  // composed: std::vector BVHScene::m_triangles through m_pAccelStruct
-layout(std430, binding = 9) buffer m_verticesBuffer { vec4 m_vertices[]; };  // member std::vector m_vertices
+layout(std430, binding = 1) buffer pixelsBuffer
+{
+  uint pixels[];
+};  // parameter 'pixels'
+layout(std430, binding = 2) buffer m_indicesBuffer
+{
+  uint m_indices[];
+};  // member std::vector m_indices
+layout(std430, binding = 3) buffer m_pAccelStruct_m_boxesBuffer
+{
+  BVH4Node m_pAccelStruct_m_boxes[];
+};  // composed: std::vector BVHScene::m_boxes through m_pAccelStruct
+layout(std430, binding = 4) buffer m_pAccelStruct_m_instancesBuffer
+{
+  BVHInstance m_pAccelStruct_m_instances[];
+};  // composed: std::vector BVHScene::m_instances through m_pAccelStruct
+layout(std430, binding = 5) buffer m_pAccelStruct_m_motionBuffer
+{
+  vec4 m_pAccelStruct_m_motion[];
+};  // composed: std::vector BVHScene::m_motion through m_pAccelStruct
+layout(std430, binding = 6) buffer m_pAccelStruct_m_nodesBuffer
+{
+  BVH4Node m_pAccelStruct_m_nodes[];
+};  // composed: std::vector BVHScene::m_nodes through m_pAccelStruct
+layout(std430, binding = 7) buffer m_pAccelStruct_m_primIdsBuffer
+{
+  uint m_pAccelStruct_m_primIds[];
+};  // composed: std::vector BVHScene::m_primIds through m_pAccelStruct
+layout(std430, binding = 8) buffer m_pAccelStruct_m_trianglesBuffer
+{
+  BVHTriangle4 m_pAccelStruct_m_triangles[];
+};  // composed: std::vector BVHScene::m_triangles through m_pAccelStruct
+layout(std430, binding = 9) buffer m_verticesBuffer
+{
+  vec4 m_vertices[];
+};  // member std::vector m_vertices
 
 layout(push_constant) uniform kernel2D_RenderArgs
 {
@@ -118,7 +150,10 @@ bool m_pAccelStruct_RayInterval(vec4 posAndNear, vec4 dirAndFar, inout float tne
 {
   tnear = max(posAndNear.w, 0.0);
   tfar = dirAndFar.w;
-  const bool finite = !(isinf(posAndNear.x) || isnan(posAndNear.x)) && !(isinf(posAndNear.y) || isnan(posAndNear.y)) && !(isinf(posAndNear.z) || isnan(posAndNear.z)) && !(isinf(posAndNear.w) || isnan(posAndNear.w)) && !(isinf(dirAndFar.x) || isnan(dirAndFar.x)) && !(isinf(dirAndFar.y) || isnan(dirAndFar.y)) && !(isinf(dirAndFar.z) || isnan(dirAndFar.z));
+  const bool finite = !(isinf(posAndNear.x) || isnan(posAndNear.x)) && !(isinf(posAndNear.y) || isnan(posAndNear.y)) &&
+                      !(isinf(posAndNear.z) || isnan(posAndNear.z)) && !(isinf(posAndNear.w) || isnan(posAndNear.w)) &&
+                      !(isinf(dirAndFar.x) || isnan(dirAndFar.x)) && !(isinf(dirAndFar.y) || isnan(dirAndFar.y)) &&
+                      !(isinf(dirAndFar.z) || isnan(dirAndFar.z));
   const bool nonZeroDir = dirAndFar.x != 0.0 || dirAndFar.y != 0.0 || dirAndFar.z != 0.0;
   return finite && nonZeroDir && tnear < tfar;
 }
@@ -126,11 +161,13 @@ bool m_pAccelStruct_RayInterval(vec4 posAndNear, vec4 dirAndFar, inout float tne
 // from (anonymous namespace)::Prepare
 BVHTraceRay m_pAccelStruct_Prepare(vec3 org, vec3 dir, float tnear)
 {
-  BVHTraceRay r = BVHTraceRay(vec3(0), vec3(0), vec3(0), float(0), int(0), int(0), int(0), float(0), float(0), float(0), bool(0));
+  BVHTraceRay r =
+      BVHTraceRay(vec3(0), vec3(0), vec3(0), float(0), int(0), int(0), int(0), float(0), float(0), float(0), bool(0));
   r.org = org;
   r.dir = dir;
   r.tnear = tnear;
-  r.invDir = vec3(isinf(1.0 / dir.x) ? 0.0 : 1.0 / dir.x, isinf(1.0 / dir.y) ? 0.0 : 1.0 / dir.y, isinf(1.0 / dir.z) ? 0.0 : 1.0 / dir.z);
+  r.invDir = vec3(isinf(1.0 / dir.x) ? 0.0 : 1.0 / dir.x, isinf(1.0 / dir.y) ? 0.0 : 1.0 / dir.y,
+                  isinf(1.0 / dir.z) ? 0.0 : 1.0 / dir.z);
   r.anyZeroAxis = r.invDir.x == 0.0 || r.invDir.y == 0.0 || r.invDir.z == 0.0;
   const vec3 ad = vec3(abs(dir.x), abs(dir.y), abs(dir.z));
   r.kz = ad.x >= ad.y && ad.x >= ad.z ? 0 : ad.y >= ad.z ? 1 : 2;
@@ -230,7 +267,9 @@ float m_pAccelStruct_DifferenceOfProducts(float a, float b, float c, float d)
 // from (anonymous namespace)::DifferenceOfProducts
 vec4 m_pAccelStruct_DifferenceOfProducts(vec4 a, vec4 b, vec4 c, vec4 d)
 {
-  return vec4(m_pAccelStruct_DifferenceOfProducts(a.x, b.x, c.x, d.x), m_pAccelStruct_DifferenceOfProducts(a.y, b.y, c.y, d.y), m_pAccelStruct_DifferenceOfProducts(a.z, b.z, c.z, d.z), m_pAccelStruct_DifferenceOfProducts(a.w, b.w, c.w, d.w));
+  return vec4(
+      m_pAccelStruct_DifferenceOfProducts(a.x, b.x, c.x, d.x), m_pAccelStruct_DifferenceOfProducts(a.y, b.y, c.y, d.y),
+      m_pAccelStruct_DifferenceOfProducts(a.z, b.z, c.z, d.z), m_pAccelStruct_DifferenceOfProducts(a.w, b.w, c.w, d.w));
 }
 
 // from BVHScene::IntersectGroup
@@ -258,11 +297,14 @@ uint m_pAccelStruct_IntersectGroup(BVHTraceRay r, uint group, float tfar, inout 
     ev = m_pAccelStruct_DifferenceOfProducts(ax, cy, ay, cx);
     ew = m_pAccelStruct_DifferenceOfProducts(bx, ay, by, ax);
   }
-  uint hits = uint(dot(vec4(lessThanEqual(zero, min(min(eu, ev), ew))), vec4(1.0, 2.0, 4.0, 8.0))) | uint(dot(vec4(lessThanEqual(max(max(eu, ev), ew), zero)), vec4(1.0, 2.0, 4.0, 8.0)));
+  uint hits = uint(dot(vec4(lessThanEqual(zero, min(min(eu, ev), ew))), vec4(1.0, 2.0, 4.0, 8.0))) |
+              uint(dot(vec4(lessThanEqual(max(max(eu, ev), ew), zero)), vec4(1.0, 2.0, 4.0, 8.0)));
   const vec4 det = eu + ev + ew;
-  hits = hits & ~(uint(dot(vec4(lessThanEqual(det, zero)), vec4(1.0, 2.0, 4.0, 8.0))) & uint(dot(vec4(lessThanEqual(zero, det)), vec4(1.0, 2.0, 4.0, 8.0))));
+  hits = hits & ~(uint(dot(vec4(lessThanEqual(det, zero)), vec4(1.0, 2.0, 4.0, 8.0))) &
+                  uint(dot(vec4(lessThanEqual(zero, det)), vec4(1.0, 2.0, 4.0, 8.0))));
   t = (eu * (r.sz * az) + ev * (r.sz * bz) + ew * (r.sz * cz)) / det;
-  hits = hits & uint(dot(vec4(lessThanEqual(vec4(r.tnear), t)), vec4(1.0, 2.0, 4.0, 8.0))) & uint(dot(vec4(lessThanEqual(t, vec4(tfar))), vec4(1.0, 2.0, 4.0, 8.0)));
+  hits = hits & uint(dot(vec4(lessThanEqual(vec4(r.tnear), t)), vec4(1.0, 2.0, 4.0, 8.0))) &
+         uint(dot(vec4(lessThanEqual(t, vec4(tfar))), vec4(1.0, 2.0, 4.0, 8.0)));
   u = ev / det;
   v = ew / det;
   return hits;
@@ -388,8 +430,7 @@ bool m_pAccelStruct_TraceMesh(BVHTraceRay ray, uint root, bool boxes, bool anyHi
       if (top == 0)
         return found;
       top = top - 1;
-    }
-    while (stackEntry[top] > tfar);
+    } while (stackEntry[top] > tfar);
     node = stack[top];
   }
 }
@@ -409,7 +450,8 @@ vec3 m_pAccelStruct_ToObjectVector(BVHInstance inst, vec3 d)
 }
 
 // from BVHScene::TraceInstance
-bool m_pAccelStruct_TraceInstance(uint k, BVHTraceRay worldRay, float time, bool anyHit, inout float tfar, inout CRT_Hit hit)
+bool m_pAccelStruct_TraceInstance(uint k, BVHTraceRay worldRay, float time, bool anyHit, inout float tfar,
+                                  inout CRT_Hit hit)
 {
   const BVHInstance inst = m_pAccelStruct_m_instances[k];
   const bool boxes = (inst.flags & m_pAccelStruct_kInstanceBoxes) != 0u;
@@ -425,13 +467,16 @@ bool m_pAccelStruct_TraceInstance(uint k, BVHTraceRay worldRay, float time, bool
     const vec4 row2 = mix(m_pAccelStruct_m_motion[at + 2u], m_pAccelStruct_m_motion[at + 5u], w);
     const mat3 toObject = inverse(transpose(mat3((row0).xyz, (row1).xyz, (row2).xyz)));
     const vec3 org = toObject * (worldRay.org - vec3(row0.w, row1.w, row2.w));
-    found = m_pAccelStruct_TraceMesh(m_pAccelStruct_Prepare(org, toObject * worldRay.dir, worldRay.tnear), inst.root, boxes, anyHit, tfar, hit);
+    found = m_pAccelStruct_TraceMesh(m_pAccelStruct_Prepare(org, toObject * worldRay.dir, worldRay.tnear), inst.root,
+                                     boxes, anyHit, tfar, hit);
   }
+  else if ((inst.flags & m_pAccelStruct_kInstanceIdentity) != 0u)
+    found = m_pAccelStruct_TraceMesh(worldRay, inst.root, boxes, anyHit, tfar, hit);
   else
-    if ((inst.flags & m_pAccelStruct_kInstanceIdentity) != 0u)
-      found = m_pAccelStruct_TraceMesh(worldRay, inst.root, boxes, anyHit, tfar, hit);
-    else
-      found = m_pAccelStruct_TraceMesh(m_pAccelStruct_Prepare(m_pAccelStruct_ToObjectPoint(inst, worldRay.org), m_pAccelStruct_ToObjectVector(inst, worldRay.dir), worldRay.tnear), inst.root, boxes, anyHit, tfar, hit);
+    found = m_pAccelStruct_TraceMesh(m_pAccelStruct_Prepare(m_pAccelStruct_ToObjectPoint(inst, worldRay.org),
+                                                            m_pAccelStruct_ToObjectVector(inst, worldRay.dir),
+                                                            worldRay.tnear),
+                                     inst.root, boxes, anyHit, tfar, hit);
   if (found)
   {
     hit.instId = inst.instId;
@@ -492,8 +537,7 @@ bool m_pAccelStruct_Trace(vec4 posAndNear, vec4 dirAndFar, float time, bool anyH
       if (top == 0)
         return found;
       top = top - 1;
-    }
-    while (stackEntry[top] > tfar);
+    } while (stackEntry[top] > tfar);
     node = stack[top];
   }
 }

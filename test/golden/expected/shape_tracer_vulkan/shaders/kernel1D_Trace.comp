@@ -6,7 +6,8 @@
 
 layout(local_size_x = 256, local_size_y = 1, local_size_z = 1) in;
 
-struct ShapeHit {  // from ShapeHit
+struct ShapeHit
+{  // from ShapeHit
   float t;
   uint shape;
   float nx;
@@ -17,36 +18,63 @@ struct ShapeHit {  // from ShapeHit
   float pad2;
 };
 
-layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer m_scene_m_shapes_Tags { uvec2 tags[]; };  // per element of m_scene->m_shapes: (class, index among its class's objects)
+layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer m_scene_m_shapes_Tags
+{
+  uvec2 tags[];
+};  // per element of m_scene->m_shapes: (class, index among its class's objects)
 
-struct Sphere_Data {  // the data members of Sphere
+struct Sphere_Data
+{  // the data members of Sphere
   vec4 centerAndRadius;
 };
 
-layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer m_scene_m_shapes_SphereObjects { Sphere_Data objects[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer m_scene_m_shapes_SphereObjects
+{
+  Sphere_Data objects[];
+};
 
-struct Box_Data {  // the data members of Box
+struct Box_Data
+{  // the data members of Box
   vec4 boxMin;
   vec4 boxMax;
 };
 
-layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer m_scene_m_shapes_BoxObjects { Box_Data objects[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer m_scene_m_shapes_BoxObjects
+{
+  Box_Data objects[];
+};
 
-struct Disc_Data {  // the data members of Disc
+struct Disc_Data
+{  // the data members of Disc
   vec4 center;
   vec4 normal;
   float radius;
 };
 
-layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer m_scene_m_shapes_DiscObjects { Disc_Data objects[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer m_scene_m_shapes_DiscObjects
+{
+  Disc_Data objects[];
+};
 
-layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer m_scene_m_lights_Tags { uvec2 tags[]; };  // per element of m_scene->m_lights: (class, index among its class's objects)
+layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer m_scene_m_lights_Tags
+{
+  uvec2 tags[];
+};  // per element of m_scene->m_lights: (class, index among its class's objects)
 
-layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer m_scene_m_lights_SphereObjects { Sphere_Data objects[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer m_scene_m_lights_SphereObjects
+{
+  Sphere_Data objects[];
+};
 
-layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer m_scene_m_lights_BoxObjects { Box_Data objects[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer m_scene_m_lights_BoxObjects
+{
+  Box_Data objects[];
+};
 
-layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer m_scene_m_lights_DiscObjects { Disc_Data objects[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer m_scene_m_lights_DiscObjects
+{
+  Disc_Data objects[];
+};
 
 // Data members of ShapeTracer, uploaded before every control function call.
 layout(std430, binding = 0) buffer ShapeTracerData
@@ -66,11 +94,26 @@ layout(std430, binding = 0) buffer ShapeTracerData
   uint m_scene_m_shapes_size;
   uint m_scene_m_lights_size;
 };
-layout(std430, binding = 1) readonly buffer originsBuffer { vec4 origins[]; };  // parameter 'origins'
-layout(std430, binding = 2) readonly buffer dirsBuffer { vec4 dirs[]; };  // parameter 'dirs'
-layout(std430, binding = 3) buffer hitsBuffer { ShapeHit hits[]; };  // parameter 'hits'
-layout(std430, binding = 4) buffer m_scene_m_boxesBuffer { vec4 m_scene_m_boxes[]; };  // composed: std::vector ShapeScene::m_boxes through m_scene
-layout(std430, binding = 5) buffer m_scene_m_lightBoxesBuffer { vec4 m_scene_m_lightBoxes[]; };  // composed: std::vector ShapeScene::m_lightBoxes through m_scene
+layout(std430, binding = 1) readonly buffer originsBuffer
+{
+  vec4 origins[];
+};  // parameter 'origins'
+layout(std430, binding = 2) readonly buffer dirsBuffer
+{
+  vec4 dirs[];
+};  // parameter 'dirs'
+layout(std430, binding = 3) buffer hitsBuffer
+{
+  ShapeHit hits[];
+};  // parameter 'hits'
+layout(std430, binding = 4) buffer m_scene_m_boxesBuffer
+{
+  vec4 m_scene_m_boxes[];
+};  // composed: std::vector ShapeScene::m_boxes through m_scene
+layout(std430, binding = 5) buffer m_scene_m_lightBoxesBuffer
+{
+  vec4 m_scene_m_lightBoxes[];
+};  // composed: std::vector ShapeScene::m_lightBoxes through m_scene
 
 layout(push_constant) uniform kernel1D_TraceArgs
 {
@@ -140,11 +183,10 @@ void Box_Intersect(Box_Data self, vec4 posAndNear, vec4 dirAndFar, uint shapeId,
   vec3 n = vec3(0.0, 0.0, 0.0);
   if (enter == tmin.x)
     n.x = dirAndFar.x > 0.0 ? -1.0 : 1.0;
+  else if (enter == tmin.y)
+    n.y = dirAndFar.y > 0.0 ? -1.0 : 1.0;
   else
-    if (enter == tmin.y)
-      n.y = dirAndFar.y > 0.0 ? -1.0 : 1.0;
-    else
-      n.z = dirAndFar.z > 0.0 ? -1.0 : 1.0;
+    n.z = dirAndFar.z > 0.0 ? -1.0 : 1.0;
   Record(enter, posAndNear, shapeId, n, hit);
 }
 
@@ -168,9 +210,18 @@ void m_scene_m_shapes_Intersect(uint index, vec4 posAndNear, vec4 dirAndFar, uin
   const uvec2 tag = m_scene_m_shapes_Tags(m_scene_m_shapes_tags).tags[index];
   switch (tag.x)
   {
-    case 0u: Sphere_Intersect(m_scene_m_shapes_SphereObjects(m_scene_m_shapes_Sphere).objects[tag.y], posAndNear, dirAndFar, shapeId, hit); return;
-    case 1u: Box_Intersect(m_scene_m_shapes_BoxObjects(m_scene_m_shapes_Box).objects[tag.y], posAndNear, dirAndFar, shapeId, hit); return;
-    case 2u: Disc_Intersect(m_scene_m_shapes_DiscObjects(m_scene_m_shapes_Disc).objects[tag.y], posAndNear, dirAndFar, shapeId, hit); return;
+  case 0u:
+    Sphere_Intersect(m_scene_m_shapes_SphereObjects(m_scene_m_shapes_Sphere).objects[tag.y], posAndNear, dirAndFar,
+                     shapeId, hit);
+    return;
+  case 1u:
+    Box_Intersect(m_scene_m_shapes_BoxObjects(m_scene_m_shapes_Box).objects[tag.y], posAndNear, dirAndFar, shapeId,
+                  hit);
+    return;
+  case 2u:
+    Disc_Intersect(m_scene_m_shapes_DiscObjects(m_scene_m_shapes_Disc).objects[tag.y], posAndNear, dirAndFar, shapeId,
+                   hit);
+    return;
   }
 }
 
@@ -180,9 +231,18 @@ void m_scene_m_lights_Intersect(uint index, vec4 posAndNear, vec4 dirAndFar, uin
   const uvec2 tag = m_scene_m_lights_Tags(m_scene_m_lights_tags).tags[index];
   switch (tag.x)
   {
-    case 0u: Sphere_Intersect(m_scene_m_lights_SphereObjects(m_scene_m_lights_Sphere).objects[tag.y], posAndNear, dirAndFar, shapeId, hit); return;
-    case 1u: Box_Intersect(m_scene_m_lights_BoxObjects(m_scene_m_lights_Box).objects[tag.y], posAndNear, dirAndFar, shapeId, hit); return;
-    case 2u: Disc_Intersect(m_scene_m_lights_DiscObjects(m_scene_m_lights_Disc).objects[tag.y], posAndNear, dirAndFar, shapeId, hit); return;
+  case 0u:
+    Sphere_Intersect(m_scene_m_lights_SphereObjects(m_scene_m_lights_Sphere).objects[tag.y], posAndNear, dirAndFar,
+                     shapeId, hit);
+    return;
+  case 1u:
+    Box_Intersect(m_scene_m_lights_BoxObjects(m_scene_m_lights_Box).objects[tag.y], posAndNear, dirAndFar, shapeId,
+                  hit);
+    return;
+  case 2u:
+    Disc_Intersect(m_scene_m_lights_DiscObjects(m_scene_m_lights_Disc).objects[tag.y], posAndNear, dirAndFar, shapeId,
+                   hit);
+    return;
   }
 }
 
@@ -228,7 +288,8 @@ ShapeHit m_scene_Trace(vec4 posAndNear, vec4 dirAndFar)
   ShapeHit light = hit;
   light.shape = ~0u;
   for (uint i = 0u; i < m_scene_m_lights_size; ++i)
-    if (m_scene_HitsBox(posAndNear, dirAndFar, light.t, m_scene_m_lightBoxes[2u * i], m_scene_m_lightBoxes[2u * i + 1u]))
+    if (m_scene_HitsBox(posAndNear, dirAndFar, light.t, m_scene_m_lightBoxes[2u * i],
+                        m_scene_m_lightBoxes[2u * i + 1u]))
       m_scene_m_lights_Intersect(uint(i), posAndNear, dirAndFar, i, light);
   if (light.shape != ~0u)
   {

@@ -10,8 +10,14 @@ layout(std430, binding = 0) buffer SortPairsData
   uint m_pairs_size;
   uint m_pairs_capacity;
 };
-layout(std430, binding = 1) buffer a_outBuffer { uvec2 a_out[]; };  // parameter 'a_out'
-layout(std430, binding = 2) buffer m_pairsBuffer { uvec2 m_pairs[]; };  // member std::vector m_pairs
+layout(std430, binding = 1) buffer a_outBuffer
+{
+  uvec2 a_out[];
+};  // parameter 'a_out'
+layout(std430, binding = 2) buffer m_pairsBuffer
+{
+  uvec2 m_pairs[];
+};  // member std::vector m_pairs
 
 layout(push_constant) uniform kernel1D_CopyArgs
 {

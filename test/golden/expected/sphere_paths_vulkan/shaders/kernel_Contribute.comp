@@ -4,7 +4,8 @@
 
 layout(local_size_x = 16, local_size_y = 16, local_size_z = 1) in;
 
-struct Sphere {  // from Sphere
+struct Sphere
+{  // from Sphere
   vec4 centerRadius;
   vec4 color;
 };
@@ -19,8 +20,14 @@ layout(std430, binding = 0) buffer SpherePathsData
   uint m_spheres_size;
   uint m_spheres_capacity;
 };
-layout(std430, binding = 1) readonly buffer colorPerThreadBuffer { vec4 colorPerThread[]; };  // parameter 'color': one value per thread, kept between the kernels of a thread loop
-layout(std430, binding = 2) buffer out_colorBuffer { vec4 out_color[]; };  // parameter 'out_color'
+layout(std430, binding = 1) readonly buffer colorPerThreadBuffer
+{
+  vec4 colorPerThread[];
+};  // parameter 'color': one value per thread, kept between the kernels of a thread loop
+layout(std430, binding = 2) buffer out_colorBuffer
+{
+  vec4 out_color[];
+};  // parameter 'out_color'
 
 layout(push_constant) uniform kernel_ContributeArgs
 {
@@ -47,6 +54,7 @@ void main()
     // This thread's values, kept between the kernels of the thread loop (wavefront mode).
     const uint threadIndex = gl_GlobalInvocationID.x + crt_countX * gl_GlobalInvocationID.y;
     vec4 color = colorPerThread[threadIndex];
-    kernel_Contribute(uint(crt_startX + int(gl_GlobalInvocationID.x)), uint(crt_startY + int(gl_GlobalInvocationID.y)), width, samples, color);
+    kernel_Contribute(uint(crt_startX + int(gl_GlobalInvocationID.x)), uint(crt_startY + int(gl_GlobalInvocationID.y)),
+                      width, samples, color);
   }
 }

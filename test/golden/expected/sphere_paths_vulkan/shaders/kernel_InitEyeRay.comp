@@ -4,7 +4,8 @@
 
 layout(local_size_x = 16, local_size_y = 16, local_size_z = 1) in;
 
-struct Sphere {  // from Sphere
+struct Sphere
+{  // from Sphere
   vec4 centerRadius;
   vec4 color;
 };
@@ -19,9 +20,18 @@ layout(std430, binding = 0) buffer SpherePathsData
   uint m_spheres_size;
   uint m_spheres_capacity;
 };
-layout(std430, binding = 1) buffer rayPosPerThreadBuffer { vec4 rayPosPerThread[]; };  // parameter 'rayPos': one value per thread, kept between the kernels of a thread loop
-layout(std430, binding = 2) buffer rayDirPerThreadBuffer { vec4 rayDirPerThread[]; };  // parameter 'rayDir': one value per thread, kept between the kernels of a thread loop
-layout(std430, binding = 3) buffer throughputPerThreadBuffer { vec4 throughputPerThread[]; };  // parameter 'throughput': one value per thread, kept between the kernels of a thread loop
+layout(std430, binding = 1) buffer rayPosPerThreadBuffer
+{
+  vec4 rayPosPerThread[];
+};  // parameter 'rayPos': one value per thread, kept between the kernels of a thread loop
+layout(std430, binding = 2) buffer rayDirPerThreadBuffer
+{
+  vec4 rayDirPerThread[];
+};  // parameter 'rayDir': one value per thread, kept between the kernels of a thread loop
+layout(std430, binding = 3) buffer throughputPerThreadBuffer
+{
+  vec4 throughputPerThread[];
+};  // parameter 'throughput': one value per thread, kept between the kernels of a thread loop
 
 layout(push_constant) uniform kernel_InitEyeRayArgs
 {
@@ -50,13 +60,15 @@ float Random(uint pixel, int sample_, int bounce, uint stream)
 }
 
 // from SpherePaths::kernel_InitEyeRay (SpherePaths.cpp)
-void kernel_InitEyeRay(uint tidX, uint tidY, uint width, uint height, int sample_, inout vec4 rayPos, inout vec4 rayDir, inout vec4 throughput)
+void kernel_InitEyeRay(uint tidX, uint tidY, uint width, uint height, int sample_, inout vec4 rayPos, inout vec4 rayDir,
+                       inout vec4 throughput)
 {
   const uint pixel = tidY * width + tidX;
   const float u = (float(tidX) + Random(pixel, sample_, 0, 11u)) / float(width);
   const float v = (float(tidY) + Random(pixel, sample_, 0, 12u)) / float(height);
   const float aspect = float(width) / float(height);
-  const vec3 dir = normalize(vec3((2.0 * u - 1.0) * m_tanHalfFov * aspect, (1.0 - 2.0 * v) * m_tanHalfFov - 0.15, -1.0));
+  const vec3 dir =
+      normalize(vec3((2.0 * u - 1.0) * m_tanHalfFov * aspect, (1.0 - 2.0 * v) * m_tanHalfFov - 0.15, -1.0));
   rayPos = m_cameraPos;
   rayDir = vec4(dir.x, dir.y, dir.z, 0.0);
   throughput = vec4(1.0, 1.0, 1.0, 1.0);
@@ -72,7 +84,8 @@ void main()
     vec4 rayPos = rayPosPerThread[threadIndex];
     vec4 rayDir = rayDirPerThread[threadIndex];
     vec4 throughput = throughputPerThread[threadIndex];
-    kernel_InitEyeRay(uint(crt_startX + int(gl_GlobalInvocationID.x)), uint(crt_startY + int(gl_GlobalInvocationID.y)), width, height, sample_, rayPos, rayDir, throughput);
+    kernel_InitEyeRay(uint(crt_startX + int(gl_GlobalInvocationID.x)), uint(crt_startY + int(gl_GlobalInvocationID.y)),
+                      width, height, sample_, rayPos, rayDir, throughput);
     rayPosPerThread[threadIndex] = rayPos;
     rayDirPerThread[threadIndex] = rayDir;
     throughputPerThread[threadIndex] = throughput;

@@ -4,12 +4,14 @@
 
 layout(local_size_x = 16, local_size_y = 16, local_size_z = 1) in;
 
-struct Sphere {  // from Sphere
+struct Sphere
+{  // from Sphere
   vec4 centerRadius;
   vec4 color;
 };
 
-struct SphereHit {  // from SphereHit
+struct SphereHit
+{  // from SphereHit
   vec4 position;
   vec4 normal;
   int sphere;
@@ -25,12 +27,30 @@ layout(std430, binding = 0) buffer SpherePathsData
   uint m_spheres_size;
   uint m_spheres_capacity;
 };
-layout(std430, binding = 1) readonly buffer hitPerThreadBuffer { SphereHit hitPerThread[]; };  // parameter 'hit': one value per thread, kept between the kernels of a thread loop
-layout(std430, binding = 2) buffer rayPosPerThreadBuffer { vec4 rayPosPerThread[]; };  // parameter 'rayPos': one value per thread, kept between the kernels of a thread loop
-layout(std430, binding = 3) buffer rayDirPerThreadBuffer { vec4 rayDirPerThread[]; };  // parameter 'rayDir': one value per thread, kept between the kernels of a thread loop
-layout(std430, binding = 4) buffer throughputPerThreadBuffer { vec4 throughputPerThread[]; };  // parameter 'throughput': one value per thread, kept between the kernels of a thread loop
-layout(std430, binding = 5) buffer colorPerThreadBuffer { vec4 colorPerThread[]; };  // parameter 'color': one value per thread, kept between the kernels of a thread loop
-layout(std430, binding = 6) buffer m_spheresBuffer { Sphere m_spheres[]; };  // member std::vector m_spheres
+layout(std430, binding = 1) readonly buffer hitPerThreadBuffer
+{
+  SphereHit hitPerThread[];
+};  // parameter 'hit': one value per thread, kept between the kernels of a thread loop
+layout(std430, binding = 2) buffer rayPosPerThreadBuffer
+{
+  vec4 rayPosPerThread[];
+};  // parameter 'rayPos': one value per thread, kept between the kernels of a thread loop
+layout(std430, binding = 3) buffer rayDirPerThreadBuffer
+{
+  vec4 rayDirPerThread[];
+};  // parameter 'rayDir': one value per thread, kept between the kernels of a thread loop
+layout(std430, binding = 4) buffer throughputPerThreadBuffer
+{
+  vec4 throughputPerThread[];
+};  // parameter 'throughput': one value per thread, kept between the kernels of a thread loop
+layout(std430, binding = 5) buffer colorPerThreadBuffer
+{
+  vec4 colorPerThread[];
+};  // parameter 'color': one value per thread, kept between the kernels of a thread loop
+layout(std430, binding = 6) buffer m_spheresBuffer
+{
+  Sphere m_spheres[];
+};  // member std::vector m_spheres
 
 layout(push_constant) uniform kernel_NextBounceArgs
 {
@@ -59,7 +79,8 @@ float Random(uint pixel, int sample_, int bounce, uint stream)
 }
 
 // from SpherePaths::kernel_NextBounce (SpherePaths.cpp)
-void kernel_NextBounce(uint tidX, uint tidY, uint width, int sample_, int bounce, SphereHit hit, inout vec4 rayPos, inout vec4 rayDir, inout vec4 throughput, inout vec4 color)
+void kernel_NextBounce(uint tidX, uint tidY, uint width, int sample_, int bounce, SphereHit hit, inout vec4 rayPos,
+                       inout vec4 rayDir, inout vec4 throughput, inout vec4 color)
 {
   if (throughput.w == 0.0)
     return;
@@ -113,7 +134,8 @@ void main()
     vec4 rayDir = rayDirPerThread[threadIndex];
     vec4 throughput = throughputPerThread[threadIndex];
     vec4 color = colorPerThread[threadIndex];
-    kernel_NextBounce(uint(crt_startX + int(gl_GlobalInvocationID.x)), uint(crt_startY + int(gl_GlobalInvocationID.y)), width, sample_, bounce, hit, rayPos, rayDir, throughput, color);
+    kernel_NextBounce(uint(crt_startX + int(gl_GlobalInvocationID.x)), uint(crt_startY + int(gl_GlobalInvocationID.y)),
+                      width, sample_, bounce, hit, rayPos, rayDir, throughput, color);
     rayPosPerThread[threadIndex] = rayPos;
     rayDirPerThread[threadIndex] = rayDir;
     throughputPerThread[threadIndex] = throughput;

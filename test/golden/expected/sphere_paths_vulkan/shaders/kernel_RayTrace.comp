@@ -4,12 +4,14 @@
 
 layout(local_size_x = 16, local_size_y = 16, local_size_z = 1) in;
 
-struct Sphere {  // from Sphere
+struct Sphere
+{  // from Sphere
   vec4 centerRadius;
   vec4 color;
 };
 
-struct SphereHit {  // from SphereHit
+struct SphereHit
+{  // from SphereHit
   vec4 position;
   vec4 normal;
   int sphere;
@@ -25,11 +27,26 @@ layout(std430, binding = 0) buffer SpherePathsData
   uint m_spheres_size;
   uint m_spheres_capacity;
 };
-layout(std430, binding = 1) readonly buffer rayPosPerThreadBuffer { vec4 rayPosPerThread[]; };  // parameter 'rayPos': one value per thread, kept between the kernels of a thread loop
-layout(std430, binding = 2) readonly buffer rayDirPerThreadBuffer { vec4 rayDirPerThread[]; };  // parameter 'rayDir': one value per thread, kept between the kernels of a thread loop
-layout(std430, binding = 3) readonly buffer throughputPerThreadBuffer { vec4 throughputPerThread[]; };  // parameter 'throughput': one value per thread, kept between the kernels of a thread loop
-layout(std430, binding = 4) buffer hitPerThreadBuffer { SphereHit hitPerThread[]; };  // parameter 'hit': one value per thread, kept between the kernels of a thread loop
-layout(std430, binding = 5) buffer m_spheresBuffer { Sphere m_spheres[]; };  // member std::vector m_spheres
+layout(std430, binding = 1) readonly buffer rayPosPerThreadBuffer
+{
+  vec4 rayPosPerThread[];
+};  // parameter 'rayPos': one value per thread, kept between the kernels of a thread loop
+layout(std430, binding = 2) readonly buffer rayDirPerThreadBuffer
+{
+  vec4 rayDirPerThread[];
+};  // parameter 'rayDir': one value per thread, kept between the kernels of a thread loop
+layout(std430, binding = 3) readonly buffer throughputPerThreadBuffer
+{
+  vec4 throughputPerThread[];
+};  // parameter 'throughput': one value per thread, kept between the kernels of a thread loop
+layout(std430, binding = 4) buffer hitPerThreadBuffer
+{
+  SphereHit hitPerThread[];
+};  // parameter 'hit': one value per thread, kept between the kernels of a thread loop
+layout(std430, binding = 5) buffer m_spheresBuffer
+{
+  Sphere m_spheres[];
+};  // member std::vector m_spheres
 
 layout(push_constant) uniform kernel_RayTraceArgs
 {
@@ -87,7 +104,8 @@ void main()
     vec4 rayDir = rayDirPerThread[threadIndex];
     vec4 throughput = throughputPerThread[threadIndex];
     SphereHit hit = hitPerThread[threadIndex];
-    kernel_RayTrace(uint(crt_startX + int(gl_GlobalInvocationID.x)), uint(crt_startY + int(gl_GlobalInvocationID.y)), rayPos, rayDir, throughput, hit);
+    kernel_RayTrace(uint(crt_startX + int(gl_GlobalInvocationID.x)), uint(crt_startY + int(gl_GlobalInvocationID.y)),
+                    rayPos, rayDir, throughput, hit);
     hitPerThread[threadIndex] = hit;
   }
 }

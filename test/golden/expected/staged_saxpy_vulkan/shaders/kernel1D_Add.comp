@@ -9,9 +9,18 @@ layout(std430, binding = 0) buffer StagedSaxpyData
 {
   uint dummy;
 };
-layout(std430, binding = 1) buffer a_resBuffer { float a_res[]; };  // parameter 'a_res'
-layout(std430, binding = 2) readonly buffer a_in1Buffer { float a_in1[]; };  // parameter 'a_in1'
-layout(std430, binding = 3) readonly buffer a_in2Buffer { float a_in2[]; };  // parameter 'a_in2'
+layout(std430, binding = 1) buffer a_resBuffer
+{
+  float a_res[];
+};  // parameter 'a_res'
+layout(std430, binding = 2) readonly buffer a_in1Buffer
+{
+  float a_in1[];
+};  // parameter 'a_in1'
+layout(std430, binding = 3) readonly buffer a_in2Buffer
+{
+  float a_in2[];
+};  // parameter 'a_in2'
 
 layout(push_constant) uniform kernel1D_AddArgs
 {
