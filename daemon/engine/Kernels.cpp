@@ -334,6 +334,10 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     k.memberVectors.push_back(f->getNameAsString());
     if (auto* m = FindMember(c.model, f->getNameAsString())) m->usedByKernels = true;
     RequireReachable(c.rep, f, c.cls);
+    QualType elem;
+    if (IsStdVector(f->getType(), &elem) && !LayoutMatchesCpp(c.ctx, elem, false) && !LayoutMatchesCpp(c.ctx, elem, true))
+      c.rep.GpuError(f->getLocation(), "the elements of '" + f->getNameAsString() + "' have a C++ layout that a GPU buffer cannot reproduce",
+                     "use int instead of bool, and 32-bit scalars and LiteMath vectors in structs");
   }
   std::sort(k.memberVectors.begin(), k.memberVectors.end());
   k.ownFunctionList = k.functionList;

@@ -5,6 +5,7 @@
 #include "AnalysisContext.h"
 #include "AstQueries.h"
 #include "ControlRewriter.h"
+#include "LoopShape.h"
 
 #include <llvm/Support/FileSystem.h>
 #include <llvm/Support/Path.h>
@@ -23,13 +24,13 @@ std::optional<ControlRewriter::Position> ControlRewriter::PositionOf(const Expr*
   if (auto* bo = dyn_cast<BinaryOperator>(e); bo && bo->getOpcode() == BO_Add) {
     auto p = PositionOf(bo->getLHS());
     if (!p || p->isEnd) return std::nullopt;
-    p->offset = (p->offset.empty() ? "" : p->offset + " + ") + "(" + m_c.Text(bo->getRHS()->getSourceRange()) + ")";
+    p->offset = (p->offset.empty() ? "" : p->offset + " + ") + AsOperand(m_c.Text(bo->getRHS()->getSourceRange()));
     return p;
   }
   if (auto* op = dyn_cast<CXXOperatorCallExpr>(e); op && op->getOperator() == OO_Plus && op->getNumArgs() == 2) {
     auto p = PositionOf(op->getArg(0));
     if (!p || p->isEnd) return std::nullopt;
-    p->offset = (p->offset.empty() ? "" : p->offset + " + ") + "(" + m_c.Text(op->getArg(1)->getSourceRange()) + ")";
+    p->offset = (p->offset.empty() ? "" : p->offset + " + ") + AsOperand(m_c.Text(op->getArg(1)->getSourceRange()));
     return p;
   }
   if (auto* dr = dyn_cast<DeclRefExpr>(e))
@@ -60,7 +61,8 @@ std::optional<std::string> ControlRewriter::Count(const Position& first, const P
   if (first.key != last.key) return std::nullopt;
   std::string end = last.isEnd ? first.vector->name + ".size()" : last.offset;
   if (end.empty()) end = "0";
-  return first.offset.empty() ? "(" + end + ")" : "(" + end + ") - (" + first.offset + ")";
+  // In parentheses as a whole: callers put a type in front (uint32_t(n)).
+  return first.offset.empty() ? "(" + end + ")" : "(" + AsOperand(end) + " - " + AsOperand(first.offset) + ")";
 }
 
 void ControlRewriter::WrittenVector(const Position& p) {

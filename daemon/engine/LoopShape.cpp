@@ -46,18 +46,18 @@ bool ParseLoop(Context& c, const ForStmt* fs, LoopHeader& h, const std::string& 
   return true;
 }
 
+std::string AsOperand(const std::string& expr) {
+  std::string bare = expr;
+  for (const char* token : {"->", "::"})
+    for (size_t at; (at = bare.find(token)) != std::string::npos;) bare.erase(at, 2);
+  return bare.find_first_of("+-*/%<>=!&|^?, ") == std::string::npos ? expr : "(" + expr + ")";
+}
+
 std::string CountExpr(Context& c, const LoopHeader& h) {
   std::string end = c.Text(h.end->getSourceRange()), start = c.Text(h.start->getSourceRange());
   Expr::EvalResult r;
   bool zeroStart = h.start->EvaluateAsInt(r, c.ctx) && r.Val.getInt() == 0;
-  // Operands in parentheses only where an operator inside them needs it: `n`, `(n - 1) - (k)`.
-  auto operand = [](const std::string& e) {
-    std::string bare = e;
-    for (const char* token : {"->", "::"})
-      for (size_t at; (at = bare.find(token)) != std::string::npos;) bare.erase(at, 2);
-    return bare.find_first_of("+-*/%<>=!&|^?, ") == std::string::npos ? e : "(" + e + ")";
-  };
-  std::string count = zeroStart ? operand(end) : operand(end) + " - " + operand(start);
+  std::string count = zeroStart ? AsOperand(end) : AsOperand(end) + " - " + AsOperand(start);
   return h.inclusive ? count + " + 1" : count;
 }
 

@@ -24,6 +24,10 @@ struct LoopHeader {
 bool ParseLoop(Context& c, const ForStmt* fs, LoopHeader& h, const std::string& kernel);
 
 // Casts the host-side C++ count to the loop variable's range: (end) - (start) [+ 1].
+// `expr` as an operand of a wider expression: in parentheses only where an operator inside it
+// needs them (`n`, `m_v.size()`, `(n - 1)`).
+std::string AsOperand(const std::string& expr);
+
 std::string CountExpr(Context& c, const LoopHeader& h);
 
 }  // namespace crossrt::engine

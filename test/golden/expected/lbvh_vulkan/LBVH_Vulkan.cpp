@@ -272,10 +272,10 @@ void LBVH_Vulkan::BuildCmd(VkCommandBuffer a_cmd, int count, [[maybe_unused]] co
   UpdateMemberCmd(a_cmd, offsetof(ClassData, m_centerMax), &m_centerMax, sizeof(m_centerMax));
   kernel1D_BoundsCmd(a_cmd, count, m_inOut_Build.boxes);
   kernel1D_EvalMCCmd(a_cmd, count, m_inOut_Build.boxes);
-  m_sorter.RecordCmd(a_cmd, m_vdata.m_codes.View(), uint32_t((count)),
+  m_sorter.RecordCmd(a_cmd, m_vdata.m_codes.View(), uint32_t(count),
                      crossrt::SortKey{2, 0, crossrt::ElementType::Uint, false});
   kernel1D_AppendInitCmd(a_cmd, count);
-  m_scanner.RecordCmd(a_cmd, m_vdata.m_newGroup.View(), m_vdata.m_groupOf.View(), uint32_t((count)), false,
+  m_scanner.RecordCmd(a_cmd, m_vdata.m_newGroup.View(), m_vdata.m_groupOf.View(), uint32_t(count), false,
                       crossrt::ElementType::Uint, crossrt::Bits32(static_cast<unsigned int>(0u)));
   m_leafCount = 0;
   UpdateMemberCmd(a_cmd, offsetof(ClassData, m_leafCount), &m_leafCount, sizeof(m_leafCount));

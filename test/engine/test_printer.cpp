@@ -1,0 +1,107 @@
+// The GLSL printer (Glsl.cpp, GlslCalls.cpp): what a kernel's C++ becomes, on a small class with a
+// user struct, a member helper, a static helper of the .cpp, a local array, a switch, casts and
+// the standard library. The expectations are GLSL's spellings of the same C++.
+#include "EngineSupport.h"
+
+using namespace crossrt::engine;
+
+namespace {
+
+const char* kHeader = R"(#pragma once
+#include "LiteMath.h"
+#include <vector>
+#include <cstdint>
+#include <limits>
+using namespace LiteMath;
+struct Ray { float3 origin; float tmax; float3 dir; uint32_t id; };
+class Printer
+{
+public:
+  virtual ~Printer() = default;
+  virtual void Run(int n, [[crossrt::size("n")]] const Ray* rays, [[crossrt::size("n")]] float* out);
+protected:
+  void kernel1D_Shade(int n, const Ray* rays, float* out);
+  float Falloff(float d) const;
+  float m_exposure = 1.0f;
+};
+)";
+
+const char* kSource = R"(#include "Printer.h"
+#include <algorithm>
+#include <cmath>
+static float Square(float x) { return x * x; }
+void Printer::Run(int n, const Ray* rays, float* out) { kernel1D_Shade(n, rays, out); }
+float Printer::Falloff(float d) const { return 1.0f / (1.0f + Square(d)); }
+void Printer::kernel1D_Shade(int n, const Ray* rays, float* out)
+{
+  for (int i = 0; i < n; ++i)
+  {
+    const Ray ray = rays[i];
+    float weights[3] = {0.25f, 0.5f, 0.25f};
+    float sum = 0.0f;
+    for (int k = 0; k < 3; ++k) sum += weights[k] * Falloff(float(k) * length(ray.dir));
+    const int bucket = static_cast<int>(ray.id % 4u);
+    float v = bucket == 0 ? sum : std::max(sum, 0.5f);
+    switch (bucket)
+    {
+    case 1: v *= 2.0f; break;
+    case 2: v = std::sqrt(v); break;
+    default: break;
+    }
+    out[i] = v * m_exposure + dot(ray.origin, normalize(ray.dir));
+  }
+}
+)";
+
+size_t Count(const std::string& text, const std::string& piece)
+{
+  size_t n = 0;
+  for (size_t at = text.find(piece); at != std::string::npos; at = text.find(piece, at + 1)) ++n;
+  return n;
+}
+
+}  // namespace
+
+TEST_CASE("Printer: a kernel's C++ in GLSL's spelling, helpers once and ahead of their callers", "[engine][printer]")
+{
+  TempClass tc("Printer", kHeader, kSource);
+  const TranslateResult r = Translate(MakeRequest(tc, "Printer"));
+  INFO(r.diagnostics);
+  REQUIRE(r.ok);
+  const std::string glsl = Squeezed(r.files.at("shaders/kernel1D_Shade.comp"));
+  INFO(r.files.at("shaders/kernel1D_Shade.comp"));
+  // The user's struct, field for field in GLSL types.
+  CHECK(glsl.find(Squeezed("struct Ray")) != std::string::npos);
+  CHECK(glsl.find(Squeezed("vec3 origin; float tmax; vec3 dir; uint id; };")) != std::string::npos);
+  // Helpers: the .cpp's static function and the const member function become free functions,
+  // each printed once, callees before callers.
+  const size_t square = glsl.find(Squeezed("float Square(float x)")), falloff = glsl.find(Squeezed("float Falloff(float d)")),
+               kernel = glsl.find(Squeezed("void kernel1D_Shade(int i)"));
+  REQUIRE(square != std::string::npos);
+  REQUIRE(falloff != std::string::npos);
+  REQUIRE(kernel != std::string::npos);
+  CHECK((square < falloff && falloff < kernel));
+  CHECK(Count(glsl, Squeezed("float Square(float x)")) == 1);
+  // Statements and expressions.
+  CHECK(glsl.find(Squeezed("float weights[3] = float[3](0.25, 0.5, 0.25);")) != std::string::npos);  // array constructor
+  CHECK(glsl.find(Squeezed("sum += weights[k] * Falloff(float(k) * length(ray.dir));")) != std::string::npos);
+  CHECK(glsl.find(Squeezed("const int bucket = int(ray.id % 4u);")) != std::string::npos);  // static_cast
+  CHECK(glsl.find(Squeezed("float v = bucket == 0 ? sum : max(sum, 0.5);")) != std::string::npos);  // std::max
+  CHECK(glsl.find(Squeezed("switch (bucket) { case 1: v *= 2.0; break; case 2: v = sqrt(v); break; default: break; }")) !=
+        std::string::npos);
+  // 'out' is a GLSL keyword: the parameter's buffer is out_.
+  CHECK(glsl.find(Squeezed("out_[i] = v * m_exposure + dot(ray.origin, normalize(ray.dir));")) != std::string::npos);
+}
+
+TEST_CASE("Printer: recursion in a kernel's reach is a diagnostic at the call", "[engine][printer]")
+{
+  std::string source = kSource;
+  source.replace(source.find("return 1.0f / (1.0f + Square(d));"), std::string("return 1.0f / (1.0f + Square(d));").size(),
+                 "return d > 1.0f ? Falloff(d - 1.0f) : 1.0f;");
+  TempClass tc("Printer", kHeader, source);
+  const TranslateResult r = Translate(MakeRequest(tc, "Printer"));
+  CHECK_FALSE(r.ok);
+  INFO(r.diagnostics);
+  CHECK(r.diagnostics.find("Printer.cpp:6:59: error: recursive call to 'Printer::Falloff' in a kernel") != std::string::npos);
+  CHECK(r.diagnostics.find("hint:") != std::string::npos);
+}
