@@ -20,7 +20,6 @@
 namespace crossrt::engine {
 using namespace clang;
 
-
 std::string Text(const ASTContext& ctx, SourceRange range);
 
 struct Context {

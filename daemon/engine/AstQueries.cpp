@@ -3,14 +3,9 @@
 // functions push_back to member vectors. Takes AST nodes, gives answers; changes nothing.
 #include "AstQueries.h"
 
-
-#include <llvm/Support/FileSystem.h>
-#include <llvm/Support/Path.h>
-
 #include <algorithm>
 #include <cctype>
 #include <regex>
-#include <sstream>
 
 using namespace clang;
 

@@ -7,12 +7,7 @@
 #include "Members.h"
 #include "VirtualCalls.h"
 
-#include <llvm/Support/FileSystem.h>
-#include <llvm/Support/Path.h>
-
 #include <algorithm>
-#include <cctype>
-#include <regex>
 #include <sstream>
 
 using namespace clang;
@@ -42,8 +37,8 @@ void AddCallableShader(ASTContext& ctx, Reporter& rep, ClassModel& model, const 
                   " runs when the object is\n// a " + vi.name +
                   ", as a callable shader of the ray tracing pipelines of the kernels calling it (virtual functions, level 3)";
   c.scalarLayout = vi.scalarLayout;
-  for (auto& x : printer.Constants()) c.constants += x;
-  for (auto& x : printer.Structs()) c.structs += x + "\n";
+  for (auto& x : printer.Constants()) c.constants += x.text;
+  for (auto& x : printer.Structs()) c.structs += x.text + "\n";
   c.structs += dataStruct + "\n" + objectsReference + "\n" + payload + "layout(location = 0) callableDataInEXT " + vm.member + "_" + method->getNameAsString() +
                "_Call call;\n";
   for (auto& x : printer.Functions()) c.functions += x + "\n";
@@ -60,7 +55,7 @@ void AddCallableShader(ASTContext& ctx, Reporter& rep, ClassModel& model, const 
 // the kernel's callables so far); each implementation's callable shader joins the model.
 void CallableDispatcher(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& k, GlslPrinter& kernelPrinter, const VirtualMember& vm,
                         const std::vector<const CXXRecordDecl*>& impls, const CXXMethodDecl* m, SourceLocation callLoc,
-                        const std::map<std::string, std::pair<std::string, std::string>>& implData, CallableCode& out) {
+                        const std::map<std::string, std::pair<GlslDecl, GlslDecl>>& implData, CallableCode& out) {
   const std::string method = m->getNameAsString(), callName = vm.member + "_" + method, variable = callName + "_call";
   const std::string display = vm.display + "[index]->" + method + (m->getNumParams() ? "(...)" : "()");
   auto ret = kernelPrinter.Type(m->getReturnType(), m->getLocation());
@@ -76,13 +71,13 @@ void CallableDispatcher(ASTContext& ctx, Reporter& rep, ClassModel& model, Kerne
   if (retType != "void") payload << "  " << retType << " crt_result;\n";
   payload << "};\n";
   const size_t location = out.payloads++, first = k.callables.size();
-  out.structs.push_back(payload.str() + "layout(location = " + std::to_string(location) + ") callableDataEXT " + callName + "_Call " + variable + ";\n");
+  out.structs.push_back({callName + "_Call", payload.str() + "layout(location = " + std::to_string(location) + ") callableDataEXT " + callName + "_Call " + variable + ";\n"});
 
   std::string names;
   for (const VirtualImpl& vi : vm.impls) {
     auto impl = std::find_if(impls.begin(), impls.end(), [&](const CXXRecordDecl* r) { return r->getNameAsString() == vi.name; });
     const auto& [dataStruct, objectsReference] = implData.at(vi.name);
-    AddCallableShader(ctx, rep, model, vm, vi, *impl, m, callLoc, dataStruct, objectsReference, payload.str());
+    AddCallableShader(ctx, rep, model, vm, vi, *impl, m, callLoc, dataStruct.text, objectsReference.text, payload.str());
     k.callables.push_back(vm.member + "_" + vi.name + "_" + method);
     names += (names.empty() ? "" : ", ") + k.callables.back();
   }
@@ -106,13 +101,13 @@ void CallableDispatcher(ASTContext& ctx, Reporter& rep, ClassModel& model, Kerne
 }  // namespace
 
 void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& k, GlslPrinter& kernelPrinter, const VirtualOwner& owner,
-                     std::vector<std::string>& structs, std::vector<std::string>& functions, CallableCode* callable) {
+                     std::vector<GlslDecl>& structs, std::vector<std::string>& functions, CallableCode* callable) {
   // Vectors and methods in source order: the generated code must not depend on where the AST
   // happens to sit in memory (the daemon reparses).
   SourceManager& sm = ctx.getSourceManager();
   auto before = [&](const Decl* a, const Decl* b) { return sm.isBeforeInTranslationUnit(a->getLocation(), b->getLocation()); };
   std::vector<std::pair<const FieldDecl*, std::vector<const CXXMethodDecl*>>> calls;
-  for (auto& [field, method] : kernelPrinter.virtualCalls) {
+  for (auto& [field, method] : kernelPrinter.Uses().virtualCalls) {
     auto same = std::find_if(calls.begin(), calls.end(), [&, f = field](const auto& c) { return c.first == f; });
     if (same == calls.end()) same = calls.insert(calls.end(), {field, {}});
     same->second.push_back(method);
@@ -196,11 +191,11 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
     const VirtualMember& vm = *known;
     k.bufferReferences = true;
     // Data structs and buffer references, then each implementation's methods.
-    const std::string tags = TagsReference(model, vm);
+    const GlslDecl tags = TagsReference(model, vm);
     structs.push_back(tags);
     if (callable) callable->structs.push_back(tags);
     std::map<std::string, std::string> implFunction;  // (impl, method) -> GLSL name
-    std::map<std::string, std::pair<std::string, std::string>> implData;  // impl -> (data struct, buffer reference to its objects)
+    std::map<std::string, std::pair<GlslDecl, GlslDecl>> implData;  // impl -> (data struct, buffer reference to its objects)
     for (auto* impl : impls) {
       auto vi = std::find_if(vm.impls.begin(), vm.impls.end(), [&](const VirtualImpl& x) { return x.name == impl->getNameAsString(); });
       if (vi == vm.impls.end()) continue;
@@ -208,10 +203,10 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
       printer.selfClass = impl;
       printer.composedPrefix = vi->name + "_";
       for (auto& sn : ClassStructNames(model)) printer.predeclaredStructs.insert(sn);
-      const std::string data = ImplDataStruct(printer, impl, vm, *vi);
+      const GlslDecl data = ImplDataStruct(printer, impl, vm, *vi);
       for (auto* m : methods) implFunction[vi->name + "::" + m->getNameAsString()] = ImplementationMethod(rep, printer, impl, m, field->getLocation());
       for (auto& x : printer.Structs()) structs.push_back(x);
-      const std::string objectsReference = ObjectsReference(vm, *vi);
+      const GlslDecl objectsReference = ObjectsReference(vm, *vi);
       structs.push_back(data);
       structs.push_back(objectsReference);
       implData[vi->name] = {data, objectsReference};

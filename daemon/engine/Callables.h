@@ -9,7 +9,7 @@ namespace crossrt::engine {
 
 // Level 3: what a kernel's ray generation shader has instead of the switches.
 struct CallableCode {
-  std::vector<std::string> structs;    // the vectors' tags, the calls' payloads and the variables passed to executeCallableEXT
+  std::vector<GlslDecl> structs;       // the vectors' tags, the calls' payloads and the variables passed to executeCallableEXT
   std::vector<std::string> functions;  // per method, a dispatcher that executes the callable shader of the object's class
   unsigned payloads = 0;               // callableDataEXT variables so far: the next one's location
 };
@@ -21,6 +21,6 @@ struct CallableCode {
 // `callable` given, also the callable shaders of the implementations and what the ray generation
 // shader calls them with.
 void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& k, GlslPrinter& kernelPrinter, const VirtualOwner& owner,
-                     std::vector<std::string>& structs, std::vector<std::string>& functions, CallableCode* callable = nullptr);
+                     std::vector<GlslDecl>& structs, std::vector<std::string>& functions, CallableCode* callable = nullptr);
 
 }  // namespace crossrt::engine

@@ -1,16 +1,11 @@
 // The class data after every translation unit: the megakernels' merged code and buffers, the members
 // kernels use, and the layout of the class data block the shaders read.
 
+#include "GeneratedNames.h"
 #include "AnalysisContext.h"
 #include "Composition.h"
 
-#include <llvm/Support/FileSystem.h>
-#include <llvm/Support/Path.h>
-
 #include <algorithm>
-#include <cctype>
-#include <regex>
-#include <sstream>
 
 using namespace clang;
 
@@ -30,7 +25,7 @@ static void MergeMegakernelCode(ClassModel& model) {
       auto k = std::find_if(model.kernels.begin(), model.kernels.end(), [&](const Kernel& x) { return x.name == name; });
       if (k == model.kernels.end()) continue;
       for (auto& chunk : k->structList)
-        if (std::none_of(mk.structList.begin(), mk.structList.end(), [&](const std::string& x) { return StructName(x) == StructName(chunk); }))
+        if (std::none_of(mk.structList.begin(), mk.structList.end(), [&](const GlslDecl& x) { return x.name == chunk.name; }))
           mk.structList.push_back(chunk);
       for (auto& x : k->constantList) addUnique(mk.constantList, x);
       for (auto& x : k->functionList) addUnique(functions, x);
@@ -77,12 +72,12 @@ void FinishModel(ClassModel& model) {
     if (m.usedByKernels && m.kind == MemberKind::TextureArray) fields.push_back({m.name + "_size", "uint32_t", "uint", 4, "", "uint32_t(" + m.hostExpr + ".size())"});
   // Virtual functions: where each vector's tags and each implementation's objects are on the device.
   for (auto& v : model.virtuals) {
-    fields.push_back({v.member + "_tags", "uint64_t", "uvec2", 8, "", "m_virtual." + v.member + "_tags.Address()"});
+    fields.push_back({v.member + "_tags", "uint64_t", "uvec2", 8, "", generated::kVirtualObjects + "." + v.member + "_tags.Address()"});
     fields.push_back({v.member + "_size", "uint32_t", "uint", 4, "", "uint32_t(" + v.hostExpr + ".size())"});
-    if (model.virtualLevel == 1) fields.push_back({v.member + "_objects", "uint64_t", "uvec2", 8, "", "m_virtual." + v.member + "_objects.Address()"});
+    if (model.virtualLevel == 1) fields.push_back({v.member + "_objects", "uint64_t", "uvec2", 8, "", generated::kVirtualObjects + "." + v.member + "_objects.Address()"});
     for (auto& impl : v.impls)
       if (model.virtualLevel >= 2)
-        fields.push_back({v.member + "_" + impl.name, "uint64_t", "uvec2", 8, "", "m_virtual." + v.member + "_" + impl.name + ".Address()"});
+        fields.push_back({v.member + "_" + impl.name, "uint64_t", "uvec2", 8, "", generated::kVirtualObjects + "." + v.member + "_" + impl.name + ".Address()"});
   }
   std::stable_sort(fields.begin(), fields.end(), [](const BlockField& a, const BlockField& b) { return a.std430Align > b.std430Align; });
   if (fields.empty()) fields.push_back({"dummy", "uint32_t", "uint", 4, "", ""});  // a block needs a member

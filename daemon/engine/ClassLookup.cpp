@@ -12,7 +12,6 @@
 #include <llvm/Support/Path.h>
 
 #include <algorithm>
-#include <cctype>
 #include <regex>
 #include <sstream>
 

@@ -4,7 +4,6 @@
 #include "CodeGen.h"
 #include "Glsl.h"
 
-#include <cctype>
 #include <fstream>
 #include <regex>
 #include <set>

@@ -10,13 +10,7 @@
 #include "VirtualCalls.h"
 #include "WriteVisitor.h"
 
-#include <llvm/Support/FileSystem.h>
-#include <llvm/Support/Path.h>
-
 #include <algorithm>
-#include <cctype>
-#include <regex>
-#include <sstream>
 
 using namespace clang;
 
@@ -49,12 +43,6 @@ struct ComposedWriteFinder : WriteVisitor<ComposedWriteFinder> {
 };
 
 }  // namespace
-
-std::string StructName(const std::string& chunk) {
-  static const std::regex decl(R"(^struct (\w+) \{)");
-  std::smatch m;
-  return std::regex_search(chunk, m, decl) ? m[1].str() : "";
-}
 
 bool ComposeFromTranslationUnit(ASTContext& ctx, Reporter& reporter, ClassModel& model) {
   bool any = false;
@@ -89,12 +77,13 @@ bool ComposeFromTranslationUnit(ASTContext& ctx, Reporter& reporter, ClassModel&
       if (printer.Functions().empty()) continue;
       // Virtual calls in the composed code (listing 2: an intersection function per primitive):
       // their dispatchers and the implementations' code go ahead of it.
-      std::vector<std::string> virtualStructs, virtualFunctions;
-      if (!printer.virtualCalls.empty())
+      std::vector<GlslDecl> virtualStructs;
+      std::vector<std::string> virtualFunctions;
+      if (!printer.Uses().virtualCalls.empty())
         VirtualCallCode(ctx, reporter, model, k, printer, VirtualOwner{impl, holderPrefix, "crt_" + comp.holder + "()->", comp.holder}, virtualStructs,
                         virtualFunctions);
       CheckObjectSizeReads(reporter, printer);
-      for (auto* fn : printer.helpers) {
+      for (auto* fn : printer.Uses().helpers) {
         ComposedWriteFinder finder;
         finder.TraverseStmt(fn->getBody());
         for (auto& [field, loc] : finder.writes)
@@ -104,7 +93,7 @@ bool ComposeFromTranslationUnit(ASTContext& ctx, Reporter& reporter, ClassModel&
       // The implementation's data: its std::vector members become buffers, plain members join
       // the class data, all reached through the holder on the host.
       std::vector<std::string> vectors;
-      for (auto* f : printer.memberVectors) {
+      for (auto* f : printer.Uses().memberVectors) {
         QualType elem;
         IsStdVector(f->getType(), &elem);
         printer.Type(elem, f->getLocation());
@@ -112,7 +101,7 @@ bool ComposeFromTranslationUnit(ASTContext& ctx, Reporter& reporter, ClassModel&
       auto requirePublic = [&](const FieldDecl* f) {
         RequirePublicForComposition(reporter, f, comp.implName, " (" + comp.interfaceName + "=" + comp.implName + ")");
       };
-      for (auto* f : printer.memberVectors) {
+      for (auto* f : printer.Uses().memberVectors) {
         requirePublic(f);
         QualType elem;
         IsStdVector(f->getType(), &elem);
@@ -134,7 +123,7 @@ bool ComposeFromTranslationUnit(ASTContext& ctx, Reporter& reporter, ClassModel&
         m.usedByKernels = true;
         model.members.push_back(m);
       }
-      for (auto* f : printer.plainMembers) {
+      for (auto* f : printer.Uses().plainMembers) {
         requirePublic(f);
         std::string name = holderPrefix + f->getNameAsString();
         if (FindMember(model, name)) continue;
@@ -153,16 +142,15 @@ bool ComposeFromTranslationUnit(ASTContext& ctx, Reporter& reporter, ClassModel&
         model.members.push_back(m);
       }
       // Composed code first: the kernel's own code calls it and may use its structs.
-      std::vector<std::string> structs = printer.Structs(), constants = printer.Constants(), functions;
+      std::vector<GlslDecl> structs = printer.Structs(), constants = printer.Constants();
+      std::vector<std::string> functions;
       std::vector<std::string> own = printer.Functions();
       for (auto* list : {&virtualFunctions, &own})  // free functions several print are the same text: once
         for (auto& x : *list)
           if (std::find(functions.begin(), functions.end(), x) == functions.end()) functions.push_back(x);
       for (auto* list : {&virtualStructs, &k.structList})
         for (auto& chunk : *list) {
-          auto same = std::find_if(structs.begin(), structs.end(), [&](const std::string& x) {
-            return StructName(x) == StructName(chunk) && (!StructName(x).empty() || x == chunk);
-          });
+          auto same = std::find_if(structs.begin(), structs.end(), [&](const GlslDecl& x) { return x.name == chunk.name; });
           if (same == structs.end()) structs.push_back(chunk);
         }
       for (auto& line : k.constantList)
@@ -180,9 +168,9 @@ bool ComposeFromTranslationUnit(ASTContext& ctx, Reporter& reporter, ClassModel&
       });
       // Not when the traversal calls virtual intersection functions: those become intersection shaders
       // of a ray tracing pipeline instead (AnalyzeLeafTraversal).
-      if (comp.interfaceName == "ISceneObject" && onlyRayQueries && printer.virtualCalls.empty()) k.rayQueryHolder = comp.holder;
+      if (comp.interfaceName == "ISceneObject" && onlyRayQueries && printer.Uses().virtualCalls.empty()) k.rayQueryHolder = comp.holder;
       // Virtual intersection functions called per leaf can run as intersection shaders (level 3).
-      if (model.virtualLevel == 3 && !printer.virtualCalls.empty() && reporter.Errors() == 0)
+      if (model.virtualLevel == 3 && !printer.Uses().virtualCalls.empty() && reporter.Errors() == 0)
         AnalyzeLeafTraversal(ctx, reporter, model, k, comp, impl, holderPrefix, printer);
     }
   }

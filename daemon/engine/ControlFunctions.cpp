@@ -1,6 +1,7 @@
 // Control functions: the non-kernel methods that call kernels. Their bodies are rewritten twice, into
 // the Vulkan class's ...Cmd recording (kernel calls become dispatches) and into the CPU class's code.
 // Takes a control function; adds a Control to the model.
+#include "GeneratedNames.h"
 #include "ControlFunctions.h"
 
 #include "AnalysisContext.h"
@@ -11,13 +12,8 @@
 #include "Naming.h"
 #include "VirtualCalls.h"
 
-#include <llvm/Support/FileSystem.h>
-#include <llvm/Support/Path.h>
-
 #include <algorithm>
 #include <cctype>
-#include <regex>
-#include <sstream>
 
 using namespace clang;
 
@@ -201,7 +197,7 @@ std::string ControlRewriter::BufferArg(const Expr* arg) {
   const Expr* e = arg->IgnoreParenImpCasts();
   if (auto* dr = dyn_cast<DeclRefExpr>(e))
     if (auto* p = dyn_cast<ParmVarDecl>(dr->getDecl()); p && p->getDeclContext() == m_def)
-      return "m_inOut_" + m_ctrl.name + "." + p->getNameAsString();
+      return generated::kInOutPrefix + m_ctrl.name + "." + p->getNameAsString();
   const Expr* offset = nullptr;
   if (auto* bo = dyn_cast<BinaryOperator>(e); bo && bo->getOpcode() == BO_Add) {
     offset = bo->getRHS();
@@ -210,7 +206,7 @@ std::string ControlRewriter::BufferArg(const Expr* arg) {
   if (auto* mc = dyn_cast<CXXMemberCallExpr>(e); mc && mc->getMethodDecl()->getName() == "data") {
     if (auto* f = ThisField(mc->getImplicitObjectArgument()); f && IsStdVector(f->getType())) {
       if (auto* m = FindMember(m_c.model, f->getNameAsString())) m->usedByKernels = true;
-      std::string view = "m_vdata." + f->getNameAsString() + ".View(";
+      std::string view = generated::kVectorCopies + "." + f->getNameAsString() + ".View(";
       if (offset) {
         auto* m = FindMember(m_c.model, f->getNameAsString());
         view += "sizeof(" + (m ? m->elemCppType : std::string("float")) + ") * size_t(" + m_c.Text(offset->getSourceRange()) + ")";
@@ -224,7 +220,7 @@ std::string ControlRewriter::BufferArg(const Expr* arg) {
         auto* t = Temporary(vd);
         if (!t) return "{}";
         m_temporaryUses.insert(dr);
-        std::string view = "m_temporaries." + t->buffer + ".View(";
+        std::string view = generated::kTemporaries + "." + t->buffer + ".View(";
         if (offset) view += "sizeof(" + t->cppType + ") * size_t(" + m_c.Text(offset->getSourceRange()) + ")";
         return view + ")";
       }
@@ -300,7 +296,7 @@ std::string ControlRewriter::ImageArg(const ParmVarDecl* p, const Expr* arg) {
   const Expr* e = arg->IgnoreParenImpCasts();
   if (auto* dr = dyn_cast<DeclRefExpr>(e))
     if (auto* cp = dyn_cast<ParmVarDecl>(dr->getDecl()); cp && cp->getDeclContext() == m_def)
-      return "m_inOut_" + m_ctrl.name + "." + cp->getNameAsString();
+      return generated::kInOutPrefix + m_ctrl.name + "." + cp->getNameAsString();
   if (auto* f = ThisField(e); f && IsImage2D(f->getType())) {
     const std::string name = f->getNameAsString();
     RequireReachable(m_c.rep, f, m_c.cls);

@@ -5,11 +5,7 @@
 #include "AnalysisContext.h"
 #include "AstQueries.h"
 
-#include <llvm/Support/FileSystem.h>
-#include <llvm/Support/Path.h>
-
 #include <algorithm>
-#include <cctype>
 #include <regex>
 #include <sstream>
 

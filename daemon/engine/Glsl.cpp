@@ -104,12 +104,13 @@ void GlslPrinter::NeedStruct(const RecordDecl* rd) {
   if (m_emitted.count(rd) || m_inProgress.count(rd) || predeclaredStructs.count(rd->getNameAsString())) return;
   m_inProgress.insert(rd);
   std::ostringstream os;
-  os << "struct " << rd->getName().str() << " {  // from " << rd->getQualifiedNameAsString() << "\n";
+  if (rd->getQualifiedNameAsString() != rd->getName()) os << "// " << rd->getQualifiedNameAsString() << "\n";
+  os << "struct " << rd->getName().str() << " {\n";
   for (auto* f : rd->fields()) os << "  " << Declare(f->getType(), f->getName().str(), f->getLocation()) << ";\n";
   os << "};\n";
   m_inProgress.erase(rd);
   m_emitted.insert(rd);
-  m_structs.push_back(os.str());
+  m_structs.push_back({rd->getName().str(), os.str()});
 }
 
 void GlslPrinter::NeedConstant(const VarDecl* vd) {
@@ -117,12 +118,13 @@ void GlslPrinter::NeedConstant(const VarDecl* vd) {
   m_emitted.insert(vd);
   const clang::Expr* init = vd->getAnyInitializer();
   std::string value = init ? Expr(init) : "0";
-  m_constants.push_back("const " + Declare(vd->getType(), composedPrefix + vd->getName().str(), vd->getLocation()) + " = " + value + ";\n");
+  m_constants.push_back({composedPrefix + vd->getName().str(),
+                         "const " + Declare(vd->getType(), composedPrefix + vd->getName().str(), vd->getLocation()) + " = " + value + ";\n"});
 }
 
 std::string GlslPrinter::PreludeTypes() const {
   std::string out;
-  for (auto& s : m_structs) out += s + "\n";
+  for (auto& s : m_structs) out += s.text + "\n";
   return out;
 }
 
@@ -334,7 +336,7 @@ std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callL
   m_inLoopBody = savedLoopBody;
   m_pointers = outerPointers;
   m_inProgress.erase(def);
-  if (!m_emitted.count(def)) helpers.push_back(def);
+  if (!m_emitted.count(def)) m_uses.helpers.push_back(def);
   m_emitted.insert(def);
   m_functions.push_back(os.str());
   return name;
@@ -364,7 +366,7 @@ std::string GlslPrinter::ComposedCall(const CXXMemberCallExpr* mc) {
   std::vector<std::string> args;
   for (auto* arg : mc->arguments()) args.push_back(Expr(arg));
   Type(mc->getType(), mc->getBeginLoc());  // declares a returned struct (CRT_Hit)
-  composedCalls.insert({holder, method});
+  m_uses.composedCalls.insert({holder, method});
   std::string s = holder + "_" + method + "(";
   for (size_t i = 0; i < args.size(); ++i) s += (i ? ", " : "") + args[i];
   return s + ")";
@@ -398,8 +400,8 @@ std::string GlslPrinter::VirtualCall(const CXXMemberCallExpr* mc) {
   std::vector<std::string> args = {"uint(" + Expr(indexExpr) + ")"};
   for (auto* arg : mc->arguments()) args.push_back(Expr(arg));
   Type(mc->getType(), mc->getBeginLoc());  // declares a returned struct
-  virtualCalls.insert({field, method->getCanonicalDecl()});
-  virtualCallSites.push_back(mc);
+  m_uses.virtualCalls.insert({field, method->getCanonicalDecl()});
+  m_uses.virtualCallSites.push_back(mc);
   std::string s = composedPrefix + field->getNameAsString() + "_" + method->getNameAsString() + "(";
   for (size_t i = 0; i < args.size(); ++i) s += (i ? ", " : "") + args[i];
   return s + ")";
@@ -515,7 +517,7 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
                     "call its textures where the array is a member: " + field->getNameAsString() + "[i].sample(uv), " +
                     field->getNameAsString() + "[i][p], " + field->getNameAsString() + "[i].width(), " + field->getNameAsString() + ".size()");
       if (IsStdVector(field->getType())) {
-        memberVectors.insert(field);
+        m_uses.memberVectors.insert(field);
         return composedPrefix + field->getNameAsString();
       }
       if (IsImage2D(field->getType()))
@@ -528,7 +530,7 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
       if (field->getType()->isPointerType() || !GlslTypeOf(field->getType()))
         return Fail(e->getBeginLoc(), "member '" + field->getNameAsString() + "' of type '" + field->getType().getAsString(m_ctx.getPrintingPolicy()) +
                     "' cannot be used in a kernel", "kernels may use plain data members and std::vector members");
-      plainMembers.insert(field);
+      m_uses.plainMembers.insert(field);
       return composedPrefix + field->getNameAsString();
     }
     if (!field) return Fail(e->getBeginLoc(), "member function used as a value", "");
@@ -562,7 +564,7 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
       if (auto* image = ImageTexel(op, &coord)) {
         auto format = UsableImage(image, e->getBeginLoc());
         if (!format) return "/*error*/";
-        loadedImages.insert(image);
+        m_uses.loadedImages.insert(image);
         return TexelOf(*format, "imageLoad(" + ImageName(image) + ", " + coord + ")");
       }
     const clang::Expr* textureIndex = nullptr;
@@ -796,6 +798,5 @@ std::string GlslPrinter::Stmt(const clang::Stmt* s, int indent) {
   return Fail(s->getBeginLoc(), std::string("statement '") + s->getStmtClassName() + "' is not supported in kernels",
               "kernels may use declarations, if, for, while, do, switch, return, break and continue"), "";
 }
-
 
 }  // namespace crossrt::engine

@@ -3,6 +3,7 @@
 #pragma once
 #include "Diagnostics.h"
 #include "GlslTypes.h"
+#include "Model.h"
 #include "OrderedSet.h"
 
 #include <clang/AST/ASTContext.h>
@@ -28,6 +29,41 @@ const clang::CXXRecordDecl* PolymorphicPointee(clang::QualType type);
 // (and in `index`, the expression i), or null for other calls.
 const clang::FieldDecl* VirtualCallTarget(const clang::CXXMemberCallExpr* call, const clang::Expr** index = nullptr);
 
+// What the code a printer printed uses, recorded while printing: the facts the passes read
+// afterwards (which buffers, images and helpers a kernel binds and calls) instead of parsing the
+// text. Iterated in the order the printer met them.
+struct PrintedUses {
+  // Members declared std::vector that the code reaches, plain members it reads.
+  OrderedSet<const clang::FieldDecl*> memberVectors, plainMembers;
+  // Where it reads a member vector's size (a kernel may not read what it appends to).
+  std::multimap<const clang::FieldDecl*, clang::SourceLocation> sizeReads;
+  // Where it reads the size of a vector of objects (the class data holds it with the vector's
+  // tags, so the kernel must also call through it).
+  std::multimap<const clang::FieldDecl*, clang::SourceLocation> objectSizeReads;
+  // Image2D members and parameters it loads or stores texels of (storage images), samples
+  // (textures), and the Sampler members it samples with.
+  OrderedSet<const clang::ValueDecl*> loadedImages, storedImages, sampledImages;
+  OrderedSet<const clang::FieldDecl*> samplers;
+  OrderedSet<const clang::ValueDecl*> sizedImages;  // whose width() or height() it reads
+  OrderedSet<std::pair<const clang::ValueDecl*, const clang::FieldDecl*>> samplePairs;  // (image, sampler)
+  // Arrays of textures (std::vector<LiteImage::Texture2D<T>> members) it samples or reads.
+  OrderedSet<const clang::FieldDecl*> textureArrays;
+  // Helper functions it reaches (their writes to members matter too).
+  std::vector<const clang::FunctionDecl*> helpers;
+  // Calls through composed interfaces, as (holder member, method).
+  std::set<std::pair<std::string, std::string>> composedCalls;
+  // Virtual calls `m_objects[i]->Method(...)` through a std::vector of pointers to a polymorphic
+  // class, as (vector member, interface method), and each such call in printing order.
+  OrderedSet<std::pair<const clang::FieldDecl*, const clang::CXXMethodDecl*>> virtualCalls;
+  std::vector<const clang::CXXMemberCallExpr*> virtualCallSites;
+  // crossrt::Atomic* calls: buffers must be coherent (GL_KHR_memory_scope_semantics).
+  bool atomics = false;
+  // Floats added atomically (LiteMath's InterlockedAdd, ReduceAdd): GL_EXT_shader_atomic_float.
+  bool floatAtomics = false;
+  // Member vectors emptied (clear() or resize(0)) in single-thread code.
+  OrderedSet<const clang::FieldDecl*> emptiedVectors;
+};
+
 // Prints the code one kernel reaches. One instance per kernel; it collects the helper functions,
 // structs and constants the kernel needs, in an order GLSL accepts (callees before callers).
 class GlslPrinter {
@@ -39,42 +75,20 @@ public:
   // Pointer parameters that hold one value per thread (a local of a control function's thread
   // loop passed as &local): the GPU passes the value itself, so *p, p->f and p[0] print as p, p.f.
   std::set<const clang::ValueDecl*> valueParams;
-  // Members declared std::vector that the kernel reaches, plain members it reads.
-  OrderedSet<const clang::FieldDecl*> memberVectors, plainMembers;
-  // Where the kernel reads a member vector's size (a kernel may not read what it appends to).
-  std::multimap<const clang::FieldDecl*, clang::SourceLocation> sizeReads;
-  // Where the kernel reads the size of a vector of objects (the class data holds it with the
-  // vector's tags, so the kernel must also call through it).
-  std::multimap<const clang::FieldDecl*, clang::SourceLocation> objectSizeReads;
   // The kernel's Image2D reference parameters (the definition's): images bound per call, used in
   // the kernel's own body as member images are.
   OrderedSet<const clang::ValueDecl*> imageParams;
-  // Image2D members and parameters the kernel loads or stores texels of (storage images), samples
-  // (textures), and the Sampler members it samples with.
-  OrderedSet<const clang::ValueDecl*> loadedImages, storedImages, sampledImages;
-  OrderedSet<const clang::FieldDecl*> samplers;
-  OrderedSet<const clang::ValueDecl*> sizedImages;  // whose width() or height() it reads
-  OrderedSet<std::pair<const clang::ValueDecl*, const clang::FieldDecl*>> samplePairs;  // (image, sampler)
-  // Arrays of textures (std::vector<LiteImage::Texture2D<T>> members) the kernel samples or reads.
-  OrderedSet<const clang::FieldDecl*> textureArrays;
-  // Helper functions the kernel reaches (their writes to members matter too).
-  std::vector<const clang::FunctionDecl*> helpers;
 
   // Composition (paper 3.6). In a kernel's printer: interfaces with an implementation
   // ("ISceneObject" -> "BVHScene"); a call through a member holding one prints as
-  // `<member>_<method>(...)` and is recorded in composedCalls (member, method) for the
-  // implementation's printer, which runs on the implementation's AST afterwards.
+  // `<member>_<method>(...)` and is recorded in Uses().composedCalls for the implementation's
+  // printer, which runs on the implementation's AST afterwards.
   std::map<std::string, std::string> compositions;
-  std::set<std::pair<std::string, std::string>> composedCalls;
   // In an implementation's printer: the prefix its members and functions get ("m_pAccelStruct_").
   std::string composedPrefix;
   // Prints the implementation of an interface method, called from kernels as <prefix><name>.
   std::string EmitComposedMethod(const clang::CXXMethodDecl* method);
 
-  // Virtual functions (paper 3.9). In a kernel's printer: calls `m_objects[i]->Method(...)` through
-  // a std::vector of pointers to a polymorphic class, as (vector member, interface method).
-  OrderedSet<std::pair<const clang::FieldDecl*, const clang::CXXMethodDecl*>> virtualCalls;
-  std::vector<const clang::CXXMemberCallExpr*> virtualCallSites;  // each such call, in printing order
   // Statements printed as other text (each line indented as the statement): the loops over leaves
   // of a traversal that the ray tracing hardware runs instead (virtual functions, level 3).
   std::map<const clang::Stmt*, std::string> replacedStatements;
@@ -82,16 +96,16 @@ public:
   // read from the parameter `self` of type <Class>_Data, and its methods take `self` first.
   const clang::CXXRecordDecl* selfClass = nullptr;
 
-  // The kernel calls crossrt::Atomic*: its buffers must be coherent (GL_KHR_memory_scope_semantics).
-  bool usesAtomics = false;
-  // It adds floats atomically (LiteMath's InterlockedAdd, ReduceAdd): GL_EXT_shader_atomic_float.
-  bool usesFloatAtomics = false;
   // Printing statements one thread runs (before or after a kernel's loop nest): a member vector that
   // kernels append to may be emptied there (its count restarts).
   bool singleThread = false;
   // The thread function returns a value (a kernel_ function returning bool).
   bool threadReturnsValue = false;
-  OrderedSet<const clang::FieldDecl*> emptiedVectors;  // clear() or resize(0) there
+
+  // What the code printed so far uses.
+  const PrintedUses& Uses() const { return m_uses; }
+  // Size reads recorded while printing single-thread code (where they are allowed) are forgotten.
+  void RestoreSizeReads(std::multimap<const clang::FieldDecl*, clang::SourceLocation> reads) { m_uses.sizeReads = std::move(reads); }
 
   std::string Expr(const clang::Expr* e);
   std::string Stmt(const clang::Stmt* s, int indent);
@@ -105,8 +119,8 @@ public:
   // Structs the code needs (above the buffer blocks), then constants and helper functions (below),
   // one by one so that composed code can be merged ahead of a kernel's; PreludeTypes joins the structs.
   std::string PreludeTypes() const;
-  const std::vector<std::string>& Structs() const { return m_structs; }
-  const std::vector<std::string>& Constants() const { return m_constants; }
+  const std::vector<GlslDecl>& Structs() const { return m_structs; }
+  const std::vector<GlslDecl>& Constants() const { return m_constants; }
   const std::vector<std::string>& Functions() const { return m_functions; }
   // Structs declared once for the whole class (the class-data block needs them): not emitted again.
   std::set<std::string> predeclaredStructs;
@@ -188,8 +202,10 @@ private:
   int m_loopDepth = 0;
   bool m_inThreadBody = false;
   bool m_inLoopBody = false;
-  std::vector<std::string> m_structs, m_constants, m_functions;  // in emission order
+  std::vector<GlslDecl> m_structs, m_constants;  // in emission order
+  std::vector<std::string> m_functions;
   std::set<const clang::Decl*> m_emitted, m_inProgress;
+  PrintedUses m_uses;
 };
 
 }  // namespace crossrt::engine

@@ -210,7 +210,7 @@ std::string GlslPrinter::AtomicCall(const FunctionDecl* fd, const CallExpr* call
   if (std::string problem = AtomicTargetProblem(call->getArg(0)); !problem.empty())
     return Fail(call->getArg(0)->getExprLoc(), "the target of crossrt::" + name + " is not in device memory: " + problem,
                 "make the target an element of a std::vector member, a data member, or an element of a kernel's pointer parameter");
-  usesAtomics = true;
+  m_uses.atomics = true;
   std::vector<std::string> args;
   for (auto* arg : call->arguments()) args.push_back(Expr(arg));
   // The fences of acquire-release order (the kernel template defines crt_release/crt_acquire):
@@ -283,13 +283,13 @@ std::string GlslPrinter::Call(const CallExpr* call) {
       QualType element;
       if (field && isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts()) && name == "size" && IsStdVector(field->getType(), &element) &&
           PolymorphicPointee(element)) {
-        objectSizeReads.emplace(field, call->getBeginLoc());
+        m_uses.objectSizeReads.emplace(field, call->getBeginLoc());
         return composedPrefix + field->getNameAsString() + "_size";
       }
       if (field && isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts())) {
-        memberVectors.insert(field);
+        m_uses.memberVectors.insert(field);
         if (name == "size") {
-          sizeReads.emplace(field, call->getBeginLoc());
+          m_uses.sizeReads.emplace(field, call->getBeginLoc());
           return composedPrefix + field->getNameAsString() + "_size";
         }
         if (name == "capacity") return composedPrefix + field->getNameAsString() + "_capacity";
@@ -297,7 +297,7 @@ std::string GlslPrinter::Call(const CallExpr* call) {
         const bool empties = name == "clear" || (name == "resize" && call->getNumArgs() == 1 && call->getArg(0)->isIntegerConstantExpr(m_ctx) &&
                                                   call->getArg(0)->EvaluateKnownConstInt(m_ctx) == 0);
         if (empties && singleThread && composedPrefix.empty()) {
-          emptiedVectors.insert(field);
+          m_uses.emptiedVectors.insert(field);
           return field->getNameAsString() + "_size = 0u";
         }
         if (name == "push_back" && call->getNumArgs() == 1 && composedPrefix.empty())
@@ -356,7 +356,7 @@ std::string GlslPrinter::InterlockedCall(const FunctionDecl* fd, const CallExpr*
     if (std::string problem = AtomicTargetProblem(call->getArg(0)); !problem.empty())
       return Fail(call->getArg(0)->getExprLoc(), "the target of " + name + " is not in device memory: " + problem,
                   "make the target an element of a std::vector member, a data member, or an element of a kernel's pointer parameter");
-    usesFloatAtomics |= call->getArg(0)->getType()->isRealFloatingType();
+    m_uses.floatAtomics |= call->getArg(0)->getType()->isRealFloatingType();
     const std::string add = "atomicAdd(" + Expr(call->getArg(0)) + ", " + Expr(call->getArg(1)) + ")";
     return call->getNumArgs() == 3 ? Expr(call->getArg(2)) + " = " + add : add;
   }
@@ -367,7 +367,7 @@ std::string GlslPrinter::InterlockedCall(const FunctionDecl* fd, const CallExpr*
     if (!t->value.empty() || t->local)
       return Fail(call->getArg(0)->getExprLoc(), "the array of InterlockedAdd3f is not in device memory",
                   "pass a kernel's pointer parameter or a std::vector member's data()");
-    usesFloatAtomics = true;
+    m_uses.floatAtomics = true;
     const std::string at = (t->offset.empty() ? "" : t->offset + " + ") + "(" + Expr(call->getArg(1)) + ")", value = "(" + Expr(call->getArg(2)) + ")";
     return "atomicAdd(" + t->array + "[" + at + "], " + value + ".x), atomicAdd(" + t->array + "[" + at + " + 1], " + value +
            ".y), atomicAdd(" + t->array + "[" + at + " + 2], " + value + ".z)";
@@ -376,10 +376,10 @@ std::string GlslPrinter::InterlockedCall(const FunctionDecl* fd, const CallExpr*
   QualType element;
   if (!field || !IsStdVector(field->getType(), &element))
     return Fail(call->getArg(0)->getBeginLoc(), "ReduceAdd in a kernel adds into a std::vector member", "pass the member vector itself");
-  memberVectors.insert(field);
+  m_uses.memberVectors.insert(field);
   const std::string vector = field->getNameAsString(), helper = vector + "_ReduceAdd";
   const bool isFloat = element->isRealFloatingType();
-  usesFloatAtomics |= isFloat;
+  m_uses.floatAtomics |= isFloat;
   if (!std::count(m_reduceAddVectors.begin(), m_reduceAddVectors.end(), vector)) {
     m_reduceAddVectors.push_back(vector);
     std::ostringstream os;
@@ -392,6 +392,5 @@ std::string GlslPrinter::InterlockedCall(const FunctionDecl* fd, const CallExpr*
   const clang::Expr* value = call->getArg(call->getNumArgs() - 1);
   return helper + "(uint(" + Expr(call->getArg(1)) + "), " + Expr(value) + ")";
 }
-
 
 }  // namespace crossrt::engine

@@ -11,7 +11,6 @@
 #include <cstdio>
 #include <map>
 #include <set>
-#include <sstream>
 
 using namespace clang;
 
@@ -83,7 +82,7 @@ std::string GlslPrinter::ImageStore(const clang::Expr* lhs, const std::string& v
   const ValueDecl* image = ImageTexel(lhs, &coord);
   auto format = UsableImage(image, whole->getBeginLoc());
   if (!format) return "/*error*/";
-  storedImages.insert(image);
+  m_uses.storedImages.insert(image);
   const std::string channels = format->prefix + "vec4";
   return "imageStore(" + ImageName(image) + ", " + coord + ", " + (format->texel == "vec4" ? value : channels + "(" + value + ")") + ")";
 }
@@ -94,17 +93,17 @@ std::string GlslPrinter::ImageCall(const ValueDecl* image, const CXXMemberCallEx
   auto format = UsableImage(image, call->getBeginLoc());
   if (!format) return "/*error*/";
   if (method == "width" || method == "height") {
-    sizedImages.insert(image);
+    m_uses.sizedImages.insert(image);
     return image->getNameAsString() + "_" + method;
   }
   if (method == "at") {
     std::string coord;
     ImageTexel(call, &coord);
-    loadedImages.insert(image);
+    m_uses.loadedImages.insert(image);
     return TexelOf(*format, "imageLoad(" + name + ", " + coord + ")");
   }
   if (method == "set" && call->getNumArgs() == 3) {
-    storedImages.insert(image);
+    m_uses.storedImages.insert(image);
     const std::string value = Expr(call->getArg(2));
     return "imageStore(" + name + ", ivec2(" + Expr(call->getArg(0)) + ", " + Expr(call->getArg(1)) + "), " +
            (format->texel == "vec4" ? value : format->prefix + "vec4(" + value + ")") + ")";
@@ -118,9 +117,9 @@ std::string GlslPrinter::ImageCall(const ValueDecl* image, const CXXMemberCallEx
     if (!sampler || !IsImageSampler(sampler->getType()))
       return Fail(call->getArg(0)->getBeginLoc(), "the sampler of " + image->getNameAsString() + ".sample() is not a member of the class",
                   "declare the LiteImage::Sampler as a member, so it is created on the GPU with the image");
-    sampledImages.insert(image);
-    samplers.insert(sampler);
-    samplePairs.insert({image, sampler});
+    m_uses.sampledImages.insert(image);
+    m_uses.samplers.insert(sampler);
+    m_uses.samplePairs.insert({image, sampler});
     // Compute shaders have no derivatives: sample the one mip level explicitly.
     return TexelOf(*format, "textureLod(sampler2D(" + image->getNameAsString() + "_texture, " + sampler->getNameAsString() + "), " + Expr(call->getArg(1)) + ", 0.0)");
   }
@@ -153,7 +152,7 @@ bool GlslPrinter::UsableTextures(const FieldDecl* array, SourceLocation use) {
     Fail(use, "array of textures '" + array->getNameAsString() + "' used outside the class's own kernels",
          "use textures only in kernels and helpers of the translated class; pass a texture index to the object instead");
   else {
-    textureArrays.insert(array);
+    m_uses.textureArrays.insert(array);
     return true;
   }
   return false;
@@ -182,6 +181,5 @@ std::string GlslPrinter::TextureTexel(const FieldDecl* array, const clang::Expr*
   const bool ivec = GlslTypeOf(coord->getType()).value_or("") == "ivec2";
   return array->getNameAsString() + "_texel(" + TextureIndex(index, Expr(index)) + ", " + (ivec ? Expr(coord) : "ivec2(" + Expr(coord) + ")") + ")";
 }
-
 
 }  // namespace crossrt::engine

@@ -10,7 +10,6 @@
 #include <cstdio>
 #include <map>
 #include <set>
-#include <sstream>
 
 using namespace clang;
 
@@ -199,6 +198,5 @@ bool LayoutMatchesCpp(ASTContext& ctx, QualType type, bool scalar) {
   }
   return true;
 }
-
 
 }  // namespace crossrt::engine

@@ -5,11 +5,8 @@
 #include "CodeGen.h"
 #include "Glsl.h"
 
-#include <cctype>
 #include <fstream>
-#include <regex>
 #include <set>
-#include <sstream>
 #include <stdexcept>
 
 namespace crossrt::engine {

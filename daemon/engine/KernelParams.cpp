@@ -7,13 +7,8 @@
 #include "Members.h"
 #include "Naming.h"
 
-#include <llvm/Support/FileSystem.h>
-#include <llvm/Support/Path.h>
-
 #include <algorithm>
 #include <cctype>
-#include <regex>
-#include <sstream>
 
 using namespace clang;
 

@@ -13,12 +13,7 @@
 #include "VirtualCalls.h"
 #include "Writes.h"
 
-#include <llvm/Support/FileSystem.h>
-#include <llvm/Support/Path.h>
-
 #include <algorithm>
-#include <cctype>
-#include <regex>
 #include <sstream>
 
 using namespace clang;
@@ -253,7 +248,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   k.glslBody = os.str();
   // The statements around the loop nest, as functions one thread runs before and after the others.
   if (std::any_of(before.begin(), before.end(), [](const Stmt* s) { return !isa<DeclStmt>(s); }) || !after.empty()) {
-    const auto sizeReadsInLoop = printer.sizeReads;  // after the loop a vector's final size is known
+    const auto sizeReadsInLoop = printer.Uses().sizeReads;  // after the loop a vector's final size is known
     const auto renames = printer.renames;
     for (auto& r : k.reductions)
       for (auto* f : ClassFields(c.cls))
@@ -285,14 +280,14 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     }
     printer.singleThread = false;
     printer.renames = renames;
-    for (auto* f : printer.emptiedVectors)
+    for (auto* f : printer.Uses().emptiedVectors)
       if (!c.appended.count(f->getNameAsString()))
         c.rep.GpuError(f->getLocation(), "kernel '" + k.name + "' empties '" + f->getNameAsString() + "', which no kernel appends to: on the GPU only an appended vector's size is counted there",
                     "empty it in the control function (before the kernel), or append to it with push_back in the loop");
-    printer.sizeReads = sizeReadsInLoop;
+    printer.RestoreSizeReads(sizeReadsInLoop);
   }
   std::map<const FieldDecl*, SourceLocation> appends = ws.appends;
-  for (auto* helper : printer.helpers) {
+  for (auto* helper : printer.Uses().helpers) {
     WriteScanner hs(c);
     hs.helper = helper;
     hs.TraverseStmt(helper->getBody());
@@ -305,22 +300,22 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   // control function) and of helpers: those that append get copies with a lock.
   std::vector<const FunctionDecl*> reached;
   if (k.rtv) reached.push_back(def);
-  reached.insert(reached.end(), printer.helpers.begin(), printer.helpers.end());
+  reached.insert(reached.end(), printer.Uses().helpers.begin(), printer.Uses().helpers.end());
   AddLockedCopies(c, reached);
   // Threads append in any order: a size read in the same kernel would see a partial count.
   CheckObjectSizeReads(c.rep, printer);
-  for (auto& [field, loc] : printer.sizeReads)
+  for (auto& [field, loc] : printer.Uses().sizeReads)
     if (appends.count(field))
       c.rep.Error(loc, "kernel '" + k.name + "' reads the size of '" + field->getNameAsString() + "', which it appends to",
                   "the final size is known after the kernel: read it in a later kernel, or after the control function returns");
   k.structList = printer.Structs();
   k.constantList = printer.Constants();
   k.functionList = printer.Functions();
-  k.atomics = printer.usesAtomics;
-  k.floatAtomics = printer.usesFloatAtomics;
-  if (!printer.virtualCalls.empty()) AnalyzeVirtualCalls(c, k, printer);
-  k.composedCalls = printer.composedCalls;
-  for (auto& [holder, method] : printer.composedCalls) {
+  k.atomics = printer.Uses().atomics;
+  k.floatAtomics = printer.Uses().floatAtomics;
+  if (!printer.Uses().virtualCalls.empty()) AnalyzeVirtualCalls(c, k, printer);
+  k.composedCalls = printer.Uses().composedCalls;
+  for (auto& [holder, method] : printer.Uses().composedCalls) {
     if (std::any_of(c.model.compositions.begin(), c.model.compositions.end(), [&](const Composition& x) { return x.holder == holder; }))
       continue;
     Composition comp;
@@ -330,7 +325,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     comp.implName = c.compositions.count(comp.interfaceName) ? c.compositions.at(comp.interfaceName) : "";
     c.model.compositions.push_back(comp);
   }
-  for (auto* f : printer.memberVectors) {
+  for (auto* f : printer.Uses().memberVectors) {
     k.memberVectors.push_back(f->getNameAsString());
     if (auto* m = FindMember(c.model, f->getNameAsString())) m->usedByKernels = true;
     RequireReachable(c.rep, f, c.cls);
@@ -344,9 +339,9 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   k.ownMemberVectors = k.memberVectors;
   // Images and samplers, in declaration order so that bindings stay stable across regenerations.
   for (auto* f : ClassFields(c.cls)) {
-    const bool loaded = printer.loadedImages.count(f), stored = printer.storedImages.count(f);
-    const bool sampled = printer.sampledImages.count(f), sampler = printer.samplers.count(f);
-    if (!(loaded || stored || sampled || sampler || printer.sizedImages.count(f))) continue;
+    const bool loaded = printer.Uses().loadedImages.count(f), stored = printer.Uses().storedImages.count(f);
+    const bool sampled = printer.Uses().sampledImages.count(f), sampler = printer.Uses().samplers.count(f);
+    if (!(loaded || stored || sampled || sampler || printer.Uses().sizedImages.count(f))) continue;
     RequireReachable(c.rep, f, c.cls);
     auto* m = FindMember(c.model, f->getNameAsString());
     if (!m) continue;
@@ -359,14 +354,14 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   // Image parameters after the members, in parameter order.
   for (auto* p : def->parameters()) {
     if (!printer.imageParams.count(p)) continue;
-    const bool loaded = printer.loadedImages.count(p), stored = printer.storedImages.count(p);
+    const bool loaded = printer.Uses().loadedImages.count(p), stored = printer.Uses().storedImages.count(p);
     if (loaded || stored) k.images.push_back({p->getNameAsString(), ImageUse::Storage, loaded, stored, true});
-    if (printer.sampledImages.count(p)) k.images.push_back({p->getNameAsString(), ImageUse::Texture, false, false, true});
+    if (printer.Uses().sampledImages.count(p)) k.images.push_back({p->getNameAsString(), ImageUse::Texture, false, false, true});
   }
-  for (auto& [image, sampler] : printer.samplePairs)
+  for (auto& [image, sampler] : printer.Uses().samplePairs)
     (isa<FieldDecl>(image) ? k.samplePairs : k.paramSamplePairs).push_back({image->getNameAsString(), sampler->getNameAsString()});
   for (auto* f : ClassFields(c.cls)) {
-    if (!printer.textureArrays.count(f)) continue;
+    if (!printer.Uses().textureArrays.count(f)) continue;
     RequireReachable(c.rep, f, c.cls);
     if (auto* m = FindMember(c.model, f->getNameAsString())) {
       m->usedByKernels = true;
@@ -374,7 +369,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     }
   }
   std::sort(k.samplePairs.begin(), k.samplePairs.end());
-  for (auto* f : printer.plainMembers) {
+  for (auto* f : printer.Uses().plainMembers) {
     auto* m = FindMember(c.model, f->getNameAsString());
     if (m) m->usedByKernels = true;
     if (m && !m->inClassData && f->getAccess() != AS_private)

@@ -9,12 +9,7 @@
 #include "VirtualCalls.h"
 #include "WriteVisitor.h"
 
-#include <llvm/Support/FileSystem.h>
-#include <llvm/Support/Path.h>
-
 #include <algorithm>
-#include <cctype>
-#include <regex>
 #include <sstream>
 
 using namespace clang;
@@ -146,7 +141,7 @@ const CXXMethodDecl* BoxCorner(const CXXRecordDecl* interface, const std::string
 // (its vector and method, shared by other calls of both) joins `sites`, and its intersection,
 // closest-hit and miss shaders join `shaders`. Returns why not, or "".
 std::string TraceLeafCall(ASTContext& ctx, Reporter& rep, const ClassModel& model, const Composition& comp, const CXXRecordDecl* implClass,
-                          const CXXMemberCallExpr* call, GlslPrinter& hardware, std::vector<LeafTraversal>& sites, std::vector<std::string>& payloads,
+                          const CXXMemberCallExpr* call, GlslPrinter& hardware, std::vector<LeafTraversal>& sites, std::vector<GlslDecl>& payloads,
                           std::vector<StageShader>& shaders) {
   SourceManager& sm = ctx.getSourceManager();
   auto at = [&](SourceLocation loc) {
@@ -261,8 +256,8 @@ std::string TraceLeafCall(ASTContext& ctx, Reporter& rep, const ClassModel& mode
   hardware.replacedStatements[leaf.loop] = trace.str();
   const std::string hitType = *hardware.Type(hitParam.getNonReferenceType().getUnqualifiedType(), call->getBeginLoc());
   if (fresh)
-    payloads.push_back("// The hit the leaves' intersection shaders report to (" + callText + "'s last argument)\nlayout(location = " + number +
-                       ") rayPayloadEXT " + hitType + " " + payload + ";\n");
+    payloads.push_back({payload, "// The hit the leaves' intersection shaders report to (" + callText + "'s last argument)\nlayout(location = " +
+                                     number + ") rayPayloadEXT " + hitType + " " + payload + ";\n"});
 
   // A shader per name: another call (of this kernel or another) may already have it, from the same code.
   auto addShader = [&](const StageShader& s) {
@@ -298,9 +293,9 @@ std::string TraceLeafCall(ASTContext& ctx, Reporter& rep, const ClassModel& mode
                     vm->display + "'s leaves (virtual functions, level 3)";
     s.scalarLayout = vi.scalarLayout;
     s.classData = true;
-    for (auto& x : object.Constants()) s.constants += x;
-    for (auto& x : object.Structs()) s.structs += x + "\n";
-    s.structs += TagsReference(model, *vm) + "\n" + ImplDataStruct(object, *impl, *vm, vi) + "\n" + ObjectsReference(*vm, vi) + "\n" +
+    for (auto& x : object.Constants()) s.constants += x.text;
+    for (auto& x : object.Structs()) s.structs += x.text + "\n";
+    s.structs += TagsReference(model, *vm).text + "\n" + ImplDataStruct(object, *impl, *vm, vi).text + "\n" + ObjectsReference(*vm, vi).text + "\n" +
                  "hitAttributeEXT " + hitType + " crt_hit;  // what the closest-hit shader receives\n";
     for (auto& x : object.Functions()) s.functions += x + "\n";
     std::string args = "self, vec4(gl_WorldRayOriginEXT, gl_RayTminEXT), vec4(gl_WorldRayDirectionEXT, gl_RayTmaxEXT)";
@@ -320,7 +315,7 @@ std::string TraceLeafCall(ASTContext& ctx, Reporter& rep, const ClassModel& mode
   lt.closestHitShader = member + "_" + methodName + "_Hit";
   lt.missShader = member + "_" + methodName + "_Miss";
   std::string hitStructs;
-  for (auto& x : hardware.Structs()) hitStructs += x + "\n";
+  for (auto& x : hardware.Structs()) hitStructs += x.text + "\n";
   StageShader chit;
   chit.name = lt.closestHitShader;
   chit.stage = "rchit";
@@ -353,9 +348,9 @@ void AnalyzeLeafTraversal(ASTContext& ctx, Reporter& rep, ClassModel& model, Ker
   hardware.composedPrefix = holderPrefix;
   for (auto& sn : ClassStructNames(model)) hardware.predeclaredStructs.insert(sn);
   std::vector<LeafTraversal> sites;
-  std::vector<std::string> payloads;
+  std::vector<GlslDecl> payloads;
   std::vector<StageShader> shaders;
-  for (const CXXMemberCallExpr* call : printer.virtualCallSites)
+  for (const CXXMemberCallExpr* call : printer.Uses().virtualCallSites)
     if (std::string why = TraceLeafCall(ctx, rep, model, comp, implClass, call, hardware, sites, payloads, shaders); !why.empty()) {
       k.whyNoLeafShaders = why;
       return;

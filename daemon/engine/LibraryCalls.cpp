@@ -2,18 +2,13 @@
 // std::exclusive_scan and std::inclusive_scan, std::reduce, memcpy, std::copy and std::fill. Each
 // becomes a call of the runtime's primitive on device buffers.
 
+#include "GeneratedNames.h"
 #include "AnalysisContext.h"
 #include "AstQueries.h"
 #include "ControlRewriter.h"
 #include "LoopShape.h"
 
-#include <llvm/Support/FileSystem.h>
-#include <llvm/Support/Path.h>
-
 #include <algorithm>
-#include <cctype>
-#include <regex>
-#include <sstream>
 
 using namespace clang;
 
@@ -35,7 +30,7 @@ std::optional<ControlRewriter::Position> ControlRewriter::PositionOf(const Expr*
   }
   if (auto* dr = dyn_cast<DeclRefExpr>(e))
     if (auto* p = dyn_cast<ParmVarDecl>(dr->getDecl()); p && p->getDeclContext() == m_def && p->getType()->isPointerType())
-      return Position{"m_inOut_" + m_ctrl.name + "." + p->getNameAsString(), p->getNameAsString(), "", p->getType()->getPointeeType().getUnqualifiedType()};
+      return Position{generated::kInOutPrefix + m_ctrl.name + "." + p->getNameAsString(), p->getNameAsString(), "", p->getType()->getPointeeType().getUnqualifiedType()};
   if (auto* mc = dyn_cast<CXXMemberCallExpr>(e)) {
     std::string method = mc->getMethodDecl() ? mc->getMethodDecl()->getNameAsString() : "";
     auto* f = ThisField(mc->getImplicitObjectArgument());
@@ -44,7 +39,7 @@ std::optional<ControlRewriter::Position> ControlRewriter::PositionOf(const Expr*
       Member* m = FindMember(m_c.model, f->getNameAsString());
       if (!m) return std::nullopt;
       m->usedByKernels = true;  // so that it gets a device buffer
-      Position p{"m_vdata." + m->name + ".View()", m->name, "", element.getUnqualifiedType(), m};
+      Position p{generated::kVectorCopies + "." + m->name + ".View()", m->name, "", element.getUnqualifiedType(), m};
       p.isEnd = method == "end";
       return p;
     }
@@ -199,7 +194,7 @@ bool ControlRewriter::TryLibraryCall(const CallExpr* call) {
     std::string elem = CppTypeName(m_c.ctx, first->element);
     std::string init = initArg ? "crossrt::Bits32(static_cast<" + elem + ">(" + m_c.Text(initArg->getSourceRange()) + "))" : "0u";
     m_c.model.usesScanner = true;
-    replacement = "m_scanner.RecordCmd(a_cmd, " + ViewAt(*first) + ", " + ViewAt(*out) + ", uint32_t" + *count + ", " +
+    replacement = generated::kScanner + ".RecordCmd(a_cmd, " + ViewAt(*first) + ", " + ViewAt(*out) + ", uint32_t" + *count + ", " +
                   (name == "inclusive_scan" ? "true" : "false") + ", crossrt::ElementType::" + type + ", " + init + ")";
     WrittenVector(*out);
   } else if (name == "sort" && (call->getNumArgs() == 2 || call->getNumArgs() == 3)) {
@@ -214,13 +209,13 @@ bool ControlRewriter::TryLibraryCall(const CallExpr* call) {
     const std::string key = "crossrt::SortKey{" + std::to_string(words) + ", " + std::to_string(order->keyWord) +
                             ", crossrt::ElementType::" + order->type + ", " + (order->descending ? "true" : "false") + "}";
     m_c.model.usesSorter = true;
-    replacement = "m_sorter.RecordCmd(a_cmd, " + ViewAt(*first) + ", uint32_t" + *count + ", " + key + ")";
+    replacement = generated::kSorter + ".RecordCmd(a_cmd, " + ViewAt(*first) + ", uint32_t" + *count + ", " + key + ")";
     // A vector that kernels append to has its size on the GPU: the sort reads it there.
     if (first->vector && m_c.appended.count(first->vector->name)) {
       if (!IsWholeVector(call)) return bad("'" + first->vector->name + "' is appended to by kernels, so its size is known only on the GPU: sort all of it, from begin() to end()");
       const std::string v = first->vector->name;
       m_c.model.usesSorter = true;
-      replacement = "m_sorter.RecordCmd(a_cmd, " + first->view + ", uint32_t(m_vdata." + v + "Capacity), " + key +
+      replacement = generated::kSorter + ".RecordCmd(a_cmd, " + first->view + ", uint32_t(" + generated::kVectorCopies + "." + v + "Capacity), " + key +
                     ", m_classDataBuffer.View(), offsetof(ClassData, " + v + "_size))";
     }
     // The CPU backend sorts on all cores too, with the same radix sort.

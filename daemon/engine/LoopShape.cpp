@@ -6,13 +6,7 @@
 #include "AstQueries.h"
 #include "WriteVisitor.h"
 
-#include <llvm/Support/FileSystem.h>
-#include <llvm/Support/Path.h>
-
 #include <algorithm>
-#include <cctype>
-#include <regex>
-#include <sstream>
 
 using namespace clang;
 

@@ -6,13 +6,7 @@
 #include "AnalysisContext.h"
 #include "AstQueries.h"
 
-#include <llvm/Support/FileSystem.h>
-#include <llvm/Support/Path.h>
-
 #include <algorithm>
-#include <cctype>
-#include <regex>
-#include <sstream>
 
 using namespace clang;
 
@@ -89,6 +83,7 @@ void AnalyzeMembers(Context& c) {
     c.model.members.push_back(m);
   }
   c.model.glslClassStructs = structs.PreludeTypes();
+  for (auto& s : structs.Structs()) c.model.glslClassStructNames.insert(s.name);
   for (auto* ctor : c.cls->ctors()) {
     if (ctor->isImplicit() || ctor->isCopyOrMoveConstructor() || ctor->isDeleted() || ctor->getAccess() == AS_private) continue;
     Constructor k;
@@ -107,12 +102,6 @@ void AnalyzeMembers(Context& c) {
   }
 }
 
-std::set<std::string> ClassStructNames(const ClassModel& model) {
-  std::set<std::string> names;
-  static const std::regex decl(R"(struct (\w+) \{)");
-  for (std::sregex_iterator it(model.glslClassStructs.begin(), model.glslClassStructs.end(), decl), end; it != end; ++it)
-    names.insert((*it)[1]);
-  return names;
-}
+std::set<std::string> ClassStructNames(const ClassModel& model) { return model.glslClassStructNames; }
 
 }  // namespace crossrt::engine

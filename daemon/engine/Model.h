@@ -52,6 +52,15 @@ struct Reduction {
   std::string cppType;  // locals: the C++ type (members: the member's)
 };
 
+// A GLSL declaration a shader needs (a struct, a constant, a buffer reference type, a payload),
+// with the name it declares: later passes merge and filter declarations by name and never read
+// the name back from the text.
+struct GlslDecl {
+  std::string name;  // the type or constant it declares
+  std::string text;
+  bool operator==(const GlslDecl& other) const { return name == other.name && text == other.text; }
+};
+
 struct KernelParam {
   std::string name;       // as in the user's code
   std::string glslName;   // renamed when it is a GLSL keyword
@@ -141,7 +150,8 @@ struct Kernel {
   std::string sourceFile;             // where the kernel is defined (for comments)
   // The GLSL prelude: structs it needs beyond the class's, constants and helper functions, in an
   // order GLSL accepts (composed code is merged in ahead of the kernel's own).
-  std::vector<std::string> structList, constantList, functionList;
+  std::vector<GlslDecl> structList, constantList;
+  std::vector<std::string> functionList;
   std::set<std::pair<std::string, std::string>> composedCalls;  // (holder member, interface method)
   // Hardware ray tracing (paper 3.5): when the kernel's only composed calls are ISceneObject's
   // RayQuery_NearestHit / RayQuery_AnyHit through one member, a second shader, <kernel>_RayQuery,
@@ -162,7 +172,8 @@ struct Kernel {
   // generation shader: the kernel's own structs and functions, the calls' payloads, and dispatchers
   // that execute the object's class's callable shader instead of switching over implementations.
   std::vector<std::string> callables;
-  std::vector<std::string> callableStructList, callableFunctionList;
+  std::vector<GlslDecl> callableStructList;
+  std::vector<std::string> callableFunctionList;
   bool atomics = false;               // calls crossrt::Atomic*: coherent buffers, memory scope semantics
   bool floatAtomics = false;          // adds floats atomically (InterlockedAdd, ReduceAdd): GL_EXT_shader_atomic_float
   // Virtual functions, level 3, in composed code: the leaf calls the ray tracing hardware runs, in
@@ -171,7 +182,8 @@ struct Kernel {
   // each leaves' loop was.
   std::vector<LeafTraversal> leaves;
   std::string whyNoLeafShaders;
-  std::vector<std::string> leafStructList, leafFunctionList;
+  std::vector<GlslDecl> leafStructList;
+  std::vector<std::string> leafFunctionList;
 };
 
 struct ControlParam {
@@ -261,7 +273,6 @@ struct StageShader {
   std::string mainBody;               // loads the object, calls the implementation, stores the result
 };
 
-
 // A member function that appends to a member vector, reached from a kernel's threads: the CPU
 // backend hides it with a copy whose push_backs take a lock (crossrt::Locked), as it does in the
 // kernels' own loops. Callers on the way from the kernel are copied too, so that they call the copy.
@@ -290,6 +301,7 @@ struct ClassModel {
   bool virtualDestructor = false;      // the class's destructor is virtual: the generated ones override it
   std::vector<BlockField> classData;   // plain members + vector sizes, in block order
   std::string glslClassStructs;        // structs the class-data block and member vectors need
+  std::set<std::string> glslClassStructNames;  // the names they declare
   std::vector<std::string> sourceIncludes;  // #include lines of the sources (quoted ones made absolute)
   std::vector<std::string> usingDecls; // top-level using-directives of the sources: copied bodies need them
   // Declarations of the sources themselves that copied bodies use (static helpers, constants, types;

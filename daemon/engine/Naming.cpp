@@ -4,14 +4,7 @@
 // vectorization": the kernel holds its own loop nest, whose iterations become the threads).
 #include "Naming.h"
 
-
-#include <llvm/Support/FileSystem.h>
-#include <llvm/Support/Path.h>
-
 #include <algorithm>
-#include <cctype>
-#include <regex>
-#include <sstream>
 
 using namespace clang;
 

@@ -7,9 +7,7 @@
 
 #include <cctype>
 #include <fstream>
-#include <regex>
 #include <set>
-#include <sstream>
 #include <stdexcept>
 
 namespace crossrt::engine {
@@ -49,17 +47,16 @@ bool MentionsWord(const std::string& text, const std::string& name) {
   return false;
 }
 
-// The structs and constants of `chunks` that `used` (code kept) mentions, directly or through a
-// kept chunk; order is kept. Chunks come dependencies first, so one pass from the back suffices.
-std::vector<std::string> KeepMentioned(const std::vector<std::string>& chunks, std::string used, const std::regex& nameOf) {
+// The structs and constants of `chunks` that `used` (code kept) mentions by the names they
+// declare, directly or through a kept chunk; order is kept. Chunks come dependencies first, so one pass from the back suffices.
+std::vector<GlslDecl> KeepMentioned(const std::vector<GlslDecl>& chunks, std::string used) {
   std::vector<bool> keep(chunks.size(), false);
   for (size_t i = chunks.size(); i-- > 0;) {
-    std::smatch m;
-    if (!std::regex_search(chunks[i], m, nameOf) || !MentionsWord(used, m[1].str())) continue;
+    if (chunks[i].name.empty() || !MentionsWord(used, chunks[i].name)) continue;
     keep[i] = true;
-    used += chunks[i];
+    used += chunks[i].text;
   }
-  std::vector<std::string> kept;
+  std::vector<GlslDecl> kept;
   for (size_t i = 0; i < chunks.size(); ++i)
     if (keep[i]) kept.push_back(chunks[i]);
   return kept;
@@ -124,7 +121,8 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   // The ray query variant drops the composed implementation: its functions, buffers, and the
   // structs and constants only they used.
   const std::vector<std::string>& memberVectors = hardwareRayQuery ? k.ownMemberVectors : k.memberVectors;
-  std::vector<std::string> functionList = k.functionList, structList = k.structList, constantList = k.constantList;
+  std::vector<std::string> functionList = k.functionList;
+  std::vector<GlslDecl> structList = k.structList, constantList = k.constantList;
   if (callables) {
     functionList = k.callableFunctionList;
     structList = k.callableStructList;
@@ -141,20 +139,15 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
     for (auto& p : k.params) used += " " + p.glslType;
     for (auto& v : memberVectors)
       if (auto* m = FindMember(model, v)) used += " " + m->glslType;
-    // Structs, and the buffer reference types of virtual calls (layout(buffer_reference, ...) buffer T).
-    static const std::regex structName(R"(^(?:struct|layout\(buffer_reference[^)]*\) readonly buffer) (\w+))"), constantName(R"(^const \w+ (\w+))");
-    constantList = KeepMentioned(k.constantList, used, constantName);
-    for (auto& c : constantList) used += c;
-    structList = KeepMentioned(k.structList, used, structName);
+    // Constants, structs, and the buffer reference types of virtual calls, by the names they declare.
+    constantList = KeepMentioned(k.constantList, used);
+    for (auto& c : constantList) used += c.text;
+    structList = KeepMentioned(k.structList, used);
   }
   std::string structs;
-  for (auto& x : structList) structs += x + "\n";
-  if (!k.textureArrays.empty())
-    structs += "// A texture of an array as the host describes it (crossrt::TextureInfo): its texels' place in the\n"
-               "// texel buffer, its size, its sampler's address modes and filter, its border colour.\n"
-               "struct crt_TextureInfo\n{\n  uint offset;\n  uint width;\n  uint height;\n  uint mode;  // addressU | addressV << 2 | linear << 4\n"
-               "  vec4 border;\n};\n\n";
+  for (auto& x : structList) structs += x.text + "\n";
   d.set("kernelStructs", structs);
+  d.set("textureInfo", !k.textureArrays.empty());  // crt_TextureInfo, in the template
   for (size_t i = k.textureArrays.size(); i-- > 0;)
     if (auto* m = FindMember(model, k.textureArrays[i])) functionList.insert(functionList.begin(), TextureArrayFunctions(*m, hardwareTextures, i == 0, opt));
   // Atomics order the kernel's other writes for other threads (Atomics.h): the buffers it may
@@ -312,7 +305,7 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   }
   d.set("pushConstants", push);
   std::string helpers;
-  for (auto& x : constantList) helpers += x;
+  for (auto& x : constantList) helpers += x.text;
   if (!constantList.empty()) helpers += "\n";
   for (auto& x : functionList) helpers += x + "\n";
   d.set("helpers", helpers);

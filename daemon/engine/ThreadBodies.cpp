@@ -2,6 +2,7 @@
 // whole body per thread) and as the wavefront's host code (one dispatch per kernel call, the per-thread
 // locals kept in buffers between them).
 
+#include "GeneratedNames.h"
 #include "AnalysisContext.h"
 #include "AstQueries.h"
 #include "ControlFunctions.h"
@@ -10,13 +11,8 @@
 #include "LoopShape.h"
 #include "Naming.h"
 
-#include <llvm/Support/FileSystem.h>
-#include <llvm/Support/Path.h>
-
 #include <algorithm>
-#include <cctype>
 #include <regex>
-#include <sstream>
 
 using namespace clang;
 
@@ -226,7 +222,7 @@ std::string ControlRewriter::ThreadBodyCpp(ThreadLoop& tl, const Stmt* s) {
     }
     auto* vd = AddressedVar(arg);
     std::string buffer = vd ? StateBuffer(tl, vd) : "";
-    args += ", " + (buffer.empty() ? BufferArg(Resolve(arg)) : "m_threadState." + buffer + ".View()");
+    args += ", " + (buffer.empty() ? BufferArg(Resolve(arg)) : generated::kThreadState + "." + buffer + ".View()");
   }
   return md->getNameAsString() + "Cmd(a_cmd" + tl.counts + args + ");\n";
 }

@@ -10,13 +10,7 @@
 #include "Members.h"
 #include "Naming.h"
 
-#include <llvm/Support/FileSystem.h>
-#include <llvm/Support/Path.h>
-
 #include <algorithm>
-#include <cctype>
-#include <regex>
-#include <sstream>
 
 using namespace clang;
 
@@ -99,9 +93,9 @@ bool ControlRewriter::TryThreadLoop(const ForStmt* outerLoop) {
   for (auto& [param, arg] : m_inlined) printer.renames[param] = printer.Expr(Resolve(arg));  // read through
   std::string glsl = ThreadBodyGlsl(tl, printer, body, 1);
   if (!tl.ok) return true;
-  for (auto* f : printer.plainMembers)
+  for (auto* f : printer.Uses().plainMembers)
     if (auto* m = FindMember(m_c.model, f->getNameAsString())) m->usedByKernels = true;
-  if (!printer.memberVectors.empty() || !printer.helpers.empty())
+  if (!printer.Uses().memberVectors.empty() || !printer.Uses().helpers.empty())
     Error(tl, outerLoop->getBeginLoc(), "the host code of a thread loop of '" + m_ctrl.name + "' uses member vectors or calls functions",
           "count host loops with plain members, parameters or constants; move other work into a kernel");
   const bool axesCovered = tl.axisOf.size() == tl.loops.size() &&

@@ -5,12 +5,7 @@
 #include "AnalysisContext.h"
 #include "Callables.h"
 
-#include <llvm/Support/FileSystem.h>
-#include <llvm/Support/Path.h>
-
 #include <algorithm>
-#include <cctype>
-#include <regex>
 #include <sstream>
 
 using namespace clang;
@@ -98,12 +93,12 @@ std::string DispatcherParams(GlslPrinter& printer, const CXXMethodDecl* m) {
   return out;
 }
 
-std::string TagsReference(const ClassModel& model, const VirtualMember& vm) {
-  return "layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer " + vm.member + "_Tags { uvec2 tags[]; };  // per element of " +
-         vm.display + ": (class, " + (model.virtualLevel == 1 ? "its slot" : "index among its class's objects") + ")\n";
+GlslDecl TagsReference(const ClassModel& model, const VirtualMember& vm) {
+  return {vm.member + "_Tags", "layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer " + vm.member + "_Tags { uvec2 tags[]; };  // per element of " +
+         vm.display + ": (class, " + (model.virtualLevel == 1 ? "its slot" : "index among its class's objects") + ")\n"};
 }
 
-std::string ImplDataStruct(GlslPrinter& printer, const CXXRecordDecl* impl, const VirtualMember& vm, const VirtualImpl& vi) {
+GlslDecl ImplDataStruct(GlslPrinter& printer, const CXXRecordDecl* impl, const VirtualMember& vm, const VirtualImpl& vi) {
   std::ostringstream data;
   data << "struct " << vi.name << "_Data {  // the data members of " << vi.name << "\n";
   std::vector<const FieldDecl*> fields;
@@ -113,23 +108,24 @@ std::string ImplDataStruct(GlslPrinter& printer, const CXXRecordDecl* impl, cons
     data << "  uint crt_padding[" << vi.paddingWords << "];  // every element of a vector of " << vm.interfaceName << " has a slot of " << vm.slotBytes
          << " bytes\n";
   data << "};\n";
-  return data.str();
+  return {vi.name + "_Data", data.str()};
 }
 
-std::string ObjectsReference(const VirtualMember& vm, const VirtualImpl& vi) {
-  return std::string("layout(buffer_reference, ") + (vi.scalarLayout ? "scalar" : "std430") + ", buffer_reference_align = 4) readonly buffer " +
-         vm.member + "_" + vi.name + "Objects { " + vi.name + "_Data objects[]; };\n";
+GlslDecl ObjectsReference(const VirtualMember& vm, const VirtualImpl& vi) {
+  return {vm.member + "_" + vi.name + "Objects", std::string("layout(buffer_reference, ") + (vi.scalarLayout ? "scalar" : "std430") + ", buffer_reference_align = 4) readonly buffer " +
+         vm.member + "_" + vi.name + "Objects { " + vi.name + "_Data objects[]; };\n"};
 }
 
 void CheckObjectSizeReads(Reporter& rep, const GlslPrinter& printer) {
-  for (auto& [field, loc] : printer.objectSizeReads)
-    if (std::none_of(printer.virtualCalls.begin(), printer.virtualCalls.end(), [&](const auto& call) { return call.first == field; }))
+  for (auto& [field, loc] : printer.Uses().objectSizeReads)
+    if (std::none_of(printer.Uses().virtualCalls.begin(), printer.Uses().virtualCalls.end(), [&](const auto& call) { return call.first == field; }))
       rep.GpuError(loc, "the kernel reads the size of '" + field->getNameAsString() + "', a vector of objects it calls no virtual function through",
                 "keep the count in a plain member, or read the size where the kernel also calls through the vector");
 }
 
 void AnalyzeVirtualCalls(Context& c, Kernel& k, GlslPrinter& kernelPrinter) {
-  std::vector<std::string> structs, functions;
+  std::vector<GlslDecl> structs;
+  std::vector<std::string> functions;
   CallableCode callable;
   VirtualCallCode(c.ctx, c.rep, c.model, k, kernelPrinter, VirtualOwner{c.cls, "", "", ""}, structs, functions,
                   c.model.virtualLevel == 3 ? &callable : nullptr);

@@ -36,13 +36,13 @@ bool WrittenBack(const CXXMethodDecl* m, unsigned i);
 std::string DispatcherParams(GlslPrinter& printer, const CXXMethodDecl* m);
 
 // The buffer reference to a vector's tags: per element, its class and where its object is.
-std::string TagsReference(const ClassModel& model, const VirtualMember& vm);
+GlslDecl TagsReference(const ClassModel& model, const VirtualMember& vm);
 
 // The GLSL mirror of the data of an implementation's objects (printed by its object-mode printer).
-std::string ImplDataStruct(GlslPrinter& printer, const CXXRecordDecl* impl, const VirtualMember& vm, const VirtualImpl& vi);
+GlslDecl ImplDataStruct(GlslPrinter& printer, const CXXRecordDecl* impl, const VirtualMember& vm, const VirtualImpl& vi);
 
 // The buffer reference to the objects of one implementation (level 2 and 3).
-std::string ObjectsReference(const VirtualMember& vm, const VirtualImpl& vi);
+GlslDecl ObjectsReference(const VirtualMember& vm, const VirtualImpl& vi);
 
 // The size of a vector of objects is in the class data next to the vector's tags, which exist for
 // vectors the kernel calls through.

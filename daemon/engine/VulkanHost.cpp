@@ -1,16 +1,14 @@
 // The host code's data for the templates: per control function its ...Cmd recording (Vulkan) and
 // its body (CPU), per Vulkan kernel its pipeline, bindings and dispatch, and the buffers and images
 // the Vulkan class holds.
+#include "GeneratedNames.h"
 #include "VulkanHost.h"
 #include "CodeGenSupport.h"
 #include "CodeGen.h"
 #include "Glsl.h"
 
-#include <cctype>
 #include <fstream>
-#include <regex>
 #include <set>
-#include <sstream>
 #include <stdexcept>
 
 namespace crossrt::engine {
@@ -212,7 +210,7 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
     const std::vector<KernelVariant> kinds = Variants(k);
     for (size_t vi = 0; vi < kinds.size(); ++vi) {
       const KernelVariant& kind = kinds[vi];
-      std::string list = "m_classDataBuffer.View()", types = "VK_DESCRIPTOR_TYPE_STORAGE_BUFFER";
+      std::string list = generated::kClassData + ".View()", types = "VK_DESCRIPTOR_TYPE_STORAGE_BUFFER";
       unsigned buffers = 1;
       auto buffer = [&](const std::string& view) {
         list += ", " + view;
@@ -221,8 +219,8 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
       };
       for (auto& p : k.params)
         if (p.isPointer) buffer(p.name);
-      for (auto& v : kind.rayQuery ? k.ownMemberVectors : k.memberVectors) buffer("m_vdata." + v + ".View()");
-      for (auto& r : k.reductions) buffer("m_partials." + k.name + "_" + r.member + ".View()");
+      for (auto& v : kind.rayQuery ? k.ownMemberVectors : k.memberVectors) buffer(generated::kVectorCopies + "." + v + ".View()");
+      for (auto& r : k.reductions) buffer(generated::kPartials + "." + k.name + "_" + r.member + ".View()");
       bool typed = false;  // bindings other than storage buffers
       for (auto& ib : k.images) {
         const char* type = ib.use == ImageUse::Storage ? "VK_DESCRIPTOR_TYPE_STORAGE_IMAGE"
@@ -230,14 +228,14 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
         types += std::string(", ") + type;
         list += std::string(", crossrt::Binding::") +
                 (ib.use == ImageUse::Storage ? "StorageImage" : ib.use == ImageUse::Texture ? "SampledImage" : "SamplerOf") + "(" +
-                (ib.parameter ? "" : "m_images.") + ib.member + ")";
+                (ib.parameter ? "" : generated::kImages + ".") + ib.member + ")";
         typed = true;
       }
       std::string sets;
       for (auto& a : k.textureArrays) {
-        buffer("m_textures." + a + "_info.View()");
+        buffer(generated::kTextures + "." + a + "_info.View()");
         if (kind.textures) sets += (sets.empty() ? "&m_textures." : ", &m_textures.") + a;
-        else buffer("m_textures." + a + "_texels.View()");
+        else buffer(generated::kTextures + "." + a + "_texels.View()");
       }
       if (kind.rayQuery) {
         types += ", VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR";
@@ -285,7 +283,7 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
       // A kernel with a ray generation variant records its launch in each branch: a trace or a dispatch.
       const bool traces = RunsCallables(k) || RunsLeafShaders(k);
       std::string launch;
-      if (rayGeneration) launch = "m_pipelines." + k.name + kind.suffix + ".TraceCmd(a_cmd, " + LaunchSize(k) + ")";
+      if (rayGeneration) launch = generated::kPipelines + "." + k.name + kind.suffix + ".TraceCmd(a_cmd, " + LaunchSize(k) + ")";
       else if (traces) launch = DispatchExpr(k);
       if (launch.empty()) y.set("launch", false);  // the shared dispatch after the variants launches it
       else y.set("launch", launch);

@@ -5,13 +5,7 @@
 
 #include "AnalysisContext.h"
 
-#include <llvm/Support/FileSystem.h>
-#include <llvm/Support/Path.h>
-
 #include <algorithm>
-#include <cctype>
-#include <regex>
-#include <sstream>
 
 using namespace clang;
 

@@ -7,7 +7,7 @@
 layout(local_size_x = 256) in;
 
 struct BVHNode
-{  // from BVHNode
+{
   vec3 boxMin;
   uint left;
   vec3 boxMax;

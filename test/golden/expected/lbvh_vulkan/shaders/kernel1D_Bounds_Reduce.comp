@@ -8,7 +8,7 @@ layout(local_size_x = 256) in;
 #define CRT_INFINITY uintBitsToFloat(0x7F800000u)  // the identity of min over floats (max: -CRT_INFINITY)
 
 struct BVHNode
-{  // from BVHNode
+{
   vec3 boxMin;
   uint left;
   vec3 boxMax;

@@ -5,15 +5,16 @@
 layout(local_size_x = 256, local_size_y = 1, local_size_z = 1) in;
 
 struct BVHNode
-{  // from BVHNode
+{
   vec3 boxMin;
   uint left;
   vec3 boxMax;
   uint right;
 };
 
+// LiteMath::Box4f
 struct Box4f
-{  // from LiteMath::Box4f
+{
   vec4 boxMin;
   vec4 boxMax;
 };

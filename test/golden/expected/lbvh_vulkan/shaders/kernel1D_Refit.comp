@@ -5,7 +5,7 @@
 layout(local_size_x = 256, local_size_y = 1, local_size_z = 1) in;
 
 struct BVHNode
-{  // from BVHNode
+{
   vec3 boxMin;
   uint left;
   vec3 boxMax;

@@ -5,7 +5,7 @@
 layout(local_size_x = 256, local_size_y = 1, local_size_z = 1) in;
 
 struct CRT_Hit
-{  // from CRT_Hit
+{
   float t;
   uint primId;
   uint instId;
@@ -14,7 +14,7 @@ struct CRT_Hit
 };
 
 struct BVHTraceRay
-{  // from BVHTraceRay
+{
   vec3 org;
   vec3 dir;
   vec3 invDir;
@@ -29,7 +29,7 @@ struct BVHTraceRay
 };
 
 struct BVHInstance
-{  // from BVHInstance
+{
   vec4 toObjectRow0;
   vec4 toObjectRow1;
   vec4 toObjectRow2;
@@ -44,7 +44,7 @@ struct BVHInstance
 };
 
 struct BVH4Node
-{  // from BVH4Node
+{
   vec4 minX;
   vec4 maxX;
   vec4 minY;
@@ -56,7 +56,7 @@ struct BVH4Node
 };
 
 struct BVHTriangle4
-{  // from BVHTriangle4
+{
   vec4 coord[9];
 };
 

@@ -7,7 +7,7 @@
 layout(local_size_x = 16, local_size_y = 16, local_size_z = 1) in;
 
 struct CRT_Hit
-{  // from CRT_Hit
+{
   float t;
   uint primId;
   uint instId;

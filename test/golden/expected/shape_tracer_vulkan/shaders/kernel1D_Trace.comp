@@ -7,7 +7,7 @@
 layout(local_size_x = 256, local_size_y = 1, local_size_z = 1) in;
 
 struct ShapeHit
-{  // from ShapeHit
+{
   float t;
   uint shape;
   float nx;

@@ -4,7 +4,7 @@
 #extension GL_EXT_ray_tracing : require
 
 struct ShapeHit
-{  // from ShapeHit
+{
   float t;
   uint shape;
   float nx;

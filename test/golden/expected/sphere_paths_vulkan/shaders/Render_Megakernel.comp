@@ -6,13 +6,13 @@
 layout(local_size_x = 16, local_size_y = 16, local_size_z = 1) in;
 
 struct Sphere
-{  // from Sphere
+{
   vec4 centerRadius;
   vec4 color;
 };
 
 struct SphereHit
-{  // from SphereHit
+{
   vec4 position;
   vec4 normal;
   int sphere;
