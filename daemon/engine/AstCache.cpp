@@ -1,3 +1,5 @@
+// Parsed translation units, kept between translations (AstCache.h says how): parse once, then reparse
+// with the precompiled preamble; least recently used entries are evicted.
 #include "AstCache.h"
 
 #include <clang/Basic/DiagnosticOptions.h>

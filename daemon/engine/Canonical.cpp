@@ -1,3 +1,5 @@
+// Canonical form of copied C++ and the layout of generated files, both through clang-format
+// (Canonical.h says why).
 #include "Canonical.h"
 
 #include <clang/Basic/LangOptions.h>

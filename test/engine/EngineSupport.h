@@ -57,6 +57,22 @@ inline crossrt::engine::TranslateRequest MakeRequest(const TempClass& tc, const 
   return r;
 }
 
+// The model's member or control function of that name (the test fails when there is none).
+inline const crossrt::engine::Member& MemberNamed(const crossrt::engine::ClassModel& model, const std::string& name)
+{
+  for (auto& m : model.members)
+    if (m.name == name) return m;
+  FAIL("no member " << name);
+  throw;
+}
+inline const crossrt::engine::Control& ControlNamed(const crossrt::engine::ClassModel& model, const std::string& name)
+{
+  for (auto& c : model.controls)
+    if (c.name == name) return c;
+  FAIL("no control function " << name);
+  throw;
+}
+
 struct CommandResult { int exitCode = -1; bool crashed = false; std::string output; };
 
 // Runs the crossrt command (stderr merged into the captured output). Safe to call from threads.

@@ -56,15 +56,6 @@ void Layouts::kernel1D_Touch(int n)
   }
 }
 )";
-
-const Member& MemberNamed(const ClassModel& model, const std::string& name)
-{
-  for (auto& m : model.members)
-    if (m.name == name) return m;
-  FAIL("no member " << name);
-  throw;
-}
-
 }  // namespace
 
 TEST_CASE("Layouts: vector elements get std430 where it reproduces C++, scalar where only it does", "[engine][layout]")

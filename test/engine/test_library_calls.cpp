@@ -52,15 +52,6 @@ void Library::kernel1D_Flags(int n)
 }
 )";
 }
-
-const Control& ControlNamed(const ClassModel& model, const std::string& name)
-{
-  for (auto& c : model.controls)
-    if (c.name == name) return c;
-  FAIL("no control function " << name);
-  throw;
-}
-
 }  // namespace
 
 TEST_CASE("Library calls: sort, scan, fill and memcpy on member vectors become GPU primitives", "[engine][library]")
