@@ -2,6 +2,7 @@
 // method a dispatcher that switches over the object's class (levels 1-2), or at level 3 a callable
 // shader per implementation and the call that the ray generation shader makes.
 #include "Callables.h"
+#include "CodeGenSupport.h"
 
 #include "AstQueries.h"
 #include "Members.h"
@@ -81,21 +82,35 @@ void CallableDispatcher(ASTContext& ctx, Reporter& rep, ClassModel& model, Kerne
     k.callables.push_back(vm.member + "_" + vi.name + "_" + method);
     names += (names.empty() ? "" : ", ") + k.callables.back();
   }
-  std::ostringstream os;
-  os << "// " << display << ": the callable shader of the object's class runs its implementation\n";
-  os << retType << " " << callName << "(uint index" << DispatcherParams(kernelPrinter, m) << ")\n{\n";
-  os << "  const uvec2 tag = " << vm.member << "_Tags(" << vm.member << "_tags).tags[index];\n";
-  os << "  switch (tag.x)  // the objects of its class\n  {\n";
-  for (size_t t = 0; t < vm.impls.size(); ++t)
-    os << "    case " << t << "u: " << variable << ".crt_objects = " << vm.member << "_" << vm.impls[t].name << "; break;\n";
-  os << "  }\n  " << variable << ".crt_index = tag.y;\n";
-  for (unsigned i = 0; i < m->getNumParams(); ++i) os << "  " << variable << "." << CallArgumentName(m, i) << " = " << CallArgumentName(m, i) << ";\n";
-  os << "  executeCallableEXT(" << first << "u + tag.x, " << location << ");  // " << names << "\n";
-  for (unsigned i = 0; i < m->getNumParams(); ++i)
-    if (WrittenBack(m, i)) os << "  " << CallArgumentName(m, i) << " = " << variable << "." << CallArgumentName(m, i) << ";\n";
-  if (retType != "void") os << "  return " << variable << ".crt_result;\n";
-  os << "}\n";
-  out.functions.push_back(os.str());
+  // The dispatcher (templates/glsl/callable_dispatcher.glsl.mustache): the arguments into the
+  // payload, the callable shader of the object's class, the written-back arguments and the result out.
+  Data d;
+  d.set("display", display);
+  d.set("returnType", retType);
+  d.set("returnsVoid", retType == "void");
+  d.set("callName", callName);
+  d.set("params", DispatcherParams(kernelPrinter, m));
+  d.set("member", vm.member);
+  d.set("variable", variable);
+  Data classes = List(), arguments = List();
+  for (size_t t = 0; t < vm.impls.size(); ++t) {
+    Data x;
+    x.set("tag", std::to_string(t));
+    x.set("class", vm.impls[t].name);
+    classes.push_back(x);
+  }
+  for (unsigned i = 0; i < m->getNumParams(); ++i) {
+    Data x;
+    x.set("name", CallArgumentName(m, i));
+    x.set("writtenBack", WrittenBack(m, i));
+    arguments.push_back(x);
+  }
+  d.set("classes", classes);
+  d.set("arguments", arguments);
+  d.set("first", std::to_string(first));
+  d.set("location", std::to_string(location));
+  d.set("shaders", names);
+  out.functions.push_back(Render(model.templateDir + "/glsl/callable_dispatcher.glsl.mustache", d));
 }
 
 }  // namespace
@@ -216,25 +231,32 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
       for (auto& x : printer.Functions()) functions.push_back(x);
     }
     for (auto* m : methods) {
-      std::ostringstream os;
+      // The dispatcher (templates/glsl/dispatcher.glsl.mustache): a case per implementing class.
       auto ret = kernelPrinter.Type(m->getReturnType(), m->getLocation());
       const std::string retType = ret ? *ret : "void";
-      os << "// " << vm.display << "[index]->" << m->getNameAsString() << (m->getNumParams() ? "(...)" : "()") << ": the object's class picks the implementation\n";
-      os << retType << " " << member << "_" << m->getNameAsString() << "(uint index" << DispatcherParams(kernelPrinter, m) << ")\n{\n";
-      os << "  const uvec2 tag = " << member << "_Tags(" << member << "_tags).tags[index];\n  switch (tag.x)\n  {\n";
+      Data d;
+      d.set("display", vm.display);
+      d.set("method", m->getNameAsString());
+      d.set("argsHint", m->getNumParams() ? "(...)" : "()");
+      d.set("returnType", retType);
+      d.set("returnsVoid", retType == "void");
+      d.set("member", member);
+      d.set("params", DispatcherParams(kernelPrinter, m));
+      Data cases = List();
       for (size_t t = 0; t < vm.impls.size(); ++t) {
         const auto& vi = vm.impls[t];
         // Level 1: all elements in one array of equal slots; level 2: each class's objects apart.
         const std::string address = member + (model.virtualLevel == 1 ? std::string("_objects") : "_" + vi.name);
         std::string args = member + "_" + vi.name + "Objects(" + address + ").objects[tag.y]";
         for (unsigned i = 0; i < m->getNumParams(); ++i) args += ", " + CallArgumentName(m, i);
-        const std::string call = implFunction[vi.name + "::" + m->getNameAsString()] + "(" + args + ")";
-        os << "    case " << t << "u: " << (retType == "void" ? call + "; return;" : "return " + call + ";") << "\n";
+        Data x;
+        x.set("tag", std::to_string(t));
+        x.set("call", implFunction[vi.name + "::" + m->getNameAsString()] + "(" + args + ")");
+        x.set("returnsVoid", retType == "void");
+        cases.push_back(x);
       }
-      os << "  }\n";
-      if (retType != "void") os << "  " << retType << " none;  // not reached: every element holds one of these classes\n  return none;\n";
-      os << "}\n";
-      functions.push_back(os.str());
+      d.set("cases", cases);
+      functions.push_back(Render(model.templateDir + "/glsl/dispatcher.glsl.mustache", d));
       if (callable) CallableDispatcher(ctx, rep, model, k, kernelPrinter, vm, impls, m, field->getLocation(), implData, *callable);
     }
   }

@@ -300,6 +300,7 @@ struct ClassModel {
   bool declaresGetExecutionTime = false;
   bool virtualDestructor = false;      // the class's destructor is virtual: the generated ones override it
   std::vector<BlockField> classData;   // plain members + vector sizes, in block order
+  std::string templateDir;             // templates/: the shapes of generated code (GLSL the analysis assembles too)
   std::string glslClassStructs;        // structs the class-data block and member vectors need
   std::set<std::string> glslClassStructNames;  // the names they declare
   std::vector<std::string> sourceIncludes;  // #include lines of the sources (quoted ones made absolute)

@@ -156,6 +156,7 @@ AnalyzeResult Analyze(const TranslateRequest& request, AstCache* sharedCache) {
   model.forCpu = request.backend == Backend::Cpu;
   model.virtualLevel = request.virtualLevel;
   model.megakernelByDefault = request.megakernel;
+  model.templateDir = request.templateDir;
   unsigned errors = 0;
   auto forEachAst = [&](auto&& pass) {
     for (auto& handle : handles) {
@@ -228,7 +229,8 @@ TranslateResult Translate(const TranslateRequest& request, AstCache* cache, Spir
   }
   // Inputs: every file the ASTs read, and the templates (editing one regenerates).
   result.inputs = analysis.inputs;
-  for (const char* t : {"glsl/kernel.comp.mustache", "glsl/reduce.comp.mustache", "glsl/ray_query.glsl.mustache",
+  for (const char* t : {"glsl/kernel.comp.mustache", "glsl/reduce.comp.mustache", "glsl/ray_query.glsl.mustache", "glsl/dispatcher.glsl.mustache",
+                        "glsl/callable_dispatcher.glsl.mustache",
                         "glsl/texture_array.glsl.mustache", "glsl/stage.glsl.mustache", "vulkan/class.h.mustache",
                         "vulkan/class.cpp.mustache", "cpu/class.h.mustache", "cpu/class.cpp.mustache"})
     result.inputs.push_back(request.templateDir + "/" + t);
