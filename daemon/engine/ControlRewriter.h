@@ -108,8 +108,6 @@ private:
   // for (...) for (...) kernel_X(tidX, tidY, ...): one dispatch of the whole nest.
   bool TryRtvNest(const ForStmt* outer);
 
-  // The loop shape of ParseLoop, without reporting: `for (int i = a; i < b; ++i)`.
-  bool QuietParseLoop(const ForStmt* fs, LoopHeader& h);
 
   // `m_x = v;` in a control function runs on the host while recording; the kernels recorded
   // around it must see it in order, so the ...Cmd also records an update of the GPU copy (and

@@ -2,9 +2,11 @@
 // functions become traces of a ray tracing pipeline, with an intersection shader per leaf class and a
 // hit and a miss shader per call. Takes the traversal's loops; gives Kernel::leaves and the shaders.
 #include "LeafShaders.h"
+#include "CodeGenSupport.h"
 
 #include "AstQueries.h"
 #include "Composition.h"
+#include "LoopShape.h"
 #include "Members.h"
 #include "VirtualCalls.h"
 #include "WriteVisitor.h"
@@ -42,17 +44,13 @@ LeafSite FindLeafSite(ASTContext& ctx, const clang::Stmt* call) {
 
 // The variable of a loop over all leaves, `for (T i = 0; i < count; ++i) [if (test)] call;` (braces
 // allowed around one statement), or null when the loop has another shape.
-const VarDecl* LeafLoopVariable(const clang::Stmt* loop, const CXXMemberCallExpr* call) {
+const VarDecl* LeafLoopVariable(ASTContext& ctx, const clang::Stmt* loop, const CXXMemberCallExpr* call) {
   auto* fs = dyn_cast<ForStmt>(loop);
-  auto* ds = fs ? dyn_cast_or_null<DeclStmt>(fs->getInit()) : nullptr;
-  auto* var = ds && ds->isSingleDecl() ? dyn_cast<VarDecl>(ds->getSingleDecl()) : nullptr;
-  if (!var || !var->getInit() || !var->getType()->isIntegerType()) return nullptr;
-  auto* zero = dyn_cast<IntegerLiteral>(var->getInit()->IgnoreParenImpCasts());
-  auto* cond = dyn_cast_or_null<BinaryOperator>(fs->getCond() ? fs->getCond()->IgnoreImplicit() : nullptr);
-  auto* inc = dyn_cast_or_null<UnaryOperator>(fs->getInc() ? fs->getInc()->IgnoreImplicit() : nullptr);
-  if (!zero || zero->getValue() != 0 || !cond || cond->getOpcode() != BO_LT || NamedVar(cond->getLHS()) != var || !inc || !inc->isIncrementOp() ||
-      NamedVar(inc->getSubExpr()) != var)
-    return nullptr;
+  LoopHeader h;
+  if (!fs || !LoopShapeProblem(ctx, fs, h).empty() || h.inclusive) return nullptr;
+  auto* zero = dyn_cast<IntegerLiteral>(h.start->IgnoreParenImpCasts());
+  if (!zero || zero->getValue() != 0) return nullptr;
+  const VarDecl* var = h.var;
   auto single = [](const clang::Stmt* st) {
     while (auto* cs = dyn_cast_or_null<CompoundStmt>(st)) {
       if (cs->size() != 1) return static_cast<const clang::Stmt*>(nullptr);
@@ -160,7 +158,7 @@ std::string TraceLeafCall(ASTContext& ctx, Reporter& rep, const ClassModel& mode
     return "the leaf call " + callText + " (" + site + ") is not inside a loop of the traversal's body";
   // The trace visits every leaf once: the loop must say so, `for (T i = 0; i < count; ++i)` whose
   // body is the call, perhaps behind a test (the leaf's box test, which the hardware does instead).
-  const VarDecl* loopVar = LeafLoopVariable(leaf.loop, call);
+  const VarDecl* loopVar = LeafLoopVariable(ctx, leaf.loop, call);
   if (!loopVar)
     return "the loop calling " + callText + " (" + site + ") is not 'for (i = 0; i < count; ++i) [if (box test)] " + method->getNameAsString() +
            "(...);', which visits every leaf once as the hardware does";
@@ -241,19 +239,23 @@ std::string TraceLeafCall(ASTContext& ctx, Reporter& rep, const ClassModel& mode
   const std::string payload = member + "_" + methodName + "_hit", scene = member + "_leaves";
   const std::string p = hardware.Expr(call->getArg(0)), d = hardware.Expr(call->getArg(1)), h = hardware.Expr(call->getArg(n - 1));
   const std::string t = h + "." + GlslPrinter::SafeName(distance->getNameAsString()), number = std::to_string(lt.missIndex);
-  std::ostringstream trace;
-  trace << "// The loop of " << comp.implName << "::" << leaf.fn->getNameAsString() << " calling " << callText << " (" << site << ")\n"
-        << "// runs on the ray tracing hardware: it finds the leaves whose boxes the ray meets, and the\n"
-        << "// intersection shader of each leaf's class calls its " << methodName << " (virtual functions, level 3).\n"
-        << "{\n  const float crt_near = max(" << p << ".w, 0.0);  // rays start at a distance >= 0 on the hardware\n"
-        << "  const bool crt_finite = !any(isnan(" << p << ")) && !any(isinf(" << p << ".xyz)) && !any(isnan(" << d << ".xyz)) && !any(isinf(" << d << ".xyz));\n"
-        << "  " << payload << " = " << h << ";\n"
-        << "  // The leaf's hit group is " << (lt.firstHitGroup ? std::to_string(lt.firstHitGroup) + " + " : std::string()) << "its class; miss shader and payload " << number << ".\n"
-        << "  if (crt_finite && crt_near < " << t << ")\n"
-        << "    traceRayEXT(" << scene << ", gl_RayFlagsNoneEXT, 0xFF, " << lt.firstHitGroup << ", 0, " << number << ", " << p << ".xyz, crt_near, " << d
-        << ".xyz, " << t << ", " << number << ");\n"
-        << "  " << h << " = " << payload << ";\n}\n";
-  hardware.replacedStatements[leaf.loop] = trace.str();
+  // The trace (templates/glsl/leaf_trace.glsl.mustache) stands where the loop was.
+  Data trace;
+  trace.set("traversal", comp.implName + "::" + leaf.fn->getNameAsString());
+  trace.set("callText", callText);
+  trace.set("site", site);
+  trace.set("method", methodName);
+  trace.set("origin", p);
+  trace.set("direction", d);
+  trace.set("hit", h);
+  trace.set("distance", t);
+  trace.set("payload", payload);
+  trace.set("scene", scene);
+  trace.set("missIndex", number);
+  trace.set("hitGroupOffset", std::to_string(lt.firstHitGroup));
+  if (lt.firstHitGroup) trace.set("firstHitGroup", std::to_string(lt.firstHitGroup));
+  else trace.set("firstHitGroup", false);
+  hardware.replacedStatements[leaf.loop] = Render(model.templateDir + "/glsl/leaf_trace.glsl.mustache", trace);
   const std::string hitType = *hardware.Type(hitParam.getNonReferenceType().getUnqualifiedType(), call->getBeginLoc());
   if (fresh)
     payloads.push_back({payload, "// The hit the leaves' intersection shaders report to (" + callText + "'s last argument)\nlayout(location = " +

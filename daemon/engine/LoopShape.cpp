@@ -12,32 +12,35 @@ using namespace clang;
 
 namespace crossrt::engine {
 
-bool ParseLoop(Context& c, const ForStmt* fs, LoopHeader& h, const std::string& kernel) {
-  auto bad = [&](const std::string& what) {
-    c.rep.Error(fs->getBeginLoc(), "loop of kernel '" + kernel + "' is not a parallel loop: " + what,
-                "write it as 'for (int i = start; i < end; i++)'; each iteration becomes one thread");
-    return false;
-  };
+std::string LoopShapeProblem(ASTContext& ctx, const ForStmt* fs, LoopHeader& h) {
   auto* ds = dyn_cast_or_null<DeclStmt>(fs->getInit());
-  if (!ds || !ds->isSingleDecl()) return bad("it must declare one loop variable");
+  if (!ds || !ds->isSingleDecl()) return "it must declare one loop variable";
   h.var = dyn_cast<VarDecl>(ds->getSingleDecl());
-  if (!h.var || !h.var->getInit() || !h.var->getType()->isIntegerType()) return bad("the loop variable must be an initialised integer");
+  if (!h.var || !h.var->getInit() || !h.var->getType()->isIntegerType()) return "the loop variable must be an initialised integer";
   h.start = h.var->getInit();
   auto* cond = dyn_cast_or_null<BinaryOperator>(fs->getCond() ? fs->getCond()->IgnoreImplicit() : nullptr);
-  if (!cond || (cond->getOpcode() != BO_LT && cond->getOpcode() != BO_LE)) return bad("the condition must be 'i < end' or 'i <= end'");
+  if (!cond || (cond->getOpcode() != BO_LT && cond->getOpcode() != BO_LE)) return "the condition must be 'i < end' or 'i <= end'";
   auto* lhs = dyn_cast<DeclRefExpr>(cond->getLHS()->IgnoreParenImpCasts());
-  if (!lhs || lhs->getDecl() != h.var) return bad("the condition must compare the loop variable");
+  if (!lhs || lhs->getDecl() != h.var) return "the condition must compare the loop variable";
   h.end = cond->getRHS();
   h.inclusive = cond->getOpcode() == BO_LE;
   const Expr* inc = fs->getInc() ? fs->getInc()->IgnoreImplicit() : nullptr;
   bool stepOne = false;
-  if (auto* uo = dyn_cast_or_null<UnaryOperator>(inc)) stepOne = uo->isIncrementOp();
+  if (auto* uo = dyn_cast_or_null<UnaryOperator>(inc)) stepOne = uo->isIncrementOp() && NamedVar(uo->getSubExpr()) == h.var;
   if (auto* ca = dyn_cast_or_null<CompoundAssignOperator>(inc)) {
     Expr::EvalResult r;
-    stepOne = ca->getOpcode() == BO_AddAssign && ca->getRHS()->EvaluateAsInt(r, c.ctx) && r.Val.getInt() == 1;
+    stepOne = ca->getOpcode() == BO_AddAssign && NamedVar(ca->getLHS()) == h.var && ca->getRHS()->EvaluateAsInt(r, ctx) && r.Val.getInt() == 1;
   }
-  if (!stepOne) return bad("the step must be ++i, i++ or i += 1");
-  return true;
+  if (!stepOne) return "the step must be ++i, i++ or i += 1";
+  return "";
+}
+
+bool ParseLoop(Context& c, const ForStmt* fs, LoopHeader& h, const std::string& kernel) {
+  const std::string problem = LoopShapeProblem(c.ctx, fs, h);
+  if (problem.empty()) return true;
+  c.rep.Error(fs->getBeginLoc(), "loop of kernel '" + kernel + "' is not a parallel loop: " + problem,
+              "write it as 'for (int i = start; i < end; i++)'; each iteration becomes one thread");
+  return false;
 }
 
 std::string AsOperand(const std::string& expr) {

@@ -20,6 +20,11 @@ struct LoopHeader {
   bool inclusive = false;
 };
 
+// The one parser of loop headers, for kernels' loop nests, thread loops and leaves' loops: why `fs`
+// is not `for (T i = a; i < b; ++i)` (also i++, i += 1, <=; T an integer), or "" when it is, with
+// `h` filled in.
+std::string LoopShapeProblem(ASTContext& ctx, const ForStmt* fs, LoopHeader& h);
+
 // Accepts `for (T i = a; i < b; ++i)` (also i++, i += 1, <=). Returns false and reports otherwise.
 bool ParseLoop(Context& c, const ForStmt* fs, LoopHeader& h, const std::string& kernel);
 

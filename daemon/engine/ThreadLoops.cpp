@@ -59,7 +59,7 @@ bool ControlRewriter::TryThreadLoop(const ForStmt* outerLoop) {
   const Stmt* body = outerLoop;
   while (auto* fs = dyn_cast_or_null<ForStmt>(body)) {
     LoopHeader h;
-    if (!QuietParseLoop(fs, h) || !idVars.count(h.var)) break;
+    if (!LoopShapeProblem(m_c.ctx, fs, h).empty() || !idVars.count(h.var)) break;
     tl.loops.push_back(h);
     body = SingleStatement(fs->getBody());
   }
@@ -225,7 +225,7 @@ bool ControlRewriter::TryRtvNest(const ForStmt* outer) {
   const Stmt* cur = outer;
   while (auto* fs = dyn_cast_or_null<ForStmt>(cur)) {
     LoopHeader h;
-    if (!QuietParseLoop(fs, h)) return false;
+    if (!LoopShapeProblem(m_c.ctx, fs, h).empty()) return false;
     loops.push_back(h);
     cur = SingleStatement(fs->getBody());
   }
@@ -273,27 +273,6 @@ bool ControlRewriter::TryRtvNest(const ForStmt* outer) {
   if (loops.size() > 1) pragma += " collapse(" + std::to_string(loops.size()) + ")";
   m_cpu.InsertTextBefore(outer->getBeginLoc(), pragma + "\n" + indent);
   return true;
-}
-
-bool ControlRewriter::QuietParseLoop(const ForStmt* fs, LoopHeader& h) {
-  auto* ds = dyn_cast_or_null<DeclStmt>(fs->getInit());
-  if (!ds || !ds->isSingleDecl()) return false;
-  h.var = dyn_cast<VarDecl>(ds->getSingleDecl());
-  if (!h.var || !h.var->getInit()) return false;
-  h.start = h.var->getInit();
-  auto* cond = dyn_cast_or_null<BinaryOperator>(fs->getCond() ? fs->getCond()->IgnoreImplicit() : nullptr);
-  if (!cond || (cond->getOpcode() != BO_LT && cond->getOpcode() != BO_LE)) return false;
-  auto* lhs = dyn_cast<DeclRefExpr>(cond->getLHS()->IgnoreParenImpCasts());
-  if (!lhs || lhs->getDecl() != h.var) return false;
-  h.end = cond->getRHS();
-  h.inclusive = cond->getOpcode() == BO_LE;
-  const Expr* inc = fs->getInc() ? fs->getInc()->IgnoreImplicit() : nullptr;
-  if (auto* uo = dyn_cast_or_null<UnaryOperator>(inc)) return uo->isIncrementOp();
-  if (auto* ca = dyn_cast_or_null<CompoundAssignOperator>(inc)) {
-    Expr::EvalResult r;
-    return ca->getOpcode() == BO_AddAssign && ca->getRHS()->EvaluateAsInt(r, m_c.ctx) && r.Val.getInt() == 1;
-  }
-  return false;
 }
 
 }  // namespace crossrt::engine

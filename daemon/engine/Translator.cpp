@@ -171,11 +171,16 @@ AnalyzeResult Analyze(const TranslateRequest& request, AstCache* sharedCache) {
       diagText += handle.diagnostics().substr(before) + reporter.Notes();
     }
   };
-  forEachAst([&](clang::ASTContext& ctx, Reporter& rep) { AnalyzeTranslationUnit(ctx, request.className, compositions, rep, model); });
-  // Composition: the implementations' code, printed from the AST that defines their methods (a CPU
-  // class calls the interface as written).
-  if (errors == 0 && request.backend == Backend::Vulkan && !model.compositions.empty())
-    forEachAst([&](clang::ASTContext& ctx, Reporter& rep) { ComposeFromTranslationUnit(ctx, rep, model); });
+  try {
+    forEachAst([&](clang::ASTContext& ctx, Reporter& rep) { AnalyzeTranslationUnit(ctx, request.className, compositions, rep, model); });
+    // Composition: the implementations' code, printed from the AST that defines their methods (a CPU
+    // class calls the interface as written).
+    if (errors == 0 && request.backend == Backend::Vulkan && !model.compositions.empty())
+      forEachAst([&](clang::ASTContext& ctx, Reporter& rep) { ComposeFromTranslationUnit(ctx, rep, model); });
+  } catch (const std::exception& e) {  // a template the analysis fills (dispatchers, traces) is missing or malformed
+    result.diagnostics = diagText + "error: " + e.what() + "\n";
+    return result;
+  }
   if (errors > 0) {
     result.diagnostics = diagText;
     return result;
@@ -230,7 +235,7 @@ TranslateResult Translate(const TranslateRequest& request, AstCache* cache, Spir
   // Inputs: every file the ASTs read, and the templates (editing one regenerates).
   result.inputs = analysis.inputs;
   for (const char* t : {"glsl/kernel.comp.mustache", "glsl/reduce.comp.mustache", "glsl/ray_query.glsl.mustache", "glsl/dispatcher.glsl.mustache",
-                        "glsl/callable_dispatcher.glsl.mustache",
+                        "glsl/callable_dispatcher.glsl.mustache", "glsl/leaf_trace.glsl.mustache",
                         "glsl/texture_array.glsl.mustache", "glsl/stage.glsl.mustache", "vulkan/class.h.mustache",
                         "vulkan/class.cpp.mustache", "cpu/class.h.mustache", "cpu/class.cpp.mustache"})
     result.inputs.push_back(request.templateDir + "/" + t);
