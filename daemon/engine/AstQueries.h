@@ -7,10 +7,13 @@
 
 namespace crossrt::engine {
 
+// "dir/File.cpp" -> "File.cpp".
 std::string BaseName(const std::string& path);
 
+// The source text of `range` as written.
 std::string Text(const ASTContext& ctx, SourceRange range);
 
+// The name of the file that holds `loc` (its expansion), as Clang opened it; "" for none.
 std::string FileOf(const ASTContext& ctx, SourceLocation loc);
 
 std::string ParamDecl(const ASTContext& ctx, const ParmVarDecl* p, unsigned index);
@@ -21,6 +24,7 @@ std::string ParamDecl(const ASTContext& ctx, const ParmVarDecl* p, const ParmVar
 
 std::string CppTypeName(const ASTContext& ctx, QualType t);
 
+// The member `e` names through `this` (m_x or this->m_x), or null.
 const FieldDecl* ThisField(const Expr* e);
 
 // The member a written lvalue belongs to: this->m_v[i].x -> m_v.

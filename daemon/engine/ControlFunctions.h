@@ -15,6 +15,7 @@ bool IsPerThreadFunction(const CXXMethodDecl* md, const CXXRecordDecl* cls);
 
 const Stmt* SingleStatement(const Stmt* s);
 
+// The pass: control function `md` into a Control of the model (its ...Cmd body and its CPU body).
 void AnalyzeControl(Context& c, const CXXMethodDecl* md, const FunctionDecl* def);
 
 struct KernelCallFinder : RecursiveASTVisitor<KernelCallFinder> {

@@ -6,6 +6,7 @@
 
 namespace crossrt::engine {
 
+// The pass: kernel `md`, whose body `def` holds, into a Kernel of the model (GLSL, CPU copy, bindings).
 void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def);
 
 }  // namespace crossrt::engine

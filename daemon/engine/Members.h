@@ -10,9 +10,11 @@ namespace crossrt::engine {
 // alignment), so a lone float3 matches; float3x3, bool and arrays of float3 do not.
 bool FitsClassData(ASTContext& ctx, QualType t);
 
+// The pass: every data member of the class (bases first) into model.members; constructors too.
 void AnalyzeMembers(Context& c);
 
-// Struct names already declared by the class-wide prelude ("struct Foo {  // ...").
+// The structs the class-wide prelude declares (the class data block needs them): other printers
+// do not declare them again.
 std::set<std::string> ClassStructNames(const ClassModel& model);
 
 }  // namespace crossrt::engine
