@@ -218,10 +218,10 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
       printer.selfClass = impl;
       printer.composedPrefix = vi->name + "_";
       for (auto& sn : ClassStructNames(model)) printer.predeclaredStructs.insert(sn);
-      const GlslDecl data = ImplDataStruct(printer, impl, vm, *vi);
+      const GlslDecl data = ImplDataStruct(model, printer, impl, vm, *vi);
       for (auto* m : methods) implFunction[vi->name + "::" + m->getNameAsString()] = ImplementationMethod(rep, printer, impl, m, field->getLocation());
       for (auto& x : printer.Structs()) structs.push_back(x);
-      const GlslDecl objectsReference = ObjectsReference(vm, *vi);
+      const GlslDecl objectsReference = ObjectsReference(model, vm, *vi);
       structs.push_back(data);
       structs.push_back(objectsReference);
       implData[vi->name] = {data, objectsReference};

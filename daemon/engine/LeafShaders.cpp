@@ -297,7 +297,7 @@ std::string TraceLeafCall(ASTContext& ctx, Reporter& rep, const ClassModel& mode
     s.classData = true;
     for (auto& x : object.Constants()) s.constants += x.text;
     for (auto& x : object.Structs()) s.structs += x.text + "\n";
-    s.structs += TagsReference(model, *vm).text + "\n" + ImplDataStruct(object, *impl, *vm, vi).text + "\n" + ObjectsReference(*vm, vi).text + "\n" +
+    s.structs += TagsReference(model, *vm).text + "\n" + ImplDataStruct(model, object, *impl, *vm, vi).text + "\n" + ObjectsReference(model, *vm, vi).text + "\n" +
                  "hitAttributeEXT " + hitType + " crt_hit;  // what the closest-hit shader receives\n";
     for (auto& x : object.Functions()) s.functions += x + "\n";
     std::string args = "self, vec4(gl_WorldRayOriginEXT, gl_RayTminEXT), vec4(gl_WorldRayDirectionEXT, gl_RayTmaxEXT)";

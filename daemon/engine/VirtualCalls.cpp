@@ -1,6 +1,7 @@
 // Virtual calls through std::vector<Interface*> members (paper 3.9): finds the implementations of the
 // interface, lays out each one's data as the GPU mirrors it, and records the calls a kernel makes.
 #include "VirtualCalls.h"
+#include "CodeGenSupport.h"
 
 #include "AnalysisContext.h"
 #include "Callables.h"
@@ -93,27 +94,43 @@ std::string DispatcherParams(GlslPrinter& printer, const CXXMethodDecl* m) {
   return out;
 }
 
+// The declarations of a vector of objects' GLSL (templates/glsl/virtual_objects.glsl.mustache): its
+// tags, a class's data struct, the buffer reference to a class's objects.
 GlslDecl TagsReference(const ClassModel& model, const VirtualMember& vm) {
-  return {vm.member + "_Tags", "layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer " + vm.member + "_Tags { uvec2 tags[]; };  // per element of " +
-         vm.display + ": (class, " + (model.virtualLevel == 1 ? "its slot" : "index among its class's objects") + ")\n"};
+  Data d;
+  d.set("tags", true);
+  d.set("member", vm.member);
+  d.set("display", vm.display);
+  d.set("tagMeaning", model.virtualLevel == 1 ? "its slot" : "index among its class's objects");
+  return {vm.member + "_Tags", Render(model.templateDir + "/glsl/virtual_objects.glsl.mustache", d)};
 }
 
-GlslDecl ImplDataStruct(GlslPrinter& printer, const CXXRecordDecl* impl, const VirtualMember& vm, const VirtualImpl& vi) {
-  std::ostringstream data;
-  data << "struct " << vi.name << "_Data {  // the data members of " << vi.name << "\n";
-  std::vector<const FieldDecl*> fields;
-  CollectObjectFields(impl, fields);
-  for (auto* f : fields) data << "  " << printer.Declare(f->getType(), GlslPrinter::SafeName(f->getNameAsString()), f->getLocation()) << ";\n";
-  if (vi.paddingWords > 0)
-    data << "  uint crt_padding[" << vi.paddingWords << "];  // every element of a vector of " << vm.interfaceName << " has a slot of " << vm.slotBytes
-         << " bytes\n";
-  data << "};\n";
-  return {vi.name + "_Data", data.str()};
+GlslDecl ImplDataStruct(const ClassModel& model, GlslPrinter& printer, const CXXRecordDecl* impl, const VirtualMember& vm, const VirtualImpl& vi) {
+  Data d, fields = List();
+  d.set("data", true);
+  d.set("class", vi.name);
+  std::vector<const FieldDecl*> members;
+  CollectObjectFields(impl, members);
+  for (auto* f : members) {
+    Data x;
+    x.set("declaration", printer.Declare(f->getType(), GlslPrinter::SafeName(f->getNameAsString()), f->getLocation()));
+    fields.push_back(x);
+  }
+  d.set("fields", fields);
+  if (vi.paddingWords > 0) d.set("paddingWords", std::to_string(vi.paddingWords));
+  else d.set("paddingWords", false);
+  d.set("interface", vm.interfaceName);
+  d.set("slotBytes", std::to_string(vm.slotBytes));
+  return {vi.name + "_Data", Render(model.templateDir + "/glsl/virtual_objects.glsl.mustache", d)};
 }
 
-GlslDecl ObjectsReference(const VirtualMember& vm, const VirtualImpl& vi) {
-  return {vm.member + "_" + vi.name + "Objects", std::string("layout(buffer_reference, ") + (vi.scalarLayout ? "scalar" : "std430") + ", buffer_reference_align = 4) readonly buffer " +
-         vm.member + "_" + vi.name + "Objects { " + vi.name + "_Data objects[]; };\n"};
+GlslDecl ObjectsReference(const ClassModel& model, const VirtualMember& vm, const VirtualImpl& vi) {
+  Data d;
+  d.set("objects", true);
+  d.set("member", vm.member);
+  d.set("class", vi.name);
+  d.set("layout", vi.scalarLayout ? "scalar" : "std430");
+  return {vm.member + "_" + vi.name + "Objects", Render(model.templateDir + "/glsl/virtual_objects.glsl.mustache", d)};
 }
 
 void CheckObjectSizeReads(Reporter& rep, const GlslPrinter& printer) {

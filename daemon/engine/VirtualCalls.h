@@ -39,10 +39,10 @@ std::string DispatcherParams(GlslPrinter& printer, const CXXMethodDecl* m);
 GlslDecl TagsReference(const ClassModel& model, const VirtualMember& vm);
 
 // The GLSL mirror of the data of an implementation's objects (printed by its object-mode printer).
-GlslDecl ImplDataStruct(GlslPrinter& printer, const CXXRecordDecl* impl, const VirtualMember& vm, const VirtualImpl& vi);
+GlslDecl ImplDataStruct(const ClassModel& model, GlslPrinter& printer, const CXXRecordDecl* impl, const VirtualMember& vm, const VirtualImpl& vi);
 
 // The buffer reference to the objects of one implementation (level 2 and 3).
-GlslDecl ObjectsReference(const VirtualMember& vm, const VirtualImpl& vi);
+GlslDecl ObjectsReference(const ClassModel& model, const VirtualMember& vm, const VirtualImpl& vi);
 
 // The size of a vector of objects is in the class data next to the vector's tags, which exist for
 // vectors the kernel calls through.
