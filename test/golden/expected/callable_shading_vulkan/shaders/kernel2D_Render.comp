@@ -12,8 +12,9 @@ layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer m_m
   uvec2 tags[];
 };  // per element of m_materials: (class, index among its class's objects)
 
+// The data members of a Lambert.
 struct Lambert_Data
-{  // the data members of Lambert
+{
   vec3 albedo;
 };
 
@@ -22,8 +23,9 @@ layout(buffer_reference, scalar, buffer_reference_align = 4) readonly buffer m_m
   Lambert_Data objects[];
 };
 
+// The data members of a Phong.
 struct Phong_Data
-{  // the data members of Phong
+{
   vec3 diffuse;
   vec3 specular;
   float shininess;
@@ -34,8 +36,9 @@ layout(buffer_reference, scalar, buffer_reference_align = 4) readonly buffer m_m
   Phong_Data objects[];
 };
 
+// The data members of a Checker.
 struct Checker_Data
-{  // the data members of Checker
+{
   vec3 even;
   vec3 odd;
   float scale;

@@ -23,8 +23,9 @@ layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer m_s
   uvec2 tags[];
 };  // per element of m_scene->m_shapes: (class, index among its class's objects)
 
+// The data members of a Sphere.
 struct Sphere_Data
-{  // the data members of Sphere
+{
   vec4 centerAndRadius;
 };
 
@@ -33,8 +34,9 @@ layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer m_s
   Sphere_Data objects[];
 };
 
+// The data members of a Box.
 struct Box_Data
-{  // the data members of Box
+{
   vec4 boxMin;
   vec4 boxMax;
 };
@@ -44,8 +46,9 @@ layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer m_s
   Box_Data objects[];
 };
 
+// The data members of a Disc.
 struct Disc_Data
-{  // the data members of Disc
+{
   vec4 center;
   vec4 normal;
   float radius;
