@@ -1,11 +1,15 @@
 // Parsed translation units, kept between translations.
 //
-// Each entry is a clang::ASTUnit keyed by (source file, compile arguments). The first request
-// parses from scratch; later ones call Reparse(), which reuses the precompiled preamble (the
-// #include block) kept in memory as long as no header changed: a few tens of milliseconds instead
-// of a few hundred. The cache holds at most `capacity` entries and evicts the least recently used.
-// An AstCache that a single translation creates and drops gives plain, uncached parsing.
+// Each entry is a ParsedFile keyed by (source file, compile arguments). The first request builds a
+// precompiled preamble (the #include block) in memory and parses the file over it; later ones parse
+// the file again over the same preamble as long as no header changed: milliseconds instead of a
+// few hundred. The preamble skips the bodies of functions in system headers (the C++ library), which
+// kernels call by name, if at all; the user's headers keep theirs. The cache
+// holds at most `capacity` entries and evicts the least recently used. An AstCache that a single
+// translation creates and drops gives plain, uncached parsing.
 #pragma once
+#include "IncludesSeen.h"
+
 #include <cstdint>
 #include <list>
 #include <map>
@@ -15,11 +19,34 @@
 #include <vector>
 
 namespace clang {
-class ASTUnit;
+class ASTContext;
+class CompilerInstance;
+class DiagnosticsEngine;
+class LangOptions;
+class Preprocessor;
+class SourceManager;
 class TextDiagnosticPrinter;
 }  // namespace clang
 
 namespace crossrt::engine {
+
+// One parsed source file: the compiler instance that holds its AST, and the accessors the
+// translator uses (named as clang::ASTUnit names them).
+class ParsedFile {
+public:
+  ParsedFile(std::unique_ptr<clang::CompilerInstance> compiler, IncludesSeen includes);
+  ~ParsedFile();
+  clang::ASTContext& getASTContext() const;
+  clang::SourceManager& getSourceManager() const;
+  clang::Preprocessor& getPreprocessor() const;
+  const clang::LangOptions& getLangOpts() const;
+  clang::DiagnosticsEngine& getDiagnostics() const;
+  const IncludesSeen& Includes() const { return m_includes; }  // in the preamble and after it
+
+private:
+  std::unique_ptr<clang::CompilerInstance> m_compiler;
+  IncludesSeen m_includes;
+};
 
 struct AstCacheStats {
   size_t entries = 0, capacity = 0;
@@ -37,7 +64,7 @@ public:
   // A parsed file, locked for the caller's exclusive use while the handle lives.
   class Handle {
   public:
-    clang::ASTUnit* ast() const;
+    ParsedFile* ast() const;
     clang::TextDiagnosticPrinter& printer() const;  // client of ast()'s diagnostics
     const std::string& diagnostics() const;          // what printer() wrote since the (re)parse
     bool failed() const;                             // the parse had errors

@@ -7,13 +7,16 @@
 #include <clang/Lex/Lexer.h>
 #include <clang/Tooling/Core/Replacement.h>
 
+#include <map>
+#include <mutex>
+
 namespace crossrt::engine {
 
 namespace {
 
 // clang-format in the layout of generated code: Allman braces, 2-space indents, `float* p`, two
 // spaces before a trailing comment; `wholeFile`: one-line inline functions stay on their line.
-std::string Format(const std::string& code, unsigned columns, bool wholeFile = false) {
+std::string Reformat(const std::string& code, unsigned columns, bool wholeFile) {
   clang::format::FormatStyle style = clang::format::getLLVMStyle();
   style.BreakBeforeBraces = clang::format::FormatStyle::BS_Allman;
   style.IndentWidth = 2;
@@ -30,6 +33,25 @@ std::string Format(const std::string& code, unsigned columns, bool wholeFile = f
   auto replacements = clang::format::reformat(style, code, {clang::tooling::Range(0, unsigned(code.size()))});
   auto formatted = clang::tooling::applyAllReplacements(code, replacements);
   return formatted ? *formatted : code;
+}
+
+// Reformat, remembered: the daemon lays out the same text again after an edit that changed another
+// file (most of a class's files stay the same when one kernel changes). Bounded by what it holds.
+std::string Format(const std::string& code, unsigned columns, bool wholeFile = false) {
+  static std::mutex mutex;
+  static std::map<std::string, std::string> laidOut;
+  static size_t bytes = 0;
+  const std::string key = std::to_string(columns) + (wholeFile ? "w" : "s") + code;
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (auto it = laidOut.find(key); it != laidOut.end()) return it->second;
+  }
+  std::string formatted = Reformat(code, columns, wholeFile);
+  std::lock_guard<std::mutex> lock(mutex);
+  if (bytes > (64u << 20)) laidOut.clear(), bytes = 0;
+  bytes += key.size() + formatted.size();
+  laidOut.emplace(key, formatted);
+  return formatted;
 }
 
 }  // namespace

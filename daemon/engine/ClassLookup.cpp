@@ -19,7 +19,7 @@ using namespace clang;
 
 namespace crossrt::engine {
 
-bool AnalyzeTranslationUnit(ASTContext& ctx, const std::string& className, const std::map<std::string, std::string>& compositions,
+bool AnalyzeTranslationUnit(ASTContext& ctx, const IncludesSeen& includes, const std::string& className, const std::map<std::string, std::string>& compositions,
                             Reporter& reporter, ClassModel& model) {
   // Name lookups, namespace by namespace ("demo::Render"): walking every declaration of the
   // standard library would cost more than the rest of the analysis.
@@ -92,20 +92,6 @@ bool AnalyzeTranslationUnit(ASTContext& ctx, const std::string& className, const
     StringRef buffer = sm.getBufferData(sm.getMainFileID());
     static const std::regex inc(R"(^[ \t]*#[ \t]*include[ \t]*([<"])([^>"]+)[>"])");
     std::string dir = llvm::sys::path::parent_path(FileOf(ctx, sm.getLocForStartOfFile(sm.getMainFileID()))).str();
-    // The file each #include line of the main file brought in, by line.
-    std::map<unsigned, std::string> included;
-    std::vector<std::string> read;  // every file Clang read, for an include that was skipped (#pragma once)
-    auto note = [&](const SrcMgr::SLocEntry& entry) {
-      if (!entry.isFile()) return;
-      if (auto file = entry.getFile().getContentCache().OrigEntry) read.push_back(file->getName().str());
-      const SourceLocation from = entry.getFile().getIncludeLoc();
-      // The main file, or its copy in the preamble the AST cache loaded (another FileID).
-      if (from.isValid() && (sm.getFileID(from) == sm.getMainFileID() || sm.getFilename(from) == sm.getFilename(sm.getLocForStartOfFile(sm.getMainFileID()))))
-        if (auto file = entry.getFile().getContentCache().OrigEntry)
-          included[sm.getSpellingLineNumber(from)] = file->getName().str();
-    };
-    for (unsigned i = 0; i < sm.local_sloc_entry_size(); ++i) note(sm.getLocalSLocEntry(i));
-    for (unsigned i = 0; i < sm.loaded_sloc_entry_size(); ++i) note(sm.getLoadedSLocEntry(i));  // the preamble's
     std::istringstream lines(buffer.str());
     unsigned lineNumber = 0;
     for (std::string line; std::getline(lines, line);) {
@@ -116,9 +102,9 @@ bool AnalyzeTranslationUnit(ASTContext& ctx, const std::string& className, const
       if (m[1] == "<") text = "#include <" + m[2].str() + ">";
       else {
         std::string path = dir + "/" + m[2].str();
-        if (!llvm::sys::fs::exists(path) && included.count(lineNumber)) path = included[lineNumber];  // found through an include directory
+        if (!llvm::sys::fs::exists(path) && includes.mainFile.count(lineNumber)) path = includes.mainFile.at(lineNumber);  // found through an include directory
         else if (!llvm::sys::fs::exists(path))  // read before, through another include: the file of that name
-          for (auto& name : read)
+          for (auto& name : includes.files)
             if (StringRef(name).ends_with("/" + m[2].str())) path = name;
         if (path == model.headerFile) continue;  // the generated header includes it already
         text = "#include \"" + path + "\"";

@@ -2,6 +2,7 @@
 // numeric limits, crossrt::Atomic* and LiteMath's InterlockedAdd family, and what kernels may not
 // call (I/O, the heap). Part of GlslPrinter (Glsl.h).
 #include "Glsl.h"
+#include "AstQueries.h"
 #include "GlslParts.h"
 
 #include <clang/AST/RecordLayout.h>
@@ -335,9 +336,16 @@ std::string GlslPrinter::Call(const CallExpr* call) {
     args = HelperArgs(fd, call, bindings);
   std::string b = Builtin(fd, args, call);
   if (!b.empty()) return b;
-  if (IsSystemDecl(fd) || fd->isInStdNamespace())
+  // A system header outside the compiler's and the C library's folders is the user's, reached with -isystem.
+  const std::string file = IsSystemDecl(fd) ? FileOf(m_ctx, fd->getLocation()) : "";
+  const bool usersSystemHeader = !file.empty() && file.rfind("/usr/include/", 0) != 0 && file.rfind("/usr/lib/", 0) != 0;
+  if (fd->isInStdNamespace() || (IsSystemDecl(fd) && !usersSystemHeader))
     return Fail(call->getBeginLoc(), "unsupported library call '" + qname + "' in a kernel",
                 "kernels may call LiteMath, <cmath> and std::min/max/abs, and your own functions with visible bodies");
+  if (usersSystemHeader)
+    return Fail(call->getBeginLoc(), "'" + qname + "' is declared in a system header: kernels treat those as libraries",
+                "reach the helper's header with -I, not -isystem (CMake passes an imported target's include directories "
+                "with -isystem: set NO_SYSTEM_FROM_IMPORTED on your target, or include the directory directly)");
   // The user's own free function.
   std::string callee = EmitHelper(fd, call->getBeginLoc(), false, bindings);
   std::string s = callee + "(";

@@ -10,8 +10,12 @@
 #include "CodeGen.h"
 #include "Spirv.h"
 
-#include <clang/Frontend/ASTUnit.h>
+#include <clang/AST/ASTContext.h>
+#include <clang/Basic/SourceManager.h>
+#include <clang/AST/ASTContext.h>
 #include <clang/Frontend/TextDiagnosticPrinter.h>
+#include <clang/Lex/Preprocessor.h>
+#include <clang/Lex/Preprocessor.h>
 #include <llvm/ADT/SmallString.h>
 #include <llvm/Support/FileSystem.h>
 #include <llvm/Support/Path.h>
@@ -58,15 +62,12 @@ std::vector<std::string> ResolveSources(const TranslateRequest& request, std::st
 // rebuilds on every run.
 std::set<std::string> InputsRead(const std::vector<AstCache::Handle>& handles) {
   std::set<std::string> inputs;
-  for (auto& handle : handles) {
-    auto& sm = handle.ast()->getSourceManager();
-    for (auto it = sm.fileinfo_begin(); it != sm.fileinfo_end(); ++it) {
+  for (auto& handle : handles)
+    for (const std::string& name : handle.ast()->Includes().files) {
       std::error_code ec;
-      const std::string name = it->first.getName().str();
       const std::filesystem::path real = std::filesystem::weakly_canonical(name, ec);
       inputs.insert(ec ? name : real.string());
     }
-  }
   return inputs;
 }
 
@@ -160,23 +161,25 @@ AnalyzeResult Analyze(const TranslateRequest& request, AstCache* sharedCache) {
   unsigned errors = 0;
   auto forEachAst = [&](auto&& pass) {
     for (auto& handle : handles) {
-      clang::ASTUnit* ast = handle.ast();
+      ParsedFile* ast = handle.ast();
       size_t before = handle.diagnostics().size();
       handle.printer().BeginSourceFile(ast->getLangOpts(), &ast->getPreprocessor());
       Reporter reporter(ast->getDiagnostics());
       reporter.SetGpuRules(request.backend == Backend::Vulkan);  // a CPU class runs the user's C++ as written
-      pass(ast->getASTContext(), reporter);
+      pass(*ast, reporter);
       errors += reporter.Errors();
       handle.printer().EndSourceFile();
       diagText += handle.diagnostics().substr(before) + reporter.Notes();
     }
   };
   try {
-    forEachAst([&](clang::ASTContext& ctx, Reporter& rep) { AnalyzeTranslationUnit(ctx, request.className, compositions, rep, model); });
+    forEachAst([&](ParsedFile& file, Reporter& rep) {
+      AnalyzeTranslationUnit(file.getASTContext(), file.Includes(), request.className, compositions, rep, model);
+    });
     // Composition: the implementations' code, printed from the AST that defines their methods (a CPU
     // class calls the interface as written).
     if (errors == 0 && request.backend == Backend::Vulkan && !model.compositions.empty())
-      forEachAst([&](clang::ASTContext& ctx, Reporter& rep) { ComposeFromTranslationUnit(ctx, rep, model); });
+      forEachAst([&](ParsedFile& file, Reporter& rep) { ComposeFromTranslationUnit(file.getASTContext(), rep, model); });
   } catch (const std::exception& e) {  // a template the analysis fills (dispatchers, traces) is missing or malformed
     result.diagnostics = diagText + "error: " + e.what() + "\n";
     return result;

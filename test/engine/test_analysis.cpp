@@ -374,6 +374,66 @@ void Broken::kernel1D_Fill(int n, float* out) { for (int i = 0; i < n; i++) out[
   REQUIRE(r.ok);
 }
 
+TEST_CASE("The AST cache's preamble keeps the user's function bodies and knows every header it read", "[engine]")
+{
+  // The preamble drops the bodies of system headers' functions, not those of the user's helpers.
+  TempClass tc("Doubler", R"(#pragma once
+#include <vector>
+class Doubler
+{
+public:
+  virtual ~Doubler() = default;
+  virtual void Run(int n, [[crossrt::size("n")]] float* out);
+protected:
+  void kernel1D_Run(int n, float* out);
+};
+)", R"(#include "Doubler.h"
+#include "twice.h"
+void Doubler::Run(int n, float* out) { kernel1D_Run(n, out); }
+#include "offset.h"
+void Doubler::kernel1D_Run(int n, float* out) { for (int i = 0; i < n; i++) out[i] = Twice(float(i)) + kOffset; }
+)");
+  fs::create_directories(tc.dir / "inc");
+  std::ofstream(tc.dir / "inc" / "twice.h") << "#pragma once\ninline float Twice(float x) { return 2.0f * x; }\n";
+  std::ofstream(tc.dir / "inc" / "offset.h") << "#pragma once\nconstexpr float kOffset = 0.5f;\n";
+  AstCache cache;
+  for (Backend backend : {Backend::Vulkan, Backend::Cpu})
+    for (int parse = 0; parse < 2; ++parse)  // the first parse builds the preamble, the second reuses it
+    {
+      INFO("backend " << int(backend) << ", parse " << parse);
+      TranslateRequest request = MakeRequest(tc, "Doubler", backend);
+      request.compileArgs.push_back("-I" + (tc.dir / "inc").string());
+      TranslateResult r = Translate(request, &cache);
+      INFO(r.diagnostics);
+      REQUIRE(r.ok);
+      auto hasInput = [&](const std::string& suffix) {
+        return std::any_of(r.inputs.begin(), r.inputs.end(), [&](const std::string& f) { return f.size() >= suffix.size() && f.compare(f.size() - suffix.size(), suffix.size(), suffix) == 0; });
+      };
+      CHECK(hasInput("/Doubler.cpp"));
+      CHECK(hasInput("/Doubler.h"));
+      CHECK(hasInput("/inc/twice.h"));
+      CHECK(hasInput("/inc/offset.h"));       // included below the preamble
+      CHECK(hasInput("/bits/stl_vector.h"));  // read for <vector>, though nothing in it is used
+      if (backend == Backend::Vulkan)
+      {
+        std::string glsl;
+        for (auto& [name, text] : r.files)
+          if (name.find("kernel1D_Run") != std::string::npos && name.find("shaders/") == 0) glsl = text;
+        CHECK(Squeezed(glsl).find("floatTwice(floatx)") != std::string::npos);
+      }
+      else  // the CPU source includes the helpers' header by the path the compiler found
+        CHECK(r.files["Doubler_CPU.cpp"].find("#include \"" + (tc.dir / "inc" / "twice.h").string() + "\"") != std::string::npos);
+      std::ofstream(tc.Source("Doubler"), std::ios::app) << "// an edit below the preamble\n";
+    }
+  // The same helper's header reached with -isystem (as CMake passes an imported target's): a clear error.
+  TranslateRequest request = MakeRequest(tc, "Doubler");
+  request.compileArgs.insert(request.compileArgs.end(), {"-isystem", (tc.dir / "inc").string()});
+  TranslateResult r = Translate(request, &cache);
+  CHECK_FALSE(r.ok);
+  CHECK(r.diagnostics.find("Doubler.cpp:5:86: error: 'Twice' is declared in a system header") != std::string::npos);
+  CHECK(r.diagnostics.find("-I, not -isystem") != std::string::npos);
+}
+
 // Level 3 in composed code (paper 3.10): the traversal's leaf calls become intersection shaders.
 namespace {
 const char* kLeafHeader = R"(#pragma once
