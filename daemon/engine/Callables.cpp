@@ -9,7 +9,6 @@
 #include "VirtualCalls.h"
 
 #include <algorithm>
-#include <sstream>
 
 using namespace clang;
 
@@ -18,7 +17,8 @@ namespace crossrt::engine {
 namespace {
 
 // Level 3: `vm`'s implementation `vi` (an object of class `impl`) of `method` as a callable shader,
-// named <member>_<class>_<method>, added to the model unless another kernel added it.
+// named <member>_<class>_<method>, added to the model unless another kernel added it. `payload`
+// declares the incoming call.
 void AddCallableShader(ASTContext& ctx, Reporter& rep, ClassModel& model, const VirtualMember& vm, const VirtualImpl& vi,
                        const CXXRecordDecl* impl, const CXXMethodDecl* method, SourceLocation callLoc, const std::string& dataStruct,
                        const std::string& objectsReference, const std::string& payload) {
@@ -40,8 +40,7 @@ void AddCallableShader(ASTContext& ctx, Reporter& rep, ClassModel& model, const 
   c.scalarLayout = vi.scalarLayout;
   for (auto& x : printer.Constants()) c.constants += x.text;
   for (auto& x : printer.Structs()) c.structs += x.text + "\n";
-  c.structs += dataStruct + "\n" + objectsReference + "\n" + payload + "layout(location = 0) callableDataInEXT " + vm.member + "_" + method->getNameAsString() +
-               "_Call call;\n";
+  c.structs += dataStruct + "\n" + objectsReference + "\n" + payload;
   for (auto& x : printer.Functions()) c.functions += x + "\n";
   std::string args = "self";
   for (unsigned i = 0; i < method->getNumParams(); ++i) args += ", call." + CallArgumentName(method, i);
@@ -61,24 +60,36 @@ void CallableDispatcher(ASTContext& ctx, Reporter& rep, ClassModel& model, Kerne
   const std::string display = vm.display + "[index]->" + method + (m->getNumParams() ? "(...)" : "()");
   auto ret = kernelPrinter.Type(m->getReturnType(), m->getLocation());
   const std::string retType = ret ? *ret : "void";
-  std::ostringstream payload;
-  payload << "// " << display << ": its arguments and result, passed to the callable shader of the object's class\n";
-  payload << "struct " << callName << "_Call\n{\n  uvec2 crt_objects;  // the objects of its class (a buffer reference)\n"
-          << "  uint crt_index;     // the object's index among them\n";
+  // The payload (templates/glsl/callable_payload.glsl.mustache): the call's arguments and result,
+  // declared by the ray generation shader (outgoing, at the next location) and by each callable
+  // shader (incoming, as `call`).
+  const size_t location = out.payloads++, first = k.callables.size();
+  Data payload;
+  payload.set("display", display);
+  payload.set("callName", callName);
+  payload.set("returnType", retType);
+  payload.set("returnsVoid", retType == "void");
+  payload.set("location", std::to_string(location));
+  payload.set("variable", variable);
+  Data fields = List();
   for (unsigned i = 0; i < m->getNumParams(); ++i) {
     const ParmVarDecl* p = m->getParamDecl(i);
-    payload << "  " << kernelPrinter.Declare(p->getType().getNonReferenceType().getUnqualifiedType(), CallArgumentName(m, i), p->getLocation()) << ";\n";
+    Data x;
+    x.set("declaration", kernelPrinter.Declare(p->getType().getNonReferenceType().getUnqualifiedType(), CallArgumentName(m, i), p->getLocation()));
+    fields.push_back(x);
   }
-  if (retType != "void") payload << "  " << retType << " crt_result;\n";
-  payload << "};\n";
-  const size_t location = out.payloads++, first = k.callables.size();
-  out.structs.push_back({callName + "_Call", payload.str() + "layout(location = " + std::to_string(location) + ") callableDataEXT " + callName + "_Call " + variable + ";\n"});
+  payload.set("fields", fields);
+  payload.set("incoming", false);
+  const std::string payloadTemplate = model.templateDir + "/glsl/callable_payload.glsl.mustache";
+  out.structs.push_back({callName + "_Call", Render(payloadTemplate, payload)});
+  payload.set("incoming", true);
+  const std::string incomingPayload = Render(payloadTemplate, payload);
 
   std::string names;
   for (const VirtualImpl& vi : vm.impls) {
     auto impl = std::find_if(impls.begin(), impls.end(), [&](const CXXRecordDecl* r) { return r->getNameAsString() == vi.name; });
     const auto& [dataStruct, objectsReference] = implData.at(vi.name);
-    AddCallableShader(ctx, rep, model, vm, vi, *impl, m, callLoc, dataStruct.text, objectsReference.text, payload.str());
+    AddCallableShader(ctx, rep, model, vm, vi, *impl, m, callLoc, dataStruct.text, objectsReference.text, incomingPayload);
     k.callables.push_back(vm.member + "_" + vi.name + "_" + method);
     names += (names.empty() ? "" : ", ") + k.callables.back();
   }

@@ -238,7 +238,8 @@ TranslateResult Translate(const TranslateRequest& request, AstCache* cache, Spir
   // Inputs: every file the ASTs read, and the templates (editing one regenerates).
   result.inputs = analysis.inputs;
   for (const char* t : {"glsl/kernel.comp.mustache", "glsl/reduce.comp.mustache", "glsl/ray_query.glsl.mustache", "glsl/dispatcher.glsl.mustache",
-                        "glsl/callable_dispatcher.glsl.mustache", "glsl/leaf_trace.glsl.mustache", "glsl/virtual_objects.glsl.mustache",
+                        "glsl/callable_dispatcher.glsl.mustache", "glsl/callable_payload.glsl.mustache",
+                        "glsl/leaf_trace.glsl.mustache", "glsl/virtual_objects.glsl.mustache",
                         "glsl/texture_array.glsl.mustache", "glsl/stage.glsl.mustache", "vulkan/class.h.mustache",
                         "vulkan/class.cpp.mustache", "cpu/class.h.mustache", "cpu/class.cpp.mustache"})
     result.inputs.push_back(request.templateDir + "/" + t);
