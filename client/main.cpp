@@ -6,19 +6,22 @@
 //   crossrt --help | --version
 //
 // translate: when the recorded translation key is unchanged it writes nothing and returns at
-// once. Otherwise it asks the build tree's daemon (starting it when absent) and, when the daemon
-// cannot answer for any reason, translates in-process: the build never fails because of the
-// daemon. Outputs are written atomically, only where their bytes changed.
+// once. Otherwise it looks in the remote storages (CROSSRT_REMOTE_STORAGE), then asks the build
+// tree's daemon (starting it when absent) and, when the daemon cannot answer for any reason,
+// translates in-process: the build never fails because of the daemon or a remote storage. A local
+// translation is uploaded. Outputs are written atomically, only where their bytes changed.
 #include "DaemonClient.h"
 #include "InProcess.h"
 #include "Manifest.h"
 #include "Outputs.h"
+#include "RemoteCache.h"
 #include "Protocol.h"
 #include "SourceFinder.h"
 #include "TranslateTypes.h"
 
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <string>
@@ -37,7 +40,8 @@ const char* kUsage =
     "                         [--candidate FILE... [--source-dir DIR]] [--compose INTERFACE=IMPL...] [--virtual-level 1|2|3]\n"
     "                         [--execution-mode wavefront|megakernel] [--templates DIR]\n"
     "                         [--depfile FILE --depfile-target FILE]\n"
-    "                         [--build-dir DIR | --no-daemon] [-- COMPILE_ARGS...]\n"
+    "                         [--build-dir DIR | --no-daemon] [--remote-storage URLS [--source-root DIR]]\n"
+    "                         [-- COMPILE_ARGS...]\n"
     "       crossrt daemon status [--build-dir DIR] [--json]\n"
     "       crossrt daemon stop [--build-dir DIR]\n"
     "       crossrt --help | --version\n";
@@ -53,9 +57,40 @@ const char* kHelp =
     "               Compile arguments (-I, -D, -std=...) follow '--'. The build tree's daemon (crossrtd)\n"
     "               translates, and is started when absent; --no-daemon (or CROSSRT_NO_DAEMON=1)\n"
     "               translates in this process. An unchanged class writes nothing.\n"
+    "               --remote-storage (or CROSSRT_REMOTE_STORAGE, which wins) names remote caches shared\n"
+    "               by a team: redis://host[:port], http[s]://host/path, space-separated, each with\n"
+    "               optional |read-only, |connect-timeout=MS, |operation-timeout=MS, |layout=bazel.\n"
+    "               Paths under --build-dir and --source-root are stored relative to them.\n"
     "daemon status  prints what the build tree's daemon holds (--json for a machine).\n"
     "daemon stop    stops it; the next translation starts another.\n"
     "\n";
+
+// Relative paths in the request, made absolute from this process's folder: the daemon that
+// translates runs elsewhere.
+void MakePathsAbsolute(engine::TranslateRequest& request) {
+  auto absolute = [](std::string& path) {
+    if (!path.empty() && path[0] != '/') path = (std::filesystem::current_path() / path).lexically_normal().string();
+  };
+  for (auto& s : request.sources) absolute(s);
+  absolute(request.outputDir);
+  absolute(request.templateDir);
+  auto& args = request.compileArgs;
+  for (size_t i = 0; i < args.size(); ++i) {
+    for (const char* flag : {"-I", "-isystem", "-iquote", "-idirafter", "-include"}) {
+      const std::string f = flag;
+      if (args[i] == f && i + 1 < args.size()) {
+        absolute(args[++i]);
+        break;
+      }
+      if (args[i].size() > f.size() && args[i].compare(0, f.size(), f) == 0 && (f == "-I" || args[i][f.size()] != '-')) {
+        std::string path = args[i].substr(f.size());
+        absolute(path);
+        args[i] = f + path;
+        break;
+      }
+    }
+  }
+}
 
 int Usage(const std::string& message) {
   std::cerr << "crossrt: error: " << message << "\n" << kUsage;
@@ -159,7 +194,7 @@ int main(int argc, char** argv) {
 
   engine::TranslateRequest request;
   request.templateDir = CROSSRT_DEFAULT_TEMPLATE_DIR;
-  std::string depfile, depfileTarget, backend, buildDir, sourceDir;
+  std::string depfile, depfileTarget, backend, buildDir, sourceDir, remoteStorage, sourceRoot;
   bool useDaemon = std::getenv("CROSSRT_NO_DAEMON") == nullptr;
   std::vector<std::string> candidates;
   for (size_t i = 1; i < args.size(); ++i) {
@@ -203,6 +238,8 @@ int main(int argc, char** argv) {
     else if (a == "--depfile") depfile = v;
     else if (a == "--depfile-target") depfileTarget = v;
     else if (a == "--build-dir") buildDir = v;
+    else if (a == "--remote-storage") remoteStorage = v;
+    else if (a == "--source-root") sourceRoot = v;
     else return Usage("unknown option '" + a + "'");
   }
   if (request.className.empty()) return Usage("--class is required");
@@ -229,12 +266,17 @@ int main(int argc, char** argv) {
     request.sources.insert(request.sources.end(), found.sources.begin(), found.sources.end());
   }
 
+  MakePathsAbsolute(request);
   // Unchanged key: nothing to translate, nothing to write.
   if (crossrt::client::UpToDate(request)) return 0;
 
   engine::TranslateResult result;
   bool translated = false;
-  if (useDaemon && !buildDir.empty()) {
+  if (const char* env = std::getenv("CROSSRT_REMOTE_STORAGE")) remoteStorage = env;
+  crossrt::client::RemoteCache remote(remoteStorage, sourceRoot, buildDir);
+  const bool fromRemote = remote.Enabled() && remote.Fetch(request, result);
+  translated = fromRemote;
+  if (!translated && useDaemon && !buildDir.empty()) {
     DaemonClient daemon(buildDir);
     auto response = daemon.Call({{"command", "translate"}, {"request", crossrt::protocol::ToJson(request)}}, /*start=*/true);
     std::string why = response ? response->value("error", "unknown error") : daemon.Error();
@@ -269,6 +311,7 @@ int main(int argc, char** argv) {
     std::cerr << "crossrt: error: " << e.what() << "\n";
     return 1;
   }
+  if (!fromRemote && remote.Enabled()) remote.Store(request, result);
   if (!depfile.empty() && !WriteDepfile(depfile, depfileTarget.empty() ? depfile : depfileTarget, result.inputs)) {
     std::cerr << "crossrt: error: cannot write depfile '" << depfile << "'\n";
     return 1;

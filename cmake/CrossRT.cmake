@@ -32,8 +32,16 @@
 # The translation goes through the build tree's daemon (crossrtd, started on demand, exits when
 # idle), which keeps parsed headers warm; set CROSSRT_NO_DAEMON=1 to translate in-process.
 #
+# CROSSRT_REMOTE_STORAGE (a cache variable, or the environment variable of the same name at build
+# time, which wins): remote caches a team shares translations through, e.g.
+# "redis://cache.lab:6379 http://cache.lab/crossrt|read-only" (docs/remote-cache.md). Paths under
+# the build tree and the top-level source folder are stored relative to them.
+#
 # Works from the source tree (add_subdirectory) and from an installed package (find_package).
 include_guard(GLOBAL)
+
+set(CROSSRT_REMOTE_STORAGE "" CACHE STRING
+    "Remote translation caches: redis://host[:port] or http[s]://host/path, space-separated, each with optional |read-only")
 
 # Registers the source files that define Implementation's methods, so that
 # crossrt_add_class(... COMPOSE Interface=Implementation) parses them (absolute paths).
@@ -154,7 +162,8 @@ function(crossrt_add_class target class)
             ${source_args} ${candidate_args} ${option_args}
             --templates ${CROSSRT_TEMPLATE_DIR}
             --depfile ${out_dir}/${name}_${suffix}.d --depfile-target ${first_output}
-            --build-dir ${CMAKE_BINARY_DIR}
+            --build-dir ${CMAKE_BINARY_DIR} --source-root ${CMAKE_SOURCE_DIR}
+            "$<$<BOOL:${CROSSRT_REMOTE_STORAGE}>:--remote-storage;${CROSSRT_REMOTE_STORAGE}>"
             -- ${compile_args}
     DEPENDS ${abs_sources} ${candidates} ${translator_dep}
     DEPFILE ${out_dir}/${name}_${suffix}.d

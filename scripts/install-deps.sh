@@ -12,6 +12,8 @@ PACKAGES=(
   libopenimageio-dev openimageio-tools                     # image IO
   catch2 nlohmann-json3-dev libkainjow-mustache-dev libxxhash-dev
   python3-matplotlib                                       # plots of the benchmarks' CSV tables
+  libhiredis-dev libcurl4-openssl-dev                      # the remote translation cache (Redis, HTTP)
+  redis-server nginx-light                                 # its tests' servers, on loopback ports
 )
 missing=()
 for p in "${PACKAGES[@]}"; do
