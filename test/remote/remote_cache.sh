@@ -150,6 +150,13 @@ for storage in "redis://127.0.0.1:$redis_port" "http://127.0.0.1:$http_port/cach
   [ "$(translations "tree-$kind-jwarm1")" -eq 0 ] || fail "a warm parallel build translated"
 done
 
+echo "== http: the Bazel remote cache's layout (<url>/ac/<64 hex digits>)"
+new_tree tree-bazel-a; new_tree tree-bazel-b
+translate tree-bazel-a "http://127.0.0.1:$http_port/cache|layout=bazel" > /dev/null 2>&1 || fail "bazel layout"
+[ "$(find "$work/dav/cache/ac" -type f | grep -c -E '/ac/[0-9a-f]{64}$')" -eq 2 ] || fail "no manifest and result under ac/"
+translate tree-bazel-b "http://127.0.0.1:$http_port/cache|layout=bazel" > /dev/null 2>&1 || fail "bazel layout (2)"
+[ "$(translations tree-bazel-b)" -eq 0 ] || fail "the bazel layout was not fetched"
+
 echo "== a server that is down, silent, or stops mid-build"
 kill "$redis_pid"; wait "$redis_pid" 2> /dev/null || true
 new_tree tree-down
