@@ -102,8 +102,8 @@ struct AstCache::Handle::Entry {
   std::shared_ptr<clang::CompilerInvocation> invocation;  // from the arguments, before any preamble
   std::optional<clang::PrecompiledPreamble> preamble;
   IncludesSeen preambleIncludes;  // what the preamble's #include lines found
-  // The last parse, destroyed in this order: the action ends the source file while the compiler and
-  // the main file's buffer still live.
+  // The last parse. EndParse() drops it action first: the action ends the source file while the
+  // compiler and the main file's buffer still live.
   std::unique_ptr<llvm::MemoryBuffer> mainBuffer;
   std::unique_ptr<ParsedFile> parsed;
   std::unique_ptr<clang::SyntaxOnlyAction> action;
