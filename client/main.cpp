@@ -14,8 +14,8 @@
 #include "InProcess.h"
 #include "Manifest.h"
 #include "Outputs.h"
-#include "RemoteCache.h"
 #include "Protocol.h"
+#include "RemoteCache.h"
 #include "SourceFinder.h"
 #include "TranslateTypes.h"
 

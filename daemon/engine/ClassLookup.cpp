@@ -19,8 +19,8 @@ using namespace clang;
 
 namespace crossrt::engine {
 
-bool AnalyzeTranslationUnit(ASTContext& ctx, const IncludesSeen& includes, const std::string& className, const std::map<std::string, std::string>& compositions,
-                            Reporter& reporter, ClassModel& model) {
+bool AnalyzeTranslationUnit(ASTContext& ctx, const IncludesSeen& includes, const std::string& className,
+                            const std::map<std::string, std::string>& compositions, Reporter& reporter, ClassModel& model) {
   // Name lookups, namespace by namespace ("demo::Render"): walking every declaration of the
   // standard library would cost more than the rest of the analysis.
   std::vector<std::string> path;

@@ -344,8 +344,7 @@ std::string GlslPrinter::Call(const CallExpr* call) {
                 "kernels may call LiteMath, <cmath> and std::min/max/abs, and your own functions with visible bodies");
   if (usersSystemHeader)
     return Fail(call->getBeginLoc(), "'" + qname + "' is declared in a system header: kernels treat those as libraries",
-                "reach the helper's header with -I, not -isystem (CMake passes an imported target's include directories "
-                "with -isystem: set NO_SYSTEM_FROM_IMPORTED on your target, or include the directory directly)");
+                "pass the folder of the helper's header with -I, not -isystem");
   // The user's own free function.
   std::string callee = EmitHelper(fd, call->getBeginLoc(), false, bindings);
   std::string s = callee + "(";
