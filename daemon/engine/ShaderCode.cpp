@@ -14,6 +14,18 @@ namespace crossrt::engine {
 
 namespace {
 
+// One binding of a kernel's images, textures or acceleration structures, for the `images` section
+// of templates/glsl/kernel.comp.mustache: every kind's flag is set, so that none is looked up in the
+// enclosing context.
+Data Binding(unsigned binding, const std::string& name) {
+  Data x;
+  for (const char* kind : {"storageImage", "texture", "sampler", "textureSizes", "samplerArray", "texelBuffer", "accelerationStructure"})
+    x.set(kind, false);
+  x.set("binding", std::to_string(binding));
+  x.set("name", name);
+  return x;
+}
+
 // Whether a kernel's reductions start from an infinity (min or max over floats): its shaders then
 // define CRT_INFINITY.
 bool UsesInfinity(const Kernel& k) {
@@ -224,17 +236,22 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
         name = p.glslName;
       }
     const std::string what = (ib.parameter ? "parameter Image2D " : "member Image2D ") + ib.member;
-    const std::string at = "layout(binding = " + std::to_string(binding++);
-    Data x;
+    Data x = Binding(binding++, "");
     if (ib.use == ImageUse::Storage) {
-      std::string access = !ib.stored ? "readonly " : !ib.loaded ? "writeonly " : "";
-      x.set("decl", at + ", " + format + ") uniform " + access + prefix + "image2D " + name);
+      x.set("storageImage", true);
+      x.set("format", format);
+      x.set("access", std::string(!ib.stored ? "readonly " : !ib.loaded ? "writeonly " : ""));
+      x.set("prefix", prefix);
+      x.set("name", name);
       x.set("comment", what + ": texels " + (ib.loaded && ib.stored ? "loaded and stored" : ib.loaded ? "loaded" : "stored"));
     } else if (ib.use == ImageUse::Texture) {
-      x.set("decl", at + ") uniform " + prefix + "texture2D " + ib.member + "_texture");
+      x.set("texture", true);
+      x.set("prefix", prefix);
+      x.set("name", ib.member + "_texture");
       x.set("comment", what + ": sampled");
     } else {
-      x.set("decl", at + ") uniform sampler " + ib.member);
+      x.set("sampler", true);
+      x.set("name", ib.member);
       x.set("comment", "member LiteImage::Sampler " + ib.member);
     }
     images.push_back(x);
@@ -244,30 +261,34 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
     auto* m = FindMember(model, k.textureArrays[i]);
     const std::string& a = k.textureArrays[i];
     const std::string cppType = "std::vector<LiteImage::Texture2D<" + (m ? m->elemCppType : std::string("?")) + ">>";
-    Data x;
-    x.set("decl", "layout(std430, binding = " + std::to_string(binding++) + ") readonly buffer " + a + "InfoBuffer { crt_TextureInfo " + a + "_info[]; }");
+    Data x = Binding(binding++, a);
+    x.set("textureSizes", true);
     x.set("comment", "member " + cppType + " " + a + ": its textures' sizes and samplers");
     images.push_back(x);
-    Data y;
     if (hardwareTextures) {
-      y.set("decl", "layout(set = " + std::to_string(1 + i) + ", binding = 0) uniform sampler2D " + a + "[]");
-      y.set("comment", "its textures, with their samplers");
+      Data y = Binding(0, a);
+      y.set("samplerArray", true);
+      y.set("set", std::to_string(1 + i));
+      y.set("comment", std::string("its textures, with their samplers"));
+      images.push_back(y);
     } else {
-      y.set("decl", "layout(std430, binding = " + std::to_string(binding++) + ") readonly buffer " + a + "TexelBuffer { " + (m ? m->glslType : "vec4") + " " + a + "_texels[]; }");
-      y.set("comment", "their texels, one texture after the other");
+      Data y = Binding(binding++, a);
+      y.set("texelBuffer", true);
+      y.set("type", m ? m->glslType : std::string("vec4"));
+      y.set("comment", std::string("their texels, one texture after the other"));
+      images.push_back(y);
     }
-    images.push_back(y);
   }
   if (hardwareRayQuery) {
-    Data x;
-    x.set("decl", "layout(binding = " + std::to_string(binding++) + ") uniform accelerationStructureEXT " + k.rayQueryHolder + "_scene");
+    Data x = Binding(binding++, k.rayQueryHolder + "_scene");
+    x.set("accelerationStructure", true);
     x.set("comment", "the scene " + k.rayQueryHolder + " holds, built for the ray tracing hardware");
     images.push_back(x);
   }
   if (kind.leaves)
     for (const LeafTraversal* lt : LeafScenes(k)) {
-      Data x;
-      x.set("decl", "layout(binding = " + std::to_string(binding++) + ") uniform accelerationStructureEXT " + lt->member + "_leaves");
+      Data x = Binding(binding++, lt->member + "_leaves");
+      x.set("accelerationStructure", true);
       x.set("comment", "a box per element of " + lt->display + ", for the ray tracing hardware");
       images.push_back(x);
     }
