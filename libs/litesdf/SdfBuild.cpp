@@ -1,0 +1,220 @@
+// Quantisation, packing and the builders of SdfStructures.h.
+#include "SdfStructures.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+#include <cmath>
+#include <functional>
+#include <stdexcept>
+#include <string>
+
+namespace litesdf {
+
+namespace {
+
+uint32_t MaxCode(uint32_t bytesPerValue) { return bytesPerValue >= 4 ? 0xFFFFFFFFu : (1u << (8 * bytesPerValue)) - 1u; }
+
+void CheckBytes(uint32_t bytesPerValue) {
+  if (bytesPerValue != 1 && bytesPerValue != 2 && bytesPerValue != 4)
+    throw std::invalid_argument("bytes per value must be 1, 2 or 4, not " + std::to_string(bytesPerValue));
+}
+void CheckDepth(uint32_t depth) {
+  if (depth > 10) throw std::invalid_argument("depth must be at most 10 (1024 voxels per axis), not " + std::to_string(depth));
+}
+
+uint32_t PackCoords(uint32_t x, uint32_t y, uint32_t z) { return x | (y << 10) | (z << 20); }
+float3 UnpackCoords(uint32_t c) { return float3(float(c & 1023u), float((c >> 10) & 1023u), float((c >> 20) & 1023u)); }
+
+// Calls visit(x, y, z) for every cell of level `level` (2^level per axis) that the surface may cross,
+// descending from the whole box: a cell is skipped when the distance at its centre exceeds half its
+// diagonal (then no point of it is on the surface, the distance being 1-Lipschitz, or a lower bound).
+void VisitCrossableCells(const ISdf& sdf, float3 boxMin, float boxSize, uint32_t level, SdfBuildStats& stats,
+                         const std::function<void(uint32_t, uint32_t, uint32_t)>& visit) {
+  std::function<void(uint32_t, uint32_t, uint32_t, uint32_t)> descend = [&](uint32_t l, uint32_t x, uint32_t y, uint32_t z) {
+    const float size = boxSize / float(1u << l);
+    const float3 center = boxMin + size * (float3(float(x), float(y), float(z)) + float3(0.5f, 0.5f, 0.5f));
+    ++stats.cellsVisited;
+    if (!(std::fabs(sdf.Distance(center)) <= 0.5f * std::sqrt(3.0f) * size)) return;  // NaN: skipped too
+    if (l == level) {
+      visit(x, y, z);
+      return;
+    }
+    for (uint32_t c = 0; c < 8; ++c) descend(l + 1, 2 * x + (c & 1), 2 * y + ((c >> 1) & 1), 2 * z + (c >> 2));
+  };
+  descend(0, 0, 0, 0);
+}
+
+double MsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+uint32_t QuantiseDistance(float d, float diagonal, uint32_t bytesPerValue) {
+  if (bytesPerValue >= 4) {
+    uint32_t bits;
+    std::memcpy(&bits, &d, sizeof bits);
+    return bits;
+  }
+  const float unit = LiteMath::clamp(d / diagonal, -1.0f, 1.0f) * 0.5f + 0.5f;
+  return uint32_t(std::lround(double(unit) * MaxCode(bytesPerValue)));
+}
+
+float DequantiseDistance(uint32_t code, float diagonal, uint32_t bytesPerValue) {
+  if (bytesPerValue >= 4) {
+    float d;
+    std::memcpy(&d, &code, sizeof d);
+    return d;
+  }
+  return (float(code) / float(MaxCode(bytesPerValue)) * 2.0f - 1.0f) * diagonal;
+}
+
+void PackValue(std::vector<uint32_t>& words, size_t index, uint32_t code, uint32_t bytesPerValue) {
+  if (bytesPerValue >= 4) {
+    words[index] = code;
+    return;
+  }
+  const uint32_t perWord = 4 / bytesPerValue, shift = uint32_t(index % perWord) * 8 * bytesPerValue;
+  uint32_t& w = words[index / perWord];
+  w = (w & ~(MaxCode(bytesPerValue) << shift)) | (code << shift);
+}
+
+uint32_t UnpackValue(const std::vector<uint32_t>& words, size_t index, uint32_t bytesPerValue) {
+  if (bytesPerValue >= 4) return words[index];
+  const uint32_t perWord = 4 / bytesPerValue, shift = uint32_t(index % perWord) * 8 * bytesPerValue;
+  return (words[index / perWord] >> shift) & MaxCode(bytesPerValue);
+}
+
+float SdfGrid::Sample(float3 p) const {
+  const float cell = CellSize();
+  const float3 u = LiteMath::clamp((p - boxMin) / cell, 0.0f, float(samples - 1) - 1e-4f);
+  const uint32_t x = uint32_t(u.x), y = uint32_t(u.y), z = uint32_t(u.z);
+  VoxelValues v;
+  for (uint32_t c = 0; c < 8; ++c) v.v[c] = Value(x + (c & 1), y + ((c >> 1) & 1), z + (c >> 2));
+  return EvalTrilinear(TrilinearOf(v), u - float3(float(x), float(y), float(z)));
+}
+
+float3 SdfSVS::VoxelMin(size_t i) const { return boxMin + VoxelSize() * UnpackCoords(coords[i]); }
+
+VoxelValues SdfSVS::Values(size_t i) const {
+  const float diagonal = std::sqrt(3.0f) * VoxelSize();
+  VoxelValues v;
+  for (uint32_t c = 0; c < 8; ++c) v.v[c] = DequantiseDistance(UnpackValue(values, 8 * i + c, bytesPerValue), diagonal, bytesPerValue);
+  return v;
+}
+
+float3 SdfSBS::BrickMin(size_t brick) const { return boxMin + VoxelSize() * UnpackCoords(coords[brick]); }
+
+VoxelValues SdfSBS::Values(size_t brick, uint32_t x, uint32_t y, uint32_t z) const {
+  const float diagonal = std::sqrt(3.0f) * VoxelSize();
+  const uint32_t n = brickSize + 1;
+  const size_t first = size_t(brick) * WordsPerBrick() * (4 / std::min(bytesPerValue, 4u));
+  VoxelValues v;
+  for (uint32_t c = 0; c < 8; ++c) {
+    const uint32_t cx = x + (c & 1), cy = y + ((c >> 1) & 1), cz = z + (c >> 2);
+    v.v[c] = DequantiseDistance(UnpackValue(values, first + (cz * n + cy) * n + cx, bytesPerValue), diagonal, bytesPerValue);
+  }
+  return v;
+}
+
+SdfGrid BuildGrid(const ISdf& sdf, float3 boxMin, float boxSize, uint32_t samples) {
+  if (samples < 2) throw std::invalid_argument("a grid needs at least 2 samples per axis");
+  SdfGrid grid;
+  grid.samples = samples;
+  grid.boxMin = boxMin;
+  grid.boxSize = boxSize;
+  grid.values.resize(size_t(samples) * samples * samples);
+  const float cell = grid.CellSize();
+  for (uint32_t z = 0; z < samples; ++z)
+    for (uint32_t y = 0; y < samples; ++y)
+      for (uint32_t x = 0; x < samples; ++x)
+        grid.values[(size_t(z) * samples + y) * samples + x] = sdf.Distance(boxMin + cell * float3(float(x), float(y), float(z)));
+  return grid;
+}
+
+SdfSVS BuildSVS(const ISdf& sdf, float3 boxMin, float boxSize, uint32_t depth, uint32_t bytesPerValue, SdfBuildStats* stats) {
+  CheckBytes(bytesPerValue);
+  CheckDepth(depth);
+  const auto t0 = std::chrono::steady_clock::now();
+  SdfBuildStats local;
+  SdfBuildStats& s = stats ? *stats : local;
+  SdfSVS svs;
+  svs.boxMin = boxMin;
+  svs.boxSize = boxSize;
+  svs.depth = depth;
+  svs.bytesPerValue = bytesPerValue;
+  const float size = svs.VoxelSize(), diagonal = std::sqrt(3.0f) * size;
+  VisitCrossableCells(sdf, boxMin, boxSize, depth, s, [&](uint32_t x, uint32_t y, uint32_t z) {
+    ++s.voxelsCrossable;
+    float corner[8], lo = 0.0f, hi = 0.0f;
+    for (uint32_t c = 0; c < 8; ++c) {
+      corner[c] = sdf.Distance(boxMin + size * float3(float(x + (c & 1)), float(y + ((c >> 1) & 1)), float(z + (c >> 2))));
+      lo = c ? std::min(lo, corner[c]) : corner[c];
+      hi = c ? std::max(hi, corner[c]) : corner[c];
+    }
+    if (!(lo <= 0.0f && hi >= 0.0f)) return;  // the interpolant keeps its sign: no surface here
+    ++s.voxelsKept;
+    svs.coords.push_back(PackCoords(x, y, z));
+    const size_t first = svs.values.size() * (4 / bytesPerValue);
+    svs.values.resize(svs.values.size() + 8 * bytesPerValue / 4, 0u);
+    for (uint32_t c = 0; c < 8; ++c) PackValue(svs.values, first + c, QuantiseDistance(corner[c], diagonal, bytesPerValue), bytesPerValue);
+  });
+  s.milliseconds = MsSince(t0);
+  return svs;
+}
+
+SdfSBS BuildSBS(const ISdf& sdf, float3 boxMin, float boxSize, uint32_t depth, uint32_t brickSize, uint32_t bytesPerValue,
+                SdfBuildStats* stats) {
+  CheckBytes(bytesPerValue);
+  CheckDepth(depth);
+  uint32_t brickLevels = 0;
+  while ((1u << brickLevels) < brickSize) ++brickLevels;
+  if ((1u << brickLevels) != brickSize || brickLevels > depth)
+    throw std::invalid_argument("brick size must be a power of 2 no larger than 2^depth, not " + std::to_string(brickSize));
+  const auto t0 = std::chrono::steady_clock::now();
+  SdfBuildStats local;
+  SdfBuildStats& s = stats ? *stats : local;
+  SdfSBS sbs;
+  sbs.boxMin = boxMin;
+  sbs.boxSize = boxSize;
+  sbs.depth = depth;
+  sbs.brickSize = brickSize;
+  sbs.bytesPerValue = bytesPerValue;
+  const float size = sbs.VoxelSize(), diagonal = std::sqrt(3.0f) * size;
+  const uint32_t n = brickSize + 1;
+  std::vector<float> brick(size_t(n) * n * n);
+  VisitCrossableCells(sdf, boxMin, boxSize, depth - brickLevels, s, [&](uint32_t bx, uint32_t by, uint32_t bz) {
+    const uint32_t x0 = bx * brickSize, y0 = by * brickSize, z0 = bz * brickSize;
+    for (uint32_t z = 0; z < n; ++z)
+      for (uint32_t y = 0; y < n; ++y)
+        for (uint32_t x = 0; x < n; ++x)
+          brick[(z * n + y) * n + x] = sdf.Distance(boxMin + size * float3(float(x0 + x), float(y0 + y), float(z0 + z)));
+    bool keep = false;
+    for (uint32_t z = 0; z < brickSize; ++z)
+      for (uint32_t y = 0; y < brickSize; ++y)
+        for (uint32_t x = 0; x < brickSize; ++x) {
+          ++s.voxelsCrossable;
+          float lo = brick[(z * n + y) * n + x], hi = lo;
+          for (uint32_t c = 1; c < 8; ++c) {
+            const float v = brick[((z + (c >> 2)) * n + y + ((c >> 1) & 1)) * n + x + (c & 1)];
+            lo = std::min(lo, v);
+            hi = std::max(hi, v);
+          }
+          if (lo <= 0.0f && hi >= 0.0f) {
+            ++s.voxelsKept;
+            keep = true;
+          }
+        }
+    if (!keep) return;
+    sbs.coords.push_back(PackCoords(x0, y0, z0));
+    const size_t firstWord = sbs.values.size();
+    sbs.values.resize(firstWord + sbs.WordsPerBrick(), 0u);
+    const size_t first = firstWord * (4 / bytesPerValue);
+    for (uint32_t i = 0; i < n * n * n; ++i) PackValue(sbs.values, first + i, QuantiseDistance(brick[i], diagonal, bytesPerValue), bytesPerValue);
+  });
+  s.milliseconds = MsSince(t0);
+  return sbs;
+}
+
+}  // namespace litesdf

@@ -1,0 +1,288 @@
+// litesdf: the cubic along a ray, quantisation, the builders' sign test, and rays against the
+// sparse voxel and brick sets at the extremes (faces, edges, corners, inside starts, tmin/tmax
+// inside a voxel, NaN and inf, scales 1e-3 to 1e3), against exact analytic answers.
+#include "SdfTrace.h"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+using namespace litesdf;
+using LiteMath::float3;
+
+namespace {
+
+// The exact first hit of a ray with the sphere (center 0), or -1.
+float ExactSphereHit(float3 o, float3 d, float radius) {
+  const float b = LiteMath::dot(o, d), c = LiteMath::dot(o, o) - radius * radius;
+  const float disc = b * b - c;
+  if (disc < 0.0f) return -1.0f;
+  const float t = -b - std::sqrt(disc);
+  return t >= 0.0f ? t : -1.0f;
+}
+
+float3 RandomUnit(std::mt19937& rng) {
+  std::normal_distribution<float> n(0.0f, 1.0f);
+  float3 v(n(rng), n(rng), n(rng));
+  return LiteMath::normalize(v);
+}
+
+struct RayStats {
+  int rays = 0, misses = 0;
+  float maxError = 0.0f, minNormalDot = 1.0f;
+};
+
+// Rays from a sphere of radius 3 at points within `aim` of the centre; each must hit the sphere of
+// `radius` where the exact answer says.
+template <class Trace>
+RayStats SphereRays(Trace trace, float radius, float scale, int count, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  RayStats s;
+  for (int i = 0; i < count; ++i) {
+    const float3 origin = 3.0f * scale * RandomUnit(rng);
+    const float3 target = 0.5f * radius * float3(u(rng), u(rng), u(rng));
+    const float3 dir = LiteMath::normalize(target - origin);
+    const float exact = ExactSphereHit(origin, dir, radius);
+    REQUIRE(exact > 0.0f);
+    const SdfHit hit = trace(origin, dir);
+    ++s.rays;
+    if (hit.t < 0.0f) {
+      ++s.misses;
+      continue;
+    }
+    s.maxError = std::max(s.maxError, std::fabs(hit.t - exact) / scale);
+    const float3 n = LiteMath::normalize(origin + exact * dir);
+    s.minNormalDot = std::min(s.minNormalDot, LiteMath::dot(n, hit.normal));
+  }
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("SDF: the cubic along a ray is the trilinear interpolant", "[sdf]")
+{
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f), p(0.0f, 1.0f);
+  for (int i = 0; i < 200; ++i) {
+    VoxelValues v;
+    for (float& x : v.v) x = u(rng);
+    const TrilinearTerms k = TrilinearOf(v);
+    for (uint32_t c = 0; c < 8; ++c)  // the terms reproduce the corners
+      REQUIRE(EvalTrilinear(k, float3(float(c & 1), float((c >> 1) & 1), float(c >> 2))) == Approx(v.v[c]).margin(1e-6));
+    const float3 a(p(rng), p(rng), p(rng)), b(u(rng), u(rng), u(rng));
+    const Cubic cubic = CubicAlongRay(k, a, b);
+    for (float t = 0.0f; t <= 1.0f; t += 0.125f)
+      REQUIRE(EvalCubic(cubic, t) == Approx(EvalTrilinear(k, a + t * b)).margin(1e-5));
+  }
+}
+
+TEST_CASE("SDF: quantised distances round-trip within half a step of the voxel diagonal", "[sdf]")
+{
+  std::mt19937 rng(2);
+  const float diagonal = 0.1f;
+  std::uniform_real_distribution<float> d(-diagonal, diagonal);
+  for (uint32_t bytes : {1u, 2u, 4u}) {
+    // Half a step, plus float rounding of the values themselves.
+    const float bound = bytes == 4 ? 0.0f : diagonal / float((1u << (8 * bytes)) - 1u) + 4.0f * diagonal * 1.2e-7f;
+    float worst = 0.0f;
+    for (int i = 0; i < 10000; ++i) {
+      const float x = d(rng);
+      worst = std::max(worst, std::fabs(DequantiseDistance(QuantiseDistance(x, diagonal, bytes), diagonal, bytes) - x));
+    }
+    INFO(bytes << " bytes per value: worst " << worst << ", bound " << bound);
+    CHECK(worst <= bound);
+    // Beyond the diagonal a value saturates with its sign kept.
+    if (bytes < 4) {
+      CHECK(DequantiseDistance(QuantiseDistance(5.0f, diagonal, bytes), diagonal, bytes) == Approx(diagonal));
+      CHECK(DequantiseDistance(QuantiseDistance(-5.0f, diagonal, bytes), diagonal, bytes) == Approx(-diagonal));
+    }
+  }
+  // Packing: neighbours in a word do not disturb each other.
+  std::vector<uint32_t> words(4, 0u);
+  for (uint32_t i = 0; i < 8; ++i) PackValue(words, i, 0xA0u + i, 1);
+  PackValue(words, 3, 0x11u, 1);
+  for (uint32_t i = 0; i < 8; ++i) CHECK(UnpackValue(words, i, 1) == (i == 3 ? 0x11u : 0xA0u + i));
+}
+
+TEST_CASE("SDF: the builders keep only voxels whose interpolant changes sign, and say what they take", "[sdf]")
+{
+  const SdfSphere sphere(float3(0.0f, 0.0f, 0.0f), 0.7f);
+  SdfBuildStats svsStats, sbsStats;
+  const SdfSVS svs = BuildSVS(sphere, float3(-1.0f, -1.0f, -1.0f), 2.0f, 5, 2, &svsStats);
+  const SdfSBS sbs = BuildSBS(sphere, float3(-1.0f, -1.0f, -1.0f), 2.0f, 5, 4, 1, &sbsStats);
+  INFO("SVS: visited " << svsStats.cellsVisited << ", crossable " << svsStats.voxelsCrossable << ", kept " << svsStats.voxelsKept);
+  REQUIRE(svs.VoxelCount() == svsStats.voxelsKept);
+  CHECK(svsStats.voxelsKept > 0);
+  CHECK(svsStats.voxelsKept < svsStats.voxelsCrossable);       // the sign test saves voxels
+  CHECK(svsStats.cellsVisited < 32u * 32u * 32u / 4u);          // the octree skips most of the box
+  CHECK(svs.Bytes() == svs.VoxelCount() * (4 + 8 * 2));          // coordinates + 8 two-byte values
+  CHECK(sbs.Bytes() == sbs.BrickCount() * (4 + 4 * ((125 + 3) / 4)));  // 5^3 one-byte values per 4^3 brick
+  // Every voxel of the dense grid that the sphere crosses is in the SVS.
+  const SdfGrid grid = BuildGrid(sphere, float3(-1.0f, -1.0f, -1.0f), 2.0f, 33);
+  uint64_t crossing = 0;
+  for (uint32_t z = 0; z < 32; ++z)
+    for (uint32_t y = 0; y < 32; ++y)
+      for (uint32_t x = 0; x < 32; ++x) {
+        float lo = 1e9f, hi = -1e9f;
+        for (uint32_t c = 0; c < 8; ++c) {
+          const float v = grid.Value(x + (c & 1), y + ((c >> 1) & 1), z + (c >> 2));
+          lo = std::min(lo, v);
+          hi = std::max(hi, v);
+        }
+        crossing += lo <= 0.0f && hi >= 0.0f;
+      }
+  CHECK(crossing == svs.VoxelCount());
+  CHECK_THROWS_WITH(BuildSVS(sphere, float3(-1.0f, -1.0f, -1.0f), 2.0f, 5, 3), "bytes per value must be 1, 2 or 4, not 3");
+  CHECK_THROWS_WITH(BuildSBS(sphere, float3(-1.0f, -1.0f, -1.0f), 2.0f, 5, 3, 1), "brick size must be a power of 2 no larger than 2^depth, not 3");
+}
+
+TEST_CASE("SDF: rays hit the sparse voxel and brick sets where the exact surface is", "[sdf]")
+{
+  // Sphere of radius 0.7 in [-1, 1]^3 at depth 5: voxels of 1/16. The trilinear interpolant of the
+  // exact distance errs by O(h^2 / R) = 0.006; the bound, with quantisation: 0.01.
+  const float radius = 0.7f;
+  const SdfSphere sphere(float3(0.0f, 0.0f, 0.0f), radius);
+  for (uint32_t bytes : {1u, 2u, 4u}) {
+    const SdfSVS svs = BuildSVS(sphere, float3(-1.0f, -1.0f, -1.0f), 2.0f, 5, bytes);
+    const RayStats s = SphereRays([&](float3 o, float3 d) { return TraceSVS(svs, o, d, 0.0f, 1e9f, 8); }, radius, 1.0f, 200, 3);
+    INFO("SVS, " << bytes << " bytes: " << s.misses << " misses, max error " << s.maxError << ", min normal dot " << s.minNormalDot);
+    CHECK(s.misses == 0);
+    CHECK(s.maxError < 0.01f);
+    CHECK(s.minNormalDot > 0.99f);
+  }
+  for (uint32_t brick : {2u, 4u, 8u}) {
+    const SdfSBS sbs = BuildSBS(sphere, float3(-1.0f, -1.0f, -1.0f), 2.0f, 5, brick, 2);
+    const RayStats s = SphereRays([&](float3 o, float3 d) { return TraceSBS(sbs, o, d, 0.0f, 1e9f, 8); }, radius, 1.0f, 200, 4);
+    INFO("SBS, bricks of " << brick << ": " << s.misses << " misses, max error " << s.maxError);
+    CHECK(s.misses == 0);
+    CHECK(s.maxError < 0.01f);
+    CHECK(s.minNormalDot > 0.99f);
+  }
+  // More Newton iterations: no larger error (the iteration count is a knob).
+  const SdfSVS svs = BuildSVS(sphere, float3(-1.0f, -1.0f, -1.0f), 2.0f, 5, 4);
+  const RayStats one = SphereRays([&](float3 o, float3 d) { return TraceSVS(svs, o, d, 0.0f, 1e9f, 1); }, radius, 1.0f, 100, 5);
+  const RayStats eight = SphereRays([&](float3 o, float3 d) { return TraceSVS(svs, o, d, 0.0f, 1e9f, 8); }, radius, 1.0f, 100, 5);
+  INFO("max error with 1 Newton iteration " << one.maxError << ", with 8 " << eight.maxError);
+  CHECK(eight.maxError <= one.maxError);
+}
+
+TEST_CASE("SDF: rays along voxel faces, edges and corners do not leak through", "[sdf]")
+{
+  // Rays parallel to the axes through the grid's planes, lines and vertices, at a rounded box and a
+  // sphere: every ray aimed inside the shape's silhouette hits.
+  const SdfRoundedBox box(float3(0.0f, 0.0f, 0.0f), float3(0.55f, 0.45f, 0.5f), 0.1f);
+  const SdfSphere sphere(float3(0.0f, 0.0f, 0.0f), 0.6f);
+  const float h = 2.0f / 32.0f;
+  for (const ISdf* shape : {static_cast<const ISdf*>(&box), static_cast<const ISdf*>(&sphere)}) {
+    const SdfSVS svs = BuildSVS(*shape, float3(-1.0f, -1.0f, -1.0f), 2.0f, 5, 2);
+    const SdfSBS sbs = BuildSBS(*shape, float3(-1.0f, -1.0f, -1.0f), 2.0f, 5, 4, 2);
+    int rays = 0, leaks = 0;
+    for (int axis = 0; axis < 3; ++axis)
+      for (int i = -5; i <= 5; ++i)
+        for (int j = -5; j <= 5; ++j)
+          for (float offset : {0.0f, 0.5f * h}) {  // on grid lines (edges, corners), and on faces only
+            float3 origin(0.0f, 0.0f, 0.0f), dir(0.0f, 0.0f, 0.0f);
+            const float a = float(i) * h + offset, b = float(j) * h;
+            origin[axis] = -3.0f;
+            origin[(axis + 1) % 3] = a;
+            origin[(axis + 2) % 3] = b;
+            dir[axis] = 1.0f;
+            if (SphereTrace(*shape, origin, dir, 0.0f, 10.0f, 1e-5f, 256) < 0.0f) continue;  // misses the shape
+            ++rays;
+            leaks += TraceSVS(svs, origin, dir, 0.0f, 10.0f, 8).t < 0.0f;
+            leaks += TraceSBS(sbs, origin, dir, 0.0f, 10.0f, 8).t < 0.0f;
+          }
+    INFO(rays << " axis-aligned rays, " << leaks << " leaks");
+    CHECK(rays > 300);
+    CHECK(leaks == 0);
+  }
+}
+
+TEST_CASE("SDF: inside starts, tmin and tmax inside a voxel, NaN and inf rays", "[sdf]")
+{
+  const SdfSphere sphere(float3(0.0f, 0.0f, 0.0f), 0.7f);
+  const SdfSVS svs = BuildSVS(sphere, float3(-1.0f, -1.0f, -1.0f), 2.0f, 5, 2);
+  const float3 origin(0.0f, 0.0f, -2.0f), dir(0.0f, 0.0f, 1.0f);
+  const float exact = 1.3f;
+  // From inside: a hit before the ray could leave (a shadow ray from inside is blocked). Where the
+  // start's voxel is stored (near the surface), at the start itself.
+  const float3 deep(0.1f, 0.2f, 0.0f);
+  const SdfHit inside = TraceSVS(svs, deep, dir, 0.0f, 10.0f, 8);
+  CHECK(inside.t >= 0.0f);
+  CHECK(inside.t < std::sqrt(0.49f - 0.05f));  // where it leaves the sphere
+  const float3 nearSurface(0.0f, 0.0f, -0.695f);  // in the stored voxel z in [-0.75, -0.6875]
+  CHECK(TraceSVS(svs, nearSurface, dir, 0.0f, 10.0f, 8).t == Approx(0.0f).margin(1e-6));
+  // tmax ending inside the voxel before the surface: no hit; just past it: the hit.
+  CHECK(TraceSVS(svs, origin, dir, 0.0f, exact - 0.01f, 8).t < 0.0f);
+  CHECK(TraceSVS(svs, origin, dir, 0.0f, exact + 0.01f, 8).t == Approx(exact).margin(0.01));
+  // tmin starting inside the voxel before the surface: the same hit; past the far side: none.
+  CHECK(TraceSVS(svs, origin, dir, exact - 0.02f, 10.0f, 8).t == Approx(exact).margin(0.01));
+  CHECK(TraceSVS(svs, origin, dir, 2.0f + 0.75f, 10.0f, 8).t < 0.0f);
+  // tmin == tmax at the surface: a hit at most there.
+  const SdfHit degenerate = TraceSVS(svs, origin, dir, 5.0f, 5.0f, 8);
+  CHECK(degenerate.t < 0.0f);
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  for (float3 d : {float3(nan, 0.0f, 1.0f), float3(0.0f, 0.0f, nan), float3(inf, 0.0f, 1.0f), float3(0.0f, 0.0f, 0.0f)})
+    CHECK(TraceSVS(svs, origin, d, 0.0f, 10.0f, 8).t < 0.0f);
+  CHECK(TraceSVS(svs, float3(nan, 0.0f, -2.0f), dir, 0.0f, 10.0f, 8).t < 0.0f);
+  CHECK(TraceSVS(svs, origin, dir, nan, 10.0f, 8).t < 0.0f);
+  CHECK(SphereTrace(sphere, origin, float3(nan, nan, nan), 0.0f, 10.0f, 1e-5f, 64) < 0.0f);
+}
+
+TEST_CASE("SDF: scales from 1e-3 to 1e3 keep the relative error", "[sdf]")
+{
+  for (float scale : {1e-3f, 1.0f, 1e3f}) {
+    const float radius = 0.7f * scale;
+    const SdfSphere sphere(float3(0.0f, 0.0f, 0.0f), radius);
+    const SdfSVS svs = BuildSVS(sphere, float3(-scale, -scale, -scale), 2.0f * scale, 5, 2);
+    const RayStats s = SphereRays([&](float3 o, float3 d) { return TraceSVS(svs, o, d, 0.0f, 1e9f, 8); }, radius, scale, 100, 6);
+    INFO("scale " << scale << ": " << s.misses << " misses, max error / scale " << s.maxError);
+    CHECK(s.misses == 0);
+    CHECK(s.maxError < 0.01f);
+  }
+}
+
+TEST_CASE("SDF: sphere tracing the analytic shapes and the dense grid", "[sdf]")
+{
+  const SdfSphere sphere(float3(0.0f, 0.0f, 0.0f), 0.7f);
+  const SdfGrid grid = BuildGrid(sphere, float3(-1.0f, -1.0f, -1.0f), 2.0f, 65);
+  CHECK(grid.Bytes() == 65u * 65u * 65u * 4u);
+  const auto analytic = SphereRays([&](float3 o, float3 d) { return SdfHit{SphereTrace(sphere, o, d, 0.0f, 10.0f, 1e-5f, 256), LiteMath::normalize(o)}; },
+                                   0.7f, 1.0f, 100, 7);
+  CHECK(analytic.misses == 0);
+  CHECK(analytic.maxError < 1e-4f);
+  const auto sampled = SphereRays([&](float3 o, float3 d) { return SdfHit{SphereTraceGrid(grid, o, d, 0.0f, 10.0f, 1e-5f, 256), LiteMath::normalize(o)}; },
+                                  0.7f, 1.0f, 100, 7);
+  CHECK(sampled.misses == 0);
+  CHECK(sampled.maxError < 0.01f);
+  // The other analytic shapes: a hit from outside lands on their surface.
+  const SdfTorus torus(float3(0.0f, 0.0f, 0.0f), 0.6f, 0.2f);
+  const float t = SphereTrace(torus, float3(0.6f, 0.0f, -2.0f), float3(0.0f, 0.0f, 1.0f), 0.0f, 10.0f, 1e-5f, 256);
+  CHECK(t == Approx(2.0f - std::sqrt(0.8f * 0.8f - 0.6f * 0.6f)).margin(1e-4));  // the tube's near side at x = 0.6
+  const SdfBox box(float3(0.0f, 0.0f, 0.0f), float3(0.5f, 0.5f, 0.5f));
+  CHECK(box.Distance(float3(1.0f, 0.0f, 0.0f)) == Approx(0.5f));
+  CHECK(box.Distance(float3(0.0f, 0.0f, 0.0f)) == Approx(-0.5f));
+}
+
+TEST_CASE("SDF: the Mandelbulb builds a sparse voxel set that rays hit near its surface", "[sdf]")
+{
+  const SdfMandelbulb bulb(float3(0.0f, 0.0f, 0.0f), 1.0f);
+  SdfBuildStats stats;
+  const SdfSVS svs = BuildSVS(bulb, float3(-1.5f, -1.5f, -1.5f), 3.0f, 5, 2, &stats);
+  INFO("kept " << stats.voxelsKept << " of " << stats.voxelsCrossable << " crossable voxels");
+  REQUIRE(svs.VoxelCount() > 100);
+  std::mt19937 rng(8);
+  int hits = 0;
+  for (int i = 0; i < 50; ++i) {
+    const float3 origin = 3.0f * RandomUnit(rng), dir = LiteMath::normalize(-origin);
+    const SdfHit h = TraceSVS(svs, origin, dir, 0.0f, 10.0f, 8);
+    if (h.t < 0.0f) continue;
+    ++hits;
+    // The hit is within a voxel diagonal of where the estimator says the surface is.
+    CHECK(std::fabs(bulb.Distance(origin + h.t * dir)) < std::sqrt(3.0f) * svs.VoxelSize());
+  }
+  CHECK(hits > 40);  // rays at the centre hit the bulb's body
+}
