@@ -286,3 +286,128 @@ TEST_CASE("SDF: the Mandelbulb builds a sparse voxel set that rays hit near its 
   }
   CHECK(hits > 40);  // rays at the centre hit the bulb's body
 }
+
+// ---- Meshes: exact distance, robust sign ----
+#include "SdfMesh.h"
+
+#include <map>
+
+namespace {
+
+struct Mesh {
+  std::vector<float3> vertices;
+  std::vector<uint32_t> indices;
+};
+
+// An icosahedron subdivided `levels` times onto the sphere of `radius`: closed, outward-facing.
+Mesh Icosphere(float radius, int levels) {
+  const float g = (1.0f + std::sqrt(5.0f)) * 0.5f;
+  Mesh m;
+  for (float3 v : {float3(-1, g, 0), float3(1, g, 0), float3(-1, -g, 0), float3(1, -g, 0), float3(0, -1, g), float3(0, 1, g),
+                   float3(0, -1, -g), float3(0, 1, -g), float3(g, 0, -1), float3(g, 0, 1), float3(-g, 0, -1), float3(-g, 0, 1)})
+    m.vertices.push_back(radius * LiteMath::normalize(v));
+  m.indices = {0, 11, 5, 0, 5, 1, 0, 1, 7, 0, 7, 10, 0, 10, 11, 1, 5, 9, 5, 11, 4, 11, 10, 2, 10, 7, 6, 7, 1, 8,
+               3, 9, 4, 3, 4, 2, 3, 2, 6, 3, 6, 8, 3, 8, 9, 4, 9, 5, 2, 4, 11, 6, 2, 10, 8, 6, 7, 9, 8, 1};
+  for (int l = 0; l < levels; ++l) {
+    std::map<std::pair<uint32_t, uint32_t>, uint32_t> middle;
+    auto mid = [&](uint32_t a, uint32_t b) {
+      auto key = std::make_pair(std::min(a, b), std::max(a, b));
+      auto it = middle.find(key);
+      if (it != middle.end()) return it->second;
+      m.vertices.push_back(radius * LiteMath::normalize(m.vertices[a] + m.vertices[b]));
+      return middle[key] = uint32_t(m.vertices.size() - 1);
+    };
+    std::vector<uint32_t> next;
+    for (size_t t = 0; t < m.indices.size(); t += 3) {
+      const uint32_t a = m.indices[t], b = m.indices[t + 1], c = m.indices[t + 2];
+      const uint32_t ab = mid(a, b), bc = mid(b, c), ca = mid(c, a);
+      next.insert(next.end(), {a, ab, ca, b, bc, ab, c, ca, bc, ab, bc, ca});
+    }
+    m.indices = next;
+  }
+  return m;
+}
+
+// A torus around the y axis, `u` segments around it and `v` around the tube: closed, not convex.
+Mesh TorusMesh(float major, float minor, uint32_t u, uint32_t v) {
+  Mesh m;
+  for (uint32_t i = 0; i < u; ++i)
+    for (uint32_t j = 0; j < v; ++j) {
+      const float a = 2.0f * float(LiteMath::M_PI) * float(i) / float(u), b = 2.0f * float(LiteMath::M_PI) * float(j) / float(v);
+      const float r = major + minor * std::cos(b);
+      m.vertices.push_back(float3(r * std::cos(a), minor * std::sin(b), r * std::sin(a)));
+    }
+  for (uint32_t i = 0; i < u; ++i)
+    for (uint32_t j = 0; j < v; ++j) {
+      const uint32_t p = i * v + j, q = ((i + 1) % u) * v + j, r = i * v + (j + 1) % v, s = ((i + 1) % u) * v + (j + 1) % v;
+      m.indices.insert(m.indices.end(), {p, r, q, q, r, s});
+    }
+  return m;
+}
+
+// A cube [-h, h]^3 of 12 triangles: sharp edges and corners.
+Mesh CubeMesh(float h) {
+  Mesh m;
+  for (uint32_t c = 0; c < 8; ++c) m.vertices.push_back(float3(c & 1 ? h : -h, c & 2 ? h : -h, c & 4 ? h : -h));
+  m.indices = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4, 2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5};
+  for (size_t t = 0; t < m.indices.size(); t += 3) {  // each face outward: its normal away from the centre
+    const float3 a = m.vertices[m.indices[t]], b = m.vertices[m.indices[t + 1]], c = m.vertices[m.indices[t + 2]];
+    if (LiteMath::dot(LiteMath::cross(b - a, c - a), a + b + c) < 0.0f) std::swap(m.indices[t + 1], m.indices[t + 2]);
+  }
+  return m;
+}
+
+}  // namespace
+
+TEST_CASE("SDF from a mesh: exact distances, and the sign agrees with the winding number everywhere", "[sdf][mesh]")
+{
+  for (const Mesh& mesh : {Icosphere(0.7f, 3), TorusMesh(0.6f, 0.25f, 48, 24), CubeMesh(0.5f)}) {
+    const SdfMesh sdf(mesh.vertices, mesh.indices);
+    int samples = 0, disagreements = 0;
+    for (int z = 0; z < 17; ++z)
+      for (int y = 0; y < 17; ++y)
+        for (int x = 0; x < 17; ++x) {
+          // Grid samples, offset so that some fall on the meshes' planes and edges.
+          const float3 p = float3(-1.0f, -1.0f, -1.0f) + 0.125f * float3(float(x), float(y), float(z));
+          const float winding = sdf.WindingNumber(p);
+          if (std::fabs(winding - 0.5f) < 0.25f) continue;  // on the surface: no side to agree on
+          ++samples;
+          const float d = sdf.Distance(p);
+          disagreements += (d < 0.0f) != (winding > 0.5f);
+        }
+    INFO(sdf.TriangleCount() << " triangles: " << disagreements << " of " << samples << " samples disagree");
+    CHECK(samples > 4000);
+    CHECK(disagreements == 0);
+  }
+  // Exact distances: the cube against the analytic box, at its edges and corners from both sides.
+  const SdfMesh cube(CubeMesh(0.5f).vertices, CubeMesh(0.5f).indices);
+  const SdfBox box(float3(0.0f, 0.0f, 0.0f), float3(0.5f, 0.5f, 0.5f));
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<float> u(-0.8f, 0.8f);
+  for (int i = 0; i < 2000; ++i) {
+    const float3 p(u(rng), u(rng), u(rng));
+    REQUIRE(cube.Distance(p) == Approx(box.Distance(p)).margin(1e-5));
+  }
+  for (float e : {1e-4f, -1e-4f})
+    for (float3 p : {float3(0.5f, 0.5f, 0.1f), float3(0.5f, 0.5f, 0.5f), float3(-0.5f, 0.5f, -0.5f), float3(0.5f, -0.2f, -0.5f)}) {
+      const float3 q = p + e * LiteMath::normalize(p);  // just outside (e > 0) or inside an edge or corner
+      INFO("(" << q.x << ", " << q.y << ", " << q.z << ")");
+      CHECK((cube.Distance(q) > 0.0f) == (e > 0.0f));
+    }
+  CHECK_THROWS_WITH(SdfMesh({float3(0, 0, 0)}, {0, 0}), "a mesh needs triangles: three indices each");
+  CHECK_THROWS_WITH(SdfMesh({float3(0, 0, 0)}, {0, 0, 1}), "a triangle index is out of the vertices' range");
+}
+
+TEST_CASE("SDF from a mesh: a sparse voxel set of a tessellated sphere traces like the sphere", "[sdf][mesh]")
+{
+  const Mesh mesh = Icosphere(0.7f, 4);  // 5120 triangles: deviates from the sphere by under 0.002
+  const SdfMesh sdf(mesh.vertices, mesh.indices);
+  SdfBuildStats stats;
+  const SdfSVS svs = BuildSVS(sdf, float3(-1.0f, -1.0f, -1.0f), 2.0f, 5, 2, &stats);
+  INFO("kept " << stats.voxelsKept << " voxels in " << stats.milliseconds << " ms");
+  const RayStats s = SphereRays([&](float3 o, float3 d) { return TraceSVS(svs, o, d, 0.0f, 1e9f, 8); }, 0.7f, 1.0f, 200, 10);
+  INFO(s.misses << " misses, max error " << s.maxError << ", min normal dot " << s.minNormalDot);
+  CHECK(s.misses == 0);
+  CHECK(s.maxError < 0.012f);
+  CHECK(s.minNormalDot > 0.98f);
+}
