@@ -218,3 +218,4 @@ SdfSBS BuildSBS(const ISdf& sdf, float3 boxMin, float boxSize, uint32_t depth, u
 }
 
 }  // namespace litesdf
+

@@ -1,6 +1,7 @@
 // litesdf: the cubic along a ray, quantisation, the builders' sign test, and rays against the
 // sparse voxel and brick sets at the extremes (faces, edges, corners, inside starts, tmin/tmax
 // inside a voxel, NaN and inf, scales 1e-3 to 1e3), against exact analytic answers.
+#include "SdfBVH.h"
 #include "SdfTrace.h"
 
 #include <catch2/catch.hpp>
@@ -410,4 +411,29 @@ TEST_CASE("SDF from a mesh: a sparse voxel set of a tessellated sphere traces li
   CHECK(s.misses == 0);
   CHECK(s.maxError < 0.012f);
   CHECK(s.minNormalDot > 0.98f);
+}
+
+TEST_CASE("SDF: the BVH over voxels and bricks finds the hits the reference loops find", "[sdf]")
+{
+  const SdfTorus torus(float3(0.0f, 0.0f, 0.0f), 0.6f, 0.25f);
+  const SdfSVS svs = BuildSVS(torus, float3(-1.0f, -1.0f, -1.0f), 2.0f, 6, 2);
+  const SdfSBS sbs = BuildSBS(torus, float3(-1.0f, -1.0f, -1.0f), 2.0f, 6, 4, 1);
+  const BVHTree svsTree = BuildSdfBVH(svs), sbsTree = BuildSdfBVH(sbs);
+  REQUIRE(svsTree.primIndices.size() == svs.VoxelCount());
+  REQUIRE(sbsTree.primIndices.size() == sbs.BrickCount());
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  int hits = 0;
+  for (int i = 0; i < 300; ++i) {
+    const float3 origin = 2.5f * RandomUnit(rng), dir = LiteMath::normalize(0.8f * float3(u(rng), u(rng), u(rng)) - origin);
+    const SdfHit a = TraceSVS(svs, origin, dir, 0.0f, 10.0f, 8), b = TraceSVS(svs, svsTree, origin, dir, 0.0f, 10.0f, 8);
+    const SdfHit c = TraceSBS(sbs, origin, dir, 0.0f, 10.0f, 8), d = TraceSBS(sbs, sbsTree, origin, dir, 0.0f, 10.0f, 8);
+    REQUIRE(b.t == a.t);
+    REQUIRE(d.t == c.t);
+    hits += a.t >= 0.0f;
+  }
+  CHECK(hits > 100);
+  // No voxels: no tree, no hit.
+  const SdfSVS empty = BuildSVS(SdfSphere(float3(5.0f, 5.0f, 5.0f), 0.1f), float3(-1.0f, -1.0f, -1.0f), 2.0f, 4, 2);
+  CHECK(TraceSVS(empty, BuildSdfBVH(empty), float3(0.0f, 0.0f, -2.0f), float3(0.0f, 0.0f, 1.0f), 0.0f, 10.0f, 8).t < 0.0f);
 }
