@@ -14,6 +14,7 @@ PACKAGES=(
   python3-matplotlib                                       # plots of the benchmarks' CSV tables
   libhiredis-dev libcurl4-openssl-dev                      # the remote translation cache (Redis, HTTP)
   redis-server nginx-light                                 # its tests' servers, on loopback ports
+  libopenvdb-dev                                           # bench_sdf's peer: OpenVDB level sets
 )
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -428,8 +428,8 @@ TEST_CASE("SDF: the BVH over voxels and bricks finds the hits the reference loop
     const float3 origin = 2.5f * RandomUnit(rng), dir = LiteMath::normalize(0.8f * float3(u(rng), u(rng), u(rng)) - origin);
     const SdfHit a = TraceSVS(svs, origin, dir, 0.0f, 10.0f, 8), b = TraceSVS(svs, svsTree, origin, dir, 0.0f, 10.0f, 8);
     const SdfHit c = TraceSBS(sbs, origin, dir, 0.0f, 10.0f, 8), d = TraceSBS(sbs, sbsTree, origin, dir, 0.0f, 10.0f, 8);
-    REQUIRE(b.t == a.t);
-    REQUIRE(d.t == c.t);
+    REQUIRE(b.t == Approx(a.t).margin(1e-6));  // the same voxel's root; the bracket may differ in its far end
+    REQUIRE(d.t == Approx(c.t).margin(1e-6));
     hits += a.t >= 0.0f;
   }
   CHECK(hits > 100);

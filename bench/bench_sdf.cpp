@@ -1,0 +1,304 @@
+// bench_sdf: signed distance fields, speed against accuracy (a program that prints tables).
+//
+// For each mesh, scaled into [-1, 1]^3: the exact signed distance (SdfMesh) is sampled into a dense
+// grid, sparse voxel sets and sparse brick sets over a sweep of their knobs (depth, bytes per value,
+// brick size, Newton iterations). The same camera rays are traced through each, and through OpenVDB's
+// level set of the same mesh (meshToLevelSet + LevelSetRayIntersector) as the peer, single-threaded
+// alike. The reference is the exact mesh distance, sphere-traced to 1e-5.
+// Per row: build ms, bytes (data, and with the BVH), Mrays/s, the mean and maximum distance of hit
+// points from the mesh surface, hit agreement, and the PSNR of depth and normal images against the
+// reference. Writes out/bench_sdf.csv; bench/plot_sdf.py plots error against time.
+//
+//   bench_sdf [--size N] [MESH...]     (default: bunny, armadillo and dragon from build/data/meshes)
+#include "BenchSupport.h"
+#include "MeshIO.h"
+#include "SdfBVH.h"
+#include "SdfMesh.h"
+#include "SdfTrace.h"
+
+#include <openvdb/openvdb.h>
+#include <openvdb/tools/MeshToVolume.h>
+#include <openvdb/tools/RayIntersector.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iostream>
+#include <string>
+#include <vector>
+
+using namespace litesdf;
+using LiteMath::float3;
+
+namespace {
+
+double MsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+struct Camera {
+  int size;
+  float3 eye, forward, right, up;
+  void Ray(int x, int y, float3& origin, float3& dir) const {
+    const float u = (float(x) + 0.5f) / float(size) * 2.0f - 1.0f, v = 1.0f - (float(y) + 0.5f) / float(size) * 2.0f;
+    origin = eye;
+    dir = LiteMath::normalize(forward + 0.45f * (u * right + v * up));
+  }
+};
+
+// One traced image: depth (t, -1 for a miss) and normal per pixel.
+struct Image {
+  std::vector<float> t;
+  std::vector<float3> normal;
+};
+
+struct Row {
+  std::string mesh, representation, knobs;
+  double buildMs = 0, dataBytes = 0, totalBytes = 0, mraysPerS = 0;
+  double meanError = 0, maxError = 0, hitAgreement = 0, depthPsnr = 0, normalPsnr = 0;
+};
+
+// Compares an image with the reference: surface error of hits (exact mesh distance at the hit
+// point), agreement of hit masks, and PSNR of depth (over the scene's depth range) and normals.
+void Score(const Image& image, const Image& ref, const Camera& cam, const SdfMesh& mesh, Row& row) {
+  double sumError = 0, maxError = 0, depthSe = 0, normalSe = 0;
+  size_t hits = 0, agree = 0, n = image.t.size();
+  for (size_t i = 0; i < n; ++i) {
+    const bool h = image.t[i] >= 0.0f, r = ref.t[i] >= 0.0f;
+    agree += h == r;
+    const float depth = h ? image.t[i] / 6.0f : 1.0f, refDepth = r ? ref.t[i] / 6.0f : 1.0f;
+    depthSe += double(depth - refDepth) * (depth - refDepth);
+    const float3 nn = h ? 0.5f * (image.normal[i] + float3(1.0f, 1.0f, 1.0f)) : float3(0.0f, 0.0f, 0.0f);
+    const float3 rn = r ? 0.5f * (ref.normal[i] + float3(1.0f, 1.0f, 1.0f)) : float3(0.0f, 0.0f, 0.0f);
+    const float3 d = nn - rn;
+    normalSe += LiteMath::dot(d, d) / 3.0;
+    if (!h) continue;
+    float3 origin, dir;
+    cam.Ray(int(i % cam.size), int(i / cam.size), origin, dir);
+    const double e = std::fabs(mesh.Distance(origin + image.t[i] * dir));
+    sumError += e;
+    maxError = std::max(maxError, e);
+    ++hits;
+  }
+  row.meanError = hits ? sumError / double(hits) : 0.0;
+  row.maxError = maxError;
+  row.hitAgreement = double(agree) / double(n);
+  row.depthPsnr = 10.0 * std::log10(1.0 / std::max(depthSe / double(n), 1e-12));
+  row.normalPsnr = 10.0 * std::log10(1.0 / std::max(normalSe / double(n), 1e-12));
+}
+
+// Traces every pixel with `trace` (returns t and the normal); the median of 3 timed runs.
+Image TraceImage(const Camera& cam, const std::function<SdfHit(float3, float3)>& trace, double& mraysPerS) {
+  Image image;
+  image.t.resize(size_t(cam.size) * cam.size);
+  image.normal.resize(image.t.size());
+  const double ms = MedianMs(2, [&] {
+    for (int y = 0; y < cam.size; ++y)
+      for (int x = 0; x < cam.size; ++x) {
+        float3 origin, dir;
+        cam.Ray(x, y, origin, dir);
+        const SdfHit h = trace(origin, dir);
+        image.t[size_t(y) * cam.size + x] = h.t;
+        image.normal[size_t(y) * cam.size + x] = h.normal;
+      }
+  });
+  mraysPerS = double(image.t.size()) / (ms * 1000.0);
+  return image;
+}
+
+float3 MeshNormal(const SdfMesh& mesh, float3 p) {
+  const float e = 1e-4f;
+  return LiteMath::normalize(float3(mesh.Distance(p + float3(e, 0, 0)) - mesh.Distance(p - float3(e, 0, 0)),
+                                    mesh.Distance(p + float3(0, e, 0)) - mesh.Distance(p - float3(0, e, 0)),
+                                    mesh.Distance(p + float3(0, 0, e)) - mesh.Distance(p - float3(0, 0, e))));
+}
+
+void Print(const Row& r) {
+  std::printf("| %-10s | %-26s | %9.0f | %9.2f | %9.2f | %8.3f | %9.5f | %9.5f | %6.2f%% | %6.1f | %6.1f |\n", r.representation.c_str(),
+              r.knobs.c_str(), r.buildMs, r.dataBytes / 1048576.0, r.totalBytes / 1048576.0, r.mraysPerS, r.meanError, r.maxError,
+              100.0 * r.hitAgreement, r.depthPsnr, r.normalPsnr);
+  std::fflush(stdout);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int size = 160;
+  std::vector<std::string> meshes;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--help" || a == "-h") {
+      std::cout << "usage: bench_sdf [--size N] [MESH...]\n"
+                   "  SDF grid, sparse voxel and brick sets against OpenVDB: build time, bytes, Mrays/s (one thread),\n"
+                   "  surface error and image PSNR against the exact mesh distance. Default meshes: bunny, armadillo\n"
+                   "  and dragon from build/data/meshes (scripts/fetch-meshes.sh). Writes out/bench_sdf.csv.\n";
+      return 0;
+    }
+    if (a == "--size" && i + 1 < argc) size = std::atoi(argv[++i]);
+    else meshes.push_back(a);
+  }
+  if (meshes.empty())
+    for (const char* name : {"bunny00.off", "armadillo.off", "dragon_vrip_res2.ply.gz"})
+      if (std::filesystem::exists(std::string("build/data/meshes/") + name)) meshes.push_back(std::string("build/data/meshes/") + name);
+  if (meshes.empty()) {
+    std::cerr << "bench_sdf: no meshes: run scripts/fetch-meshes.sh, or name mesh files\n";
+    return 1;
+  }
+  openvdb::initialize();
+  std::filesystem::create_directories("out");
+  std::ofstream csv("out/bench_sdf.csv");
+  csv << "mesh,representation,knobs,build_ms,data_bytes,total_bytes,mrays_per_s,mean_error,max_error,hit_agreement,depth_psnr,normal_psnr\n";
+
+  for (const std::string& path : meshes) {
+    TriangleMesh tm;
+    try {
+      tm = LoadMesh(path);
+    } catch (const std::exception& e) {
+      std::cerr << "bench_sdf: " << e.what() << "\n";
+      return 1;
+    }
+    // Into [-0.9, 0.9]^3, centred: the fields cover [-1, 1]^3.
+    float3 lo(1e30f, 1e30f, 1e30f), hi(-1e30f, -1e30f, -1e30f);
+    for (size_t v = 0; v < tm.VertexCount(); ++v) {
+      const float3 p(tm.positions[3 * v], tm.positions[3 * v + 1], tm.positions[3 * v + 2]);
+      lo = LiteMath::min(lo, p);
+      hi = LiteMath::max(hi, p);
+    }
+    const float3 center = 0.5f * (lo + hi);
+    const float extent = std::max(hi.x - lo.x, std::max(hi.y - lo.y, hi.z - lo.z));
+    std::vector<float3> vertices(tm.VertexCount());
+    for (size_t v = 0; v < vertices.size(); ++v)
+      vertices[v] = (float3(tm.positions[3 * v], tm.positions[3 * v + 1], tm.positions[3 * v + 2]) - center) * (1.8f / extent);
+    const SdfMesh mesh(vertices, tm.indices);
+    const std::string name = std::filesystem::path(path).filename().string();
+    const Camera cam{size, float3(1.2f, 0.9f, -2.6f), LiteMath::normalize(float3(-1.2f, -0.9f, 2.6f)),
+                     LiteMath::normalize(LiteMath::cross(float3(0, 1, 0), float3(-1.2f, -0.9f, 2.6f))), float3(0, 0, 0)};
+    Camera camera = cam;
+    camera.up = LiteMath::cross(camera.forward, camera.right);
+
+    // The reference: the exact distance, sphere-traced.
+    double refRate = 0;
+    const Image ref = TraceImage(camera, [&](float3 o, float3 d) {
+      SdfHit h;
+      h.t = SphereTrace(mesh, o, d, 0.0f, 6.0f, 1e-5f, 512);
+      h.normal = h.t >= 0.0f ? MeshNormal(mesh, o + h.t * d) : float3(0, 0, 0);
+      return h;
+    }, refRate);
+    std::printf("\n%s: %zu triangles, %dx%d rays, one thread; errors in units of the mesh's extent / 1.8 (the box is 2 wide)\n\n",
+                name.c_str(), mesh.TriangleCount(), size, size);
+    std::printf("| %-10s | %-26s | %9s | %9s | %9s | %8s | %9s | %9s | %7s | %6s | %6s |\n", "kind", "knobs", "build ms", "data MiB",
+                "+BVH MiB", "Mrays/s", "mean err", "max err", "hits", "dPSNR", "nPSNR");
+    std::printf("|%s|\n", std::string(150, '-').c_str());
+    auto emit = [&](Row& row, const Image& image) {
+      row.mesh = name;
+      Score(image, ref, camera, mesh, row);
+      Print(row);
+      csv << row.mesh << "," << row.representation << ",\"" << row.knobs << "\"," << row.buildMs << "," << row.dataBytes << ","
+          << row.totalBytes << "," << row.mraysPerS << "," << row.meanError << "," << row.maxError << "," << row.hitAgreement << ","
+          << row.depthPsnr << "," << row.normalPsnr << "\n";
+    };
+    const float3 boxMin(-1.0f, -1.0f, -1.0f);
+
+    {  // The dense grid, sphere-traced; normals by central differences of the interpolant.
+      Row row;
+      row.representation = "grid";
+      row.knobs = "64^3 samples";
+      const auto t0 = std::chrono::steady_clock::now();
+      const SdfGrid grid = BuildGrid(mesh, boxMin, 2.0f, 64);
+      row.buildMs = MsSince(t0);
+      row.dataBytes = row.totalBytes = double(grid.Bytes());
+      const Image image = TraceImage(camera, [&](float3 o, float3 d) {
+        SdfHit h;
+        h.t = SphereTraceGrid(grid, o, d, 0.0f, 6.0f, 1e-4f, 512);
+        const float e = 0.5f * grid.CellSize();
+        const float3 p = o + h.t * d;
+        h.normal = h.t < 0.0f ? float3(0, 0, 0)
+                              : LiteMath::normalize(float3(grid.Sample(p + float3(e, 0, 0)) - grid.Sample(p - float3(e, 0, 0)),
+                                                           grid.Sample(p + float3(0, e, 0)) - grid.Sample(p - float3(0, e, 0)),
+                                                           grid.Sample(p + float3(0, 0, e)) - grid.Sample(p - float3(0, 0, e))));
+        return h;
+      }, row.mraysPerS);
+      emit(row, image);
+    }
+    for (uint32_t depth : {5u, 6u, 7u})
+      for (uint32_t bytes : {1u, 2u}) {
+        Row row;
+        row.representation = "SVS";
+        row.knobs = std::to_string(1u << depth) + "^3, " + std::to_string(bytes) + " B, 4 Newton";
+        SdfBuildStats stats;
+        const auto t0 = std::chrono::steady_clock::now();
+        const SdfSVS svs = BuildSVS(mesh, boxMin, 2.0f, depth, bytes, &stats);
+        const BVHTree bvh = BuildSdfBVH(svs);
+        row.buildMs = MsSince(t0);
+        row.dataBytes = double(svs.Bytes());
+        row.totalBytes = row.dataBytes + double(bvh.nodes.size() * sizeof(BVHNode) + bvh.primIndices.size() * 4);
+        const Image image = TraceImage(camera, [&](float3 o, float3 d) { return TraceSVS(svs, bvh, o, d, 0.0f, 6.0f, 4); }, row.mraysPerS);
+        emit(row, image);
+      }
+    {  // Newton iterations: the knob at 128^3, 2 bytes.
+      const SdfSVS svs = BuildSVS(mesh, boxMin, 2.0f, 7, 2);
+      const BVHTree bvh = BuildSdfBVH(svs);
+      for (int iterations : {1, 2, 8}) {
+        Row row;
+        row.representation = "SVS";
+        row.knobs = "128^3, 2 B, " + std::to_string(iterations) + " Newton";
+        row.dataBytes = double(svs.Bytes());
+        row.totalBytes = row.dataBytes + double(bvh.nodes.size() * sizeof(BVHNode) + bvh.primIndices.size() * 4);
+        const Image image = TraceImage(camera, [&](float3 o, float3 d) { return TraceSVS(svs, bvh, o, d, 0.0f, 6.0f, iterations); },
+                                       row.mraysPerS);
+        emit(row, image);
+      }
+    }
+    for (uint32_t depth : {6u, 7u})
+      for (uint32_t brick : {4u, 8u}) {
+        Row row;
+        row.representation = "SBS";
+        row.knobs = std::to_string(1u << depth) + "^3, brick " + std::to_string(brick) + ", 1 B";
+        const auto t0 = std::chrono::steady_clock::now();
+        const SdfSBS sbs = BuildSBS(mesh, boxMin, 2.0f, depth, brick, 1);
+        const BVHTree bvh = BuildSdfBVH(sbs);
+        row.buildMs = MsSince(t0);
+        row.dataBytes = double(sbs.Bytes());
+        row.totalBytes = row.dataBytes + double(bvh.nodes.size() * sizeof(BVHNode) + bvh.primIndices.size() * 4);
+        const Image image = TraceImage(camera, [&](float3 o, float3 d) { return TraceSBS(sbs, bvh, o, d, 0.0f, 6.0f, 4); }, row.mraysPerS);
+        emit(row, image);
+      }
+    // The peer: OpenVDB's narrow-band level set of the same mesh, at the same voxel sizes.
+    for (uint32_t depth : {6u, 7u}) {
+      Row row;
+      row.representation = "OpenVDB";
+      row.knobs = std::to_string(1u << depth) + "^3 voxels, band 3";
+      std::vector<openvdb::Vec3s> points(vertices.size());
+      for (size_t v = 0; v < vertices.size(); ++v) points[v] = openvdb::Vec3s(vertices[v].x, vertices[v].y, vertices[v].z);
+      std::vector<openvdb::Vec3I> triangles(mesh.TriangleCount());
+      for (size_t t = 0; t < triangles.size(); ++t)
+        triangles[t] = openvdb::Vec3I(tm.indices[3 * t], tm.indices[3 * t + 1], tm.indices[3 * t + 2]);
+      const auto t0 = std::chrono::steady_clock::now();
+      auto transform = openvdb::math::Transform::createLinearTransform(2.0 / double(1u << depth));
+      openvdb::FloatGrid::Ptr grid = openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(*transform, points, triangles, 3.0f);
+      row.buildMs = MsSince(t0);
+      row.dataBytes = row.totalBytes = double(grid->memUsage());
+      const openvdb::tools::LevelSetRayIntersector<openvdb::FloatGrid> intersector(*grid);
+      const Image image = TraceImage(camera, [&](float3 o, float3 d) {
+        SdfHit h;
+        h.t = -1.0f;
+        h.normal = float3(0, 0, 0);
+        openvdb::math::Ray<double> ray(openvdb::Vec3d(o.x, o.y, o.z), openvdb::Vec3d(d.x, d.y, d.z), 0.0, 6.0);
+        openvdb::Vec3d p, n;
+        double t = 0;
+        if (intersector.intersectsWS(ray, p, n, t)) {
+          h.t = float(t);
+          n.normalize();
+          h.normal = float3(float(n[0]), float(n[1]), float(n[2]));
+        }
+        return h;
+      }, row.mraysPerS);
+      emit(row, image);
+    }
+  }
+  std::printf("\nwrote out/bench_sdf.csv (plot: bench/plot_sdf.py)\n");
+  return 0;
+}
