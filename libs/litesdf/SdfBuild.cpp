@@ -164,6 +164,24 @@ SdfSVS BuildSVS(const ISdf& sdf, float3 boxMin, float boxSize, uint32_t depth, u
   return svs;
 }
 
+SdfSVS BuildSVSWithinBudget(const ISdf& sdf, float3 boxMin, float boxSize, uint32_t maxDepth, uint32_t bytesPerValue, size_t maxBytes,
+                            SdfBuildStats* stats) {
+  CheckDepth(maxDepth);
+  SdfSVS best;
+  bool found = false;
+  for (uint32_t depth = 1; depth <= maxDepth; ++depth) {
+    SdfBuildStats s;
+    SdfSVS svs = BuildSVS(sdf, boxMin, boxSize, depth, bytesPerValue, &s);
+    if (svs.Bytes() > maxBytes) break;
+    best = std::move(svs);
+    found = true;
+    if (stats) *stats = s;
+  }
+  if (!found)
+    throw std::invalid_argument("no sparse voxel set of this SDF fits in " + std::to_string(maxBytes) + " bytes, not even at depth 1");
+  return best;
+}
+
 SdfSBS BuildSBS(const ISdf& sdf, float3 boxMin, float boxSize, uint32_t depth, uint32_t brickSize, uint32_t bytesPerValue,
                 SdfBuildStats* stats) {
   CheckBytes(bytesPerValue);

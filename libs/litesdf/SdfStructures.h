@@ -86,6 +86,11 @@ SdfGrid BuildGrid(const ISdf& sdf, float3 boxMin, float boxSize, uint32_t sample
 // half its diagonal); a finest voxel is kept only when its trilinear interpolant changes sign (the
 // interpolant's extremes are at the corners).
 SdfSVS BuildSVS(const ISdf& sdf, float3 boxMin, float boxSize, uint32_t depth, uint32_t bytesPerValue, SdfBuildStats* stats = nullptr);
+// The deepest SVS, up to `maxDepth`, that fits in `maxBytes`: depths are built from coarse to fine
+// (each costs about 4x the one before) until the next would not fit. Throws when even depth 1 does
+// not fit.
+SdfSVS BuildSVSWithinBudget(const ISdf& sdf, float3 boxMin, float boxSize, uint32_t maxDepth, uint32_t bytesPerValue, size_t maxBytes,
+                            SdfBuildStats* stats = nullptr);
 // As BuildSVS, keeping the bricks that hold at least one voxel whose interpolant changes sign.
 SdfSBS BuildSBS(const ISdf& sdf, float3 boxMin, float boxSize, uint32_t depth, uint32_t brickSize, uint32_t bytesPerValue,
                 SdfBuildStats* stats = nullptr);

@@ -140,6 +140,18 @@ TEST_CASE("SDF: the builders keep only voxels whose interpolant changes sign, an
   CHECK_THROWS_WITH(BuildSBS(sphere, float3(-1.0f, -1.0f, -1.0f), 2.0f, 5, 3, 1), "brick size must be a power of 2 no larger than 2^depth, not 3");
 }
 
+TEST_CASE("SDF: a memory budget picks the deepest sparse voxel set that fits", "[sdf]")
+{
+  const SdfSphere sphere(float3(0.0f, 0.0f, 0.0f), 0.7f);
+  const float3 boxMin(-1.0f, -1.0f, -1.0f);
+  const size_t depth5 = BuildSVS(sphere, boxMin, 2.0f, 5, 1).Bytes(), depth6 = BuildSVS(sphere, boxMin, 2.0f, 6, 1).Bytes();
+  REQUIRE(depth5 < depth6);
+  CHECK(BuildSVSWithinBudget(sphere, boxMin, 2.0f, 8, 1, depth6 - 1).depth == 5);
+  CHECK(BuildSVSWithinBudget(sphere, boxMin, 2.0f, 8, 1, depth6).depth == 6);
+  CHECK(BuildSVSWithinBudget(sphere, boxMin, 2.0f, 5, 1, size_t(1) << 30).depth == 5);  // the depth limit holds
+  CHECK_THROWS_WITH(BuildSVSWithinBudget(sphere, boxMin, 2.0f, 8, 1, 4), "no sparse voxel set of this SDF fits in 4 bytes, not even at depth 1");
+}
+
 TEST_CASE("SDF: rays hit the sparse voxel and brick sets where the exact surface is", "[sdf]")
 {
   // Sphere of radius 0.7 in [-1, 1]^3 at depth 5: voxels of 1/16. The trilinear interpolant of the
