@@ -160,18 +160,7 @@ int main(int argc, char** argv) {
       std::cerr << "bench_sdf: " << e.what() << "\n";
       return 1;
     }
-    // Into [-0.9, 0.9]^3, centred: the fields cover [-1, 1]^3.
-    float3 lo(1e30f, 1e30f, 1e30f), hi(-1e30f, -1e30f, -1e30f);
-    for (size_t v = 0; v < tm.VertexCount(); ++v) {
-      const float3 p(tm.positions[3 * v], tm.positions[3 * v + 1], tm.positions[3 * v + 2]);
-      lo = LiteMath::min(lo, p);
-      hi = LiteMath::max(hi, p);
-    }
-    const float3 center = 0.5f * (lo + hi);
-    const float extent = std::max(hi.x - lo.x, std::max(hi.y - lo.y, hi.z - lo.z));
-    std::vector<float3> vertices(tm.VertexCount());
-    for (size_t v = 0; v < vertices.size(); ++v)
-      vertices[v] = (float3(tm.positions[3 * v], tm.positions[3 * v + 1], tm.positions[3 * v + 2]) - center) * (1.8f / extent);
+    const std::vector<float3> vertices = FitIntoCube(tm.positions, 0.9f);  // the fields cover [-1, 1]^3
     const SdfMesh mesh(vertices, tm.indices);
     const std::string name = std::filesystem::path(path).filename().string();
     const Camera cam{size, float3(1.2f, 0.9f, -2.6f), LiteMath::normalize(float3(-1.2f, -0.9f, 2.6f)),
@@ -283,9 +272,7 @@ int main(int argc, char** argv) {
       row.dataBytes = row.totalBytes = double(grid->memUsage());
       const openvdb::tools::LevelSetRayIntersector<openvdb::FloatGrid> intersector(*grid);
       const Image image = TraceImage(camera, [&](float3 o, float3 d) {
-        SdfHit h;
-        h.t = -1.0f;
-        h.normal = float3(0, 0, 0);
+        SdfHit h = Missed();
         openvdb::math::Ray<double> ray(openvdb::Vec3d(o.x, o.y, o.z), openvdb::Vec3d(d.x, d.y, d.z), 0.0, 6.0);
         openvdb::Vec3d p, n;
         double t = 0;

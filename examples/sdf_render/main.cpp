@@ -92,18 +92,7 @@ int main(int argc, char** argv)
       std::fprintf(stderr, "sdf_render: %s\n", e.what());
       return 1;
     }
-    float3 lo(1e30f, 1e30f, 1e30f), hi(-1e30f, -1e30f, -1e30f);
-    for (size_t v = 0; v < tm.VertexCount(); ++v)
-    {
-      lo = LiteMath::min(lo, float3(tm.positions[3 * v], tm.positions[3 * v + 1], tm.positions[3 * v + 2]));
-      hi = LiteMath::max(hi, float3(tm.positions[3 * v], tm.positions[3 * v + 1], tm.positions[3 * v + 2]));
-    }
-    const float3 center = 0.5f * (lo + hi);
-    const float extent = std::max(hi.x - lo.x, std::max(hi.y - lo.y, hi.z - lo.z));
-    std::vector<float3> vertices(tm.VertexCount());
-    for (size_t v = 0; v < vertices.size(); ++v)  // into [-0.9, 0.9]^3
-      vertices[v] = (float3(tm.positions[3 * v], tm.positions[3 * v + 1], tm.positions[3 * v + 2]) - center) * (1.8f / extent);
-    field = std::make_unique<litesdf::SdfMesh>(vertices, tm.indices);
+    field = std::make_unique<litesdf::SdfMesh>(litesdf::FitIntoCube(tm.positions, 0.9f), tm.indices);  // the field covers [-1, 1]^3
     what = meshPath + " (" + std::to_string(tm.TriangleCount()) + " triangles)";
   }
   else

@@ -49,9 +49,7 @@ void TraverseBVH(const BVHTree& bvh, float3 origin, float3 dir, float tmin, Limi
 }  // namespace detail
 
 inline SdfHit TraceSVS(const SdfSVS& svs, const BVHTree& bvh, float3 origin, float3 dir, float tmin, float tmax, int newtonIterations) {
-  SdfHit best;
-  best.t = -1.0f;
-  best.normal = float3(0.0f, 0.0f, 0.0f);
+  SdfHit best = Missed();
   const float size = svs.VoxelSize();
   auto limit = [&]() { return best.t >= 0.0f ? best.t : tmax; };
   detail::TraverseBVH(bvh, origin, dir, tmin, limit, [&](uint32_t first, uint32_t count) {
@@ -65,9 +63,7 @@ inline SdfHit TraceSVS(const SdfSVS& svs, const BVHTree& bvh, float3 origin, flo
 }
 
 inline SdfHit TraceSBS(const SdfSBS& sbs, const BVHTree& bvh, float3 origin, float3 dir, float tmin, float tmax, int newtonIterations) {
-  SdfHit best;
-  best.t = -1.0f;
-  best.normal = float3(0.0f, 0.0f, 0.0f);
+  SdfHit best = Missed();
   const float size = sbs.VoxelSize();
   auto limit = [&]() { return best.t >= 0.0f ? best.t : tmax; };
   const float3 invDir = float3(1.0f / dir.x, 1.0f / dir.y, 1.0f / dir.z);

@@ -57,6 +57,22 @@ float BoxDistanceSquared(float3 p, float3 boxMin, float3 boxMax) {
 
 }  // namespace
 
+std::vector<float3> FitIntoCube(const std::vector<float>& positions, float halfExtent) {
+  std::vector<float3> vertices(positions.size() / 3);
+  for (size_t v = 0; v < vertices.size(); ++v) vertices[v] = float3(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]);
+  if (vertices.empty()) return vertices;
+  float3 lo = vertices[0], hi = vertices[0];
+  for (const float3& p : vertices) {
+    lo = LiteMath::min(lo, p);
+    hi = LiteMath::max(hi, p);
+  }
+  const float3 center = 0.5f * (lo + hi);
+  const float extent = std::max(hi.x - lo.x, std::max(hi.y - lo.y, hi.z - lo.z));
+  const float scale = extent > 0.0f ? 2.0f * halfExtent / extent : 1.0f;
+  for (float3& p : vertices) p = (p - center) * scale;
+  return vertices;
+}
+
 SdfMesh::SdfMesh(std::vector<float3> vertices, std::vector<uint32_t> indices)
     : m_vertices(std::move(vertices)), m_indices(std::move(indices)) {
   if (m_indices.empty() || m_indices.size() % 3 != 0) throw std::invalid_argument("a mesh needs triangles: three indices each");

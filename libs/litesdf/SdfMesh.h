@@ -12,6 +12,10 @@
 
 namespace litesdf {
 
+// xyz positions (3 floats per vertex) moved and scaled uniformly so that their bounding box is
+// centred at the origin and its longest side is 2 * halfExtent.
+std::vector<float3> FitIntoCube(const std::vector<float>& positions, float halfExtent);
+
 class SdfMesh : public ISdf {
 public:
   // `vertices` as float3; `indices` three per triangle.

@@ -35,9 +35,7 @@ inline float SphereTraceGrid(const SdfGrid& grid, float3 origin, float3 dir, flo
 }
 
 inline SdfHit TraceSVS(const SdfSVS& svs, float3 origin, float3 dir, float tmin, float tmax, int newtonIterations) {
-  SdfHit best;
-  best.t = -1.0f;
-  best.normal = float3(0.0f, 0.0f, 0.0f);
+  SdfHit best = Missed();
   const float size = svs.VoxelSize();
   for (size_t i = 0; i < svs.VoxelCount(); ++i) {
     const SdfHit h = IntersectVoxel(svs.Values(i), svs.VoxelMin(i), size, origin, dir, tmin, best.t >= 0.0f ? best.t : tmax, newtonIterations);
@@ -47,9 +45,7 @@ inline SdfHit TraceSVS(const SdfSVS& svs, float3 origin, float3 dir, float tmin,
 }
 
 inline SdfHit TraceSBS(const SdfSBS& sbs, float3 origin, float3 dir, float tmin, float tmax, int newtonIterations) {
-  SdfHit best;
-  best.t = -1.0f;
-  best.normal = float3(0.0f, 0.0f, 0.0f);
+  SdfHit best = Missed();
   const float size = sbs.VoxelSize(), brickExtent = size * float(sbs.brickSize);
   const float3 invDir = float3(1.0f / dir.x, 1.0f / dir.y, 1.0f / dir.z);
   for (size_t b = 0; b < sbs.BrickCount(); ++b) {

@@ -132,6 +132,13 @@ struct SdfHit {
   float3 normal;   // the interpolant's normalised gradient, world space
 };
 
+inline SdfHit Missed() {
+  SdfHit hit;
+  hit.t = -1.0f;
+  hit.normal = float3(0.0f, 0.0f, 0.0f);
+  return hit;
+}
+
 // Ray (origin, dir, [tmin, tmax]) against the voxel [voxelMin, voxelMin + size]^3 with corner
 // values `values`. Entry and exit are snapped to the voxel's faces, so that neighbouring voxels,
 // which share the values of their common face, agree where a ray crosses from one to the other.
@@ -140,9 +147,7 @@ struct SdfHit {
 // hits before it could leave the shape.
 inline SdfHit IntersectVoxel(const VoxelValues& values, float3 voxelMin, float size, float3 origin, float3 dir, float tmin, float tmax,
                              int newtonIterations) {
-  SdfHit hit;
-  hit.t = -1.0f;
-  hit.normal = float3(0.0f, 0.0f, 0.0f);
+  SdfHit hit = Missed();
   const float3 invDir = float3(1.0f / dir.x, 1.0f / dir.y, 1.0f / dir.z);
   float tNear = 0.0f, tFar = 0.0f;
   if (!RayBox(origin, invDir, voxelMin, voxelMin + float3(size, size, size), tmin, tmax, tNear, tFar)) return hit;
