@@ -1,6 +1,7 @@
 #include "BVHScene.h"
 
 #include "SceneInput.h"
+#include "SdfStructures.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,6 +9,7 @@
 #include <limits>
 #include <stdexcept>
 
+using LiteMath::as_float;
 using LiteMath::Box4f;
 using LiteMath::clamp;
 using LiteMath::float3;
@@ -481,6 +483,8 @@ void BVHScene::ClearDeviceData()
   m_primIds.clear();
   m_boxes.clear();
   m_motion.clear();
+  m_sdfBricks.clear();
+  m_sdfWords.clear();
 }
 
 void BVHScene::ClearGeom()
@@ -493,6 +497,7 @@ void BVHScene::SetMesh(Mesh& mesh, const float* vpos3f, size_t vertNum, const ui
                        size_t vByteStride)
 {
   litert_detail::ValidateMesh(m_name.c_str(), vpos3f, vertNum, triIndices, indNum, vByteStride);
+  mesh = Mesh{};  // triangles now, whatever it was
   const char* base = reinterpret_cast<const char*>(vpos3f);
   auto vertex = [&](uint32_t i) {
     float3 p;
@@ -579,9 +584,104 @@ uint32_t BVHScene::AddGeom_AABB(uint32_t, const CRT_AABB* boxMinMaxF8, size_t bo
 void BVHScene::UpdateGeom_AABB(uint32_t geomId, uint32_t, const CRT_AABB* boxMinMaxF8, size_t boxNumber, void**, size_t customPrimCount)
 {
   geomId &= CRT_GEOM_MASK_AABB_BIT_RM;
-  if (geomId >= m_meshes.size() || !m_meshes[geomId].boxes)
+  if (geomId >= m_meshes.size() || !m_meshes[geomId].boxes || m_meshes[geomId].sdf)
     throw std::out_of_range(m_name + "::UpdateGeom_AABB: " + std::to_string(geomId) + " is no box geometry");
   SetBoxes(m_meshes[geomId], boxMinMaxF8, boxNumber, customPrimCount);
+}
+
+// ---- signed distance fields: bricks of voxels as box geometry ----
+
+namespace {
+
+BVHSdfBrick MakeBrick(float3 brickMin, float voxelSize, uint32_t firstValue, uint32_t voxels, uint32_t stride, uint32_t bytesPerValue,
+                      uint32_t localId)
+{
+  BVHSdfBrick b;
+  b.minAndVoxelSize = float4(brickMin.x, brickMin.y, brickMin.z, voxelSize);
+  b.firstValue = firstValue;
+  b.voxels = voxels;
+  b.stride = stride;
+  b.bytesPerValue = bytesPerValue;
+  b.localId = localId;
+  b.unused0 = b.unused1 = b.unused2 = 0u;
+  return b;
+}
+
+}  // namespace
+
+uint32_t BVHScene::AddSdf(std::vector<BVHSdfBrick> bricks, std::vector<uint32_t> words)
+{
+  std::vector<CRT_AABB> boxes(bricks.size());
+  for (size_t i = 0; i < bricks.size(); ++i)
+  {
+    const float4 m = bricks[i].minAndVoxelSize;
+    const float extent = m.w * float(bricks[i].voxels);
+    boxes[i].boxMin = float4(m.x, m.y, m.z, 0.0f);
+    boxes[i].boxMax = float4(m.x + extent, m.y + extent, m.z + extent, 0.0f);
+  }
+  Mesh mesh;
+  SetBoxes(mesh, boxes.data(), boxes.size(), 0);
+  mesh.sdf = true;
+  mesh.sdfBricks = std::move(bricks);
+  mesh.sdfWords = std::move(words);
+  m_meshes.push_back(std::move(mesh));
+  return uint32_t(m_meshes.size() - 1);
+}
+
+uint32_t BVHScene::AddGeom_SdfSVS(const litesdf::SdfSVS& svs, uint32_t)
+{
+  if (const std::string problem = litesdf::Problem(svs); !problem.empty())
+    throw std::invalid_argument(m_name + "::AddGeom_SdfSVS: " + problem);
+  std::vector<BVHSdfBrick> bricks(svs.VoxelCount());
+  for (size_t i = 0; i < bricks.size(); ++i)  // a voxel's 8 values: a brick of one voxel, x + 2y + 4z
+    bricks[i] = MakeBrick(svs.VoxelMin(i), svs.VoxelSize(), uint32_t(8 * i), 1, 2, svs.bytesPerValue, uint32_t(i));
+  return AddSdf(std::move(bricks), svs.values);
+}
+
+uint32_t BVHScene::AddGeom_SdfSBS(const litesdf::SdfSBS& sbs, uint32_t)
+{
+  if (const std::string problem = litesdf::Problem(sbs); !problem.empty())
+    throw std::invalid_argument(m_name + "::AddGeom_SdfSBS: " + problem);
+  std::vector<BVHSdfBrick> bricks(sbs.BrickCount());
+  const uint32_t valuesPerWord = 4 / sbs.bytesPerValue;
+  for (size_t b = 0; b < bricks.size(); ++b)  // each brick's values from a word of its own
+    bricks[b] = MakeBrick(sbs.BrickMin(b), sbs.VoxelSize(), uint32_t(b * sbs.WordsPerBrick() * valuesPerWord), sbs.brickSize,
+                          sbs.brickSize + 1, sbs.bytesPerValue, uint32_t(b));
+  return AddSdf(std::move(bricks), sbs.values);
+}
+
+uint32_t BVHScene::AddGeom_SdfGrid(const litesdf::SdfGrid& grid, uint32_t)
+{
+  if (const std::string problem = litesdf::Problem(grid); !problem.empty())
+    throw std::invalid_argument(m_name + "::AddGeom_SdfGrid: " + problem);
+  const uint32_t s = grid.samples;
+  std::vector<uint32_t> words(grid.values.size());
+  std::memcpy(words.data(), grid.values.data(), words.size() * sizeof(uint32_t));
+  // Bricks of 8^3 cells (fewer for a small grid); the last along an axis moves back to end at the
+  // grid's end, overlapping its neighbour. Kept when the surface may cross them.
+  const uint32_t cells = s - 1, edge = std::min(cells, 8u);
+  std::vector<uint32_t> starts;
+  for (uint32_t c = 0; c < cells; c += edge)
+    starts.push_back(std::min(c, cells - edge));
+  std::vector<BVHSdfBrick> bricks;
+  for (uint32_t z0 : starts)
+    for (uint32_t y0 : starts)
+      for (uint32_t x0 : starts)
+      {
+        float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+        for (uint32_t z = z0; z <= z0 + edge; ++z)
+          for (uint32_t y = y0; y <= y0 + edge; ++y)
+            for (uint32_t x = x0; x <= x0 + edge; ++x)
+            {
+              lo = std::min(lo, grid.Value(x, y, z));
+              hi = std::max(hi, grid.Value(x, y, z));
+            }
+        if (!(lo <= 0.0f && hi > 0.0f))
+          continue;  // wholly outside or wholly inside
+        const float3 brickMin = grid.boxMin + grid.CellSize() * float3(float(x0), float(y0), float(z0));
+        bricks.push_back(MakeBrick(brickMin, grid.CellSize(), (z0 * s + y0) * s + x0, edge, s, 4, 0));
+      }
+  return AddSdf(std::move(bricks), std::move(words));
 }
 
 uint32_t BVHScene::AddInstanceMotion(uint32_t geomId, const float4x4* matrices, uint32_t matrixNumber)
@@ -651,6 +751,26 @@ void BVHScene::CommitScene(uint32_t)
     const Mesh& mesh = m_meshes[g];
     if (mesh.wide.empty())
       continue;
+    if (mesh.sdf)
+    {
+      // Its box lanes and bricks moved behind those of the fields before it.
+      const uint32_t firstBrick = uint32_t(m_sdfBricks.size());
+      meshRoot[g] = AppendTree(m_nodes, mesh.wide, uint32_t(m_boxes.size()));
+      for (BVH4Node group : mesh.boxGroups)
+      {
+        for (int lane = 0; lane < 4; ++lane)
+          if (group.child[lane] != kNoChild)
+            group.child[lane] += firstBrick;
+        m_boxes.push_back(group);
+      }
+      for (BVHSdfBrick brick : mesh.sdfBricks)
+      {
+        brick.firstValue += uint32_t(m_sdfWords.size()) * (4u / brick.bytesPerValue);
+        m_sdfBricks.push_back(brick);
+      }
+      m_sdfWords.insert(m_sdfWords.end(), mesh.sdfWords.begin(), mesh.sdfWords.end());
+      continue;
+    }
     if (mesh.boxes)
     {
       meshRoot[g] = AppendTree(m_nodes, mesh.wide, uint32_t(m_boxes.size()));
@@ -668,12 +788,12 @@ void BVHScene::CommitScene(uint32_t)
     inst.toObjectRow0 = placed.toObject.get_row(0);
     inst.toObjectRow1 = placed.toObject.get_row(1);
     inst.toObjectRow2 = placed.toObject.get_row(2);
-    const bool boxes = m_meshes[placed.geomId].boxes;
+    const bool boxes = m_meshes[placed.geomId].boxes, sdf = m_meshes[placed.geomId].sdf;
     inst.instId = ids[k];
-    inst.geomId = boxes ? placed.geomId | CRT_GEOM_MASK_AABB_BIT : placed.geomId;
+    inst.geomId = boxes && !sdf ? placed.geomId | CRT_GEOM_MASK_AABB_BIT : placed.geomId;
     inst.root = meshRoot[placed.geomId];
     inst.flags = (IsIdentity(placed.toObject) && placed.motion.empty() ? kInstanceIdentity : 0u) | (boxes ? kInstanceBoxes : 0u) |
-                 (placed.motion.empty() ? 0u : kInstanceMotion);
+                 (sdf ? kInstanceSdf : 0u) | (placed.motion.empty() ? 0u : kInstanceMotion);
     inst.motionFirst = uint32_t(m_motion.size());
     inst.motionSteps = uint32_t(placed.motion.size());
     inst.unused0 = inst.unused1 = 0u;
@@ -766,8 +886,9 @@ uint32_t BVHScene::IntersectGroup(const BVHTraceRay& r, uint32_t group, float tf
 }
 
 // The four boxes of box geometry's m_boxes[group], as a node's lanes: a ray hits one where it enters
-// it (at tnear from inside). On a hit nearer than tfar: sets tfar and the hit's t and primId.
-bool BVHScene::IntersectBoxes(const BVHTraceRay& r, uint32_t group, float& tfar, CRT_Hit& hit) const
+// it (at tnear from inside), or for a signed distance field where it meets the surface in the brick
+// the lane holds. On a hit nearer than tfar: sets tfar and the hit's t, primId and coords.
+bool BVHScene::IntersectBoxes(const BVHTraceRay& r, uint32_t group, bool sdf, float& tfar, CRT_Hit& hit) const
 {
   float4 exits;
   const float4 entries = SlabEntries(r, m_boxes[group], tfar, exits);
@@ -779,6 +900,11 @@ bool BVHScene::IntersectBoxes(const BVHTraceRay& r, uint32_t group, float& tfar,
     hits = hits & (hits - 1u);
     if (entries[lane] > tfar)
       continue;  // behind a box of this group taken before it
+    if (sdf)
+    {
+      found = IntersectSdfBrick(r, m_boxes[group].child[lane], entries[lane], exits[lane], tfar, hit) || found;
+      continue;
+    }
     found = true;
     tfar = entries[lane];
     hit.t = entries[lane];
@@ -789,10 +915,82 @@ bool BVHScene::IntersectBoxes(const BVHTraceRay& r, uint32_t group, float& tfar,
   return found;
 }
 
+// Corner value `index` of brick m_sdfBricks[brick] as a distance (litesdf's DequantiseDistance).
+float BVHScene::SdfValue(uint32_t brick, uint32_t index) const
+{
+  const uint32_t bytes = m_sdfBricks[brick].bytesPerValue;
+  const uint32_t at = m_sdfBricks[brick].firstValue + index;
+  if (bytes == 4u)
+    return as_float(m_sdfWords[at]);
+  const uint32_t perWord = 4u / bytes;
+  const uint32_t maxCode = bytes == 1u ? 255u : 65535u;
+  const uint32_t code = (m_sdfWords[at / perWord] >> ((at % perWord) * 8u * bytes)) & maxCode;
+  const float diagonal = 1.7320508f * m_sdfBricks[brick].minAndVoxelSize.w;  // sqrt(3) voxel edges
+  return (float(code) / float(maxCode) * 2.0f - 1.0f) * diagonal;
+}
+
+// The ray's span [tEnter, tExit] in brick m_sdfBricks[brick]: its voxels in order along the ray
+// (Amanatides and Woo), those whose corners allow the surface intersected (litesdf's
+// IntersectVoxelSpan), up to the first hit. On a hit nearer than tfar: sets tfar and the hit's t,
+// primId and normal (coords[0..2]).
+bool BVHScene::IntersectSdfBrick(const BVHTraceRay& r, uint32_t brick, float tEnter, float tExit, float& tfar, CRT_Hit& hit) const
+{
+  const float size = m_sdfBricks[brick].minAndVoxelSize.w;
+  const float3 brickMin = to_float3(m_sdfBricks[brick].minAndVoxelSize);
+  const int n = int(m_sdfBricks[brick].voxels);
+  const uint32_t stride = m_sdfBricks[brick].stride;
+  const float t1 = std::min(tExit, tfar);
+  const float3 entry = (r.org + tEnter * r.dir - brickMin) / size;
+  int cell[3];
+  int step[3];
+  float tNext[3];
+  float tDelta[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    cell[a] = clamp(int(std::floor(entry[a])), 0, n - 1);
+    step[a] = r.dir[a] > 0.0f ? 1 : -1;
+    const float boundary = brickMin[a] + size * float(cell[a] + (r.dir[a] > 0.0f ? 1 : 0));
+    tNext[a] = r.invDir[a] != 0.0f ? (boundary - r.org[a]) * r.invDir[a] : std::numeric_limits<float>::max();
+    tDelta[a] = r.invDir[a] != 0.0f ? size * std::fabs(r.invDir[a]) : std::numeric_limits<float>::max();
+  }
+  float tVoxel = tEnter;
+  while (true)
+  {
+    const int a = tNext[0] < tNext[1] ? (tNext[0] < tNext[2] ? 0 : 2) : (tNext[1] < tNext[2] ? 1 : 2);
+    const uint32_t first = (uint32_t(cell[2]) * stride + uint32_t(cell[1])) * stride + uint32_t(cell[0]);
+    litesdf::VoxelValues values;
+    for (uint32_t c = 0u; c < 8u; ++c)
+      values.v[c] = SdfValue(brick, first + (c & 1u) + ((c >> 1u) & 1u) * stride + (c >> 2u) * stride * stride);
+    if (litesdf::MayHoldSurface(values))
+    {
+      const float3 voxelMin = brickMin + size * float3(float(cell[0]), float(cell[1]), float(cell[2]));
+      const litesdf::SdfHit h = litesdf::IntersectVoxelSpan(values, voxelMin, size, r.org, r.dir, tVoxel, std::min(tNext[a], t1),
+                                                            kSdfNewtonIterations);
+      if (h.t >= 0.0f)
+      {
+        tfar = h.t;
+        hit.t = h.t;
+        hit.primId = m_sdfBricks[brick].localId;
+        hit.coords[0] = h.normal.x;
+        hit.coords[1] = h.normal.y;
+        hit.coords[2] = h.normal.z;
+        return true;
+      }
+    }
+    if (!(tNext[a] <= t1))
+      return false;  // left the brick, or reached tfar
+    cell[a] = cell[a] + step[a];
+    if (cell[a] < 0 || cell[a] >= n)
+      return false;
+    tVoxel = tNext[a];
+    tNext[a] = tNext[a] + tDelta[a];
+  }
+}
+
 // Visits the leaves of the mesh tree at `root` that the ray may reach, nearest box first, and
 // tests their triangles (or boxes). On a hit nearer than tfar: sets tfar and the hit's t, primId and
 // barycentrics, and returns true (at the first hit when anyHit).
-bool BVHScene::TraceMesh(const BVHTraceRay& ray, uint32_t root, bool boxes, bool anyHit, float& tfar, CRT_Hit& hit) const
+bool BVHScene::TraceMesh(const BVHTraceRay& ray, uint32_t root, uint32_t leaves, bool anyHit, float& tfar, CRT_Hit& hit) const
 {
   uint32_t stack[kStackSize];    // node indices and leaf references
   float stackEntry[kStackSize];  // their entry distances, to skip those beyond a hit found since
@@ -807,9 +1005,9 @@ bool BVHScene::TraceMesh(const BVHTraceRay& ray, uint32_t root, bool boxes, bool
       const uint32_t last = first + (node & 7u);
       for (uint32_t g = first; g <= last; ++g)
       {
-        if (boxes)
+        if ((leaves & kInstanceBoxes) != 0u)
         {
-          if (IntersectBoxes(ray, g, tfar, hit))
+          if (IntersectBoxes(ray, g, (leaves & kInstanceSdf) != 0u, tfar, hit))
           {
             found = true;
             if (anyHit)
@@ -872,7 +1070,7 @@ bool BVHScene::TraceMesh(const BVHTraceRay& ray, uint32_t root, bool boxes, bool
 bool BVHScene::TraceInstance(uint32_t k, const BVHTraceRay& worldRay, float time, bool anyHit, float& tfar, CRT_Hit& hit) const
 {
   const BVHInstance& inst = m_instances[k];
-  const bool boxes = (inst.flags & kInstanceBoxes) != 0u;
+  const uint32_t leaves = inst.flags & (kInstanceBoxes | kInstanceSdf);
   bool found = false;
   if ((inst.flags & kInstanceMotion) != 0u)
   {
@@ -886,12 +1084,12 @@ bool BVHScene::TraceInstance(uint32_t k, const BVHTraceRay& worldRay, float time
     const float4 row2 = mix(m_motion[at + 2u], m_motion[at + 5u], w);
     const float3x3 toObject = inverse(make_float3x3_from_rows(to_float3(row0), to_float3(row1), to_float3(row2)));
     const float3 org = toObject * (worldRay.org - float3(row0.w, row1.w, row2.w));
-    found = TraceMesh(Prepare(org, toObject * worldRay.dir, worldRay.tnear), inst.root, boxes, anyHit, tfar, hit);
+    found = TraceMesh(Prepare(org, toObject * worldRay.dir, worldRay.tnear), inst.root, leaves, anyHit, tfar, hit);
   }
   else if ((inst.flags & kInstanceIdentity) != 0u)
-    found = TraceMesh(worldRay, inst.root, boxes, anyHit, tfar, hit);
+    found = TraceMesh(worldRay, inst.root, leaves, anyHit, tfar, hit);
   else
-    found = TraceMesh(Prepare(ToObjectPoint(inst, worldRay.org), ToObjectVector(inst, worldRay.dir), worldRay.tnear), inst.root, boxes,
+    found = TraceMesh(Prepare(ToObjectPoint(inst, worldRay.org), ToObjectVector(inst, worldRay.dir), worldRay.tnear), inst.root, leaves,
                       anyHit, tfar, hit);
   if (found)
   {

@@ -51,6 +51,7 @@ struct BVHTriangle4
 constexpr uint32_t kInstanceIdentity = 1u;  // toObject is the identity: the world ray is the object ray
 constexpr uint32_t kInstanceBoxes = 2u;     // its geometry is boxes (AddGeom_AABB): leaves index m_boxes
 constexpr uint32_t kInstanceMotion = 4u;    // it moves: toObject comes from m_motion at the ray's time
+constexpr uint32_t kInstanceSdf = 8u;       // its geometry is a signed distance field: leaves' boxes are m_sdfBricks
 struct BVHInstance
 {
   LiteMath::float4 toObjectRow0, toObjectRow1, toObjectRow2;
@@ -59,6 +60,21 @@ struct BVHInstance
   uint32_t motionFirst, motionSteps;  // a moving instance: its object-to-world rows 0-2 per step, at m_motion[motionFirst...]
   uint32_t unused0, unused1;
 };
+
+// A brick of a signed distance field: voxels^3 voxels of edge minAndVoxelSize.w from
+// minAndVoxelSize.xyz, whose (voxels + 1)^3 corner values are read from m_sdfWords: the one at
+// corner (x, y, z) is value number firstValue + (z * stride + y) * stride + x, packed bytesPerValue
+// bytes at a time (1 and 2: quantised over +-the voxel's diagonal; 4: the float). A voxel of an SVS
+// is a brick of one voxel, a brick of an SBS one of its bricks, a dense grid bricks of 8^3 cells
+// (stride: the grid's samples per axis). localId is what a hit reports as primId (0 for a grid's). 48 bytes, std430
+// as in C++.
+struct BVHSdfBrick
+{
+  LiteMath::float4 minAndVoxelSize;
+  uint32_t firstValue, voxels, stride, bytesPerValue;
+  uint32_t localId, unused0, unused1, unused2;
+};
+constexpr int kSdfNewtonIterations = 4;  // per voxel the ray crosses
 
 // A ray prepared for one tree: slab test reciprocals (0 for a zero or denormal direction
 // component) and the watertight test's shear (Woop, Benthin and Wald 2013).
@@ -96,6 +112,10 @@ public:
   void UpdateGeom_AABB(uint32_t geomId, uint32_t typeId, const CRT_AABB* boxMinMaxF8, size_t boxNumber, void** customPrimPtrs = nullptr,
                        size_t customPrimCount = 0) override;
   uint32_t AddInstanceMotion(uint32_t geomId, const LiteMath::float4x4* matrices, uint32_t matrixNumber) override;
+  // Signed distance fields (CrossRT.h): boxes of bricks (BVHSdfBrick) under a tree of their own.
+  uint32_t AddGeom_SdfGrid(const litesdf::SdfGrid& grid, uint32_t flags = BUILD_HIGH) override;
+  uint32_t AddGeom_SdfSVS(const litesdf::SdfSVS& svs, uint32_t flags = BUILD_HIGH) override;
+  uint32_t AddGeom_SdfSBS(const litesdf::SdfSBS& sbs, uint32_t flags = BUILD_HIGH) override;
   CRT_Hit RayQuery_NearestHitMotion(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar, float time) override;
   bool RayQuery_AnyHitMotion(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar, float time = 0.0f) override;
   // Triangle meshes placed still; a scene with boxes or moving instances is not exported (false).
@@ -112,11 +132,16 @@ public:
   std::vector<uint32_t> m_primIds;        // lane l of m_triangles[g] is triangle m_primIds[4 * g + l] of its mesh
   std::vector<BVH4Node> m_boxes;          // box geometry's boxes in leaf order, four per group, a lane's child its primitive
   std::vector<LiteMath::float4> m_motion; // moving instances' object-to-world rows 0-2, per time step
+  std::vector<BVHSdfBrick> m_sdfBricks;   // every signed distance field's bricks (an SDF's box lanes index here)
+  std::vector<uint32_t> m_sdfWords;       // their corner values, packed
 
 private:
   struct Mesh
   {
-    bool boxes = false;                  // box geometry (AddGeom_AABB): boxGroups instead of triangles
+    bool boxes = false;                  // box geometry (AddGeom_AABB, or an SDF's): boxGroups instead of triangles
+    bool sdf = false;                    // a signed distance field: boxGroups' lanes index sdfBricks
+    std::vector<BVHSdfBrick> sdfBricks;  // its bricks, with values in sdfWords
+    std::vector<uint32_t> sdfWords;
     std::vector<BVH4Node> boxGroups;     // what wide's leaves index: each leaf's boxes, four per group
     BVHTree tree;                        // as the builder made it
     std::vector<BVH4Node> wide;          // the same tree collapsed for the traversal (empty without triangles)
@@ -132,6 +157,7 @@ private:
   };
   void SetMesh(Mesh& mesh, const float* vpos3f, size_t vertNum, const uint32_t* triIndices, size_t indNum, size_t vByteStride);
   void SetBoxes(Mesh& mesh, const CRT_AABB* boxes, size_t boxNumber, size_t customPrimCount);
+  uint32_t AddSdf(std::vector<BVHSdfBrick> bricks, std::vector<uint32_t> words);
   void ClearDeviceData();
 
   // The traversal (translated for the GPU when composed).
@@ -139,10 +165,12 @@ private:
   bool AnyHit(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar, float time) const;
   bool Trace(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar, float time, bool anyHit, CRT_Hit& hit) const;
   bool TraceInstance(uint32_t k, const BVHTraceRay& worldRay, float time, bool anyHit, float& tfar, CRT_Hit& hit) const;
-  bool TraceMesh(const BVHTraceRay& ray, uint32_t root, bool boxes, bool anyHit, float& tfar, CRT_Hit& hit) const;
+  bool TraceMesh(const BVHTraceRay& ray, uint32_t root, uint32_t leaves, bool anyHit, float& tfar, CRT_Hit& hit) const;
   uint32_t IntersectGroup(const BVHTraceRay& r, uint32_t group, float tfar, LiteMath::float4& t, LiteMath::float4& u,
                           LiteMath::float4& v) const;
-  bool IntersectBoxes(const BVHTraceRay& r, uint32_t group, float& tfar, CRT_Hit& hit) const;
+  bool IntersectBoxes(const BVHTraceRay& r, uint32_t group, bool sdf, float& tfar, CRT_Hit& hit) const;
+  bool IntersectSdfBrick(const BVHTraceRay& r, uint32_t brick, float tEnter, float tExit, float& tfar, CRT_Hit& hit) const;
+  float SdfValue(uint32_t brick, uint32_t index) const;
 
   std::string m_name;
   Builder m_builder;

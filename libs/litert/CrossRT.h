@@ -12,15 +12,23 @@
 #include <string>
 #include <vector>
 
+namespace litesdf {  // signed distance fields (libs/litesdf), as scenes take them
+struct SdfGrid;
+struct SdfSVS;
+struct SdfSBS;
+}  // namespace litesdf
+
 // Result of RayQuery_NearestHit. A miss has primId == instId == geomId == 0xFFFFFFFF and t set to
-// the ray's tmax. A hit on box geometry has CRT_GEOM_MASK_AABB_BIT in geomId.
+// the ray's tmax. A hit on box geometry has CRT_GEOM_MASK_AABB_BIT in geomId. A hit on a signed
+// distance field has its surface normal (object space, unit length) in coords[0..2] and the voxel
+// (SVS) or brick (SBS) hit as primId (0 on a dense grid).
 struct CRT_Hit
 {
   float    t;         // ray parameter of the hit
   uint32_t primId;    // triangle index within the geometry
   uint32_t instId;    // id returned by AddInstance
   uint32_t geomId;    // id returned by AddGeom_Triangles3f
-  float    coords[4]; // [0], [1]: barycentrics u, v (Embree convention: p = (1-u-v)*v0 + u*v1 + v*v2); [2], [3]: 0
+  float    coords[4]; // triangles: [0], [1] barycentrics u, v (Embree convention: p = (1-u-v)*v0 + u*v1 + v*v2); [2], [3]: 0
 };
 
 // Build flags, with the paper's values: a quality, BUILD_REFIT for geometry that will be updated,
@@ -110,6 +118,27 @@ struct ISceneObject
   {
     (void)geomId, (void)typeId, (void)boxMinMaxF8, (void)boxNumber, (void)customPrimPtrs, (void)customPrimCount;
     throw std::runtime_error(std::string(Name()) + ": this ISceneObject has no box geometry (UpdateGeom_AABB)");
+  }
+
+  // Signed distance fields as geometry (paper 4.2): the surface where the trilinear interpolant of the
+  // samples is 0, found per voxel with Newton's method (litesdf/SdfVoxel.h). Copied; placed by
+  // AddInstance like meshes. Returns the geometry id. Implementations without SDFs throw
+  // std::runtime_error; bad input (no samples, a depth over 10, an unknown value size) is
+  // std::invalid_argument.
+  virtual uint32_t AddGeom_SdfGrid(const litesdf::SdfGrid& grid, uint32_t flags = BUILD_HIGH)
+  {
+    (void)grid, (void)flags;
+    throw std::runtime_error(std::string(Name()) + ": this ISceneObject has no signed distance fields (AddGeom_SdfGrid)");
+  }
+  virtual uint32_t AddGeom_SdfSVS(const litesdf::SdfSVS& svs, uint32_t flags = BUILD_HIGH)
+  {
+    (void)svs, (void)flags;
+    throw std::runtime_error(std::string(Name()) + ": this ISceneObject has no signed distance fields (AddGeom_SdfSVS)");
+  }
+  virtual uint32_t AddGeom_SdfSBS(const litesdf::SdfSBS& sbs, uint32_t flags = BUILD_HIGH)
+  {
+    (void)sbs, (void)flags;
+    throw std::runtime_error(std::string(Name()) + ": this ISceneObject has no signed distance fields (AddGeom_SdfSBS)");
   }
 
   // Removes all instances (meshes stay).

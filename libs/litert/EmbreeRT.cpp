@@ -1,11 +1,13 @@
 // Embree 3 implementation of ISceneObject.
 //
 // Layout: one RTCScene per mesh (holding a single triangle geometry with id 0, or for box geometry
-// a user geometry of boxes) and a top-level RTCScene whose geometries are INSTANCE geometries
+// and signed distance fields a user geometry: EmbreeSdf.h) and a top-level RTCScene whose geometries are INSTANCE geometries
 // referencing the mesh scenes, with a time step per matrix of a moving instance. Instance i is
 // attached with geometry id i, so Embree's instID is directly our instance id.
 #include "CrossRT.h"
+#include "EmbreeSdf.h"
 #include "SceneInput.h"
+#include "SdfStructures.h"
 
 #include <embree3/rtcore.h>
 
@@ -213,6 +215,10 @@ public:
     return geomId | CRT_GEOM_MASK_AABB_BIT;
   }
 
+  uint32_t AddGeom_SdfGrid(const litesdf::SdfGrid& grid, uint32_t) override { return addSdf("AddGeom_SdfGrid", grid); }
+  uint32_t AddGeom_SdfSVS(const litesdf::SdfSVS& svs, uint32_t) override { return addSdf("AddGeom_SdfSVS", svs); }
+  uint32_t AddGeom_SdfSBS(const litesdf::SdfSBS& sbs, uint32_t) override { return addSdf("AddGeom_SdfSBS", sbs); }
+
   void UpdateGeom_AABB(uint32_t geomId, uint32_t typeId, const CRT_AABB* boxMinMaxF8, size_t boxNumber, void** customPrimPtrs,
                        size_t customPrimCount) override
   {
@@ -331,6 +337,12 @@ public:
     res.geomId    = mesh.boxes ? geomId | CRT_GEOM_MASK_AABB_BIT : geomId;
     res.coords[0] = rh.hit.u;
     res.coords[1] = rh.hit.v;
+    if (mesh.sdf)  // the normal (EmbreeSdf.cpp)
+    {
+      res.coords[0] = rh.hit.Ng_x;
+      res.coords[1] = rh.hit.Ng_y;
+      res.coords[2] = rh.hit.Ng_z;
+    }
     return res;
   }
 
@@ -354,7 +366,23 @@ private:
     size_t      vertNum = 0, triNum = 0;
     bool        changed = false;   // updated since the last CommitScene
     std::shared_ptr<BoxData> boxes; // box geometry: its boxes (Embree keeps a pointer to them)
+    std::shared_ptr<void> sdf;      // a signed distance field: what its callbacks read
   };
+
+  template <class Field>
+  uint32_t addSdf(const char* what, const Field& field)
+  {
+    if (const std::string problem = litesdf::Problem(field); !problem.empty())
+      throw std::invalid_argument(std::string("EmbreeRT::") + what + ": " + problem);
+    Mesh m;
+    m.scene = rtcNewScene(m_device);
+    m.geom = litert_detail::NewSdfGeometry(m_device, field, m.sdf);
+    rtcAttachGeometryByID(m.scene, m.geom, 0);
+    rtcCommitScene(m.scene);
+    m.changed = true;
+    m_meshes.push_back(m);
+    return uint32_t(m_meshes.size() - 1);
+  }
 
   void setBoxData(Mesh& m, uint32_t typeId, const CRT_AABB* boxMinMaxF8, size_t boxNumber, void** customPrimPtrs, size_t customPrimCount)
   {
@@ -394,13 +422,15 @@ private:
                    uint32_t flags, size_t vByteStride)
   {
     const size_t triNum   = indNum / 3;
-    const bool   reusable = m.geom != nullptr && m.vertNum == vertNum && m.triNum == triNum;
+    const bool   reusable = m.geom != nullptr && !m.boxes && !m.sdf && m.vertNum == vertNum && m.triNum == triNum;
     if (!reusable && m.geom != nullptr)
     {
       rtcDetachGeometry(m.scene, 0);
       rtcReleaseGeometry(m.geom);
       m.geom = nullptr;
     }
+    m.boxes.reset();  // triangles now, whatever it was
+    m.sdf.reset();
 
     if (triNum > 0 && vertNum > 0)
     {

@@ -3,7 +3,7 @@
 // per leaf box: the nearest hit, children visited nearer first, pruned by the hit so far.
 #pragma once
 #include "BVHNode.h"
-#include "SdfStructures.h"
+#include "SdfLeaves.h"
 
 #include <cmath>
 
@@ -50,12 +50,10 @@ void TraverseBVH(const BVHTree& bvh, float3 origin, float3 dir, float tmin, Limi
 
 inline SdfHit TraceSVS(const SdfSVS& svs, const BVHTree& bvh, float3 origin, float3 dir, float tmin, float tmax, int newtonIterations) {
   SdfHit best = Missed();
-  const float size = svs.VoxelSize();
   auto limit = [&]() { return best.t >= 0.0f ? best.t : tmax; };
   detail::TraverseBVH(bvh, origin, dir, tmin, limit, [&](uint32_t first, uint32_t count) {
     for (uint32_t i = first; i < first + count; ++i) {
-      const uint32_t v = bvh.primIndices[i];
-      const SdfHit h = IntersectVoxel(svs.Values(v), svs.VoxelMin(v), size, origin, dir, tmin, limit(), newtonIterations);
+      const SdfHit h = IntersectSVSVoxel(svs, bvh.primIndices[i], origin, dir, tmin, limit(), newtonIterations);
       if (h.t >= 0.0f && (best.t < 0.0f || h.t < best.t)) best = h;
     }
   });
@@ -64,41 +62,11 @@ inline SdfHit TraceSVS(const SdfSVS& svs, const BVHTree& bvh, float3 origin, flo
 
 inline SdfHit TraceSBS(const SdfSBS& sbs, const BVHTree& bvh, float3 origin, float3 dir, float tmin, float tmax, int newtonIterations) {
   SdfHit best = Missed();
-  const float size = sbs.VoxelSize();
   auto limit = [&]() { return best.t >= 0.0f ? best.t : tmax; };
-  const float3 invDir = float3(1.0f / dir.x, 1.0f / dir.y, 1.0f / dir.z);
-  const int n = int(sbs.brickSize);
   detail::TraverseBVH(bvh, origin, dir, tmin, limit, [&](uint32_t first, uint32_t count) {
     for (uint32_t i = first; i < first + count; ++i) {
-      const uint32_t b = bvh.primIndices[i];
-      const float3 brickMin = sbs.BrickMin(b), brickMax = brickMin + float3(float(n) * size, float(n) * size, float(n) * size);
-      float t0 = 0.0f, t1 = 0.0f;
-      if (!RayBox(origin, invDir, brickMin, brickMax, tmin, limit(), t0, t1)) continue;
-      // The brick's voxels along the ray, in order (Amanatides and Woo): the first hit is the brick's nearest.
-      const float3 entry = (origin + t0 * dir - brickMin) / size;
-      int cell[3], step[3];
-      float tNext[3], tDelta[3];
-      for (int a = 0; a < 3; ++a) {
-        cell[a] = LiteMath::clamp(int(std::floor(entry[a])), 0, n - 1);
-        step[a] = dir[a] > 0.0f ? 1 : -1;
-        const float boundary = brickMin[a] + size * float(cell[a] + (dir[a] > 0.0f ? 1 : 0));
-        tNext[a] = dir[a] != 0.0f ? (boundary - origin[a]) * invDir[a] : INFINITY;
-        tDelta[a] = dir[a] != 0.0f ? size * std::fabs(invDir[a]) : INFINITY;
-      }
-      while (true) {
-        const float3 voxelMin = brickMin + size * float3(float(cell[0]), float(cell[1]), float(cell[2]));
-        const SdfHit h = IntersectVoxel(sbs.Values(b, uint32_t(cell[0]), uint32_t(cell[1]), uint32_t(cell[2])), voxelMin, size, origin,
-                                        dir, tmin, limit(), newtonIterations);
-        if (h.t >= 0.0f && (best.t < 0.0f || h.t < best.t)) {
-          best = h;
-          break;
-        }
-        const int a = tNext[0] < tNext[1] ? (tNext[0] < tNext[2] ? 0 : 2) : (tNext[1] < tNext[2] ? 1 : 2);
-        if (!(tNext[a] <= t1)) break;  // left the brick (or the ray's end)
-        cell[a] += step[a];
-        if (cell[a] < 0 || cell[a] >= n) break;
-        tNext[a] += tDelta[a];
-      }
+      const SdfHit h = IntersectSBSBrick(sbs, bvh.primIndices[i], origin, dir, tmin, limit(), newtonIterations);
+      if (h.t >= 0.0f && (best.t < 0.0f || h.t < best.t)) best = h;
     }
   });
   return best;

@@ -118,6 +118,40 @@ VoxelValues SdfSBS::Values(size_t brick, uint32_t x, uint32_t y, uint32_t z) con
   return v;
 }
 
+namespace {
+std::string CubeProblem(float3 boxMin, float boxSize, uint32_t depth, uint32_t bytesPerValue) {
+  if (!(boxSize > 0.0f) || !std::isfinite(boxSize) || !std::isfinite(boxMin.x + boxMin.y + boxMin.z))
+    return "the field's cube is empty or not finite";
+  if (depth > 10) return "depth " + std::to_string(depth) + " is over 10 (voxel coordinates have 10 bits)";
+  if (bytesPerValue != 1 && bytesPerValue != 2 && bytesPerValue != 4)
+    return std::to_string(bytesPerValue) + " bytes per value (1, 2 or 4)";
+  return "";
+}
+}  // namespace
+
+std::string Problem(const SdfGrid& grid) {
+  if (grid.samples < 2 || grid.values.size() != size_t(grid.samples) * grid.samples * grid.samples)
+    return std::to_string(grid.values.size()) + " values for " + std::to_string(grid.samples) + "^3 samples (at least 2 per axis)";
+  return CubeProblem(grid.boxMin, grid.boxSize, 0, 4);
+}
+
+std::string Problem(const SdfSVS& svs) {
+  if (std::string p = CubeProblem(svs.boxMin, svs.boxSize, svs.depth, svs.bytesPerValue); !p.empty()) return p;
+  if (svs.values.size() != svs.coords.size() * 8 * svs.bytesPerValue / 4)
+    return std::to_string(svs.values.size()) + " words of values for " + std::to_string(svs.coords.size()) + " voxels";
+  return "";
+}
+
+std::string Problem(const SdfSBS& sbs) {
+  if (std::string p = CubeProblem(sbs.boxMin, sbs.boxSize, sbs.depth, sbs.bytesPerValue); !p.empty()) return p;
+  if (sbs.brickSize == 0 || (sbs.brickSize & (sbs.brickSize - 1)) != 0 || sbs.brickSize > (1u << sbs.depth))
+    return "bricks of " + std::to_string(sbs.brickSize) + " voxels (a power of 2 up to 2^depth)";
+  if (sbs.values.size() != sbs.coords.size() * sbs.WordsPerBrick())
+    return std::to_string(sbs.values.size()) + " words of values for " + std::to_string(sbs.coords.size()) + " bricks of " +
+           std::to_string(sbs.brickSize) + "^3 voxels";
+  return "";
+}
+
 SdfGrid BuildGrid(const ISdf& sdf, float3 boxMin, float boxSize, uint32_t samples) {
   if (samples < 2) throw std::invalid_argument("a grid needs at least 2 samples per axis");
   SdfGrid grid;

@@ -11,6 +11,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace litesdf {
@@ -79,6 +80,12 @@ struct SdfSBS {
   VoxelValues Values(size_t brick, uint32_t x, uint32_t y, uint32_t z) const;
   size_t Bytes() const { return (coords.size() + values.size()) * sizeof(uint32_t); }
 };
+
+// What makes a structure unusable (no samples, a depth over 10, a value size other than 1, 2 or 4,
+// values that do not match the counts, a cube that is empty or not finite), or "" when it is sound.
+std::string Problem(const SdfGrid& grid);
+std::string Problem(const SdfSVS& svs);
+std::string Problem(const SdfSBS& sbs);
 
 // Builders from an analytic SDF over the cube [boxMin, boxMin + boxSize]^3.
 SdfGrid BuildGrid(const ISdf& sdf, float3 boxMin, float boxSize, uint32_t samples);

@@ -139,20 +139,17 @@ inline SdfHit Missed() {
   return hit;
 }
 
-// Ray (origin, dir, [tmin, tmax]) against the voxel [voxelMin, voxelMin + size]^3 with corner
-// values `values`. Entry and exit are snapped to the voxel's faces, so that neighbouring voxels,
-// which share the values of their common face, agree where a ray crosses from one to the other.
-// A ray that enters the voxel inside the surface (value <= 0: it starts inside, or came from cells
-// wholly inside, which a sparse set does not store) hits where it enters: a ray that starts inside
-// hits before it could leave the shape.
-inline SdfHit IntersectVoxel(const VoxelValues& values, float3 voxelMin, float size, float3 origin, float3 dir, float tmin, float tmax,
-                             int newtonIterations) {
+// The ray's span [tNear, tFar] inside the voxel [voxelMin, voxelMin + size]^3, with corner values
+// `values`: its first point on the surface. The entry point is clamped onto the voxel (snapped to its
+// faces), so that neighbouring voxels, which share the values of their common face, agree where a
+// ray crosses from one to the other. A ray that enters the voxel inside the surface (value <= 0: it
+// starts inside, or came from cells wholly inside, which a sparse set does not store) hits where it
+// enters: a ray that starts inside hits before it could leave the shape.
+inline SdfHit IntersectVoxelSpan(const VoxelValues& values, float3 voxelMin, float size, float3 origin, float3 dir, float tNear, float tFar,
+                                 int newtonIterations) {
   SdfHit hit = Missed();
-  const float3 invDir = float3(1.0f / dir.x, 1.0f / dir.y, 1.0f / dir.z);
-  float tNear = 0.0f, tFar = 0.0f;
-  if (!RayBox(origin, invDir, voxelMin, voxelMin + float3(size, size, size), tmin, tmax, tNear, tFar)) return hit;
+  if (!(tNear <= tFar)) return hit;
   const float invSize = 1.0f / size;
-  // The entry point in voxel units, clamped onto the voxel: the snap to its faces.
   const float3 a = LiteMath::clamp((origin + tNear * dir - voxelMin) * invSize, float3(0.0f, 0.0f, 0.0f), float3(1.0f, 1.0f, 1.0f));
   const float3 b = dir * invSize;
   const TrilinearTerms k = TrilinearOf(values);
@@ -165,6 +162,53 @@ inline SdfHit IntersectVoxel(const VoxelValues& values, float3 voxelMin, float s
   const float len = LiteMath::length(g);
   hit.normal = len > 0.0f ? g / len : float3(0.0f, 0.0f, 0.0f);
   return hit;
+}
+
+// Ray (origin, dir, [tmin, tmax]) against the voxel [voxelMin, voxelMin + size]^3.
+inline SdfHit IntersectVoxel(const VoxelValues& values, float3 voxelMin, float size, float3 origin, float3 dir, float tmin, float tmax,
+                             int newtonIterations) {
+  const float3 invDir = float3(1.0f / dir.x, 1.0f / dir.y, 1.0f / dir.z);
+  float tNear = 0.0f, tFar = 0.0f;
+  if (!RayBox(origin, invDir, voxelMin, voxelMin + float3(size, size, size), tmin, tmax, tNear, tFar)) return Missed();
+  return IntersectVoxelSpan(values, voxelMin, size, origin, dir, tNear, tFar, newtonIterations);
+}
+
+// Whether some point of the voxel may lie on or inside the surface: the interpolant's minimum is at
+// a corner.
+inline bool MayHoldSurface(const VoxelValues& values) {
+  float lowest = values.v[0];
+  for (int c = 1; c < 8; ++c) lowest = values.v[c] < lowest ? values.v[c] : lowest;
+  return lowest <= 0.0f;
+}
+
+// The voxels of a box of n.x * n.y * n.z voxels of edge `size` from boxMin that the ray crosses
+// within [t0, t1] (its span inside the box), in order along the ray (Amanatides and Woo): calls
+// `voxel(x, y, z, voxelMin, tEnter, tLeave)` for each until one returns a hit, and returns it.
+template <class Voxel>
+SdfHit MarchVoxels(const int n[3], float3 boxMin, float size, float3 origin, float3 dir, float t0, float t1, Voxel voxel) {
+  const float3 entry = (origin + t0 * dir - boxMin) / size;
+  int cell[3], step[3];
+  float tNext[3], tDelta[3];
+  for (int a = 0; a < 3; ++a) {
+    cell[a] = LiteMath::clamp(int(std::floor(entry[a])), 0, n[a] - 1);
+    step[a] = dir[a] > 0.0f ? 1 : -1;
+    const float boundary = boxMin[a] + size * float(cell[a] + (dir[a] > 0.0f ? 1 : 0));
+    tNext[a] = dir[a] != 0.0f ? (boundary - origin[a]) / dir[a] : INFINITY;
+    tDelta[a] = dir[a] != 0.0f ? size / std::fabs(dir[a]) : INFINITY;
+  }
+  float tEnter = t0;
+  while (true) {
+    const int a = tNext[0] < tNext[1] ? (tNext[0] < tNext[2] ? 0 : 2) : (tNext[1] < tNext[2] ? 1 : 2);
+    const float tLeave = tNext[a] < t1 ? tNext[a] : t1;
+    const float3 voxelMin = boxMin + size * float3(float(cell[0]), float(cell[1]), float(cell[2]));
+    const SdfHit h = voxel(cell[0], cell[1], cell[2], voxelMin, tEnter, tLeave);
+    if (h.t >= 0.0f) return h;
+    if (!(tNext[a] <= t1)) return Missed();  // left the box (or the ray's end)
+    cell[a] += step[a];
+    if (cell[a] < 0 || cell[a] >= n[a]) return Missed();
+    tEnter = tNext[a];
+    tNext[a] += tDelta[a];
+  }
 }
 
 }  // namespace litesdf

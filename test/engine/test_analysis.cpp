@@ -248,7 +248,8 @@ TEST_CASE("Ray queries through ISceneObject get a variant for ray tracing hardwa
   r.className = "PrimaryRays";
   r.sources = {CROSSRT_SOURCE_DIR "/examples/primary_rays/PrimaryRays.cpp", CROSSRT_SOURCE_DIR "/libs/litert/BVHScene.cpp"};
   r.compileArgs = {"-std=c++17", "-I" CROSSRT_SOURCE_DIR "/libs/litemath", "-I" CROSSRT_SOURCE_DIR "/libs/litert",
-                   "-I" CROSSRT_SOURCE_DIR "/libs/litebvh", "-I" CROSSRT_SOURCE_DIR "/examples/primary_rays"};
+                   "-I" CROSSRT_SOURCE_DIR "/libs/litebvh", "-I" CROSSRT_SOURCE_DIR "/libs/litesdf",
+                   "-I" CROSSRT_SOURCE_DIR "/examples/primary_rays"};
   r.templateDir = CROSSRT_SOURCE_DIR "/templates";
   r.outputDir = (fs::temp_directory_path() / "crossrt-test-rayquery").string();
   r.compositions = {"ISceneObject=BVHScene"};
@@ -312,7 +313,8 @@ void Tracer::kernel_Depth(uint32_t tid, const CRT_Hit* hit, float* depth) { dept
 )");
   TranslateRequest r = MakeRequest(tc, "Tracer");
   r.sources.push_back(CROSSRT_SOURCE_DIR "/libs/litert/BVHScene.cpp");
-  r.compileArgs.insert(r.compileArgs.end(), {"-std=c++17", "-I" CROSSRT_SOURCE_DIR "/libs/litert", "-I" CROSSRT_SOURCE_DIR "/libs/litebvh"});
+  r.compileArgs.insert(r.compileArgs.end(), {"-std=c++17", "-I" CROSSRT_SOURCE_DIR "/libs/litert", "-I" CROSSRT_SOURCE_DIR "/libs/litebvh",
+                                              "-I" CROSSRT_SOURCE_DIR "/libs/litesdf"});
   r.compositions = {"ISceneObject=BVHScene"};
   const TranslateResult result = Translate(r);  // every shader is compiled by glslang on the way
   INFO(result.diagnostics);

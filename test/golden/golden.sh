@@ -48,7 +48,7 @@ for entry in "${cases[@]}"; do
   # shellcheck disable=SC2086  # options are words
   if ! (cd "$root" && "$crossrt" translate --no-daemon --class "$class" --backend "$backend" --out "$out" \
         "${source_args[@]}" $options --templates "$root/templates" -- -std=c++17 \
-        -I"$root/$include" -I"$root/libs/litemath" -I"$root/libs/litert" -I"$root/libs/litebvh" \
+        -I"$root/$include" -I"$root/libs/litemath" -I"$root/libs/litert" -I"$root/libs/litebvh" -I"$root/libs/litesdf" \
         -I"$root/libs/liteimage" -I"$root/libs/liteimage/compat" >"$work/$name.log" 2>&1); then
     echo "golden: $name: translation failed:"; cat "$work/$name.log"; failed=1; continue
   fi

@@ -57,7 +57,7 @@ void PrimaryRays_Vulkan::InitPipelines()
                                       VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR},
         sizeof(kernel2D_RenderArgs), "PrimaryRays::kernel2D_Render_RayQuery");
   m_pipelines.kernel2D_Render =
-      crossrt::ComputePipeline(m_ctx, PrimaryRays_kernel2D_Render_spv, PrimaryRays_kernel2D_Render_spvBytes, 10,
+      crossrt::ComputePipeline(m_ctx, PrimaryRays_kernel2D_Render_spv, PrimaryRays_kernel2D_Render_spvBytes, 12,
                                sizeof(kernel2D_RenderArgs), "PrimaryRays::kernel2D_Render");
   if (m_ctx->hasRayQuery)  // m_pAccelStruct's ray queries on the ray tracing hardware: the shader needs them even to be
                            // created
@@ -68,7 +68,7 @@ void PrimaryRays_Vulkan::InitPipelines()
                                       VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR},
         sizeof(kernel1D_CastRaysArgs), "PrimaryRays::kernel1D_CastRays_RayQuery");
   m_pipelines.kernel1D_CastRays =
-      crossrt::ComputePipeline(m_ctx, PrimaryRays_kernel1D_CastRays_spv, PrimaryRays_kernel1D_CastRays_spvBytes, 10,
+      crossrt::ComputePipeline(m_ctx, PrimaryRays_kernel1D_CastRays_spv, PrimaryRays_kernel1D_CastRays_spvBytes, 12,
                                sizeof(kernel1D_CastRaysArgs), "PrimaryRays::kernel1D_CastRays");
 }
 
@@ -136,6 +136,10 @@ void PrimaryRays_Vulkan::UpdatePlainMembers()
   data.m_pAccelStruct_m_motion_capacity = uint32_t(crt_m_pAccelStruct()->m_motion.capacity());
   data.m_pAccelStruct_m_boxes_size = uint32_t(crt_m_pAccelStruct()->m_boxes.size());
   data.m_pAccelStruct_m_boxes_capacity = uint32_t(crt_m_pAccelStruct()->m_boxes.capacity());
+  data.m_pAccelStruct_m_sdfBricks_size = uint32_t(crt_m_pAccelStruct()->m_sdfBricks.size());
+  data.m_pAccelStruct_m_sdfBricks_capacity = uint32_t(crt_m_pAccelStruct()->m_sdfBricks.capacity());
+  data.m_pAccelStruct_m_sdfWords_size = uint32_t(crt_m_pAccelStruct()->m_sdfWords.size());
+  data.m_pAccelStruct_m_sdfWords_capacity = uint32_t(crt_m_pAccelStruct()->m_sdfWords.capacity());
   data.m_pAccelStruct_m_triangles_size = uint32_t(crt_m_pAccelStruct()->m_triangles.size());
   data.m_pAccelStruct_m_triangles_capacity = uint32_t(crt_m_pAccelStruct()->m_triangles.capacity());
   data.m_pAccelStruct_m_primIds_size = uint32_t(crt_m_pAccelStruct()->m_primIds.size());
@@ -196,6 +200,24 @@ void PrimaryRays_Vulkan::CommitDeviceData()
   m_vdata.m_pAccelStruct_m_boxesSize = crt_m_pAccelStruct()->m_boxes.size();
   if (!m_useRayTracingHardware)  // only the translated traversal reads it
   {
+    crossrt::EnsureSize(m_ctx, m_vdata.m_pAccelStruct_m_sdfBricks,
+                        sizeof(BVHSdfBrick) * crt_m_pAccelStruct()->m_sdfBricks.capacity());
+    if (!crt_m_pAccelStruct()->m_sdfBricks.empty())
+      m_vdata.m_pAccelStruct_m_sdfBricks.Upload(crt_m_pAccelStruct()->m_sdfBricks.data(),
+                                                sizeof(BVHSdfBrick) * crt_m_pAccelStruct()->m_sdfBricks.size());
+  }
+  m_vdata.m_pAccelStruct_m_sdfBricksSize = crt_m_pAccelStruct()->m_sdfBricks.size();
+  if (!m_useRayTracingHardware)  // only the translated traversal reads it
+  {
+    crossrt::EnsureSize(m_ctx, m_vdata.m_pAccelStruct_m_sdfWords,
+                        sizeof(unsigned int) * crt_m_pAccelStruct()->m_sdfWords.capacity());
+    if (!crt_m_pAccelStruct()->m_sdfWords.empty())
+      m_vdata.m_pAccelStruct_m_sdfWords.Upload(crt_m_pAccelStruct()->m_sdfWords.data(),
+                                               sizeof(unsigned int) * crt_m_pAccelStruct()->m_sdfWords.size());
+  }
+  m_vdata.m_pAccelStruct_m_sdfWordsSize = crt_m_pAccelStruct()->m_sdfWords.size();
+  if (!m_useRayTracingHardware)  // only the translated traversal reads it
+  {
     crossrt::EnsureSize(m_ctx, m_vdata.m_pAccelStruct_m_triangles,
                         sizeof(BVHTriangle4) * crt_m_pAccelStruct()->m_triangles.capacity());
     if (!crt_m_pAccelStruct()->m_triangles.empty())
@@ -227,6 +249,8 @@ bool PrimaryRays_Vulkan::VectorMembersResized() const
   resized = resized || crt_m_pAccelStruct()->m_instances.size() != m_vdata.m_pAccelStruct_m_instancesSize;
   resized = resized || crt_m_pAccelStruct()->m_motion.size() != m_vdata.m_pAccelStruct_m_motionSize;
   resized = resized || crt_m_pAccelStruct()->m_boxes.size() != m_vdata.m_pAccelStruct_m_boxesSize;
+  resized = resized || crt_m_pAccelStruct()->m_sdfBricks.size() != m_vdata.m_pAccelStruct_m_sdfBricksSize;
+  resized = resized || crt_m_pAccelStruct()->m_sdfWords.size() != m_vdata.m_pAccelStruct_m_sdfWordsSize;
   resized = resized || crt_m_pAccelStruct()->m_triangles.size() != m_vdata.m_pAccelStruct_m_trianglesSize;
   resized = resized || crt_m_pAccelStruct()->m_primIds.size() != m_vdata.m_pAccelStruct_m_primIdsSize;
   return resized;
@@ -400,6 +424,7 @@ void PrimaryRays_Vulkan::kernel2D_RenderCmd(VkCommandBuffer a_cmd, crossrt::Buff
         a_cmd, {m_classDataBuffer.View(), pixels, m_vdata.m_indices.View(), m_vdata.m_pAccelStruct_m_boxes.View(),
                 m_vdata.m_pAccelStruct_m_instances.View(), m_vdata.m_pAccelStruct_m_motion.View(),
                 m_vdata.m_pAccelStruct_m_nodes.View(), m_vdata.m_pAccelStruct_m_primIds.View(),
+                m_vdata.m_pAccelStruct_m_sdfBricks.View(), m_vdata.m_pAccelStruct_m_sdfWords.View(),
                 m_vdata.m_pAccelStruct_m_triangles.View(), m_vdata.m_vertices.View()});
     m_pipelines.kernel2D_Render.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   }
@@ -434,6 +459,7 @@ void PrimaryRays_Vulkan::kernel1D_CastRaysCmd(VkCommandBuffer a_cmd, crossrt::Bu
         a_cmd, {m_classDataBuffer.View(), posAndNear, dirAndFar, hits, m_vdata.m_pAccelStruct_m_boxes.View(),
                 m_vdata.m_pAccelStruct_m_instances.View(), m_vdata.m_pAccelStruct_m_motion.View(),
                 m_vdata.m_pAccelStruct_m_nodes.View(), m_vdata.m_pAccelStruct_m_primIds.View(),
+                m_vdata.m_pAccelStruct_m_sdfBricks.View(), m_vdata.m_pAccelStruct_m_sdfWords.View(),
                 m_vdata.m_pAccelStruct_m_triangles.View()});
     m_pipelines.kernel1D_CastRays.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   }

@@ -99,6 +99,10 @@ protected:
     alignas(4) uint32_t m_pAccelStruct_m_motion_capacity;
     alignas(4) uint32_t m_pAccelStruct_m_boxes_size;
     alignas(4) uint32_t m_pAccelStruct_m_boxes_capacity;
+    alignas(4) uint32_t m_pAccelStruct_m_sdfBricks_size;
+    alignas(4) uint32_t m_pAccelStruct_m_sdfBricks_capacity;
+    alignas(4) uint32_t m_pAccelStruct_m_sdfWords_size;
+    alignas(4) uint32_t m_pAccelStruct_m_sdfWords_capacity;
     alignas(4) uint32_t m_pAccelStruct_m_triangles_size;
     alignas(4) uint32_t m_pAccelStruct_m_triangles_capacity;
     alignas(4) uint32_t m_pAccelStruct_m_primIds_size;
@@ -123,6 +127,10 @@ protected:
     size_t m_pAccelStruct_m_motionSize = 0;  // elements at the last CommitDeviceData()
     crossrt::Buffer m_pAccelStruct_m_boxes;
     size_t m_pAccelStruct_m_boxesSize = 0;  // elements at the last CommitDeviceData()
+    crossrt::Buffer m_pAccelStruct_m_sdfBricks;
+    size_t m_pAccelStruct_m_sdfBricksSize = 0;  // elements at the last CommitDeviceData()
+    crossrt::Buffer m_pAccelStruct_m_sdfWords;
+    size_t m_pAccelStruct_m_sdfWordsSize = 0;  // elements at the last CommitDeviceData()
     crossrt::Buffer m_pAccelStruct_m_triangles;
     size_t m_pAccelStruct_m_trianglesSize = 0;  // elements at the last CommitDeviceData()
     crossrt::Buffer m_pAccelStruct_m_primIds;

@@ -55,6 +55,54 @@ struct BVH4Node
   uvec4 unused;
 };
 
+// litesdf::VoxelValues
+struct VoxelValues
+{
+  float v[8];
+};
+
+// litesdf::SdfHit
+struct SdfHit
+{
+  float t;
+  vec3 normal;
+};
+
+// litesdf::TrilinearTerms
+struct TrilinearTerms
+{
+  float A;
+  float B;
+  float C;
+  float D;
+  float E;
+  float F;
+  float G;
+  float H;
+};
+
+// litesdf::Cubic
+struct Cubic
+{
+  float c0;
+  float c1;
+  float c2;
+  float c3;
+};
+
+struct BVHSdfBrick
+{
+  vec4 minAndVoxelSize;
+  uint firstValue;
+  uint voxels;
+  uint stride;
+  uint bytesPerValue;
+  uint localId;
+  uint unused0;
+  uint unused1;
+  uint unused2;
+};
+
 struct BVHTriangle4
 {
   vec4 coord[9];
@@ -83,6 +131,10 @@ layout(std430, binding = 0) buffer PrimaryRaysData
   uint m_pAccelStruct_m_motion_capacity;
   uint m_pAccelStruct_m_boxes_size;
   uint m_pAccelStruct_m_boxes_capacity;
+  uint m_pAccelStruct_m_sdfBricks_size;
+  uint m_pAccelStruct_m_sdfBricks_capacity;
+  uint m_pAccelStruct_m_sdfWords_size;
+  uint m_pAccelStruct_m_sdfWords_capacity;
   uint m_pAccelStruct_m_triangles_size;
   uint m_pAccelStruct_m_triangles_capacity;
   uint m_pAccelStruct_m_primIds_size;
@@ -120,7 +172,15 @@ layout(std430, binding = 8) buffer m_pAccelStruct_m_primIdsBuffer
 {
   uint m_pAccelStruct_m_primIds[];
 };  // composed: std::vector BVHScene::m_primIds through m_pAccelStruct
-layout(std430, binding = 9) buffer m_pAccelStruct_m_trianglesBuffer
+layout(std430, binding = 9) buffer m_pAccelStruct_m_sdfBricksBuffer
+{
+  BVHSdfBrick m_pAccelStruct_m_sdfBricks[];
+};  // composed: std::vector BVHScene::m_sdfBricks through m_pAccelStruct
+layout(std430, binding = 10) buffer m_pAccelStruct_m_sdfWordsBuffer
+{
+  uint m_pAccelStruct_m_sdfWords[];
+};  // composed: std::vector BVHScene::m_sdfWords through m_pAccelStruct
+layout(std430, binding = 11) buffer m_pAccelStruct_m_trianglesBuffer
 {
   BVHTriangle4 m_pAccelStruct_m_triangles[];
 };  // composed: std::vector BVHScene::m_triangles through m_pAccelStruct
@@ -133,10 +193,12 @@ layout(push_constant) uniform kernel1D_CastRaysArgs
 };
 
 const uint m_pAccelStruct_kNoId = 4294967295u;
+const uint m_pAccelStruct_kInstanceSdf = 8u;
 const uint m_pAccelStruct_kInstanceBoxes = 2u;
 const uint m_pAccelStruct_kLeafFlag = 2147483648u;
 const float m_pAccelStruct_kMissed = -1.0;
 const float m_pAccelStruct_kWiden = 1.00000036;
+const int m_pAccelStruct_kSdfNewtonIterations = 4;
 const uint m_pAccelStruct_kInstanceMotion = 4u;
 const uint m_pAccelStruct_kInstanceIdentity = 1u;
 
@@ -228,8 +290,252 @@ vec4 m_pAccelStruct_SlabEntries(BVHTraceRay r, BVH4Node n, float tfar, inout vec
   return max(max(nearX, nearY), max(nearZ, vec4(r.tnear)));
 }
 
+// from BVHScene::SdfValue
+float m_pAccelStruct_SdfValue(uint brick, uint index)
+{
+  const uint bytes = m_pAccelStruct_m_sdfBricks[brick].bytesPerValue;
+  const uint at = m_pAccelStruct_m_sdfBricks[brick].firstValue + index;
+  if (bytes == 4u)
+    return uintBitsToFloat(m_pAccelStruct_m_sdfWords[at]);
+  const uint perWord = 4u / bytes;
+  const uint maxCode = bytes == 1u ? 255u : 65535u;
+  const uint code = (m_pAccelStruct_m_sdfWords[at / perWord] >> ((at % perWord) * 8u * bytes)) & maxCode;
+  const float diagonal = 1.7320508 * m_pAccelStruct_m_sdfBricks[brick].minAndVoxelSize.w;
+  return (float(code) / float(maxCode) * 2.0 - 1.0) * diagonal;
+}
+
+// from litesdf::Missed
+SdfHit m_pAccelStruct_Missed()
+{
+  SdfHit hit = SdfHit(float(0), vec3(0));
+  hit.t = -1.0;
+  hit.normal = vec3(0.0, 0.0, 0.0);
+  return hit;
+}
+
+// from litesdf::TrilinearOf
+TrilinearTerms m_pAccelStruct_TrilinearOf(VoxelValues s)
+{
+  TrilinearTerms k;
+  k.A = s.v[0];
+  k.B = s.v[1] - s.v[0];
+  k.C = s.v[2] - s.v[0];
+  k.D = s.v[4] - s.v[0];
+  k.E = s.v[3] - s.v[1] - s.v[2] + s.v[0];
+  k.F = s.v[5] - s.v[1] - s.v[4] + s.v[0];
+  k.G = s.v[6] - s.v[2] - s.v[4] + s.v[0];
+  k.H = s.v[7] - s.v[3] - s.v[5] - s.v[6] + s.v[1] + s.v[2] + s.v[4] - s.v[0];
+  return k;
+}
+
+// from litesdf::EvalTrilinear
+float m_pAccelStruct_EvalTrilinear(TrilinearTerms k, vec3 u)
+{
+  return k.A + k.B * u.x + k.C * u.y + k.D * u.z + k.E * u.x * u.y + k.F * u.x * u.z + k.G * u.y * u.z +
+         k.H * u.x * u.y * u.z;
+}
+
+// from litesdf::CubicAlongRay
+Cubic m_pAccelStruct_CubicAlongRay(TrilinearTerms k, vec3 a, vec3 b)
+{
+  Cubic c;
+  c.c0 = m_pAccelStruct_EvalTrilinear(k, a);
+  c.c1 = k.B * b.x + k.C * b.y + k.D * b.z + k.E * (a.x * b.y + a.y * b.x) + k.F * (a.x * b.z + a.z * b.x) +
+         k.G * (a.y * b.z + a.z * b.y) + k.H * (a.x * a.y * b.z + a.x * a.z * b.y + a.y * a.z * b.x);
+  c.c2 =
+      k.E * b.x * b.y + k.F * b.x * b.z + k.G * b.y * b.z + k.H * (a.x * b.y * b.z + a.y * b.x * b.z + a.z * b.x * b.y);
+  c.c3 = k.H * b.x * b.y * b.z;
+  return c;
+}
+
+// from litesdf::EvalCubic
+float m_pAccelStruct_EvalCubic(Cubic c, float t)
+{
+  return c.c0 + t * (c.c1 + t * (c.c2 + t * c.c3));
+}
+
+// from litesdf::EvalCubicDerivative
+float m_pAccelStruct_EvalCubicDerivative(Cubic c, float t)
+{
+  return c.c1 + t * (2.0 * c.c2 + t * 3.0 * c.c3);
+}
+
+// from litesdf::SolveBracketed
+float m_pAccelStruct_SolveBracketed(Cubic c, float t0, float t1, float f0, float f1, int iterations)
+{
+  float lo = t0;
+  float hi = t1;
+  float flo = f0;
+  float t = (abs(f0) < abs(f1)) ? t0 : t1;
+  for (int i = 0; i < iterations; ++i)
+  {
+    const float f = m_pAccelStruct_EvalCubic(c, t);
+    if (f == 0.0)
+      return t;
+    if (int((f < 0.0)) == int((flo < 0.0)))
+    {
+      lo = t;
+      flo = f;
+    }
+    else
+      hi = t;
+    const float d = m_pAccelStruct_EvalCubicDerivative(c, t);
+    float next = d != 0.0 ? t - f / d : 0.5 * (lo + hi);
+    if (!(next > lo && next < hi))
+      next = 0.5 * (lo + hi);
+    t = next;
+  }
+  return t;
+}
+
+// from litesdf::FirstRoot
+float m_pAccelStruct_FirstRoot(Cubic c, float t0, float t1, int iterations)
+{
+  float splits[4];
+  int n = 0;
+  splits[n++] = t0;
+  const float qa = 3.0 * c.c3;
+  const float qb = 2.0 * c.c2;
+  const float qc = c.c1;
+  if (abs(qa) > 1e-12)
+  {
+    const float disc = qb * qb - 4.0 * qa * qc;
+    if (disc >= 0.0)
+    {
+      const float s = sqrt(disc);
+      const float q = -0.5 * (qb + (qb >= 0.0 ? s : -s));
+      float r0 = q / qa;
+      float r1 = q != 0.0 ? qc / q : r0;
+      if (r0 > r1)
+      {
+        const float tmp = r0;
+        r0 = r1;
+        r1 = tmp;
+      }
+      if (r0 > t0 && r0 < t1)
+        splits[n++] = r0;
+      if (r1 > t0 && r1 < t1 && r1 != r0)
+        splits[n++] = r1;
+    }
+  }
+  else if (abs(qb) > 1e-12)
+  {
+    const float r = -qc / qb;
+    if (r > t0 && r < t1)
+      splits[n++] = r;
+  }
+  splits[n++] = t1;
+  float fa = m_pAccelStruct_EvalCubic(c, splits[0]);
+  if (!(fa > 0.0))
+    return fa <= 0.0 ? splits[0] : -1.0;
+  for (int i = 0; i + 1 < n; ++i)
+  {
+    const float fb = m_pAccelStruct_EvalCubic(c, splits[i + 1]);
+    if (fb <= 0.0)
+      return m_pAccelStruct_SolveBracketed(c, splits[i], splits[i + 1], fa, fb, iterations);
+    fa = fb;
+  }
+  return -1.0;
+}
+
+// from litesdf::GradTrilinear
+vec3 m_pAccelStruct_GradTrilinear(TrilinearTerms k, vec3 u)
+{
+  return vec3(k.B + k.E * u.y + k.F * u.z + k.H * u.y * u.z, k.C + k.E * u.x + k.G * u.z + k.H * u.x * u.z,
+              k.D + k.F * u.x + k.G * u.y + k.H * u.x * u.y);
+}
+
+// from litesdf::IntersectVoxelSpan
+SdfHit m_pAccelStruct_IntersectVoxelSpan(VoxelValues values, vec3 voxelMin, float size, vec3 origin, vec3 dir,
+                                         float tNear, float tFar, int newtonIterations)
+{
+  SdfHit hit = m_pAccelStruct_Missed();
+  if (!(tNear <= tFar))
+    return hit;
+  const float invSize = 1.0 / size;
+  const vec3 a = clamp((origin + tNear * dir - voxelMin) * invSize, vec3(0.0, 0.0, 0.0), vec3(1.0, 1.0, 1.0));
+  const vec3 b = dir * invSize;
+  const TrilinearTerms k = m_pAccelStruct_TrilinearOf(values);
+  const Cubic c = m_pAccelStruct_CubicAlongRay(k, a, b);
+  const float t = m_pAccelStruct_FirstRoot(c, 0.0, tFar - tNear, newtonIterations);
+  if (t < 0.0)
+    return hit;
+  hit.t = tNear + t;
+  const vec3 u = clamp(a + t * b, vec3(0.0, 0.0, 0.0), vec3(1.0, 1.0, 1.0));
+  const vec3 g = m_pAccelStruct_GradTrilinear(k, u);
+  const float len = length(g);
+  hit.normal = len > 0.0 ? g / len : vec3(0.0, 0.0, 0.0);
+  return hit;
+}
+
+// from litesdf::MayHoldSurface
+bool m_pAccelStruct_MayHoldSurface(VoxelValues values)
+{
+  float lowest = values.v[0];
+  for (int c = 1; c < 8; ++c)
+    lowest = values.v[c] < lowest ? values.v[c] : lowest;
+  return lowest <= 0.0;
+}
+
+// from BVHScene::IntersectSdfBrick
+bool m_pAccelStruct_IntersectSdfBrick(BVHTraceRay r, uint brick, float tEnter, float tExit, inout float tfar,
+                                      inout CRT_Hit hit)
+{
+  const float size = m_pAccelStruct_m_sdfBricks[brick].minAndVoxelSize.w;
+  const vec3 brickMin = (m_pAccelStruct_m_sdfBricks[brick].minAndVoxelSize).xyz;
+  const int n = int(m_pAccelStruct_m_sdfBricks[brick].voxels);
+  const uint stride = m_pAccelStruct_m_sdfBricks[brick].stride;
+  const float t1 = min(tExit, tfar);
+  const vec3 entry = (r.org + tEnter * r.dir - brickMin) / size;
+  int cell[3];
+  int step[3];
+  float tNext[3];
+  float tDelta[3];
+  for (int a = 0; a < 3; ++a)
+  {
+    cell[a] = clamp(int(floor(entry[a])), 0, n - 1);
+    step[a] = r.dir[a] > 0.0 ? 1 : -1;
+    const float boundary = brickMin[a] + size * float(cell[a] + (r.dir[a] > 0.0 ? 1 : 0));
+    tNext[a] = r.invDir[a] != 0.0 ? (boundary - r.org[a]) * r.invDir[a] : 3.40282347e+38;
+    tDelta[a] = r.invDir[a] != 0.0 ? size * abs(r.invDir[a]) : 3.40282347e+38;
+  }
+  float tVoxel = tEnter;
+  while (true)
+  {
+    const int a = tNext[0] < tNext[1] ? (tNext[0] < tNext[2] ? 0 : 2) : (tNext[1] < tNext[2] ? 1 : 2);
+    const uint first = (uint(cell[2]) * stride + uint(cell[1])) * stride + uint(cell[0]);
+    VoxelValues values;
+    for (uint c = 0u; c < 8u; ++c)
+      values.v[c] =
+          m_pAccelStruct_SdfValue(brick, first + (c & 1u) + ((c >> 1u) & 1u) * stride + (c >> 2u) * stride * stride);
+    if (m_pAccelStruct_MayHoldSurface(values))
+    {
+      const vec3 voxelMin = brickMin + size * vec3(float(cell[0]), float(cell[1]), float(cell[2]));
+      const SdfHit h = m_pAccelStruct_IntersectVoxelSpan(values, voxelMin, size, r.org, r.dir, tVoxel,
+                                                         min(tNext[a], t1), m_pAccelStruct_kSdfNewtonIterations);
+      if (h.t >= 0.0)
+      {
+        tfar = h.t;
+        hit.t = h.t;
+        hit.primId = m_pAccelStruct_m_sdfBricks[brick].localId;
+        hit.coords[0] = h.normal.x;
+        hit.coords[1] = h.normal.y;
+        hit.coords[2] = h.normal.z;
+        return true;
+      }
+    }
+    if (!(tNext[a] <= t1))
+      return false;
+    cell[a] = cell[a] + step[a];
+    if (cell[a] < 0 || cell[a] >= n)
+      return false;
+    tVoxel = tNext[a];
+    tNext[a] = tNext[a] + tDelta[a];
+  }
+}
+
 // from BVHScene::IntersectBoxes
-bool m_pAccelStruct_IntersectBoxes(BVHTraceRay r, uint group, inout float tfar, inout CRT_Hit hit)
+bool m_pAccelStruct_IntersectBoxes(BVHTraceRay r, uint group, bool sdf, inout float tfar, inout CRT_Hit hit)
 {
   vec4 exits = vec4(0);
   const vec4 entries = m_pAccelStruct_SlabEntries(r, m_pAccelStruct_m_boxes[group], tfar, exits);
@@ -241,6 +547,13 @@ bool m_pAccelStruct_IntersectBoxes(BVHTraceRay r, uint group, inout float tfar, 
     hits = hits & (hits - 1u);
     if (entries[lane] > tfar)
       continue;
+    if (sdf)
+    {
+      found = m_pAccelStruct_IntersectSdfBrick(r, m_pAccelStruct_m_boxes[group].child[lane], entries[lane], exits[lane],
+                                               tfar, hit) ||
+              found;
+      continue;
+    }
     found = true;
     tfar = entries[lane];
     hit.t = entries[lane];
@@ -357,7 +670,7 @@ int m_pAccelStruct_EnteredLanes(BVHTraceRay r, BVH4Node n, float tfar, inout vec
 }
 
 // from BVHScene::TraceMesh
-bool m_pAccelStruct_TraceMesh(BVHTraceRay ray, uint root, bool boxes, bool anyHit, inout float tfar, inout CRT_Hit hit)
+bool m_pAccelStruct_TraceMesh(BVHTraceRay ray, uint root, uint leaves, bool anyHit, inout float tfar, inout CRT_Hit hit)
 {
   uint stack[64];
   float stackEntry[64];
@@ -372,9 +685,9 @@ bool m_pAccelStruct_TraceMesh(BVHTraceRay ray, uint root, bool boxes, bool anyHi
       const uint last = first + (node & 7u);
       for (uint g = first; g <= last; ++g)
       {
-        if (boxes)
+        if ((leaves & m_pAccelStruct_kInstanceBoxes) != 0u)
         {
-          if (m_pAccelStruct_IntersectBoxes(ray, g, tfar, hit))
+          if (m_pAccelStruct_IntersectBoxes(ray, g, (leaves & m_pAccelStruct_kInstanceSdf) != 0u, tfar, hit))
           {
             found = true;
             if (anyHit)
@@ -449,7 +762,7 @@ bool m_pAccelStruct_TraceInstance(uint k, BVHTraceRay worldRay, float time, bool
                                   inout CRT_Hit hit)
 {
   const BVHInstance inst = m_pAccelStruct_m_instances[k];
-  const bool boxes = (inst.flags & m_pAccelStruct_kInstanceBoxes) != 0u;
+  const uint leaves = inst.flags & (m_pAccelStruct_kInstanceBoxes | m_pAccelStruct_kInstanceSdf);
   bool found = false;
   if ((inst.flags & m_pAccelStruct_kInstanceMotion) != 0u)
   {
@@ -463,15 +776,15 @@ bool m_pAccelStruct_TraceInstance(uint k, BVHTraceRay worldRay, float time, bool
     const mat3 toObject = inverse(transpose(mat3((row0).xyz, (row1).xyz, (row2).xyz)));
     const vec3 org = toObject * (worldRay.org - vec3(row0.w, row1.w, row2.w));
     found = m_pAccelStruct_TraceMesh(m_pAccelStruct_Prepare(org, toObject * worldRay.dir, worldRay.tnear), inst.root,
-                                     boxes, anyHit, tfar, hit);
+                                     leaves, anyHit, tfar, hit);
   }
   else if ((inst.flags & m_pAccelStruct_kInstanceIdentity) != 0u)
-    found = m_pAccelStruct_TraceMesh(worldRay, inst.root, boxes, anyHit, tfar, hit);
+    found = m_pAccelStruct_TraceMesh(worldRay, inst.root, leaves, anyHit, tfar, hit);
   else
     found = m_pAccelStruct_TraceMesh(m_pAccelStruct_Prepare(m_pAccelStruct_ToObjectPoint(inst, worldRay.org),
                                                             m_pAccelStruct_ToObjectVector(inst, worldRay.dir),
                                                             worldRay.tnear),
-                                     inst.root, boxes, anyHit, tfar, hit);
+                                     inst.root, leaves, anyHit, tfar, hit);
   if (found)
   {
     hit.instId = inst.instId;

@@ -38,6 +38,10 @@ layout(std430, binding = 0) buffer PrimaryRaysData
   uint m_pAccelStruct_m_motion_capacity;
   uint m_pAccelStruct_m_boxes_size;
   uint m_pAccelStruct_m_boxes_capacity;
+  uint m_pAccelStruct_m_sdfBricks_size;
+  uint m_pAccelStruct_m_sdfBricks_capacity;
+  uint m_pAccelStruct_m_sdfWords_size;
+  uint m_pAccelStruct_m_sdfWords_capacity;
   uint m_pAccelStruct_m_triangles_size;
   uint m_pAccelStruct_m_triangles_capacity;
   uint m_pAccelStruct_m_primIds_size;
