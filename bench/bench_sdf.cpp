@@ -5,20 +5,28 @@
 // brick size, Newton iterations). The same camera rays are traced through each, and through OpenVDB's
 // level set of the same mesh (meshToLevelSet + LevelSetRayIntersector) as the peer, single-threaded
 // alike. The reference is the exact mesh distance, sphere-traced to 1e-5.
-// Per row: build ms, bytes (data, and with the BVH), Mrays/s, the mean and maximum distance of hit
-// points from the mesh surface, hit agreement, and the PSNR of depth and normal images against the
-// reference. Writes out/bench_sdf.csv; bench/plot_sdf.py plots error against time.
+// Per row: build ms, bytes (data, and with the BVH), Mrays/s on one thread (litesdf's own traversal),
+// the mean and maximum distance of hit points from the mesh surface, hit agreement, and the PSNR of
+// depth and normal images against the reference. Then the same field placed in a scene through
+// ISceneObject (BVHScene, 4 Newton iterations) and the same camera rays traced by the translated
+// SdfRender_CPU (all cores) and SdfRender_Vulkan (the default device); OpenVDB's intersector on all
+// cores too, one copy per thread. Writes out/bench_sdf.csv; bench/plot_sdf.py plots error against time.
 //
 //   bench_sdf [--size N] [MESH...]     (default: bunny, armadillo and dragon from build/data/meshes)
 #include "BenchSupport.h"
 #include "MeshIO.h"
 #include "SdfBVH.h"
 #include "SdfMesh.h"
+#include "SdfRender.h"
+#include "SdfRender_CPU.h"
+#include "SdfRender_Vulkan.h"
 #include "SdfTrace.h"
 
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/MeshToVolume.h>
 #include <openvdb/tools/RayIntersector.h>
+
+#include <omp.h>
 
 #include <chrono>
 #include <cmath>
@@ -58,6 +66,7 @@ struct Image {
 struct Row {
   std::string mesh, representation, knobs;
   double buildMs = 0, dataBytes = 0, totalBytes = 0, mraysPerS = 0;
+  double mraysCpu = 0, mraysVulkan = 0;  // all cores (SdfRender_CPU, or OpenVDB with OpenMP), and SdfRender_Vulkan; 0: not run
   double meanError = 0, maxError = 0, hitAgreement = 0, depthPsnr = 0, normalPsnr = 0;
 };
 
@@ -117,10 +126,37 @@ float3 MeshNormal(const SdfMesh& mesh, float3 p) {
 }
 
 void Print(const Row& r) {
-  std::printf("| %-10s | %-26s | %9.0f | %9.2f | %9.2f | %8.3f | %9.5f | %9.5f | %6.2f%% | %6.1f | %6.1f |\n", r.representation.c_str(),
-              r.knobs.c_str(), r.buildMs, r.dataBytes / 1048576.0, r.totalBytes / 1048576.0, r.mraysPerS, r.meanError, r.maxError,
-              100.0 * r.hitAgreement, r.depthPsnr, r.normalPsnr);
+  std::printf("| %-10s | %-26s | %9.0f | %9.2f | %9.2f | %8.3f | %8.3f | %8.3f | %9.5f | %9.5f | %6.2f%% | %6.1f | %6.1f |\n",
+              r.representation.c_str(), r.knobs.c_str(), r.buildMs, r.dataBytes / 1048576.0, r.totalBytes / 1048576.0, r.mraysPerS,
+              r.mraysCpu, r.mraysVulkan, r.meanError, r.maxError, 100.0 * r.hitAgreement, r.depthPsnr, r.normalPsnr);
   std::fflush(stdout);
+}
+
+// The translated renderers, made once per run (a Vulkan class compiles its pipelines when made) and
+// given each field's scene in turn.
+struct Translated {
+  std::shared_ptr<SdfRender> cpu, vulkan;
+  int size = 0;
+  std::vector<uint32_t> pixels;
+  std::vector<float> depth;
+};
+
+double RenderMrays(SdfRender& r, const Translated& tr, std::shared_ptr<ISceneObject> scene, std::vector<uint32_t>& pixels,
+                   std::vector<float>& depth) {
+  r.SetScene(std::move(scene));
+  r.CommitDeviceData();
+  r.Render(pixels.data(), depth.data());  // uploads the scene
+  const double ms = MedianMs(3, [&] { r.Render(pixels.data(), depth.data()); });
+  return double(tr.size) * tr.size / (ms * 1000.0);
+}
+
+// Places `add`'s field in a BVHScene and times SdfRender_CPU and SdfRender_Vulkan on it.
+void TimeTranslated(Translated& tr, const std::function<uint32_t(ISceneObject&)>& add, Row& row) {
+  auto scene = MakeSceneRT("sah");
+  scene->AddInstance(add(*scene), LiteMath::float4x4());
+  scene->CommitScene();
+  row.mraysCpu = RenderMrays(*tr.cpu, tr, scene, tr.pixels, tr.depth);
+  if (tr.vulkan) row.mraysVulkan = RenderMrays(*tr.vulkan, tr, scene, tr.pixels, tr.depth);
 }
 
 }  // namespace
@@ -148,9 +184,27 @@ int main(int argc, char** argv) {
     return 1;
   }
   openvdb::initialize();
+  Translated translated;
+  translated.size = size;
+  translated.pixels.resize(size_t(size) * size);
+  translated.depth.resize(size_t(size) * size);
+  translated.cpu = CreateSdfRender_CPU(size, size);
+  try {
+    auto vulkan = std::make_shared<SdfRender_Vulkan>(crossrt::VulkanContext::CreateDefault(), size, size);
+    vulkan->UseRayTracingHardware(false);  // ray queries take triangles only
+    translated.vulkan = vulkan;
+  } catch (const std::exception& e) {
+    std::cerr << "bench_sdf: Vulkan is not available, no SdfRender_Vulkan column: " << e.what() << "\n";
+  }
+  const float fovY = 2.0f * std::atan(0.45f) * 180.0f / 3.14159265f;  // Camera's
+  for (SdfRender* r : {translated.cpu.get(), translated.vulkan.get()})
+    if (r) {
+      r->SetCamera(float3(1.2f, 0.9f, -2.6f), float3(0.0f, 0.0f, 0.0f), fovY);
+      r->SetOcclusion(0, 0.0f);
+    }
   std::filesystem::create_directories("out");
   std::ofstream csv("out/bench_sdf.csv");
-  csv << "mesh,representation,knobs,build_ms,data_bytes,total_bytes,mrays_per_s,mean_error,max_error,hit_agreement,depth_psnr,normal_psnr\n";
+  csv << "mesh,representation,knobs,build_ms,data_bytes,total_bytes,mrays_per_s,mrays_per_s_cpu,mrays_per_s_vulkan,mean_error,max_error,hit_agreement,depth_psnr,normal_psnr\n";
 
   for (const std::string& path : meshes) {
     TriangleMesh tm;
@@ -176,17 +230,18 @@ int main(int argc, char** argv) {
       h.normal = h.t >= 0.0f ? MeshNormal(mesh, o + h.t * d) : float3(0, 0, 0);
       return h;
     }, refRate);
-    std::printf("\n%s: %zu triangles, %dx%d rays, one thread; errors in units of the mesh's extent / 1.8 (the box is 2 wide)\n\n",
-                name.c_str(), mesh.TriangleCount(), size, size);
-    std::printf("| %-10s | %-26s | %9s | %9s | %9s | %8s | %9s | %9s | %7s | %6s | %6s |\n", "kind", "knobs", "build ms", "data MiB",
-                "+BVH MiB", "Mrays/s", "mean err", "max err", "hits", "dPSNR", "nPSNR");
-    std::printf("|%s|\n", std::string(150, '-').c_str());
+    std::printf("\n%s: %zu triangles, %dx%d rays; errors in units of the mesh's extent / 1.8 (the box is 2 wide). Mrays/s: 1 thread,\n"
+                "the field in a BVHScene through SdfRender_CPU (all %d cores; OpenVDB: one intersector per thread) and SdfRender_Vulkan\n\n",
+                name.c_str(), mesh.TriangleCount(), size, size, omp_get_max_threads());
+    std::printf("| %-10s | %-26s | %9s | %9s | %9s | %8s | %8s | %8s | %9s | %9s | %7s | %6s | %6s |\n", "kind", "knobs", "build ms", "data MiB",
+                "+BVH MiB", "1 thread", "_CPU", "_Vulkan", "mean err", "max err", "hits", "dPSNR", "nPSNR");
+    std::printf("|%s|\n", std::string(172, '-').c_str());
     auto emit = [&](Row& row, const Image& image) {
       row.mesh = name;
       Score(image, ref, camera, mesh, row);
       Print(row);
       csv << row.mesh << "," << row.representation << ",\"" << row.knobs << "\"," << row.buildMs << "," << row.dataBytes << ","
-          << row.totalBytes << "," << row.mraysPerS << "," << row.meanError << "," << row.maxError << "," << row.hitAgreement << ","
+          << row.totalBytes << "," << row.mraysPerS << "," << row.mraysCpu << "," << row.mraysVulkan << "," << row.meanError << "," << row.maxError << "," << row.hitAgreement << ","
           << row.depthPsnr << "," << row.normalPsnr << "\n";
     };
     const float3 boxMin(-1.0f, -1.0f, -1.0f);
@@ -210,6 +265,7 @@ int main(int argc, char** argv) {
                                                            grid.Sample(p + float3(0, 0, e)) - grid.Sample(p - float3(0, 0, e))));
         return h;
       }, row.mraysPerS);
+      TimeTranslated(translated, [&](ISceneObject& scene) { return scene.AddGeom_SdfGrid(grid); }, row);
       emit(row, image);
     }
     for (uint32_t depth : {5u, 6u, 7u})
@@ -225,6 +281,7 @@ int main(int argc, char** argv) {
         row.dataBytes = double(svs.Bytes());
         row.totalBytes = row.dataBytes + double(bvh.nodes.size() * sizeof(BVHNode) + bvh.primIndices.size() * 4);
         const Image image = TraceImage(camera, [&](float3 o, float3 d) { return TraceSVS(svs, bvh, o, d, 0.0f, 6.0f, 4); }, row.mraysPerS);
+        TimeTranslated(translated, [&](ISceneObject& scene) { return scene.AddGeom_SdfSVS(svs); }, row);
         emit(row, image);
       }
     {  // Newton iterations: the knob at 128^3, 2 bytes.
@@ -253,6 +310,7 @@ int main(int argc, char** argv) {
         row.dataBytes = double(sbs.Bytes());
         row.totalBytes = row.dataBytes + double(bvh.nodes.size() * sizeof(BVHNode) + bvh.primIndices.size() * 4);
         const Image image = TraceImage(camera, [&](float3 o, float3 d) { return TraceSBS(sbs, bvh, o, d, 0.0f, 6.0f, 4); }, row.mraysPerS);
+        TimeTranslated(translated, [&](ISceneObject& scene) { return scene.AddGeom_SdfSBS(sbs); }, row);
         emit(row, image);
       }
     // The peer: OpenVDB's narrow-band level set of the same mesh, at the same voxel sizes.
@@ -270,8 +328,8 @@ int main(int argc, char** argv) {
       openvdb::FloatGrid::Ptr grid = openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(*transform, points, triangles, 3.0f);
       row.buildMs = MsSince(t0);
       row.dataBytes = row.totalBytes = double(grid->memUsage());
-      const openvdb::tools::LevelSetRayIntersector<openvdb::FloatGrid> intersector(*grid);
-      const Image image = TraceImage(camera, [&](float3 o, float3 d) {
+      using Intersector = openvdb::tools::LevelSetRayIntersector<openvdb::FloatGrid>;
+      auto trace = [&](const Intersector& intersector, float3 o, float3 d) {
         SdfHit h = Missed();
         openvdb::math::Ray<double> ray(openvdb::Vec3d(o.x, o.y, o.z), openvdb::Vec3d(d.x, d.y, d.z), 0.0, 6.0);
         openvdb::Vec3d p, n;
@@ -282,7 +340,25 @@ int main(int argc, char** argv) {
           h.normal = float3(float(n[0]), float(n[1]), float(n[2]));
         }
         return h;
-      }, row.mraysPerS);
+      };
+      const Intersector intersector(*grid);
+      const Image image = TraceImage(camera, [&](float3 o, float3 d) { return trace(intersector, o, d); }, row.mraysPerS);
+      // All cores: rows over the threads, an intersector each (they are not thread-safe).
+      std::vector<float> allCores(size_t(size) * size);
+      const double ms = MedianMs(3, [&] {
+#pragma omp parallel
+        {
+          const Intersector mine(*grid);
+#pragma omp for schedule(dynamic, 4)
+          for (int y = 0; y < size; ++y)
+            for (int x = 0; x < size; ++x) {
+              float3 o, d;
+              camera.Ray(x, y, o, d);
+              allCores[size_t(y) * size + x] = trace(mine, o, d).t;
+            }
+        }
+      });
+      row.mraysCpu = double(size) * size / (ms * 1000.0);
       emit(row, image);
     }
   }
