@@ -1,7 +1,9 @@
 #!/usr/bin/python3
-"""Plots bench_sdf's table (out/bench_sdf.csv): the mean distance of hit points from the mesh
-surface against the time per ray, one point per representation and knob setting, one panel per
-mesh. Writes out/bench_sdf.png.
+"""Plots bench_sdf's table (out/bench_sdf.csv), one column of panels per mesh. Top: the mean
+distance of hit points from the mesh surface against the time per ray on one thread, one point per
+representation and knob setting. Bottom, as the paper's Figure 9: the time per ray of the translated
+renderer (_CPU, all cores; _Vulkan, the device bench_sdf ran on) against the model's size in memory.
+Writes out/bench_sdf.png.
 
 usage: bench/plot_sdf.py [CSV (default out/bench_sdf.csv)] [PNG (default out/bench_sdf.png)]"""
 import csv
@@ -19,7 +21,7 @@ source = sys.argv[1] if len(sys.argv) > 1 else "out/bench_sdf.csv"
 target = sys.argv[2] if len(sys.argv) > 2 else "out/bench_sdf.png"
 rows = list(csv.DictReader(open(source)))
 meshes = sorted({r["mesh"] for r in rows})
-fig, axes = plt.subplots(1, len(meshes), figsize=(6 * len(meshes), 5), squeeze=False)
+fig, axes = plt.subplots(2, len(meshes), figsize=(6 * len(meshes), 10), squeeze=False)
 markers = {"grid": "s", "SVS": "o", "SBS": "^", "OpenVDB": "x"}
 for ax, mesh in zip(axes[0], meshes):
     for kind, marker in markers.items():
@@ -38,6 +40,24 @@ for ax, mesh in zip(axes[0], meshes):
     ax.set_title(f"{mesh}: surface error against time")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
+for ax, mesh in zip(axes[1], meshes):
+    for kind, marker in markers.items():
+        for column, style, label in (("mrays_per_s_cpu", "-", "_CPU"), ("mrays_per_s_vulkan", "--", "_Vulkan")):
+            pts = sorted((r for r in rows if r["mesh"] == mesh and r["representation"] == kind and float(r.get(column) or 0) > 0),
+                         key=lambda r: float(r["total_bytes"]))
+            if not pts:
+                continue
+            x = [float(r["total_bytes"]) / 1048576.0 for r in pts]
+            y = [1.0 / float(r[column]) for r in pts]  # microseconds per ray
+            name = f"{kind}, {label}" if kind != "OpenVDB" else "OpenVDB, all cores"
+            ax.plot(x, y, style, marker=marker, label=name)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("model size with its BVH (MiB)")
+    ax.set_ylabel("time per camera ray (µs)")
+    ax.set_title(f"{mesh}: render time against model size")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
 fig.tight_layout()
 fig.savefig(target, dpi=120)
 print(f"wrote {target}")
