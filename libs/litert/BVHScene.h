@@ -66,8 +66,8 @@ struct BVHInstance
 // corner (x, y, z) is value number firstValue + (z * stride + y) * stride + x, packed bytesPerValue
 // bytes at a time (1 and 2: quantised over +-the voxel's diagonal; 4: the float). A voxel of an SVS
 // is a brick of one voxel, a brick of an SBS one of its bricks, a dense grid bricks of 8^3 cells
-// (stride: the grid's samples per axis). localId is what a hit reports as primId (0 for a grid's). 48 bytes, std430
-// as in C++.
+// (stride: the grid's samples per axis). localId is what a hit reports as primId (0 for a grid's).
+// 48 bytes, std430 as in C++.
 struct BVHSdfBrick
 {
   LiteMath::float4 minAndVoxelSize;

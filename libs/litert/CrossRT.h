@@ -20,8 +20,9 @@ struct SdfSBS;
 
 // Result of RayQuery_NearestHit. A miss has primId == instId == geomId == 0xFFFFFFFF and t set to
 // the ray's tmax. A hit on box geometry has CRT_GEOM_MASK_AABB_BIT in geomId. A hit on a signed
-// distance field has its surface normal (object space, unit length) in coords[0..2] and the voxel
-// (SVS) or brick (SBS) hit as primId (0 on a dense grid).
+// distance field has its surface normal in coords[0..2] (object space, unit length; 0 where the
+// interpolant has no gradient, as at a start inside among equal values) and the voxel (SVS) or brick
+// (SBS) hit as primId (0 on a dense grid).
 struct CRT_Hit
 {
   float    t;         // ray parameter of the hit

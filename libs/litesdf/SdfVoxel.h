@@ -181,7 +181,7 @@ inline bool MayHoldSurface(const VoxelValues& values) {
   return lowest <= 0.0f;
 }
 
-// The voxels of a box of n.x * n.y * n.z voxels of edge `size` from boxMin that the ray crosses
+// The voxels of a box of n[0] x n[1] x n[2] voxels of edge `size` from boxMin that the ray crosses
 // within [t0, t1] (its span inside the box), in order along the ray (Amanatides and Woo): calls
 // `voxel(x, y, z, voxelMin, tEnter, tLeave)` for each until one returns a hit, and returns it.
 template <class Voxel>
