@@ -141,12 +141,11 @@ struct Translated {
   std::vector<float> depth;
 };
 
-double RenderMrays(SdfRender& r, const Translated& tr, std::shared_ptr<ISceneObject> scene, std::vector<uint32_t>& pixels,
-                   std::vector<float>& depth) {
+double RenderMrays(SdfRender& r, Translated& tr, std::shared_ptr<ISceneObject> scene) {
   r.SetScene(std::move(scene));
   r.CommitDeviceData();
-  r.Render(pixels.data(), depth.data());  // uploads the scene
-  const double ms = MedianMs(3, [&] { r.Render(pixels.data(), depth.data()); });
+  r.Render(tr.pixels.data(), tr.depth.data());  // uploads the scene
+  const double ms = MedianMs(3, [&] { r.Render(tr.pixels.data(), tr.depth.data()); });
   return double(tr.size) * tr.size / (ms * 1000.0);
 }
 
@@ -155,8 +154,8 @@ void TimeTranslated(Translated& tr, const std::function<uint32_t(ISceneObject&)>
   auto scene = MakeSceneRT("sah");
   scene->AddInstance(add(*scene), LiteMath::float4x4());
   scene->CommitScene();
-  row.mraysCpu = RenderMrays(*tr.cpu, tr, scene, tr.pixels, tr.depth);
-  if (tr.vulkan) row.mraysVulkan = RenderMrays(*tr.vulkan, tr, scene, tr.pixels, tr.depth);
+  row.mraysCpu = RenderMrays(*tr.cpu, tr, scene);
+  if (tr.vulkan) row.mraysVulkan = RenderMrays(*tr.vulkan, tr, scene);
 }
 
 }  // namespace

@@ -15,12 +15,22 @@ namespace {
 
 uint32_t MaxCode(uint32_t bytesPerValue) { return bytesPerValue >= 4 ? 0xFFFFFFFFu : (1u << (8 * bytesPerValue)) - 1u; }
 
-void CheckBytes(uint32_t bytesPerValue) {
-  if (bytesPerValue != 1 && bytesPerValue != 2 && bytesPerValue != 4)
-    throw std::invalid_argument("bytes per value must be 1, 2 or 4, not " + std::to_string(bytesPerValue));
+// What is wrong with a knob, or "" (the builders throw it, Problem() returns it).
+std::string BytesProblem(uint32_t bytesPerValue) {
+  return bytesPerValue == 1 || bytesPerValue == 2 || bytesPerValue == 4 ? ""
+                                                                          : "bytes per value must be 1, 2 or 4, not " + std::to_string(bytesPerValue);
 }
-void CheckDepth(uint32_t depth) {
-  if (depth > 10) throw std::invalid_argument("depth must be at most 10 (1024 voxels per axis), not " + std::to_string(depth));
+std::string DepthProblem(uint32_t depth) {
+  return depth <= 10 ? "" : "depth must be at most 10 (1024 voxels per axis), not " + std::to_string(depth);
+}
+std::string BrickProblem(uint32_t brickSize, uint32_t depth) {
+  const bool powerOf2 = brickSize != 0 && (brickSize & (brickSize - 1)) == 0;
+  return powerOf2 && depth <= 10 && brickSize <= (1u << depth)
+             ? ""
+             : "brick size must be a power of 2 no larger than 2^depth, not " + std::to_string(brickSize);
+}
+void Check(const std::string& problem) {
+  if (!problem.empty()) throw std::invalid_argument(problem);
 }
 
 uint32_t PackCoords(uint32_t x, uint32_t y, uint32_t z) { return x | (y << 10) | (z << 20); }
@@ -122,10 +132,8 @@ namespace {
 std::string CubeProblem(float3 boxMin, float boxSize, uint32_t depth, uint32_t bytesPerValue) {
   if (!(boxSize > 0.0f) || !std::isfinite(boxSize) || !std::isfinite(boxMin.x + boxMin.y + boxMin.z))
     return "the field's cube is empty or not finite";
-  if (depth > 10) return "depth " + std::to_string(depth) + " is over 10 (voxel coordinates have 10 bits)";
-  if (bytesPerValue != 1 && bytesPerValue != 2 && bytesPerValue != 4)
-    return std::to_string(bytesPerValue) + " bytes per value (1, 2 or 4)";
-  return "";
+  if (std::string p = DepthProblem(depth); !p.empty()) return p;
+  return BytesProblem(bytesPerValue);
 }
 }  // namespace
 
@@ -144,8 +152,7 @@ std::string Problem(const SdfSVS& svs) {
 
 std::string Problem(const SdfSBS& sbs) {
   if (std::string p = CubeProblem(sbs.boxMin, sbs.boxSize, sbs.depth, sbs.bytesPerValue); !p.empty()) return p;
-  if (sbs.brickSize == 0 || (sbs.brickSize & (sbs.brickSize - 1)) != 0 || sbs.brickSize > (1u << sbs.depth))
-    return "bricks of " + std::to_string(sbs.brickSize) + " voxels (a power of 2 up to 2^depth)";
+  if (std::string p = BrickProblem(sbs.brickSize, sbs.depth); !p.empty()) return p;
   if (sbs.values.size() != sbs.coords.size() * sbs.WordsPerBrick())
     return std::to_string(sbs.values.size()) + " words of values for " + std::to_string(sbs.coords.size()) + " bricks of " +
            std::to_string(sbs.brickSize) + "^3 voxels";
@@ -168,8 +175,8 @@ SdfGrid BuildGrid(const ISdf& sdf, float3 boxMin, float boxSize, uint32_t sample
 }
 
 SdfSVS BuildSVS(const ISdf& sdf, float3 boxMin, float boxSize, uint32_t depth, uint32_t bytesPerValue, SdfBuildStats* stats) {
-  CheckBytes(bytesPerValue);
-  CheckDepth(depth);
+  Check(BytesProblem(bytesPerValue));
+  Check(DepthProblem(depth));
   const auto t0 = std::chrono::steady_clock::now();
   SdfBuildStats local;
   SdfBuildStats& s = stats ? *stats : local;
@@ -200,7 +207,7 @@ SdfSVS BuildSVS(const ISdf& sdf, float3 boxMin, float boxSize, uint32_t depth, u
 
 SdfSVS BuildSVSWithinBudget(const ISdf& sdf, float3 boxMin, float boxSize, uint32_t maxDepth, uint32_t bytesPerValue, size_t maxBytes,
                             SdfBuildStats* stats) {
-  CheckDepth(maxDepth);
+  Check(DepthProblem(maxDepth));
   SdfSVS best;
   bool found = false;
   for (uint32_t depth = 1; depth <= maxDepth; ++depth) {
@@ -218,12 +225,11 @@ SdfSVS BuildSVSWithinBudget(const ISdf& sdf, float3 boxMin, float boxSize, uint3
 
 SdfSBS BuildSBS(const ISdf& sdf, float3 boxMin, float boxSize, uint32_t depth, uint32_t brickSize, uint32_t bytesPerValue,
                 SdfBuildStats* stats) {
-  CheckBytes(bytesPerValue);
-  CheckDepth(depth);
+  Check(BytesProblem(bytesPerValue));
+  Check(DepthProblem(depth));
+  Check(BrickProblem(brickSize, depth));
   uint32_t brickLevels = 0;
   while ((1u << brickLevels) < brickSize) ++brickLevels;
-  if ((1u << brickLevels) != brickSize || brickLevels > depth)
-    throw std::invalid_argument("brick size must be a power of 2 no larger than 2^depth, not " + std::to_string(brickSize));
   const auto t0 = std::chrono::steady_clock::now();
   SdfBuildStats local;
   SdfBuildStats& s = stats ? *stats : local;

@@ -225,7 +225,7 @@ TEST_CASE("SDF scenes: NaN and inf rays, tmin == tmax, scales from 1e-3 to 1e3, 
     CHECK_THROWS_WITH(scene->AddGeom_SdfSVS(broken), Catch::Contains("words of values for"));
     SdfSBS deep = fields.sbs;
     deep.depth = 11;
-    CHECK_THROWS_WITH(scene->AddGeom_SdfSBS(deep), Catch::Contains("depth 11 is over 10"));
+    CHECK_THROWS_WITH(scene->AddGeom_SdfSBS(deep), Catch::Contains("depth must be at most 10"));
     SdfGrid empty;
     CHECK_THROWS_AS(scene->AddGeom_SdfGrid(empty), std::invalid_argument);
   }
