@@ -31,6 +31,12 @@ float Sigmoid(float x) { return 1.0f / (1.0f + std::exp(-x)); }
 
 float3 Xyz(float4 v) { return float3(v.x, v.y, v.z); }
 
+// The trilinear weight of a cell's corner (bit 0: x, 1: y, 2: z) at place f inside the cell.
+float CornerWeight(int corner, float3 f)
+{
+  return ((corner & 1) != 0 ? f.x : 1.0f - f.x) * ((corner & 2) != 0 ? f.y : 1.0f - f.y) * ((corner & 4) != 0 ? f.z : 1.0f - f.z);
+}
+
 }  // namespace
 
 void ReluField::SetGrid(const literf::RFGrid& grid)
@@ -79,23 +85,34 @@ bool ReluField::BoxSpan(float3 org, float3 dir, float& tNear, float& tFar) const
   return tNear < tFar;
 }
 
-void ReluField::Sample(float3 p, float3 dir, float& density, float& raw, float3& colour) const
+void ReluField::Locate(float3 p, int& firstVertex, float3& place) const
 {
-  // The cell holding p and p's place inside it.
   const float3 u = (p - Xyz(m_boxMin)) / (Xyz(m_boxMax) - Xyz(m_boxMin)) * float(m_cells);
   const int x = std::min(std::max(int(std::floor(u.x)), 0), m_cells - 1);
   const int y = std::min(std::max(int(std::floor(u.y)), 0), m_cells - 1);
   const int z = std::min(std::max(int(std::floor(u.z)), 0), m_cells - 1);
-  const float3 f = LiteMath::clamp(u - float3(float(x), float(y), float(z)), 0.0f, 1.0f);
-  const ShBasis sh = EvaluateSh(dir);
+  place = LiteMath::clamp(u - float3(float(x), float(y), float(z)), 0.0f, 1.0f);
+  firstVertex = x + (m_cells + 1) * (y + (m_cells + 1) * z);
+}
+
+int ReluField::CornerOffset(int corner) const
+{
   const int vertices = m_cells + 1;
+  return (corner & 1) + vertices * (((corner >> 1) & 1) + vertices * (corner >> 2));
+}
+
+void ReluField::Sample(float3 p, float3 dir, float& density, float& raw, float3& colour) const
+{
+  int first;
+  float3 f;
+  Locate(p, first, f);
+  const ShBasis sh = EvaluateSh(dir);
   raw = 0.0f;
   float3 z3 = float3(0.0f, 0.0f, 0.0f);  // the colour before the sigmoid
   for (int corner = 0; corner < 8; ++corner)
   {
-    const int dx = corner & 1, dy = (corner >> 1) & 1, dz = corner >> 2;
-    const float w = (dx == 1 ? f.x : 1.0f - f.x) * (dy == 1 ? f.y : 1.0f - f.y) * (dz == 1 ? f.z : 1.0f - f.z);
-    const int base = ((x + dx) + vertices * ((y + dy) + vertices * (z + dz))) * m_channels;
+    const float w = CornerWeight(corner, f);
+    const int base = (first + CornerOffset(corner)) * m_channels;
     raw += w * m_values[base];
     for (int k = 0; k < m_shCoefficients; ++k)
     {
@@ -110,21 +127,17 @@ void ReluField::Sample(float3 p, float3 dir, float& density, float& raw, float3&
 
 void ReluField::ScatterGradient(float3 p, float3 dir, float raw, float3 colour, float dDensity, float3 dColour)
 {
-  const float3 u = (p - Xyz(m_boxMin)) / (Xyz(m_boxMax) - Xyz(m_boxMin)) * float(m_cells);
-  const int x = std::min(std::max(int(std::floor(u.x)), 0), m_cells - 1);
-  const int y = std::min(std::max(int(std::floor(u.y)), 0), m_cells - 1);
-  const int z = std::min(std::max(int(std::floor(u.z)), 0), m_cells - 1);
-  const float3 f = LiteMath::clamp(u - float3(float(x), float(y), float(z)), 0.0f, 1.0f);
+  int first;
+  float3 f;
+  Locate(p, first, f);
   const ShBasis sh = EvaluateSh(dir);
   // Through the ReLU and the sigmoids to the interpolated values.
   const float dRaw = raw > 0.0f ? dDensity * m_densityScale : 0.0f;
   const float3 dZ = dColour * colour * (float3(1.0f, 1.0f, 1.0f) - colour);
-  const int vertices = m_cells + 1;
   for (int corner = 0; corner < 8; ++corner)
   {
-    const int dx = corner & 1, dy = (corner >> 1) & 1, dz = corner >> 2;
-    const float w = (dx == 1 ? f.x : 1.0f - f.x) * (dy == 1 ? f.y : 1.0f - f.y) * (dz == 1 ? f.z : 1.0f - f.z);
-    const int base = ((x + dx) + vertices * ((y + dy) + vertices * (z + dz))) * m_channels;
+    const float w = CornerWeight(corner, f);
+    const int base = (first + CornerOffset(corner)) * m_channels;
     if (dRaw != 0.0f)
       LiteMath::InterlockedAdd(m_gradients[base], w * dRaw);
     for (int k = 0; k < m_shCoefficients; ++k)

@@ -66,6 +66,10 @@ protected:
 
   // The ray's span inside the grid's box, [tNear, tFar]; false when it misses.
   bool BoxSpan(float3 org, float3 dir, float& tNear, float& tFar) const;
+  // The cell holding p: the index of its lowest vertex, and p's place inside it ([0, 1]³).
+  void Locate(float3 p, int& firstVertex, float3& place) const;
+  // From a cell's lowest vertex to its corner (bit 0: +x, 1: +y, 2: +z), in vertices.
+  int CornerOffset(int corner) const;
   // Density and colour at p seen along dir (raw: the trilinear raw density, before ReLU).
   void Sample(float3 p, float3 dir, float& density, float& raw, float3& colour) const;
   // Adds the gradients of one sample (of its density and colour) to its 8 vertices.
