@@ -149,6 +149,16 @@ void ReluField::ScatterGradient(float3 p, float3 dir, float raw, float3 colour, 
   }
 }
 
+void ReluField::Composite(float3 p, float3 dir, float delta, float3& colour, float& transmittance) const
+{
+  float density, raw;
+  float3 c;
+  Sample(p, dir, density, raw, c);
+  const float alpha = 1.0f - std::exp(-density * delta);
+  colour += c * (transmittance * alpha);
+  transmittance *= 1.0f - alpha;
+}
+
 float3 ReluField::March(float3 org, float3 dir, float& transmittance) const
 {
   float3 colour = float3(0.0f, 0.0f, 0.0f);
@@ -160,12 +170,7 @@ float3 ReluField::March(float3 org, float3 dir, float& transmittance) const
   for (float t = tNear; t < tFar && transmittance >= m_stopTransmittance; t += step)
   {
     const float delta = std::min(step, tFar - t);
-    float density, raw;
-    float3 c;
-    Sample(org + dir * (t + 0.5f * delta), dir, density, raw, c);
-    const float alpha = 1.0f - std::exp(-density * delta);
-    colour += c * (transmittance * alpha);
-    transmittance *= 1.0f - alpha;
+    Composite(org + dir * (t + 0.5f * delta), dir, delta, colour, transmittance);
   }
   return colour;
 }
@@ -191,12 +196,7 @@ float3 ReluField::TraverseCells(float3 org, float3 dir, float& transmittance) co
     {
       // One sample in the middle of the chord; the chord's length is the step.
       const float delta = leave - enter;
-      float density, raw;
-      float3 c;
-      Sample(org + dir * (enter + 0.5f * delta), dir, density, raw, c);
-      const float alpha = 1.0f - std::exp(-density * delta);
-      colour += c * (transmittance * alpha);
-      transmittance *= 1.0f - alpha;
+      Composite(org + dir * (enter + 0.5f * delta), dir, delta, colour, transmittance);
       continue;
     }
     // The child below the plane comes first when the ray runs up the axis.

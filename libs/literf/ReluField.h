@@ -74,6 +74,8 @@ protected:
   void Sample(float3 p, float3 dir, float& density, float& raw, float3& colour) const;
   // Adds the gradients of one sample (of its density and colour) to its 8 vertices.
   void ScatterGradient(float3 p, float3 dir, float raw, float3 colour, float dDensity, float3 dColour);
+  // Adds a segment of length delta sampled at p to the colour, behind the transmittance so far.
+  void Composite(float3 p, float3 dir, float delta, float3& colour, float& transmittance) const;
   // The colour of a ray and the transmittance left: constant steps, or the occupied cells.
   float3 March(float3 org, float3 dir, float& transmittance) const;
   float3 TraverseCells(float3 org, float3 dir, float& transmittance) const;
