@@ -22,7 +22,8 @@ namespace {
 // spellings) is dropped: the class is only parsed, and an unknown flag would stop Clang.
 bool KeepFlag(const std::string& a) {
   static const char* prefixes[] = {"-D", "-U", "-I", "-std=", "-m", "-isystem", "-iquote", "-include", "-fopenmp",
-                                   "-fno-exceptions", "-fno-rtti", "-fexceptions", "-frtti", "-fchar8_t", "-fno-char8_t"};
+                                   "-fno-exceptions", "-fno-rtti", "-fexceptions", "-frtti", "-fchar8_t", "-fno-char8_t",
+                                   "-ffast-math", "-fno-fast-math", "-ffp-contract="};
   for (const char* p : prefixes)
     if (a.rfind(p, 0) == 0) return true;
   return false;
@@ -104,6 +105,15 @@ std::vector<std::string> ParseArguments(const TranslateRequest& request) {
   if (!hasStandard) args.push_back("-std=c++17");  // the least the LiteMath headers need
   args.insert(args.end(), kept.begin(), kept.end());
   return args;
+}
+
+bool AllowsContraction(const std::vector<std::string>& args) {
+  bool allowed = false;  // x86-64 without -mfma rounds every multiply and add: the default
+  for (const auto& a : args) {
+    if (a == "-ffast-math" || a == "-ffp-contract=fast") allowed = true;
+    if (a == "-fno-fast-math" || a == "-ffp-contract=off" || a == "-ffp-contract=on") allowed = false;
+  }
+  return allowed;
 }
 
 }  // namespace crossrt::engine

@@ -20,4 +20,8 @@ std::string IncludeSpelling(const std::string& header, const std::vector<std::st
 // exist yet: the diagnostic that names it, or empty.
 std::string GeneratedIncludeProblem(const std::string& source, const std::vector<std::string>& args);
 
+// Whether the class's flags let the GPU fuse multiplies and adds (-ffast-math, -ffp-contract=fast;
+// the last such flag wins). Without them every shader gets NoContraction (NoContraction.h).
+bool AllowsContraction(const std::vector<std::string>& args);
+
 }  // namespace crossrt::engine

@@ -8,13 +8,12 @@
 #include "AstCache.h"
 #include "Canonical.h"
 #include "CodeGen.h"
+#include "NoContraction.h"
 #include "Spirv.h"
 
 #include <clang/AST/ASTContext.h>
 #include <clang/Basic/SourceManager.h>
-#include <clang/AST/ASTContext.h>
 #include <clang/Frontend/TextDiagnosticPrinter.h>
-#include <clang/Lex/Preprocessor.h>
 #include <clang/Lex/Preprocessor.h>
 #include <llvm/ADT/SmallString.h>
 #include <llvm/Support/FileSystem.h>
@@ -105,13 +104,16 @@ std::string WholeClassProblems(const TranslateRequest& request, const ClassModel
 }
 
 // The shaders compiled to SPIR-V (unchanged ones from the cache) and embedded in one C++ source.
-std::string CompileShaders(const std::string& className, const std::vector<ShaderSource>& shaders, SpirvCache* spirvCache) {
+// Unless `contract`, no multiply and add may be fused (NoContraction.h).
+std::string CompileShaders(const std::string& className, const std::vector<ShaderSource>& shaders, SpirvCache* spirvCache, bool contract) {
   std::vector<std::pair<std::string, std::vector<uint32_t>>> spirv;
   for (auto& shader : shaders) {
     std::vector<uint32_t> words;
-    if (!spirvCache || !spirvCache->Find(shader.glsl, words)) {
+    const std::string key = (contract ? "// -ffp-contract=fast\n" : "") + shader.glsl;
+    if (!spirvCache || !spirvCache->Find(key, words)) {
       words = CompileGlsl(shader.name, shader.glsl, shader.stage);
-      if (spirvCache) spirvCache->Add(shader.glsl, words);
+      if (!contract) ForbidContraction(words);
+      if (spirvCache) spirvCache->Add(key, words);
     }
     spirv.push_back({shader.name, words});
   }
@@ -228,7 +230,7 @@ TranslateResult Translate(const TranslateRequest& request, AstCache* cache, Spir
     result.timingsMs["generate"] = MsSince(t0);
     // Compile: SPIR-V, embedded in the class's _shaders.cpp.
     t0 = std::chrono::steady_clock::now();
-    if (vulkan) result.files[model.className + "_Vulkan_shaders.cpp"] = CompileShaders(model.className, shaders, spirvCache);
+    if (vulkan) result.files[model.className + "_Vulkan_shaders.cpp"] = CompileShaders(model.className, shaders, spirvCache, AllowsContraction(request.compileArgs));
     if (vulkan) result.timingsMs["spirv"] = MsSince(t0);
   } catch (const std::exception& e) {
     result.diagnostics += "error: " + std::string(e.what()) + "\n";

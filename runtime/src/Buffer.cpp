@@ -1,5 +1,6 @@
 // Buffer: storage buffers in device-local memory, persistently mapped when that memory is also
-// host-visible (lavapipe, resizable-BAR GPUs), otherwise filled/read through a staging buffer.
+// host-visible (lavapipe, resizable-BAR GPUs), otherwise filled/read through a staging buffer;
+// read through one too where the mapping is not host-cached (slow to read over PCIe).
 #include "crossrt/VulkanRuntime.h"
 #include "Internal.h"
 
@@ -95,6 +96,7 @@ Buffer::Buffer(std::shared_ptr<VulkanContext> ctx, VkDeviceSize bytes, VkBufferU
   if (!ctx_->forceStaging && (a.flags & kHostCoherent) == kHostCoherent) {
     VkResult r = vkMapMemory(ctx_->device, memory_, 0, VK_WHOLE_SIZE, 0, &mapped_);
     if (r != VK_SUCCESS) mapped_ = nullptr;  // staging still works
+    hostCached_ = mapped_ && (a.flags & VK_MEMORY_PROPERTY_HOST_CACHED_BIT);
   }
   if (usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) {
     auto info = VkInit<VkBufferDeviceAddressInfo>(VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO);
@@ -113,6 +115,7 @@ Buffer& Buffer::operator=(Buffer&& other) noexcept {
     memory_ = std::exchange(other.memory_, VK_NULL_HANDLE);
     size_ = std::exchange(other.size_, 0);
     mapped_ = std::exchange(other.mapped_, nullptr);
+    hostCached_ = std::exchange(other.hostCached_, false);
     address_ = std::exchange(other.address_, 0);
     extraUsage_ = std::exchange(other.extraUsage_, 0);
   }
@@ -129,6 +132,7 @@ void Buffer::Release() noexcept {
   buffer_ = VK_NULL_HANDLE;
   memory_ = VK_NULL_HANDLE;
   mapped_ = nullptr;
+  hostCached_ = false;
   size_ = 0;
   address_ = 0;
   ctx_.reset();
@@ -152,7 +156,7 @@ void Buffer::Upload(const void* src, size_t bytes, size_t dstOffset) {
 void Buffer::Download(void* dst, size_t bytes, size_t srcOffset) const {
   CheckRange(*this, bytes, srcOffset, "Buffer::Download");
   if (bytes == 0) return;
-  if (mapped_) {
+  if (mapped_ && hostCached_) {
     std::memcpy(dst, static_cast<const char*>(mapped_) + srcOffset, bytes);
     return;
   }

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <mutex>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -455,6 +456,17 @@ void VulkanContext::CreateDevice(const ContextOptions& options) {
       Check(vkCreateDescriptorSetLayout(device, &setInfo, nullptr, &textureArrayLayout), "vkCreateDescriptorSetLayout (arrays of textures)");
       hasTextureArrays = true;
     }
+  }
+
+  if (EnvFlag("CROSSRT_VERBOSE")) {  // which paths generated classes will take, once per process
+    static std::once_flag once;
+    std::call_once(once, [&] {
+      std::fprintf(stderr,
+                   "crossrt: Vulkan device '%s': ray queries %s, ray tracing pipelines %s, arrays of textures %s, "
+                   "float atomics %s, subgroup size %u\n",
+                   properties.deviceName, hasRayQuery ? "yes" : "no", hasRayTracingPipeline ? "yes" : "no",
+                   hasTextureArrays ? "yes" : "no", hasFloatAtomicAdd ? "yes" : "no", subgroupSize);
+    });
   }
 
   vkCmdPushDescriptorSetKHR = reinterpret_cast<PFN_vkCmdPushDescriptorSetKHR>(

@@ -28,6 +28,14 @@ inline std::shared_ptr<crossrt::VulkanContext> ValidatedContext()
   return ctx;
 }
 
+// Whether the device divides and takes square roots correctly rounded, as the CPU does. Lavapipe
+// runs LLVM's IEEE operations; GPUs may be 2.5 ulp off in a division and more in a square root
+// (Vulkan's precision rules), so results that hinge on the last bit of a quotient can differ there.
+inline bool RoundsLikeTheCpu(const crossrt::VulkanContext& ctx)
+{
+  return ctx.DeviceName().find("llvmpipe") != std::string::npos;
+}
+
 // n floats uniform in [lo, hi), the same for a given seed.
 inline std::vector<float> RandomFloats(int n, unsigned seed, float lo, float hi)
 {

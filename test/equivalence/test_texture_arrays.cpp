@@ -252,9 +252,12 @@ TEST_CASE("Arrays of textures with ray queries in one kernel: the texture of the
     std::vector<float4> colors(n, float4(-7.0f));
     impl->Shade(n, org.data(), dir.data(), colors.data());
     // Barycentrics from another traversal differ in the last bits: nearest samples may pick the
-    // neighbouring texel right at an edge.
+    // neighbouring texel right at an edge. The GPU's samplers weigh texels with a few bits of
+    // sub-texel precision (8 on NVIDIA): their bilinear results are as close as SamplerClose's.
+    auto* vulkan = dynamic_cast<TexturedHits_Vulkan*>(impl.get());
+    const float tolerance = vulkan && vulkan->UsesTextureHardware() ? 4.0f / 512.0f : 1e-3f;
     size_t close = 0;
-    for (int i = 0; i < n; ++i) close += MaxDifference(colors[i], expected[i]) <= 1e-3f;
+    for (int i = 0; i < n; ++i) close += MaxDifference(colors[i], expected[i]) <= tolerance;
     CHECK(close >= size_t(n) * 99 / 100);
   }
   RequireNoValidationMessages(ctx);

@@ -9,10 +9,13 @@
 // _Vulkan must give the same primId for at least 99.99% of the rays, counting ties as the same: a
 // ray aimed exactly at a vertex or an edge hits several triangles at the same distance, and a
 // last-ulp difference picks another of them (it must contain the hit point). And t must lie within
-// 1e-5 * (t + |origin| + scene size): GPU compilers may fuse a * b + c into one fma (SPIR-V allows
-// that contraction), which moves each edge function and the distance by about an ulp of their
-// largest term; 1e-5 is about 80 ulps of the largest magnitude in the computation, and far below
-// the distance between neighbouring triangles, so a wrong triangle cannot pass.
+// 1e-5 * (t + |origin| + scene size), about 80 ulps of the largest magnitude in the computation and
+// far below the distance between neighbouring triangles, so a wrong triangle cannot pass. The
+// shaders multiply and add without fusing (NoContraction), as the CPU does: fused, a shared edge's
+// two functions are no longer exact negatives and rays leak between triangles (seen on an H100).
+// A GPU's division is only within 2.5 ulp, though, and the ray's shear constants are quotients: on
+// devices that do not round like the CPU (RoundsLikeTheCpu) 99.9% and 0.1% of rays outside the
+// tolerance are allowed, as for ray tracing hardware, whose own triangle test differs anyway.
 #include <catch2/catch.hpp>
 
 #include "PrimaryRays.h"
@@ -84,7 +87,7 @@ struct Outcome
 
 // The agreement stated at the top of this file, of `gpu` hits with the original's.
 void RequireAgreement(const char* what, const std::vector<CRT_Hit>& original, const std::vector<CRT_Hit>& gpu, const Rays& rays,
-                      float sceneSize, const TriangleMesh* mesh)
+                      float sceneSize, const TriangleMesh* mesh, bool exact)
 {
   size_t samePrim = 0, ties = 0, tOutside = 0, idsDiffer = 0;
   for (size_t i = 0; i < rays.Size(); ++i)
@@ -108,8 +111,16 @@ void RequireAgreement(const char* what, const std::vector<CRT_Hit>& original, co
   }
   INFO(what << ": " << samePrim << " of " << rays.Size() << " rays on the original's primId, " << ties
             << " more on another triangle at the same point; " << tOutside << " t outside the tolerance");
-  REQUIRE(double(samePrim + ties) >= 0.9999 * double(rays.Size()));
-  REQUIRE(tOutside == 0);
+  if (exact)
+  {
+    REQUIRE(double(samePrim + ties) >= 0.9999 * double(rays.Size()));
+    REQUIRE(tOutside == 0);
+  }
+  else  // the ray's shear constants are quotients: a GPU's may differ in the last bit (RoundsLikeTheCpu)
+  {
+    REQUIRE(double(samePrim + ties) >= 0.999 * double(rays.Size()));
+    REQUIRE(double(tOutside) <= 0.001 * double(rays.Size()));
+  }
   REQUIRE(idsDiffer == 0);
 }
 
@@ -135,13 +146,13 @@ Outcome TraceEverywhere(const std::shared_ptr<ISceneObject>& scene, const Rays& 
   out.vulkan = Cast(*vulkan, scene, rays);
   out.hasVulkan = true;
   RequireNoValidationMessages(ctx);
-  RequireAgreement("translated traversal", out.original, out.vulkan, rays, sceneSize, mesh);
+  RequireAgreement("translated traversal", out.original, out.vulkan, rays, sceneSize, mesh, RoundsLikeTheCpu(*ctx));
   if (ctx->hasRayQuery && exports)
   {
     vulkan->UseRayTracingHardware(true);
     const std::vector<CRT_Hit> hardware = Cast(*vulkan, scene, rays);
     RequireNoValidationMessages(ctx);
-    RequireAgreement("ray tracing hardware", out.original, hardware, rays, sceneSize, mesh);
+    RequireAgreement("ray tracing hardware", out.original, hardware, rays, sceneSize, mesh, false);
   }
   return out;
 }
