@@ -22,7 +22,7 @@ build=${1:-build}
 out=${2:-.device-bundle}
 
 tests="$build/test/crossrt_device_tests"
-benches=(bench_examples bench_lbvh bench_sdf bench_textures bench_scan)
+benches=(bench_examples bench_lbvh bench_sdf bench_textures bench_scan bench_radiance_fields)
 echo "device-bundle: building crossrt_device_tests in $build"
 cmake --build "$build" --target crossrt_device_tests >/dev/null
 (( benchmarks )) && cmake --build "$build" --target "${benches[@]}" >/dev/null

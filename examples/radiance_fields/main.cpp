@@ -3,6 +3,7 @@
 //   radiance_fields train DATASET_DIR --out MODEL [options]
 //   radiance_fields render MODEL --dataset DATASET_DIR --out DIR [options]
 //   radiance_fields synthetic DIR: writes a small dataset of an analytic scene (for trying it out).
+#include "AnalyticScene.h"
 #include "NerfDataset.h"
 #include "RFTraining.h"
 #include "ReluField.h"
@@ -64,7 +65,7 @@ struct Args
   std::vector<std::string> positional;
   std::string out, device = "cpu", dataset, split = "test", method = "bvh";
   int grid = 64, iterations = 300, batch = 4096, sh = 2, views = 60, size = 64;
-  float lr = 0.03f, stop = 0.01f;
+  float lr = 0.01f, stop = 0.01f;
   uint32_t seed = 1;
 };
 
@@ -238,72 +239,14 @@ int Render(const Args& a)
   return 0;
 }
 
-// An analytic scene for trying the program without a dataset: a sphere shaded by its normal and a
-// box, opaque, on white; exact ray casts, cameras on the upper hemisphere of radius 4.
-float4 ScenePixel(float3 o, float3 d)
-{
-  float best = 1e30f;
-  float4 colour = float4(1.0f, 1.0f, 1.0f, 0.0f);
-  const float3 c = float3(-0.3f, 0.0f, 0.0f);
-  const float b = LiteMath::dot(o - c, d), disc = b * b - (LiteMath::dot(o - c, o - c) - 0.49f);
-  if (disc >= 0.0f && -b - std::sqrt(disc) > 0.0f)
-  {
-    best = -b - std::sqrt(disc);
-    const float3 n = LiteMath::normalize(o + d * best - c);
-    colour = float4(0.5f + 0.4f * n.x, 0.5f + 0.4f * n.y, 0.5f + 0.4f * n.z, 1.0f);
-  }
-  const float3 lo = float3(0.3f, -0.6f, -0.4f), hi = float3(0.9f, 0.2f, 0.4f);
-  float enter = 0.0f, leave = 1e30f;
-  int axis = 0;
-  for (int k = 0; k < 3; ++k)
-  {
-    const float t0 = (lo[k] - o[k]) / d[k], t1 = (hi[k] - o[k]) / d[k];
-    if (std::min(t0, t1) > enter)
-    {
-      enter = std::min(t0, t1);
-      axis = k;
-    }
-    leave = std::min(leave, std::max(t0, t1));
-  }
-  if (enter < leave && enter > 0.0f && enter < best)
-    colour = axis == 0 ? float4(0.9f, 0.3f, 0.2f, 1.0f) : axis == 1 ? float4(0.9f, 0.8f, 0.2f, 1.0f) : float4(0.3f, 0.4f, 0.9f, 1.0f);
-  return colour;
-}
-
 int Synthetic(const Args& a)
 {
   if (a.positional.size() != 1)
     Fail("synthetic takes DIR (see --help)");
   if (a.size < 8 || a.views < 1)
     Fail("synthetic needs --size of at least 8 and at least one view");
-  std::mt19937 rng(a.seed);
-  std::uniform_real_distribution<float> u(0.0f, 1.0f);
   for (const auto& [split, views] : {std::pair<std::string, int>{"train", a.views}, std::pair<std::string, int>{"test", 8}})
-  {
-    NerfSplit s;
-    s.cameraAngleX = 0.6911f;  // the NeRF synthetic scenes'
-    s.width = s.height = a.size;
-    for (int v = 0; v < views; ++v)
-    {
-      const float phi = 6.2831853f * u(rng), z = 0.1f + 0.85f * u(rng), r = std::sqrt(1.0f - z * z);
-      const float3 eye = float3(r * std::cos(phi), z, r * std::sin(phi)) * 4.0f;
-      const float3 back = LiteMath::normalize(eye), right = LiteMath::normalize(LiteMath::cross(float3(0.0f, 1.0f, 0.0f), back));
-      const float3 up = LiteMath::cross(back, right);
-      NerfFrame f;
-      f.filePath = "./" + split + "/r_" + std::to_string(v);
-      f.cameraToWorld = LiteMath::float4x4(right.x, up.x, back.x, eye.x, right.y, up.y, back.y, eye.y, right.z, up.z, back.z, eye.z, 0.0f, 0.0f, 0.0f, 1.0f);
-      f.image = LiteImage::Image2D<float4>(uint32_t(a.size), uint32_t(a.size));
-      for (int y = 0; y < a.size; ++y)
-        for (int x = 0; x < a.size; ++x)
-        {
-          float3 o, d;
-          PixelRay(f.cameraToWorld, s.Focal(), a.size, a.size, x, y, o, d);
-          f.image.data()[y * a.size + x] = ScenePixel(o, d);
-        }
-      s.frames.push_back(std::move(f));
-    }
-    SaveNerfSplit(a.positional[0], split, s);
-  }
+    SaveNerfSplit(a.positional[0], split, MakeAnalyticSplit(split, views, a.size, split == "train" ? a.seed : a.seed + 1000u));
   std::printf("wrote %d training and 8 test views of %dx%d to %s\n", a.views, a.size, a.size, a.positional[0].c_str());
   return 0;
 }

@@ -12,8 +12,6 @@ namespace literf {
 using LiteMath::float3;
 using LiteMath::float4;
 
-float NerfSplit::Focal() const { return 0.5f * float(width) / std::tan(0.5f * cameraAngleX); }
-
 namespace {
 
 std::string TransformsPath(const std::string& dir, const std::string& split) { return (std::filesystem::path(dir) / ("transforms_" + split + ".json")).string(); }
@@ -124,30 +122,6 @@ void SaveNerfSplit(const std::string& dir, const std::string& split, const NerfS
   out << doc.dump(2) << "\n";
   if (!out)
     throw std::runtime_error(TransformsPath(dir, split) + ": cannot write");
-}
-
-void PixelRay(const LiteMath::float4x4& cameraToWorld, float focal, int width, int height, int x, int y, float3& origin, float3& direction)
-{
-  const float4 d = cameraToWorld.get_col(0) * ((float(x) + 0.5f - 0.5f * float(width)) / focal) -
-                   cameraToWorld.get_col(1) * ((float(y) + 0.5f - 0.5f * float(height)) / focal) - cameraToWorld.get_col(2);
-  const float4 o = cameraToWorld.get_col(3);
-  origin = float3(o.x, o.y, o.z);
-  direction = LiteMath::normalize(float3(d.x, d.y, d.z));
-}
-
-float Psnr(const LiteImage::Image2D<float4>& a, const LiteImage::Image2D<float4>& b)
-{
-  if (a.width() != b.width() || a.height() != b.height() || a.width() == 0)
-    throw std::runtime_error("PSNR of images of different sizes");
-  double sum = 0.0;
-  const size_t n = size_t(a.width()) * a.height();
-  for (size_t i = 0; i < n; ++i)
-  {
-    const float4 d = a.data()[i] - b.data()[i];
-    sum += double(d.x) * d.x + double(d.y) * d.y + double(d.z) * d.z;
-  }
-  const double mse = sum / (3.0 * double(n));
-  return mse > 0.0 ? float(-10.0 * std::log10(mse)) : 99.0f;
 }
 
 }  // namespace literf

@@ -17,8 +17,8 @@ struct TrainOptions
   int iterations = 500;                         // per stage
   int batch = 4096;                             // rays per iteration
   int shDegree = 2;
-  float learningRate = 0.03f;
-  float initialRawDensity = 0.01f;  // every vertex's raw density at the start (density 1 at scale 100)
+  float learningRate = 0.01f;       // Adam moves every value by about this at first: at 0.03 the first step switched every density off
+  float initialRawDensity = 0.02f;  // every vertex's raw density at the start (density 2 at scale 100): above a step
   float pruneAlpha = 1e-3f;         // cells less opaque than this are emptied between stages
   float marchStep = 0.5f;           // in cells
   float stopTransmittance = 0.01f;

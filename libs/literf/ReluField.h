@@ -91,7 +91,7 @@ protected:
   // The camera: position, and the directions of a pixel step right and down and of the image centre.
   float4 m_camPos, m_camRight, m_camDown, m_camCentre;
   // Adam (Kingma and Ba 2015): the rate and its bias-corrected form for the next step.
-  float m_learningRate = 0.03f, m_beta1 = 0.9f, m_beta2 = 0.999f, m_epsilon = 1e-8f;
+  float m_learningRate = 0.01f, m_beta1 = 0.9f, m_beta2 = 0.999f, m_epsilon = 1e-8f;
   float m_stepRate = 0.0f;
   int m_steps = 0;
   float m_gradientScale = 1.0f;  // 1 / rays of the batch: the loss is their mean
