@@ -110,6 +110,7 @@ size_t TreeBytes(const RFGrid& grid) { return BuildCellTree(grid).size() * sizeo
 
 int main(int argc, char** argv)
 {
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);  // each table row as it is measured, even if the run is cut short
   Options opt;
   for (int i = 1; i < argc; ++i)
   {
@@ -177,7 +178,7 @@ int main(int argc, char** argv)
     });
     if (b.name == "original") originalMs = ms;
     std::printf("| %-8s | %8.2f | %11.2fx |\n", b.name.c_str(), ms, originalMs / ms);
-    csv << "train," << b.name << ",," << trainCells << ",2,,,,,," << ms << ",\n";
+    csv << "train," << b.name << ",," << trainCells << ",2,,,,,," << ms << ",\n" << std::flush;
   }
 
   // 3 (trained first, rendered in 2 and 3). One model per grid (SH 2) and per SH degree (largest grid).
@@ -228,7 +229,7 @@ int main(int argc, char** argv)
       std::printf("| %4dx%-4d | %-8s | %10.1f | %10.1f | %12.2fx | %13.2fx | %13.2fx |\n", size, size, b.name.c_str(), march, tree, march / tree,
                   origMarch / march, origMarch / tree);
       csv << "render," << b.name << ",march," << best.cells << ",2,0.01," << size << ",," << march << ",,,\n";
-      csv << "render," << b.name << ",tree," << best.cells << ",2,0.01," << size << ",," << tree << ",,,\n";
+      csv << "render," << b.name << ",tree," << best.cells << ",2,0.01," << size << ",," << tree << ",,,\n" << std::flush;
     }
   }
 
@@ -245,7 +246,7 @@ int main(int argc, char** argv)
     const double gridMb = double(m.grid.Bytes()) / 1e6, treeMb = double(TreeBytes(m.grid)) / 1e6;
     std::printf("| %4d | %2d | %6.3f | %13.2f | %9.2f | %8.1f | %7.2f | %7.2f |\n", m.cells, m.sh, stop, psnr, ms, m.trainS, gridMb, treeMb);
     csv << "sweep," << fastest.name << ",tree," << m.cells << "," << m.sh << "," << stop << "," << opt.size << "," << psnr << "," << ms << ","
-        << m.trainS << ",," << gridMb + treeMb << "\n";
+        << m.trainS << ",," << gridMb + treeMb << "\n" << std::flush;
   };
   for (size_t i = 0; i < grids.size(); ++i) row(models[i], 0.01f);
   for (size_t i = grids.size(); i < models.size(); ++i) row(models[i], 0.01f);
