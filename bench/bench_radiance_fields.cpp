@@ -92,18 +92,6 @@ std::shared_ptr<ReluField> Loaded(const Backend& b, const RFGrid& grid, int widt
   return field;
 }
 
-double MeanPsnr(ReluField& field, const NerfSplit& test)
-{
-  double sum = 0.0;
-  for (const NerfFrame& f : test.frames)
-  {
-    LiteImage::Image2D<float4> image;
-    RenderFrame(field, test, f, image);
-    sum += Psnr(image, f.image);
-  }
-  return sum / double(test.frames.size());
-}
-
 size_t TreeBytes(const RFGrid& grid) { return BuildCellTree(grid).size() * sizeof(RFNode); }
 
 }  // namespace
@@ -240,9 +228,9 @@ int main(int argc, char** argv)
   std::printf("|-------------------------------------------------------------------------------|\n");
   auto row = [&](const Model& m, float stop) {
     auto field = Loaded(fastest, m.grid, opt.size, opt.size, ReluField::kCells, stop);
-    MeanPsnr(*field, test);  // warm-up
+    SplitPsnr(*field, test);  // warm-up
     double psnr = 0.0;
-    const double ms = 1e3 * Seconds([&] { psnr = MeanPsnr(*field, test); }) / double(test.frames.size());
+    const double ms = 1e3 * Seconds([&] { psnr = SplitPsnr(*field, test); }) / double(test.frames.size());
     const double gridMb = double(m.grid.Bytes()) / 1e6, treeMb = double(TreeBytes(m.grid)) / 1e6;
     std::printf("| %4d | %2d | %6.3f | %13.2f | %9.2f | %8.1f | %7.2f | %7.2f |\n", m.cells, m.sh, stop, psnr, ms, m.trainS, gridMb, treeMb);
     csv << "sweep," << fastest.name << ",tree," << m.cells << "," << m.sh << "," << stop << "," << opt.size << "," << psnr << "," << ms << ","

@@ -87,4 +87,16 @@ void RenderFrame(ReluField& field, const NerfSplit& split, const NerfFrame& fram
   field.Render(out.data());
 }
 
+float SplitPsnr(ReluField& field, const NerfSplit& split)
+{
+  float sum = 0.0f;
+  for (const NerfFrame& f : split.frames)
+  {
+    LiteImage::Image2D<float4> image;
+    RenderFrame(field, split, f, image);
+    sum += Psnr(image, f.image);
+  }
+  return split.frames.empty() ? 0.0f : sum / float(split.frames.size());
+}
+
 }  // namespace literf

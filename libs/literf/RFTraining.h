@@ -46,4 +46,7 @@ RFGrid ReadGrid(ReluField& field, const RFGrid& shape);
 // the grid) into `out`.
 void RenderFrame(ReluField& field, const NerfSplit& split, const NerfFrame& frame, LiteImage::Image2D<LiteMath::float4>& out);
 
+// The mean PSNR over a split's frames of `field` (constructed at the split's image size, holding the grid).
+float SplitPsnr(ReluField& field, const NerfSplit& split);
+
 }  // namespace literf

@@ -125,18 +125,6 @@ NerfSplit SphereSplit(int views, int size, unsigned seed)
   return s;
 }
 
-float MeanPsnr(ReluField& field, const NerfSplit& split)
-{
-  float sum = 0.0f;
-  for (const NerfFrame& f : split.frames)
-  {
-    LiteImage::Image2D<float4> image;
-    RenderFrame(field, split, f, image);
-    sum += Psnr(image, f.image);
-  }
-  return sum / float(split.frames.size());
-}
-
 }  // namespace
 
 TEST_CASE("a uniform field renders the closed form on both methods", "[rf]")
@@ -299,11 +287,11 @@ TEST_CASE("training on images of an analytic scene reaches a test PSNR", "[rf]")
   ReluField render(32, 32);
   RFGrid initial = MakeGrid(8, 1, options.initialRawDensity, options.boxMin, options.boxMax);
   render.SetGrid(initial);
-  const float before = MeanPsnr(render, test);
+  const float before = SplitPsnr(render, test);
   render.SetGrid(trained);
-  const float after = MeanPsnr(render, test);
+  const float after = SplitPsnr(render, test);
   render.SetMethod(ReluField::kMarch);
-  const float afterMarch = MeanPsnr(render, test);
+  const float afterMarch = SplitPsnr(render, test);
   INFO("test PSNR " << before << " dB before training, " << after << " dB after (" << afterMarch << " dB marching); loss " << firstLoss << " -> "
                     << lastLoss);
   REQUIRE(after > 20.0f);
