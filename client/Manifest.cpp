@@ -24,7 +24,7 @@ std::string Hex(uint64_t v) {
 std::string OptionsKey(const engine::TranslateRequest& r) {
   // The translator's build is part of the key: a rebuilt translator translates again.
   std::string text = protocol::TranslatorIdentity(DaemonExecutable()) + '\n' + r.className + '\n' +
-                     (r.backend == engine::Backend::Vulkan ? "vulkan" : "cpu") + '\n' + r.templateDir;
+                     engine::BackendName(r.backend) + '\n' + r.templateDir;
   for (auto& s : r.sources) text += "\nsrc " + s;
   for (auto& a : r.compileArgs) text += "\narg " + a;
   for (auto& c : r.compositions) text += "\ncompose " + c;

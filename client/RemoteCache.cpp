@@ -180,7 +180,7 @@ std::string RemoteCache::Local(const std::string& text) const {
 }
 
 std::string RemoteCache::ManifestKey(const engine::TranslateRequest& r) const {
-  std::string text = "manifest\n" + m_identity + "\n" + r.className + "\n" + (r.backend == engine::Backend::Vulkan ? "vulkan" : "cpu");
+  std::string text = "manifest\n" + m_identity + "\n" + r.className + "\n" + engine::BackendName(r.backend);
   text += "\ntemplates " + Portable(r.templateDir) + "\nout " + Portable(r.outputDir);
   for (auto& s : r.sources) text += "\nsrc " + Portable(s);
   for (auto& a : r.compileArgs) text += "\narg " + Portable(a);

@@ -1,6 +1,6 @@
 // crossrt: the command crossrt_add_class() runs.
 //
-//   crossrt translate --class NAME --backend vulkan|cpu --out DIR --source FILE... [options] [-- ARGS]
+//   crossrt translate --class NAME --backend vulkan|cpu|ispc --out DIR --source FILE... [options] [-- ARGS]
 //   crossrt daemon status [--build-dir DIR] [--json]
 //   crossrt daemon stop [--build-dir DIR]
 //   crossrt --help | --version
@@ -36,7 +36,7 @@ using crossrt::client::DaemonClient;
 namespace {
 
 const char* kUsage =
-    "usage: crossrt translate --class NAME --backend vulkan|cpu --out DIR --source FILE [--source FILE...]\n"
+    "usage: crossrt translate --class NAME --backend vulkan|cpu|ispc --out DIR --source FILE [--source FILE...]\n"
     "                         [--candidate FILE... [--source-dir DIR]] [--compose INTERFACE=IMPL...] [--virtual-level 1|2|3]\n"
     "                         [--execution-mode wavefront|megakernel] [--templates DIR]\n"
     "                         [--depfile FILE --depfile-target FILE]\n"
@@ -47,8 +47,9 @@ const char* kUsage =
     "       crossrt --help | --version\n";
 
 const char* kHelp =
-    "crossrt: translates a C++ class into a class that runs its kernels on Vulkan (NAME_Vulkan) or on\n"
-    "all CPU cores (NAME_CPU). crossrt_add_class() in CMake runs it; you rarely call it by hand.\n"
+    "crossrt: translates a C++ class into a class that runs its kernels on Vulkan (NAME_Vulkan), on\n"
+    "all CPU cores (NAME_CPU), or on all cores in SIMD lanes (NAME_ISPC, whose NAME_ISPC_kernels.ispc\n"
+    "the ISPC compiler compiles). crossrt_add_class() in CMake runs it; you rarely call it by hand.\n"
     "\n"
     "translate      translates class NAME, whose member functions the --source files define, into DIR.\n"
     "               Of the --candidate files (a target's sources), those that define NAME's member\n"
@@ -245,9 +246,7 @@ int main(int argc, char** argv) {
   if (request.className.empty()) return Usage("--class is required");
   if (request.outputDir.empty()) return Usage("--out is required");
   if (request.sources.empty() && candidates.empty()) return Usage("at least one --source (or --candidate) is required");
-  if (backend == "vulkan") request.backend = engine::Backend::Vulkan;
-  else if (backend == "cpu") request.backend = engine::Backend::Cpu;
-  else return Usage("--backend must be 'vulkan' or 'cpu', not '" + backend + "'");
+  if (!engine::ParseBackend(backend, request.backend)) return Usage("--backend must be 'vulkan', 'cpu' or 'ispc', not '" + backend + "'");
   if (!candidates.empty()) {
     std::vector<std::string> includeDirs;
     for (size_t i = 0; i < request.compileArgs.size(); ++i) {

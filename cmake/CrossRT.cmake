@@ -40,6 +40,11 @@
 # Works from the source tree (add_subdirectory) and from an installed package (find_package).
 include_guard(GLOBAL)
 
+# BACKEND ispc: the ISPC compiler (found on PATH unless given) and the targets every ISPC class is
+# compiled for, dispatched at run time (crossrt::IspcPick in IspcSupport.h lists the same ISAs).
+find_program(CROSSRT_ISPC_EXECUTABLE ispc DOC "The ISPC compiler, for crossrt_add_class(... BACKEND ispc)")
+set(CROSSRT_ISPC_TARGETS sse4-i32x4 avx2-i32x8 avx512skx-x16)
+
 set(CROSSRT_REMOTE_STORAGE "" CACHE STRING
     "Remote translation caches: redis://host[:port] or http[s]://host/path, space-separated, each with optional |read-only")
 
@@ -65,8 +70,16 @@ function(crossrt_add_class target class)
     set(suffix Vulkan)
   elseif(backend STREQUAL "cpu")
     set(suffix CPU)
+  elseif(backend STREQUAL "ispc")
+    set(suffix ISPC)
+    if(NOT CROSSRT_ISPC_EXECUTABLE)
+      message(FATAL_ERROR "crossrt_add_class(${target} ${class} BACKEND ispc): no ISPC compiler was found. Install it "
+                          "from your distribution (e.g. 'apt-get install ispc' where packaged) or from Intel's release "
+                          "archives (https://github.com/ispc/ispc/releases), then put 'ispc' on PATH or set "
+                          "-DCROSSRT_ISPC_EXECUTABLE=/path/to/ispc. BACKEND cpu runs the same class with OpenMP alone.")
+    endif()
   else()
-    message(FATAL_ERROR "crossrt_add_class(${target} ${class}): BACKEND must be vulkan or cpu, not '${ARG_BACKEND}'")
+    message(FATAL_ERROR "crossrt_add_class(${target} ${class}): BACKEND must be vulkan, cpu or ispc, not '${ARG_BACKEND}'")
   endif()
   if(NOT TARGET ${target})
     message(FATAL_ERROR "crossrt_add_class: '${target}' is not a target")
@@ -125,6 +138,9 @@ function(crossrt_add_class target class)
   set(outputs ${out_dir}/${name}_${suffix}.h ${out_dir}/${name}_${suffix}.cpp)
   if(suffix STREQUAL "Vulkan")
     list(APPEND outputs ${out_dir}/${name}_Vulkan_shaders.cpp)
+  elseif(suffix STREQUAL "ISPC")
+    set(ispc_source ${out_dir}/${name}_ISPC_kernels.ispc)
+    list(APPEND outputs ${ispc_source})
   endif()
 
   # Parse the class as the target compiles it: its include paths, definitions and standard, plus
@@ -180,6 +196,31 @@ function(crossrt_add_class target class)
 
   target_sources(${target} PRIVATE ${outputs})
   target_include_directories(${target} PRIVATE ${out_dir})
+  if(suffix STREQUAL "ISPC")
+    # The kernels, compiled for every target in CROSSRT_ISPC_TARGETS with ISPC's run-time dispatch:
+    # one object per target and the dispatcher, and the header the generated class includes.
+    set(ispc_object ${out_dir}/${name}_ISPC_kernels${CMAKE_CXX_OUTPUT_EXTENSION})
+    set(ispc_header ${out_dir}/${name}_ISPC_kernels_ispc.h)
+    set(ispc_objects ${ispc_object})
+    foreach(t IN LISTS CROSSRT_ISPC_TARGETS)
+      string(REGEX REPLACE "-.*$" "" isa "${t}")
+      list(APPEND ispc_objects ${out_dir}/${name}_ISPC_kernels_${isa}${CMAKE_CXX_OUTPUT_EXTENSION})
+    endforeach()
+    string(REPLACE ";" "," ispc_targets "${CROSSRT_ISPC_TARGETS}")
+    set(runtime_inc "$<TARGET_PROPERTY:crossrt::cpu_runtime,INTERFACE_INCLUDE_DIRECTORIES>")
+    add_custom_command(
+      OUTPUT ${ispc_objects} ${ispc_header}
+      COMMAND ${CROSSRT_ISPC_EXECUTABLE} ${ispc_source} -o ${ispc_object} -h ${ispc_header}
+              --target=${ispc_targets} -O2 --pic --wno-perf
+              "$<$<BOOL:${runtime_inc}>:-I$<JOIN:${runtime_inc},$<SEMICOLON>-I>>"
+              -M -MF ${ispc_object}.d -MT ${ispc_object}
+      DEPENDS ${ispc_source}
+      DEPFILE ${ispc_object}.d
+      COMMENT "CrossRT: compiling ${name}_ISPC_kernels.ispc for ${ispc_targets}"
+      COMMAND_EXPAND_LISTS
+      VERBATIM)
+    target_sources(${target} PRIVATE ${ispc_objects} ${ispc_header})
+  endif()
   if(suffix STREQUAL "Vulkan")
     target_link_libraries(${target} PRIVATE crossrt::runtime)
   else()

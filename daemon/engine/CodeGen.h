@@ -25,5 +25,7 @@ struct ShaderSource {
 std::vector<ShaderSource> GenerateShaders(const ClassModel& model, const GenerateOptions& options);
 // Host C++ of the Vulkan class (vulkan = true) or of the CPU class.
 std::map<std::string, std::string> GenerateHost(const ClassModel& model, const GenerateOptions& options, bool vulkan);
+// The ISPC backend (IspcCode.cpp): <Class>_ISPC_kernels.ispc.
+std::string GenerateIspcKernels(const ClassModel& model, const GenerateOptions& options);
 
 }  // namespace crossrt::engine

@@ -89,5 +89,7 @@ std::string LaunchSize(const Kernel& k);
 std::string ReductionCppType(const ClassModel& model, const Reduction& r);
 
 Data Common(const ClassModel& model, const GenerateOptions& opt);
+// The ISPC class's host data (IspcCode.cpp): the members it passes, its kernels' chunks and reductions.
+void IspcHostData(const ClassModel& model, Data& d);
 
 }  // namespace crossrt::engine

@@ -64,6 +64,12 @@ std::string GlslPrinter::Fail(SourceLocation loc, const std::string& message, co
   return "/*error*/";
 }
 
+std::string GlslPrinter::IspcFail(SourceLocation loc, const std::string& what) {
+  return Fail(loc, what + " is not translated to ISPC yet", "translate this class with BACKEND cpu (OpenMP) or vulkan");
+}
+
+std::string GlslPrinter::DataStruct() const { return m_class->getNameAsString() + "_Data"; }
+
 std::optional<std::string> GlslPrinter::Type(QualType t, SourceLocation loc) {
   QualType base = t.getNonReferenceType();
   while (auto* arr = dyn_cast<ConstantArrayType>(base.getCanonicalType().getTypePtr())) base = arr->getElementType();
@@ -89,6 +95,13 @@ std::optional<std::string> GlslPrinter::Type(QualType t, SourceLocation loc) {
     return std::nullopt;
   }
   if (auto* rd = base->getAsCXXRecordDecl(); rd && !IsLiteMathType(base, nullptr)) NeedStruct(rd);
+  if (ispc) {
+    if (g->find("mat") != std::string::npos || g->find("bvec") != std::string::npos) {
+      IspcFail(loc, "type '" + t.getAsString(m_ctx.getPrintingPolicy()) + "'");
+      return std::nullopt;
+    }
+    return IspcTypeName(*g);
+  }
   return g;
 }
 
@@ -106,8 +119,34 @@ void GlslPrinter::NeedStruct(const RecordDecl* rd) {
   std::ostringstream os;
   if (rd->getQualifiedNameAsString() != rd->getName()) os << "// " << rd->getQualifiedNameAsString() << "\n";
   os << "struct " << rd->getName().str() << " {\n";
-  for (auto* f : rd->fields()) os << "  " << Declare(f->getType(), f->getName().str(), f->getLocation()) << ";\n";
-  os << "};\n";
+  if (ispc) {
+    // ISPC aligns every member of these types to 4 bytes; C++ may align more (LiteMath's float4 to
+    // 16): explicit padding puts each field where C++ has it, so that buffers are shared as they are.
+    const ASTRecordLayout& layout = m_ctx.getASTRecordLayout(rd);
+    uint64_t at = 0;
+    unsigned index = 0, pads = 0;
+    std::string params, assigns;
+    bool constructible = true;
+    for (auto* f : rd->fields()) {
+      const uint64_t offset = layout.getFieldOffset(index++) / 8;
+      if (offset > at) os << "  uint8 crt_pad" << pads++ << "[" << (offset - at) << "];\n";
+      os << "  " << Declare(f->getType(), f->getName().str(), f->getLocation()) << ";\n";
+      at = offset + m_ctx.getTypeSizeInChars(f->getType()).getQuantity();
+      constructible &= !f->getType()->isArrayType();
+      auto type = Type(f->getType(), f->getLocation());
+      params += (params.empty() ? "" : ", ") + type.value_or("int") + " " + SafeName(f->getName().str());
+      assigns += " r." + SafeName(f->getName().str()) + " = " + SafeName(f->getName().str()) + ";";
+    }
+    const uint64_t size = layout.getSize().getQuantity();
+    if (size > at) os << "  uint8 crt_pad" << pads++ << "[" << (size - at) << "];\n";
+    os << "};\n";
+    if (constructible)
+      os << "static inline " << rd->getName().str() << " make_" << rd->getName().str() << "(" << params << ")\n{\n  "
+         << rd->getName().str() << " r;" << assigns << "\n  return r;\n}\n";
+  } else {
+    for (auto* f : rd->fields()) os << "  " << Declare(f->getType(), f->getName().str(), f->getLocation()) << ";\n";
+    os << "};\n";
+  }
   m_inProgress.erase(rd);
   m_emitted.insert(rd);
   m_structs.push_back({rd->getName().str(), os.str()});
@@ -165,7 +204,7 @@ std::string GlslPrinter::Cast(QualType to, const clang::Expr* sub) {
       !sub->getType()->isSpecificBuiltinType(BuiltinType::Float))
     return Expr(sub);
   if (to->isRealFloatingType() && !to->isSpecificBuiltinType(BuiltinType::Float) && sub->getType()->isIntegerType())
-    return "float(" + Expr(sub) + ")";
+    return ispc ? "((float)(" + Expr(sub) + "))" : "float(" + Expr(sub) + ")";
   auto target = GlslTypeOf(to);
   auto source = GlslTypeOf(sub->getType());
   if (!target) return Fail(sub->getBeginLoc(), "conversion to '" + to.getAsString(m_ctx.getPrintingPolicy()) + "' is not supported in kernels", "");
@@ -181,6 +220,11 @@ std::string GlslPrinter::Cast(QualType to, const clang::Expr* sub) {
     if (source && (*source == "float")) return "((" + Expr(sub) + ") != 0.0)";
     return "((" + Expr(sub) + ") != 0)";
   }
+  if (ispc) {  // C's cast of a scalar, LiteMath's make_T of a vector
+    const std::string name = IspcTypeName(*target);
+    if (target->find("vec") != std::string::npos) return "make_" + name + "(" + Expr(sub) + ")";
+    return "((" + name + ")(" + Expr(sub) + "))";
+  }
   return *target + "(" + Expr(sub) + ")";
 }
 
@@ -191,8 +235,9 @@ std::string GlslPrinter::Construct(QualType t, const std::vector<const clang::Ex
   for (auto* a : args)
     if (!isa<CXXDefaultArgExpr>(a)) real.push_back(a);
   // Copies and moves are plain values in GLSL.
-  if (real.size() == 1 && GlslTypeOf(real[0]->getType()) == g && IsLiteMathType(real[0]->getType(), "half4") == IsLiteMathType(t, "half4"))
+  if (real.size() == 1 && GlslTypeOf(real[0]->getType()) == GlslTypeOf(t) && IsLiteMathType(real[0]->getType(), "half4") == IsLiteMathType(t, "half4"))
     return Expr(real[0]);
+  if (ispc) return IspcConstruct(t, *g, real, loc);
   if (IsLiteMathType(t, "half4") || IsLiteMathType(t, "half2") || (real.size() == 1 && IsLiteMathType(real[0]->getType(), "half4")))
     return HalfConstruct(t, real, loc);
   auto [base, dims] = SplitArray(*g);
@@ -226,6 +271,32 @@ std::string GlslPrinter::Construct(QualType t, const std::vector<const clang::Ex
   // LiteMath lists matrix elements row by row; GLSL constructors take them column by column.
   if (matrix && real.size() > 1) return "transpose(" + out + ")";
   return out;
+}
+
+// ISPC has no constructor calls: LiteMath's make_float3(...), the struct's make_S(...) that NeedStruct
+// writes, a cast of a scalar, and an initializer list of an array (which only a declaration takes).
+std::string GlslPrinter::IspcConstruct(QualType t, const std::string& type, const std::vector<const clang::Expr*>& args, SourceLocation loc) {
+  if (IsLiteMathType(t, "half4") || IsLiteMathType(t, "half2") || (args.size() == 1 && IsLiteMathType(args[0]->getType(), "half4")))
+    return IspcFail(loc, "LiteMath's half2 and half4");
+  auto list = [&](const std::vector<std::string>& items) {
+    std::string out;
+    for (size_t i = 0; i < items.size(); ++i) out += (i ? ", " : "") + items[i];
+    return out;
+  };
+  std::vector<std::string> values;
+  for (auto* a : args) values.push_back(Expr(a));
+  if (auto* arr = dyn_cast<ConstantArrayType>(t.getCanonicalType().getTypePtr())) {
+    if (values.empty())
+      values.assign(arr->getSize().getZExtValue(), Construct(arr->getElementType(), {}, loc));
+    return "{" + list(values) + "}";
+  }
+  auto* rd = t.getCanonicalType()->getAsCXXRecordDecl();
+  if (!rd) return values.empty() ? "((" + type + ")0)" : "((" + type + ")(" + values[0] + "))";  // a scalar
+  if (values.empty() && !IsLiteMathType(t))  // value-initialised struct: default member initialisers, else zero
+    for (auto* f : rd->fields())
+      values.push_back(f->hasInClassInitializer() && f->getInClassInitializer() ? Expr(f->getInClassInitializer())
+                                                                                : Construct(f->getType(), {}, loc));
+  return "make_" + type + "(" + list(values) + ")";
 }
 
 // LiteMath's half2 and half4 hold their 16-bit floats two per uint (packHalf2x16); float4(h) and
@@ -290,10 +361,24 @@ std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callL
   m_inProgress.insert(def);
   std::ostringstream os;
   auto ret = Type(def->getReturnType(), def->getLocation());
-  os << "// from " << def->getQualifiedNameAsString() << "\n" << (ret ? *ret : "void") << " " << name << "(";
-  const bool withSelf = (selfClass || structSelf) && isa<CXXMethodDecl>(def) && !cast<CXXMethodDecl>(def)->isStatic();
-  if (withSelf && structSelf) os << (cast<CXXMethodDecl>(def)->isConst() ? "" : "inout ") << structSelf->getNameAsString() << " self";
-  else if (withSelf) os << selfClass->getNameAsString() << "_Data self";
+  os << "// from " << def->getQualifiedNameAsString() << "\n" << (ispc ? "static " : "") << (ret ? *ret : "void") << " " << name << "(";
+  // ISPC: the class's own methods reach its members through `self`, as the kernels do.
+  const bool ispcSelf = ispc && !selfClass && !structSelf && isa<CXXMethodDecl>(def) && !cast<CXXMethodDecl>(def)->isStatic();
+  const bool withSelf = ((selfClass || structSelf) && isa<CXXMethodDecl>(def) && !cast<CXXMethodDecl>(def)->isStatic()) || ispcSelf;
+  // A parameter the callee may write: GLSL's inout, ISPC's reference.
+  auto writable = [&](QualType type, const std::string& name, SourceLocation loc) {
+    std::string declared = Declare(type, name, loc);
+    if (!ispc) return "inout " + declared;
+    if (declared.back() == ']') return declared;  // arrays are passed by reference already
+    const size_t space = declared.rfind(' ');
+    return declared.substr(0, space) + " &" + declared.substr(space + 1);
+  };
+  if (ispcSelf) os << "uniform " << DataStruct() << " *uniform self";
+  else if (withSelf && structSelf) {
+    if (cast<CXXMethodDecl>(def)->isConst()) os << structSelf->getNameAsString() << " self";
+    else if (ispc) os << structSelf->getNameAsString() << " &self";
+    else os << "inout " << structSelf->getNameAsString() << " self";
+  } else if (withSelf) os << selfClass->getNameAsString() << "_Data self";
   const auto outerPointers = m_pointers;  // this function's pointer parameters shadow the caller's names
   for (unsigned i = 0; i < def->getNumParams(); ++i) {
     auto* p = def->getParamDecl(i);
@@ -315,12 +400,13 @@ std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callL
         os << "uint " << t.offset;
       } else {
         t.value = name;
-        os << (pt->getPointeeType().isConstQualified() ? "" : "inout ") << Declare(pt->getPointeeType(), p->getNameAsString(), p->getLocation());
+        os << (pt->getPointeeType().isConstQualified() ? Declare(pt->getPointeeType(), p->getNameAsString(), p->getLocation())
+                                                       : writable(pt->getPointeeType(), p->getNameAsString(), p->getLocation()));
       }
       m_pointers[p] = t;
       continue;
     }
-    os << qualifier << Declare(pt, p->getNameAsString(), p->getLocation());
+    os << (qualifier.empty() ? Declare(pt, p->getNameAsString(), p->getLocation()) : writable(pt, p->getNameAsString(), p->getLocation()));
   }
   os << ")\n";
   int savedDepth = m_loopDepth;
@@ -518,6 +604,7 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
                     field->getNameAsString() + "[i][p], " + field->getNameAsString() + "[i].width(), " + field->getNameAsString() + ".size()");
       if (IsStdVector(field->getType())) {
         m_uses.memberVectors.insert(field);
+        if (ispc) return IspcMember(field->getNameAsString());
         return composedPrefix + field->getNameAsString();
       }
       if (IsImage2D(field->getType()))
@@ -531,6 +618,7 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
         return Fail(e->getBeginLoc(), "member '" + field->getNameAsString() + "' of type '" + field->getType().getAsString(m_ctx.getPrintingPolicy()) +
                     "' cannot be used in a kernel", "kernels may use plain data members and std::vector members");
       m_uses.plainMembers.insert(field);
+      if (ispc) return IspcMember(field->getNameAsString());
       return composedPrefix + field->getNameAsString();
     }
     if (!field) return Fail(e->getBeginLoc(), "member function used as a value", "");
@@ -558,6 +646,8 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
   }
   if (auto* op = dyn_cast<CXXOperatorCallExpr>(e)) {
     if (IsStructOperator(op)) return StructOperatorCall(op);  // a struct's own operator: its code
+    if (ispc)
+      if (std::string vector = IspcVectorOperator(op); !vector.empty()) return vector;
     auto kind = op->getOperator();
     std::string coord;
     if (kind == OO_Subscript)
@@ -660,6 +750,7 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
       // `float a[4] = {1}`: GLSL needs every element; the rest come from the array filler.
       if (auto* arr = dyn_cast<ConstantArrayType>(il->getType().getCanonicalType().getTypePtr()); arr && il->hasArrayFiller())
         while (args.size() < arr->getSize().getZExtValue()) args.push_back(il->getArrayFiller());
+      if (ispc) return IspcConstruct(il->getType(), base, args, e->getBeginLoc());
       std::string out = base + dims + "(";
       for (size_t i = 0; i < args.size(); ++i) out += (i ? ", " : "") + Expr(args[i]);
       return out + ")";
@@ -675,6 +766,29 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
   if (isa<CXXThisExpr>(e) && m_structSelf) return "self";
   if (isa<CXXThisExpr>(e)) return Fail(e->getBeginLoc(), "'this' used as a value in a kernel", "access members directly");
   return Fail(e->getBeginLoc(), std::string("expression '") + e->getStmtClassName() + "' is not supported in kernels", "");
+}
+
+// LiteMath's vector operators that ISPC's struct operators cannot be: compound assignment (written
+// out, the target printed twice), negation (LiteMath.isph's neg), a component by a constant index.
+std::string GlslPrinter::IspcVectorOperator(const CXXOperatorCallExpr* op) {
+  if (op->getNumArgs() == 0 || !IsLiteMathType(op->getArg(0)->getType().getNonReferenceType())) return "";
+  const auto kind = op->getOperator();
+  if (kind == OO_Minus && op->getNumArgs() == 1) return "neg(" + Expr(op->getArg(0)) + ")";
+  if (kind == OO_Plus && op->getNumArgs() == 1) return Expr(op->getArg(0));
+  if ((kind == OO_PlusEqual || kind == OO_MinusEqual || kind == OO_StarEqual || kind == OO_SlashEqual) && op->getNumArgs() == 2) {
+    if (op->getArg(0)->HasSideEffects(m_ctx, /*IncludePossibleEffects=*/false))
+      return IspcFail(op->getBeginLoc(), "compound assignment to a vector whose address has side effects");
+    const std::string target = Expr(op->getArg(0)), spelling = getOperatorSpelling(kind);
+    return target + " = " + target + " " + spelling.substr(0, 1) + " (" + Expr(op->getArg(1)) + ")";
+  }
+  if (kind == OO_Subscript) {
+    clang::Expr::EvalResult index;
+    if (!op->getArg(1)->EvaluateAsInt(index, m_ctx) || index.Val.getInt().getExtValue() < 0 || index.Val.getInt().getExtValue() > 3)
+      return IspcFail(op->getBeginLoc(), "a vector's component by a variable index");
+    return "(" + Expr(op->getArg(0)) + ")." + std::string(1, "xyzw"[index.Val.getInt().getExtValue()]);
+  }
+  if (kind == OO_EqualEqual || kind == OO_ExclaimEqual) return IspcFail(op->getBeginLoc(), "comparison of whole vectors");
+  return "";
 }
 
 std::string GlslPrinter::ThreadBody(const clang::Stmt* body, int indent, bool loopBody) {

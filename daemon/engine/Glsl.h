@@ -96,6 +96,14 @@ public:
   // read from the parameter `self` of type <Class>_Data, and its methods take `self` first.
   const clang::CXXRecordDecl* selfClass = nullptr;
 
+  // ISPC instead of GLSL (the ISPC backend, IspcCode.cpp): LiteMath's type names, make_T(...)
+  // constructors, C casts, references for inout parameters, members read through `self` (a pointer
+  // to <Class>_Data, which the class's methods take first), and the built-ins of LiteMath.isph.
+  bool ispc = false;
+  // The ISPC data struct's name and the text of a member through it ("self->m_x").
+  std::string DataStruct() const;
+  std::string IspcMember(const std::string& name) const { return "self->" + name; }
+
   // Printing statements one thread runs (before or after a kernel's loop nest): a member vector that
   // kernels append to may be emptied there (its count restarts).
   bool singleThread = false;
@@ -131,7 +139,10 @@ private:
   const clang::ValueDecl* ValueParamOf(const clang::Expr* e, bool pointerItself = false) const;
   std::string Call(const clang::CallExpr* call);
   std::string Builtin(const clang::FunctionDecl* fd, const std::vector<std::string>& args, const clang::CallExpr* call);
+  std::string IspcBuiltin(const clang::FunctionDecl* fd, const std::vector<std::string>& args, const clang::CallExpr* call,
+                          const std::map<std::string, std::string>& same);
   std::string Construct(clang::QualType t, const std::vector<const clang::Expr*>& args, clang::SourceLocation loc);
+  std::string IspcConstruct(clang::QualType t, const std::string& type, const std::vector<const clang::Expr*>& args, clang::SourceLocation loc);
   std::string HalfConstruct(clang::QualType t, const std::vector<const clang::Expr*>& args, clang::SourceLocation loc);
   std::string Literal(const clang::Expr* e);
   std::string Cast(clang::QualType to, const clang::Expr* sub);
@@ -195,6 +206,10 @@ private:
   void NeedStruct(const clang::RecordDecl* rd);
   void NeedConstant(const clang::VarDecl* vd);
   std::string Fail(clang::SourceLocation loc, const std::string& message, const std::string& hint);
+  // What ISPC has no counterpart for (yet): an error with the hint to use the Vulkan or CPU class.
+  std::string IspcFail(clang::SourceLocation loc, const std::string& what);
+  // `a op= b` on LiteMath vectors (ISPC overloads no compound assignment), `-v`.
+  std::string IspcVectorOperator(const clang::CXXOperatorCallExpr* op);
 
   clang::ASTContext& m_ctx;
   const clang::CXXRecordDecl* m_class;

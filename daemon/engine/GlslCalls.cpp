@@ -95,6 +95,7 @@ std::string GlslPrinter::Builtin(const FunctionDecl* fd, const std::vector<std::
   }
   bool library = IsSystemDecl(fd) || InNamespace(fd, "LiteMath");
   if (!library) return "";
+  if (ispc) return IspcBuiltin(fd, a, call, same);
   const std::string arg0Type = call->getNumArgs() ? GlslTypeOf(call->getArg(0)->getType()).value_or("") : "";
   if (n == "to_float4" && call->getNumArgs() == 1 && IsLiteMathType(call->getArg(0)->getType(), "half4"))
     return "vec4(unpackHalf2x16((" + a[0] + ").x), unpackHalf2x16((" + a[0] + ").y))";
@@ -141,6 +142,54 @@ std::string GlslPrinter::Builtin(const FunctionDecl* fd, const std::vector<std::
     return std::string(n == "make_float4x4_from_cols" ? "mat4(" : "mat3(") + a[0] + ", " + a[1] + ", " + a[2] + (a.size() > 3 ? ", " + a[3] : "") + ")";
   if (n == "rcp") return "(1.0 / " + a[0] + ")";
   if (n == "isfinite") return "!(isinf(" + a[0] + ") || isnan(" + a[0] + "))";
+  auto it = same.find(n);
+  if (it != same.end()) return join(it->second);
+  return "";
+}
+
+// The same for ISPC: LiteMath.isph has LiteMath's constructors and conversions under their own
+// names (make_float3, to_float3), GLSL's functions under GLSL's (`same`), and no matrices yet.
+std::string GlslPrinter::IspcBuiltin(const FunctionDecl* fd, const std::vector<std::string>& a, const CallExpr* call,
+                                     const std::map<std::string, std::string>& same) {
+  const std::string n = fd->getNameAsString();
+  auto join = [&](const std::string& f) {
+    std::string s = f + "(";
+    for (size_t i = 0; i < a.size(); ++i) s += (i ? ", " : "") + a[i];
+    return s + ")";
+  };
+  static const std::set<std::string> ownNames = {
+      "make_float2", "make_float3", "make_float4", "make_int2", "make_int3", "make_int4", "make_uint2", "make_uint3",
+      "make_uint4", "to_float2", "to_float3", "to_float4", "to_int2", "to_int3", "to_int4", "to_uint2", "to_uint3", "to_uint4"};
+  const std::string arg0Type = call->getNumArgs() ? GlslTypeOf(call->getArg(0)->getType()).value_or("") : "";
+  if (arg0Type.find("half") != std::string::npos || n.find("half") != std::string::npos) return IspcFail(call->getBeginLoc(), "LiteMath's half types");
+  if (n.rfind("to_", 0) == 0 && n != "to_float3" && n != "to_float2" && call->getNumArgs() == 1)  // to_int3(v): a conversion
+    return "make_" + n.substr(3) + "(" + a[0] + ")";
+  if (ownNames.count(n)) return join(n);
+  if (n == "round" || n == "roundf") return "(sign(" + a[0] + ") * floor(abs(" + a[0] + ") + 0.5f))";
+  if (n == "as_int") return "floatBitsToInt(" + a[0] + ")";
+  if (n == "as_uint") return "floatBitsToUint(" + a[0] + ")";
+  if (n == "as_float") return (arg0Type[0] == 'u' ? "uintBitsToFloat(" : "intBitsToFloat(") + a[0] + ")";
+  if (n == "hmin" || n == "hmax") {
+    const char* f = n == "hmin" ? "min" : "max";
+    const std::string v = "(" + a[0] + ")";
+    std::string r = std::string(f) + "(" + v + ".x, " + v + ".y)";
+    if (arg0Type.back() == '3' || arg0Type.back() == '4') r = std::string(f) + "(" + r + ", " + v + ".z)";
+    if (arg0Type.back() == '4') r = std::string(f) + "(" + r + ", " + v + ".w)";
+    return call->getArg(0)->HasSideEffects(m_ctx) ? IspcFail(call->getBeginLoc(), "hmin/hmax of an expression with side effects") : r;
+  }
+  if (n == "fmod" || n == "fmodf") return "(" + a[0] + " - " + a[1] + " * trunc(" + a[0] + " / " + a[1] + "))";
+  if (n == "rcp") return "(1.0f / " + a[0] + ")";
+  if (n == "isfinite") return "!(isinf(" + a[0] + ") || isnan(" + a[0] + "))";
+  if (n == "copysign" || n == "copysignf")
+    return "uintBitsToFloat((floatBitsToUint(" + a[0] + ") & 0x7FFFFFFFu) | (floatBitsToUint(" + a[1] + ") & 0x80000000u))";
+  if ((n == "cross3" || n == "cross") && arg0Type == "vec4")
+    return "make_float4(cross(to_float3(" + a[0] + "), to_float3(" + a[1] + ")), 0.0f)";
+  if (arg0Type.rfind("mat", 0) == 0 || n.find("float4x4") != std::string::npos || n.find("float3x3") != std::string::npos ||
+      n == "mul4x3" || n == "mul3x3" || n == "lane_mask_le" || n == "transpose" || n == "inverse" || n == "outerProduct" ||
+      n == "determinant" || n == "refract" || n == "faceforward")
+    return IspcFail(call->getBeginLoc(), "'" + fd->getQualifiedNameAsString() + "'");
+  if (n == "atan2" || n == "atan2f") return join("atan2");
+  if (n == "sqrt" || n == "sqrtf") return join("sqrt");
   auto it = same.find(n);
   if (it != same.end()) return join(it->second);
   return "";
@@ -245,6 +294,7 @@ std::string GlslPrinter::Call(const CallExpr* call) {
       if (StringRef(name).starts_with("kernel"))
         return Fail(call->getBeginLoc(), "kernel '" + name + "' is called from inside a kernel", "call kernels only from control functions");
       std::vector<std::string> args;
+      if (ispc && !method->isStatic()) args.push_back("self");  // the class's data, as kernels have it
       if (selfClass) {
         args.push_back("self");
         // The object's exact class is known: a virtual call on it is static.
@@ -263,16 +313,17 @@ std::string GlslPrinter::Call(const CallExpr* call) {
       return s + ")";
     }
     // Calls on an Image2D member or parameter: texel loads and stores, samples, its size.
-    if (auto* image = ImageOf(obj)) return ImageCall(image, mc);
+    if (auto* image = ImageOf(obj)) return ispc ? IspcFail(call->getBeginLoc(), "an Image2D in a kernel") : ImageCall(image, mc);
     // Calls on a texture of an array of textures.
     const clang::Expr* textureIndex = nullptr;
-    if (auto* array = TextureElement(obj, &textureIndex)) return TextureCall(array, textureIndex, mc);
+    if (auto* array = TextureElement(obj, &textureIndex))
+      return ispc ? IspcFail(call->getBeginLoc(), "an array of textures in a kernel") : TextureCall(array, textureIndex, mc);
     // Calls through a member holding an interface: composition.
     std::string composed = ComposedCall(mc);
-    if (!composed.empty()) return composed;
+    if (!composed.empty()) return ispc ? IspcFail(call->getBeginLoc(), "a call through a composed interface (COMPOSE)") : composed;
     // Calls through an element of a vector of objects: dynamic dispatch.
     std::string dispatched = VirtualCall(mc);
-    if (!dispatched.empty()) return dispatched;
+    if (!dispatched.empty()) return ispc ? IspcFail(call->getBeginLoc(), "a virtual call through a vector of objects") : dispatched;
     // Calls on a std::vector member.
     if (auto* me = dyn_cast<MemberExpr>(obj); me && IsStdVector(me->getType())) {
       auto* field = dyn_cast<FieldDecl>(me->getMemberDecl());
@@ -291,8 +342,10 @@ std::string GlslPrinter::Call(const CallExpr* call) {
         m_uses.memberVectors.insert(field);
         if (name == "size") {
           m_uses.sizeReads.emplace(field, call->getBeginLoc());
+          if (ispc) return IspcMember(field->getNameAsString() + "_size");
           return composedPrefix + field->getNameAsString() + "_size";
         }
+        if (ispc) return IspcFail(call->getBeginLoc(), "std::vector::" + name + " of a member in a kernel");
         if (name == "capacity") return composedPrefix + field->getNameAsString() + "_capacity";
         // Emptied by the one thread before a loop nest: the appends that follow count from 0.
         const bool empties = name == "clear" || (name == "resize" && call->getNumArgs() == 1 && call->getArg(0)->isIntegerConstantExpr(m_ctx) &&
@@ -324,9 +377,10 @@ std::string GlslPrinter::Call(const CallExpr* call) {
     return Fail(call->getBeginLoc(), "I/O ('" + name + "') in a kernel",
                 "kernels cannot do I/O: write results to an output buffer and print them in the control function");
 
+  const bool interlocked = InNamespace(fd, "LiteMath") && (name == "InterlockedAdd" || name == "atomicAdd" || name == "InterlockedAdd3f" || name == "ReduceAdd");
+  if (ispc && (IsCrossrtAtomic(fd) || interlocked)) return IspcFail(call->getBeginLoc(), "an atomic operation ('" + qname + "')");
   if (IsCrossrtAtomic(fd)) return AtomicCall(fd, call);
-  if (InNamespace(fd, "LiteMath") && (name == "InterlockedAdd" || name == "atomicAdd" || name == "InterlockedAdd3f" || name == "ReduceAdd"))
-    return InterlockedCall(fd, call);
+  if (interlocked) return InterlockedCall(fd, call);
   std::vector<std::string> args;
   const bool library = IsSystemDecl(fd) || fd->isInStdNamespace() || InNamespace(fd, "LiteMath");
   std::map<unsigned, std::string> bindings;

@@ -89,10 +89,19 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
     files[model.className + "_Vulkan.cpp"] = Render(opt.templateDir + "/vulkan/class.cpp.mustache", d);
     return files;
   }
+  const std::string derived = model.className + (model.forIspc ? "_ISPC" : "_CPU");
+  d.set("derived", derived);
+  d.set("ispc", model.forIspc);
+  d.set("whatRuns", model.forIspc ? "The loop nests of " + model.className + "'s kernels run here\n// as ISPC (" +
+                                        model.className + "_ISPC_kernels.ispc), on all CPU cores, each in SIMD lanes; the thread loops\n"
+                                        "// of its control functions run on all cores with OpenMP; everything else is inherited unchanged."
+                                  : "The kernels of " + model.className + " run here on all\n// CPU cores with OpenMP; everything else is inherited unchanged.");
+  if (model.forIspc) IspcHostData(model, d);
   Data kernels = List(), ompReductions = List();
   std::set<std::string> declared;
   for (auto& k : model.kernels) {
     if (k.rtv) continue;  // kernel_* bodies are inherited; their loops are parallelised in the control function
+    if (model.forIspc) continue;  // IspcHostData's
     Data x;
     x.set("name", k.name);
     x.set("sourceFile", k.sourceFile);
@@ -154,8 +163,8 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
   }
   d.set("lockedCopies", copies);
   d.set("hasLockedCopies", !model.lockedCopies.empty());
-  files[model.className + "_CPU.h"] = Render(opt.templateDir + "/cpu/class.h.mustache", d);
-  files[model.className + "_CPU.cpp"] = Render(opt.templateDir + "/cpu/class.cpp.mustache", d);
+  files[derived + ".h"] = Render(opt.templateDir + "/cpu/class.h.mustache", d);
+  files[derived + ".cpp"] = Render(opt.templateDir + "/cpu/class.cpp.mustache", d);
   return files;
 }
 

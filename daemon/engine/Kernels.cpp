@@ -20,6 +20,26 @@ using namespace clang;
 
 namespace crossrt::engine {
 
+// The ISPC thread function's parameters after the thread ids (varying): the class's data, the
+// kernel's arguments (uniform: one value, or one array, for all lanes) and each reduction's
+// per-lane accumulator, by reference.
+static std::string IspcThreadHead(Context& c, const Kernel& k, const std::vector<std::pair<std::string, std::string>>& threadIds, const FunctionDecl* def) {
+  std::string head = "static void " + k.name + "(uniform " + c.cls->getNameAsString() + "_Data *uniform self";
+  for (auto& [type, name] : threadIds) head += ", " + type + " " + name;
+  for (unsigned i = 0; i < k.params.size(); ++i) {
+    const KernelParam& p = k.params[i];
+    if (p.isImage) {
+      c.rep.Error(def->getParamDecl(i)->getLocation(), "Image2D parameters are not translated to ISPC yet", "translate this class with BACKEND cpu (OpenMP) or vulkan");
+      continue;
+    }
+    const auto [base, dims] = SplitArray(IspcTypeName(p.glslType));
+    if (p.isPointer) head += std::string(", ") + (p.isConstPointee ? "const " : "") + "uniform " + base + " *uniform " + p.glslName;
+    else head += ", uniform " + base + " " + p.glslName + dims;
+  }
+  for (auto& r : k.reductions) head += ", " + IspcTypeName(r.glslType) + " &" + r.member + "Local";
+  return head + ")";
+}
+
 void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def) {
   Kernel k;
   k.name = md->getNameAsString();
@@ -38,6 +58,9 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   CheckKernelParams(c, md, def, k);
   for (unsigned i = 0; i < def->getNumParams(); ++i) k.cppParamsDecl += (i ? ", " : "") + ParamDecl(c.ctx, md->getParamDecl(i), def->getParamDecl(i), i);
   GlslPrinter printer(c.ctx, c.cls, c.rep);
+  // The ISPC class runs the loop nests of kernelND_ functions as ISPC; the thread loops that call
+  // kernel_ functions stay in its control functions, on all cores as in the CPU class.
+  printer.ispc = c.model.forIspc && !k.rtv;
   printer.compositions = c.compositions;
   printer.threadReturnsValue = k.returnsBool;
   for (auto& s : ClassStructNames(c.model)) printer.predeclaredStructs.insert(s);
@@ -232,12 +255,18 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   markVectorWrites(ends);
   for (auto& [field, loc] : ends.appends) ws.appends.emplace(field, loc);
 
-  // GLSL: the thread function.
+  // GLSL: the thread function. ISPC: the same, its uniform arguments passed in (IspcThreadHead).
   std::ostringstream os;
   os << "// from " << c.cls->getNameAsString() << "::" << k.name << " (" << k.sourceFile << ")\n";
-  os << (k.returnsBool ? "bool " : "void ") << k.name << "(";
-  for (size_t i = 0; i < threadParams.size(); ++i) os << (i ? ", " : "") << threadParams[i].first << " " << threadParams[i].second;
-  os << ")\n{\n";
+  if (printer.ispc) {
+    for (auto& [type, name] : threadParams) type = IspcTypeName(type);
+    os << IspcThreadHead(c, k, threadParams, def);
+  } else {
+    os << (k.returnsBool ? "bool " : "void ") << k.name << "(";
+    for (size_t i = 0; i < threadParams.size(); ++i) os << (i ? ", " : "") << threadParams[i].first << " " << threadParams[i].second;
+    os << ")";
+  }
+  os << "\n{\n";
   for (auto* s : preamble)
     if (!reductionDecls.count(s)) os << printer.Stmt(s, 1);
   if (auto* cs = dyn_cast<CompoundStmt>(threadBody))
@@ -247,7 +276,8 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   os << "}\n";
   k.glslBody = os.str();
   // The statements around the loop nest, as functions one thread runs before and after the others.
-  if (std::any_of(before.begin(), before.end(), [](const Stmt* s) { return !isa<DeclStmt>(s); }) || !after.empty()) {
+  // (The ISPC class runs them on the host, as the CPU class does.)
+  if (!printer.ispc && (std::any_of(before.begin(), before.end(), [](const Stmt* s) { return !isa<DeclStmt>(s); }) || !after.empty())) {
     const auto sizeReadsInLoop = printer.Uses().sizeReads;  // after the loop a vector's final size is known
     const auto renames = printer.renames;
     for (auto& r : k.reductions)

@@ -33,6 +33,7 @@ bool HasVirtualDestructor(const CXXRecordDecl* rd) {
 
 void AnalyzeMembers(Context& c) {
   GlslPrinter structs(c.ctx, c.cls, c.rep);
+  structs.ispc = c.model.forIspc;
   for (auto* f : ClassFields(c.cls)) {
     Member m;
     m.name = f->getNameAsString();

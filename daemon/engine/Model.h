@@ -286,7 +286,8 @@ struct LockedCopy {
 };
 
 struct ClassModel {
-  bool forCpu = false;         // translated for the CPU backend (else Vulkan)
+  bool forCpu = false;         // translated for the CPU backend or the ISPC backend (else Vulkan)
+  bool forIspc = false;        // translated for the ISPC backend: kernelND_ loop nests as ISPC
   std::string className;       // Render
   std::string namespaceName;   // demo (or a::b) where the class is declared: the generated classes join it
   std::string headerFile;      // header declaring the class (as included by generated code)

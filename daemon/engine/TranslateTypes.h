@@ -9,7 +9,14 @@ namespace crossrt::engine {
 
 constexpr const char* kTranslatorVersion = "0.1.0";
 
-enum class Backend { Vulkan, Cpu };
+enum class Backend { Vulkan, Cpu, Ispc };
+// "vulkan", "cpu", "ispc"; and back (false for any other name).
+inline const char* BackendName(Backend b) { return b == Backend::Vulkan ? "vulkan" : b == Backend::Cpu ? "cpu" : "ispc"; }
+inline bool ParseBackend(const std::string& name, Backend& b) {
+  for (Backend x : {Backend::Vulkan, Backend::Cpu, Backend::Ispc})
+    if (name == BackendName(x)) { b = x; return true; }
+  return false;
+}
 
 struct TranslateRequest {
   std::string className;                 // e.g. "MyRender"

@@ -156,7 +156,8 @@ AnalyzeResult Analyze(const TranslateRequest& request, AstCache* sharedCache) {
 
   // Analyse: one pass over every AST, with its diagnostics printed against that AST's sources.
   ClassModel& model = result.model;
-  model.forCpu = request.backend == Backend::Cpu;
+  model.forCpu = request.backend == Backend::Cpu || request.backend == Backend::Ispc;
+  model.forIspc = request.backend == Backend::Ispc;
   model.virtualLevel = request.virtualLevel;
   model.megakernelByDefault = request.megakernel;
   model.templateDir = request.templateDir;
@@ -167,7 +168,8 @@ AnalyzeResult Analyze(const TranslateRequest& request, AstCache* sharedCache) {
       size_t before = handle.diagnostics().size();
       handle.printer().BeginSourceFile(ast->getLangOpts(), &ast->getPreprocessor());
       Reporter reporter(ast->getDiagnostics());
-      reporter.SetGpuRules(request.backend == Backend::Vulkan);  // a CPU class runs the user's C++ as written
+      // A CPU class runs the user's C++ as written; ISPC kernels have the GPU's rules (and their own).
+      reporter.SetGpuRules(request.backend != Backend::Cpu);
       pass(*ast, reporter);
       errors += reporter.Errors();
       handle.printer().EndSourceFile();
@@ -225,6 +227,7 @@ TranslateResult Translate(const TranslateRequest& request, AstCache* cache, Spir
     if (vulkan) shaders = GenerateShaders(model, options);
     // Lay out: C++ and GLSL as the project's own code looks (clang-format: whitespace only).
     for (auto& [name, text] : result.files) text = FormattedGeneratedCode(text);
+    if (request.backend == Backend::Ispc) result.files[model.className + "_ISPC_kernels.ispc"] = GenerateIspcKernels(model, options);
     for (auto& shader : shaders) shader.glsl = FormattedGeneratedCode(shader.glsl);
     for (auto& shader : shaders) result.files["shaders/" + shader.name + "." + shader.stage] = shader.glsl;
     result.timingsMs["generate"] = MsSince(t0);
@@ -243,7 +246,7 @@ TranslateResult Translate(const TranslateRequest& request, AstCache* cache, Spir
                         "glsl/callable_dispatcher.glsl.mustache", "glsl/callable_payload.glsl.mustache",
                         "glsl/leaf_trace.glsl.mustache", "glsl/virtual_objects.glsl.mustache",
                         "glsl/texture_array.glsl.mustache", "glsl/stage.glsl.mustache", "vulkan/class.h.mustache",
-                        "vulkan/class.cpp.mustache", "cpu/class.h.mustache", "cpu/class.cpp.mustache"})
+                        "vulkan/class.cpp.mustache", "cpu/class.h.mustache", "cpu/class.cpp.mustache", "ispc/kernels.ispc.mustache"})
     result.inputs.push_back(request.templateDir + "/" + t);
   std::sort(result.inputs.begin(), result.inputs.end());
   result.inputs.erase(std::unique(result.inputs.begin(), result.inputs.end()), result.inputs.end());

@@ -40,7 +40,7 @@ std::string TranslatorIdentity(const std::string& executable) {
 
 nlohmann::json ToJson(const engine::TranslateRequest& r) {
   return {{"className", r.className},
-          {"backend", r.backend == engine::Backend::Vulkan ? "vulkan" : "cpu"},
+          {"backend", engine::BackendName(r.backend)},
           {"sources", r.sources},
           {"compileArgs", r.compileArgs},
           {"outputDir", r.outputDir},
@@ -54,8 +54,7 @@ engine::TranslateRequest RequestFromJson(const nlohmann::json& j) {
   engine::TranslateRequest r;
   r.className = j.at("className").get<std::string>();
   std::string backend = j.at("backend").get<std::string>();
-  if (backend != "vulkan" && backend != "cpu") throw std::runtime_error("unknown backend '" + backend + "'");
-  r.backend = backend == "vulkan" ? engine::Backend::Vulkan : engine::Backend::Cpu;
+  if (!engine::ParseBackend(backend, r.backend)) throw std::runtime_error("unknown backend '" + backend + "'");
   r.sources = j.at("sources").get<std::vector<std::string>>();
   r.compileArgs = j.at("compileArgs").get<std::vector<std::string>>();
   r.outputDir = j.at("outputDir").get<std::string>();

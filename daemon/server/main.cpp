@@ -154,7 +154,7 @@ json Handle(Daemon& d, const std::string& line) {
   if (!result.ok) ++d.failures;
   std::string phases;
   for (auto& [phase, t] : result.timingsMs) phases += " " + phase + " " + std::to_string(int(t));
-  d.Log("translate " + tr.className + " (" + (tr.backend == engine::Backend::Vulkan ? "vulkan" : "cpu") + "): " +
+  d.Log("translate " + tr.className + " (" + engine::BackendName(tr.backend) + "): " +
         (result.ok ? "ok" : "failed") + " in " + std::to_string(int(ms)) + " ms (" + phases.substr(phases.empty() ? 0 : 1) + ")");
   d.MaybeCrash("translated");
   return protocol::ResultToJson(result);

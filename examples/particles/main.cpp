@@ -2,6 +2,9 @@
 // Particles_Vulkan (the default Vulkan device), compares results and prints a table of times.
 #include "Particles.h"
 #include "Particles_CPU.h"
+#ifdef CROSSRT_HAS_ISPC
+#include "Particles_ISPC.h"
+#endif
 #include "Particles_Vulkan.h"
 
 #include <cmath>
@@ -27,7 +30,7 @@ int main(int argc, char** argv)
 {
   if (argc > 1 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h"))
   {
-    std::printf("usage: particles [N (default 1048576)] [STEPS (default 10)]\n  Moves N particles STEPS times with the original class, Particles_CPU and Particles_Vulkan, and prints\n  a table of times. Exits non-zero when their results differ.\n");
+    std::printf("usage: particles [N (default 1048576)] [STEPS (default 10)]\n  Moves N particles STEPS times with the original class, Particles_CPU, Particles_ISPC (where built) and Particles_Vulkan, and prints\n  a table of times. Exits non-zero when their results differ.\n");
     return 0;
   }
   const int n = argc > 1 ? std::atoi(argv[1]) : 1 << 20;
@@ -44,6 +47,9 @@ int main(int argc, char** argv)
   std::vector<Run> runs;
   runs.push_back({"original (1 thread)", pos, vel, std::make_shared<Particles>()});
   runs.push_back({"Particles_CPU (OpenMP)", pos, vel, CreateParticles_CPU()});
+#ifdef CROSSRT_HAS_ISPC
+  runs.push_back({"Particles_ISPC", pos, vel, CreateParticles_ISPC()});
+#endif
   try
   {
     runs.push_back({"Particles_Vulkan", pos, vel, CreateParticles_Vulkan()});

@@ -1,0 +1,209 @@
+// The ISPC backend's code: <Class>_ISPC_kernels.ispc (the kernels' thread functions as the printer
+// wrote them in its ISPC dialect, and an export function per kernel that runs one chunk of the loop
+// nest in SIMD lanes) and the data the ISPC class's host code needs to call them (IspcHostData:
+// the class data it fills, the chunks it hands to the cores and how it folds their reductions).
+#include "CodeGen.h"
+#include "CodeGenSupport.h"
+#include "GlslTypes.h"
+
+#include <algorithm>
+#include <set>
+
+namespace crossrt::engine {
+
+namespace {
+
+// The ISA suffixes of the objects ISPC writes for cmake/CrossRT.cmake's targets, in that order
+// (crossrt::IspcPick in runtime/include/crossrt/IspcSupport.h takes them so).
+const char* const kIspcTargetSuffixes[] = {"sse4", "avx2", "avx512skx"};
+
+// Iterations of a 1D loop nest per chunk (2D and 3D nests hand out rows and slices one by one).
+constexpr int kChunk1D = 4096;
+
+bool IsScalar(const std::string& glslType) { return glslType == "float" || glslType == "int" || glslType == "uint" || glslType == "bool"; }
+
+// What C++ passes for an ISPC parameter of this GLSL type: the type ispc::'s header declares.
+std::string IspcCppType(const std::string& glslType) {
+  if (glslType == "int") return "int32_t";
+  if (glslType == "uint") return "uint32_t";
+  if (IsScalar(glslType)) return glslType;
+  return "ispc::" + IspcTypeName(glslType);
+}
+
+// The identity of a reduction, in ISPC: a lane that ran no iteration changes nothing.
+std::string IspcIdentity(ReduceOp op, const std::string& glslType) {
+  const std::string t = IspcTypeName(glslType);
+  const bool floating = t.rfind("float", 0) == 0;
+  std::string scalar = "0";
+  if (op == ReduceOp::Min) scalar = floating ? "floatbits(0x7F800000u)" : t.rfind("uint", 0) == 0 ? "0xFFFFFFFFu" : "2147483647";
+  if (op == ReduceOp::Max) scalar = floating ? "floatbits(0xFF800000u)" : t.rfind("uint", 0) == 0 ? "0u" : "(-2147483647 - 1)";
+  if (op != ReduceOp::Min && op != ReduceOp::Max && floating) scalar = "0.0f";
+  return IsScalar(glslType) ? scalar : "make_" + t + "(" + scalar + ")";
+}
+
+// The lanes' accumulators reduced to one uniform value, component by component, into *partial.
+std::string IspcLaneReduce(ReduceOp op, const std::string& glslType, const std::string& v, const std::string& partial) {
+  const std::string f = op == ReduceOp::Min ? "reduce_min" : op == ReduceOp::Max ? "reduce_max" : "reduce_add";
+  if (IsScalar(glslType)) return "*" + partial + " = " + f + "(" + v + ");";
+  const int n = IspcTypeName(glslType).back() - '0';
+  std::string out;
+  for (int i = 0; i < n; ++i) out += std::string(i ? "\n  " : "") + partial + "->" + "xyzw"[i] + " = " + f + "(" + v + "." + "xyzw"[i] + ");";
+  return out;
+}
+
+// The order GLSL's thread ids come in: x (the innermost loop) first.
+const char* Axis(unsigned d, unsigned dims) { return &"X\0Y\0Z"[2 * (dims - 1 - d)]; }
+
+}  // namespace
+
+std::string GenerateIspcKernels(const ClassModel& model, const GenerateOptions& opt) {
+  Data d = Common(model, opt);
+  // Declarations once each, in the order the printers met them: the class's structs, then the
+  // kernels' own, their constants and helper functions (callees before callers).
+  std::string structs = model.glslClassStructs;
+  std::set<std::string> seen(model.glslClassStructNames.begin(), model.glslClassStructNames.end());
+  std::vector<std::string> functions;
+  std::string constants;
+  Data kernels = List();
+  for (const Kernel& k : model.kernels) {
+    if (k.rtv) continue;
+    for (auto& s : k.structList)
+      if (seen.insert(s.name).second) structs += s.text + "\n";
+    for (auto& c : k.constantList)
+      if (seen.insert(c.name).second) constants += c.text;
+    for (auto& f : k.functionList)
+      if (std::find(functions.begin(), functions.end(), f) == functions.end()) functions.push_back(f);
+    functions.push_back(k.glslBody);
+
+    Data x;
+    x.set("name", k.name);
+    x.set("sourceFile", k.sourceFile);
+    // The outermost loop is cut into chunks [crt_begin, crt_end); the inner ones run whole.
+    std::string params, innerParams, args, loopsOpen, loopsClose, ids;
+    const unsigned dims = unsigned(k.loops.size());
+    for (unsigned a = 1; a < dims; ++a) innerParams += std::string(", uniform int crt_start") + Axis(a, dims) + ", uniform int crt_count" + Axis(a, dims);
+    std::string indent = "  ";
+    for (unsigned a = 0; a < dims; ++a) {
+      const std::string var = k.loops[a].var, axis = Axis(a, dims);
+      if (a + 1 < dims) {
+        loopsOpen += indent + "for (uniform int " + var + " = " + (a == 0 ? "crt_begin" : "crt_start" + axis) + "; " + var + " < " +
+                     (a == 0 ? "crt_end" : "crt_start" + axis + " + crt_count" + axis) + "; ++" + var + ")\n";
+      } else {
+        loopsOpen += indent + "foreach (" + var + " = " + (a == 0 ? "crt_begin ... crt_end" : "crt_start" + axis + " ... crt_start" + axis + " + crt_count" + axis) + ")\n";
+      }
+      indent += "  ";
+    }
+    for (unsigned a = dims; a-- > 0;) ids += ", " + k.loops[a].var;  // x first, as the thread function takes them
+    for (auto& p : k.params) {
+      const auto [base, dims2] = SplitArray(IspcTypeName(p.glslType));
+      if (p.isPointer) params += std::string(", ") + (p.isConstPointee ? "const " : "") + "uniform " + base + " *uniform " + p.glslName;
+      else if (IsScalar(p.glslType)) params += ", uniform " + base + " " + p.glslName + dims2;
+      else params += ", const uniform " + base + " &" + p.glslName;  // structs by reference: C++ passes them so
+      args += ", " + p.glslName;
+    }
+    Data reds = List();
+    for (auto& r : k.reductions) {
+      params += ", uniform " + IspcTypeName(r.glslType) + " *uniform " + r.member + "Partial";
+      args += ", " + r.member + "Local";
+      Data y;
+      y.set("member", r.member);
+      y.set("type", IspcTypeName(r.glslType));
+      y.set("identity", IspcIdentity(r.op, r.glslType));
+      y.set("reduced", IspcLaneReduce(r.op, r.glslType, r.member + "Local", r.member + "Partial"));
+      reds.push_back(y);
+    }
+    x.set("params", innerParams + params);
+    x.set("loops", loopsOpen);
+    x.set("call", indent + k.name + "(self" + ids + args + ");");
+    x.set("reductions", reds);
+    kernels.push_back(x);
+  }
+  std::string code;
+  for (auto& f : functions) code += f + "\n";
+  d.set("structs", structs);
+  d.set("constants", constants);
+  d.set("functions", code);
+  d.set("kernels", kernels);
+  Data members = List(), vectors = List();
+  for (auto& m : model.members) {
+    if (!m.usedByKernels) continue;
+    Data x;
+    x.set("name", m.name);
+    const auto [base, dims] = SplitArray(IspcTypeName(m.glslType));
+    x.set("declaration", (m.kind == MemberKind::Vector ? "uniform " + base + " *" + m.name : base + " " + m.name + dims) + ";");
+    if (m.kind == MemberKind::Plain) members.push_back(x);
+    if (m.kind == MemberKind::Vector) vectors.push_back(x);
+  }
+  d.set("members", members);
+  d.set("vectors", vectors);
+  return Render(opt.templateDir + "/ispc/kernels.ispc.mustache", d);
+}
+
+void IspcHostData(const ClassModel& model, Data& d) {
+  Data members = List(), vectors = List();
+  for (auto& m : model.members) {
+    if (!m.usedByKernels) continue;
+    Data x;
+    x.set("name", m.name);
+    if (m.kind == MemberKind::Plain) members.push_back(x);
+    if (m.kind == MemberKind::Vector) vectors.push_back(x);
+  }
+  d.set("ispcMembers", members);
+  d.set("ispcVectors", vectors);
+  Data kernels = List();
+  for (const Kernel& k : model.kernels) {
+    if (k.rtv) continue;
+    Data x;
+    x.set("name", k.name);
+    x.set("sourceFile", k.sourceFile);
+    x.set("paramsDecl", k.cppParamsDecl);
+    x.set("preamble", IndentTail(k.cpuPreamble, "  "));
+    x.set("hasPreamble", !k.cpuPreamble.empty());
+    x.set("postamble", IndentTail(k.cpuPostamble, "  "));
+    x.set("hasPostamble", !k.cpuPostamble.empty());
+    const unsigned dims = unsigned(k.loops.size());
+    Data loops = List();
+    std::string innerArgs;
+    for (unsigned a = 0; a < dims; ++a) {
+      Data l;
+      l.set("axis", Axis(a, dims));
+      l.set("start", k.loops[a].startCpp);
+      l.set("count", k.loops[a].countCpp);
+      loops.push_back(l);
+      if (a > 0) innerArgs += std::string(", crt_start") + Axis(a, dims) + ", crt_count" + Axis(a, dims);
+    }
+    x.set("loops", loops);
+    x.set("outer", Axis(0, dims));
+    x.set("chunk", std::to_string(dims == 1 ? kChunk1D : 1));
+    x.set("chunkWhat", dims == 1 ? std::to_string(kChunk1D) + " iterations" : dims == 2 ? "one row" : "one slice");
+    x.set("innerArgs", innerArgs);
+    std::string args;
+    for (auto& p : k.params) {
+      if (p.isPointer) args += ", crossrt::IspcPointer<" + std::string(p.isConstPointee ? "const " : "") + IspcCppType(p.glslType) + "*>(" + p.name + ")";
+      else if (IsScalar(p.glslType)) args += ", " + p.name;
+      else args += ", crossrt::IspcReference<" + IspcCppType(p.glslType) + ">(" + p.name + ")";
+    }
+    Data reds = List();
+    for (auto& r : k.reductions) {
+      const std::string cppType = ReductionCppType(model, r);
+      args += ", crossrt::IspcPointer<" + IspcCppType(r.glslType) + "*>(&" + r.member + "Partials[crt_chunk])";
+      Data y;
+      y.set("member", r.member);
+      y.set("cppType", cppType);
+      const char* ns = IsScalar(r.glslType) ? "std::" : "LiteMath::";
+      y.set("fold", r.op == ReduceOp::Min   ? std::string(ns) + "min(" + r.member + ", partial)"
+                    : r.op == ReduceOp::Max ? std::string(ns) + "max(" + r.member + ", partial)"
+                                            : r.member + " + partial");
+      reds.push_back(y);
+    }
+    x.set("args", args);
+    x.set("reductions", reds);
+    std::string targets;
+    for (const char* t : kIspcTargetSuffixes) targets += std::string(targets.empty() ? "" : ", ") + model.className + "_" + k.name + "_" + t;
+    x.set("targetFunctions", targets);
+    kernels.push_back(x);
+  }
+  d.set("ispcKernels", kernels);
+}
+
+}  // namespace crossrt::engine

@@ -1,0 +1,65 @@
+// What the ISPC backend's generated classes call around their ISPC kernels (header only): passing
+// C++ objects to the ISPC functions (whose header declares its own structs of the same layout),
+// and choosing the compiled target, for tests that force one.
+#pragma once
+
+#include <cstdlib>
+#include <cstring>
+#include <initializer_list>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+
+namespace crossrt {
+
+// A C++ pointer as the ISPC header's pointer type (LiteMath::float4* as ispc::float4*): the
+// layouts are the same, which the generated structs' padding ensures.
+template <class To, class From>
+To IspcPointer(From* p) {
+  return reinterpret_cast<To>(const_cast<std::remove_const_t<From>*>(p));
+}
+// A C++ object as the ISPC header's type of the same layout, by reference.
+template <class To, class From>
+const To& IspcReference(const From& value) {
+  static_assert(sizeof(To) == sizeof(From), "the ISPC struct and the C++ type differ in size");
+  return *reinterpret_cast<const To*>(&value);
+}
+// A member copied into the ISPC class data.
+template <class To, class From>
+void IspcCopy(To& to, const From& from) {
+  static_assert(sizeof(To) == sizeof(From), "the ISPC struct and the C++ type differ in size");
+  std::memcpy(static_cast<void*>(&to), static_cast<const void*>(&from), sizeof to);
+}
+
+// The ISPC targets every generated class is compiled for, in the order of CrossRT.cmake's
+// CROSSRT_ISPC_TARGETS, and whether this CPU runs each.
+inline const char* const kIspcTargets[] = {"sse4", "avx2", "avx512skx"};
+inline bool CpuRunsIspcTarget(int index) {
+  __builtin_cpu_init();
+  switch (index) {
+    case 0: return __builtin_cpu_supports("sse4.2");
+    case 1: return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+    default:
+      return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512cd") &&
+             __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl");
+  }
+}
+
+// The function an ISPC kernel runs: `dispatch` (ISPC's own choice of the best target this CPU has)
+// unless CROSSRT_ISPC_TARGET names one of kIspcTargets, whose version of the function it then is.
+// A name it does not know, or a target this CPU cannot run, throws with what to set instead.
+template <class F>
+F IspcPick(F dispatch, std::initializer_list<F> perTarget) {
+  const char* forced = std::getenv("CROSSRT_ISPC_TARGET");
+  if (!forced || !*forced || std::string(forced) == "auto") return dispatch;
+  std::string known;
+  for (int i = 0; i < int(std::size(kIspcTargets)); ++i) {
+    known += std::string(i ? ", " : "") + kIspcTargets[i];
+    if (forced != std::string(kIspcTargets[i])) continue;
+    if (!CpuRunsIspcTarget(i)) throw std::runtime_error(std::string("CROSSRT_ISPC_TARGET=") + forced + ": this CPU cannot run that ISPC target");
+    return perTarget.begin()[i];
+  }
+  throw std::runtime_error(std::string("CROSSRT_ISPC_TARGET=") + forced + " is not a target the ISPC classes are built for (" + known + ", or auto)");
+}
+
+}  // namespace crossrt
