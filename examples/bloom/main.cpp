@@ -4,6 +4,9 @@
 // Without an input (or with "") it renders its own HDR test scene (lights over a dark gradient).
 #include "Bloom.h"
 #include "Bloom_CPU.h"
+#ifdef CROSSRT_HAS_ISPC
+#include "Bloom_ISPC.h"
+#endif
 #include "Bloom_Vulkan.h"
 #include "Image2D.h"
 
@@ -40,7 +43,7 @@ int main(int argc, char** argv)
 {
   if (argc > 1 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h"))
   {
-    std::printf("usage: bloom [INPUT_IMAGE | \"\"] [OUTPUT.png]\n  Bloom of INPUT_IMAGE (\"\" or none: a built-in scene) by the original class, Bloom_CPU and Bloom_Vulkan;\n  writes OUTPUT.png (default bloom.png) and a table of times. Exits non-zero when they differ.\n");
+    std::printf("usage: bloom [INPUT_IMAGE | \"\"] [OUTPUT.png]\n  Bloom of INPUT_IMAGE (\"\" or none: a built-in scene) by the original class, Bloom_CPU, Bloom_ISPC (where built) and Bloom_Vulkan;\n  writes OUTPUT.png (default bloom.png) and a table of times. Exits non-zero when they differ.\n");
     return 0;
   }
   LiteImage::Image2D<float4> input;
@@ -58,6 +61,9 @@ int main(int argc, char** argv)
   std::vector<Run> runs;
   runs.push_back({"original (1 thread)", std::make_shared<Bloom>(w, h, 12, 5.0f), {}});
   runs.push_back({"Bloom_CPU (OpenMP)", CreateBloom_CPU(w, h, 12, 5.0f), {}});
+#ifdef CROSSRT_HAS_ISPC
+  runs.push_back({"Bloom_ISPC", CreateBloom_ISPC(w, h, 12, 5.0f), {}});
+#endif
   try
   {
     runs.push_back({"Bloom_Vulkan", CreateBloom_Vulkan(w, h, 12, 5.0f), {}});
