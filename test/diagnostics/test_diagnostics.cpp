@@ -104,6 +104,37 @@ TEST_CASE("Unsupported constructs in kernels give file:line:col diagnostics with
   }
 }
 
+TEST_CASE("What the ISPC backend does not translate yet is an error at the user's code, with a hint", "[diagnostics][ispc]")
+{
+  const Case ispcCases[] = {
+      {"atomic", "    x += float(crossrt::AtomicAdd(m_counts[i], 1u));", "  std::vector<uint32_t> m_counts;", "",
+       "an atomic operation ('crossrt::AtomicAdd') is not translated to ISPC yet", "BACKEND cpu (OpenMP) or vulkan", 8},
+      {"append", "    m_hits.push_back(x);", "  std::vector<float> m_hits;", "",
+       "std::vector::push_back of a member in a kernel is not translated to ISPC yet", "BACKEND cpu (OpenMP) or vulkan", 8},
+      {"vector component by a variable index", "    LiteMath::float4 v(x); x = v[i % 4];", "", "",
+       "a vector's component by a variable index is not translated to ISPC yet", "BACKEND cpu (OpenMP) or vulkan", 8},
+      {"matrix", "    LiteMath::float4x4 m; x = m.get_col(0).x;", "", "",
+       "type 'LiteMath::float4x4' is not translated to ISPC yet", "BACKEND cpu (OpenMP) or vulkan", 8},
+  };
+  for (const Case& c : ispcCases)
+  {
+    SECTION(c.name)
+    {
+      TempClass tc("Bad", Header(c), Source(c));
+      const std::string out = (tc.dir / "out").string();
+      CommandResult r = RunCrossrt("translate --no-daemon --class Bad --backend ispc --out " + out + " --source " + tc.Source("Bad") +
+                                   " --templates " CROSSRT_SOURCE_DIR "/templates -- -I" CROSSRT_SOURCE_DIR "/libs/litemath");
+      INFO(r.output);
+      REQUIRE_FALSE(r.crashed);
+      REQUIRE(r.exitCode == 1);
+      REQUIRE(r.output.find(tc.Source("Bad") + ":" + std::to_string(c.expectedLine) + ":") != std::string::npos);
+      REQUIRE(r.output.find(c.expectedMessage) != std::string::npos);
+      REQUIRE(r.output.find(c.expectedHint) != std::string::npos);
+      REQUIRE_FALSE(fs::exists(out));
+    }
+  }
+}
+
 TEST_CASE("A pointer parameter of a control function without a size is reported", "[diagnostics]")
 {
   TempClass tc("NoSize", R"(#pragma once
@@ -218,7 +249,7 @@ TEST_CASE("Bad command lines get a usage message", "[diagnostics]")
 {
   CommandResult r = RunCrossrt("translate --class X --backend metal --out /tmp/x --source /tmp/x.cpp");
   REQUIRE(r.exitCode == 2);
-  REQUIRE(r.output.find("--backend must be 'vulkan' or 'cpu'") != std::string::npos);
+  REQUIRE(r.output.find("--backend must be 'vulkan', 'cpu' or 'ispc'") != std::string::npos);
   r = RunCrossrt("translate --class X --backend cpu --out /tmp/x --source /nonexistent/x.cpp");
   REQUIRE(r.exitCode == 1);
   REQUIRE(r.output.find("source file '/nonexistent/x.cpp' does not exist") != std::string::npos);
