@@ -52,7 +52,10 @@ std::string IspcLaneReduce(ReduceOp op, const std::string& glslType, const std::
 }
 
 // The order GLSL's thread ids come in: x (the innermost loop) first.
-const char* Axis(unsigned d, unsigned dims) { return &"X\0Y\0Z"[2 * (dims - 1 - d)]; }
+const char* Axis(unsigned d, unsigned dims) {
+  const unsigned fromInnermost = d < dims ? dims - 1 - d : 0;
+  return fromInnermost == 0 ? "X" : fromInnermost == 1 ? "Y" : "Z";
+}
 
 }  // namespace
 
