@@ -240,6 +240,18 @@ Data ClassDataList(const ClassModel& model) {
 
 }  // namespace
 
+Data CpuKernelData(const Kernel& k) {
+  Data x;
+    x.set("name", k.name);
+    x.set("sourceFile", k.sourceFile);
+    x.set("paramsDecl", k.cppParamsDecl);
+    x.set("preamble", IndentTail(k.cpuPreamble, "  "));
+    x.set("hasPreamble", !k.cpuPreamble.empty());
+    x.set("postamble", IndentTail(k.cpuPostamble, "  "));
+    x.set("hasPostamble", !k.cpuPostamble.empty());
+  return x;
+}
+
 Data Common(const ClassModel& model, const GenerateOptions& opt) {
   Data d;
   d.set("className", model.className);

@@ -89,6 +89,9 @@ std::string LaunchSize(const Kernel& k);
 std::string ReductionCppType(const ClassModel& model, const Reduction& r);
 
 Data Common(const ClassModel& model, const GenerateOptions& opt);
+// What the CPU and ISPC classes' kernel functions share: name, source, parameters, and the
+// statements before and after the loop nest that the host runs.
+Data CpuKernelData(const Kernel& k);
 // The ISPC class's host data (IspcCode.cpp): the members it passes, its kernels' chunks and reductions.
 void IspcHostData(const ClassModel& model, Data& d);
 

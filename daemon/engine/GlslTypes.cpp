@@ -203,8 +203,8 @@ std::string IspcTypeName(const std::string& glslType) {
   auto [base, dims] = SplitArray(glslType);
   static const std::map<std::string, std::string> names = {
       {"vec2", "float2"}, {"vec3", "float3"}, {"vec4", "float4"}, {"ivec2", "int2"}, {"ivec3", "int3"},
-      {"ivec4", "int4"}, {"uvec2", "uint2"}, {"uvec3", "uint3"}, {"uvec4", "uint4"}, {"bvec2", "bool2"},
-      {"bvec3", "bool3"}, {"bvec4", "bool4"}, {"mat3", "float3x3"}, {"mat4", "float4x4"}};
+      {"ivec4", "int4"}, {"uvec2", "uint2"}, {"uvec3", "uint3"}, {"uvec4", "uint4"}, {"mat3", "float3x3"},
+      {"mat4", "float4x4"}};
   auto it = names.find(base);
   return (it == names.end() ? base : it->second) + dims;
 }

@@ -102,14 +102,7 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
   for (auto& k : model.kernels) {
     if (k.rtv) continue;  // kernel_* bodies are inherited; their loops are parallelised in the control function
     if (model.forIspc) continue;  // IspcHostData's
-    Data x;
-    x.set("name", k.name);
-    x.set("sourceFile", k.sourceFile);
-    x.set("paramsDecl", k.cppParamsDecl);
-    x.set("preamble", IndentTail(k.cpuPreamble, "  "));
-    x.set("hasPreamble", !k.cpuPreamble.empty());
-    x.set("postamble", IndentTail(k.cpuPostamble, "  "));
-    x.set("hasPostamble", !k.cpuPostamble.empty());
+    Data x = CpuKernelData(k);
     x.set("loopNest", IndentTail(k.cpuLoopNest, "  "));
     // Dynamic chunks: iterations may cost very different amounts (a ray that hits against one that
     // misses). With static halves PrimaryRays_CPU cast the bunny's rays at 0.57-0.63x of Embree,

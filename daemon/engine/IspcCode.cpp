@@ -82,7 +82,7 @@ std::string GenerateIspcKernels(const ClassModel& model, const GenerateOptions& 
     x.set("name", k.name);
     x.set("sourceFile", k.sourceFile);
     // The outermost loop is cut into chunks [crt_begin, crt_end); the inner ones run whole.
-    std::string params, innerParams, args, loopsOpen, loopsClose, ids;
+    std::string params, innerParams, args, loopsOpen, ids;
     const unsigned dims = unsigned(k.loops.size());
     for (unsigned a = 1; a < dims; ++a) innerParams += std::string(", uniform int crt_start") + Axis(a, dims) + ", uniform int crt_count" + Axis(a, dims);
     std::string indent = "  ";
@@ -156,14 +156,7 @@ void IspcHostData(const ClassModel& model, Data& d) {
   Data kernels = List();
   for (const Kernel& k : model.kernels) {
     if (k.rtv) continue;
-    Data x;
-    x.set("name", k.name);
-    x.set("sourceFile", k.sourceFile);
-    x.set("paramsDecl", k.cppParamsDecl);
-    x.set("preamble", IndentTail(k.cpuPreamble, "  "));
-    x.set("hasPreamble", !k.cpuPreamble.empty());
-    x.set("postamble", IndentTail(k.cpuPostamble, "  "));
-    x.set("hasPostamble", !k.cpuPostamble.empty());
+    Data x = CpuKernelData(k);
     const unsigned dims = unsigned(k.loops.size());
     Data loops = List();
     std::string innerArgs;

@@ -78,29 +78,33 @@ const Case kCases[] = {
      "control function 'Outer' calls control function 'Run'", "one submission", 12},
 };
 
+// Translates the case's class for `backend`: exit status 1, no crash, nothing written, and an
+// error at the expected line of Bad.cpp with the expected message and hint.
+void RequireDiagnostic(const Case& c, const std::string& backend)
+{
+  TempClass tc("Bad", Header(c), Source(c));
+  const std::string out = (tc.dir / "out").string();
+  CommandResult r = RunCrossrt("translate --class Bad --backend " + backend + " --out " + out + " --source " + tc.Source("Bad") +
+                               " --templates " CROSSRT_SOURCE_DIR "/templates -- -I" CROSSRT_SOURCE_DIR "/libs/litemath");
+  INFO(r.output);
+  REQUIRE_FALSE(r.crashed);
+  REQUIRE(r.exitCode == 1);
+  const std::string where = tc.Source("Bad") + ":" + std::to_string(c.expectedLine) + ":";
+  REQUIRE(r.output.find(where) != std::string::npos);
+  REQUIRE(std::regex_search(r.output, std::regex(R"(Bad\.cpp:\d+:\d+: error: )")));
+  REQUIRE(r.output.find(c.expectedMessage) != std::string::npos);
+  REQUIRE(r.output.find("note: hint: ") != std::string::npos);
+  REQUIRE(r.output.find(c.expectedHint) != std::string::npos);
+  REQUIRE_FALSE(fs::exists(out));  // nothing written on failure
+}
+
 }  // namespace
 
 TEST_CASE("Unsupported constructs in kernels give file:line:col diagnostics with hints", "[diagnostics]")
 {
   for (const Case& c : kCases)
   {
-    SECTION(c.name)
-    {
-      TempClass tc("Bad", Header(c), Source(c));
-      const std::string out = (tc.dir / "out").string();
-      CommandResult r = RunCrossrt("translate --class Bad --backend vulkan --out " + out + " --source " + tc.Source("Bad") +
-                                   " --templates " CROSSRT_SOURCE_DIR "/templates -- -I" CROSSRT_SOURCE_DIR "/libs/litemath");
-      INFO(r.output);
-      REQUIRE_FALSE(r.crashed);
-      REQUIRE(r.exitCode == 1);
-      const std::string where = tc.Source("Bad") + ":" + std::to_string(c.expectedLine) + ":";
-      REQUIRE(r.output.find(where) != std::string::npos);
-      REQUIRE(std::regex_search(r.output, std::regex(R"(Bad\.cpp:\d+:\d+: error: )")));
-      REQUIRE(r.output.find(c.expectedMessage) != std::string::npos);
-      REQUIRE(r.output.find("note: hint: ") != std::string::npos);
-      REQUIRE(r.output.find(c.expectedHint) != std::string::npos);
-      REQUIRE_FALSE(fs::exists(out));  // nothing written on failure
-    }
+    SECTION(c.name) { RequireDiagnostic(c, "vulkan"); }
   }
 }
 
@@ -118,20 +122,7 @@ TEST_CASE("What the ISPC backend does not translate yet is an error at the user'
   };
   for (const Case& c : ispcCases)
   {
-    SECTION(c.name)
-    {
-      TempClass tc("Bad", Header(c), Source(c));
-      const std::string out = (tc.dir / "out").string();
-      CommandResult r = RunCrossrt("translate --no-daemon --class Bad --backend ispc --out " + out + " --source " + tc.Source("Bad") +
-                                   " --templates " CROSSRT_SOURCE_DIR "/templates -- -I" CROSSRT_SOURCE_DIR "/libs/litemath");
-      INFO(r.output);
-      REQUIRE_FALSE(r.crashed);
-      REQUIRE(r.exitCode == 1);
-      REQUIRE(r.output.find(tc.Source("Bad") + ":" + std::to_string(c.expectedLine) + ":") != std::string::npos);
-      REQUIRE(r.output.find(c.expectedMessage) != std::string::npos);
-      REQUIRE(r.output.find(c.expectedHint) != std::string::npos);
-      REQUIRE_FALSE(fs::exists(out));
-    }
+    SECTION(c.name) { RequireDiagnostic(c, "ispc"); }
   }
 }
 
