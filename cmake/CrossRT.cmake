@@ -199,7 +199,8 @@ function(crossrt_add_class target class)
   if(suffix STREQUAL "ISPC")
     # The kernels, compiled for every target in CROSSRT_ISPC_TARGETS with ISPC's run-time dispatch:
     # one object per target and the dispatcher, and the header the generated class includes.
-    # Without fused multiply-adds, as the C++ and the Vulkan shaders compute (NoContraction).
+    # Without fused multiply-adds, as the C++ and the Vulkan shaders compute (NoContraction); the
+    # fma() a kernel calls is LLVM's, exact as C++'s std::fma (--enable-llvm-intrinsics).
     set(ispc_object ${out_dir}/${name}_ISPC_kernels${CMAKE_CXX_OUTPUT_EXTENSION})
     set(ispc_header ${out_dir}/${name}_ISPC_kernels_ispc.h)
     set(ispc_objects ${ispc_object})
@@ -212,7 +213,7 @@ function(crossrt_add_class target class)
     add_custom_command(
       OUTPUT ${ispc_objects} ${ispc_header}
       COMMAND ${CROSSRT_ISPC_EXECUTABLE} ${ispc_source} -o ${ispc_object} -h ${ispc_header}
-              --target=${ispc_targets} -O2 --pic --wno-perf --opt=disable-fma
+              --target=${ispc_targets} -O2 --pic --wno-perf --opt=disable-fma --enable-llvm-intrinsics
               "$<$<BOOL:${runtime_inc}>:-I$<JOIN:${runtime_inc},$<SEMICOLON>-I>>"
               -M -MF ${ispc_object}.d -MT ${ispc_object}
       DEPENDS ${ispc_source}

@@ -68,7 +68,7 @@ std::string GlslPrinter::IspcFail(SourceLocation loc, const std::string& what) {
   return Fail(loc, what + " is not translated to ISPC yet", "translate this class with BACKEND cpu (OpenMP) or vulkan");
 }
 
-std::string GlslPrinter::DataStruct() const { return m_class->getNameAsString() + "_Data"; }
+std::string GlslPrinter::DataStruct() const { return ispcDataStruct.empty() ? m_class->getNameAsString() + "_Data" : ispcDataStruct; }
 
 std::optional<std::string> GlslPrinter::Type(QualType t, SourceLocation loc) {
   QualType base = t.getNonReferenceType();
@@ -96,7 +96,7 @@ std::optional<std::string> GlslPrinter::Type(QualType t, SourceLocation loc) {
   }
   if (auto* rd = base->getAsCXXRecordDecl(); rd && !IsLiteMathType(base, nullptr)) NeedStruct(rd);
   if (ispc) {
-    if (g->find("mat") != std::string::npos || g->find("bvec") != std::string::npos) {
+    if (g->find("bvec") != std::string::npos) {
       IspcFail(loc, "type '" + t.getAsString(m_ctx.getPrintingPolicy()) + "'");
       return std::nullopt;
     }
@@ -291,7 +291,9 @@ std::string GlslPrinter::IspcConstruct(QualType t, const std::string& type, cons
     return "{" + list(values) + "}";
   }
   auto* rd = t.getCanonicalType()->getAsCXXRecordDecl();
-  if (!rd) return values.empty() ? "((" + type + ")0)" : "((" + type + ")(" + values[0] + "))";  // a scalar
+  if (!rd && values.empty())  // a scalar's zero: a literal, varying or uniform as its use needs
+    return type == "float" ? "0.0f" : type == "uint" ? "0u" : type == "bool" ? "false" : type == "int" ? "0" : "((" + type + ")0)";
+  if (!rd) return "((" + type + ")(" + values[0] + "))";
   if (values.empty() && !IsLiteMathType(t))  // value-initialised struct: default member initialisers, else zero
     for (auto* f : rd->fields())
       values.push_back(f->hasInClassInitializer() && f->getInClassInitializer() ? Expr(f->getInClassInitializer())
@@ -450,6 +452,7 @@ std::string GlslPrinter::ComposedCall(const CXXMemberCallExpr* mc) {
                 "name the implementation the GPU runs: crossrt_add_class(... COMPOSE " + interface +
                 "=<Implementation>), e.g. ISceneObject=BVHScene, and list its source file in SOURCES");
   std::vector<std::string> args;
+  if (ispc) args.push_back("self");  // the implementation's data is the class's, under the holder's prefix
   for (auto* arg : mc->arguments()) args.push_back(Expr(arg));
   Type(mc->getType(), mc->getBeginLoc());  // declares a returned struct (CRT_Hit)
   m_uses.composedCalls.insert({holder, method});
@@ -627,7 +630,7 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
                   "convert it first: to_float4(h).x, float4(h)");
     // LiteMath's matrices keep their columns in m_col, which GLSL's matrices index directly.
     if (field->getName() == "m_col" && (IsLiteMathType(me->getBase()->getType(), "float4x4") || IsLiteMathType(me->getBase()->getType(), "float3x3")))
-      return Expr(me->getBase());
+      return ispc ? Expr(me->getBase()) + ".m_col" : Expr(me->getBase());
     if (me->isArrow()) {  // p->f: the field of what p points at
       auto t = Pointer(me->getBase());
       return t ? Pointee(*t, nullptr, e->getBeginLoc()) + "." + field->getNameAsString() : "/*error*/";
@@ -693,6 +696,8 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
     return Fail(e->getBeginLoc(), "operator not supported in kernels", "");
   }
   if (auto* bo = dyn_cast<BinaryOperator>(e)) {
+    if (ispc && bo->isAssignmentOp())
+      if (std::string set = IspcComponentAssignment(bo); !set.empty()) return set;
     if (bo->isAssignmentOp()) {  // m_img[p].x = v: the analysis reports it for members; parameters here
       const clang::Expr* part = bo->getLHS()->IgnoreParenImpCasts();
       while (auto* me = dyn_cast<MemberExpr>(part)) part = me->getBase()->IgnoreParenImpCasts();
@@ -768,11 +773,15 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
   return Fail(e->getBeginLoc(), std::string("expression '") + e->getStmtClassName() + "' is not supported in kernels", "");
 }
 
-// LiteMath's vector operators that ISPC's struct operators cannot be: compound assignment (written
-// out, the target printed twice), negation (LiteMath.isph's neg), a component by a constant index.
+// LiteMath's vector and matrix operators that ISPC's struct operators cannot be: compound assignment
+// (written out, the target printed twice), negation (LiteMath.isph's neg), a component by index (a
+// constant: the field; else LiteMath.isph's crt_get), a matrix's column m[i] and element m(r, c).
 std::string GlslPrinter::IspcVectorOperator(const CXXOperatorCallExpr* op) {
   if (op->getNumArgs() == 0 || !IsLiteMathType(op->getArg(0)->getType().getNonReferenceType())) return "";
   const auto kind = op->getOperator();
+  const bool matrix = IsLiteMathType(op->getArg(0)->getType().getNonReferenceType(), "float4x4") ||
+                      IsLiteMathType(op->getArg(0)->getType().getNonReferenceType(), "float3x3");
+  if (kind == OO_Minus && op->getNumArgs() == 1 && matrix) return "((" + Expr(op->getArg(0)) + ") * -1.0f)";
   if (kind == OO_Minus && op->getNumArgs() == 1) return "neg(" + Expr(op->getArg(0)) + ")";
   if (kind == OO_Plus && op->getNumArgs() == 1) return Expr(op->getArg(0));
   if ((kind == OO_PlusEqual || kind == OO_MinusEqual || kind == OO_StarEqual || kind == OO_SlashEqual) && op->getNumArgs() == 2) {
@@ -781,14 +790,35 @@ std::string GlslPrinter::IspcVectorOperator(const CXXOperatorCallExpr* op) {
     const std::string target = Expr(op->getArg(0)), spelling = getOperatorSpelling(kind);
     return target + " = " + target + " " + spelling.substr(0, 1) + " (" + Expr(op->getArg(1)) + ")";
   }
+  if (kind == OO_Subscript && matrix) return "(" + Expr(op->getArg(0)) + ").m_col[" + Expr(op->getArg(1)) + "]";  // column i
+  if (kind == OO_Call && matrix && op->getNumArgs() == 3)  // m(row, col)
+    return "crt_get((" + Expr(op->getArg(0)) + ").m_col[" + Expr(op->getArg(2)) + "], " + Expr(op->getArg(1)) + ")";
   if (kind == OO_Subscript) {
     clang::Expr::EvalResult index;
-    if (!op->getArg(1)->EvaluateAsInt(index, m_ctx) || index.Val.getInt().getExtValue() < 0 || index.Val.getInt().getExtValue() > 3)
-      return IspcFail(op->getBeginLoc(), "a vector's component by a variable index");
+    if (!op->getArg(1)->EvaluateAsInt(index, m_ctx))
+      return "crt_get(" + Expr(op->getArg(0)) + ", " + Expr(op->getArg(1)) + ")";  // LiteMath.isph: a select per component
+    if (index.Val.getInt().getExtValue() < 0 || index.Val.getInt().getExtValue() > 3)
+      return IspcFail(op->getBeginLoc(), "a vector's component by an index out of its range");
     return "(" + Expr(op->getArg(0)) + ")." + std::string(1, "xyzw"[index.Val.getInt().getExtValue()]);
   }
   if (kind == OO_EqualEqual || kind == OO_ExclaimEqual) return IspcFail(op->getBeginLoc(), "comparison of whole vectors");
   return "";
+}
+
+// v[i] = a and v[i] op= a, where v is a LiteMath vector and i known only at run time: ISPC's structs
+// have no subscript, so LiteMath.isph's crt_set writes the component (v and i printed twice for op=).
+std::string GlslPrinter::IspcComponentAssignment(const BinaryOperator* bo) {
+  auto* op = dyn_cast<CXXOperatorCallExpr>(bo->getLHS()->IgnoreParenImpCasts());
+  if (!op || op->getOperator() != OO_Subscript || op->getNumArgs() != 2) return "";
+  const auto glsl = GlslTypeOf(op->getArg(0)->getType().getNonReferenceType());
+  clang::Expr::EvalResult index;
+  if (!glsl || glsl->find("vec") == std::string::npos || op->getArg(1)->EvaluateAsInt(index, m_ctx)) return "";
+  const std::string v = Expr(op->getArg(0)), i = Expr(op->getArg(1));
+  if (bo->getOpcode() == BO_Assign) return "crt_set(" + v + ", " + i + ", " + Expr(bo->getRHS()) + ")";
+  if (op->getArg(0)->HasSideEffects(m_ctx, false) || op->getArg(1)->HasSideEffects(m_ctx, false))
+    return IspcFail(bo->getBeginLoc(), "compound assignment to a vector's component whose vector or index has side effects");
+  const std::string spelling = BinaryOperator::getOpcodeStr(BinaryOperator::getOpForCompoundAssignment(bo->getOpcode())).str();
+  return "crt_set(" + v + ", " + i + ", crt_get(" + v + ", " + i + ") " + spelling + " (" + Expr(bo->getRHS()) + "))";
 }
 
 std::string GlslPrinter::ThreadBody(const clang::Stmt* body, int indent, bool loopBody) {

@@ -100,9 +100,11 @@ public:
   // constructors, C casts, references for inout parameters, members read through `self` (a pointer
   // to <Class>_Data, which the class's methods take first), and the built-ins of LiteMath.isph.
   bool ispc = false;
-  // The ISPC data struct's name and the text of a member through it ("self->m_x").
+  // The ISPC data struct's name and the text of a member through it ("self->m_x"). A composed
+  // implementation's printer names the class's (ispcDataStruct): its members are the class's too.
+  std::string ispcDataStruct;
   std::string DataStruct() const;
-  std::string IspcMember(const std::string& name) const { return "self->" + name; }
+  std::string IspcMember(const std::string& name) const { return "self->" + composedPrefix + name; }
 
   // Printing statements one thread runs (before or after a kernel's loop nest): a member vector that
   // kernels append to may be emptied there (its count restarts).
@@ -210,6 +212,8 @@ private:
   std::string IspcFail(clang::SourceLocation loc, const std::string& what);
   // `a op= b` on LiteMath vectors (ISPC overloads no compound assignment), `-v`.
   std::string IspcVectorOperator(const clang::CXXOperatorCallExpr* op);
+  // `v[i] = a`, `v[i] op= a` with i known only at run time; "" for other assignments.
+  std::string IspcComponentAssignment(const clang::BinaryOperator* bo);
 
   clang::ASTContext& m_ctx;
   const clang::CXXRecordDecl* m_class;

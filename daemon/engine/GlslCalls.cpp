@@ -89,9 +89,10 @@ std::string GlslPrinter::Builtin(const FunctionDecl* fd, const std::vector<std::
       {"determinant", "determinant"}, {"inverse3x3", "inverse"}};
   // GCC/Clang bit builtins (C++ leaves clz and ctz of 0 undefined).
   if (fd->getBuiltinID() != 0) {
-    if (n == "__builtin_clz") return "(31 - findMSB(uint(" + a[0] + ")))";
-    if (n == "__builtin_ctz") return "findLSB(uint(" + a[0] + "))";
-    if (n == "__builtin_popcount") return "bitCount(uint(" + a[0] + "))";
+    const std::string u = ispc ? "((uint)(" + a[0] + "))" : "uint(" + a[0] + ")";
+    if (n == "__builtin_clz") return "(31 - findMSB(" + u + "))";
+    if (n == "__builtin_ctz") return "findLSB(" + u + ")";
+    if (n == "__builtin_popcount") return "bitCount(" + u + ")";
   }
   bool library = IsSystemDecl(fd) || InNamespace(fd, "LiteMath");
   if (!library) return "";
@@ -148,7 +149,7 @@ std::string GlslPrinter::Builtin(const FunctionDecl* fd, const std::vector<std::
 }
 
 // The same for ISPC: LiteMath.isph has LiteMath's constructors and conversions under their own
-// names (make_float3, to_float3), GLSL's functions under GLSL's (`same`), and no matrices yet.
+// names (make_float3, to_float3), GLSL's functions under GLSL's (`same`), and LiteMath's matrices.
 std::string GlslPrinter::IspcBuiltin(const FunctionDecl* fd, const std::vector<std::string>& a, const CallExpr* call,
                                      const std::map<std::string, std::string>& same) {
   const std::string n = fd->getNameAsString();
@@ -169,14 +170,17 @@ std::string GlslPrinter::IspcBuiltin(const FunctionDecl* fd, const std::vector<s
   if (n == "as_int") return "floatBitsToInt(" + a[0] + ")";
   if (n == "as_uint") return "floatBitsToUint(" + a[0] + ")";
   if (n == "as_float") return (arg0Type[0] == 'u' ? "uintBitsToFloat(" : "intBitsToFloat(") + a[0] + ")";
-  if (n == "hmin" || n == "hmax") {
-    const char* f = n == "hmin" ? "min" : "max";
+  if (n == "hmin" || n == "hmax") {  // in LiteMath's order of std::min/max
+    const std::string f = n == "hmin" ? "crt_min(" : "crt_max(";
     const std::string v = "(" + a[0] + ")";
-    std::string r = std::string(f) + "(" + v + ".x, " + v + ".y)";
-    if (arg0Type.back() == '3' || arg0Type.back() == '4') r = std::string(f) + "(" + r + ", " + v + ".z)";
-    if (arg0Type.back() == '4') r = std::string(f) + "(" + r + ", " + v + ".w)";
+    const char last = arg0Type.back();
+    const std::string r = last == '2'   ? f + v + ".x, " + v + ".y)"
+                          : last == '3' ? f + v + ".x, " + f + v + ".y, " + v + ".z))"
+                                        : f + f + v + ".x, " + v + ".y), " + f + v + ".z, " + v + ".w))";
     return call->getArg(0)->HasSideEffects(m_ctx) ? IspcFail(call->getBeginLoc(), "hmin/hmax of an expression with side effects") : r;
   }
+  // As C++ compares (LiteMath.isph): a NaN or a signed zero comes out as in the C++ class.
+  if (n == "min" || n == "max" || n == "clamp") return join("crt_" + n);
   if (n == "fmod" || n == "fmodf") return "(" + a[0] + " - " + a[1] + " * trunc(" + a[0] + " / " + a[1] + "))";
   if (n == "rcp") return "(1.0f / " + a[0] + ")";
   if (n == "isfinite") return "!(isinf(" + a[0] + ") || isnan(" + a[0] + "))";
@@ -184,9 +188,14 @@ std::string GlslPrinter::IspcBuiltin(const FunctionDecl* fd, const std::vector<s
     return "uintBitsToFloat((floatBitsToUint(" + a[0] + ") & 0x7FFFFFFFu) | (floatBitsToUint(" + a[1] + ") & 0x80000000u))";
   if ((n == "cross3" || n == "cross") && arg0Type == "vec4")
     return "make_float4(cross(to_float3(" + a[0] + "), to_float3(" + a[1] + ")), 0.0f)";
+  // LiteMath.isph has the matrices' arithmetic and constructors by LiteMath's names.
+  static const std::set<std::string> matrixNames = {
+      "make_float3x3", "make_float3x3_from_rows", "make_float3x3_from_cols", "make_float3x3_by_columns", "make_float4x4_from_rows",
+      "make_float4x4_from_cols", "transpose", "inverse", "inverse4x4", "determinant", "outerProduct", "mul", "mul4x3", "mul3x3",
+      "mul4x4x4", "lane_mask_le"};
+  if (matrixNames.count(n)) return join(n);
   if (arg0Type.rfind("mat", 0) == 0 || n.find("float4x4") != std::string::npos || n.find("float3x3") != std::string::npos ||
-      n == "mul4x3" || n == "mul3x3" || n == "lane_mask_le" || n == "transpose" || n == "inverse" || n == "outerProduct" ||
-      n == "determinant" || n == "refract" || n == "faceforward")
+      n == "refract" || n == "faceforward")
     return IspcFail(call->getBeginLoc(), "'" + fd->getQualifiedNameAsString() + "'");
   if (n == "atan2" || n == "atan2f") return join("atan2");
   if (n == "sqrt" || n == "sqrtf") return join("sqrt");
@@ -320,7 +329,7 @@ std::string GlslPrinter::Call(const CallExpr* call) {
       return ispc ? IspcFail(call->getBeginLoc(), "an array of textures in a kernel") : TextureCall(array, textureIndex, mc);
     // Calls through a member holding an interface: composition.
     std::string composed = ComposedCall(mc);
-    if (!composed.empty()) return ispc ? IspcFail(call->getBeginLoc(), "a call through a composed interface (COMPOSE)") : composed;
+    if (!composed.empty()) return composed;
     // Calls through an element of a vector of objects: dynamic dispatch.
     std::string dispatched = VirtualCall(mc);
     if (!dispatched.empty()) return ispc ? IspcFail(call->getBeginLoc(), "a virtual call through a vector of objects") : dispatched;

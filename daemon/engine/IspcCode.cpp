@@ -148,6 +148,8 @@ void IspcHostData(const ClassModel& model, Data& d) {
     if (!m.usedByKernels) continue;
     Data x;
     x.set("name", m.name);
+    x.set("expr", m.hostExpr.empty() ? m.name : m.hostExpr);  // a composed member: through its holder
+    x.set("composedFrom", m.composedFrom);
     if (m.kind == MemberKind::Plain) members.push_back(x);
     if (m.kind == MemberKind::Vector) vectors.push_back(x);
   }

@@ -181,8 +181,8 @@ AnalyzeResult Analyze(const TranslateRequest& request, AstCache* sharedCache) {
       AnalyzeTranslationUnit(file.getASTContext(), file.Includes(), request.className, compositions, rep, model);
     });
     // Composition: the implementations' code, printed from the AST that defines their methods (a CPU
-    // class calls the interface as written).
-    if (errors == 0 && request.backend == Backend::Vulkan && !model.compositions.empty())
+    // class calls the interface as written; an ISPC class's loop nests call the printed code).
+    if (errors == 0 && request.backend != Backend::Cpu && !model.compositions.empty())
       forEachAst([&](ParsedFile& file, Reporter& rep) { ComposeFromTranslationUnit(file.getASTContext(), rep, model); });
   } catch (const std::exception& e) {  // a template the analysis fills (dispatchers, traces) is missing or malformed
     result.diagnostics = diagText + "error: " + e.what() + "\n";

@@ -1,11 +1,13 @@
-// The BVH traversal translated by composition (PrimaryRays_CPU and PrimaryRays_Vulkan, which
-// compose ISceneObject=BVHScene) against BVHScene as written, on the numerical extremes of
+// The BVH traversal translated by composition (PrimaryRays_CPU, _ISPC and _Vulkan, which compose
+// ISceneObject=BVHScene) against BVHScene as written, on the numerical extremes of
 // test_bvh_extremes.cpp: rays through the edges and vertices of closed meshes, tiny, huge and
 // far-away scenes, axis-parallel rays with +0 and -0 components, degenerate triangles, one shared
 // centre, 0, 1 and 2 triangles, instances, and invalid rays; and signed distance fields (grid, SVS,
 // SBS) at their own extremes.
 //
-// _CPU runs the very same compiled traversal on all cores: its hits must be bit-identical.
+// _CPU runs the very same compiled traversal on all cores: its hits must be bit-identical. So must
+// _ISPC's, one ray a SIMD lane (where ISPC is found): it computes without fused multiply-adds, its
+// fma is exact as std::fma, and its min and max compare as C++'s do (LiteMath.isph).
 // _Vulkan must give the same primId for at least 99.99% of the rays, counting ties as the same: a
 // ray aimed exactly at a vertex or an edge hits several triangles at the same distance, and a
 // last-ulp difference picks another of them (it must contain the hit point). And t must lie within
@@ -21,6 +23,9 @@
 #include "PrimaryRays.h"
 #include "PrimaryRays_CPU.h"
 #include "PrimaryRays_Vulkan.h"
+#ifdef CROSSRT_HAS_ISPC
+#include "PrimaryRays_ISPC.h"
+#endif
 #include "SdfStructures.h"
 #include "TestMeshes.h"
 #include "TestSupport.h"
@@ -30,6 +35,7 @@
 #include <limits>
 #include <random>
 #include <set>
+#include <sstream>
 
 using namespace LiteMath;
 
@@ -137,6 +143,27 @@ Outcome TraceEverywhere(const std::shared_ptr<ISceneObject>& scene, const Rays& 
   auto cpu = CreatePrimaryRays_CPU(1, 1);
   out.cpu = Cast(*cpu, scene, rays);
   REQUIRE(std::memcmp(out.cpu.data(), out.original.data(), sizeof(CRT_Hit) * rays.Size()) == 0);
+#ifdef CROSSRT_HAS_ISPC
+  {
+    auto ispc = CreatePrimaryRays_ISPC(1, 1);
+    const std::vector<CRT_Hit> lanes = Cast(*ispc, scene, rays);
+    RequireAgreement("ISPC traversal", out.original, lanes, rays, sceneSize, mesh, true);
+    size_t bitIdentical = 0, first = rays.Size();
+    for (size_t i = 0; i < rays.Size(); ++i)
+      if (std::memcmp(&lanes[i], &out.original[i], sizeof(CRT_Hit)) == 0)
+        ++bitIdentical;
+      else if (first == rays.Size())
+        first = i;
+    INFO(bitIdentical << " of " << rays.Size() << " ISPC hits bit-identical to the original's");
+    std::ostringstream firstDiffering;
+    if (first < rays.Size())
+      firstDiffering << "the first differs: ray " << first << ", t " << std::hexfloat << out.original[first].t << " vs " << lanes[first].t
+                     << ", u " << out.original[first].coords[0] << " vs " << lanes[first].coords[0] << std::defaultfloat << ", primId "
+                     << out.original[first].primId << " vs " << lanes[first].primId;
+    INFO(firstDiffering.str());
+    CHECK(bitIdentical == rays.Size());
+  }
+#endif
 
   auto ctx = ValidatedContext();
   if (!ctx)
@@ -359,7 +386,7 @@ TEST_CASE("Translated traversal: degenerate triangles, one shared centre, 0, 1 a
   }
 }
 
-TEST_CASE("PrimaryRays renders the same image as written, on _CPU and on _Vulkan", "[composition]")
+TEST_CASE("PrimaryRays renders the same image as written, on _CPU, _ISPC and _Vulkan", "[composition]")
 {
   const TriangleMesh mesh = BumpySphere(4);
   auto scene = SceneOf("lbvh", mesh);
@@ -380,6 +407,9 @@ TEST_CASE("PrimaryRays renders the same image as written, on _CPU and on _Vulkan
   REQUIRE(background > 1000);                   // the sphere does not fill the frame...
   REQUIRE(background < expected.size() - 1000);  // ...but covers much of it
   REQUIRE(render(*CreatePrimaryRays_CPU(96, 64)) == expected);
+#ifdef CROSSRT_HAS_ISPC
+  REQUIRE(render(*CreatePrimaryRays_ISPC(96, 64)) == expected);
+#endif
   auto ctx = ValidatedContext();
   if (!ctx)
     return;

@@ -31,6 +31,16 @@ void IspcCopy(To& to, const From& from) {
   std::memcpy(static_cast<void*>(&to), static_cast<const void*>(&from), sizeof to);
 }
 
+// The object a composed member (shared_ptr, unique_ptr or plain pointer) holds, or null.
+template <class T>
+T* IspcHeld(T* p) {
+  return p;
+}
+template <class Smart>
+auto* IspcHeld(const Smart& p) {
+  return p.get();
+}
+
 // The ISPC targets every generated class is compiled for, in the order of CrossRT.cmake's
 // CROSSRT_ISPC_TARGETS, and whether this CPU runs each.
 inline const char* const kIspcTargets[] = {"sse4", "avx2", "avx512skx"};
