@@ -1,9 +1,9 @@
 // Benchmark in the form of the paper's Tables 1 and 3, for every mesh scripts/fetch-meshes.sh
-// cached: BVH build time (Embree LOW and MEDIUM, the LBVH as written, LBVH_CPU, LBVH_Vulkan on the
-// default device, binned SAH), SAH cost of each tree, and traversal of 1024x1024 primary rays
+// cached: BVH build time (Embree LOW and MEDIUM, the LBVH as written, LBVH_CPU, LBVH_ISPC where ISPC
+// is found, LBVH_Vulkan on the default device, binned SAH), SAH cost of each tree, and traversal of 1024x1024 primary rays
 // (Embree rtcIntersect1 and rtcIntersect16, CrossRT's traversal over the LBVH and SAH trees as
-// written, and translated: PrimaryRays_CPU and PrimaryRays_Vulkan, which compose BVHScene's
-// traversal), with ratios against Embree. Every figure is measured in this run: the CPU builders and
+// written, and translated: PrimaryRays_CPU, PrimaryRays_ISPC (one ray a SIMD lane, where ISPC is
+// found) and PrimaryRays_Vulkan, which compose BVHScene's traversal), with ratios against Embree. Every figure is measured in this run: the CPU builders and
 // the CPU tracers in rounds that run each in turn (7 and 5), with ratios as medians of the rounds'
 // ratios; the Vulkan figures as medians of 3 after a warm-up.
 // Then the speed-against-quality trade of LBVH against binned SAH, as a table and as CSV, which
@@ -15,9 +15,15 @@
 #include "CrossRT.h"
 #include "LBVH.h"
 #include "LBVH_CPU.h"
+#ifdef CROSSRT_HAS_ISPC
+#include "LBVH_ISPC.h"
+#endif
 #include "LBVH_Vulkan.h"
 #include "MeshIO.h"
 #include "PrimaryRays_CPU.h"
+#ifdef CROSSRT_HAS_ISPC
+#include "PrimaryRays_ISPC.h"
+#endif
 #include "PrimaryRays_Vulkan.h"
 #include "SAHBuilder.h"
 
@@ -28,6 +34,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -199,12 +206,17 @@ int main(int argc, char** argv)
 
   std::printf("\nBuild time, ms (ratio = time / Embree LOW; the CPU builders' medians of 7 interleaved rounds, their ratios\n"
               "medians of the rounds' ratios; Vulkan: median of 3 wall times with copies, its ratio one of medians, [GPU time])\n");
-  std::printf("| %-22s | %9s | %10s | %12s | %15s | %15s | %23s | %15s |\n", "mesh", "triangles", "Embree LOW", "Embree MEDIUM",
-              "LBVH original", "LBVH_CPU", "LBVH_Vulkan", "binned SAH");
-  std::printf("|%s|\n", std::string(146, '-').c_str());
+  std::printf("| %-22s | %9s | %10s | %12s | %15s | %15s | %15s | %23s | %15s |\n", "mesh", "triangles", "Embree LOW", "Embree MEDIUM",
+              "LBVH original", "LBVH_CPU", "LBVH_ISPC", "LBVH_Vulkan", "binned SAH");
+  std::printf("|%s|\n", std::string(164, '-').c_str());
   struct Row { std::string name; TriangleMesh mesh; BVHTree lbvh, sah; double lbvhCpuMs, sahMs; };
   std::vector<Row> rows;
   auto lbvhCpu = CreateLBVH_CPU();
+#ifdef CROSSRT_HAS_ISPC
+  std::shared_ptr<LBVH> lbvhIspc = CreateLBVH_ISPC();
+#else
+  std::shared_ptr<LBVH> lbvhIspc;
+#endif
   std::shared_ptr<LBVH> lbvhGpu = ctx ? CreateLBVH_Vulkan(ctx) : nullptr;
   for (const char* name : names)
   {
@@ -222,11 +234,20 @@ int main(int argc, char** argv)
     original.Reserve(n);
     lbvhCpu->Reserve(n);
     lbvhCpu->CommitDeviceData();
+    if (lbvhIspc)
+    {
+      lbvhIspc->Reserve(n);
+      lbvhIspc->CommitDeviceData();
+    }
     // The CPU builders in 7 interleaved rounds; ratios to Embree LOW are medians of per-round ratios.
     const auto cpuMs = InterleavedMs({[&] { embree.Build(row.mesh, RTC_BUILD_QUALITY_LOW); },
                                       [&] { embree.Build(row.mesh, RTC_BUILD_QUALITY_MEDIUM); },
                                       [&] { original.Build(n, boxes.data()); }, [&] { lbvhCpu->Build(n, boxes.data()); },
-                                      [&] { row.sah = BuildBinnedSAH(boxes.data(), n); }},
+                                      [&] { row.sah = BuildBinnedSAH(boxes.data(), n); },
+                                      [&] {
+                                        if (lbvhIspc)
+                                          lbvhIspc->Build(n, boxes.data());
+                                      }},
                                      7);
     const double low = Median(cpuMs[0]), medium = Median(cpuMs[1]), originalMs = Median(cpuMs[2]);
     row.lbvh = original.Tree(n);
@@ -242,20 +263,36 @@ int main(int argc, char** argv)
       std::snprintf(gpu, sizeof(gpu), "%7.1f (%4.2fx) [%6.1f]", wall, wall / low, times[0]);
     }
     row.sahMs = Median(cpuMs[4]);
-    std::printf("| %-22s | %9d | %10.1f | %6.1f (%4.2fx) | %7.1f (%5.2fx) | %7.1f (%5.2fx) | %23s | %7.1f (%5.2fx) |\n", name, n, low,
+    char ispc[24] = "no ISPC";
+    if (lbvhIspc)
+    {
+      const BVHTree tree = lbvhIspc->Tree(n);
+      if (tree.nodes.size() != row.lbvh.nodes.size() ||
+          std::memcmp(tree.nodes.data(), row.lbvh.nodes.data(), tree.nodes.size() * sizeof(BVHNode)) != 0)
+        std::fprintf(stderr, "bench_lbvh: %s: LBVH_ISPC built another tree than the original\n", name);
+      std::snprintf(ispc, sizeof(ispc), "%7.1f (%5.2fx)", Median(cpuMs[5]), PairedRatio(cpuMs[5], cpuMs[0]));
+    }
+    std::printf("| %-22s | %9d | %10.1f | %6.1f (%4.2fx) | %7.1f (%5.2fx) | %7.1f (%5.2fx) | %15s | %23s | %7.1f (%5.2fx) |\n", name, n, low,
                 medium, PairedRatio(cpuMs[1], cpuMs[0]), originalMs, PairedRatio(cpuMs[2], cpuMs[0]), row.lbvhCpuMs,
-                PairedRatio(cpuMs[3], cpuMs[0]), gpu, row.sahMs, PairedRatio(cpuMs[4], cpuMs[0]));
+                PairedRatio(cpuMs[3], cpuMs[0]), ispc, gpu, row.sahMs, PairedRatio(cpuMs[4], cpuMs[0]));
     rows.push_back(std::move(row));
   }
 
   std::printf("\nTraversal of %dx%d primary rays, Mrays/s, all %d threads but 1T (ratio against Embree rtcIntersect1 on all\n"
               "threads: medians of %d interleaved rounds' ratios; _Vulkan: median of 3, its ratio one of medians); SAH cost of the trees\n",
               kImageSize, kImageSize, omp_get_max_threads(), kTraceRounds);
-  std::printf("| %-22s | %9s | %9s | %15s | %15s | %15s | %15s | %23s | %9s | %9s | %8s |\n", "mesh", "Embree 1", "Embree 16",
-              "CrossRT LBVH", "CrossRT LBVH 1T", "LBVH _CPU", "CrossRT SAH", "LBVH _Vulkan [GPU]", "SAH cost L", "SAH cost S", "same hit");
-  std::printf("|%s|\n", std::string(188, '-').c_str());
+  std::printf("| %-22s | %9s | %15s | %15s | %15s | %15s | %15s | %15s | %23s | %9s | %9s | %8s |\n", "mesh", "Embree 1", "Embree 16",
+              "CrossRT LBVH", "CrossRT LBVH 1T", "LBVH _CPU", "LBVH _ISPC", "CrossRT SAH", "LBVH _Vulkan [GPU]", "SAH cost L", "SAH cost S",
+              "same hit");
+  std::printf("|%s|\n", std::string(212, '-').c_str());
   // The translated traversal: PrimaryRays_CPU / _Vulkan trace ray batches through the composed BVHScene.
   auto castCpu = CreatePrimaryRays_CPU(1, 1);
+#ifdef CROSSRT_HAS_ISPC
+  std::shared_ptr<PrimaryRays> castIspc = CreatePrimaryRays_ISPC(1, 1);
+#else
+  std::shared_ptr<PrimaryRays> castIspc;
+  std::printf("no ISPC compiler was found at configure time: the _ISPC column is left out\n");
+#endif
   std::shared_ptr<PrimaryRays> castGpu;
   try
   {
@@ -340,20 +377,33 @@ int main(int argc, char** argv)
     auto mrays = [&](double ms) { return pixels / ms / 1e3; };
     std::vector<float4> rayPos(pixels, float4(cam.eye.x, cam.eye.y, cam.eye.z, 0.0f)), rayDir(pixels);
     for (int i = 0; i < pixels; ++i) rayDir[i] = cam.Ray(i % kImageSize, i / kImageSize);
-    std::vector<CRT_Hit> castHits(pixels);
+    std::vector<CRT_Hit> castHits(pixels), ispcHits(pixels);
     std::shared_ptr<ISceneObject> lbvhShared(&lbvhScene, [](ISceneObject*) {});  // lives on this stack frame
     castCpu->SetScene(lbvhShared, {}, {});
+    if (castIspc)
+      castIspc->SetScene(lbvhShared, {}, {});
     // The CPU tracers in interleaved rounds, as the builders above: ratios are medians of per-round ratios.
     std::vector<uint32_t> unusedPrim(pixels);  // hits of the tracers only timed here
     const auto traceMs = InterleavedMs({embreeSingle, embreePacket, traceWith(lbvhScene, threads, ourPrim), traceWith(lbvhScene, 1, unusedPrim),
                                         [&] { castCpu->CastRays(rayPos.data(), rayDir.data(), castHits.data(), pixels); },
-                                        traceWith(sahScene, threads, unusedPrim)},
+                                        traceWith(sahScene, threads, unusedPrim),
+                                        [&] {
+                                          if (castIspc)
+                                            castIspc->CastRays(rayPos.data(), rayDir.data(), ispcHits.data(), pixels);
+                                        }},
                                        kTraceRounds);
     const double embree1 = Median(traceMs[0]), embree16 = Median(traceMs[1]), lbvhMs = Median(traceMs[2]), lbvh1T = Median(traceMs[3]),
                  castCpuMs = Median(traceMs[4]), sahMs = Median(traceMs[5]);
     auto againstEmbree1 = [&](int work) { return PairedRatio(traceMs[0], traceMs[work]); };  // throughput ratio
     size_t translatedDiffer = 0;
     for (int i = 0; i < pixels; ++i) translatedDiffer += castHits[i].primId != ourPrim[i];
+    char ispcCast[24] = "no ISPC";
+    if (castIspc)
+    {
+      for (int i = 0; i < pixels; ++i) translatedDiffer += ispcHits[i].primId != ourPrim[i];
+      std::snprintf(ispcCast, sizeof(ispcCast), "%6.2f (%5.2fx)", mrays(Median(traceMs[6])), againstEmbree1(6));
+      castIspc->SetScene(nullptr, {}, {});
+    }
     char gpuCast[48] = "no device";
     if (castGpu)
     {
@@ -371,10 +421,10 @@ int main(int argc, char** argv)
       std::fprintf(stderr, "bench_lbvh: %s: the translated traversal differs from the original on %zu rays\n", row.name.c_str(), translatedDiffer);
     size_t same = 0;
     for (int i = 0; i < pixels; ++i) same += ourPrim[i] == embreePrim[i];
-    std::printf("| %-22s | %9.2f | %9.2f | %6.2f (%5.2fx) | %6.2f (%5.2fx) | %6.2f (%5.2fx) | %6.2f (%5.2fx) | %23s | %9.1f | %9.1f | %7.4f%% |\n",
-                row.name.c_str(), mrays(embree1), mrays(embree16), mrays(lbvhMs), againstEmbree1(2), mrays(lbvh1T), againstEmbree1(3),
-                mrays(castCpuMs), againstEmbree1(4), mrays(sahMs), againstEmbree1(5), gpuCast, SAHCost(row.lbvh), SAHCost(row.sah),
-                100.0 * same / pixels);
+    std::printf("| %-22s | %9.2f | %6.2f (%5.2fx) | %6.2f (%5.2fx) | %6.2f (%5.2fx) | %6.2f (%5.2fx) | %15s | %6.2f (%5.2fx) | %23s | %9.1f | %9.1f | %7.4f%% |\n",
+                row.name.c_str(), mrays(embree1), mrays(embree16), againstEmbree1(1), mrays(lbvhMs), againstEmbree1(2), mrays(lbvh1T),
+                againstEmbree1(3), mrays(castCpuMs), againstEmbree1(4), ispcCast, mrays(sahMs), againstEmbree1(5), gpuCast, SAHCost(row.lbvh),
+                SAHCost(row.sah), 100.0 * same / pixels);
     trade.push_back({row.name, row.lbvhCpuMs, mrays(lbvhMs), row.sahMs, mrays(sahMs)});
   }
 

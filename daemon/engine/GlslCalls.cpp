@@ -272,6 +272,16 @@ std::string GlslPrinter::AtomicCall(const FunctionDecl* fd, const CallExpr* call
   m_uses.atomics = true;
   std::vector<std::string> args;
   for (auto* arg : call->arguments()) args.push_back(Expr(arg));
+  // ISPC: its global atomics, on the target's address (a lane at a time where lanes share one).
+  if (ispc) {
+    static const std::map<std::string, std::string> ispcNames = {
+        {"AtomicAdd", "atomic_add_global"}, {"AtomicAnd", "atomic_and_global"},       {"AtomicOr", "atomic_or_global"},
+        {"AtomicXor", "atomic_xor_global"}, {"AtomicExchange", "atomic_swap_global"}, {"AtomicMin", "atomic_min_global"},
+        {"AtomicMax", "atomic_max_global"}, {"AtomicCompareExchange", "atomic_compare_exchange_global"}};
+    std::string s = ispcNames.at(name) + "(&" + args[0];
+    for (size_t i = 1; i < args.size(); ++i) s += ", " + args[i];
+    return s + ")";
+  }
   // The fences of acquire-release order (the kernel template defines crt_release/crt_acquire):
   // the last argument passes a release fence before the atomic runs, the result an acquire fence
   // after. crossrt::AtomicCompareExchange is atomicCompSwap; the others keep their name.
@@ -387,7 +397,7 @@ std::string GlslPrinter::Call(const CallExpr* call) {
                 "kernels cannot do I/O: write results to an output buffer and print them in the control function");
 
   const bool interlocked = InNamespace(fd, "LiteMath") && (name == "InterlockedAdd" || name == "atomicAdd" || name == "InterlockedAdd3f" || name == "ReduceAdd");
-  if (ispc && (IsCrossrtAtomic(fd) || interlocked)) return IspcFail(call->getBeginLoc(), "an atomic operation ('" + qname + "')");
+  if (ispc && interlocked) return IspcFail(call->getBeginLoc(), "LiteMath's atomic '" + qname + "'");
   if (IsCrossrtAtomic(fd)) return AtomicCall(fd, call);
   if (interlocked) return InterlockedCall(fd, call);
   std::vector<std::string> args;

@@ -194,8 +194,19 @@ void IspcHostData(const ClassModel& model, Data& d) {
                                             : r.member + " + partial");
       reds.push_back(y);
     }
+    // Plain members the kernels write (atomics among them) go back from the ISPC class data after
+    // the chunks; this kernel's reductions are folded from their partials instead.
+    Data written = List();
+    for (auto& m : model.members) {
+      const bool reduced = std::any_of(k.reductions.begin(), k.reductions.end(), [&](const Reduction& r) { return !r.local && r.member == m.name; });
+      if (m.kind != MemberKind::Plain || !m.usedByKernels || !m.writtenByKernels || !m.hostExpr.empty() || reduced) continue;
+      Data w;
+      w.set("name", m.name);
+      written.push_back(w);
+    }
     x.set("args", args);
     x.set("reductions", reds);
+    x.set("writtenMembers", written);
     std::string targets;
     for (const char* t : kIspcTargetSuffixes) targets += std::string(targets.empty() ? "" : ", ") + model.className + "_" + k.name + "_" + t;
     x.set("targetFunctions", targets);

@@ -1,11 +1,15 @@
-// The LBVH builder as written (single-threaded C++), translated for all CPU cores (LBVH_CPU) and
-// translated for Vulkan (LBVH_Vulkan, on lavapipe with validation on). Every tree is checked for
+// The LBVH builder as written (single-threaded C++), translated for all CPU cores (LBVH_CPU; and
+// LBVH_ISPC, in SIMD lanes too, where ISPC is found) and translated for Vulkan (LBVH_Vulkan, on
+// lavapipe with validation on). Every tree is checked for
 // structure (each primitive in exactly one leaf, each node reached once, each box exactly the union
 // of its children's), and the translated trees must equal the original's node for node: the codes
 // are unique after grouping, so the hierarchy is determined; only the order of primitives inside a
 // leaf may differ (std::sort is not stable, the GPU radix sort is).
 #include "LBVH.h"
 #include "LBVH_CPU.h"
+#ifdef CROSSRT_HAS_ISPC
+#include "LBVH_ISPC.h"
+#endif
 #include "LBVH_Vulkan.h"
 #include "TestSupport.h"
 
@@ -125,6 +129,9 @@ TEST_CASE("LBVH: the deepest tree 30-bit codes allow is refit to the root on eve
   CHECK(depth(expected) >= 30);  // 31 levels of inner nodes above the deepest leaf pair
   REQUIRE(CheckTree(expected, boxes) == "");
   std::vector<std::pair<const char*, std::shared_ptr<LBVH>>> translated = {{"CPU", CreateLBVH_CPU()}};
+#ifdef CROSSRT_HAS_ISPC
+  translated.push_back({"ISPC", CreateLBVH_ISPC()});
+#endif
   if (ctx) translated.push_back({"Vulkan", CreateLBVH_Vulkan(ctx)});
   for (auto& [name, impl] : translated)
   {
@@ -134,7 +141,7 @@ TEST_CASE("LBVH: the deepest tree 30-bit codes allow is refit to the root on eve
   RequireNoValidationMessages(ctx);
 }
 
-TEST_CASE("LBVH: the original, LBVH_CPU and LBVH_Vulkan build the same valid tree", "[lbvh][equivalence]")
+TEST_CASE("LBVH: the original, LBVH_CPU, LBVH_ISPC and LBVH_Vulkan build the same valid tree", "[lbvh][equivalence]")
 {
   auto ctx = ValidatedContext();
   struct Case { int n; bool clustered; };
@@ -151,6 +158,9 @@ TEST_CASE("LBVH: the original, LBVH_CPU and LBVH_Vulkan build the same valid tre
       if (c.n == 70001) REQUIRE(original.m_leafCount > 60000u);  // equal codes are rare at this density
 
       std::vector<std::pair<const char*, std::shared_ptr<LBVH>>> translated = {{"CPU", CreateLBVH_CPU()}};
+#ifdef CROSSRT_HAS_ISPC
+      translated.push_back({"ISPC", CreateLBVH_ISPC()});
+#endif
       if (ctx) translated.push_back({"Vulkan", CreateLBVH_Vulkan(ctx)});
       for (auto& [name, impl] : translated)
       {
