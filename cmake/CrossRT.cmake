@@ -221,7 +221,14 @@ function(crossrt_add_class target class)
       COMMENT "CrossRT: compiling ${name}_ISPC_kernels.ispc for ${ispc_targets}"
       COMMAND_EXPAND_LISTS
       VERBATIM)
-    target_sources(${target} PRIVATE ${ispc_objects} ${ispc_header})
+    get_target_property(target_type ${target} TYPE)
+    if(target_type STREQUAL "OBJECT_LIBRARY")
+      # An object library does not hand compiled objects it did not compile on: its users link them.
+      target_sources(${target} PRIVATE ${ispc_header})
+      target_link_libraries(${target} INTERFACE ${ispc_objects})
+    else()
+      target_sources(${target} PRIVATE ${ispc_objects} ${ispc_header})
+    endif()
   endif()
   if(suffix STREQUAL "Vulkan")
     target_link_libraries(${target} PRIVATE crossrt::runtime)

@@ -199,7 +199,7 @@ void IspcHostData(const ClassModel& model, Data& d) {
     Data written = List();
     for (auto& m : model.members) {
       const bool reduced = std::any_of(k.reductions.begin(), k.reductions.end(), [&](const Reduction& r) { return !r.local && r.member == m.name; });
-      if (m.kind != MemberKind::Plain || !m.usedByKernels || !m.writtenByKernels || !m.hostExpr.empty() || reduced) continue;
+      if (m.kind != MemberKind::Plain || !m.usedByKernels || !m.writtenByKernels || !m.composedFrom.empty() || reduced) continue;
       Data w;
       w.set("name", m.name);
       written.push_back(w);
@@ -207,6 +207,11 @@ void IspcHostData(const ClassModel& model, Data& d) {
     x.set("args", args);
     x.set("reductions", reds);
     x.set("writtenMembers", written);
+    // The loop nest's own copies of the locals declared before it are computed in the ISPC kernel:
+    // the host's may go unused (by the statements after the nest, or a reduction into them).
+    std::string unused;
+    for (auto& l : k.preambleLocals) unused += "(void)" + l + "; ";
+    x.set("preambleLocals", unused.empty() ? "" : unused + " // the ISPC kernel computes its own");
     std::string targets;
     for (const char* t : kIspcTargetSuffixes) targets += std::string(targets.empty() ? "" : ", ") + model.className + "_" + k.name + "_" + t;
     x.set("targetFunctions", targets);

@@ -442,6 +442,10 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
                                                 : rw.getRewrittenText(outer->getSourceRange()));
     if (c.model.forCpu) CopySourceDeclarations(c, def->getBody(), "kernel '" + k.name + "'");  // the CPU class copies the loop nest
     for (auto* s : before) k.cpuPreamble += StatementText(c, s) + "\n";
+    for (auto* s : before)
+      if (auto* ds = dyn_cast<DeclStmt>(s))
+        for (auto* d : ds->decls())
+          if (auto* vd = dyn_cast<VarDecl>(d)) k.preambleLocals.push_back(vd->getNameAsString());
     k.cpuPreamble = CanonicalCode(k.cpuPreamble);
     for (auto* s : after) k.cpuPostamble += StatementText(c, s) + "\n";
     k.cpuPostamble = CanonicalCode(k.cpuPostamble);

@@ -142,6 +142,7 @@ struct Kernel {
   std::string glslBody;               // the thread's code, as a GLSL function body
   std::string cpuLoopNest;            // IPV, CPU backend: the loop nest with reductions renamed
   std::string cpuPreamble;            // IPV, CPU backend: statements before the loops
+  std::vector<std::string> preambleLocals;  // the locals they declare (an ISPC kernel computes its own)
   std::string cpuPostamble;           // IPV, CPU backend: statements after the loops
   // IPV: the statements before and after the loop nest (the paper's loop_start and loop_end), as
   // GLSL functions <kernel>_Start() and <kernel>_Finish() that one thread runs, in shaders of their

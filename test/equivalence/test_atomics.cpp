@@ -4,6 +4,9 @@
 // first is up to the scheduler, so claims are checked for being valid, not equal.
 #include "AtomicCounters.h"
 #include "AtomicCounters_CPU.h"
+#ifdef CROSSRT_HAS_ISPC
+#include "AtomicCounters_ISPC.h"
+#endif
 #include "AtomicCounters_Vulkan.h"
 #include "TestSupport.h"
 
@@ -17,6 +20,9 @@ Impls AllBackends(const std::shared_ptr<crossrt::VulkanContext>& ctx, int bins, 
 {
   Impls impls = {{"original", std::make_shared<AtomicCounters>(bins, maxLeaves)},
                  {"CPU", CreateAtomicCounters_CPU(bins, maxLeaves)}};
+#ifdef CROSSRT_HAS_ISPC
+  impls.push_back({"ISPC", CreateAtomicCounters_ISPC(bins, maxLeaves)});  // ISPC's global atomics
+#endif
   if (ctx) impls.push_back({"Vulkan", CreateAtomicCounters_Vulkan(ctx, bins, maxLeaves)});
   return impls;
 }

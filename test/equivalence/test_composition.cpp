@@ -1,11 +1,15 @@
 // Composition of a user's interface: SphereTracer holds an ISdf and its _Vulkan class runs
-// SdfSpheres::Distance (composed with COMPOSE ISdf=SdfSpheres) on the GPU. The original, _CPU and
-// _Vulkan must give the same depths, also after the implementation's plain members change.
+// SdfSpheres::Distance (composed with COMPOSE ISdf=SdfSpheres) on the GPU, and its _ISPC class in
+// SIMD lanes. The original, _CPU, _ISPC and _Vulkan must give the same depths, also after the
+// implementation's plain members change.
 #include "Composed.h"
 #include "ShapeTracer.h"
 #include "ShapeTracer_CPU.h"
 #include "ShapeTracer_Vulkan.h"
 #include "SphereTracer_CPU.h"
+#ifdef CROSSRT_HAS_ISPC
+#include "SphereTracer_ISPC.h"
+#endif
 #include "SphereTracer_Vulkan.h"
 #include "TestSupport.h"
 
@@ -29,9 +33,14 @@ TEST_CASE("Composition of a user's interface: plain and vector members of the im
 
   SphereTracer original;
   auto cpu = CreateSphereTracer_CPU();
+#ifdef CROSSRT_HAS_ISPC
+  std::shared_ptr<SphereTracer> lanes = CreateSphereTracer_ISPC();
+#else
+  std::shared_ptr<SphereTracer> lanes;
+#endif
   auto ctx = ValidatedContext();
   std::shared_ptr<SphereTracer> gpu = ctx ? CreateSphereTracer_Vulkan(ctx) : nullptr;
-  for (SphereTracer* t : {&original, cpu.get(), gpu.get()})
+  for (SphereTracer* t : {&original, cpu.get(), lanes.get(), gpu.get()})
     if (t)
     {
       t->SetShape(shape);
@@ -55,6 +64,12 @@ TEST_CASE("Composition of a user's interface: plain and vector members of the im
     previous = expected;
     cpu->Trace(n, origins.data(), onCpu.data());
     REQUIRE(onCpu == expected);
+    if (lanes)
+    {
+      std::vector<float> onLanes(n);
+      lanes->Trace(n, origins.data(), onLanes.data());
+      REQUIRE(onLanes == expected);  // no fused multiply-adds, C++'s min and max: the same floats
+    }
     if (!gpu)
       continue;
     gpu->Trace(n, origins.data(), onGpu.data());

@@ -1,9 +1,12 @@
-// Every construct of the first slice, run by the original class, Constructs_CPU and
-// Constructs_Vulkan (lavapipe, validation on). Tolerances: per-element results within 1e-5
+// Every construct of the first slice, run by the original class, Constructs_CPU, Constructs_ISPC
+// (where ISPC is found) and Constructs_Vulkan (lavapipe, validation on). Tolerances: per-element results within 1e-5
 // relative (GPU compilers may fuse multiply-adds); reductions over n values within 1e-4
 // relative (the summation order differs); integer results exactly.
 #include "Constructs.h"
 #include "Constructs_CPU.h"
+#ifdef CROSSRT_HAS_ISPC
+#include "Constructs_ISPC.h"
+#endif
 #include "Constructs_Vulkan.h"
 #include "TestSupport.h"
 
@@ -19,6 +22,9 @@ struct Impls
   {
     list.push_back({"original", std::make_shared<Constructs>(tableSize)});
     list.push_back({"CPU", CreateConstructs_CPU(tableSize)});
+#ifdef CROSSRT_HAS_ISPC
+    list.push_back({"ISPC", CreateConstructs_ISPC(tableSize)});
+#endif
     if (ctx) list.push_back({"Vulkan", CreateConstructs_Vulkan(ctx, tableSize)});
   }
 };

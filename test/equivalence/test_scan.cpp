@@ -4,6 +4,9 @@
 // within 1e-4 relative plus 1e-3 absolute (the GPU adds in a tree order, the CPU left to right).
 #include "Compaction.h"
 #include "Compaction_CPU.h"
+#ifdef CROSSRT_HAS_ISPC
+#include "Compaction_ISPC.h"
+#endif
 #include "Compaction_Vulkan.h"
 #include "TestSupport.h"
 
@@ -23,6 +26,9 @@ TEST_CASE("Stream compaction: a kernel, std::exclusive_scan, a kernel", "[equiva
       for (auto& v : values) v = u(rng);
       std::vector<std::pair<const char*, std::shared_ptr<Compaction>>> impls = {
           {"original", std::make_shared<Compaction>(n)}, {"CPU", CreateCompaction_CPU(n)}};
+#ifdef CROSSRT_HAS_ISPC
+      impls.push_back({"ISPC", CreateCompaction_ISPC(n)});
+#endif
       if (ctx) impls.push_back({"Vulkan", CreateCompaction_Vulkan(ctx, n)});
       std::vector<float> expected;
       for (float v : values)
@@ -53,6 +59,9 @@ TEST_CASE("std::inclusive_scan of floats, memcpy and std::fill in a control func
       for (int i = 0; i < n; ++i) values[i] = float((i * 7919) % 13) * 0.25f - 1.0f;
       std::vector<std::pair<const char*, std::shared_ptr<Compaction>>> impls = {
           {"original", std::make_shared<Compaction>(n)}, {"CPU", CreateCompaction_CPU(n)}};
+#ifdef CROSSRT_HAS_ISPC
+      impls.push_back({"ISPC", CreateCompaction_ISPC(n)});
+#endif
       if (ctx) impls.push_back({"Vulkan", CreateCompaction_Vulkan(ctx, n)});
       double running = 0.0;
       std::vector<float> exact(n);
@@ -83,6 +92,9 @@ TEST_CASE("std::sort of uint32_t keys in a control function becomes a GPU radix 
     {
       std::vector<std::pair<const char*, std::shared_ptr<Compaction>>> impls = {
           {"original", std::make_shared<Compaction>(n)}, {"CPU", CreateCompaction_CPU(n)}};
+#ifdef CROSSRT_HAS_ISPC
+      impls.push_back({"ISPC", CreateCompaction_ISPC(n)});
+#endif
       if (ctx) impls.push_back({"Vulkan", CreateCompaction_Vulkan(ctx, n)});
       for (auto& [name, impl] : impls)
       {

@@ -3,15 +3,21 @@
 // relative: the GPU may fuse multiply-adds.
 #include "Semantics.h"
 #include "Semantics_CPU.h"
+#ifdef CROSSRT_HAS_ISPC
+#include "Semantics_ISPC.h"
+#endif
 #include "Semantics_Vulkan.h"
 #include "TestSupport.h"
 
 namespace {
-// The original class, Semantics_CPU and, when a Vulkan device exists, Semantics_Vulkan.
+// The original class, Semantics_CPU, Semantics_ISPC where ISPC is found and, when a Vulkan device exists, Semantics_Vulkan.
 std::vector<std::pair<const char*, std::shared_ptr<Semantics>>> AllImplementations(const std::shared_ptr<crossrt::VulkanContext>& ctx)
 {
   std::vector<std::pair<const char*, std::shared_ptr<Semantics>>> impls = {{"original", std::make_shared<Semantics>()},
                                                                           {"CPU", CreateSemantics_CPU()}};
+#ifdef CROSSRT_HAS_ISPC
+  impls.push_back({"ISPC", CreateSemantics_ISPC()});
+#endif
   if (ctx) impls.push_back({"Vulkan", CreateSemantics_Vulkan(ctx)});
   return impls;
 }

@@ -4,6 +4,9 @@
 // must equal the original's exactly, and each run of equal keys must hold the same records.
 #include "Sorting.h"
 #include "Sorting_CPU.h"
+#ifdef CROSSRT_HAS_ISPC
+#include "Sorting_ISPC.h"
+#endif
 #include "Sorting_Vulkan.h"
 #include "TestSupport.h"
 
@@ -44,6 +47,9 @@ std::vector<std::pair<const char*, std::shared_ptr<Sorting>>> Implementations(co
 {
   std::vector<std::pair<const char*, std::shared_ptr<Sorting>>> impls = {{"original", std::make_shared<Sorting>(n)},
                                                                          {"CPU", CreateSorting_CPU(n)}};
+#ifdef CROSSRT_HAS_ISPC
+  impls.push_back({"ISPC", CreateSorting_ISPC(n)});
+#endif
   if (ctx) impls.push_back({"Vulkan", CreateSorting_Vulkan(ctx, n)});
   return impls;
 }
