@@ -398,7 +398,15 @@ std::string GlslPrinter::Call(const CallExpr* call) {
                 "kernels cannot do I/O: write results to an output buffer and print them in the control function");
 
   const bool interlocked = InNamespace(fd, "LiteMath") && (name == "InterlockedAdd" || name == "atomicAdd" || name == "InterlockedAdd3f" || name == "ReduceAdd");
-  if (ispc && interlocked) return IspcFail(call->getBeginLoc(), "LiteMath's atomic '" + qname + "'");
+  if (ispc && interlocked && (name == "InterlockedAdd" || name == "atomicAdd") && call->getNumArgs() >= 2) {
+    // ISPC's global atomic add (int, uint and float), on the target's address.
+    if (std::string problem = AtomicTargetProblem(call->getArg(0)); !problem.empty())
+      return Fail(call->getArg(0)->getExprLoc(), "the target of " + name + " is not in device memory: " + problem,
+                  "make the target an element of a std::vector member, a data member, or an element of a kernel's pointer parameter");
+    const std::string add = "atomic_add_global(&" + Expr(call->getArg(0)) + ", " + Expr(call->getArg(1)) + ")";
+    return call->getNumArgs() == 3 ? Expr(call->getArg(2)) + " = " + add : add;
+  }
+  if (ispc && interlocked) return IspcFail(call->getBeginLoc(), "LiteMath's '" + qname + "'");
   if (IsCrossrtAtomic(fd)) return AtomicCall(fd, call);
   if (interlocked) return InterlockedCall(fd, call);
   std::vector<std::string> args;
