@@ -1,12 +1,19 @@
 // Benchmark: each example class as the original single-threaded C++, as <Class>_CPU (OpenMP on
-// all cores) and as <Class>_Vulkan on the default device. Every figure comes from this one run;
-// ratios are against the original. Each time is the median of the repeats after a warm-up.
+// all cores), as <Class>_ISPC (all cores, SIMD lanes on each; where ISPC is found) and as
+// <Class>_Vulkan on the default device. Every figure comes from this one run; ratios are against
+// the original, and _ISPC's also against _CPU. Each time is the median of the repeats after a
+// warm-up. The table goes to CSV too (default out/bench_examples.csv), which
+// bench/plot_examples.py plots.
 // SpherePaths runs on Vulkan in both execution modes: wavefront (one dispatch per kernel call) and
 // megakernel (its thread loop as one shader).
-//   bench_examples [particles] [bloom side] [paths side]
+//   bench_examples [particles] [bloom side] [paths side] [CSV]
 #include "BenchSupport.h"
 #include "Bloom.h"
 #include "Bloom_CPU.h"
+#ifdef CROSSRT_HAS_ISPC
+#include "Bloom_ISPC.h"
+#include "Particles_ISPC.h"
+#endif
 #include "Bloom_Vulkan.h"
 #include "Particles.h"
 #include "Particles_CPU.h"
@@ -16,6 +23,8 @@
 #include "SpherePaths_Vulkan.h"
 
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <cstdlib>
 #include <memory>
 #include <random>
@@ -27,11 +36,20 @@ using LiteMath::float4;
 
 namespace {
 
+std::ofstream g_csv;  // example,implementation,ms_per_call,speedup_vs_original,gpu_ms_per_call
+
 void Row(const char* example, const char* impl, double ms, double baseMs, double gpuMs)
 {
   char gpu[32] = "";
   if (gpuMs > 0.0) std::snprintf(gpu, sizeof gpu, "%.2f", gpuMs);
   std::printf("| %-10s | %-18s | %10.2f | %8.2fx | %12s |\n", example, impl, ms, baseMs / ms, gpu);
+  g_csv << example << "," << impl << "," << ms << "," << baseMs / ms << "," << gpuMs << "\n";
+}
+
+// _ISPC against _CPU, both measured above in this run.
+void IspcAgainstCpu(const char* example, double cpuMs, double ispcMs)
+{
+  if (cpuMs > 0.0 && ispcMs > 0.0) std::printf("| %-10s | %-18s | %10s | %8.2fx | %12s |\n", example, "_ISPC vs _CPU", "", cpuMs / ispcMs, "");
 }
 
 }  // namespace
@@ -40,13 +58,27 @@ int main(int argc, char** argv)
 {
   if (argc > 1 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h"))
   {
-    std::printf("usage: bench_examples [PARTICLES (default 1048576)] [IMAGE_SIDE (default 1024)] [PATH_SIDE (default 256)]\n  Times the examples as written, as _CPU and as _Vulkan, in interleaved rounds, and prints ratios.\n");
+    std::printf("usage: bench_examples [PARTICLES (default 1048576)] [IMAGE_SIDE (default 1024)] [PATH_SIDE (default 256)] [CSV (default "
+                "out/bench_examples.csv)]\n  Times the examples as written, as _CPU, _ISPC and _Vulkan, and prints ratios; the table goes to CSV "
+                "too (bench/plot_examples.py plots it).\n");
     return 0;
   }
   const int particles = argc > 1 ? std::atoi(argv[1]) : 1 << 20;
   const int side = argc > 2 ? std::atoi(argv[2]) : 1024;
   const int pathSide = argc > 3 ? std::atoi(argv[3]) : 256;
   const int pathSamples = 8;
+  const std::string csvPath = argc > 4 ? argv[4] : "out/bench_examples.csv";
+  if (std::filesystem::path(csvPath).has_parent_path()) std::filesystem::create_directories(std::filesystem::path(csvPath).parent_path());
+  g_csv.open(csvPath);
+  if (!g_csv)
+  {
+    std::fprintf(stderr, "bench_examples: cannot write %s\n", csvPath.c_str());
+    return 1;
+  }
+  g_csv << "example,implementation,ms_per_call,speedup_vs_original,gpu_ms_per_call\n";
+#ifndef CROSSRT_HAS_ISPC
+  std::printf("no ISPC compiler was found at configure time: the _ISPC rows are left out\n");
+#endif
   std::shared_ptr<crossrt::VulkanContext> ctx;
   try { ctx = crossrt::VulkanContext::CreateDefault(); }
   catch (const std::exception& e) { std::fprintf(stderr, "no Vulkan device, the _Vulkan rows are skipped: %s\n", e.what()); }
@@ -60,8 +92,11 @@ int main(int argc, char** argv)
     std::vector<float4> pos0(particles), vel0(particles);
     for (int i = 0; i < particles; ++i) { pos0[i] = float4(u(rng), 5.0f + u(rng), u(rng), 0.0f); vel0[i] = float4(u(rng), u(rng), u(rng), 0.0f); }
     std::vector<std::pair<const char*, std::shared_ptr<Particles>>> impls = {{"original", std::make_shared<Particles>()}, {"Particles_CPU", CreateParticles_CPU()}};
+#ifdef CROSSRT_HAS_ISPC
+    impls.push_back({"Particles_ISPC", CreateParticles_ISPC()});
+#endif
     if (ctx) impls.push_back({"Particles_Vulkan", CreateParticles_Vulkan(ctx)});
-    double base = 0.0;
+    double base = 0.0, cpuMs = 0.0, ispcMs = 0.0;
     for (auto& [name, p] : impls)
     {
       std::vector<float4> pos = pos0, vel = vel0;
@@ -71,15 +106,21 @@ int main(int argc, char** argv)
       p->GetExecutionTime("Step", t);
       if (base == 0.0) base = ms;
       Row("particles", name, ms, base, ctx && std::string(name) == "Particles_Vulkan" ? t[0] : 0.0);
+      if (std::string(name) == "Particles_CPU") cpuMs = ms;
+      if (std::string(name) == "Particles_ISPC") ispcMs = ms;
     }
+    IspcAgainstCpu("particles", cpuMs, ispcMs);
   }
   {  // bloom: three 2D kernels, a 25-tap separable blur
     std::vector<float4> in(size_t(side) * side), out(in.size());
     for (int y = 0; y < side; ++y)
       for (int x = 0; x < side; ++x) in[size_t(y) * side + x] = float4(float(x % 64) / 16.0f, float(y % 32) / 8.0f, 0.5f, 1.0f);
     std::vector<std::pair<const char*, std::shared_ptr<Bloom>>> impls = {{"original", std::make_shared<Bloom>(side, side, 12, 5.0f)}, {"Bloom_CPU", CreateBloom_CPU(side, side, 12, 5.0f)}};
+#ifdef CROSSRT_HAS_ISPC
+    impls.push_back({"Bloom_ISPC", CreateBloom_ISPC(side, side, 12, 5.0f)});
+#endif
     if (ctx) impls.push_back({"Bloom_Vulkan", CreateBloom_Vulkan(ctx, side, side, 12, 5.0f)});
-    double base = 0.0;
+    double base = 0.0, cpuMs = 0.0, ispcMs = 0.0;
     for (auto& [name, b] : impls)
     {
       b->CommitDeviceData();
@@ -88,7 +129,10 @@ int main(int argc, char** argv)
       b->GetExecutionTime("Run", t);
       if (base == 0.0) base = ms;
       Row("bloom", name, ms, base, ctx && std::string(name) == "Bloom_Vulkan" ? t[0] : 0.0);
+      if (std::string(name) == "Bloom_CPU") cpuMs = ms;
+      if (std::string(name) == "Bloom_ISPC") ispcMs = ms;
     }
+    IspcAgainstCpu("bloom", cpuMs, ispcMs);
   }
   {  // paths: a 2D thread loop of four kernels, 8 samples x 4 bounces = 65 kernel calls per pixel
     const uint32_t w = uint32_t(pathSide);
@@ -119,5 +163,6 @@ int main(int argc, char** argv)
   std::printf("\nparticles: %d particles per step; bloom: %dx%d image, radius 12; paths: %dx%d pixels, %d paths per pixel, 4 bounces.\n", particles, side,
               side, pathSide, pathSide, pathSamples);
   std::printf("_Vulkan ms/call includes copying the arguments in and out; 'GPU ms' is the timestamp-measured kernel time.\n");
+  std::printf("table: %s (plot it: bench/plot_examples.py %s out/bench_examples.png)\n", csvPath.c_str(), csvPath.c_str());
   return 0;
 }
