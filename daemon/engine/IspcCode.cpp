@@ -149,7 +149,7 @@ void IspcHostData(const ClassModel& model, Data& d) {
     Data x;
     x.set("name", m.name);
     x.set("expr", m.hostExpr.empty() ? m.name : m.hostExpr);  // a composed member: through its holder
-    x.set("composedFrom", m.composedFrom);
+    if (!m.composedFrom.empty()) x.set("composedFrom", m.composedFrom);  // its comment
     if (m.kind == MemberKind::Plain) members.push_back(x);
     if (m.kind == MemberKind::Vector) vectors.push_back(x);
   }
