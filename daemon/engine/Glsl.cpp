@@ -805,18 +805,29 @@ std::string GlslPrinter::IspcVectorOperator(const CXXOperatorCallExpr* op) {
   return "";
 }
 
-// v[i] = a and v[i] op= a, where v is a LiteMath vector and i known only at run time: ISPC's structs
-// have no subscript, so LiteMath.isph's crt_set writes the component (v and i printed twice for op=).
+// v[i] = a and v[i] op= a, where v is a LiteMath vector and i known only at run time, and a matrix's
+// m(r, c) = a: ISPC's structs have no subscript, so LiteMath.isph's crt_set writes the component
+// (v and i printed twice for op=).
 std::string GlslPrinter::IspcComponentAssignment(const BinaryOperator* bo) {
   auto* op = dyn_cast<CXXOperatorCallExpr>(bo->getLHS()->IgnoreParenImpCasts());
-  if (!op || op->getOperator() != OO_Subscript || op->getNumArgs() != 2) return "";
+  if (!op) return "";
+  std::string v, i;
   const auto glsl = GlslTypeOf(op->getArg(0)->getType().getNonReferenceType());
   clang::Expr::EvalResult index;
-  if (!glsl || glsl->find("vec") == std::string::npos || op->getArg(1)->EvaluateAsInt(index, m_ctx)) return "";
-  const std::string v = Expr(op->getArg(0)), i = Expr(op->getArg(1));
+  if (op->getOperator() == OO_Call && op->getNumArgs() == 3 && glsl && glsl->rfind("mat", 0) == 0) {  // m(row, col) = a
+    v = "(" + Expr(op->getArg(0)) + ").m_col[" + Expr(op->getArg(2)) + "]";
+    i = Expr(op->getArg(1));
+  } else if (op->getOperator() == OO_Subscript && op->getNumArgs() == 2 && glsl && glsl->find("vec") != std::string::npos &&
+             !op->getArg(1)->EvaluateAsInt(index, m_ctx)) {
+    v = Expr(op->getArg(0));
+    i = Expr(op->getArg(1));
+  } else {
+    return "";
+  }
   if (bo->getOpcode() == BO_Assign) return "crt_set(" + v + ", " + i + ", " + Expr(bo->getRHS()) + ")";
-  if (op->getArg(0)->HasSideEffects(m_ctx, false) || op->getArg(1)->HasSideEffects(m_ctx, false))
-    return IspcFail(bo->getBeginLoc(), "compound assignment to a vector's component whose vector or index has side effects");
+  for (unsigned a = 0; a < op->getNumArgs(); ++a)
+    if (op->getArg(a)->HasSideEffects(m_ctx, false))
+      return IspcFail(bo->getBeginLoc(), "compound assignment to a vector's component whose vector or index has side effects");
   const std::string spelling = BinaryOperator::getOpcodeStr(BinaryOperator::getOpForCompoundAssignment(bo->getOpcode())).str();
   return "crt_set(" + v + ", " + i + ", crt_get(" + v + ", " + i + ") " + spelling + " (" + Expr(bo->getRHS()) + "))";
 }

@@ -212,7 +212,7 @@ private:
   std::string IspcFail(clang::SourceLocation loc, const std::string& what);
   // `a op= b` on LiteMath vectors (ISPC overloads no compound assignment), `-v`.
   std::string IspcVectorOperator(const clang::CXXOperatorCallExpr* op);
-  // `v[i] = a`, `v[i] op= a` with i known only at run time; "" for other assignments.
+  // `v[i] = a`, `v[i] op= a` with i known only at run time, `m(r, c) = a`; "" for other assignments.
   std::string IspcComponentAssignment(const clang::BinaryOperator* bo);
 
   clang::ASTContext& m_ctx;
