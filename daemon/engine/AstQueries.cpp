@@ -98,7 +98,7 @@ const VarDecl* WrittenVar(const clang::Expr* e) {
     e = e->IgnoreParenImpCasts();
     if (auto* me = dyn_cast<MemberExpr>(e)) e = me->getBase();
     else if (auto* sub = dyn_cast<ArraySubscriptExpr>(e)) e = sub->getBase();
-    else if (auto* op = dyn_cast<CXXOperatorCallExpr>(e); op && op->getOperator() == OO_Subscript) e = op->getArg(0);
+    else if (auto* op = dyn_cast<CXXOperatorCallExpr>(e); op && (op->getOperator() == OO_Subscript || op->getOperator() == OO_Call)) e = op->getArg(0);
     else return NamedVar(e);
   }
 }

@@ -683,6 +683,14 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
       std::string spelling = getOperatorSpelling(kind);
       return ImageStore(op->getArg(0), Expr(op->getArg(0)) + " " + spelling.substr(0, spelling.size() - 1) + " (" + Expr(op->getArg(1)) + ")", e);
     }
+    if (kind == OO_Call && op->getNumArgs() == 3) {  // LiteMath's m(row, col): GLSL's matrices index the column first
+      const auto glsl = GlslTypeOf(op->getArg(0)->getType().getNonReferenceType());
+      if (glsl && glsl->rfind("mat", 0) == 0) {
+        const clang::Expr* m = op->getArg(0)->IgnoreParenImpCasts();
+        const std::string matrix = isa<DeclRefExpr>(m) || isa<MemberExpr>(m) ? Expr(m) : "(" + Expr(m) + ")";
+        return matrix + "[" + Expr(op->getArg(2)) + "][" + Expr(op->getArg(1)) + "]";
+      }
+    }
     if (kind == OO_Call) return Fail(e->getBeginLoc(), "call of a function object in a kernel", "call a plain function instead");
     if (kind == OO_LessLess || kind == OO_GreaterGreater) {
       if (IsSystemDecl(op->getDirectCallee() ? (const Decl*)op->getDirectCallee() : (const Decl*)m_class))

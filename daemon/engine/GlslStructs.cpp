@@ -163,9 +163,12 @@ bool GlslPrinter::IsUserConstructor(const CXXConstructorDecl* ctor) const {
   return ctor && IsPlainStruct(ctor->getParent()) && ctor->isUserProvided() && !ctor->isCopyOrMoveConstructor();
 }
 
-// LiteMath matrices' member functions: GLSL's matrix indexing.
+// LiteMath matrices' member functions: GLSL's matrix indexing, or the columns of LiteMath.isph's structs.
 std::string GlslPrinter::MatrixMethodCall(const CXXMemberCallExpr* call) {
-  const std::string n = call->getMethodDecl()->getNameAsString(), m = Expr(call->getImplicitObjectArgument());
+  const std::string n = call->getMethodDecl()->getNameAsString();
+  std::string m = Expr(call->getImplicitObjectArgument());
+  if (ispc) m = "(" + m + ").m_col";  // LiteMath.isph's matrices are structs of columns
+  if (ispc && n == "get_row" && call->getNumArgs() == 1) return "transpose(" + Expr(call->getImplicitObjectArgument()) + ").m_col[" + Expr(call->getArg(0)) + "]";
   if ((n == "get_col" || n == "col") && call->getNumArgs() == 1) return m + "[" + Expr(call->getArg(0)) + "]";
   if (n == "get_row" && call->getNumArgs() == 1) return "transpose(" + m + ")[" + Expr(call->getArg(0)) + "]";
   if (n == "set_col" && call->getNumArgs() == 2) return m + "[" + Expr(call->getArg(0)) + "] = " + Expr(call->getArg(1));

@@ -113,8 +113,6 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
       if (!outer && isa<ForStmt>(s)) outer = cast<ForStmt>(s);
       else (outer ? after : before).push_back(s);
     }
-    for (auto* s : before)
-      if (isa<DeclStmt>(s)) preamble.push_back(s);
     if (!outer) {
       c.rep.Error(md->getLocation(), "kernel '" + k.name + "' has no loop", "a kernel" + std::to_string(k.dims) + "D_ function holds " + std::to_string(k.dims) + " nested for loops whose iterations become GPU threads");
       return;
@@ -163,6 +161,22 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     for (unsigned d = 0; d < k.dims; ++d) k.threadAxes.push_back(d);
   }
 
+  // The locals declared before the nest, and the statements that only set them: every thread
+  // evaluates them for itself, in order. (The locals the nest reduces are found first: a thread
+  // starts those from the identity, and statements before the nest may not set them.)
+  std::set<const VarDecl*> beforeLocals;
+  for (auto* s : before)
+    if (auto* ds = dyn_cast<DeclStmt>(s))
+      for (auto* d : ds->decls())
+        if (auto* vd = dyn_cast<VarDecl>(d)) beforeLocals.insert(vd);
+  LocalReductionScanner localReductions(c, beforeLocals);
+  localReductions.TraverseStmt(const_cast<Stmt*>(threadBody));
+  std::set<const VarDecl*> reducedLocals;
+  for (auto& [vd, op] : localReductions.reductions) reducedLocals.insert(vd);
+  const std::set<const Stmt*> settingLocals = StatementsSettingLocals(before, reducedLocals);
+  for (auto* s : before)
+    if (isa<DeclStmt>(s) || settingLocals.count(s)) preamble.push_back(s);
+
   // Reductions and member writes.
   WriteScanner ws(c);
   ws.TraverseStmt(const_cast<Stmt*>(threadBody));
@@ -171,14 +185,8 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   ends.singleThread = true;
   for (auto* list : {&before, &after})
     for (auto* s : *list)
-      if (!isa<DeclStmt>(s)) ends.TraverseStmt(const_cast<Stmt*>(s));
-  std::set<const VarDecl*> beforeLocals;
-  for (auto* s : preamble)
-    for (auto* d : cast<DeclStmt>(s)->decls())
-      if (auto* vd = dyn_cast<VarDecl>(d)) beforeLocals.insert(vd);
-  LocalReductionScanner localReductions(c, beforeLocals);
-  localReductions.TraverseStmt(const_cast<Stmt*>(threadBody));
-  if (!CheckLoopEnds(c, k.name, before, after, threadBody, localReductions.targets)) return;
+      if (!isa<DeclStmt>(s) && !settingLocals.count(s)) ends.TraverseStmt(const_cast<Stmt*>(s));
+  if (!CheckLoopEnds(c, k.name, before, after, threadBody, localReductions.targets, settingLocals)) return;
   LocalReductionReads(c, k.name, localReductions, threadBody);
   ReductionReadScanner rs(c, ws);
   rs.TraverseStmt(const_cast<Stmt*>(threadBody));
@@ -204,7 +212,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   // Reduced locals, in declaration order: a thread's part is <local>Local, as a member's is.
   std::set<const Stmt*> reductionDecls;  // their declarations, which the threads do not evaluate
   for (auto* s : preamble)
-    for (auto* d : cast<DeclStmt>(s)->decls()) {
+    for (auto* d : isa<DeclStmt>(s) ? cast<DeclStmt>(s)->decls() : DeclStmt::decl_range(nullptr, nullptr)) {
       auto* vd = dyn_cast<VarDecl>(d);
       auto found = vd ? localReductions.reductions.find(vd) : localReductions.reductions.end();
       if (found == localReductions.reductions.end()) continue;
@@ -277,7 +285,9 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   k.glslBody = os.str();
   // The statements around the loop nest, as functions one thread runs before and after the others.
   // (The ISPC class runs them on the host, as the CPU class does.)
-  if (!printer.ispc && (std::any_of(before.begin(), before.end(), [](const Stmt* s) { return !isa<DeclStmt>(s); }) || !after.empty())) {
+  // (Statements that only set locals need no thread of their own: every thread evaluated them.)
+  const bool startRuns = std::any_of(before.begin(), before.end(), [&](const Stmt* s) { return !isa<DeclStmt>(s) && !settingLocals.count(s); });
+  if (!printer.ispc && (startRuns || !after.empty())) {
     const auto sizeReadsInLoop = printer.Uses().sizeReads;  // after the loop a vector's final size is known
     const auto renames = printer.renames;
     for (auto& r : k.reductions)
@@ -286,7 +296,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     for (auto& [vd, op] : localReductions.reductions) printer.renames.erase(vd);
     printer.singleThread = true;
     const std::string from = "// from " + c.cls->getNameAsString() + "::" + k.name + " (" + k.sourceFile + "): ";
-    if (std::any_of(before.begin(), before.end(), [](const Stmt* s) { return !isa<DeclStmt>(s); })) {
+    if (startRuns) {
       k.glslStart = from + "the statements before its loop nest, run by one thread before the others\nvoid " + k.name + "_Start()\n{\n";
       for (auto* s : before) k.glslStart += printer.Stmt(s, 1);
       k.glslStart += "}\n";

@@ -58,8 +58,74 @@ std::string CountExpr(Context& c, const LoopHeader& h) {
   return h.inclusive ? count + " + 1" : count;
 }
 
+namespace {
+
+// The locals a statement declares (a loop's variable, a block's temporaries): its own to set.
+struct DeclaredWithin : RecursiveASTVisitor<DeclaredWithin> {
+  std::set<const VarDecl*> vars;
+  bool VisitVarDecl(VarDecl* vd) { vars.insert(vd); return true; }
+};
+
+// What a statement sets: the locals of `locals` (or its own), or anything else: a member, a
+// parameter, a reduced local, an object through a non-const call.
+struct SetsWhat : WriteVisitor<SetsWhat> {
+  const std::set<const VarDecl*>& locals;
+  std::set<const VarDecl*> own;
+  bool setsLocal = false, setsOther = false;
+  explicit SetsWhat(const std::set<const VarDecl*>& l) : locals(l) {}
+  void Written(const Expr* target, SourceLocation) {
+    auto* vd = WrittenVar(target);
+    if (vd && own.count(vd)) return;
+    (vd && locals.count(vd) ? setsLocal : setsOther) = true;
+  }
+  bool VisitCXXMemberCallExpr(CXXMemberCallExpr* call) {
+    if (auto* m = call->getMethodDecl(); m && !m->isConst()) Written(call->getImplicitObjectArgument(), call->getExprLoc());
+    return true;
+  }
+  bool VisitCallExpr(CallExpr* call) {
+    if (isa<CXXMemberCallExpr>(call) || isa<CXXOperatorCallExpr>(call)) return true;
+    auto* fd = call->getDirectCallee();
+    if (!fd) { setsOther = true; return true; }
+    // A free function writes what it takes by non-const reference or pointer.
+    for (unsigned i = 0; i < std::min(fd->getNumParams(), call->getNumArgs()); ++i) {
+      QualType t = fd->getParamDecl(i)->getType();
+      const bool byRef = t->isReferenceType() && !t.getNonReferenceType().isConstQualified();
+      const bool byPtr = t->isPointerType() && !t->getPointeeType().isConstQualified();
+      const Expr* arg = call->getArg(i)->IgnoreParenImpCasts();
+      if (auto* uo = dyn_cast<UnaryOperator>(arg); byPtr && uo && uo->getOpcode() == UO_AddrOf) arg = uo->getSubExpr();
+      if (byRef || byPtr) Written(arg, call->getExprLoc());
+    }
+    return true;
+  }
+  bool VisitCXXNewExpr(CXXNewExpr*) { setsOther = true; return true; }
+  bool VisitCXXDeleteExpr(CXXDeleteExpr*) { setsOther = true; return true; }
+  bool VisitCXXThrowExpr(CXXThrowExpr*) { setsOther = true; return true; }
+};
+
+}  // namespace
+
+std::set<const Stmt*> StatementsSettingLocals(const std::vector<const Stmt*>& before, const std::set<const VarDecl*>& reduced) {
+  std::set<const VarDecl*> locals;
+  std::set<const Stmt*> out;
+  for (auto* s : before) {
+    if (auto* ds = dyn_cast<DeclStmt>(s)) {
+      for (auto* d : ds->decls())
+        if (auto* vd = dyn_cast<VarDecl>(d); vd && !reduced.count(vd)) locals.insert(vd);
+      continue;
+    }
+    DeclaredWithin within;
+    within.TraverseStmt(const_cast<Stmt*>(s));
+    SetsWhat sets(locals);
+    sets.own = within.vars;
+    sets.TraverseStmt(const_cast<Stmt*>(s));
+    if (sets.setsLocal && !sets.setsOther) out.insert(s);
+  }
+  return out;
+}
+
 bool CheckLoopEnds(Context& c, const std::string& kernel, const std::vector<const Stmt*>& before,
-                   const std::vector<const Stmt*>& after, const Stmt* threadBody, const std::set<const Expr*>& reductionTargets) {
+                   const std::vector<const Stmt*>& after, const Stmt* threadBody, const std::set<const Expr*>& reductionTargets,
+                   const std::set<const Stmt*>& settingLocals) {
   std::set<const VarDecl*> locals;
   for (auto* s : before)
     if (auto* ds = dyn_cast<DeclStmt>(s))
@@ -78,16 +144,20 @@ bool CheckLoopEnds(Context& c, const std::string& kernel, const std::vector<cons
       if (uo->getOpcode() == UO_AddrOf) Written(uo->getSubExpr(), uo->getExprLoc());
       return WriteVisitor<LocalWrites>::VisitUnaryOperator(uo);
     }
+    bool VisitCXXMemberCallExpr(CXXMemberCallExpr* call) {  // m.set_col(1, c)
+      if (auto* m = call->getMethodDecl(); m && !m->isConst()) Written(call->getImplicitObjectArgument(), call->getExprLoc());
+      return true;
+    }
   };
   bool ok = true;
   for (auto* s : before) {
-    if (isa<DeclStmt>(s)) continue;
+    if (isa<DeclStmt>(s) || settingLocals.count(s)) continue;
     LocalWrites w(locals);
     w.TraverseStmt(const_cast<Stmt*>(s));
     for (auto& [vd, loc] : w.found) {
       c.rep.Error(loc, "a statement before the loop nest of kernel '" + kernel + "' changes '" + vd->getNameAsString() +
-                  "', which every thread of the nest computes from its declaration",
-                  "give '" + vd->getNameAsString() + "' its final value where it is declared");
+                  "', which every thread of the nest computes for itself, and also has effects beyond the locals (a member, a parameter, a reduced local, a call)",
+                  "split it: one statement that only sets '" + vd->getNameAsString() + "', and one for the rest");
       ok = false;
     }
   }

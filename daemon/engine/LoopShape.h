@@ -5,13 +5,21 @@
 
 namespace crossrt::engine {
 
+// The statements before a kernelND_'s loop nest that do nothing but set locals declared before it
+// (`float4x4 m = m_xf; m(0, 3) = 0.5f;`): every thread evaluates them, in order with the
+// declarations, as the C++ class evaluated them once. `reduced` are the locals the nest reduces,
+// whose threads start from the identity instead.
+std::set<const Stmt*> StatementsSettingLocals(const std::vector<const Stmt*>& before, const std::set<const VarDecl*>& reduced);
+
 // The statements before and after a kernelND_'s loop nest run on one thread, around the threads of
 // the nest: before them (the GPU's <kernel>_Start) and after them (<kernel>_Finish). Every thread
-// evaluates the declarations before the nest for itself, so the statements before it may not change
-// those locals afterwards, and neither may the threads (a race on the CPU too). A 'return' before
-// the nest would skip it on the CPU but not on the GPU.
+// evaluates the declarations before the nest for itself, and the statements that only set those
+// locals (`settingLocals`); any other statement before the nest may not change those locals, and
+// neither may the threads (a race on the CPU too). A 'return' before the nest would skip it on the
+// CPU but not on the GPU.
 bool CheckLoopEnds(Context& c, const std::string& kernel, const std::vector<const Stmt*>& before,
-                   const std::vector<const Stmt*>& after, const Stmt* threadBody, const std::set<const Expr*>& reductionTargets);
+                   const std::vector<const Stmt*>& after, const Stmt* threadBody, const std::set<const Expr*>& reductionTargets,
+                   const std::set<const Stmt*>& settingLocals);
 
 struct LoopHeader {
   const VarDecl* var = nullptr;

@@ -59,3 +59,30 @@ void Semantics::kernel_Bump(int tid, float* out)
 {
   out[tid] += 0.25f * m_time;
 }
+
+void Semantics::Transform(int n, const float4* in, float* out)
+{
+  kernel1D_Transform(n, in, out);
+}
+
+// Locals set up by statements before the loop nest, not only by their declarations: the loop sees
+// them as those statements left them, and so do the statements after it. A statement that sets a
+// member runs once.
+void Semantics::kernel1D_Transform(int n, const float4* in, float* out)
+{
+  float4x4 m = m_xf;
+  m(0, 3) = 0.5f;                     // an element, through operator()
+  m.set_col(1, float4(0.0f, 2.0f, 0.0f, 0.0f));
+  float bias = 1.0f;
+  if (m_time > 0.0f)
+    bias *= m_time;
+  m(1, 0) += 0.25f;
+  m(1, 1) += 0.25f;
+  m_transforms += 1;
+  for (int i = 0; i < n; i++)
+  {
+    const float4 p = m * in[i];
+    out[i] = p.x + 0.5f * p.y + bias;
+  }
+  m_corner = m(0, 3) + m(1, 0) + bias;
+}

@@ -226,6 +226,56 @@ void Sums::kernel1D_Sum(int n, float* data, float* total)
   }
 }
 
+TEST_CASE("A statement before a loop nest that sets a local and does more is refused; one that only sets locals is not", "[diagnostics]")
+{
+  const char* header = R"(#pragma once
+#include "LiteMath.h"
+class Scales
+{
+public:
+  virtual ~Scales() = default;
+  virtual void Scale(int n, [[crossrt::size("n")]] float* data);
+  float m_step = 1.0f;
+protected:
+  float NextStep() { m_step *= 2.0f; return m_step; }
+  void kernel1D_Scale(int n, float* data);
+};
+)";
+  // Line 6 of Scales.cpp is the statement before the loop nest.
+  for (const bool onlyLocals : {true, false})
+  {
+    SECTION(onlyLocals ? "only locals" : "a local and a member")
+    {
+      TempClass tc("Scales", header, std::string(R"(#include "Scales.h"
+void Scales::Scale(int n, float* data) { kernel1D_Scale(n, data); }
+void Scales::kernel1D_Scale(int n, float* data)
+{
+  LiteMath::float2 s(1.0f, 0.0f);
+)") + (onlyLocals ? "  s[1] = m_step * 3.0f;" : "  s[1] = NextStep();") + R"(
+  for (int i = 0; i < n; i++)
+    data[i] *= s.x + s.y;
+}
+)");
+      CommandResult r = RunCrossrt("translate --class Scales --backend vulkan --out " + (tc.dir / "out").string() + " --source " + tc.Source("Scales") +
+                                   " --templates " CROSSRT_SOURCE_DIR "/templates -- -I" CROSSRT_SOURCE_DIR "/libs/litemath");
+      INFO(r.output);
+      REQUIRE_FALSE(r.crashed);
+      if (onlyLocals)
+      {
+        REQUIRE(r.exitCode == 0);
+        std::ifstream shader(tc.dir / "out" / "shaders" / "kernel1D_Scale.comp");
+        const std::string text((std::istreambuf_iterator<char>(shader)), std::istreambuf_iterator<char>());
+        REQUIRE(text.find("  s[1] = m_step * 3.0;\n  data[i] *= s.x + s.y;") != std::string::npos);  // every thread sets it
+        continue;
+      }
+      REQUIRE(r.exitCode == 1);
+      REQUIRE(r.output.find(tc.Source("Scales") + ":6:") != std::string::npos);
+      REQUIRE(r.output.find("a statement before the loop nest of kernel 'kernel1D_Scale' changes 's'") != std::string::npos);
+      REQUIRE(r.output.find("split it") != std::string::npos);
+    }
+  }
+}
+
 TEST_CASE("A source that does not parse passes the compiler's diagnostics through", "[diagnostics]")
 {
   TempClass tc("Broken", "#pragma once\nclass Broken { public: virtual void Run(); };\n",

@@ -81,3 +81,38 @@ TEST_CASE("Members changed between kernels, and RTV loops inside host loops, run
   }
   RequireNoValidationMessages(ctx);
 }
+
+TEST_CASE("Statements before a loop nest that set its locals reach every thread and the statements after it", "[equivalence]")
+{
+  auto ctx = ValidatedContext();
+  const int n = 300;
+  std::vector<float4> in(n);
+  for (int i = 0; i < n; ++i)
+    in[i] = float4(float(i % 7) - 3.0f, float(i % 5), 1.0f + float(i % 3), 1.0f);
+  auto impls = AllImplementations(ctx);
+  std::vector<std::vector<float>> results;
+  for (auto& [name, impl] : impls)
+  {
+    INFO(name);
+    impl->m_xf = translate4x4(float3(1.0f, 2.0f, 3.0f));
+    impl->m_time = 2.0f;
+    impl->CommitDeviceData();
+    std::vector<float> out(n, -1.0f);
+    impl->Transform(n, in.data(), out.data());
+    impl->Transform(n, in.data(), out.data());
+    results.push_back(out);
+    // By hand: m(0, 3) = 0.5 replaces the translation's 1, column 1 is (0, 2, 0, 0), row 1 gains 0.25
+    // in columns 0 and 1, and bias = 1 * m_time = 2.
+    REQUIRE(impl->m_transforms == 2);
+    REQUIRE(impl->m_corner == 0.5f + 0.25f + 2.0f);
+    const float4 p = in[4];   // (1, 4, 2, 1)
+    const float x = p.x + 0.5f, y = 0.25f * p.x + (2.0f + 0.25f) * p.y + 2.0f;
+    REQUIRE(out[4] == Approx(x + 0.5f * y + 2.0f));
+  }
+  for (size_t k = 1; k < results.size(); ++k)
+  {
+    INFO(impls[k].first);
+    REQUIRE(CountMismatches(results[0], results[k], 1e-5f) == 0);
+  }
+  RequireNoValidationMessages(ctx);
+}
