@@ -215,11 +215,14 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
       known = model.virtuals.end() - 1;
     }
     const VirtualMember& vm = *known;
-    k.bufferReferences = true;
-    // Data structs and buffer references, then each implementation's methods.
-    const GlslDecl tags = TagsReference(model, vm);
-    structs.push_back(tags);
-    if (callable) callable->structs.push_back(tags);
+    const bool ispc = kernelPrinter.ispc;  // ISPC: the class data points at the tags and at each class's objects
+    if (!ispc) {
+      k.bufferReferences = true;
+      // Data structs and buffer references, then each implementation's methods.
+      const GlslDecl tags = TagsReference(model, vm);
+      structs.push_back(tags);
+      if (callable) callable->structs.push_back(tags);
+    }
     std::map<std::string, std::string> implFunction;  // (impl, method) -> GLSL name
     std::map<std::string, std::pair<GlslDecl, GlslDecl>> implData;  // impl -> (data struct, buffer reference to its objects)
     for (auto* impl : impls) {
@@ -227,16 +230,19 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
       if (vi == vm.impls.end()) continue;
       GlslPrinter printer(ctx, impl, rep);
       printer.selfClass = impl;
+      printer.ispc = ispc;
       printer.composedPrefix = vi->name + "_";
       for (auto& sn : ClassStructNames(model)) printer.predeclaredStructs.insert(sn);
       const GlslDecl data = ImplDataStruct(model, printer, impl, vm, *vi);
       for (auto* m : methods) implFunction[vi->name + "::" + m->getNameAsString()] = ImplementationMethod(rep, printer, impl, m, field->getLocation());
       for (auto& x : printer.Structs()) structs.push_back(x);
-      const GlslDecl objectsReference = ObjectsReference(model, vm, *vi);
       structs.push_back(data);
-      structs.push_back(objectsReference);
-      implData[vi->name] = {data, objectsReference};
-      k.scalarReferences |= vi->scalarLayout;
+      if (!ispc) {
+        const GlslDecl objectsReference = ObjectsReference(model, vm, *vi);
+        structs.push_back(objectsReference);
+        implData[vi->name] = {data, objectsReference};
+        k.scalarReferences |= vi->scalarLayout;
+      }
       for (auto& x : printer.Constants())
         if (std::find(k.constantList.begin(), k.constantList.end(), x) == k.constantList.end()) k.constantList.push_back(x);
       for (auto& x : printer.Functions()) functions.push_back(x);
@@ -253,12 +259,14 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
       d.set("returnsVoid", retType == "void");
       d.set("member", member);
       d.set("params", DispatcherParams(kernelPrinter, m));
+      d.set("dataStruct", kernelPrinter.DataStruct());
       Data cases = List();
       for (size_t t = 0; t < vm.impls.size(); ++t) {
         const auto& vi = vm.impls[t];
         // Level 1: all elements in one array of equal slots; level 2: each class's objects apart.
+        // (ISPC, at every level: an array per class that the class data points at.)
         const std::string address = member + (model.virtualLevel == 1 ? std::string("_objects") : "_" + vi.name);
-        std::string args = member + "_" + vi.name + "Objects(" + address + ").objects[tag.y]";
+        std::string args = ispc ? "self->" + member + "_" + vi.name + "[slot]" : member + "_" + vi.name + "Objects(" + address + ").objects[tag.y]";
         for (unsigned i = 0; i < m->getNumParams(); ++i) args += ", " + CallArgumentName(m, i);
         Data x;
         x.set("tag", std::to_string(t));
@@ -267,8 +275,8 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
         cases.push_back(x);
       }
       d.set("cases", cases);
-      functions.push_back(Render(model.templateDir + "/glsl/dispatcher.glsl.mustache", d));
-      if (callable) CallableDispatcher(ctx, rep, model, k, kernelPrinter, vm, impls, m, field->getLocation(), implData, *callable);
+      functions.push_back(Render(model.templateDir + (ispc ? "/ispc/dispatcher.ispc.mustache" : "/glsl/dispatcher.glsl.mustache"), d));
+      if (callable && !ispc) CallableDispatcher(ctx, rep, model, k, kernelPrinter, vm, impls, m, field->getLocation(), implData, *callable);
     }
   }
 }

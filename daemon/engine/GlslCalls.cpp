@@ -314,7 +314,7 @@ std::string GlslPrinter::Call(const CallExpr* call) {
       if (StringRef(name).starts_with("kernel"))
         return Fail(call->getBeginLoc(), "kernel '" + name + "' is called from inside a kernel", "call kernels only from control functions");
       std::vector<std::string> args;
-      if (ispc && !method->isStatic()) args.push_back("self");  // the class's data, as kernels have it
+      if (ispc && !selfClass && !method->isStatic()) args.push_back("self");  // the class's data, as kernels have it
       if (selfClass) {
         args.push_back("self");
         // The object's exact class is known: a virtual call on it is static.
@@ -343,7 +343,7 @@ std::string GlslPrinter::Call(const CallExpr* call) {
     if (!composed.empty()) return composed;
     // Calls through an element of a vector of objects: dynamic dispatch.
     std::string dispatched = VirtualCall(mc);
-    if (!dispatched.empty()) return ispc ? IspcFail(call->getBeginLoc(), "a virtual call through a vector of objects") : dispatched;
+    if (!dispatched.empty()) return dispatched;
     // Calls on a std::vector member.
     if (auto* me = dyn_cast<MemberExpr>(obj); me && IsStdVector(me->getType())) {
       auto* field = dyn_cast<FieldDecl>(me->getMemberDecl());
@@ -356,7 +356,7 @@ std::string GlslPrinter::Call(const CallExpr* call) {
       if (field && isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts()) && name == "size" && IsStdVector(field->getType(), &element) &&
           PolymorphicPointee(element)) {
         m_uses.objectSizeReads.emplace(field, call->getBeginLoc());
-        return composedPrefix + field->getNameAsString() + "_size";
+        return ispc ? IspcMember(field->getNameAsString() + "_size") : composedPrefix + field->getNameAsString() + "_size";
       }
       if (field && isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts())) {
         m_uses.memberVectors.insert(field);

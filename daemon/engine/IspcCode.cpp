@@ -217,6 +217,7 @@ void IspcHostData(const ClassModel& model, Data& d) {
     x.set("targetFunctions", targets);
     kernels.push_back(x);
   }
+  d.set("ispcHasKernels", !kernels.is_empty_list());  // else ISPC declares no <Class>_Data
   d.set("ispcKernels", kernels);
 }
 

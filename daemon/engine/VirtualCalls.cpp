@@ -88,9 +88,12 @@ bool WrittenBack(const CXXMethodDecl* m, unsigned i) {
 
 std::string DispatcherParams(GlslPrinter& printer, const CXXMethodDecl* m) {
   std::string out;
-  for (unsigned i = 0; i < m->getNumParams(); ++i)
-    out += std::string(", ") + (WrittenBack(m, i) ? "inout " : "") +
-           printer.Declare(m->getParamDecl(i)->getType(), CallArgumentName(m, i), m->getParamDecl(i)->getLocation());
+  for (unsigned i = 0; i < m->getNumParams(); ++i) {
+    std::string declared = printer.Declare(m->getParamDecl(i)->getType(), CallArgumentName(m, i), m->getParamDecl(i)->getLocation());
+    if (WrittenBack(m, i) && printer.ispc) declared.insert(declared.rfind(' ') + 1, "&");  // ISPC: a reference
+    else if (WrittenBack(m, i)) declared = "inout " + declared;
+    out += ", " + declared;
+  }
   return out;
 }
 
@@ -121,7 +124,7 @@ GlslDecl ImplDataStruct(const ClassModel& model, GlslPrinter& printer, const CXX
   else d.set("paddingWords", false);
   d.set("interface", vm.interfaceName);
   d.set("slotBytes", std::to_string(vm.slotBytes));
-  return {vi.name + "_Data", Render(model.templateDir + "/glsl/virtual_objects.glsl.mustache", d)};
+  return {vi.name + "_Data", Render(model.templateDir + (printer.ispc ? "/ispc/virtual_objects.ispc.mustache" : "/glsl/virtual_objects.glsl.mustache"), d)};
 }
 
 GlslDecl ObjectsReference(const ClassModel& model, const VirtualMember& vm, const VirtualImpl& vi) {

@@ -8,6 +8,7 @@
 #include "ShapeTracer_Vulkan.h"
 #include "SphereTracer_CPU.h"
 #ifdef CROSSRT_HAS_ISPC
+#include "ShapeTracer_ISPC.h"
 #include "SphereTracer_ISPC.h"
 #endif
 #include "SphereTracer_Vulkan.h"
@@ -156,6 +157,10 @@ TEST_CASE("Composition: virtual intersection functions called from the composed 
     bool intersectionShaders;
   };
   std::vector<Run> runs = {{"CPU", cpu.get(), false}};
+#ifdef CROSSRT_HAS_ISPC
+  auto lanes = CreateShapeTracer_ISPC();  // level 3 on the CPU: the switch, lane by lane
+  runs.push_back({"ISPC", lanes.get(), false});
+#endif
   if (gpu && ctx->hasRayTracingPipeline) runs.push_back({"Vulkan, intersection shaders", gpu.get(), true});
   if (gpu) runs.push_back({"Vulkan, switch", gpu.get(), false});
   for (const Run& run : runs)

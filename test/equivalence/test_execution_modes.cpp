@@ -1,11 +1,15 @@
 // Execution modes (paper 2.1 and 4.4): a control function whose thread loop calls several kernels, passing
 // per-thread locals between them, runs on the GPU as one megakernel or as one dispatch per kernel
-// call (wavefront, the locals kept in buffers). The original, _CPU and _Vulkan in both modes must
-// agree. SpherePaths (the sphere_paths example) is a 2D loop of path-tracing kernels; Walkers a 1D
+// call (wavefront, the locals kept in buffers). The original, _CPU, _ISPC (whose thread loops run
+// the kernels' C++ on all cores, as _CPU's do) and _Vulkan in both modes must agree. SpherePaths (the sphere_paths example) is a 2D loop of path-tracing kernels; Walkers a 1D
 // loop with a struct of state, translated with EXECUTION_MODE megakernel.
 #include "SpherePaths.h"
 #include "SpherePaths_CPU.h"
 #include "SpherePaths_Vulkan.h"
+#ifdef CROSSRT_HAS_ISPC
+#include "SpherePaths_ISPC.h"
+#include "Walkers_ISPC.h"
+#endif
 #include "TestSupport.h"
 #include "Walkers.h"
 #include "Walkers_CPU.h"
@@ -51,6 +55,9 @@ TEST_CASE("Execution modes: a 2D thread loop of path-tracing kernels gives the s
 
   auto cpu = CreateSpherePaths_CPU();
   CHECK(DifferentPixels(expected, RenderPaths(*cpu, w, h, samples), 0.0f) == 0);  // the same code, per pixel
+#ifdef CROSSRT_HAS_ISPC
+  CHECK(DifferentPixels(expected, RenderPaths(*CreateSpherePaths_ISPC(), w, h, samples), 0.0f) == 0);
+#endif
 
   auto ctx = ValidatedContext();
   if (!ctx)
@@ -110,6 +117,9 @@ TEST_CASE("Execution modes: a 1D thread loop with struct state starts as a megak
   };
   auto cpu = CreateWalkers_CPU();
   CHECK(compare(*cpu) == 0);
+#ifdef CROSSRT_HAS_ISPC
+  CHECK(compare(*CreateWalkers_ISPC()) == 0);
+#endif
   auto ctx = ValidatedContext();
   if (!ctx)
     return;

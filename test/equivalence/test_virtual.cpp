@@ -1,6 +1,7 @@
 // Virtual functions in kernels: MaterialShading, FlatShading and CallableShading call IMaterial
-// through a std::vector of shared_ptr. The original, _CPU and _Vulkan shade the same points, at
-// all three levels: MaterialShading_Vulkan keeps each class's objects in a buffer of their own
+// through a std::vector of shared_ptr. The original, _CPU, _ISPC and _Vulkan shade the same points,
+// at all three levels (the ISPC classes, at levels 1 and 2, keep each class's objects in an array
+// of their own and switch over the class lane by lane): MaterialShading_Vulkan keeps each class's objects in a buffer of their own
 // (level 2), FlatShading_Vulkan every element in one array of equal slots (level 1); a switch over
 // the object's class picks the code. CallableShading_Vulkan (level 3) runs a callable shader per
 // class where the device has ray tracing pipelines, the level-2 switch elsewhere. The GPU may
@@ -14,6 +15,11 @@
 #include "MaterialShading.h"
 #include "MaterialShading_CPU.h"
 #include "MaterialShading_Vulkan.h"
+#ifdef CROSSRT_HAS_ISPC
+#include "CallableShading_ISPC.h"
+#include "FlatShading_ISPC.h"
+#include "MaterialShading_ISPC.h"
+#endif
 #include "TestSupport.h"
 
 #include <functional>
@@ -94,9 +100,10 @@ size_t Differing(const std::vector<float4>& a, const std::vector<float4>& b, flo
 }
 }  // namespace
 
-// Both translations of the same kernel, against the original of their class.
+// The translations of the same kernel, against the original of their class: _CPU, _ISPC (where ISPC
+// is found) and _Vulkan (where a device is).
 template <typename Shading>
-void CheckVirtualCalls(std::shared_ptr<Shading> cpu, std::function<std::shared_ptr<Shading>()> createGpu)
+void CheckVirtualCalls(std::shared_ptr<Shading> cpu, std::shared_ptr<Shading> ispc, std::function<std::shared_ptr<Shading>()> createGpu)
 {
   auto ctx = ValidatedContext();
   const auto palette = Palette();
@@ -115,10 +122,16 @@ void CheckVirtualCalls(std::shared_ptr<Shading> cpu, std::function<std::shared_p
   cpu->m_materials = palette;
   REQUIRE(Differing(ShadeWith(*cpu, scene), expected, 0.0f) == 0);  // the same compiled C++ on all cores
 
-  if (!ctx) return;
-  auto gpu = createGpu();
-  gpu->m_materials = palette;
-  REQUIRE(Differing(ShadeWith(*gpu, scene), expected, 1e-5f) == 0);
+  // The ISPC kernels' pow and the GPU's may differ from std::pow by an ulp or so.
+  std::vector<std::pair<const char*, std::shared_ptr<Shading>>> translated;
+  if (ispc) translated.push_back({"ISPC", ispc});
+  if (ctx) translated.push_back({"Vulkan", createGpu()});
+  for (auto& [name, t] : translated)
+  {
+    INFO(name);
+    t->m_materials = palette;
+    REQUIRE(Differing(ShadeWith(*t, scene), expected, 1e-5f) == 0);
+  }
 
   SECTION("objects changed in place are seen after CommitDeviceData()")
   {
@@ -127,11 +140,15 @@ void CheckVirtualCalls(std::shared_ptr<Shading> cpu, std::function<std::shared_p
     static_cast<Checker&>(*changed[5]).opacity = 0.125f;
     changed[1] = changed[3];  // an element now holds another class: the tags change
     original.m_materials = changed;
-    gpu->m_materials = changed;
-    gpu->CommitDeviceData();
     const auto expectedChanged = ShadeWith(original, scene);
     REQUIRE(Differing(expectedChanged, expected, 0.0f) > 0);
-    REQUIRE(Differing(ShadeWith(*gpu, scene), expectedChanged, 1e-5f) == 0);
+    for (auto& [name, t] : translated)
+    {
+      INFO(name);
+      t->m_materials = changed;
+      t->CommitDeviceData();
+      REQUIRE(Differing(ShadeWith(*t, scene), expectedChanged, 1e-5f) == 0);
+    }
   }
   SECTION("added objects are seen without CommitDeviceData()")
   {
@@ -142,28 +159,49 @@ void CheckVirtualCalls(std::shared_ptr<Shading> cpu, std::function<std::shared_p
     more.push_back(extra);
     const Scene wide = RandomScene(3001, uint32_t(more.size()), 4);
     original.m_materials = more;
-    gpu->m_materials = more;
-    REQUIRE(Differing(ShadeWith(*gpu, wide), ShadeWith(original, wide), 1e-5f) == 0);
+    for (auto& [name, t] : translated)
+    {
+      INFO(name);
+      t->m_materials = more;
+      REQUIRE(Differing(ShadeWith(*t, wide), ShadeWith(original, wide), 1e-5f) == 0);
+    }
   }
   SECTION("an element without an object, or of a class the translator never saw, is a clear error")
   {
-    gpu->m_materials[2] = nullptr;
-    REQUIRE_THROWS_WITH(gpu->CommitDeviceData(), Catch::Contains("m_materials[2] holds no object"));
-    gpu->m_materials[2] = std::make_shared<Glass>();
-    REQUIRE_THROWS_WITH(gpu->CommitDeviceData(), Catch::Contains("m_materials[2] holds a") && Catch::Contains("Glass") &&
-                                                     Catch::Contains("it knows Lambert, Phong, Checker"));
+    // The GPU class copies the objects in CommitDeviceData, the ISPC class before each kernel.
+    for (auto& [name, t] : translated)
+    {
+      INFO(name);
+      auto commitAndShade = [&, t = t] {
+        t->CommitDeviceData();
+        ShadeWith(*t, scene);
+      };
+      t->m_materials[2] = nullptr;
+      REQUIRE_THROWS_WITH(commitAndShade(), Catch::Contains("m_materials[2] holds no object"));
+      t->m_materials[2] = std::make_shared<Glass>();
+      REQUIRE_THROWS_WITH(commitAndShade(), Catch::Contains("m_materials[2] holds a") && Catch::Contains("Glass") &&
+                                                Catch::Contains("know") && Catch::Contains("Lambert, Phong, Checker"));
+    }
   }
   RequireNoValidationMessages(ctx);
 }
 
+#ifdef CROSSRT_HAS_ISPC
+#define CROSSRT_ISPC_OR_NULL(x) x
+#else
+#define CROSSRT_ISPC_OR_NULL(x) nullptr
+#endif
+
 TEST_CASE("Virtual functions, level 2: three implementations of different sizes, each in a buffer of its own", "[equivalence][virtual]")
 {
-  CheckVirtualCalls<MaterialShading>(CreateMaterialShading_CPU(), [] { return CreateMaterialShading_Vulkan(ValidatedContext()); });
+  CheckVirtualCalls<MaterialShading>(CreateMaterialShading_CPU(), CROSSRT_ISPC_OR_NULL(CreateMaterialShading_ISPC()),
+                                     [] { return CreateMaterialShading_Vulkan(ValidatedContext()); });
 }
 
 TEST_CASE("Virtual functions, level 1: the same kernel with every element in one array of equal slots", "[equivalence][virtual]")
 {
-  CheckVirtualCalls<FlatShading>(CreateFlatShading_CPU(), [] { return CreateFlatShading_Vulkan(ValidatedContext()); });
+  CheckVirtualCalls<FlatShading>(CreateFlatShading_CPU(), CROSSRT_ISPC_OR_NULL(CreateFlatShading_ISPC()),
+                                 [] { return CreateFlatShading_Vulkan(ValidatedContext()); });
 }
 
 TEST_CASE("Virtual functions, level 3: callable shaders on ray tracing pipelines, else the level-2 switch", "[equivalence][virtual]")
@@ -196,6 +234,11 @@ TEST_CASE("Virtual functions, level 3: callable shaders on ray tracing pipelines
   auto cpu = CreateCallableShading_CPU();
   cpu->m_materials = palette;
   REQUIRE(Differing(render(*cpu), expected, 0.0f) == 0);
+#ifdef CROSSRT_HAS_ISPC
+  auto lanes = CreateCallableShading_ISPC();  // level 3 on the CPU: the switch, lane by lane
+  lanes->m_materials = palette;
+  REQUIRE(Differing(render(*lanes), expected, 1e-5f) == 0);
+#endif
 
   if (!ctx) return;
   auto gpu = CreateCallableShading_Vulkan(ctx);
