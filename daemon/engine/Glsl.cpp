@@ -331,6 +331,26 @@ std::string GlslPrinter::EmitAppend(const FieldDecl* field, const CallExpr* call
   QualType element;
   IsStdVector(field->getType(), &element);
   std::ostringstream os;
+  if (ispc) {
+    // The ISPC class appends on the host, under its lock, as the _CPU class's threads do: no
+    // capacity to reserve. A gang hands over its active lanes' values at once, in lane order.
+    const std::string cls = DataStruct().substr(0, DataStruct().size() - std::string("_Data").size());
+    const std::string type = Type(element, call->getBeginLoc()).value_or("uint"), host = cls + "_append_" + vector;
+    os << "// " << vector << ".push_back(value): " << cls << "_ISPC::IspcAppend_" << vector << " appends the values (C++, under a lock)\n"
+       << "extern \"C\" void " << host << "(int8 *uniform owner, const uniform " << type << " *uniform values, uniform int count);\n\n"
+       << "// " << vector << ".push_back(value) from the active lanes, in lane order\n"
+       << "static void " << name << "(uniform " << DataStruct() << " *uniform self, " << type << " value)\n"
+       << "{\n"
+       << "  uniform " << type << " lanes[programCount], packed[programCount];\n"
+       << "  lanes[programIndex] = value;\n"
+       << "  uniform int count = 0;\n"
+       << "  foreach_active (lane)\n"
+       << "    packed[count++] = lanes[lane];\n"
+       << "  " << host << "(self->crt_owner, packed, count);\n"
+       << "}\n";
+    m_functions.push_back(os.str());
+    return name;
+  }
   os << "// " << vector << ".push_back(value), from any number of threads at once\n"
      << "void " << name << "(" << Declare(element, "value", call->getBeginLoc()) << ")\n"
      << "{\n"

@@ -365,6 +365,8 @@ std::string GlslPrinter::Call(const CallExpr* call) {
           if (ispc) return IspcMember(field->getNameAsString() + "_size");
           return composedPrefix + field->getNameAsString() + "_size";
         }
+        if (ispc && name == "push_back" && call->getNumArgs() == 1 && composedPrefix.empty())
+          return EmitAppend(field, call) + "(self, " + Expr(call->getArg(0)) + ")";
         if (ispc) return IspcFail(call->getBeginLoc(), "std::vector::" + name + " of a member in a kernel");
         if (name == "capacity") return composedPrefix + field->getNameAsString() + "_capacity";
         // Emptied by the one thread before a loop nest: the appends that follow count from 0.

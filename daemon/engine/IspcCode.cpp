@@ -218,6 +218,15 @@ void IspcHostData(const ClassModel& model, Data& d) {
     kernels.push_back(x);
   }
   d.set("ispcHasKernels", !kernels.is_empty_list());  // else ISPC declares no <Class>_Data
+  // The vectors kernels append to: the ISPC kernels hand the values to the class.
+  Data appends = List();
+  for (auto& m : model.members)
+    if (m.appendedByKernels && m.kind == MemberKind::Vector && m.composedFrom.empty()) {
+      Data x;
+      x.set("name", m.name);
+      appends.push_back(x);
+    }
+  d.set("ispcAppends", appends);
   d.set("ispcKernels", kernels);
 }
 

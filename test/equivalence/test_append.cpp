@@ -5,6 +5,9 @@
 #include "Appending.h"
 #include "Appending_CPU.h"
 #include "Appending_Vulkan.h"
+#ifdef CROSSRT_HAS_ISPC
+#include "Appending_ISPC.h"
+#endif
 #include "TestSupport.h"
 
 #include <algorithm>
@@ -37,6 +40,9 @@ using Impls = std::vector<std::pair<const char*, std::shared_ptr<Appending>>>;
 Impls AllBackends(const std::shared_ptr<crossrt::VulkanContext>& ctx, int capacity)
 {
   Impls impls = {{"original", std::make_shared<Appending>(capacity)}, {"CPU", demo::appends::CreateAppending_CPU(capacity)}};
+#ifdef CROSSRT_HAS_ISPC
+  impls.push_back({"ISPC", demo::appends::CreateAppending_ISPC(capacity)});  // a gang's lanes at once, under the CPU class's lock
+#endif
   if (ctx) impls.push_back({"Vulkan", demo::appends::CreateAppending_Vulkan(ctx, capacity)});
   return impls;
 }
