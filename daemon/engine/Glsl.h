@@ -164,6 +164,7 @@ private:
   bool UsableTextures(const clang::FieldDecl* array, clang::SourceLocation use);  // reports why not
   std::string AtomicCall(const clang::FunctionDecl* fd, const clang::CallExpr* call);
   std::string InterlockedCall(const clang::FunctionDecl* fd, const clang::CallExpr* call);  // LiteMath's InterlockedAdd, ReduceAdd
+  std::string IspcInterlockedCall(const clang::FunctionDecl* fd, const clang::CallExpr* call);  // the same in ISPC
   std::string AtomicTargetProblem(const clang::Expr* target) const;
   std::string EmitAppend(const clang::FieldDecl* field, const clang::CallExpr* call);
   // A user function as a GLSL function, once; with `bufferBindings` (parameter index -> buffer), a copy

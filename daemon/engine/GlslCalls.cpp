@@ -408,7 +408,7 @@ std::string GlslPrinter::Call(const CallExpr* call) {
     const std::string add = "atomic_add_global(&" + Expr(call->getArg(0)) + ", " + Expr(call->getArg(1)) + ")";
     return call->getNumArgs() == 3 ? Expr(call->getArg(2)) + " = " + add : add;
   }
-  if (ispc && interlocked) return IspcFail(call->getBeginLoc(), "LiteMath's '" + qname + "'");
+  if (ispc && interlocked) return IspcInterlockedCall(fd, call);
   if (IsCrossrtAtomic(fd)) return AtomicCall(fd, call);
   if (interlocked) return InterlockedCall(fd, call);
   std::vector<std::string> args;
@@ -482,6 +482,55 @@ std::string GlslPrinter::InterlockedCall(const FunctionDecl* fd, const CallExpr*
   }
   const clang::Expr* value = call->getArg(call->getNumArgs() - 1);
   return helper + "(uint(" + Expr(call->getArg(1)) + "), " + Expr(value) + ")";
+}
+
+}  // namespace crossrt::engine
+
+namespace crossrt::engine {
+
+// LiteMath's ReduceAdd(vector, index, v) and InterlockedAdd3f(array, offset, v) in ISPC: its global
+// atomic adds, each lane's to its own element (a finite v only, for ReduceAdd, as LiteMath's;
+// InterlockedAdd3f is LiteMath.isph's).
+std::string GlslPrinter::IspcInterlockedCall(const FunctionDecl* fd, const CallExpr* call) {
+  const std::string name = fd->getNameAsString();
+  if (name == "InterlockedAdd3f") {
+    if (call->getNumArgs() != 3) return Fail(call->getBeginLoc(), "InterlockedAdd3f takes an array, an offset and a float3", "");
+    // The array: a kernel's pointer parameter, or a member vector's data().
+    const clang::Expr* array = call->getArg(0)->IgnoreParenImpCasts();
+    std::string base;
+    if (auto* dr = dyn_cast<DeclRefExpr>(array); dr && isa<ParmVarDecl>(dr->getDecl()) && dr->getType()->isPointerType() && !m_pointers.count(dr->getDecl()))
+      base = Expr(array);
+    else if (auto* mc = dyn_cast<CXXMemberCallExpr>(array); mc && mc->getMethodDecl() && mc->getMethodDecl()->getName() == "data")
+      if (auto* f = ThisMemberField(mc->getImplicitObjectArgument()); f && IsStdVector(f->getType())) {
+        m_uses.memberVectors.insert(f);
+        base = IspcMember(f->getNameAsString());
+      }
+    if (base.empty())
+      return Fail(call->getArg(0)->getExprLoc(), "the array of InterlockedAdd3f is not in device memory",
+                  "pass a kernel's pointer parameter or a std::vector member's data()");
+    return "InterlockedAdd3f(" + base + ", (int)(" + Expr(call->getArg(1)) + "), " + Expr(call->getArg(2)) + ")";  // LiteMath.isph
+  }
+  if (name != "ReduceAdd") return IspcFail(call->getBeginLoc(), "LiteMath's '" + fd->getQualifiedNameAsString() + "'");
+  const FieldDecl* field = ThisMemberField(call->getArg(0));
+  QualType element;
+  if (!field || !IsStdVector(field->getType(), &element))
+    return Fail(call->getArg(0)->getBeginLoc(), "ReduceAdd in a kernel adds into a std::vector member", "pass the member vector itself");
+  if (!element->isRealFloatingType() && !element->isIntegerType())
+    return IspcFail(call->getBeginLoc(), "ReduceAdd into a vector of '" + element.getAsString(m_ctx.getPrintingPolicy()) + "'");
+  m_uses.memberVectors.insert(field);
+  const std::string vector = field->getNameAsString(), helper = vector + "_ReduceAdd";
+  const bool isFloat = element->isRealFloatingType();
+  if (!std::count(m_reduceAddVectors.begin(), m_reduceAddVectors.end(), vector)) {
+    m_reduceAddVectors.push_back(vector);
+    std::ostringstream os;
+    os << "// ReduceAdd(" << vector << ", offset, value) from the lanes: " << (isFloat ? "a finite value" : "the value")
+       << " added to each lane's element\n"
+       << "static void " << helper << "(uniform " << DataStruct() << " *uniform self, uint offset, " << Declare(element, "value", call->getBeginLoc()) << ")\n{\n"
+       << (isFloat ? "  if (!(isinf(value) || isnan(value)))\n    " : "  ") << "atomic_add_global(&" << IspcMember(vector) << "[offset], value);\n}\n";
+    m_functions.push_back(os.str());
+  }
+  const clang::Expr* value = call->getArg(call->getNumArgs() - 1);
+  return helper + "(self, (uint)(" + Expr(call->getArg(1)) + "), " + Expr(value) + ")";
 }
 
 }  // namespace crossrt::engine

@@ -450,7 +450,12 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     SourceLocation end = Lexer::findLocationAfterToken(outer->getEndLoc(), tok::semi, c.ctx.getSourceManager(), c.ctx.getLangOpts(), false);
     k.cpuLoopNest = CanonicalCode(end.isValid() ? rw.getRewrittenText(CharSourceRange::getCharRange(outer->getBeginLoc(), end))
                                                 : rw.getRewrittenText(outer->getSourceRange()));
-    if (c.model.forCpu) CopySourceDeclarations(c, def->getBody(), "kernel '" + k.name + "'");  // the CPU class copies the loop nest
+    // The CPU class copies the loop nest and what it uses; the ISPC class only the statements around
+    // it, which run on the host (the nest runs as ISPC).
+    if (c.model.forCpu && !c.model.forIspc) CopySourceDeclarations(c, def->getBody(), "kernel '" + k.name + "'");
+    if (c.model.forIspc)
+      for (auto* list : {&before, &after})
+        for (auto* s : *list) CopySourceDeclarations(c, s, "kernel '" + k.name + "'");
     for (auto* s : before) k.cpuPreamble += StatementText(c, s) + "\n";
     for (auto* s : before)
       if (auto* ds = dyn_cast<DeclStmt>(s))

@@ -68,3 +68,18 @@ void AtomicCounters::kernel1D_Climb(int leafCount, const uint32_t* values)
     }
   }
 }
+
+void AtomicCounters::Splat(int n, int cells, const LiteMath::float4* points, float* sums)
+{
+  kernel1D_Splat(n, cells, points, sums);
+}
+
+void AtomicCounters::kernel1D_Splat(int n, int cells, const LiteMath::float4* points, float* sums)
+{
+  for (int i = 0; i < n; i++)
+  {
+    const int cell = i % cells;
+    LiteMath::ReduceAdd(m_weights, cell, points[i].w);  // skips an infinite or NaN weight
+    LiteMath::InterlockedAdd3f(sums, 3 * cell, LiteMath::to_float3(points[i]));
+  }
+}

@@ -111,8 +111,6 @@ TEST_CASE("Unsupported constructs in kernels give file:line:col diagnostics with
 TEST_CASE("What the ISPC backend does not translate yet is an error at the user's code, with a hint", "[diagnostics][ispc]")
 {
   const Case ispcCases[] = {
-      {"ReduceAdd", "    LiteMath::ReduceAdd(m_sums, i % 4, x);", "  std::vector<float> m_sums;", "",
-       "LiteMath's 'LiteMath::ReduceAdd' is not translated to ISPC yet", "BACKEND cpu (OpenMP) or vulkan", 8},
       {"a vector's capacity", "    x += float(m_hits.capacity());", "  std::vector<float> m_hits;", "",
        "std::vector::capacity of a member in a kernel is not translated to ISPC yet", "BACKEND cpu (OpenMP) or vulkan", 8},
       {"a component updated through an index with side effects", "    LiteMath::float4 v(x); int k = i; v[k++ % 4] += 1.0f; x = v.x;", "", "",

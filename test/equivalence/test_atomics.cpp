@@ -10,6 +10,8 @@
 #include "AtomicCounters_Vulkan.h"
 #include "TestSupport.h"
 
+#include <cmath>
+#include <limits>
 #include <numeric>
 
 namespace
@@ -117,6 +119,37 @@ TEST_CASE("Atomics in kernels: a bottom-up tree pass where the second child to a
         }
       }
     }
+  }
+  RequireNoValidationMessages(ctx);
+}
+
+TEST_CASE("LiteMath's ReduceAdd and InterlockedAdd3f: float sums into a member vector and an array agree on every backend", "[equivalence][atomics]")
+{
+  auto ctx = ValidatedContext();
+  const int n = 5000, cells = 37;
+  // Multiples of 1/8 below 2^10: every partial sum is exact, so the order of the adds does not matter.
+  std::vector<LiteMath::float4> points(n);
+  std::vector<float> weights(cells, 0.0f), sums(3 * cells, 0.0f);
+  for (int i = 0; i < n; ++i)
+  {
+    points[i] = LiteMath::float4(float(i % 5) * 0.125f, -float(i % 3) * 0.25f, float(i % 11), float(i % 4) * 0.5f);
+    if (i % 97 == 0) points[i].w = i % 2 ? std::numeric_limits<float>::infinity() : std::nanf("");  // ReduceAdd skips these
+    weights[i % cells] += 1.0f;  // the start (below)
+    if (std::isfinite(points[i].w)) weights[i % cells] += points[i].w;
+    for (int c = 0; c < 3; ++c) sums[3 * (i % cells) + c] += points[i][c];
+  }
+  REQUIRE(weights[1] > 10.0f);
+  for (auto& [name, impl] : AllBackends(ctx, 8, 4))
+  {
+    INFO(name);
+    impl->m_weights.assign(cells, 0.0f);
+    for (int i = 0; i < n; ++i)
+      impl->m_weights[i % cells] += 1.0f;  // a start the kernel adds to
+    impl->CommitDeviceData();
+    std::vector<float> out(3 * cells, 0.0f);
+    impl->Splat(n, cells, points.data(), out.data());
+    REQUIRE(impl->m_weights == weights);
+    REQUIRE(out == sums);
   }
   RequireNoValidationMessages(ctx);
 }

@@ -7,6 +7,9 @@
 #include "RFTraining.h"
 #include "ReluField.h"
 #include "ReluField_CPU.h"
+#ifdef CROSSRT_HAS_ISPC
+#include "ReluField_ISPC.h"
+#endif
 #include "ReluField_Vulkan.h"
 #include "TestSupport.h"
 
@@ -300,7 +303,7 @@ TEST_CASE("training on images of an analytic scene reaches a test PSNR", "[rf]")
   REQUIRE(std::fabs(afterMarch - after) < 1.5f);
 }
 
-TEST_CASE("ReluField_CPU and ReluField_Vulkan render and train as the original", "[rf]")
+TEST_CASE("ReluField_CPU, ReluField_ISPC and ReluField_Vulkan render and train as the original", "[rf]")
 {
   RFGrid grid = MakeGrid(6, 2, 0.0f, float3(-1.5f), float3(1.5f));
   std::mt19937 rng(5);
@@ -360,6 +363,13 @@ TEST_CASE("ReluField_CPU and ReluField_Vulkan render and train as the original",
     auto cpu = CreateReluField_CPU(size, size);
     compare(*cpu, 1e-6f);
   }
+#ifdef CROSSRT_HAS_ISPC
+  SECTION("_ISPC")
+  {
+    auto lanes = CreateReluField_ISPC(size, size);
+    compare(*lanes, 2e-5f);  // ISPC's exp and log are not the C library's
+  }
+#endif
   SECTION("_Vulkan")
   {
     auto ctx = ValidatedContext();
