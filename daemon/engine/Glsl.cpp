@@ -383,7 +383,7 @@ std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callL
   m_inProgress.insert(def);
   std::ostringstream os;
   auto ret = Type(def->getReturnType(), def->getLocation());
-  os << "// from " << def->getQualifiedNameAsString() << "\n" << (ispc ? "static " : "") << (ret ? *ret : "void") << " " << name << "(";
+  os << "// from " << def->getQualifiedNameAsString() << "\n" << (ispc ? "static inline " : "") << (ret ? *ret : "void") << " " << name << "(";
   // ISPC: the class's own methods reach its members through `self`, as the kernels do.
   const bool ispcSelf = ispc && !selfClass && !structSelf && isa<CXXMethodDecl>(def) && !cast<CXXMethodDecl>(def)->isStatic();
   const bool withSelf = ((selfClass || structSelf) && isa<CXXMethodDecl>(def) && !cast<CXXMethodDecl>(def)->isStatic()) || ispcSelf;
