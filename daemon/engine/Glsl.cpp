@@ -158,7 +158,8 @@ void GlslPrinter::NeedConstant(const VarDecl* vd) {
   const clang::Expr* init = vd->getAnyInitializer();
   std::string value = init ? Expr(init) : "0";
   m_constants.push_back({composedPrefix + vd->getName().str(),
-                         "const " + Declare(vd->getType(), composedPrefix + vd->getName().str(), vd->getLocation()) + " = " + value + ";\n"});
+                         std::string(ispc ? "static const uniform " : "const ") +  // ISPC: one per object file, not a global symbol
+                             Declare(vd->getType(), composedPrefix + vd->getName().str(), vd->getLocation()) + " = " + value + ";\n"});
 }
 
 std::string GlslPrinter::PreludeTypes() const {
@@ -674,6 +675,10 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
       if (std::string vector = IspcVectorOperator(op); !vector.empty()) return vector;
     auto kind = op->getOperator();
     std::string coord;
+    if (kind == OO_Subscript && ispc && ImageTexel(op)) {
+      m_uses.loadedImages.insert(ImageTexel(op));  // (ISPC binds no images: loads and stores are alike)
+      return IspcTexel(op);
+    }
     if (kind == OO_Subscript)
       if (auto* image = ImageTexel(op, &coord)) {
         auto format = UsableImage(image, e->getBeginLoc());
@@ -683,7 +688,8 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
       }
     const clang::Expr* textureIndex = nullptr;
     if (kind == OO_Subscript)
-      if (auto* array = TextureElement(op->getArg(0), &textureIndex)) return TextureTexel(array, textureIndex, op->getArg(1), e->getBeginLoc());
+      if (auto* array = TextureElement(op->getArg(0), &textureIndex))
+        return ispc ? IspcTextureTexel(array, textureIndex, op->getArg(1), e->getBeginLoc()) : TextureTexel(array, textureIndex, op->getArg(1), e->getBeginLoc());
     if (kind == OO_Subscript) {
       // A LiteMath vector's component by a constant index past its end: undefined in C++, an error in GLSL.
       clang::Expr::EvalResult index;
@@ -697,7 +703,7 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
       }
       return Expr(op->getArg(0)) + "[" + Expr(op->getArg(1)) + "]";
     }
-    if (op->isAssignmentOp() && op->getNumArgs() == 2 && ImageTexel(op->getArg(0))) {
+    if (!ispc && op->isAssignmentOp() && op->getNumArgs() == 2 && ImageTexel(op->getArg(0))) {  // (ISPC's texels are lvalues)
       if (kind == OO_Equal) return ImageStore(op->getArg(0), Expr(op->getArg(1)), e);
       if (op->getArg(0)->HasSideEffects(m_ctx, /*IncludePossibleEffects=*/false))  // it is printed twice
         return Fail(e->getBeginLoc(), "compound assignment to a texel whose coordinate has side effects", "compute the coordinate into a variable first");
@@ -727,7 +733,7 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
   if (auto* bo = dyn_cast<BinaryOperator>(e)) {
     if (ispc && bo->isAssignmentOp())
       if (std::string set = IspcComponentAssignment(bo); !set.empty()) return set;
-    if (bo->isAssignmentOp()) {  // m_img[p].x = v: the analysis reports it for members; parameters here
+    if (!ispc && bo->isAssignmentOp()) {  // m_img[p].x = v: the analysis reports it for members; parameters here
       const clang::Expr* part = bo->getLHS()->IgnoreParenImpCasts();
       while (auto* me = dyn_cast<MemberExpr>(part)) part = me->getBase()->IgnoreParenImpCasts();
       if (part != bo->getLHS()->IgnoreParenImpCasts())
@@ -736,7 +742,7 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
                       "GPU images store whole texels: read the texel into a variable, change it, and write it back with " +
                           image->getNameAsString() + "[p] = value");
     }
-    if (bo->isAssignmentOp() && ImageTexel(bo->getLHS())) {  // a texel of a float or uint image
+    if (!ispc && bo->isAssignmentOp() && ImageTexel(bo->getLHS())) {  // a texel of a float or uint image
       if (bo->getOpcode() == BO_Assign) return ImageStore(bo->getLHS(), Expr(bo->getRHS()), e);
       if (bo->getLHS()->HasSideEffects(m_ctx, /*IncludePossibleEffects=*/false))  // it is printed twice
         return Fail(e->getBeginLoc(), "compound assignment to a texel whose coordinate has side effects", "compute the coordinate into a variable first");

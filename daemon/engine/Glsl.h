@@ -164,6 +164,11 @@ private:
   bool UsableTextures(const clang::FieldDecl* array, clang::SourceLocation use);  // reports why not
   std::string AtomicCall(const clang::FunctionDecl* fd, const clang::CallExpr* call);
   std::string InterlockedCall(const clang::FunctionDecl* fd, const clang::CallExpr* call);  // LiteMath's InterlockedAdd, ReduceAdd
+  std::string IspcImage(const clang::ValueDecl* image) const;              // ISPC: an image member or parameter
+  std::string IspcTexel(const clang::Expr* texel);                          // ISPC: img[p], img.at(x, y) as an lvalue
+  std::string IspcImageCall(const clang::ValueDecl* image, const clang::CXXMemberCallExpr* call);  // ISPC: width(), sample(), ...
+  std::string IspcTextureCall(const clang::FieldDecl* array, const clang::Expr* index, const clang::CXXMemberCallExpr* call);
+  std::string IspcTextureTexel(const clang::FieldDecl* array, const clang::Expr* index, const clang::Expr* coord, clang::SourceLocation loc);
   std::string IspcInterlockedCall(const clang::FunctionDecl* fd, const clang::CallExpr* call);  // the same in ISPC
   std::string AtomicTargetProblem(const clang::Expr* target) const;
   std::string EmitAppend(const clang::FieldDecl* field, const clang::CallExpr* call);

@@ -333,11 +333,11 @@ std::string GlslPrinter::Call(const CallExpr* call) {
       return s + ")";
     }
     // Calls on an Image2D member or parameter: texel loads and stores, samples, its size.
-    if (auto* image = ImageOf(obj)) return ispc ? IspcFail(call->getBeginLoc(), "an Image2D in a kernel") : ImageCall(image, mc);
+    if (auto* image = ImageOf(obj)) return ispc ? IspcImageCall(image, mc) : ImageCall(image, mc);
     // Calls on a texture of an array of textures.
     const clang::Expr* textureIndex = nullptr;
     if (auto* array = TextureElement(obj, &textureIndex))
-      return ispc ? IspcFail(call->getBeginLoc(), "an array of textures in a kernel") : TextureCall(array, textureIndex, mc);
+      return ispc ? IspcTextureCall(array, textureIndex, mc) : TextureCall(array, textureIndex, mc);
     // Calls through a member holding an interface: composition.
     std::string composed = ComposedCall(mc);
     if (!composed.empty()) return composed;
@@ -348,7 +348,7 @@ std::string GlslPrinter::Call(const CallExpr* call) {
     if (auto* me = dyn_cast<MemberExpr>(obj); me && IsStdVector(me->getType())) {
       auto* field = dyn_cast<FieldDecl>(me->getMemberDecl());
       if (field && isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts()) && IsTextureArray(field->getType())) {
-        if (name == "size" && UsableTextures(field, call->getBeginLoc())) return field->getNameAsString() + "_size";
+        if (name == "size" && UsableTextures(field, call->getBeginLoc())) return ispc ? IspcMember(field->getNameAsString() + "_size") : field->getNameAsString() + "_size";
         return Fail(call->getBeginLoc(), "std::vector::" + name + " of an array of textures in a kernel",
                     "kernels read its size() and use its textures: " + field->getNameAsString() + "[i].sample(uv)");
       }

@@ -100,6 +100,7 @@ std::string GenerateIspcKernels(const ClassModel& model, const GenerateOptions& 
     for (auto& p : k.params) {
       const auto [base, dims2] = SplitArray(IspcTypeName(p.glslType));
       if (p.isPointer) params += std::string(", ") + (p.isConstPointee ? "const " : "") + "uniform " + base + " *uniform " + p.glslName;
+      else if (p.isImage) params += ", const uniform crt_Image_" + base + " &" + p.glslName;
       else if (IsScalar(p.glslType)) params += ", uniform " + base + " " + p.glslName + dims2;
       else params += ", const uniform " + base + " &" + p.glslName;  // structs by reference: C++ passes them so
       args += ", " + p.glslName;
@@ -134,8 +135,11 @@ std::string GenerateIspcKernels(const ClassModel& model, const GenerateOptions& 
     x.set("name", m.name);
     const auto [base, dims] = SplitArray(IspcTypeName(m.glslType));
     x.set("declaration", (m.kind == MemberKind::Vector ? "uniform " + base + " *" + m.name : base + " " + m.name + dims) + ";");
-    if (m.kind == MemberKind::Plain) members.push_back(x);
-    if (m.kind == MemberKind::Vector) vectors.push_back(x);
+    if (m.kind == MemberKind::Image) x.set("declaration", "crt_Image_" + base + " " + m.name + ";");  // LiteMath.isph's
+    if (m.kind == MemberKind::Sampler) x.set("declaration", "crt_Sampler " + m.name + ";");
+    if (m.kind == MemberKind::TextureArray) x.set("declaration", "uniform crt_Texture_" + base + " *" + m.name + ";");
+    if (m.kind == MemberKind::Plain || m.kind == MemberKind::Image || m.kind == MemberKind::Sampler) members.push_back(x);
+    if (m.kind == MemberKind::Vector || m.kind == MemberKind::TextureArray) vectors.push_back(x);
   }
   d.set("members", members);
   d.set("vectors", vectors);
@@ -143,17 +147,21 @@ std::string GenerateIspcKernels(const ClassModel& model, const GenerateOptions& 
 }
 
 void IspcHostData(const ClassModel& model, Data& d) {
-  Data members = List(), vectors = List();
+  Data members = List(), vectors = List(), textures = List();
   for (auto& m : model.members) {
     if (!m.usedByKernels) continue;
     Data x;
     x.set("name", m.name);
     x.set("expr", m.hostExpr.empty() ? m.name : m.hostExpr);  // a composed member: through its holder
     if (!m.composedFrom.empty()) x.set("composedFrom", m.composedFrom);  // its comment
-    if (m.kind == MemberKind::Plain) members.push_back(x);
+    if (m.kind == MemberKind::Image) x.set("image", "ispc::crt_Image_" + IspcTypeName(m.glslType));
+    if (m.kind == MemberKind::TextureArray) x.set("texture", "ispc::crt_Texture_" + IspcTypeName(m.glslType));
+    if (m.kind == MemberKind::Plain || m.kind == MemberKind::Image || m.kind == MemberKind::Sampler) members.push_back(x);
     if (m.kind == MemberKind::Vector) vectors.push_back(x);
+    if (m.kind == MemberKind::TextureArray) textures.push_back(x);
   }
   d.set("ispcMembers", members);
+  d.set("ispcTextures", textures);
   d.set("ispcVectors", vectors);
   Data kernels = List();
   for (const Kernel& k : model.kernels) {
@@ -178,6 +186,7 @@ void IspcHostData(const ClassModel& model, Data& d) {
     std::string args;
     for (auto& p : k.params) {
       if (p.isPointer) args += ", crossrt::IspcPointer<" + std::string(p.isConstPointee ? "const " : "") + IspcCppType(p.glslType) + "*>(" + p.name + ")";
+      else if (p.isImage) args += ", crossrt::IspcImage<ispc::crt_Image_" + IspcTypeName(p.glslType) + ">(" + p.name + ")";
       else if (IsScalar(p.glslType)) args += ", " + p.name;
       else args += ", crossrt::IspcReference<" + IspcCppType(p.glslType) + ">(" + p.name + ")";
     }

@@ -28,8 +28,8 @@ static std::string IspcThreadHead(Context& c, const Kernel& k, const std::vector
   for (auto& [type, name] : threadIds) head += ", " + type + " " + name;
   for (unsigned i = 0; i < k.params.size(); ++i) {
     const KernelParam& p = k.params[i];
-    if (p.isImage) {
-      c.rep.Error(def->getParamDecl(i)->getLocation(), "Image2D parameters are not translated to ISPC yet", "translate this class with BACKEND cpu (OpenMP) or vulkan");
+    if (p.isImage) {  // LiteMath.isph's view of the C++ image
+      head += ", const uniform crt_Image_" + IspcTypeName(p.glslType) + " &" + p.glslName;
       continue;
     }
     const auto [base, dims] = SplitArray(IspcTypeName(p.glslType));

@@ -4,6 +4,9 @@
 // its size in push constants, and binds members passed to kernels' image parameters likewise.
 #include "ImageArguments.h"
 #include "ImageArguments_CPU.h"
+#ifdef CROSSRT_HAS_ISPC
+#include "ImageArguments_ISPC.h"
+#endif
 #include "ImageArguments_Vulkan.h"
 #include "ImageSupport.h"
 #include "TestSupport.h"
@@ -22,6 +25,9 @@ using Impls = std::vector<std::pair<const char*, std::shared_ptr<ImageArguments>
 Impls AllBackends(const std::shared_ptr<crossrt::VulkanContext>& ctx)
 {
   Impls impls = {{"original", std::make_shared<ImageArguments>()}, {"CPU", CreateImageArguments_CPU()}};
+#ifdef CROSSRT_HAS_ISPC
+  impls.push_back({"ISPC", CreateImageArguments_ISPC()});  // the texels in place, sampled as LiteImage samples
+#endif
   if (ctx) impls.push_back({"Vulkan", CreateImageArguments_Vulkan(ctx)});
   return impls;
 }

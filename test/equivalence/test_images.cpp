@@ -4,6 +4,9 @@
 // GPU's sub-texel precision (Vulkan requires at least 4 bits; lavapipe has 8).
 #include "ImageFilters.h"
 #include "ImageFilters_CPU.h"
+#ifdef CROSSRT_HAS_ISPC
+#include "ImageFilters_ISPC.h"
+#endif
 #include "ImageFilters_Vulkan.h"
 #include "ImageSupport.h"
 #include "TestSupport.h"
@@ -34,6 +37,9 @@ using Impls = std::vector<std::pair<const char*, std::shared_ptr<ImageFilters>>>
 Impls AllBackends(const std::shared_ptr<crossrt::VulkanContext>& ctx)
 {
   Impls impls = {{"original", std::make_shared<ImageFilters>()}, {"CPU", CreateImageFilters_CPU()}};
+#ifdef CROSSRT_HAS_ISPC
+  impls.push_back({"ISPC", CreateImageFilters_ISPC()});  // the texels in place, sampled as LiteImage samples
+#endif
   if (ctx) impls.push_back({"Vulkan", CreateImageFilters_Vulkan(ctx)});
   return impls;
 }

@@ -8,6 +8,10 @@
 #include "TexturedMaterials_Vulkan.h"
 #include "TexturedHits.h"
 #include "TexturedHits_CPU.h"
+#ifdef CROSSRT_HAS_ISPC
+#include "TexturedHits_ISPC.h"
+#include "TexturedMaterials_ISPC.h"
+#endif
 #include "TexturedHits_Vulkan.h"
 #include "ImageSupport.h"
 #include "TestSupport.h"
@@ -123,6 +127,9 @@ TEST_CASE("Arrays of textures: each its own size, address modes and filter, pick
   for (int count : picked) REQUIRE(count > 400);
 
   std::vector<std::pair<const char*, std::shared_ptr<TexturedMaterials>>> impls = {{"CPU", CreateTexturedMaterials_CPU()}};
+#ifdef CROSSRT_HAS_ISPC
+  impls.push_back({"ISPC", CreateTexturedMaterials_ISPC()});  // LiteImage's sampling, per lane: exact
+#endif
   if (ctx) impls.push_back({"Vulkan", CreateTexturedMaterials_Vulkan(ctx)});
   for (auto& [name, impl] : impls)
   {
@@ -244,6 +251,9 @@ TEST_CASE("Arrays of textures with ray queries in one kernel: the texture of the
   REQUIRE(black < n / 2);
 
   std::vector<std::pair<const char*, std::shared_ptr<TexturedHits>>> impls = {{"CPU", CreateTexturedHits_CPU()}};
+#ifdef CROSSRT_HAS_ISPC
+  impls.push_back({"ISPC", CreateTexturedHits_ISPC()});
+#endif
   if (ctx) impls.push_back({"Vulkan", CreateTexturedHits_Vulkan(ctx)});
   for (auto& [name, impl] : impls)
   {

@@ -31,6 +31,16 @@ void IspcCopy(To& to, const From& from) {
   std::memcpy(static_cast<void*>(&to), static_cast<const void*>(&from), sizeof to);
 }
 
+// An Image2D as LiteMath.isph's crt_Image_<T>: its texels (read and written in place) and size.
+template <class To, class Image>
+To IspcImage(const Image& image) {
+  To to;
+  to.data = IspcPointer<decltype(to.data)>(image.data());
+  to.width = image.width();
+  to.height = image.height();
+  return to;
+}
+
 // The object a composed member (shared_ptr, unique_ptr or plain pointer) holds, or null.
 template <class T>
 T* IspcHeld(T* p) {
