@@ -953,6 +953,11 @@ std::string GlslPrinter::Stmt(const clang::Stmt* s, int indent) {
     } else if (fs->getInit()) {
       init = Stmt(fs->getInit(), 0);
       while (!init.empty() && (init.back() == '\n' || init.back() == ';')) init.pop_back();
+      if (ispc)
+        if (const VarDecl* shared = IspcUniformLoop(fs)) {  // IspcUniform.cpp: the gang runs it once
+          uniformValues.insert(shared);
+          init = "uniform " + init;
+        }
     }
     return pad + "for (" + init + "; " + Expr(fs->getCond()) + "; " + Expr(fs->getInc()) + ")\n" + loopBody(fs->getBody());
   }

@@ -78,6 +78,10 @@ public:
   // The kernel's Image2D reference parameters (the definition's): images bound per call, used in
   // the kernel's own body as member images are.
   OrderedSet<const clang::ValueDecl*> imageParams;
+  // ISPC: the values every lane of a gang shares (a kernel's scalar parameters, the outer loops'
+  // variables of a 2D or 3D nest), and loop variables found uniform from them (IspcUniformLoop).
+  std::set<const clang::ValueDecl*> uniformValues;
+  bool IspcUniform(const clang::Expr* e) const;
 
   // Composition (paper 3.6). In a kernel's printer: interfaces with an implementation
   // ("ISceneObject" -> "BVHScene"); a call through a member holding one prints as
@@ -169,6 +173,7 @@ private:
   std::string IspcImageCall(const clang::ValueDecl* image, const clang::CXXMemberCallExpr* call);  // ISPC: width(), sample(), ...
   std::string IspcTextureCall(const clang::FieldDecl* array, const clang::Expr* index, const clang::CXXMemberCallExpr* call);
   std::string IspcTextureTexel(const clang::FieldDecl* array, const clang::Expr* index, const clang::Expr* coord, clang::SourceLocation loc);
+  const clang::VarDecl* IspcUniformLoop(const clang::ForStmt* fs) const;
   std::string IspcInterlockedCall(const clang::FunctionDecl* fd, const clang::CallExpr* call);  // the same in ISPC
   std::string AtomicTargetProblem(const clang::Expr* target) const;
   std::string EmitAppend(const clang::FieldDecl* field, const clang::CallExpr* call);

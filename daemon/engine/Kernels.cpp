@@ -24,8 +24,11 @@ namespace crossrt::engine {
 // kernel's arguments (uniform: one value, or one array, for all lanes) and each reduction's
 // per-lane accumulator, by reference.
 static std::string IspcThreadHead(Context& c, const Kernel& k, const std::vector<std::pair<std::string, std::string>>& threadIds, const FunctionDecl* def) {
+  // Not inline: inlined into its export function, LBVH's Karras12 (a varying early return in a
+  // helper it calls in a loop) crashed on the deepest tree test_lbvh builds (ISPC 1.28.2, avx512skx).
   std::string head = "static void " + k.name + "(uniform " + c.cls->getNameAsString() + "_Data *uniform self";
-  for (auto& [type, name] : threadIds) head += ", " + type + " " + name;
+  // The innermost loop's variable runs across the lanes; the outer loops' are the gang's.
+  for (size_t i = 0; i < threadIds.size(); ++i) head += ", " + std::string(i ? "uniform " : "") + threadIds[i].first + " " + threadIds[i].second;
   for (unsigned i = 0; i < k.params.size(); ++i) {
     const KernelParam& p = k.params[i];
     if (p.isImage) {  // LiteMath.isph's view of the C++ image
@@ -80,6 +83,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   std::vector<const Stmt*> preamble;      // declarations before the loop nest: every thread evaluates them
   std::vector<const Stmt*> before, after;  // all statements before and after the loop nest: one thread runs them
   const Stmt* threadBody = body;
+  std::vector<const VarDecl*> outerVars;  // the loop nest's variables, outermost first
   std::vector<std::pair<std::string, std::string>> threadParams;  // (glsl type, name)
 
   if (k.rtv) {
@@ -129,6 +133,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
       LoopHeader h;
       if (!ParseLoop(c, fs, h, k.name)) return;
       headers.push_back(h);
+      outerVars.push_back(h.var);
       // `i < m_v.size()` of a vector that kernels append to: its size is only known on the GPU.
       if (auto* mc = dyn_cast<CXXMemberCallExpr>(h.end->IgnoreParenCasts()); mc && mc->getMethodDecl() && mc->getMethodDecl()->getName() == "size")
         if (auto* f = ThisField(mc->getImplicitObjectArgument()); f && c.appended.count(f->getNameAsString())) {
@@ -176,6 +181,15 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   const std::set<const Stmt*> settingLocals = StatementsSettingLocals(before, reducedLocals);
   for (auto* s : before)
     if (isa<DeclStmt>(s) || settingLocals.count(s)) preamble.push_back(s);
+
+  // ISPC: what every lane of a gang shares (IspcUniform.cpp): the kernel's scalar parameters, and
+  // the outer loops' variables of a 2D or 3D nest.
+  if (printer.ispc) {
+    for (unsigned i = 0; i < k.params.size() && i < def->getNumParams(); ++i)
+      if (!k.params[i].isPointer && !k.params[i].isImage && !k.params[i].isThreadId && def->getParamDecl(i)->getType()->isArithmeticType())
+        printer.uniformValues.insert(def->getParamDecl(i));
+    for (size_t d = 0; d + 1 < outerVars.size(); ++d) printer.uniformValues.insert(outerVars[d]);
+  }
 
   // Reductions and member writes.
   WriteScanner ws(c);

@@ -125,6 +125,51 @@ TEST_CASE("What the ISPC backend does not translate yet is an error at the user'
   }
 }
 
+TEST_CASE("ISPC: a loop whose bounds every lane shares is uniform; one the lanes differ in, or leave early, is varying", "[diagnostics][ispc]")
+{
+  TempClass tc("Loops", R"(#pragma once
+class Loops
+{
+public:
+  virtual ~Loops() = default;
+  virtual void Run(int n, int taps, [[crossrt::size("n")]] float* data);
+  int m_radius = 2;
+protected:
+  void kernel1D_Run(int n, int taps, float* data);
+};
+)",
+               R"(#include "Loops.h"
+void Loops::Run(int n, int taps, float* data) { kernel1D_Run(n, taps, data); }
+void Loops::kernel1D_Run(int n, int taps, float* data)
+{
+  for (int i = 0; i < n; i++)
+  {
+    float x = data[i];
+    for (int k = -m_radius; k <= m_radius; k++)
+      for (int t = 0; t < taps * k; t += 2)
+        x += 0.5f;
+    for (int j = 0; j < i % 4; j++)
+      x *= 2.0f;
+    for (int e = 0; e < taps; e++)
+      if (x > 100.0f)
+        break;
+    data[i] = x;
+  }
+}
+)");
+  CommandResult r = RunCrossrt("translate --class Loops --backend ispc --out " + (tc.dir / "out").string() + " --source " + tc.Source("Loops") +
+                               " --templates " CROSSRT_SOURCE_DIR "/templates");
+  INFO(r.output);
+  REQUIRE(r.exitCode == 0);
+  std::ifstream file(tc.dir / "out" / "Loops_ISPC_kernels.ispc");
+  const std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  INFO(text);
+  REQUIRE(text.find("for (uniform int k = -self->m_radius; k <= self->m_radius; k++)") != std::string::npos);  // members
+  REQUIRE(text.find("for (uniform int t = 0; t < taps * k; t += 2)") != std::string::npos);  // a parameter, an outer uniform loop
+  REQUIRE(text.find("for (int j = 0;") != std::string::npos);  // a bound per lane
+  REQUIRE(text.find("for (int e = 0;") != std::string::npos);  // some lanes may leave early
+}
+
 TEST_CASE("A pointer parameter of a control function without a size is reported", "[diagnostics]")
 {
   TempClass tc("NoSize", R"(#pragma once
