@@ -675,10 +675,11 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
       if (std::string vector = IspcVectorOperator(op); !vector.empty()) return vector;
     auto kind = op->getOperator();
     std::string coord;
-    if (kind == OO_Subscript && ispc && ImageTexel(op)) {
-      m_uses.loadedImages.insert(ImageTexel(op));  // (ISPC binds no images: loads and stores are alike)
-      return IspcTexel(op);
-    }
+    if (kind == OO_Subscript && ispc)
+      if (const ValueDecl* image = ImageTexel(op)) {
+        m_uses.loadedImages.insert(image);  // (ISPC binds no images: loads and stores are alike)
+        return IspcTexel(op);
+      }
     if (kind == OO_Subscript)
       if (auto* image = ImageTexel(op, &coord)) {
         auto format = UsableImage(image, e->getBeginLoc());

@@ -158,6 +158,7 @@ private:
   const clang::ValueDecl* ImageOf(const clang::Expr* e) const;
   const clang::ValueDecl* ImageTexel(const clang::Expr* e, std::string* coord = nullptr);
   std::optional<ImageFormat> UsableImage(const clang::ValueDecl* image, clang::SourceLocation use);  // reports why not
+  const clang::FieldDecl* SampledWith(const clang::ValueDecl* image, const ImageFormat& format, const clang::CXXMemberCallExpr* call);
   std::string ImageStore(const clang::Expr* lhs, const std::string& value, const clang::Expr* whole);
   std::string ImageCall(const clang::ValueDecl* image, const clang::CXXMemberCallExpr* call);
   // Arrays of textures: the array of an element expression (m_textures[i]) and its index; calls on

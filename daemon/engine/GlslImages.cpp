@@ -77,6 +77,27 @@ std::optional<ImageFormat> GlslPrinter::UsableImage(const ValueDecl* image, Sour
   return std::nullopt;
 }
 
+// The sampler member of img.sample(sampler, uv), recorded as used with the image; null (reported)
+// for an image of uint32_t, which samplers do not filter, or a sampler that is not a member.
+const FieldDecl* GlslPrinter::SampledWith(const ValueDecl* image, const ImageFormat& format, const CXXMemberCallExpr* call) {
+  if (format.texel == "uint") {
+    Fail(call->getBeginLoc(), "sample() of Image2D<uint32_t> " + std::string(isa<FieldDecl>(image) ? "member" : "parameter") + " '" +
+         image->getNameAsString() + "' (samplers filter only float images)",
+         "read texels with " + image->getNameAsString() + "[int2(x, y)], or store the image as Image2D<float> or Image2D<float4>");
+    return nullptr;
+  }
+  const FieldDecl* sampler = ThisMemberField(call->getArg(0));
+  if (!sampler || !IsImageSampler(sampler->getType())) {
+    Fail(call->getArg(0)->getBeginLoc(), "the sampler of " + image->getNameAsString() + ".sample() is not a member of the class",
+         "declare the LiteImage::Sampler as a member, so it is created on the GPU with the image");
+    return nullptr;
+  }
+  m_uses.sampledImages.insert(image);
+  m_uses.samplers.insert(sampler);
+  m_uses.samplePairs.insert({image, sampler});
+  return sampler;
+}
+
 std::string GlslPrinter::ImageStore(const clang::Expr* lhs, const std::string& value, const clang::Expr* whole) {
   std::string coord;
   const ValueDecl* image = ImageTexel(lhs, &coord);
@@ -109,17 +130,8 @@ std::string GlslPrinter::ImageCall(const ValueDecl* image, const CXXMemberCallEx
            (format->texel == "vec4" ? value : format->prefix + "vec4(" + value + ")") + ")";
   }
   if (method == "sample" && call->getNumArgs() == 2) {
-    if (format->texel == "uint")
-      return Fail(call->getBeginLoc(), "sample() of Image2D<uint32_t> " + std::string(isa<FieldDecl>(image) ? "member" : "parameter") + " '" +
-                  image->getNameAsString() + "' (GPU samplers filter only float images)",
-                  "read texels with " + image->getNameAsString() + "[int2(x, y)], or store the image as Image2D<float> or Image2D<float4>");
-    const FieldDecl* sampler = ThisMemberField(call->getArg(0));
-    if (!sampler || !IsImageSampler(sampler->getType()))
-      return Fail(call->getArg(0)->getBeginLoc(), "the sampler of " + image->getNameAsString() + ".sample() is not a member of the class",
-                  "declare the LiteImage::Sampler as a member, so it is created on the GPU with the image");
-    m_uses.sampledImages.insert(image);
-    m_uses.samplers.insert(sampler);
-    m_uses.samplePairs.insert({image, sampler});
+    const FieldDecl* sampler = SampledWith(image, *format, call);
+    if (!sampler) return "/*error*/";
     // Compute shaders have no derivatives: sample the one mip level explicitly.
     return TexelOf(*format, "textureLod(sampler2D(" + image->getNameAsString() + "_texture, " + sampler->getNameAsString() + "), " + Expr(call->getArg(1)) + ", 0.0)");
   }
@@ -240,16 +252,8 @@ std::string GlslPrinter::IspcImageCall(const ValueDecl* image, const CXXMemberCa
     return img + ".data[crt_texel(" + img + ".width, " + Expr(call->getArg(0)) + ", " + Expr(call->getArg(1)) + ")] = " + Expr(call->getArg(2));
   }
   if (method == "sample" && call->getNumArgs() == 2) {
-    if (format->texel == "uint")
-      return Fail(call->getBeginLoc(), "sample() of Image2D<uint32_t> '" + image->getNameAsString() + "' (LiteImage filters only float images)",
-                  "read texels with " + image->getNameAsString() + "[int2(x, y)], or store the image as Image2D<float> or Image2D<float4>");
-    const FieldDecl* sampler = ThisMemberField(call->getArg(0));
-    if (!sampler || !IsImageSampler(sampler->getType()))
-      return Fail(call->getArg(0)->getBeginLoc(), "the sampler of " + image->getNameAsString() + ".sample() is not a member of the class",
-                  "declare the LiteImage::Sampler as a member");
-    m_uses.sampledImages.insert(image);
-    m_uses.samplers.insert(sampler);
-    m_uses.samplePairs.insert({image, sampler});
+    const FieldDecl* sampler = SampledWith(image, *format, call);
+    if (!sampler) return "/*error*/";
     return "crt_sample(" + img + ", " + IspcMember(sampler->getNameAsString()) + ", " + Expr(call->getArg(1)) + ")";  // LiteMath.isph
   }
   return Fail(call->getBeginLoc(), "Image2D::" + method + " is not supported in kernels",
