@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <map>
 #include <set>
+#include <functional>
 #include <sstream>
 
 using namespace clang;
@@ -152,14 +153,21 @@ void GlslPrinter::NeedStruct(const RecordDecl* rd) {
   m_structs.push_back({rd->getName().str(), os.str()});
 }
 
-void GlslPrinter::NeedConstant(const VarDecl* vd) {
-  if (m_emitted.count(vd)) return;
+// Composed code's constants keep its holder's prefix; the namespace-scope constants that objects'
+// methods use are shared, as the free functions calling them are (a class's static members are not).
+std::string GlslPrinter::ConstantName(const VarDecl* vd) const {
+  return (selfClass && !vd->isStaticDataMember() ? "" : composedPrefix) + vd->getName().str();
+}
+
+std::string GlslPrinter::NeedConstant(const VarDecl* vd) {
+  const std::string name = ConstantName(vd);
+  if (m_emitted.count(vd)) return name;
   m_emitted.insert(vd);
   const clang::Expr* init = vd->getAnyInitializer();
   std::string value = init ? Expr(init) : "0";
-  m_constants.push_back({composedPrefix + vd->getName().str(),
-                         std::string(ispc ? "static const uniform " : "const ") +  // ISPC: one per object file, not a global symbol
-                             Declare(vd->getType(), composedPrefix + vd->getName().str(), vd->getLocation()) + " = " + value + ";\n"});
+  m_constants.push_back({name, std::string(ispc ? "static const uniform " : "const ") +  // ISPC: one per object file, not a global symbol
+                                   Declare(vd->getType(), name, vd->getLocation()) + " = " + value + ";\n"});
+  return name;
 }
 
 std::string GlslPrinter::PreludeTypes() const {
@@ -592,8 +600,7 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
     if (auto* vd = dyn_cast<VarDecl>(d)) {
       if (vd->hasGlobalStorage() && !vd->isStaticLocal()) {
         if (vd->getType().isConstQualified() && vd->getAnyInitializer()) {
-          NeedConstant(vd);
-          return composedPrefix + vd->getNameAsString();
+          return NeedConstant(vd);
         }
         return Fail(e->getBeginLoc(), "global variable '" + vd->getNameAsString() + "' used in a kernel",
                     "make it constexpr, or a member of the class so it is uploaded to the GPU");
@@ -988,8 +995,15 @@ std::string GlslPrinter::Stmt(const clang::Stmt* s, int indent) {
   if (auto* cs = dyn_cast<CaseStmt>(s)) return pad + "case " + Expr(cs->getLHS()) + ":\n" + Stmt(cs->getSubStmt(), indent + 1);
   if (auto* ds = dyn_cast<DefaultStmt>(s)) return pad + "default:\n" + Stmt(ds->getSubStmt(), indent + 1);
   if (isa<NullStmt>(s)) return pad + ";\n";
-  // `(void)unused;` only quiets a C++ warning: nothing to run.
-  if (auto* cast = dyn_cast<CStyleCastExpr>(s); cast && cast->getType()->isVoidType() && !cast->getSubExpr()->HasSideEffects(m_ctx)) return "";
+  // `(void)unused;`, `(void)a, (void)b;` or `static_cast<void>(x);` only quiet a C++ warning: nothing to run.
+  std::function<bool(const clang::Expr*)> quietsWarning = [&](const clang::Expr* e) {
+    e = e->IgnoreParens();
+    if (auto* comma = dyn_cast<BinaryOperator>(e); comma && comma->getOpcode() == BO_Comma)
+      return quietsWarning(comma->getLHS()) && quietsWarning(comma->getRHS());
+    auto* cast = dyn_cast<ExplicitCastExpr>(e);
+    return cast && cast->getType()->isVoidType() && !cast->getSubExpr()->HasSideEffects(m_ctx);
+  };
+  if (auto* e = dyn_cast<clang::Expr>(s); e && quietsWarning(e)) return "";
   if (auto* e = dyn_cast<clang::Expr>(s)) return pad + Expr(e) + ";\n";
   return Fail(s->getBeginLoc(), std::string("statement '") + s->getStmtClassName() + "' is not supported in kernels",
               "kernels may use declarations, if, for, while, do, switch, return, break and continue"), "";

@@ -218,7 +218,8 @@ private:
   std::string ComposedCall(const clang::CXXMemberCallExpr* call);
   std::string VirtualCall(const clang::CXXMemberCallExpr* call);
   void NeedStruct(const clang::RecordDecl* rd);
-  void NeedConstant(const clang::VarDecl* vd);
+  std::string NeedConstant(const clang::VarDecl* vd);  // its GLSL name
+  std::string ConstantName(const clang::VarDecl* vd) const;
   std::string Fail(clang::SourceLocation loc, const std::string& message, const std::string& hint);
   // What ISPC has no counterpart for (yet): an error with the hint to use the Vulkan or CPU class.
   std::string IspcFail(clang::SourceLocation loc, const std::string& what);

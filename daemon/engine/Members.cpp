@@ -5,8 +5,10 @@
 
 #include "AnalysisContext.h"
 #include "AstQueries.h"
+#include "GeneratedNames.h"
 
 #include <algorithm>
+#include <set>
 
 using namespace clang;
 
@@ -34,9 +36,20 @@ bool HasVirtualDestructor(const CXXRecordDecl* rd) {
 void AnalyzeMembers(Context& c) {
   GlslPrinter structs(c.ctx, c.cls, c.rep);
   structs.ispc = c.model.forIspc;
+  // The generated Vulkan class keeps its GPU objects in members of these names: a data member of
+  // the same name would be hidden by them.
+  static const std::set<std::string> generatedMembers = {
+      generated::kVectorCopies, generated::kTemporaries,    generated::kThreadState, generated::kScanner,
+      generated::kSorter,       generated::kVirtualObjects, generated::kImages,      generated::kTextures,
+      generated::kPartials,     generated::kPipelines,      generated::kClassData};
   for (auto* f : ClassFields(c.cls)) {
     Member m;
     m.name = f->getNameAsString();
+    if (!c.model.forCpu && (generatedMembers.count(m.name) || m.name.rfind(generated::kInOutPrefix, 0) == 0))
+      c.rep.Error(f->getLocation(), "data member '" + m.name + "' has the name of a member the generated " + c.cls->getNameAsString() +
+                                        "_Vulkan class declares for its GPU objects",
+                  "rename it; the generated class's own members are m_vdata, m_temporaries, m_threadState, m_inOut_*, m_scanner, "
+                  "m_sorter, m_virtual, m_images, m_textureArrays, m_partials, m_pipelines and m_classDataBuffer");
     m.hostExpr = m.name;
     QualType elem;
     if (IsTextureArray(f->getType(), &elem)) {

@@ -7,6 +7,8 @@
 #include <glslang/SPIRV/GlslangToSpv.h>
 
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <mutex>
 #include <sstream>
@@ -50,8 +52,11 @@ std::vector<uint32_t> CompileGlsl(const std::string& name, const std::string& gl
       if (lineNo >= 1 && lineNo <= lines.size())
         quoted += "  " + std::to_string(lineNo) + " | " + lines[lineNo - 1] + "\n";
     }
-    throw std::runtime_error("internal error: the GLSL generated for '" + name + "' does not compile (please report it):\n" +
-                             log + quoted);
+    // The whole shader goes beside the report, for the issue it asks for.
+    const std::string keptAt = (std::filesystem::temp_directory_path() / ("crossrt-" + name + "." + stage)).string();
+    std::ofstream(keptAt) << glsl;
+    throw std::runtime_error("internal error: the GLSL generated for '" + name + "' does not compile (please report it with " + keptAt +
+                             "):\n" + log + quoted);
   }
   std::vector<uint32_t> words;
   glslang::SpvOptions options;

@@ -234,7 +234,7 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
       std::string sets;
       for (auto& a : k.textureArrays) {
         buffer(generated::kTextures + "." + a + "_info.View()");
-        if (kind.textures) sets += (sets.empty() ? "&m_textures." : ", &m_textures.") + a;
+        if (kind.textures) sets += (sets.empty() ? "&" : ", &") + generated::kTextures + "." + a;
         else buffer(generated::kTextures + "." + a + "_texels.View()");
       }
       if (kind.rayQuery) {

@@ -24,8 +24,8 @@ TexturedMaterials_Vulkan::TexturedMaterials_Vulkan(std::shared_ptr<crossrt::Vulk
   m_useTextureHardware = m_ctx->hasTextureArrays;
   if (m_ctx->hasTextureArrays)
   {
-    m_textures.m_albedo = crossrt::TextureArray(m_ctx, "TexturedMaterials::m_albedo");
-    m_textures.m_bumps = crossrt::TextureArray(m_ctx, "TexturedMaterials::m_bumps");
+    m_textureArrays.m_albedo = crossrt::TextureArray(m_ctx, "TexturedMaterials::m_albedo");
+    m_textureArrays.m_bumps = crossrt::TextureArray(m_ctx, "TexturedMaterials::m_bumps");
   }
   InitPipelines();
 }
@@ -98,20 +98,20 @@ void TexturedMaterials_Vulkan::CommitDeviceData()
                          std::to_string(m_ctx->maxTextureArraySize) +
                          " in an array: call UseTextureHardware(false) to sample them from buffers");
   if (m_useTextureHardware)
-    crossrt::AssignTextures(m_textures.m_albedo, VK_FORMAT_R32G32B32A32_SFLOAT, m_albedo);
-  crossrt::CommitTextureBuffers(m_ctx, m_albedo, m_textures.m_albedo_info,
-                                m_useTextureHardware ? nullptr : &m_textures.m_albedo_texels);
-  m_textures.m_albedoSize = m_albedo.size();
+    crossrt::AssignTextures(m_textureArrays.m_albedo, VK_FORMAT_R32G32B32A32_SFLOAT, m_albedo);
+  crossrt::CommitTextureBuffers(m_ctx, m_albedo, m_textureArrays.m_albedo_info,
+                                m_useTextureHardware ? nullptr : &m_textureArrays.m_albedo_texels);
+  m_textureArrays.m_albedoSize = m_albedo.size();
   if (m_useTextureHardware && m_bumps.size() > m_ctx->maxTextureArraySize)
     throw crossrt::Error("TexturedMaterials_Vulkan: m_bumps holds " + std::to_string(m_bumps.size()) +
                          " textures, but device '" + m_ctx->DeviceName() + "' binds at most " +
                          std::to_string(m_ctx->maxTextureArraySize) +
                          " in an array: call UseTextureHardware(false) to sample them from buffers");
   if (m_useTextureHardware)
-    crossrt::AssignTextures(m_textures.m_bumps, VK_FORMAT_R32_SFLOAT, m_bumps);
-  crossrt::CommitTextureBuffers(m_ctx, m_bumps, m_textures.m_bumps_info,
-                                m_useTextureHardware ? nullptr : &m_textures.m_bumps_texels);
-  m_textures.m_bumpsSize = m_bumps.size();
+    crossrt::AssignTextures(m_textureArrays.m_bumps, VK_FORMAT_R32_SFLOAT, m_bumps);
+  crossrt::CommitTextureBuffers(m_ctx, m_bumps, m_textureArrays.m_bumps_info,
+                                m_useTextureHardware ? nullptr : &m_textureArrays.m_bumps_texels);
+  m_textureArrays.m_bumpsSize = m_bumps.size();
   UpdatePlainMembers();
   m_deviceDataCommitted = true;
 }
@@ -119,8 +119,8 @@ void TexturedMaterials_Vulkan::CommitDeviceData()
 bool TexturedMaterials_Vulkan::VectorMembersResized() const
 {
   bool resized = false;
-  resized = resized || m_albedo.size() != m_textures.m_albedoSize;
-  resized = resized || m_bumps.size() != m_textures.m_bumpsSize;
+  resized = resized || m_albedo.size() != m_textureArrays.m_albedoSize;
+  resized = resized || m_bumps.size() != m_textureArrays.m_bumpsSize;
   return resized;
 }
 
@@ -236,18 +236,19 @@ void TexturedMaterials_Vulkan::kernel1D_ShadeCmd(VkCommandBuffer a_cmd, int n, c
   if (m_useTextureHardware)  // textures on the GPU's samplers
   {
     m_pipelines.kernel1D_Shade_Textures.Bind(a_cmd);
-    m_pipelines.kernel1D_Shade_Textures.PushBuffers(a_cmd,
-                                                    {m_classDataBuffer.View(), texIds, uvs, colors, heights, texels,
-                                                     m_textures.m_albedo_info.View(), m_textures.m_bumps_info.View()});
-    m_pipelines.kernel1D_Shade_Textures.BindTextureArrays(a_cmd, {&m_textures.m_albedo, &m_textures.m_bumps});
+    m_pipelines.kernel1D_Shade_Textures.PushBuffers(a_cmd, {m_classDataBuffer.View(), texIds, uvs, colors, heights,
+                                                            texels, m_textureArrays.m_albedo_info.View(),
+                                                            m_textureArrays.m_bumps_info.View()});
+    m_pipelines.kernel1D_Shade_Textures.BindTextureArrays(a_cmd, {&m_textureArrays.m_albedo, &m_textureArrays.m_bumps});
     m_pipelines.kernel1D_Shade_Textures.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   }
   else
   {
     m_pipelines.kernel1D_Shade.Bind(a_cmd);
-    m_pipelines.kernel1D_Shade.PushBuffers(a_cmd, {m_classDataBuffer.View(), texIds, uvs, colors, heights, texels,
-                                                   m_textures.m_albedo_info.View(), m_textures.m_albedo_texels.View(),
-                                                   m_textures.m_bumps_info.View(), m_textures.m_bumps_texels.View()});
+    m_pipelines.kernel1D_Shade.PushBuffers(
+        a_cmd, {m_classDataBuffer.View(), texIds, uvs, colors, heights, texels, m_textureArrays.m_albedo_info.View(),
+                m_textureArrays.m_albedo_texels.View(), m_textureArrays.m_bumps_info.View(),
+                m_textureArrays.m_bumps_texels.View()});
     m_pipelines.kernel1D_Shade.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
   }
   crossrt::Dispatch1D(a_cmd, crt_countX, 256);

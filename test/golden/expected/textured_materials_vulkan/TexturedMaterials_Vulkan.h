@@ -90,7 +90,7 @@ protected:
     crossrt::TextureArray m_bumps;                   // for the GPU's samplers
     crossrt::Buffer m_bumps_info, m_bumps_texels;    // each texture's size and sampler; texels for the shader's sampler
     size_t m_bumpsSize = 0;                          // textures at the last CommitDeviceData()
-  } m_textures;
+  } m_textureArrays;
 
   struct InOut_Shade  // buffers bound by SetVulkanInOutFor_Shade
   {

@@ -1,0 +1,237 @@
+// path_tracer: renders a glTF 2.0 or OBJ scene with litept's PathTracer, as written (one thread),
+// translated for all CPU cores (PathTracer_CPU) or for Vulkan (PathTracer_Vulkan, megakernel or
+// wavefront), progressively in passes of bounded size, with a progress bar on stderr. Writes linear
+// EXR or sRGB PNG; --compare prints the PSNR (8-bit sRGB) and relative MSE (linear) against a
+// reference image, such as one from scripts/cycles-reference.py.
+#include "PathTracer.h"
+#include "PathTracer_CPU.h"
+#include "PathTracer_Vulkan.h"
+#include "SceneLoader.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+using LiteMath::float4;
+
+namespace {
+
+const char* kUsage =
+    "usage: path_tracer SCENE [--size WxH] [--spp N] [--depth D] [--device original|cpu|vulkan]\n"
+    "                   [--mode megakernel|wavefront] [--accel embree|sah|lbvh] [--env FILE.exr] [--env-strength F]\n"
+    "                   [--seed S] [--pass-spp K] [--compare REF.exr] --out FILE.exr|FILE.png\n"
+    "  Path traces SCENE (.gltf, .glb or .obj) with next-event estimation and multiple importance sampling.\n"
+    "  --size      image size (default 256x256)            --spp     samples per pixel (default 64)\n"
+    "  --depth     bounces, as Cycles counts them (default 8; 0 is direct light only)\n"
+    "  --device    original: the class as written, one thread; cpu: PathTracer_CPU, all cores (default);\n"
+    "              vulkan: PathTracer_Vulkan on the default Vulkan device\n"
+    "  --mode      PathTracer_Vulkan's execution mode (default megakernel)\n"
+    "  --accel     the CPU devices' ray tracing: Embree (default) or CrossRT's BVHs; Vulkan always uses sah\n"
+    "  --env       an equirectangular environment map (linear EXR, Blender's orientation), times --env-strength\n"
+    "  --seed      the random sequence (a pixel's samples depend only on pixel, sample index and seed)\n"
+    "  --pass-spp  samples per pass (default 4): memory stays the same whatever --spp is\n"
+    "  --compare   prints PSNR (8-bit sRGB) and relative MSE (linear) of the image against REF\n"
+    "  --out       .exr: linear radiance; .png: sRGB, clamped\n";
+
+struct Options
+{
+  std::string scene, out, device = "cpu", mode = "megakernel", accel = "embree", env, compare;
+  uint32_t width = 256, height = 256, spp = 64, passSpp = 4, seed = 0;
+  int depth = 8;
+  float envStrength = 1.0f;
+};
+
+[[noreturn]] void Usage(const std::string& problem)
+{
+  std::fprintf(stderr, "path_tracer: error: %s\n%s", problem.c_str(), kUsage);
+  std::exit(2);
+}
+
+uint32_t Positive(const std::string& flag, const char* text)
+{
+  char* end = nullptr;
+  const long v = std::strtol(text, &end, 10);
+  if (*end != '\0' || v <= 0 || v > (1 << 24))
+    Usage(flag + " takes a positive integer, not '" + text + "'");
+  return uint32_t(v);
+}
+
+Options Parse(int argc, char** argv)
+{
+  Options o;
+  for (int i = 1; i < argc; ++i)
+  {
+    const std::string a = argv[i];
+    if (a == "--help" || a == "-h")
+    {
+      std::printf("%s", kUsage);
+      std::exit(0);
+    }
+    const bool takesValue = a.rfind("--", 0) == 0;
+    if (takesValue && i + 1 >= argc)
+      Usage(a + " needs a value");
+    if (a == "--size")
+    {
+      const std::string v = argv[++i];
+      const size_t x = v.find('x');
+      if (x == std::string::npos)
+        Usage("--size takes WxH, not '" + v + "'");
+      o.width = Positive(a, v.substr(0, x).c_str());
+      o.height = Positive(a, v.substr(x + 1).c_str());
+    }
+    else if (a == "--spp") o.spp = Positive(a, argv[++i]);
+    else if (a == "--pass-spp") o.passSpp = Positive(a, argv[++i]);
+    else if (a == "--seed") o.seed = uint32_t(std::strtoul(argv[++i], nullptr, 10));
+    else if (a == "--depth")
+    {
+      o.depth = std::atoi(argv[++i]);
+      if (o.depth < 0 || o.depth > 64)
+        Usage("--depth takes 0 to 64");
+    }
+    else if (a == "--device") o.device = argv[++i];
+    else if (a == "--mode") o.mode = argv[++i];
+    else if (a == "--accel") o.accel = argv[++i];
+    else if (a == "--env") o.env = argv[++i];
+    else if (a == "--env-strength") o.envStrength = float(std::atof(argv[++i]));
+    else if (a == "--compare") o.compare = argv[++i];
+    else if (a == "--out") o.out = argv[++i];
+    else if (takesValue) Usage("unknown option " + a);
+    else if (o.scene.empty()) o.scene = a;
+    else Usage("more than one scene: '" + o.scene + "' and '" + a + "'");
+  }
+  if (o.scene.empty()) Usage("no scene given");
+  if (o.out.empty()) Usage("no --out file given");
+  if (o.device != "original" && o.device != "cpu" && o.device != "vulkan") Usage("--device is original, cpu or vulkan, not '" + o.device + "'");
+  if (o.mode != "megakernel" && o.mode != "wavefront") Usage("--mode is megakernel or wavefront, not '" + o.mode + "'");
+  const std::string ext = o.out.size() > 4 ? o.out.substr(o.out.size() - 4) : "";
+  if (ext != ".exr" && ext != ".png") Usage("--out must end in .exr or .png");
+  return o;
+}
+
+float LinearToSrgb(float v)
+{
+  v = std::clamp(v, 0.0f, 1.0f);
+  return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
+}
+
+uint32_t Srgb8(float v) { return uint32_t(std::lround(255.0f * LinearToSrgb(v))); }
+
+// PSNR of the 8-bit sRGB images and the mean relative squared error of the linear ones.
+void Compare(const LiteImage::Image2D<float4>& image, const std::string& refPath)
+{
+  LiteImage::Image2D<float4> ref;
+  if (!LiteImage::LoadImage(refPath.c_str(), ref))
+    throw std::runtime_error(refPath + ": error: the reference image could not be read");
+  if (ref.width() != image.width() || ref.height() != image.height())
+    throw std::runtime_error(refPath + ": error: the reference is " + std::to_string(ref.width()) + "x" + std::to_string(ref.height()) +
+                             ", the image " + std::to_string(image.width()) + "x" + std::to_string(image.height()));
+  double se8 = 0.0, rel = 0.0;
+  const size_t n = image.vector().size();
+  for (size_t i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c)
+    {
+      const float a = image.vector()[i][c], b = ref.vector()[i][c];
+      const double d8 = double(Srgb8(a)) - double(Srgb8(b));
+      se8 += d8 * d8;
+      rel += double(a - b) * double(a - b) / (double(b) * double(b) + 1e-2);
+    }
+  const double mse8 = se8 / double(3 * n);
+  const double psnr = mse8 > 0.0 ? 10.0 * std::log10(255.0 * 255.0 / mse8) : 99.0;
+  std::printf("compare: against %s: PSNR %.2f dB (8-bit sRGB), relMSE %.5f (linear)\n", refPath.c_str(), psnr, rel / double(3 * n));
+}
+
+}  // namespace
+
+int main(int argc, char** argv)
+{
+  const Options o = Parse(argc, argv);
+  try
+  {
+    PathScene scene = LoadScene(o.scene);
+    if (!o.env.empty())
+      LoadEnvironment(scene, o.env, o.envStrength);
+    ApplySceneDefaults(scene);
+    for (const std::string& note : scene.notes)
+      std::fprintf(stderr, "%s\n", note.c_str());
+
+    std::shared_ptr<PathTracer> tracer;
+    std::string accel = o.accel;
+    if (o.device == "original")
+      tracer = std::make_shared<PathTracer>();
+    else if (o.device == "cpu")
+      tracer = CreatePathTracer_CPU();
+    else
+    {
+      auto ctx = crossrt::VulkanContext::CreateDefault();
+      auto vk = std::make_shared<PathTracer_Vulkan>(ctx);
+      vk->SetExecutionMode(o.mode == "megakernel" ? crossrt::ExecutionMode::Megakernel : crossrt::ExecutionMode::Wavefront);
+      std::fprintf(stderr, "device: %s\n", ctx->DeviceName().c_str());
+      tracer = vk;
+      accel = "sah";  // the GPU runs BVHScene's traversal
+    }
+    tracer->SetScene(scene, MakeSceneRT(accel.c_str()));
+    tracer->SetImageAspect(float(o.width) / float(o.height));
+    tracer->SetMaxDepth(o.depth);
+    tracer->SetSeed(o.seed);
+    tracer->CommitDeviceData();
+
+    const size_t pixels = size_t(o.width) * o.height;
+    std::vector<float4> pass(pixels), sum(pixels, float4(0.0f));
+    const auto start = std::chrono::steady_clock::now();
+    for (uint32_t done = 0; done < o.spp;)
+    {
+      const uint32_t n = std::min(o.passSpp, o.spp - done);
+      tracer->RenderPass(o.width, o.height, done, int(n), pass.data());
+      for (size_t i = 0; i < pixels; ++i)
+        sum[i] += pass[i];
+      done += n;
+      const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const int bar = int(40.0 * done / o.spp);
+      std::fprintf(stderr, "\r[%s%s] %u/%u spp, %.2f Mpaths/s, %.0f s left ", std::string(size_t(bar), '#').c_str(),
+                   std::string(size_t(40 - bar), '.').c_str(), done, o.spp, double(pixels) * done / s * 1e-6, s / done * (o.spp - done));
+    }
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::fprintf(stderr, "\n");
+
+    LiteImage::Image2D<float4> image(o.width, o.height);
+    size_t bad = 0;
+    for (size_t i = 0; i < pixels; ++i)
+    {
+      float4 v = sum[i] * (1.0f / float(o.spp));
+      if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+        ++bad, v = float4(0.0f);
+      image.vector()[i] = float4(v.x, v.y, v.z, 1.0f);
+    }
+    bool saved;
+    if (o.out.substr(o.out.size() - 4) == ".png")
+    {
+      LiteImage::Image2D<uint32_t> png(o.width, o.height);
+      for (size_t i = 0; i < pixels; ++i)
+      {
+        const float4 v = image.vector()[i];
+        png.vector()[i] = Srgb8(v.x) | Srgb8(v.y) << 8 | Srgb8(v.z) << 16 | 255u << 24;
+      }
+      saved = LiteImage::SaveImage(o.out.c_str(), png);
+    }
+    else
+      saved = LiteImage::SaveImage(o.out.c_str(), image);
+    if (!saved)
+      throw std::runtime_error(o.out + ": error: could not write the image");
+    std::printf("path_tracer: %s, %ux%u, %u spp, depth %d, %s%s: %.3f s (%.2f Mpaths/s); wrote %s\n", o.scene.c_str(), o.width, o.height, o.spp,
+                o.depth, o.device.c_str(), o.device == "vulkan" ? (", " + o.mode).c_str() : "", seconds, double(pixels) * o.spp / seconds * 1e-6,
+                o.out.c_str());
+    if (bad > 0)
+      throw std::runtime_error(std::to_string(bad) + " pixels were NaN or infinite (written as black)");
+    if (!o.compare.empty())
+      Compare(image, o.compare);
+  }
+  catch (const std::exception& e)
+  {
+    std::fprintf(stderr, "path_tracer: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
