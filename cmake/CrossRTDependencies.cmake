@@ -18,5 +18,4 @@ endif()
 
 # Mesh files (OFF, PLY, OBJ) for litemesh; zlib reads gzipped ones.
 find_package(assimp CONFIG REQUIRED)
-find_package(TinyGLTF REQUIRED)
 find_package(ZLIB REQUIRED)

@@ -9,7 +9,7 @@ PACKAGES=(
   mesa-vulkan-drivers                                      # lavapipe, the CPU Vulkan driver
   libembree-dev                                            # CPU ray tracing reference
   libassimp-dev zlib1g-dev                                 # mesh files (OFF, PLY, OBJ, gzipped)
-  libtinygltf-dev                                          # glTF 2.0 scenes for the path tracer
+  libtinygltf-dev                                          # glTF 2.0 scenes for the path tracer (its header)
   libopenimageio-dev openimageio-tools                     # image IO
   catch2 nlohmann-json3-dev libkainjow-mustache-dev libxxhash-dev
   python3-matplotlib                                       # plots of the benchmarks' CSV tables

@@ -5,7 +5,11 @@
 #include <assimp/material.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+#define TINYGLTF_NO_STB_IMAGE  // as TinyGltf.cpp compiles it
+#define TINYGLTF_NO_STB_IMAGE_WRITE
 #include <tiny_gltf.h>
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
 
 #include <algorithm>
 #include <cmath>
@@ -92,6 +96,42 @@ void ComputeTangents(PathScene::Mesh& mesh)
 
 // ---------------------------------------------------------------- glTF
 
+// tinygltf's image loader: PNG, JPEG (or anything OpenImageIO reads) from the bytes tinygltf found
+// in a file, a buffer view or a data URI, as 8 or 16 bits per channel.
+bool DecodeGltfImage(tinygltf::Image* image, const int index, std::string* err, std::string* warn, int reqWidth, int reqHeight,
+                     const unsigned char* bytes, int size, void* user)
+{
+  (void)warn, (void)reqWidth, (void)reqHeight, (void)user;
+  OIIO::Filesystem::IOMemReader memory(bytes, size_t(size));
+  // OpenImageIO picks the reader by the name's extension: the image's type, from its first bytes.
+  const bool png = size > 4 && bytes[0] == 0x89 && bytes[1] == 'P';
+  const bool jpeg = size > 2 && bytes[0] == 0xFF && bytes[1] == 0xD8;
+  const std::string name = png ? "image.png" : jpeg ? "image.jpg" : image->uri.empty() ? "image.png" : image->uri;
+  OIIO::ImageSpec config;
+  auto in = OIIO::ImageInput::open(name, &config, &memory);
+  if (!in)
+  {
+    if (err)
+      *err += "image " + std::to_string(index) + " ('" + image->uri + "'): " + OIIO::geterror() + "\n";
+    return false;
+  }
+  const OIIO::ImageSpec& spec = in->spec();
+  const bool wide = spec.format.size() > 1;
+  image->width = spec.width;
+  image->height = spec.height;
+  image->component = spec.nchannels;
+  image->bits = wide ? 16 : 8;
+  image->pixel_type = wide ? TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT : TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
+  image->image.resize(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels) * (wide ? 2u : 1u));
+  if (!in->read_image(0, 0, 0, spec.nchannels, wide ? OIIO::TypeDesc::UINT16 : OIIO::TypeDesc::UINT8, image->image.data()))
+  {
+    if (err)
+      *err += "image " + std::to_string(index) + " ('" + image->uri + "'): " + in->geterror() + "\n";
+    return false;
+  }
+  return true;
+}
+
 class GltfReader
 {
 public:
@@ -100,6 +140,7 @@ public:
   void Read()
   {
     tinygltf::TinyGLTF loader;
+    loader.SetImageLoader(DecodeGltfImage, nullptr);
     std::string err, warn;
     const bool binary = Lower(std::filesystem::path(m_path).extension().string()) == ".glb";
     const bool ok = binary ? loader.LoadBinaryFromFile(&m_model, &err, &warn, m_path) : loader.LoadASCIIFromFile(&m_model, &err, &warn, m_path);
