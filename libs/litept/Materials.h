@@ -52,6 +52,19 @@ inline BsdfSample NoSample()
   return s;
 }
 
+// The sample of direction wi (local) whose evaluation f (Evaluate's f |cos| and density) is given:
+// a lobe drawn by the material, weighted by the density of all its lobes together.
+inline BsdfSample EvaluatedSample(float3 wi, float4 f, uint32_t flags)
+{
+  if (f.w <= 0.0f)
+    return NoSample();
+  BsdfSample s;
+  s.weight = to_float4(to_float3(f) * (1.0f / f.w), 1.0f);
+  s.wiPdf = to_float4(wi, f.w);
+  s.flags = flags;
+  return s;
+}
+
 struct IMaterial
 {
   virtual ~IMaterial() = default;
@@ -190,14 +203,7 @@ struct GltfMetalRough : IMaterial
     if (wi.z <= 0.0f)
       return NoSample();
     const float3 wiOut = UpperHemisphere(wi, side);
-    const float4 f = Evaluate(woIn, wiOut, in);
-    if (f.w <= 0.0f)
-      return NoSample();
-    BsdfSample s;
-    s.weight = to_float4(to_float3(f) * (1.0f / f.w), 1.0f);
-    s.wiPdf = to_float4(wiOut, f.w);
-    s.flags = 0u;
-    return s;
+    return EvaluatedSample(wiOut, Evaluate(woIn, wiOut, in), 0u);
   }
 };
 
@@ -330,12 +336,7 @@ struct Dielectric : IMaterial
       s.wiPdf = to_float4(wi, 0.0f);
       return s;
     }
-    const float4 f = Evaluate(wo, wi, in);
-    if (f.w <= 0.0f)
-      return NoSample();
-    s.weight = to_float4(to_float3(f) * (1.0f / f.w), 1.0f);
-    s.wiPdf = to_float4(wi, f.w);
-    return s;
+    return EvaluatedSample(wi, Evaluate(wo, wi, in), flags);
   }
 };
 
@@ -395,24 +396,12 @@ struct Plastic : IMaterial
       const float3 wi = LiteMath::reflect(-1.0f * wo, h);
       if (wi.z <= 0.0f)
         return NoSample();
-      const float4 f = Evaluate(woIn, UpperHemisphere(wi, side), in);
-      if (f.w <= 0.0f)
-        return NoSample();
-      s.weight = to_float4(to_float3(f) * (1.0f / f.w), 1.0f);
-      s.wiPdf = to_float4(UpperHemisphere(wi, side), f.w);
-      s.flags = 0u;
-      return s;
+      return EvaluatedSample(UpperHemisphere(wi, side), Evaluate(woIn, UpperHemisphere(wi, side), in), 0u);
     }
     const float3 wi = SampleCosineHemisphere(u.x, u.y);
     if (wi.z <= 0.0f)
       return NoSample();
-    const float4 f = Evaluate(woIn, UpperHemisphere(wi, side), in);
-    if (f.w <= 0.0f)
-      return NoSample();
-    s.weight = to_float4(to_float3(f) * (1.0f / f.w), 1.0f);
-    s.wiPdf = to_float4(UpperHemisphere(wi, side), f.w);
-    s.flags = 0u;
-    return s;
+    return EvaluatedSample(UpperHemisphere(wi, side), Evaluate(woIn, UpperHemisphere(wi, side), in), 0u);
   }
 };
 
