@@ -99,6 +99,21 @@ struct TriangleLight : ILight
 
 // ---------------------------------------------------------------- punctual lights
 
+// Light of this intensity from the point q, as seen from p: intensity / d^2, a delta light.
+inline LightSample FromPoint(float3 p, float3 q, float3 intensity)
+{
+  const float3 d = q - p;
+  const float dist2 = LiteMath::dot(d, d);
+  if (dist2 <= 0.0f)
+    return NoLight();
+  const float dist = std::sqrt(dist2);
+  LightSample s;
+  s.dirDist = to_float4(d * (1.0f / dist), dist);
+  s.radiancePdf = to_float4(intensity * (1.0f / dist2), 1.0f);
+  s.delta = 1u;
+  return s;
+}
+
 struct PointLight : ILight
 {
   float4 position;   // xyz
@@ -107,16 +122,7 @@ struct PointLight : ILight
   LightSample Sample(float3 p, float2 u) const override
   {
     (void)u;
-    const float3 d = to_float3(position) - p;
-    const float dist2 = LiteMath::dot(d, d);
-    if (dist2 <= 0.0f)
-      return NoLight();
-    const float dist = std::sqrt(dist2);
-    LightSample s;
-    s.dirDist = to_float4(d * (1.0f / dist), dist);
-    s.radiancePdf = to_float4(to_float3(intensity) * (1.0f / dist2), 1.0f);
-    s.delta = 1u;
-    return s;
+    return FromPoint(p, to_float3(position), to_float3(intensity));
   }
   float Power() const override { return 4.0f * kPi * Luminance(to_float3(intensity)); }
 };
@@ -132,21 +138,11 @@ struct SpotLight : ILight
   LightSample Sample(float3 p, float2 u) const override
   {
     (void)u;
-    const float3 d = to_float3(position) - p;
-    const float dist2 = LiteMath::dot(d, d);
-    if (dist2 <= 0.0f)
-      return NoLight();
-    const float dist = std::sqrt(dist2);
-    const float3 dir = d * (1.0f / dist);
-    const float cd = -LiteMath::dot(dir, to_float3(direction));
+    LightSample s = FromPoint(p, to_float3(position), to_float3(intensity));
+    const float cd = -LiteMath::dot(to_float3(s.dirDist), to_float3(direction));
     // glTF's recommended edge: a squared linear ramp in the cosine between the cones.
     const float t = LiteMath::clamp((cd - cosOuter) / LiteMath::max(cosInner - cosOuter, 1e-4f), 0.0f, 1.0f);
-    if (t <= 0.0f)
-      return NoLight();
-    LightSample s;
-    s.dirDist = to_float4(dir, dist);
-    s.radiancePdf = to_float4(to_float3(intensity) * (t * t / dist2), 1.0f);
-    s.delta = 1u;
+    s.radiancePdf = to_float4(to_float3(s.radiancePdf) * (t * t), s.radiancePdf.w * (t > 0.0f ? 1.0f : 0.0f));
     return s;
   }
   float Power() const override { return 2.0f * kPi * (1.0f - 0.5f * (cosInner + cosOuter)) * Luminance(to_float3(intensity)); }

@@ -42,6 +42,16 @@ struct BsdfSample
 constexpr uint32_t kBsdfDelta = 1u;         // a mirror or a refraction: no light sampling can find it
 constexpr uint32_t kBsdfTransmission = 2u;  // wi is on the other side of the surface
 
+// What a material sees where it names no textures.
+inline MaterialInputs Untextured()
+{
+  MaterialInputs in;
+  in.baseColor = float4(1.0f);
+  in.metallicRoughness = float4(1.0f);
+  in.emissive = float4(1.0f);
+  return in;
+}
+
 // Marks a sample that failed (absorbed).
 inline BsdfSample NoSample()
 {
@@ -49,6 +59,19 @@ inline BsdfSample NoSample()
   s.weight = float4(0.0f);
   s.wiPdf = float4(0.0f);
   s.flags = 0u;
+  return s;
+}
+
+// Opaque materials are two-sided: seen from below, the frame flips.
+inline float3 UpperHemisphere(float3 w, float side) { return float3(w.x, w.y, w.z * side); }
+
+// A delta reflection of wo about the (local) normal with this weight, on wo's side.
+inline BsdfSample MirrorSample(float3 wo, float side, float3 weight)
+{
+  BsdfSample s;
+  s.weight = to_float4(weight, 1.0f);
+  s.wiPdf = to_float4(UpperHemisphere(float3(-wo.x, -wo.y, wo.z), side), 0.0f);
+  s.flags = kBsdfDelta;
   return s;
 }
 
@@ -84,9 +107,6 @@ struct IMaterial
   // Draws wi from four uniform numbers.
   virtual BsdfSample Sample(float3 wo, float4 u, const MaterialInputs& in) const = 0;
 };
-
-// Opaque materials are two-sided: seen from below, the frame flips.
-inline float3 UpperHemisphere(float3 w, float side) { return float3(w.x, w.y, w.z * side); }
 
 // ---------------------------------------------------------------- Lambert
 
@@ -236,15 +256,9 @@ struct RoughConductor : IMaterial
     const float3 wo = UpperHemisphere(woIn, side);
     if (wo.z <= 0.0f)
       return NoSample();
-    BsdfSample s;
     if (alpha < 1e-3f)  // a mirror
-    {
-      const float3 wi = float3(-wo.x, -wo.y, wo.z);
-      s.weight = to_float4(FresnelConductor(wo.z, to_float3(eta), to_float3(k)) * to_float3(tint), 1.0f);
-      s.wiPdf = to_float4(UpperHemisphere(wi, side), 0.0f);
-      s.flags = kBsdfDelta;
-      return s;
-    }
+      return MirrorSample(wo, side, FresnelConductor(wo.z, to_float3(eta), to_float3(k)) * to_float3(tint));
+    BsdfSample s;
     const float3 h = SampleGgxVisibleNormal(wo, alpha, u.x, u.y);
     const float3 wi = LiteMath::reflect(-1.0f * wo, h);
     if (wi.z <= 0.0f)
@@ -381,17 +395,10 @@ struct Plastic : IMaterial
     const float3 wo = UpperHemisphere(woIn, side);
     if (wo.z <= 0.0f)
       return NoSample();
-    BsdfSample s;
     if (u.z >= diffuseChance)  // the coat
     {
       if (alpha < 1e-3f)
-      {
-        const float3 wi = float3(-wo.x, -wo.y, wo.z);
-        s.weight = to_float4(float3(FresnelDielectric(wo.z, ior) / (1.0f - diffuseChance)), 1.0f);
-        s.wiPdf = to_float4(UpperHemisphere(wi, side), 0.0f);
-        s.flags = kBsdfDelta;
-        return s;
-      }
+        return MirrorSample(wo, side, float3(FresnelDielectric(wo.z, ior) / (1.0f - diffuseChance)));
       const float3 h = SampleGgxVisibleNormal(wo, alpha, u.x, u.y);
       const float3 wi = LiteMath::reflect(-1.0f * wo, h);
       if (wi.z <= 0.0f)

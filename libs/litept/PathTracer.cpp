@@ -265,10 +265,7 @@ void PathTracer::kernel_Contribute(uint32_t tidX, uint32_t tidY, uint32_t width,
 
 MaterialInputs PathTracer::MaterialInputsAt(int4 textures, float2 uv) const
 {
-  MaterialInputs in;
-  in.baseColor = float4(1.0f);
-  in.metallicRoughness = float4(1.0f);
-  in.emissive = float4(1.0f);
+  MaterialInputs in = Untextured();
   if (textures.x >= 0)
     in.baseColor = m_textures[textures.x].sample(uv);
   if (textures.y >= 0)

@@ -9,17 +9,6 @@
 using namespace LiteMath;
 using namespace litept;
 
-namespace {
-
-// The radiance a material emits from its front (and back) side, when it is not textured.
-float3 ConstantEmission(const IMaterial& m, bool back)
-{
-  const MaterialInputs white{float4(1.0f), float4(1.0f), float4(1.0f)};
-  return m.Emitted(float3(0.0f, 0.0f, back ? -1.0f : 1.0f), white);
-}
-
-}  // namespace
-
 void PathTracer::SetScene(const PathScene& scene, std::shared_ptr<ISceneObject> accel)
 {
   m_pAccelStruct = std::move(accel);
@@ -54,7 +43,19 @@ void PathTracer::SetScene(const PathScene& scene, std::shared_ptr<ISceneObject> 
   if (m_textures.empty())  // the GPU's texture array needs an element
     m_textures.emplace_back(LiteImage::Image2D<float4>(1, 1, float4(1.0f)), LiteImage::Sampler());
 
-  // Instances, and a light per emissive triangle of each (textured emission is found by BSDF rays only).
+  // Per material, the radiance its triangles emit as lights (w: 1 when from both sides), or 0:
+  // textured emission is found by BSDF rays only.
+  std::vector<float4> lightRadiance;
+  for (const auto& material : scene.materials)
+  {
+    const float3 front = material->Emitted(float3(0.0f, 0.0f, 1.0f), Untextured());
+    const float3 back = material->Emitted(float3(0.0f, 0.0f, -1.0f), Untextured());
+    const bool emits = front.x + front.y + front.z + back.x + back.y + back.z > 0.0f && material->TextureIds().w < 0;
+    lightRadiance.push_back(emits ? to_float4(front.x + front.y + front.z > 0.0f ? front : back, back.x + back.y + back.z > 0.0f ? 1.0f : 0.0f)
+                                  : float4(0.0f));
+  }
+
+  // Instances, and a light per emissive triangle of each.
   m_lights = scene.lights;
   m_instToWorld.clear(), m_instNormalToWorld.clear(), m_instFirstLight.clear(), m_triangleLight.clear();
   m_pAccelStruct->ClearScene();
@@ -72,9 +73,8 @@ void PathTracer::SetScene(const PathScene& scene, std::shared_ptr<ISceneObject> 
     m_instNormalToWorld[id] = transpose(inverse4x4(inst.toWorld));
     for (size_t t = 0; t < mesh.triangleMaterial.size(); ++t)
     {
-      const IMaterial& material = *scene.materials[mesh.triangleMaterial[t]];
-      const float3 front = ConstantEmission(material, false), back = ConstantEmission(material, true);
-      if (front.x + front.y + front.z + back.x + back.y + back.z <= 0.0f || material.TextureIds().w >= 0)
+      const float4 radiance = lightRadiance[mesh.triangleMaterial[t]];
+      if (radiance.x + radiance.y + radiance.z <= 0.0f)
         continue;
       if (m_instFirstLight[id] < 0)
       {
@@ -90,7 +90,7 @@ void PathTracer::SetScene(const PathScene& scene, std::shared_ptr<ISceneObject> 
       light->v0 = to_float4(p0, 0.0f);
       light->edge1 = to_float4(p1 - p0, 0.0f);
       light->edge2 = to_float4(p2 - p0, 0.0f);
-      light->radiance = to_float4(front.x + front.y + front.z > 0.0f ? front : back, back.x + back.y + back.z > 0.0f ? 1.0f : 0.0f);
+      light->radiance = radiance;
       m_triangleLight[size_t(m_instFirstLight[id]) + t] = int(m_lights.size());
       m_lights.push_back(light);
     }

@@ -699,7 +699,6 @@ void LoadEnvironment(PathScene& scene, const std::string& path, float strength)
   for (auto& t : env.vector())
     t = float4(t.x * strength, t.y * strength, t.z * strength, 1.0f);
   scene.environment = std::move(env);
-  scene.environmentStrength = strength;
 }
 
 void SceneBounds(const PathScene& scene, float3& boxMin, float3& boxMax)
@@ -736,14 +735,13 @@ void ApplySceneDefaults(PathScene& scene)
   bool emits = !scene.lights.empty() || scene.environment.width() > 0;
   for (const auto& m : scene.materials)
   {
-    const litept::MaterialInputs white{float4(1.0f), float4(1.0f), float4(1.0f)};
-    const float3 e1 = m->Emitted(float3(0.0f, 0.0f, 1.0f), white);
-    emits = emits || e1.x + e1.y + e1.z > 0.0f;
+    const float3 front = m->Emitted(float3(0.0f, 0.0f, 1.0f), litept::Untextured());
+    const float3 back = m->Emitted(float3(0.0f, 0.0f, -1.0f), litept::Untextured());
+    emits = emits || front.x + front.y + front.z + back.x + back.y + back.z > 0.0f;
   }
   if (!emits)
   {
     scene.environment = LiteImage::Image2D<float4>(1, 1, float4(1.0f, 1.0f, 1.0f, 1.0f));
-    scene.environmentStrength = 1.0f;
     scene.notes.push_back("note: the scene has no light; using the default light: a uniform white environment of radiance 1");
   }
 }

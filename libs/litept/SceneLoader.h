@@ -59,8 +59,7 @@ struct PathScene
   std::vector<std::shared_ptr<litept::ILight>> lights;            // punctual lights; emissive triangles come from the materials
   Camera camera;
   bool hasCamera = false;
-  LiteImage::Image2D<LiteMath::float4> environment;  // equirectangular, linear; empty: none
-  float environmentStrength = 1.0f;
+  LiteImage::Image2D<LiteMath::float4> environment;  // equirectangular, linear, strength applied; empty: none
   std::vector<std::string> notes;  // defaults taken and approximations made, for the user
 };
 
