@@ -211,6 +211,7 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
                           "' but a " + std::to_string(other.slotBytes) + "-byte slot in '" + other.member + "'",
                           "use level 2 (a buffer per class), where a class's objects need no slot");
       }
+      for (auto& other : model.virtuals) vm.firstClassConstant += unsigned(other.impls.size());
       model.virtuals.push_back(vm);
       known = model.virtuals.end() - 1;
     }
@@ -221,6 +222,7 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
       // Data structs and buffer references, then each implementation's methods.
       const GlslDecl tags = TagsReference(model, vm);
       structs.push_back(tags);
+      for (auto& c : ClassConstants(model, vm)) structs.push_back(c);
       if (callable) callable->structs.push_back(tags);
     }
     std::map<std::string, std::string> implFunction;  // (impl, method) -> GLSL name
@@ -272,6 +274,8 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
         x.set("tag", std::to_string(t));
         x.set("call", implFunction[vi.name + "::" + m->getNameAsString()] + "(" + args + ")");
         x.set("returnsVoid", retType == "void");
+        x.set("held", ispc ? "" : ClassConstantName(vm, t));
+        x.set("class", vi.name);
         cases.push_back(x);
       }
       d.set("cases", cases);

@@ -351,6 +351,7 @@ Data Common(const ClassModel& model, const GenerateOptions& opt) {
     x.set("level1", model.virtualLevel == 1);
     x.set("level2", model.virtualLevel >= 2);  // level 3 keeps the objects as level 2 does
     x.set("slotBytes", std::to_string(v.slotBytes));
+    x.set("firstClassConstant", std::to_string(v.firstClassConstant));
     // Its elements are leaves the ray tracing hardware finds: their boxes are committed with it.
     x.set("leaves", std::any_of(model.kernels.begin(), model.kernels.end(), [&](const Kernel& k) {
             return RunsLeafShaders(k) && std::any_of(k.leaves.begin(), k.leaves.end(), [&](const LeafTraversal& lt) { return lt.member == v.member; });
@@ -359,6 +360,15 @@ Data Common(const ClassModel& model, const GenerateOptions& opt) {
   }
   d.set("virtuals", virtuals);
   d.set("hasVirtuals", !model.virtuals.empty());
+  unsigned classConstants = 0;
+  std::string displays;
+  for (auto& v : model.virtuals) {
+    classConstants += unsigned(v.impls.size());
+    displays += (displays.empty() ? "" : ", ") + v.display;
+  }
+  d.set("virtualDisplays", displays);
+  d.set("classConstantCount", std::to_string(classConstants));
+  d.set("classConstantBase", std::to_string(kClassConstantIdBase));
   d.set("virtualIncludes", implIncludes);
   return d;
 }

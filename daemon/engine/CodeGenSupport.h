@@ -64,6 +64,10 @@ std::string IndentTail(const std::string& text, const std::string& pad);
 // runtime names it crossrt::kFenceAtomicsConstantId; generated host code static_asserts they agree.
 inline constexpr const char* kFenceAtomicsConstantId = "1700";
 
+// The first specialization constant of virtual calls specialised to the scene: constant
+// kClassConstantIdBase + i says whether the objects hold class i (crossrt::kClassConstantIdBase).
+inline constexpr unsigned kClassConstantIdBase = 1800;
+
 const char* Axis(unsigned a);
 
 const char* GlAxis(unsigned a);

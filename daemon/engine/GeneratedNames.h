@@ -18,5 +18,6 @@ inline const std::string kTextures = "m_textureArrays";     // arrays of texture
 inline const std::string kPartials = "m_partials";          // per-workgroup partial results of reductions
 inline const std::string kPipelines = "m_pipelines";        // one per shader
 inline const std::string kClassData = "m_classDataBuffer";  // the class data block
+inline const std::string kPipelineClasses = "m_pipelineClasses";  // the classes the pipelines switch over
 
 }  // namespace crossrt::engine::generated

@@ -41,7 +41,7 @@ void AnalyzeMembers(Context& c) {
   static const std::set<std::string> generatedMembers = {
       generated::kVectorCopies, generated::kTemporaries,    generated::kThreadState, generated::kScanner,
       generated::kSorter,       generated::kVirtualObjects, generated::kImages,      generated::kTextures,
-      generated::kPartials,     generated::kPipelines,      generated::kClassData};
+      generated::kPartials,     generated::kPipelines,      generated::kClassData,   generated::kPipelineClasses};
   for (auto* f : ClassFields(c.cls)) {
     Member m;
     m.name = f->getNameAsString();

@@ -255,6 +255,9 @@ struct VirtualMember {
   std::string interfaceName;  // IMaterial
   std::vector<VirtualImpl> impls;  // every class of the translation unit that implements it
   unsigned slotBytes = 0;          // level 1: the size of every element's slot
+  // Its classes' specialization constants are kClassConstantIdBase + firstClassConstant + t, t the
+  // class's tag: numbered on after the vectors before it, so that each (vector, class) has its own.
+  unsigned firstClassConstant = 0;
 };
 
 // Virtual functions, level 3: a shader of a ray tracing pipeline other than the ray generation

@@ -108,6 +108,22 @@ GlslDecl TagsReference(const ClassModel& model, const VirtualMember& vm) {
   return {vm.member + "_Tags", Render(model.templateDir + "/glsl/virtual_objects.glsl.mustache", d)};
 }
 
+std::vector<GlslDecl> ClassConstants(const ClassModel& model, const VirtualMember& vm) {
+  std::vector<GlslDecl> out;
+  for (size_t t = 0; t < vm.impls.size(); ++t) {
+    Data d, constant;
+    constant.set("id", std::to_string(kClassConstantIdBase + vm.firstClassConstant + t));
+    constant.set("name", ClassConstantName(vm, t));
+    constant.set("class", vm.impls[t].name);
+    constant.set("display", vm.display);
+    d.set("classConstant", constant);
+    out.push_back({ClassConstantName(vm, t), Render(model.templateDir + "/glsl/virtual_objects.glsl.mustache", d)});
+  }
+  return out;
+}
+
+std::string ClassConstantName(const VirtualMember& vm, size_t t) { return "crt_" + vm.member + "_holds" + vm.impls[t].name; }
+
 GlslDecl ImplDataStruct(const ClassModel& model, GlslPrinter& printer, const CXXRecordDecl* impl, const VirtualMember& vm, const VirtualImpl& vi) {
   Data d, fields = List();
   d.set("data", true);

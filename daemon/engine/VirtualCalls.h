@@ -35,6 +35,11 @@ bool WrittenBack(const CXXMethodDecl* m, unsigned i);
 // ", vec3 normal, inout float weight": a dispatcher's parameters after the element's index.
 std::string DispatcherParams(GlslPrinter& printer, const CXXMethodDecl* m);
 
+// The specialization constants that say which classes a vector's objects hold (kClassConstantIdBase),
+// one per class: a dispatcher's case for a class the scene lacks is dead code in the pipeline.
+std::vector<GlslDecl> ClassConstants(const ClassModel& model, const VirtualMember& vm);
+std::string ClassConstantName(const VirtualMember& vm, size_t t);  // crt_m_materials_holdsLambert
+
 // The buffer reference to a vector's tags: per element, its class and where its object is.
 GlslDecl TagsReference(const ClassModel& model, const VirtualMember& vm);
 

@@ -322,9 +322,9 @@ struct Dielectric : IMaterial
       return NoSample();
     const float side = wo.z < 0.0f ? -1.0f : 1.0f;
     const float eta = wo.z > 0.0f ? ior : 1.0f / ior;
-    float3 h = float3(0.0f, 0.0f, side);  // the (micro)normal on wo's side
+    float3 h = float3(0.0f, 0.0f, side);  // the (micro)normal on wo's side: mirrored in z, as wo is
     if (alpha >= 1e-3f)
-      h = SampleGgxVisibleNormal(UpperHemisphere(wo, side), alpha, u.x, u.y) * side;
+      h = UpperHemisphere(SampleGgxVisibleNormal(UpperHemisphere(wo, side), alpha, u.x, u.y), side);
     const float F = FresnelDielectric(LiteMath::dot(wo, h) * side, ior);
     float3 wi;
     uint32_t flags = alpha < 1e-3f ? kBsdfDelta : 0u;

@@ -145,9 +145,10 @@ inline float3 FresnelConductor(float cosThetaI, float3 eta, float3 k)
 
 inline float GgxD(float3 h, float alpha)
 {
+  // cos^2 alpha^2 + sin^2 for a unit h: written as 1 + cos^2 (alpha^2 - 1) it rounds to 0 at
+  // alpha^2 below float's epsilon (glTF roughness 0) and h along the normal.
   const float a2 = alpha * alpha;
-  const float c2 = h.z * h.z;
-  const float d = c2 * (a2 - 1.0f) + 1.0f;
+  const float d = h.z * h.z * a2 + h.x * h.x + h.y * h.y;
   return a2 / (kPi * d * d);
 }
 

@@ -18,16 +18,23 @@ T VkInit(VkStructureType sType) {
   return t;
 }
 
-// The specialization every pipeline's shaders get: crt_fenceAtomics (kFenceAtomicsConstantId)
-// from the context; shaders without the constant ignore it. `info` points into the object, which
-// therefore stays where it was made while the pipeline is created.
-struct FenceSpecialization {
-  VkBool32 fence;
-  VkSpecializationMapEntry entry{kFenceAtomicsConstantId, 0, sizeof(VkBool32)};
-  VkSpecializationInfo info;
-  explicit FenceSpecialization(bool on) : fence(on ? VK_TRUE : VK_FALSE), info{1, &entry, sizeof(VkBool32), &fence} {}
-  FenceSpecialization(const FenceSpecialization&) = delete;
-  FenceSpecialization& operator=(const FenceSpecialization&) = delete;
+// The specialization every pipeline's shaders get: crt_fenceAtomics (kFenceAtomicsConstantId) from
+// the context and, for kernels with virtual calls, the classes the scene holds (kClassConstantIdBase
+// + i); shaders without a constant ignore it. `info` points into the object, which therefore stays
+// where it was made while the pipeline is created.
+struct Specialization {
+  std::vector<VkBool32> values;
+  std::vector<VkSpecializationMapEntry> entries;
+  VkSpecializationInfo info{};
+  Specialization(bool fence, const std::vector<VkBool32>& classesHeld) {
+    values.push_back(fence ? VK_TRUE : VK_FALSE);
+    for (VkBool32 held : classesHeld) values.push_back(held ? VK_TRUE : VK_FALSE);
+    for (uint32_t i = 0; i < values.size(); ++i)
+      entries.push_back({i == 0 ? kFenceAtomicsConstantId : kClassConstantIdBase + i - 1, uint32_t(sizeof(VkBool32) * i), sizeof(VkBool32)});
+    info = {uint32_t(entries.size()), entries.data(), sizeof(VkBool32) * values.size(), values.data()};
+  }
+  Specialization(const Specialization&) = delete;
+  Specialization& operator=(const Specialization&) = delete;
 };
 
 // x rounded up to a multiple of a (a Vulkan alignment; 0 and 1 leave x as it is).

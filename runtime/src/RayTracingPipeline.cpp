@@ -40,7 +40,7 @@ RayTracingPipeline::RayTracingPipeline(std::shared_ptr<VulkanContext> ctx, const
     // the callables.
     std::vector<VkPipelineShaderStageCreateInfo> stages;
     std::vector<VkRayTracingShaderGroupCreateInfoKHR> groups;
-    const FenceSpecialization specialization(ctx_->fenceAtomics);  // kernels with atomics read it
+    const Specialization specialization(ctx_->fenceAtomics, {});  // kernels with atomics read it
     auto stage = [&](ShaderCode code, VkShaderStageFlagBits bit) {
       modules.push_back(CreateModule(code.spirv, code.bytes));
       auto s = VkInit<VkPipelineShaderStageCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO);

@@ -259,3 +259,40 @@ TEST_CASE("Virtual functions, level 3: callable shaders on ray tracing pipelines
   }
   RequireNoValidationMessages(ctx);
 }
+
+TEST_CASE("Virtual functions: pipelines made for the classes the objects hold give the same results, and are made again when those change",
+          "[equivalence][virtual]")
+{
+  auto ctx = ValidatedContext();
+  if (!ctx)
+    return;  // no Vulkan device: the generated class cannot run
+  std::vector<std::shared_ptr<IMaterial>> lamberts;
+  for (auto& m : Palette())
+    if (dynamic_cast<Lambert*>(m.get()))
+      lamberts.push_back(m);
+  const Scene scene = RandomScene(4001, uint32_t(lamberts.size()), 5);
+  MaterialShading original;
+  original.m_materials = lamberts;
+  const auto expected = ShadeWith(original, scene);
+
+  auto gpu = CreateMaterialShading_Vulkan(ctx);
+  auto& vulkan = dynamic_cast<MaterialShading_Vulkan&>(*gpu);
+  REQUIRE(vulkan.SpecializesVirtualCalls());  // the default
+  gpu->m_materials = lamberts;  // pipelines with the Lambert cases only
+  REQUIRE(Differing(ShadeWith(*gpu, scene), expected, 1e-5f) == 0);
+  vulkan.SpecializeVirtualCalls(false);  // every case
+  REQUIRE(Differing(ShadeWith(*gpu, scene), expected, 1e-5f) == 0);
+  vulkan.SpecializeVirtualCalls(true);
+  REQUIRE(Differing(ShadeWith(*gpu, scene), expected, 1e-5f) == 0);
+
+  // Phongs and Checkers join the Lamberts in place (same size): CommitDeviceData() makes the
+  // pipelines again, or their cases would still be dead code and shade nothing.
+  const auto palette = Palette();
+  gpu->m_materials.assign(palette.begin(), palette.begin() + lamberts.size());
+  original.m_materials = gpu->m_materials;
+  gpu->CommitDeviceData();
+  const Scene mixed = RandomScene(4001, uint32_t(lamberts.size()), 6);
+  const auto expectedMixed = ShadeWith(original, mixed);
+  REQUIRE(Differing(ShadeWith(*gpu, mixed), expectedMixed, 1e-5f) == 0);
+  RequireNoValidationMessages(ctx);
+}

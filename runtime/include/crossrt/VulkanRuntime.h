@@ -26,6 +26,12 @@ namespace crossrt {
 // the translator writes it into the shaders, and generated classes static_assert that it matches.
 constexpr uint32_t kFenceAtomicsConstantId = 1700;
 
+// Virtual calls specialised to the scene: specialization constant kClassConstantIdBase + i of a
+// generated kernel is true while the objects its virtual calls reach include one of class i (the
+// generated class numbers the (vector, class) pairs); a switch case whose constant is false is dead
+// code, which the driver removes from the pipeline.
+constexpr uint32_t kClassConstantIdBase = 1800;
+
 struct Error : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
@@ -596,12 +602,14 @@ public:
   ComputePipeline() = default;
   // storageBufferBindings: bindings 0..n-1 in set 0; pushConstantBytes may be 0.
   ComputePipeline(std::shared_ptr<VulkanContext> ctx, const uint32_t* spirv, size_t spirvBytes,
-                  uint32_t storageBufferBindings, uint32_t pushConstantBytes, const char* debugName);
+                  uint32_t storageBufferBindings, uint32_t pushConstantBytes, const char* debugName,
+                  const std::vector<VkBool32>& classesHeld = {});
   // Binding i of set 0 has bindingTypes[i] (storage buffers, storage images, sampled images, samplers);
   // sets 1..textureArraySets are arrays of textures (throws unless ctx->hasTextureArrays).
+  // classesHeld: the values of the constants kClassConstantIdBase + i (none given: their defaults, true).
   ComputePipeline(std::shared_ptr<VulkanContext> ctx, const uint32_t* spirv, size_t spirvBytes,
                   std::vector<VkDescriptorType> bindingTypes, uint32_t pushConstantBytes, const char* debugName,
-                  uint32_t textureArraySets = 0);
+                  uint32_t textureArraySets = 0, const std::vector<VkBool32>& classesHeld = {});
 };
 
 // SPIR-V code of one shader: a pointer into the generated arrays, and its size in bytes.

@@ -39,7 +39,11 @@ CallableShading_Vulkan::CallableShading_Vulkan(std::shared_ptr<crossrt::VulkanCo
   if (m_ctx->hasRayTracingPipeline)
   {
   }
-  InitPipelines();
+  // Virtual functions reach each class's objects through buffer references.
+  if (!m_ctx->hasBufferDeviceAddress)
+    throw crossrt::Error("CallableShading_Vulkan: device '" + m_ctx->DeviceName() +
+                         "' lacks bufferDeviceAddress, which virtual function calls in kernels need");
+  // The pipelines are made by CommitDeviceData(), for the classes the objects hold.
 }
 
 std::shared_ptr<CallableShading> CreateCallableShading_Vulkan()
@@ -56,10 +60,10 @@ CallableShading_Vulkan::~CallableShading_Vulkan() = default;
 
 void CallableShading_Vulkan::InitPipelines()
 {
-  // Virtual functions reach each class's objects through buffer references.
-  if (!m_ctx->hasBufferDeviceAddress)
-    throw crossrt::Error("CallableShading_Vulkan: device '" + m_ctx->DeviceName() +
-                         "' lacks bufferDeviceAddress, which virtual function calls in kernels need");
+  // Kernels switch over the classes in m_pipelineClasses only (specialization constants from
+  // crossrt::kClassConstantIdBase): the driver drops the cases of the others.
+  static_assert(crossrt::kClassConstantIdBase == 1800,
+                "the shaders and the runtime number the class constants differently");
   if (m_ctx->hasRayTracingPipeline)  // virtual calls as callable shaders, in a ray tracing pipeline: the shader needs
                                      // them even to be created
     m_pipelines.kernel2D_Render_Callables = crossrt::RayTracingPipeline(
@@ -87,7 +91,7 @@ void CallableShading_Vulkan::InitPipelines()
         sizeof(kernel2D_RenderArgs), "CallableShading::kernel2D_Render_Callables");
   m_pipelines.kernel2D_Render =
       crossrt::ComputePipeline(m_ctx, CallableShading_kernel2D_Render_spv, CallableShading_kernel2D_Render_spvBytes, 4,
-                               sizeof(kernel2D_RenderArgs), "CallableShading::kernel2D_Render");
+                               sizeof(kernel2D_RenderArgs), "CallableShading::kernel2D_Render", m_pipelineClasses);
 }
 
 void CallableShading_Vulkan::UseRayTracingPipelines(bool a_use)
@@ -97,6 +101,13 @@ void CallableShading_Vulkan::UseRayTracingPipelines(bool a_use)
                          "' has no ray tracing pipelines (VK_KHR_ray_tracing_pipeline): its kernels switch over the "
                          "objects' classes in compute shaders");
   m_useRayTracingPipelines = a_use;
+}
+
+void CallableShading_Vulkan::SpecializeVirtualCalls(bool a_on)
+{
+  if (a_on != m_specializeVirtualCalls)
+    m_deviceDataCommitted = false;  // the next call commits, making the pipelines again
+  m_specializeVirtualCalls = a_on;
 }
 
 void CallableShading_Vulkan::UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size)
@@ -126,7 +137,16 @@ void CallableShading_Vulkan::ReadPlainMembers()
 void CallableShading_Vulkan::CommitDeviceData()
 {
   // std::vector members become buffers of their capacity; kernels see size and capacity.
-  CommitVirtual_m_materials();
+  // Objects called through virtual functions, regrouped; the classes they hold, for the pipelines.
+  std::vector<VkBool32> crt_classesHeld(3, m_specializeVirtualCalls ? VK_FALSE : VK_TRUE);
+  const std::vector<uint32_t> crt_m_materialsTags = CommitVirtual_m_materials();
+  for (size_t i = 0; i < m_virtual.m_materialsSize; ++i)
+    crt_classesHeld[0 + crt_m_materialsTags[2 * i]] = VK_TRUE;
+  if (crt_classesHeld != m_pipelineClasses)  // made for other classes, or not made yet
+  {
+    m_pipelineClasses = crt_classesHeld;
+    InitPipelines();
+  }
   UpdatePlainMembers();
   m_deviceDataCommitted = true;
 }

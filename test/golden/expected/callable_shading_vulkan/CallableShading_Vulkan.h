@@ -47,6 +47,13 @@ public:
   bool UsesRayTracingPipelines() const { return m_useRayTracingPipelines; }
   virtual void UseRayTracingPipelines(bool a_use);
 
+  // Virtual calls specialised to the scene (the default): CommitDeviceData() makes the pipelines
+  // for the classes of the objects in m_materials, and makes them again when those
+  // change; the switch cases of the other classes are dead code that the driver drops (shorter
+  // shaders, fewer registers). Off, the pipelines keep every class's case. Same results.
+  bool SpecializesVirtualCalls() const { return m_specializeVirtualCalls; }
+  virtual void SpecializeVirtualCalls(bool a_on);
+
 protected:
   // One per kernel (and megakernel of a thread loop): records its dispatch (and barrier) into a_cmd.
   virtual void kernel2D_RenderCmd(VkCommandBuffer a_cmd, int width, int height, crossrt::BufferView normals,
@@ -117,6 +124,10 @@ protected:
     crossrt::Buffer m_materials_Checker;
     size_t m_materialsSize = 0;  // elements at the last CommitDeviceData()
   } m_virtual;
+  bool m_specializeVirtualCalls = true;
+  // Per (vector, class), numbered as the shaders' constants crossrt::kClassConstantIdBase + i: whether
+  // the pipelines switch over that class (its objects were there at the last CommitDeviceData()).
+  std::vector<VkBool32> m_pipelineClasses;
   bool m_useRayTracingPipelines = false;  // record the kernels' _Callables and _Intersections variants
 
   struct InOut_Render  // buffers bound by SetVulkanInOutFor_Render

@@ -49,7 +49,11 @@ ShapeTracer_Vulkan::ShapeTracer_Vulkan(std::shared_ptr<crossrt::VulkanContext> a
     m_scenes.m_scene_m_shapes_leaves = crossrt::RayTracingScene(m_ctx);
     m_scenes.m_scene_m_lights_leaves = crossrt::RayTracingScene(m_ctx);
   }
-  InitPipelines();
+  // Virtual functions reach each class's objects through buffer references.
+  if (!m_ctx->hasBufferDeviceAddress)
+    throw crossrt::Error("ShapeTracer_Vulkan: device '" + m_ctx->DeviceName() +
+                         "' lacks bufferDeviceAddress, which virtual function calls in kernels need");
+  // The pipelines are made by CommitDeviceData(), for the classes the objects hold.
 }
 
 std::shared_ptr<ShapeTracer> CreateShapeTracer_Vulkan()
@@ -66,10 +70,10 @@ ShapeTracer_Vulkan::~ShapeTracer_Vulkan() = default;
 
 void ShapeTracer_Vulkan::InitPipelines()
 {
-  // Virtual functions reach each class's objects through buffer references.
-  if (!m_ctx->hasBufferDeviceAddress)
-    throw crossrt::Error("ShapeTracer_Vulkan: device '" + m_ctx->DeviceName() +
-                         "' lacks bufferDeviceAddress, which virtual function calls in kernels need");
+  // Kernels switch over the classes in m_pipelineClasses only (specialization constants from
+  // crossrt::kClassConstantIdBase): the driver drops the cases of the others.
+  static_assert(crossrt::kClassConstantIdBase == 1800,
+                "the shaders and the runtime number the class constants differently");
   if (m_ctx->hasRayTracingPipeline)  // the leaves of m_scene->m_shapes and m_scene->m_lights as intersection shaders,
                                      // in a ray tracing pipeline: the shader needs them even to be created
     m_pipelines.kernel1D_Trace_Intersections = crossrt::RayTracingPipeline(
@@ -108,7 +112,7 @@ void ShapeTracer_Vulkan::InitPipelines()
         sizeof(kernel1D_TraceArgs), "ShapeTracer::kernel1D_Trace_Intersections");
   m_pipelines.kernel1D_Trace =
       crossrt::ComputePipeline(m_ctx, ShapeTracer_kernel1D_Trace_spv, ShapeTracer_kernel1D_Trace_spvBytes, 6,
-                               sizeof(kernel1D_TraceArgs), "ShapeTracer::kernel1D_Trace");
+                               sizeof(kernel1D_TraceArgs), "ShapeTracer::kernel1D_Trace", m_pipelineClasses);
 }
 
 void ShapeTracer_Vulkan::UseRayTracingPipelines(bool a_use)
@@ -156,6 +160,13 @@ void ShapeTracer_Vulkan::CommitLeaves_m_scene_m_lights(const std::vector<uint32_
   m_scenes.m_scene_m_lights_leaves.BuildLeaves(leaves, "ShapeTracer::m_scene->m_lights");
 }
 
+void ShapeTracer_Vulkan::SpecializeVirtualCalls(bool a_on)
+{
+  if (a_on != m_specializeVirtualCalls)
+    m_deviceDataCommitted = false;  // the next call commits, making the pipelines again
+  m_specializeVirtualCalls = a_on;
+}
+
 void ShapeTracer_Vulkan::UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size)
 {
   crossrt::ComputeBarrier(a_cmd);  // kernels recorded before it are done with the class data
@@ -201,12 +212,23 @@ void ShapeTracer_Vulkan::CommitDeviceData()
     m_vdata.m_scene_m_lightBoxes.Upload(crt_m_scene()->m_lightBoxes.data(),
                                         sizeof(LiteMath::float4) * crt_m_scene()->m_lightBoxes.size());
   m_vdata.m_scene_m_lightBoxesSize = crt_m_scene()->m_lightBoxes.size();
+  // Objects called through virtual functions, regrouped; the classes they hold, for the pipelines.
+  std::vector<VkBool32> crt_classesHeld(6, m_specializeVirtualCalls ? VK_FALSE : VK_TRUE);
   const std::vector<uint32_t> crt_m_scene_m_shapesTags = CommitVirtual_m_scene_m_shapes();
+  for (size_t i = 0; i < m_virtual.m_scene_m_shapesSize; ++i)
+    crt_classesHeld[0 + crt_m_scene_m_shapesTags[2 * i]] = VK_TRUE;
   if (m_useRayTracingPipelines)
     CommitLeaves_m_scene_m_shapes(crt_m_scene_m_shapesTags);
   const std::vector<uint32_t> crt_m_scene_m_lightsTags = CommitVirtual_m_scene_m_lights();
+  for (size_t i = 0; i < m_virtual.m_scene_m_lightsSize; ++i)
+    crt_classesHeld[3 + crt_m_scene_m_lightsTags[2 * i]] = VK_TRUE;
   if (m_useRayTracingPipelines)
     CommitLeaves_m_scene_m_lights(crt_m_scene_m_lightsTags);
+  if (crt_classesHeld != m_pipelineClasses)  // made for other classes, or not made yet
+  {
+    m_pipelineClasses = crt_classesHeld;
+    InitPipelines();
+  }
   UpdatePlainMembers();
   m_deviceDataCommitted = true;
 }

@@ -47,6 +47,13 @@ public:
   bool UsesRayTracingPipelines() const { return m_useRayTracingPipelines; }
   virtual void UseRayTracingPipelines(bool a_use);
 
+  // Virtual calls specialised to the scene (the default): CommitDeviceData() makes the pipelines
+  // for the classes of the objects in m_scene->m_shapes, m_scene->m_lights, and makes them again when those
+  // change; the switch cases of the other classes are dead code that the driver drops (shorter
+  // shaders, fewer registers). Off, the pipelines keep every class's case. Same results.
+  bool SpecializesVirtualCalls() const { return m_specializeVirtualCalls; }
+  virtual void SpecializeVirtualCalls(bool a_on);
+
 protected:
   // One per kernel (and megakernel of a thread loop): records its dispatch (and barrier) into a_cmd.
   virtual void kernel1D_TraceCmd(VkCommandBuffer a_cmd, int n, crossrt::BufferView origins, crossrt::BufferView dirs,
@@ -137,6 +144,10 @@ protected:
     crossrt::Buffer m_scene_m_lights_Disc;
     size_t m_scene_m_lightsSize = 0;  // elements at the last CommitDeviceData()
   } m_virtual;
+  bool m_specializeVirtualCalls = true;
+  // Per (vector, class), numbered as the shaders' constants crossrt::kClassConstantIdBase + i: whether
+  // the pipelines switch over that class (its objects were there at the last CommitDeviceData()).
+  std::vector<VkBool32> m_pipelineClasses;
   // m_scene as the ShapeScene whose traversal the kernels run and whose data they read; throws
   // when it holds another IScene (or none).
   ShapeScene* crt_m_scene() const;

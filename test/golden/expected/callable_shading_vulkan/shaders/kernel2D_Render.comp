@@ -12,6 +12,15 @@ layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer m_m
   uvec2 tags[];
 };  // per element of m_materials: (class, index among its class's objects)
 
+// Off where m_materials holds no Lambert: its cases are dead code.
+layout(constant_id = 1800) const bool crt_m_materials_holdsLambert = true;
+
+// Off where m_materials holds no Phong: its cases are dead code.
+layout(constant_id = 1801) const bool crt_m_materials_holdsPhong = true;
+
+// Off where m_materials holds no Checker: its cases are dead code.
+layout(constant_id = 1802) const bool crt_m_materials_holdsChecker = true;
+
 // The data members of a Lambert.
 struct Lambert_Data
 {
@@ -160,12 +169,18 @@ vec3 m_materials_Shade(uint index, vec3 normal, vec3 toLight)
   const uvec2 tag = m_materials_Tags(m_materials_tags).tags[index];
   switch (tag.x)
   {
-  case 0u:
-    return Lambert_Shade(m_materials_LambertObjects(m_materials_Lambert).objects[tag.y], normal, toLight);
-  case 1u:
-    return Phong_Shade(m_materials_PhongObjects(m_materials_Phong).objects[tag.y], normal, toLight);
-  case 2u:
-    return Checker_Shade(m_materials_CheckerObjects(m_materials_Checker).objects[tag.y], normal, toLight);
+  case 0u:  // dead code in a pipeline made for objects without a Lambert
+    if (crt_m_materials_holdsLambert)
+      return Lambert_Shade(m_materials_LambertObjects(m_materials_Lambert).objects[tag.y], normal, toLight);
+    break;
+  case 1u:  // dead code in a pipeline made for objects without a Phong
+    if (crt_m_materials_holdsPhong)
+      return Phong_Shade(m_materials_PhongObjects(m_materials_Phong).objects[tag.y], normal, toLight);
+    break;
+  case 2u:  // dead code in a pipeline made for objects without a Checker
+    if (crt_m_materials_holdsChecker)
+      return Checker_Shade(m_materials_CheckerObjects(m_materials_Checker).objects[tag.y], normal, toLight);
+    break;
   }
   vec3 none;  // not reached: every element holds one of these classes
   return none;
@@ -177,12 +192,18 @@ float m_materials_Opacity(uint index)
   const uvec2 tag = m_materials_Tags(m_materials_tags).tags[index];
   switch (tag.x)
   {
-  case 0u:
-    return Lambert_Opacity(m_materials_LambertObjects(m_materials_Lambert).objects[tag.y]);
-  case 1u:
-    return Phong_Opacity(m_materials_PhongObjects(m_materials_Phong).objects[tag.y]);
-  case 2u:
-    return Checker_Opacity(m_materials_CheckerObjects(m_materials_Checker).objects[tag.y]);
+  case 0u:  // dead code in a pipeline made for objects without a Lambert
+    if (crt_m_materials_holdsLambert)
+      return Lambert_Opacity(m_materials_LambertObjects(m_materials_Lambert).objects[tag.y]);
+    break;
+  case 1u:  // dead code in a pipeline made for objects without a Phong
+    if (crt_m_materials_holdsPhong)
+      return Phong_Opacity(m_materials_PhongObjects(m_materials_Phong).objects[tag.y]);
+    break;
+  case 2u:  // dead code in a pipeline made for objects without a Checker
+    if (crt_m_materials_holdsChecker)
+      return Checker_Opacity(m_materials_CheckerObjects(m_materials_Checker).objects[tag.y]);
+    break;
   }
   float none;  // not reached: every element holds one of these classes
   return none;
@@ -194,14 +215,23 @@ void m_materials_Attenuate(uint index, inout vec3 color, float distance)
   const uvec2 tag = m_materials_Tags(m_materials_tags).tags[index];
   switch (tag.x)
   {
-  case 0u:
-    Lambert_Attenuate(m_materials_LambertObjects(m_materials_Lambert).objects[tag.y], color, distance);
+  case 0u:  // dead code in a pipeline made for objects without a Lambert
+    if (crt_m_materials_holdsLambert)
+    {
+      Lambert_Attenuate(m_materials_LambertObjects(m_materials_Lambert).objects[tag.y], color, distance);
+    }
     return;
-  case 1u:
-    Phong_Attenuate(m_materials_PhongObjects(m_materials_Phong).objects[tag.y], color, distance);
+  case 1u:  // dead code in a pipeline made for objects without a Phong
+    if (crt_m_materials_holdsPhong)
+    {
+      Phong_Attenuate(m_materials_PhongObjects(m_materials_Phong).objects[tag.y], color, distance);
+    }
     return;
-  case 2u:
-    Checker_Attenuate(m_materials_CheckerObjects(m_materials_Checker).objects[tag.y], color, distance);
+  case 2u:  // dead code in a pipeline made for objects without a Checker
+    if (crt_m_materials_holdsChecker)
+    {
+      Checker_Attenuate(m_materials_CheckerObjects(m_materials_Checker).objects[tag.y], color, distance);
+    }
     return;
   }
 }

@@ -23,6 +23,15 @@ layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer m_s
   uvec2 tags[];
 };  // per element of m_scene->m_shapes: (class, index among its class's objects)
 
+// Off where m_scene->m_shapes holds no Sphere: its cases are dead code.
+layout(constant_id = 1800) const bool crt_m_scene_m_shapes_holdsSphere = true;
+
+// Off where m_scene->m_shapes holds no Box: its cases are dead code.
+layout(constant_id = 1801) const bool crt_m_scene_m_shapes_holdsBox = true;
+
+// Off where m_scene->m_shapes holds no Disc: its cases are dead code.
+layout(constant_id = 1802) const bool crt_m_scene_m_shapes_holdsDisc = true;
+
 // The data members of a Sphere.
 struct Sphere_Data
 {
@@ -63,6 +72,15 @@ layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer m_s
 {
   uvec2 tags[];
 };  // per element of m_scene->m_lights: (class, index among its class's objects)
+
+// Off where m_scene->m_lights holds no Sphere: its cases are dead code.
+layout(constant_id = 1803) const bool crt_m_scene_m_lights_holdsSphere = true;
+
+// Off where m_scene->m_lights holds no Box: its cases are dead code.
+layout(constant_id = 1804) const bool crt_m_scene_m_lights_holdsBox = true;
+
+// Off where m_scene->m_lights holds no Disc: its cases are dead code.
+layout(constant_id = 1805) const bool crt_m_scene_m_lights_holdsDisc = true;
 
 layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer m_scene_m_lights_SphereObjects
 {
@@ -213,17 +231,26 @@ void m_scene_m_shapes_Intersect(uint index, vec4 posAndNear, vec4 dirAndFar, uin
   const uvec2 tag = m_scene_m_shapes_Tags(m_scene_m_shapes_tags).tags[index];
   switch (tag.x)
   {
-  case 0u:
-    Sphere_Intersect(m_scene_m_shapes_SphereObjects(m_scene_m_shapes_Sphere).objects[tag.y], posAndNear, dirAndFar,
-                     shapeId, hit);
+  case 0u:  // dead code in a pipeline made for objects without a Sphere
+    if (crt_m_scene_m_shapes_holdsSphere)
+    {
+      Sphere_Intersect(m_scene_m_shapes_SphereObjects(m_scene_m_shapes_Sphere).objects[tag.y], posAndNear, dirAndFar,
+                       shapeId, hit);
+    }
     return;
-  case 1u:
-    Box_Intersect(m_scene_m_shapes_BoxObjects(m_scene_m_shapes_Box).objects[tag.y], posAndNear, dirAndFar, shapeId,
-                  hit);
+  case 1u:  // dead code in a pipeline made for objects without a Box
+    if (crt_m_scene_m_shapes_holdsBox)
+    {
+      Box_Intersect(m_scene_m_shapes_BoxObjects(m_scene_m_shapes_Box).objects[tag.y], posAndNear, dirAndFar, shapeId,
+                    hit);
+    }
     return;
-  case 2u:
-    Disc_Intersect(m_scene_m_shapes_DiscObjects(m_scene_m_shapes_Disc).objects[tag.y], posAndNear, dirAndFar, shapeId,
-                   hit);
+  case 2u:  // dead code in a pipeline made for objects without a Disc
+    if (crt_m_scene_m_shapes_holdsDisc)
+    {
+      Disc_Intersect(m_scene_m_shapes_DiscObjects(m_scene_m_shapes_Disc).objects[tag.y], posAndNear, dirAndFar, shapeId,
+                     hit);
+    }
     return;
   }
 }
@@ -234,17 +261,26 @@ void m_scene_m_lights_Intersect(uint index, vec4 posAndNear, vec4 dirAndFar, uin
   const uvec2 tag = m_scene_m_lights_Tags(m_scene_m_lights_tags).tags[index];
   switch (tag.x)
   {
-  case 0u:
-    Sphere_Intersect(m_scene_m_lights_SphereObjects(m_scene_m_lights_Sphere).objects[tag.y], posAndNear, dirAndFar,
-                     shapeId, hit);
+  case 0u:  // dead code in a pipeline made for objects without a Sphere
+    if (crt_m_scene_m_lights_holdsSphere)
+    {
+      Sphere_Intersect(m_scene_m_lights_SphereObjects(m_scene_m_lights_Sphere).objects[tag.y], posAndNear, dirAndFar,
+                       shapeId, hit);
+    }
     return;
-  case 1u:
-    Box_Intersect(m_scene_m_lights_BoxObjects(m_scene_m_lights_Box).objects[tag.y], posAndNear, dirAndFar, shapeId,
-                  hit);
+  case 1u:  // dead code in a pipeline made for objects without a Box
+    if (crt_m_scene_m_lights_holdsBox)
+    {
+      Box_Intersect(m_scene_m_lights_BoxObjects(m_scene_m_lights_Box).objects[tag.y], posAndNear, dirAndFar, shapeId,
+                    hit);
+    }
     return;
-  case 2u:
-    Disc_Intersect(m_scene_m_lights_DiscObjects(m_scene_m_lights_Disc).objects[tag.y], posAndNear, dirAndFar, shapeId,
-                   hit);
+  case 2u:  // dead code in a pipeline made for objects without a Disc
+    if (crt_m_scene_m_lights_holdsDisc)
+    {
+      Disc_Intersect(m_scene_m_lights_DiscObjects(m_scene_m_lights_Disc).objects[tag.y], posAndNear, dirAndFar, shapeId,
+                     hit);
+    }
     return;
   }
 }
