@@ -3,6 +3,7 @@
 // wavefront), progressively in passes of bounded size, with a progress bar on stderr. Writes linear
 // EXR or sRGB PNG; --compare prints the PSNR (8-bit sRGB) and relative MSE (linear) against a
 // reference image, such as one from scripts/cycles-reference.py.
+#include "ImageMetrics.h"
 #include "PathTracer.h"
 #include "PathTracer_CPU.h"
 #include "PathTracer_Vulkan.h"
@@ -14,6 +15,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <vector>
 
 using LiteMath::float4;
 
@@ -22,7 +24,7 @@ namespace {
 const char* kUsage =
     "usage: path_tracer SCENE [--size WxH] [--spp N] [--depth D] [--device original|cpu|vulkan]\n"
     "                   [--mode megakernel|wavefront] [--accel embree|sah|lbvh] [--env FILE.exr] [--env-strength F]\n"
-    "                   [--seed S] [--pass-spp K] [--compare REF.exr] --out FILE.exr|FILE.png\n"
+    "                   [--seed S] [--pass-spp K] [--compare REF.exr] --out FILE.exr|FILE.png [--out ...]\n"
     "  Path traces SCENE (.gltf, .glb or .obj) with next-event estimation and multiple importance sampling.\n"
     "  --size      image size (default 256x256)            --spp     samples per pixel (default 64)\n"
     "  --depth     bounces, as Cycles counts them (default 8; 0 is direct light only)\n"
@@ -34,11 +36,12 @@ const char* kUsage =
     "  --seed      the random sequence (a pixel's samples depend only on pixel, sample index and seed)\n"
     "  --pass-spp  samples per pass (default 4): memory stays the same whatever --spp is\n"
     "  --compare   prints PSNR (8-bit sRGB) and relative MSE (linear) of the image against REF\n"
-    "  --out       .exr: linear radiance; .png: sRGB, clamped\n";
+    "  --out       .exr: linear radiance; .png: sRGB, clamped (several --out: the same image to each)\n";
 
 struct Options
 {
-  std::string scene, out, device = "cpu", mode = "megakernel", accel = "embree", env, compare;
+  std::string scene, device = "cpu", mode = "megakernel", accel = "embree", env, compare;
+  std::vector<std::string> outs;  // one image per --out
   uint32_t width = 256, height = 256, spp = 64, passSpp = 4, seed = 0;
   int depth = 8;
   float envStrength = 1.0f;
@@ -97,29 +100,24 @@ Options Parse(int argc, char** argv)
     else if (a == "--env") o.env = argv[++i];
     else if (a == "--env-strength") o.envStrength = float(std::atof(argv[++i]));
     else if (a == "--compare") o.compare = argv[++i];
-    else if (a == "--out") o.out = argv[++i];
+    else if (a == "--out") o.outs.push_back(argv[++i]);
     else if (takesValue) Usage("unknown option " + a);
     else if (o.scene.empty()) o.scene = a;
     else Usage("more than one scene: '" + o.scene + "' and '" + a + "'");
   }
   if (o.scene.empty()) Usage("no scene given");
-  if (o.out.empty()) Usage("no --out file given");
+  if (o.outs.empty()) Usage("no --out file given");
   if (o.device != "original" && o.device != "cpu" && o.device != "vulkan") Usage("--device is original, cpu or vulkan, not '" + o.device + "'");
   if (o.mode != "megakernel" && o.mode != "wavefront") Usage("--mode is megakernel or wavefront, not '" + o.mode + "'");
-  const std::string ext = o.out.size() > 4 ? o.out.substr(o.out.size() - 4) : "";
-  if (ext != ".exr" && ext != ".png") Usage("--out must end in .exr or .png");
+  for (const std::string& out : o.outs)
+  {
+    const std::string ext = out.size() > 4 ? out.substr(out.size() - 4) : "";
+    if (ext != ".exr" && ext != ".png") Usage("--out must end in .exr or .png, not '" + out + "'");
+  }
   return o;
 }
 
-float LinearToSrgb(float v)
-{
-  v = std::clamp(v, 0.0f, 1.0f);
-  return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.0f / 2.4f) - 0.055f;
-}
-
-uint32_t Srgb8(float v) { return uint32_t(std::lround(255.0f * LinearToSrgb(v))); }
-
-// PSNR of the 8-bit sRGB images and the mean relative squared error of the linear ones.
+// Prints the PSNR (8-bit sRGB) and relative MSE (linear) of the image against the one at refPath.
 void Compare(const LiteImage::Image2D<float4>& image, const std::string& refPath)
 {
   LiteImage::Image2D<float4> ref;
@@ -128,19 +126,8 @@ void Compare(const LiteImage::Image2D<float4>& image, const std::string& refPath
   if (ref.width() != image.width() || ref.height() != image.height())
     throw std::runtime_error(refPath + ": error: the reference is " + std::to_string(ref.width()) + "x" + std::to_string(ref.height()) +
                              ", the image " + std::to_string(image.width()) + "x" + std::to_string(image.height()));
-  double se8 = 0.0, rel = 0.0;
-  const size_t n = image.vector().size();
-  for (size_t i = 0; i < n; ++i)
-    for (int c = 0; c < 3; ++c)
-    {
-      const float a = image.vector()[i][c], b = ref.vector()[i][c];
-      const double d8 = double(Srgb8(a)) - double(Srgb8(b));
-      se8 += d8 * d8;
-      rel += double(a - b) * double(a - b) / (double(b) * double(b) + 1e-2);
-    }
-  const double mse8 = se8 / double(3 * n);
-  const double psnr = mse8 > 0.0 ? 10.0 * std::log10(255.0 * 255.0 / mse8) : 99.0;
-  std::printf("compare: against %s: PSNR %.2f dB (8-bit sRGB), relMSE %.5f (linear)\n", refPath.c_str(), psnr, rel / double(3 * n));
+  const litept::ImageError e = litept::CompareImages(image.vector(), ref.vector());
+  std::printf("compare: against %s: PSNR %.2f dB (8-bit sRGB), relMSE %.5f (linear)\n", refPath.c_str(), e.psnr8, e.relMse);
 }
 
 }  // namespace
@@ -205,24 +192,30 @@ int main(int argc, char** argv)
         ++bad, v = float4(0.0f);
       image.vector()[i] = float4(v.x, v.y, v.z, 1.0f);
     }
-    bool saved;
-    if (o.out.substr(o.out.size() - 4) == ".png")
+    for (const std::string& out : o.outs)
     {
-      LiteImage::Image2D<uint32_t> png(o.width, o.height);
-      for (size_t i = 0; i < pixels; ++i)
+      bool saved;
+      if (out.substr(out.size() - 4) == ".png")
       {
-        const float4 v = image.vector()[i];
-        png.vector()[i] = Srgb8(v.x) | Srgb8(v.y) << 8 | Srgb8(v.z) << 16 | 255u << 24;
+        LiteImage::Image2D<uint32_t> png(o.width, o.height);
+        for (size_t i = 0; i < pixels; ++i)
+        {
+          const float4 v = image.vector()[i];
+          png.vector()[i] = litept::Srgb8(v.x) | litept::Srgb8(v.y) << 8 | litept::Srgb8(v.z) << 16 | 255u << 24;
+        }
+        saved = LiteImage::SaveImage(out.c_str(), png);
       }
-      saved = LiteImage::SaveImage(o.out.c_str(), png);
+      else
+        saved = LiteImage::SaveImage(out.c_str(), image);
+      if (!saved)
+        throw std::runtime_error(out + ": error: could not write the image");
     }
-    else
-      saved = LiteImage::SaveImage(o.out.c_str(), image);
-    if (!saved)
-      throw std::runtime_error(o.out + ": error: could not write the image");
+    std::string written;
+    for (const std::string& out : o.outs)
+      written += (written.empty() ? "" : " and ") + out;
     std::printf("path_tracer: %s, %ux%u, %u spp, depth %d, %s%s: %.3f s (%.2f Mpaths/s); wrote %s\n", o.scene.c_str(), o.width, o.height, o.spp,
                 o.depth, o.device.c_str(), o.device == "vulkan" ? (", " + o.mode).c_str() : "", seconds, double(pixels) * o.spp / seconds * 1e-6,
-                o.out.c_str());
+                written.c_str());
     if (bad > 0)
       throw std::runtime_error(std::to_string(bad) + " pixels were NaN or infinite (written as black)");
     if (!o.compare.empty())

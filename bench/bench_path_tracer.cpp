@@ -1,0 +1,328 @@
+// Benchmark: litept's PathTracer on a glTF scene (the Cornell box by default), from one run:
+//   1. the paper's Table 10 form: samples per second of the class as written (one thread),
+//      PathTracer_CPU (all cores) and PathTracer_Vulkan as a megakernel and as plain wavefront, in
+//      interleaved rounds (medians), with the ratio to the original;
+//   2. the gain from specialisation: PathTracer_Vulkan with its virtual calls specialised to the
+//      material and light classes the scene holds, and with every class's case: the time to make
+//      the pipelines, the speed, and the megakernel's SPIR-V size once spirv-opt has folded the
+//      constants as the driver does;
+//   3. time to equal quality against Blender's Cycles on the same cores, with --reference REF.exr
+//      (a converged image) and --cycles-log CSV (scripts/cycles-reference.py --time-log, its
+//      renders at 1, 2, 4, ... spp): PathTracer_CPU renders the same spp, each from scratch; both
+//      get PSNR and relative MSE against the reference, and the time each needs for 30 and 35 dB is
+//      interpolated on log-time. Writes the curves to CSV for bench/plot_path_tracer.py.
+#include "ImageMetrics.h"
+#include "PathTracer.h"
+#include "PathTracer_CPU.h"
+#include "PathTracer_Vulkan.h"
+#include "SceneLoader.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+using LiteMath::float4;
+
+// The megakernel's SPIR-V, from the generated PathTracer_Vulkan_shaders.cpp.
+extern const uint32_t PathTracer_RenderPass_Megakernel_spv[];
+extern const size_t PathTracer_RenderPass_Megakernel_spvBytes;
+
+namespace {
+
+const char* kUsage =
+    "usage: bench_path_tracer [SCENE (default: the build's Cornell box)] [--size N (128)] [--depth D (8)] [--rounds R (3)]\n"
+    "                         [--reference REF.exr --cycles-log CSV] [--max-spp N (1024)] [--csv FILE] [--no-vulkan]\n"
+    "  Prints the path tracer's samples per second per implementation and mode, the gain from specialising virtual\n"
+    "  calls to the scene, and (with a converged reference and Cycles' time log) the time to 30 and 35 dB against Cycles.\n";
+
+double Seconds(const std::function<void()>& work)
+{
+  const auto t0 = std::chrono::steady_clock::now();
+  work();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// The generated class as a user subclasses it: the classes its pipelines were made for.
+class InspectedTracer : public PathTracer_Vulkan
+{
+public:
+  using PathTracer_Vulkan::PathTracer_Vulkan;
+  std::vector<VkBool32> PipelineClasses() const { return m_pipelineClasses; }
+};
+
+struct Setup
+{
+  PathScene scene;
+  uint32_t size = 128;
+  int depth = 8;
+};
+
+void Prepare(PathTracer& t, const Setup& s, const char* accel)
+{
+  t.SetScene(s.scene, MakeSceneRT(accel));
+  t.SetImageAspect(1.0f);
+  t.SetMaxDepth(s.depth);
+  t.SetSeed(1);
+  t.CommitDeviceData();
+}
+
+// The mean of `spp` samples per pixel, rendered from scratch.
+std::vector<float4> Render(PathTracer& t, const Setup& s, int spp)
+{
+  std::vector<float4> pass(size_t(s.size) * s.size), sum(pass.size(), float4(0.0f));
+  for (int done = 0; done < spp;)
+  {
+    const int n = std::min(16, spp - done);
+    t.RenderPass(s.size, s.size, uint32_t(done), n, pass.data());
+    for (size_t i = 0; i < pass.size(); ++i)
+      sum[i] += pass[i];
+    done += n;
+  }
+  for (auto& v : sum)
+    v = v * (1.0f / float(spp));
+  return sum;
+}
+
+double Median(std::vector<double> v)
+{
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+// The megakernel's SPIR-V size after spirv-opt sets the class constants as `held` and optimises
+// (what a driver does with the specialisation); 0 when spirv-opt is missing.
+size_t SpecialisedSpirvBytes(const std::vector<VkBool32>& held)
+{
+  const std::string in = "/tmp/bench_path_tracer_megakernel.spv", out = "/tmp/bench_path_tracer_megakernel_opt.spv";
+  std::ofstream(in, std::ios::binary).write(reinterpret_cast<const char*>(PathTracer_RenderPass_Megakernel_spv),
+                                            std::streamsize(PathTracer_RenderPass_Megakernel_spvBytes));
+  std::string values;
+  for (size_t i = 0; i < held.size(); ++i)
+    values += (i ? " " : "") + std::to_string(crossrt::kClassConstantIdBase + i) + ":" + (held[i] ? "true" : "false");
+  const std::string cmd = "spirv-opt --set-spec-const-default-value \"" + values + "\" --freeze-spec-const -O " + in + " -o " + out + " 2>/dev/null";
+  if (std::system(cmd.c_str()) != 0)
+    return 0;
+  std::ifstream f(out, std::ios::binary | std::ios::ate);
+  return f ? size_t(f.tellg()) : 0;
+}
+
+struct Curve
+{
+  std::vector<double> seconds, psnr;
+};
+
+// Seconds to reach `db` on a curve of rising quality, interpolated on log-time; <0 if never reached.
+double TimeTo(const Curve& c, double db)
+{
+  for (size_t i = 0; i < c.psnr.size(); ++i)
+    if (c.psnr[i] >= db)
+    {
+      if (i == 0)
+        return c.seconds[0];
+      const double f = (db - c.psnr[i - 1]) / (c.psnr[i] - c.psnr[i - 1]);
+      return std::exp(std::log(c.seconds[i - 1]) + f * (std::log(c.seconds[i]) - std::log(c.seconds[i - 1])));
+    }
+  return -1.0;
+}
+
+std::vector<float4> LoadExr(const std::string& path, uint32_t size)
+{
+  LiteImage::Image2D<float4> img;
+  if (!LiteImage::LoadImage(path.c_str(), img))
+    throw std::runtime_error(path + ": error: cannot read the image");
+  if (img.width() != size || img.height() != size)
+    throw std::runtime_error(path + ": error: the image is " + std::to_string(img.width()) + "x" + std::to_string(img.height()) +
+                             ", the benchmark renders " + std::to_string(size) + "x" + std::to_string(size) + " (--size)");
+  return img.vector();
+}
+
+}  // namespace
+
+int main(int argc, char** argv)
+{
+  Setup s;
+  std::string scenePath = CROSSRT_CORNELL_BOX, reference, cyclesLog, csvPath = "out/bench_path_tracer.csv";
+  int rounds = 3, maxSpp = 1024;
+  bool vulkan = true;
+  for (int i = 1; i < argc; ++i)
+  {
+    const std::string a = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc)
+      {
+        std::fprintf(stderr, "bench_path_tracer: error: %s needs a value\n%s", a.c_str(), kUsage);
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (a == "--help" || a == "-h")
+    {
+      std::printf("%s", kUsage);
+      return 0;
+    }
+    else if (a == "--size") s.size = uint32_t(std::max(8, std::atoi(value().c_str())));
+    else if (a == "--depth") s.depth = std::atoi(value().c_str());
+    else if (a == "--rounds") rounds = std::max(1, std::atoi(value().c_str()));
+    else if (a == "--max-spp") maxSpp = std::max(1, std::atoi(value().c_str()));
+    else if (a == "--reference") reference = value();
+    else if (a == "--cycles-log") cyclesLog = value();
+    else if (a == "--csv") csvPath = value();
+    else if (a == "--no-vulkan") vulkan = false;
+    else if (a.rfind("--", 0) == 0)
+    {
+      std::fprintf(stderr, "bench_path_tracer: error: unknown option %s\n%s", a.c_str(), kUsage);
+      return 2;
+    }
+    else scenePath = a;
+  }
+  try
+  {
+    s.scene = LoadScene(scenePath);
+    ApplySceneDefaults(s.scene);
+    const double paths = double(s.size) * s.size;
+    std::printf("bench_path_tracer: %s, %ux%u, depth %d, %d interleaved rounds\n\n", scenePath.c_str(), s.size, s.size, s.depth, rounds);
+
+    // ---- 1. Table 10: megakernel against wavefront
+    PathTracer original;
+    Prepare(original, s, "embree");
+    auto cpu = CreatePathTracer_CPU();
+    Prepare(*cpu, s, "embree");
+    std::shared_ptr<InspectedTracer> gpu;
+    if (vulkan)
+    {
+      try
+      {
+        gpu = std::make_shared<InspectedTracer>(crossrt::VulkanContext::CreateDefault());
+        Prepare(*gpu, s, "sah");
+      }
+      catch (const crossrt::NoDeviceError& e)
+      {
+        std::printf("(no Vulkan device: %s; the Vulkan rows are left out)\n\n", e.what());
+        gpu.reset();
+      }
+    }
+    struct Row
+    {
+      std::string name, mode;
+      PathTracer* tracer;
+      int spp;
+      std::function<void()> before;
+      std::vector<double> seconds;
+    };
+    std::vector<Row> rows = {{"PathTracer (as written, 1 thread)", "-", &original, 1, [] {}, {}},
+                             {"PathTracer_CPU (all cores)", "-", cpu.get(), 8, [] {}, {}}};
+    if (gpu)
+    {
+      rows.push_back({"PathTracer_Vulkan", "megakernel", gpu.get(), 4, [&] { gpu->SetExecutionMode(crossrt::ExecutionMode::Megakernel); }, {}});
+      rows.push_back({"PathTracer_Vulkan", "wavefront", gpu.get(), 4, [&] { gpu->SetExecutionMode(crossrt::ExecutionMode::Wavefront); }, {}});
+      for (auto& r : rows)  // first use: the pipelines of each mode are made before timing
+        if (r.tracer == gpu.get())
+          r.before(), Render(*gpu, s, 1);
+    }
+    for (int round = 0; round < rounds; ++round)
+      for (auto& r : rows)
+      {
+        r.before();
+        r.seconds.push_back(Seconds([&] { Render(*r.tracer, s, r.spp); }));
+      }
+    if (std::filesystem::path(csvPath).has_parent_path())
+      std::filesystem::create_directories(std::filesystem::path(csvPath).parent_path());
+    std::ofstream csv(csvPath);
+    csv << "table,implementation,mode,spp,seconds,samples_per_s,mpaths_per_s,vs_original,psnr_db,relmse\n";
+    std::printf("Table 10 form (%s): samples per pixel per second, medians of %d rounds\n\n", scenePath.c_str(), rounds);
+    std::printf("| implementation | mode | spp per round | spp/s | Mpaths/s | vs original |\n|---|---|---|---|---|---|\n");
+    const double originalRate = rows[0].spp / Median(rows[0].seconds);
+    for (auto& r : rows)
+    {
+      const double rate = r.spp / Median(r.seconds);
+      std::printf("| %s | %s | %d | %.2f | %.3f | %.2fx |\n", r.name.c_str(), r.mode.c_str(), r.spp, rate, rate * paths * 1e-6, rate / originalRate);
+      csv << "throughput," << r.name << "," << r.mode << "," << r.spp << "," << Median(r.seconds) << "," << rate << "," << rate * paths * 1e-6 << ","
+          << rate / originalRate << ",,\n";
+    }
+
+    // ---- 2. specialisation to the scene's classes
+    if (gpu)
+    {
+      gpu->SetExecutionMode(crossrt::ExecutionMode::Megakernel);
+      std::printf("\nSpecialisation: PathTracer_Vulkan's megakernel, virtual calls switched over the scene's classes or over all\n\n");
+      std::printf("| virtual calls | classes in the pipelines | make pipelines s | spp/s | SPIR-V bytes (folded by spirv-opt) |\n|---|---|---|---|---|\n");
+      for (bool specialise : {false, true})  // each remakes the pipelines
+      {
+        gpu->SpecializeVirtualCalls(specialise);
+        const double make = Seconds([&] { gpu->CommitDeviceData(); });
+        std::vector<double> t;
+        for (int round = 0; round < rounds; ++round)
+          t.push_back(Seconds([&] { Render(*gpu, s, 4); }));
+        const std::vector<VkBool32> held = gpu->PipelineClasses();
+        const size_t count = size_t(std::count(held.begin(), held.end(), VkBool32(VK_TRUE)));
+        const size_t bytes = SpecialisedSpirvBytes(held);
+        std::printf("| %s | %zu of %zu | %.2f | %.2f | %zu |\n", specialise ? "specialised to the scene" : "every class", count, held.size(), make,
+                    4.0 / Median(t), bytes);
+        csv << "specialisation," << (specialise ? "specialised" : "all classes") << ",megakernel,4," << Median(t) << "," << 4.0 / Median(t) << ","
+            << 4.0 / Median(t) * paths * 1e-6 << ",," << bytes << ",\n";
+      }
+      gpu->SpecializeVirtualCalls(true);
+    }
+
+    // ---- 3. time to equal quality against Cycles
+    if (reference.empty() || cyclesLog.empty())
+    {
+      std::printf("\nTime to quality against Cycles: give --reference REF.exr (converged, another seed) and --cycles-log CSV\n"
+                  "(blender -b --factory-startup --python scripts/cycles-reference.py -- SCENE --out C.exr --size %ux%u --depth %d\n"
+                  " --threads 2 --seed 1 --spp %d --time-log C.csv)\n",
+                  s.size, s.size, s.depth, maxSpp);
+      return 0;
+    }
+    const std::vector<float4> ref = LoadExr(reference, s.size);
+    Curve ours, cycles;
+    std::ifstream log(cyclesLog);
+    if (!log)
+      throw std::runtime_error(cyclesLog + ": error: cannot read the Cycles time log");
+    std::string line;
+    std::getline(log, line);  // spp,seconds,path
+    while (std::getline(log, line))
+    {
+      std::stringstream ls(line);
+      std::string spp, sec, path;
+      std::getline(ls, spp, ',');
+      std::getline(ls, sec, ',');
+      std::getline(ls, path);
+      const litept::ImageError e = litept::CompareImages(LoadExr(path, s.size), ref);
+      cycles.seconds.push_back(std::stod(sec));
+      cycles.psnr.push_back(e.psnr8);
+      csv << "quality,Cycles,-," << spp << "," << sec << ",,,," << e.psnr8 << "," << e.relMse << "\n";
+    }
+    for (int spp = 1; spp <= maxSpp; spp *= 2)
+    {
+      std::vector<float4> image;
+      const double sec = Seconds([&] { image = Render(*cpu, s, spp); });
+      const litept::ImageError e = litept::CompareImages(image, ref);
+      ours.seconds.push_back(sec);
+      ours.psnr.push_back(e.psnr8);
+      csv << "quality,PathTracer_CPU,-," << spp << "," << sec << ",,,," << e.psnr8 << "," << e.relMse << "\n";
+    }
+    std::printf("\nTime to equal quality against %s (PSNR, 8-bit sRGB), both renderers on this machine's cores\n\n", reference.c_str());
+    std::printf("| renderer | to 30 dB (s) | to 35 dB (s) | best PSNR (dB) |\n|---|---|---|---|\n");
+    for (auto& [name, c] : {std::pair<const char*, Curve&>{"PathTracer_CPU", ours}, {"Cycles", cycles}})
+    {
+      auto show = [](double t) { return t < 0.0 ? std::string("not reached") : std::to_string(t); };
+      std::printf("| %s | %s | %s | %.2f |\n", name, show(TimeTo(c, 30.0)).c_str(), show(TimeTo(c, 35.0)).c_str(),
+                  c.psnr.empty() ? 0.0 : *std::max_element(c.psnr.begin(), c.psnr.end()));
+    }
+    std::printf("\nwrote %s (plot: bench/plot_path_tracer.py %s)\n", csvPath.c_str(), csvPath.c_str());
+  }
+  catch (const std::exception& e)
+  {
+    std::fprintf(stderr, "bench_path_tracer: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
