@@ -101,7 +101,8 @@ double Median(std::vector<double> v)
 // (what a driver does with the specialisation); 0 when spirv-opt is missing.
 size_t SpecialisedSpirvBytes(const std::vector<VkBool32>& held)
 {
-  const std::string in = "/tmp/bench_path_tracer_megakernel.spv", out = "/tmp/bench_path_tracer_megakernel_opt.spv";
+  const std::filesystem::path dir = std::filesystem::temp_directory_path();
+  const std::string in = (dir / "bench_path_tracer_megakernel.spv").string(), out = (dir / "bench_path_tracer_megakernel_opt.spv").string();
   std::ofstream(in, std::ios::binary).write(reinterpret_cast<const char*>(PathTracer_RenderPass_Megakernel_spv),
                                             std::streamsize(PathTracer_RenderPass_Megakernel_spvBytes));
   std::string values;
@@ -253,7 +254,7 @@ int main(int argc, char** argv)
     {
       gpu->SetExecutionMode(crossrt::ExecutionMode::Megakernel);
       std::printf("\nSpecialisation: PathTracer_Vulkan's megakernel, virtual calls switched over the scene's classes or over all\n\n");
-      std::printf("| virtual calls | classes in the pipelines | make pipelines s | spp/s | SPIR-V bytes (folded by spirv-opt) |\n|---|---|---|---|---|\n");
+      std::printf("| virtual calls | classes in the pipelines | CommitDeviceData s (makes the pipelines) | spp/s | SPIR-V bytes (folded by spirv-opt) |\n|---|---|---|---|---|\n");
       for (bool specialise : {false, true})  // each remakes the pipelines
       {
         gpu->SpecializeVirtualCalls(specialise);

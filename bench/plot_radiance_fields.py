@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Plots bench_radiance_fields' CSV: test PSNR against render time over the knobs (grid resolution,
 SH degree, early-termination threshold), and render time per backend and method.
 
@@ -7,6 +7,9 @@ usage: plot_radiance_fields.py [CSV (default out/bench_radiance_fields.csv)] [PN
 import csv
 import sys
 
+if __name__ == "__main__" and len(sys.argv) > 1 and sys.argv[1] in ("-h", "--help"):
+    print(__doc__.strip().splitlines()[-1])  # before matplotlib, which --help does not need
+    sys.exit(0)
 import matplotlib
 
 matplotlib.use("Agg")
