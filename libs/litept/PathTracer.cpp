@@ -207,10 +207,21 @@ void PathTracer::kernel_Shade(uint32_t tidX, uint32_t tidY, uint32_t width, uint
         const float weight = ls.delta != 0u ? 1.0f : PowerHeuristic(lightPdf, f.w);
         const float3 contribution = beta * to_float3(f) * to_float3(ls.radiancePdf) * (weight / lightPdf);
         const float3 start = OffsetRayOrigin(position, geomNormal, toLight, m_sceneRadius);
-        // The ray stops just short of the light's point, measured from where it starts.
-        const float far = ls.dirDist.w >= 1e30f ? 1e30f : length(position + toLight * ls.dirDist.w - start) * (1.0f - 1e-4f);
+        // The ray aims from where it starts at the light's point and stops just short of it. Kept
+        // parallel to toLight, a ray lifted off the surface would meet the light's plane before the
+        // point when the light is seen obliquely, and hit the light itself (a glossy reflection of
+        // the light lost a third of its energy so).
+        float3 shadowDirection = toLight;
+        float far = 1e30f;
+        if (ls.dirDist.w < 1e30f)
+        {
+          const float3 toPoint = position + toLight * ls.dirDist.w - start;
+          const float distance = length(toPoint);
+          shadowDirection = toPoint * (1.0f / distance);
+          far = distance * (1.0f - 1e-4f);
+        }
         *shadowPos = to_float4(start, 0.0f);
-        *shadowDir = to_float4(toLight, far);
+        *shadowDir = to_float4(shadowDirection, far);
         *shadowColor = to_float4(contribution, 1.0f);
       }
     }

@@ -9,6 +9,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -165,6 +166,74 @@ TEST_CASE("path tracer: an emitter seen directly gives exactly its radiance", "[
       REQUIRE(v.z == Approx(10.2f).epsilon(1e-6));
     }
   }
+}
+
+// Irradiance at p (normal n) from a polygon of uniform radiance L: Lambert's formula, the sum over
+// its edges of the angle each subtends times the cosine of that edge's plane with n, over 2.
+float PolygonIrradiance(float3 p, float3 n, const std::vector<float3>& polygon, float L)
+{
+  double sum = 0.0;
+  for (size_t i = 0; i < polygon.size(); ++i)
+  {
+    const float3 a = normalize(polygon[i] - p), b = normalize(polygon[(i + 1) % polygon.size()] - p);
+    sum += std::acos(std::clamp(dot(a, b), -1.0f, 1.0f)) * dot(normalize(cross(a, b)), n);
+  }
+  return float(std::fabs(sum) * 0.5 * L);
+}
+
+TEST_CASE("path tracer: an area light seen obliquely lights a Lambert floor as Lambert's formula says", "[path_tracer]")
+{
+  // A white Lambert floor (y = 0) and a small square emitter facing down at (1, 0.5, 0), seen from
+  // the floor's middle 63 degrees off the normal. The camera looks straight down at a small patch.
+  // Shadow rays used to run parallel to the light's direction from a point lifted off the floor, so
+  // at such angles they met the light's plane before the sampled point and hit the light itself.
+  PathScene scene;
+  PathScene::Mesh quads;
+  quads.name = "floor and light";
+  const float3 floor[4] = {float3(-2, 0, -2), float3(-2, 0, 2), float3(2, 0, 2), float3(2, 0, -2)};
+  const std::vector<float3> light = {float3(0.9f, 0.5f, -0.1f), float3(1.1f, 0.5f, -0.1f), float3(1.1f, 0.5f, 0.1f), float3(0.9f, 0.5f, 0.1f)};
+  for (int q = 0; q < 2; ++q)
+  {
+    const uint32_t first = uint32_t(quads.positions.size());
+    for (int i = 0; i < 4; ++i)
+    {
+      quads.positions.push_back(to_float4(q == 0 ? floor[i] : light[size_t(i)], 1.0f));
+      quads.normals.push_back(float4(0.0f, q == 0 ? 1.0f : -1.0f, 0.0f, 0.0f));
+    }
+    for (uint32_t v : {0u, 1u, 2u, 0u, 2u, 3u})
+      quads.indices.push_back(first + v);
+    quads.triangleMaterial.push_back(uint32_t(q));
+    quads.triangleMaterial.push_back(uint32_t(q));
+  }
+  scene.meshes.push_back(quads);
+  scene.instances.push_back({0, float4x4()});
+  auto white = std::make_shared<litept::Lambert>();
+  white->albedo = float4(1.0f);
+  auto emitter = std::make_shared<litept::Lambert>();
+  emitter->albedo = float4(0.0f);
+  emitter->emission = float4(10.0f, 10.0f, 10.0f, 0.0f);
+  scene.materials = {white, emitter};
+  scene.camera.position = float3(0.0f, 3.0f, 0.0f);
+  scene.camera.forward = float3(0.0f, -1.0f, 0.0f);
+  scene.camera.up = float3(0.0f, 0.0f, -1.0f);
+  scene.camera.yfov = 0.02f;  // a 6 cm patch of floor
+  scene.hasCamera = true;
+
+  // Outgoing radiance of an albedo-1 Lambert: E / pi, over the patch (E varies by 2% across it).
+  double expected = 0.0;
+  for (float z = -0.03f; z <= 0.03f; z += 0.005f)
+    for (float x = -0.03f; x <= 0.03f; x += 0.005f)
+      expected += PolygonIrradiance(float3(x, 0.0f, z), float3(0.0f, 1.0f, 0.0f), light, 10.0f) / litept::kPi;
+  expected /= 13.0 * 13.0;
+
+  auto cpu = CreatePathTracer_CPU();
+  const std::vector<float4> image = Render(*cpu, scene, "embree", 8, 8, 1024, 0);
+  double mean = 0.0;
+  for (const auto& v : image)
+    mean += (v.x + v.y + v.z) / 3.0;
+  mean /= double(image.size());
+  INFO("rendered " << mean << ", Lambert's formula " << expected);
+  CHECK(mean == Approx(expected).epsilon(0.01));
 }
 
 TEST_CASE("path tracer: white furnaces: what each material keeps of a uniform environment", "[path_tracer]")
