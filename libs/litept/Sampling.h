@@ -26,8 +26,9 @@ constexpr float kInvPi = 0.318309886183791f;
 // Hash-based Owen Scrambling"): a pixel's first 2^m samples of each group of four stay a stratified
 // (0, m, 2)-net in the first two numbers, and each pixel and group gets its own scramble and order,
 // so neither pixels nor groups correlate. Deeper vertices take hashed numbers: there stratification
-// gains little and the scrambling's cost shows (Cornell box, 512 spp: Sobol everywhere 8% less
-// error for 90% more time; at the first two vertices the same 8% less error for 10% more time).
+// gains little and the scrambling's cost shows. Measured on the Cornell box at 512 spp, against
+// hashed numbers throughout: Sobol at the first two vertices, 13% less error for 16% more time (it
+// pays in direct light and at low spp); at every vertex, 15% less error for 50% more time.
 
 // A well-mixed 32-bit hash (the PCG output permutation).
 inline uint32_t PcgHash(uint32_t x)
