@@ -35,6 +35,18 @@ What it does
        alpha < 1 or textured, a Mix with a Transparent BSDF.  Classification
        uses the glTF JSON; Blender materials are matched by the importer's
        naming rule (name, or "Material_<index>", possibly with ".NNN").
+     * Non-metal materials (metallicFactor 0, no transmission or sheen)
+       that are not pure diffuse get glTF 2.0's dielectric BRDF as CrossRT
+       evaluates it, instead of the Principled BSDF's Burley diffuse under an
+       added specular layer (on 2CylinderEngine under an HDR map that renders
+       13% brighter): the specular layer is a black Principled BSDF (its
+       Fresnel follows the microfacet normal; Specular = F0 / 0.08 for F0 from
+       KHR_materials_ior's IOR, 1.5, times KHR_materials_specular's factor),
+       plus a Lambert Diffuse BSDF of the base colour weighted by 1 - F by a
+       Mix Shader, F from a Fresnel node.  Cycles weighs the base by the
+       Fresnel of the shading normal, CrossRT by that of the microfacet
+       normal.  A KHR_materials_clearcoat layer is left out, as CrossRT leaves
+       it out.
      * Every remaining Principled BSDF gets distribution 'GGX' (single
        scattering), not multiscatter GGX.
      * Punctual lights get radius 0 (point/spot shadow_soft_size, sun angle;
@@ -223,6 +235,36 @@ def is_pure_diffuse(m):
     return ext["KHR_materials_specular"].get("specularFactor", 1.0) == 0
 
 
+def material_class(m):
+    """'diffuse' (Lambert in CrossRT), 'dielectric' (glTF's dielectric BRDF:
+    GGX specular over diffuse, mixed by Fresnel; a clearcoat is dropped, as
+    CrossRT drops it) or 'principled' (left to the Principled BSDF)."""
+    if is_pure_diffuse(m):
+        return "diffuse"
+    ext = m.get("extensions") or {}
+    if "KHR_materials_pbrSpecularGlossiness" in ext or \
+            "KHR_materials_unlit" in ext:
+        return "principled"
+    pbr = m.get("pbrMetallicRoughness") or {}
+    if pbr.get("metallicFactor", 1.0) != 0:
+        return "principled"
+    if (ext.get("KHR_materials_transmission") or {}).get(
+            "transmissionFactor", 0.0) != 0:
+        return "principled"
+    if any(c != 0 for c in (ext.get("KHR_materials_sheen") or {}).get(
+            "sheenColorFactor", [0, 0, 0])):
+        return "principled"
+    return "dielectric"
+
+
+def dielectric_f0_scale(m):
+    """glTF dielectric: (IOR, specularFactor) of KHR_materials_ior/_specular."""
+    ext = m.get("extensions") or {}
+    ior = (ext.get("KHR_materials_ior") or {}).get("ior", 1.5)
+    spec = (ext.get("KHR_materials_specular") or {}).get("specularFactor", 1.0)
+    return ior, spec
+
+
 def gltf_base_name(blender_name, known):
     """Map a Blender ID name back to the glTF name it was created from."""
     if blender_name in known:
@@ -358,9 +400,66 @@ def copy_input(tree, src, dst):
         dst.default_value = src.default_value
 
 
-def swap_to_diffuse(mat):
-    """Replace the material's Principled BSDF by a Lambertian Diffuse BSDF
-    (+ emission, + alpha).  Returns a short description or None."""
+def lambert(tree, p):
+    """A Diffuse BSDF of roughness 0 (Lambert) with p's colour and normal."""
+    diffuse = tree.nodes.new("ShaderNodeBsdfDiffuse")
+    diffuse.location = p.location
+    diffuse.inputs["Roughness"].default_value = 0.0
+    copy_input(tree, p.inputs["Base Color"], diffuse.inputs["Color"])
+    if p.inputs["Normal"].is_linked:
+        copy_input(tree, p.inputs["Normal"], diffuse.inputs["Normal"])
+    return diffuse.outputs["BSDF"]
+
+
+def gltf_dielectric(tree, p, ior, specular):
+    """glTF 2.0's dielectric BRDF as CrossRT evaluates it: a GGX reflection
+    whose Fresnel follows the microfacet normal (the Principled BSDF itself,
+    black, so that only its specular layer is left: Specular = F0 / 0.08 for
+    F0 from the IOR times KHR_materials_specular's factor) plus a Lambert base
+    weighted by 1 - Fresnel.  Cycles' weight is the Fresnel of the shading
+    normal, CrossRT's that of the microfacet normal: the same at roughness 0,
+    a few percent apart in the base at roughness 1."""
+    base = lambert(tree, p)
+    fresnel = tree.nodes.new("ShaderNodeFresnel")
+    fresnel.location = (p.location[0], p.location[1] + 150)
+    fresnel.inputs["IOR"].default_value = ior
+    if p.inputs["Normal"].is_linked:
+        copy_input(tree, p.inputs["Normal"], fresnel.inputs["Normal"])
+    weight = fresnel.outputs["Fac"]
+    if specular != 1.0:
+        scale = tree.nodes.new("ShaderNodeMath")
+        scale.operation = "MULTIPLY"
+        tree.links.new(weight, scale.inputs[0])
+        scale.inputs[1].default_value = specular
+        weight = scale.outputs["Value"]
+    under = tree.nodes.new("ShaderNodeMixShader")  # (1 - F) base + F nothing
+    under.location = (p.location[0] + 200, p.location[1])
+    tree.links.new(weight, under.inputs["Fac"])
+    tree.links.new(base, under.inputs[1])
+    coat = tree.nodes.new("ShaderNodeBsdfPrincipled")
+    coat.location = (p.location[0], p.location[1] - 300)
+    coat.distribution = "GGX"
+    coat.inputs["Base Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+    coat.inputs["Metallic"].default_value = 0.0
+    f0 = ((ior - 1.0) / (ior + 1.0)) ** 2 * specular
+    coat.inputs["Specular"].default_value = f0 / 0.08
+    coat.inputs["Specular Tint"].default_value = 0.0
+    coat.inputs["Sheen"].default_value = 0.0
+    coat.inputs["Clearcoat"].default_value = 0.0
+    coat.inputs["IOR"].default_value = ior
+    copy_input(tree, p.inputs["Roughness"], coat.inputs["Roughness"])
+    if p.inputs["Normal"].is_linked:
+        copy_input(tree, p.inputs["Normal"], coat.inputs["Normal"])
+    add = tree.nodes.new("ShaderNodeAddShader")
+    add.location = (p.location[0] + 400, p.location[1])
+    tree.links.new(under.outputs["Shader"], add.inputs[0])
+    tree.links.new(coat.outputs["BSDF"], add.inputs[1])
+    return add.outputs["Shader"]
+
+
+def replace_principled(mat, surface, kind):
+    """Replace the material's Principled BSDF by surface(tree, p) (+ emission,
+    + alpha).  Returns a short description or None."""
     tree = mat.node_tree
     principled = [n for n in tree.nodes
                   if n.bl_idname == "ShaderNodeBsdfPrincipled"]
@@ -370,15 +469,8 @@ def swap_to_diffuse(mat):
         return None
     p = principled[0]
     targets = [link.to_socket for link in p.outputs["BSDF"].links]
-
-    diffuse = tree.nodes.new("ShaderNodeBsdfDiffuse")
-    diffuse.location = p.location
-    diffuse.inputs["Roughness"].default_value = 0.0      # Lambert
-    copy_input(tree, p.inputs["Base Color"], diffuse.inputs["Color"])
-    if p.inputs["Normal"].is_linked:
-        copy_input(tree, p.inputs["Normal"], diffuse.inputs["Normal"])
-    shader = diffuse.outputs["BSDF"]
-    parts = ["diffuse"]
+    shader = surface(tree, p)
+    parts = [kind]
 
     colour, strength = p.inputs["Emission"], p.inputs["Emission Strength"]
     emits = (strength.is_linked or strength.default_value != 0) and \
@@ -412,10 +504,11 @@ def swap_to_diffuse(mat):
 
 
 def fix_materials(scene, gltf):
-    classes = {}
+    classes, f0 = {}, {}
     for i, m in enumerate(gltf.get("materials", [])):
         name = m.get("name") or "Material_%d" % i
-        classes.setdefault(name, set()).add(is_pure_diffuse(m))
+        classes.setdefault(name, set()).add(material_class(m))
+        f0[name] = dielectric_f0_scale(m)
 
     used = []
     for o in scene.objects:
@@ -429,16 +522,21 @@ def fix_materials(scene, gltf):
             continue
         base = gltf_base_name(mat.name, classes)
         kind = classes.get(base)
-        if kind == {True}:
-            what = swap_to_diffuse(mat)
-            if what:
-                swapped.append("%s (%s)" % (mat.name, what))
-                continue
-        elif kind == {True, False}:
-            note("warning: several glTF materials are named %r and not all "
-                 "are pure diffuse; %s keeps its Principled BSDF"
-                 % (base, mat.name))
-        kept.append(mat.name)
+        what = None
+        if kind == {"diffuse"}:
+            what = replace_principled(mat, lambert, "diffuse")
+        elif kind == {"dielectric"}:
+            ior, spec = f0[base]
+            what = replace_principled(
+                mat, lambda t, p: gltf_dielectric(t, p, ior, spec),
+                "glTF dielectric")
+        elif kind and len(kind) > 1:
+            note("warning: several glTF materials are named %r and they are "
+                 "not all alike; %s keeps its Principled BSDF" % (base, mat.name))
+        if what:
+            swapped.append("%s (%s)" % (mat.name, what))
+        else:
+            kept.append(mat.name)
 
     ggx = 0
     trees = [m.node_tree for m in bpy.data.materials if m.node_tree]
@@ -448,7 +546,7 @@ def fix_materials(scene, gltf):
             if n.bl_idname == "ShaderNodeBsdfPrincipled":
                 n.distribution = "GGX"
                 ggx += 1
-    note("pure-diffuse materials swapped to Diffuse BSDF (Lambert): %s"
+    note("materials swapped to Lambert or glTF's dielectric: %s"
          % (", ".join(swapped) or "none"))
     note("materials kept as Principled BSDF (distribution GGX, %d nodes): %s"
          % (ggx, ", ".join(kept) or "none"))

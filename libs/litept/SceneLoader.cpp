@@ -61,7 +61,8 @@ void MakeFlat(PathScene::Mesh& mesh)
   mesh = std::move(flat);
 }
 
-// Per-vertex tangents from the texture coordinates (for normal maps), orthogonalised against the normal.
+// Per-vertex tangents from the texture coordinates (for normal maps), orthogonalised against the normal,
+// for meshes without glTF TANGENT.
 void ComputeTangents(PathScene::Mesh& mesh)
 {
   std::vector<float3> tan(mesh.positions.size(), float3(0.0f)), bitan(mesh.positions.size(), float3(0.0f));
@@ -89,7 +90,9 @@ void ComputeTangents(PathScene::Mesh& mesh)
       litept::BranchlessOnb(n, t, b);
     }
     t = normalize(t);
-    const float w = dot(cross(n, t), bitan[i]) < 0.0f ? -1.0f : 1.0f;
+    // A normal map's green axis points up the image, and glTF's v runs down it: the bitangent
+    // (cross(n, t) * w, as glTF defines it) is -dP/dv.
+    const float w = dot(cross(n, t), bitan[i]) < 0.0f ? 1.0f : -1.0f;
     mesh.tangents[i] = to_float4(t, w);
   }
 }
@@ -107,8 +110,12 @@ bool DecodeGltfImage(tinygltf::Image* image, const int index, std::string* err, 
   const bool png = size > 4 && bytes[0] == 0x89 && bytes[1] == 'P';
   const bool jpeg = size > 2 && bytes[0] == 0xFF && bytes[1] == 0xD8;
   const std::string name = png ? "image.png" : jpeg ? "image.jpg" : image->uri.empty() ? "image.png" : image->uri;
+  // The memory goes to the reader as the configuration's "oiio:ioproxy": handed over as open()'s
+  // third argument instead, OpenImageIO 2.4's PNG reader still looks for a file of that name.
   OIIO::ImageSpec config;
-  auto in = OIIO::ImageInput::open(name, &config, &memory);
+  void* proxy = &memory;
+  config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
+  auto in = OIIO::ImageInput::open(name, &config);
   if (!in)
   {
     if (err)
@@ -367,6 +374,10 @@ private:
     const int mrTex = Texture(pbr.metallicRoughnessTexture.index, false, name);
     const int normalTex = Texture(m.normalTexture.index, false, name);
     const int emissiveTex = Texture(m.emissiveTexture.index, true, name);
+    for (const auto& extension : m.extensions)  // what the materials here do not model, said once per material
+      if (extension.first != "KHR_materials_emissive_strength" && extension.first != "KHR_materials_transmission" &&
+          extension.first != "KHR_materials_ior" && extension.first != "KHR_materials_specular")
+        m_scene.notes.push_back(m_path + ": material '" + name + "': " + extension.first + " is ignored");
     if (m.alphaMode != "OPAQUE" && base.w < 1.0f)
       m_scene.notes.push_back(m_path + ": material '" + name + "': alpha (" + m.alphaMode + ") is ignored: the surface is opaque");
     if (transmission > 0.0f && metallic < 1.0f)

@@ -286,6 +286,43 @@ TEST_CASE("path tracer: white furnaces: what each material keeps of a uniform en
   }
 }
 
+TEST_CASE("path tracer: a glTF scene's PNG and JPEG textures load, base colour linearised from sRGB", "[path_tracer]")
+{
+  // A quad whose base colour is a 2x2 PNG and whose emission is a flat 8x8 JPEG, written here.
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "crossrt_textured_scene";
+  std::filesystem::create_directories(dir);
+  LiteImage::Image2D<float4> png(2, 2);
+  png[int2(0, 0)] = float4(1.0f, 0.0f, 0.0f, 1.0f);
+  png[int2(1, 0)] = float4(0.0f, 1.0f, 0.0f, 1.0f);
+  png[int2(0, 1)] = float4(0.0f, 0.0f, 1.0f, 1.0f);
+  png[int2(1, 1)] = float4(128.0f / 255.0f, 128.0f / 255.0f, 128.0f / 255.0f, 1.0f);
+  REQUIRE(LiteImage::SaveImage((dir / "base.png").string().c_str(), png));
+  REQUIRE(LiteImage::SaveImage((dir / "glow.jpg").string().c_str(), LiteImage::Image2D<float4>(8, 8, float4(1.0f, 1.0f, 1.0f, 1.0f))));
+  // Four positions (vec3) and six indices (uint16) of the quad, base64 in a data URI.
+  std::ofstream(dir / "quad.gltf") << R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],
+    "meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1,"material":0}]}],
+    "materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0}},"emissiveTexture":{"index":1},"emissiveFactor":[1,1,1]}],
+    "textures":[{"source":0},{"source":1}],"images":[{"uri":"base.png"},{"uri":"glow.jpg"}],
+    "accessors":[{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[0,0,0],"max":[1,1,0]},
+                 {"bufferView":1,"componentType":5123,"count":6,"type":"SCALAR"}],
+    "bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":48},{"buffer":0,"byteOffset":48,"byteLength":12}],
+    "buffers":[{"byteLength":60,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAACAPwAAgD8AAAAAAAAAAAAAgD8AAAAAAAABAAIAAAACAAMA"}]})";
+  const PathScene scene = LoadScene((dir / "quad.gltf").string());
+  REQUIRE(scene.textures.size() == 2u);
+  const auto& base = scene.textures[0];
+  REQUIRE(base.width() == 2u);
+  REQUIRE(base.height() == 2u);
+  CHECK(base[int2(0, 0)].x == Approx(1.0f));
+  CHECK(base[int2(0, 0)].y == Approx(0.0f).margin(1e-6));
+  CHECK(base[int2(1, 0)].y == Approx(1.0f));
+  CHECK(base[int2(0, 1)].z == Approx(1.0f));
+  CHECK(base[int2(1, 1)].x == Approx(0.2158605f).epsilon(1e-3));  // sRGB 128 in linear
+  const auto& glow = scene.textures[1];
+  REQUIRE(glow.width() == 8u);
+  CHECK(glow[int2(3, 3)].x == Approx(1.0f).margin(2.0f / 255.0f));
+  std::filesystem::remove_all(dir);
+}
+
 TEST_CASE("path tracer: scene files that cannot be read give a clear error", "[path_tracer]")
 {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / "crossrt_path_tracer_test";
