@@ -288,7 +288,9 @@ TEST_CASE("path tracer: white furnaces: what each material keeps of a uniform en
 
 TEST_CASE("path tracer: a glTF scene's PNG and JPEG textures load, base colour linearised from sRGB", "[path_tracer]")
 {
-  // A quad whose base colour is a 2x2 PNG and whose emission is a flat 8x8 JPEG, written here.
+  // A quad in the xy plane whose base colour (and normal map) is a 2x2 PNG and whose emission is a
+  // flat 8x8 JPEG, written here. Its texture coordinates put the image's top at y = 1 (glTF's v runs
+  // down the image).
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / "crossrt_textured_scene";
   std::filesystem::create_directories(dir);
   LiteImage::Image2D<float4> png(2, 2);
@@ -298,18 +300,25 @@ TEST_CASE("path tracer: a glTF scene's PNG and JPEG textures load, base colour l
   png[int2(1, 1)] = float4(128.0f / 255.0f, 128.0f / 255.0f, 128.0f / 255.0f, 1.0f);
   REQUIRE(LiteImage::SaveImage((dir / "base.png").string().c_str(), png));
   REQUIRE(LiteImage::SaveImage((dir / "glow.jpg").string().c_str(), LiteImage::Image2D<float4>(8, 8, float4(1.0f, 1.0f, 1.0f, 1.0f))));
-  // Four positions (vec3) and six indices (uint16) of the quad, base64 in a data URI.
+  // Four positions (vec3), six indices (uint16) and four texture coordinates (vec2), base64.
   std::ofstream(dir / "quad.gltf") << R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0]}],"nodes":[{"mesh":0}],
-    "meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1,"material":0}]}],
-    "materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0}},"emissiveTexture":{"index":1},"emissiveFactor":[1,1,1]}],
+    "meshes":[{"primitives":[{"attributes":{"POSITION":0,"TEXCOORD_0":2},"indices":1,"material":0}]}],
+    "materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0}},"emissiveTexture":{"index":1},"emissiveFactor":[1,1,1],
+                  "normalTexture":{"index":0}}],
     "textures":[{"source":0},{"source":1}],"images":[{"uri":"base.png"},{"uri":"glow.jpg"}],
     "accessors":[{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[0,0,0],"max":[1,1,0]},
-                 {"bufferView":1,"componentType":5123,"count":6,"type":"SCALAR"}],
-    "bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":48},{"buffer":0,"byteOffset":48,"byteLength":12}],
-    "buffers":[{"byteLength":60,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAACAPwAAgD8AAAAAAAAAAAAAgD8AAAAAAAABAAIAAAACAAMA"}]})";
+                 {"bufferView":1,"componentType":5123,"count":6,"type":"SCALAR"},
+                 {"bufferView":2,"componentType":5126,"count":4,"type":"VEC2"}],
+    "bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":48},{"buffer":0,"byteOffset":48,"byteLength":12},
+                   {"buffer":0,"byteOffset":60,"byteLength":32}],
+    "buffers":[{"byteLength":92,"uri":"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAACAPwAAgD8AAAAAAAAAAAAAgD8AAAAAAAABAAIAAAACAAMAAAAAAAAAgD8AAIA/AACAPwAAgD8AAAAAAAAAAAAAAAA="}]})";
   const PathScene scene = LoadScene((dir / "quad.gltf").string());
-  REQUIRE(scene.textures.size() == 2u);
-  const auto& base = scene.textures[0];
+  REQUIRE(scene.meshes.size() == 1u);
+  const int4 ids = scene.materials.at(scene.meshes[0].triangleMaterial.at(0))->TextureIds();  // colour, metal-rough, normal, emission
+  REQUIRE(ids.x >= 0);
+  REQUIRE(ids.w >= 0);
+  REQUIRE(scene.textures.size() == 3u);  // base.png twice: as sRGB colour and as a linear normal map
+  const auto& base = scene.textures[size_t(ids.x)];
   REQUIRE(base.width() == 2u);
   REQUIRE(base.height() == 2u);
   CHECK(base[int2(0, 0)].x == Approx(1.0f));
@@ -317,9 +326,19 @@ TEST_CASE("path tracer: a glTF scene's PNG and JPEG textures load, base colour l
   CHECK(base[int2(1, 0)].y == Approx(1.0f));
   CHECK(base[int2(0, 1)].z == Approx(1.0f));
   CHECK(base[int2(1, 1)].x == Approx(0.2158605f).epsilon(1e-3));  // sRGB 128 in linear
-  const auto& glow = scene.textures[1];
+  const auto& glow = scene.textures[size_t(ids.w)];
   REQUIRE(glow.width() == 8u);
   CHECK(glow[int2(3, 3)].x == Approx(1.0f).margin(2.0f / 255.0f));
+  // Tangents computed for the normal map: along +u (x), and the bitangent glTF defines,
+  // cross(normal, tangent) * w, along the image's up, where the map's green axis points (+y).
+  REQUIRE(scene.meshes[0].tangents.size() == scene.meshes[0].positions.size());
+  for (size_t i = 0; i < scene.meshes[0].tangents.size(); ++i)
+  {
+    const float4 t = scene.meshes[0].tangents[i];
+    const float3 bitangent = cross(to_float3(scene.meshes[0].normals[i]), to_float3(t)) * t.w;
+    CHECK(t.x == Approx(1.0f));
+    CHECK(bitangent.y == Approx(1.0f));
+  }
   std::filesystem::remove_all(dir);
 }
 
