@@ -2,11 +2,15 @@
 //   1. the paper's Table 10 form: samples per second of the class as written (one thread),
 //      PathTracer_CPU (all cores) and PathTracer_Vulkan as a megakernel and as plain wavefront, in
 //      interleaved rounds (medians), with the ratio to the original;
-//   2. the gain from specialisation: PathTracer_Vulkan with its virtual calls specialised to the
+//   2. the paper's Table 11 form: PathTracer_Vulkan translated at virtual levels 1 (one array of
+//      equal slots, PathTracer_VulkanLevel1), 2 (a buffer per class, PathTracer_Vulkan) and 3 (2 plus
+//      callable shaders where the device has ray tracing pipelines, PathTracer_VulkanLevel3), both
+//      modes, interleaved rounds;
+//   3. the gain from specialisation: PathTracer_Vulkan with its virtual calls specialised to the
 //      material and light classes the scene holds, and with every class's case: the time to make
 //      the pipelines, the speed, and the megakernel's SPIR-V size once spirv-opt has folded the
 //      constants as the driver does;
-//   3. time to equal quality against Blender's Cycles on the same cores, with --reference REF.exr
+//   4. time to equal quality against Blender's Cycles on the same cores, with --reference REF.exr
 //      (a converged image) and --cycles-log CSV (scripts/cycles-reference.py --time-log, its
 //      renders at 1, 2, 4, ... spp): PathTracer_CPU renders the same spp, each from scratch; both
 //      get PSNR and relative MSE against the reference, and the time each needs for 30 and 35 dB is
@@ -15,6 +19,8 @@
 #include "PathTracer.h"
 #include "PathTracer_CPU.h"
 #include "PathTracer_Vulkan.h"
+#include "PathTracer_VulkanLevel1.h"
+#include "PathTracer_VulkanLevel3.h"
 #include "SceneLoader.h"
 
 #include <algorithm>
@@ -197,12 +203,19 @@ int main(int argc, char** argv)
     auto cpu = CreatePathTracer_CPU();
     Prepare(*cpu, s, "embree");
     std::shared_ptr<InspectedTracer> gpu;
+    std::shared_ptr<PathTracer_VulkanLevel1> gpuLevel1;
+    std::shared_ptr<PathTracer_VulkanLevel3> gpuLevel3;
     if (vulkan)
     {
       try
       {
-        gpu = std::make_shared<InspectedTracer>(crossrt::VulkanContext::CreateDefault());
+        auto ctx = crossrt::VulkanContext::CreateDefault();
+        gpu = std::make_shared<InspectedTracer>(ctx);
         Prepare(*gpu, s, "sah");
+        gpuLevel1 = std::make_shared<PathTracer_VulkanLevel1>(ctx);
+        Prepare(*gpuLevel1, s, "sah");
+        gpuLevel3 = std::make_shared<PathTracer_VulkanLevel3>(ctx);
+        Prepare(*gpuLevel3, s, "sah");
       }
       catch (const crossrt::NoDeviceError& e)
       {
@@ -249,16 +262,52 @@ int main(int argc, char** argv)
           << rate / originalRate << ",,\n";
     }
 
-    // ---- 2. specialisation to the scene's classes
+    // ---- 2. Table 11: virtual levels
+    if (gpu)
+    {
+      std::vector<Row> levels;
+      for (const char* mode : {"megakernel", "wavefront"})
+      {
+        const auto m = std::string(mode) == "megakernel" ? crossrt::ExecutionMode::Megakernel : crossrt::ExecutionMode::Wavefront;
+        levels.push_back({"1 (PathTracer_VulkanLevel1)", mode, gpuLevel1.get(), 4, [&, m] { gpuLevel1->SetExecutionMode(m); }, {}});
+        levels.push_back({"2 (PathTracer_Vulkan)", mode, gpu.get(), 4, [&, m] { gpu->SetExecutionMode(m); }, {}});
+        levels.push_back({"3 (PathTracer_VulkanLevel3)", mode, gpuLevel3.get(), 4, [&, m] { gpuLevel3->SetExecutionMode(m); }, {}});
+      }
+      for (auto& r : levels)  // the pipelines of each mode are made before timing
+        r.before(), Render(*r.tracer, s, 1);
+      for (int round = 0; round < rounds; ++round)
+        for (auto& r : levels)
+        {
+          r.before();
+          r.seconds.push_back(Seconds([&] { Render(*r.tracer, s, r.spp); }));
+        }
+      std::printf("\nTable 11 form: PathTracer_Vulkan translated at each virtual level, samples per pixel per second, medians of %d rounds\n\n",
+                  rounds);
+      std::printf("| virtual level | mode | spp/s | Mpaths/s | vs level 2 |\n|---|---|---|---|---|\n");
+      for (size_t i = 0; i < levels.size(); ++i)
+      {
+        const Row& r = levels[i];
+        const double rate = r.spp / Median(r.seconds), level2 = levels[i - i % 3 + 1].spp / Median(levels[i - i % 3 + 1].seconds);
+        std::printf("| %s | %s | %.2f | %.3f | %.2fx |\n", r.name.c_str(), r.mode.c_str(), rate, rate * paths * 1e-6, rate / level2);
+        csv << "virtual_level," << r.name << "," << r.mode << "," << r.spp << "," << Median(r.seconds) << "," << rate << "," << rate * paths * 1e-6
+            << "," << rate / level2 << ",,\n";
+      }
+      std::printf("(level 3 runs callable shaders only on a device with ray tracing pipelines, and only for kernels without\n"
+                  " other hardware variants: PathTracer's kernel_Shade samples arrays of textures, so it keeps level 2's switch)\n");
+    }
+
+    // ---- 3. specialisation to the scene's classes
     if (gpu)
     {
       gpu->SetExecutionMode(crossrt::ExecutionMode::Megakernel);
       std::printf("\nSpecialisation: PathTracer_Vulkan's megakernel, virtual calls switched over the scene's classes or over all\n\n");
-      std::printf("| virtual calls | classes in the pipelines | CommitDeviceData s (makes the pipelines) | spp/s | SPIR-V bytes (folded by spirv-opt) |\n|---|---|---|---|---|\n");
+      std::printf("| virtual calls | classes in the pipelines | pipelines made, s (CommitDeviceData and a first 1-spp pass) | spp/s | SPIR-V bytes (folded by spirv-opt) |\n|---|---|---|---|---|\n");
       for (bool specialise : {false, true})  // each remakes the pipelines
       {
         gpu->SpecializeVirtualCalls(specialise);
-        const double make = Seconds([&] { gpu->CommitDeviceData(); });
+        // Some drivers (lavapipe) compile a pipeline's shaders at its first dispatch, unless their disk
+        // cache has them: the first 1-spp pass counts as making the pipelines.
+        const double make = Seconds([&] { gpu->CommitDeviceData(), Render(*gpu, s, 1); });
         std::vector<double> t;
         for (int round = 0; round < rounds; ++round)
           t.push_back(Seconds([&] { Render(*gpu, s, 4); }));
@@ -273,7 +322,7 @@ int main(int argc, char** argv)
       gpu->SpecializeVirtualCalls(true);
     }
 
-    // ---- 3. time to equal quality against Cycles
+    // ---- 4. time to equal quality against Cycles
     if (reference.empty() || cyclesLog.empty())
     {
       std::printf("\nTime to quality against Cycles: give --reference REF.exr (converged, another seed) and --cycles-log CSV\n"

@@ -30,6 +30,7 @@ std::string OptionsKey(const engine::TranslateRequest& r) {
   for (auto& c : r.compositions) text += "\ncompose " + c;
   text += "\nvirtual-level " + std::to_string(r.virtualLevel);
   text += std::string("\nexecution-mode ") + (r.megakernel ? "megakernel" : "wavefront");
+  text += "\nname " + r.generatedName;
   return Hex(XXH64(text.data(), text.size(), 0));
 }
 

@@ -187,6 +187,7 @@ std::string RemoteCache::ManifestKey(const engine::TranslateRequest& r) const {
   for (auto& c : r.compositions) text += "\ncompose " + c;
   text += "\nvirtual-level " + std::to_string(r.virtualLevel);
   text += std::string("\nexecution-mode ") + (r.megakernel ? "megakernel" : "wavefront");
+  text += "\nname " + r.generatedName;
   return Key(text);
 }
 

@@ -38,7 +38,7 @@ namespace {
 const char* kUsage =
     "usage: crossrt translate --class NAME --backend vulkan|cpu|ispc --out DIR --source FILE [--source FILE...]\n"
     "                         [--candidate FILE... [--source-dir DIR]] [--compose INTERFACE=IMPL...] [--virtual-level 1|2|3]\n"
-    "                         [--execution-mode wavefront|megakernel] [--templates DIR]\n"
+    "                         [--execution-mode wavefront|megakernel] [--name GENERATED] [--templates DIR]\n"
     "                         [--depfile FILE --depfile-target FILE]\n"
     "                         [--build-dir DIR | --no-daemon] [--remote-storage URLS [--source-root DIR]]\n"
     "                         [-- COMPILE_ARGS...]\n"
@@ -62,6 +62,9 @@ const char* kHelp =
     "               by a team: redis://host[:port], http[s]://host/path, space-separated, each with\n"
     "               optional |read-only, |connect-timeout=MS, |operation-timeout=MS, |layout=bazel.\n"
     "               Paths under --build-dir and --source-root are stored relative to them.\n"
+    "               --name names the generated class (and its files and global symbols) instead of\n"
+    "               NAME_Vulkan, NAME_CPU or NAME_ISPC, so that several translations of one class (at\n"
+    "               different virtual levels, say) link into one program.\n"
     "daemon status  prints what the build tree's daemon holds (--json for a machine).\n"
     "daemon stop    stops it; the next translation starts another.\n"
     "\n";
@@ -235,6 +238,12 @@ int main(int argc, char** argv) {
       if (v != "megakernel" && v != "wavefront")
         return Usage("--execution-mode takes megakernel (one shader per thread loop) or wavefront (one dispatch per kernel call), not '" + v + "'");
       request.megakernel = v == "megakernel";
+    }
+    else if (a == "--name") {
+      if (v.empty() || !(std::isalpha((unsigned char)v[0]) || v[0] == '_') ||
+          v.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") != std::string::npos)
+        return Usage("--name takes a C++ identifier (the generated class's name), not '" + v + "'");
+      request.generatedName = v;
     }
     else if (a == "--depfile") depfile = v;
     else if (a == "--depfile-target") depfileTarget = v;

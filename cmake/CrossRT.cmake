@@ -1,6 +1,6 @@
 # crossrt_add_class(<target> <Class> BACKEND vulkan|cpu [SOURCES file...]
 #                   [COMPOSE Interface=Implementation...] [VIRTUAL_LEVEL 1|2|3]
-#                   [EXECUTION_MODE wavefront|megakernel])
+#                   [EXECUTION_MODE wavefront|megakernel] [NAME <Generated>])
 #
 # Translates class <Class> into <Class>_Vulkan (or <Class>_CPU), in the build tree, and adds the
 # generated sources, their include path and the runtime to <target>. A class in a namespace is
@@ -28,6 +28,10 @@
 # wavefront (default) = one dispatch per kernel call, per-thread locals kept in buffers between
 # them; megakernel = the whole loop body in one shader, locals in registers. Both are generated;
 # this picks the one the class starts with, and SetExecutionMode() switches at run time.
+#
+# NAME: the generated class's name (and its files' and global symbols'), instead of <Class>_Vulkan,
+# <Class>_CPU or <Class>_ISPC: several translations of one class, at different VIRTUAL_LEVELs say,
+# then link into one program (crossrt_add_class(app Render VIRTUAL_LEVEL 1 NAME Render_VulkanLevel1)).
 #
 # The translation goes through the build tree's daemon (crossrtd, started on demand, exits when
 # idle), which keeps parsed headers warm; set CROSSRT_NO_DAEMON=1 to translate in-process.
@@ -61,7 +65,7 @@ function(crossrt_register_implementation impl)
 endfunction()
 
 function(crossrt_add_class target class)
-  cmake_parse_arguments(ARG "" "BACKEND;VIRTUAL_LEVEL;EXECUTION_MODE" "SOURCES;COMPOSE" ${ARGN})
+  cmake_parse_arguments(ARG "" "BACKEND;VIRTUAL_LEVEL;EXECUTION_MODE;NAME" "SOURCES;COMPOSE" ${ARGN})
   if(NOT ARG_BACKEND)
     set(ARG_BACKEND vulkan)
   endif()
@@ -87,6 +91,15 @@ function(crossrt_add_class target class)
   # A class in a namespace (demo::Render) is translated by that name; files, folders and targets
   # take the class's own name (Render_Vulkan), and the generated class joins the namespace.
   string(REGEX REPLACE "^.*::" "" name "${class}")
+  set(gen ${name}_${suffix})  # the generated class, its folder and files
+  set(name_args "")
+  if(ARG_NAME)
+    if(NOT ARG_NAME MATCHES "^[A-Za-z_][A-Za-z0-9_]*$")
+      message(FATAL_ERROR "crossrt_add_class(${target} ${class}): NAME is the generated class's name, a C++ identifier, not '${ARG_NAME}'")
+    endif()
+    set(gen ${ARG_NAME})
+    list(APPEND name_args --name ${ARG_NAME})
+  endif()
 
   set(sources ${ARG_SOURCES})
   set(candidates "")
@@ -104,7 +117,7 @@ function(crossrt_add_class target class)
       list(APPEND candidate_args --candidate ${CMAKE_CURRENT_SOURCE_DIR}/${name}.cpp)
     endif()
   endif()
-  set(option_args "")
+  set(option_args ${name_args})
   foreach(c IN LISTS ARG_COMPOSE)
     if(NOT c MATCHES "^[A-Za-z_][A-Za-z0-9_]*=[A-Za-z_][A-Za-z0-9_]*$")
       message(FATAL_ERROR "crossrt_add_class(${target} ${class}): COMPOSE takes Interface=Implementation (e.g. ISceneObject=BVHScene), not '${c}'")
@@ -134,12 +147,17 @@ function(crossrt_add_class target class)
     list(APPEND source_args --source "${a}")
   endforeach()
 
+  # A named class's folder is inside the default one's, so that the filter on the target's sources
+  # above keeps every generated file out.
   set(out_dir ${CMAKE_CURRENT_BINARY_DIR}/crossrt/${name}_${suffix})
-  set(outputs ${out_dir}/${name}_${suffix}.h ${out_dir}/${name}_${suffix}.cpp)
+  if(ARG_NAME)
+    set(out_dir ${out_dir}/${gen})
+  endif()
+  set(outputs ${out_dir}/${gen}.h ${out_dir}/${gen}.cpp)
   if(suffix STREQUAL "Vulkan")
-    list(APPEND outputs ${out_dir}/${name}_Vulkan_shaders.cpp)
+    list(APPEND outputs ${out_dir}/${gen}_shaders.cpp)
   elseif(suffix STREQUAL "ISPC")
-    set(ispc_source ${out_dir}/${name}_ISPC_kernels.ispc)
+    set(ispc_source ${out_dir}/${gen}_kernels.ispc)
     list(APPEND outputs ${ispc_source})
   endif()
 
@@ -177,13 +195,13 @@ function(crossrt_add_class target class)
             --class ${class} --backend ${backend} --out ${out_dir}
             ${source_args} ${candidate_args} ${option_args}
             --templates ${CROSSRT_TEMPLATE_DIR}
-            --depfile ${out_dir}/${name}_${suffix}.d --depfile-target ${first_output}
+            --depfile ${out_dir}/${gen}.d --depfile-target ${first_output}
             --build-dir ${CMAKE_BINARY_DIR} --source-root ${CMAKE_SOURCE_DIR}
             "$<$<BOOL:${CROSSRT_REMOTE_STORAGE}>:--remote-storage;${CROSSRT_REMOTE_STORAGE}>"
             -- ${compile_args}
     DEPENDS ${abs_sources} ${candidates} ${translator_dep}
-    DEPFILE ${out_dir}/${name}_${suffix}.d
-    COMMENT "CrossRT: translating ${class} -> ${name}_${suffix}"
+    DEPFILE ${out_dir}/${gen}.d
+    COMMENT "CrossRT: translating ${class} -> ${gen}"
     COMMAND_EXPAND_LISTS
     VERBATIM)
 
@@ -191,8 +209,8 @@ function(crossrt_add_class target class)
   if(NOT TARGET crossrt_generate)
     add_custom_target(crossrt_generate)
   endif()
-  add_custom_target(crossrt_generate_${target}_${name}_${suffix} DEPENDS ${outputs})
-  add_dependencies(crossrt_generate crossrt_generate_${target}_${name}_${suffix})
+  add_custom_target(crossrt_generate_${target}_${gen} DEPENDS ${outputs})
+  add_dependencies(crossrt_generate crossrt_generate_${target}_${gen})
 
   target_sources(${target} PRIVATE ${outputs})
   target_include_directories(${target} PRIVATE ${out_dir})
@@ -201,12 +219,12 @@ function(crossrt_add_class target class)
     # one object per target and the dispatcher, and the header the generated class includes.
     # Without fused multiply-adds, as the C++ and the Vulkan shaders compute (NoContraction); the
     # fma() a kernel calls is LLVM's, exact as C++'s std::fma (--enable-llvm-intrinsics).
-    set(ispc_object ${out_dir}/${name}_ISPC_kernels${CMAKE_CXX_OUTPUT_EXTENSION})
-    set(ispc_header ${out_dir}/${name}_ISPC_kernels_ispc.h)
+    set(ispc_object ${out_dir}/${gen}_kernels${CMAKE_CXX_OUTPUT_EXTENSION})
+    set(ispc_header ${out_dir}/${gen}_kernels_ispc.h)
     set(ispc_objects ${ispc_object})
     foreach(t IN LISTS CROSSRT_ISPC_TARGETS)
       string(REGEX REPLACE "-.*$" "" isa "${t}")
-      list(APPEND ispc_objects ${out_dir}/${name}_ISPC_kernels_${isa}${CMAKE_CXX_OUTPUT_EXTENSION})
+      list(APPEND ispc_objects ${out_dir}/${gen}_kernels_${isa}${CMAKE_CXX_OUTPUT_EXTENSION})
     endforeach()
     string(REPLACE ";" "," ispc_targets "${CROSSRT_ISPC_TARGETS}")
     set(runtime_inc "$<TARGET_PROPERTY:crossrt::cpu_runtime,INTERFACE_INCLUDE_DIRECTORIES>")
@@ -218,7 +236,7 @@ function(crossrt_add_class target class)
               -M -MF ${ispc_object}.d -MT ${ispc_object}
       DEPENDS ${ispc_source}
       DEPFILE ${ispc_object}.d
-      COMMENT "CrossRT: compiling ${name}_ISPC_kernels.ispc for ${ispc_targets}"
+      COMMENT "CrossRT: compiling ${gen}_kernels.ispc for ${ispc_targets}"
       COMMAND_EXPAND_LISTS
       VERBATIM)
     get_target_property(target_type ${target} TYPE)

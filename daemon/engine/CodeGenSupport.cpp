@@ -255,6 +255,8 @@ Data CpuKernelData(const Kernel& k) {
 Data Common(const ClassModel& model, const GenerateOptions& opt) {
   Data d;
   d.set("className", model.className);
+  d.set("generatedName", model.generatedName);
+  d.set("symbolPrefix", model.symbolPrefix);
   d.set("namespaceName", model.namespaceName);
   d.set("hasNamespace", !model.namespaceName.empty());
   d.set("headerName", opt.headerName);

@@ -68,7 +68,7 @@ bool ComposeFromTranslationUnit(ASTContext& ctx, Reporter& reporter, ClassModel&
       if (model.forIspc && k.rtv) continue;  // the ISPC class's thread loops call the interface as written
       GlslPrinter printer(ctx, impl, reporter);
       printer.ispc = model.forIspc;
-      printer.ispcDataStruct = model.className + "_Data";
+      printer.ispcDataStruct = model.symbolPrefix + "_Data";
       printer.composedPrefix = holderPrefix;
       for (auto& s : classStructs) printer.predeclaredStructs.insert(s);
       for (auto& [holder, method] : k.composedCalls) {

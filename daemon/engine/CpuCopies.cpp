@@ -205,7 +205,7 @@ void AddLockedCopies(Context& c, const std::vector<const FunctionDecl*>& reached
     const NamedDecl* named = rt->getAsTagDecl();
     if (auto* td = rt->getAs<TypedefType>()) named = td->getDecl();
     const bool nested = named && named->getDeclContext() == c.cls;
-    const std::string qualified = c.cls->getNameAsString() + (c.model.forIspc ? "_ISPC::" : "_CPU::") + name + "(" + defParams + ")" + cv;
+    const std::string qualified = c.model.generatedName + "::" + name + "(" + defParams + ")" + cv;
     copy.definitionHead = nested ? "auto " + qualified + " -> " + ret : ret + " " + qualified;
     Rewriter rw(c.ctx.getSourceManager(), c.ctx.getLangOpts());
     LockAppends(rw, fn->getBody());

@@ -85,15 +85,15 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
     d.set("anyAtomics", std::any_of(model.kernels.begin(), model.kernels.end(), [](const Kernel& k) { return k.atomics; }));
     d.set("anyFloatAtomics", std::any_of(model.kernels.begin(), model.kernels.end(), [](const Kernel& k) { return k.floatAtomics; }));
     d.set("fenceConstantId", kFenceAtomicsConstantId);
-    files[model.className + "_Vulkan.h"] = Render(opt.templateDir + "/vulkan/class.h.mustache", d);
-    files[model.className + "_Vulkan.cpp"] = Render(opt.templateDir + "/vulkan/class.cpp.mustache", d);
+    files[model.generatedName + ".h"] = Render(opt.templateDir + "/vulkan/class.h.mustache", d);
+    files[model.generatedName + ".cpp"] = Render(opt.templateDir + "/vulkan/class.cpp.mustache", d);
     return files;
   }
-  const std::string derived = model.className + (model.forIspc ? "_ISPC" : "_CPU");
+  const std::string derived = model.generatedName;
   d.set("derived", derived);
   d.set("ispc", model.forIspc);
   d.set("whatRuns", model.forIspc ? "The loop nests of " + model.className + "'s kernels run here\n// as ISPC (" +
-                                        model.className + "_ISPC_kernels.ispc), on all CPU cores, each in SIMD lanes; the thread loops\n"
+                                        model.generatedName + "_kernels.ispc), on all CPU cores, each in SIMD lanes; the thread loops\n"
                                         "// of its control functions run on all cores with OpenMP; everything else is inherited unchanged."
                                   : "The kernels of " + model.className + " run here on all\n// CPU cores with OpenMP; everything else is inherited unchanged.");
   if (model.forIspc) IspcHostData(model, d);

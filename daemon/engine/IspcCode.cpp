@@ -222,7 +222,7 @@ void IspcHostData(const ClassModel& model, Data& d) {
     for (auto& l : k.preambleLocals) unused += "(void)" + l + "; ";
     x.set("preambleLocals", unused.empty() ? "" : unused + " // the ISPC kernel computes its own");
     std::string targets;
-    for (const char* t : kIspcTargetSuffixes) targets += std::string(targets.empty() ? "" : ", ") + model.className + "_" + k.name + "_" + t;
+    for (const char* t : kIspcTargetSuffixes) targets += std::string(targets.empty() ? "" : ", ") + model.symbolPrefix + "_" + k.name + "_" + t;
     x.set("targetFunctions", targets);
     kernels.push_back(x);
   }

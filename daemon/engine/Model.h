@@ -319,6 +319,9 @@ struct ClassModel {
   // own virtual calls) and intersection shaders (composed traversals' leaves) for kernels whose ray
   // generation variant a device with ray tracing pipelines runs.
   int virtualLevel = 2;
+  // The generated class (MyRender_Vulkan unless named), and the prefix of the global symbols it
+  // defines (MyRender unless named: then the name).
+  std::string generatedName, symbolPrefix;
   std::vector<StageShader> callables;      // level 3, by name
   std::vector<StageShader> leafShaders;    // level 3: intersection, closest-hit and miss shaders, by name
   // Thread loops that call several kernels run as one shader each (megakernels) or one dispatch per

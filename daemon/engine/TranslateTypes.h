@@ -35,6 +35,10 @@ struct TranslateRequest {
   // Execution modes (paper 2.1 and 4.4) of thread loops that call several kernels: both are generated, this
   // is the one the generated class starts in.
   bool megakernel = false;
+  // The generated class's name; empty: className + "_Vulkan", "_CPU" or "_ISPC". A given name also
+  // prefixes the generated global symbols (SPIR-V arrays, ISPC kernels), so that several
+  // translations of one class (at different virtual levels, say) link into one program.
+  std::string generatedName;
 };
 
 struct TranslateResult {

@@ -8,6 +8,7 @@
 #include "AstCache.h"
 #include "Canonical.h"
 #include "CodeGen.h"
+#include "CodeGenSupport.h"
 #include "NoContraction.h"
 #include "Spirv.h"
 
@@ -159,6 +160,10 @@ AnalyzeResult Analyze(const TranslateRequest& request, AstCache* sharedCache) {
   model.forCpu = request.backend == Backend::Cpu || request.backend == Backend::Ispc;
   model.forIspc = request.backend == Backend::Ispc;
   model.virtualLevel = request.virtualLevel;
+  const std::string unqualified = request.className.substr(request.className.rfind(':') == std::string::npos ? 0 : request.className.rfind(':') + 1);
+  model.generatedName = !request.generatedName.empty() ? request.generatedName
+                        : unqualified + (request.backend == Backend::Vulkan ? "_Vulkan" : request.backend == Backend::Ispc ? "_ISPC" : "_CPU");
+  model.symbolPrefix = !request.generatedName.empty() ? request.generatedName : unqualified;
   model.megakernelByDefault = request.megakernel;
   model.templateDir = request.templateDir;
   unsigned errors = 0;
@@ -227,14 +232,21 @@ TranslateResult Translate(const TranslateRequest& request, AstCache* cache, Spir
     if (vulkan) shaders = GenerateShaders(model, options);
     // Lay out: C++ and GLSL as the project's own code looks (clang-format: whitespace only).
     for (auto& [name, text] : result.files) text = FormattedGeneratedCode(text);
-    if (request.backend == Backend::Ispc) result.files[model.className + "_ISPC_kernels.ispc"] = GenerateIspcKernels(model, options);
+    if (request.backend == Backend::Ispc) result.files[model.generatedName + "_kernels.ispc"] = GenerateIspcKernels(model, options);
     for (auto& shader : shaders) shader.glsl = FormattedGeneratedCode(shader.glsl);
     for (auto& shader : shaders) result.files["shaders/" + shader.name + "." + shader.stage] = shader.glsl;
     result.timingsMs["generate"] = MsSince(t0);
     // Compile: SPIR-V, embedded in the class's _shaders.cpp.
     t0 = std::chrono::steady_clock::now();
-    if (vulkan) result.files[model.className + "_Vulkan_shaders.cpp"] = CompileShaders(model.className, shaders, spirvCache, AllowsContraction(request.compileArgs));
+    if (vulkan) result.files[model.generatedName + "_shaders.cpp"] = CompileShaders(model.symbolPrefix, shaders, spirvCache, AllowsContraction(request.compileArgs));
     if (vulkan) result.timingsMs["spirv"] = MsSince(t0);
+    // Level 3 asked for callable shaders: say which kernels' virtual calls still switch over classes.
+    if (vulkan && model.virtualLevel == 3)
+      for (const Kernel* k : VulkanKernels(model))
+        if (!k->callables.empty() && !RunsCallables(*k))
+          result.diagnostics += options.headerName + ": note: virtual level 3: " + model.className + "::" + k->name +
+                                "'s virtual calls switch over the classes in its compute shader, not through callable shaders: " +
+                                WhyNoCallables(*k) + "\n";
   } catch (const std::exception& e) {
     result.diagnostics += "error: " + std::string(e.what()) + "\n";
     result.files.clear();

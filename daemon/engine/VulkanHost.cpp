@@ -261,7 +261,7 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
       y.set("pipelineType", rayGeneration ? "crossrt::RayTracingPipeline" : "crossrt::ComputePipeline");
       // The pipeline's shaders (crossrt::RayTracingShaders): ray generation, miss shaders, hit
       // groups (intersection and closest hit), callables in executeCallableEXT's numbering.
-      auto code = [&](const std::string& shader) { return "{" + model.className + "_" + shader + "_spv, " + model.className + "_" + shader + "_spvBytes}"; };
+      auto code = [&](const std::string& shader) { return "{" + model.symbolPrefix + "_" + shader + "_spv, " + model.symbolPrefix + "_" + shader + "_spvBytes}"; };
       std::string shaders;
       if (rayGeneration) {
         const std::string pad = "\n          ";

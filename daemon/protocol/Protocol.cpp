@@ -47,7 +47,8 @@ nlohmann::json ToJson(const engine::TranslateRequest& r) {
           {"templateDir", r.templateDir},
           {"compositions", r.compositions},
           {"virtualLevel", r.virtualLevel},
-          {"executionMode", r.megakernel ? "megakernel" : "wavefront"}};
+          {"executionMode", r.megakernel ? "megakernel" : "wavefront"},
+          {"generatedName", r.generatedName}};
 }
 
 engine::TranslateRequest RequestFromJson(const nlohmann::json& j) {
@@ -67,6 +68,7 @@ engine::TranslateRequest RequestFromJson(const nlohmann::json& j) {
     if (mode != "megakernel" && mode != "wavefront") throw std::runtime_error("executionMode must be megakernel or wavefront, not '" + mode + "'");
     r.megakernel = mode == "megakernel";
   }
+  if (j.contains("generatedName")) r.generatedName = j.at("generatedName").get<std::string>();
   if (r.className.empty() || r.sources.empty()) throw std::runtime_error("className and sources must not be empty");
   return r;
 }

@@ -1,12 +1,14 @@
 // path_tracer: renders a glTF 2.0 or OBJ scene with litept's PathTracer, as written (one thread),
 // translated for all CPU cores (PathTracer_CPU) or for Vulkan (PathTracer_Vulkan, megakernel or
-// wavefront), progressively in passes of bounded size, with a progress bar on stderr. Writes linear
+// wavefront, at virtual level 1, 2 or 3), progressively in passes of bounded size, with a progress bar on stderr. Writes linear
 // EXR or sRGB PNG; --compare prints the PSNR (8-bit sRGB) and relative MSE (linear) against a
 // reference image, such as one from scripts/cycles-reference.py.
 #include "ImageMetrics.h"
 #include "PathTracer.h"
 #include "PathTracer_CPU.h"
 #include "PathTracer_Vulkan.h"
+#include "PathTracer_VulkanLevel1.h"
+#include "PathTracer_VulkanLevel3.h"
 #include "SceneLoader.h"
 
 #include <algorithm>
@@ -23,7 +25,8 @@ namespace {
 
 const char* kUsage =
     "usage: path_tracer SCENE [--size WxH] [--spp N] [--depth D] [--device original|cpu|vulkan]\n"
-    "                   [--mode megakernel|wavefront] [--accel embree|sah|lbvh] [--env FILE.exr] [--env-strength F]\n"
+    "                   [--mode megakernel|wavefront] [--virtual-level 1|2|3] [--accel embree|sah|lbvh]\n"
+    "                   [--env FILE.exr] [--env-strength F]\n"
     "                   [--seed S] [--pass-spp K] [--compare REF.exr] --out FILE.exr|FILE.png [--out ...]\n"
     "  Path traces SCENE (.gltf, .glb or .obj) with next-event estimation and multiple importance sampling.\n"
     "  --size      image size (default 256x256)            --spp     samples per pixel (default 64)\n"
@@ -31,6 +34,9 @@ const char* kUsage =
     "  --device    original: the class as written, one thread; cpu: PathTracer_CPU, all cores (default);\n"
     "              vulkan: PathTracer_Vulkan on the default Vulkan device\n"
     "  --mode      PathTracer_Vulkan's execution mode (default megakernel)\n"
+    "  --virtual-level  how the GPU reaches materials and lights (paper 3.9): 1, one array of equal slots\n"
+    "              (PathTracer_VulkanLevel1); 2, a buffer per class (PathTracer_Vulkan, default); 3, as 2 plus\n"
+    "              callable shaders where the device has ray tracing pipelines (PathTracer_VulkanLevel3)\n"
     "  --accel     the CPU devices' ray tracing: Embree (default) or CrossRT's BVHs; Vulkan always uses sah\n"
     "  --env       an equirectangular environment map (linear EXR, Blender's orientation), times --env-strength\n"
     "  --seed      the random sequence (a pixel's samples depend only on pixel, sample index and seed)\n"
@@ -43,9 +49,17 @@ struct Options
   std::string scene, device = "cpu", mode = "megakernel", accel = "embree", env, compare;
   std::vector<std::string> outs;  // one image per --out
   uint32_t width = 256, height = 256, spp = 64, passSpp = 4, seed = 0;
-  int depth = 8;
+  int depth = 8, virtualLevel = 2;
   float envStrength = 1.0f;
 };
+
+template <class Generated>
+std::shared_ptr<PathTracer> VulkanTracer(std::shared_ptr<crossrt::VulkanContext> ctx, crossrt::ExecutionMode mode)
+{
+  auto tracer = std::make_shared<Generated>(ctx);
+  tracer->SetExecutionMode(mode);
+  return tracer;
+}
 
 [[noreturn]] void Usage(const std::string& problem)
 {
@@ -96,6 +110,13 @@ Options Parse(int argc, char** argv)
     }
     else if (a == "--device") o.device = argv[++i];
     else if (a == "--mode") o.mode = argv[++i];
+    else if (a == "--virtual-level")
+    {
+      const std::string v = argv[++i];
+      if (v != "1" && v != "2" && v != "3")
+        Usage("--virtual-level is 1, 2 or 3, not '" + v + "'");
+      o.virtualLevel = std::stoi(v);
+    }
     else if (a == "--accel") o.accel = argv[++i];
     else if (a == "--env") o.env = argv[++i];
     else if (a == "--env-strength") o.envStrength = float(std::atof(argv[++i]));
@@ -153,10 +174,12 @@ int main(int argc, char** argv)
     else
     {
       auto ctx = crossrt::VulkanContext::CreateDefault();
-      auto vk = std::make_shared<PathTracer_Vulkan>(ctx);
-      vk->SetExecutionMode(o.mode == "megakernel" ? crossrt::ExecutionMode::Megakernel : crossrt::ExecutionMode::Wavefront);
-      std::fprintf(stderr, "device: %s\n", ctx->DeviceName().c_str());
-      tracer = vk;
+      const auto mode = o.mode == "megakernel" ? crossrt::ExecutionMode::Megakernel : crossrt::ExecutionMode::Wavefront;
+      // The same class translated at three virtual levels: three generated classes.
+      tracer = o.virtualLevel == 1   ? VulkanTracer<PathTracer_VulkanLevel1>(ctx, mode)
+               : o.virtualLevel == 3 ? VulkanTracer<PathTracer_VulkanLevel3>(ctx, mode)
+                                     : VulkanTracer<PathTracer_Vulkan>(ctx, mode);
+      std::fprintf(stderr, "device: %s, virtual level %d\n", ctx->DeviceName().c_str(), o.virtualLevel);
       accel = "sah";  // the GPU runs BVHScene's traversal
     }
     tracer->SetScene(scene, MakeSceneRT(accel.c_str()));

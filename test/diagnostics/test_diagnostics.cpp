@@ -716,6 +716,58 @@ protected:
   }
 }
 
+TEST_CASE("--name names the generated class, its files and its global symbols", "[diagnostics][name]")
+{
+  TempClass tc("Filler", R"(#pragma once
+class Filler {
+public:
+  virtual ~Filler() = default;
+  virtual void Run(int n, [[crossrt::size("n")]] float* out);
+protected:
+  void kernel1D_Fill(int n, float* out);
+};
+)",
+               R"(#include "Filler.h"
+void Filler::Run(int n, float* out) { kernel1D_Fill(n, out); }
+void Filler::kernel1D_Fill(int n, float* out) { for (int i = 0; i < n; i++) out[i] = 1.0f; }
+)");
+  auto read = [&](const char* name) {
+    std::ifstream file(tc.dir / "out" / name);
+    return std::string((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  };
+  SECTION("Vulkan")
+  {
+    CommandResult r = RunCrossrt("translate --class Filler --backend vulkan --name FillerOnGpu --out " + (tc.dir / "out").string() +
+                                 " --source " + tc.Source("Filler") + " --templates " CROSSRT_SOURCE_DIR "/templates");
+    INFO(r.output);
+    REQUIRE(r.exitCode == 0);
+    REQUIRE_FALSE(std::filesystem::exists(tc.dir / "out" / "Filler_Vulkan.h"));
+    const std::string header = read("FillerOnGpu.h"), source = read("FillerOnGpu.cpp"), spirv = read("FillerOnGpu_shaders.cpp");
+    CHECK(header.find("class FillerOnGpu : public Filler") != std::string::npos);
+    CHECK(header.find("std::shared_ptr<Filler> CreateFillerOnGpu(") != std::string::npos);
+    CHECK(source.find("FillerOnGpu_kernel1D_Fill_spv") != std::string::npos);
+    CHECK(spirv.find("const uint32_t FillerOnGpu_kernel1D_Fill_spv[]") != std::string::npos);
+    CHECK(spirv.find("Filler_kernel1D_Fill_spv") == std::string::npos);
+  }
+  SECTION("CPU")
+  {
+    CommandResult r = RunCrossrt("translate --class Filler --backend cpu --name FillerOnCores --out " + (tc.dir / "out").string() +
+                                 " --source " + tc.Source("Filler") + " --templates " CROSSRT_SOURCE_DIR "/templates");
+    INFO(r.output);
+    REQUIRE(r.exitCode == 0);
+    CHECK(read("FillerOnCores.h").find("class FillerOnCores : public Filler") != std::string::npos);
+    CHECK(read("FillerOnCores.cpp").find("void FillerOnCores::Run(") != std::string::npos);
+  }
+  SECTION("a name that is not an identifier is a usage error")
+  {
+    CommandResult r = RunCrossrt("translate --class Filler --backend vulkan --name 2Fill --out " + (tc.dir / "out").string() + " --source " +
+                                 tc.Source("Filler") + " --templates " CROSSRT_SOURCE_DIR "/templates");
+    INFO(r.output);
+    REQUIRE(r.exitCode == 2);
+    REQUIRE(r.output.find("--name takes a C++ identifier (the generated class's name), not '2Fill'") != std::string::npos);
+  }
+}
+
 TEST_CASE("Image uses the GPU cannot make are reported", "[diagnostics][images]")
 {
   struct Case { const char* name; const char* body; const char* message; const char* hint; };
