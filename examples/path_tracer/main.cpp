@@ -1,8 +1,8 @@
 // path_tracer: renders a glTF 2.0 or OBJ scene with litept's PathTracer, as written (one thread),
 // translated for all CPU cores (PathTracer_CPU) or for Vulkan (PathTracer_Vulkan, megakernel or
-// wavefront, at virtual level 1, 2 or 3), progressively in passes of bounded size, with a progress bar on stderr. Writes linear
-// EXR or sRGB PNG; --compare prints the PSNR (8-bit sRGB) and relative MSE (linear) against a
-// reference image, such as one from scripts/cycles-reference.py.
+// wavefront, at virtual level 1, 2 or 3), progressively in passes of bounded size, with a progress
+// bar on stderr. Writes linear EXR or sRGB PNG; --compare prints the PSNR (8-bit sRGB) and relative
+// MSE (linear) against a reference image, such as one from scripts/cycles-reference.py.
 #include "ImageMetrics.h"
 #include "PathTracer.h"
 #include "PathTracer_CPU.h"

@@ -1,7 +1,7 @@
-// The path tracer's numbers and warps (libs/litept): scrambled Sobol numbers that depend only on
-// (pixel, sample, bounce, dimension), so every backend and thread count draws the same path; the maps from
-// the unit square to directions, with their densities; Fresnel terms; and GGX, the microfacet
-// distribution every rough material here uses. Plain inline functions over LiteMath: the translator
+// The path tracer's numbers and warps (libs/litept): scrambled Sobol and hashed numbers that depend
+// only on (pixel, sample, bounce, dimension), so every backend and thread count draws the same path;
+// the maps from the unit square to directions, with their densities; Fresnel terms; and GGX, the
+// microfacet distribution every rough material here uses. Plain inline functions over LiteMath: the translator
 // prints the ones kernels reach for the GPU.
 #pragma once
 #include "LiteMath.h"
