@@ -134,7 +134,9 @@ void PathTracer::kernel_Shade(uint32_t tidX, uint32_t tidY, uint32_t width, uint
   const float3 position = p0 * b0 + p1 * b1 + p2 * b2;
   float3 geomNormal = normalize(cross(p1 - p0, p2 - p0));
   const float4 objNormal = m_normals[i0] * b0 + m_normals[i1] * b1 + m_normals[i2] * b2;
-  float3 normal = normalize(to_float3(normalToWorld * float4(objNormal.x, objNormal.y, objNormal.z, 0.0f)));
+  const float3 interpolated = to_float3(normalToWorld * float4(objNormal.x, objNormal.y, objNormal.z, 0.0f));
+  // Vertex normals that cancel out or are zero (as broken files have them): the face's own.
+  float3 normal = dot(interpolated, interpolated) > 1e-20f ? normalize(interpolated) : geomNormal;
   if (dot(normal, geomNormal) < 0.0f)  // the geometric normal follows the shading normal's side
     geomNormal = -1.0f * geomNormal;
   const float2 uv = m_texcoords[i0] * b0 + m_texcoords[i1] * b1 + m_texcoords[i2] * b2;

@@ -236,6 +236,58 @@ TEST_CASE("path tracer: an area light seen obliquely lights a Lambert floor as L
   CHECK(mean == Approx(expected).epsilon(0.01));
 }
 
+TEST_CASE("path tracer: degenerate triangles and zero normals put no NaN or inf in the image", "[path_tracer]")
+{
+  // A floor lit by a small area light, and in view: a quad whose vertex normals are all zero (as
+  // broken files have them), triangles with a repeated corner or collinear corners, a sliver of
+  // area 1e-12, and an emitter of zero area (which cannot be sampled).
+  PathScene scene;
+  PathScene::Mesh m;
+  m.name = "degenerate";
+  auto triangle = [&](float3 a, float3 b, float3 c, float3 normal, uint32_t material) {
+    for (float3 p : {a, b, c})
+    {
+      m.indices.push_back(uint32_t(m.positions.size()));
+      m.positions.push_back(to_float4(p, 1.0f));
+      m.normals.push_back(to_float4(normal, 0.0f));
+    }
+    m.triangleMaterial.push_back(material);
+  };
+  const float3 up(0.0f, 1.0f, 0.0f), down(0.0f, -1.0f, 0.0f), zero(0.0f);
+  triangle(float3(-2, 0, -2), float3(-2, 0, 2), float3(2, 0, 2), up, 0);  // the floor
+  triangle(float3(-2, 0, -2), float3(2, 0, 2), float3(2, 0, -2), up, 0);
+  triangle(float3(-0.2f, 1, -0.2f), float3(0.2f, 1, -0.2f), float3(0.2f, 1, 0.2f), down, 1);  // the light
+  triangle(float3(-0.2f, 1, -0.2f), float3(0.2f, 1, 0.2f), float3(-0.2f, 1, 0.2f), down, 1);
+  triangle(float3(-1, 0.2f, -1), float3(-1, 0.2f, 0), float3(1, 0.2f, 0), zero, 0);  // zero normals
+  triangle(float3(-1, 0.2f, -1), float3(1, 0.2f, 0), float3(1, 0.2f, -1), zero, 0);
+  triangle(float3(0.5f, 0.1f, 0.5f), float3(0.5f, 0.1f, 0.5f), float3(1, 0.1f, 1), up, 0);     // a repeated corner
+  triangle(float3(0.2f, 0.1f, 0.2f), float3(0.6f, 0.1f, 0.6f), float3(1.4f, 0.1f, 1.4f), up, 0);  // collinear
+  triangle(float3(0.3f, 0.3f, -0.5f), float3(1.3f, 0.3f, -0.5f), float3(0.8f, 0.3f, -0.5f + 1e-12f), zero, 0);  // a sliver
+  triangle(float3(0.5f, 0.9f, 0.5f), float3(0.5f, 0.9f, 0.5f), float3(0.7f, 0.9f, 0.7f), down, 1);  // an emitter of no area
+  scene.meshes.push_back(m);
+  scene.instances.push_back({0, float4x4()});
+  auto white = std::make_shared<litept::Lambert>();
+  auto emitter = std::make_shared<litept::Lambert>();
+  emitter->albedo = float4(0.0f);
+  emitter->emission = float4(20.0f, 20.0f, 20.0f, 0.0f);
+  scene.materials = {white, emitter};
+  scene.camera.position = float3(0.0f, 3.0f, 0.0f);
+  scene.camera.forward = float3(0.0f, -1.0f, 0.0f);
+  scene.camera.up = float3(0.0f, 0.0f, -1.0f);
+  scene.camera.yfov = 1.0f;
+  scene.hasCamera = true;
+
+  PathTracer original;
+  auto cpu = CreatePathTracer_CPU();
+  const std::vector<float4> bvh = Render(original, scene, "sah", 32, 32, 16, 4);
+  const std::vector<float4> embree = Render(*cpu, scene, "embree", 32, 32, 16, 4);
+  CHECK(NonFinite(bvh) == 0);
+  CHECK(NonFinite(embree) == 0);
+  // The zero-normal quad is lit (it shades with its geometric normal), not black.
+  const float4 patch = bvh[size_t(32 * 12 + 12)];
+  CHECK(patch.x > 0.01f);
+}
+
 TEST_CASE("path tracer: white furnaces: what each material keeps of a uniform environment", "[path_tracer]")
 {
   auto cpu = CreatePathTracer_CPU();
