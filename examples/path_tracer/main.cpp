@@ -138,17 +138,17 @@ Options Parse(int argc, char** argv)
   return o;
 }
 
-// Prints the PSNR (8-bit sRGB) and relative MSE (linear) of the image against the one at refPath.
-void Compare(const LiteImage::Image2D<float4>& image, const std::string& refPath)
+// The --compare image, read (and checked against --size) before rendering, so that a wrong one costs
+// no render.
+LiteImage::Image2D<float4> LoadReference(const std::string& refPath, uint32_t width, uint32_t height)
 {
   LiteImage::Image2D<float4> ref;
   if (!LiteImage::LoadImage(refPath.c_str(), ref))
     throw std::runtime_error(refPath + ": error: the reference image could not be read");
-  if (ref.width() != image.width() || ref.height() != image.height())
+  if (ref.width() != width || ref.height() != height)
     throw std::runtime_error(refPath + ": error: the reference is " + std::to_string(ref.width()) + "x" + std::to_string(ref.height()) +
-                             ", the image " + std::to_string(image.width()) + "x" + std::to_string(image.height()));
-  const litept::ImageError e = litept::CompareImages(image.vector(), ref.vector());
-  std::printf("compare: against %s: PSNR %.2f dB (8-bit sRGB), relMSE %.5f (linear)\n", refPath.c_str(), e.psnr8, e.relMse);
+                             ", the image " + std::to_string(width) + "x" + std::to_string(height));
+  return ref;
 }
 
 }  // namespace
@@ -158,6 +158,9 @@ int main(int argc, char** argv)
   const Options o = Parse(argc, argv);
   try
   {
+    LiteImage::Image2D<float4> reference;
+    if (!o.compare.empty())
+      reference = LoadReference(o.compare, o.width, o.height);
     PathScene scene = LoadScene(o.scene);
     if (!o.env.empty())
       LoadEnvironment(scene, o.env, o.envStrength);
@@ -242,7 +245,10 @@ int main(int argc, char** argv)
     if (bad > 0)
       throw std::runtime_error(std::to_string(bad) + " pixels were NaN or infinite (written as black)");
     if (!o.compare.empty())
-      Compare(image, o.compare);
+    {
+      const litept::ImageError e = litept::CompareImages(image.vector(), reference.vector());
+      std::printf("compare: against %s: PSNR %.2f dB (8-bit sRGB), relMSE %.5f (linear)\n", o.compare.c_str(), e.psnr8, e.relMse);
+    }
   }
   catch (const std::exception& e)
   {
