@@ -21,14 +21,14 @@ constexpr float kInvPi = 0.318309886183791f;
 
 // ---------------------------------------------------------------- random numbers
 //
-// The numbers of a path vertex come four at a time. At the camera and the first two vertices they
+// The numbers of a path vertex come four at a time. At the camera and the first surface hit they
 // are a 4D Sobol sequence, Owen-scrambled and shuffled by hashing (Burley 2020, "Practical
 // Hash-based Owen Scrambling"): a pixel's first 2^m samples of each group of four stay a stratified
 // (0, m, 2)-net in the first two numbers, and each pixel and group gets its own scramble and order,
 // so neither pixels nor groups correlate. Deeper vertices take hashed numbers: there stratification
 // gains little and the scrambling's cost shows. Measured on the Cornell box at 512 spp, against
-// hashed numbers throughout: Sobol at the first two vertices, 13% less error for 16% more time (it
-// pays in direct light and at low spp); at every vertex, 15% less error for 50% more time.
+// hashed numbers throughout: Sobol at the camera and the first hit, 13% less error for 16% more
+// time (it pays in direct light and at low spp); at every vertex, 15% less error for 50% more time.
 
 // A well-mixed 32-bit hash (the PCG output permutation).
 inline uint32_t PcgHash(uint32_t x)
@@ -96,7 +96,7 @@ inline uint4 Sobol4(uint32_t index)
 // A 32-bit fraction as a float in [0, 1): its top 24 bits, exact, so every backend agrees.
 inline float UnitFloat(uint32_t bits) { return float(bits >> 8u) * (1.0f / 16777216.0f); }
 
-// Sobol points are drawn for vertices below this.
+// Sobol points are drawn for vertices below this (0 is the camera, 1 the first surface hit).
 constexpr uint32_t kSobolVertices = 2u;
 
 // A uniform number from hashing (pixel, sample, bounce, dimension).
