@@ -6,6 +6,10 @@
 //
 //   TriangleLight     an emissive triangle, sampled uniformly by area (front side only unless
 //                     two-sided); the scene's emissive meshes become one per triangle.
+//   SphereLight       a sphere of uniform radiance, sampled by the cone of directions it fills.
+//   RectLight         a rectangle of uniform radiance, sampled uniformly by area.
+//                     Spheres and rectangles are not in the scene's geometry: the integrator
+//                     meets them itself (Intersect), so that BSDF rays find them too.
 //   PointLight        glTF KHR_lights_punctual "point": an intensity, falling off with 1 / d^2.
 //   SpotLight         "spot": a point light within a cone, with glTF's smooth edge.
 //   DirectionalLight  "directional": parallel light of a given irradiance.
@@ -44,6 +48,19 @@ struct ILight
   {
     (void)p, (void)dir, (void)dist;
     return 0.0f;
+  }
+  // For a light with a shape of its own (not in the scene's geometry): the distance along the unit
+  // dir from p to where a ray meets it, 1e30 if it does not; and the radiance it sends back along
+  // -dir from there. Lights that are geometry, or points, meet nothing here.
+  virtual float Intersect(float3 p, float3 dir) const
+  {
+    (void)p, (void)dir;
+    return 1e30f;
+  }
+  virtual float3 RadianceTowards(float3 dir) const
+  {
+    (void)dir;
+    return float3(0.0f);
   }
   // Roughly the power it emits (the weight for picking it among the scene's lights); host side.
   virtual float Power() const = 0;
@@ -94,6 +111,135 @@ struct TriangleLight : ILight
   float Power() const override
   {
     return Luminance(to_float3(radiance)) * 0.5f * LiteMath::length(Normal()) * kPi * (radiance.w != 0.0f ? 2.0f : 1.0f);
+  }
+};
+
+// ---------------------------------------------------------------- lights with shapes of their own
+
+struct SphereLight : ILight
+{
+  float4 centerRadius;  // xyz: the centre; w: the radius
+  float4 radiance;      // xyz
+
+  // 1 - cos of the half-angle the sphere fills from p (0 when p is inside), written so that a small
+  // distant sphere keeps its digits.
+  float OneMinusCosMax(float3 p) const
+  {
+    const float3 d = to_float3(centerRadius) - p;
+    const float dist2 = LiteMath::dot(d, d), r2 = centerRadius.w * centerRadius.w;
+    if (dist2 <= r2)
+      return 0.0f;
+    const float sin2 = r2 / dist2;
+    return sin2 / (1.0f + std::sqrt(1.0f - sin2));
+  }
+  LightSample Sample(float3 p, float2 u) const override
+  {
+    const float oneMinusCos = OneMinusCosMax(p);
+    if (oneMinusCos <= 0.0f)
+      return NoLight();
+    const float3 d = to_float3(centerRadius) - p;
+    const float3 w = LiteMath::normalize(d);
+    float3 t, b;
+    BranchlessOnb(w, t, b);
+    const float cosT = 1.0f - u.x * oneMinusCos;
+    const float sinT = std::sqrt(LiteMath::max(0.0f, 1.0f - cosT * cosT));
+    const float phi = 2.0f * kPi * u.y;
+    const float3 dir = t * (sinT * std::cos(phi)) + b * (sinT * std::sin(phi)) + w * cosT;
+    const float dist = Intersect(p, dir);
+    if (dist >= 1e30f)  // grazing the rim in float
+      return NoLight();
+    LightSample s;
+    s.dirDist = to_float4(dir, dist);
+    s.radiancePdf = to_float4(to_float3(radiance), 1.0f / (2.0f * kPi * oneMinusCos));
+    s.delta = 0u;
+    return s;
+  }
+  float Pdf(float3 p, float3 dir, float dist) const override
+  {
+    (void)dir, (void)dist;
+    const float oneMinusCos = OneMinusCosMax(p);
+    return oneMinusCos > 0.0f ? 1.0f / (2.0f * kPi * oneMinusCos) : 0.0f;
+  }
+  float Intersect(float3 p, float3 dir) const override
+  {
+    const float3 d = to_float3(centerRadius) - p;
+    const float along = LiteMath::dot(d, dir);
+    const float miss2 = LiteMath::dot(d, d) - along * along;  // squared distance of the line from the centre
+    const float r2 = centerRadius.w * centerRadius.w;
+    if (miss2 > r2)
+      return 1e30f;
+    const float half = std::sqrt(r2 - miss2);
+    const float tNear = along - half, tFar = along + half;
+    return tNear > 0.0f ? tNear : (tFar > 0.0f ? tFar : 1e30f);
+  }
+  float3 RadianceTowards(float3 dir) const override
+  {
+    (void)dir;
+    return to_float3(radiance);
+  }
+  float Power() const override { return 4.0f * kPi * kPi * centerRadius.w * centerRadius.w * Luminance(to_float3(radiance)); }
+};
+
+struct RectLight : ILight
+{
+  float4 corner;    // xyz
+  float4 edge1;     // xyz: along one side
+  float4 edge2;     // xyz: along the other, at right angles; it emits towards cross(edge1, edge2)
+  float4 radiance;  // xyz; w: 1 when it emits from both sides
+
+  float3 Normal() const { return LiteMath::cross(to_float3(edge1), to_float3(edge2)); }  // length: the area
+
+  LightSample Sample(float3 p, float2 u) const override
+  {
+    const float3 q = to_float3(corner) + to_float3(edge1) * u.x + to_float3(edge2) * u.y;
+    const float3 d = q - p;
+    const float dist2 = LiteMath::dot(d, d);
+    const float3 n = Normal();
+    const float area = LiteMath::length(n);
+    if (dist2 <= 0.0f || area <= 0.0f)
+      return NoLight();
+    const float dist = std::sqrt(dist2);
+    const float3 dir = d * (1.0f / dist);
+    const float cosL = -LiteMath::dot(n, dir) / area;
+    if (cosL <= 0.0f && (radiance.w == 0.0f || cosL == 0.0f))
+      return NoLight();
+    LightSample s;
+    s.dirDist = to_float4(dir, dist);
+    s.radiancePdf = to_float4(to_float3(radiance), dist2 / (area * std::fabs(cosL)));
+    s.delta = 0u;
+    return s;
+  }
+  float Pdf(float3 p, float3 dir, float dist) const override
+  {
+    (void)p;
+    const float3 n = Normal();
+    const float area = LiteMath::length(n);
+    const float cosL = -LiteMath::dot(n, dir) / area;
+    if (area <= 0.0f || cosL == 0.0f || (cosL < 0.0f && radiance.w == 0.0f))
+      return 0.0f;
+    return dist * dist / (area * std::fabs(cosL));
+  }
+  float Intersect(float3 p, float3 dir) const override
+  {
+    const float3 n = Normal();
+    const float facing = LiteMath::dot(n, dir);
+    if (facing == 0.0f)
+      return 1e30f;
+    const float t = LiteMath::dot(n, to_float3(corner) - p) / facing;
+    if (t <= 0.0f)
+      return 1e30f;
+    const float3 q = p + dir * t - to_float3(corner);
+    const float a = LiteMath::dot(q, to_float3(edge1)) / LiteMath::dot(to_float3(edge1), to_float3(edge1));
+    const float b = LiteMath::dot(q, to_float3(edge2)) / LiteMath::dot(to_float3(edge2), to_float3(edge2));
+    return a >= 0.0f && a <= 1.0f && b >= 0.0f && b <= 1.0f ? t : 1e30f;
+  }
+  float3 RadianceTowards(float3 dir) const override
+  {
+    return LiteMath::dot(Normal(), dir) < 0.0f || radiance.w != 0.0f ? to_float3(radiance) : float3(0.0f);
+  }
+  float Power() const override
+  {
+    return kPi * LiteMath::length(Normal()) * Luminance(to_float3(radiance)) * (radiance.w != 0.0f ? 2.0f : 1.0f);
   }
 };
 

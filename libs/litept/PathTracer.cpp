@@ -109,6 +109,30 @@ void PathTracer::kernel_Shade(uint32_t tidX, uint32_t tidY, uint32_t width, uint
   const float3 beta = to_float3(*throughput);
   const float lastBsdfPdf = pathState->x;
 
+  // Lights with shapes of their own are not in the scene's geometry: a ray that meets one before any
+  // surface ends there, with its radiance weighted against the light sample that could have found it.
+  float nearest = hit->primId == kMiss ? 1e30f : hit->t;
+  int shapeLight = -1;
+  for (uint32_t i = 0; i < m_shapeLightCount; i++)
+  {
+    const uint32_t light = m_shapeLights[i];
+    const float t = m_lights[light]->Intersect(origin, dir);
+    if (t < nearest)
+    {
+      nearest = t;
+      shapeLight = int(light);
+    }
+  }
+  if (shapeLight >= 0)
+  {
+    float weight = 1.0f;
+    if (lastBsdfPdf > 0.0f)
+      weight = PowerHeuristic(lastBsdfPdf, LightChoicePdf(uint32_t(shapeLight)) * m_lights[shapeLight]->Pdf(origin, dir, nearest));
+    *color += to_float4(beta * m_lights[shapeLight]->RadianceTowards(dir) * weight, 0.0f);
+    throughput->w = 0.0f;
+    return;
+  }
+
   if (hit->primId == kMiss)  // the ray left the scene: the environment, weighted against its light sample
   {
     if (m_envEnabled != 0)

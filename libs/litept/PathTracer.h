@@ -98,6 +98,10 @@ protected:
   // any, is the last choice (index m_lights.size()).
   std::vector<std::shared_ptr<litept::ILight>> m_lights;
   std::vector<float> m_lightCdf;  // m_lights.size() + 2 entries: 0, ..., 1
+  // The lights with shapes of their own (spheres, rectangles), which rays meet outside the scene's
+  // geometry; never empty on the GPU: m_shapeLightCount says how many there are.
+  std::vector<uint32_t> m_shapeLights;
+  uint32_t m_shapeLightCount = 0;
 
   // The environment: an equirectangular map (Blender's orientation, see Environment()), bilinear,
   // and its distribution: rows by m_envCdf[0 .. h], then row r's columns at (h + 1) + r (w + 1).

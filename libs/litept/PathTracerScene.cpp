@@ -57,6 +57,13 @@ void PathTracer::SetScene(const PathScene& scene, std::shared_ptr<ISceneObject> 
 
   // Instances, and a light per emissive triangle of each.
   m_lights = scene.lights;
+  m_shapeLights.clear();
+  for (size_t i = 0; i < m_lights.size(); ++i)
+    if (dynamic_cast<const SphereLight*>(m_lights[i].get()) || dynamic_cast<const RectLight*>(m_lights[i].get()))
+      m_shapeLights.push_back(uint32_t(i));
+  m_shapeLightCount = uint32_t(m_shapeLights.size());
+  if (m_shapeLights.empty())
+    m_shapeLights.push_back(0u);  // GPU buffers are not empty
   m_instToWorld.clear(), m_instNormalToWorld.clear(), m_instFirstLight.clear(), m_triangleLight.clear();
   m_pAccelStruct->ClearScene();
   for (const PathScene::Instance& inst : scene.instances)

@@ -261,7 +261,30 @@ private:
     const float3 value = color * (float(l.intensity) / kLumensPerWatt);
     const float3 position = TransformPoint(world, float3(0.0f));
     const float3 direction = normalize(TransformVector(world, float3(0.0f, 0.0f, -1.0f)));
-    if (l.type == "point")
+    // A point light with a size in its "extras" is a sphere ("radius") or a rectangle ("width" and
+    // "height", in the node's xy plane, facing -z) of the same intensity along its axis.
+    auto extra = [&](const char* field) {
+      return l.extras.IsObject() && l.extras.Has(field) && l.extras.Get(field).IsNumber() ? l.extras.Get(field).GetNumberAsDouble() : 0.0;
+    };
+    const float radius = float(extra("radius")), width = float(extra("width")), height = float(extra("height"));
+    if (l.type == "point" && radius > 0.0f)
+    {
+      auto sphere = std::make_shared<litept::SphereLight>();
+      sphere->centerRadius = to_float4(position, radius);
+      sphere->radiance = to_float4(value * (1.0f / (litept::kPi * radius * radius)), 0.0f);
+      m_scene.lights.push_back(sphere);
+    }
+    else if (l.type == "point" && width > 0.0f && height > 0.0f)
+    {
+      const float3 x = normalize(TransformVector(world, float3(1.0f, 0.0f, 0.0f))), y = normalize(TransformVector(world, float3(0.0f, 1.0f, 0.0f)));
+      auto rect = std::make_shared<litept::RectLight>();
+      rect->corner = to_float4(position - x * (0.5f * width) - y * (0.5f * height), 1.0f);
+      rect->edge1 = to_float4(y * height, 0.0f);  // cross(y, x) = -z: it faces the way the node looks
+      rect->edge2 = to_float4(x * width, 0.0f);
+      rect->radiance = to_float4(value * (1.0f / (width * height)), 0.0f);
+      m_scene.lights.push_back(rect);
+    }
+    else if (l.type == "point")
     {
       auto p = std::make_shared<litept::PointLight>();
       p->position = to_float4(position, 1.0f);

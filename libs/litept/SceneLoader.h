@@ -6,8 +6,12 @@
 // glTF: the default scene's node hierarchy (matrices or TRS), each mesh once with an instance per
 // node that uses it, perspective cameras, metallic-roughness materials with their textures, and the
 // extensions KHR_materials_emissive_strength, KHR_materials_transmission with KHR_materials_ior,
-// KHR_materials_specular (its factor) and KHR_lights_punctual. A scene without a camera or any light
-// gets a stated default (`notes`), as does anything read only approximately.
+// KHR_materials_specular (its factor) and KHR_lights_punctual. glTF has no area lights: a point
+// light whose "extras" give a "radius" is a sphere light, one with "width" and "height" a rectangle
+// in its node's xy plane facing -z; either has the point light's intensity along its axis (radiance
+// = intensity / (pi r^2), or intensity / area). PathScene::lights takes SphereLight and RectLight
+// directly too. A scene without a camera or any light gets a stated default (`notes`), as does
+// anything read only approximately.
 #pragma once
 #include "Image2D.h"
 #include "Lights.h"

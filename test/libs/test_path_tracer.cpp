@@ -236,6 +236,72 @@ TEST_CASE("path tracer: an area light seen obliquely lights a Lambert floor as L
   CHECK(mean == Approx(expected).epsilon(0.01));
 }
 
+TEST_CASE("path tracer: sphere and rectangle lights from glTF light extras light a floor as the formulas say", "[path_tracer]")
+{
+  // A white Lambert floor (KHR_materials_specular factor 0), and two point lights of intensity 2 at
+  // (0, 1, 0) with sizes in their extras: a sphere of radius 0.1, and a 0.4 x 0.2 rectangle turned to
+  // face down. Each is rendered alone, direct light only.
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "crossrt_shape_lights";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "lights.gltf") << R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0,1,2]}],
+    "extensionsUsed":["KHR_lights_punctual","KHR_materials_specular"],
+    "extensions":{"KHR_lights_punctual":{"lights":[
+      {"type":"point","color":[1,1,1],"intensity":2,"extras":{"radius":0.1}},
+      {"type":"point","color":[1,1,1],"intensity":2,"extras":{"width":0.4,"height":0.2}}]}},
+    "nodes":[{"mesh":0},
+             {"translation":[0,1,0],"extensions":{"KHR_lights_punctual":{"light":0}}},
+             {"translation":[0,1,0],"rotation":[-0.70710678,0,0,0.70710678],"extensions":{"KHR_lights_punctual":{"light":1}}}],
+    "meshes":[{"primitives":[{"attributes":{"POSITION":0},"indices":1,"material":0}]}],
+    "materials":[{"pbrMetallicRoughness":{"baseColorFactor":[1,1,1,1],"metallicFactor":0},
+                  "extensions":{"KHR_materials_specular":{"specularFactor":0}}}],
+    "accessors":[{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[-4,0,-4],"max":[4,0,4]},
+                 {"bufferView":1,"componentType":5123,"count":6,"type":"SCALAR"}],
+    "bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":48},{"buffer":0,"byteOffset":48,"byteLength":12}],
+    "buffers":[{"byteLength":60,"uri":"data:application/octet-stream;base64,AACAwAAAAAAAAIDAAACAwAAAAAAAAIBAAACAQAAAAAAAAIBAAACAQAAAAAAAAIDAAAABAAIAAAACAAMA"}]})";
+  const PathScene loaded = LoadScene((dir / "lights.gltf").string());
+  std::filesystem::remove_all(dir);
+  REQUIRE(loaded.lights.size() == 2u);
+  REQUIRE(dynamic_cast<const litept::SphereLight*>(loaded.lights[0].get()) != nullptr);
+  REQUIRE(dynamic_cast<const litept::RectLight*>(loaded.lights[1].get()) != nullptr);
+
+  const float intensity = 2.0f / 683.0f;  // glTF's candelas in W/sr, as Blender's importer converts them
+  const float sphereRadiance = intensity / (litept::kPi * 0.01f), rectRadiance = intensity / 0.08f;
+  const std::vector<float3> rect = {float3(-0.2f, 1, -0.1f), float3(0.2f, 1, -0.1f), float3(0.2f, 1, 0.1f), float3(-0.2f, 1, 0.1f)};
+  const float expected[2] = {
+      sphereRadiance * 0.01f,                                                           // E / pi = L sin^2 of the cone, below its centre
+      PolygonIrradiance(float3(0.0f), float3(0.0f, 1.0f, 0.0f), rect, rectRadiance) / litept::kPi};  // Lambert's formula
+  auto cpu = CreatePathTracer_CPU();
+  for (int which = 0; which < 2; ++which)
+  {
+    PathScene scene = loaded;
+    scene.lights = {loaded.lights[size_t(which)]};
+    // The floor's middle, seen obliquely from the side with a narrow view (the patch is 3 cm long).
+    scene.camera.position = float3(3.0f, 1.5f, 0.0f);
+    scene.camera.forward = normalize(float3(-3.0f, -1.5f, 0.0f));
+    scene.camera.up = normalize(float3(-1.5f, 3.0f, 0.0f));
+    scene.camera.yfov = 0.004f;
+    scene.hasCamera = true;
+    const std::vector<float4> lit = Render(*cpu, scene, "embree", 8, 8, 1024, 0);
+    double mean = 0.0;
+    for (const auto& v : lit)
+      mean += v.y / double(lit.size());
+    INFO((which == 0 ? "sphere" : "rectangle") << ": rendered " << mean << ", expected " << expected[which]);
+    CHECK(mean == Approx(expected[which]).epsilon(0.01));
+    // Seen directly from below, each gives its radiance; the rectangle's back is dark.
+    scene.camera.position = float3(0.0f, 0.5f, 0.0f);
+    scene.camera.forward = float3(0.0f, 1.0f, 0.0f);
+    scene.camera.up = float3(0.0f, 0.0f, -1.0f);
+    scene.camera.yfov = 0.01f;
+    const std::vector<float4> seen = Render(*cpu, scene, "embree", 4, 4, 4, 0);
+    CHECK(seen[5].y == Approx(which == 0 ? sphereRadiance : rectRadiance).epsilon(1e-5));
+    scene.camera.position = float3(0.0f, 1.5f, 0.0f);
+    scene.camera.forward = float3(0.0f, -1.0f, 0.0f);
+    const std::vector<float4> above = Render(*cpu, scene, "embree", 4, 4, 4, 0);
+    if (which == 1)
+      CHECK(above[5].y == 0.0f);
+  }
+}
+
 TEST_CASE("path tracer: degenerate triangles and zero normals put no NaN or inf in the image", "[path_tracer]")
 {
   // A floor lit by a small area light, and in view: a quad whose vertex normals are all zero (as
