@@ -50,7 +50,11 @@ What it does
      * Every remaining Principled BSDF gets distribution 'GGX' (single
        scattering), not multiscatter GGX.
      * Punctual lights get radius 0 (point/spot shadow_soft_size, sun angle;
-       Blender's default is a 0.25 m sphere).  With the importer's default
+       Blender's default is a 0.25 m sphere), except CrossRT's lights with a
+       size: a point light whose glTF extras give a "radius" keeps it (a
+       sphere light), one with "width" and "height" becomes a rectangular
+       area light of that size with a quarter of the power (the same
+       intensity along its axis); both are made visible to camera rays.  With the importer's default
        --lighting-mode SPEC a point/spot light of glTF intensity I (cd) has
        radiant intensity I/683 W/sr in Cycles, a sun of E lux has irradiance
        E/683 W/m^2.  COMPAT: I W/sr and E W/m^2.  RAW: Blender Watts = I.
@@ -384,6 +388,30 @@ def fix_lights(scene):
         if o.type != "LIGHT":
             continue
         light = o.data
+        # CrossRT's lights with a size: a glTF point light whose extras (the
+        # importer's custom properties) give a radius is a sphere, one with a
+        # width and height a rectangle facing the node's -z.
+        radius = float(light.get("radius", 0.0))
+        width, height = float(light.get("width", 0.0)), float(light.get("height", 0.0))
+        if radius > 0.0 or (width > 0.0 and height > 0.0):
+            o.visible_camera = True  # CrossRT's camera rays see them too
+        if light.type == "POINT" and radius > 0.0:
+            light.shadow_soft_size = radius
+            note("light %s: a sphere of radius %g, Blender energy %g"
+                 % (o.name, radius, light.energy))
+            continue
+        if light.type == "POINT" and width > 0.0 and height > 0.0:
+            energy = light.energy
+            light.type = "AREA"
+            light = o.data
+            light.shape = "RECTANGLE"
+            light.size, light.size_y = width, height
+            # The same intensity along the axis: a point light's power is
+            # 4 pi I, a one-sided Lambertian rectangle's pi I.
+            light.energy = energy / 4.0
+            note("light %s: a %g x %g rectangle, Blender energy %g"
+                 % (o.name, width, height, light.energy))
+            continue
         if light.type in ("POINT", "SPOT"):
             light.shadow_soft_size = 0.0
         elif light.type == "SUN":
