@@ -53,8 +53,9 @@ What it does
        Blender's default is a 0.25 m sphere), except CrossRT's lights with a
        size: a point light whose glTF extras give a "radius" keeps it (a
        sphere light), one with "width" and "height" becomes a rectangular
-       area light of that size with a quarter of the power (the same
-       intensity along its axis); both are made visible to camera rays.  With the importer's default
+       area light of that size and the same radiance (Cycles' area light
+       of power P sends P / (4 A)); both are made visible to camera rays
+       (Cycles' lights do not stop them: what is behind adds up).  With the importer's default
        --lighting-mode SPEC a point/spot light of glTF intensity I (cd) has
        radiant intensity I/683 W/sr in Cycles, a sun of E lux has irradiance
        E/683 W/m^2.  COMPAT: I W/sr and E W/m^2.  RAW: Blender Watts = I.
@@ -406,9 +407,10 @@ def fix_lights(scene):
             light = o.data
             light.shape = "RECTANGLE"
             light.size, light.size_y = width, height
-            # The same intensity along the axis: a point light's power is
-            # 4 pi I, a one-sided Lambertian rectangle's pi I.
-            light.energy = energy / 4.0
+            # The same radiance, intensity / area: the point light's power is
+            # 4 pi I, and Cycles' area light of power P sends P / (4 A)
+            # (measured: seen directly, P / (pi A) would be 27% brighter).
+            light.energy = energy / math.pi
             note("light %s: a %g x %g rectangle, Blender energy %g"
                  % (o.name, width, height, light.energy))
             continue
