@@ -1,10 +1,11 @@
 #!/bin/bash
-# The path tracer against Blender's Cycles on three scenes: the Cornell box this project writes
-# (area light, rough metal, glass), and two assimp-testmodels glTF models (2CylinderEngine, 110k
-# triangles; ClearCoatTest, textures and normal maps) lit by Blender's "forest" HDR map. Each scene is
-# rendered by scripts/cycles-reference.py and by path_tracer (PathTracer_CPU) at the same size,
-# depth and spp; the table gives the PSNR (8-bit sRGB) and relative MSE (linear) of ours against
-# Cycles', and each renderer's time on this machine's cores.
+# The path tracer against Blender's Cycles on four scenes: the Cornell box this project writes
+# (area light, rough metal, glass), the same with a sphere and a rectangle light as well, and two
+# assimp-testmodels glTF models (2CylinderEngine, 110k triangles; ClearCoatTest, textures and
+# normal maps) lit by Blender's "forest" HDR map. Each scene is rendered by
+# scripts/cycles-reference.py and by path_tracer (PathTracer_CPU) at the same size, depth and spp;
+# the table gives the PSNR (8-bit sRGB) and relative MSE (linear) of ours against Cycles', and each
+# renderer's time on this machine's cores.
 set -euo pipefail
 
 usage() {
@@ -57,9 +58,13 @@ echo "scene,size,spp,depth,cycles_s,crossrt_s,psnr_db,relmse,goal_db" > "$csv"
   echo "|---|---|---|---|---|---|---|---|"
 } > "$md"
 
+# The Cornell box with a sphere and a rectangle light as well.
+/usr/bin/python3 "$root/scripts/make-cornell-box.py" --shape-lights "$out/cornell_box_shape_lights.gltf"
+
 # name, file, size, spp, environment (- for none), goal in dB
 scenes=(
   "cornell_box|$cornell|128x128|4096|-|35"
+  "cornell_box_shape_lights|$out/cornell_box_shape_lights.gltf|128x128|4096|-|35"
   "2CylinderEngine|$models/2CylinderEngine-glTF-Binary/2CylinderEngine.glb|160x120|1024|$env_map|30"
   "ClearCoatTest|$models/ClearCoat-glTF/ClearCoatTest.gltf|320x240|1024|$env_map|30"
 )

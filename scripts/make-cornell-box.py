@@ -2,7 +2,7 @@
 """Write a Cornell box test scene as a self-contained glTF 2.0 file.
 
 Usage:
-    python3 scripts/make-cornell-box.py OUT.gltf
+    python3 scripts/make-cornell-box.py [--shape-lights] OUT.gltf
 
 The output is a text .gltf whose single buffer is embedded as a base64 data
 URI.  The file is deterministic byte for byte (plain Python, no numpy, no
@@ -35,6 +35,8 @@ Scene (Y up, metres, glTF conventions):
   * Perspective camera node "Camera" at (0, 1, 3.6) with identity rotation
     (looks down -z), yfov 0.6911112 rad (39.6 degrees, Blender's default
     50 mm lens on a 36 mm sensor), aspectRatio 1, znear 0.01, zfar 100.
+  * With --shape-lights, also a sphere light and a rectangle light: glTF
+    point lights whose extras give a size (see add_shape_lights).
 
 Validate with e.g.
     blender -b --factory-startup --python-exit-code 1 \
@@ -421,6 +423,26 @@ def build_gltf():
     }
 
 
+def add_shape_lights(gltf):
+    """--shape-lights: a bluish sphere light (radius 0.12, 400 cd) upper left,
+    and a warm 0.5 x 0.25 rectangle (300 cd along its axis) by the right wall,
+    facing -x: KHR_lights_punctual point lights with CrossRT's size extras."""
+    gltf["extensionsUsed"] = sorted(gltf["extensionsUsed"] + ["KHR_lights_punctual"])
+    gltf["extensions"] = {"KHR_lights_punctual": {"lights": [
+        {"name": "Sphere", "type": "point", "color": [0.6, 0.8, 1.0],
+         "intensity": 400.0, "extras": {"radius": 0.12}},
+        {"name": "Rectangle", "type": "point", "color": [1.0, 0.9, 0.7],
+         "intensity": 300.0, "extras": {"width": 0.5, "height": 0.25}}]}}
+    first = len(gltf["nodes"])
+    gltf["nodes"].append({"name": "SphereLight", "translation": [-0.5, 1.4, 0.4],
+                          "extensions": {"KHR_lights_punctual": {"light": 0}}})
+    half = math.sqrt(0.5)  # a quarter turn about +y: the node's -z looks along -x
+    gltf["nodes"].append({"name": "RectLight", "translation": [0.95, 1.2, -0.3],
+                          "rotation": [0.0, half, 0.0, half],
+                          "extensions": {"KHR_lights_punctual": {"light": 1}}})
+    gltf["scenes"][0]["nodes"] += [first, first + 1]
+
+
 def main(argv):
     usage = (__doc__.split("\n\n")[1] + "\n\n"
              "Writes a deterministic Cornell box glTF 2.0 scene (embedded "
@@ -428,10 +450,15 @@ def main(argv):
     if argv in (["-h"], ["--help"]):
         sys.stdout.write(usage)
         return 0
+    shape_lights = "--shape-lights" in argv
+    argv = [a for a in argv if a != "--shape-lights"]
     if len(argv) != 1 or argv[0].startswith("-"):
         sys.stderr.write(usage)
         return 2
-    text = json.dumps(build_gltf(), indent=1) + "\n"
+    gltf = build_gltf()
+    if shape_lights:
+        add_shape_lights(gltf)
+    text = json.dumps(gltf, indent=1) + "\n"
     with open(argv[0], "w", encoding="ascii", newline="\n") as f:
         f.write(text)
     return 0
