@@ -66,6 +66,42 @@ struct ILight
   virtual float Power() const = 0;
 };
 
+// ---------------------------------------------------------------- lights with an area
+
+// The point q of a flat light drawn uniformly by area (normal: its facing side, any length; area:
+// its area), as seen from p, with the density of that choice in solid angle. None from behind a
+// one-sided light (radiance.w == 0).
+inline LightSample FromAreaPoint(float3 p, float3 q, float3 normal, float area, float4 radiance)
+{
+  const float3 d = q - p;
+  const float dist2 = LiteMath::dot(d, d);
+  const float normalLength = LiteMath::length(normal);
+  if (dist2 <= 0.0f || area <= 0.0f || normalLength <= 0.0f)
+    return NoLight();
+  const float dist = std::sqrt(dist2);
+  const float3 dir = d * (1.0f / dist);
+  const float cosL = -LiteMath::dot(normal, dir) / normalLength;
+  if (cosL <= 0.0f && (radiance.w == 0.0f || cosL == 0.0f))
+    return NoLight();
+  LightSample s;
+  s.dirDist = to_float4(dir, dist);
+  s.radiancePdf = to_float4(to_float3(radiance), dist2 / (area * std::fabs(cosL)));
+  s.delta = 0u;
+  return s;
+}
+
+// The density FromAreaPoint gives the point a ray from p found at dist along dir.
+inline float AreaPointPdf(float3 normal, float area, float4 radiance, float3 dir, float dist)
+{
+  const float normalLength = LiteMath::length(normal);
+  if (area <= 0.0f || normalLength <= 0.0f)
+    return 0.0f;
+  const float cosL = -LiteMath::dot(normal, dir) / normalLength;
+  if (cosL == 0.0f || (cosL < 0.0f && radiance.w == 0.0f))
+    return 0.0f;
+  return dist * dist / (area * std::fabs(cosL));
+}
+
 // ---------------------------------------------------------------- an emissive triangle
 
 struct TriangleLight : ILight
@@ -80,33 +116,14 @@ struct TriangleLight : ILight
   LightSample Sample(float3 p, float2 u) const override
   {
     const float2 b = SampleTriangle(u.x, u.y);
-    const float3 q = to_float3(v0) + to_float3(edge1) * b.x + to_float3(edge2) * b.y;
-    const float3 d = q - p;
-    const float dist2 = LiteMath::dot(d, d);
     const float3 n = Normal();
-    const float area2 = LiteMath::length(n);
-    if (dist2 <= 0.0f || area2 <= 0.0f)
-      return NoLight();
-    const float dist = std::sqrt(dist2);
-    const float3 dir = d * (1.0f / dist);
-    const float cosL = -LiteMath::dot(n, dir) / area2;
-    if (cosL <= 0.0f && (radiance.w == 0.0f || cosL == 0.0f))
-      return NoLight();
-    LightSample s;
-    s.dirDist = to_float4(dir, dist);
-    s.radiancePdf = to_float4(to_float3(radiance), dist2 / (0.5f * area2 * std::fabs(cosL)));
-    s.delta = 0u;
-    return s;
+    return FromAreaPoint(p, to_float3(v0) + to_float3(edge1) * b.x + to_float3(edge2) * b.y, n, 0.5f * LiteMath::length(n), radiance);
   }
   float Pdf(float3 p, float3 dir, float dist) const override
   {
     (void)p;
     const float3 n = Normal();
-    const float area2 = LiteMath::length(n);
-    const float cosL = -LiteMath::dot(n, dir) / area2;
-    if (area2 <= 0.0f || cosL == 0.0f || (cosL < 0.0f && radiance.w == 0.0f))
-      return 0.0f;
-    return dist * dist / (0.5f * area2 * std::fabs(cosL));
+    return AreaPointPdf(n, 0.5f * LiteMath::length(n), radiance, dir, dist);
   }
   float Power() const override
   {
@@ -191,33 +208,14 @@ struct RectLight : ILight
 
   LightSample Sample(float3 p, float2 u) const override
   {
-    const float3 q = to_float3(corner) + to_float3(edge1) * u.x + to_float3(edge2) * u.y;
-    const float3 d = q - p;
-    const float dist2 = LiteMath::dot(d, d);
     const float3 n = Normal();
-    const float area = LiteMath::length(n);
-    if (dist2 <= 0.0f || area <= 0.0f)
-      return NoLight();
-    const float dist = std::sqrt(dist2);
-    const float3 dir = d * (1.0f / dist);
-    const float cosL = -LiteMath::dot(n, dir) / area;
-    if (cosL <= 0.0f && (radiance.w == 0.0f || cosL == 0.0f))
-      return NoLight();
-    LightSample s;
-    s.dirDist = to_float4(dir, dist);
-    s.radiancePdf = to_float4(to_float3(radiance), dist2 / (area * std::fabs(cosL)));
-    s.delta = 0u;
-    return s;
+    return FromAreaPoint(p, to_float3(corner) + to_float3(edge1) * u.x + to_float3(edge2) * u.y, n, LiteMath::length(n), radiance);
   }
   float Pdf(float3 p, float3 dir, float dist) const override
   {
     (void)p;
     const float3 n = Normal();
-    const float area = LiteMath::length(n);
-    const float cosL = -LiteMath::dot(n, dir) / area;
-    if (area <= 0.0f || cosL == 0.0f || (cosL < 0.0f && radiance.w == 0.0f))
-      return 0.0f;
-    return dist * dist / (area * std::fabs(cosL));
+    return AreaPointPdf(n, LiteMath::length(n), radiance, dir, dist);
   }
   float Intersect(float3 p, float3 dir) const override
   {

@@ -168,6 +168,27 @@ TEST_CASE("path tracer: an emitter seen directly gives exactly its radiance", "[
   }
 }
 
+// A white Lambert (material 0), and a black one (material 1) emitting `radiance` from its front.
+std::vector<std::shared_ptr<litept::IMaterial>> WhiteAndEmitter(float radiance)
+{
+  auto white = std::make_shared<litept::Lambert>();
+  white->albedo = float4(1.0f);
+  auto emitter = std::make_shared<litept::Lambert>();
+  emitter->albedo = float4(0.0f);
+  emitter->emission = float4(radiance, radiance, radiance, 0.0f);
+  return {white, emitter};
+}
+
+// The camera straight above the origin at `height`, looking down (the image's up: -z).
+void LookDown(PathScene& scene, float height, float yfov)
+{
+  scene.camera.position = float3(0.0f, height, 0.0f);
+  scene.camera.forward = float3(0.0f, -1.0f, 0.0f);
+  scene.camera.up = float3(0.0f, 0.0f, -1.0f);
+  scene.camera.yfov = yfov;
+  scene.hasCamera = true;
+}
+
 // Irradiance at p (normal n) from a polygon of uniform radiance L: Lambert's formula, the sum over
 // its edges of the angle each subtends times the cosine of that edge's plane with n, over 2.
 float PolygonIrradiance(float3 p, float3 n, const std::vector<float3>& polygon, float L)
@@ -207,17 +228,8 @@ TEST_CASE("path tracer: an area light seen obliquely lights a Lambert floor as L
   }
   scene.meshes.push_back(quads);
   scene.instances.push_back({0, float4x4()});
-  auto white = std::make_shared<litept::Lambert>();
-  white->albedo = float4(1.0f);
-  auto emitter = std::make_shared<litept::Lambert>();
-  emitter->albedo = float4(0.0f);
-  emitter->emission = float4(10.0f, 10.0f, 10.0f, 0.0f);
-  scene.materials = {white, emitter};
-  scene.camera.position = float3(0.0f, 3.0f, 0.0f);
-  scene.camera.forward = float3(0.0f, -1.0f, 0.0f);
-  scene.camera.up = float3(0.0f, 0.0f, -1.0f);
-  scene.camera.yfov = 0.02f;  // a 6 cm patch of floor
-  scene.hasCamera = true;
+  scene.materials = WhiteAndEmitter(10.0f);
+  LookDown(scene, 3.0f, 0.02f);  // a 6 cm patch of floor
 
   // Outgoing radiance of an albedo-1 Lambert: E / pi, over the patch (E varies by 2% across it).
   double expected = 0.0;
@@ -332,16 +344,8 @@ TEST_CASE("path tracer: degenerate triangles and zero normals put no NaN or inf 
   triangle(float3(0.5f, 0.9f, 0.5f), float3(0.5f, 0.9f, 0.5f), float3(0.7f, 0.9f, 0.7f), down, 1);  // an emitter of no area
   scene.meshes.push_back(m);
   scene.instances.push_back({0, float4x4()});
-  auto white = std::make_shared<litept::Lambert>();
-  auto emitter = std::make_shared<litept::Lambert>();
-  emitter->albedo = float4(0.0f);
-  emitter->emission = float4(20.0f, 20.0f, 20.0f, 0.0f);
-  scene.materials = {white, emitter};
-  scene.camera.position = float3(0.0f, 3.0f, 0.0f);
-  scene.camera.forward = float3(0.0f, -1.0f, 0.0f);
-  scene.camera.up = float3(0.0f, 0.0f, -1.0f);
-  scene.camera.yfov = 1.0f;
-  scene.hasCamera = true;
+  scene.materials = WhiteAndEmitter(20.0f);
+  LookDown(scene, 3.0f, 1.0f);
 
   PathTracer original;
   auto cpu = CreatePathTracer_CPU();
