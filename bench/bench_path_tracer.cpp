@@ -287,7 +287,8 @@ int main(int argc, char** argv)
       for (size_t i = 0; i < levels.size(); ++i)
       {
         const Row& r = levels[i];
-        const double rate = r.spp / Median(r.seconds), level2 = levels[i - i % 3 + 1].spp / Median(levels[i - i % 3 + 1].seconds);
+        const Row& sameModeLevel2 = levels[i - i % 3 + 1];  // each mode's rows are levels 1, 2, 3
+        const double rate = r.spp / Median(r.seconds), level2 = sameModeLevel2.spp / Median(sameModeLevel2.seconds);
         std::printf("| %s | %s | %.2f | %.3f | %.2fx |\n", r.name.c_str(), r.mode.c_str(), rate, rate * paths * 1e-6, rate / level2);
         csv << "virtual_level," << r.name << "," << r.mode << "," << r.spp << "," << Median(r.seconds) << "," << rate << "," << rate * paths * 1e-6
             << "," << rate / level2 << ",,\n";
