@@ -2,8 +2,9 @@
 // cached: BVH build time (Embree LOW and MEDIUM, the LBVH as written, LBVH_CPU, LBVH_ISPC where ISPC
 // is found, LBVH_Vulkan on the default device, binned SAH), SAH cost of each tree, and traversal of 1024x1024 primary rays
 // (Embree rtcIntersect1 and rtcIntersect16, CrossRT's traversal over the LBVH and SAH trees as
-// written, and translated: PrimaryRays_CPU, PrimaryRays_ISPC (one ray a SIMD lane, where ISPC is
-// found) and PrimaryRays_Vulkan, which compose BVHScene's traversal), with ratios against Embree. Every figure is measured in this run: the CPU builders and
+// written, and translated: PrimaryRays_CPU, PrimaryRays_ISPC (one ray a SIMD lane, where ISPC is found; over the
+// LBVH and over the SAH tree, the kind Embree MEDIUM builds) and PrimaryRays_Vulkan, which compose BVHScene's
+// traversal), with ratios against Embree. Every figure is measured in this run: the CPU builders and
 // the CPU tracers in rounds that run each in turn (7 and 5), with ratios as medians of the rounds'
 // ratios; the Vulkan figures as medians of 3 after a warm-up.
 // Then the speed-against-quality trade of LBVH against binned SAH, as a table and as CSV, which
@@ -281,16 +282,16 @@ int main(int argc, char** argv)
   std::printf("\nTraversal of %dx%d primary rays, Mrays/s, all %d threads but 1T (ratio against Embree rtcIntersect1 on all\n"
               "threads: medians of %d interleaved rounds' ratios; _Vulkan: median of 3, its ratio one of medians); SAH cost of the trees\n",
               kImageSize, kImageSize, omp_get_max_threads(), kTraceRounds);
-  std::printf("| %-22s | %9s | %15s | %15s | %15s | %15s | %15s | %15s | %23s | %9s | %9s | %8s |\n", "mesh", "Embree 1", "Embree 16",
-              "CrossRT LBVH", "CrossRT LBVH 1T", "LBVH _CPU", "LBVH _ISPC", "CrossRT SAH", "LBVH _Vulkan [GPU]", "SAH cost L", "SAH cost S",
-              "same hit");
-  std::printf("|%s|\n", std::string(212, '-').c_str());
+  std::printf("| %-22s | %9s | %15s | %15s | %15s | %15s | %15s | %15s | %15s | %23s | %9s | %9s | %8s |\n", "mesh", "Embree 1",
+              "Embree 16", "CrossRT LBVH", "CrossRT LBVH 1T", "LBVH _CPU", "LBVH _ISPC", "CrossRT SAH", "SAH _ISPC", "LBVH _Vulkan [GPU]",
+              "SAH cost L", "SAH cost S", "same hit");
+  std::printf("|%s|\n", std::string(230, '-').c_str());
   // The translated traversal: PrimaryRays_CPU / _Vulkan trace ray batches through the composed BVHScene.
   auto castCpu = CreatePrimaryRays_CPU(1, 1);
 #ifdef CROSSRT_HAS_ISPC
-  std::shared_ptr<PrimaryRays> castIspc = CreatePrimaryRays_ISPC(1, 1);
+  std::shared_ptr<PrimaryRays> castIspc = CreatePrimaryRays_ISPC(1, 1), castIspcSah = CreatePrimaryRays_ISPC(1, 1);
 #else
-  std::shared_ptr<PrimaryRays> castIspc;
+  std::shared_ptr<PrimaryRays> castIspc, castIspcSah;
   std::printf("no ISPC compiler was found at configure time: the _ISPC column is left out\n");
 #endif
   std::shared_ptr<PrimaryRays> castGpu;
@@ -377,19 +378,27 @@ int main(int argc, char** argv)
     auto mrays = [&](double ms) { return pixels / ms / 1e3; };
     std::vector<float4> rayPos(pixels, float4(cam.eye.x, cam.eye.y, cam.eye.z, 0.0f)), rayDir(pixels);
     for (int i = 0; i < pixels; ++i) rayDir[i] = cam.Ray(i % kImageSize, i / kImageSize);
-    std::vector<CRT_Hit> castHits(pixels), ispcHits(pixels);
-    std::shared_ptr<ISceneObject> lbvhShared(&lbvhScene, [](ISceneObject*) {});  // lives on this stack frame
+    std::vector<CRT_Hit> castHits(pixels), ispcHits(pixels), ispcSahHits(pixels);
+    std::shared_ptr<ISceneObject> lbvhShared(&lbvhScene, [](ISceneObject*) {});  // live on this stack frame
+    std::shared_ptr<ISceneObject> sahShared(&sahScene, [](ISceneObject*) {});
     castCpu->SetScene(lbvhShared, {}, {});
     if (castIspc)
+    {
       castIspc->SetScene(lbvhShared, {}, {});
+      castIspcSah->SetScene(sahShared, {}, {});
+    }
     // The CPU tracers in interleaved rounds, as the builders above: ratios are medians of per-round ratios.
-    std::vector<uint32_t> unusedPrim(pixels);  // hits of the tracers only timed here
+    std::vector<uint32_t> unusedPrim(pixels), sahPrim(pixels);  // hits of the LBVH on 1 thread are only timed
     const auto traceMs = InterleavedMs({embreeSingle, embreePacket, traceWith(lbvhScene, threads, ourPrim), traceWith(lbvhScene, 1, unusedPrim),
                                         [&] { castCpu->CastRays(rayPos.data(), rayDir.data(), castHits.data(), pixels); },
-                                        traceWith(sahScene, threads, unusedPrim),
+                                        traceWith(sahScene, threads, sahPrim),
                                         [&] {
                                           if (castIspc)
                                             castIspc->CastRays(rayPos.data(), rayDir.data(), ispcHits.data(), pixels);
+                                        },
+                                        [&] {
+                                          if (castIspcSah)
+                                            castIspcSah->CastRays(rayPos.data(), rayDir.data(), ispcSahHits.data(), pixels);
                                         }},
                                        kTraceRounds);
     const double embree1 = Median(traceMs[0]), embree16 = Median(traceMs[1]), lbvhMs = Median(traceMs[2]), lbvh1T = Median(traceMs[3]),
@@ -397,12 +406,14 @@ int main(int argc, char** argv)
     auto againstEmbree1 = [&](int work) { return PairedRatio(traceMs[0], traceMs[work]); };  // throughput ratio
     size_t translatedDiffer = 0;
     for (int i = 0; i < pixels; ++i) translatedDiffer += castHits[i].primId != ourPrim[i];
-    char ispcCast[24] = "no ISPC";
+    char ispcCast[24] = "no ISPC", ispcSahCast[24] = "no ISPC";
     if (castIspc)
     {
-      for (int i = 0; i < pixels; ++i) translatedDiffer += ispcHits[i].primId != ourPrim[i];
+      for (int i = 0; i < pixels; ++i) translatedDiffer += (ispcHits[i].primId != ourPrim[i]) + (ispcSahHits[i].primId != sahPrim[i]);
       std::snprintf(ispcCast, sizeof(ispcCast), "%6.2f (%5.2fx)", mrays(Median(traceMs[6])), againstEmbree1(6));
+      std::snprintf(ispcSahCast, sizeof(ispcSahCast), "%6.2f (%5.2fx)", mrays(Median(traceMs[7])), againstEmbree1(7));
       castIspc->SetScene(nullptr, {}, {});
+      castIspcSah->SetScene(nullptr, {}, {});
     }
     char gpuCast[48] = "no device";
     if (castGpu)
@@ -421,10 +432,10 @@ int main(int argc, char** argv)
       std::fprintf(stderr, "bench_lbvh: %s: the translated traversal differs from the original on %zu rays\n", row.name.c_str(), translatedDiffer);
     size_t same = 0;
     for (int i = 0; i < pixels; ++i) same += ourPrim[i] == embreePrim[i];
-    std::printf("| %-22s | %9.2f | %6.2f (%5.2fx) | %6.2f (%5.2fx) | %6.2f (%5.2fx) | %6.2f (%5.2fx) | %15s | %6.2f (%5.2fx) | %23s | %9.1f | %9.1f | %7.4f%% |\n",
+    std::printf("| %-22s | %9.2f | %6.2f (%5.2fx) | %6.2f (%5.2fx) | %6.2f (%5.2fx) | %6.2f (%5.2fx) | %15s | %6.2f (%5.2fx) | %15s | %23s | %9.1f | %9.1f | %7.4f%% |\n",
                 row.name.c_str(), mrays(embree1), mrays(embree16), againstEmbree1(1), mrays(lbvhMs), againstEmbree1(2), mrays(lbvh1T),
-                againstEmbree1(3), mrays(castCpuMs), againstEmbree1(4), ispcCast, mrays(sahMs), againstEmbree1(5), gpuCast, SAHCost(row.lbvh),
-                SAHCost(row.sah), 100.0 * same / pixels);
+                againstEmbree1(3), mrays(castCpuMs), againstEmbree1(4), ispcCast, mrays(sahMs), againstEmbree1(5), ispcSahCast, gpuCast,
+                SAHCost(row.lbvh), SAHCost(row.sah), 100.0 * same / pixels);
     trade.push_back({row.name, row.lbvhCpuMs, mrays(lbvhMs), row.sahMs, mrays(sahMs)});
   }
 

@@ -664,6 +664,7 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
       auto t = Pointer(me->getBase());
       return t ? Pointee(*t, nullptr, e->getBeginLoc()) + "." + field->getNameAsString() : "/*error*/";
     }
+    m_fieldBase = me->getBase()->IgnoreParenImpCasts();
     return Expr(me->getBase()) + "." + field->getNameAsString();
   }
   if (auto* as = dyn_cast<ArraySubscriptExpr>(e)) {
@@ -709,6 +710,7 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
           return Fail(op->getArg(1)->getBeginLoc(), "index " + std::to_string(i) + " is out of range of a " + std::to_string(n) +
                       "-component vector (undefined behaviour in C++, rejected by GLSL)", "index components 0 to " + std::to_string(n - 1));
       }
+      if (std::string load = IspcCoherentLoad(op); !load.empty()) return load;
       return Expr(op->getArg(0)) + "[" + Expr(op->getArg(1)) + "]";
     }
     if (!ispc && op->isAssignmentOp() && op->getNumArgs() == 2 && ImageTexel(op->getArg(0))) {  // (ISPC's texels are lvalues)

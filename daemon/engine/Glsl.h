@@ -209,6 +209,8 @@ private:
   std::string TextOf(const clang::Expr* e) const;
   std::map<const clang::ValueDecl*, PointerTarget> m_pointers;  // pointer locals and helper parameters in scope
   std::set<std::string> m_emittedCopies;                         // helpers bound to buffers, by name
+  std::vector<std::string> m_coherentLoads;                      // struct types with an ISPC load helper
+  const clang::Expr* m_fieldBase = nullptr;                        // the base of the field access being printed
   std::vector<std::string> m_reduceAddVectors;                   // member vectors with a ReduceAdd function
 
 public:
@@ -227,6 +229,9 @@ private:
   std::string IspcVectorOperator(const clang::CXXOperatorCallExpr* op);
   // `v[i] = a`, `v[i] op= a` with i known only at run time, `m(r, c) = a`; "" for other assignments.
   std::string IspcComponentAssignment(const clang::BinaryOperator* bo);
+  // A member vector's struct element read whole at a per-lane index, through a helper that loads what
+  // the lanes agree on once (IspcLoads.cpp); "" where a plain subscript is printed.
+  std::string IspcCoherentLoad(const clang::CXXOperatorCallExpr* op);
 
   clang::ASTContext& m_ctx;
   const clang::CXXRecordDecl* m_class;

@@ -999,7 +999,28 @@ bool BVHScene::TraceMesh(const BVHTraceRay& ray, uint32_t root, uint32_t leaves,
   bool found = false;
   while (true)
   {
-    if ((node & kLeafFlag) != 0)
+    // Down the inner nodes to a leaf, the nearest lane entered first; the other lanes entered wait on the
+    // stack, the farthest lowest. A node with no lane entered ends the descent with kNoChild. (Rays that
+    // run side by side in SIMD lanes, on ISPC and GPUs, so reach their leaves, and the stack, together.)
+    while ((node & kLeafFlag) == 0)
+    {
+      float4 entries;
+      uint4 children;
+      const int entered = EnteredLanes(ray, m_nodes[node], tfar, entries, children);
+      if (entered == 0)
+      {
+        node = kNoChild;
+        break;
+      }
+      for (int lane = entered - 1; lane > 0; --lane)
+      {
+        stack[top] = children[lane];
+        stackEntry[top] = entries[lane];
+        top = top + 1;
+      }
+      node = children[0];
+    }
+    if (node != kNoChild)
     {
       const uint32_t first = (node & ~kLeafFlag) >> 3;
       const uint32_t last = first + (node & 7u);
@@ -1034,24 +1055,6 @@ bool BVHScene::TraceMesh(const BVHTraceRay& ray, uint32_t root, uint32_t leaves,
           if (anyHit)
             return true;
         }
-      }
-    }
-    else
-    {
-      // Go on with the nearest lane entered; the others wait on the stack, the farthest lowest.
-      float4 entries;
-      uint4 children;
-      const int entered = EnteredLanes(ray, m_nodes[node], tfar, entries, children);
-      if (entered > 0)
-      {
-        for (int lane = entered - 1; lane > 0; --lane)
-        {
-          stack[top] = children[lane];
-          stackEntry[top] = entries[lane];
-          top = top + 1;
-        }
-        node = children[0];
-        continue;
       }
     }
     // Pop the next subtree that may still hold something nearer than tfar.

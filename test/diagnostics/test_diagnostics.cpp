@@ -170,6 +170,61 @@ void Loops::kernel1D_Run(int n, int taps, float* data)
   REQUIRE(text.find("for (int e = 0;") != std::string::npos);  // some lanes may leave early
 }
 
+TEST_CASE("ISPC: a struct of 32 bytes or more read whole at a per-lane index in a const method loads what the lanes agree on once",
+          "[diagnostics][ispc]")
+{
+  TempClass tc("Lookup", R"(#pragma once
+#include "LiteMath.h"
+#include <vector>
+struct Big { LiteMath::float4 lo, hi; };     // 32 bytes
+struct Small { float a, b; };                // 8 bytes: a gather is as cheap
+class Lookup
+{
+public:
+  virtual ~Lookup() = default;
+  virtual void Run(int n, [[crossrt::size("n")]] const unsigned* keys, [[crossrt::size("n")]] float* out);
+  std::vector<Big> m_big;
+  std::vector<Small> m_small;
+protected:
+  float Whole(unsigned k) const;
+  float Field(unsigned k) const;
+  void kernel1D_Run(int n, const unsigned* keys, float* out);
+};
+)",
+               R"(#include "Lookup.h"
+void Lookup::Run(int n, const unsigned* keys, float* out) { kernel1D_Run(n, keys, out); }
+float Lookup::Whole(unsigned k) const
+{
+  const Big b = m_big[k];
+  const Big first = m_big[0];
+  const Small s = m_small[k];
+  return b.lo.x + b.hi.y + first.lo.z + s.a;
+}
+float Lookup::Field(unsigned k) const { return m_big[k].hi.w; }
+void Lookup::kernel1D_Run(int n, const unsigned* keys, float* out)
+{
+  for (int i = 0; i < n; i++)
+  {
+    const Big mine = m_big[keys[i]];
+    out[i] = Whole(keys[i]) + Field(keys[i]) + mine.lo.w;
+  }
+}
+)");
+  CommandResult r = RunCrossrt("translate --class Lookup --backend ispc --out " + (tc.dir / "out").string() + " --source " + tc.Source("Lookup") +
+                               " --templates " CROSSRT_SOURCE_DIR "/templates -- -I" CROSSRT_SOURCE_DIR "/libs/litemath");
+  INFO(r.output);
+  REQUIRE(r.exitCode == 0);
+  std::ifstream file(tc.dir / "out" / "Lookup_ISPC_kernels.ispc");
+  const std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  INFO(text);
+  REQUIRE(text.find("static inline Big crt_load_Big(const uniform Big *uniform a, uint i)") != std::string::npos);
+  REQUIRE(text.find("const Big b = crt_load_Big(self->m_big, (uint)(k));") != std::string::npos);  // const, whole, per lane
+  REQUIRE(text.find("const Big first = self->m_big[0u];") != std::string::npos);                   // one index for all lanes
+  REQUIRE(text.find("const Small s = self->m_small[k];") != std::string::npos);                    // small: a gather
+  REQUIRE(text.find("return self->m_big[k].hi.w;") != std::string::npos);                          // one field of it: a gather
+  REQUIRE(text.find("const Big mine = self->m_big[keys[i]];") != std::string::npos);               // not const: as written
+}
+
 TEST_CASE("A pointer parameter of a control function without a size is reported", "[diagnostics]")
 {
   TempClass tc("NoSize", R"(#pragma once

@@ -195,9 +195,10 @@ layout(push_constant) uniform kernel1D_CastRaysArgs
 const uint m_pAccelStruct_kNoId = 4294967295u;
 const uint m_pAccelStruct_kInstanceSdf = 8u;
 const uint m_pAccelStruct_kInstanceBoxes = 2u;
-const uint m_pAccelStruct_kLeafFlag = 2147483648u;
 const float m_pAccelStruct_kMissed = -1.0;
 const float m_pAccelStruct_kWiden = 1.00000036;
+const uint m_pAccelStruct_kNoChild = 4294967295u;
+const uint m_pAccelStruct_kLeafFlag = 2147483648u;
 const int m_pAccelStruct_kSdfNewtonIterations = 4;
 const uint m_pAccelStruct_kInstanceMotion = 4u;
 const uint m_pAccelStruct_kInstanceIdentity = 1u;
@@ -288,6 +289,57 @@ vec4 m_pAccelStruct_SlabEntries(BVHTraceRay r, BVH4Node n, float tfar, inout vec
   const vec4 farZ = ((r.invDir.z < 0.0 ? n.minZ : n.maxZ) - r.org.z) * r.invDir.z;
   exits = min(min(min(farX, farY), farZ) * m_pAccelStruct_kWiden, vec4(tfar));
   return max(max(nearX, nearY), max(nearZ, vec4(r.tnear)));
+}
+
+// from (anonymous namespace)::OrderLanes
+void m_pAccelStruct_OrderLanes(inout vec4 entries, inout uvec4 children, int i, int j)
+{
+  if (entries[j] < entries[i])
+  {
+    const float e = entries[i];
+    entries[i] = entries[j];
+    entries[j] = e;
+    const uint c = children[i];
+    children[i] = children[j];
+    children[j] = c;
+  }
+}
+
+// from (anonymous namespace)::EnteredLanes
+int m_pAccelStruct_EnteredLanes(BVHTraceRay r, BVH4Node n, float tfar, inout vec4 entries, inout uvec4 children)
+{
+  vec4 exits = vec4(0);
+  const vec4 laneEntries = m_pAccelStruct_SlabEntries(r, n, tfar, exits);
+  uint mask = uint(dot(vec4(lessThanEqual(laneEntries, exits)), vec4(1.0, 2.0, 4.0, 8.0)));
+  if (mask == 0u)
+    return 0;
+  const int first = findLSB(uint(mask));
+  entries[0] = laneEntries[first];
+  children[0] = n.child[first];
+  mask = mask & (mask - 1u);
+  if (mask == 0u)
+    return 1;
+  const int second = findLSB(uint(mask));
+  entries[1] = laneEntries[second];
+  children[1] = n.child[second];
+  m_pAccelStruct_OrderLanes(entries, children, 0, 1);
+  mask = mask & (mask - 1u);
+  if (mask == 0u)
+    return 2;
+  const int third = findLSB(uint(mask));
+  entries[2] = laneEntries[third];
+  children[2] = n.child[third];
+  m_pAccelStruct_OrderLanes(entries, children, 1, 2);
+  m_pAccelStruct_OrderLanes(entries, children, 0, 1);
+  mask = mask & (mask - 1u);
+  if (mask == 0u)
+    return 3;
+  entries[3] = laneEntries[3];
+  children[3] = n.child[3];
+  m_pAccelStruct_OrderLanes(entries, children, 2, 3);
+  m_pAccelStruct_OrderLanes(entries, children, 1, 2);
+  m_pAccelStruct_OrderLanes(entries, children, 0, 1);
+  return 4;
 }
 
 // from BVHScene::SdfValue
@@ -618,57 +670,6 @@ uint m_pAccelStruct_IntersectGroup(BVHTraceRay r, uint group, float tfar, inout 
   return hits;
 }
 
-// from (anonymous namespace)::OrderLanes
-void m_pAccelStruct_OrderLanes(inout vec4 entries, inout uvec4 children, int i, int j)
-{
-  if (entries[j] < entries[i])
-  {
-    const float e = entries[i];
-    entries[i] = entries[j];
-    entries[j] = e;
-    const uint c = children[i];
-    children[i] = children[j];
-    children[j] = c;
-  }
-}
-
-// from (anonymous namespace)::EnteredLanes
-int m_pAccelStruct_EnteredLanes(BVHTraceRay r, BVH4Node n, float tfar, inout vec4 entries, inout uvec4 children)
-{
-  vec4 exits = vec4(0);
-  const vec4 laneEntries = m_pAccelStruct_SlabEntries(r, n, tfar, exits);
-  uint mask = uint(dot(vec4(lessThanEqual(laneEntries, exits)), vec4(1.0, 2.0, 4.0, 8.0)));
-  if (mask == 0u)
-    return 0;
-  const int first = findLSB(uint(mask));
-  entries[0] = laneEntries[first];
-  children[0] = n.child[first];
-  mask = mask & (mask - 1u);
-  if (mask == 0u)
-    return 1;
-  const int second = findLSB(uint(mask));
-  entries[1] = laneEntries[second];
-  children[1] = n.child[second];
-  m_pAccelStruct_OrderLanes(entries, children, 0, 1);
-  mask = mask & (mask - 1u);
-  if (mask == 0u)
-    return 2;
-  const int third = findLSB(uint(mask));
-  entries[2] = laneEntries[third];
-  children[2] = n.child[third];
-  m_pAccelStruct_OrderLanes(entries, children, 1, 2);
-  m_pAccelStruct_OrderLanes(entries, children, 0, 1);
-  mask = mask & (mask - 1u);
-  if (mask == 0u)
-    return 3;
-  entries[3] = laneEntries[3];
-  children[3] = n.child[3];
-  m_pAccelStruct_OrderLanes(entries, children, 2, 3);
-  m_pAccelStruct_OrderLanes(entries, children, 1, 2);
-  m_pAccelStruct_OrderLanes(entries, children, 0, 1);
-  return 4;
-}
-
 // from BVHScene::TraceMesh
 bool m_pAccelStruct_TraceMesh(BVHTraceRay ray, uint root, uint leaves, bool anyHit, inout float tfar, inout CRT_Hit hit)
 {
@@ -679,7 +680,25 @@ bool m_pAccelStruct_TraceMesh(BVHTraceRay ray, uint root, uint leaves, bool anyH
   bool found = false;
   while (true)
   {
-    if ((node & m_pAccelStruct_kLeafFlag) != 0u)
+    while ((node & m_pAccelStruct_kLeafFlag) == 0u)
+    {
+      vec4 entries = vec4(0);
+      uvec4 children = uvec4(0);
+      const int entered = m_pAccelStruct_EnteredLanes(ray, m_pAccelStruct_m_nodes[node], tfar, entries, children);
+      if (entered == 0)
+      {
+        node = m_pAccelStruct_kNoChild;
+        break;
+      }
+      for (int lane = entered - 1; lane > 0; --lane)
+      {
+        stack[top] = children[lane];
+        stackEntry[top] = entries[lane];
+        top = top + 1;
+      }
+      node = children[0];
+    }
+    if (node != m_pAccelStruct_kNoChild)
     {
       const uint first = (node & ~m_pAccelStruct_kLeafFlag) >> 3;
       const uint last = first + (node & 7u);
@@ -714,23 +733,6 @@ bool m_pAccelStruct_TraceMesh(BVHTraceRay ray, uint root, uint leaves, bool anyH
           if (anyHit)
             return true;
         }
-      }
-    }
-    else
-    {
-      vec4 entries = vec4(0);
-      uvec4 children = uvec4(0);
-      const int entered = m_pAccelStruct_EnteredLanes(ray, m_pAccelStruct_m_nodes[node], tfar, entries, children);
-      if (entered > 0)
-      {
-        for (int lane = entered - 1; lane > 0; --lane)
-        {
-          stack[top] = children[lane];
-          stackEntry[top] = entries[lane];
-          top = top + 1;
-        }
-        node = children[0];
-        continue;
       }
     }
     do
