@@ -40,7 +40,7 @@ const char* kUsage =
     "  --accel     the CPU devices' ray tracing: Embree (default) or CrossRT's BVHs; Vulkan always uses sah\n"
     "  --env       an equirectangular environment map (linear EXR, Blender's orientation), times --env-strength\n"
     "  --seed      the random sequence (a pixel's samples depend only on pixel, sample index and seed)\n"
-    "  --pass-spp  samples per pass (default 4): memory stays the same whatever --spp is\n"
+    "  --pass-spp  samples per pass (default 4): memory stays the same whatever --spp is (1 for megakernels on llvmpipe)\n"
     "  --compare   prints PSNR (8-bit sRGB) and relative MSE (linear) of the image against REF\n"
     "  --out       .exr: linear radiance; .png: sRGB, clamped (several --out: the same image to each)\n";
 
@@ -155,7 +155,7 @@ LiteImage::Image2D<float4> LoadReference(const std::string& refPath, uint32_t wi
 
 int main(int argc, char** argv)
 {
-  const Options o = Parse(argc, argv);
+  Options o = Parse(argc, argv);
   try
   {
     LiteImage::Image2D<float4> reference;
@@ -183,6 +183,13 @@ int main(int argc, char** argv)
                : o.virtualLevel == 3 ? VulkanTracer<PathTracer_VulkanLevel3>(ctx, mode)
                                      : VulkanTracer<PathTracer_Vulkan>(ctx, mode);
       std::fprintf(stderr, "device: %s, virtual level %d\n", ctx->DeviceName().c_str(), o.virtualLevel);
+      if (ctx->loopIterationLimit != 0 && mode == crossrt::ExecutionMode::Megakernel && o.passSpp > 1)
+      {
+        // A megakernel pass runs all its samples' bounces and traversals in one invocation's loops.
+        std::fprintf(stderr, "note: this device ends a shader's loops after %u iterations in all (llvmpipe), which a megakernel pass of "
+                             "%u spp may reach: passes of 1 spp here\n", ctx->loopIterationLimit, o.passSpp);
+        o.passSpp = 1;
+      }
       accel = "sah";  // the GPU runs BVHScene's traversal
     }
     tracer->SetScene(scene, MakeSceneRT(accel.c_str()));

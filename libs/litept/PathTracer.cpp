@@ -252,9 +252,18 @@ void PathTracer::kernel_Shade(uint32_t tidX, uint32_t tidY, uint32_t width, uint
           shadowDirection = toPoint * (1.0f / distance);
           far = distance * (1.0f - 1e-4f);
         }
-        *shadowPos = to_float4(start, 0.0f);
-        *shadowDir = to_float4(shadowDirection, far);
-        *shadowColor = to_float4(contribution, 1.0f);
+        // Lights with shapes are not in the scene's geometry that the shadow ray is traced through:
+        // one in the way (not the light sampled) blocks it here, as it would any other ray.
+        bool blocked = false;
+        for (uint32_t i = 0; i < m_shapeLightCount; i++)
+          if (m_shapeLights[i] != chosen && m_lights[m_shapeLights[i]]->Intersect(start, shadowDirection) < far)
+            blocked = true;
+        if (!blocked)
+        {
+          *shadowPos = to_float4(start, 0.0f);
+          *shadowDir = to_float4(shadowDirection, far);
+          *shadowColor = to_float4(contribution, 1.0f);
+        }
       }
     }
   }

@@ -427,6 +427,7 @@ void VulkanContext::CreateDevice(const ContextOptions& options) {
   if (vk12) subgroup.pNext = &driver;
   vkGetPhysicalDeviceProperties2(physicalDevice, &props2);
   fenceAtomics = !(vk12 && driver.driverID == VK_DRIVER_ID_MESA_LLVMPIPE);
+  loopIterationLimit = vk12 && driver.driverID == VK_DRIVER_ID_MESA_LLVMPIPE ? 65535u : 0u;
   subgroupSize = subgroup.subgroupSize;
   hasSubgroupArithmetic = (subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) &&
                           (subgroup.supportedOperations & VK_SUBGROUP_FEATURE_ARITHMETIC_BIT);

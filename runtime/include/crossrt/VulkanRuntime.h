@@ -109,6 +109,11 @@ public:
   // from here. Off on llvmpipe: its atomics are sequentially consistent already, and its memory
   // barriers inside loops that threads leave at different times give wrong results (Mesa 22.3).
   bool fenceAtomics = true;
+  // The iterations a shader invocation may run through all its loops together before the device ends
+  // them, 0 for no limit. llvmpipe counts every loop's back edges in one counter per invocation and
+  // leaves all loops at 65535 (Mesa's LP_MAX_TGSI_LOOP_ITERATIONS), silently: a megakernel that loops
+  // over many samples, bounces and traversal steps there must split its work into smaller dispatches.
+  uint32_t loopIterationLimit = 0;
 
   std::string DeviceName() const;
 
