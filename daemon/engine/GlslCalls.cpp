@@ -367,8 +367,8 @@ std::string GlslPrinter::Call(const CallExpr* call) {
         }
         if (ispc && name == "push_back" && call->getNumArgs() == 1 && composedPrefix.empty())
           return EmitAppend(field, call) + "(self, " + Expr(call->getArg(0)) + ")";
+        if (name == "capacity") return ispc ? IspcMember(field->getNameAsString() + "_capacity") : composedPrefix + field->getNameAsString() + "_capacity";
         if (ispc) return IspcFail(call->getBeginLoc(), "std::vector::" + name + " of a member in a kernel");
-        if (name == "capacity") return composedPrefix + field->getNameAsString() + "_capacity";
         // Emptied by the one thread before a loop nest: the appends that follow count from 0.
         const bool empties = name == "clear" || (name == "resize" && call->getNumArgs() == 1 && call->getArg(0)->isIntegerConstantExpr(m_ctx) &&
                                                   call->getArg(0)->EvaluateKnownConstInt(m_ctx) == 0);

@@ -70,6 +70,17 @@ void Appending::kernel1D_Rank(float* ranks)
     ranks[m_large[i].index] = float(i);
 }
 
+void Appending::Room(int n, uint32_t* room)
+{
+  kernel1D_Room(n, room);
+}
+
+void Appending::kernel1D_Room(int n, uint32_t* room)
+{
+  for (int i = 0; i < n; ++i)
+    room[i] = uint32_t(m_negative.capacity() - m_negative.size());
+}
+
 void Appending::kernel1D_FindNegative(int n, const float* values)
 {
   for (int i = 0; i < n; ++i)

@@ -45,6 +45,9 @@ public:
   // |value| < 0.1 through two helpers, m_tagged gets {index, value} of those above 0.9 from a
   // kernel_ function whose loop is here, in the control function.
   virtual void Classify(int n, [[crossrt::size("n")]] const float* values);
+  // room[i] = the elements m_negative has room for before it must grow, for every i: kernels read
+  // capacity() and size() as the control function found them.
+  virtual void Room(int n, [[crossrt::size("n")]] uint32_t* room);
   virtual void CommitDeviceData() {}
 
   std::vector<uint32_t> m_positive;
@@ -61,6 +64,7 @@ protected:
   void kernel1D_FindNegative(int n, const float* values);
   void kernel1D_FindSmall(int n, const float* values);
   virtual void kernel_Tag(int tid, const float* values);
+  void kernel1D_Room(int n, uint32_t* room);
 
   // 1 if it appended i. The default argument, the overload and the helper it calls are part of
   // the test: the CPU backend copies this one, and the copy must still call the other overload.

@@ -102,8 +102,13 @@ TEST_CASE("Appends accumulate across calls when the control function does not cl
   for (auto& [name, impl] : AllBackends(ctx, n))
   {
     INFO(name);
+    std::vector<uint32_t> room(4, 0u);
+    impl->Room(4, room.data());
+    REQUIRE(room == std::vector<uint32_t>(4, uint32_t(2 * n)));  // capacity() and size() in a kernel
     impl->Collect(n, first.data());
     const size_t afterFirst = impl->m_negative.size();
+    impl->Room(4, room.data());
+    REQUIRE(room == std::vector<uint32_t>(4, uint32_t(2 * n - afterFirst)));
     impl->Collect(n, second.data());
     REQUIRE(afterFirst > 0);
     REQUIRE(Sorted(impl->m_negative) == expected);
