@@ -286,7 +286,7 @@ std::string GlslPrinter::Construct(QualType t, const std::vector<const clang::Ex
 // writes, a cast of a scalar, and an initializer list of an array (which only a declaration takes).
 std::string GlslPrinter::IspcConstruct(QualType t, const std::string& type, const std::vector<const clang::Expr*>& args, SourceLocation loc) {
   if (IsLiteMathType(t, "half4") || IsLiteMathType(t, "half2") || (args.size() == 1 && IsLiteMathType(args[0]->getType(), "half4")))
-    return IspcFail(loc, "LiteMath's half2 and half4");
+    return HalfConstruct(t, args, loc);
   auto list = [&](const std::vector<std::string>& items) {
     std::string out;
     for (size_t i = 0; i < items.size(); ++i) out += (i ? ", " : "") + items[i];
@@ -310,23 +310,37 @@ std::string GlslPrinter::IspcConstruct(QualType t, const std::string& type, cons
   return "make_" + type + "(" + list(values) + ")";
 }
 
-// LiteMath's half2 and half4 hold their 16-bit floats two per uint (packHalf2x16); float4(h) and
-// to_float4(h) unpack them. Their components are reached only through that conversion.
+// LiteMath's half2 and half4 hold their 16-bit floats two per uint (packHalf2x16; in ISPC the
+// crt_ conversions of LiteMath.isph); float4(h) and to_float4(h) unpack them. Their components are
+// reached only through that conversion.
 std::string GlslPrinter::HalfConstruct(QualType t, const std::vector<const clang::Expr*>& args, SourceLocation loc) {
-  auto pair = [](const std::string& a, const std::string& b) { return "packHalf2x16(vec2(" + a + ", " + b + "))"; };
+  const bool four = IsLiteMathType(t, "half4");
   if (IsLiteMathType(t, "float4")) {  // float4(half4)
     const std::string h = Expr(args[0]);
-    return "vec4(unpackHalf2x16((" + h + ").x), unpackHalf2x16((" + h + ").y))";
+    return ispc ? "crt_half4_to_float4(" + h + ")" : "vec4(unpackHalf2x16((" + h + ").x), unpackHalf2x16((" + h + ").y))";
   }
   std::vector<std::string> a;
   for (auto* arg : args) a.push_back(Expr(arg));
-  const bool four = IsLiteMathType(t, "half4");
-  if (args.empty()) return four ? "uvec2(0u)" : "0u";
-  if (args.size() == 1 && IsLiteMathType(args[0]->getType(), "float4")) return "uvec2(packHalf2x16((" + a[0] + ").xy), packHalf2x16((" + a[0] + ").zw))";
-  if (args.size() == 1 && IsLiteMathType(args[0]->getType(), "float2")) return "packHalf2x16(" + a[0] + ")";
-  if (args.size() == 1 && args[0]->getType()->isArithmeticType()) return four ? "uvec2(" + pair(a[0], a[0]) + ")" : pair(a[0], a[0]);
-  if (four && args.size() == 4) return "uvec2(" + pair(a[0], a[1]) + ", " + pair(a[2], a[3]) + ")";
-  if (!four && args.size() == 2) return pair(a[0], a[1]);
+  if (ispc) {  // through a float2 or float4 of the values
+    const std::string to = four ? "crt_float4_to_half4(" : "crt_float2_to_half2(", vec = four ? "make_float4(" : "make_float2(";
+    if (args.empty()) return four ? "make_uint2(0u)" : "0u";
+    if (args.size() == 1 && IsLiteMathType(args[0]->getType(), four ? "float4" : "float2")) return to + a[0] + ")";
+    if (args.size() == 1 && args[0]->getType()->isArithmeticType()) return to + vec + "(float)(" + a[0] + ")))";
+    if (args.size() == (four ? 4u : 2u)) {
+      std::string list;
+      for (size_t i = 0; i < a.size(); ++i) list += (i ? ", " : "") + std::string("(float)(") + a[i] + ")";
+      return to + vec + list + "))";
+    }
+  }
+  if (!ispc) {
+    auto pair = [](const std::string& x, const std::string& y) { return "packHalf2x16(vec2(" + x + ", " + y + "))"; };
+    if (args.empty()) return four ? "uvec2(0u)" : "0u";
+    if (args.size() == 1 && IsLiteMathType(args[0]->getType(), "float4")) return "uvec2(packHalf2x16((" + a[0] + ").xy), packHalf2x16((" + a[0] + ").zw))";
+    if (args.size() == 1 && IsLiteMathType(args[0]->getType(), "float2")) return "packHalf2x16(" + a[0] + ")";
+    if (args.size() == 1 && args[0]->getType()->isArithmeticType()) return four ? "uvec2(" + pair(a[0], a[0]) + ")" : pair(a[0], a[0]);
+    if (four && args.size() == 4) return "uvec2(" + pair(a[0], a[1]) + ", " + pair(a[2], a[3]) + ")";
+    if (!four && args.size() == 2) return pair(a[0], a[1]);
+  }
   return Fail(loc, "this construction of LiteMath::" + t.getUnqualifiedType().getAsString(m_ctx.getPrintingPolicy()) + " is not supported in kernels",
               "build it from a float4 (half4(v)) or from four floats");
 }

@@ -162,7 +162,9 @@ std::string GlslPrinter::IspcBuiltin(const FunctionDecl* fd, const std::vector<s
       "make_float2", "make_float3", "make_float4", "make_int2", "make_int3", "make_int4", "make_uint2", "make_uint3",
       "make_uint4", "to_float2", "to_float3", "to_float4", "to_int2", "to_int3", "to_int4", "to_uint2", "to_uint3", "to_uint4"};
   const std::string arg0Type = call->getNumArgs() ? GlslTypeOf(call->getArg(0)->getType()).value_or("") : "";
-  if (arg0Type.find("half") != std::string::npos || n.find("half") != std::string::npos) return IspcFail(call->getBeginLoc(), "LiteMath's half types");
+  if (n == "to_float4" && call->getNumArgs() == 1 && IsLiteMathType(call->getArg(0)->getType(), "half4")) return "crt_half4_to_float4(" + a[0] + ")";
+  if (n == "to_float2" && call->getNumArgs() == 1 && IsLiteMathType(call->getArg(0)->getType(), "half2")) return "crt_half2_to_float2(" + a[0] + ")";
+  if (n.find("half") != std::string::npos) return IspcFail(call->getBeginLoc(), "LiteMath's '" + n + "'");
   // to_int3(v), to_float3(int3): a conversion (as many components); to_float3(float4): a part.
   if (n.rfind("to_", 0) == 0 && call->getNumArgs() == 1 && !arg0Type.empty() && arg0Type.back() == n.back())
     return "make_" + n.substr(3) + "(" + a[0] + ")";

@@ -132,6 +132,24 @@ void Constructs::FillSquares(int n)
   kernel1D_Squares(n);
 }
 
+void Constructs::RoundTripHalves(int n, float scale, const float4* in, float4* out)
+{
+  kernel1D_ToHalves(n, scale, in);
+  kernel1D_FromHalves(n, scale, out);
+}
+
+void Constructs::kernel1D_ToHalves(int n, float scale, const float4* in)
+{
+  for (int i = 0; i < n; i++)
+    m_halves[i] = i % 2 == 0 ? half4(in[i] * scale) : half4(in[i].x * scale, in[i].y * scale, in[i].z * scale, in[i].w * scale);
+}
+
+void Constructs::kernel1D_FromHalves(int n, float scale, float4* out)
+{
+  for (int i = 0; i < n; i++)
+    out[i] = to_float4(m_halves[i]) / scale;
+}
+
 void Constructs::kernel1D_Squares(int n)
 {
   for (int i = 0; i < n; i++)

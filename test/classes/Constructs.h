@@ -40,6 +40,9 @@ public:
   virtual void Volume(int nx, int ny, int nz, [[crossrt::size("nx*ny*nz")]] float* out);
   // A kernel that writes a std::vector member, which the generated class reads back.
   virtual void FillSquares(int n);
+  // 16-bit floats: m_halves[i] = half4(in[i] * scale), then out[i] = to_float4(m_halves[i]) / scale,
+  // through a member vector of half4 between two kernels (the caller sizes m_halves).
+  virtual void RoundTripHalves(int n, float scale, [[crossrt::size("n")]] const float4* in, [[crossrt::size("n")]] float4* out);
 
   virtual void CommitDeviceData() {}
   virtual void GetExecutionTime(const char* a_funcName, float a_out[4]) { (void)a_funcName; for (int i = 0; i < 4; ++i) a_out[i] = 0.0f; }
@@ -49,6 +52,7 @@ public:
   uint32_t m_maxBits = 0;
   float3 m_boxMin, m_boxMax;
   std::vector<int> m_squares;
+  std::vector<half4> m_halves;
 
 protected:
   void kernel1D_Saxpy(int n, float a, const float* x, float* y);
@@ -58,6 +62,8 @@ protected:
   void kernel_Row(uint32_t tid, float* row);
   void kernel3D_Volume(int nx, int ny, int nz, float* out);
   void kernel1D_Squares(int n);
+  void kernel1D_ToHalves(int n, float scale, const float4* in);
+  void kernel1D_FromHalves(int n, float scale, float4* out);
 
   float Shade(float v, int i) const;  // helper member function
 

@@ -10,7 +10,11 @@
 #include "Constructs_Vulkan.h"
 #include "TestSupport.h"
 
+#include <cmath>
+#include <cstring>
+#include <limits>
 #include <random>
+#include <string>
 
 namespace {
 
@@ -190,6 +194,53 @@ TEST_CASE("A kernel that writes a std::vector member", "[equivalence]")
     REQUIRE(impl->m_squares[0] == -n);
     REQUIRE(impl->m_squares[n - 1] == (n - 1) * (n - 1) - n);
     REQUIRE(impl->m_squares == impls.list[0].second->m_squares);
+  }
+  RequireNoValidationMessages(impls.ctx);
+}
+
+TEST_CASE("half4: 16-bit floats round to the nearest even, with subnormals, infinities and NaN, on every backend", "[equivalence]")
+{
+  // Values around every rounding case: ties between halves, subnormal halves, the largest half and
+  // beyond (infinity), signed zeros, NaN, and random values over the whole range.
+  std::vector<float> values = {0.0f, -0.0f, 1.0f, -1.0f, 65504.0f, 65519.99f, 65520.0f, 1e9f, -1e9f, 6.1035156e-05f, 5.9604645e-08f,
+                               2.9802322e-08f, 2.9802326e-08f, 8.9406967e-08f, 1e-10f, std::numeric_limits<float>::infinity(),
+                               -std::numeric_limits<float>::infinity(), std::numeric_limits<float>::quiet_NaN(), 1.0009766f, 1.00048828f,
+                               1.00146484f, 2049.0f, 2051.0f};
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> exponent(-30.0f, 17.0f), sign(-1.0f, 1.0f);
+  while (values.size() < 4 * 4001)
+    values.push_back(std::copysign(std::exp2(exponent(rng)), sign(rng)));
+  const int n = int(values.size() / 4);
+  std::vector<float4> in(size_t(n), float4(0.0f));
+  std::memcpy(in.data(), values.data(), values.size() * sizeof(float));
+  Impls impls(5);
+  std::vector<float4> expected;
+  for (auto& [name, impl] : impls.list)
+  {
+    INFO(name);
+    for (float scale : {1.0f, 0.5f})
+    {
+      impl->m_halves.assign(size_t(n), half4(0.0f));
+      impl->CommitDeviceData();
+      std::vector<float4> out(size_t(n), float4(-7.0f));
+      impl->RoundTripHalves(n, scale, in.data(), out.data());
+      if (expected.size() < 2 * size_t(n))
+        expected.insert(expected.end(), out.begin(), out.end());  // the original's
+      size_t differ = 0;
+      std::string first;
+      for (int i = 0; i < n; ++i)
+        for (int c = 0; c < 4; ++c)
+        {
+          const float e = expected[size_t(scale == 1.0f ? 0 : n) + size_t(i)][c], o = out[size_t(i)][c];
+          if ((std::isnan(e) && std::isnan(o)) || std::memcmp(&e, &o, sizeof(float)) == 0)
+            continue;  // the same bits (any NaN for a NaN)
+          if (differ++ == 0)
+            first = std::to_string(in[size_t(i)][c]) + " at scale " + std::to_string(scale) + " gave " + std::to_string(o) + ", the original " +
+                    std::to_string(e);
+        }
+      INFO("the first: " << first);
+      REQUIRE(differ == 0);
+    }
   }
   RequireNoValidationMessages(impls.ctx);
 }
