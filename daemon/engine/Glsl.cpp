@@ -331,8 +331,7 @@ std::string GlslPrinter::HalfConstruct(QualType t, const std::vector<const clang
       for (size_t i = 0; i < a.size(); ++i) list += (i ? ", " : "") + std::string("(float)(") + a[i] + ")";
       return to + vec + list + "))";
     }
-  }
-  if (!ispc) {
+  } else {
     auto pair = [](const std::string& x, const std::string& y) { return "packHalf2x16(vec2(" + x + ", " + y + "))"; };
     if (args.empty()) return four ? "uvec2(0u)" : "0u";
     if (args.size() == 1 && IsLiteMathType(args[0]->getType(), "float4")) return "uvec2(packHalf2x16((" + a[0] + ").xy), packHalf2x16((" + a[0] + ").zw))";
