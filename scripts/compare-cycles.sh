@@ -1,6 +1,7 @@
 #!/bin/bash
 # The path tracer against Blender's Cycles on four scenes: the Cornell box this project writes
-# (area light, rough metal, glass), the same with a sphere and a rectangle light as well, and two
+# (area light, rough metal, glass), the same with a sphere and a rectangle light as well (opaque
+# emitters in both renderers: cycles-reference.py makes them emitting meshes for Cycles), and two
 # assimp-testmodels glTF models (2CylinderEngine, 110k triangles; ClearCoatTest, textures and
 # normal maps) lit by Blender's "forest" HDR map. Each scene is rendered by
 # scripts/cycles-reference.py and by path_tracer (PathTracer_CPU) at the same size, depth and spp;

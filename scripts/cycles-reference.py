@@ -7,7 +7,7 @@ Usage (everything after "--" belongs to this script):
         [--size WxH] [--spp N] [--depth D] [--seed S] \\
         [--env FILE.exr] [--env-strength F] [--threads T] \\
         [--time-log CSV] [--default-camera] [--camera NAME] \\
-        [--lighting-mode SPEC|COMPAT|RAW]
+        [--lighting-mode SPEC|COMPAT|RAW] [--cycles-lights]
 
     blender -b --factory-startup --python scripts/cycles-reference.py -- --help
 
@@ -51,11 +51,15 @@ What it does
        scattering), not multiscatter GGX.
      * Punctual lights get radius 0 (point/spot shadow_soft_size, sun angle;
        Blender's default is a 0.25 m sphere), except CrossRT's lights with a
-       size: a point light whose glTF extras give a "radius" keeps it (a
-       sphere light), one with "width" and "height" becomes a rectangular
-       area light of that size and the same radiance (Cycles' area light
-       of power P sends P / (4 A)); both are made visible to camera rays
-       (Cycles' lights do not stop them: what is behind adds up).  With the importer's default
+       size: a point light whose glTF extras give a "radius" (a sphere light)
+       or a "width" and "height" (a rectangle) becomes an opaque mesh of that
+       shape with an Emission shader of the same radiance.  CrossRT's sphere
+       and rectangle lights stop every ray that meets them, camera, BSDF and
+       shadow rays alike, as a glowing object would; Cycles' lights let every
+       ray through.  --cycles-lights keeps them Cycles lights instead: a
+       sphere light of that radius, and a rectangular area light (Cycles'
+       area light of power P sends P / (4 A)), both visible to camera rays.
+       With the importer's default
        --lighting-mode SPEC a point/spot light of glTF intensity I (cd) has
        radiant intensity I/683 W/sr in Cycles, a sun of E lux has irradiance
        E/683 W/m^2.  COMPAT: I W/sr and E W/m^2.  RAW: Blender Watts = I.
@@ -195,6 +199,10 @@ def parse_args():
                         "box (automatic when the scene has no camera)")
     p.add_argument("--camera", metavar="NAME",
                    help="Blender object name of the camera to use")
+    p.add_argument("--cycles-lights", action="store_true",
+                   help="keep CrossRT's sphere and rectangle lights as Cycles "
+                        "lights, which every ray passes through (default: "
+                        "opaque emitting meshes, as CrossRT traces them)")
     p.add_argument("--lighting-mode", choices=("SPEC", "COMPAT", "RAW"),
                    default="SPEC",
                    help="glTF importer's punctual light unit conversion "
@@ -384,8 +392,53 @@ def add_default_camera(scene, width, height, prefix):
     return obj
 
 
-def fix_lights(scene):
-    for o in scene.objects:
+def emitting_mesh(scene, light_object, shape, size, radiance):
+    """An opaque mesh in place of a light with a shape, emitting `radiance`
+    (RGB, W/(m^2 sr)): a sphere of radius size[0], or a size[0] x size[1]
+    rectangle that emits towards the light's -z and is black behind.  Cycles'
+    lights let every ray through (camera, BSDF and shadow rays), CrossRT's
+    sphere and rectangle lights stop them, as a glowing object would; the
+    mesh makes Cycles do the same.  An Emission closure of strength s sends
+    radiance s, and a surface with nothing but emission ends a path."""
+    if shape == "SPHERE":
+        bpy.ops.mesh.primitive_uv_sphere_add(segments=256, ring_count=128,
+                                             radius=size[0])
+    else:
+        bpy.ops.mesh.primitive_plane_add(size=1.0)
+    mesh_object = bpy.context.active_object
+    mesh_object.matrix_world = light_object.matrix_world.copy()
+    if shape == "RECTANGLE":
+        mesh_object.scale = (size[0], size[1], 1.0)
+    if shape == "SPHERE":
+        for polygon in mesh_object.data.polygons:
+            polygon.use_smooth = True
+    material = bpy.data.materials.new(light_object.name + "_emitter")
+    material.use_nodes = True
+    tree = material.node_tree
+    tree.nodes.clear()
+    output = tree.nodes.new("ShaderNodeOutputMaterial")
+    emission = tree.nodes.new("ShaderNodeEmission")
+    emission.inputs["Color"].default_value = (radiance[0], radiance[1],
+                                              radiance[2], 1.0)
+    emission.inputs["Strength"].default_value = 1.0
+    shader = emission.outputs["Emission"]
+    if shape == "RECTANGLE":  # the plane's normal is +z: it emits from its back
+        black = tree.nodes.new("ShaderNodeEmission")
+        black.inputs["Strength"].default_value = 0.0
+        geometry = tree.nodes.new("ShaderNodeNewGeometry")
+        mix = tree.nodes.new("ShaderNodeMixShader")
+        tree.links.new(geometry.outputs["Backfacing"], mix.inputs["Fac"])
+        tree.links.new(black.outputs["Emission"], mix.inputs[1])
+        tree.links.new(emission.outputs["Emission"], mix.inputs[2])
+        shader = mix.outputs["Shader"]
+    tree.links.new(shader, output.inputs["Surface"])
+    mesh_object.data.materials.append(material)
+    bpy.data.objects.remove(light_object, do_unlink=True)
+    return mesh_object
+
+
+def fix_lights(scene, opaque_shapes):
+    for o in list(scene.objects):
         if o.type != "LIGHT":
             continue
         light = o.data
@@ -396,6 +449,23 @@ def fix_lights(scene):
         width, height = float(light.get("width", 0.0)), float(light.get("height", 0.0))
         if radius > 0.0 or (width > 0.0 and height > 0.0):
             o.visible_camera = True  # CrossRT's camera rays see them too
+        # A point light of Blender energy P sends P / (4 pi) W/sr: over a
+        # sphere's disc, or over the rectangle, that is its radiance.
+        colour, name = tuple(light.color), o.name
+        if opaque_shapes and light.type == "POINT" and radius > 0.0:
+            value = light.energy / (4.0 * math.pi) / (math.pi * radius * radius)
+            emitting_mesh(scene, o, "SPHERE", (radius,),
+                          tuple(c * value for c in colour))
+            note("light %s: an emitting sphere of radius %g, radiance %g"
+                 % (name, radius, value))
+            continue
+        if opaque_shapes and light.type == "POINT" and width > 0.0 and height > 0.0:
+            value = light.energy / (4.0 * math.pi) / (width * height)
+            emitting_mesh(scene, o, "RECTANGLE", (width, height),
+                          tuple(c * value for c in colour))
+            note("light %s: an emitting %g x %g rectangle, radiance %g"
+                 % (name, width, height, value))
+            continue
         if light.type == "POINT" and radius > 0.0:
             light.shadow_soft_size = radius
             note("light %s: a sphere of radius %g, Blender energy %g"
@@ -742,7 +812,7 @@ def main():
          % (camera.name, camera.data.angle_y, camera.data.clip_start,
             camera.data.clip_end))
 
-    fix_lights(scene)
+    fix_lights(scene, not args.cycles_lights)
     fix_materials(scene, gltf)
     configure_render(scene, args)
     configure_world(scene, args.env, args.env_strength)
