@@ -686,7 +686,9 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
     const bool array = decay && decay->getCastKind() == CK_ArrayToPointerDecay;
     if (!array && as->getBase()->getType()->isPointerType()) {
       auto t = Pointer(as->getBase());
-      return t ? Pointee(*t, as->getIdx(), e->getBeginLoc()) : "/*error*/";
+      if (!t) return "/*error*/";
+      if (std::string load = IspcConsecutiveLoad(as, *t); !load.empty()) return load;
+      return Pointee(*t, as->getIdx(), e->getBeginLoc());
     }
     return Expr(as->getBase()) + "[" + Expr(as->getIdx()) + "]";
   }

@@ -232,6 +232,10 @@ private:
   // A member vector's struct element read whole at a per-lane index, through a helper that loads what
   // the lanes agree on once (IspcLoads.cpp); "" where a plain subscript is printed.
   std::string IspcCoherentLoad(const clang::CXXOperatorCallExpr* op);
+  // A float4, int4 or uint4 read whole through a pointer at a per-lane index, through LiteMath.isph's
+  // crt_load4 (vector loads where the lanes read consecutive elements, IspcLoads.cpp); "" otherwise.
+  std::string IspcConsecutiveLoad(const clang::ArraySubscriptExpr* as, const PointerTarget& t);
+  bool ReadWhole(const clang::Expr* e);  // e's value is copied or passed by value or const reference
 
   clang::ASTContext& m_ctx;
   const clang::CXXRecordDecl* m_class;

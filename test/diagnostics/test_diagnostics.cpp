@@ -225,6 +225,47 @@ void Lookup::kernel1D_Run(int n, const unsigned* keys, float* out)
   REQUIRE(text.find("const Big mine = self->m_big[keys[i]];") != std::string::npos);               // not const: as written
 }
 
+TEST_CASE("ISPC: a float4 read whole through a pointer at a per-lane index goes through crt_load4; one written, or a field of it, does not",
+          "[diagnostics][ispc]")
+{
+  TempClass tc("Rows", R"(#pragma once
+#include "LiteMath.h"
+using LiteMath::float4;
+class Rows
+{
+public:
+  virtual ~Rows() = default;
+  virtual void Run(int n, [[crossrt::size("n")]] const float4* in, [[crossrt::size("n")]] float4* out);
+protected:
+  void kernel1D_Run(int n, const float4* in, float4* out);
+};
+)",
+               R"(#include "Rows.h"
+void Rows::Run(int n, const float4* in, float4* out) { kernel1D_Run(n, in, out); }
+void Rows::kernel1D_Run(int n, const float4* in, float4* out)
+{
+  for (int i = 0; i < n; i++)
+  {
+    const float4 copied = in[i];
+    const float4 first = in[0];
+    out[i] = copied + in[i] * 2.0f + float4(in[i].x) + first;
+  }
+}
+)");
+  CommandResult r = RunCrossrt("translate --class Rows --backend ispc --out " + (tc.dir / "out").string() + " --source " + tc.Source("Rows") +
+                               " --templates " CROSSRT_SOURCE_DIR "/templates -- -I" CROSSRT_SOURCE_DIR "/libs/litemath");
+  INFO(r.output);
+  REQUIRE(r.exitCode == 0);
+  std::ifstream file(tc.dir / "out" / "Rows_ISPC_kernels.ispc");
+  const std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  INFO(text);
+  REQUIRE(text.find("const float4 copied = crt_load4(in_, (int)(i));") != std::string::npos);  // copied whole
+  REQUIRE(text.find("const float4 first = in_[0];") != std::string::npos);                   // one element for all lanes
+  REQUIRE(text.find("crt_load4(in_, (int)(i)) * 2.0") != std::string::npos);                 // passed by const reference
+  REQUIRE(text.find("in_[i].x") != std::string::npos);                                        // one field: a gather
+  REQUIRE(text.find("out_[i] = ") != std::string::npos);                                      // written: as written
+}
+
 TEST_CASE("A pointer parameter of a control function without a size is reported", "[diagnostics]")
 {
   TempClass tc("NoSize", R"(#pragma once
