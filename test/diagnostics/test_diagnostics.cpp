@@ -125,6 +125,21 @@ TEST_CASE("What the ISPC backend does not translate yet is an error at the user'
   }
 }
 
+namespace {
+
+// Translates class `name` of `tc` for ISPC (LiteMath on the include path) and returns its kernels file.
+std::string IspcKernelsOf(const TempClass& tc, const std::string& name)
+{
+  CommandResult r = RunCrossrt("translate --class " + name + " --backend ispc --out " + (tc.dir / "out").string() + " --source " +
+                               tc.Source(name) + " --templates " CROSSRT_SOURCE_DIR "/templates -- -I" CROSSRT_SOURCE_DIR "/libs/litemath");
+  INFO(r.output);
+  REQUIRE(r.exitCode == 0);
+  std::ifstream file(tc.dir / "out" / (name + "_ISPC_kernels.ispc"));
+  return std::string((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+}
+
+}  // namespace
+
 TEST_CASE("ISPC: a loop whose bounds every lane shares is uniform; one the lanes differ in, or leave early, is varying", "[diagnostics][ispc]")
 {
   TempClass tc("Loops", R"(#pragma once
@@ -157,12 +172,7 @@ void Loops::kernel1D_Run(int n, int taps, float* data)
   }
 }
 )");
-  CommandResult r = RunCrossrt("translate --class Loops --backend ispc --out " + (tc.dir / "out").string() + " --source " + tc.Source("Loops") +
-                               " --templates " CROSSRT_SOURCE_DIR "/templates");
-  INFO(r.output);
-  REQUIRE(r.exitCode == 0);
-  std::ifstream file(tc.dir / "out" / "Loops_ISPC_kernels.ispc");
-  const std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  const std::string text = IspcKernelsOf(tc, "Loops");
   INFO(text);
   REQUIRE(text.find("for (uniform int k = -self->m_radius; k <= self->m_radius; k++)") != std::string::npos);  // members
   REQUIRE(text.find("for (uniform int t = 0; t < taps * k; t += 2)") != std::string::npos);  // a parameter, an outer uniform loop
@@ -210,12 +220,7 @@ void Lookup::kernel1D_Run(int n, const unsigned* keys, float* out)
   }
 }
 )");
-  CommandResult r = RunCrossrt("translate --class Lookup --backend ispc --out " + (tc.dir / "out").string() + " --source " + tc.Source("Lookup") +
-                               " --templates " CROSSRT_SOURCE_DIR "/templates -- -I" CROSSRT_SOURCE_DIR "/libs/litemath");
-  INFO(r.output);
-  REQUIRE(r.exitCode == 0);
-  std::ifstream file(tc.dir / "out" / "Lookup_ISPC_kernels.ispc");
-  const std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  const std::string text = IspcKernelsOf(tc, "Lookup");
   INFO(text);
   REQUIRE(text.find("static inline Big crt_load_Big(const uniform Big *uniform a, uint i)") != std::string::npos);
   REQUIRE(text.find("const Big b = crt_load_Big(self->m_big, (uint)(k));") != std::string::npos);  // const, whole, per lane
@@ -252,12 +257,7 @@ void Rows::kernel1D_Run(int n, const float4* in, float4* out)
   }
 }
 )");
-  CommandResult r = RunCrossrt("translate --class Rows --backend ispc --out " + (tc.dir / "out").string() + " --source " + tc.Source("Rows") +
-                               " --templates " CROSSRT_SOURCE_DIR "/templates -- -I" CROSSRT_SOURCE_DIR "/libs/litemath");
-  INFO(r.output);
-  REQUIRE(r.exitCode == 0);
-  std::ifstream file(tc.dir / "out" / "Rows_ISPC_kernels.ispc");
-  const std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  const std::string text = IspcKernelsOf(tc, "Rows");
   INFO(text);
   REQUIRE(text.find("const float4 copied = crt_load4(in_, (int)(i));") != std::string::npos);  // copied whole
   REQUIRE(text.find("const float4 first = in_[0];") != std::string::npos);                   // one element for all lanes
