@@ -211,6 +211,7 @@ std::string LaunchSize(const Kernel& k) {
 
 std::string ReductionCppType(const ClassModel& model, const Reduction& r) {
   if (!r.cppType.empty()) return r.cppType;
+  if (r.glslType == "double") return "double";  // ISPC's (the GPU has none)
   auto* m = FindMember(model, r.member);
   return m ? m->cppType : "float";
 }

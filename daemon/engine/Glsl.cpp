@@ -4,6 +4,7 @@
 #include "Glsl.h"
 #include "GlslParts.h"
 
+#include <clang/AST/ParentMapContext.h>
 #include <clang/AST/RecordLayout.h>
 #include <clang/Basic/SourceManager.h>
 #include <clang/Lex/Lexer.h>
@@ -85,6 +86,8 @@ std::optional<std::string> GlslPrinter::Type(QualType t, SourceLocation loc) {
          "use int or uint32_t in kernels (and mask explicitly where the wrap-around matters)");
     return std::nullopt;
   }
+  if (ispc && base->isSpecificBuiltinType(BuiltinType::Double) && !t.getNonReferenceType()->isArrayType())
+    return std::string("double");  // C's double, which ISPC has (arrays of it are not translated yet)
   if (auto* bt = base->getAs<BuiltinType>(); bt && bt->isFloatingPoint() && bt->getKind() != BuiltinType::Float) {
     Fail(loc, DoubleRefusal(t.getAsString(m_ctx.getPrintingPolicy())), DoubleRefusalHint());
     return std::nullopt;
@@ -111,6 +114,17 @@ std::string GlslPrinter::Declare(QualType t, const std::string& name, SourceLoca
   if (!g) return "/*error*/ " + name;
   auto [base, dims] = SplitArray(*g);
   return base + " " + SafeName(name) + dims;
+}
+
+// ISPC: the function that builds a struct from its fields, make_S, or crt_make_S where the user's
+// code has a make_S of its own (which then comes along as the user wrote it).
+std::string GlslPrinter::IspcStructMaker(const RecordDecl* rd) const {
+  const std::string maker = "make_" + rd->getName().str();
+  auto& idents = m_ctx.Idents;
+  for (const DeclContext* dc : {rd->getDeclContext()->getRedeclContext(), static_cast<const DeclContext*>(m_ctx.getTranslationUnitDecl())})
+    for (auto* d : dc->lookup(&idents.get(maker)))
+      if (isa<FunctionDecl>(d)) return "crt_" + maker;
+  return maker;
 }
 
 void GlslPrinter::NeedStruct(const RecordDecl* rd) {
@@ -142,7 +156,7 @@ void GlslPrinter::NeedStruct(const RecordDecl* rd) {
     if (size > at) os << "  uint8 crt_pad" << pads++ << "[" << (size - at) << "];\n";
     os << "};\n";
     if (constructible)
-      os << "static inline " << rd->getName().str() << " make_" << rd->getName().str() << "(" << params << ")\n{\n  "
+      os << "static inline " << rd->getName().str() << " " << IspcStructMaker(rd) << "(" << params << ")\n{\n  "
          << rd->getName().str() << " r;" << assigns << "\n  return r;\n}\n";
   } else {
     for (auto* f : rd->fields()) os << "  " << Declare(f->getType(), f->getName().str(), f->getLocation()) << ";\n";
@@ -195,6 +209,7 @@ std::string GlslPrinter::Literal(const clang::Expr* e) {
       if (text.find_first_of(".eEin") == std::string::npos) text += ".0";
     }
     if (text.find_first_of(".eE") == std::string::npos) text += ".0";
+    if (IspcInDoubleContext(fl)) text += "d";  // ISPC's double literal (an unsuffixed one is a float)
     return text;
   }
   if (auto* bl = dyn_cast<CXXBoolLiteralExpr>(e)) return bl->getValue() ? "true" : "false";
@@ -205,15 +220,21 @@ std::string GlslPrinter::Literal(const clang::Expr* e) {
 // An explicit or implicit conversion. GLSL converts implicitly only int->uint->float, so spell
 // the others out, and fold integer literals into the target type so the code stays readable.
 std::string GlslPrinter::Cast(QualType to, const clang::Expr* sub) {
-  // Double precision only arises from promotions such as `x * 0.5` (explicit double variables
-  // are refused): on the GPU the arithmetic stays in float.
+  // On the GPU double precision only arises from promotions such as `x * 0.5` (explicit double
+  // variables are refused), and the arithmetic stays in float. ISPC computes in double where the
+  // kernel declared a double (IspcDoubles.cpp).
   if (to->isRealFloatingType() && !to->isSpecificBuiltinType(BuiltinType::Float) && sub->getType()->isFloatingType())
     return Expr(sub);
   if (to->isSpecificBuiltinType(BuiltinType::Float) && sub->getType()->isRealFloatingType() &&
       !sub->getType()->isSpecificBuiltinType(BuiltinType::Float))
-    return Expr(sub);
-  if (to->isRealFloatingType() && !to->isSpecificBuiltinType(BuiltinType::Float) && sub->getType()->isIntegerType())
+    return ispc && IspcDeclaredDouble(sub) ? "((float)(" + Expr(sub) + "))" : Expr(sub);
+  if (to->isRealFloatingType() && !to->isSpecificBuiltinType(BuiltinType::Float) && sub->getType()->isIntegerType()) {
+    const clang::Expr* self = nullptr;  // the conversion itself, to see where its value goes
+    for (const auto& parent : m_ctx.getParents(*sub))
+      if (auto* cast = parent.get<CastExpr>()) self = cast;
+    if (ispc && self && IspcInDoubleContext(self)) return "((double)(" + Expr(sub) + "))";
     return ispc ? "((float)(" + Expr(sub) + "))" : "float(" + Expr(sub) + ")";
+  }
   auto target = GlslTypeOf(to);
   auto source = GlslTypeOf(sub->getType());
   if (!target) return Fail(sub->getBeginLoc(), "conversion to '" + to.getAsString(m_ctx.getPrintingPolicy()) + "' is not supported in kernels", "");
@@ -307,7 +328,7 @@ std::string GlslPrinter::IspcConstruct(QualType t, const std::string& type, cons
     for (auto* f : rd->fields())
       values.push_back(f->hasInClassInitializer() && f->getInClassInitializer() ? Expr(f->getInClassInitializer())
                                                                                 : Construct(f->getType(), {}, loc));
-  return "make_" + type + "(" + list(values) + ")";
+  return (rd && !IsLiteMathType(t) ? IspcStructMaker(rd) : "make_" + type) + "(" + list(values) + ")";
 }
 
 // LiteMath's half2 and half4 hold their 16-bit floats two per uint (packHalf2x16; in ISPC the
@@ -395,7 +416,10 @@ std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callL
   // Methods printed for an object (virtual calls) are per class; free functions are shared.
   std::string name = (selfClass && !isa<CXXMethodDecl>(fd) ? "" : composedPrefix) + FunctionName(fd, structSelf);
   if (IsGlslBuiltinFunction(name)) name += "_";  // GLSL forbids overloading its built-in functions
-  for (auto& [index, buffer] : bufferBindings) name += "_" + buffer;  // a copy per buffer its pointers index
+  // GLSL: a copy per buffer its pointers index (buffers are globals there). ISPC passes the buffer
+  // itself, so one copy serves them all: named after the parameters that point into a buffer.
+  for (auto& [index, buffer] : bufferBindings)
+    name += ispc ? "_at_" + SafeName(def->getParamDecl(index)->getNameAsString()) : "_" + buffer;
   if (m_inProgress.count(def))
     return Fail(callLoc, "recursive call to '" + fd->getQualifiedNameAsString() + "' in a kernel",
                 "GPUs have no call stack: rewrite the recursion as a loop with an explicit stack array");
@@ -439,8 +463,13 @@ std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callL
       PointerTarget t;
       const std::string name = SafeName(p->getNameAsString());
       if (auto bound = bufferBindings.find(i); bound != bufferBindings.end()) {
-        t.array = bound->second;
+        t.array = ispc ? name : bound->second;
         t.offset = name + "_offset";
+        if (ispc) {
+          auto element = Type(pt->getPointeeType().getUnqualifiedType(), p->getLocation());
+          os << (pt->getPointeeType().isConstQualified() ? "const " : "") << "uniform " << (element ? *element : "int") << " *uniform "
+             << name << ", ";
+        }
         os << "uint " << t.offset;
       } else {
         t.value = name;

@@ -220,6 +220,7 @@ private:
   std::string ComposedCall(const clang::CXXMemberCallExpr* call);
   std::string VirtualCall(const clang::CXXMemberCallExpr* call);
   void NeedStruct(const clang::RecordDecl* rd);
+  std::string IspcStructMaker(const clang::RecordDecl* rd) const;
   std::string NeedConstant(const clang::VarDecl* vd);  // its GLSL name
   std::string ConstantName(const clang::VarDecl* vd) const;
   std::string Fail(clang::SourceLocation loc, const std::string& message, const std::string& hint);
@@ -235,6 +236,9 @@ private:
   // A float4, int4 or uint4 read whole through a pointer at a per-lane index, through LiteMath.isph's
   // crt_load4 (vector loads where the lanes read consecutive elements, IspcLoads.cpp); "" otherwise.
   std::string IspcConsecutiveLoad(const clang::ArraySubscriptExpr* as, const PointerTarget& t);
+  // IspcDoubles.cpp: where a kernel computes in double on ISPC.
+  bool IspcDeclaredDouble(const clang::Expr* e) const;
+  bool IspcInDoubleContext(const clang::Expr* e) const;
   bool ReadWhole(const clang::Expr* e);  // e's value is copied or passed by value or const reference
 
   clang::ASTContext& m_ctx;

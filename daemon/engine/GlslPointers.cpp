@@ -168,7 +168,10 @@ std::vector<std::string> GlslPrinter::HelperArgs(const FunctionDecl* fd, const C
       args.push_back("/*error*/");
       continue;
     }
-    if (PointerIsValueOnly(def, p)) {
+    // ISPC binds no reference to a buffer's element (one per lane, at different addresses): a helper
+    // that writes through its pointer gets the buffer and the offset there.
+    const bool ispcBufferElement = ispc && !t->array.empty() && !t->local && !p->getType()->getPointeeType().isConstQualified();
+    if (PointerIsValueOnly(def, p) && !ispcBufferElement) {
       args.push_back(Pointee(*t, nullptr, arg->getBeginLoc()));
       continue;
     }
@@ -180,6 +183,7 @@ std::vector<std::string> GlslPrinter::HelperArgs(const FunctionDecl* fd, const C
       continue;
     }
     bindings[pi] = t->array;
+    if (ispc) args.push_back(t->array);  // ISPC: the buffer itself, then the offset into it
     args.push_back(t->offset.empty() ? "0u" : t->offset);
   }
   return args;

@@ -20,7 +20,9 @@ const char* const kIspcTargetSuffixes[] = {"sse4", "avx2", "avx512skx"};
 // Iterations of a 1D loop nest per chunk (2D and 3D nests hand out rows and slices one by one).
 constexpr int kChunk1D = 4096;
 
-bool IsScalar(const std::string& glslType) { return glslType == "float" || glslType == "int" || glslType == "uint" || glslType == "bool"; }
+bool IsScalar(const std::string& glslType) {
+  return glslType == "float" || glslType == "int" || glslType == "uint" || glslType == "bool" || glslType == "double";
+}
 
 // What C++ passes for an ISPC parameter of this GLSL type: the type ispc::'s header declares.
 std::string IspcCppType(const std::string& glslType) {
@@ -34,6 +36,8 @@ std::string IspcCppType(const std::string& glslType) {
 std::string IspcIdentity(ReduceOp op, const std::string& glslType) {
   const std::string t = IspcTypeName(glslType);
   const bool floating = t.rfind("float", 0) == 0;
+  if (t == "double")
+    return op == ReduceOp::Min ? "doublebits(0x7FF0000000000000ull)" : op == ReduceOp::Max ? "doublebits(0xFFF0000000000000ull)" : "0.0d";
   std::string scalar = "0";
   if (op == ReduceOp::Min) scalar = floating ? "floatbits(0x7F800000u)" : t.rfind("uint", 0) == 0 ? "0xFFFFFFFFu" : "2147483647";
   if (op == ReduceOp::Max) scalar = floating ? "floatbits(0xFF800000u)" : t.rfind("uint", 0) == 0 ? "0u" : "(-2147483647 - 1)";

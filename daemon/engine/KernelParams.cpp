@@ -57,6 +57,11 @@ void CheckKernelParams(Context& c, const CXXMethodDecl* md, const FunctionDecl* 
       kp.threadState = k.rtv && c.threadState.count({k.name, kp.name});
       kp.isConstPointee = pointee.isConstQualified();
       auto g = GlslTypeOf(pointee);
+      if (c.model.forIspc && pointee->isSpecificBuiltinType(BuiltinType::Double)) {  // ISPC has C's double
+        kp.glslType = "double";
+        k.params.push_back(kp);
+        continue;
+      }
       if (pointee->isRealFloatingType() && !pointee->isSpecificBuiltinType(BuiltinType::Float)) {
         c.rep.GpuError(p->getLocation(), DoubleRefusal(pointee.getUnqualifiedType().getAsString(c.ctx.getPrintingPolicy())), DoubleRefusalHint());
         continue;
@@ -77,7 +82,8 @@ void CheckKernelParams(Context& c, const CXXMethodDecl* md, const FunctionDecl* 
                   "kernels return results through pointer parameters or members");
     } else {
       auto g = GlslTypeOf(t);
-      if (t.getNonReferenceType()->isRealFloatingType() && !t.getNonReferenceType()->isSpecificBuiltinType(BuiltinType::Float)) {
+      if (c.model.forIspc && t.getNonReferenceType()->isSpecificBuiltinType(BuiltinType::Double)) g = "double";
+      else if (t.getNonReferenceType()->isRealFloatingType() && !t.getNonReferenceType()->isSpecificBuiltinType(BuiltinType::Float)) {
         c.rep.GpuError(p->getLocation(), DoubleRefusal(t.getNonReferenceType().getUnqualifiedType().getAsString(c.ctx.getPrintingPolicy())), DoubleRefusalHint());
         continue;
       }
@@ -102,7 +108,7 @@ void CheckKernelParams(Context& c, const CXXMethodDecl* md, const FunctionDecl* 
         k.params.push_back(kp);
         continue;
       }
-      auto layout = Std430Layout(c.ctx, value, false);
+      auto layout = *g == "double" ? std::optional<LayoutInfo>(LayoutInfo{8, 8}) : Std430Layout(c.ctx, value, false);
       if (!layout || !FitsClassData(c.ctx, value)) {
         c.rep.GpuError(p->getLocation(), "kernel parameter '" + kp.name + "' of type '" + t.getAsString(c.ctx.getPrintingPolicy()) + "' cannot be passed to the GPU as it is laid out in C++",
                     "use 32-bit int, uint or float, LiteMath vectors, float4x4, or structs whose fields keep the std430 layout (bool is 1 byte in C++, 4 on the GPU: use int)");

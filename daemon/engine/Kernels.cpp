@@ -23,6 +23,12 @@ namespace crossrt::engine {
 // The ISPC thread function's parameters after the thread ids (varying): the class's data, the
 // kernel's arguments (uniform: one value, or one array, for all lanes) and each reduction's
 // per-lane accumulator, by reference.
+// A reduction's type: GLSL's, or on ISPC also double (a sum of doubles stays double there).
+static std::string ReductionType(Context& c, QualType t) {
+  if (c.model.forIspc && t.getCanonicalType()->isSpecificBuiltinType(BuiltinType::Double)) return "double";
+  return GlslTypeOf(t).value_or("float");
+}
+
 static std::string IspcThreadHead(Context& c, const Kernel& k, const std::vector<std::pair<std::string, std::string>>& threadIds, const FunctionDecl* def) {
   // Not inline: inlined into its export function, LBVH's Karras12 (a varying early return in a
   // helper it calls in a loop) crashed on the deepest tree test_lbvh builds (ISPC 1.28.2, avx512skx).
@@ -239,7 +245,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
       Reduction r;
       r.member = vd->getNameAsString();
       r.op = found->second;
-      r.glslType = GlslTypeOf(vd->getType()).value_or("float");
+      r.glslType = ReductionType(c, vd->getType());
       r.identity = Identity(r.op, r.glslType);
       r.local = true;
       r.cppType = vd->getType().getUnqualifiedType().getAsString(c.ctx.getPrintingPolicy());
@@ -262,7 +268,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     Reduction r;
     r.member = field->getNameAsString();
     r.op = op;
-    r.glslType = GlslTypeOf(field->getType()).value_or("float");
+    r.glslType = ReductionType(c, field->getType());
     r.identity = Identity(op, r.glslType);
     printer.renames[field] = r.member + "Local";
     k.reductions.push_back(r);

@@ -1,6 +1,7 @@
 // The conformance suite: small classes written as users write them, in the paper's conventions
-// (cases/), each run as written, as <Class>_CPU and as <Class>_Vulkan (lavapipe, or the device
-// CROSSRT_DEVICE names, with validation layers on), and compared. Each check_*.cpp registers the
+// (cases/), each run as written, as <Class>_CPU, as <Class>_Vulkan (lavapipe, or the device
+// CROSSRT_DEVICE names, with validation layers on) and, where an ISPC compiler was found, as
+// <Class>_ISPC, and compared. Each check_*.cpp registers the
 // cases of one theme; main.cpp runs them all and prints which constructs pass.
 #pragma once
 #include <crossrt/VulkanRuntime.h>
@@ -25,7 +26,7 @@ struct Case {
   std::string construct;  // what the class exercises
   std::string files;      // where it is, under cases/
   double tolerance = 1e-5;  // |translated - original| <= tolerance * max(1, |original|), per output
-  std::function<Run()> original, cpu, vulkan;
+  std::function<Run()> original, cpu, vulkan, ispc;  // ispc: empty where the build has no ISPC classes
   // Set when the Vulkan backend refuses the class by design: the diagnostic it gives (checked by
   // translating the class again; the build translates it for the CPU only).
   std::string vulkanRefusal, className;
@@ -58,10 +59,11 @@ Run RunOn(const std::function<std::shared_ptr<T>()>& make, const std::function<O
   return r;
 }
 
-// A case from the three ways of making the class (as written, _CPU, _Vulkan) and what to run on it.
+// A case from the ways of making the class (as written, _CPU, _Vulkan, _ISPC) and what to run on it.
 template <class T>
 Case MakeCase(std::string construct, std::string files, double tolerance, std::function<std::shared_ptr<T>()> original,
-              std::function<std::shared_ptr<T>()> cpu, std::function<std::shared_ptr<T>()> vulkan, std::function<Outputs(T&)> work) {
+              std::function<std::shared_ptr<T>()> cpu, std::function<std::shared_ptr<T>()> vulkan,
+              std::function<std::shared_ptr<T>()> ispc, std::function<Outputs(T&)> work) {
   Case c;
   c.construct = std::move(construct);
   c.files = std::move(files);
@@ -69,6 +71,7 @@ Case MakeCase(std::string construct, std::string files, double tolerance, std::f
   c.original = [=] { return RunOn<T>(original, work); };
   c.cpu = [=] { return RunOn<T>(cpu, work); };
   if (vulkan) c.vulkan = [=] { return RunOn<T>(vulkan, work); };
+  if (ispc) c.ispc = [=] { return RunOn<T>(ispc, work); };
   return c;
 }
 
@@ -79,8 +82,13 @@ void Append(Outputs& out, const V& values) {
 
 }  // namespace conformance
 
-// The three constructions of Class with the same arguments: as written, Class_CPU, Class_Vulkan on
-// the suite's device.
+// The constructions of Class with the same arguments: as written, Class_CPU, Class_Vulkan on the
+// suite's device, and Class_ISPC where the build has it (CONFORMANCE_ISPC).
+#ifdef CONFORMANCE_ISPC
+#define CONFORMANCE_ISPC_MAKER(Class, ...) [] { return Create##Class##_ISPC(__VA_ARGS__); }
+#else
+#define CONFORMANCE_ISPC_MAKER(Class, ...) std::function<std::shared_ptr<Class>()>()
+#endif
 #define CONFORMANCE_MAKERS(Class, ...)                                                               \
   [] { return std::make_shared<Class>(__VA_ARGS__); }, [] { return Create##Class##_CPU(__VA_ARGS__); }, \
-      [] { return Create##Class##_Vulkan(conformance::Context(), ##__VA_ARGS__); }
+      [] { return Create##Class##_Vulkan(conformance::Context(), ##__VA_ARGS__); }, CONFORMANCE_ISPC_MAKER(Class, __VA_ARGS__)

@@ -8,26 +8,44 @@
 #if __has_include("ImageScale_CPU.h")
 #include "ImageScale_CPU.h"
 #include "ImageScale_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "ImageScale_ISPC.h"
+#endif
 #endif
 #if __has_include("Saxpy_CPU.h")
 #include "Saxpy_CPU.h"
 #include "Saxpy_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "Saxpy_ISPC.h"
+#endif
 #endif
 #if __has_include("Brighten_CPU.h")
 #include "Brighten_CPU.h"
 #include "Brighten_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "Brighten_ISPC.h"
+#endif
 #endif
 #if __has_include("Accumulate_CPU.h")
 #include "Accumulate_CPU.h"
 #include "Accumulate_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "Accumulate_ISPC.h"
+#endif
 #endif
 #if __has_include("Decay_CPU.h")
 #include "Decay_CPU.h"
 #include "Decay_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "Decay_ISPC.h"
+#endif
 #endif
 #if __has_include("BoxBlur_CPU.h")
 #include "BoxBlur_CPU.h"
 #include "BoxBlur_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "BoxBlur_ISPC.h"
+#endif
 #endif
 
 using namespace conformance;
@@ -85,18 +103,25 @@ Register brighten(MakeCase<Brighten>(
 Register accumulate(MakeCase<Accumulate>(
     "a control function that is not virtual (warning; the generated one hides it)", "non_virtual_control.h/.cpp", 1e-6,
     [] { return std::make_shared<Accumulate>(); }, [] { return CreateAccumulate_CPU(); },
-    [] { return CreateAccumulate_Vulkan(Context()); },
+    [] { return CreateAccumulate_Vulkan(Context()); }, CONFORMANCE_ISPC_MAKER(Accumulate, ),
     [](Accumulate& a) {
       const int n = 500;
       std::vector<float> in = Ramp(n, 1.0f), acc(n, 1.0f);
+      bool translated = true;
       if (auto* cpu = dynamic_cast<Accumulate_CPU*>(&a)) cpu->AddInto(n, in.data(), acc.data());
       else if (auto* gpu = dynamic_cast<Accumulate_Vulkan*>(&a)) gpu->AddInto(n, in.data(), acc.data());
-      else a.AddInto(n, in.data(), acc.data());
+#ifdef CONFORMANCE_ISPC
+      else if (auto* simd = dynamic_cast<Accumulate_ISPC*>(&a)) simd->AddInto(n, in.data(), acc.data());
+#endif
+      else {
+        a.AddInto(n, in.data(), acc.data());
+        translated = false;
+      }
       float times[4];
       a.GetExecutionTime("AddInto", times);
       Outputs r;
       Append(r, acc);
-      r.push_back(dynamic_cast<Accumulate_CPU*>(&a) || dynamic_cast<Accumulate_Vulkan*>(&a) ? double(times[3] > 0.0f) : 1.0);
+      r.push_back(translated ? double(times[3] > 0.0f) : 1.0);
       return r;
     }));
 #endif

@@ -9,34 +9,58 @@
 #if __has_include("Transforms_CPU.h")
 #include "Transforms_CPU.h"
 #include "Transforms_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "Transforms_ISPC.h"
+#endif
 #endif
 #if __has_include("Conversions_CPU.h")
 #include "Conversions_CPU.h"
 #include "Conversions_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "Conversions_ISPC.h"
+#endif
 #endif
 #if __has_include("HalfPack_CPU.h")
 #include "HalfPack_CPU.h"
 #include "HalfPack_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "HalfPack_ISPC.h"
+#endif
 #endif
 #if __has_include("ThinFilm_CPU.h")
 #include "ThinFilm_CPU.h"
 #include "ThinFilm_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "ThinFilm_ISPC.h"
+#endif
 #endif
 #if __has_include("Histogram_CPU.h")
 #include "Histogram_CPU.h"
 #include "Histogram_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "Histogram_ISPC.h"
+#endif
 #endif
 #if __has_include("OldAtomics_CPU.h")
 #include "OldAtomics_CPU.h"
 #include "OldAtomics_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "OldAtomics_ISPC.h"
+#endif
 #endif
 #if __has_include("AccumGrid_CPU.h")
 #include "AccumGrid_CPU.h"
 #include "AccumGrid_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "AccumGrid_ISPC.h"
+#endif
 #endif
 #if __has_include("Projector_CPU.h")
 #include "Projector_CPU.h"
 #include "Projector_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "Projector_ISPC.h"
+#endif
 #endif
 
 using namespace conformance;

@@ -8,26 +8,44 @@
 #if __has_include("PointStats_CPU.h")
 #include "PointStats_CPU.h"
 #include "PointStats_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "PointStats_ISPC.h"
+#endif
 #endif
 #if __has_include("HalfSum_CPU.h")
 #include "HalfSum_CPU.h"
 #include "HalfSum_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "HalfSum_ISPC.h"
+#endif
 #endif
 #if __has_include("KeepPositive_CPU.h")
 #include "KeepPositive_CPU.h"
 #include "KeepPositive_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "KeepPositive_ISPC.h"
+#endif
 #endif
 #if __has_include("ThresholdFlag_CPU.h")
 #include "ThresholdFlag_CPU.h"
 #include "ThresholdFlag_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "ThresholdFlag_ISPC.h"
+#endif
 #endif
 #if __has_include("ArraySum_CPU.h")
 #include "ArraySum_CPU.h"
 #include "ArraySum_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "ArraySum_ISPC.h"
+#endif
 #endif
 #if __has_include("LocalTotals_CPU.h")
 #include "LocalTotals_CPU.h"
 #include "LocalTotals_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "LocalTotals_ISPC.h"
+#endif
 #endif
 
 #include <algorithm>

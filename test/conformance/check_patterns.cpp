@@ -10,22 +10,37 @@
 #if __has_include("SortPairs_CPU.h")
 #include "SortPairs_CPU.h"
 #include "SortPairs_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "SortPairs_ISPC.h"
+#endif
 #endif
 #if __has_include("RedPixels_CPU.h")
 #include "RedPixels_CPU.h"
 #include "RedPixels_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "RedPixels_ISPC.h"
+#endif
 #endif
 #if __has_include("ShadedSpheres_CPU.h")
 #include "ShadedSpheres_CPU.h"
 #include "ShadedSpheres_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "ShadedSpheres_ISPC.h"
+#endif
 #endif
 #if __has_include("StagedSaxpy_CPU.h")
 #include "StagedSaxpy_CPU.h"
 #include "StagedSaxpy_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "StagedSaxpy_ISPC.h"
+#endif
 #endif
 #if __has_include("MovingBoxes_CPU.h")
 #include "MovingBoxes_CPU.h"
 #include "MovingBoxes_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "MovingBoxes_ISPC.h"
+#endif
 #endif
 
 using namespace conformance;

@@ -9,26 +9,44 @@
 #if __has_include("NoisyFill_CPU.h")
 #include "NoisyFill_CPU.h"
 #include "NoisyFill_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "NoisyFill_ISPC.h"
+#endif
 #endif
 #if __has_include("MinMaxPair_CPU.h")
 #include "MinMaxPair_CPU.h"
 #include "MinMaxPair_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "MinMaxPair_ISPC.h"
+#endif
 #endif
 #if __has_include("ParticleStep_CPU.h")
 #include "ParticleStep_CPU.h"
 #include "ParticleStep_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "ParticleStep_ISPC.h"
+#endif
 #endif
 #if __has_include("RowSums_CPU.h")
 #include "RowSums_CPU.h"
 #include "RowSums_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "RowSums_ISPC.h"
+#endif
 #endif
 #if __has_include("Gather_CPU.h")
 #include "Gather_CPU.h"
 #include "Gather_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "Gather_ISPC.h"
+#endif
 #endif
 #if __has_include("SaxpyBlock_CPU.h")
 #include "SaxpyBlock_CPU.h"
 #include "SaxpyBlock_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "SaxpyBlock_ISPC.h"
+#endif
 #endif
 
 using namespace conformance;

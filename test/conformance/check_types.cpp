@@ -9,33 +9,57 @@
 #if __has_include("Tonemap_CPU.h")
 #include "Tonemap_CPU.h"
 #include "Tonemap_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "Tonemap_ISPC.h"
+#endif
 #endif
 #if __has_include("SignFlip_CPU.h")
 #include "SignFlip_CPU.h"
 #include "SignFlip_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "SignFlip_ISPC.h"
+#endif
 #endif
 #if __has_include("PrefixSums_CPU.h")
 #include "PrefixSums_CPU.h"
 #include "PrefixSums_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "PrefixSums_ISPC.h"
+#endif
 #endif
 #if __has_include("DoubleSum_CPU.h")
 #include "DoubleSum_CPU.h"
+#ifdef CONFORMANCE_ISPC
+#include "DoubleSum_ISPC.h"
+#endif
 #endif
 #if __has_include("BounceLoop_CPU.h")
 #include "BounceLoop_CPU.h"
 #include "BounceLoop_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "BounceLoop_ISPC.h"
+#endif
 #endif
 #if __has_include("Smooth4_CPU.h")
 #include "Smooth4_CPU.h"
 #include "Smooth4_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "Smooth4_ISPC.h"
+#endif
 #endif
 #if __has_include("FillVariable_CPU.h")
 #include "FillVariable_CPU.h"
 #include "FillVariable_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "FillVariable_ISPC.h"
+#endif
 #endif
 #if __has_include("DerivedBlend_CPU.h")
 #include "DerivedBlend_CPU.h"
 #include "DerivedBlend_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "DerivedBlend_ISPC.h"
+#endif
 #endif
 
 #include <limits>
@@ -90,8 +114,8 @@ Register prefixSums(MakeCase<PrefixSums>(
 
 #if __has_include("DoubleSum_CPU.h")
 Register doubleSum([] {
-  Case c = MakeCase<DoubleSum>("double in a kernel (the CPU backend has none of the GPU's limits)", "double_sum.h/.cpp", 1e-12,
-                               [] { return std::make_shared<DoubleSum>(); }, [] { return CreateDoubleSum_CPU(); }, nullptr, [](DoubleSum& d) {
+  Case c = MakeCase<DoubleSum>("double in a kernel (the CPU backends have none of the GPU's limits)", "double_sum.h/.cpp", 1e-12,
+                               [] { return std::make_shared<DoubleSum>(); }, [] { return CreateDoubleSum_CPU(); }, nullptr, CONFORMANCE_ISPC_MAKER(DoubleSum, ), [](DoubleSum& d) {
                                  std::vector<double> data(4001);
                                  for (int i = 0; i < 4001; i++) data[i] = 1e-3 * double(i % 37) - 0.01;
                                  d.Sum(data.data(), data.size());

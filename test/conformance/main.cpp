@@ -1,7 +1,8 @@
-// Runs every conformance case on the three backends and prints which constructs pass:
+// Runs every conformance case on each backend and prints which constructs pass:
 //   crossrt_conformance [--csv FILE]
-// Exit status 0 only when every case agrees with the class as written on every backend, and every
-// refusal by design is the diagnostic the case expects.
+// Exit status 0 only when every case agrees with the class as written on every backend the build
+// has (_CPU, _Vulkan, and _ISPC where an ISPC compiler was found), and every refusal by design is
+// the diagnostic the case expects.
 #include "Conformance.h"
 
 #include <algorithm>
@@ -103,7 +104,8 @@ int main(int argc, char** argv) {
     if (std::strcmp(argv[i], "--csv") == 0 && i + 1 < argc) csvPath = argv[++i];
     else {
       std::printf("usage: crossrt_conformance [--csv FILE]\n"
-                  "Runs the conformance classes (test/conformance/cases) as written, as _CPU and as _Vulkan, and prints\n"
+                  "Runs the conformance classes (test/conformance/cases) as written, as _CPU, as _Vulkan and (where the\n"
+                  "build found an ISPC compiler) as _ISPC, and prints"
                   "which constructs translate, run and agree. CROSSRT_DEVICE picks the Vulkan device.\n");
       return std::strcmp(argv[i], "--help") == 0 ? 0 : 2;
     }
@@ -111,24 +113,32 @@ int main(int argc, char** argv) {
   auto& cases = conformance::Registry();
   std::sort(cases.begin(), cases.end(), [](const Case& a, const Case& b) { return a.files < b.files; });
   auto ctx = conformance::Context();
-  std::printf("CrossRT conformance: %zu classes on the CPU and on Vulkan (%s, validation on)\n\n", cases.size(),
-              ctx ? ctx->DeviceName().c_str() : "no Vulkan driver: Vulkan column skipped");
+#ifdef CONFORMANCE_ISPC
+  const bool ispcBuilt = true;
+#else
+  const bool ispcBuilt = false;
+#endif
+  std::printf("CrossRT conformance: %zu classes on the CPU, on Vulkan (%s, validation on) and in ISPC%s\n\n", cases.size(),
+              ctx ? ctx->DeviceName().c_str() : "no Vulkan driver: Vulkan column skipped",
+              ispcBuilt ? "" : " (no ISPC compiler in this build: ISPC column skipped)");
   const size_t w0 = 62, w1 = 26, w2 = 22;
-  std::printf("%s | %s | %s | %s\n", Cell("construct", w0).c_str(), Cell("class (cases/)", w1).c_str(), Cell("_CPU", w2).c_str(), "_Vulkan");
-  std::printf("%s-+-%s-+-%s-+-%s\n", std::string(w0, '-').c_str(), std::string(w1, '-').c_str(), std::string(w2, '-').c_str(), std::string(w2, '-').c_str());
+  std::printf("%s | %s | %s | %s | %s\n", Cell("construct", w0).c_str(), Cell("class (cases/)", w1).c_str(), Cell("_CPU", w2).c_str(),
+              Cell("_Vulkan", w2).c_str(), "_ISPC");
+  std::printf("%s-+-%s-+-%s-+-%s-+-%s\n", std::string(w0, '-').c_str(), std::string(w1, '-').c_str(), std::string(w2, '-').c_str(),
+              std::string(w2, '-').c_str(), std::string(w2, '-').c_str());
   std::ofstream csv;
   if (!csvPath.empty()) {
     csv.open(csvPath);
-    csv << "construct,files,cpu,vulkan\n";
+    csv << "construct,files,cpu,vulkan,ispc\n";
   }
   int failures = 0, passes = 0;
   for (const Case& c : cases) {
     const Run original = c.original();
-    Verdict cpu, vulkan;
+    Verdict cpu, vulkan, ispc;
     if (!original.ran) {
-      cpu = vulkan = {false, "original threw: " + original.error};
+      cpu = vulkan = ispc = {false, "original threw: " + original.error};
     } else if (std::all_of(original.outputs.begin(), original.outputs.end(), [](double v) { return v == 0.0; })) {
-      cpu = vulkan = {false, "the original computed nothing"};  // a check that cannot fail
+      cpu = vulkan = ispc = {false, "the original computed nothing"};  // a check that cannot fail
     } else {
       cpu = Compare(original, c.cpu(), c.tolerance);
       if (!c.vulkanRefusal.empty()) vulkan = CheckRefusal(c);
@@ -138,18 +148,21 @@ int main(int argc, char** argv) {
         for (auto& m : ctx->ValidationMessages()) vulkan = {false, "validation: " + m};
         ctx->ClearValidationMessages();
       }
+      if (!ispcBuilt) ispc = {true, "skipped: no ISPC compiler"};
+      else if (c.ispc) ispc = Compare(original, c.ispc(), c.tolerance);
+      else ispc = {false, "no _ISPC class: the build translated it for ISPC but the case does not run it"};
     }
-    const bool pass = cpu.pass && vulkan.pass;
+    const bool pass = cpu.pass && vulkan.pass && ispc.pass;
     (pass ? passes : failures)++;
-    std::printf("%s | %s | %s | %s%s\n", Cell(c.construct, w0).c_str(), Cell(c.files, w1).c_str(), Cell(cpu.text, w2).c_str(),
-                vulkan.text.c_str(), pass ? "" : "   <-- FAIL");
-    if (csv) csv << '"' << c.construct << "\",\"" << c.files << "\",\"" << cpu.text << "\",\"" << vulkan.text << "\"\n";
+    std::printf("%s | %s | %s | %s | %s%s\n", Cell(c.construct, w0).c_str(), Cell(c.files, w1).c_str(), Cell(cpu.text, w2).c_str(),
+                Cell(vulkan.text, w2).c_str(), ispc.text.c_str(), pass ? "" : "   <-- FAIL");
+    if (csv) csv << '"' << c.construct << "\",\"" << c.files << "\",\"" << cpu.text << "\",\"" << vulkan.text << "\",\"" << ispc.text << "\"\n";
   }
   if (cases.size() != CONFORMANCE_EXPECTED_CASES) {
     std::printf("\n%zu cases ran, but the build translated %d classes: a case is missing its check\n", cases.size(), CONFORMANCE_EXPECTED_CASES);
     ++failures;
   }
-  std::printf("\n%d of %zu constructs translate, run and agree on both backends%s\n", passes, cases.size(),
+  std::printf("\n%d of %zu constructs translate, run and agree on every backend%s\n", passes, cases.size(),
               failures ? "" : " (OK)");
   return failures == 0 ? 0 : 1;
 }
