@@ -86,8 +86,10 @@ std::optional<std::string> GlslPrinter::Type(QualType t, SourceLocation loc) {
          "use int or uint32_t in kernels (and mask explicitly where the wrap-around matters)");
     return std::nullopt;
   }
-  if (ispc && base->isSpecificBuiltinType(BuiltinType::Double) && !t.getNonReferenceType()->isArrayType())
-    return std::string("double");  // C's double, which ISPC has (arrays of it are not translated yet)
+  if (ispc && base->isSpecificBuiltinType(BuiltinType::Double)) {  // C's double, which ISPC has
+    if (t.getNonReferenceType()->isArrayType()) return IspcFail(loc, "an array of double"), std::nullopt;
+    return std::string("double");
+  }
   if (auto* bt = base->getAs<BuiltinType>(); bt && bt->isFloatingPoint() && bt->getKind() != BuiltinType::Float) {
     Fail(loc, DoubleRefusal(t.getAsString(m_ctx.getPrintingPolicy())), DoubleRefusalHint());
     return std::nullopt;

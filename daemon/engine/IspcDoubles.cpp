@@ -43,8 +43,8 @@ bool GlslPrinter::IspcDeclaredDouble(const clang::Expr* e) const {
 }
 
 // e (a literal, or an int converted to double) sits where C++ computes in double with something
-// declared double: beside one in arithmetic or a comparison, or as the value of a double variable,
-// member, parameter or return.
+// declared double: beside one in arithmetic or a comparison, or (itself or arithmetic on it) as the
+// value of a double variable, member, parameter or return.
 bool GlslPrinter::IspcInDoubleContext(const clang::Expr* e) const {
   if (!ispc || !IsDouble(e->getType().getCanonicalType())) return false;
   const clang::Expr* child = e;
@@ -56,7 +56,11 @@ bool GlslPrinter::IspcInDoubleContext(const clang::Expr* e) const {
     if (parents[0].get<ImplicitCastExpr>()) return false;  // converted to the float (or int) it is used as
     if (auto* bo = parents[0].get<BinaryOperator>()) {
       const clang::Expr* other = bo->getLHS()->IgnoreParens() == child->IgnoreParens() ? bo->getRHS() : bo->getLHS();
-      return IspcDeclaredDouble(other->IgnoreParenImpCasts()) || (bo->isAssignmentOp() && IsDouble(bo->getLHS()->getType().getCanonicalType()));
+      if (IspcDeclaredDouble(other->IgnoreParenImpCasts()) || (bo->isAssignmentOp() && IsDouble(bo->getLHS()->getType().getCanonicalType())))
+        return true;
+      if (!bo->isAdditiveOp() && !bo->isMultiplicativeOp()) return false;
+      child = bo;  // 1.0 / 3.0: double where its result goes
+      continue;
     }
     if (auto* call = parents[0].get<CallExpr>()) {  // an argument: of the user's function, or beside a double
       const FunctionDecl* callee = call->getDirectCallee();

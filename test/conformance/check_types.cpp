@@ -33,6 +33,12 @@
 #include "DoubleSum_ISPC.h"
 #endif
 #endif
+#if __has_include("DoubleScale_CPU.h")
+#include "DoubleScale_CPU.h"
+#ifdef CONFORMANCE_ISPC
+#include "DoubleScale_ISPC.h"
+#endif
+#endif
 #if __has_include("BounceLoop_CPU.h")
 #include "BounceLoop_CPU.h"
 #include "BounceLoop_Vulkan.h"
@@ -122,6 +128,24 @@ Register doubleSum([] {
                                  return Outputs{d.m_summ};
                                });
   c.className = "DoubleSum";
+  c.vulkanRefusal = "is not supported in Vulkan kernels: many GPUs have no 64-bit floats";
+  return c;
+}());
+#endif
+
+#if __has_include("DoubleScale_CPU.h")
+Register doubleScale([] {
+  Case c = MakeCase<DoubleScale>("arithmetic in double: 1.0 / 3.0, a helper of double, an int added in double", "double_scale.h/.cpp", 1e-15,
+                                 [] { return std::make_shared<DoubleScale>(); }, [] { return CreateDoubleScale_CPU(); }, nullptr,
+                                 CONFORMANCE_ISPC_MAKER(DoubleScale, ), [](DoubleScale& d) {
+                                   const int n = 1000;
+                                   std::vector<float> in(n);
+                                   for (int i = 0; i < n; i++) in[i] = 0.37f * float(i % 91) - 11.0f;
+                                   std::vector<double> out(n, 0.0);
+                                   d.Scale(n, in.data(), out.data());
+                                   return Outputs(out.begin(), out.end());
+                                 });
+  c.className = "DoubleScale";
   c.vulkanRefusal = "is not supported in Vulkan kernels: many GPUs have no 64-bit floats";
   return c;
 }());
