@@ -870,6 +870,7 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
 std::string GlslPrinter::IspcVectorOperator(const CXXOperatorCallExpr* op) {
   if (op->getNumArgs() == 0 || !IsLiteMathType(op->getArg(0)->getType().getNonReferenceType())) return "";
   const auto kind = op->getOperator();
+  if (std::string store = IspcConsecutiveStore(op); !store.empty()) return store;
   const bool matrix = IsLiteMathType(op->getArg(0)->getType().getNonReferenceType(), "float4x4") ||
                       IsLiteMathType(op->getArg(0)->getType().getNonReferenceType(), "float3x3");
   if (kind == OO_Minus && op->getNumArgs() == 1 && matrix) return "((" + Expr(op->getArg(0)) + ") * -1.0f)";

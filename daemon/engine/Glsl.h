@@ -236,6 +236,7 @@ private:
   // A float4, int4 or uint4 read whole through a pointer at a per-lane index, through LiteMath.isph's
   // crt_load4 (vector loads where the lanes read consecutive elements, IspcLoads.cpp); "" otherwise.
   std::string IspcConsecutiveLoad(const clang::ArraySubscriptExpr* as, const PointerTarget& t);
+  std::string IspcConsecutiveStore(const clang::CXXOperatorCallExpr* op);
   // IspcDoubles.cpp: where a kernel computes in double on ISPC.
   bool IspcDeclaredDouble(const clang::Expr* e) const;
   bool IspcInDoubleContext(const clang::Expr* e) const;

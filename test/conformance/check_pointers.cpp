@@ -6,6 +6,13 @@
 #include "LiteMath.h"
 
 // A case compiles where this build translated its class (CONFORMANCE_CLASSES); main checks that all were.
+#if __has_include("PixelRows_CPU.h")
+#include "PixelRows_CPU.h"
+#include "PixelRows_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "PixelRows_ISPC.h"
+#endif
+#endif
 #if __has_include("NoisyFill_CPU.h")
 #include "NoisyFill_CPU.h"
 #include "NoisyFill_Vulkan.h"
@@ -127,6 +134,24 @@ Register gather(MakeCase<Gather>(
       g.Run(300, out.data());
       Outputs r;
       Append(r, out);
+      return r;
+    }));
+#endif
+
+#if __has_include("PixelRows_CPU.h")
+Register pixelRows(MakeCase<PixelRows>(
+    "whole float4/int4 pixels written in order and mirrored, n = 1001", "pixel_rows.h/.cpp", 0.0, CONFORMANCE_MAKERS(PixelRows),
+    [](PixelRows& p) {
+      const int n = 1001;
+      std::vector<float4> in(n), rows(n), mirrored(n);
+      std::vector<int4> cells(n);
+      for (int i = 0; i < n; i++) in[i] = float4(0.25f * float(i), float(i % 13), -float(i), 0.5f);
+      p.Shade(n, in.data(), rows.data(), mirrored.data(), cells.data());
+      Outputs r;
+      for (int i = 0; i < n; i++) {
+        Append(r, std::vector<float>{rows[i].x, rows[i].y, rows[i].z, rows[i].w, mirrored[i].x, mirrored[i].y, mirrored[i].z, mirrored[i].w});
+        Append(r, std::vector<int>{cells[i].x, cells[i].y, cells[i].z, cells[i].w});
+      }
       return r;
     }));
 #endif

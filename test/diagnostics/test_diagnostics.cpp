@@ -230,7 +230,7 @@ void Lookup::kernel1D_Run(int n, const unsigned* keys, float* out)
   REQUIRE(text.find("const Big mine = self->m_big[keys[i]];") != std::string::npos);               // not const: as written
 }
 
-TEST_CASE("ISPC: a float4 read whole through a pointer at a per-lane index goes through crt_load4; one written, or a field of it, does not",
+TEST_CASE("ISPC: a float4 read whole through a pointer at a per-lane index goes through crt_load4, one stored whole through crt_store4; a field of it does neither",
           "[diagnostics][ispc]")
 {
   TempClass tc("Rows", R"(#pragma once
@@ -254,6 +254,7 @@ void Rows::kernel1D_Run(int n, const float4* in, float4* out)
     const float4 copied = in[i];
     const float4 first = in[0];
     out[i] = copied + in[i] * 2.0f + float4(in[i].x) + first;
+    out[i].w = 1.0f;
   }
 }
 )");
@@ -263,7 +264,8 @@ void Rows::kernel1D_Run(int n, const float4* in, float4* out)
   REQUIRE(text.find("const float4 first = in_[0];") != std::string::npos);                   // one element for all lanes
   REQUIRE(text.find("crt_load4(in_, (int)(i)) * 2.0") != std::string::npos);                 // passed by const reference
   REQUIRE(text.find("in_[i].x") != std::string::npos);                                        // one field: a gather
-  REQUIRE(text.find("out_[i] = ") != std::string::npos);                                      // written: as written
+  REQUIRE(text.find("crt_store4(out_, (int)(i), copied + ") != std::string::npos);           // stored whole
+  REQUIRE(text.find("out_[i].w = 1.0") != std::string::npos);                                 // one field: a scatter
 }
 
 TEST_CASE("A pointer parameter of a control function without a size is reported", "[diagnostics]")

@@ -1,0 +1,17 @@
+#include "pixel_rows.h"
+
+void PixelRows::Shade(int n, const float4* a_in, float4* a_rows, float4* a_mirrored, int4* a_cells)
+{
+  kernel1D_Shade(n, a_in, a_rows, a_mirrored, a_cells);
+}
+
+void PixelRows::kernel1D_Shade(int n, const float4* a_in, float4* a_rows, float4* a_mirrored, int4* a_cells)
+{
+  for (int i = 0; i < n; i++)
+  {
+    const float4 c = a_in[i];
+    a_rows[i] = c * 0.5f + float4(1.0f, 2.0f, 3.0f, 4.0f);
+    a_mirrored[n - 1 - i] = float4(c.w, c.z, c.y, c.x);
+    a_cells[i] = int4(i, -i, int(c.x), 7);
+  }
+}
