@@ -132,6 +132,7 @@ std::string GenerateIspcKernels(const ClassModel& model, const GenerateOptions& 
   d.set("constants", constants);
   d.set("functions", code);
   d.set("kernels", kernels);
+  d.set("ispcHasKernels", !kernels.is_empty_list());  // else no <Class>_Data: nothing declares the types of its members
   Data members = List(), vectors = List();
   for (auto& m : model.members) {
     if (!m.usedByKernels) continue;

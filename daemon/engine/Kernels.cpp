@@ -70,6 +70,9 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   // The ISPC class runs the loop nests of kernelND_ functions as ISPC; the thread loops that call
   // kernel_ functions stay in its control functions, on all cores as in the CPU class.
   printer.ispc = c.model.forIspc && !k.rtv;
+  if (c.model.forIspc && k.rtv)  // once for the class
+    c.rep.Note(c.cls->getLocation(), "the ISPC class runs the kernel_ functions that control functions call from thread loops as C++ "
+                                     "on all cores, as the CPU class does; only kernel1D_/2D_/3D_ loop nests run in SIMD lanes");
   printer.compositions = c.compositions;
   printer.threadReturnsValue = k.returnsBool;
   for (auto& s : ClassStructNames(c.model)) printer.predeclaredStructs.insert(s);

@@ -1,9 +1,12 @@
 // litept's path tracer: the Cornell box that scripts/make-cornell-box.py writes, rendered by the class
-// as written, PathTracer_CPU and PathTracer_Vulkan (both modes) with a fixed seed; an emitter seen
+// as written, PathTracer_CPU, PathTracer_ISPC (where built) and PathTracer_Vulkan (both modes) with a fixed seed; an emitter seen
 // directly; sphere and rectangle lights and what they hide; white furnaces; and scene files that cannot be read.
 #include "PathTracer.h"
 #include "PathTracer_CPU.h"
 #include "PathTracer_Vulkan.h"
+#ifdef CROSSRT_LITEPT_ISPC
+#include "PathTracer_ISPC.h"
+#endif
 #include "SceneLoader.h"
 #include "TestSupport.h"
 
@@ -135,6 +138,11 @@ TEST_CASE("path tracer: the Cornell box on the class as written, PathTracer_CPU 
   const std::vector<float4> embree = Render(*cpu, scene, "embree", w, h, spp, depth);
   // Embree's hits differ from BVHScene's in the last bits: a path may rarely take another way.
   REQUIRE(Mismatches(reference, embree, 1e-3f) <= reference.size() / 50);
+#ifdef CROSSRT_LITEPT_ISPC
+  // PathTracer_ISPC runs its thread loops as C++ on all cores, as PathTracer_CPU does.
+  auto ispc = CreatePathTracer_ISPC();
+  REQUIRE(Mismatches(reference, Render(*ispc, scene, "sah", w, h, spp, depth), 1e-5f) == 0);
+#endif
 
   auto ctx = ValidatedContext();
   if (!ctx)
