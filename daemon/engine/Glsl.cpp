@@ -690,7 +690,8 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
       if (IsImageSampler(field->getType()))
         return Fail(e->getBeginLoc(), "sampler member '" + field->getNameAsString() + "' used as a value in a kernel",
                     "pass it straight to an Image2D member's sample(" + field->getNameAsString() + ", uv)");
-      if (field->getType()->isPointerType() || !GlslTypeOf(field->getType()))
+      const bool ispcDouble = ispc && field->getType().getCanonicalType()->isSpecificBuiltinType(BuiltinType::Double);
+      if (field->getType()->isPointerType() || (!GlslTypeOf(field->getType()) && !ispcDouble))
         return Fail(e->getBeginLoc(), "member '" + field->getNameAsString() + "' of type '" + field->getType().getAsString(m_ctx.getPrintingPolicy()) +
                     "' cannot be used in a kernel", "kernels may use plain data members and std::vector members");
       m_uses.plainMembers.insert(field);

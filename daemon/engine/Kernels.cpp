@@ -393,7 +393,8 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     if (auto* m = FindMember(c.model, f->getNameAsString())) m->usedByKernels = true;
     RequireReachable(c.rep, f, c.cls);
     QualType elem;
-    if (IsStdVector(f->getType(), &elem) && !LayoutMatchesCpp(c.ctx, elem, false) && !LayoutMatchesCpp(c.ctx, elem, true))
+    const bool ispcDoubles = c.model.forIspc && IsStdVector(f->getType(), &elem) && elem.getCanonicalType()->isSpecificBuiltinType(BuiltinType::Double);
+    if (IsStdVector(f->getType(), &elem) && !ispcDoubles && !LayoutMatchesCpp(c.ctx, elem, false) && !LayoutMatchesCpp(c.ctx, elem, true))
       c.rep.GpuError(f->getLocation(), "the elements of '" + f->getNameAsString() + "' have a C++ layout that a GPU buffer cannot reproduce",
                      "use int instead of bool, and 32-bit scalars and LiteMath vectors in structs");
   }

@@ -31,6 +31,9 @@ bool HasVirtualDestructor(const CXXRecordDecl* rd) {
   return false;
 }
 
+// A double (not an array of them) that an ISPC class keeps as double (the GPU has none).
+bool IspcDouble(const Context& c, QualType t) { return c.model.forIspc && t.getCanonicalType()->isSpecificBuiltinType(BuiltinType::Double); }
+
 }  // namespace
 
 void AnalyzeMembers(Context& c) {
@@ -74,7 +77,7 @@ void AnalyzeMembers(Context& c) {
       m.kind = MemberKind::Sampler;
       m.cppType = CppTypeName(c.ctx, f->getType());
     } else if (IsStdVector(f->getType(), &elem)) {
-      auto g = GlslTypeOf(elem);
+      auto g = IspcDouble(c, elem) ? std::optional<std::string>("double") : GlslTypeOf(elem);
       if (!g) continue;  // reported if a kernel uses it
       m.kind = MemberKind::Vector;
       m.glslType = *g;
@@ -83,14 +86,14 @@ void AnalyzeMembers(Context& c) {
       m.scalarLayout = !LayoutMatchesCpp(c.ctx, elem, false);
       if (f->getAccess() != AS_private && (!m.scalarLayout || LayoutMatchesCpp(c.ctx, elem, true))) structs.Type(elem, f->getLocation());
     } else {
-      auto g = GlslTypeOf(f->getType());
+      auto g = IspcDouble(c, f->getType()) ? std::optional<std::string>("double") : GlslTypeOf(f->getType());
       if (!g) continue;
       m.kind = MemberKind::Plain;
       m.glslType = *g;
       QualType base = f->getType();
       while (auto* arr = dyn_cast<ConstantArrayType>(base.getCanonicalType().getTypePtr())) base = arr->getElementType();
       m.cppType = CppTypeName(c.ctx, base);
-      m.inClassData = f->getAccess() != AS_private && FitsClassData(c.ctx, f->getType());
+      m.inClassData = f->getAccess() != AS_private && (*g == "double" || FitsClassData(c.ctx, f->getType()));  // ISPC's double: as in C++
       if (auto layout = Std430Layout(c.ctx, f->getType(), false)) m.std430Align = unsigned(layout->align);
       if (m.inClassData) structs.Type(f->getType(), f->getLocation());
     }
