@@ -86,9 +86,11 @@ std::optional<std::string> GlslPrinter::Type(QualType t, SourceLocation loc) {
          "use int or uint32_t in kernels (and mask explicitly where the wrap-around matters)");
     return std::nullopt;
   }
-  if (ispc && base->isSpecificBuiltinType(BuiltinType::Double)) {  // C's double, which ISPC has
-    if (t.getNonReferenceType()->isArrayType()) return IspcFail(loc, "an array of double"), std::nullopt;
-    return std::string("double");
+  if (ispc && base->isSpecificBuiltinType(BuiltinType::Double)) {  // C's double, which ISPC has: double, double[2][3]
+    std::string dims;
+    for (QualType a = t.getNonReferenceType(); auto* arr = dyn_cast<ConstantArrayType>(a.getCanonicalType().getTypePtr()); a = arr->getElementType())
+      dims += "[" + std::to_string(arr->getSize().getZExtValue()) + "]";
+    return "double" + dims;
   }
   if (auto* bt = base->getAs<BuiltinType>(); bt && bt->isFloatingPoint() && bt->getKind() != BuiltinType::Float) {
     Fail(loc, DoubleRefusal(t.getAsString(m_ctx.getPrintingPolicy())), DoubleRefusalHint());

@@ -135,7 +135,7 @@ Register doubleSum([] {
 
 #if __has_include("DoubleScale_CPU.h")
 Register doubleScale([] {
-  Case c = MakeCase<DoubleScale>("double members, vectors, helpers and buffers; 1.0 / 3.0; an int added in double", "double_scale.h/.cpp", 1e-15,
+  Case c = MakeCase<DoubleScale>("double members, vectors, arrays, helpers, buffers; 1.0 / 3.0; int + double", "double_scale.h/.cpp", 1e-15,
                                  [] { return std::make_shared<DoubleScale>(); }, [] { return CreateDoubleScale_CPU(); }, nullptr,
                                  CONFORMANCE_ISPC_MAKER(DoubleScale, ), [](DoubleScale& d) {
                                    const int n = 1000;

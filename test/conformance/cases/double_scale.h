@@ -1,5 +1,5 @@
-// Arithmetic in double: a double buffer, member and member vector, a static helper of double,
-// 1.0 / 3.0 and an int added in double. Runs as written on the CPU backends; Vulkan refuses double by design.
+// Arithmetic in double: a double buffer, member, member vector and local array, a static helper
+// of double, 1.0 / 3.0 and an int added in double. Runs as written on the CPU backends; Vulkan refuses double by design.
 #pragma once
 #include "LiteMath.h"
 #include <vector>
