@@ -210,6 +210,7 @@ private:
   std::map<const clang::ValueDecl*, PointerTarget> m_pointers;  // pointer locals and helper parameters in scope
   std::set<std::string> m_emittedCopies;                         // helpers bound to buffers, by name
   std::vector<std::string> m_coherentLoads;                      // struct types with an ISPC load helper
+  std::set<std::string> m_compoundHelpers;                       // ISPC's crt_<op>_assign_<type> written so far
   const clang::Expr* m_fieldBase = nullptr;                      // the base of the field access being printed
   std::vector<std::string> m_reduceAddVectors;                   // member vectors with a ReduceAdd function
 
@@ -237,6 +238,7 @@ private:
   // crt_load4 (vector loads where the lanes read consecutive elements, IspcLoads.cpp); "" otherwise.
   std::string IspcConsecutiveLoad(const clang::ArraySubscriptExpr* as, const PointerTarget& t);
   std::string IspcConsecutiveStore(const clang::CXXOperatorCallExpr* op);
+  std::string IspcCompoundAssignOnce(const clang::CXXOperatorCallExpr* op);
   // IspcDoubles.cpp: where a kernel computes in double on ISPC.
   bool IspcDeclaredDouble(const clang::Expr* e) const;
   bool IspcInDoubleContext(const clang::Expr* e) const;

@@ -117,7 +117,7 @@ TEST_CASE("What the ISPC backend does not translate yet is an error at the user'
        "compound assignment to a vector's component whose vector or index has side effects is not translated to ISPC yet",
        "BACKEND cpu (OpenMP) or vulkan", 8},
       {"a vector updated through an address with side effects", "    LiteMath::float4 v[2]; int k = 0; v[k++] += LiteMath::float4(x); x = v[0].x;", "",
-       "", "compound assignment to a vector whose address has side effects is not translated to ISPC yet", "BACKEND cpu (OpenMP) or vulkan", 8},
+       "", "compound assignment to a vector whose address has side effects, other than an element of a buffer or member vector, is not translated to ISPC yet", "BACKEND cpu (OpenMP) or vulkan", 8},
   };
   for (const Case& c : ispcCases)
   {

@@ -12,6 +12,8 @@ void PixelRows::kernel1D_Shade(int n, const float4* a_in, float4* a_rows, float4
     const float4 c = a_in[i];
     a_rows[i] = c * 0.5f + float4(1.0f, 2.0f, 3.0f, 4.0f);
     a_mirrored[n - 1 - i] = float4(c.w, c.z, c.y, c.x);
-    a_cells[i] = int4(i, -i, int(c.x), 7);
+    int slot = i;
+    a_rows[slot++] += float4(0.0f, 0.0f, 0.0f, 0.5f);  // the address once: slot is i + 1 after it
+    a_cells[i] = int4(i, -i, int(c.x), slot);
   }
 }
