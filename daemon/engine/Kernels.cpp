@@ -20,15 +20,15 @@ using namespace clang;
 
 namespace crossrt::engine {
 
-// The ISPC thread function's parameters after the thread ids (varying): the class's data, the
-// kernel's arguments (uniform: one value, or one array, for all lanes) and each reduction's
-// per-lane accumulator, by reference.
 // A reduction's type: GLSL's, or on ISPC also double (a sum of doubles stays double there).
 static std::string ReductionType(Context& c, QualType t) {
   if (c.model.forIspc && t.getCanonicalType()->isSpecificBuiltinType(BuiltinType::Double)) return "double";
   return GlslTypeOf(t).value_or("float");
 }
 
+// The ISPC thread function's parameters after the thread ids (varying): the class's data, the
+// kernel's arguments (uniform: one value, or one array, for all lanes) and each reduction's
+// per-lane accumulator, by reference.
 static std::string IspcThreadHead(Context& c, const Kernel& k, const std::vector<std::pair<std::string, std::string>>& threadIds, const FunctionDecl* def) {
   // Not inline: inlined into its export function, LBVH's Karras12 (a varying early return in a
   // helper it calls in a loop) crashed on the deepest tree test_lbvh builds (ISPC 1.28.2, avx512skx).
