@@ -4,7 +4,8 @@
 // (Embree rtcIntersect1 and rtcIntersect16, CrossRT's traversal over the LBVH and SAH trees as
 // written, and translated: PrimaryRays_CPU, PrimaryRays_ISPC (one ray a SIMD lane, where ISPC is found; over the
 // LBVH and over the SAH tree, the kind Embree MEDIUM builds) and PrimaryRays_Vulkan, which compose BVHScene's
-// traversal), with ratios against Embree. Every figure is measured in this run: the CPU builders and
+// traversal), with ratios against Embree. Every tracer reads the same batch of rays (4x4 tiles of
+// pixels) and writes each hit as a CRT_Hit, as CastRays does. Every figure is measured in this run: the CPU builders and
 // the CPU tracers in rounds that run each in turn (7 and 5), with ratios as medians of the rounds'
 // ratios; the Vulkan figures as medians of 3 after a warm-up.
 // Then the speed-against-quality trade of LBVH against binned SAH, as a table and as CSV, which
@@ -280,7 +281,8 @@ int main(int argc, char** argv)
   }
 
   std::printf("\nTraversal of %dx%d primary rays, Mrays/s, all %d threads but 1T (ratio against Embree rtcIntersect1 on all\n"
-              "threads: medians of %d interleaved rounds' ratios; _Vulkan: median of 3, its ratio one of medians); SAH cost of the trees\n",
+              "threads: medians of %d interleaved rounds' ratios; _Vulkan: median of 3, its ratio one of medians); SAH cost of the trees.\n"
+              "Each tracer reads the same rays (4x4 tiles of pixels, in rows of tiles) and writes CRT_Hit (t, ids, u, v), as CastRays does\n",
               kImageSize, kImageSize, omp_get_max_threads(), kTraceRounds);
   std::printf("| %-22s | %9s | %15s | %15s | %15s | %15s | %15s | %15s | %15s | %23s | %9s | %9s | %8s |\n", "mesh", "Embree 1",
               "Embree 16", "CrossRT LBVH", "CrossRT LBVH 1T", "LBVH _CPU", "LBVH _ISPC", "CrossRT SAH", "SAH _ISPC", "LBVH _Vulkan [GPU]",
@@ -310,55 +312,75 @@ int main(int argc, char** argv)
     const int pixels = kImageSize * kImageSize;
     EmbreeMesh embree;
     embree.Build(row.mesh, RTC_BUILD_QUALITY_MEDIUM);
-    std::vector<uint32_t> embreePrim(pixels), ourPrim(pixels);
+    // Every tracer reads the same batch of rays, as PrimaryRays::CastRays takes it (4x4 tiles of
+    // pixels, the tiles in rows: the order a renderer hands out coherent rays), and writes each
+    // nearest hit as a CRT_Hit: the same work on both sides of each ratio.
+    std::vector<float4> rayPos(pixels, float4(cam.eye.x, cam.eye.y, cam.eye.z, 0.0f)), rayDir(pixels);
+    for (int i = 0; i < pixels; ++i)
+    {
+      const int tile = i / 16, k = i % 16;
+      rayDir[i] = cam.Ray(tile % (kImageSize / 4) * 4 + k % 4, tile / (kImageSize / 4) * 4 + k / 4);
+    }
+    std::vector<CRT_Hit> embreeHits(pixels), embreePacketHits(pixels), ourHits(pixels), ourHits1T(pixels), sahHits(pixels);
+    auto embreeHit = [](const RTCRayHit& rh, float tfar) {
+      CRT_Hit h{};
+      const bool missed = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID;
+      h.t = missed ? tfar : rh.ray.tfar;
+      h.primId = missed ? 0xFFFFFFFFu : rh.hit.primID;
+      h.instId = missed ? 0xFFFFFFFFu : rh.hit.instID[0] == RTC_INVALID_GEOMETRY_ID ? 0u : rh.hit.instID[0];
+      h.geomId = missed ? 0xFFFFFFFFu : rh.hit.geomID;
+      h.coords[0] = rh.hit.u, h.coords[1] = rh.hit.v;
+      return h;
+    };
     auto embreeSingle = [&] {
-#pragma omp parallel for schedule(dynamic, 16)
-      for (int y = 0; y < kImageSize; ++y)
+#pragma omp parallel for schedule(dynamic, 256)
+      for (int b = 0; b < pixels / 256; ++b)
       {
         RTCIntersectContext context;
         rtcInitIntersectContext(&context);
-        for (int x = 0; x < kImageSize; ++x)
+        for (int i = 256 * b; i < 256 * (b + 1); ++i)
         {
-          const float4 d = cam.Ray(x, y);
           RTCRayHit rh{};
-          rh.ray.org_x = cam.eye.x, rh.ray.org_y = cam.eye.y, rh.ray.org_z = cam.eye.z;
-          rh.ray.dir_x = d.x, rh.ray.dir_y = d.y, rh.ray.dir_z = d.z;
-          rh.ray.tnear = 0.0f, rh.ray.tfar = d.w, rh.ray.mask = 0xFFFFFFFFu;
+          rh.ray.org_x = rayPos[i].x, rh.ray.org_y = rayPos[i].y, rh.ray.org_z = rayPos[i].z, rh.ray.tnear = rayPos[i].w;
+          rh.ray.dir_x = rayDir[i].x, rh.ray.dir_y = rayDir[i].y, rh.ray.dir_z = rayDir[i].z, rh.ray.tfar = rayDir[i].w;
+          rh.ray.mask = 0xFFFFFFFFu;
           rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
           rtcIntersect1(embree.scene, &context, &rh);
-          embreePrim[y * kImageSize + x] = rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? 0xFFFFFFFFu : rh.hit.primID;
+          embreeHits[i] = embreeHit(rh, rayDir[i].w);
         }
       }
     };
     auto embreePacket = [&] {
-#pragma omp parallel for schedule(dynamic, 4)
-      for (int ty = 0; ty < kImageSize / 4; ++ty)
+#pragma omp parallel for schedule(dynamic, 16)
+      for (int b = 0; b < pixels / 16; ++b)
       {
         RTCIntersectContext context;
         rtcInitIntersectContext(&context);
-        for (int tx = 0; tx < kImageSize / 4; ++tx)
+        alignas(64) RTCRayHit16 rh;
+        alignas(64) int valid[16];
+        for (int k = 0; k < 16; ++k)
         {
-          alignas(64) RTCRayHit16 rh;
-          alignas(64) int valid[16];
-          for (int k = 0; k < 16; ++k)
-          {
-            const float4 d = cam.Ray(4 * tx + k % 4, 4 * ty + k / 4);
-            valid[k] = -1;
-            rh.ray.org_x[k] = cam.eye.x, rh.ray.org_y[k] = cam.eye.y, rh.ray.org_z[k] = cam.eye.z;
-            rh.ray.dir_x[k] = d.x, rh.ray.dir_y[k] = d.y, rh.ray.dir_z[k] = d.z;
-            rh.ray.tnear[k] = 0.0f, rh.ray.tfar[k] = d.w, rh.ray.mask[k] = 0xFFFFFFFFu, rh.ray.time[k] = 0.0f;
-            rh.ray.flags[k] = 0, rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
-          }
-          rtcIntersect16(valid, embree.scene, &context, &rh);
+          const int i = 16 * b + k;
+          valid[k] = -1;
+          rh.ray.org_x[k] = rayPos[i].x, rh.ray.org_y[k] = rayPos[i].y, rh.ray.org_z[k] = rayPos[i].z, rh.ray.tnear[k] = rayPos[i].w;
+          rh.ray.dir_x[k] = rayDir[i].x, rh.ray.dir_y[k] = rayDir[i].y, rh.ray.dir_z[k] = rayDir[i].z, rh.ray.tfar[k] = rayDir[i].w;
+          rh.ray.mask[k] = 0xFFFFFFFFu, rh.ray.time[k] = 0.0f, rh.ray.flags[k] = 0, rh.hit.geomID[k] = RTC_INVALID_GEOMETRY_ID;
+        }
+        rtcIntersect16(valid, embree.scene, &context, &rh);
+        for (int k = 0; k < 16; ++k)
+        {
+          RTCRayHit one{};
+          one.ray.tfar = rh.ray.tfar[k], one.hit.geomID = rh.hit.geomID[k], one.hit.primID = rh.hit.primID[k];
+          one.hit.instID[0] = rh.hit.instID[0][k], one.hit.u = rh.hit.u[k], one.hit.v = rh.hit.v[k];
+          embreePacketHits[16 * b + k] = embreeHit(one, rayDir[16 * b + k].w);
         }
       }
     };
-    auto traceWith = [&](ISceneObject& scene, int threads, std::vector<uint32_t>& prims) {
-      return [&scene, threads, &prims, &cam] {
-#pragma omp parallel for schedule(dynamic, 16) num_threads(threads)
-        for (int y = 0; y < kImageSize; ++y)
-          for (int x = 0; x < kImageSize; ++x)
-            prims[y * kImageSize + x] = scene.RayQuery_NearestHit(float4(cam.eye.x, cam.eye.y, cam.eye.z, 0.0f), cam.Ray(x, y)).primId;
+    auto traceWith = [&](ISceneObject& scene, int threads, std::vector<CRT_Hit>& hits) {
+      return [&scene, threads, &hits, &rayPos, &rayDir, pixels] {
+#pragma omp parallel for schedule(dynamic, 256) num_threads(threads)
+        for (int i = 0; i < pixels; ++i)
+          hits[i] = scene.RayQuery_NearestHit(rayPos[i], rayDir[i]);
       };
     };
     const BVHTree lbvhTree = row.lbvh, sahTree = row.sah;
@@ -376,8 +398,6 @@ int main(int argc, char** argv)
     }
     const int threads = omp_get_max_threads();
     auto mrays = [&](double ms) { return pixels / ms / 1e3; };
-    std::vector<float4> rayPos(pixels, float4(cam.eye.x, cam.eye.y, cam.eye.z, 0.0f)), rayDir(pixels);
-    for (int i = 0; i < pixels; ++i) rayDir[i] = cam.Ray(i % kImageSize, i / kImageSize);
     std::vector<CRT_Hit> castHits(pixels), ispcHits(pixels), ispcSahHits(pixels);
     std::shared_ptr<ISceneObject> lbvhShared(&lbvhScene, [](ISceneObject*) {});  // live on this stack frame
     std::shared_ptr<ISceneObject> sahShared(&sahScene, [](ISceneObject*) {});
@@ -388,10 +408,9 @@ int main(int argc, char** argv)
       castIspcSah->SetScene(sahShared, {}, {});
     }
     // The CPU tracers in interleaved rounds, as the builders above: ratios are medians of per-round ratios.
-    std::vector<uint32_t> unusedPrim(pixels), sahPrim(pixels);  // hits of the LBVH on 1 thread are only timed
-    const auto traceMs = InterleavedMs({embreeSingle, embreePacket, traceWith(lbvhScene, threads, ourPrim), traceWith(lbvhScene, 1, unusedPrim),
+    const auto traceMs = InterleavedMs({embreeSingle, embreePacket, traceWith(lbvhScene, threads, ourHits), traceWith(lbvhScene, 1, ourHits1T),
                                         [&] { castCpu->CastRays(rayPos.data(), rayDir.data(), castHits.data(), pixels); },
-                                        traceWith(sahScene, threads, sahPrim),
+                                        traceWith(sahScene, threads, sahHits),
                                         [&] {
                                           if (castIspc)
                                             castIspc->CastRays(rayPos.data(), rayDir.data(), ispcHits.data(), pixels);
@@ -405,11 +424,11 @@ int main(int argc, char** argv)
                  castCpuMs = Median(traceMs[4]), sahMs = Median(traceMs[5]);
     auto againstEmbree1 = [&](int work) { return PairedRatio(traceMs[0], traceMs[work]); };  // throughput ratio
     size_t translatedDiffer = 0;
-    for (int i = 0; i < pixels; ++i) translatedDiffer += castHits[i].primId != ourPrim[i];
+    for (int i = 0; i < pixels; ++i) translatedDiffer += castHits[i].primId != ourHits[i].primId;
     char ispcCast[24] = "no ISPC", ispcSahCast[24] = "no ISPC";
     if (castIspc)
     {
-      for (int i = 0; i < pixels; ++i) translatedDiffer += (ispcHits[i].primId != ourPrim[i]) + (ispcSahHits[i].primId != sahPrim[i]);
+      for (int i = 0; i < pixels; ++i) translatedDiffer += (ispcHits[i].primId != ourHits[i].primId) + (ispcSahHits[i].primId != sahHits[i].primId);
       std::snprintf(ispcCast, sizeof(ispcCast), "%6.2f (%5.2fx)", mrays(Median(traceMs[6])), againstEmbree1(6));
       std::snprintf(ispcSahCast, sizeof(ispcSahCast), "%6.2f (%5.2fx)", mrays(Median(traceMs[7])), againstEmbree1(7));
       castIspc->SetScene(nullptr, {}, {});
@@ -423,7 +442,7 @@ int main(int argc, char** argv)
       const double wall = MedianMs(3, [&] { castGpu->CastRays(rayPos.data(), rayDir.data(), castHits.data(), pixels); });
       float times[4];
       castGpu->GetExecutionTime("CastRays", times);
-      for (int i = 0; i < pixels; ++i) translatedDiffer += castHits[i].primId != ourPrim[i];
+      for (int i = 0; i < pixels; ++i) translatedDiffer += castHits[i].primId != ourHits[i].primId;
       std::snprintf(gpuCast, sizeof(gpuCast), "%6.2f (%5.2fx) [%5.2f]", mrays(wall), embree1 / wall, pixels / times[0] / 1e3);
       castGpu->SetScene(nullptr, {}, {});
     }
@@ -431,7 +450,7 @@ int main(int argc, char** argv)
     if (translatedDiffer > 0)
       std::fprintf(stderr, "bench_lbvh: %s: the translated traversal differs from the original on %zu rays\n", row.name.c_str(), translatedDiffer);
     size_t same = 0;
-    for (int i = 0; i < pixels; ++i) same += ourPrim[i] == embreePrim[i];
+    for (int i = 0; i < pixels; ++i) same += ourHits[i].primId == embreeHits[i].primId;
     std::printf("| %-22s | %9.2f | %6.2f (%5.2fx) | %6.2f (%5.2fx) | %6.2f (%5.2fx) | %6.2f (%5.2fx) | %15s | %6.2f (%5.2fx) | %15s | %23s | %9.1f | %9.1f | %7.4f%% |\n",
                 row.name.c_str(), mrays(embree1), mrays(embree16), againstEmbree1(1), mrays(lbvhMs), againstEmbree1(2), mrays(lbvh1T),
                 againstEmbree1(3), mrays(castCpuMs), againstEmbree1(4), ispcCast, mrays(sahMs), againstEmbree1(5), ispcSahCast, gpuCast,

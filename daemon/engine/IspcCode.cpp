@@ -17,8 +17,10 @@ namespace {
 // (crossrt::IspcPick in runtime/include/crossrt/IspcSupport.h takes them so).
 const char* const kIspcTargetSuffixes[] = {"sse4", "avx2", "avx512skx"};
 
-// Iterations of a 1D loop nest per chunk (2D and 3D nests hand out rows and slices one by one).
+// Iterations of a 1D loop nest per chunk (2D and 3D nests hand out rows and slices one by one, and
+// a tiled 2D nest four rows at a time: a tile is up to 4 rows high).
 constexpr int kChunk1D = 4096;
+constexpr int kTileRows = 4;
 
 bool IsScalar(const std::string& glslType) {
   return glslType == "float" || glslType == "int" || glslType == "uint" || glslType == "bool" || glslType == "double";
@@ -90,7 +92,11 @@ std::string GenerateIspcKernels(const ClassModel& model, const GenerateOptions& 
     const unsigned dims = unsigned(k.loops.size());
     for (unsigned a = 1; a < dims; ++a) innerParams += std::string(", uniform int crt_start") + Axis(a, dims) + ", uniform int crt_count" + Axis(a, dims);
     std::string indent = "  ";
-    for (unsigned a = 0; a < dims; ++a) {
+    if (k.ispcTiled) {  // rows and columns across the lanes (Kernel::ispcTiled)
+      loopsOpen = indent + "foreach_tiled (" + k.loops[0].var + " = crt_begin ... crt_end, " + k.loops[1].var + " = crt_startX ... crt_startX + crt_countX)\n";
+      indent += "  ";
+    }
+    for (unsigned a = 0; a < dims && !k.ispcTiled; ++a) {
       const std::string var = k.loops[a].var, axis = Axis(a, dims);
       if (a + 1 < dims) {
         loopsOpen += indent + "for (uniform int " + var + " = " + (a == 0 ? "crt_begin" : "crt_start" + axis) + "; " + var + " < " +
@@ -185,8 +191,11 @@ void IspcHostData(const ClassModel& model, Data& d) {
     }
     x.set("loops", loops);
     x.set("outer", Axis(0, dims));
-    x.set("chunk", std::to_string(dims == 1 ? kChunk1D : 1));
-    x.set("chunkWhat", dims == 1 ? std::to_string(kChunk1D) + " iterations" : dims == 2 ? "one row" : "one slice");
+    x.set("chunk", std::to_string(dims == 1 ? kChunk1D : k.ispcTiled ? kTileRows : 1));
+    x.set("chunkWhat", dims == 1      ? std::to_string(kChunk1D) + " iterations"
+                       : k.ispcTiled ? std::to_string(kTileRows) + " rows, in tiles of rows and columns (foreach_tiled)"
+                       : dims == 2    ? "one row"
+                                      : "one slice");
     x.set("innerArgs", innerArgs);
     std::string args;
     for (auto& p : k.params) {

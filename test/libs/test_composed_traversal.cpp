@@ -409,6 +409,10 @@ TEST_CASE("PrimaryRays renders the same image as written, on _CPU, _ISPC and _Vu
   REQUIRE(render(*CreatePrimaryRays_CPU(96, 64)) == expected);
 #ifdef CROSSRT_HAS_ISPC
   REQUIRE(render(*CreatePrimaryRays_ISPC(96, 64)) == expected);
+  // _ISPC runs Render's rows and columns in tiles (foreach_tiled), four rows a chunk: a size that is
+  // no multiple of the tiles leaves partial tiles at the right and a partial chunk at the bottom.
+  PrimaryRays odd(37, 23);
+  REQUIRE(render(*CreatePrimaryRays_ISPC(37, 23)) == render(odd));
 #endif
   auto ctx = ValidatedContext();
   if (!ctx)
