@@ -333,7 +333,7 @@ int main(int argc, char** argv)
       return h;
     };
     auto embreeSingle = [&] {
-#pragma omp parallel for schedule(dynamic, 256)
+#pragma omp parallel for schedule(dynamic, 4)
       for (int b = 0; b < pixels / 256; ++b)
       {
         RTCIntersectContext context;

@@ -128,7 +128,7 @@ struct Kernel {
   std::vector<unsigned> threadAxes;   // axis (0=x,1=y,2=z) of each thread-function parameter
   std::vector<Loop> loops;            // IPV: outermost first
   // ISPC: a 2D nest whose iterations call composed code (a traversal) runs foreach_tiled, its lanes
-  // a tile of rows and columns: neighbouring rays walk the same nodes (IspcTiledNest in Kernels.cpp).
+  // a tile of rows and columns: neighbouring rays walk the same nodes (CallsComposedCode in Kernels.cpp).
   bool ispcTiled = false;
   std::vector<Reduction> reductions;
   std::vector<std::string> memberVectors;   // member vectors the kernel reaches (incl. helpers)
