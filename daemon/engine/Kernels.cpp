@@ -30,8 +30,9 @@ static std::string ReductionType(Context& c, QualType t) {
 // kernel's arguments (uniform: one value, or one array, for all lanes) and each reduction's
 // per-lane accumulator, by reference.
 static std::string IspcThreadHead(Context& c, const Kernel& k, const std::vector<std::pair<std::string, std::string>>& threadIds, const FunctionDecl* def) {
-  // Not inline: inlined into its export function, LBVH's Karras12 (a varying early return in a
+  // Not inline here: inlined into its export function, LBVH's Karras12 (a varying early return in a
   // helper it calls in a loop) crashed on the deepest tree test_lbvh builds (ISPC 1.28.2, avx512skx).
+  // AnalyzeKernel inlines the bodies that call no functions of the user's (IspcInlineBody).
   std::string head = "static void " + k.name + "(uniform " + c.cls->getNameAsString() + "_Data *uniform self";
   // The innermost loop's variable runs across the lanes; the outer loops' are the gang's (in tiles,
   // both run across the lanes).
@@ -71,6 +72,17 @@ static bool CallsComposedCode(const Stmt* s, const CXXRecordDecl* cls, std::set<
   } finder(cls, seen);
   finder.TraverseStmt(const_cast<Stmt*>(s));
   return finder.found;
+}
+
+// An ISPC thread function that calls no functions of the user's (no helpers, virtual or composed
+// calls) is inlined into its export function, which then runs it with all lanes on in full gangs:
+// called, it got the execution mask as an argument, and ran every load masked and every uniform
+// branch as a varying one. Bloom_ISPC's blurs went from 1.74x to 2.2-2.4x of Bloom_CPU's speed.
+static void IspcInlineBody(Kernel& k, const GlslPrinter& printer) {
+  const auto& uses = printer.Uses();
+  if (!uses.helpers.empty() || !uses.virtualCalls.empty() || !uses.composedCalls.empty()) return;
+  const std::string plain = "\nstatic void " + k.name + "(";
+  if (const size_t at = k.glslBody.find(plain); at != std::string::npos) k.glslBody.replace(at + 1, 7, "static inline ");
 }
 
 void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def) {
@@ -332,6 +344,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     os << printer.ThreadBody(threadBody, 1, !k.rtv);
   os << "}\n";
   k.glslBody = os.str();
+  if (printer.ispc) IspcInlineBody(k, printer);
   // The statements around the loop nest, as functions one thread runs before and after the others.
   // (The ISPC class runs them on the host, as the CPU class does.)
   // (Statements that only set locals need no thread of their own: every thread evaluated them.)
