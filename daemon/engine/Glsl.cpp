@@ -769,6 +769,8 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
       std::string spelling = getOperatorSpelling(kind);
       return ImageStore(op->getArg(0), Expr(op->getArg(0)) + " " + spelling.substr(0, spelling.size() - 1) + " (" + Expr(op->getArg(1)) + ")", e);
     }
+    if (ispc && kind == OO_Equal)  // a struct stored whole at a per-lane index (LiteMath's vectors: IspcVectorOperator)
+      if (std::string store = IspcConsecutiveStore(op); !store.empty()) return store;
     if (kind == OO_Call && op->getNumArgs() == 3) {  // LiteMath's m(row, col): GLSL's matrices index the column first
       const auto glsl = GlslTypeOf(op->getArg(0)->getType().getNonReferenceType());
       if (glsl && glsl->rfind("mat", 0) == 0) {

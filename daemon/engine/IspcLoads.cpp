@@ -13,6 +13,8 @@
 // read consecutive elements, as a row of pixels does, four vector loads and a transpose instead of
 // four gathers (a bloom filter's taps: 1.45x -> 1.75x of _CPU). A statement that stores one whole,
 // p[i] = v, goes through crt_store4: a transpose and four vector stores instead of four scatters.
+// A struct of eight 32-bit words stored so (a CRT_Hit from a traversal) goes through a helper of its
+// own that packs the words for crt_store_words8: eight vector stores instead of eight scatters.
 //
 // And a vector updated through an address with side effects, p[k++] += v: the address found once.
 // Part of GlslPrinter (Glsl.h).
@@ -141,12 +143,58 @@ std::string GlslPrinter::IspcCompoundAssignOnce(const clang::CXXOperatorCallExpr
   return name + "(" + array + ", (int)(" + index + "), " + Expr(op->getArg(1)) + ")";
 }
 
+// The words of a struct of eight 32-bit fields (floats, ints and arrays of them, no bases), as ISPC
+// expressions of a value `v` spelled as floats; empty for any other struct.
+static std::vector<std::string> EightWords(ASTContext& ctx, QualType type) {
+  const auto* record = type->getAsCXXRecordDecl();
+  if (!record || !record->getDefinition() || record->getNumBases() != 0 || ctx.getTypeSize(type) != 8 * 32) return {};
+  std::vector<std::string> words;
+  auto word = [&](QualType t, const std::string& access) {
+    t = t.getCanonicalType();
+    if (t->isSpecificBuiltinType(BuiltinType::Float)) words.push_back(access);
+    else if (t->isIntegerType() && ctx.getTypeSize(t) == 32) words.push_back("floatbits((unsigned int32)" + access + ")");
+    else return false;
+    return true;
+  };
+  for (const FieldDecl* f : record->fields()) {
+    const std::string access = "v." + f->getNameAsString();
+    if (const auto* array = ctx.getAsConstantArrayType(f->getType())) {
+      for (uint64_t k = 0; k < array->getSize().getZExtValue(); ++k)
+        if (!word(array->getElementType(), access + "[" + std::to_string(k) + "]")) return {};
+    } else if (!word(f->getType(), access)) {
+      return {};
+    }
+  }
+  return words.size() == 8 ? words : std::vector<std::string>{};
+}
+
 std::string GlslPrinter::IspcConsecutiveStore(const clang::CXXOperatorCallExpr* op) {
   if (!ispc || op->getOperator() != OO_Equal || op->getNumArgs() != 2) return "";
   const auto* as = dyn_cast<ArraySubscriptExpr>(op->getArg(0)->IgnoreParenImpCasts());
   if (!as || !as->getBase()->getType()->isPointerType() || IspcUniform(as->getIdx())) return "";
-  const QualType element = as->getType();
-  if (!IsLiteMathType(element, "float4") && !IsLiteMathType(element, "int4") && !IsLiteMathType(element, "uint4")) return "";
+  const QualType element = as->getType().getUnqualifiedType();
+  // A struct of eight words (a CRT_Hit) goes through a helper of its own: crt_store_words8 after
+  // packing its fields, or the scatters.
+  std::string store = "crt_store4";
+  if (IsLiteMathType(element)) {
+    if (!IsLiteMathType(element, "float4") && !IsLiteMathType(element, "int4") && !IsLiteMathType(element, "uint4")) return "";
+  } else if (const auto words = EightWords(m_ctx, element); !words.empty()) {
+    const auto glsl = GlslTypeOf(element);
+    if (!glsl) return "";
+    const std::string type = IspcTypeName(*glsl);
+    store = "crt_store_" + type;
+    if (m_compoundHelpers.insert(store).second) {
+      std::string packed;
+      for (const auto& w : words) packed += ", " + w;
+      m_functions.push_back("// a[i] = v for each lane, " + type + " being eight 32-bit words: vector stores where the lanes write\n"
+                            "// consecutive elements (crt_store_words8 in LiteMath.isph), otherwise the scatters\n"
+                            "static inline void " + store + "(uniform " + type + " *uniform a, int i, " + type + " v)\n{\n"
+                            "  if (!crt_consecutive(i))\n    a[i] = v;\n  else\n    crt_store_words8((uniform float *uniform)(a + extract(i, 0))" +
+                            packed + ");\n}\n");
+    }
+  } else {
+    return "";
+  }
   const clang::Stmt* statement = op;  // a statement of its own (its value is not used), with any temporaries' cleanups
   auto parents = m_ctx.getParents(*statement);
   while (parents.size() == 1 && parents[0].get<ExprWithCleanups>()) {
@@ -157,7 +205,7 @@ std::string GlslPrinter::IspcConsecutiveStore(const clang::CXXOperatorCallExpr* 
   auto t = Pointer(as->getBase());
   if (!t || !t->value.empty() || t->local || t->array.empty()) return "";
   const std::string i = Expr(as->getIdx());
-  return "crt_store4(" + t->array + ", (int)(" + (t->offset.empty() ? i : t->offset + " + " + i) + "), " + Expr(op->getArg(1)) + ")";
+  return store + "(" + t->array + ", (int)(" + (t->offset.empty() ? i : t->offset + " + " + i) + "), " + Expr(op->getArg(1)) + ")";
 }
 
 }  // namespace crossrt::engine

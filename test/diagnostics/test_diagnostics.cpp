@@ -268,6 +268,51 @@ void Rows::kernel1D_Run(int n, const float4* in, float4* out)
   REQUIRE(text.find("out_[i].w = 1.0") != std::string::npos);                                 // one field: a scatter
 }
 
+TEST_CASE("ISPC: a struct of eight 32-bit words stored whole at a per-lane index goes through a crt_store_ helper of its own; other structs scatter",
+          "[diagnostics][ispc]")
+{
+  TempClass tc("Hits", R"(#pragma once
+#include <cstdint>
+struct Hit { float t; uint32_t prim, inst, geom; float coords[4]; };  // 32 bytes, as CRT_Hit
+struct Pair { float a; int b; };                                      // 8 bytes
+class Hits
+{
+public:
+  virtual ~Hits() = default;
+  virtual void Run(int n, [[crossrt::size("n")]] Hit* hits, [[crossrt::size("n")]] Pair* pairs);
+protected:
+  void kernel1D_Run(int n, Hit* hits, Pair* pairs);
+};
+)",
+               R"(#include "Hits.h"
+void Hits::Run(int n, Hit* hits, Pair* pairs) { kernel1D_Run(n, hits, pairs); }
+void Hits::kernel1D_Run(int n, Hit* hits, Pair* pairs)
+{
+  for (int i = 0; i < n; i++)
+  {
+    Hit h;
+    h.t = float(i);
+    h.prim = uint32_t(i);
+    h.inst = h.geom = 0u;
+    h.coords[0] = h.coords[1] = h.coords[2] = h.coords[3] = 0.5f;
+    hits[i] = h;
+    Pair p;
+    p.a = 1.0f;
+    p.b = i;
+    pairs[i] = p;
+  }
+}
+)");
+  const std::string text = IspcKernelsOf(tc, "Hits");
+  INFO(text);
+  REQUIRE(text.find("static inline void crt_store_Hit(uniform Hit *uniform a, int i, Hit v)") != std::string::npos);
+  REQUIRE(text.find("crt_store_words8((uniform float *uniform)(a + extract(i, 0)), v.t, floatbits((unsigned int32)v.prim), "
+                    "floatbits((unsigned int32)v.inst), floatbits((unsigned int32)v.geom), v.coords[0], v.coords[1], v.coords[2], v.coords[3]);") !=
+          std::string::npos);
+  REQUIRE(text.find("crt_store_Hit(hits, (int)(i), h);") != std::string::npos);
+  REQUIRE(text.find("pairs[i] = p;") != std::string::npos);  // not eight words: the scatters
+}
+
 TEST_CASE("A pointer parameter of a control function without a size is reported", "[diagnostics]")
 {
   TempClass tc("NoSize", R"(#pragma once
