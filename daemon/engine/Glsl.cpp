@@ -223,6 +223,11 @@ std::string GlslPrinter::Literal(const clang::Expr* e) {
 
 // An explicit or implicit conversion. GLSL converts implicitly only int->uint->float, so spell
 // the others out, and fold integer literals into the target type so the code stays readable.
+// "uniform " where an ISPC cast's operand is one value for all lanes: a cast with no variability
+// takes its operand's, and ISPC warns of such a cast where it is an argument (its operator overloads
+// included). Else "" (varying, the default).
+std::string GlslPrinter::IspcVariability(const clang::Expr* sub) const { return IspcUniform(sub) ? "uniform " : ""; }
+
 std::string GlslPrinter::Cast(QualType to, const clang::Expr* sub) {
   // On the GPU double precision only arises from promotions such as `x * 0.5` (explicit double
   // variables are refused), and the arithmetic stays in float. ISPC computes in double where the
@@ -237,7 +242,7 @@ std::string GlslPrinter::Cast(QualType to, const clang::Expr* sub) {
     for (const auto& parent : m_ctx.getParents(*sub))
       if (auto* cast = parent.get<CastExpr>()) self = cast;
     if (ispc && self && IspcInDoubleContext(self)) return "((double)(" + Expr(sub) + "))";
-    return ispc ? "((float)(" + Expr(sub) + "))" : "float(" + Expr(sub) + ")";
+    return ispc ? "((" + IspcVariability(sub) + "float)(" + Expr(sub) + "))" : "float(" + Expr(sub) + ")";
   }
   auto target = GlslTypeOf(to);
   auto source = GlslTypeOf(sub->getType());
@@ -257,7 +262,7 @@ std::string GlslPrinter::Cast(QualType to, const clang::Expr* sub) {
   if (ispc) {  // C's cast of a scalar, LiteMath's make_T of a vector
     const std::string name = IspcTypeName(*target);
     if (target->find("vec") != std::string::npos) return "make_" + name + "(" + Expr(sub) + ")";
-    return "((" + name + ")(" + Expr(sub) + "))";
+    return "((" + IspcVariability(sub) + name + ")(" + Expr(sub) + "))";
   }
   return *target + "(" + Expr(sub) + ")";
 }

@@ -238,6 +238,7 @@ private:
   // crt_load4 (vector loads where the lanes read consecutive elements, IspcLoads.cpp); "" otherwise.
   std::string IspcConsecutiveLoad(const clang::ArraySubscriptExpr* as, const PointerTarget& t);
   std::string IspcConsecutiveStore(const clang::CXXOperatorCallExpr* op);
+  std::string IspcVariability(const clang::Expr* sub) const;
   std::string IspcCompoundAssignOnce(const clang::CXXOperatorCallExpr* op);
   // IspcDoubles.cpp: where a kernel computes in double on ISPC.
   bool IspcDeclaredDouble(const clang::Expr* e) const;
