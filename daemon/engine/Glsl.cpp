@@ -221,13 +221,13 @@ std::string GlslPrinter::Literal(const clang::Expr* e) {
   return "/*literal*/";
 }
 
-// An explicit or implicit conversion. GLSL converts implicitly only int->uint->float, so spell
-// the others out, and fold integer literals into the target type so the code stays readable.
 // "uniform " where an ISPC cast's operand is one value for all lanes: a cast with no variability
 // takes its operand's, and ISPC warns of such a cast where it is an argument (its operator overloads
 // included). Else "" (varying, the default).
 std::string GlslPrinter::IspcVariability(const clang::Expr* sub) const { return IspcUniform(sub) ? "uniform " : ""; }
 
+// An explicit or implicit conversion. GLSL converts implicitly only int->uint->float, so spell
+// the others out, and fold integer literals into the target type so the code stays readable.
 std::string GlslPrinter::Cast(QualType to, const clang::Expr* sub) {
   // On the GPU double precision only arises from promotions such as `x * 0.5` (explicit double
   // variables are refused), and the arithmetic stays in float. ISPC computes in double where the
