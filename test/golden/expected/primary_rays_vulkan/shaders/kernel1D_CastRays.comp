@@ -712,26 +712,28 @@ bool m_pAccelStruct_TraceMesh(BVHTraceRay ray, uint root, uint leaves, bool anyH
             if (anyHit)
               return true;
           }
-          continue;
         }
-        vec4 t = vec4(0);
-        vec4 u = vec4(0);
-        vec4 v = vec4(0);
-        uint hits = m_pAccelStruct_IntersectGroup(ray, g, tfar, t, u, v);
-        while (hits != 0u)
+        else
         {
-          const int lane = findLSB(uint(hits));
-          hits = hits & (hits - 1u);
-          if (t[lane] > tfar)
-            continue;
-          found = true;
-          tfar = t[lane];
-          hit.t = t[lane];
-          hit.primId = m_pAccelStruct_m_primIds[4u * g + uint(lane)];
-          hit.coords[0] = u[lane];
-          hit.coords[1] = v[lane];
-          if (anyHit)
-            return true;
+          vec4 t = vec4(0);
+          vec4 u = vec4(0);
+          vec4 v = vec4(0);
+          uint hits = m_pAccelStruct_IntersectGroup(ray, g, tfar, t, u, v);
+          while (hits != 0u)
+          {
+            const int lane = findLSB(uint(hits));
+            hits = hits & (hits - 1u);
+            if (t[lane] > tfar)
+              continue;
+            found = true;
+            tfar = t[lane];
+            hit.t = t[lane];
+            hit.primId = m_pAccelStruct_m_primIds[4u * g + uint(lane)];
+            hit.coords[0] = u[lane];
+            hit.coords[1] = v[lane];
+            if (anyHit)
+              return true;
+          }
         }
       }
     }
