@@ -566,7 +566,7 @@ std::string GlslPrinter::VirtualCall(const CXXMemberCallExpr* mc) {
   if (!method->isVirtual())
     return Fail(mc->getBeginLoc(), "call of the non-virtual " + method->getQualifiedNameAsString() + " through '" + field->getNameAsString() + "' in a kernel",
                 "the GPU picks the implementation by the object's type: make the method virtual in the interface");
-  std::vector<std::string> args = {ispc ? "(uint)(" + Expr(indexExpr) + ")" : "uint(" + Expr(indexExpr) + ")"};
+  std::vector<std::string> args = {ispc ? "((" + IspcVariability(indexExpr) + "uint)(" + Expr(indexExpr) + "))" : "uint(" + Expr(indexExpr) + ")"};
   if (ispc) args.insert(args.begin(), "self");  // the dispatcher finds the tags and the objects in the class data
   for (auto* arg : mc->arguments()) args.push_back(Expr(arg));
   Type(mc->getType(), mc->getBeginLoc());  // declares a returned struct

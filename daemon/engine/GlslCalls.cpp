@@ -532,7 +532,7 @@ std::string GlslPrinter::IspcInterlockedCall(const FunctionDecl* fd, const CallE
     m_functions.push_back(os.str());
   }
   const clang::Expr* value = call->getArg(call->getNumArgs() - 1);
-  return helper + "(self, (uint)(" + Expr(call->getArg(1)) + "), " + Expr(value) + ")";
+  return helper + "(self, ((" + IspcVariability(call->getArg(1)) + "uint)(" + Expr(call->getArg(1)) + ")), " + Expr(value) + ")";
 }
 
 }  // namespace crossrt::engine

@@ -65,7 +65,7 @@ std::string GlslPrinter::IspcCoherentLoad(const clang::CXXOperatorCallExpr* op) 
        << "  return e;\n}\n";
     m_functions.push_back(os.str());
   }
-  return helper + "(" + Expr(op->getArg(0)) + ", (uint)(" + Expr(op->getArg(1)) + "))";
+  return helper + "(" + Expr(op->getArg(0)) + ", ((" + IspcVariability(op->getArg(1)) + "uint)(" + Expr(op->getArg(1)) + ")))";
 }
 
 // Whether e's value is only read, as a whole: copied into a new value, or passed to a function by

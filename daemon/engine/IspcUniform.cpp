@@ -6,6 +6,7 @@
 #include "AstQueries.h"
 #include "Glsl.h"
 #include "GlslParts.h"
+#include "GlslTypes.h"
 #include "WriteVisitor.h"
 
 using namespace clang;
@@ -28,6 +29,10 @@ bool GlslPrinter::IspcUniform(const clang::Expr* e) const {
     return f && isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts()) && f->getType()->isArithmeticType() && composedPrefix.empty() && !selfClass;
   }
   if (auto* mc = dyn_cast<CXXMemberCallExpr>(e)) {  // a member vector's size(): self->m_v_size
+    const CXXMethodDecl* method = mc->getMethodDecl();
+    const bool side = method && (method->getName() == "width" || method->getName() == "height");
+    if (side && IsImage2D(mc->getImplicitObjectArgument()->getType().getNonReferenceType()))  // an image's (kernels' images are the gang's)
+      return composedPrefix.empty() && !selfClass;
     auto* f = ThisMemberField(mc->getImplicitObjectArgument());
     return f && mc->getMethodDecl() && mc->getMethodDecl()->getName() == "size" && IsStdVector(f->getType()) && composedPrefix.empty() && !selfClass;
   }

@@ -223,7 +223,7 @@ void Lookup::kernel1D_Run(int n, const unsigned* keys, float* out)
   const std::string text = IspcKernelsOf(tc, "Lookup");
   INFO(text);
   REQUIRE(text.find("static inline Big crt_load_Big(const uniform Big *uniform a, uint i)") != std::string::npos);
-  REQUIRE(text.find("const Big b = crt_load_Big(self->m_big, (uint)(k));") != std::string::npos);  // const, whole, per lane
+  REQUIRE(text.find("const Big b = crt_load_Big(self->m_big, ((uint)(k)));") != std::string::npos);  // const, whole, per lane
   REQUIRE(text.find("const Big first = self->m_big[0u];") != std::string::npos);                   // one index for all lanes
   REQUIRE(text.find("const Small s = self->m_small[k];") != std::string::npos);                    // small: a gather
   REQUIRE(text.find("return self->m_big[k].hi.w;") != std::string::npos);                          // one field of it: a gather
