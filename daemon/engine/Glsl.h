@@ -210,7 +210,7 @@ private:
   std::map<const clang::ValueDecl*, PointerTarget> m_pointers;  // pointer locals and helper parameters in scope
   std::set<std::string> m_emittedCopies;                         // helpers bound to buffers, by name
   std::vector<std::string> m_coherentLoads;                      // struct types with an ISPC load helper
-  std::set<std::string> m_compoundHelpers;                       // ISPC helpers written so far: crt_<op>_assign_<type>, crt_store_<Struct>
+  std::set<std::string> m_ispcHelpers;                       // ISPC helpers written so far: crt_<op>_assign_<type>, crt_store_<Struct>
   const clang::Expr* m_fieldBase = nullptr;                      // the base of the field access being printed
   std::vector<std::string> m_reduceAddVectors;                   // member vectors with a ReduceAdd function
 

@@ -137,7 +137,7 @@ std::string GlslPrinter::IspcCompoundAssignOnce(const clang::CXXOperatorCallExpr
   const std::string type = IspcTypeName(*glsl), spelling = getOperatorSpelling(op->getOperator());
   const char* names[] = {"add", "sub", "mul", "div"};
   const std::string name = std::string("crt_") + names[std::string("+-*/").find(spelling[0])] + "_assign_" + type;
-  if (m_compoundHelpers.insert(name).second)
+  if (m_ispcHelpers.insert(name).second)
     m_functions.push_back("// a[i] " + spelling + " v, a[i] found once\nstatic inline " + type + " " + name + "(uniform " + type +
                           " *uniform a, int i, " + type + " v)\n{\n  a[i] = a[i] " + spelling.substr(0, 1) + " v;\n  return a[i];\n}\n");
   return name + "(" + array + ", (int)(" + index + "), " + Expr(op->getArg(1)) + ")";
@@ -183,7 +183,7 @@ std::string GlslPrinter::IspcConsecutiveStore(const clang::CXXOperatorCallExpr* 
     if (!glsl) return "";
     const std::string type = IspcTypeName(*glsl);
     store = "crt_store_" + type;
-    if (m_compoundHelpers.insert(store).second) {
+    if (m_ispcHelpers.insert(store).second) {
       std::string packed;
       for (const auto& w : words) packed += ", " + w;
       m_functions.push_back("// a[i] = v for each lane, " + type + " being eight 32-bit words: vector stores where the lanes write\n"

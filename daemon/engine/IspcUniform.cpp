@@ -28,13 +28,13 @@ bool GlslPrinter::IspcUniform(const clang::Expr* e) const {
     auto* f = dyn_cast<FieldDecl>(me->getMemberDecl());
     return f && isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts()) && f->getType()->isArithmeticType() && composedPrefix.empty() && !selfClass;
   }
-  if (auto* mc = dyn_cast<CXXMemberCallExpr>(e)) {  // a member vector's size(): self->m_v_size
+  if (auto* mc = dyn_cast<CXXMemberCallExpr>(e)) {  // a member vector's size() (self->m_v_size), an image's width() or height()
     const CXXMethodDecl* method = mc->getMethodDecl();
-    const bool side = method && (method->getName() == "width" || method->getName() == "height");
-    if (side && IsImage2D(mc->getImplicitObjectArgument()->getType().getNonReferenceType()))  // an image's (kernels' images are the gang's)
-      return composedPrefix.empty() && !selfClass;
-    auto* f = ThisMemberField(mc->getImplicitObjectArgument());
-    return f && mc->getMethodDecl() && mc->getMethodDecl()->getName() == "size" && IsStdVector(f->getType()) && composedPrefix.empty() && !selfClass;
+    if (!method || !composedPrefix.empty() || selfClass) return false;
+    const clang::Expr* object = mc->getImplicitObjectArgument();
+    if (method->getName() == "width" || method->getName() == "height") return IsImage2D(object->getType().getNonReferenceType());
+    auto* f = ThisMemberField(object);
+    return f && method->getName() == "size" && IsStdVector(f->getType());
   }
   if (auto* uo = dyn_cast<UnaryOperator>(e))
     return (uo->getOpcode() == UO_Minus || uo->getOpcode() == UO_Plus || uo->getOpcode() == UO_Not || uo->getOpcode() == UO_LNot) &&

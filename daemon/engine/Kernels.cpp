@@ -77,7 +77,7 @@ static bool CallsComposedCode(const Stmt* s, const CXXRecordDecl* cls, std::set<
 // An ISPC thread function that calls no functions of the user's (no helpers, virtual or composed
 // calls) is inlined into its export function, which then runs it with all lanes on in full gangs:
 // called, it got the execution mask as an argument, and ran every load masked and every uniform
-// branch as a varying one. Bloom_ISPC's blurs went from 1.74x to 2.2-2.4x of Bloom_CPU's speed.
+// branch as a varying one. Bloom_ISPC went from 1.74x to 2.1-2.4x of Bloom_CPU's speed.
 static void IspcInlineBody(Kernel& k, const GlslPrinter& printer) {
   const auto& uses = printer.Uses();
   if (!uses.helpers.empty() || !uses.virtualCalls.empty() || !uses.composedCalls.empty()) return;
