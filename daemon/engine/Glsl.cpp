@@ -57,8 +57,10 @@ std::string TrimmedSourceText(const ASTContext& ctx, SourceRange range) {
 GlslPrinter::GlslPrinter(ASTContext& ctx, const CXXRecordDecl* cls, Reporter& reporter)
     : m_ctx(ctx), m_class(cls), m_reporter(reporter) {}
 
+// A variable or field named like a GLSL keyword, or like a built-in function (which it would hide
+// in GLSL, and shadow in ISPC's standard library: `float distance` in Attenuate), takes a '_'.
 std::string GlslPrinter::SafeName(const std::string& name) {
-  return GlslKeywords().count(name) ? name + "_" : name;
+  return GlslKeywords().count(name) || IsGlslBuiltinFunction(name) ? name + "_" : name;
 }
 
 std::string GlslPrinter::Fail(SourceLocation loc, const std::string& message, const std::string& hint) {
@@ -664,7 +666,7 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
   }
   if (const ValueDecl* param = ValueParamOf(e)) return SafeName(param->getNameAsString());
   if (auto* me = dyn_cast<MemberExpr>(e); me && me->isArrow() && ValueParamOf(me->getBase(), true))
-    return SafeName(ValueParamOf(me->getBase(), true)->getNameAsString()) + "." + me->getMemberDecl()->getNameAsString();
+    return SafeName(ValueParamOf(me->getBase(), true)->getNameAsString()) + "." + SafeName(me->getMemberDecl()->getNameAsString());
   if (auto* me = dyn_cast<MemberExpr>(e)) {
     const clang::Expr* base = me->getBase()->IgnoreParenImpCasts();
     auto* field = dyn_cast<FieldDecl>(me->getMemberDecl());
@@ -714,10 +716,10 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
       return ispc ? Expr(me->getBase()) + ".m_col" : Expr(me->getBase());
     if (me->isArrow()) {  // p->f: the field of what p points at
       auto t = Pointer(me->getBase());
-      return t ? Pointee(*t, nullptr, e->getBeginLoc()) + "." + field->getNameAsString() : "/*error*/";
+      return t ? Pointee(*t, nullptr, e->getBeginLoc()) + "." + SafeName(field->getNameAsString()) : "/*error*/";
     }
     m_fieldBase = me->getBase()->IgnoreParenImpCasts();
-    return Expr(me->getBase()) + "." + field->getNameAsString();
+    return Expr(me->getBase()) + "." + SafeName(field->getNameAsString());
   }
   if (auto* as = dyn_cast<ArraySubscriptExpr>(e)) {
     // p[i] through a pointer (a buffer parameter, a pointer local, data()); an array's own elements as written.

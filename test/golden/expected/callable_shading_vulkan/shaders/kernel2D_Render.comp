@@ -113,9 +113,9 @@ float Lambert_Opacity(Lambert_Data self)
 }
 
 // from IMaterial::Attenuate
-void Lambert_Attenuate(Lambert_Data self, inout vec3 color, float distance)
+void Lambert_Attenuate(Lambert_Data self, inout vec3 color, float distance_)
 {
-  color = color / (1.0 + distance * distance);
+  color = color / (1.0 + distance_ * distance_);
 }
 
 // from Phong::Highlight
@@ -138,9 +138,9 @@ float Phong_Opacity(Phong_Data self)
 }
 
 // from IMaterial::Attenuate
-void Phong_Attenuate(Phong_Data self, inout vec3 color, float distance)
+void Phong_Attenuate(Phong_Data self, inout vec3 color, float distance_)
 {
-  color = color / (1.0 + distance * distance);
+  color = color / (1.0 + distance_ * distance_);
 }
 
 // from Checker::Shade
@@ -158,9 +158,9 @@ float Checker_Opacity(Checker_Data self)
 }
 
 // from Checker::Attenuate
-void Checker_Attenuate(Checker_Data self, inout vec3 color, float distance)
+void Checker_Attenuate(Checker_Data self, inout vec3 color, float distance_)
 {
-  color = color * max(1.0 - distance * self.opacity, 0.0);
+  color = color * max(1.0 - distance_ * self.opacity, 0.0);
 }
 
 // m_materials[index]->Shade(...): the object's class picks the implementation
@@ -210,7 +210,7 @@ float m_materials_Opacity(uint index)
 }
 
 // m_materials[index]->Attenuate(...): the object's class picks the implementation
-void m_materials_Attenuate(uint index, inout vec3 color, float distance)
+void m_materials_Attenuate(uint index, inout vec3 color, float distance_)
 {
   const uvec2 tag = m_materials_Tags(m_materials_tags).tags[index];
   switch (tag.x)
@@ -218,19 +218,19 @@ void m_materials_Attenuate(uint index, inout vec3 color, float distance)
   case 0u:  // dead code in a pipeline made for objects without a Lambert
     if (crt_m_materials_holdsLambert)
     {
-      Lambert_Attenuate(m_materials_LambertObjects(m_materials_Lambert).objects[tag.y], color, distance);
+      Lambert_Attenuate(m_materials_LambertObjects(m_materials_Lambert).objects[tag.y], color, distance_);
     }
     return;
   case 1u:  // dead code in a pipeline made for objects without a Phong
     if (crt_m_materials_holdsPhong)
     {
-      Phong_Attenuate(m_materials_PhongObjects(m_materials_Phong).objects[tag.y], color, distance);
+      Phong_Attenuate(m_materials_PhongObjects(m_materials_Phong).objects[tag.y], color, distance_);
     }
     return;
   case 2u:  // dead code in a pipeline made for objects without a Checker
     if (crt_m_materials_holdsChecker)
     {
-      Checker_Attenuate(m_materials_CheckerObjects(m_materials_Checker).objects[tag.y], color, distance);
+      Checker_Attenuate(m_materials_CheckerObjects(m_materials_Checker).objects[tag.y], color, distance_);
     }
     return;
   }

@@ -80,19 +80,19 @@ void kernel1D_Karras12(int i)
   int lengthMax = 2;
   while (Delta(i, i + lengthMax * d) > deltaMin)
     lengthMax *= 2;
-  int length = 0;
-  for (int step = lengthMax / 2; step >= 1; step /= 2)
-    if (Delta(i, i + (length + step) * d) > deltaMin)
-      length += step;
-  const int j = i + length * d;
+  int length_ = 0;
+  for (int step_ = lengthMax / 2; step_ >= 1; step_ /= 2)
+    if (Delta(i, i + (length_ + step_) * d) > deltaMin)
+      length_ += step_;
+  const int j = i + length_ * d;
   const int deltaNode = Delta(i, j);
   int split = 0;
-  for (int divisor = 2; divisor < 2 * length + 2; divisor *= 2)
+  for (int divisor = 2; divisor < 2 * length_ + 2; divisor *= 2)
   {
-    const int step = (length + divisor - 1) / divisor;
-    if (Delta(i, i + (split + step) * d) > deltaNode)
-      split += step;
-    if (step == 1)
+    const int step_ = (length_ + divisor - 1) / divisor;
+    if (Delta(i, i + (split + step_) * d) > deltaNode)
+      split += step_;
+    if (step_ == 1)
       break;
   }
   const int gamma = i + split * d + min(d, 0);

@@ -540,13 +540,13 @@ bool m_pAccelStruct_IntersectSdfBrick(BVHTraceRay r, uint brick, float tEnter, f
   const float t1 = min(tExit, tfar);
   const vec3 entry = (r.org + tEnter * r.dir - brickMin) / size;
   int cell[3];
-  int step[3];
+  int step_[3];
   float tNext[3];
   float tDelta[3];
   for (int a = 0; a < 3; ++a)
   {
     cell[a] = clamp(int(floor(entry[a])), 0, n - 1);
-    step[a] = r.dir[a] > 0.0 ? 1 : -1;
+    step_[a] = r.dir[a] > 0.0 ? 1 : -1;
     const float boundary = brickMin[a] + size * float(cell[a] + (r.dir[a] > 0.0 ? 1 : 0));
     tNext[a] = r.invDir[a] != 0.0 ? (boundary - r.org[a]) * r.invDir[a] : 3.40282347e+38;
     tDelta[a] = r.invDir[a] != 0.0 ? size * abs(r.invDir[a]) : 3.40282347e+38;
@@ -578,7 +578,7 @@ bool m_pAccelStruct_IntersectSdfBrick(BVHTraceRay r, uint brick, float tEnter, f
     }
     if (!(tNext[a] <= t1))
       return false;
-    cell[a] = cell[a] + step[a];
+    cell[a] = cell[a] + step_[a];
     if (cell[a] < 0 || cell[a] >= n)
       return false;
     tVoxel = tNext[a];
@@ -771,9 +771,9 @@ bool m_pAccelStruct_TraceInstance(uint k, BVHTraceRay worldRay, float time, bool
   if ((inst.flags & m_pAccelStruct_kInstanceMotion) != 0u)
   {
     const float f = clamp(time, 0.0, 1.0) * float(inst.motionSteps - 1u);
-    const uint step = min(uint(f), inst.motionSteps - 2u);
-    const float w = f - float(step);
-    const uint at = inst.motionFirst + 3u * step;
+    const uint step_ = min(uint(f), inst.motionSteps - 2u);
+    const float w = f - float(step_);
+    const uint at = inst.motionFirst + 3u * step_;
     const vec4 row0 = mix(m_pAccelStruct_m_motion[at], m_pAccelStruct_m_motion[at + 3u], w);
     const vec4 row1 = mix(m_pAccelStruct_m_motion[at + 1u], m_pAccelStruct_m_motion[at + 4u], w);
     const vec4 row2 = mix(m_pAccelStruct_m_motion[at + 2u], m_pAccelStruct_m_motion[at + 5u], w);

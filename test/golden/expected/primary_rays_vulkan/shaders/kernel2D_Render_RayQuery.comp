@@ -166,11 +166,11 @@ vec3 Shade(CRT_Hit hit, vec3 org, vec3 dir, uint pixel)
   {
     const vec3 p = org + dir * hit.t;
     const vec3 start = p + normal * (1e-3 * m_aoDistance + 1e-6 * length(p));
-    const float sign = normal.z >= 0.0 ? 1.0 : -1.0;
-    const float k = -1.0 / (sign + normal.z);
+    const float sign_ = normal.z >= 0.0 ? 1.0 : -1.0;
+    const float k = -1.0 / (sign_ + normal.z);
     const float m = normal.x * normal.y * k;
-    const vec3 t1 = vec3(1.0 + sign * normal.x * normal.x * k, sign * m, -sign * normal.x);
-    const vec3 t2 = vec3(m, sign + normal.y * normal.y * k, -normal.y);
+    const vec3 t1 = vec3(1.0 + sign_ * normal.x * normal.x * k, sign_ * m, -sign_ * normal.x);
+    const vec3 t2 = vec3(m, sign_ + normal.y * normal.y * k, -normal.y);
     int blocked = 0;
     for (int s = 0; s < m_aoSamples; ++s)
     {
