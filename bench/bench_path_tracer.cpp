@@ -315,8 +315,8 @@ int main(int argc, char** argv)
         csv << "virtual_level," << r.name << "," << r.mode << "," << r.spp << "," << Median(r.seconds) << "," << rate << "," << rate * paths * 1e-6
             << "," << rate / level2 << ",,\n";
       }
-      std::printf("(level 3 runs callable shaders only on a device with ray tracing pipelines, and only for kernels without\n"
-                  " other hardware variants: PathTracer's kernel_Shade samples arrays of textures, so it keeps level 2's switch)\n");
+      std::printf("(level 3 runs callable shaders only where the device has ray tracing pipelines, and only in wavefront mode:\n"
+                  " kernel_Shade_Callables_Textures; a megakernel keeps level 2's switch)\n");
     }
 
     // ---- 3. specialisation to the scene's classes

@@ -26,12 +26,14 @@ namespace {
 // Virtual functions, level 3: a kernel whose virtual calls run as callable shaders, or whose composed
 // traversal's leaves the ray tracing hardware finds, in a ray generation shader of its own. Not for
 // kernels that need what only compute shaders have (shared memory for reductions, indirect dispatch)
-// or other hardware variants, nor for megakernels: those keep the level-2 switch.
+// or ray queries (their own hardware variant), nor for megakernels: those keep the level-2 switch.
+// Arrays of textures come along: every device with ray tracing pipelines samples them with its
+// samplers (descriptor indexing), so the ray generation shader is also the kernel's _Textures form.
 // Why a kernel cannot be a ray generation shader ("" when it can).
 std::string WhyNoRayGeneration(const Kernel& k) {
   if (!k.reductions.empty()) return "its reductions need a compute shader's shared memory";
   if (!k.indirectVector.empty()) return "it is dispatched indirectly, which ray tracing pipelines are not here";
-  if (!k.textureArrays.empty() || !k.rayQueryHolder.empty()) return "it has other hardware variants (arrays of textures or ray queries)";
+  if (!k.rayQueryHolder.empty()) return "it has a variant of its own for ray queries";
   return "";  // megakernels have no callables or leaves of their own: MergeMegakernelCode keeps the kernels' switches
 }
 
@@ -89,8 +91,10 @@ std::vector<const StageShader*> ExecutedStageShaders(const ClassModel& model) {
 
 std::vector<KernelVariant> Variants(const Kernel& k) {
   std::vector<KernelVariant> variants;
-  if (RunsCallables(k)) variants.push_back({"_Callables", false, false, true, false, ""});
-  if (RunsLeafShaders(k)) variants.push_back({"_Intersections", false, false, false, true, ""});
+  const bool textures = !k.textureArrays.empty();  // a ray generation shader samples them on the GPU's samplers
+  const std::string samplers = textures ? "_Textures" : "";
+  if (RunsCallables(k)) variants.push_back({"_Callables" + samplers, false, textures, true, false, ""});
+  if (RunsLeafShaders(k)) variants.push_back({"_Intersections" + samplers, false, textures, false, true, ""});
   for (bool rayQuery : {true, false})
     for (bool textures : {true, false})
       if ((!rayQuery || !k.rayQueryHolder.empty()) && (!textures || !k.textureArrays.empty()))

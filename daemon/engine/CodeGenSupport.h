@@ -18,7 +18,7 @@ Data List();
 // The shaders of a kernel, most specific first (the order the host tries them in): the variants for
 // ray tracing hardware and for arrays of textures on the GPU's samplers, and the one every device runs.
 struct KernelVariant {
-  std::string suffix;  // "_Callables", "_Intersections", "_RayQuery_Textures", "_RayQuery", "_Textures" or ""
+  std::string suffix;  // "_Callables", "_Intersections" (either + "_Textures"), "_RayQuery_Textures", "_RayQuery", "_Textures" or ""
   bool rayQuery = false, textures = false, callables = false, leaves = false;
   // "Start" or "Finish": the one-thread shader of the statements before or after the loop nest,
   // with the bindings of the variant every device runs.

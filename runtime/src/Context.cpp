@@ -449,7 +449,11 @@ void VulkanContext::CreateDevice(const ContextOptions& options) {
       auto bindingFlags = VkInit<VkDescriptorSetLayoutBindingFlagsCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_BINDING_FLAGS_CREATE_INFO);
       bindingFlags.bindingCount = 1;
       bindingFlags.pBindingFlags = &flags;
-      const VkDescriptorSetLayoutBinding binding{0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, maxTextureArraySize, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+      // Compute shaders sample them, and where ray tracing pipelines exist, their ray generation
+      // and callable shaders too (a kernel's level-3 variant).
+      VkShaderStageFlags stages = VK_SHADER_STAGE_COMPUTE_BIT;
+      if (hasRayTracingPipeline) stages |= VK_SHADER_STAGE_RAYGEN_BIT_KHR | VK_SHADER_STAGE_CALLABLE_BIT_KHR;
+      const VkDescriptorSetLayoutBinding binding{0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, maxTextureArraySize, stages, nullptr};
       auto setInfo = VkInit<VkDescriptorSetLayoutCreateInfo>(VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO);
       setInfo.pNext = &bindingFlags;
       setInfo.bindingCount = 1;

@@ -31,9 +31,10 @@ std::shared_ptr<VulkanContext> WithRayTracingPipelines(std::shared_ptr<VulkanCon
 }  // namespace
 
 RayTracingPipeline::RayTracingPipeline(std::shared_ptr<VulkanContext> ctx, const RayTracingShaders& shaders,
-                                       std::vector<VkDescriptorType> bindingTypes, uint32_t pushConstantBytes, const char* debugName)
+                                       std::vector<VkDescriptorType> bindingTypes, uint32_t pushConstantBytes, const char* debugName,
+                                       uint32_t textureArraySets)
     : Pipeline("RayTracingPipeline", VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, StagesOf(shaders), WithRayTracingPipelines(std::move(ctx), debugName),
-               std::move(bindingTypes), pushConstantBytes, debugName, 0) {
+               std::move(bindingTypes), pushConstantBytes, debugName, textureArraySets) {
   std::vector<VkShaderModule> modules;
   try {
     // Groups in shader binding table order: the ray generation shader, the misses, the hit groups,

@@ -3,8 +3,8 @@
 # with glslangValidator, checks that it asks for that hardware, and validates the SPIR-V with
 # spirv-val. Lavapipe cannot run these shaders, so this is what a machine without them can check.
 #   *_RayQuery*.comp: ray queries (GL_EXT_ray_query), capability RayQueryKHR;
-#   *_Textures.comp: arrays of textures indexed per thread (descriptor indexing), capabilities
-#   RuntimeDescriptorArray and SampledImageArrayNonUniformIndexing;
+#   *_Textures.comp and *_Textures.rgen: arrays of textures indexed per thread (descriptor indexing),
+#   capabilities RuntimeDescriptorArray and SampledImageArrayNonUniformIndexing;
 #   *_Callables.rgen and *.rcall: a kernel as a ray generation shader and the callable shaders its
 #   virtual calls execute (ray tracing pipelines, GL_EXT_ray_tracing), capability RayTracingKHR;
 #   *_Intersections.rgen, *.rint, *.rchit and *.rmiss: a kernel whose composed traversal traces its
@@ -33,7 +33,7 @@ for shader in "${shaders[@]}"; do
   fi
   needed=()
   case "$shader" in *_RayQuery*) needed+=(RayQueryKHR) ;; esac
-  case "$shader" in *_Textures.comp) needed+=(RuntimeDescriptorArray SampledImageArrayNonUniformIndexing) ;; esac
+  case "$shader" in *_Textures.comp | *_Textures.rgen) needed+=(RuntimeDescriptorArray SampledImageArrayNonUniformIndexing) ;; esac
   case "$shader" in *.rgen | *.rcall | *.rint | *.rchit | *.rmiss) needed+=(RayTracingKHR) ;; esac
   "$spirvdis" "$spv" > "$work/dis" 2>/dev/null
   missing=""

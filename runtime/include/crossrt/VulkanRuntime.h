@@ -639,13 +639,14 @@ struct RayTracingShaders {
 
 // RAII ray tracing pipeline (virtual functions, level 3), move-only: a kernel as a ray generation
 // shader, whose virtual calls run as callable shaders or whose traversal traces rays against leaves
-// intersected by intersection shaders. Bindings and push constants are visible to every stage.
-// Throws unless ctx->hasRayTracingPipeline.
+// intersected by intersection shaders. Bindings and push constants are visible to every stage; sets
+// 1..textureArraySets are arrays of textures, which the ray generation and callable shaders sample.
+// Throws unless ctx->hasRayTracingPipeline (and ctx->hasTextureArrays, with texture sets).
 class RayTracingPipeline : public Pipeline {
 public:
   RayTracingPipeline() = default;
   RayTracingPipeline(std::shared_ptr<VulkanContext> ctx, const RayTracingShaders& shaders, std::vector<VkDescriptorType> bindingTypes,
-                     uint32_t pushConstantBytes, const char* debugName);
+                     uint32_t pushConstantBytes, const char* debugName, uint32_t textureArraySets = 0);
   // Launches width x height x depth ray generation threads (gl_LaunchIDEXT), behind and ahead of
   // barriers to and from the compute and transfer stages the other commands use.
   void TraceCmd(VkCommandBuffer cmd, uint32_t width, uint32_t height, uint32_t depth) const;
