@@ -891,7 +891,7 @@ std::string GlslPrinter::IspcVectorOperator(const CXXOperatorCallExpr* op) {
   if ((kind == OO_PlusEqual || kind == OO_MinusEqual || kind == OO_StarEqual || kind == OO_SlashEqual) && op->getNumArgs() == 2) {
     if (op->getArg(0)->HasSideEffects(m_ctx, /*IncludePossibleEffects=*/false)) {  // v[k++] += a: the address once
       if (std::string once = IspcCompoundAssignOnce(op); !once.empty()) return once;
-      return IspcFail(op->getBeginLoc(), "compound assignment to a vector whose address has side effects, other than an element of a buffer or member vector,");
+      return IspcFail(op->getBeginLoc(), "compound assignment to a vector whose address has side effects, other than an element of a buffer, member vector or local array,");
     }
     const std::string target = Expr(op->getArg(0)), spelling = getOperatorSpelling(kind);
     return target + " = " + target + " " + spelling.substr(0, 1) + " (" + Expr(op->getArg(1)) + ")";

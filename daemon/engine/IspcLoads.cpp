@@ -114,12 +114,23 @@ std::string GlslPrinter::IspcConsecutiveLoad(const clang::ArraySubscriptExpr* as
   return "crt_load4(" + t.array + ", (int)(" + (t.offset.empty() ? i : t.offset + " + " + i) + "))";
 }
 
-// v[k++] += a for a LiteMath vector element of a buffer or member vector: ISPC structs have no +=,
-// so it is a[i] = a[i] + v, in a helper that takes the buffer and the index, computed once.
+// v[k++] += a for a LiteMath vector element of a buffer, a member vector or a local array: ISPC
+// structs have no +=, so it is a[i] = a[i] + v, in a helper that takes the array and the index,
+// computed once. A local array is the thread's own (varying elements, each lane its own index).
 std::string GlslPrinter::IspcCompoundAssignOnce(const clang::CXXOperatorCallExpr* op) {
   const clang::Expr* target = op->getArg(0)->IgnoreParenImpCasts();
-  std::string array, index;
-  if (auto* as = dyn_cast<ArraySubscriptExpr>(target); as && as->getBase()->getType()->isPointerType()) {
+  std::string array, index, pointee = "uniform ", helperKind;
+  const VarDecl* localArray = nullptr;
+  if (auto* as = dyn_cast<ArraySubscriptExpr>(target))
+    if (auto* ref = dyn_cast<DeclRefExpr>(as->getBase()->IgnoreParenImpCasts()))
+      if (auto* vd = dyn_cast<VarDecl>(ref->getDecl()); vd && vd->isLocalVarDecl() && vd->getType()->isConstantArrayType()) localArray = vd;
+  if (localArray) {
+    auto* as = cast<ArraySubscriptExpr>(target);
+    array = Expr(as->getBase());
+    index = Expr(as->getIdx());
+    pointee = "varying ";  // the lanes' own arrays
+    helperKind = "_local";
+  } else if (auto* as = dyn_cast<ArraySubscriptExpr>(target); as && as->getBase()->getType()->isPointerType()) {
     auto t = Pointer(as->getBase());
     if (!t || !t->value.empty() || t->local || t->array.empty()) return "";
     array = t->array;
@@ -136,10 +147,11 @@ std::string GlslPrinter::IspcCompoundAssignOnce(const clang::CXXOperatorCallExpr
   if (!glsl) return "";
   const std::string type = IspcTypeName(*glsl), spelling = getOperatorSpelling(op->getOperator());
   const char* names[] = {"add", "sub", "mul", "div"};
-  const std::string name = std::string("crt_") + names[std::string("+-*/").find(spelling[0])] + "_assign_" + type;
+  const std::string name = std::string("crt_") + names[std::string("+-*/").find(spelling[0])] + "_assign_" + type + helperKind;
   if (m_ispcHelpers.insert(name).second)
-    m_functions.push_back("// a[i] " + spelling + " v, a[i] found once\nstatic inline " + type + " " + name + "(uniform " + type +
-                          " *uniform a, int i, " + type + " v)\n{\n  a[i] = a[i] " + spelling.substr(0, 1) + " v;\n  return a[i];\n}\n");
+    m_functions.push_back("// a[i] " + spelling + " v, a[i] found once" + (localArray ? " (a: a thread's local array)" : "") + "\nstatic inline " + type +
+                          " " + name + "(" + pointee + type + " *uniform a, int i, " + type + " v)\n{\n  a[i] = a[i] " + spelling.substr(0, 1) +
+                          " v;\n  return a[i];\n}\n");
   return name + "(" + array + ", (int)(" + index + "), " + Expr(op->getArg(1)) + ")";
 }
 

@@ -140,7 +140,7 @@ Register gather(MakeCase<Gather>(
 
 #if __has_include("PixelRows_CPU.h")
 Register pixelRows(MakeCase<PixelRows>(
-    "float4/int4 pixels stored in order, mirrored, and rows[k++] += v", "pixel_rows.h/.cpp", 0.0, CONFORMANCE_MAKERS(PixelRows),
+    "float4/int4 pixels stored in order, mirrored, and rows[k++] += v, local[k++] += v", "pixel_rows.h/.cpp", 0.0, CONFORMANCE_MAKERS(PixelRows),
     [](PixelRows& p) {
       const int n = 1001;
       std::vector<float4> in(n), rows(n), mirrored(n);

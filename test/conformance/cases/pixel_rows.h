@@ -1,6 +1,6 @@
 // Whole float4 and int4 pixels written through pointers: a row in order, and the same row mirrored
 // (each thread writes another thread's pixel), for a length that no SIMD width divides; and a
-// pixel updated through an index with a side effect (rows[slot++] += v).
+// pixel and an element of a local array updated through an index with a side effect (rows[slot++] += v).
 #pragma once
 #include "LiteMath.h"
 using namespace LiteMath;
