@@ -29,7 +29,11 @@ const std::set<std::string>& GlslKeywords() {
       "discard", "lowp", "mediump", "highp", "precision", "vec2", "vec3", "vec4", "ivec2", "ivec3",
       "ivec4", "uvec2", "uvec3", "uvec4", "bvec2", "bvec3", "bvec4", "mat2", "mat3", "mat4",
       "texture", "filter", "common", "partition", "active", "superp", "output", "resource",
-      "mix", "main", "gl_Position", "packed", "half", "fixed", "image1D", "image2D", "sampler2D"};
+      "mix", "main", "gl_Position", "packed", "half", "fixed", "image1D", "image2D", "image3D", "imageCube", "sampler1D", "sampler2D",
+      "sampler3D", "samplerCube", "texture2D", "texture3D",
+      // Types named like a buffer block of `image`, `sampler` or `texture` (ShaderCode's <name>Buffer).
+      "imageBuffer", "iimageBuffer", "uimageBuffer", "samplerBuffer", "isamplerBuffer", "usamplerBuffer", "textureBuffer",
+      "itextureBuffer", "utextureBuffer"};
   return words;
 }
 
@@ -546,9 +550,9 @@ std::string GlslPrinter::ComposedCall(const CXXMemberCallExpr* mc) {
 // `m_objects[i]->Method(args)` where m_objects is a std::vector of shared_ptr, unique_ptr or plain
 // pointers to a polymorphic class: `m_objects_Method(uint(i), args)`, the dispatcher that the
 // analysis writes for the implementations it finds; "" when the call is not of that form.
-const FieldDecl* VirtualCallTarget(const CXXMemberCallExpr* mc, const clang::Expr** index) {
-  const clang::Expr* obj = mc->getImplicitObjectArgument()->IgnoreParenImpCasts();
-  if (auto* op = dyn_cast<CXXOperatorCallExpr>(obj); op && op->getOperator() == OO_Arrow) obj = op->getArg(0)->IgnoreParenImpCasts();
+namespace {
+// `m_v[i]` where m_v is a member std::vector of pointers to a polymorphic class: m_v, i in `index`.
+const FieldDecl* ObjectElement(const clang::Expr* obj, const clang::Expr** index) {
   auto* subscript = dyn_cast<CXXOperatorCallExpr>(obj);
   if (!subscript || subscript->getOperator() != OO_Subscript) return nullptr;
   auto* me = dyn_cast<MemberExpr>(subscript->getArg(0)->IgnoreParenImpCasts());
@@ -559,6 +563,26 @@ const FieldDecl* VirtualCallTarget(const CXXMemberCallExpr* mc, const clang::Exp
   if (index) *index = subscript->getArg(1);
   return field;
 }
+}  // namespace
+
+const FieldDecl* ObjectLocal(const VarDecl* local, const clang::Expr** index) {
+  if (!local || !local->isLocalVarDecl() || !local->getType()->isPointerType() || !local->getInit()) return nullptr;
+  const clang::Expr* init = local->getInit()->IgnoreParenImpCasts();
+  if (auto* get = dyn_cast<CXXMemberCallExpr>(init); get && get->getMethodDecl() && get->getMethodDecl()->getName() == "get" && get->getNumArgs() == 0)
+    init = get->getImplicitObjectArgument()->IgnoreParenImpCasts();  // m_v[i].get() of a shared_ptr or unique_ptr
+  return ObjectElement(init, index);
+}
+
+const FieldDecl* VirtualCallTarget(const CXXMemberCallExpr* mc, const clang::Expr** index) {
+  const clang::Expr* obj = mc->getImplicitObjectArgument()->IgnoreParenImpCasts();
+  if (auto* op = dyn_cast<CXXOperatorCallExpr>(obj); op && op->getOperator() == OO_Arrow) obj = op->getArg(0)->IgnoreParenImpCasts();
+  if (auto* ref = dyn_cast<DeclRefExpr>(obj))  // p->Method() through `T* p = m_v[i]`: p holds i
+    if (const FieldDecl* field = ObjectLocal(dyn_cast<VarDecl>(ref->getDecl()))) {
+      if (index) *index = ref;
+      return field;
+    }
+  return ObjectElement(obj, index);
+}
 
 std::string GlslPrinter::VirtualCall(const CXXMemberCallExpr* mc) {
   const clang::Expr* indexExpr = nullptr;
@@ -568,7 +592,10 @@ std::string GlslPrinter::VirtualCall(const CXXMemberCallExpr* mc) {
   if (!method->isVirtual())
     return Fail(mc->getBeginLoc(), "call of the non-virtual " + method->getQualifiedNameAsString() + " through '" + field->getNameAsString() + "' in a kernel",
                 "the GPU picks the implementation by the object's type: make the method virtual in the interface");
-  std::vector<std::string> args = {ispc ? "((" + IspcVariability(indexExpr) + "uint)(" + Expr(indexExpr) + "))" : "uint(" + Expr(indexExpr) + ")"};
+  auto* local = dyn_cast<DeclRefExpr>(indexExpr);
+  std::vector<std::string> args = {local && m_objectLocals.count(local->getDecl()) ? SafeName(local->getDecl()->getNameAsString())  // already the index
+                                   : ispc ? "((" + IspcVariability(indexExpr) + "uint)(" + Expr(indexExpr) + "))"
+                                          : "uint(" + Expr(indexExpr) + ")"};
   if (ispc) args.insert(args.begin(), "self");  // the dispatcher finds the tags and the objects in the class data
   for (auto* arg : mc->arguments()) args.push_back(Expr(arg));
   Type(mc->getType(), mc->getBeginLoc());  // declares a returned struct
@@ -650,6 +677,11 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
       return Fail(e->getBeginLoc(), "'" + d->getNameAsString() + "' holds one value per thread (a local of the control function's thread loop), used here as a pointer",
                   "read and write it as *" + d->getNameAsString() + " or " + d->getNameAsString() + "->field");
     if (auto* ec = dyn_cast<EnumConstantDecl>(d)) return std::to_string(ec->getInitVal().getSExtValue());
+    if (auto object = m_objectLocals.find(d); object != m_objectLocals.end())
+      return Fail(e->getBeginLoc(), "'" + d->getNameAsString() + "' points at an element of " + object->second->getNameAsString() +
+                                        ", which kernels hold as its index: it can only call virtual methods here",
+                  "call them as " + d->getNameAsString() + "->Method(...); for anything else, keep the element's index and use " +
+                      object->second->getNameAsString() + "[index]");
     if (auto* vd = dyn_cast<VarDecl>(d)) {
       if (vd->hasGlobalStorage() && !vd->isStaticLocal()) {
         if (vd->getType().isConstQualified() && vd->getAnyInitializer()) {

@@ -26,8 +26,12 @@ bool IsCrossrtAtomic(const clang::FunctionDecl* fd);
 // The polymorphic class a shared_ptr, unique_ptr or plain pointer type points to, or null.
 const clang::CXXRecordDecl* PolymorphicPointee(clang::QualType type);
 // `m_v[i]->Method(...)` through a member std::vector of pointers to a polymorphic class: the vector
-// (and in `index`, the expression i), or null for other calls.
+// (and in `index`, the expression i), or null for other calls. Also `p->Method(...)` through a local
+// `T* p = m_v[i];` or `= m_v[i].get();` (ObjectLocal): then `index` is p, which kernels hold as i.
 const clang::FieldDecl* VirtualCallTarget(const clang::CXXMemberCallExpr* call, const clang::Expr** index = nullptr);
+// A local pointer to an element of such a vector, `T* p = m_v[i]` or `= m_v[i].get()`: the vector
+// (and in `index`, the expression i), or null for other locals.
+const clang::FieldDecl* ObjectLocal(const clang::VarDecl* local, const clang::Expr** index = nullptr);
 
 // What the code a printer printed uses, recorded while printing: the facts the passes read
 // afterwards (which buffers, images and helpers a kernel binds and calls) instead of parsing the
@@ -208,6 +212,7 @@ private:
   std::string PointerLocal(const clang::VarDecl* vd, const std::string& pad);  // T* p = ...;
   std::string TextOf(const clang::Expr* e) const;
   std::map<const clang::ValueDecl*, PointerTarget> m_pointers;  // pointer locals and helper parameters in scope
+  std::map<const clang::ValueDecl*, const clang::FieldDecl*> m_objectLocals;  // `T* p = m_v[i]`: p holds i (ObjectLocal)
   std::set<std::string> m_emittedCopies;                         // helpers bound to buffers, by name
   std::vector<std::string> m_coherentLoads;                      // struct types with an ISPC load helper
   std::set<std::string> m_ispcHelpers;                       // ISPC helpers written so far: crt_<op>_assign_<type>, crt_store_<Struct>

@@ -4,6 +4,8 @@
 // member vector's data(), or a local array) at an offset, or one variable. Then
 //   *p, p[k], p->f        print as   array[offset + k], array[offset + k].f   or   variable, variable.f
 //   T* row = a + y * w;   prints as  const uint row_offset = y * w;   (later uses read a[row_offset + x])
+//   const I* m = m_objects[k].get();  (a member vector of polymorphic pointers) prints as
+//                         const uint m = k;   whose virtual calls m->F(...) print as m_objects_F(m, ...)
 //   helper(&x) / helper(p)          a helper that only reads and writes *p gets p as an inout value;
 //                                   one that indexes p gets a copy per buffer, with the offset.
 #include "Glsl.h"
@@ -83,6 +85,10 @@ std::optional<GlslPrinter::PointerTarget> GlslPrinter::Pointer(const clang::Expr
   if (auto* dr = dyn_cast<DeclRefExpr>(e)) {
     const ValueDecl* d = dr->getDecl();
     if (auto it = m_pointers.find(d); it != m_pointers.end()) return it->second;
+    if (m_objectLocals.count(d)) {  // p->field of an object: reported as what p may do
+      Expr(dr);
+      return std::nullopt;
+    }
     PointerTarget t;
     if (valueParams.count(d)) {  // a local of a thread loop, one value per thread
       t.value = SafeName(d->getNameAsString());
@@ -207,6 +213,15 @@ std::string GlslPrinter::PointerLocal(const VarDecl* vd, const std::string& pad)
   if (auto* fn = dyn_cast<FunctionDecl>(vd->getDeclContext()); fn && fn->getBody()) reassigned.TraverseStmt(fn->getBody());
   if (reassigned.found)
     return Fail(vd->getLocation(), "pointer '" + vd->getNameAsString() + "' is moved in a kernel", "keep an index next to the array and change that instead"), "";
+  // An object of a member vector of polymorphic pointers: the element's index, through which the
+  // virtual calls p->Method(...) reach the object's class (VirtualCall).
+  const clang::Expr* objectIndex = nullptr;
+  if (const FieldDecl* objects = ObjectLocal(vd, &objectIndex)) {
+    m_objectLocals[vd] = objects;
+    const std::string index = Expr(objectIndex);
+    return pad + "const uint " + SafeName(vd->getNameAsString()) + " = " + (ispc ? "(uint)(" + index + ")" : "uint(" + index + ")") + ";  // " +
+           vd->getNameAsString() + " points at " + objects->getNameAsString() + "[" + SafeName(vd->getNameAsString()) + "]\n";
+  }
   auto t = Pointer(init);
   if (!t) {
     PointerTarget reported;  // reported once: its uses say nothing more

@@ -78,7 +78,7 @@ Register redPixels(MakeCase<RedPixels>(
 
 #if __has_include("ShadedSpheres_CPU.h")
 Register shadedSpheres(MakeCase<ShadedSpheres>(
-    "virtual calls through std::vector<std::shared_ptr<IMaterial>>", "shaded_spheres.h/.cpp", 1e-5, CONFORMANCE_MAKERS(ShadedSpheres),
+    "virtual calls through std::vector<std::shared_ptr<IMaterial>>, an element or a local pointer to it", "shaded_spheres.h/.cpp", 1e-5, CONFORMANCE_MAKERS(ShadedSpheres),
     [](ShadedSpheres& s) {
       s.CommitDeviceData();
       std::vector<float4> normals(300), out(300);

@@ -58,6 +58,12 @@ const Case kCases[] = {
      "float Bad::Fact(float v) const { return v <= 1.0f ? 1.0f : v * Fact(v - 1.0f); }\n",
      "recursive call to 'Bad::Fact' in a kernel", "explicit stack", 12},
     {"new", "    float* p = new float[4]; x += p[0];", "", "", "'new' in a kernel (heap allocation)", "cannot allocate", 8},
+    {"an object's field through a local pointer to it",
+     "    const Shape* s = m_shapes[i % 2];\n    x += s->Area() + s->size;",
+     "  struct Shape { virtual ~Shape() = default; virtual float Area() const { return size * size; } float size = 1.0f; };\n"
+     "  std::vector<Shape*> m_shapes;",
+     "", "'s' points at an element of m_shapes, which kernels hold as its index: it can only call virtual methods here",
+     "call them as s->Method(...)", 9},
     {"delete", "    delete[] data;", "", "", "'delete' in a kernel (heap allocation)", "cannot allocate", 8},
     {"malloc", "    x += float(std::malloc(4) != nullptr);", "", "", "heap allocation ('malloc') in a kernel", "cannot allocate", 8},
     {"printf", "    std::printf(\"%f\\n\", x);", "", "", "I/O ('printf') in a kernel", "write results to an output buffer", 8},

@@ -631,3 +631,40 @@ TEST_CASE("Level 3: a composed traversal's leaf calls become intersection shader
     CHECK(host.find(Squeezed(why)) != std::string::npos);
   }
 }
+
+TEST_CASE("Names a user gives that GLSL reserves come out renamed: a parameter 'image', a local 'length', a field 'sample'", "[engine]")
+{
+  const char* header = R"(#pragma once
+#include "LiteMath.h"
+#include <cstdint>
+struct Tap { float sample; float step; };
+class Names
+{
+public:
+  virtual ~Names() = default;
+  virtual void Run(int n, [[crossrt::size("n")]] const Tap* taps, [[crossrt::size("n")]] uint32_t* image);
+protected:
+  void kernel1D_Run(int n, const Tap* taps, uint32_t* image);
+};
+)";
+  const char* source = R"(#include "Names.h"
+void Names::Run(int n, const Tap* taps, uint32_t* image) { kernel1D_Run(n, taps, image); }
+void Names::kernel1D_Run(int n, const Tap* taps, uint32_t* image)
+{
+  for (int i = 0; i < n; ++i)
+  {
+    const float length = taps[i].sample + LiteMath::length(LiteMath::float2(taps[i].step, 1.0f));
+    image[i] = uint32_t(length);
+  }
+}
+)";
+  TempClass tc("Names", header, source);
+  TranslateResult r = Translate(MakeRequest(tc, "Names"));  // the translation compiles its shaders: it fails if GLSL rejects them
+  INFO(r.diagnostics);
+  REQUIRE(r.ok);
+  const std::string glsl = Squeezed(r.files.at("shaders/kernel1D_Run.comp"));
+  CHECK(glsl.find(Squeezed("buffer imageBuffer_")) != std::string::npos);  // imageBuffer is a GLSL type
+  CHECK(glsl.find(Squeezed("float sample_;")) != std::string::npos);
+  CHECK(glsl.find(Squeezed("const float length_ = taps[i].sample_ + length(vec2(taps[i].step_, 1.0));")) != std::string::npos);
+  CHECK(glsl.find(Squeezed("image[i] = uint(length_);")) != std::string::npos);
+}

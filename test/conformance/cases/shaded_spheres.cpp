@@ -17,6 +17,8 @@ void ShadedSpheres::kernel1D_Shade(uint32_t n, const float4* a_normals, float4* 
   {
     const float3 normal = normalize(to_float3(a_normals[i]));
     const uint32_t id = uint32_t(a_normals[i].w) % uint32_t(m_materials.size());
-    a_out[i] = to_float4(m_materials[id]->Shade(normal, m_light), 1.0f);
+    const IMaterial* material = m_materials[id].get();  // a local pointer to the element, called through
+    const float3 next = m_materials[(id + 1) % uint32_t(m_materials.size())]->Shade(normal, m_light);
+    a_out[i] = to_float4(material->Shade(normal, m_light), next.x + next.z);
   }
 }

@@ -1,4 +1,5 @@
-// Virtual calls through a std::vector of pointers to an interface, one implementation per material.
+// Virtual calls through a std::vector of pointers to an interface, one implementation per material:
+// on an element (m_materials[k]->Shade) and through a local pointer to one (material->Shade).
 #pragma once
 #include "LiteMath.h"
 #include <cstdint>
