@@ -67,13 +67,18 @@ struct BVHInstance
 // bytes at a time (1 and 2: quantised over +-the voxel's diagonal; 4: the float). A voxel of an SVS
 // is a brick of one voxel, a brick of an SBS one of its bricks, a dense grid bricks of 8^3 cells
 // (stride: the grid's samples per axis). localId is what a hit reports as primId (0 for a grid's).
-// 48 bytes, std430 as in C++.
+// A brick of at most 4^3 voxels has a bit per voxel, x + n (y + n z), set where a corner value is
+// <= 0 (litesdf's MayHoldSurface), in occupied[0] (bits 0-31) and occupied[1]: the traversal skips
+// the others without reading their corners. 48 bytes, std430 as in C++.
 struct BVHSdfBrick
 {
   LiteMath::float4 minAndVoxelSize;
   uint32_t firstValue, voxels, stride, bytesPerValue;
-  uint32_t localId, unused0, unused1, unused2;
+  uint32_t localId;
+  uint32_t occupied[2];
+  uint32_t unused;
 };
+constexpr uint32_t kSdfMaskedVoxels = 4;  // bricks of up to 4^3 voxels have occupancy bits
 constexpr int kSdfNewtonIterations = 4;  // per voxel the ray crosses
 
 // A ray prepared for one tree: slab test reciprocals (0 for a zero or denormal direction
@@ -170,7 +175,7 @@ private:
                           LiteMath::float4& v) const;
   bool IntersectBoxes(const BVHTraceRay& r, uint32_t group, bool sdf, float& tfar, CRT_Hit& hit) const;
   bool IntersectSdfBrick(const BVHTraceRay& r, uint32_t brick, float tEnter, float tExit, float& tfar, CRT_Hit& hit) const;
-  float SdfValue(uint32_t brick, uint32_t index) const;
+  uint32_t SdfCode(uint32_t at, uint32_t bytes) const;
 
   std::string m_name;
   Builder m_builder;

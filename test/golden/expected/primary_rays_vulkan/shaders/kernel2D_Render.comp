@@ -98,9 +98,8 @@ struct BVHSdfBrick
   uint stride;
   uint bytesPerValue;
   uint localId;
-  uint unused0;
-  uint unused1;
-  uint unused2;
+  uint occupied[2];
+  uint unused;
 };
 
 struct BVHTriangle4
@@ -201,6 +200,7 @@ const float m_pAccelStruct_kMissed = -1.0;
 const float m_pAccelStruct_kWiden = 1.00000036;
 const uint m_pAccelStruct_kNoChild = 4294967295u;
 const uint m_pAccelStruct_kLeafFlag = 2147483648u;
+const uint m_pAccelStruct_kSdfMaskedVoxels = 4u;
 const int m_pAccelStruct_kSdfNewtonIterations = 4;
 const uint m_pAccelStruct_kInstanceMotion = 4u;
 const uint m_pAccelStruct_kInstanceIdentity = 1u;
@@ -347,18 +347,21 @@ int m_pAccelStruct_EnteredLanes(BVHTraceRay r, BVH4Node n, float tfar, inout vec
   return 4;
 }
 
-// from BVHScene::SdfValue
-float m_pAccelStruct_SdfValue(uint brick, uint index)
+// from litesdf::MayHoldSurface
+bool m_pAccelStruct_MayHoldSurface(VoxelValues values)
 {
-  const uint bytes = m_pAccelStruct_m_sdfBricks[brick].bytesPerValue;
-  const uint at = m_pAccelStruct_m_sdfBricks[brick].firstValue + index;
-  if (bytes == 4u)
-    return uintBitsToFloat(m_pAccelStruct_m_sdfWords[at]);
-  const uint perWord = 4u / bytes;
+  float lowest = values.v[0];
+  for (int c = 1; c < 8; ++c)
+    lowest = values.v[c] < lowest ? values.v[c] : lowest;
+  return lowest <= 0.0;
+}
+
+// from BVHScene::SdfCode
+uint m_pAccelStruct_SdfCode(uint at, uint bytes)
+{
+  const uint shift = bytes == 1u ? 2u : 1u;
   const uint maxCode = bytes == 1u ? 255u : 65535u;
-  const uint code = (m_pAccelStruct_m_sdfWords[at / perWord] >> ((at % perWord) * 8u * bytes)) & maxCode;
-  const float diagonal = 1.7320508 * m_pAccelStruct_m_sdfBricks[brick].minAndVoxelSize.w;
-  return (float(code) / float(maxCode) * 2.0 - 1.0) * diagonal;
+  return (m_pAccelStruct_m_sdfWords[at >> shift] >> ((at & ((1u << shift) - 1u)) * 8u * bytes)) & maxCode;
 }
 
 // from litesdf::Missed
@@ -525,15 +528,6 @@ SdfHit m_pAccelStruct_IntersectVoxelSpan(VoxelValues values, vec3 voxelMin, floa
   return hit;
 }
 
-// from litesdf::MayHoldSurface
-bool m_pAccelStruct_MayHoldSurface(VoxelValues values)
-{
-  float lowest = values.v[0];
-  for (int c = 1; c < 8; ++c)
-    lowest = values.v[c] < lowest ? values.v[c] : lowest;
-  return lowest <= 0.0;
-}
-
 // from BVHScene::IntersectSdfBrick
 bool m_pAccelStruct_IntersectSdfBrick(BVHTraceRay r, uint brick, float tEnter, float tExit, inout float tfar,
                                       inout CRT_Hit hit)
@@ -542,6 +536,12 @@ bool m_pAccelStruct_IntersectSdfBrick(BVHTraceRay r, uint brick, float tEnter, f
   const vec3 brickMin = (m_pAccelStruct_m_sdfBricks[brick].minAndVoxelSize).xyz;
   const int n = int(m_pAccelStruct_m_sdfBricks[brick].voxels);
   const uint stride = m_pAccelStruct_m_sdfBricks[brick].stride;
+  const uint plane = stride * stride;
+  const uint firstValue = m_pAccelStruct_m_sdfBricks[brick].firstValue;
+  const uint bytes = m_pAccelStruct_m_sdfBricks[brick].bytesPerValue;
+  const uint occupiedLow = m_pAccelStruct_m_sdfBricks[brick].occupied[0];
+  const uint occupiedHigh = m_pAccelStruct_m_sdfBricks[brick].occupied[1];
+  const float diagonal = 1.7320508 * size;
   const float t1 = min(tExit, tfar);
   const vec3 entry = (r.org + tEnter * r.dir - brickMin) / size;
   int cell[3];
@@ -560,12 +560,35 @@ bool m_pAccelStruct_IntersectSdfBrick(BVHTraceRay r, uint brick, float tEnter, f
   while (true)
   {
     const int a = tNext[0] < tNext[1] ? (tNext[0] < tNext[2] ? 0 : 2) : (tNext[1] < tNext[2] ? 1 : 2);
-    const uint first = (uint(cell[2]) * stride + uint(cell[1])) * stride + uint(cell[0]);
+    const uint first = firstValue + (uint(cell[2]) * stride + uint(cell[1])) * stride + uint(cell[0]);
+    const uint bit = uint(cell[0] + n * (cell[1] + n * cell[2]));
+    const uint occupied =
+        n > int(m_pAccelStruct_kSdfMaskedVoxels) ? 1u : ((bit < 32u ? occupiedLow : occupiedHigh) >> (bit % 32u)) & 1u;
     VoxelValues values;
-    for (uint c = 0u; c < 8u; ++c)
-      values.v[c] =
-          m_pAccelStruct_SdfValue(brick, first + (c & 1u) + ((c >> 1u) & 1u) * stride + (c >> 2u) * stride * stride);
-    if (m_pAccelStruct_MayHoldSurface(values))
+    bool mayHoldSurface = false;
+    if (occupied != 0u && bytes == 4u)
+    {
+      for (uint c = 0u; c < 8u; ++c)
+        values.v[c] = uintBitsToFloat(
+            m_pAccelStruct_m_sdfWords[first + (c & 1u) + ((c >> 1u) & 1u) * stride + (c >> 2u) * plane]);
+      mayHoldSurface = m_pAccelStruct_MayHoldSurface(values);
+    }
+    else if (occupied != 0u)
+    {
+      const uint maxCode = bytes == 1u ? 255u : 65535u;
+      uint codes[8];
+      uint lowest = maxCode;
+      for (uint c = 0u; c < 8u; ++c)
+      {
+        codes[c] = m_pAccelStruct_SdfCode(first + (c & 1u) + ((c >> 1u) & 1u) * stride + (c >> 2u) * plane, bytes);
+        lowest = min(lowest, codes[c]);
+      }
+      mayHoldSurface = 2u * lowest <= maxCode;
+      if (mayHoldSurface)
+        for (uint c = 0u; c < 8u; ++c)
+          values.v[c] = (float(codes[c]) / float(maxCode) * 2.0 - 1.0) * diagonal;
+    }
+    if (mayHoldSurface)
     {
       const vec3 voxelMin = brickMin + size * vec3(float(cell[0]), float(cell[1]), float(cell[2]));
       const SdfHit h = m_pAccelStruct_IntersectVoxelSpan(values, voxelMin, size, r.org, r.dir, tVoxel,
