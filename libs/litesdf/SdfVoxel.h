@@ -145,8 +145,8 @@ inline SdfHit Missed() {
 // ray crosses from one to the other. A ray that enters the voxel inside the surface (value <= 0: it
 // starts inside, or came from cells wholly inside, which a sparse set does not store) hits where it
 // enters: a ray that starts inside hits before it could leave the shape.
-inline SdfHit IntersectVoxelSpan(const VoxelValues& values, float3 voxelMin, float size, float3 origin, float3 dir, float tNear, float tFar,
-                                 int newtonIterations) {
+[[gnu::always_inline]] inline SdfHit IntersectVoxelSpan(const VoxelValues& values, float3 voxelMin, float size, float3 origin, float3 dir,
+                                                        float tNear, float tFar, int newtonIterations) {
   SdfHit hit = Missed();
   if (!(tNear <= tFar)) return hit;
   const float invSize = 1.0f / size;
