@@ -905,7 +905,11 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
   if (isa<LambdaExpr>(e)) return Fail(e->getBeginLoc(), "lambda in a kernel", "use a helper member function");
   if (isa<CXXThisExpr>(e) && m_structSelf) return "self";
   if (isa<CXXThisExpr>(e)) return Fail(e->getBeginLoc(), "'this' used as a value in a kernel", "access members directly");
-  return Fail(e->getBeginLoc(), std::string("expression '") + e->getStmtClassName() + "' is not supported in kernels", "");
+  if (isa<CXXNullPtrLiteralExpr, GNUNullExpr>(e))
+    return Fail(e->getBeginLoc(), "nullptr in a kernel", "GPU code has no pointers that may be null: test an index or a count instead "
+                                                         "(an element of a vector of objects is never null there: CommitDeviceData refuses one)");
+  return Fail(e->getBeginLoc(), std::string("expression '") + e->getStmtClassName() + "' is not supported in kernels",
+              "rewrite it with the constructs of the paper's kernels: arithmetic, locals, loops, calls of helpers and members");
 }
 
 // LiteMath's vector and matrix operators that ISPC's struct operators cannot be: compound assignment

@@ -64,6 +64,11 @@ const Case kCases[] = {
      "  std::vector<Shape*> m_shapes;",
      "", "'s' points at an element of m_shapes, which kernels hold as its index: it can only call virtual methods here",
      "call them as s->Method(...)", 9},
+    {"a null test of a local pointer to an object",
+     "    const Shape* s = m_shapes[i % 2];\n    if (s != nullptr) x += s->Area();",
+     "  struct Shape { virtual ~Shape() = default; virtual float Area() const { return 1.0f; } };\n"
+     "  std::vector<Shape*> m_shapes;",
+     "", "nullptr in a kernel", "test an index or a count instead", 9},
     {"delete", "    delete[] data;", "", "", "'delete' in a kernel (heap allocation)", "cannot allocate", 8},
     {"malloc", "    x += float(std::malloc(4) != nullptr);", "", "", "heap allocation ('malloc') in a kernel", "cannot allocate", 8},
     {"printf", "    std::printf(\"%f\\n\", x);", "", "", "I/O ('printf') in a kernel", "write results to an output buffer", 8},
