@@ -87,7 +87,7 @@ void Score(const Image& image, const Image& ref, const Camera& cam, const SdfMes
     if (!h) continue;
     float3 origin, dir;
     cam.Ray(int(i % cam.size), int(i / cam.size), origin, dir);
-    const double e = std::fabs(mesh.Distance(origin + image.t[i] * dir));
+    const double e = mesh.UnsignedDistance(origin + image.t[i] * dir);
     sumError += e;
     maxError = std::max(maxError, e);
     ++hits;
@@ -230,8 +230,10 @@ int main(int argc, char** argv) {
       return h;
     }, refRate);
     std::printf("\n%s: %zu triangles, %dx%d rays; errors in units of the mesh's extent / 1.8 (the box is 2 wide). Mrays/s: 1 thread,\n"
-                "the field in a BVHScene through SdfRender_CPU (all %d cores; OpenVDB: one intersector per thread) and SdfRender_Vulkan\n\n",
-                name.c_str(), mesh.TriangleCount(), size, size, omp_get_max_threads());
+                "the field in a BVHScene through SdfRender_CPU (all %d cores; OpenVDB: one intersector per thread) and SdfRender_Vulkan.\n"
+                "Sign: %s (%zu edges not shared by exactly two triangles)\n\n",
+                name.c_str(), mesh.TriangleCount(), size, size, omp_get_max_threads(),
+                mesh.Sign() == SdfSign::WindingNumber ? "the fast winding number" : "angle-weighted pseudo-normals", mesh.OpenOrNonManifoldEdges());
     std::printf("| %-10s | %-26s | %9s | %9s | %9s | %8s | %8s | %8s | %9s | %9s | %7s | %6s | %6s |\n", "kind", "knobs", "build ms", "data MiB",
                 "+BVH MiB", "1 thread", "_CPU", "_Vulkan", "mean err", "max err", "hits", "dPSNR", "nPSNR");
     std::printf("|%s|\n", std::string(172, '-').c_str());

@@ -15,6 +15,9 @@ class ISdf {
 public:
   virtual ~ISdf() = default;
   virtual float Distance(float3 p) const = 0;
+  // |Distance(p)|, or a lower bound of it: all the builders' subdivision needs. A field whose sign
+  // costs more than its magnitude (SdfMesh's winding number) overrides it.
+  virtual float UnsignedDistance(float3 p) const { return std::fabs(Distance(p)); }
 };
 
 class SdfSphere : public ISdf {

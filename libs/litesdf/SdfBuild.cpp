@@ -45,7 +45,7 @@ void VisitCrossableCells(const ISdf& sdf, float3 boxMin, float boxSize, uint32_t
     const float size = boxSize / float(1u << l);
     const float3 center = boxMin + size * (float3(float(x), float(y), float(z)) + float3(0.5f, 0.5f, 0.5f));
     ++stats.cellsVisited;
-    if (!(std::fabs(sdf.Distance(center)) <= 0.5f * std::sqrt(3.0f) * size)) return;  // NaN: skipped too
+    if (!(sdf.UnsignedDistance(center) <= 0.5f * std::sqrt(3.0f) * size)) return;  // NaN: skipped too
     if (l == level) {
       visit(x, y, z);
       return;

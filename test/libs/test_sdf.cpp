@@ -369,28 +369,71 @@ Mesh CubeMesh(float h) {
   return m;
 }
 
+// Counts the samples of a 17^3 grid over [-1, 1]^3 where the sign of sdf.Distance disagrees with
+// the exact winding number, leaving out those where the winding number is within 1/4 of 1/2 (on
+// the surface, or in a hole's mouth: no side to agree on).
+struct SignAgreement {
+  int samples = 0, disagreements = 0;
+};
+SignAgreement AgreeWithWindingNumber(const SdfMesh& sdf) {
+  SignAgreement a;
+  for (int z = 0; z < 17; ++z)
+    for (int y = 0; y < 17; ++y)
+      for (int x = 0; x < 17; ++x) {
+        // Grid samples, offset so that some fall on the meshes' planes and edges.
+        const float3 p = float3(-1.0f, -1.0f, -1.0f) + 0.125f * float3(float(x), float(y), float(z));
+        const float winding = sdf.WindingNumber(p);
+        if (std::fabs(winding - 0.5f) < 0.25f) continue;
+        ++a.samples;
+        a.disagreements += (sdf.Distance(p) < 0.0f) != (winding > 0.5f);
+      }
+  return a;
+}
+
+// An icosphere with the cap above `capAngle` radians from +z cut away: a scan's hole.
+Mesh HoledSphere(float radius, float capAngle) {
+  Mesh m = Icosphere(radius, 3);
+  std::vector<uint32_t> kept;
+  for (size_t t = 0; t < m.indices.size(); t += 3) {
+    const float3 centroid = (m.vertices[m.indices[t]] + m.vertices[m.indices[t + 1]] + m.vertices[m.indices[t + 2]]) / 3.0f;
+    if (centroid.z < radius * std::cos(capAngle)) kept.insert(kept.end(), {m.indices[t], m.indices[t + 1], m.indices[t + 2]});
+  }
+  m.indices = kept;
+  return m;
+}
+
+// Two cubes of half-size h that share one edge (its two vertices and the edge itself): the edge
+// has four triangles, and its pseudo-normal, their sum, is zero.
+Mesh CubesSharingAnEdge(float h) {
+  Mesh m = CubeMesh(h);
+  const Mesh second = CubeMesh(h);
+  // The second cube sits at (2h, 2h, 0): its corners with x = y = -h are the first's with x = y = h.
+  std::vector<uint32_t> index(8);
+  for (uint32_t c = 0; c < 8; ++c) {
+    const float3 v = second.vertices[c] + float3(2.0f * h, 2.0f * h, 0.0f);
+    index[c] = uint32_t(m.vertices.size());
+    for (uint32_t k = 0; k < 8; ++k)
+      if (LiteMath::length(m.vertices[k] - v) == 0.0f) index[c] = k;
+    if (index[c] == m.vertices.size()) m.vertices.push_back(v);
+  }
+  for (uint32_t i : second.indices) m.indices.push_back(index[i]);
+  return m;
+}
+
 }  // namespace
 
 TEST_CASE("SDF from a mesh: exact distances, and the sign agrees with the winding number everywhere", "[sdf][mesh]")
 {
-  for (const Mesh& mesh : {Icosphere(0.7f, 3), TorusMesh(0.6f, 0.25f, 48, 24), CubeMesh(0.5f)}) {
-    const SdfMesh sdf(mesh.vertices, mesh.indices);
-    int samples = 0, disagreements = 0;
-    for (int z = 0; z < 17; ++z)
-      for (int y = 0; y < 17; ++y)
-        for (int x = 0; x < 17; ++x) {
-          // Grid samples, offset so that some fall on the meshes' planes and edges.
-          const float3 p = float3(-1.0f, -1.0f, -1.0f) + 0.125f * float3(float(x), float(y), float(z));
-          const float winding = sdf.WindingNumber(p);
-          if (std::fabs(winding - 0.5f) < 0.25f) continue;  // on the surface: no side to agree on
-          ++samples;
-          const float d = sdf.Distance(p);
-          disagreements += (d < 0.0f) != (winding > 0.5f);
-        }
-    INFO(sdf.TriangleCount() << " triangles: " << disagreements << " of " << samples << " samples disagree");
-    CHECK(samples > 4000);
-    CHECK(disagreements == 0);
-  }
+  for (const Mesh& mesh : {Icosphere(0.7f, 3), TorusMesh(0.6f, 0.25f, 48, 24), CubeMesh(0.5f)})
+    for (SdfSign sign : {SdfSign::Auto, SdfSign::WindingNumber}) {
+      const SdfMesh sdf(mesh.vertices, mesh.indices, sign);
+      CHECK(sdf.OpenOrNonManifoldEdges() == 0);
+      CHECK(sdf.Sign() == (sign == SdfSign::Auto ? SdfSign::PseudoNormal : SdfSign::WindingNumber));
+      const SignAgreement a = AgreeWithWindingNumber(sdf);
+      INFO(sdf.TriangleCount() << " triangles, sign " << int(sdf.Sign()) << ": " << a.disagreements << " of " << a.samples << " samples disagree");
+      CHECK(a.samples > 4000);
+      CHECK(a.disagreements == 0);
+    }
   // Exact distances: the cube against the analytic box, at its edges and corners from both sides.
   const SdfMesh cube(CubeMesh(0.5f).vertices, CubeMesh(0.5f).indices);
   const SdfBox box(float3(0.0f, 0.0f, 0.0f), float3(0.5f, 0.5f, 0.5f));
@@ -408,6 +451,47 @@ TEST_CASE("SDF from a mesh: exact distances, and the sign agrees with the windin
     }
   CHECK_THROWS_WITH(SdfMesh({float3(0, 0, 0)}, {0, 0}), "a mesh needs triangles: three indices each");
   CHECK_THROWS_WITH(SdfMesh({float3(0, 0, 0)}, {0, 0, 1}), "a triangle index is out of the vertices' range");
+}
+
+TEST_CASE("SDF from a mesh with a hole or a non-manifold edge: the fast winding number gives the sign", "[sdf][mesh]")
+{
+  for (const Mesh& mesh : {HoledSphere(0.7f, 0.8f), CubesSharingAnEdge(0.4f)}) {
+    const SdfMesh sdf(mesh.vertices, mesh.indices);  // Auto
+    INFO(sdf.TriangleCount() << " triangles, " << sdf.OpenOrNonManifoldEdges() << " edges without exactly two faces");
+    CHECK(sdf.OpenOrNonManifoldEdges() > 0);
+    REQUIRE(sdf.Sign() == SdfSign::WindingNumber);
+    const SignAgreement a = AgreeWithWindingNumber(sdf);
+    INFO(a.disagreements << " of " << a.samples << " samples disagree");
+    CHECK(a.samples > 4000);
+    CHECK(a.disagreements == 0);
+    // The distance itself does not depend on the sign's source.
+    const SdfMesh pseudo(mesh.vertices, mesh.indices, SdfSign::PseudoNormal);
+    for (float3 p : {float3(0.1f, 0.2f, 0.9f), float3(-0.3f, 0.0f, 0.1f), float3(0.4f, 0.4f, 0.0f)})
+      CHECK(std::fabs(sdf.Distance(p)) == std::fabs(pseudo.Distance(p)));
+  }
+  // Pseudo-normals read the holed sphere's mouth wrongly: above a wide hole, outside, the nearest
+  // point is on the hole's rim, whose face leans outwards, so the point seems behind it.
+  const Mesh holed = HoledSphere(0.7f, 0.8f);
+  const SdfMesh pseudo(holed.vertices, holed.indices, SdfSign::PseudoNormal);
+  CHECK(AgreeWithWindingNumber(pseudo).disagreements > 0);
+}
+
+TEST_CASE("SDF from a mesh: the fast winding number stays near the exact one", "[sdf][mesh]")
+{
+  const Mesh torus = TorusMesh(0.6f, 0.25f, 48, 24);
+  const SdfMesh sdf(torus.vertices, torus.indices, SdfSign::WindingNumber);
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<float> u(-1.2f, 1.2f);
+  float worst = 0.0f;
+  for (int i = 0; i < 3000; ++i) {
+    const float3 p(u(rng), u(rng), u(rng));
+    worst = std::max(worst, std::fabs(sdf.FastWindingNumber(p) - sdf.WindingNumber(p)));
+  }
+  INFO("largest difference " << worst);
+  CHECK(worst < 0.05f);  // the sign is read against 1/2
+  CHECK(worst > 0.0f);   // it did take the dipoles: the clusters are in use
+  // Far away the whole mesh is one dipole, whose moment a closed mesh cancels: 0 exactly.
+  CHECK(std::fabs(sdf.FastWindingNumber(float3(50.0f, 3.0f, -7.0f))) < 1e-6f);
 }
 
 TEST_CASE("SDF from a mesh: a sparse voxel set of a tessellated sphere traces like the sphere", "[sdf][mesh]")
