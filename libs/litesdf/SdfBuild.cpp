@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cstring>
 #include <cmath>
+#include <exception>
 #include <functional>
 #include <stdexcept>
 #include <string>
@@ -36,23 +37,46 @@ void Check(const std::string& problem) {
 uint32_t PackCoords(uint32_t x, uint32_t y, uint32_t z) { return x | (y << 10) | (z << 20); }
 float3 UnpackCoords(uint32_t c) { return float3(float(c & 1023u), float((c >> 10) & 1023u), float((c >> 20) & 1023u)); }
 
-// Calls visit(x, y, z) for every cell of level `level` (2^level per axis) that the surface may cross,
-// descending from the whole box: a cell is skipped when the distance at its centre exceeds half its
-// diagonal (then no point of it is on the surface, the distance being 1-Lipschitz, or a lower bound).
-void VisitCrossableCells(const ISdf& sdf, float3 boxMin, float boxSize, uint32_t level, SdfBuildStats& stats,
-                         const std::function<void(uint32_t, uint32_t, uint32_t)>& visit) {
-  std::function<void(uint32_t, uint32_t, uint32_t, uint32_t)> descend = [&](uint32_t l, uint32_t x, uint32_t y, uint32_t z) {
-    const float size = boxSize / float(1u << l);
-    const float3 center = boxMin + size * (float3(float(x), float(y), float(z)) + float3(0.5f, 0.5f, 0.5f));
-    ++stats.cellsVisited;
-    if (!(sdf.UnsignedDistance(center) <= 0.5f * std::sqrt(3.0f) * size)) return;  // NaN: skipped too
-    if (l == level) {
-      visit(x, y, z);
-      return;
+// Runs body(i) for i in [0, count) on all cores. An exception thrown by one (an ISdf's) is
+// rethrown here, after the loop: one may not leave an OpenMP region.
+void ParallelFor(size_t count, const std::function<void(size_t)>& body) {
+  std::exception_ptr failure;
+#pragma omp parallel for schedule(dynamic, 64)
+  for (size_t i = 0; i < count; ++i) {
+    try {
+      body(i);
+    } catch (...) {
+#pragma omp critical(litesdf_build_failure)
+      if (!failure) failure = std::current_exception();
     }
-    for (uint32_t c = 0; c < 8; ++c) descend(l + 1, 2 * x + (c & 1), 2 * y + ((c >> 1) & 1), 2 * z + (c >> 2));
-  };
-  descend(0, 0, 0, 0);
+  }
+  if (failure) std::rethrow_exception(failure);
+}
+
+// The cells of level `level` (2^level per axis) that the surface may cross, packed, in Morton
+// order: the octree is descended a level at a time, and a cell is dropped when the distance at its
+// centre exceeds half its diagonal (then no point of it is on the surface, the distance being
+// 1-Lipschitz, or a lower bound). Each level's cells are tested on all cores.
+std::vector<uint32_t> CrossableCells(const ISdf& sdf, float3 boxMin, float boxSize, uint32_t level, SdfBuildStats& stats) {
+  std::vector<uint32_t> cells = {PackCoords(0, 0, 0)};
+  for (uint32_t l = 0;; ++l) {
+    const float size = boxSize / float(1u << l);
+    std::vector<char> crossable(cells.size());
+    ParallelFor(cells.size(), [&](size_t i) {
+      const float3 center = boxMin + size * (UnpackCoords(cells[i]) + float3(0.5f, 0.5f, 0.5f));
+      crossable[i] = sdf.UnsignedDistance(center) <= 0.5f * std::sqrt(3.0f) * size;  // NaN: dropped too
+    });
+    stats.cellsVisited += cells.size();
+    std::vector<uint32_t> kept;
+    for (size_t i = 0; i < cells.size(); ++i)
+      if (crossable[i]) kept.push_back(cells[i]);
+    if (l == level) return kept;
+    cells.clear();
+    for (uint32_t cell : kept) {
+      const uint32_t x = cell & 1023u, y = (cell >> 10) & 1023u, z = (cell >> 20) & 1023u;
+      for (uint32_t c = 0; c < 8; ++c) cells.push_back(PackCoords(2 * x + (c & 1), 2 * y + ((c >> 1) & 1), 2 * z + (c >> 2)));
+    }
+  }
 }
 
 double MsSince(std::chrono::steady_clock::time_point t0) {
@@ -167,10 +191,11 @@ SdfGrid BuildGrid(const ISdf& sdf, float3 boxMin, float boxSize, uint32_t sample
   grid.boxSize = boxSize;
   grid.values.resize(size_t(samples) * samples * samples);
   const float cell = grid.CellSize();
-  for (uint32_t z = 0; z < samples; ++z)
-    for (uint32_t y = 0; y < samples; ++y)
-      for (uint32_t x = 0; x < samples; ++x)
-        grid.values[(size_t(z) * samples + y) * samples + x] = sdf.Distance(boxMin + cell * float3(float(x), float(y), float(z)));
+  ParallelFor(size_t(samples) * samples, [&](size_t zy) {
+    const uint32_t z = uint32_t(zy / samples), y = uint32_t(zy % samples);
+    for (uint32_t x = 0; x < samples; ++x)
+      grid.values[zy * samples + x] = sdf.Distance(boxMin + cell * float3(float(x), float(y), float(z)));
+  });
   return grid;
 }
 
@@ -186,21 +211,24 @@ SdfSVS BuildSVS(const ISdf& sdf, float3 boxMin, float boxSize, uint32_t depth, u
   svs.depth = depth;
   svs.bytesPerValue = bytesPerValue;
   const float size = svs.VoxelSize(), diagonal = std::sqrt(3.0f) * size;
-  VisitCrossableCells(sdf, boxMin, boxSize, depth, s, [&](uint32_t x, uint32_t y, uint32_t z) {
-    ++s.voxelsCrossable;
-    float corner[8], lo = 0.0f, hi = 0.0f;
-    for (uint32_t c = 0; c < 8; ++c) {
-      corner[c] = sdf.Distance(boxMin + size * float3(float(x + (c & 1)), float(y + ((c >> 1) & 1)), float(z + (c >> 2))));
-      lo = c ? std::min(lo, corner[c]) : corner[c];
-      hi = c ? std::max(hi, corner[c]) : corner[c];
-    }
-    if (!(lo <= 0.0f && hi >= 0.0f)) return;  // the interpolant keeps its sign: no surface here
+  const std::vector<uint32_t> cells = CrossableCells(sdf, boxMin, boxSize, depth, s);
+  std::vector<float> corners(8 * cells.size());
+  ParallelFor(cells.size(), [&](size_t i) {
+    const float3 at = UnpackCoords(cells[i]);
+    for (uint32_t c = 0; c < 8; ++c)
+      corners[8 * i + c] = sdf.Distance(boxMin + size * (at + float3(float(c & 1), float((c >> 1) & 1), float(c >> 2))));
+  });
+  s.voxelsCrossable += cells.size();
+  for (size_t i = 0; i < cells.size(); ++i) {
+    const float* corner = &corners[8 * i];
+    const float lo = *std::min_element(corner, corner + 8), hi = *std::max_element(corner, corner + 8);
+    if (!(lo <= 0.0f && hi >= 0.0f)) continue;  // the interpolant keeps its sign: no surface here
     ++s.voxelsKept;
-    svs.coords.push_back(PackCoords(x, y, z));
+    svs.coords.push_back(cells[i]);
     const size_t first = svs.values.size() * (4 / bytesPerValue);
     svs.values.resize(svs.values.size() + 8 * bytesPerValue / 4, 0u);
     for (uint32_t c = 0; c < 8; ++c) PackValue(svs.values, first + c, QuantiseDistance(corner[c], diagonal, bytesPerValue), bytesPerValue);
-  });
+  }
   s.milliseconds = MsSince(t0);
   return svs;
 }
@@ -241,13 +269,18 @@ SdfSBS BuildSBS(const ISdf& sdf, float3 boxMin, float boxSize, uint32_t depth, u
   sbs.bytesPerValue = bytesPerValue;
   const float size = sbs.VoxelSize(), diagonal = std::sqrt(3.0f) * size;
   const uint32_t n = brickSize + 1;
-  std::vector<float> brick(size_t(n) * n * n);
-  VisitCrossableCells(sdf, boxMin, boxSize, depth - brickLevels, s, [&](uint32_t bx, uint32_t by, uint32_t bz) {
-    const uint32_t x0 = bx * brickSize, y0 = by * brickSize, z0 = bz * brickSize;
+  const size_t valuesPerBrick = size_t(n) * n * n;
+  const std::vector<uint32_t> cells = CrossableCells(sdf, boxMin, boxSize, depth - brickLevels, s);
+  std::vector<float> values(valuesPerBrick * cells.size());
+  ParallelFor(cells.size(), [&](size_t i) {
+    const float3 at = float(brickSize) * UnpackCoords(cells[i]);
+    float* brick = &values[valuesPerBrick * i];
     for (uint32_t z = 0; z < n; ++z)
       for (uint32_t y = 0; y < n; ++y)
-        for (uint32_t x = 0; x < n; ++x)
-          brick[(z * n + y) * n + x] = sdf.Distance(boxMin + size * float3(float(x0 + x), float(y0 + y), float(z0 + z)));
+        for (uint32_t x = 0; x < n; ++x) brick[(z * n + y) * n + x] = sdf.Distance(boxMin + size * (at + float3(float(x), float(y), float(z))));
+  });
+  for (size_t i = 0; i < cells.size(); ++i) {
+    const float* brick = &values[valuesPerBrick * i];
     bool keep = false;
     for (uint32_t z = 0; z < brickSize; ++z)
       for (uint32_t y = 0; y < brickSize; ++y)
@@ -264,13 +297,15 @@ SdfSBS BuildSBS(const ISdf& sdf, float3 boxMin, float boxSize, uint32_t depth, u
             keep = true;
           }
         }
-    if (!keep) return;
-    sbs.coords.push_back(PackCoords(x0, y0, z0));
+    if (!keep) continue;
+    const float3 at = float(brickSize) * UnpackCoords(cells[i]);
+    sbs.coords.push_back(PackCoords(uint32_t(at.x), uint32_t(at.y), uint32_t(at.z)));
     const size_t firstWord = sbs.values.size();
     sbs.values.resize(firstWord + sbs.WordsPerBrick(), 0u);
     const size_t first = firstWord * (4 / bytesPerValue);
-    for (uint32_t i = 0; i < n * n * n; ++i) PackValue(sbs.values, first + i, QuantiseDistance(brick[i], diagonal, bytesPerValue), bytesPerValue);
-  });
+    for (uint32_t v = 0; v < valuesPerBrick; ++v)
+      PackValue(sbs.values, first + v, QuantiseDistance(brick[v], diagonal, bytesPerValue), bytesPerValue);
+  }
   s.milliseconds = MsSince(t0);
   return sbs;
 }

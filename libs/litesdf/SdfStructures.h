@@ -87,7 +87,9 @@ std::string Problem(const SdfGrid& grid);
 std::string Problem(const SdfSVS& svs);
 std::string Problem(const SdfSBS& sbs);
 
-// Builders from an analytic SDF over the cube [boxMin, boxMin + boxSize]^3.
+// Builders from an analytic SDF over the cube [boxMin, boxMin + boxSize]^3. They evaluate it on
+// all cores (OpenMP): `sdf.Distance` is called from several threads at once. The result does not
+// depend on the number of threads.
 SdfGrid BuildGrid(const ISdf& sdf, float3 boxMin, float boxSize, uint32_t samples);
 // Top-down: an octree cell is split only when the surface may cross it (|distance at its centre| <=
 // half its diagonal); a finest voxel is kept only when its trilinear interpolant changes sign (the

@@ -6,9 +6,11 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
+#include <stdexcept>
 
 using namespace litesdf;
 using LiteMath::float3;
@@ -138,6 +140,46 @@ TEST_CASE("SDF: the builders keep only voxels whose interpolant changes sign, an
   CHECK(crossing == svs.VoxelCount());
   CHECK_THROWS_WITH(BuildSVS(sphere, float3(-1.0f, -1.0f, -1.0f), 2.0f, 5, 3), "bytes per value must be 1, 2 or 4, not 3");
   CHECK_THROWS_WITH(BuildSBS(sphere, float3(-1.0f, -1.0f, -1.0f), 2.0f, 5, 3, 1), "brick size must be a power of 2 no larger than 2^depth, not 3");
+}
+
+namespace {
+// A sphere whose distance throws past a plane: an ISdf that fails partway through a build.
+class FailingSphere : public SdfSphere {
+public:
+  FailingSphere() : SdfSphere(float3(0.0f, 0.0f, 0.0f), 0.7f) {}
+  float Distance(float3 p) const override {
+    if (p.x > 0.5f) throw std::runtime_error("no distance past x = 0.5");
+    return SdfSphere::Distance(p);
+  }
+};
+}  // namespace
+
+TEST_CASE("SDF: the builders run on all cores, with one result, and pass on an ISdf's exception", "[sdf]")
+{
+  // Built twice: the values are computed in parallel and packed in order, so the two are equal bit
+  // for bit, in the octree's (Morton) order.
+  const SdfTorus torus(float3(0.05f, -0.02f, 0.01f), 0.6f, 0.2f);
+  const SdfSBS a = BuildSBS(torus, float3(-1.0f, -1.0f, -1.0f), 2.0f, 6, 4, 2), b = BuildSBS(torus, float3(-1.0f, -1.0f, -1.0f), 2.0f, 6, 4, 2);
+  REQUIRE(a.BrickCount() > 100);
+  CHECK(a.coords == b.coords);
+  CHECK(a.values == b.values);
+  const SdfSVS c = BuildSVS(torus, float3(-1.0f, -1.0f, -1.0f), 2.0f, 6, 1), d = BuildSVS(torus, float3(-1.0f, -1.0f, -1.0f), 2.0f, 6, 1);
+  CHECK(c.coords == d.coords);
+  CHECK(c.values == d.values);
+  CHECK(std::is_sorted(c.coords.begin(), c.coords.end(), [](uint32_t l, uint32_t r) {
+    auto morton = [](uint32_t v) {  // interleaves x, y, z (10 bits each) as the octree visits them
+      uint64_t m = 0;
+      for (uint32_t bit = 0; bit < 10; ++bit)
+        for (uint32_t axis = 0; axis < 3; ++axis) m |= uint64_t((v >> (10 * axis + bit)) & 1u) << (3 * bit + axis);
+      return m;
+    };
+    return morton(l) < morton(r);
+  }));
+  // An exception from a worker thread reaches the caller (an escaped one would end the program).
+  const FailingSphere failing;
+  CHECK_THROWS_WITH(BuildSVS(failing, float3(-1.0f, -1.0f, -1.0f), 2.0f, 5, 1), "no distance past x = 0.5");
+  CHECK_THROWS_WITH(BuildSBS(failing, float3(-1.0f, -1.0f, -1.0f), 2.0f, 5, 4, 1), "no distance past x = 0.5");
+  CHECK_THROWS_WITH(BuildGrid(failing, float3(-1.0f, -1.0f, -1.0f), 2.0f, 17), "no distance past x = 0.5");
 }
 
 TEST_CASE("SDF: a memory budget picks the deepest sparse voxel set that fits", "[sdf]")
