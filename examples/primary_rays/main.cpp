@@ -1,5 +1,6 @@
 // Primary rays with ambient occlusion through ISceneObject: the class as written on Embree and on
-// CrossRT's BVH, PrimaryRays_CPU (all cores) and PrimaryRays_Vulkan (the BVH traversal composed
+// CrossRT's BVH, PrimaryRays_CPU (all cores), PrimaryRays_ISPC (all cores, a ray per SIMD lane;
+// where ISPC was found at configure time) and PrimaryRays_Vulkan (the BVH traversal composed
 // into the shader, and on devices with ray queries also the ray tracing hardware). Prints a table
 // of times and of pixels that differ from the original on the same BVH, and writes the last image.
 //   primary_rays [mesh file] [output image] [--size N] [--ao SAMPLES] [--bvh lbvh|sah]
@@ -9,6 +10,9 @@
 #include "PrimaryRays.h"
 #include "PrimaryRays_CPU.h"
 #include "PrimaryRays_Vulkan.h"
+#ifdef CROSSRT_HAS_ISPC
+#include "PrimaryRays_ISPC.h"
+#endif
 
 #include <chrono>
 #include <cmath>
@@ -74,7 +78,7 @@ int main(int argc, char** argv)
 {
   if (argc > 1 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h"))
   {
-    std::printf("usage: primary_rays [MESH | \"\"] [OUTPUT.png] [--size N] [--ao SAMPLES] [--bvh lbvh|sah]\n  Renders MESH (OFF, PLY or OBJ, also gzipped; \"\" or none: a built-in scene) with primary rays and\n  ambient occlusion through ISceneObject: Embree, the original class, PrimaryRays_CPU and PrimaryRays_Vulkan.\n");
+    std::printf("usage: primary_rays [MESH | \"\"] [OUTPUT.png] [--size N] [--ao SAMPLES] [--bvh lbvh|sah]\n  Renders MESH (OFF, PLY or OBJ, also gzipped; \"\" or none: a built-in scene) with primary rays and\n  ambient occlusion through ISceneObject: Embree, the original class, PrimaryRays_CPU, PrimaryRays_ISPC\n  (where ISPC was found when CrossRT was configured) and PrimaryRays_Vulkan.\n");
     return 0;
   }
   std::string meshPath, outPath = "primary_rays.png", bvh = "lbvh";
@@ -141,6 +145,12 @@ int main(int argc, char** argv)
     runs.back().renderer->SetScene(makeScene("embree"), mesh.positions, mesh.indices);
     runs.push_back({"PrimaryRays_CPU, " + bvh, CreatePrimaryRays_CPU(size, size), {}});
     runs.back().renderer->SetScene(bvhScene, mesh.positions, mesh.indices);
+#ifdef CROSSRT_HAS_ISPC
+    runs.push_back({"PrimaryRays_ISPC, " + bvh, CreatePrimaryRays_ISPC(size, size), {}});
+    runs.back().renderer->SetScene(bvhScene, mesh.positions, mesh.indices);
+#else
+    std::printf("CrossRT was configured without ISPC: no PrimaryRays_ISPC\n");
+#endif
     try
     {
       // The translated traversal, and where the device has ray queries its ray tracing hardware.
