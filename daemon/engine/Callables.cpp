@@ -161,9 +161,11 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
       vm.hostExpr = owner.hostPrefix + field->getNameAsString();
       vm.display = owner.holder.empty() ? member : owner.holder + "->" + field->getNameAsString();
       vm.interfaceName = interface->getNameAsString();
+      vm.interfaceCpp = interface->getQualifiedNameAsString();
       for (auto* impl : impls) {
         VirtualImpl vi;
         vi.name = impl->getNameAsString();
+        vi.cppName = impl->getQualifiedNameAsString();
         vi.header = FileOf(ctx, impl->getLocation());
         std::vector<const FieldDecl*> fields;
         CollectObjectFields(impl, fields);
@@ -176,15 +178,17 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
             ok = false;
             continue;
           }
-          if (f->getAccess() != AS_public) {
-            rep.GpuError(f->getLocation(), "member '" + f->getNameAsString() + "' of " + vi.name + " is copied to the GPU (kernels call " + vm.interfaceName +
-                        " through '" + member + "'), but the generated class cannot read it", "declare it public");
-            ok = false;
-            continue;
-          }
           QualType base = f->getType();
           while (auto* arr = dyn_cast<ConstantArrayType>(base.getCanonicalType().getTypePtr())) base = arr->getElementType();
-          vi.fields.push_back({f->getNameAsString(), CppTypeName(ctx, base.getCanonicalType()), *g, 4, "", ""});
+          std::string read = "from." + f->getNameAsString();
+          if (f->getAccess() != AS_public) {  // private or protected: read through a member pointer
+            const CXXRecordDecl* owner = cast<CXXRecordDecl>(f->getParent());
+            HiddenField h{owner->getNameAsString() + "_" + f->getNameAsString(), owner->getQualifiedNameAsString(), f->getNameAsString(),
+                          CppTypeName(ctx, f->getType().getCanonicalType())};
+            read = "(from.*PointerTo(" + h.tag + "{}))";
+            vi.hidden.push_back(h);
+          }
+          vi.fields.push_back({f->getNameAsString(), CppTypeName(ctx, base.getCanonicalType()), *g, 4, read, ""});
         }
         if (!ok) continue;
         auto cpp = MirrorOffsets(ctx, fields, 0), std430 = MirrorOffsets(ctx, fields, 1), scalar = MirrorOffsets(ctx, fields, 2);

@@ -316,14 +316,15 @@ Data Common(const ClassModel& model, const GenerateOptions& opt) {
   d.set("rayQueryScenes", rayQueryScenes);
   d.set("hasRayQuery", !rayQueryScenes.is_empty_list());
   // Virtual functions: the implementations' data mirrors and the regrouping of the objects.
-  Data virtuals = List(), implIncludes = List();
-  std::set<std::string> headers, mirrored;
+  Data virtuals = List(), implIncludes = List(), hiddenMembers = List();
+  std::set<std::string> headers, mirrored, hiddenTags;
   for (auto& v : model.virtuals) {
     Data x;
     x.set("member", v.member);
     x.set("host", v.hostExpr);
     x.set("display", v.display);
     x.set("interface", v.interfaceName);
+    x.set("interfaceType", v.interfaceCpp);
     std::string names;
     Data impls = List();
     for (size_t t = 0; t < v.impls.size(); ++t) {
@@ -331,6 +332,7 @@ Data Common(const ClassModel& model, const GenerateOptions& opt) {
       names += (t ? ", " : "") + vi.name;
       Data y;
       y.set("impl", vi.name);
+      y.set("implType", vi.cppName);
       y.set("member", v.member);
       y.set("typeIndex", std::to_string(t));
       y.set("first", t == 0);
@@ -341,7 +343,17 @@ Data Common(const ClassModel& model, const GenerateOptions& opt) {
         z.set("name", f.name);
         z.set("cppType", f.cppType);
         z.set("arraySuffix", SplitArray(f.glslType).second);
+        z.set("read", f.hostExpr);
         fields.push_back(z);
+      }
+      for (auto& h : vi.hidden) {
+        if (!hiddenTags.insert(h.tag).second) continue;  // a base's member, read for another class already
+        Data z;
+        z.set("tag", h.tag);
+        z.set("owner", h.owner);
+        z.set("name", h.name);
+        z.set("fieldType", h.fieldType);
+        hiddenMembers.push_back(z);
       }
       y.set("fields", fields);
       y.set("layout", vi.scalarLayout ? "scalar" : "std430");
@@ -377,6 +389,8 @@ Data Common(const ClassModel& model, const GenerateOptions& opt) {
   d.set("classConstantCount", std::to_string(classConstants));
   d.set("classConstantBase", std::to_string(kClassConstantIdBase));
   d.set("virtualIncludes", implIncludes);
+  d.set("hiddenMembers", hiddenMembers);
+  d.set("hasHiddenMembers", !hiddenMembers.is_empty_list());
   return d;
 }
 

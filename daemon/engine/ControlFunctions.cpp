@@ -166,8 +166,10 @@ void AnalyzeControl(Context& c, const CXXMethodDecl* md, const FunctionDecl* def
 void ControlRewriter::Run() {
   CheckAppendedUses();
   RemoveOpenMpPragmas();
+  FindHostTail();
   Visit(m_def->getBody());
   CheckTemporaryUses();
+  MoveHostTail();
   m_ctrl.vulkanCmdBody = CanonicalCode(m_gpu.getRewrittenText(m_def->getBody()->getSourceRange()));
   m_ctrl.cpuBody = CanonicalCode(m_cpu.getRewrittenText(m_def->getBody()->getSourceRange()));
 }
@@ -344,6 +346,7 @@ void ControlRewriter::Note(const CXXMemberCallExpr* call) {
 }
 
 void ControlRewriter::RecordMemberWrite(const Stmt* s) {
+  if (std::find(m_tail.begin(), m_tail.end(), s) != m_tail.end()) return;  // runs on the host after the kernels
   RecordClear(s);
   if (auto* ewc = dyn_cast_or_null<ExprWithCleanups>(s)) s = ewc->getSubExpr();
   const Expr* lhs = nullptr;

@@ -1,6 +1,7 @@
 // The rewriter of one control function. Its work is split by job: ControlFunctions.cpp (arguments,
 // std::vector temporaries, member writes, the visit), ThreadLoops.cpp (loops that call kernels per
-// thread), ThreadBodies.cpp (megakernel and wavefront bodies), LibraryCalls.cpp (sort, scan, copy, fill).
+// thread), ThreadBodies.cpp (megakernel and wavefront bodies), LibraryCalls.cpp (sort, scan, copy,
+// fill), HostReads.cpp (host code that reads what kernels wrote).
 #pragma once
 #include "AnalysisContext.h"
 #include "LoopShape.h"
@@ -126,6 +127,15 @@ private:
   // the kernels recorded around it. Both go in one block, so a clear that is the body of an `if`
   // or a loop stays one statement.
   void RecordClear(const Stmt* s);
+
+  // ---- host code that reads members kernels write (HostReads.cpp) ----
+  // Finds the host tail: the statements after the last one that records GPU work, when they read a
+  // member kernels write (m_tail; empty otherwise). Reads between kernels are errors.
+  void FindHostTail();
+  // Takes the tail out of the ...Cmd body into Control::hostTail, which the generated control
+  // function runs after the results are back.
+  void MoveHostTail();
+  std::vector<const Stmt*> m_tail;
 
   // Another control function would submit its own work while this one is being recorded.
   void CheckNestedControl(const CXXMemberCallExpr* call);

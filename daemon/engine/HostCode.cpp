@@ -69,6 +69,8 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
         x.set("host", lt->hostExpr);
         x.set("display", lt->display);
         x.set("interface", lt->interfaceName);
+        auto vm = std::find_if(model.virtuals.begin(), model.virtuals.end(), [&](const VirtualMember& v) { return v.member == lt->member; });
+        x.set("interfaceType", vm != model.virtuals.end() ? vm->interfaceCpp : lt->interfaceName);
         leafScenes.push_back(x);
       }
     }

@@ -211,6 +211,9 @@ struct Control {
   bool isVirtual = true;            // else the generated one hides it, and calls through the base run the original
   std::vector<ControlParam> params;
   std::string vulkanCmdBody;        // body with kernel calls turned into ...Cmd calls
+  // The statements after its last kernel (or other GPU work), when they read members kernels write:
+  // the Vulkan class runs them after the results are back, not while recording (HostReads.cpp).
+  std::string hostTail;
   std::string cpuBody;              // body with RTV loops parallelised
   std::vector<std::string> kernelsCalled;
   std::vector<std::string> vectorsWritten;  // member vectors its library calls (scan, fill, memcpy) write
@@ -242,10 +245,23 @@ struct Composition {
 // Virtual functions (paper 3.9, level 2): a std::vector member holding pointers to an interface.
 // On the GPU each implementation's objects sit in a buffer of their own, and a (class, index) tag
 // per element picks the implementation in a switch.
+// A data member the generated host code copies but may not name: private or protected in the
+// user's class. The host reads it through a member pointer that an explicit instantiation hands
+// out (such an instantiation may name any member; see templates' PointerTo).
+struct HiddenField {
+  std::string tag;        // Lambert_m_albedo: the tag type PointerTo takes, in the generated .cpp
+  std::string owner;      // litesdf::SdfSphere: the class that declares it (the impl or a base)
+  std::string name;       // m_albedo
+  std::string fieldType;  // its C++ type-id, arrays included: float[3]
+};
+
 struct VirtualImpl {
   std::string name;                // Lambert
+  std::string cppName;             // ns::Lambert: how host C++ names it
   std::string header;              // the file that declares it (generated code includes it)
-  std::vector<BlockField> fields;  // its data, base classes' first: the mirror <name>_Data
+  std::vector<BlockField> fields;  // its data, base classes' first: the mirror <name>_Data; a hidden
+                                   // field's hostExpr reads it through its member pointer
+  std::vector<HiddenField> hidden; // the fields host code may not name
   bool scalarLayout = false;       // the mirror matches C++ only with GL_EXT_scalar_block_layout
   unsigned size = 0;               // bytes of the mirror
   unsigned paddingWords = 0;       // level 1: words after the data, so that every class's slot has one size
@@ -256,6 +272,7 @@ struct VirtualMember {
   std::string hostExpr;       // how the generated class reaches it: m_materials, crt_m_scene()->m_shapes
   std::string display;        // for messages: m_materials, m_scene->m_shapes
   std::string interfaceName;  // IMaterial
+  std::string interfaceCpp;   // ns::IMaterial: how host C++ names it
   std::vector<VirtualImpl> impls;  // every class of the translation unit that implements it
   unsigned slotBytes = 0;          // level 1: the size of every element's slot
   // Its classes' specialization constants are kClassConstantIdBase + firstClassConstant + t, t the

@@ -30,14 +30,17 @@ private:
   float m_radius;
 };
 
+// The distance from p to the box [-halfSize, halfSize] (p relative to the box's centre).
+inline float BoxDistance(float3 p, float3 halfSize) {
+  const float3 q = LiteMath::abs(p) - halfSize;
+  const float3 outside = LiteMath::max(q, float3(0.0f, 0.0f, 0.0f));
+  return LiteMath::length(outside) + std::fmin(std::fmax(q.x, std::fmax(q.y, q.z)), 0.0f);
+}
+
 class SdfBox : public ISdf {
 public:
   SdfBox(float3 center, float3 halfSize) : m_center(center), m_halfSize(halfSize) {}
-  float Distance(float3 p) const override {
-    const float3 q = LiteMath::abs(p - m_center) - m_halfSize;
-    const float3 outside = LiteMath::max(q, float3(0.0f, 0.0f, 0.0f));
-    return LiteMath::length(outside) + std::fmin(std::fmax(q.x, std::fmax(q.y, q.z)), 0.0f);
-  }
+  float Distance(float3 p) const override { return BoxDistance(p - m_center, m_halfSize); }
 
 private:
   float3 m_center, m_halfSize;
@@ -47,11 +50,11 @@ private:
 class SdfRoundedBox : public ISdf {
 public:
   SdfRoundedBox(float3 center, float3 halfSize, float radius)
-      : m_inner(center, halfSize - float3(radius, radius, radius)), m_radius(radius) {}
-  float Distance(float3 p) const override { return m_inner.Distance(p) - m_radius; }
+      : m_center(center), m_innerHalfSize(halfSize - float3(radius, radius, radius)), m_radius(radius) {}
+  float Distance(float3 p) const override { return BoxDistance(p - m_center, m_innerHalfSize) - m_radius; }
 
 private:
-  SdfBox m_inner;
+  float3 m_center, m_innerHalfSize;
   float m_radius;
 };
 

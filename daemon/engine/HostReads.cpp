@@ -1,0 +1,118 @@
+// Host code of a control function that reads members kernels write on the GPU. The Vulkan class
+// records the whole body before any of it runs, so such a read, done while recording, would see
+// the value from before the call. After the last statement that records GPU work the reads are
+// sound once moved: those statements (the host tail, `m_mean = m_sum / float(n);`) run in the
+// generated control function after the kernels' results are back. Between kernels they are an
+// error. Takes a control function's body; gives Control::hostTail and the tail the ...Cmd leaves out.
+#include "ControlFunctions.h"
+#include "ControlRewriter.h"
+
+#include "Canonical.h"
+
+using namespace clang;
+
+namespace crossrt::engine {
+
+namespace {
+
+// The reads in `s` of plain members of the class data that kernels write: every mention but the
+// left side of a plain assignment (`m_x = ...` writes it only).
+std::vector<const MemberExpr*> KernelWrittenReads(Context& c, const Stmt* s) {
+  struct Finder : RecursiveASTVisitor<Finder> {
+    Context& c;
+    std::set<const MemberExpr*> assigned;
+    std::vector<const MemberExpr*> reads;
+    explicit Finder(Context& cc) : c(cc) {}
+    void Assigned(const Expr* lhs) {
+      if (auto* me = dyn_cast<MemberExpr>(lhs->IgnoreParenImpCasts())) assigned.insert(me);
+    }
+    bool VisitBinaryOperator(BinaryOperator* bo) {  // visited before its operands
+      if (bo->getOpcode() == BO_Assign) Assigned(bo->getLHS());
+      return true;
+    }
+    bool VisitCXXOperatorCallExpr(CXXOperatorCallExpr* op) {
+      if (op->getOperator() == OO_Equal) Assigned(op->getArg(0));
+      return true;
+    }
+    bool VisitMemberExpr(MemberExpr* me) {
+      if (assigned.count(me) || !isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts())) return true;
+      auto* f = dyn_cast<FieldDecl>(me->getMemberDecl());
+      const Member* m = f ? FindMember(c.model, f->getNameAsString()) : nullptr;
+      if (m && m->kind == MemberKind::Plain && m->inClassData && m->writtenByKernels) reads.push_back(me);
+      return true;
+    }
+  } finder(c);
+  finder.TraverseStmt(const_cast<Stmt*>(s));
+  return finder.reads;
+}
+
+// Where `s` first records GPU work: a kernel call (or a per-thread function's), a library call on
+// device data, LiteMath's ReduceAddInit, or clear() of a vector kernels append to. Invalid if none.
+SourceLocation FirstGpuWork(Context& c, const Stmt* s) {
+  KernelCallFinder kernels(c.cls);
+  kernels.TraverseStmt(const_cast<Stmt*>(s));
+  SourceLocation first = kernels.calls.empty() ? SourceLocation() : kernels.calls.front()->getBeginLoc();
+  struct Others : RecursiveASTVisitor<Others> {
+    Context& c;
+    SourceLocation at;
+    explicit Others(Context& cc) : c(cc) {}
+    bool VisitCallExpr(CallExpr* call) {
+      auto* fd = call->getDirectCallee();
+      bool gpu = fd && fd->getName() == "ReduceAddInit";
+      if (auto* mc = dyn_cast<CXXMemberCallExpr>(call); mc && mc->getMethodDecl() && mc->getMethodDecl()->getName() == "clear")
+        if (auto* f = ThisField(mc->getImplicitObjectArgument())) gpu = gpu || c.appended.count(f->getNameAsString());
+      if (gpu && at.isInvalid()) at = call->getBeginLoc();
+      return true;
+    }
+  } others(c);
+  others.TraverseStmt(const_cast<Stmt*>(s));
+  auto& sm = c.ctx.getSourceManager();
+  if (first.isInvalid() || (others.at.isValid() && sm.isBeforeInTranslationUnit(others.at, first))) first = others.at;
+  return first;
+}
+
+}  // namespace
+
+void ControlRewriter::FindHostTail() {
+  auto* body = dyn_cast<CompoundStmt>(m_def->getBody());
+  if (!body) return;
+  auto& sm = m_c.ctx.getSourceManager();
+  const std::vector<const Stmt*> statements(body->body_begin(), body->body_end());
+  int first = -1, last = -1;
+  SourceLocation firstWork;
+  for (int i = 0; i < int(statements.size()); ++i)
+    if (SourceLocation at = FirstGpuWork(m_c, statements[i]); at.isValid()) {
+      if (first < 0) firstWork = at, first = i;
+      last = i;
+    }
+  if (last < 0) return;
+  // Between the first GPU work and the last: a read after the first, or anywhere in a loop that
+  // records GPU work (its next round reads what this one's kernels write).
+  for (int i = first; i <= last; ++i) {
+    const bool loop = isa<ForStmt, WhileStmt, DoStmt, CXXForRangeStmt>(statements[i]) && FirstGpuWork(m_c, statements[i]).isValid();
+    for (const MemberExpr* read : KernelWrittenReads(m_c, statements[i])) {
+      if (!loop && !sm.isBeforeInTranslationUnit(firstWork, read->getBeginLoc())) continue;
+      const std::string name = read->getMemberDecl()->getNameAsString();
+      m_c.rep.GpuError(read->getExprLoc(), "control function '" + m_ctrl.name + "' reads '" + name +
+                       "' between kernel calls, but kernels write it on the GPU: the calls are recorded before any runs, so this reads its value from before the call",
+                       "read it inside a kernel, which sees the GPU's copy, or after the last kernel call: code there runs once the results are back");
+    }
+  }
+  // The tail moves only when it needs to: when it reads what the kernels wrote.
+  bool reads = false;
+  for (size_t i = size_t(last) + 1; i < statements.size(); ++i) reads = reads || !KernelWrittenReads(m_c, statements[i]).empty();
+  if (!reads) return;
+  m_tail.assign(statements.begin() + last + 1, statements.end());
+}
+
+void ControlRewriter::MoveHostTail() {
+  if (m_tail.empty()) return;
+  auto& sm = m_c.ctx.getSourceManager();
+  SourceLocation end = Lexer::findLocationAfterToken(m_tail.back()->getEndLoc(), tok::semi, sm, m_c.ctx.getLangOpts(), false);
+  if (end.isInvalid()) end = Lexer::getLocForEndOfToken(m_tail.back()->getEndLoc(), 0, sm, m_c.ctx.getLangOpts());  // a block or loop
+  const CharSourceRange range = CharSourceRange::getCharRange(m_tail.front()->getBeginLoc(), end);
+  m_ctrl.hostTail = CanonicalCode(std::string(Lexer::getSourceText(range, sm, m_c.ctx.getLangOpts())));
+  m_gpu.RemoveText(range);
+}
+
+}  // namespace crossrt::engine
