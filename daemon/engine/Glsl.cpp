@@ -103,6 +103,11 @@ std::optional<std::string> GlslPrinter::Type(QualType t, SourceLocation loc) {
     return std::nullopt;
   }
   auto g = GlslTypeOf(t);
+  if (auto* closure = base->getAsCXXRecordDecl(); !g && closure && closure->isLambda()) {
+    Fail(loc, "a lambda used other than by calling it in a kernel (passed, copied or returned)",
+         "keep it in a local and call it: auto f = [](float x) { ... }; f(v)");
+    return std::nullopt;
+  }
   if (!g) {
     Fail(loc, "type '" + t.getAsString(m_ctx.getPrintingPolicy()) + "' has no GPU equivalent",
          "kernels may use int, uint, float, bool, LiteMath vectors and matrices, and plain structs of those");
@@ -818,7 +823,9 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
         return matrix + "[" + Expr(op->getArg(2)) + "][" + Expr(op->getArg(1)) + "]";
       }
     }
-    if (kind == OO_Call) return Fail(e->getBeginLoc(), "call of a function object in a kernel", "call a plain function instead");
+    if (kind == OO_Call)
+      if (auto* md = dyn_cast_or_null<CXXMethodDecl>(op->getCalleeDecl()); md && md->getParent()->isLambda()) return LambdaCall(op);
+    if (kind == OO_Call) return Fail(e->getBeginLoc(), "call of a function object in a kernel", "call a plain function or a lambda instead");
     if (kind == OO_LessLess || kind == OO_GreaterGreater) {
       if (IsSystemDecl(op->getDirectCallee() ? (const Decl*)op->getDirectCallee() : (const Decl*)m_class))
         return Fail(e->getBeginLoc(), "I/O (stream operator) in a kernel",
@@ -902,7 +909,8 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
     return Fail(e->getBeginLoc(), std::string(isa<CXXNewExpr>(e) ? "'new'" : "'delete'") + " in a kernel (heap allocation)",
                 "GPU threads cannot allocate: use a fixed-size local array or a std::vector member sized before the call");
   if (isa<CXXThrowExpr>(e)) return Fail(e->getBeginLoc(), "'throw' in a kernel", "GPU code has no exceptions: return an error code in an output buffer");
-  if (isa<LambdaExpr>(e)) return Fail(e->getBeginLoc(), "lambda in a kernel", "use a helper member function");
+  if (isa<LambdaExpr>(e))
+    return Fail(e->getBeginLoc(), "a lambda used other than by calling it in a kernel", "keep it in a local and call it: auto f = [](float x) { ... }; f(v)");
   if (isa<CXXThisExpr>(e) && m_structSelf) return "self";
   if (isa<CXXThisExpr>(e)) return Fail(e->getBeginLoc(), "'this' used as a value in a kernel", "access members directly");
   if (isa<CXXNullPtrLiteralExpr, GNUNullExpr>(e))
@@ -983,6 +991,36 @@ std::string GlslPrinter::ThreadBody(const clang::Stmt* body, int indent, bool lo
   return out;
 }
 
+std::string GlslPrinter::RangeFor(const CXXForRangeStmt* rf, int indent) {
+  const std::string pad(indent * 2, ' ');
+  const clang::Expr* range = rf->getRangeInit();
+  const VarDecl* var = rf->getLoopVariable();
+  auto* array = dyn_cast<ConstantArrayType>(range->getType().getCanonicalType().getTypePtr());
+  if (!array)
+    return Fail(rf->getColonLoc(), "a range-based for over '" + range->getType().getAsString(m_ctx.getPrintingPolicy()) + "' in a kernel",
+                "kernels may loop with ':' over arrays of fixed size; index other ranges: for (uint32_t k = 0; k < v.size(); ++k)"), "";
+  if (rf->getInit()) return Fail(rf->getBeginLoc(), "an init-statement in a range-based for in a kernel", "declare the variable before the loop"), "";
+  const QualType t = var->getType();
+  if (t->isReferenceType() && !t.getNonReferenceType().isConstQualified())
+    return Fail(var->getLocation(), "a range-based for with a non-const reference in a kernel",
+                "GLSL has no references: index the array, for (int k = 0; k < n; ++k) a[k] = ..."), "";
+  if (range->HasSideEffects(m_ctx)) return Fail(range->getBeginLoc(), "a range-based for over an expression with side effects in a kernel", "loop over a variable"), "";
+  // The counter is named by depth, so that nested loops have their own.
+  const std::string k = "crt_k" + std::to_string(m_loopDepth), n = std::to_string(array->getSize().getZExtValue());
+  const std::string element = pad + "  " + (t.getNonReferenceType().isConstQualified() ? "const " : "") + Declare(t, var->getNameAsString(), var->getLocation()) +
+                              " = " + Expr(range) + "[" + k + "];\n";
+  ++m_loopDepth;
+  const clang::Stmt* body = rf->getBody();
+  std::string inner;
+  if (auto* cs = dyn_cast<CompoundStmt>(body))
+    for (auto* c : cs->body()) inner += Stmt(c, indent + 1);
+  else
+    inner = Stmt(body, indent + 1);
+  --m_loopDepth;
+  return pad + "for (int " + k + " = 0; " + k + " < " + n + "; ++" + k + ")  // for (" + var->getNameAsString() + " : " +
+         TrimmedSourceText(m_ctx, range->getSourceRange()) + ")\n" + pad + "{\n" + element + inner + pad + "}\n";
+}
+
 std::string GlslPrinter::Stmt(const clang::Stmt* s, int indent) {
   std::string pad(indent * 2, ' ');
   if (!s) return pad + ";\n";
@@ -1002,6 +1040,7 @@ std::string GlslPrinter::Stmt(const clang::Stmt* s, int indent) {
     for (auto* d : ds->decls()) {
       auto* vd = dyn_cast<VarDecl>(d);
       if (!vd) continue;  // local typedefs and such need nothing
+      if (auto* closure = vd->getType()->getAsCXXRecordDecl(); closure && closure->isLambda()) continue;  // a lambda: a function of its own where called
       if (vd->isStaticLocal()) { Fail(vd->getLocation(), "static local variable in a kernel", "use a class member or a constant"); continue; }
       QualType t = vd->getType();
       if (t->isPointerType()) {
@@ -1068,6 +1107,7 @@ std::string GlslPrinter::Stmt(const clang::Stmt* s, int indent) {
     }
     return pad + "for (" + init + "; " + Expr(fs->getCond()) + "; " + Expr(fs->getInc()) + ")\n" + loopBody(fs->getBody());
   }
+  if (auto* rf = dyn_cast<CXXForRangeStmt>(s)) return RangeFor(rf, indent);
   if (auto* ws = dyn_cast<WhileStmt>(s)) return pad + "while (" + Expr(ws->getCond()) + ")\n" + loopBody(ws->getBody());
   if (auto* dos = dyn_cast<DoStmt>(s)) return pad + "do\n" + loopBody(dos->getBody()) + pad + "while (" + Expr(dos->getCond()) + ");\n";
   if (auto* rs = dyn_cast<ReturnStmt>(s)) {

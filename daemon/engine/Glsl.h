@@ -127,6 +127,9 @@ public:
 
   std::string Expr(const clang::Expr* e);
   std::string Stmt(const clang::Stmt* s, int indent);
+  // `for (T x : a)` over a fixed-size array (local, member or field): a counted loop whose body
+  // starts by declaring x as a's element.
+  std::string RangeFor(const clang::CXXForRangeStmt* rf, int indent);
   // The thread's function body: `continue` at loop depth 0 ends the thread (becomes `return`).
   // In a loop-holding kernel (loopBody), `return` would end every later iteration on the CPU,
   // which threads cannot do: it is reported.
@@ -182,6 +185,12 @@ private:
   std::string IspcInterlockedCall(const clang::FunctionDecl* fd, const clang::CallExpr* call);  // the same in ISPC
   std::string AtomicTargetProblem(const clang::Expr* target) const;
   std::string EmitAppend(const clang::FieldDecl* field, const clang::CallExpr* call);
+  // ---- lambdas in kernels (GlslLambdas.cpp) ----
+  // `f(args)` where f is a local lambda, or a lambda called where it is written: a call of the
+  // lambda as a function of its own (EmitLambda), its captures passed after the arguments.
+  std::string LambdaCall(const clang::CXXOperatorCallExpr* op);
+  std::string EmitLambda(const clang::LambdaExpr* lambda, const std::string& name);
+  std::map<const clang::LambdaExpr*, std::string> m_lambdaNames;
   // A user function as a GLSL function, once; with `bufferBindings` (parameter index -> buffer), a copy
   // of it whose pointer parameters index those buffers from an offset (see GlslPointers.cpp).
   // With `structSelf`, a member function of that plain struct: the object comes first, as `self`.

@@ -1,7 +1,9 @@
 // Analytic signed distance functions as a virtual hierarchy (sphere, box, rounded box, torus, and
 // the Mandelbulb fractal's distance estimator), the input of the grid, SVS and SBS builders and of
 // sphere tracing. Distances are negative inside. The Mandelbulb's estimate is a lower bound of the
-// true distance, which is what the builders and sphere tracing need.
+// true distance, which is what the builders and sphere tracing need. Each class holds plain data
+// (scalars and LiteMath vectors), so a translated class can call them in its kernels through a
+// std::vector<std::shared_ptr<ISdf>> (test/conformance/cases/analytic_sdf.cpp).
 #pragma once
 #include "LiteMath.h"
 

@@ -43,6 +43,13 @@
 #include "FractalView_ISPC.h"
 #endif
 #endif
+#if __has_include("LambdaMix_CPU.h")
+#include "LambdaMix_CPU.h"
+#include "LambdaMix_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "LambdaMix_ISPC.h"
+#endif
+#endif
 #if __has_include("MovingBoxes_CPU.h")
 #include "MovingBoxes_CPU.h"
 #include "MovingBoxes_Vulkan.h"
@@ -119,6 +126,20 @@ Register fractalView(MakeCase<FractalView>(
         if (t >= 0.0f) sum += t, hits += 1.0;
       }
       r.push_back(sum / std::max(hits, 1.0));
+      return r;
+    }));
+#endif
+
+#if __has_include("LambdaMix_CPU.h")
+Register lambdaMix(MakeCase<LambdaMix>(
+    "lambdas (no capture, [k], [&sum], [this], called in place) and for (x : array) over local and member arrays", "lambdas.h/.cpp", 1e-5,
+    CONFORMANCE_MAKERS(LambdaMix), [](LambdaMix& m) {
+      m.CommitDeviceData();
+      std::vector<float> in(333), out(333);
+      for (size_t i = 0; i < in.size(); i++) in[i] = std::sin(0.05f * float(i));
+      m.Mix(uint32_t(in.size()), in.data(), out.data());
+      Outputs r;
+      Append(r, out);
       return r;
     }));
 #endif

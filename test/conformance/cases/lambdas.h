@@ -1,0 +1,21 @@
+// Lambdas and range-based for loops in a kernel, as C++ users write them: a local lambda without
+// captures, one capturing a local by copy, one adding into a local by reference, one reading a
+// member through [this], one called where it is written; and `for (x : array)` over a local array
+// and over a member array, nested.
+#pragma once
+#include "LiteMath.h"
+#include <cstdint>
+
+class LambdaMix
+{
+public:
+  LambdaMix() = default;
+  virtual ~LambdaMix() = default;
+  virtual void Mix(uint32_t n, const float* a_in [[size("n")]], float* a_out [[size("n")]]);
+  virtual void CommitDeviceData() {}
+  float m_gain = 1.5f;
+  float m_taps[4] = {0.1f, 0.2f, 0.3f, 0.4f};
+
+protected:
+  void kernel1D_Mix(uint32_t n, const float* a_in, float* a_out);
+};
