@@ -7,6 +7,7 @@
 #include <clang/AST/ParentMapContext.h>
 #include <clang/AST/RecordLayout.h>
 #include <clang/Basic/SourceManager.h>
+#include <clang/AST/RecursiveASTVisitor.h>
 #include <clang/Lex/Lexer.h>
 
 #include <cstdio>
@@ -996,9 +997,15 @@ std::string GlslPrinter::RangeFor(const CXXForRangeStmt* rf, int indent) {
   const clang::Expr* range = rf->getRangeInit();
   const VarDecl* var = rf->getLoopVariable();
   auto* array = dyn_cast<ConstantArrayType>(range->getType().getCanonicalType().getTypePtr());
-  if (!array)
+  // A member std::vector of the class: up to its size, which kernels read as they read size().
+  auto* member = dyn_cast<MemberExpr>(range->IgnoreParenImpCasts());
+  auto* field = member && isa<CXXThisExpr>(member->getBase()->IgnoreParenImpCasts()) ? dyn_cast<FieldDecl>(member->getMemberDecl()) : nullptr;
+  QualType elementType;
+  if (field && (!IsStdVector(field->getType(), &elementType) || PolymorphicPointee(elementType))) field = nullptr;  // objects: call through them by index
+  if (!array && !field)
     return Fail(rf->getColonLoc(), "a range-based for over '" + range->getType().getAsString(m_ctx.getPrintingPolicy()) + "' in a kernel",
-                "kernels may loop with ':' over arrays of fixed size; index other ranges: for (uint32_t k = 0; k < v.size(); ++k)"), "";
+                "kernels may loop with ':' over arrays of fixed size and the class's std::vector members; index other ranges: "
+                "for (uint32_t k = 0; k < v.size(); ++k)"), "";
   if (rf->getInit()) return Fail(rf->getBeginLoc(), "an init-statement in a range-based for in a kernel", "declare the variable before the loop"), "";
   const QualType t = var->getType();
   if (t->isReferenceType() && !t.getNonReferenceType().isConstQualified())
@@ -1006,7 +1013,15 @@ std::string GlslPrinter::RangeFor(const CXXForRangeStmt* rf, int indent) {
                 "GLSL has no references: index the array, for (int k = 0; k < n; ++k) a[k] = ..."), "";
   if (range->HasSideEffects(m_ctx)) return Fail(range->getBeginLoc(), "a range-based for over an expression with side effects in a kernel", "loop over a variable"), "";
   // The counter is named by depth, so that nested loops have their own.
-  const std::string k = "crt_k" + std::to_string(m_loopDepth), n = std::to_string(array->getSize().getZExtValue());
+  const std::string k = "crt_k" + std::to_string(m_loopDepth);
+  std::string n;
+  if (array)
+    n = std::to_string(array->getSize().getZExtValue());
+  else {
+    m_uses.memberVectors.insert(field);
+    m_uses.sizeReads.emplace(field, rf->getColonLoc());
+    n = ispc ? IspcMember(field->getNameAsString() + "_size") : "int(" + composedPrefix + field->getNameAsString() + "_size)";
+  }
   const std::string element = pad + "  " + (t.getNonReferenceType().isConstQualified() ? "const " : "") + Declare(t, var->getNameAsString(), var->getLocation()) +
                               " = " + Expr(range) + "[" + k + "];\n";
   ++m_loopDepth;
@@ -1017,7 +1032,18 @@ std::string GlslPrinter::RangeFor(const CXXForRangeStmt* rf, int indent) {
   else
     inner = Stmt(body, indent + 1);
   --m_loopDepth;
-  return pad + "for (int " + k + " = 0; " + k + " < " + n + "; ++" + k + ")  // for (" + var->getNameAsString() + " : " +
+  // ISPC: the count is the same in every lane, so the counter is uniform unless the body may leave
+  // the loop early in some lanes only (as IspcUniformLoop decides for counted loops).
+  struct Exits : RecursiveASTVisitor<Exits> {
+    bool found = false;
+    bool VisitBreakStmt(BreakStmt*) { return !(found = true); }
+    bool VisitContinueStmt(ContinueStmt*) { return !(found = true); }
+    bool VisitReturnStmt(ReturnStmt*) { return !(found = true); }
+    bool VisitGotoStmt(GotoStmt*) { return !(found = true); }
+  } exits;
+  exits.TraverseStmt(const_cast<clang::Stmt*>(body));
+  const std::string counter = ispc && !exits.found ? "uniform int " : "int ";
+  return pad + "for (" + counter + k + " = 0; " + k + " < " + n + "; ++" + k + ")  // for (" + var->getNameAsString() + " : " +
          TrimmedSourceText(m_ctx, range->getSourceRange()) + ")\n" + pad + "{\n" + element + inner + pad + "}\n";
 }
 

@@ -127,8 +127,8 @@ public:
 
   std::string Expr(const clang::Expr* e);
   std::string Stmt(const clang::Stmt* s, int indent);
-  // `for (T x : a)` over a fixed-size array (local, member or field): a counted loop whose body
-  // starts by declaring x as a's element.
+  // `for (T x : a)` over a fixed-size array (local, member or field) or a member std::vector of the
+  // class: a counted loop whose body starts by declaring x as a's element.
   std::string RangeFor(const clang::CXXForRangeStmt* rf, int indent);
   // The thread's function body: `continue` at loop depth 0 ends the thread (becomes `return`).
   // In a loop-holding kernel (loopBody), `return` would end every later iteration on the CPU,

@@ -132,7 +132,7 @@ Register fractalView(MakeCase<FractalView>(
 
 #if __has_include("LambdaMix_CPU.h")
 Register lambdaMix(MakeCase<LambdaMix>(
-    "lambdas (no capture, [k], [&sum], [this], called in place) and for (x : array) over local and member arrays", "lambdas.h/.cpp", 1e-5,
+    "lambdas (no capture, [k], [&sum], [this], called in place); for (x : range) over arrays and a member std::vector", "lambdas.h/.cpp", 1e-5,
     CONFORMANCE_MAKERS(LambdaMix), [](LambdaMix& m) {
       m.CommitDeviceData();
       std::vector<float> in(333), out(333);

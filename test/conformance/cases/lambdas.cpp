@@ -20,7 +20,9 @@ void LambdaMix::kernel1D_Mix(uint32_t n, const float* a_in, float* a_out)
     for (float o : offsets)
       for (const float& tap : m_taps)
         addTo(tap * square(x + o));
-    const float bias = [&]() { return std::min(x, k); }();
+    float bias = [&]() { return std::min(x, k); }();
+    for (const LiteMath::float2& bend : m_bends)
+      bias += bend.x * std::sin(bend.y * x);
     a_out[i] = gained(scaled(sum)) + bias;
   }
 }
