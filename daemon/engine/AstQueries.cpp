@@ -71,10 +71,20 @@ const FieldDecl* ThisField(const Expr* e) {
   return dyn_cast<FieldDecl>(me->getMemberDecl());
 }
 
+// The initialiser a local reference `T& r = init;` names, or null for anything else. Kernels print
+// r as init (GlslPrinter::ReferenceAlias), so what is written through r is written to init's root.
+static const Expr* ReferredTo(const Expr* e) {
+  auto* dr = dyn_cast<DeclRefExpr>(e);
+  auto* vd = dr ? dyn_cast<VarDecl>(dr->getDecl()) : nullptr;
+  if (!vd || isa<ParmVarDecl>(vd) || !vd->getType()->isReferenceType() || !vd->hasLocalStorage() || !vd->getInit()) return nullptr;
+  return vd->getInit();
+}
+
 const FieldDecl* RootField(const Expr* e) {
   while (true) {
     e = e->IgnoreParenImpCasts();
     if (auto* f = ThisField(e)) return f;
+    if (const Expr* referred = ReferredTo(e)) { e = referred; continue; }
     if (auto* as = dyn_cast<ArraySubscriptExpr>(e)) { e = as->getBase(); continue; }
     if (auto* op = dyn_cast<CXXOperatorCallExpr>(e); op && op->getOperator() == OO_Subscript) { e = op->getArg(0); continue; }
     if (auto* me = dyn_cast<MemberExpr>(e)) { e = me->getBase(); continue; }
@@ -99,6 +109,7 @@ const VarDecl* WrittenVar(const clang::Expr* e) {
     if (auto* me = dyn_cast<MemberExpr>(e)) e = me->getBase();
     else if (auto* sub = dyn_cast<ArraySubscriptExpr>(e)) e = sub->getBase();
     else if (auto* op = dyn_cast<CXXOperatorCallExpr>(e); op && (op->getOperator() == OO_Subscript || op->getOperator() == OO_Call)) e = op->getArg(0);
+    else if (const Expr* referred = ReferredTo(e)) e = referred;
     else return NamedVar(e);
   }
 }

@@ -81,7 +81,11 @@ std::string GlslPrinter::DataStruct() const { return ispcDataStruct.empty() ? m_
 
 std::optional<std::string> GlslPrinter::Type(QualType t, SourceLocation loc) {
   QualType base = t.getNonReferenceType();
-  while (auto* arr = dyn_cast<ConstantArrayType>(base.getCanonicalType().getTypePtr())) base = arr->getElementType();
+  for (QualType element;;) {  // to the elements of arrays, std::array's too
+    if (auto* arr = dyn_cast<ConstantArrayType>(base.getCanonicalType().getTypePtr())) base = arr->getElementType();
+    else if (IsStdArray(base, &element)) base = element;
+    else break;
+  }
   base = base.getCanonicalType();
   if (base->isPointerType()) {
     Fail(loc, "pointer '" + t.getAsString(m_ctx.getPrintingPolicy()) + "' cannot be used here in a kernel",
@@ -885,10 +889,22 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
   if (auto* call = dyn_cast<CallExpr>(e)) return Call(call);
   if (auto* cons = dyn_cast<CXXConstructExpr>(e)) {  // also CXXTemporaryObjectExpr
     std::vector<const clang::Expr*> args(cons->arg_begin(), cons->arg_end());
+    if (IsStdArray(cons->getType()) && args.size() == 1 && cons->getConstructor()->isCopyOrMoveConstructor()) return Expr(args[0]);  // arrays copy
     if (IsUserConstructor(cons->getConstructor())) return ConstructorCall(cons->getConstructor(), args, e->getBeginLoc());
     return Construct(cons->getType(), args, e->getBeginLoc());
   }
   if (auto* il = dyn_cast<InitListExpr>(e)) {
+    // std::array<T, N>{...}: its one field, the T[N] it wraps (value-initialised when not listed).
+    QualType arrayElement;
+    uint64_t arraySize = 0;
+    if (IsStdArray(il->getType(), &arrayElement, &arraySize)) {
+      if (il->getNumInits() == 1) return Expr(il->getInit(0));
+      std::vector<const clang::Expr*> none;
+      std::string zero = Construct(arrayElement, none, e->getBeginLoc()), out;
+      for (uint64_t i = 0; i < arraySize; ++i) out += (i ? ", " : "") + zero;
+      auto g = Type(il->getType(), e->getBeginLoc());
+      return ispc ? "{" + out + "}" : (g ? *g : "float") + "(" + out + ")";
+    }
     // The semantic form lists every field (missing ones as ImplicitValueInitExpr), as GLSL needs.
     std::vector<const clang::Expr*> args(il->inits().begin(), il->inits().end());
     if (il->getType()->isArrayType() || !IsLiteMathType(il->getType())) {
@@ -997,12 +1013,14 @@ std::string GlslPrinter::RangeFor(const CXXForRangeStmt* rf, int indent) {
   const clang::Expr* range = rf->getRangeInit();
   const VarDecl* var = rf->getLoopVariable();
   auto* array = dyn_cast<ConstantArrayType>(range->getType().getCanonicalType().getTypePtr());
+  uint64_t stdArraySize = 0;
+  const bool stdArray = IsStdArray(range->getType(), nullptr, &stdArraySize);
   // A member std::vector of the class: up to its size, which kernels read as they read size().
   auto* member = dyn_cast<MemberExpr>(range->IgnoreParenImpCasts());
   auto* field = member && isa<CXXThisExpr>(member->getBase()->IgnoreParenImpCasts()) ? dyn_cast<FieldDecl>(member->getMemberDecl()) : nullptr;
   QualType elementType;
   if (field && (!IsStdVector(field->getType(), &elementType) || PolymorphicPointee(elementType))) field = nullptr;  // objects: call through them by index
-  if (!array && !field)
+  if (!array && !stdArray && !field)
     return Fail(rf->getColonLoc(), "a range-based for over '" + range->getType().getAsString(m_ctx.getPrintingPolicy()) + "' in a kernel",
                 "kernels may loop with ':' over arrays of fixed size and the class's std::vector members; index other ranges: "
                 "for (uint32_t k = 0; k < v.size(); ++k)"), "";
@@ -1015,8 +1033,8 @@ std::string GlslPrinter::RangeFor(const CXXForRangeStmt* rf, int indent) {
   // The counter is named by depth, so that nested loops have their own.
   const std::string k = "crt_k" + std::to_string(m_loopDepth);
   std::string n;
-  if (array)
-    n = std::to_string(array->getSize().getZExtValue());
+  if (array || stdArray)
+    n = std::to_string(array ? array->getSize().getZExtValue() : stdArraySize);
   else {
     m_uses.memberVectors.insert(field);
     m_uses.sizeReads.emplace(field, rf->getColonLoc());
@@ -1073,9 +1091,16 @@ std::string GlslPrinter::Stmt(const clang::Stmt* s, int indent) {
         out += PointerLocal(vd, pad);
         continue;
       }
-      if (t->isReferenceType() && !t.getNonReferenceType().isConstQualified())
-        Fail(vd->getLocation(), "non-const reference variable in a kernel",
+      if (t->isReferenceType() && !t.getNonReferenceType().isConstQualified()) {
+        std::string why;
+        if (auto alias = ReferenceAlias(vd, ds, why)) {  // GlslPointers.cpp: its uses print as what it refers to
+          renames[vd] = *alias;
+          out += pad + "// " + SafeName(vd->getNameAsString()) + " is " + *alias + " (a reference)\n";
+          continue;
+        }
+        Fail(vd->getLocation(), "non-const reference variable in a kernel: " + why,
              "GLSL has no references: write through the original expression, e.g. arr[i].x = ...");
+      }
       std::string decl = Declare(t, vd->getNameAsString(), vd->getLocation());
       std::string cnst = t.getNonReferenceType().isConstQualified() && !t->isArrayType() ? "const " : "";
       out += pad + cnst + decl;
@@ -1092,6 +1117,14 @@ std::string GlslPrinter::Stmt(const clang::Stmt* s, int indent) {
           const std::string n = std::to_string(arr->getSize().getZExtValue()), name = SafeName(vd->getNameAsString());
           after = pad + "for (int crt_i = 0; crt_i < " + n + "; ++crt_i)  // each element default-constructed, as in C++\n" + pad + "  " +
                   name + "[crt_i] = " + Construct(arr->getElementType(), {}, vd->getLocation()) + ";\n";
+        } else if (ispc && cons && cons->getNumArgs() == 1 && IsStdArray(t) && cons->getConstructor()->isCopyOrMoveConstructor()) {
+          // ISPC arrays do not copy whole (C's rule): element by element, into a variable that is not const.
+          const std::string name = SafeName(vd->getNameAsString());
+          if (!cnst.empty()) out = pad + decl;
+          uint64_t n = 0;
+          IsStdArray(t, nullptr, &n);
+          after = pad + "for (uniform int crt_i = 0; crt_i < " + std::to_string(n) + "; ++crt_i)  // a copy of " + TrimmedSourceText(m_ctx, cons->getArg(0)->getSourceRange()) +
+                  "\n" + pad + "  " + name + "[crt_i] = " + Expr(cons->getArg(0)) + "[crt_i];\n";
         } else if (!trivialDefault) {
           out += " = " + Expr(init);
         }
@@ -1169,6 +1202,22 @@ std::string GlslPrinter::Stmt(const clang::Stmt* s, int indent) {
     return cast && cast->getType()->isVoidType() && !cast->getSubExpr()->HasSideEffects(m_ctx);
   };
   if (auto* e = dyn_cast<clang::Expr>(s); e && quietsWarning(e)) return "";
+  // assert(c): the CPU classes check it (they run the user's code); the GPU has nowhere to stop.
+  if (auto* e = dyn_cast<clang::Expr>(s); e && e->getBeginLoc().isMacroID() &&
+                                            Lexer::getImmediateMacroName(e->getBeginLoc(), m_ctx.getSourceManager(), m_ctx.getLangOpts()) == "assert") {
+    const auto range = m_ctx.getSourceManager().getExpansionRange(e->getSourceRange());
+    return pad + "// " + Lexer::getSourceText(range, m_ctx.getSourceManager(), m_ctx.getLangOpts()).str() + ": checked by the CPU classes only\n";
+  }
+  // std::swap(a, b) of two variables or elements: through a temporary, as std::swap does.
+  if (auto* call = dyn_cast<CallExpr>(s); call && call->getDirectCallee() && call->getDirectCallee()->isInStdNamespace() &&
+                                          call->getDirectCallee()->getName() == "swap" && call->getNumArgs() == 2) {
+    const clang::Expr *a = call->getArg(0), *b = call->getArg(1);
+    if (a->HasSideEffects(m_ctx, false) || b->HasSideEffects(m_ctx, false))
+      return Fail(call->getBeginLoc(), "std::swap of expressions with side effects in a kernel", "swap variables or elements"), "";
+    const std::string x = Expr(a), y = Expr(b), tmp = "crt_swap" + std::to_string(m_loopDepth);
+    return pad + "{\n" + pad + "  const " + Declare(a->getType().getNonReferenceType().getUnqualifiedType(), tmp, call->getBeginLoc()) + " = " + x + ";\n" +
+           pad + "  " + x + " = " + y + ";\n" + pad + "  " + y + " = " + tmp + ";\n" + pad + "}\n";
+  }
   if (auto* e = dyn_cast<clang::Expr>(s)) return pad + Expr(e) + ";\n";
   return Fail(s->getBeginLoc(), std::string("statement '") + s->getStmtClassName() + "' is not supported in kernels",
               "kernels may use declarations, if, for, while, do, switch, return, break and continue"), "";

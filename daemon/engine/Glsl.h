@@ -185,6 +185,10 @@ private:
   std::string IspcInterlockedCall(const clang::FunctionDecl* fd, const clang::CallExpr* call);  // the same in ISPC
   std::string AtomicTargetProblem(const clang::Expr* target) const;
   std::string EmitAppend(const clang::FieldDecl* field, const clang::CallExpr* call);
+  // `T& r = a[i].f;` in a kernel or helper: the text its uses print as (GLSL has no references), when
+  // the referred lvalue stays the same through r's scope (no side effects; its indices' variables
+  // not written after r is declared). Else nullopt, and `why` says why not (GlslPointers.cpp).
+  std::optional<std::string> ReferenceAlias(const clang::VarDecl* vd, const clang::DeclStmt* decl, std::string& why);
   // ---- lambdas in kernels (GlslLambdas.cpp) ----
   // `f(args)` where f is a local lambda, or a lambda called where it is written: a call of the
   // lambda as a function of its own (EmitLambda), its captures passed after the arguments.

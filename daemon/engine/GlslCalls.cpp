@@ -384,6 +384,9 @@ std::string GlslPrinter::Call(const CallExpr* call) {
       return Fail(call->getBeginLoc(), "std::vector::" + name + " is not supported in kernels",
                   "kernels may index member vectors, call size() and capacity(), and push_back() to a member vector");
     }
+    // std::array<T, N>, held as T[N]: its size is N.
+    if (uint64_t n = 0; IsStdArray(obj->getType(), nullptr, &n) && (name == "size" || name == "max_size") && call->getNumArgs() == 0)
+      return std::to_string(n) + (ispc ? "" : "u");
     // Member functions of plain structs (the user's, LiteMath's complex and Box4f) and of matrices.
     if (IsPlainStruct(method->getParent())) return StructMethodCall(mc);
     if (IsLiteMathType(obj->getType(), "float4x4") || IsLiteMathType(obj->getType(), "float3x3")) return MatrixMethodCall(mc);

@@ -8,7 +8,11 @@
 //                         const uint m = k;   whose virtual calls m->F(...) print as m_objects_F(m, ...)
 //   helper(&x) / helper(p)          a helper that only reads and writes *p gets p as an inout value;
 //                                   one that indexes p gets a copy per buffer, with the offset.
+//   Particle& p = m_particles[i];   prints nothing but a comment; p.vel, p prints as m_particles[i].vel
+//                                   (a reference is the lvalue it names, as long as that stays one).
+#include "AstQueries.h"
 #include "Glsl.h"
+#include "WriteVisitor.h"
 
 #include <clang/AST/RecursiveASTVisitor.h>
 #include <clang/Basic/SourceManager.h>
@@ -242,6 +246,54 @@ std::string GlslPrinter::PointerLocal(const VarDecl* vd, const std::string& pad)
 std::string GlslPrinter::TextOf(const clang::Expr* e) const {
   auto& sm = m_ctx.getSourceManager();
   return Lexer::getSourceText(CharSourceRange::getTokenRange(sm.getExpansionRange(e->getSourceRange()).getAsRange()), sm, m_ctx.getLangOpts()).str();
+}
+
+std::optional<std::string> GlslPrinter::ReferenceAlias(const VarDecl* vd, const DeclStmt* decl, std::string& why) {
+  const clang::Expr* init = vd->getInit();
+  if (!init) return why = "it has no initialiser", std::nullopt;
+  init = init->IgnoreParenImpCasts();
+  if (init->HasSideEffects(m_ctx, false)) return why = "what it refers to has side effects", std::nullopt;
+  // An lvalue of variables, members, fields and elements: the variables its indices read.
+  std::vector<const clang::Expr*> indices;
+  for (const clang::Expr* e = init;;) {
+    e = e->IgnoreParenImpCasts();
+    if (auto* me = dyn_cast<MemberExpr>(e)) { e = me->getBase(); continue; }
+    if (auto* sub = dyn_cast<ArraySubscriptExpr>(e)) { indices.push_back(sub->getIdx()); e = sub->getBase(); continue; }
+    if (auto* op = dyn_cast<CXXOperatorCallExpr>(e); op && op->getOperator() == OO_Subscript && op->getNumArgs() == 2) {
+      indices.push_back(op->getArg(1));
+      e = op->getArg(0);
+      continue;
+    }
+    if (isa<DeclRefExpr, CXXThisExpr>(e)) break;
+    return why = "it refers to something other than a variable, member, field or element", std::nullopt;
+  }
+  struct Reads : RecursiveASTVisitor<Reads> {
+    std::set<const VarDecl*> vars;
+    bool VisitDeclRefExpr(DeclRefExpr* dr) {
+      if (auto* v = dyn_cast<VarDecl>(dr->getDecl())) vars.insert(v);
+      return true;
+    }
+  } reads;
+  for (const clang::Expr* index : indices) reads.TraverseStmt(const_cast<clang::Expr*>(index));
+  // Written after the declaration, in the statements of its block that follow it?
+  struct Writes : WriteVisitor<Writes> {
+    const std::set<const VarDecl*>* vars;
+    const VarDecl* written = nullptr;
+    void Written(const clang::Expr* target, SourceLocation) {
+      if (const VarDecl* v = WrittenVar(target); v && vars->count(v) && !written) written = v;
+    }
+  } writes;
+  writes.vars = &reads.vars;
+  auto parents = m_ctx.getParents(*decl);
+  const auto* block = parents.empty() ? nullptr : parents[0].get<CompoundStmt>();
+  if (!block) return why = "it is not declared in a block", std::nullopt;
+  bool after = false;
+  for (const clang::Stmt* s : block->body()) {
+    if (after) writes.TraverseStmt(const_cast<clang::Stmt*>(s));
+    after = after || s == decl;
+  }
+  if (writes.written) return why = "'" + writes.written->getNameAsString() + "', which picks what it refers to, changes after it", std::nullopt;
+  return Expr(init);
 }
 
 }  // namespace crossrt::engine

@@ -60,6 +60,14 @@ bool IsStdVector(QualType type, QualType* element) {
   return true;
 }
 
+bool IsStdArray(QualType type, QualType* element, uint64_t* size) {
+  auto* spec = dyn_cast_or_null<ClassTemplateSpecializationDecl>(type.getNonReferenceType().getCanonicalType()->getAsCXXRecordDecl());
+  if (!spec || spec->getName() != "array" || !spec->isInStdNamespace() || spec->getTemplateArgs().size() != 2) return false;
+  if (element) *element = spec->getTemplateArgs()[0].getAsType();
+  if (size) *size = spec->getTemplateArgs()[1].getAsIntegral().getZExtValue();
+  return true;
+}
+
 bool IsImage2D(QualType type, QualType* texel) {
   auto* spec = dyn_cast_or_null<ClassTemplateSpecializationDecl>(type.getNonReferenceType().getCanonicalType()->getAsCXXRecordDecl());
   if (!spec || spec->getName() != "Image2D" || spec->getTemplateArgs().size() != 1) return false;
@@ -111,6 +119,13 @@ std::optional<std::string> GlslTypeOf(QualType type) {
     }
   }
   if (auto* et = type->getAs<EnumType>()) return GlslTypeOf(et->getDecl()->getIntegerType());
+  QualType element;
+  uint64_t size = 0;
+  if (IsStdArray(type, &element, &size)) {  // as T[N]
+    auto elem = GlslTypeOf(element);
+    if (!elem) return std::nullopt;
+    return *elem + "[" + std::to_string(size) + "]";
+  }
   if (auto* rd = type->getAsCXXRecordDecl()) {
     if (InNamespace(rd, "LiteMath"))
       if (auto* g = LiteMathGlsl(rd->getName())) return std::string(g);

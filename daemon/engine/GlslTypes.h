@@ -23,6 +23,8 @@ std::string IspcTypeName(const std::string& glslType);
 
 bool IsLiteMathType(clang::QualType type, const char* name = nullptr);
 bool IsStdVector(clang::QualType type, clang::QualType* element = nullptr);
+// std::array<T, N>, which kernels hold as T[N], and its T and N.
+bool IsStdArray(clang::QualType type, clang::QualType* element = nullptr, uint64_t* size = nullptr);
 // Image2D<T> (any namespace, as the paper's LiteImage names it) and its texel type.
 bool IsImage2D(clang::QualType type, clang::QualType* texel = nullptr);
 // LiteImage::Sampler: filtering and address modes of image samples.

@@ -6,6 +6,13 @@
 #include "LiteMath.h"
 
 // A case compiles where this build translated its class (CONFORMANCE_CLASSES); main checks that all were.
+#if __has_include("ParticleRefs_CPU.h")
+#include "ParticleRefs_CPU.h"
+#include "ParticleRefs_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "ParticleRefs_ISPC.h"
+#endif
+#endif
 #if __has_include("PixelRows_CPU.h")
 #include "PixelRows_CPU.h"
 #include "PixelRows_Vulkan.h"
@@ -165,6 +172,18 @@ Register saxpyBlock(MakeCase<SaxpyBlock>(
       s.RunBlock(n, 0.75f, x.data(), y.data(), out.data());
       Outputs r;
       Append(r, out);
+      return r;
+    }));
+#endif
+
+#if __has_include("ParticleRefs_CPU.h")
+Register particleRefs(MakeCase<ParticleRefs>(
+    "Body& b = m_bodies[i] written through, float& to a local's element, assert, std::swap, std::array", "particle_refs.h/.cpp", 1e-5,
+    CONFORMANCE_MAKERS(ParticleRefs), [](ParticleRefs& p) {
+      p.CommitDeviceData();
+      for (int step = 0; step < 3; step++) p.Advance(200, 0.01f);  // each call reads the bodies back
+      Outputs r;
+      for (const Body& b : p.m_bodies) Append(r, std::vector<float>{b.pos.x, b.pos.y, b.pos.z, b.vel.y, b.age});
       return r;
     }));
 #endif

@@ -93,6 +93,8 @@ const Case kCases[] = {
      "a lambda in a kernel capturing 'p', a pointer or reference", "capture the value", 8},
     {"a lambda passed on", "    auto keep = [](float v) { return v > 0.0f; }; x = Apply(keep, x);", "  template <class F> float Apply(F f, float v) { return f(v) ? v : 0.0f; }", "",
      "a lambda used other than by calling it", "keep it in a local and call it", 8},
+    {"a reference whose element changes", "    int k = i; float& r = data[k]; k = 0; r += 1.0f; x = r;", "", "",
+     "non-const reference variable in a kernel: 'k', which picks what it refers to, changes after it", "write through the original expression", 8},
     {"nested control", "", "  virtual void Outer(int n, [[crossrt::size(\"n\")]] float* data);", "void Bad::Outer(int n, float* data) { kernel1D_Bad(n, data); Run(n, data); }\n",
      "control function 'Outer' calls control function 'Run'", "one submission", 12},
 };
