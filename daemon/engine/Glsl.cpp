@@ -678,6 +678,7 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
   if (auto* dr = dyn_cast<DeclRefExpr>(e)) {
     const ValueDecl* d = dr->getDecl();
     if (auto it = renames.find(d); it != renames.end()) return it->second;
+    if (auto* binding = dyn_cast<BindingDecl>(d); binding && binding->getBinding()) return Expr(binding->getBinding());  // a field of its decomposition
     if (IsImage2D(d->getType().getNonReferenceType()))
       return Fail(e->getBeginLoc(), (imageParams.count(d) ? Described(d) : "Image2D '" + d->getNameAsString() + "'") + " used as a value in a kernel",
                   imageParams.count(d) ? "use its texels in the kernel itself: " + d->getNameAsString() + "[p], at(x, y), sample(sampler, uv), " +
@@ -1085,6 +1086,21 @@ std::string GlslPrinter::Stmt(const clang::Stmt* s, int indent) {
       auto* vd = dyn_cast<VarDecl>(d);
       if (!vd) continue;  // local typedefs and such need nothing
       if (auto* closure = vd->getType()->getAsCXXRecordDecl(); closure && closure->isLambda()) continue;  // a lambda: a function of its own where called
+      if (auto* dd = dyn_cast<DecompositionDecl>(vd)) {
+        // `auto [a, b] = s;`: a variable of its own (named after the bindings), whose fields or
+        // elements the bindings are.
+        std::string name = "crt";
+        for (const BindingDecl* b : dd->bindings()) {
+          name += "_" + b->getNameAsString();
+          if (auto* holding = b->getHoldingVar())
+            Fail(holding->getLocation(), "a structured binding of a tuple-like type in a kernel", "bind the fields of a struct or the elements of an array");
+        }
+        renames[dd] = name;
+        QualType bound = dd->getType().getNonReferenceType();
+        const bool isConst = bound.isConstQualified() && !bound->isArrayType();
+        out += pad + (isConst ? "const " : "") + Declare(bound, name, dd->getLocation()) + (dd->getInit() ? " = " + Expr(dd->getInit()) : "") + ";\n";
+        continue;
+      }
       if (vd->isStaticLocal()) { Fail(vd->getLocation(), "static local variable in a kernel", "use a class member or a constant"); continue; }
       QualType t = vd->getType();
       if (t->isPointerType()) {

@@ -26,11 +26,12 @@ bool GlslPrinter::IspcUniform(const clang::Expr* e) const {
   }
   if (auto* me = dyn_cast<MemberExpr>(e)) {  // a scalar data member: self->m_x
     auto* f = dyn_cast<FieldDecl>(me->getMemberDecl());
-    return f && isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts()) && f->getType()->isArithmeticType() && composedPrefix.empty() && !selfClass;
+    return f && isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts()) && f->getType()->isArithmeticType() && composedPrefix.empty() && !selfClass &&
+           !m_structSelf;  // in a plain struct's method, `this` is the struct (a varying value), not the class
   }
   if (auto* mc = dyn_cast<CXXMemberCallExpr>(e)) {  // a member vector's size() (self->m_v_size), an image's width() or height()
     const CXXMethodDecl* method = mc->getMethodDecl();
-    if (!method || !composedPrefix.empty() || selfClass) return false;
+    if (!method || !composedPrefix.empty() || selfClass || m_structSelf) return false;
     const clang::Expr* object = mc->getImplicitObjectArgument();
     if (method->getName() == "width" || method->getName() == "height") return IsImage2D(object->getType().getNonReferenceType());
     auto* f = ThisMemberField(object);

@@ -34,6 +34,8 @@ struct WriteScanner : RecursiveASTVisitor<WriteScanner> {
   void Write(const Expr* lhs, SourceLocation loc, std::optional<ReduceOp> op, const std::vector<const MemberExpr*>& uses) {
     const FieldDecl* root = RootField(lhs);
     if (!root) return;
+    // A method of a plain struct the kernel holds (rng.Next() changing rng.state) writes that struct, not the class.
+    if (auto* owner = dyn_cast<CXXRecordDecl>(root->getParent()); owner && c.cls && !IsClassOrBase(owner, c.cls)) return;
     if (IsStdVector(root->getType())) { vectorWrites.insert(root); return; }
     if (IsImage2D(root->getType())) {
       // m_img[p] = v and m_img.at(x, y) = v print as imageStore; a part of a texel cannot be stored.

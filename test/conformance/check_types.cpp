@@ -6,6 +6,13 @@
 #include "LiteMath.h"
 
 // A case compiles where this build translated its class (CONFORMANCE_CLASSES); main checks that all were.
+#if __has_include("HashNoise_CPU.h")
+#include "HashNoise_CPU.h"
+#include "HashNoise_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "HashNoise_ISPC.h"
+#endif
+#endif
 #if __has_include("Tonemap_CPU.h")
 #include "Tonemap_CPU.h"
 #include "Tonemap_Vulkan.h"
@@ -203,6 +210,19 @@ Register derivedBlend(MakeCase<DerivedBlend>(
       d.Test(data.data(), 64);
       Outputs r;
       Append(r, data);
+      return r;
+    }));
+#endif
+
+#if __has_include("HashNoise_CPU.h")
+Register hashNoise(MakeCase<HashNoise>(
+    "a struct's own state advanced by its method (rng.Next()), a structured binding, std::fmod/isnan/isfinite, {} zeros",
+    "hash_noise.h/.cpp", 1e-5, CONFORMANCE_MAKERS(HashNoise), [](HashNoise& h) {
+      std::vector<float> out(37 * 23);
+      h.CommitDeviceData();
+      h.Run(37, 23, out.data());
+      Outputs r;
+      Append(r, out);
       return r;
     }));
 #endif
