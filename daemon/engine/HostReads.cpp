@@ -1,9 +1,10 @@
-// Host code of a control function that reads members kernels write on the GPU. The Vulkan class
-// records the whole body before any of it runs, so such a read, done while recording, would see
-// the value from before the call. After the last statement that records GPU work the reads are
-// sound once moved: those statements (the host tail, `m_mean = m_sum / float(n);`) run in the
-// generated control function after the kernels' results are back. Between kernels they are an
-// error. Takes a control function's body; gives Control::hostTail and the tail the ...Cmd leaves out.
+// Host code of a control function that uses what kernels write on the GPU: members they write,
+// and output pointer parameters. The Vulkan class records the whole body before any of it runs, so
+// such a use, done while recording, would see the value from before the call. After the last
+// statement that records GPU work the uses are sound once moved: those statements (the host tail,
+// `m_mean = m_sum / float(n);`) run in the generated control function after the kernels' results
+// are back. Between kernels they are an error. Takes a control function's body; gives
+// Control::hostTail and the tail the ...Cmd leaves out.
 #include "ControlFunctions.h"
 #include "ControlRewriter.h"
 
@@ -15,16 +16,32 @@ namespace crossrt::engine {
 
 namespace {
 
-// The reads in `s` of plain members of the class data that kernels write: every mention but the
-// left side of a plain assignment (`m_x = ...` writes it only).
-std::vector<const MemberExpr*> KernelWrittenReads(Context& c, const Stmt* s) {
+// What host code in `s` reads of the GPU's results: plain members of the class data that kernels
+// write (every mention but the left side of a plain assignment, `m_x = ...`, which only writes
+// it), and the control function's output pointer parameters (non-const: copied back after the
+// call), any use but handing one to a kernel or a library call on device data. As (where, name).
+std::vector<std::pair<const Expr*, std::string>> KernelWrittenReads(Context& c, const FunctionDecl* control, const Stmt* s) {
   struct Finder : RecursiveASTVisitor<Finder> {
     Context& c;
+    const FunctionDecl* control;
     std::set<const MemberExpr*> assigned;
-    std::vector<const MemberExpr*> reads;
-    explicit Finder(Context& cc) : c(cc) {}
+    std::set<const DeclRefExpr*> handedOver;  // output parameters passed to kernels and library calls
+    std::vector<std::pair<const Expr*, std::string>> reads;
+    Finder(Context& cc, const FunctionDecl* ctrl) : c(cc), control(ctrl) {}
     void Assigned(const Expr* lhs) {
       if (auto* me = dyn_cast<MemberExpr>(lhs->IgnoreParenImpCasts())) assigned.insert(me);
+    }
+    void HandedOver(const Expr* arg) {
+      arg = arg->IgnoreParenImpCasts();
+      if (auto* bo = dyn_cast<BinaryOperator>(arg); bo && bo->isAdditiveOp()) arg = bo->getLHS()->IgnoreParenImpCasts();  // out + k
+      if (auto* dr = dyn_cast<DeclRefExpr>(arg)) handedOver.insert(dr);
+    }
+    bool VisitCallExpr(CallExpr* call) {  // visited before its arguments
+      KernelCallFinder gpu(c.cls);
+      gpu.TraverseStmt(call);
+      if (!gpu.calls.empty() && gpu.calls.front() == call)
+        for (const Expr* arg : call->arguments()) HandedOver(arg);
+      return true;
     }
     bool VisitBinaryOperator(BinaryOperator* bo) {  // visited before its operands
       if (bo->getOpcode() == BO_Assign) Assigned(bo->getLHS());
@@ -38,10 +55,17 @@ std::vector<const MemberExpr*> KernelWrittenReads(Context& c, const Stmt* s) {
       if (assigned.count(me) || !isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts())) return true;
       auto* f = dyn_cast<FieldDecl>(me->getMemberDecl());
       const Member* m = f ? FindMember(c.model, f->getNameAsString()) : nullptr;
-      if (m && m->kind == MemberKind::Plain && m->inClassData && m->writtenByKernels) reads.push_back(me);
+      if (m && m->kind == MemberKind::Plain && m->inClassData && m->writtenByKernels) reads.push_back({me, f->getNameAsString()});
       return true;
     }
-  } finder(c);
+    bool VisitDeclRefExpr(DeclRefExpr* dr) {
+      auto* p = dyn_cast<ParmVarDecl>(dr->getDecl());
+      if (!p || p->getDeclContext() != control || handedOver.count(dr)) return true;
+      const QualType t = p->getType();
+      if (t->isPointerType() && !t->getPointeeType().isConstQualified()) reads.push_back({dr, p->getNameAsString()});
+      return true;
+    }
+  } finder(c, control);
   finder.TraverseStmt(const_cast<Stmt*>(s));
   return finder.reads;
 }
@@ -90,17 +114,16 @@ void ControlRewriter::FindHostTail() {
   // records GPU work (its next round reads what this one's kernels write).
   for (int i = first; i <= last; ++i) {
     const bool loop = isa<ForStmt, WhileStmt, DoStmt, CXXForRangeStmt>(statements[i]) && FirstGpuWork(m_c, statements[i]).isValid();
-    for (const MemberExpr* read : KernelWrittenReads(m_c, statements[i])) {
+    for (const auto& [read, name] : KernelWrittenReads(m_c, m_def, statements[i])) {
       if (!loop && !sm.isBeforeInTranslationUnit(firstWork, read->getBeginLoc())) continue;
-      const std::string name = read->getMemberDecl()->getNameAsString();
-      m_c.rep.GpuError(read->getExprLoc(), "control function '" + m_ctrl.name + "' reads '" + name +
-                       "' between kernel calls, but kernels write it on the GPU: the calls are recorded before any runs, so this reads its value from before the call",
+      m_c.rep.GpuError(read->getExprLoc(), "control function '" + m_ctrl.name + "' uses '" + name +
+                       "' between kernel calls, but kernels write it on the GPU: the calls are recorded before any runs, so this sees its value from before the call",
                        "read it inside a kernel, which sees the GPU's copy, or after the last kernel call: code there runs once the results are back");
     }
   }
   // The tail moves only when it needs to: when it reads what the kernels wrote.
   bool reads = false;
-  for (size_t i = size_t(last) + 1; i < statements.size(); ++i) reads = reads || !KernelWrittenReads(m_c, statements[i]).empty();
+  for (size_t i = size_t(last) + 1; i < statements.size(); ++i) reads = reads || !KernelWrittenReads(m_c, m_def, statements[i]).empty();
   if (!reads) return;
   m_tail.assign(statements.begin() + last + 1, statements.end());
 }

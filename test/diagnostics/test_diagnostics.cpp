@@ -450,7 +450,7 @@ void Between::Run(int n, const float* in, float* out)
     INFO(r.output);
     REQUIRE_FALSE(r.crashed);
     REQUIRE(r.exitCode == 1);
-    CHECK(r.output.find("Between.cpp:6:28: error: control function 'Run' reads 'm_total' between kernel calls, but kernels write it on the GPU") !=
+    CHECK(r.output.find("Between.cpp:6:28: error: control function 'Run' uses 'm_total' between kernel calls, but kernels write it on the GPU") !=
           std::string::npos);
     CHECK(r.output.find("hint: read it inside a kernel") != std::string::npos);
     // The CPU classes run the body as written, in order: nothing to report.
@@ -458,6 +458,25 @@ void Between::Run(int n, const float* in, float* out)
                                    tc.Source("Between") + " --templates " CROSSRT_SOURCE_DIR "/templates");
     INFO(cpu.output);
     CHECK(cpu.exitCode == 0);
+  }
+  SECTION("an output parameter: an error between kernels, after the last one run once it is back")
+  {
+    TempClass tc("OutParam", header("OutParam"), std::string(R"(#include "OutParam.h"
+void OutParam::Run(int n, const float* in, float* out)
+{
+  kernel1D_Scale(n, 2.0f, in, out);
+  const float first = out[0];
+  kernel1D_Scale(n, first, in, out);
+  out[n - 1] = out[0] + 1.0f;
+}
+)") + kernels("OutParam"));
+    CommandResult r = RunCrossrt("translate --class OutParam --backend vulkan --out " + (tc.dir / "out").string() + " --source " +
+                                 tc.Source("OutParam") + " --templates " CROSSRT_SOURCE_DIR "/templates");
+    INFO(r.output);
+    REQUIRE(r.exitCode == 1);
+    CHECK(r.output.find("OutParam.cpp:5:23: error: control function 'Run' uses 'out' between kernel calls") != std::string::npos);
+    CHECK(r.output.find("OutParam.cpp:6:") == std::string::npos);  // handed to a kernel: no host use
+    CHECK(r.output.find("OutParam.cpp:7:") == std::string::npos);  // after the last kernel: moved, not refused
   }
 }
 
