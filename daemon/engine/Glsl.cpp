@@ -458,14 +458,6 @@ std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callL
   // ISPC: the class's own methods reach its members through `self`, as the kernels do.
   const bool ispcSelf = ispc && !selfClass && !structSelf && isa<CXXMethodDecl>(def) && !cast<CXXMethodDecl>(def)->isStatic();
   const bool withSelf = ((selfClass || structSelf) && isa<CXXMethodDecl>(def) && !cast<CXXMethodDecl>(def)->isStatic()) || ispcSelf;
-  // A parameter the callee may write: GLSL's inout, ISPC's reference.
-  auto writable = [&](QualType type, const std::string& name, SourceLocation loc) {
-    std::string declared = Declare(type, name, loc);
-    if (!ispc) return "inout " + declared;
-    if (declared.back() == ']') return declared;  // arrays are passed by reference already
-    const size_t space = declared.rfind(' ');
-    return declared.substr(0, space) + " &" + declared.substr(space + 1);
-  };
   if (ispcSelf) os << "uniform " << DataStruct() << " *uniform self";
   else if (withSelf && structSelf) {
     if (cast<CXXMethodDecl>(def)->isConst()) os << structSelf->getNameAsString() << " self";
@@ -499,31 +491,44 @@ std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callL
       } else {
         t.value = name;
         os << (pt->getPointeeType().isConstQualified() ? Declare(pt->getPointeeType(), p->getNameAsString(), p->getLocation())
-                                                       : writable(pt->getPointeeType(), p->getNameAsString(), p->getLocation()));
+                                                       : WritableParam(pt->getPointeeType(), p->getNameAsString(), p->getLocation()));
       }
       m_pointers[p] = t;
       continue;
     }
-    os << (qualifier.empty() ? Declare(pt, p->getNameAsString(), p->getLocation()) : writable(pt, p->getNameAsString(), p->getLocation()));
+    os << (qualifier.empty() ? Declare(pt, p->getNameAsString(), p->getLocation()) : WritableParam(pt, p->getNameAsString(), p->getLocation()));
   }
   os << ")\n";
-  int savedDepth = m_loopDepth;
-  bool savedThread = m_inThreadBody, savedLoopBody = m_inLoopBody;
   const CXXRecordDecl* savedSelf = m_structSelf;
   m_structSelf = structSelf;
-  m_loopDepth = 0;
-  m_inThreadBody = m_inLoopBody = false;
-  os << Stmt(def->getBody(), 0);
+  os << FunctionBody(def->getBody());
   m_structSelf = savedSelf;
-  m_loopDepth = savedDepth;
-  m_inThreadBody = savedThread;
-  m_inLoopBody = savedLoopBody;
   m_pointers = outerPointers;
   m_inProgress.erase(def);
   if (!m_emitted.count(def)) m_uses.helpers.push_back(def);
   m_emitted.insert(def);
   m_functions.push_back(os.str());
   return name;
+}
+
+std::string GlslPrinter::WritableParam(QualType type, const std::string& name, SourceLocation loc) {
+  const std::string declared = Declare(type, name, loc);
+  if (!ispc) return "inout " + declared;
+  if (declared.back() == ']') return declared;  // arrays are passed by reference already
+  const size_t space = declared.rfind(' ');
+  return declared.substr(0, space) + " &" + declared.substr(space + 1);
+}
+
+std::string GlslPrinter::FunctionBody(const clang::Stmt* body) {
+  const int savedDepth = m_loopDepth;
+  const bool savedThread = m_inThreadBody, savedLoopBody = m_inLoopBody;
+  m_loopDepth = 0;
+  m_inThreadBody = m_inLoopBody = false;
+  std::string out = Stmt(body, 0);
+  m_loopDepth = savedDepth;
+  m_inThreadBody = savedThread;
+  m_inLoopBody = savedLoopBody;
+  return out;
 }
 
 std::string GlslPrinter::EmitComposedMethod(const CXXMethodDecl* method) {

@@ -189,6 +189,10 @@ private:
   // the referred lvalue stays the same through r's scope (no side effects; its indices' variables
   // not written after r is declared). Else nullopt, and `why` says why not (GlslPointers.cpp).
   std::optional<std::string> ReferenceAlias(const clang::VarDecl* vd, const clang::DeclStmt* decl, std::string& why);
+  // A parameter the callee may write: GLSL's inout, ISPC's reference.
+  std::string WritableParam(clang::QualType type, const std::string& name, clang::SourceLocation loc);
+  // A function's body (a helper's, a lambda's), printed apart from the kernel's thread body.
+  std::string FunctionBody(const clang::Stmt* body);
   // ---- lambdas in kernels (GlslLambdas.cpp) ----
   // `f(args)` where f is a local lambda, or a lambda called where it is written: a call of the
   // lambda as a function of its own (EmitLambda), its captures passed after the arguments.

@@ -73,14 +73,6 @@ std::string GlslPrinter::EmitLambda(const LambdaExpr* lambda, const std::string&
              : std::string("the kernel"))
      << "\n"
      << (ispc ? "static inline " : "") << (ret ? *ret : "void") << " " << name << "(";
-  // A parameter the lambda may write: GLSL's inout, ISPC's reference.
-  auto writable = [&](QualType type, const std::string& n, SourceLocation loc) {
-    const std::string declared = Declare(type, n, loc);
-    if (!ispc) return "inout " + declared;
-    if (declared.back() == ']') return declared;  // arrays are passed by reference already
-    const size_t space = declared.rfind(' ');
-    return declared.substr(0, space) + " &" + declared.substr(space + 1);
-  };
   std::string params;
   auto add = [&](const std::string& p) { params += (params.empty() ? "" : ", ") + p; };
   bool capturesThis = false;
@@ -89,7 +81,7 @@ std::string GlslPrinter::EmitLambda(const LambdaExpr* lambda, const std::string&
   for (const ParmVarDecl* p : call->parameters()) {
     const QualType t = p->getType();
     if (t->isPointerType()) return Fail(p->getLocation(), "a lambda with a pointer parameter in a kernel", "pass the element, or an index into the buffer");
-    add(t->isReferenceType() && !t.getNonReferenceType().isConstQualified() ? writable(t.getNonReferenceType(), p->getNameAsString(), p->getLocation())
+    add(t->isReferenceType() && !t.getNonReferenceType().isConstQualified() ? WritableParam(t.getNonReferenceType(), p->getNameAsString(), p->getLocation())
                                                                               : Declare(t.getNonReferenceType(), p->getNameAsString(), p->getLocation()));
   }
   for (const LambdaCapture& capture : lambda->captures()) {
@@ -104,17 +96,9 @@ std::string GlslPrinter::EmitLambda(const LambdaExpr* lambda, const std::string&
       return Fail(capture.getLocation(), "a lambda in a kernel capturing '" + var->getNameAsString() + "', a pointer or reference",
                   "capture the value it refers to, copied into a local first");
     const bool byReference = capture.getCaptureKind() == LCK_ByRef && !t.isConstQualified();
-    add(byReference ? writable(t, var->getNameAsString(), var->getLocation()) : Declare(t, var->getNameAsString(), var->getLocation()));
+    add(byReference ? WritableParam(t, var->getNameAsString(), var->getLocation()) : Declare(t, var->getNameAsString(), var->getLocation()));
   }
-  os << params << ")\n";
-  const int savedDepth = m_loopDepth;
-  const bool savedThread = m_inThreadBody, savedLoopBody = m_inLoopBody;
-  m_loopDepth = 0;
-  m_inThreadBody = m_inLoopBody = false;
-  os << Stmt(call->getBody(), 0);
-  m_loopDepth = savedDepth;
-  m_inThreadBody = savedThread;
-  m_inLoopBody = savedLoopBody;
+  os << params << ")\n" << FunctionBody(call->getBody());
   m_uses.helpers.push_back(call);  // its writes to members count as a helper's
   m_functions.push_back(os.str());
   return name;
