@@ -1,7 +1,7 @@
 // The rewriter of one control function. Its work is split by job: ControlFunctions.cpp (arguments,
 // std::vector temporaries, member writes, the visit), ThreadLoops.cpp (loops that call kernels per
 // thread), ThreadBodies.cpp (megakernel and wavefront bodies), LibraryCalls.cpp (sort, scan, copy,
-// fill), HostReads.cpp (host code that reads what kernels wrote).
+// fill), HostReads.cpp (host code that uses what kernels write).
 #pragma once
 #include "AnalysisContext.h"
 #include "LoopShape.h"
@@ -128,9 +128,9 @@ private:
   // or a loop stays one statement.
   void RecordClear(const Stmt* s);
 
-  // ---- host code that reads members kernels write (HostReads.cpp) ----
-  // Finds the host tail: the statements after the last one that records GPU work, when they read a
-  // member kernels write (m_tail; empty otherwise). Reads between kernels are errors.
+  // ---- host code that uses what kernels write: members, output parameters (HostReads.cpp) ----
+  // Finds the host tail: the statements after the last one that records GPU work, when they use
+  // something kernels write (m_tail; empty otherwise). Such uses between kernels are errors.
   void FindHostTail();
   // Takes the tail out of the ...Cmd body into Control::hostTail, which the generated control
   // function runs after the results are back.
