@@ -416,6 +416,17 @@ std::string GlslPrinter::Call(const CallExpr* call) {
   if (ispc && interlocked) return IspcInterlockedCall(fd, call);
   if (IsCrossrtAtomic(fd)) return AtomicCall(fd, call);
   if (interlocked) return InterlockedCall(fd, call);
+  // std::min({a, b, c}) and std::max({...}): folded pairwise, left to right.
+  if (fd->isInStdNamespace() && (name == "min" || name == "max") && call->getNumArgs() >= 1)
+    if (auto* list = dyn_cast<CXXStdInitializerListExpr>(call->getArg(0)->IgnoreImplicit())) {
+      auto* init = dyn_cast<InitListExpr>(list->getSubExpr()->IgnoreImplicit());
+      if (!init || init->getNumInits() == 0 || call->getNumArgs() != 1)
+        return Fail(call->getBeginLoc(), "std::" + name + " of a list with a comparator in a kernel", "fold it with std::" + name + "(a, b)");
+      std::string folded = Expr(init->getInit(0));
+      for (unsigned i = 1; i < init->getNumInits(); ++i)
+        folded = (ispc ? "crt_" + name : name) + "(" + folded + ", " + Expr(init->getInit(i)) + ")";
+      return folded;
+    }
   std::vector<std::string> args;
   const bool library = IsSystemDecl(fd) || fd->isInStdNamespace() || InNamespace(fd, "LiteMath");
   std::map<unsigned, std::string> bindings;

@@ -178,7 +178,7 @@ Register saxpyBlock(MakeCase<SaxpyBlock>(
 
 #if __has_include("ParticleRefs_CPU.h")
 Register particleRefs(MakeCase<ParticleRefs>(
-    "Body& b = m_bodies[i] written through, float& to a local's element, assert, std::swap, std::array", "particle_refs.h/.cpp", 1e-5,
+    "references to m_bodies and its element written through, float& to a local's element, assert, std::swap, std::max({...}), std::array", "particle_refs.h/.cpp", 1e-5,
     CONFORMANCE_MAKERS(ParticleRefs), [](ParticleRefs& p) {
       p.CommitDeviceData();
       for (int step = 0; step < 3; step++) p.Advance(200, 0.01f);  // each call reads the bodies back

@@ -23,7 +23,8 @@ void ParticleRefs::kernel1D_Advance(uint32_t n, float dt)
 {
   for (uint32_t i = 0; i < n; i++)
   {
-    Body& b = m_bodies[i];
+    std::vector<Body>& all = m_bodies;
+    Body& b = all[i];
     assert(b.mass > 0.0f && "bodies have mass");
     float lo = b.pos.x, hi = b.pos.y;
     if (lo > hi)
@@ -40,6 +41,6 @@ void ParticleRefs::kernel1D_Advance(uint32_t n, float dt)
     LiteMath::float3& v = b.vel;
     v += LiteMath::float3(0.0f, -9.8f, 0.0f) * steps[0] / b.mass;
     b.pos += v * last;
-    b.age += dt + acc[1];
+    b.age += dt + acc[1] + 0.01f * std::max({lo, hi, 0.0f}) - 0.001f * std::min({hi, lo});
   }
 }

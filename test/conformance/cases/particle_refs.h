@@ -1,6 +1,6 @@
-// Everyday C++ in a kernel: a reference to the thread's element of a member vector (written
-// through), a reference to a local array's element, assert, std::swap and std::array (braces,
-// value-initialised, copied, size(), a range-for over it).
+// Everyday C++ in a kernel: a reference to a member vector and one to the thread's element of it
+// (written through), a reference to a local array's element, assert, std::swap, std::min/max of a
+// braced list, and std::array (braces, value-initialised, copied, size(), a range-for over it).
 #pragma once
 #include "LiteMath.h"
 #include <array>
