@@ -132,8 +132,8 @@ private:
   // Finds the host tail: the statements after the last one that records GPU work, when they use
   // something kernels write (m_tail; empty otherwise). Such uses between kernels are errors.
   void FindHostTail();
-  // Takes the tail out of the ...Cmd body into Control::hostTail, which the generated control
-  // function runs after the results are back.
+  // Turns the tail in the ...Cmd body into a lambda it stores (capturing the locals the tail
+  // reads), which the generated control function runs after the results are back.
   void MoveHostTail();
   std::vector<const Stmt*> m_tail;
 

@@ -1,14 +1,13 @@
 // Host code of a control function that uses what kernels write on the GPU: members they write,
 // and output pointer parameters. The Vulkan class records the whole body before any of it runs, so
 // such a use, done while recording, would see the value from before the call. After the last
-// statement that records GPU work the uses are sound once moved: those statements (the host tail,
-// `m_mean = m_sum / float(n);`) run in the generated control function after the kernels' results
-// are back. Between kernels they are an error. Takes a control function's body; gives
-// Control::hostTail and the tail the ...Cmd leaves out.
+// statement that records GPU work the uses are sound once deferred: the ...Cmd stores those
+// statements (the host tail, `m_mean = m_sum / float(n);`) as a lambda, capturing the locals they
+// read, and the generated control function runs it after the kernels' results are back. Between
+// kernels such uses are an error. Takes a control function's body; gives Control::hasHostTail and
+// the ...Cmd's lambda.
 #include "ControlFunctions.h"
 #include "ControlRewriter.h"
-
-#include "Canonical.h"
 
 using namespace clang;
 
@@ -134,8 +133,30 @@ void ControlRewriter::MoveHostTail() {
   SourceLocation end = Lexer::findLocationAfterToken(m_tail.back()->getEndLoc(), tok::semi, sm, m_c.ctx.getLangOpts(), false);
   if (end.isInvalid()) end = Lexer::getLocForEndOfToken(m_tail.back()->getEndLoc(), 0, sm, m_c.ctx.getLangOpts());  // a block or loop
   const CharSourceRange range = CharSourceRange::getCharRange(m_tail.front()->getBeginLoc(), end);
-  m_ctrl.hostTail = CanonicalCode(std::string(Lexer::getSourceText(range, sm, m_c.ctx.getLangOpts())));
-  m_gpu.RemoveText(range);
+  // The variables of the body the tail reads, declared before it (parameters too): captured by copy.
+  struct Uses : RecursiveASTVisitor<Uses> {
+    const FunctionDecl* def;
+    std::set<const Decl*> inside;
+    std::vector<std::string> captured;
+    bool VisitVarDecl(VarDecl* vd) { inside.insert(vd); return true; }
+    bool VisitDeclRefExpr(DeclRefExpr* dr) {
+      auto* vd = dyn_cast<VarDecl>(dr->getDecl());
+      if (!vd || !vd->hasLocalStorage() || inside.count(vd) || vd->getDeclContext() != def) return true;
+      if (std::find(captured.begin(), captured.end(), vd->getNameAsString()) == captured.end()) captured.push_back(vd->getNameAsString());
+      return true;
+    }
+  } uses;
+  uses.def = m_def;
+  for (const Stmt* s : m_tail) uses.TraverseStmt(const_cast<Stmt*>(s));
+  for (const auto& [vd, temporary] : m_temporaries)
+    if (std::find(uses.captured.begin(), uses.captured.end(), vd->getNameAsString()) != uses.captured.end())
+      m_c.rep.GpuError(vd->getLocation(), "the code of '" + m_ctrl.name + "' after its last kernel reads '" + vd->getNameAsString() +
+                       "', whose elements are the GPU's", "make it a member, which the generated class copies back");
+  std::string captures = "this";
+  for (const std::string& name : uses.captured) captures += ", " + name;
+  m_ctrl.hasHostTail = true;
+  m_gpu.ReplaceText(range, "m_hostTail_" + m_ctrl.name + " = [" + captures + "]() mutable {\n" +
+                               std::string(Lexer::getSourceText(range, sm, m_c.ctx.getLangOpts())) + "\n};");
 }
 
 }  // namespace crossrt::engine

@@ -211,9 +211,10 @@ struct Control {
   bool isVirtual = true;            // else the generated one hides it, and calls through the base run the original
   std::vector<ControlParam> params;
   std::string vulkanCmdBody;        // body with kernel calls turned into ...Cmd calls
-  // The statements after its last kernel (or other GPU work), when they read members kernels write:
-  // the Vulkan class runs them after the results are back, not while recording (HostReads.cpp).
-  std::string hostTail;
+  // The statements after its last kernel (or other GPU work) use what kernels write: the Vulkan
+  // class's ...Cmd stores them as a lambda that the control function runs after the results are
+  // back, not while recording (HostReads.cpp).
+  bool hasHostTail = false;
   std::string cpuBody;              // body with RTV loops parallelised
   std::vector<std::string> kernelsCalled;
   std::vector<std::string> vectorsWritten;  // member vectors its library calls (scan, fill, memcpy) write

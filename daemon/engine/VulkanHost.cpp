@@ -24,8 +24,7 @@ Data ControlsData(const ClassModel& model) {
     x.set("constQualifier", c.isConst ? " const" : "");
     x.set("notVirtual", !c.isVirtual);
     x.set("cmdBody", IndentTail(c.vulkanCmdBody, ""));
-    x.set("hostTail", !c.hostTail.empty());
-    x.set("hostTailCode", "  " + IndentTail(c.hostTail, "  "));
+    x.set("hostTail", c.hasHostTail);
     x.set("cpuBody", IndentTail(c.cpuBody, "  "));
     x.set("sourceFile", c.sourceFile);
     Data ptrs = List(), outs = List();

@@ -426,13 +426,13 @@ void Tail::Run(int n, const float* in, float* out)
     REQUIRE(r.exitCode == 0);
     std::ifstream source(tc.dir / "out" / "Tail_Vulkan.cpp");
     const std::string text((std::istreambuf_iterator<char>(source)), std::istreambuf_iterator<char>());
-    const size_t readBack = text.find("crt_self->ReadPlainMembers();"), tail = text.find("  m_mean = m_total / float(n);\n");
+    const size_t readBack = text.find("crt_self->ReadPlainMembers();"), run = text.find("    crt_tail();\n");
     const size_t cmd = text.find("void Tail_Vulkan::RunCmd(");
     REQUIRE(readBack != std::string::npos);
-    REQUIRE(tail != std::string::npos);
-    CHECK(readBack < tail);  // the tail reads the GPU's total
-    CHECK(tail < cmd);       // in Run, not in RunCmd
-    CHECK(text.find("m_mean = m_total", cmd) == std::string::npos);
+    REQUIRE(run != std::string::npos);
+    CHECK(readBack < run);  // Run runs the tail once the GPU's total is back
+    // RunCmd stores it, with the parameter it reads, instead of running it while recording.
+    CHECK(text.find("m_hostTail_Run = [this, n]() mutable { m_mean = m_total / float(n); };", cmd) != std::string::npos);
     CHECK(text.find("UpdateMemberCmd(a_cmd, offsetof(ClassData, m_total)", cmd) != std::string::npos);  // the zeroing before stays
   }
   SECTION("between kernels: an error at the read")

@@ -19,9 +19,10 @@ FractalView::FractalView(int width, int height) : m_width(width), m_height(heigh
 
 void FractalView::Render(float* depth)
 {
+  const float pixels = float(m_width * m_height);
   m_coverage = 0.0f;
   kernel2D_Render(depth, m_width, m_height);
-  m_coverage = m_coverage / float(m_width * m_height);  // after the kernel: the fraction of pixels hit
+  m_coverage = m_coverage / pixels;  // after the kernel: the fraction of pixels hit
 }
 
 float FractalView::Scene(float3 p) const
