@@ -21,6 +21,7 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
   std::map<std::string, std::string> files;
   Data d = Common(model, opt);
   d.set("controls", ControlsData(model));
+  d.set("hasHostTails", std::any_of(model.controls.begin(), model.controls.end(), [](const Control& c) { return c.hasHostTail; }));
   const Data vectors = VectorsData(model);
   d.set("vectors", vectors);
   d.set("hasVectors", !vectors.is_empty_list());
