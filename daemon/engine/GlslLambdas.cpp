@@ -38,15 +38,9 @@ std::string GlslPrinter::LambdaCall(const CXXOperatorCallExpr* op) {
   if (!lambda)
     return Fail(op->getBeginLoc(), "a call of a lambda the kernel does not hold in a local it initialises with the lambda",
                 "write `auto f = [...](...) { ... };` in the kernel and call f");
-  std::string name;
-  if (auto known = m_lambdaNames.find(lambda); known != m_lambdaNames.end())
-    name = known->second;
-  else {
-    auto* enclosing = dyn_cast<FunctionDecl>(lambda->getLambdaClass()->getDeclContext());
-    name = (enclosing ? enclosing->getNameAsString() : std::string("kernel")) + "_" +
-           (holder ? holder->getNameAsString() : "lambda" + std::to_string(m_lambdaNames.size()));
-  }
-  name = EmitLambda(lambda, composedPrefix + name);
+  auto* enclosing = dyn_cast<FunctionDecl>(lambda->getLambdaClass()->getDeclContext());
+  const std::string name = EmitLambda(lambda, composedPrefix + (enclosing ? enclosing->getNameAsString() : std::string("kernel")) + "_" +
+                                                  (holder ? holder->getNameAsString() : "lambda" + std::to_string(m_lambdaNames.size())));
   std::string args;
   for (unsigned i = 1; i < op->getNumArgs(); ++i) args += (args.empty() ? "" : ", ") + Expr(op->getArg(i));
   for (const LambdaCapture& capture : lambda->captures()) {

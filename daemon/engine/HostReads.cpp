@@ -35,13 +35,6 @@ std::vector<std::pair<const Expr*, std::string>> KernelWrittenReads(Context& c, 
       if (auto* bo = dyn_cast<BinaryOperator>(arg); bo && bo->isAdditiveOp()) arg = bo->getLHS()->IgnoreParenImpCasts();  // out + k
       if (auto* dr = dyn_cast<DeclRefExpr>(arg)) handedOver.insert(dr);
     }
-    bool VisitCallExpr(CallExpr* call) {  // visited before its arguments
-      KernelCallFinder gpu(c.cls);
-      gpu.TraverseStmt(call);
-      if (!gpu.calls.empty() && gpu.calls.front() == call)
-        for (const Expr* arg : call->arguments()) HandedOver(arg);
-      return true;
-    }
     bool VisitBinaryOperator(BinaryOperator* bo) {  // visited before its operands
       if (bo->getOpcode() == BO_Assign) Assigned(bo->getLHS());
       return true;
@@ -65,6 +58,10 @@ std::vector<std::pair<const Expr*, std::string>> KernelWrittenReads(Context& c, 
       return true;
     }
   } finder(c, control);
+  KernelCallFinder gpu(c.cls);  // the kernel and library calls of `s`, whose arguments are handed over
+  gpu.TraverseStmt(const_cast<Stmt*>(s));
+  for (const Expr* call : gpu.calls)
+    for (const Expr* arg : cast<CallExpr>(call)->arguments()) finder.HandedOver(arg);
   finder.TraverseStmt(const_cast<Stmt*>(s));
   return finder.reads;
 }
