@@ -238,6 +238,7 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
       printer.selfClass = impl;
       printer.ispc = ispc;
       printer.composedPrefix = vi->name + "_";
+      printer.owner = &kernelPrinter;  // what the methods read through a pointer to the caller
       for (auto& sn : ClassStructNames(model)) printer.predeclaredStructs.insert(sn);
       const GlslDecl data = ImplDataStruct(model, printer, impl, vm, *vi);
       for (auto* m : methods) implFunction[vi->name + "::" + m->getNameAsString()] = ImplementationMethod(rep, printer, impl, m, field->getLocation());
@@ -273,7 +274,8 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
         // (ISPC, at every level: an array per class that the class data points at.)
         const std::string address = member + (model.virtualLevel == 1 ? std::string("_objects") : "_" + vi.name);
         std::string args = ispc ? "self->" + member + "_" + vi.name + "[slot]" : member + "_" + vi.name + "Objects(" + address + ").objects[tag.y]";
-        for (unsigned i = 0; i < m->getNumParams(); ++i) args += ", " + CallArgumentName(m, i);
+        for (unsigned i = 0; i < m->getNumParams(); ++i)
+          if (!GlslPrinter::PointsTo(m->getParamDecl(i)->getType(), kernelPrinter.Class())) args += ", " + CallArgumentName(m, i);
         Data x;
         x.set("tag", std::to_string(t));
         x.set("call", implFunction[vi.name + "::" + m->getNameAsString()] + "(" + args + ")");

@@ -465,15 +465,18 @@ std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callL
     else os << "inout " << structSelf->getNameAsString() << " self";
   } else if (withSelf) os << selfClass->getNameAsString() << "_Data self";
   const auto outerPointers = m_pointers;  // this function's pointer parameters shadow the caller's names
+  bool first = !withSelf;
   for (unsigned i = 0; i < def->getNumParams(); ++i) {
     auto* p = def->getParamDecl(i);
+    if (IsOwnerParam(p)) continue;  // the traversal passed to an object's method: its data are globals (GlslOwner.cpp)
     QualType pt = p->getType();
     std::string qualifier;
     if (pt->isReferenceType() && !pt.getNonReferenceType().isConstQualified()) qualifier = "inout ";
     if (IsImage2D(pt.getNonReferenceType()))
       Fail(p->getLocation(), "helper '" + fd->getNameAsString() + "' takes an Image2D parameter; on the GPU only kernels take images",
            "read the texels in the kernel and pass them to the helper, or make the image a member, which helpers reach directly");
-    os << (i || withSelf ? ", " : "");
+    os << (first ? "" : ", ");
+    first = false;
     if (pt->isPointerType()) {
       // A pointer parameter: the element it points at (inout unless const), or the offset into the
       // buffer this copy of the helper is bound to.
@@ -612,7 +615,16 @@ std::string GlslPrinter::VirtualCall(const CXXMemberCallExpr* mc) {
                                    : ispc ? "((" + IspcVariability(indexExpr) + "uint)(" + Expr(indexExpr) + "))"
                                           : "uint(" + Expr(indexExpr) + ")"};
   if (ispc) args.insert(args.begin(), "self");  // the dispatcher finds the tags and the objects in the class data
-  for (auto* arg : mc->arguments()) args.push_back(Expr(arg));
+  for (unsigned i = 0; i < mc->getNumArgs(); ++i) {
+    const ParmVarDecl* p = i < method->getNumParams() ? method->getParamDecl(i) : nullptr;
+    if (p && PointsTo(p->getType(), m_class)) {  // the caller itself, left out on the GPU (GlslOwner.cpp)
+      if (!PassesSelf(p, mc->getArg(i)))
+        return Fail(mc->getArg(i)->getBeginLoc(), "argument " + std::to_string(i + 1) + " of " + method->getNameAsString() + " points at a " +
+                    m_class->getNameAsString() + " other than the caller", "pass `this`: on the GPU the caller's data are the only ones");
+      continue;
+    }
+    args.push_back(Expr(mc->getArg(i)));
+  }
   Type(mc->getType(), mc->getBeginLoc());  // declares a returned struct
   m_uses.virtualCalls.insert({field, method->getCanonicalDecl()});
   m_uses.virtualCallSites.push_back(mc);
@@ -643,6 +655,42 @@ const ValueDecl* GlslPrinter::ValueParamOf(const clang::Expr* e, bool pointerIts
     if (as->getIdx()->EvaluateAsInt(r, m_ctx) && r.Val.getInt() == 0) return ValueParamOf(as->getBase(), true);
   }
   return nullptr;
+}
+
+// `this->f` in the class this printer prints: an object's field (`self`), a member vector (a buffer),
+// a plain member (the class data), under the composed prefix.
+std::string GlslPrinter::SelfMember(const MemberExpr* me, const FieldDecl* field) {
+  if (auto it = renames.find(me->getMemberDecl()); it != renames.end()) return it->second;
+  if (!field) return Fail(me->getBeginLoc(), "member '" + me->getMemberDecl()->getNameAsString() + "' cannot be used here", "");
+  if (selfClass) {  // a method of an object the kernel reached through a virtual call: its data is `self`
+    if (!GlslTypeOf(field->getType()) || IsStdVector(field->getType()) || field->getType()->isPointerType())
+      return Fail(me->getBeginLoc(), "member '" + field->getNameAsString() + "' of " + selfClass->getNameAsString() + " cannot be copied to the GPU",
+                  "objects called through virtual functions hold plain data: scalars, LiteMath types and structs of them");
+    return "self." + SafeName(field->getNameAsString());
+  }
+  if (IsTextureArray(field->getType()))
+    return Fail(me->getBeginLoc(), "array of textures '" + field->getNameAsString() + "' used as a value in a kernel",
+                "call its textures where the array is a member: " + field->getNameAsString() + "[i].sample(uv), " +
+                field->getNameAsString() + "[i][p], " + field->getNameAsString() + "[i].width(), " + field->getNameAsString() + ".size()");
+  if (IsStdVector(field->getType())) {
+    m_uses.memberVectors.insert(field);
+    if (ispc) return IspcMember(field->getNameAsString());
+    return composedPrefix + field->getNameAsString();
+  }
+  if (IsImage2D(field->getType()))
+    return Fail(me->getBeginLoc(), "Image2D member '" + field->getNameAsString() + "' used as a value in a kernel",
+                "use its texels where the image is a member: " + field->getNameAsString() + "[p], at(x, y), sample(sampler, uv), " +
+                field->getNameAsString() + "[p] = v, set(x, y, v), width(), height()");
+  if (IsImageSampler(field->getType()))
+    return Fail(me->getBeginLoc(), "sampler member '" + field->getNameAsString() + "' used as a value in a kernel",
+                "pass it straight to an Image2D member's sample(" + field->getNameAsString() + ", uv)");
+  const bool ispcDouble = ispc && field->getType().getCanonicalType()->isSpecificBuiltinType(BuiltinType::Double);
+  if (field->getType()->isPointerType() || (!GlslTypeOf(field->getType()) && !ispcDouble))
+    return Fail(me->getBeginLoc(), "member '" + field->getNameAsString() + "' of type '" + field->getType().getAsString(m_ctx.getPrintingPolicy()) +
+                "' cannot be used in a kernel", "kernels may use plain data members and std::vector members");
+  m_uses.plainMembers.insert(field);
+  if (ispc) return IspcMember(field->getNameAsString());
+  return composedPrefix + field->getNameAsString();
 }
 
 std::string GlslPrinter::Expr(const clang::Expr* e) {
@@ -722,38 +770,10 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
       if (!field) return Fail(e->getBeginLoc(), "member function used as a value", "");
       return "self." + SafeName(field->getNameAsString());
     }
-    if (isa<CXXThisExpr>(base)) {
-      if (auto it = renames.find(me->getMemberDecl()); it != renames.end()) return it->second;
-      if (!field) return Fail(e->getBeginLoc(), "member '" + me->getMemberDecl()->getNameAsString() + "' cannot be used here", "");
-      if (selfClass) {  // a method of an object the kernel reached through a virtual call: its data is `self`
-        if (!GlslTypeOf(field->getType()) || IsStdVector(field->getType()) || field->getType()->isPointerType())
-          return Fail(e->getBeginLoc(), "member '" + field->getNameAsString() + "' of " + selfClass->getNameAsString() + " cannot be copied to the GPU",
-                      "objects called through virtual functions hold plain data: scalars, LiteMath types and structs of them");
-        return "self." + SafeName(field->getNameAsString());
-      }
-      if (IsTextureArray(field->getType()))
-        return Fail(e->getBeginLoc(), "array of textures '" + field->getNameAsString() + "' used as a value in a kernel",
-                    "call its textures where the array is a member: " + field->getNameAsString() + "[i].sample(uv), " +
-                    field->getNameAsString() + "[i][p], " + field->getNameAsString() + "[i].width(), " + field->getNameAsString() + ".size()");
-      if (IsStdVector(field->getType())) {
-        m_uses.memberVectors.insert(field);
-        if (ispc) return IspcMember(field->getNameAsString());
-        return composedPrefix + field->getNameAsString();
-      }
-      if (IsImage2D(field->getType()))
-        return Fail(e->getBeginLoc(), "Image2D member '" + field->getNameAsString() + "' used as a value in a kernel",
-                    "use its texels where the image is a member: " + field->getNameAsString() + "[p], at(x, y), sample(sampler, uv), " +
-                    field->getNameAsString() + "[p] = v, set(x, y, v), width(), height()");
-      if (IsImageSampler(field->getType()))
-        return Fail(e->getBeginLoc(), "sampler member '" + field->getNameAsString() + "' used as a value in a kernel",
-                    "pass it straight to an Image2D member's sample(" + field->getNameAsString() + ", uv)");
-      const bool ispcDouble = ispc && field->getType().getCanonicalType()->isSpecificBuiltinType(BuiltinType::Double);
-      if (field->getType()->isPointerType() || (!GlslTypeOf(field->getType()) && !ispcDouble))
-        return Fail(e->getBeginLoc(), "member '" + field->getNameAsString() + "' of type '" + field->getType().getAsString(m_ctx.getPrintingPolicy()) +
-                    "' cannot be used in a kernel", "kernels may use plain data members and std::vector members");
-      m_uses.plainMembers.insert(field);
-      if (ispc) return IspcMember(field->getNameAsString());
-      return composedPrefix + field->getNameAsString();
+    if (isa<CXXThisExpr>(base)) return SelfMember(me, field);
+    if (OwnerParamOf(base)) {  // scene->f: as the traversal prints this->f
+      if (ispc) return IspcFail(e->getBeginLoc(), "a member of the composed implementation read in an object's method");
+      return owner->SelfMember(me, field);
     }
     if (!field) return Fail(e->getBeginLoc(), "member function used as a value", "");
     if (IsLiteMathType(me->getBase()->getType(), "half4") || IsLiteMathType(me->getBase()->getType(), "half2"))

@@ -104,6 +104,19 @@ public:
   // read from the parameter `self` of type <Class>_Data, and its methods take `self` first.
   const clang::CXXRecordDecl* selfClass = nullptr;
 
+  // The composed implementation passed to an object's method (paper 3.10: a traversal's leaf
+  // call `m_geom[g]->Intersect(ray, info, hit, this)` with `Intersect(..., const BVHRT* scene)`),
+  // GlslOwner.cpp. In an object's printer: the traversal's printer. The parameter is left out of
+  // the GPU's functions, and what is read through it (scene->m_values[i], scene->Helper(...))
+  // prints as the traversal's own code does, under the traversal's prefix and in its Uses().
+  GlslPrinter* owner = nullptr;
+  // A parameter (or the type of one) pointing at the class this printer's `owner` prints, or, with
+  // no owner, at this printer's own class: an argument the GPU leaves out.
+  static bool PointsTo(clang::QualType t, const clang::CXXRecordDecl* cls);
+  bool IsOwnerParam(const clang::ParmVarDecl* p) const;
+  bool PassesSelf(const clang::ParmVarDecl* p, const clang::Expr* arg) const;  // `this` for such a parameter
+  const clang::CXXRecordDecl* Class() const { return m_class; }
+
   // ISPC instead of GLSL (the ISPC backend, IspcCode.cpp): LiteMath's type names, make_T(...)
   // constructors, C casts, references for inout parameters, members read through `self` (a pointer
   // to <Class>_Data, which the class's methods take first), and the built-ins of LiteMath.isph.
@@ -240,6 +253,11 @@ public:
   bool PointerIsValueOnly(const clang::FunctionDecl* fn, const clang::ParmVarDecl* p);
 
 private:
+  // A member of this printer's class as `this->f` prints (its prefix, its Uses); OwnerMember and
+  // OwnerCall print `scene->f` and `scene->Helper(...)` through the owner (GlslOwner.cpp).
+  std::string SelfMember(const clang::MemberExpr* me, const clang::FieldDecl* field);
+  const clang::ParmVarDecl* OwnerParamOf(const clang::Expr* e) const;
+  std::string OwnerCall(const clang::CXXMemberCallExpr* call);
   std::string ComposedCall(const clang::CXXMemberCallExpr* call);
   std::string VirtualCall(const clang::CXXMemberCallExpr* call);
   void NeedStruct(const clang::RecordDecl* rd);

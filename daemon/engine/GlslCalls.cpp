@@ -340,6 +340,8 @@ std::string GlslPrinter::Call(const CallExpr* call) {
     const clang::Expr* textureIndex = nullptr;
     if (auto* array = TextureElement(obj, &textureIndex))
       return ispc ? IspcTextureCall(array, textureIndex, mc) : TextureCall(array, textureIndex, mc);
+    // Calls of the traversal passed to an object's method: scene->Helper(...).
+    if (OwnerParamOf(obj)) return OwnerCall(mc);
     // Calls through a member holding an interface: composition.
     std::string composed = ComposedCall(mc);
     if (!composed.empty()) return composed;
@@ -362,10 +364,10 @@ std::string GlslPrinter::Call(const CallExpr* call) {
       }
       if (field && isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts())) {
         m_uses.memberVectors.insert(field);
-        if (name == "size") {
+        if (name == "size" || name == "empty") {
           m_uses.sizeReads.emplace(field, call->getBeginLoc());
-          if (ispc) return IspcMember(field->getNameAsString() + "_size");
-          return composedPrefix + field->getNameAsString() + "_size";
+          const std::string size = ispc ? IspcMember(field->getNameAsString() + "_size") : composedPrefix + field->getNameAsString() + "_size";
+          return name == "size" ? size : "(" + size + (ispc ? " == 0)" : " == 0u)");
         }
         if (ispc && name == "push_back" && call->getNumArgs() == 1 && composedPrefix.empty())
           return EmitAppend(field, call) + "(self, " + Expr(call->getArg(0)) + ")";

@@ -72,6 +72,8 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
         x.set("interface", lt->interfaceName);
         auto vm = std::find_if(model.virtuals.begin(), model.virtuals.end(), [&](const VirtualMember& v) { return v.member == lt->member; });
         x.set("interfaceType", vm != model.virtuals.end() ? vm->interfaceCpp : lt->interfaceName);
+        if (lt->leafBoxes.empty()) x.set("leafBoxes", false);
+        else x.set("leafBoxes", lt->leafBoxes);
         leafScenes.push_back(x);
       }
     }

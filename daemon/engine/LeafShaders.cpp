@@ -77,9 +77,13 @@ struct LoopEffects : WriteVisitor<LoopEffects> {
   void Note(SourceLocation loc, const std::string& what) {
     if (problem.empty()) { problem = what; where = loc; }
   }
+  std::vector<std::pair<const VarDecl*, SourceLocation>> outerWrites;  // every write to a variable declared before it
   void Written(const clang::Expr* target, SourceLocation loc) {
     const VarDecl* vd = WrittenVar(target);
-    if (vd && !inner.count(vd)) Note(loc, "it writes '" + vd->getNameAsString() + "', declared before the loop");
+    if (vd && !inner.count(vd)) {
+      Note(loc, "it writes '" + vd->getNameAsString() + "', declared before the loop");
+      outerWrites.push_back({vd, loc});
+    }
   }
   bool VisitVarDecl(VarDecl* vd) { inner.insert(vd); return true; }
   // Besides WriteVisitor's: non-const methods and non-const reference arguments.
@@ -97,6 +101,31 @@ struct LoopEffects : WriteVisitor<LoopEffects> {
   }
 };
 
+// Whether a statement of `fn`'s body after `loop` names `vd`.
+bool UsedAfter(const FunctionDecl* fn, const clang::Stmt* loop, const VarDecl* vd) {
+  struct Finder : RecursiveASTVisitor<Finder> {
+    const VarDecl* vd;
+    bool found = false;
+    bool VisitDeclRefExpr(DeclRefExpr* dr) {
+      found |= dr->getDecl() == vd;
+      return !found;
+    }
+  };
+  auto* body = dyn_cast_or_null<CompoundStmt>(fn->getBody());
+  if (!body) return false;
+  bool after = false;
+  for (const clang::Stmt* st : body->body()) {
+    if (after) {
+      Finder f;
+      f.vd = vd;
+      f.TraverseStmt(const_cast<clang::Stmt*>(st));
+      if (f.found) return true;
+    }
+    after |= st == loop;
+  }
+  return false;
+}
+
 // GLSL zero of a hit struct's field type (scalars, vectors and arrays of them), or "".
 std::string ZeroOf(QualType t) {
   t = t.getCanonicalType();
@@ -111,6 +140,19 @@ std::string ZeroOf(QualType t) {
   if (t->isRecordType() && !IsLiteMathType(t)) return "";
   auto g = GlslTypeOf(t);
   return g ? *g + "(0)" : "";
+}
+
+// The paper's leaf information (CrossRT.h's CRT_LeafInfo): its fields as the hardware knows them.
+std::string LeafInfoFrom(const CXXRecordDecl* info, const std::string& var) {
+  static const std::map<std::string, std::string> builtins = {
+      {"aabbId", "uint(gl_PrimitiveID)"},  {"primId", "uint(gl_PrimitiveID)"}, {"instId", "uint(gl_InstanceID)"},
+      {"geomId", "crt_element"},           {"rayxId", "gl_LaunchIDEXT.x"},     {"rayyId", "gl_LaunchIDEXT.y"}};
+  std::string out;
+  for (auto* f : info->fields()) {
+    auto known = builtins.find(f->getNameAsString());
+    out += "  " + var + "." + GlslPrinter::SafeName(f->getNameAsString()) + " = " + (known != builtins.end() ? known->second : ZeroOf(f->getType())) + ";\n";
+  }
+  return out;
 }
 
 // The interface method that gives a leaf's box corner on the host: public `name() const`, no
@@ -130,6 +172,19 @@ const CXXMethodDecl* BoxCorner(const CXXRecordDecl* interface, const std::string
   return nullptr;
 }
 
+// The composed implementation's public `std::vector<CRT_AABB> LeafBoxes(<integer>) const`, which gives
+// an element's leaf boxes on the host (the paper's form), or null.
+const CXXMethodDecl* LeafBoxesMethod(const CXXRecordDecl* impl) {
+  for (auto* d : impl->lookup(&impl->getASTContext().Idents.get("LeafBoxes")))
+    if (auto* md = dyn_cast<CXXMethodDecl>(d); md && md->isConst() && md->getAccess() == AS_public && md->getNumParams() == 1 &&
+                                                md->getParamDecl(0)->getType()->isIntegerType()) {
+      QualType element;
+      auto* box = IsStdVector(md->getReturnType(), &element) ? element->getAsCXXRecordDecl() : nullptr;
+      if (box && box->getName() == "CRT_AABB") return md;
+    }
+  return nullptr;
+}
+
 // One leaf call of a composed traversal (listing 2 of the paper):
 //   for (...) if (<box test>) m_shapes[i]->Intersect(posAndNear, dirAndFar, i, hit);
 // The ray tracing hardware can run its loop when the call has the fixed form the paper gives
@@ -139,7 +194,7 @@ const CXXMethodDecl* BoxCorner(const CXXRecordDecl* interface, const std::string
 // (its vector and method, shared by other calls of both) joins `sites`, and its intersection,
 // closest-hit and miss shaders join `shaders`. Returns why not, or "".
 std::string TraceLeafCall(ASTContext& ctx, Reporter& rep, const ClassModel& model, const Composition& comp, const CXXRecordDecl* implClass,
-                          const CXXMemberCallExpr* call, GlslPrinter& hardware, std::vector<LeafTraversal>& sites, std::vector<GlslDecl>& payloads,
+                          const std::string& kernel, const CXXMemberCallExpr* call, GlslPrinter& hardware, std::vector<LeafTraversal>& sites, std::vector<GlslDecl>& payloads,
                           std::vector<StageShader>& shaders) {
   SourceManager& sm = ctx.getSourceManager();
   auto at = [&](SourceLocation loc) {
@@ -156,24 +211,35 @@ std::string TraceLeafCall(ASTContext& ctx, Reporter& rep, const ClassModel& mode
   const LeafSite leaf = FindLeafSite(ctx, call);
   if (!leaf.fn || !isa<ForStmt, WhileStmt, DoStmt, CXXForRangeStmt>(leaf.loop))
     return "the leaf call " + callText + " (" + site + ") is not inside a loop of the traversal's body";
-  // The trace visits every leaf once: the loop must say so, `for (T i = 0; i < count; ++i)` whose
-  // body is the call, perhaps behind a test (the leaf's box test, which the hardware does instead).
-  const VarDecl* loopVar = LeafLoopVariable(ctx, leaf.loop, call);
-  if (!loopVar)
+  // Two forms. The paper's (listing 2): a CRT_LeafInfo among the arguments, the call anywhere in the
+  // traversal's loop, whose whole walk the hardware does over each element's leaf boxes. Or a loop
+  // over all leaves, one per element, `for (T i = 0; i < count; ++i) [if (box test)] call;`.
+  const unsigned n = method->getNumParams();
+  int infoIndex = -1;
+  for (unsigned i = 0; i < n; ++i)
+    if (auto* rd = method->getParamDecl(i)->getType().getNonReferenceType()->getAsCXXRecordDecl(); rd && rd->getName() == "CRT_LeafInfo") infoIndex = int(i);
+  const bool paperForm = infoIndex >= 0;
+  const VarDecl* loopVar = paperForm ? nullptr : LeafLoopVariable(ctx, leaf.loop, call);
+  if (!paperForm && !loopVar)
     return "the loop calling " + callText + " (" + site + ") is not 'for (i = 0; i < count; ++i) [if (box test)] " + method->getNameAsString() +
-           "(...);', which visits every leaf once as the hardware does";
+           "(...);', which visits every leaf once as the hardware does, and the call passes no CRT_LeafInfo (the paper's form, whose traversal the hardware replaces)";
   LoopEffects effects(call);
   effects.TraverseStmt(const_cast<clang::Stmt*>(leaf.loop));
-  if (!effects.problem.empty()) return "the loop calling " + callText + " does more than visit leaves: " + effects.problem + " (" + at(effects.where) + ")";
+  if (!paperForm && !effects.problem.empty())
+    return "the loop calling " + callText + " does more than visit leaves: " + effects.problem + " (" + at(effects.where) + ")";
 
-  // The call's form: (float4 ray origin and near, float4 direction and far, leaf index or constants..., Hit& hit).
-  const unsigned n = method->getNumParams();
+  // The call's form: (float4 ray origin and near, float4 direction and far, ..., Hit& hit, ...): the
+  // hit is the last parameter, or in the paper's form the one written back that is not the info.
   auto isFloat4 = [](QualType t) { return GlslTypeOf(t.getNonReferenceType().getUnqualifiedType()).value_or("") == "vec4"; };
-  const QualType hitParam = n ? method->getParamDecl(n - 1)->getType() : QualType();
-  const auto* hitRecord = n ? hitParam.getNonReferenceType()->getAsCXXRecordDecl() : nullptr;
-  const std::string form = "(float4 posAndNear, float4 dirAndFar, [leaf index or constants,] Hit& hit)";
-  if (n < 3 || !isFloat4(method->getParamDecl(0)->getType()) || !isFloat4(method->getParamDecl(1)->getType()) || !WrittenBack(method, n - 1) ||
-      !hitRecord || hitRecord->isPolymorphic() || !method->getReturnType()->isVoidType())
+  int hitIndex = paperForm ? -1 : int(n) - 1;
+  for (unsigned i = 2; paperForm && i < n; ++i)
+    if (int(i) != infoIndex && WrittenBack(method, i) && method->getParamDecl(i)->getType().getNonReferenceType()->isRecordType()) hitIndex = int(i);
+  const QualType hitParam = hitIndex >= 0 ? method->getParamDecl(unsigned(hitIndex))->getType() : QualType();
+  const auto* hitRecord = hitIndex >= 0 ? hitParam.getNonReferenceType()->getAsCXXRecordDecl() : nullptr;
+  const std::string form = paperForm ? "(float4 posAndNear, float4 dirAndFar, CRT_LeafInfo info, Hit& hit, [const Traversal* or constants])"
+                                     : "(float4 posAndNear, float4 dirAndFar, [leaf index or constants,] Hit& hit)";
+  if (n < 3 || !isFloat4(method->getParamDecl(0)->getType()) || !isFloat4(method->getParamDecl(1)->getType()) || hitIndex < 0 ||
+      !WrittenBack(method, unsigned(hitIndex)) || !hitRecord || hitRecord->isPolymorphic() || !method->getReturnType()->isVoidType())
     return callText + " does not have the form of an intersection function, void " + method->getNameAsString() + form;
   const FieldDecl* distance = hitRecord->field_empty() ? nullptr : *hitRecord->field_begin();
   if (!distance || !distance->getType()->isSpecificBuiltinType(BuiltinType::Float))
@@ -190,29 +256,42 @@ std::string TraceLeafCall(ASTContext& ctx, Reporter& rep, const ClassModel& mode
     zeroHit += "  hit." + GlslPrinter::SafeName(f->getNameAsString()) + " = " + zero + ";\n";
   }
   // Arguments: the ray and the hit as the traversal has them before the loop; the index as the leaf.
-  if (NamedVar(indexExpr) != loopVar)
+  if (!paperForm && NamedVar(indexExpr) != loopVar)
     return callText + " picks its object with an expression, not the loop's variable: the hardware names a leaf by its element's position";
   auto outer = [&](const clang::Expr* e) {
     const VarDecl* vd = NamedVar(e);
     return vd && vd->isLocalVarDeclOrParm() && !effects.inner.count(vd) ? vd : nullptr;
   };
-  if (!outer(call->getArg(0)) || !outer(call->getArg(1)) || !outer(call->getArg(n - 1)))
+  const VarDecl* hitVar = outer(call->getArg(unsigned(hitIndex)));
+  if (!outer(call->getArg(0)) || !outer(call->getArg(1)) || !hitVar)
     return "the ray and the hit " + callText + " takes must be variables of the traversal declared before the loop";
-  // In the intersection shader, the leaf's index is its instance's: one instance per element, in order.
+  // The paper's form: what the walk computes besides the hit is the hardware's, and no use of it may follow.
+  for (auto& [vd, loc] : effects.outerWrites)
+    if (paperForm && vd != hitVar && UsedAfter(leaf.fn, leaf.loop, vd))
+      return "the traversal's loop writes '" + vd->getNameAsString() + "' (" + at(loc) + "), read after it: the hardware's walk gives only the hit";
+  // The other arguments, in the intersection shader: the leaf's index is its instance's (one instance
+  // per element, in order); the info is the hardware's; the traversal itself (`this`) is left out.
   GlslPrinter literals(ctx, implClass, rep);
-  std::vector<std::string> leafArgs;
-  for (unsigned i = 2; i + 1 < n; ++i) {
+  std::vector<std::string> args;
+  for (unsigned i = 0; i < n; ++i) {
     const clang::Expr* arg = call->getArg(i)->IgnoreParenImpCasts();
     auto type = GlslTypeOf(method->getParamDecl(i)->getType().getNonReferenceType().getUnqualifiedType());
-    if (NamedVar(arg) == loopVar && type) leafArgs.push_back(*type + "(gl_InstanceID)");
-    else if (isa<IntegerLiteral, FloatingLiteral, CXXBoolLiteralExpr>(arg) && type) leafArgs.push_back(*type + "(" + literals.Expr(arg) + ")");
-    else return "argument " + std::to_string(i + 1) + " of " + callText + " is neither the leaf's index nor a constant";
+    if (i == 0) args.push_back(paperForm ? "vec4(gl_ObjectRayOriginEXT, gl_RayTminEXT)" : "vec4(gl_WorldRayOriginEXT, gl_RayTminEXT)");
+    else if (i == 1) args.push_back(paperForm ? "vec4(gl_ObjectRayDirectionEXT, gl_RayTmaxEXT)" : "vec4(gl_WorldRayDirectionEXT, gl_RayTmaxEXT)");
+    else if (int(i) == infoIndex) args.push_back("crt_info");
+    else if (int(i) == hitIndex) args.push_back("hit");
+    else if (GlslPrinter::PointsTo(method->getParamDecl(i)->getType(), implClass) && isa<CXXThisExpr>(arg)) continue;
+    else if (!paperForm && NamedVar(arg) == loopVar && type) args.push_back(*type + "(gl_InstanceID)");
+    else if (isa<IntegerLiteral, FloatingLiteral, CXXBoolLiteralExpr>(arg) && type) args.push_back(*type + "(" + literals.Expr(arg) + ")");
+    else return "argument " + std::to_string(i + 1) + " of " + callText + " is neither " + (paperForm ? "`this`" : "the leaf's index") + " nor a constant";
   }
   QualType element;
   IsStdVector(field->getType(), &element);
   const CXXRecordDecl* interface = PolymorphicPointee(element);  // the elements' (the method may be a base's)
-  const CXXMethodDecl *boxMin = BoxCorner(interface, "BoxMin"), *boxMax = BoxCorner(interface, "BoxMax");
-  if (!boxMin || !boxMax)
+  if (paperForm && !LeafBoxesMethod(implClass))
+    return comp.implName + " declares no public 'std::vector<CRT_AABB> LeafBoxes(uint32_t geomId) const': the hardware needs the boxes of each element of " +
+           vm->display + " (its leaves, in the order of CRT_LeafInfo::aabbId)";
+  if (!paperForm && (!BoxCorner(interface, "BoxMin") || !BoxCorner(interface, "BoxMax")))
     return interface->getNameAsString() + " declares no public BoxMin() const and BoxMax() const (float3 or float4), nor inherits them: the hardware needs each leaf's box";
 
   // The site: a vector and a method. Its traces start their hit groups after the earlier sites' (the
@@ -228,6 +307,7 @@ std::string TraceLeafCall(ASTContext& ctx, Reporter& rep, const ClassModel& mode
     lt.interfaceName = interface->getNameAsString();
     lt.method = methodName;
     lt.traversal = comp.implName + "::" + leaf.fn->getNameAsString();
+    if (paperForm) lt.leafBoxes = "crt_" + comp.holder + "()->LeafBoxes";
     lt.missIndex = unsigned(sites.size());
     for (auto& s : sites) lt.firstHitGroup += unsigned(s.intersectionShaders.size());
     if (lt.firstHitGroup > 15)
@@ -237,7 +317,7 @@ std::string TraceLeafCall(ASTContext& ctx, Reporter& rep, const ClassModel& mode
     lt = *known;
   }
   const std::string payload = member + "_" + methodName + "_hit", scene = member + "_leaves";
-  const std::string p = hardware.Expr(call->getArg(0)), d = hardware.Expr(call->getArg(1)), h = hardware.Expr(call->getArg(n - 1));
+  const std::string p = hardware.Expr(call->getArg(0)), d = hardware.Expr(call->getArg(1)), h = hardware.Expr(call->getArg(unsigned(hitIndex)));
   const std::string t = h + "." + GlslPrinter::SafeName(distance->getNameAsString()), number = std::to_string(lt.missIndex);
   // The trace (templates/glsl/leaf_trace.glsl.mustache) stands where the loop was.
   Data trace;
@@ -258,7 +338,7 @@ std::string TraceLeafCall(ASTContext& ctx, Reporter& rep, const ClassModel& mode
   hardware.replacedStatements[leaf.loop] = Render(model.templateDir + "/glsl/leaf_trace.glsl.mustache", trace);
   const std::string hitType = *hardware.Type(hitParam.getNonReferenceType().getUnqualifiedType(), call->getBeginLoc());
   if (fresh)
-    payloads.push_back({payload, "// The hit the leaves' intersection shaders report to (" + callText + "'s last argument)\nlayout(location = " +
+    payloads.push_back({payload, "// The hit the leaves' intersection shaders report to ('" + hitVar->getNameAsString() + "', passed to " + callText + ")\nlayout(location = " +
                                      number + ") rayPayloadEXT " + hitType + " " + payload + ";\n"});
 
   // A shader per name: another call (of this kernel or another) may already have it, from the same code.
@@ -278,16 +358,22 @@ std::string TraceLeafCall(ASTContext& ctx, Reporter& rep, const ClassModel& mode
   for (const VirtualImpl& vi : vm->impls) {
     auto impl = std::find_if(impls.begin(), impls.end(), [&](const CXXRecordDecl* r) { return r->getNameAsString() == vi.name; });
     if (impl == impls.end()) return vi.name + " is not defined where the traversal is";
-    const std::string name = member + "_" + vi.name + "_" + methodName;
-    lt.intersectionShaders.push_back(name);
     GlslPrinter object(ctx, *impl, rep);
     object.selfClass = *impl;
     object.composedPrefix = vi.name + "_";
+    GlslPrinter traversal(ctx, implClass, rep);  // what the object reads through `this` of the traversal
+    traversal.composedPrefix = hardware.composedPrefix;
+    object.owner = &traversal;
     for (auto& sn : ClassStructNames(model)) object.predeclaredStructs.insert(sn);
     const std::string function = ImplementationMethod(rep, object, *impl, method, call->getBeginLoc());
     if (function.empty()) return "the GPU has no body of " + vi.name + "::" + methodName;  // reported
     object.Type(hitParam.getNonReferenceType().getUnqualifiedType(), call->getBeginLoc());
     StageShader s;
+    for (auto* f : traversal.Uses().memberVectors) s.buffers.push_back(hardware.composedPrefix + f->getNameAsString());
+    // Bound as its kernel binds them: a shader reading the traversal's buffers is the kernel's own.
+    const std::string name = (s.buffers.empty() ? "" : kernel + "_") + member + "_" + vi.name + "_" + methodName;
+    if (!s.buffers.empty()) s.kernel = kernel;
+    lt.intersectionShaders.push_back(name);
     s.name = name;
     s.stage = "rint";
     s.origin = vi.name + "::" + methodName;
@@ -300,15 +386,23 @@ std::string TraceLeafCall(ASTContext& ctx, Reporter& rep, const ClassModel& mode
     s.structs += TagsReference(model, *vm).text + "\n" + ImplDataStruct(model, object, *impl, *vm, vi).text + "\n" + ObjectsReference(model, *vm, vi).text + "\n" +
                  "hitAttributeEXT " + hitType + " crt_hit;  // what the closest-hit shader receives\n";
     for (auto& x : object.Functions()) s.functions += x + "\n";
-    std::string args = "self, vec4(gl_WorldRayOriginEXT, gl_RayTminEXT), vec4(gl_WorldRayDirectionEXT, gl_RayTmaxEXT)";
-    for (auto& a : leafArgs) args += ", " + a;
+    std::string callArgs = "self";
+    for (auto& a : args) callArgs += ", " + a;
     const std::string dist = GlslPrinter::SafeName(distance->getNameAsString());
-    s.mainBody = "  // The leaf is element gl_InstanceID of " + vm->display + " (one instance per element, in order).\n"
-                 "  const uvec2 tag = " + member + "_Tags(" + member + "_tags).tags[gl_InstanceID];\n"
-                 "  const " + vi.name + "_Data self = " + member + "_" + vi.name + "Objects(" + member + "_" + vi.name + ").objects[tag.y];\n"
+    std::string leafInfo;
+    if (paperForm) {
+      const auto* info = method->getParamDecl(unsigned(infoIndex))->getType().getNonReferenceType()->getAsCXXRecordDecl();
+      leafInfo = "  // What the traversal would tell the leaf: its box, the instance, the element (geometry), the ray.\n  " + *object.Type(QualType(info->getTypeForDecl(), 0), call->getBeginLoc()) +
+                 " crt_info;\n" + LeafInfoFrom(info, "crt_info");
+    }
+    s.mainBody = (paperForm ? "  // The leaf is box gl_PrimitiveID of element gl_InstanceCustomIndexEXT of " + vm->display +
+                                  " (an instance per element over its LeafBoxes).\n  const uint crt_element = uint(gl_InstanceCustomIndexEXT);\n"
+                            : "  // The leaf is element gl_InstanceID of " + vm->display + " (one instance per element, in order).\n") +
+                 "  const uvec2 tag = " + member + "_Tags(" + member + "_tags).tags[" + (paperForm ? "crt_element" : "gl_InstanceID") + "];\n"
+                 "  const " + vi.name + "_Data self = " + member + "_" + vi.name + "Objects(" + member + "_" + vi.name + ").objects[tag.y];\n" + leafInfo +
                  "  // Nearer than the ray's end (the nearest hit so far) or nothing: the other fields start at zero.\n"
                  "  " + hitType + " hit;\n" + zeroHit + "  hit." + dist + " = gl_RayTmaxEXT;\n"
-                 "  " + function + "(" + args + ", hit);\n"
+                 "  " + function + "(" + callArgs + ");\n"
                  "  if (hit." + dist + " < gl_RayTmaxEXT)\n  {\n    crt_hit = hit;\n"
                  "    reportIntersectionEXT(hit." + dist + ", 0u);\n  }\n";
     if (!addShader(s)) return "another leaf call of " + callText + " passes other arguments (" + site + ")";
@@ -353,7 +447,7 @@ void AnalyzeLeafTraversal(ASTContext& ctx, Reporter& rep, ClassModel& model, Ker
   std::vector<GlslDecl> payloads;
   std::vector<StageShader> shaders;
   for (const CXXMemberCallExpr* call : printer.Uses().virtualCallSites)
-    if (std::string why = TraceLeafCall(ctx, rep, model, comp, implClass, call, hardware, sites, payloads, shaders); !why.empty()) {
+    if (std::string why = TraceLeafCall(ctx, rep, model, comp, implClass, k.name, call, hardware, sites, payloads, shaders); !why.empty()) {
       k.whyNoLeafShaders = why;
       return;
     }

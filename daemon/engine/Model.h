@@ -112,6 +112,10 @@ struct LeafTraversal {
   std::string interfaceName;  // IShape
   std::string method;         // Intersect
   std::string traversal;      // ShapeScene::Trace
+  // The paper's form (the call passes a CRT_LeafInfo): the hardware walks each element's leaf boxes,
+  // which this host call gives (crt_m_scene()->LeafBoxes(i)); else "": an element is a leaf, its box
+  // from the interface's BoxMin() and BoxMax().
+  std::string leafBoxes;
   std::vector<std::string> intersectionShaders;  // per class, in the tags' order: hit group firstHitGroup + i is class i
   std::string closestHitShader, missShader;
   unsigned firstHitGroup = 0;  // its traces' SBT record offset
@@ -294,6 +298,10 @@ struct StageShader {
   std::string description;            // what it is, for its header comment
   bool scalarLayout = false;          // the class's objects need GL_EXT_scalar_block_layout
   bool classData = false;             // it reads the class-data block (binding 0): where the objects are
+  // Buffers of a composed traversal it reads (an object's method reading them through `this` of the
+  // traversal, GlslOwner.cpp), bound as kernel `kernel` binds them.
+  std::vector<std::string> buffers;
+  std::string kernel;
   std::string constants, structs, functions;  // the implementation's code and the payload, in GLSL order
   std::string mainBody;               // loads the object, calls the implementation, stores the result
 };

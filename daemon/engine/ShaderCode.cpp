@@ -403,10 +403,32 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
 // shader (a callable, intersection, closest-hit or miss shader).
 std::string StageGlsl(const ClassModel& model, const StageShader& c, const GenerateOptions& opt) {
   Data d = Common(model, opt);
+  // The traversal's buffers it reads, at the bindings its kernel gives them (KernelGlsl: the pointer
+  // parameters from 1, then the member vectors).
+  Data buffers = List();
+  bool scalar = c.scalarLayout;
+  auto k = std::find_if(model.kernels.begin(), model.kernels.end(), [&](const Kernel& x) { return x.name == c.kernel; });
+  for (const std::string& v : c.buffers) {
+    if (k == model.kernels.end()) break;
+    auto at = std::find(k->memberVectors.begin(), k->memberVectors.end(), v);
+    if (at == k->memberVectors.end()) continue;
+    const Member* m = FindMember(model, v);
+    const auto pointers = std::count_if(k->params.begin(), k->params.end(), [](const KernelParam& p) { return p.isPointer; });
+    Data b;
+    b.set("layout", m && m->scalarLayout ? "scalar" : "std430");
+    scalar |= m && m->scalarLayout;
+    b.set("binding", std::to_string(1 + pointers + (at - k->memberVectors.begin())));
+    b.set("blockName", GlslPrinter::SafeName(v + "Buffer"));
+    b.set("type", m ? m->glslType : "float");
+    b.set("name", v);
+    b.set("comment", m && !m->composedFrom.empty() ? "composed: std::vector " + m->composedFrom : "member std::vector " + v);
+    buffers.push_back(b);
+  }
+  d.set("buffers", buffers);
   d.set("name", c.name);
   d.set("origin", c.origin);
   d.set("description", c.description);
-  d.set("scalarLayout", c.scalarLayout);
+  d.set("scalarLayout", scalar);
   d.set("bufferReferences", c.stage == "rcall" || c.stage == "rint");  // they reach the objects through them
   d.set("classStructs", c.stage == "rmiss" ? std::string() : model.glslClassStructs);
   d.set("hasClassData", c.classData);

@@ -89,6 +89,7 @@ bool WrittenBack(const CXXMethodDecl* m, unsigned i) {
 std::string DispatcherParams(GlslPrinter& printer, const CXXMethodDecl* m) {
   std::string out;
   for (unsigned i = 0; i < m->getNumParams(); ++i) {
+    if (GlslPrinter::PointsTo(m->getParamDecl(i)->getType(), printer.Class())) continue;  // the caller, left out (GlslOwner.cpp)
     std::string declared = printer.Declare(m->getParamDecl(i)->getType(), CallArgumentName(m, i), m->getParamDecl(i)->getLocation());
     if (WrittenBack(m, i) && printer.ispc) declared.insert(declared.rfind(' ') + 1, "&");  // ISPC: a reference
     else if (WrittenBack(m, i)) declared = "inout " + declared;

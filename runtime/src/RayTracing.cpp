@@ -214,6 +214,49 @@ void RayTracingScene::BuildLeaves(const std::vector<LeafBox>& leaves, const std:
   BuildLevels(pending, scratchBytes, records);
 }
 
+void RayTracingScene::BuildBoxGeometries(const std::vector<BoxGeometry>& geometries, const std::string& what) {
+  if (!ctx_) throw Error("crossrt::RayTracingScene::BuildBoxGeometries on a scene without a context");
+  if (geometries.size() >= (1u << 24)) throw Error("crossrt::RayTracingScene: " + what + " has more geometries than 24-bit instance ids name");
+  for (size_t g = 0; g < geometries.size(); ++g) {
+    CheckLeafBoxes(geometries[g].boxes, what + "[" + std::to_string(g) + "]'s leaf");
+    if (geometries[g].hitGroup >= (1u << 24))
+      throw Error("crossrt::RayTracingScene: the hit group of " + what + "[" + std::to_string(g) + "] does not fit the 24-bit record offset");
+  }
+  Release();
+  const VulkanContext& vk = *ctx_;
+  VkDeviceSize scratchBytes = 0;
+  std::vector<PendingLevel> pending;
+  std::vector<VkAccelerationStructureInstanceKHR> records;
+  for (size_t g = 0; g < geometries.size(); ++g) {
+    const std::vector<LeafBox>& boxes = geometries[g].boxes;
+    if (boxes.empty()) continue;  // no bottom level, no instance: never hit
+    std::vector<VkAabbPositionsKHR> aabbs(boxes.size());
+    for (size_t i = 0; i < boxes.size(); ++i)
+      aabbs[i] = {boxes[i].min[0], boxes[i].min[1], boxes[i].min[2], boxes[i].max[0], boxes[i].max[1], boxes[i].max[2]};
+    Buffer input(ctx_, sizeof(VkAabbPositionsKHR) * aabbs.size(), VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR);
+    input.Upload(aabbs.data(), sizeof(VkAabbPositionsKHR) * aabbs.size());
+    auto geometry = VkInit<VkAccelerationStructureGeometryKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR);
+    geometry.geometryType = VK_GEOMETRY_TYPE_AABBS_KHR;
+    geometry.flags = VK_GEOMETRY_OPAQUE_BIT_KHR;  // no any-hit shaders: the intersection shader's report commits
+    geometry.geometry.aabbs = VkInit<VkAccelerationStructureGeometryAabbsDataKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_AABBS_DATA_KHR);
+    geometry.geometry.aabbs.data.deviceAddress = input.Address();
+    geometry.geometry.aabbs.stride = sizeof(VkAabbPositionsKHR);
+    pending.push_back(Prepare(geometry, static_cast<uint32_t>(aabbs.size()), scratchBytes));
+    pending.back().input = std::move(input);
+    auto addressInfo = VkInit<VkAccelerationStructureDeviceAddressInfoKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_DEVICE_ADDRESS_INFO_KHR);
+    addressInfo.accelerationStructure = bottomLevels_.back().handle;
+    VkAccelerationStructureInstanceKHR r{};
+    for (int a = 0; a < 3; ++a) r.transform.matrix[a][a] = 1.0f;
+    r.instanceCustomIndex = static_cast<uint32_t>(g);
+    r.mask = 0xFF;
+    r.instanceShaderBindingTableRecordOffset = geometries[g].hitGroup;
+    r.flags = VK_GEOMETRY_INSTANCE_FORCE_OPAQUE_BIT_KHR;
+    r.accelerationStructureReference = vk.vkGetAccelerationStructureDeviceAddressKHR(vk.device, &addressInfo);
+    records.push_back(r);
+  }
+  BuildLevels(pending, scratchBytes, records);
+}
+
 void RayTracingScene::BuildLevels(std::vector<PendingLevel>& pending, VkDeviceSize scratchBytes,
                                   const std::vector<VkAccelerationStructureInstanceKHR>& records) {
   const VulkanContext& vk = *ctx_;

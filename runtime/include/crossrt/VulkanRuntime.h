@@ -383,6 +383,16 @@ public:
   };
   void BuildLeaves(const std::vector<LeafBox>& leaves, const std::string& what);
   static void CheckLeafBoxes(const std::vector<LeafBox>& leaves, const std::string& what);  // BuildLeaves' check, alone
+
+  // Leaves of a traversal in the paper's form (listing 2: Intersect(ray, CRT_LeafInfo, hit, ...)
+  // per leaf box of a geometry): a bottom level per geometry over its boxes (gl_PrimitiveID is the
+  // box's index), and an instance of it, untransformed, whose custom index is the geometry's index
+  // and whose record offset is its hit group. A geometry without boxes has no instance: never hit. Throws on boxes with NaN or min > max, naming `what`.
+  struct BoxGeometry {
+    std::vector<LeafBox> boxes;  // their hitGroup is not used
+    uint32_t hitGroup = 0;
+  };
+  void BuildBoxGeometries(const std::vector<BoxGeometry>& geometries, const std::string& what);
   bool Empty() const { return topLevel_ == VK_NULL_HANDLE; }
   VkAccelerationStructureKHR TopLevel() const { return topLevel_; }
 

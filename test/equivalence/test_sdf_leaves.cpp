@@ -1,0 +1,119 @@
+// The paper's listing 2 over signed distance fields (SdfLeafTracer.h): a traversal that calls
+// m_geom[info.geomId]->Intersect(ray, info, hit, this) at each leaf, with a class per
+// representation (grid, SVS, SBS) reading the traversal's buffers through `this`. The original,
+// _CPU and _Vulkan (the switch over the field's class; at level 3, on a device with ray tracing
+// pipelines, the intersection shaders) must find the same fields at the same distances.
+#include "SdfLeafTracer.h"
+#include "SdfLeafTracer_CPU.h"
+#include "SdfLeafTracer_Vulkan.h"
+#include "TestSupport.h"
+
+#include <cmath>
+#include <random>
+
+using LiteMath::float3;
+using LiteMath::float4;
+
+namespace
+{
+// A sphere as a grid, a torus as an SVS, a rounded box as an SBS, side by side along x, each in a
+// cube of edge 2 (16^3 voxels).
+std::shared_ptr<SdfLeafScene> ThreeFields()
+{
+  auto scene = std::make_shared<SdfLeafScene>();
+  const litesdf::SdfSphere sphere(float3(-2.5f, 0.0f, 0.0f), 0.7f);
+  const litesdf::SdfTorus torus(float3(0.0f, 0.0f, 0.0f), 0.6f, 0.25f);
+  const litesdf::SdfRoundedBox box(float3(2.5f, 0.0f, 0.0f), float3(0.5f, 0.4f, 0.6f), 0.15f);
+  scene->AddGrid(litesdf::BuildGrid(sphere, float3(-3.5f, -1.0f, -1.0f), 2.0f, 17), 4);
+  scene->AddSVS(litesdf::BuildSVS(torus, float3(-1.0f, -1.0f, -1.0f), 2.0f, 4, 4));
+  scene->AddSBS(litesdf::BuildSBS(box, float3(1.5f, -1.0f, -1.0f), 2.0f, 4, 2, 4));
+  scene->Commit();
+  return scene;
+}
+}  // namespace
+
+TEST_CASE("Intersection functions of SDF representations reach the traversal's data through `this` (paper 3.10)", "[equivalence][composition][sdf]")
+{
+  auto scene = ThreeFields();
+  REQUIRE(scene->m_geom.size() == 3);
+  for (uint32_t g = 0; g < 3; ++g)
+    REQUIRE(!scene->LeafBoxes(g).empty());
+  // Rays from in front (z = 4) towards the fields, some past them.
+  const int n = 3000;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<float4> origins(n), dirs(n);
+  for (int i = 0; i < n; ++i)
+  {
+    origins[i] = float4(4.0f * u(rng), 1.2f * u(rng), 4.0f, 0.0f);
+    const float3 d = LiteMath::normalize(float3(0.1f * u(rng), 0.1f * u(rng), -1.0f));
+    dirs[i] = float4(d.x, d.y, d.z, 100.0f);
+  }
+  SdfLeafTracer original;
+  original.SetScene(scene);
+  std::vector<CRT_Hit> expected(n);
+  original.Trace(n, origins.data(), dirs.data(), expected.data());
+  // The original itself: each field is hit, near its analytic surface, and some rays miss.
+  {
+    const float4 o(-2.5f, 0.0f, 4.0f, 0.0f), d(0.0f, 0.0f, -1.0f, 100.0f);
+    CRT_Hit h;
+    original.Trace(1, &o, &d, &h);
+    REQUIRE(h.geomId == 0u);
+    REQUIRE(std::fabs(h.t - (4.0f - 0.7f)) < 0.01f);  // the grid's cells are 0.125
+    REQUIRE(h.coords[2] > 0.99f);                       // the normal faces the ray
+  }
+  int perField[3] = {0, 0, 0}, misses = 0;
+  for (const CRT_Hit& h : expected)
+    if (h.geomId == ~0u)
+      ++misses;
+    else
+      ++perField[h.geomId];
+  for (int g = 0; g < 3; ++g)
+    REQUIRE(perField[g] > n / 40);
+  REQUIRE(misses > n / 10);
+
+  auto ctx = ValidatedContext();
+  auto cpu = CreateSdfLeafTracer_CPU();
+  std::shared_ptr<SdfLeafTracer_Vulkan> gpu = ctx ? std::make_shared<SdfLeafTracer_Vulkan>(ctx) : nullptr;
+  struct Run
+  {
+    const char* name;
+    SdfLeafTracer* tracer;
+    bool intersectionShaders;
+  };
+  std::vector<Run> runs = {{"CPU", cpu.get(), false}};
+  if (gpu && ctx->hasRayTracingPipeline)
+    runs.push_back({"Vulkan, intersection shaders", gpu.get(), true});
+  if (gpu)
+    runs.push_back({"Vulkan, switch", gpu.get(), false});
+  for (const Run& run : runs)
+  {
+    INFO(run.name);
+    if (run.tracer == gpu.get())
+      gpu->UseRayTracingPipelines(run.intersectionShaders);
+    run.tracer->SetScene(scene);
+    run.tracer->CommitDeviceData();
+    std::vector<CRT_Hit> hits(n);
+    run.tracer->Trace(n, origins.data(), dirs.data(), hits.data());
+    int same = 0;
+    for (int i = 0; i < n; ++i)
+    {
+      if (hits[i].geomId != expected[i].geomId)
+        continue;  // a ray grazing a field may tip over its edge
+      ++same;
+      INFO("ray " << i);
+      if (hits[i].geomId == ~0u)
+        continue;
+      // Tolerance: the GPU's fused and reordered float arithmetic in the Newton iterations.
+      REQUIRE(std::fabs(hits[i].t - expected[i].t) <= 1e-4f * expected[i].t);
+      REQUIRE(std::fabs(hits[i].coords[0] - expected[i].coords[0]) + std::fabs(hits[i].coords[1] - expected[i].coords[1]) +
+                  std::fabs(hits[i].coords[2] - expected[i].coords[2]) <=
+              2e-3f);
+      if (!run.intersectionShaders)
+        REQUIRE(hits[i].primId == expected[i].primId);  // of two equally near leaves the hardware may pick either
+    }
+    REQUIRE(same >= n - n / 200);
+  }
+  if (ctx)
+    RequireNoValidationMessages(ctx);
+}
