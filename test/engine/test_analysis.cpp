@@ -632,6 +632,127 @@ TEST_CASE("Level 3: a composed traversal's leaf calls become intersection shader
   }
 }
 
+namespace
+{
+// The paper's form of listing 2: the traversal walks its own boxes and calls Intersect with a
+// CRT_LeafInfo and itself; the object reads the traversal's values through it.
+const char* kPaperLeafHeader = R"(#pragma once
+#include "CrossRT.h"
+#include "LiteMath.h"
+#include <cstdint>
+#include <memory>
+#include <vector>
+struct World;
+struct IThing {
+  virtual ~IThing() = default;
+  virtual void Intersect(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar, CRT_LeafInfo info, CRT_Hit& hit, const World* world) const = 0;
+};
+struct Slab : IThing {
+  float scale = 1.0f;
+  void Intersect(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar, CRT_LeafInfo info, CRT_Hit& hit, const World* world) const override;
+};
+struct IWorld { virtual ~IWorld() = default; virtual CRT_Hit Trace(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar) = 0; };
+struct World : IWorld {
+  std::vector<std::shared_ptr<IThing>> m_things;
+  std::vector<float> m_depths;           // per box
+  std::vector<LiteMath::uint2> m_boxes;  // (thing, box)
+  CRT_Hit Trace(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar) override;
+  float Depth(uint32_t box) const { return m_depths[box]; }
+  BOXES
+};
+class Leaves {
+public:
+  virtual ~Leaves() = default;
+  virtual void Run(int n, [[crossrt::size("n")]] const LiteMath::float4* rays, [[crossrt::size("n")]] CRT_Hit* hits);
+  virtual void CommitDeviceData() {}
+protected:
+  void kernel1D_Run(int n, const LiteMath::float4* rays, CRT_Hit* hits);
+  std::shared_ptr<IWorld> m_world;
+};
+)";
+
+std::string PaperLeafSource(const std::string& after) {
+  return "#include \"Leaves.h\"\n"
+         "void Slab::Intersect(LiteMath::float4 posAndNear, LiteMath::float4, CRT_LeafInfo info, CRT_Hit& hit, const World* world) const {\n"
+         "  const float t = scale * world->Depth(info.aabbId) - posAndNear.z + 0.0f * world->m_depths[0];\n"
+         "  if (t >= posAndNear.w && t < hit.t) { hit.t = t; hit.primId = info.aabbId; hit.geomId = info.geomId; }\n}\n"
+         "CRT_Hit World::Trace(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar) {\n"
+         "  CRT_Hit hit;\n  hit.t = dirAndFar.w;\n  hit.primId = ~0u;\n  hit.instId = 0u;\n  hit.geomId = ~0u;\n"
+         "  uint32_t visited = 0;\n  uint32_t next = 0;\n"
+         "  while (next < m_boxes.size()) {\n"
+         "    CRT_LeafInfo info;\n    info.geomId = m_boxes[next].x;\n    info.aabbId = m_boxes[next].y;\n    ++visited;\n    ++next;\n"
+         "    m_things[info.geomId]->Intersect(posAndNear, dirAndFar, info, hit, this);\n  }\n" + after +
+         "  return hit;\n}\n"
+         "void Leaves::Run(int n, const LiteMath::float4* rays, CRT_Hit* hits) { kernel1D_Run(n, rays, hits); }\n"
+         "void Leaves::kernel1D_Run(int n, const LiteMath::float4* rays, CRT_Hit* hits) {\n"
+         "  for (int i = 0; i < n; ++i) hits[i] = m_world->Trace(rays[i], LiteMath::float4(0.0f, 0.0f, 1.0f, 100.0f));\n}\n";
+}
+}  // namespace
+
+TEST_CASE("Level 3 in the paper's form: a traversal passing CRT_LeafInfo and itself becomes a trace over each object's leaf boxes", "[engine][composition][virtual]")
+{
+  const std::string boxes = "std::vector<CRT_AABB> LeafBoxes(uint32_t thing) const;";
+  auto translate = [](const std::string& after, const std::string& boxesDecl) {
+    std::string header = kPaperLeafHeader;
+    header.replace(header.find("BOXES"), 5, boxesDecl);
+    TempClass tc("Leaves", header, PaperLeafSource(after));
+    TranslateRequest r = MakeRequest(tc, "Leaves");
+    r.compileArgs.push_back("-I" CROSSRT_SOURCE_DIR "/libs/litert");  // CrossRT.h: CRT_LeafInfo, CRT_Hit, CRT_AABB
+    r.compositions = {"IWorld=World"};
+    r.virtualLevel = 3;
+    return Translate(r);
+  };
+  {
+    const TranslateResult result = translate("", boxes);
+    INFO(result.diagnostics);
+    REQUIRE(result.ok);
+    // The switch of level 2 takes no `this`: the traversal's data are the kernel's buffers.
+    const std::string comp = Squeezed(result.files.at("shaders/kernel1D_Run.comp"));
+    CHECK(comp.find(Squeezed("m_world_m_things_Intersect(uint(info.geomId), posAndNear, dirAndFar, info, hit);")) != std::string::npos);
+    CHECK(comp.find(Squeezed("const float t = self.scale * m_world_Depth(info.aabbId) - posAndNear.z + 0.0 * m_world_m_depths[0u];")) != std::string::npos);
+    // The whole walk is the hardware's: the loop is a trace.
+    const std::string rgen = Squeezed(result.files.at("shaders/kernel1D_Run_Intersections.rgen"));
+    CHECK(rgen.find(Squeezed("traceRayEXT(m_world_m_things_leaves, gl_RayFlagsNoneEXT, 0xFF, 0, 0, 0, posAndNear.xyz, crt_near, dirAndFar.xyz, hit.t, 0);")) != std::string::npos);
+    CHECK(rgen.find(Squeezed("while (next <")) == std::string::npos);
+    // The intersection shader: the object from the instance's custom index, the info from the
+    // hardware, the object ray, and the traversal's buffer at the kernel's binding.
+    const std::string rint = Squeezed(result.files.at("shaders/kernel1D_Run_m_world_m_things_Slab_Intersect.rint"));
+    CHECK(rint.find(Squeezed("const uint crt_element = uint(gl_InstanceCustomIndexEXT);")) != std::string::npos);
+    CHECK(rint.find(Squeezed("crt_info.aabbId = uint(gl_PrimitiveID);")) != std::string::npos);
+    CHECK(rint.find(Squeezed("crt_info.geomId = crt_element;")) != std::string::npos);
+    CHECK(rint.find(Squeezed("Slab_Intersect(self, vec4(gl_ObjectRayOriginEXT, gl_RayTminEXT), vec4(gl_ObjectRayDirectionEXT, gl_RayTmaxEXT), crt_info, hit);")) !=
+          std::string::npos);
+    const size_t inComp = comp.find(Squeezed("buffer m_world_m_depthsBuffer")), inRint = rint.find(Squeezed("buffer m_world_m_depthsBuffer"));
+    REQUIRE(inComp != std::string::npos);
+    REQUIRE(inRint != std::string::npos);
+    const auto bindingBefore = [](const std::string& text, size_t at) {  // "binding=N)"
+      const size_t from = text.rfind("binding", at);
+      return text.substr(from, text.find(')', from) + 1 - from);
+    };
+    CHECK(bindingBefore(comp, inComp) == bindingBefore(rint, inRint));
+    // The host builds a bottom level per object over the boxes the traversal gives.
+    const std::string host = Squeezed(result.files.at("Leaves_Vulkan.cpp"));
+    CHECK(host.find(Squeezed("for (const auto& box : crt_m_world()->LeafBoxes(uint32_t(i)))")) != std::string::npos);
+    CHECK(host.find(Squeezed("m_scenes.m_world_m_things_leaves.BuildBoxGeometries(geometries,")) != std::string::npos);
+  }
+  // What the hardware's walk cannot give keeps the switch, and the host says why.
+  const std::pair<std::string, std::string> kept[] = {
+      {"", "World declares no public 'std::vector<CRT_AABB> LeafBoxes(uint32_t geomId) const'"},
+      {"  if (visited == 0u) hit.instId = 1u;\n", "the traversal's loop writes 'visited' (Leaves.cpp:18), read after it"}};
+  for (const auto& [after, why] : kept)
+  {
+    INFO(why);
+    const TranslateResult result = translate(after, after.empty() ? "" : boxes);
+    INFO(result.diagnostics);
+    REQUIRE(result.ok);
+    CHECK(result.files.count("shaders/kernel1D_Run_Intersections.rgen") == 0);
+    const std::string host = Squeezed(result.files.at("Leaves_Vulkan.cpp"));
+    const size_t said = host.find(Squeezed("still visits its leaves in software"));
+    INFO((said == std::string::npos ? std::string("no reason given") : host.substr(said, host.find('\n', said) - said)));
+    CHECK(host.find(Squeezed(why)) != std::string::npos);
+  }
+}
+
 TEST_CASE("Names a user gives that GLSL reserves come out renamed: a parameter 'image', a local 'length', a field 'sample'", "[engine]")
 {
   const char* header = R"(#pragma once
