@@ -274,8 +274,9 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
         // (ISPC, at every level: an array per class that the class data points at.)
         const std::string address = member + (model.virtualLevel == 1 ? std::string("_objects") : "_" + vi.name);
         std::string args = ispc ? "self->" + member + "_" + vi.name + "[slot]" : member + "_" + vi.name + "Objects(" + address + ").objects[tag.y]";
-        for (unsigned i = 0; i < m->getNumParams(); ++i)
+        for (unsigned i = 0; i < m->getNumParams(); ++i)  // the caller itself: GLSL leaves it out, ISPC passes the class data
           if (!GlslPrinter::PointsTo(m->getParamDecl(i)->getType(), kernelPrinter.Class())) args += ", " + CallArgumentName(m, i);
+          else if (ispc) args += ", self";
         Data x;
         x.set("tag", std::to_string(t));
         x.set("call", implFunction[vi.name + "::" + m->getNameAsString()] + "(" + args + ")");

@@ -468,8 +468,13 @@ std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callL
   bool first = !withSelf;
   for (unsigned i = 0; i < def->getNumParams(); ++i) {
     auto* p = def->getParamDecl(i);
-    if (IsOwnerParam(p)) continue;  // the traversal passed to an object's method: its data are globals (GlslOwner.cpp)
+    if (IsOwnerParam(p) && !ispc) continue;  // the traversal passed to an object's method: its data are globals (GlslOwner.cpp)
     QualType pt = p->getType();
+    if (IsOwnerParam(p)) {  // ISPC: the class data, which holds the traversal's (GlslOwner.cpp)
+      os << (first ? "" : ", ") << "uniform " << owner->DataStruct() << " *uniform " << SafeName(p->getNameAsString());
+      first = false;
+      continue;
+    }
     std::string qualifier;
     if (pt->isReferenceType() && !pt.getNonReferenceType().isConstQualified()) qualifier = "inout ";
     if (IsImage2D(pt.getNonReferenceType()))
@@ -771,9 +776,12 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
       return "self." + SafeName(field->getNameAsString());
     }
     if (isa<CXXThisExpr>(base)) return SelfMember(me, field);
-    if (OwnerParamOf(base)) {  // scene->f: as the traversal prints this->f
-      if (ispc) return IspcFail(e->getBeginLoc(), "a member of the composed implementation read in an object's method");
-      return owner->SelfMember(me, field);
+    if (const ParmVarDecl* p = OwnerParamOf(base)) {  // scene->f: as the traversal prints this->f
+      const std::string saved = owner->ispcSelf;
+      owner->ispcSelf = SafeName(p->getNameAsString());  // ISPC: the parameter is the class data
+      const std::string member = owner->SelfMember(me, field);
+      owner->ispcSelf = saved;
+      return member;
     }
     if (!field) return Fail(e->getBeginLoc(), "member function used as a value", "");
     if (IsLiteMathType(me->getBase()->getType(), "half4") || IsLiteMathType(me->getBase()->getType(), "half2"))
@@ -887,14 +895,20 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
       std::string spelling = BinaryOperator::getOpcodeStr(BinaryOperator::getOpForCompoundAssignment(bo->getOpcode())).str();
       return ImageStore(bo->getLHS(), Expr(bo->getLHS()) + " " + spelling + " (" + Expr(bo->getRHS()) + ")", e);
     }
+    // ISPC divides the masked-off lanes too, whose divisor may be 0 (a masked gather's): a per-lane
+    // integer divisor goes through crt_divisor (LiteMath.isph), which gives those lanes 1.
+    const bool division = bo->getOpcode() == BO_Div || bo->getOpcode() == BO_Rem || bo->getOpcode() == BO_DivAssign || bo->getOpcode() == BO_RemAssign;
+    const bool guarded = ispc && division && bo->getRHS()->getType()->isIntegerType() && !bo->getRHS()->isIntegerConstantExpr(m_ctx) &&
+                         !IspcUniform(bo->getRHS());
+    const std::string rhs = guarded ? "crt_divisor(" + Expr(bo->getRHS()) + ")" : Expr(bo->getRHS());
     // C++ gives the remainder the dividend's sign; GLSL's % is undefined for negative operands.
     if ((bo->getOpcode() == BO_Rem || bo->getOpcode() == BO_RemAssign) && bo->getType()->isSignedIntegerType()) {
-      std::string a = Expr(bo->getLHS()), b = "(" + Expr(bo->getRHS()) + ")";
+      std::string a = Expr(bo->getLHS()), b = "(" + rhs + ")";
       std::string rem = "(" + a + " - " + b + " * (" + a + " / " + b + "))";
       return bo->getOpcode() == BO_Rem ? rem : a + " = " + rem;
     }
     if (bo->getOpcode() == BO_Comma) return Expr(bo->getLHS()) + ", " + Expr(bo->getRHS());  // GLSL has it too
-    return Expr(bo->getLHS()) + " " + bo->getOpcodeStr().str() + " " + Expr(bo->getRHS());
+    return Expr(bo->getLHS()) + " " + bo->getOpcodeStr().str() + " " + rhs;
   }
   if (auto* uo = dyn_cast<UnaryOperator>(e)) {
     auto opc = uo->getOpcode();

@@ -125,7 +125,8 @@ public:
   // implementation's printer names the class's (ispcDataStruct): its members are the class's too.
   std::string ispcDataStruct;
   std::string DataStruct() const;
-  std::string IspcMember(const std::string& name) const { return "self->" + composedPrefix + name; }
+  std::string IspcMember(const std::string& name) const { return ispcSelf + "->" + composedPrefix + name; }
+  std::string ispcSelf = "self";  // what points at the class data (an object's method: its traversal parameter)
 
   // Printing statements one thread runs (before or after a kernel's loop nest): a member vector that
   // kernels append to may be emptied there (its count restarts).

@@ -3,9 +3,10 @@
 // stored within Intersect"). A traversal's leaf call `m_geom[g]->Intersect(ray, info, hit, this)`
 // reaches `Intersect(..., const BVHRT* scene)`, whose body reads `scene->m_values[i]` and calls
 // `scene->Helper(...)`. On the GPU the traversal's data are globals (its buffers, the class data),
-// so the parameter and its argument are left out, and what is read through it prints as the
-// traversal's own code prints it, under the traversal's prefix, into the traversal's Uses (which
-// decide the kernel's buffers).
+// so the parameter and its argument are left out (ISPC keeps the parameter as a pointer to the class
+// data, which holds the traversal's, and the dispatcher passes its own), and what is read through it
+// prints as the traversal's own code prints it, under the traversal's prefix, into the traversal's
+// Uses (which decide the kernel's buffers).
 #include "Glsl.h"
 
 #include "AstQueries.h"
@@ -44,16 +45,19 @@ const ParmVarDecl* GlslPrinter::OwnerParamOf(const clang::Expr* e) const {
 // the object's, which call them: each shader that holds the object's code holds them too.
 std::string GlslPrinter::OwnerCall(const CXXMemberCallExpr* call) {
   const CXXMethodDecl* method = call->getMethodDecl();
-  if (ispc) return IspcFail(call->getBeginLoc(), "a call of the composed implementation's " + method->getNameAsString() + " from an object's method");
   if (method->isVirtual())
     return Fail(call->getBeginLoc(), "virtual call of " + method->getQualifiedNameAsString() + " through the traversal passed to an object's method",
                 "call a non-virtual helper of the traversal");
   GlslPrinter helper(m_ctx, owner->m_class, m_reporter);
   helper.composedPrefix = owner->composedPrefix;
+  helper.ispc = ispc;
+  helper.ispcDataStruct = owner->DataStruct();
   helper.predeclaredStructs = predeclaredStructs;
   for (auto& x : m_structs) helper.predeclaredStructs.insert(x.name);  // declared here already
   std::map<unsigned, std::string> bindings;
   std::vector<std::string> args = HelperArgs(method, call, bindings);
+  if (ispc && !method->isStatic())  // the traversal's methods take the class data first, as `self`
+    args.insert(args.begin(), SafeName(OwnerParamOf(call->getImplicitObjectArgument())->getNameAsString()));
   const std::string callee = helper.EmitHelper(method, call->getBeginLoc(), false, bindings);
   if (!helper.m_uses.virtualCalls.empty())
     return Fail(call->getBeginLoc(), method->getQualifiedNameAsString() + " makes virtual calls; called from an object's method it cannot",

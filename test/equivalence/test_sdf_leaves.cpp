@@ -1,10 +1,13 @@
 // The paper's listing 2 over signed distance fields (SdfLeafTracer.h): a traversal that calls
 // m_geom[info.geomId]->Intersect(ray, info, hit, this) at each leaf, with a class per
 // representation (grid, SVS, SBS) reading the traversal's buffers through `this`. The original,
-// _CPU and _Vulkan (the switch over the field's class; at level 3, on a device with ray tracing
+// _CPU, _ISPC and _Vulkan (the switch over the field's class; at level 3, on a device with ray tracing
 // pipelines, the intersection shaders) must find the same fields at the same distances.
 #include "SdfLeafTracer.h"
 #include "SdfLeafTracer_CPU.h"
+#ifdef CROSSRT_HAS_ISPC
+#include "SdfLeafTracer_ISPC.h"
+#endif
 #include "SdfLeafTracer_Vulkan.h"
 #include "TestSupport.h"
 
@@ -82,6 +85,10 @@ TEST_CASE("Intersection functions of SDF representations reach the traversal's d
     bool intersectionShaders;
   };
   std::vector<Run> runs = {{"CPU", cpu.get(), false}};
+#ifdef CROSSRT_HAS_ISPC
+  auto lanes = CreateSdfLeafTracer_ISPC();  // the switch, lane by lane; the traversal's data through the class data
+  runs.push_back({"ISPC", lanes.get(), false});
+#endif
   if (gpu && ctx->hasRayTracingPipeline)
     runs.push_back({"Vulkan, intersection shaders", gpu.get(), true});
   if (gpu)
