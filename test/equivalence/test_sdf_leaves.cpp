@@ -1,8 +1,9 @@
-// The paper's listing 2 over signed distance fields (SdfLeafTracer.h): a traversal that calls
-// m_geom[info.geomId]->Intersect(ray, info, hit, this) at each leaf, with a class per
-// representation (grid, SVS, SBS) reading the traversal's buffers through `this`. The original,
+// The paper's listing 2 over signed distance fields (litert's SdfLeafScene, traced by SdfLeafTracer):
+// a traversal that calls m_geom[info.geomId]->Intersect(ray, info, hit, this) at each leaf, with a
+// class per representation (grid, SVS, SBS) reading the traversal's buffers through `this`. The original,
 // _CPU, _ISPC and _Vulkan (the switch over the field's class; at level 3, on a device with ray tracing
 // pipelines, the intersection shaders) must find the same fields at the same distances.
+#include "SdfLeafScene.h"
 #include "SdfLeafTracer.h"
 #include "SdfLeafTracer_CPU.h"
 #ifdef CROSSRT_HAS_ISPC
@@ -19,18 +20,22 @@ using LiteMath::float4;
 
 namespace
 {
-// A sphere as a grid, a torus as an SVS, a rounded box as an SBS, side by side along x, each in a
-// cube of edge 2 (16^3 voxels).
+// A sphere as a grid, a torus as an SVS, a rounded box as an SBS, each in a cube of edge 2 (16^3
+// voxels), placed side by side along x; the SBS turned a quarter about y and scaled by 0.9.
 std::shared_ptr<SdfLeafScene> ThreeFields()
 {
   auto scene = std::make_shared<SdfLeafScene>();
-  const litesdf::SdfSphere sphere(float3(-2.5f, 0.0f, 0.0f), 0.7f);
+  const litesdf::SdfSphere sphere(float3(0.0f, 0.0f, 0.0f), 0.7f);
   const litesdf::SdfTorus torus(float3(0.0f, 0.0f, 0.0f), 0.6f, 0.25f);
-  const litesdf::SdfRoundedBox box(float3(2.5f, 0.0f, 0.0f), float3(0.5f, 0.4f, 0.6f), 0.15f);
-  scene->AddGrid(litesdf::BuildGrid(sphere, float3(-3.5f, -1.0f, -1.0f), 2.0f, 17), 4);
-  scene->AddSVS(litesdf::BuildSVS(torus, float3(-1.0f, -1.0f, -1.0f), 2.0f, 4, 4));
-  scene->AddSBS(litesdf::BuildSBS(box, float3(1.5f, -1.0f, -1.0f), 2.0f, 4, 2, 4));
-  scene->Commit();
+  const litesdf::SdfRoundedBox box(float3(0.0f, 0.0f, 0.0f), float3(0.5f, 0.4f, 0.6f), 0.15f);
+  const float3 corner(-1.0f, -1.0f, -1.0f);
+  const uint32_t grid = scene->AddGeom_SdfGrid(litesdf::BuildGrid(sphere, corner, 2.0f, 17));
+  const uint32_t svs = scene->AddGeom_SdfSVS(litesdf::BuildSVS(torus, corner, 2.0f, 4, 4));
+  const uint32_t sbs = scene->AddGeom_SdfSBS(litesdf::BuildSBS(box, corner, 2.0f, 4, 2, 4));
+  scene->AddInstance(grid, LiteMath::translate4x4(float3(-2.5f, 0.0f, 0.0f)));
+  scene->AddInstance(svs, LiteMath::float4x4());
+  scene->AddInstance(sbs, LiteMath::translate4x4(float3(2.5f, 0.0f, 0.0f)) * LiteMath::rotate4x4Y(1.5707964f) * LiteMath::scale4x4(float3(0.9f, 0.9f, 0.9f)));
+  scene->CommitScene();
   return scene;
 }
 }  // namespace
@@ -39,8 +44,8 @@ TEST_CASE("Intersection functions of SDF representations reach the traversal's d
 {
   auto scene = ThreeFields();
   REQUIRE(scene->m_geom.size() == 3);
-  for (uint32_t g = 0; g < 3; ++g)
-    REQUIRE(!scene->LeafBoxes(g).empty());
+  for (uint32_t k = 0; k < 3; ++k)
+    REQUIRE(!scene->LeafBoxes(k).empty());
   // Rays from in front (z = 4) towards the fields, some past them.
   const int n = 3000;
   std::mt19937 rng(11);

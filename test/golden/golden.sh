@@ -29,7 +29,7 @@ cases=(
   "lbvh_cpu|LBVH|cpu|libs/litebvh/LBVH.cpp||libs/litebvh"
   "callable_shading_vulkan|CallableShading|vulkan|test/classes/CallableShading.cpp|--virtual-level 3|test/classes"
   "shape_tracer_vulkan|ShapeTracer|vulkan|test/classes/ShapeTracer.cpp|--compose IScene=ShapeScene --virtual-level 3|test/classes"
-  "sdf_leaf_tracer_vulkan|SdfLeafTracer|vulkan|test/classes/SdfLeafTracer.cpp|--compose ISdfScene=SdfLeafScene --virtual-level 3|test/classes"
+  "sdf_leaf_tracer_vulkan|SdfLeafTracer|vulkan|test/classes/SdfLeafTracer.cpp libs/litert/SdfLeafScene.cpp|--compose ISceneObject=SdfLeafScene --virtual-level 3|test/classes"
   "textured_materials_vulkan|TexturedMaterials|vulkan|test/classes/TexturedMaterials.cpp||test/classes"
   "staged_saxpy_vulkan|StagedSaxpy|vulkan|test/conformance/cases/staged_saxpy.cpp||test/conformance/cases"
   "local_totals_vulkan|LocalTotals|vulkan|test/conformance/cases/local_totals.cpp||test/conformance/cases"

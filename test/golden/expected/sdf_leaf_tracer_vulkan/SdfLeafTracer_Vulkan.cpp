@@ -7,24 +7,16 @@
 #include <cstring>
 #include <string>
 #include <typeinfo>
-
-// As in the class's source files: the bodies below are copied from them.
-#include <algorithm>
-#include <cmath>
-#include <stdexcept>
-using LiteMath::float3;
-using LiteMath::float4;
-
 extern const uint32_t SdfLeafTracer_kernel1D_Trace_Intersections_spv[];
 extern const size_t SdfLeafTracer_kernel1D_Trace_Intersections_spvBytes;
 extern const uint32_t SdfLeafTracer_kernel1D_Trace_spv[];
 extern const size_t SdfLeafTracer_kernel1D_Trace_spvBytes;
-extern const uint32_t SdfLeafTracer_kernel1D_Trace_m_scene_m_geom_SdfGridGeom_Intersect_spv[];
-extern const size_t SdfLeafTracer_kernel1D_Trace_m_scene_m_geom_SdfGridGeom_Intersect_spvBytes;
-extern const uint32_t SdfLeafTracer_kernel1D_Trace_m_scene_m_geom_SdfSVSGeom_Intersect_spv[];
-extern const size_t SdfLeafTracer_kernel1D_Trace_m_scene_m_geom_SdfSVSGeom_Intersect_spvBytes;
-extern const uint32_t SdfLeafTracer_kernel1D_Trace_m_scene_m_geom_SdfSBSGeom_Intersect_spv[];
-extern const size_t SdfLeafTracer_kernel1D_Trace_m_scene_m_geom_SdfSBSGeom_Intersect_spvBytes;
+extern const uint32_t SdfLeafTracer_kernel1D_Trace_m_scene_m_geom_SdfGridLeaves_Intersect_spv[];
+extern const size_t SdfLeafTracer_kernel1D_Trace_m_scene_m_geom_SdfGridLeaves_Intersect_spvBytes;
+extern const uint32_t SdfLeafTracer_kernel1D_Trace_m_scene_m_geom_SdfSVSLeaves_Intersect_spv[];
+extern const size_t SdfLeafTracer_kernel1D_Trace_m_scene_m_geom_SdfSVSLeaves_Intersect_spvBytes;
+extern const uint32_t SdfLeafTracer_kernel1D_Trace_m_scene_m_geom_SdfSBSLeaves_Intersect_spv[];
+extern const size_t SdfLeafTracer_kernel1D_Trace_m_scene_m_geom_SdfSBSLeaves_Intersect_spvBytes;
 extern const uint32_t SdfLeafTracer_m_scene_m_geom_Intersect_Hit_spv[];
 extern const size_t SdfLeafTracer_m_scene_m_geom_Intersect_Hit_spvBytes;
 extern const uint32_t SdfLeafTracer_m_scene_m_geom_Intersect_Miss_spv[];
@@ -77,14 +69,14 @@ void SdfLeafTracer_Vulkan::InitPipelines()
             },
             {
                 // hit groups: per leaf call, one per class of its leaves
-                {{SdfLeafTracer_kernel1D_Trace_m_scene_m_geom_SdfGridGeom_Intersect_spv,
-                  SdfLeafTracer_kernel1D_Trace_m_scene_m_geom_SdfGridGeom_Intersect_spvBytes},
+                {{SdfLeafTracer_kernel1D_Trace_m_scene_m_geom_SdfGridLeaves_Intersect_spv,
+                  SdfLeafTracer_kernel1D_Trace_m_scene_m_geom_SdfGridLeaves_Intersect_spvBytes},
                  {SdfLeafTracer_m_scene_m_geom_Intersect_Hit_spv, SdfLeafTracer_m_scene_m_geom_Intersect_Hit_spvBytes}},
-                {{SdfLeafTracer_kernel1D_Trace_m_scene_m_geom_SdfSVSGeom_Intersect_spv,
-                  SdfLeafTracer_kernel1D_Trace_m_scene_m_geom_SdfSVSGeom_Intersect_spvBytes},
+                {{SdfLeafTracer_kernel1D_Trace_m_scene_m_geom_SdfSVSLeaves_Intersect_spv,
+                  SdfLeafTracer_kernel1D_Trace_m_scene_m_geom_SdfSVSLeaves_Intersect_spvBytes},
                  {SdfLeafTracer_m_scene_m_geom_Intersect_Hit_spv, SdfLeafTracer_m_scene_m_geom_Intersect_Hit_spvBytes}},
-                {{SdfLeafTracer_kernel1D_Trace_m_scene_m_geom_SdfSBSGeom_Intersect_spv,
-                  SdfLeafTracer_kernel1D_Trace_m_scene_m_geom_SdfSBSGeom_Intersect_spvBytes},
+                {{SdfLeafTracer_kernel1D_Trace_m_scene_m_geom_SdfSBSLeaves_Intersect_spv,
+                  SdfLeafTracer_kernel1D_Trace_m_scene_m_geom_SdfSBSLeaves_Intersect_spvBytes},
                  {SdfLeafTracer_m_scene_m_geom_Intersect_Hit_spv, SdfLeafTracer_m_scene_m_geom_Intersect_Hit_spvBytes}},
             },
             {}},
@@ -148,9 +140,9 @@ void SdfLeafTracer_Vulkan::UpdatePlainMembers()
 {
   ClassData data{};
   data.m_scene_m_geom_tags = m_virtual.m_scene_m_geom_tags.Address();
-  data.m_scene_m_geom_SdfGridGeom = m_virtual.m_scene_m_geom_SdfGridGeom.Address();
-  data.m_scene_m_geom_SdfSVSGeom = m_virtual.m_scene_m_geom_SdfSVSGeom.Address();
-  data.m_scene_m_geom_SdfSBSGeom = m_virtual.m_scene_m_geom_SdfSBSGeom.Address();
+  data.m_scene_m_geom_SdfGridLeaves = m_virtual.m_scene_m_geom_SdfGridLeaves.Address();
+  data.m_scene_m_geom_SdfSVSLeaves = m_virtual.m_scene_m_geom_SdfSVSLeaves.Address();
+  data.m_scene_m_geom_SdfSBSLeaves = m_virtual.m_scene_m_geom_SdfSBSLeaves.Address();
   data.m_scene_m_geom_size = uint32_t(crt_m_scene()->m_geom.size());
   data.m_scene_m_nodeMin_size = uint32_t(crt_m_scene()->m_nodeMin.size());
   data.m_scene_m_nodeMin_capacity = uint32_t(crt_m_scene()->m_nodeMin.capacity());
@@ -270,72 +262,75 @@ bool SdfLeafTracer_Vulkan::VectorMembersResized() const
 std::vector<uint32_t> SdfLeafTracer_Vulkan::CommitVirtual_m_scene_m_geom()
 {
   std::vector<uint32_t> tags(2 * std::max<size_t>(1, crt_m_scene()->m_geom.size()));
-  std::vector<SdfGridGeom_Data> SdfGridGeomObjects;
-  std::vector<SdfSVSGeom_Data> SdfSVSGeomObjects;
-  std::vector<SdfSBSGeom_Data> SdfSBSGeomObjects;
+  std::vector<SdfGridLeaves_Data> SdfGridLeavesObjects;
+  std::vector<SdfSVSLeaves_Data> SdfSVSLeavesObjects;
+  std::vector<SdfSBSLeaves_Data> SdfSBSLeavesObjects;
   for (size_t i = 0; i < crt_m_scene()->m_geom.size(); ++i)
   {
-    const ISdfGeom* object = crossrt::RawPointer(crt_m_scene()->m_geom[i]);
+    const ISdfLeaves* object = crossrt::RawPointer(crt_m_scene()->m_geom[i]);
     if (object == nullptr)
       throw crossrt::Error("SdfLeafTracer_Vulkan: m_scene->m_geom[" + std::to_string(i) +
                            "] holds no object, but kernels call its virtual functions");
-    if (typeid(*object) == typeid(SdfGridGeom))
+    if (typeid(*object) == typeid(SdfGridLeaves))
     {
-      const auto& from = static_cast<const SdfGridGeom&>(*object);
-      SdfGridGeom_Data to{};
+      const auto& from = static_cast<const SdfGridLeaves&>(*object);
+      SdfGridLeaves_Data to{};
+      std::memcpy(&to.place, &from.place, sizeof(to.place));
       std::memcpy(&to.boxMinAndCell, &from.boxMinAndCell, sizeof(to.boxMinAndCell));
       std::memcpy(&to.firstValue, &from.firstValue, sizeof(to.firstValue));
       std::memcpy(&to.samples, &from.samples, sizeof(to.samples));
       std::memcpy(&to.brickCells, &from.brickCells, sizeof(to.brickCells));
       std::memcpy(&to.bricksPerAxis, &from.bricksPerAxis, sizeof(to.bricksPerAxis));
       tags[2 * i] = 0;
-      tags[2 * i + 1] = uint32_t(SdfGridGeomObjects.size());
-      SdfGridGeomObjects.push_back(to);
+      tags[2 * i + 1] = uint32_t(SdfGridLeavesObjects.size());
+      SdfGridLeavesObjects.push_back(to);
     }
-    else if (typeid(*object) == typeid(SdfSVSGeom))
+    else if (typeid(*object) == typeid(SdfSVSLeaves))
     {
-      const auto& from = static_cast<const SdfSVSGeom&>(*object);
-      SdfSVSGeom_Data to{};
+      const auto& from = static_cast<const SdfSVSLeaves&>(*object);
+      SdfSVSLeaves_Data to{};
+      std::memcpy(&to.place, &from.place, sizeof(to.place));
       std::memcpy(&to.firstVoxel, &from.firstVoxel, sizeof(to.firstVoxel));
       std::memcpy(&to.voxelCount, &from.voxelCount, sizeof(to.voxelCount));
       tags[2 * i] = 1;
-      tags[2 * i + 1] = uint32_t(SdfSVSGeomObjects.size());
-      SdfSVSGeomObjects.push_back(to);
+      tags[2 * i + 1] = uint32_t(SdfSVSLeavesObjects.size());
+      SdfSVSLeavesObjects.push_back(to);
     }
-    else if (typeid(*object) == typeid(SdfSBSGeom))
+    else if (typeid(*object) == typeid(SdfSBSLeaves))
     {
-      const auto& from = static_cast<const SdfSBSGeom&>(*object);
-      SdfSBSGeom_Data to{};
+      const auto& from = static_cast<const SdfSBSLeaves&>(*object);
+      SdfSBSLeaves_Data to{};
+      std::memcpy(&to.place, &from.place, sizeof(to.place));
       std::memcpy(&to.firstBrick, &from.firstBrick, sizeof(to.firstBrick));
       std::memcpy(&to.brickCount, &from.brickCount, sizeof(to.brickCount));
       std::memcpy(&to.brickSize, &from.brickSize, sizeof(to.brickSize));
       tags[2 * i] = 2;
-      tags[2 * i + 1] = uint32_t(SdfSBSGeomObjects.size());
-      SdfSBSGeomObjects.push_back(to);
+      tags[2 * i + 1] = uint32_t(SdfSBSLeavesObjects.size());
+      SdfSBSLeavesObjects.push_back(to);
     }
     else
       throw crossrt::Error(std::string("SdfLeafTracer_Vulkan: m_scene->m_geom[") + std::to_string(i) + "] holds a " +
                            typeid(*object).name() +
-                           ", which the GPU code does not know; it knows SdfGridGeom, SdfSVSGeom, SdfSBSGeom (the "
-                           "classes that implement ISdfGeom where SdfLeafTracer is translated)");
+                           ", which the GPU code does not know; it knows SdfGridLeaves, SdfSVSLeaves, SdfSBSLeaves "
+                           "(the classes that implement ISdfLeaves where SdfLeafTracer is translated)");
   }
   crossrt::EnsureSize(m_ctx, m_virtual.m_scene_m_geom_tags, sizeof(uint32_t) * tags.size());
   m_virtual.m_scene_m_geom_tags.Upload(tags.data(), sizeof(uint32_t) * tags.size());
-  crossrt::EnsureSize(m_ctx, m_virtual.m_scene_m_geom_SdfGridGeom,
-                      sizeof(SdfGridGeom_Data) * std::max<size_t>(1, SdfGridGeomObjects.size()));
-  if (!SdfGridGeomObjects.empty())
-    m_virtual.m_scene_m_geom_SdfGridGeom.Upload(SdfGridGeomObjects.data(),
-                                                sizeof(SdfGridGeom_Data) * SdfGridGeomObjects.size());
-  crossrt::EnsureSize(m_ctx, m_virtual.m_scene_m_geom_SdfSVSGeom,
-                      sizeof(SdfSVSGeom_Data) * std::max<size_t>(1, SdfSVSGeomObjects.size()));
-  if (!SdfSVSGeomObjects.empty())
-    m_virtual.m_scene_m_geom_SdfSVSGeom.Upload(SdfSVSGeomObjects.data(),
-                                               sizeof(SdfSVSGeom_Data) * SdfSVSGeomObjects.size());
-  crossrt::EnsureSize(m_ctx, m_virtual.m_scene_m_geom_SdfSBSGeom,
-                      sizeof(SdfSBSGeom_Data) * std::max<size_t>(1, SdfSBSGeomObjects.size()));
-  if (!SdfSBSGeomObjects.empty())
-    m_virtual.m_scene_m_geom_SdfSBSGeom.Upload(SdfSBSGeomObjects.data(),
-                                               sizeof(SdfSBSGeom_Data) * SdfSBSGeomObjects.size());
+  crossrt::EnsureSize(m_ctx, m_virtual.m_scene_m_geom_SdfGridLeaves,
+                      sizeof(SdfGridLeaves_Data) * std::max<size_t>(1, SdfGridLeavesObjects.size()));
+  if (!SdfGridLeavesObjects.empty())
+    m_virtual.m_scene_m_geom_SdfGridLeaves.Upload(SdfGridLeavesObjects.data(),
+                                                  sizeof(SdfGridLeaves_Data) * SdfGridLeavesObjects.size());
+  crossrt::EnsureSize(m_ctx, m_virtual.m_scene_m_geom_SdfSVSLeaves,
+                      sizeof(SdfSVSLeaves_Data) * std::max<size_t>(1, SdfSVSLeavesObjects.size()));
+  if (!SdfSVSLeavesObjects.empty())
+    m_virtual.m_scene_m_geom_SdfSVSLeaves.Upload(SdfSVSLeavesObjects.data(),
+                                                 sizeof(SdfSVSLeaves_Data) * SdfSVSLeavesObjects.size());
+  crossrt::EnsureSize(m_ctx, m_virtual.m_scene_m_geom_SdfSBSLeaves,
+                      sizeof(SdfSBSLeaves_Data) * std::max<size_t>(1, SdfSBSLeavesObjects.size()));
+  if (!SdfSBSLeavesObjects.empty())
+    m_virtual.m_scene_m_geom_SdfSBSLeaves.Upload(SdfSBSLeavesObjects.data(),
+                                                 sizeof(SdfSBSLeaves_Data) * SdfSBSLeavesObjects.size());
   m_virtual.m_scene_m_geomSize = crt_m_scene()->m_geom.size();
   return tags;
 }
@@ -349,8 +344,8 @@ SdfLeafScene* SdfLeafTracer_Vulkan::crt_m_scene() const
 {
   auto* impl = dynamic_cast<SdfLeafScene*>(crossrt::RawPointer(m_scene));
   if (impl == nullptr)
-    throw crossrt::Error(std::string("SdfLeafTracer_Vulkan: 'm_scene' must hold a SdfLeafScene, the ISdfScene composed "
-                                     "into the GPU code, but it holds ") +
+    throw crossrt::Error(std::string("SdfLeafTracer_Vulkan: 'm_scene' must hold a SdfLeafScene, the ISceneObject "
+                                     "composed into the GPU code, but it holds ") +
                          (m_scene ? "an object of another class" : "nothing"));
   return impl;
 }

@@ -5,7 +5,8 @@
 #pragma once
 
 #include "SdfLeafTracer.h"
-#include "SdfLeafTracer.h"  // ISdfScene=SdfLeafScene: the code its GPU kernels run for m_scene
+#include "SdfLeafScene.h"  // ISceneObject=SdfLeafScene: the code its GPU kernels run for m_scene
+#include "SdfLeafScene.h"  // implementations of ISdfLeaves that kernels call through virtual functions
 
 #include <crossrt/VulkanRuntime.h>
 
@@ -75,9 +76,9 @@ protected:
   struct ClassData
   {
     alignas(8) uint64_t m_scene_m_geom_tags;
-    alignas(8) uint64_t m_scene_m_geom_SdfGridGeom;
-    alignas(8) uint64_t m_scene_m_geom_SdfSVSGeom;
-    alignas(8) uint64_t m_scene_m_geom_SdfSBSGeom;
+    alignas(8) uint64_t m_scene_m_geom_SdfGridLeaves;
+    alignas(8) uint64_t m_scene_m_geom_SdfSVSLeaves;
+    alignas(8) uint64_t m_scene_m_geom_SdfSBSLeaves;
     alignas(4) uint32_t m_scene_m_nodeMin_size;
     alignas(4) uint32_t m_scene_m_nodeMin_capacity;
     alignas(4) uint32_t m_scene_m_nodeMax_size;
@@ -132,23 +133,26 @@ protected:
   virtual bool VectorMembersResized() const;
 
   // Virtual functions through m_scene->m_geom (level 2): the GPU keeps the objects of each class
-  // (SdfGridGeom, SdfSVSGeom, SdfSBSGeom) in a buffer of their own and a (class, index) tag per element.
+  // (SdfGridLeaves, SdfSVSLeaves, SdfSBSLeaves) in a buffer of their own and a (class, index) tag per element.
   // Call CommitDeviceData() after changing an object; adding or removing elements is noticed by itself.
-  struct SdfGridGeom_Data  // the data of a SdfGridGeom, as the GPU reads it (std430 layout)
+  struct SdfGridLeaves_Data  // the data of a SdfGridLeaves, as the GPU reads it (std430 layout)
   {
+    SdfPlacement place;
     LiteMath::float4 boxMinAndCell;
     unsigned int firstValue;
     unsigned int samples;
     unsigned int brickCells;
     unsigned int bricksPerAxis;
   };
-  struct SdfSVSGeom_Data  // the data of a SdfSVSGeom, as the GPU reads it (std430 layout)
+  struct SdfSVSLeaves_Data  // the data of a SdfSVSLeaves, as the GPU reads it (std430 layout)
   {
+    SdfPlacement place;
     unsigned int firstVoxel;
     unsigned int voxelCount;
   };
-  struct SdfSBSGeom_Data  // the data of a SdfSBSGeom, as the GPU reads it (std430 layout)
+  struct SdfSBSLeaves_Data  // the data of a SdfSBSLeaves, as the GPU reads it (std430 layout)
   {
+    SdfPlacement place;
     unsigned int firstBrick;
     unsigned int brickCount;
     unsigned int brickSize;
@@ -158,9 +162,9 @@ protected:
   struct VirtualObjects            // device copies of the objects kernels call virtual functions of
   {
     crossrt::Buffer m_scene_m_geom_tags;
-    crossrt::Buffer m_scene_m_geom_SdfGridGeom;
-    crossrt::Buffer m_scene_m_geom_SdfSVSGeom;
-    crossrt::Buffer m_scene_m_geom_SdfSBSGeom;
+    crossrt::Buffer m_scene_m_geom_SdfGridLeaves;
+    crossrt::Buffer m_scene_m_geom_SdfSVSLeaves;
+    crossrt::Buffer m_scene_m_geom_SdfSBSLeaves;
     size_t m_scene_m_geomSize = 0;  // elements at the last CommitDeviceData()
   } m_virtual;
   bool m_specializeVirtualCalls = true;
@@ -168,7 +172,7 @@ protected:
   // the pipelines switch over that class (its objects were there at the last CommitDeviceData()).
   std::vector<VkBool32> m_pipelineClasses;
   // m_scene as the SdfLeafScene whose traversal the kernels run and whose data they read; throws
-  // when it holds another ISdfScene (or none).
+  // when it holds another ISceneObject (or none).
   SdfLeafScene* crt_m_scene() const;
   bool m_useRayTracingPipelines = false;  // record the kernels' _Callables and _Intersections variants
 

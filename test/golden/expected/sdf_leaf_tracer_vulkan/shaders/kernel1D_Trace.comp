@@ -30,14 +30,23 @@ layout(buffer_reference, std430, buffer_reference_align = 8) readonly buffer m_s
   uvec2 tags[];
 };  // per element of m_scene->m_geom: (class, index among its class's objects)
 
-// Off where m_scene->m_geom holds no SdfGridGeom: its cases are dead code.
-layout(constant_id = 1800) const bool crt_m_scene_m_geom_holdsSdfGridGeom = true;
+// Off where m_scene->m_geom holds no SdfGridLeaves: its cases are dead code.
+layout(constant_id = 1800) const bool crt_m_scene_m_geom_holdsSdfGridLeaves = true;
 
-// Off where m_scene->m_geom holds no SdfSVSGeom: its cases are dead code.
-layout(constant_id = 1801) const bool crt_m_scene_m_geom_holdsSdfSVSGeom = true;
+// Off where m_scene->m_geom holds no SdfSVSLeaves: its cases are dead code.
+layout(constant_id = 1801) const bool crt_m_scene_m_geom_holdsSdfSVSLeaves = true;
 
-// Off where m_scene->m_geom holds no SdfSBSGeom: its cases are dead code.
-layout(constant_id = 1802) const bool crt_m_scene_m_geom_holdsSdfSBSGeom = true;
+// Off where m_scene->m_geom holds no SdfSBSLeaves: its cases are dead code.
+layout(constant_id = 1802) const bool crt_m_scene_m_geom_holdsSdfSBSLeaves = true;
+
+struct SdfPlacement
+{
+  vec4 toObject0;
+  vec4 toObject1;
+  vec4 toObject2;
+  uint geomId;
+  uint instId;
+};
 
 // litesdf::SdfHit
 struct SdfHit
@@ -74,9 +83,10 @@ struct Cubic
   float c3;
 };
 
-// The data members of a SdfGridGeom.
-struct SdfGridGeom_Data
+// The data members of a SdfGridLeaves.
+struct SdfGridLeaves_Data
 {
+  SdfPlacement place;
   vec4 boxMinAndCell;
   uint firstValue;
   uint samples;
@@ -84,43 +94,45 @@ struct SdfGridGeom_Data
   uint bricksPerAxis;
 };
 
-layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer m_scene_m_geom_SdfGridGeomObjects
+layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer m_scene_m_geom_SdfGridLeavesObjects
 {
-  SdfGridGeom_Data objects[];
+  SdfGridLeaves_Data objects[];
 };
 
-// The data members of a SdfSVSGeom.
-struct SdfSVSGeom_Data
+// The data members of a SdfSVSLeaves.
+struct SdfSVSLeaves_Data
 {
+  SdfPlacement place;
   uint firstVoxel;
   uint voxelCount;
 };
 
-layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer m_scene_m_geom_SdfSVSGeomObjects
+layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer m_scene_m_geom_SdfSVSLeavesObjects
 {
-  SdfSVSGeom_Data objects[];
+  SdfSVSLeaves_Data objects[];
 };
 
-// The data members of a SdfSBSGeom.
-struct SdfSBSGeom_Data
+// The data members of a SdfSBSLeaves.
+struct SdfSBSLeaves_Data
 {
+  SdfPlacement place;
   uint firstBrick;
   uint brickCount;
   uint brickSize;
 };
 
-layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer m_scene_m_geom_SdfSBSGeomObjects
+layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer m_scene_m_geom_SdfSBSLeavesObjects
 {
-  SdfSBSGeom_Data objects[];
+  SdfSBSLeaves_Data objects[];
 };
 
 // Data members of SdfLeafTracer, uploaded before every control function call.
 layout(std430, binding = 0) buffer SdfLeafTracerData
 {
   uvec2 m_scene_m_geom_tags;
-  uvec2 m_scene_m_geom_SdfGridGeom;
-  uvec2 m_scene_m_geom_SdfSVSGeom;
-  uvec2 m_scene_m_geom_SdfSBSGeom;
+  uvec2 m_scene_m_geom_SdfGridLeaves;
+  uvec2 m_scene_m_geom_SdfSVSLeaves;
+  uvec2 m_scene_m_geom_SdfSBSLeaves;
   uint m_scene_m_nodeMin_size;
   uint m_scene_m_nodeMin_capacity;
   uint m_scene_m_nodeMax_size;
@@ -203,8 +215,18 @@ layout(push_constant) uniform kernel1D_TraceArgs
   int n;
 };
 
+const uint m_scene_kNoId = 4294967295u;
 const int m_scene_kNewtonIterations = 4;
 const int kNewtonIterations = 4;
+
+// from (anonymous namespace)::ToField
+void ToField(SdfPlacement place, vec4 posAndNear, vec4 dirAndFar, inout vec3 org, inout vec3 dir)
+{
+  const vec4 o = vec4(posAndNear.x, posAndNear.y, posAndNear.z, 1.0);
+  const vec4 d = vec4(dirAndFar.x, dirAndFar.y, dirAndFar.z, 0.0);
+  org = vec3(dot(place.toObject0, o), dot(place.toObject1, o), dot(place.toObject2, o));
+  dir = vec3(dot(place.toObject0, d), dot(place.toObject1, d), dot(place.toObject2, d));
+}
 
 // from (anonymous namespace)::Xyz
 vec3 Xyz(vec4 v)
@@ -438,23 +460,27 @@ SdfHit m_scene_MarchBrick(vec3 corner, float cell, int n, uint first, uint strid
 }
 
 // from (anonymous namespace)::Record
-void Record(SdfHit h, CRT_LeafInfo info, inout CRT_Hit hit)
+void Record(SdfHit h, CRT_LeafInfo info, SdfPlacement place, inout CRT_Hit hit)
 {
   if (h.t >= 0.0 && h.t < hit.t)
   {
     hit.t = h.t;
     hit.primId = info.aabbId;
-    hit.instId = info.instId;
-    hit.geomId = info.geomId;
+    hit.instId = place.instId;
+    hit.geomId = place.geomId;
     hit.coords[0] = h.normal.x;
     hit.coords[1] = h.normal.y;
     hit.coords[2] = h.normal.z;
   }
 }
 
-// from SdfGridGeom::Intersect
-void SdfGridGeom_Intersect(SdfGridGeom_Data self, vec4 posAndNear, vec4 dirAndFar, CRT_LeafInfo info, inout CRT_Hit hit)
+// from SdfGridLeaves::Intersect
+void SdfGridLeaves_Intersect(SdfGridLeaves_Data self, vec4 posAndNear, vec4 dirAndFar, CRT_LeafInfo info,
+                             inout CRT_Hit hit)
 {
+  vec3 org = vec3(0);
+  vec3 dir = vec3(0);
+  ToField(self.place, posAndNear, dirAndFar, org, dir);
   const uint bx = info.aabbId % self.bricksPerAxis;
   const uint by = (info.aabbId / self.bricksPerAxis) % self.bricksPerAxis;
   const uint bz = info.aabbId / (self.bricksPerAxis * self.bricksPerAxis);
@@ -463,12 +489,12 @@ void SdfGridGeom_Intersect(SdfGridGeom_Data self, vec4 posAndNear, vec4 dirAndFa
   const vec3 corner = Xyz(self.boxMinAndCell) + edge * vec3(float(bx), float(by), float(bz));
   float t0;
   float t1;
-  if (!Span(Xyz(posAndNear), Xyz(dirAndFar), corner, corner + vec3(edge, edge, edge), posAndNear.w, hit.t, t0, t1))
+  if (!Span(org, dir, corner, corner + vec3(edge, edge, edge), posAndNear.w, hit.t, t0, t1))
     return;
   const uint first = self.firstValue + ((bz * self.samples + by) * self.samples + bx) * self.brickCells;
-  Record(m_scene_MarchBrick(corner, cell, int(self.brickCells), first, self.samples, self.samples * self.samples,
-                            Xyz(posAndNear), Xyz(dirAndFar), t0, t1),
-         info, hit);
+  Record(m_scene_MarchBrick(corner, cell, int(self.brickCells), first, self.samples, self.samples * self.samples, org,
+                            dir, t0, t1),
+         info, self.place, hit);
 }
 
 // from litesdf::Missed
@@ -635,37 +661,43 @@ SdfHit IntersectVoxelSpan(VoxelValues values, vec3 voxelMin, float size, vec3 or
   return hit;
 }
 
-// from SdfSVSGeom::Intersect
-void SdfSVSGeom_Intersect(SdfSVSGeom_Data self, vec4 posAndNear, vec4 dirAndFar, CRT_LeafInfo info, inout CRT_Hit hit)
+// from SdfSVSLeaves::Intersect
+void SdfSVSLeaves_Intersect(SdfSVSLeaves_Data self, vec4 posAndNear, vec4 dirAndFar, CRT_LeafInfo info,
+                            inout CRT_Hit hit)
 {
+  vec3 org = vec3(0);
+  vec3 dir = vec3(0);
+  ToField(self.place, posAndNear, dirAndFar, org, dir);
   const uint voxel = self.firstVoxel + info.aabbId;
   const vec4 box = m_scene_m_voxels[voxel];
   float t0;
   float t1;
-  if (!Span(Xyz(posAndNear), Xyz(dirAndFar), Xyz(box), Xyz(box) + vec3(box.w, box.w, box.w), posAndNear.w, hit.t, t0,
-            t1))
+  if (!Span(org, dir, Xyz(box), Xyz(box) + vec3(box.w, box.w, box.w), posAndNear.w, hit.t, t0, t1))
     return;
   VoxelValues values;
   for (uint c = 0u; c < 8u; ++c)
     values.v[c] = m_scene_m_voxelValues[8u * voxel + c];
-  Record(IntersectVoxelSpan(values, Xyz(box), box.w, Xyz(posAndNear), Xyz(dirAndFar), t0, t1, kNewtonIterations), info,
-         hit);
+  Record(IntersectVoxelSpan(values, Xyz(box), box.w, org, dir, t0, t1, kNewtonIterations), info, self.place, hit);
 }
 
-// from SdfSBSGeom::Intersect
-void SdfSBSGeom_Intersect(SdfSBSGeom_Data self, vec4 posAndNear, vec4 dirAndFar, CRT_LeafInfo info, inout CRT_Hit hit)
+// from SdfSBSLeaves::Intersect
+void SdfSBSLeaves_Intersect(SdfSBSLeaves_Data self, vec4 posAndNear, vec4 dirAndFar, CRT_LeafInfo info,
+                            inout CRT_Hit hit)
 {
+  vec3 org = vec3(0);
+  vec3 dir = vec3(0);
+  ToField(self.place, posAndNear, dirAndFar, org, dir);
   const uint brick = self.firstBrick + info.aabbId;
   const vec4 box = m_scene_m_bricks[brick];
   const float edge = box.w * float(self.brickSize);
   float t0;
   float t1;
-  if (!Span(Xyz(posAndNear), Xyz(dirAndFar), Xyz(box), Xyz(box) + vec3(edge, edge, edge), posAndNear.w, hit.t, t0, t1))
+  if (!Span(org, dir, Xyz(box), Xyz(box) + vec3(edge, edge, edge), posAndNear.w, hit.t, t0, t1))
     return;
   const uint side = self.brickSize + 1u;
-  Record(m_scene_MarchBrick(Xyz(box), box.w, int(self.brickSize), m_scene_m_brickValues[brick], side, side * side,
-                            Xyz(posAndNear), Xyz(dirAndFar), t0, t1),
-         info, hit);
+  Record(m_scene_MarchBrick(Xyz(box), box.w, int(self.brickSize), m_scene_m_brickValues[brick], side, side * side, org,
+                            dir, t0, t1),
+         info, self.place, hit);
 }
 
 // m_scene->m_geom[index]->Intersect(...): the object's class picks the implementation
@@ -674,25 +706,25 @@ void m_scene_m_geom_Intersect(uint index, vec4 posAndNear, vec4 dirAndFar, CRT_L
   const uvec2 tag = m_scene_m_geom_Tags(m_scene_m_geom_tags).tags[index];
   switch (tag.x)
   {
-  case 0u:  // dead code in a pipeline made for objects without a SdfGridGeom
-    if (crt_m_scene_m_geom_holdsSdfGridGeom)
+  case 0u:  // dead code in a pipeline made for objects without a SdfGridLeaves
+    if (crt_m_scene_m_geom_holdsSdfGridLeaves)
     {
-      SdfGridGeom_Intersect(m_scene_m_geom_SdfGridGeomObjects(m_scene_m_geom_SdfGridGeom).objects[tag.y], posAndNear,
-                            dirAndFar, info, hit);
+      SdfGridLeaves_Intersect(m_scene_m_geom_SdfGridLeavesObjects(m_scene_m_geom_SdfGridLeaves).objects[tag.y],
+                              posAndNear, dirAndFar, info, hit);
     }
     return;
-  case 1u:  // dead code in a pipeline made for objects without a SdfSVSGeom
-    if (crt_m_scene_m_geom_holdsSdfSVSGeom)
+  case 1u:  // dead code in a pipeline made for objects without a SdfSVSLeaves
+    if (crt_m_scene_m_geom_holdsSdfSVSLeaves)
     {
-      SdfSVSGeom_Intersect(m_scene_m_geom_SdfSVSGeomObjects(m_scene_m_geom_SdfSVSGeom).objects[tag.y], posAndNear,
-                           dirAndFar, info, hit);
+      SdfSVSLeaves_Intersect(m_scene_m_geom_SdfSVSLeavesObjects(m_scene_m_geom_SdfSVSLeaves).objects[tag.y], posAndNear,
+                             dirAndFar, info, hit);
     }
     return;
-  case 2u:  // dead code in a pipeline made for objects without a SdfSBSGeom
-    if (crt_m_scene_m_geom_holdsSdfSBSGeom)
+  case 2u:  // dead code in a pipeline made for objects without a SdfSBSLeaves
+    if (crt_m_scene_m_geom_holdsSdfSBSLeaves)
     {
-      SdfSBSGeom_Intersect(m_scene_m_geom_SdfSBSGeomObjects(m_scene_m_geom_SdfSBSGeom).objects[tag.y], posAndNear,
-                           dirAndFar, info, hit);
+      SdfSBSLeaves_Intersect(m_scene_m_geom_SdfSBSLeavesObjects(m_scene_m_geom_SdfSBSLeaves).objects[tag.y], posAndNear,
+                             dirAndFar, info, hit);
     }
     return;
   }
@@ -702,6 +734,12 @@ void m_scene_m_geom_Intersect(uint index, vec4 posAndNear, vec4 dirAndFar, CRT_L
 vec3 m_scene_Xyz(vec4 v)
 {
   return vec3(v.x, v.y, v.z);
+}
+
+// from (anonymous namespace)::Finite
+bool m_scene_Finite(vec4 v)
+{
+  return !(isinf(v.x) || isnan(v.x)) && !(isinf(v.y) || isnan(v.y)) && !(isinf(v.z) || isnan(v.z));
 }
 
 // from litesdf::RayBox
@@ -730,16 +768,18 @@ CRT_Hit m_scene_RayQuery_NearestHit(vec4 posAndNear, vec4 dirAndFar)
 {
   CRT_Hit hit;
   hit.t = dirAndFar.w;
-  hit.primId = 4294967295u;
-  hit.instId = 4294967295u;
-  hit.geomId = 4294967295u;
+  hit.primId = m_scene_kNoId;
+  hit.instId = m_scene_kNoId;
+  hit.geomId = m_scene_kNoId;
   for (int i = 0; i < 4; ++i)
     hit.coords[i] = 0.0;
   const vec3 org = m_scene_Xyz(posAndNear);
   const vec3 dir = m_scene_Xyz(dirAndFar);
+  const bool valid =
+      m_scene_Finite(posAndNear) && m_scene_Finite(dirAndFar) && dot(dir, dir) > 0.0 && posAndNear.w < dirAndFar.w;
   uint stack[64];
   int top = 0;
-  if (!(m_scene_m_nodeMin_size == 0u))
+  if (valid && !(m_scene_m_nodeMin_size == 0u))
     stack[top++] = 0u;
   while (top > 0)
   {
@@ -758,7 +798,7 @@ CRT_Hit m_scene_RayQuery_NearestHit(vec4 posAndNear, vec4 dirAndFar)
     CRT_LeafInfo info;
     info.aabbId = m_scene_m_leafIds[m_scene_m_nodeLeaf[node] - 1u].y;
     info.primId = info.aabbId;
-    info.instId = 0u;
+    info.instId = m_scene_m_leafIds[m_scene_m_nodeLeaf[node] - 1u].x;
     info.geomId = m_scene_m_leafIds[m_scene_m_nodeLeaf[node] - 1u].x;
     info.rayxId = 0u;
     info.rayyId = 0u;
