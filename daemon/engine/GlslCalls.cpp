@@ -329,7 +329,10 @@ std::string GlslPrinter::Call(const CallExpr* call) {
       }
       std::map<unsigned, std::string> bindings;
       for (auto& a : HelperArgs(method, call, bindings)) args.push_back(a);
-      std::string callee = EmitHelper(method, call->getBeginLoc(), false, bindings);
+      // In composed code, the implementation is the one COMPOSE names: a virtual method it calls on
+      // itself is its own (AnyHit calling NearestHit), as the GPU has no other.
+      const CXXMethodDecl* own = !selfClass && !composedPrefix.empty() && method->isVirtual() ? method->getCorrespondingMethodInClass(m_class) : nullptr;
+      std::string callee = own ? EmitHelper(own, call->getBeginLoc(), true, bindings) : EmitHelper(method, call->getBeginLoc(), false, bindings);
       std::string s = callee + "(";
       for (size_t i = 0; i < args.size(); ++i) s += (i ? ", " : "") + args[i];
       return s + ")";

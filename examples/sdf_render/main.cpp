@@ -1,14 +1,18 @@
 // sdf_render: a mesh (or a built-in analytic scene) as a dense grid, a sparse voxel set and a sparse
 // brick set of its signed distance, each placed in a scene through ISceneObject and rendered with
-// normals and ambient occlusion by the original SdfRender (on BVHScene and on Embree),
-// SdfRender_CPU (all cores) and SdfRender_Vulkan (the default device). Prints a table of times and
-// of the pixels that differ from the original's, and writes one image per representation.
+// normals and ambient occlusion by the original SdfRender (on BVHScene, on Embree and on
+// SdfLeafScene), SdfRender_CPU (all cores), SdfRender_Vulkan (the default device) and
+// SdfRender_VulkanLeaves (SdfLeafScene, the paper's level-3 form: intersection shaders where the
+// device has ray tracing pipelines, the switch over the representation elsewhere). Prints a table of
+// times and of the pixels that differ from the original's, and writes one image per representation.
 #include "MeshIO.h"
 #include "SdfBVH.h"
 #include "SdfMesh.h"
 #include "SdfRender.h"
 #include "SdfRender_CPU.h"
 #include "SdfRender_Vulkan.h"
+#include "SdfRender_VulkanLeaves.h"
+#include "SdfLeafScene.h"
 
 #include "Image2D.h"
 
@@ -178,10 +182,24 @@ int main(int argc, char** argv)
       runs.back().renderer->SetScene(sceneOf("embree"));
       runs.push_back({"SdfRender_CPU", CreateSdfRender_CPU(size, size), true, {}, {}});
       runs.back().renderer->SetScene(bvh);
+      auto leaves = std::make_shared<SdfLeafScene>();  // the paper's level-3 form
+      leaves->AddInstance(rep.add(*leaves), LiteMath::float4x4());
+      leaves->CommitScene();
+      runs.push_back({"original, SdfLeafScene (1 thread)", std::make_shared<SdfRender>(size, size), false, {}, {}});
+      runs.back().renderer->SetScene(leaves);
       if (ctx)
       {
         // The translated traversal, SDF leaves included. (Ray queries take triangles only: a field
         // would need procedural boxes and an intersection in the shader.)
+        for (bool hardware : {true, false})
+        {
+          if (hardware && !ctx->hasRayTracingPipeline)
+            continue;
+          auto level3 = std::make_shared<SdfRender_VulkanLeaves>(ctx, size, size);
+          level3->UseRayTracingPipelines(hardware);
+          runs.push_back({hardware ? "VulkanLeaves, intersection shd." : "VulkanLeaves, switch", level3, false, {}, {}});
+          runs.back().renderer->SetScene(leaves);
+        }
         auto vulkan = std::make_shared<SdfRender_Vulkan>(ctx, size, size);
         vulkan->UseRayTracingHardware(false);
         runs.push_back({"SdfRender_Vulkan", vulkan, false, {}, {}});
@@ -208,11 +226,11 @@ int main(int argc, char** argv)
     const size_t hits = size_t(std::count_if(runs[0].depth.begin(), runs[0].depth.end(), [](float t) { return t >= 0.0f; }));
     std::printf("\n%s: %s, %.2f MiB; %zu of %zu camera rays hit, %d AO rays per hit\n", rep.name.c_str(), rep.detail.c_str(),
                 double(rep.bytes) / 1048576.0, hits, n, ao);
-    std::printf("| %-30s | %9s | %15s | %22s |\n", "renderer", "ms", "Mrays/s (upper)", "pixels != original");
+    std::printf("| %-33s | %9s | %15s | %22s |\n", "renderer", "ms", "Mrays/s (upper)", "pixels != original");
     for (const Run& r : runs)
     {
       const size_t diff = DifferingPixels(r.pixels, runs[0].pixels);
-      std::printf("| %-30s | %9.1f | %15.2f | %13zu (%5.2f%%) |\n", r.name.c_str(), r.ms, rays / r.ms * 1e-3, diff, 100.0 * double(diff) / double(n));
+      std::printf("| %-33s | %9.1f | %15.2f | %13zu (%5.2f%%) |\n", r.name.c_str(), r.ms, rays / r.ms * 1e-3, diff, 100.0 * double(diff) / double(n));
       const bool equal = std::memcmp(r.pixels.data(), runs[0].pixels.data(), n * sizeof(uint32_t)) == 0 &&
                          std::memcmp(r.depth.data(), runs[0].depth.data(), n * sizeof(float)) == 0;
       // The same code on the CPU gives the same bits; Embree and the GPU round differently, where a

@@ -55,7 +55,8 @@ void SdfGridLeaves::Intersect(float4 posAndNear, float4 dirAndFar, CRT_LeafInfo 
 {
   float3 org, dir;
   ToField(place, posAndNear, dirAndFar, org, dir);
-  const uint32_t bx = info.aabbId % bricksPerAxis, by = (info.aabbId / bricksPerAxis) % bricksPerAxis, bz = info.aabbId / (bricksPerAxis * bricksPerAxis);
+  const uint32_t brick = scene->m_gridBricks[firstBrick + info.aabbId];
+  const uint32_t bx = brick % bricksPerAxis, by = (brick / bricksPerAxis) % bricksPerAxis, bz = brick / (bricksPerAxis * bricksPerAxis);
   const float cell = boxMinAndCell.w, edge = cell * float(brickCells);
   const float3 corner = Xyz(boxMinAndCell) + edge * float3(float(bx), float(by), float(bz));
   float t0, t1;
@@ -183,6 +184,12 @@ bool SdfLeafScene::RayQuery_AnyHit(float4 posAndNear, float4 dirAndFar) { return
 void SdfLeafScene::ClearGeom()
 {
   m_fields.clear();
+  m_values.clear();
+  m_gridBricks.clear();
+  m_voxelValues.clear();
+  m_voxels.clear();
+  m_bricks.clear();
+  m_brickValues.clear();
   ClearScene();
 }
 
@@ -209,12 +216,26 @@ uint32_t SdfLeafScene::AddGeom_SdfGrid(const litesdf::SdfGrid& grid, uint32_t)
   leaves->samples = grid.samples;
   leaves->brickCells = m_gridBrickCells;
   leaves->bricksPerAxis = (grid.samples - 1) / m_gridBrickCells;
+  leaves->firstBrick = uint32_t(m_gridBricks.size());
   m_values.insert(m_values.end(), grid.values.begin(), grid.values.end());
   Field field{0, leaves, {}};
-  const uint32_t n = leaves->bricksPerAxis;
-  const float edge = grid.CellSize() * float(m_gridBrickCells);
+  const uint32_t n = leaves->bricksPerAxis, b = m_gridBrickCells;
+  const float edge = grid.CellSize() * float(b);
   for (uint32_t i = 0; i < n * n * n; ++i)
   {
+    // A leaf where the surface may cross the brick: its samples are not all of one sign.
+    const uint32_t x0 = i % n * b, y0 = i / n % n * b, z0 = i / (n * n) * b;
+    float lowest = INFINITY, highest = -INFINITY;
+    for (uint32_t z = z0; z <= z0 + b; ++z)
+      for (uint32_t y = y0; y <= y0 + b; ++y)
+        for (uint32_t x = x0; x <= x0 + b; ++x)
+        {
+          lowest = std::min(lowest, grid.Value(x, y, z));
+          highest = std::max(highest, grid.Value(x, y, z));
+        }
+    if (!(lowest <= 0.0f && highest >= 0.0f))
+      continue;
+    m_gridBricks.push_back(i);
     const float3 lo = grid.boxMin + edge * float3(float(i % n), float(i / n % n), float(i / (n * n)));
     field.leafBoxes.push_back({float4(lo.x, lo.y, lo.z, 0.0f), float4(lo.x + edge, lo.y + edge, lo.z + edge, 0.0f)});
   }

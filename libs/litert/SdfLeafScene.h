@@ -3,7 +3,8 @@
 // calls m_geom[info.geomId]->Intersect(posAndNear, dirAndFar, info, hit, this), a virtual call with
 // a CRT_LeafInfo. Each representation is a class of its own, whose Intersect reads the field's values
 // from the scene through `this`:
-//   - SdfGridLeaves: a dense grid; a leaf is a brick of brickCells^3 of its cells;
+//   - SdfGridLeaves: a dense grid; a leaf is a brick of brickCells^3 of its cells, where the
+//     surface may cross it (its samples are not all of one sign);
 //   - SdfSVSLeaves:  a sparse voxel set; a leaf is a voxel and its 8 corner values;
 //   - SdfSBSLeaves:  a sparse brick set; a leaf is a brick and its (b+1)^3 values.
 // A class composing it (crossrt_add_class(... COMPOSE ISceneObject=SdfLeafScene)) runs the walk on the
@@ -53,6 +54,7 @@ public:
   SdfPlacement place;
   LiteMath::float4 boxMinAndCell;  // the grid's corner, and its cells' edge
   uint32_t firstValue = 0, samples = 0, brickCells = 0, bricksPerAxis = 0;
+  uint32_t firstBrick = 0;  // leaf i is brick m_gridBricks[firstBrick + i]: x + n (y + n z), n = bricksPerAxis
 };
 
 class SdfSVSLeaves : public ISdfLeaves
@@ -108,6 +110,7 @@ public:
   // ---- Device data, rebuilt by CommitScene: what the traversal and the leaves read. ----
   std::vector<std::shared_ptr<ISdfLeaves>> m_geom;  // per instance, in instance order
   std::vector<float> m_values;                      // grids' samples and SBS bricks' values
+  std::vector<uint32_t> m_gridBricks;               // grids' bricks that the surface may cross (their leaves)
   std::vector<float> m_voxelValues;                 // SVS voxels: 8 corner values each
   std::vector<LiteMath::float4> m_voxels;           // SVS voxels: corner, edge
   std::vector<LiteMath::float4> m_bricks;           // SBS bricks: corner, voxel edge

@@ -85,11 +85,11 @@ void SdfLeafTracer_Vulkan::InitPipelines()
             VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
             VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
             VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-            VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+            VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
             VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR},
         sizeof(kernel1D_TraceArgs), "SdfLeafTracer::kernel1D_Trace_Intersections");
   m_pipelines.kernel1D_Trace =
-      crossrt::ComputePipeline(m_ctx, SdfLeafTracer_kernel1D_Trace_spv, SdfLeafTracer_kernel1D_Trace_spvBytes, 14,
+      crossrt::ComputePipeline(m_ctx, SdfLeafTracer_kernel1D_Trace_spv, SdfLeafTracer_kernel1D_Trace_spvBytes, 15,
                                sizeof(kernel1D_TraceArgs), "SdfLeafTracer::kernel1D_Trace", m_pipelineClasses);
 }
 
@@ -154,6 +154,8 @@ void SdfLeafTracer_Vulkan::UpdatePlainMembers()
   data.m_scene_m_nodeLeaf_capacity = uint32_t(crt_m_scene()->m_nodeLeaf.capacity());
   data.m_scene_m_leafIds_size = uint32_t(crt_m_scene()->m_leafIds.size());
   data.m_scene_m_leafIds_capacity = uint32_t(crt_m_scene()->m_leafIds.capacity());
+  data.m_scene_m_gridBricks_size = uint32_t(crt_m_scene()->m_gridBricks.size());
+  data.m_scene_m_gridBricks_capacity = uint32_t(crt_m_scene()->m_gridBricks.capacity());
   data.m_scene_m_values_size = uint32_t(crt_m_scene()->m_values.size());
   data.m_scene_m_values_capacity = uint32_t(crt_m_scene()->m_values.capacity());
   data.m_scene_m_voxels_size = uint32_t(crt_m_scene()->m_voxels.size());
@@ -199,6 +201,12 @@ void SdfLeafTracer_Vulkan::CommitDeviceData()
     m_vdata.m_scene_m_leafIds.Upload(crt_m_scene()->m_leafIds.data(),
                                      sizeof(LiteMath::uint2) * crt_m_scene()->m_leafIds.size());
   m_vdata.m_scene_m_leafIdsSize = crt_m_scene()->m_leafIds.size();
+  crossrt::EnsureSize(m_ctx, m_vdata.m_scene_m_gridBricks,
+                      sizeof(unsigned int) * crt_m_scene()->m_gridBricks.capacity());
+  if (!crt_m_scene()->m_gridBricks.empty())
+    m_vdata.m_scene_m_gridBricks.Upload(crt_m_scene()->m_gridBricks.data(),
+                                        sizeof(unsigned int) * crt_m_scene()->m_gridBricks.size());
+  m_vdata.m_scene_m_gridBricksSize = crt_m_scene()->m_gridBricks.size();
   crossrt::EnsureSize(m_ctx, m_vdata.m_scene_m_values, sizeof(float) * crt_m_scene()->m_values.capacity());
   if (!crt_m_scene()->m_values.empty())
     m_vdata.m_scene_m_values.Upload(crt_m_scene()->m_values.data(), sizeof(float) * crt_m_scene()->m_values.size());
@@ -248,6 +256,7 @@ bool SdfLeafTracer_Vulkan::VectorMembersResized() const
   resized = resized || crt_m_scene()->m_nodeRight.size() != m_vdata.m_scene_m_nodeRightSize;
   resized = resized || crt_m_scene()->m_nodeLeaf.size() != m_vdata.m_scene_m_nodeLeafSize;
   resized = resized || crt_m_scene()->m_leafIds.size() != m_vdata.m_scene_m_leafIdsSize;
+  resized = resized || crt_m_scene()->m_gridBricks.size() != m_vdata.m_scene_m_gridBricksSize;
   resized = resized || crt_m_scene()->m_values.size() != m_vdata.m_scene_m_valuesSize;
   resized = resized || crt_m_scene()->m_voxels.size() != m_vdata.m_scene_m_voxelsSize;
   resized = resized || crt_m_scene()->m_voxelValues.size() != m_vdata.m_scene_m_voxelValuesSize;
@@ -281,6 +290,7 @@ std::vector<uint32_t> SdfLeafTracer_Vulkan::CommitVirtual_m_scene_m_geom()
       std::memcpy(&to.samples, &from.samples, sizeof(to.samples));
       std::memcpy(&to.brickCells, &from.brickCells, sizeof(to.brickCells));
       std::memcpy(&to.bricksPerAxis, &from.bricksPerAxis, sizeof(to.bricksPerAxis));
+      std::memcpy(&to.firstBrick, &from.firstBrick, sizeof(to.firstBrick));
       tags[2 * i] = 0;
       tags[2 * i + 1] = uint32_t(SdfGridLeavesObjects.size());
       SdfGridLeavesObjects.push_back(to);
@@ -437,11 +447,12 @@ void SdfLeafTracer_Vulkan::kernel1D_TraceCmd(VkCommandBuffer a_cmd, int n, cross
   {
     m_pipelines.kernel1D_Trace_Intersections.Bind(a_cmd);
     m_pipelines.kernel1D_Trace_Intersections.PushBindings(
-        a_cmd, {m_classDataBuffer.View(), origins, dirs, hits, m_vdata.m_scene_m_brickValues.View(),
-                m_vdata.m_scene_m_bricks.View(), m_vdata.m_scene_m_leafIds.View(), m_vdata.m_scene_m_nodeLeaf.View(),
-                m_vdata.m_scene_m_nodeMax.View(), m_vdata.m_scene_m_nodeMin.View(), m_vdata.m_scene_m_nodeRight.View(),
-                m_vdata.m_scene_m_values.View(), m_vdata.m_scene_m_voxelValues.View(), m_vdata.m_scene_m_voxels.View(),
-                crossrt::Binding::SceneOf(m_scenes.m_scene_m_geom_leaves)});
+        a_cmd,
+        {m_classDataBuffer.View(), origins, dirs, hits, m_vdata.m_scene_m_brickValues.View(),
+         m_vdata.m_scene_m_bricks.View(), m_vdata.m_scene_m_gridBricks.View(), m_vdata.m_scene_m_leafIds.View(),
+         m_vdata.m_scene_m_nodeLeaf.View(), m_vdata.m_scene_m_nodeMax.View(), m_vdata.m_scene_m_nodeMin.View(),
+         m_vdata.m_scene_m_nodeRight.View(), m_vdata.m_scene_m_values.View(), m_vdata.m_scene_m_voxelValues.View(),
+         m_vdata.m_scene_m_voxels.View(), crossrt::Binding::SceneOf(m_scenes.m_scene_m_geom_leaves)});
     m_pipelines.kernel1D_Trace_Intersections.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
     m_pipelines.kernel1D_Trace_Intersections.TraceCmd(a_cmd, std::min<uint32_t>(crt_countX, 65536u),
                                                       (crt_countX + 65535u) / 65536u, 1);
@@ -450,11 +461,11 @@ void SdfLeafTracer_Vulkan::kernel1D_TraceCmd(VkCommandBuffer a_cmd, int n, cross
   {
     m_pipelines.kernel1D_Trace.Bind(a_cmd);
     m_pipelines.kernel1D_Trace.PushBuffers(
-        a_cmd,
-        {m_classDataBuffer.View(), origins, dirs, hits, m_vdata.m_scene_m_brickValues.View(),
-         m_vdata.m_scene_m_bricks.View(), m_vdata.m_scene_m_leafIds.View(), m_vdata.m_scene_m_nodeLeaf.View(),
-         m_vdata.m_scene_m_nodeMax.View(), m_vdata.m_scene_m_nodeMin.View(), m_vdata.m_scene_m_nodeRight.View(),
-         m_vdata.m_scene_m_values.View(), m_vdata.m_scene_m_voxelValues.View(), m_vdata.m_scene_m_voxels.View()});
+        a_cmd, {m_classDataBuffer.View(), origins, dirs, hits, m_vdata.m_scene_m_brickValues.View(),
+                m_vdata.m_scene_m_bricks.View(), m_vdata.m_scene_m_gridBricks.View(), m_vdata.m_scene_m_leafIds.View(),
+                m_vdata.m_scene_m_nodeLeaf.View(), m_vdata.m_scene_m_nodeMax.View(), m_vdata.m_scene_m_nodeMin.View(),
+                m_vdata.m_scene_m_nodeRight.View(), m_vdata.m_scene_m_values.View(),
+                m_vdata.m_scene_m_voxelValues.View(), m_vdata.m_scene_m_voxels.View()});
     m_pipelines.kernel1D_Trace.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
     crossrt::Dispatch1D(a_cmd, crt_countX, 256);
   }

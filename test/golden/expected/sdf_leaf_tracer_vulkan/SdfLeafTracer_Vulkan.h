@@ -89,6 +89,8 @@ protected:
     alignas(4) uint32_t m_scene_m_nodeLeaf_capacity;
     alignas(4) uint32_t m_scene_m_leafIds_size;
     alignas(4) uint32_t m_scene_m_leafIds_capacity;
+    alignas(4) uint32_t m_scene_m_gridBricks_size;
+    alignas(4) uint32_t m_scene_m_gridBricks_capacity;
     alignas(4) uint32_t m_scene_m_values_size;
     alignas(4) uint32_t m_scene_m_values_capacity;
     alignas(4) uint32_t m_scene_m_voxels_size;
@@ -118,6 +120,8 @@ protected:
     size_t m_scene_m_nodeLeafSize = 0;  // elements at the last CommitDeviceData()
     crossrt::Buffer m_scene_m_leafIds;
     size_t m_scene_m_leafIdsSize = 0;  // elements at the last CommitDeviceData()
+    crossrt::Buffer m_scene_m_gridBricks;
+    size_t m_scene_m_gridBricksSize = 0;  // elements at the last CommitDeviceData()
     crossrt::Buffer m_scene_m_values;
     size_t m_scene_m_valuesSize = 0;  // elements at the last CommitDeviceData()
     crossrt::Buffer m_scene_m_voxels;
@@ -143,6 +147,7 @@ protected:
     unsigned int samples;
     unsigned int brickCells;
     unsigned int bricksPerAxis;
+    unsigned int firstBrick;
   };
   struct SdfSVSLeaves_Data  // the data of a SdfSVSLeaves, as the GPU reads it (std430 layout)
   {

@@ -92,6 +92,7 @@ struct SdfGridLeaves_Data
   uint samples;
   uint brickCells;
   uint bricksPerAxis;
+  uint firstBrick;
 };
 
 layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer m_scene_m_geom_SdfGridLeavesObjects
@@ -143,6 +144,8 @@ layout(std430, binding = 0) buffer SdfLeafTracerData
   uint m_scene_m_nodeLeaf_capacity;
   uint m_scene_m_leafIds_size;
   uint m_scene_m_leafIds_capacity;
+  uint m_scene_m_gridBricks_size;
+  uint m_scene_m_gridBricks_capacity;
   uint m_scene_m_values_size;
   uint m_scene_m_values_capacity;
   uint m_scene_m_voxels_size;
@@ -175,35 +178,39 @@ layout(std430, binding = 5) buffer m_scene_m_bricksBuffer
 {
   vec4 m_scene_m_bricks[];
 };  // composed: std::vector SdfLeafScene::m_bricks through m_scene
-layout(std430, binding = 6) buffer m_scene_m_leafIdsBuffer
+layout(std430, binding = 6) buffer m_scene_m_gridBricksBuffer
+{
+  uint m_scene_m_gridBricks[];
+};  // composed: std::vector SdfLeafScene::m_gridBricks through m_scene
+layout(std430, binding = 7) buffer m_scene_m_leafIdsBuffer
 {
   uvec2 m_scene_m_leafIds[];
 };  // composed: std::vector SdfLeafScene::m_leafIds through m_scene
-layout(std430, binding = 7) buffer m_scene_m_nodeLeafBuffer
+layout(std430, binding = 8) buffer m_scene_m_nodeLeafBuffer
 {
   uint m_scene_m_nodeLeaf[];
 };  // composed: std::vector SdfLeafScene::m_nodeLeaf through m_scene
-layout(std430, binding = 8) buffer m_scene_m_nodeMaxBuffer
+layout(std430, binding = 9) buffer m_scene_m_nodeMaxBuffer
 {
   vec4 m_scene_m_nodeMax[];
 };  // composed: std::vector SdfLeafScene::m_nodeMax through m_scene
-layout(std430, binding = 9) buffer m_scene_m_nodeMinBuffer
+layout(std430, binding = 10) buffer m_scene_m_nodeMinBuffer
 {
   vec4 m_scene_m_nodeMin[];
 };  // composed: std::vector SdfLeafScene::m_nodeMin through m_scene
-layout(std430, binding = 10) buffer m_scene_m_nodeRightBuffer
+layout(std430, binding = 11) buffer m_scene_m_nodeRightBuffer
 {
   uint m_scene_m_nodeRight[];
 };  // composed: std::vector SdfLeafScene::m_nodeRight through m_scene
-layout(std430, binding = 11) buffer m_scene_m_valuesBuffer
+layout(std430, binding = 12) buffer m_scene_m_valuesBuffer
 {
   float m_scene_m_values[];
 };  // composed: std::vector SdfLeafScene::m_values through m_scene
-layout(std430, binding = 12) buffer m_scene_m_voxelValuesBuffer
+layout(std430, binding = 13) buffer m_scene_m_voxelValuesBuffer
 {
   float m_scene_m_voxelValues[];
 };  // composed: std::vector SdfLeafScene::m_voxelValues through m_scene
-layout(std430, binding = 13) buffer m_scene_m_voxelsBuffer
+layout(std430, binding = 14) buffer m_scene_m_voxelsBuffer
 {
   vec4 m_scene_m_voxels[];
 };  // composed: std::vector SdfLeafScene::m_voxels through m_scene
@@ -481,9 +488,10 @@ void SdfGridLeaves_Intersect(SdfGridLeaves_Data self, vec4 posAndNear, vec4 dirA
   vec3 org = vec3(0);
   vec3 dir = vec3(0);
   ToField(self.place, posAndNear, dirAndFar, org, dir);
-  const uint bx = info.aabbId % self.bricksPerAxis;
-  const uint by = (info.aabbId / self.bricksPerAxis) % self.bricksPerAxis;
-  const uint bz = info.aabbId / (self.bricksPerAxis * self.bricksPerAxis);
+  const uint brick = m_scene_m_gridBricks[self.firstBrick + info.aabbId];
+  const uint bx = brick % self.bricksPerAxis;
+  const uint by = (brick / self.bricksPerAxis) % self.bricksPerAxis;
+  const uint bz = brick / (self.bricksPerAxis * self.bricksPerAxis);
   const float cell = self.boxMinAndCell.w;
   const float edge = cell * float(self.brickCells);
   const vec3 corner = Xyz(self.boxMinAndCell) + edge * vec3(float(bx), float(by), float(bz));
