@@ -11,6 +11,10 @@
 // ISceneObject (BVHScene, 4 Newton iterations) and the same camera rays traced by the translated
 // SdfRender_CPU (all cores) and SdfRender_Vulkan (the default device); OpenVDB's intersector on all
 // cores too, one copy per thread. Writes out/bench_sdf.csv; bench/plot_sdf.py plots error against time.
+// Then the paper's Figure 9: render time against model size for SBS at growing depths, on the GPU,
+// software against hardware: SdfRender_Vulkan on BVHScene, and SdfRender_VulkanLeaves on
+// SdfLeafScene (the paper's level-3 form) with its switch over the representation and, where the
+// device has ray tracing pipelines, with intersection shaders. Writes out/bench_sdf_fig9.csv.
 //
 //   bench_sdf [--size N] [MESH...]     (default: bunny, armadillo and dragon from build/data/meshes)
 #include "BenchSupport.h"
@@ -20,6 +24,8 @@
 #include "SdfRender.h"
 #include "SdfRender_CPU.h"
 #include "SdfRender_Vulkan.h"
+#include "SdfRender_VulkanLeaves.h"
+#include "SdfLeafScene.h"
 #include "SdfTrace.h"
 
 #include <openvdb/openvdb.h>
@@ -136,6 +142,8 @@ void Print(const Row& r) {
 // given each field's scene in turn.
 struct Translated {
   std::shared_ptr<SdfRender> cpu, vulkan;
+  std::shared_ptr<SdfRender_VulkanLeaves> leaves;  // on SdfLeafScene: the switch, or intersection shaders
+  bool hardware = false;                           // the device has ray tracing pipelines
   int size = 0;
   std::vector<uint32_t> pixels;
   std::vector<float> depth;
@@ -189,14 +197,18 @@ int main(int argc, char** argv) {
   translated.depth.resize(size_t(size) * size);
   translated.cpu = CreateSdfRender_CPU(size, size);
   try {
-    auto vulkan = std::make_shared<SdfRender_Vulkan>(crossrt::VulkanContext::CreateDefault(), size, size);
+    auto ctx = crossrt::VulkanContext::CreateDefault();
+    auto vulkan = std::make_shared<SdfRender_Vulkan>(ctx, size, size);
     vulkan->UseRayTracingHardware(false);  // ray queries take triangles only
     translated.vulkan = vulkan;
+    translated.leaves = std::make_shared<SdfRender_VulkanLeaves>(ctx, size, size);
+    translated.hardware = ctx->hasRayTracingPipeline;
+    std::printf("bench_sdf: the GPU is %s (%s ray tracing pipelines)\n", ctx->DeviceName().c_str(), translated.hardware ? "with" : "without");
   } catch (const std::exception& e) {
     std::cerr << "bench_sdf: Vulkan is not available, no SdfRender_Vulkan column: " << e.what() << "\n";
   }
   const float fovY = 2.0f * std::atan(0.45f) * 180.0f / 3.14159265f;  // Camera's
-  for (SdfRender* r : {translated.cpu.get(), translated.vulkan.get()})
+  for (SdfRender* r : {translated.cpu.get(), translated.vulkan.get(), static_cast<SdfRender*>(translated.leaves.get())})
     if (r) {
       r->SetCamera(float3(1.2f, 0.9f, -2.6f), float3(0.0f, 0.0f, 0.0f), fovY);
       r->SetOcclusion(0, 0.0f);
@@ -204,6 +216,8 @@ int main(int argc, char** argv) {
   std::filesystem::create_directories("out");
   std::ofstream csv("out/bench_sdf.csv");
   csv << "mesh,representation,knobs,build_ms,data_bytes,total_bytes,mrays_per_s,mrays_per_s_cpu,mrays_per_s_vulkan,mean_error,max_error,hit_agreement,depth_psnr,normal_psnr\n";
+  std::ofstream fig9("out/bench_sdf_fig9.csv");
+  fig9 << "mesh,depth,sbs_bytes,bvhscene_ms,leaves_switch_ms,leaves_hardware_ms\n";
 
   for (const std::string& path : meshes) {
     TriangleMesh tm;
@@ -362,7 +376,33 @@ int main(int argc, char** argv) {
       row.mraysCpu = double(size) * size / (ms * 1000.0);
       emit(row, image);
     }
+    // Figure 9: render time against model size, software against hardware, on the GPU.
+    if (translated.vulkan) {
+      std::printf("\n%s, the paper's Figure 9: ms per %dx%d frame on the GPU against the SBS's size (brick 4, 1 B; SdfLeafScene holds it as floats)\n", name.c_str(), size, size);
+      std::printf("| %-8s | %9s | %18s | %22s | %26s |\n", "SBS", "MiB", "BVHScene (compute)", "SdfLeafScene, switch", "SdfLeafScene, intersection");
+      for (uint32_t depth : {5u, 6u, 7u}) {
+        const SdfSBS sbs = BuildSBS(mesh, boxMin, 2.0f, depth, 4, 1);
+        auto bvhScene = MakeSceneRT("sah");
+        bvhScene->AddInstance(bvhScene->AddGeom_SdfSBS(sbs), LiteMath::float4x4());
+        bvhScene->CommitScene();
+        auto leafScene = std::make_shared<SdfLeafScene>();
+        leafScene->AddInstance(leafScene->AddGeom_SdfSBS(sbs), LiteMath::float4x4());
+        leafScene->CommitScene();
+        const double rays = double(size) * size / 1000.0;  // per ms, in Mrays/s
+        const double bvhMs = rays / RenderMrays(*translated.vulkan, translated, bvhScene);
+        translated.leaves->UseRayTracingPipelines(false);
+        const double switchMs = rays / RenderMrays(*translated.leaves, translated, leafScene);
+        double hardwareMs = 0.0;
+        if (translated.hardware) {
+          translated.leaves->UseRayTracingPipelines(true);
+          hardwareMs = rays / RenderMrays(*translated.leaves, translated, leafScene);
+        }
+        const std::string hw = translated.hardware ? std::to_string(hardwareMs).substr(0, 7) : "no RT pipelines";
+        std::printf("| %5u^3  | %9.2f | %18.2f | %22.2f | %26s |\n", 1u << depth, double(sbs.Bytes()) / 1048576.0, bvhMs, switchMs, hw.c_str());
+        fig9 << name << "," << depth << "," << sbs.Bytes() << "," << bvhMs << "," << switchMs << "," << hardwareMs << "\n";
+      }
+    }
   }
-  std::printf("\nwrote out/bench_sdf.csv (plot: bench/plot_sdf.py)\n");
+  std::printf("\nwrote out/bench_sdf.csv and out/bench_sdf_fig9.csv (plots: bench/plot_sdf.py)\n");
   return 0;
 }

@@ -3,10 +3,13 @@
 distance of hit points from the mesh surface against the time per ray on one thread, one point per
 representation and knob setting. Bottom, as the paper's Figure 9: the time per ray of the translated
 renderer (_CPU, all cores; _Vulkan, the device bench_sdf ran on) against the model's size in memory.
-Writes out/bench_sdf.png.
+A third row, from out/bench_sdf_fig9.csv beside the CSV when it is there: the GPU's time per frame
+against the SBS's size, software (BVHScene; SdfLeafScene's switch) against hardware (SdfLeafScene's
+intersection shaders, where the device had ray tracing pipelines). Writes out/bench_sdf.png.
 
 usage: bench/plot_sdf.py [CSV (default out/bench_sdf.csv)] [PNG (default out/bench_sdf.png)]"""
 import csv
+import os
 import sys
 
 if len(sys.argv) > 1 and sys.argv[1] in ("--help", "-h"):
@@ -21,7 +24,9 @@ source = sys.argv[1] if len(sys.argv) > 1 else "out/bench_sdf.csv"
 target = sys.argv[2] if len(sys.argv) > 2 else "out/bench_sdf.png"
 rows = list(csv.DictReader(open(source)))
 meshes = sorted({r["mesh"] for r in rows})
-fig, axes = plt.subplots(2, len(meshes), figsize=(6 * len(meshes), 10), squeeze=False)
+fig9_path = os.path.join(os.path.dirname(source) or ".", "bench_sdf_fig9.csv")
+fig9 = list(csv.DictReader(open(fig9_path))) if os.path.exists(fig9_path) else []
+fig, axes = plt.subplots(3 if fig9 else 2, len(meshes), figsize=(6 * len(meshes), 15 if fig9 else 10), squeeze=False)
 markers = {"grid": "s", "SVS": "o", "SBS": "^", "OpenVDB": "x"}
 for ax, mesh in zip(axes[0], meshes):
     for kind, marker in markers.items():
@@ -56,6 +61,22 @@ for ax, mesh in zip(axes[1], meshes):
     ax.set_xlabel("model size with its BVH (MiB)")
     ax.set_ylabel("time per camera ray (µs)")
     ax.set_title(f"{mesh}: render time against model size")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=7)
+for ax, mesh in zip(axes[2] if fig9 else [], meshes):
+    pts = sorted((r for r in fig9 if r["mesh"] == mesh), key=lambda r: float(r["sbs_bytes"]))
+    x = [float(r["sbs_bytes"]) / 1048576.0 for r in pts]
+    for column, style, label in (("bvhscene_ms", "-", "BVHScene traversal (compute, software)"),
+                                 ("leaves_switch_ms", "--", "SdfLeafScene, switch (compute, software)"),
+                                 ("leaves_hardware_ms", ":", "SdfLeafScene, intersection shaders (hardware)")):
+        y = [float(r[column]) for r in pts]
+        if pts and all(v > 0 for v in y):
+            ax.plot(x, y, style, marker="o", label=label)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("SBS size, brick 4, 1 B (MiB)")
+    ax.set_ylabel("GPU time per frame (ms)")
+    ax.set_title(f"{mesh}: software against hardware (Figure 9)")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7)
 fig.tight_layout()
