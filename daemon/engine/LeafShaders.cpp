@@ -1,6 +1,7 @@
 // Level 3 in composed code (paper 3.10): loops over leaves whose bodies call virtual intersection
-// functions become traces of a ray tracing pipeline, with an intersection shader per leaf class and a
-// hit and a miss shader per call. Takes the traversal's loops; gives Kernel::leaves and the shaders.
+// functions, and traversals that call them with a CRT_LeafInfo at their leaves (the paper's listing
+// 2), become traces of a ray tracing pipeline, with an intersection shader per leaf class and a hit
+// and a miss shader per call. Takes the traversal's loops; gives Kernel::leaves and the shaders.
 #include "LeafShaders.h"
 #include "CodeGenSupport.h"
 
@@ -185,12 +186,14 @@ const CXXMethodDecl* LeafBoxesMethod(const CXXRecordDecl* impl) {
   return nullptr;
 }
 
-// One leaf call of a composed traversal (listing 2 of the paper):
+// One leaf call of a composed traversal, in one of two forms:
 //   for (...) if (<box test>) m_shapes[i]->Intersect(posAndNear, dirAndFar, i, hit);
-// The ray tracing hardware can run its loop when the call has the fixed form the paper gives
-// Intersect: the ray (two float4: origin and near, direction and far) first, the hit last (a struct
-// whose first field is its distance, updated when the leaf is nearer), and between them only the
-// leaf's index or constants. Then `hardware` prints a trace where the loop was; the call's site
+//   while (<walk>) { ... m_geom[info.geomId]->Intersect(posAndNear, dirAndFar, info, hit, this); ... }
+// The ray tracing hardware can run the loop when the call has the fixed form the paper gives
+// Intersect: the ray (two float4: origin and near, direction and far) first, then the hit (a struct
+// whose first field is its distance, updated when the leaf is nearer) and the leaf's index,
+// constants, or (the second form) the CRT_LeafInfo and the traversal itself. In the second form the
+// hardware walks each element's LeafBoxes. Then `hardware` prints a trace where the loop was; the call's site
 // (its vector and method, shared by other calls of both) joins `sites`, and its intersection,
 // closest-hit and miss shaders join `shaders`. Returns why not, or "".
 std::string TraceLeafCall(ASTContext& ctx, Reporter& rep, const ClassModel& model, const Composition& comp, const CXXRecordDecl* implClass,

@@ -47,6 +47,15 @@ void Record(const litesdf::SdfHit& h, const CRT_LeafInfo& info, const SdfPlaceme
 }
 
 bool Finite(float4 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+// A copy of a field's leaves with a placement (host only).
+template <class Leaves>
+std::shared_ptr<ISdfLeaves> Placed(const std::shared_ptr<ISdfLeaves>& field, const SdfPlacement& place)
+{
+  auto leaves = std::make_shared<Leaves>(*std::static_pointer_cast<Leaves>(field));
+  leaves->place = place;
+  return leaves;
+}
 }  // namespace
 
 // ---- The leaves' intersections, one class per representation ----
@@ -332,24 +341,9 @@ void SdfLeafScene::CommitScene(uint32_t)
     place.toObject2 = toObject.get_row(2);
     place.geomId = geomId;
     place.instId = k;
-    if (field.kind == 0)
-    {
-      auto leaf = std::make_shared<SdfGridLeaves>(*std::static_pointer_cast<SdfGridLeaves>(field.prototype));
-      leaf->place = place;
-      m_geom.push_back(leaf);
-    }
-    else if (field.kind == 1)
-    {
-      auto leaf = std::make_shared<SdfSVSLeaves>(*std::static_pointer_cast<SdfSVSLeaves>(field.prototype));
-      leaf->place = place;
-      m_geom.push_back(leaf);
-    }
-    else
-    {
-      auto leaf = std::make_shared<SdfSBSLeaves>(*std::static_pointer_cast<SdfSBSLeaves>(field.prototype));
-      leaf->place = place;
-      m_geom.push_back(leaf);
-    }
+    m_geom.push_back(field.kind == 0   ? Placed<SdfGridLeaves>(field.prototype, place)
+                     : field.kind == 1 ? Placed<SdfSVSLeaves>(field.prototype, place)
+                                       : Placed<SdfSBSLeaves>(field.prototype, place));
     const std::vector<CRT_AABB> boxes = LeafBoxes(k);
     for (uint32_t i = 0; i < boxes.size(); ++i)
       leaves.push_back({boxes[i], k, i});

@@ -22,6 +22,17 @@ void BuildBarrier(VkCommandBuffer cmd, VkPipelineStageFlags dstStages, VkAccessF
                        nullptr);
 }
 
+// A bottom level's geometry of boxes (VkAabbPositionsKHR) at `boxes`, opaque: no any-hit shaders, so
+// the intersection shader's report commits.
+VkAccelerationStructureGeometryKHR AabbGeometry(VkDeviceAddress boxes) {
+  auto geometry = VkInit<VkAccelerationStructureGeometryKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR);
+  geometry.geometryType = VK_GEOMETRY_TYPE_AABBS_KHR;
+  geometry.flags = VK_GEOMETRY_OPAQUE_BIT_KHR;
+  geometry.geometry.aabbs = VkInit<VkAccelerationStructureGeometryAabbsDataKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_AABBS_DATA_KHR);
+  geometry.geometry.aabbs.data.deviceAddress = boxes;
+  geometry.geometry.aabbs.stride = sizeof(VkAabbPositionsKHR);
+  return geometry;
+}
 }  // namespace
 
 RayTracingScene::RayTracingScene(std::shared_ptr<VulkanContext> ctx) : ctx_(std::move(ctx)) {
@@ -177,12 +188,7 @@ void RayTracingScene::BuildLeaves(const std::vector<LeafBox>& leaves, const std:
   const VkAabbPositionsKHR unit{0.0f, 0.0f, 0.0f, 1.0f, 1.0f, 1.0f};
   Buffer box(ctx_, sizeof(unit), VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR);
   box.Upload(&unit, sizeof(unit));
-  auto geometry = VkInit<VkAccelerationStructureGeometryKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR);
-  geometry.geometryType = VK_GEOMETRY_TYPE_AABBS_KHR;
-  geometry.flags = VK_GEOMETRY_OPAQUE_BIT_KHR;  // no any-hit shaders: the intersection shader's report commits
-  geometry.geometry.aabbs = VkInit<VkAccelerationStructureGeometryAabbsDataKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_AABBS_DATA_KHR);
-  geometry.geometry.aabbs.data.deviceAddress = box.Address();
-  geometry.geometry.aabbs.stride = sizeof(VkAabbPositionsKHR);
+  const VkAccelerationStructureGeometryKHR geometry = AabbGeometry(box.Address());
   VkDeviceSize scratchBytes = 0;
   std::vector<PendingLevel> pending;
   pending.push_back(Prepare(geometry, 1, scratchBytes));
@@ -235,12 +241,7 @@ void RayTracingScene::BuildBoxGeometries(const std::vector<BoxGeometry>& geometr
       aabbs[i] = {boxes[i].min[0], boxes[i].min[1], boxes[i].min[2], boxes[i].max[0], boxes[i].max[1], boxes[i].max[2]};
     Buffer input(ctx_, sizeof(VkAabbPositionsKHR) * aabbs.size(), VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_BUILD_INPUT_READ_ONLY_BIT_KHR);
     input.Upload(aabbs.data(), sizeof(VkAabbPositionsKHR) * aabbs.size());
-    auto geometry = VkInit<VkAccelerationStructureGeometryKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR);
-    geometry.geometryType = VK_GEOMETRY_TYPE_AABBS_KHR;
-    geometry.flags = VK_GEOMETRY_OPAQUE_BIT_KHR;  // no any-hit shaders: the intersection shader's report commits
-    geometry.geometry.aabbs = VkInit<VkAccelerationStructureGeometryAabbsDataKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_AABBS_DATA_KHR);
-    geometry.geometry.aabbs.data.deviceAddress = input.Address();
-    geometry.geometry.aabbs.stride = sizeof(VkAabbPositionsKHR);
+    const VkAccelerationStructureGeometryKHR geometry = AabbGeometry(input.Address());
     pending.push_back(Prepare(geometry, static_cast<uint32_t>(aabbs.size()), scratchBytes));
     pending.back().input = std::move(input);
     auto addressInfo = VkInit<VkAccelerationStructureDeviceAddressInfoKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_DEVICE_ADDRESS_INFO_KHR);
