@@ -135,6 +135,16 @@ std::string GlslPrinter::IspcCompoundAssignOnce(const clang::CXXOperatorCallExpr
     if (!t || !t->value.empty() || t->local || t->array.empty()) return "";
     array = t->array;
     index = t->offset.empty() ? Expr(as->getIdx()) : t->offset + " + " + Expr(as->getIdx());
+  } else if (auto* sub = dyn_cast<CXXOperatorCallExpr>(target); sub && sub->getOperator() == OO_Subscript &&
+             (IsLiteMathType(sub->getArg(0)->getType(), "float4x4") || IsLiteMathType(sub->getArg(0)->getType(), "float3x3"))) {
+    // A column of a thread's local matrix, m[k++] += v: its columns are the lanes' own array.
+    auto* ref = dyn_cast<DeclRefExpr>(sub->getArg(0)->IgnoreParenImpCasts());
+    auto* vd = ref ? dyn_cast<VarDecl>(ref->getDecl()) : nullptr;
+    if (!vd || !vd->isLocalVarDecl()) return "";
+    array = "(" + Expr(sub->getArg(0)) + ").m_col";
+    index = Expr(sub->getArg(1));
+    pointee = "varying ";
+    helperKind = "_local";
   } else if (auto* sub = dyn_cast<CXXOperatorCallExpr>(target); sub && sub->getOperator() == OO_Subscript) {
     const FieldDecl* field = ThisMemberField(sub->getArg(0));
     if (!field || !IsStdVector(field->getType())) return "";
@@ -149,7 +159,7 @@ std::string GlslPrinter::IspcCompoundAssignOnce(const clang::CXXOperatorCallExpr
   const char* names[] = {"add", "sub", "mul", "div"};
   const std::string name = std::string("crt_") + names[std::string("+-*/").find(spelling[0])] + "_assign_" + type + helperKind;
   if (m_ispcHelpers.insert(name).second)
-    m_functions.push_back("// a[i] " + spelling + " v, a[i] found once" + (localArray ? " (a: a thread's local array)" : "") + "\nstatic inline " + type +
+    m_functions.push_back("// a[i] " + spelling + " v, a[i] found once" + (helperKind.empty() ? "" : " (a: a thread's local array)") + "\nstatic inline " + type +
                           " " + name + "(" + pointee + type + " *uniform a, int i, " + type + " v)\n{\n  a[i] = a[i] " + spelling.substr(0, 1) +
                           " v;\n  return a[i];\n}\n");
   return name + "(" + array + ", (int)(" + index + "), " + Expr(op->getArg(1)) + ")";

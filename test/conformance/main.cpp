@@ -105,8 +105,8 @@ int main(int argc, char** argv) {
     else {
       std::printf("usage: crossrt_conformance [--csv FILE]\n"
                   "Runs the conformance classes (test/conformance/cases) as written, as _CPU, as _Vulkan and (where the\n"
-                  "build found an ISPC compiler) as _ISPC, and prints"
-                  "which constructs translate, run and agree. CROSSRT_DEVICE picks the Vulkan device.\n");
+                  "build found an ISPC compiler) as _ISPC, and prints which constructs translate, run and agree.\n"
+                  "CROSSRT_DEVICE picks the Vulkan device.\n");
       return std::strcmp(argv[i], "--help") == 0 ? 0 : 2;
     }
   }

@@ -1,5 +1,5 @@
 // LiteMath's matrix API as the paper's library has it: mul4x4x4, make_float4x4_from_rows/cols,
-// rotate3x3X/Y/Z, float3x3 * float3.
+// rotate3x3X/Y/Z, float3x3 * float3, columns changed in place (m[k++] += v).
 #pragma once
 #include "LiteMath.h"
 #include <vector>
