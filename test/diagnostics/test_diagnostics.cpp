@@ -1016,7 +1016,7 @@ protected:
   }
 }
 
-TEST_CASE("--name names the generated class, its files and its global symbols", "[diagnostics][name]")
+TEST_CASE("The --name option names the generated class, its files and its global symbols", "[diagnostics][name]")
 {
   TempClass tc("Filler", R"(#pragma once
 class Filler {
