@@ -107,7 +107,9 @@ void SdfSBSLeaves::Intersect(float4 posAndNear, float4 dirAndFar, CRT_LeafInfo i
 litesdf::SdfHit SdfLeafScene::MarchBrick(float3 corner, float cell, int n, uint32_t first, uint32_t strideY, uint32_t strideZ, float3 org, float3 dir,
                                          float t0, float t1) const
 {
-  // The cells in order along the ray (Amanatides and Woo), each solved until one is hit.
+  // The cells in order along the ray (Amanatides and Woo), each solved until one is hit; a cell with
+  // no corner at or inside the surface cannot hold it (litesdf's MayHoldSurface) and is not solved.
+  // (litesdf's MarchVoxels walks the same way, but takes a callable, which kernels cannot pass.)
   const float3 entry = (org + t0 * dir - corner) / cell;
   int at[3];
   int step[3];
@@ -130,7 +132,9 @@ litesdf::SdfHit SdfLeafScene::MarchBrick(float3 corner, float cell, int n, uint3
     for (uint32_t c = 0; c < 8; ++c)
       values.v[c] = m_values[base + (c & 1u) + ((c >> 1u) & 1u) * strideY + (c >> 2u) * strideZ];
     const float3 cellMin = corner + cell * float3(float(at[0]), float(at[1]), float(at[2]));
-    const litesdf::SdfHit h = litesdf::IntersectVoxelSpan(values, cellMin, cell, org, dir, tEnter, std::min(tNext[a], t1), kNewtonIterations);
+    const litesdf::SdfHit h = litesdf::MayHoldSurface(values)
+                                  ? litesdf::IntersectVoxelSpan(values, cellMin, cell, org, dir, tEnter, std::min(tNext[a], t1), kNewtonIterations)
+                                  : litesdf::Missed();
     if (h.t >= 0.0f)
       return h;
     if (!(tNext[a] <= t1))

@@ -426,6 +426,15 @@ SdfHit m_scene_IntersectVoxelSpan(VoxelValues values, vec3 voxelMin, float size,
   return hit;
 }
 
+// from litesdf::MayHoldSurface
+bool m_scene_MayHoldSurface(VoxelValues values)
+{
+  float lowest = values.v[0];
+  for (int c = 1; c < 8; ++c)
+    lowest = values.v[c] < lowest ? values.v[c] : lowest;
+  return lowest <= 0.0;
+}
+
 // from SdfLeafScene::MarchBrick
 SdfHit m_scene_MarchBrick(vec3 corner, float cell, int n, uint first, uint strideY, uint strideZ, vec3 org, vec3 dir,
                           float t0, float t1)
@@ -452,8 +461,10 @@ SdfHit m_scene_MarchBrick(vec3 corner, float cell, int n, uint first, uint strid
     for (uint c = 0u; c < 8u; ++c)
       values.v[c] = m_scene_m_values[base + (c & 1u) + ((c >> 1u) & 1u) * strideY + (c >> 2u) * strideZ];
     const vec3 cellMin = corner + cell * vec3(float(at[0]), float(at[1]), float(at[2]));
-    const SdfHit h = m_scene_IntersectVoxelSpan(values, cellMin, cell, org, dir, tEnter, min(tNext[a], t1),
-                                                m_scene_kNewtonIterations);
+    const SdfHit h = m_scene_MayHoldSurface(values)
+                         ? m_scene_IntersectVoxelSpan(values, cellMin, cell, org, dir, tEnter, min(tNext[a], t1),
+                                                      m_scene_kNewtonIterations)
+                         : m_scene_Missed();
     if (h.t >= 0.0)
       return h;
     if (!(tNext[a] <= t1))
