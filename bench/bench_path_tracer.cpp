@@ -1,7 +1,8 @@
 // Benchmark: litept's PathTracer on a glTF scene (the Cornell box by default), from one run:
 //   1. the paper's Table 10 form: samples per second of the class as written (one thread),
-//      PathTracer_CPU (all cores) and PathTracer_Vulkan as a megakernel and as plain wavefront, in
-//      interleaved rounds (medians), with the ratio to the original;
+//      PathTracer_CPU (all cores), PathTracer_Vulkan as a megakernel and as plain wavefront, and
+//      PathTracer_ISPC (SIMD lanes, where ISPC was found) beside PathTracer_CPU over the same BVHScene,
+//      in interleaved rounds (medians), with the ratio to the original;
 //   2. the paper's Table 11 form: PathTracer_Vulkan translated at virtual levels 1 (one array of
 //      equal slots, PathTracer_VulkanLevel1), 2 (a buffer per class, PathTracer_Vulkan) and 3 (2 plus
 //      callable shaders where the device has ray tracing pipelines, PathTracer_VulkanLevel3), both
@@ -18,6 +19,9 @@
 #include "ImageMetrics.h"
 #include "PathTracer.h"
 #include "PathTracer_CPU.h"
+#ifdef CROSSRT_LITEPT_ISPC
+#include "PathTracer_ISPC.h"
+#endif
 #include "PathTracer_Vulkan.h"
 #include "PathTracer_VulkanLevel1.h"
 #include "PathTracer_VulkanLevel3.h"
@@ -263,6 +267,16 @@ int main(int argc, char** argv)
         std::printf("(warning: the megakernel's and the wavefront's images differ at %zu pixels: the Vulkan times below are not for the same work)\n\n",
                     differ);
     }
+    // The ISPC class runs the thread loop in SIMD lanes with BVHScene's traversal composed in; the CPU
+    // class over the same BVHScene is its like-for-like peer.
+    auto cpuBvh = CreatePathTracer_CPU();
+    Prepare(*cpuBvh, s, "sah");
+    rows.push_back({"PathTracer_CPU (all cores, BVHScene)", "-", cpuBvh.get(), 8, [] {}, {}});
+#ifdef CROSSRT_LITEPT_ISPC
+    auto ispc = CreatePathTracer_ISPC();
+    Prepare(*ispc, s, "sah");
+    rows.push_back({"PathTracer_ISPC (all cores, SIMD lanes, BVHScene)", "-", ispc.get(), 8, [] {}, {}});
+#endif
     for (int round = 0; round < rounds; ++round)
       for (auto& r : rows)
       {

@@ -27,5 +27,9 @@ std::vector<ShaderSource> GenerateShaders(const ClassModel& model, const Generat
 std::map<std::string, std::string> GenerateHost(const ClassModel& model, const GenerateOptions& options, bool vulkan);
 // The ISPC backend (IspcCode.cpp): <Class>_ISPC_kernels.ispc.
 std::string GenerateIspcKernels(const ClassModel& model, const GenerateOptions& options);
+// The C++ type the ISPC header gives a parameter of this GLSL type (int32_t, ispc::float4, ...).
+std::string IspcCppType(const std::string& glslType);
+// The per-target symbols of ISPC export function `symbol`, as IspcPick lists them.
+std::string IspcTargetFunctions(const std::string& symbol);
 
 }  // namespace crossrt::engine

@@ -333,6 +333,7 @@ Data Common(const ClassModel& model, const GenerateOptions& opt) {
       Data y;
       y.set("impl", vi.name);
       y.set("implType", vi.cppName);
+      y.set("ispcData", IspcObjectStruct(vi.cppName));
       y.set("member", v.member);
       y.set("typeIndex", std::to_string(t));
       y.set("first", t == 0);

@@ -65,7 +65,6 @@ bool ComposeFromTranslationUnit(ASTContext& ctx, Reporter& reporter, ClassModel&
     comp.implHeader = FileOf(ctx, impl->getLocation());
     std::string holderPrefix = comp.holder + "_";
     for (auto& k : model.kernels) {
-      if (model.forIspc && k.rtv) continue;  // the ISPC class's thread loops call the interface as written
       GlslPrinter printer(ctx, impl, reporter);
       printer.ispc = model.forIspc;
       printer.ispcDataStruct = model.symbolPrefix + "_Data";

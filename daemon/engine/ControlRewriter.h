@@ -60,6 +60,7 @@ private:
     std::map<const VarDecl*, unsigned> axisOf;     // loop variable -> thread axis
     std::vector<std::pair<const VarDecl*, std::string>> stateBuffers;  // per-thread local -> its wavefront buffer
     std::vector<std::string> bufferArgs;           // host BufferView of each megakernel parameter so far
+    std::vector<std::string> cppBufferArgs;        // the same buffers as the C++ passes them (the ISPC class's)
     std::set<const VarDecl*> locals;               // every local of the body (per-thread)
     std::set<const VarDecl*> passed;               // locals some kernel call gets the address of
     std::vector<const VarDecl*> outer;             // control-function variables the body reads, first read first
@@ -100,7 +101,13 @@ private:
   // A pointer argument of a kernel in a thread loop: in the megakernel, a buffer named as the
   // kernel's parameter (its code refers to that name). Two kernels naming different buffers alike
   // would collide there.
-  void AddMegakernelBuffer(ThreadLoop& tl, const CXXMethodDecl* md, const ParmVarDecl* p, const std::string& hostArg, SourceLocation loc);
+  void AddMegakernelBuffer(ThreadLoop& tl, const CXXMethodDecl* md, const ParmVarDecl* p, const std::string& hostArg, const std::string& cppArg,
+                           SourceLocation loc);
+
+  // The ISPC class: the thread loop's body as an ISPC function of one thread (tl.mega.glslBody) and
+  // the control function's loop replaced by chunks of it on all cores, in SIMD lanes. False where
+  // the loop stays C++ (three thread axes).
+  bool IspcThreadLoop(ThreadLoop& tl, const std::string& body, const ForStmt* outerLoop);
 
   // The wavefront version of the thread loop's body: host loops as written, each kernel call a
   // dispatch over all threads, per-thread locals bound as their buffers.

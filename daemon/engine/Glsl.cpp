@@ -463,7 +463,7 @@ std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callL
     if (cast<CXXMethodDecl>(def)->isConst()) os << structSelf->getNameAsString() << " self";
     else if (ispc) os << structSelf->getNameAsString() << " &self";
     else os << "inout " << structSelf->getNameAsString() << " self";
-  } else if (withSelf) os << selfClass->getNameAsString() << "_Data self";
+  } else if (withSelf) os << (ispc ? IspcObjectStruct(selfClass->getQualifiedNameAsString()) : selfClass->getNameAsString() + "_Data") << " self";
   const auto outerPointers = m_pointers;  // this function's pointer parameters shadow the caller's names
   bool first = !withSelf;
   for (unsigned i = 0; i < def->getNumParams(); ++i) {

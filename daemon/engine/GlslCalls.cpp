@@ -197,8 +197,7 @@ std::string GlslPrinter::IspcBuiltin(const FunctionDecl* fd, const std::vector<s
       "make_float4x4_from_cols", "transpose", "inverse", "inverse4x4", "determinant", "outerProduct", "mul", "mul4x3", "mul3x3",
       "mul4x4x4", "lane_mask_le"};
   if (matrixNames.count(n)) return join(n);
-  if (arg0Type.rfind("mat", 0) == 0 || n.find("float4x4") != std::string::npos || n.find("float3x3") != std::string::npos ||
-      n == "refract" || n == "faceforward")
+  if (arg0Type.rfind("mat", 0) == 0 || n.find("float4x4") != std::string::npos || n.find("float3x3") != std::string::npos)
     return IspcFail(call->getBeginLoc(), "'" + fd->getQualifiedNameAsString() + "'");
   if (n == "atan2" || n == "atan2f") return join("atan2");
   if (n == "sqrt" || n == "sqrtf") return join("sqrt");

@@ -214,6 +214,19 @@ bool LayoutMatchesCpp(ASTContext& ctx, QualType type, bool scalar) {
   return true;
 }
 
+std::string IspcObjectStruct(const std::string& qualifiedName) {
+  std::string name;
+  for (size_t i = 0; i < qualifiedName.size(); ++i) {
+    if (qualifiedName.compare(i, 2, "::") == 0) {
+      name += '_';
+      ++i;
+    } else {
+      name += qualifiedName[i];
+    }
+  }
+  return name + "_Data";
+}
+
 std::string IspcTypeName(const std::string& glslType) {
   auto [base, dims] = SplitArray(glslType);
   static const std::map<std::string, std::string> names = {

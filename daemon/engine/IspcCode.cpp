@@ -26,14 +26,6 @@ bool IsScalar(const std::string& glslType) {
   return glslType == "float" || glslType == "int" || glslType == "uint" || glslType == "bool" || glslType == "double";
 }
 
-// What C++ passes for an ISPC parameter of this GLSL type: the type ispc::'s header declares.
-std::string IspcCppType(const std::string& glslType) {
-  if (glslType == "int") return "int32_t";
-  if (glslType == "uint") return "uint32_t";
-  if (IsScalar(glslType)) return glslType;
-  return "ispc::" + IspcTypeName(glslType);
-}
-
 // The identity of a reduction, in ISPC: a lane that ran no iteration changes nothing.
 std::string IspcIdentity(ReduceOp op, const std::string& glslType) {
   const std::string t = IspcTypeName(glslType);
@@ -64,6 +56,20 @@ const char* Axis(unsigned d, unsigned dims) {
 }
 
 }  // namespace
+
+// What C++ passes for an ISPC parameter of this GLSL type: the type ispc::'s header declares.
+std::string IspcCppType(const std::string& glslType) {
+  if (glslType == "int") return "int32_t";
+  if (glslType == "uint") return "uint32_t";
+  if (IsScalar(glslType)) return glslType;
+  return "ispc::" + IspcTypeName(glslType);
+}
+
+std::string IspcTargetFunctions(const std::string& symbol) {
+  std::string targets;
+  for (const char* t : kIspcTargetSuffixes) targets += std::string(targets.empty() ? "" : ", ") + symbol + "_" + t;
+  return targets;
+}
 
 std::string GenerateIspcKernels(const ClassModel& model, const GenerateOptions& opt) {
   Data d = Common(model, opt);
@@ -132,13 +138,29 @@ std::string GenerateIspcKernels(const ClassModel& model, const GenerateOptions& 
     x.set("reductions", reds);
     kernels.push_back(x);
   }
+  // Thread loops run in SIMD lanes: their kernels' code, the body of one thread, and the export
+  // function of a chunk (IspcThreadLoops.cpp).
+  std::string exports;
+  for (const Kernel& mk : model.megakernels) {
+    if (mk.ispcExport.empty()) continue;
+    for (auto& s : mk.structList)
+      if (seen.insert(s.name).second) structs += s.text + "\n";
+    for (auto& c : mk.constantList)
+      if (seen.insert(c.name).second) constants += c.text;
+    for (auto& f : mk.functionList)
+      if (std::find(functions.begin(), functions.end(), f) == functions.end()) functions.push_back(f);
+    functions.push_back(mk.glslBody);
+    exports += mk.ispcExport + "\n";
+  }
   std::string code;
   for (auto& f : functions) code += f + "\n";
+  code += exports;
   d.set("structs", structs);
   d.set("constants", constants);
   d.set("functions", code);
   d.set("kernels", kernels);
-  d.set("ispcHasKernels", !kernels.is_empty_list());  // else no <Class>_Data: nothing declares the types of its members
+  const bool threadLoops = std::any_of(model.megakernels.begin(), model.megakernels.end(), [](const Kernel& mk) { return !mk.ispcExport.empty(); });
+  d.set("ispcHasKernels", !kernels.is_empty_list() || threadLoops);  // else no <Class>_Data: nothing declares the types of its members
   Data members = List(), vectors = List();
   for (auto& m : model.members) {
     if (!m.usedByKernels) continue;
@@ -235,12 +257,29 @@ void IspcHostData(const ClassModel& model, Data& d) {
     std::string unused;
     for (auto& l : k.preambleLocals) unused += "(void)" + l + "; ";
     x.set("preambleLocals", unused.empty() ? "" : unused + " // the ISPC kernel computes its own");
-    std::string targets;
-    for (const char* t : kIspcTargetSuffixes) targets += std::string(targets.empty() ? "" : ", ") + model.symbolPrefix + "_" + k.name + "_" + t;
-    x.set("targetFunctions", targets);
+    x.set("targetFunctions", IspcTargetFunctions(model.symbolPrefix + "_" + k.name));
     kernels.push_back(x);
   }
-  d.set("ispcHasKernels", !kernels.is_empty_list());  // else ISPC declares no <Class>_Data
+  // The thread loops that run in SIMD lanes: their export functions, per target.
+  Data threadLoops = List();
+  for (const Kernel& mk : model.megakernels) {
+    if (mk.ispcExport.empty()) continue;
+    Data x;
+    x.set("symbol", model.symbolPrefix + "_" + mk.name);
+    x.set("targetFunctions", IspcTargetFunctions(model.symbolPrefix + "_" + mk.name));
+    threadLoops.push_back(x);
+  }
+  d.set("ispcThreadLoops", threadLoops);
+  d.set("ispcHasThreadLoops", !threadLoops.is_empty_list());
+  Data writtenMembers = List();
+  for (auto& m : model.members)
+    if (m.kind == MemberKind::Plain && m.usedByKernels && m.writtenByKernels && m.composedFrom.empty()) {
+      Data w;
+      w.set("name", m.name);
+      writtenMembers.push_back(w);
+    }
+  d.set("ispcWrittenMembers", writtenMembers);
+  d.set("ispcHasKernels", !kernels.is_empty_list() || !threadLoops.is_empty_list());  // else ISPC declares no <Class>_Data
   // The vectors kernels append to: the ISPC kernels hand the values to the class.
   Data appends = List();
   for (auto& m : model.members)

@@ -2,7 +2,7 @@
 // loop variable `uniform` when its start, bound and step are shared (a kernel's scalar parameters,
 // members, the outer loops of a 2D or 3D nest, constants) and nothing else changes it: the loop
 // then runs once per gang, and what it indexes with the variable (m_weights[k + m_radius]) is one
-// load for all lanes instead of a gather. Part of GlslPrinter (Glsl.h).
+// load for all lanes instead of a gather, and a shared value. Part of GlslPrinter (Glsl.h).
 #include "AstQueries.h"
 #include "Glsl.h"
 #include "GlslParts.h"
@@ -36,6 +36,12 @@ bool GlslPrinter::IspcUniform(const clang::Expr* e) const {
     if (method->getName() == "width" || method->getName() == "height") return IsImage2D(object->getType().getNonReferenceType());
     auto* f = ThisMemberField(object);
     return f && method->getName() == "size" && IsStdVector(f->getType());
+  }
+  if (auto* op = dyn_cast<CXXOperatorCallExpr>(e); op && op->getOperator() == OO_Subscript && op->getNumArgs() == 2) {
+    // an element of a member vector at a shared index (self->m_v[k]: one load for the gang)
+    if (!composedPrefix.empty() || selfClass || m_structSelf || !op->getType()->isArithmeticType()) return false;
+    auto* f = ThisMemberField(op->getArg(0));
+    return f && IsStdVector(f->getType()) && IspcUniform(op->getArg(1));
   }
   if (auto* uo = dyn_cast<UnaryOperator>(e))
     return (uo->getOpcode() == UO_Minus || uo->getOpcode() == UO_Plus || uo->getOpcode() == UO_Not || uo->getOpcode() == UO_LNot) &&

@@ -23,10 +23,9 @@ void CheckKernelParams(Context& c, const CXXMethodDecl* md, const FunctionDecl* 
     auto* p = md->getParamDecl(i);
     KernelParam kp;
     kp.name = def->getParamDecl(i)->getNameAsString();  // the name the body uses
-    if (kp.name.empty()) {
-      c.rep.Error(p->getLocation(), "kernel '" + k.name + "' has a parameter without a name", "name it, or remove it");
-      continue;
-    }
+    // A parameter the definition leaves unnamed (unused there) takes the declaration's name (tidX
+    // still names a thread id), or one of its own.
+    if (kp.name.empty()) kp.name = p->getName().empty() ? "crt_unnamed" + std::to_string(i) : p->getNameAsString();
     kp.glslName = GlslPrinter::SafeName(kp.name);
     QualType t = p->getType();
     kp.isThreadId = k.rtv && IsThreadIdName(kp.name);

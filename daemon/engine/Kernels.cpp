@@ -52,6 +52,24 @@ static std::string IspcThreadHead(Context& c, const Kernel& k, const std::vector
   return head + ")";
 }
 
+// The ISPC thread function of a kernel_ function, which a thread loop's ISPC body calls: the class
+// data, then as GLSL's (the thread ids, the per-thread values, by reference where written, and the
+// by-value arguments, all per lane), then the buffers and images GLSL binds, as ISPC pointers.
+static std::string IspcRtvHead(Context& c, const Kernel& k, const std::vector<std::pair<std::string, std::string>>& threadParams) {
+  std::string head = std::string("static ") + (k.returnsBool ? "bool " : "void ") + k.name + "(uniform " + c.cls->getNameAsString() + "_Data *uniform self";
+  for (auto [type, name] : threadParams) {
+    const bool inout = type.rfind("inout ", 0) == 0;
+    if (inout) type = type.substr(6);
+    head += ", " + IspcTypeName(type) + (inout ? " &" : " ") + name;
+  }
+  for (const KernelParam& p : k.params) {
+    if (p.isImage) head += ", const uniform crt_Image_" + IspcTypeName(p.glslType) + " &" + p.glslName;
+    else if (p.isPointer && !p.threadState)
+      head += std::string(", ") + (p.isConstPointee ? "const " : "") + "uniform " + SplitArray(IspcTypeName(p.glslType)).first + " *uniform " + p.glslName;
+  }
+  return head + ")";
+}
+
 // Whether s, or a method of cls it calls, calls through a member pointer to a polymorphic class
 // (m_pAccelStruct->RayQuery_NearestHit): on ISPC such iterations branch per lane, and a tile of
 // neighbouring pixels keeps the lanes on the same path longer than a row does. With 16 lanes on
@@ -103,12 +121,9 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   CheckKernelParams(c, md, def, k);
   for (unsigned i = 0; i < def->getNumParams(); ++i) k.cppParamsDecl += (i ? ", " : "") + ParamDecl(c.ctx, md->getParamDecl(i), def->getParamDecl(i), i);
   GlslPrinter printer(c.ctx, c.cls, c.rep);
-  // The ISPC class runs the loop nests of kernelND_ functions as ISPC; the thread loops that call
-  // kernel_ functions stay in its control functions, on all cores as in the CPU class.
-  printer.ispc = c.model.forIspc && !k.rtv;
-  if (c.model.forIspc && k.rtv)  // once for the class
-    c.rep.Note(c.cls->getLocation(), "the ISPC class runs the kernel_ functions that control functions call from thread loops as C++ "
-                                     "on all cores, as the CPU class does; only kernel1D_/2D_/3D_ loop nests run in SIMD lanes");
+  // The ISPC class runs kernelND_ loop nests as ISPC, and kernel_ functions as the thread functions
+  // its thread loops' ISPC bodies call (ThreadLoops.cpp).
+  printer.ispc = c.model.forIspc;
   printer.compositions = c.compositions;
   printer.threadReturnsValue = k.returnsBool;
   for (auto& s : ClassStructNames(c.model)) printer.predeclaredStructs.insert(s);
@@ -229,7 +244,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
 
   // ISPC: what every lane of a gang shares (IspcUniform.cpp): the kernel's scalar parameters, and
   // the outer loops' variables of a 2D or 3D nest, except where a 2D nest runs in tiles.
-  if (printer.ispc) {
+  if (printer.ispc && !k.rtv) {  // (a kernel_ function's arguments may differ per lane)
     for (unsigned i = 0; i < k.params.size() && i < def->getNumParams(); ++i)
       if (!k.params[i].isPointer && !k.params[i].isImage && !k.params[i].isThreadId && def->getParamDecl(i)->getType()->isArithmeticType())
         printer.uniformValues.insert(def->getParamDecl(i));
@@ -327,7 +342,9 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   // GLSL: the thread function. ISPC: the same, its uniform arguments passed in (IspcThreadHead).
   std::ostringstream os;
   os << "// from " << c.cls->getNameAsString() << "::" << k.name << " (" << k.sourceFile << ")\n";
-  if (printer.ispc) {
+  if (printer.ispc && k.rtv) {
+    os << IspcRtvHead(c, k, threadParams);
+  } else if (printer.ispc) {
     for (auto& [type, name] : threadParams) type = IspcTypeName(type);
     os << IspcThreadHead(c, k, threadParams, def);
   } else {

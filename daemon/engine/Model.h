@@ -173,6 +173,9 @@ struct Kernel {
   // them), its by-value parameters the control function's variables the body reads.
   std::string megakernelOf;
   std::vector<std::string> megakernelCalls;  // the kernels it runs, whose code it merges
+  // The ISPC class: the export function that runs a chunk of the thread loop in SIMD lanes, calling
+  // glslBody (then ISPC) per lane (IspcThreadLoops.cpp). Empty where the loop stays C++.
+  std::string ispcExport;
   bool bufferReferences = false;      // reaches objects through buffer references (virtual calls)
   bool scalarReferences = false;      // some of them need the scalar layout
   // Virtual functions, level 3: the callable shaders (ClassModel::callables) its virtual calls

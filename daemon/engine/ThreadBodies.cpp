@@ -10,6 +10,7 @@
 #include "KernelParams.h"
 #include "LoopShape.h"
 #include "Naming.h"
+#include "GlslTypes.h"
 
 #include <algorithm>
 #include <regex>
@@ -17,6 +18,17 @@
 using namespace clang;
 
 namespace crossrt::engine {
+
+// The initializer that starts an ISPC per-thread local at zero, as LiteMath's constructors do in C++
+// (structs are left as GLSL leaves them).
+static std::string IspcZero(const std::string& glslType) {
+  if (glslType == "float" || glslType == "int" || glslType == "uint") return " = 0";
+  static const std::regex vector(R"(^[iu]?vec[234]$)");
+  if (std::regex_match(glslType, vector)) return " = make_" + IspcTypeName(glslType) + "(0)";
+  if (glslType == "mat3") return " = make_float3x3_from_cols(make_float3(0), make_float3(0), make_float3(0))";
+  if (glslType == "mat4") return " = make_float4x4_from_cols(make_float4(0), make_float4(0), make_float4(0), make_float4(0))";
+  return "";
+}
 
 std::string ControlRewriter::ThreadBodyGlsl(ThreadLoop& tl, GlslPrinter& printer, const Stmt* s, int indent) {
   const std::string pad(2 * indent, ' ');
@@ -47,6 +59,10 @@ std::string ControlRewriter::ThreadBodyGlsl(ThreadLoop& tl, GlslPrinter& printer
       tl.stateBuffers.push_back({vd, m_ctrl.name + (m_threadLoops > 1 ? std::to_string(m_threadLoops) : "") + "_" + vd->getNameAsString()});
       static const std::regex zeroable(R"(^(float|int|uint|[iu]?vec[234]|mat[234])$)");
       std::string name = GlslPrinter::SafeName(vd->getNameAsString());
+      if (printer.ispc) {  // LiteMath's types start at zero in C++ too
+        out += pad + IspcTypeName(*g) + " " + name + IspcZero(*g) + ";\n";
+        continue;
+      }
       out += pad + *g + " " + name + (std::regex_match(*g, zeroable) ? " = " + *g + "(0)" : "") + ";\n";
     }
     return out;
@@ -63,7 +79,7 @@ std::string ControlRewriter::ThreadBodyGlsl(ThreadLoop& tl, GlslPrinter& printer
     CheckUniform(tl, var->getInit(), "the loop's start");
     CheckUniform(tl, fs->getCond(), "the loop's condition");
     CheckUniform(tl, fs->getInc(), "the loop's step");
-    std::string header = "for (" + *GlslTypeOf(var->getType()) + " " + GlslPrinter::SafeName(var->getNameAsString()) + " = " + printer.Expr(var->getInit()) + "; " +
+    std::string header = "for (" + (printer.ispc ? IspcTypeName(*GlslTypeOf(var->getType())) : *GlslTypeOf(var->getType())) + " " + GlslPrinter::SafeName(var->getNameAsString()) + " = " + printer.Expr(var->getInit()) + "; " +
                          printer.Expr(fs->getCond()) + "; " + printer.Expr(fs->getInc()) + ")";
     m_hostLoopDepth++;
     const std::string loopBody = ThreadBodyGlsl(tl, printer, fs->getBody(), indent + 1);
@@ -107,7 +123,7 @@ std::string ControlRewriter::KernelCallGlsl(ThreadLoop& tl, GlslPrinter& printer
   Note(call);
   auto& calls = tl.mega.megakernelCalls;
   if (std::find(calls.begin(), calls.end(), md->getNameAsString()) == calls.end()) calls.push_back(md->getNameAsString());
-  std::string args;
+  std::string args = printer.ispc ? "self" : "", buffers;  // ISPC: the class data first, the buffers last (IspcRtvHead)
   std::set<unsigned> axes;
   for (unsigned i = 0; i < call->getNumArgs() && i < md->getNumParams(); ++i) {
     auto* p = md->getParamDecl(i);
@@ -130,7 +146,7 @@ std::string ControlRewriter::KernelCallGlsl(ThreadLoop& tl, GlslPrinter& printer
       axes.insert(axis);
       std::string type = GlslTypeOf(p->getType()).value_or("uint"), varType = GlslTypeOf(vd->getType()).value_or("int");
       std::string name = GlslPrinter::SafeName(vd->getNameAsString());
-      a = type == varType ? name : type + "(" + name + ")";
+      a = type == varType ? name : printer.ispc ? "((" + IspcTypeName(type) + ")(" + name + "))" : type + "(" + name + ")";
     } else if (IsImageParam(p)) {
       Error(tl, arg->getBeginLoc(), "Image2D argument of '" + md->getNameAsString() + "' in a thread loop that calls several kernels",
             "the megakernel binds members only: make the image a member of the class, or give the kernel a thread loop of its own");
@@ -147,7 +163,8 @@ std::string ControlRewriter::KernelCallGlsl(ThreadLoop& tl, GlslPrinter& printer
       } else {
         CheckNotThreadState(md, p, arg);
         CheckUniform(tl, arg, "a buffer argument", false);  // bound by the host
-        AddMegakernelBuffer(tl, md, p, BufferArg(Resolve(arg)), arg->getBeginLoc());
+        AddMegakernelBuffer(tl, md, p, BufferArg(Resolve(arg)), ResolvedText(arg), arg->getBeginLoc());
+        buffers += ", " + GlslPrinter::SafeName(p->getNameAsString());
         continue;  // a global buffer of the megakernel, named as the kernel names it
       }
     } else {
@@ -159,10 +176,11 @@ std::string ControlRewriter::KernelCallGlsl(ThreadLoop& tl, GlslPrinter& printer
   if (axes.size() != tl.loops.size())
     Error(tl, call->getBeginLoc(), "'" + md->getNameAsString() + "' takes " + std::to_string(axes.size()) + " thread ids, but the thread loop around it has " +
           std::to_string(tl.loops.size()) + " loops", "give every kernel of a thread loop one thread id parameter (tidX, tidY, ...) per loop");
-  return md->getNameAsString() + "(" + args + ")";
+  return md->getNameAsString() + "(" + args + (printer.ispc ? buffers : "") + ")";
 }
 
-void ControlRewriter::AddMegakernelBuffer(ThreadLoop& tl, const CXXMethodDecl* md, const ParmVarDecl* p, const std::string& hostArg, SourceLocation loc) {
+void ControlRewriter::AddMegakernelBuffer(ThreadLoop& tl, const CXXMethodDecl* md, const ParmVarDecl* p, const std::string& hostArg,
+                                          const std::string& cppArg, SourceLocation loc) {
   const KernelParam* kp = nullptr;
   for (auto& k : m_c.model.kernels)
     if (k.name == md->getNameAsString())
@@ -182,6 +200,7 @@ void ControlRewriter::AddMegakernelBuffer(ThreadLoop& tl, const CXXMethodDecl* m
   b.name = kp->glslName;
   tl.mega.params.push_back(b);
   tl.bufferArgs.push_back(hostArg);
+  tl.cppBufferArgs.push_back(cppArg);
   tl.hostArgs += ", " + hostArg;
 }
 

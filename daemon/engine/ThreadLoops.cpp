@@ -89,6 +89,7 @@ bool ControlRewriter::TryThreadLoop(const ForStmt* outerLoop) {
   tl.mega.sourceFile = m_ctrl.sourceFile;
   tl.mega.dims = unsigned(tl.loops.size());
   GlslPrinter printer(m_c.ctx, m_c.cls, m_c.rep);
+  printer.ispc = m_c.model.forIspc;  // the ISPC class runs the body in SIMD lanes (IspcThreadLoops.cpp)
   for (auto& s : ClassStructNames(m_c.model)) printer.predeclaredStructs.insert(s);
   for (auto& [param, arg] : m_inlined) printer.renames[param] = printer.Expr(Resolve(arg));  // read through
   std::string glsl = ThreadBodyGlsl(tl, printer, body, 1);
@@ -146,6 +147,11 @@ bool ControlRewriter::TryThreadLoop(const ForStmt* outerLoop) {
   }
   for (auto& v : values) tl.mega.params.push_back(v);
   if (!tl.ok) return true;
+  if (m_c.model.forIspc && IspcThreadLoop(tl, glsl, outerLoop)) {
+    m_c.model.megakernels.push_back(tl.mega);
+    m_inlined.clear();
+    return true;
+  }
   const std::string wavefront = ThreadBodyCpp(tl, body);  // after the counts
   tl.mega.glslBody = "// from " + m_c.cls->getNameAsString() + "::" + m_ctrl.name + " (" + m_ctrl.sourceFile +
                      "): the body of its thread loop, each kernel call a function call\nvoid " + tl.mega.name + "(" + signature + ")\n{\n" + glsl + "}\n";

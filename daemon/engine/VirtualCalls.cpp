@@ -129,6 +129,7 @@ GlslDecl ImplDataStruct(const ClassModel& model, GlslPrinter& printer, const CXX
   Data d, fields = List();
   d.set("data", true);
   d.set("class", vi.name);
+  d.set("dataStruct", printer.ispc ? IspcObjectStruct(vi.cppName) : vi.name + "_Data");
   std::vector<const FieldDecl*> members;
   CollectObjectFields(impl, members);
   for (auto* f : members) {
@@ -141,7 +142,7 @@ GlslDecl ImplDataStruct(const ClassModel& model, GlslPrinter& printer, const CXX
   else d.set("paddingWords", false);
   d.set("interface", vm.interfaceName);
   d.set("slotBytes", std::to_string(vm.slotBytes));
-  return {vi.name + "_Data", Render(model.templateDir + (printer.ispc ? "/ispc/virtual_objects.ispc.mustache" : "/glsl/virtual_objects.glsl.mustache"), d)};
+  return {printer.ispc ? IspcObjectStruct(vi.cppName) : vi.name + "_Data", Render(model.templateDir + (printer.ispc ? "/ispc/virtual_objects.ispc.mustache" : "/glsl/virtual_objects.glsl.mustache"), d)};
 }
 
 GlslDecl ObjectsReference(const ClassModel& model, const VirtualMember& vm, const VirtualImpl& vi) {

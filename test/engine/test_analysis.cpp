@@ -340,6 +340,65 @@ void Tracer::kernel_Depth(uint32_t tid, const CRT_Hit* hit, float* depth) { dept
   CHECK(host.find(Squeezed("only the translated traversal reads it")) == std::string::npos);
 }
 
+TEST_CASE("On ISPC a thread loop runs as the megakernel's ISPC: one thread a lane, chunks on all cores", "[engine][modes][ispc]")
+{
+  TempClass tc("Walk", R"(#pragma once
+#include "LiteMath.h"
+#include <cstdint>
+using LiteMath::float4;
+class Walk
+{
+public:
+  virtual ~Walk() = default;
+  virtual void Run(uint32_t w, uint32_t h, int steps, [[crossrt::size("w * h")]] float4* out);
+  float4 m_step = float4(0.5f);
+protected:
+  void kernel_Start(uint32_t tidX, uint32_t tidY, float4* p);
+  void kernel_Step(uint32_t tidX, uint32_t tidY, int k, float4* p);
+  void kernel_Store(uint32_t tidX, uint32_t tidY, uint32_t w, const float4* p, float4* out);
+};
+)",
+               R"(#include "Walk.h"
+void Walk::Run(uint32_t w, uint32_t h, int steps, float4* out)
+{
+  for (uint32_t y = 0; y < h; y++)
+    for (uint32_t x = 0; x < w; x++)
+    {
+      float4 p;
+      kernel_Start(x, y, &p);
+      for (int k = 0; k < steps; k++)
+        kernel_Step(x, y, k, &p);
+      kernel_Store(x, y, w, &p, out);
+    }
+}
+void Walk::kernel_Start(uint32_t tidX, uint32_t tidY, float4* p) { *p = float4(float(tidX), float(tidY), 0.0f, 1.0f); }
+void Walk::kernel_Step(uint32_t, uint32_t, int k, float4* p) { *p = *p + m_step * float(k); }
+void Walk::kernel_Store(uint32_t tidX, uint32_t tidY, uint32_t w, const float4* p, float4* out) { out[tidY * w + tidX] = *p; }
+)");
+  const TranslateResult result = Translate(MakeRequest(tc, "Walk", Backend::Ispc));
+  INFO(result.diagnostics);
+  REQUIRE(result.ok);
+  const std::string ispc = Squeezed(result.files.at("Walk_ISPC_kernels.ispc"));
+  // The kernels take the per-thread values by reference, the buffers as pointers (`out` is a GLSL
+  // word: out_), the class data first.
+  CHECK(ispc.find(Squeezed("void kernel_Step(uniform Walk_Data *uniform self, uint tidX, uint tidY, int k, float4 &p)")) != std::string::npos);
+  CHECK(ispc.find(Squeezed("void kernel_Store(uniform Walk_Data *uniform self, uint tidX, uint tidY, uint w, float4 p, "
+                           "uniform float4 *uniform out_)")) != std::string::npos);
+  // One thread: the locals start at zero, as LiteMath's do; the host loop runs in each lane.
+  CHECK(ispc.find(Squeezed("float4 p = make_float4(0);\n  kernel_Start(self, x, y, p);\n  for (int k = 0; k < steps; k++)\n"
+                           "  {\n    kernel_Step(self, x, y, k, p);\n  }\n  kernel_Store(self, x, y, w, p, out_);")) != std::string::npos);
+  CHECK(ispc.find(Squeezed("export void Walk_Run_Megakernel(uniform Walk_Data *uniform self, uniform int crt_begin, uniform int crt_end, "
+                           "uniform int crt_startX, uniform int crt_countX, uniform float4 *uniform out_, uniform int steps, uniform uint w)")) !=
+        std::string::npos);
+  CHECK(ispc.find(Squeezed("foreach_tiled (y = crt_begin ... crt_end, x = crt_startX ... crt_startX + crt_countX)")) != std::string::npos);
+  // The control function hands chunks of rows to the cores in place of its loop.
+  const std::string host = Squeezed(result.files.at("Walk_ISPC.cpp"));
+  CHECK(host.find(Squeezed("crossrt::IspcPick(ispc::Walk_Run_Megakernel, {Walk_Run_Megakernel_sse4, Walk_Run_Megakernel_avx2, "
+                           "Walk_Run_Megakernel_avx512skx})")) != std::string::npos);
+  CHECK(host.find(Squeezed("crossrt::IspcPointer<ispc::float4*>(out), steps, w);")) != std::string::npos);
+  CHECK(host.find(Squeezed("kernel_Start(x, y, &p);")) == std::string::npos);
+}
+
 TEST_CASE("An error in the class's header fails the translation, on the first parse and on every reparse", "[engine]")
 {
   // The header is parsed into the preamble, whose errors must count like the main file's.

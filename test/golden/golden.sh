@@ -25,6 +25,7 @@ cases=(
   "primary_rays_vulkan|PrimaryRays|vulkan|examples/primary_rays/PrimaryRays.cpp libs/litert/BVHScene.cpp|--compose ISceneObject=BVHScene|examples/primary_rays"
   "primary_rays_cpu|PrimaryRays|cpu|examples/primary_rays/PrimaryRays.cpp libs/litert/BVHScene.cpp|--compose ISceneObject=BVHScene|examples/primary_rays"
   "sphere_paths_vulkan|SpherePaths|vulkan|examples/sphere_paths/SpherePaths.cpp||examples/sphere_paths"
+  "sphere_paths_ispc|SpherePaths|ispc|examples/sphere_paths/SpherePaths.cpp||examples/sphere_paths"
   "lbvh_vulkan|LBVH|vulkan|libs/litebvh/LBVH.cpp||libs/litebvh"
   "lbvh_cpu|LBVH|cpu|libs/litebvh/LBVH.cpp||libs/litebvh"
   "callable_shading_vulkan|CallableShading|vulkan|test/classes/CallableShading.cpp|--virtual-level 3|test/classes"

@@ -139,7 +139,8 @@ TEST_CASE("path tracer: the Cornell box on the class as written, PathTracer_CPU 
   // Embree's hits differ from BVHScene's in the last bits: a path may rarely take another way.
   REQUIRE(Mismatches(reference, embree, 1e-3f) <= reference.size() / 50);
 #ifdef CROSSRT_LITEPT_ISPC
-  // PathTracer_ISPC runs its thread loops as C++ on all cores, as PathTracer_CPU does.
+  // PathTracer_ISPC runs the thread loop in SIMD lanes, one path a lane, BVHScene's traversal
+  // composed in: the same paths, the same numbers.
   auto ispc = CreatePathTracer_ISPC();
   REQUIRE(Mismatches(reference, Render(*ispc, scene, "sah", w, h, spp, depth), 1e-5f) == 0);
 #endif
