@@ -13,6 +13,7 @@
 #ifdef CROSSRT_HAS_ISPC
 #include "Bloom_ISPC.h"
 #include "Particles_ISPC.h"
+#include "SpherePaths_ISPC.h"
 #endif
 #include "Bloom_Vulkan.h"
 #include "Particles.h"
@@ -138,6 +139,9 @@ int main(int argc, char** argv)
     const uint32_t w = uint32_t(pathSide);
     std::vector<float4> out(size_t(w) * w);
     std::vector<std::pair<const char*, std::shared_ptr<SpherePaths>>> impls = {{"original", std::make_shared<SpherePaths>()}, {"SpherePaths_CPU", CreateSpherePaths_CPU()}};
+#ifdef CROSSRT_HAS_ISPC
+    impls.push_back({"SpherePaths_ISPC", CreateSpherePaths_ISPC()});
+#endif
     if (ctx)
     {
       auto wavefront = std::make_shared<SpherePaths_Vulkan>(ctx), megakernel = std::make_shared<SpherePaths_Vulkan>(ctx);
@@ -146,7 +150,7 @@ int main(int argc, char** argv)
       impls.push_back({"Vulkan wavefront", wavefront});
       impls.push_back({"Vulkan megakernel", megakernel});
     }
-    double base = 0.0, wavefrontMs = 0.0;
+    double base = 0.0, wavefrontMs = 0.0, cpuMs = 0.0, ispcMs = 0.0;
     for (auto& [name, p] : impls)
     {
       p->CommitDeviceData();
@@ -157,8 +161,11 @@ int main(int argc, char** argv)
       const bool gpu = std::string(name).rfind("Vulkan", 0) == 0;
       Row("paths", name, ms, base, gpu ? t[0] : 0.0);
       if (std::string(name) == "Vulkan wavefront") wavefrontMs = ms;
+      if (std::string(name) == "SpherePaths_CPU") cpuMs = ms;
+      if (std::string(name) == "SpherePaths_ISPC") ispcMs = ms;
       if (std::string(name) == "Vulkan megakernel") std::printf("| %-10s | %-18s | %10s | %8.2fx | %12s |\n", "paths", "mega vs wavefront", "", wavefrontMs / ms, "");
     }
+    IspcAgainstCpu("paths", cpuMs, ispcMs);
   }
   std::printf("\nparticles: %d particles per step; bloom: %dx%d image, radius 12; paths: %dx%d pixels, %d paths per pixel, 4 bounces.\n", particles, side,
               side, pathSide, pathSide, pathSamples);
