@@ -108,6 +108,13 @@ private:
   // the control function's loop replaced by chunks of it on all cores, in SIMD lanes. False where
   // the loop stays C++ (three thread axes).
   bool IspcThreadLoop(ThreadLoop& tl, const std::string& body, const ForStmt* outerLoop);
+  // The ISPC class: a loop nest around one kernel call, as an export function calling the kernel's
+  // thread function over a chunk, and the chunks on all cores in place of the nest. False where
+  // the nest stays C++ (three axes, a default or array argument, a kernel returning bool).
+  bool IspcRtvNest(const ForStmt* outer, const CXXMemberCallExpr* call, const std::map<unsigned, const LoopHeader*>& axes);
+  unsigned m_ispcNests = 0;
+  // The CPU class's control function: `text` in place of the loop (its closing ';' included).
+  void ReplaceLoopForCpu(const ForStmt* loop, const std::string& text);
 
   // The wavefront version of the thread loop's body: host loops as written, each kernel call a
   // dispatch over all threads, per-thread locals bound as their buffers.

@@ -97,9 +97,9 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
   const std::string derived = model.generatedName;
   d.set("derived", derived);
   d.set("ispc", model.forIspc);
-  d.set("whatRuns", model.forIspc ? "The loop nests of " + model.className + "'s kernels run here\n// as ISPC (" +
-                                        model.generatedName + "_kernels.ispc), on all CPU cores, each in SIMD lanes; the thread loops\n"
-                                        "// of its control functions run on all cores with OpenMP; everything else is inherited unchanged."
+  d.set("whatRuns", model.forIspc ? "The loop nests of " + model.className + "'s kernels, and the thread loops\n"
+                                        "// of its control functions (one or two thread ids), run here as ISPC (" + model.generatedName +
+                                        "_kernels.ispc), on all CPU cores,\n// each in SIMD lanes; everything else is inherited unchanged."
                                   : "The kernels of " + model.className + " run here on all\n// CPU cores with OpenMP; everything else is inherited unchanged.");
   if (model.forIspc) IspcHostData(model, d);
   Data kernels = List(), ompReductions = List();

@@ -149,7 +149,7 @@ std::string GenerateIspcKernels(const ClassModel& model, const GenerateOptions& 
       if (seen.insert(c.name).second) constants += c.text;
     for (auto& f : mk.functionList)
       if (std::find(functions.begin(), functions.end(), f) == functions.end()) functions.push_back(f);
-    functions.push_back(mk.glslBody);
+    if (!mk.glslBody.empty()) functions.push_back(mk.glslBody);  // (a loop nest around one kernel calls it directly)
     exports += mk.ispcExport + "\n";
   }
   std::string code;

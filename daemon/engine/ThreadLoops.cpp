@@ -269,6 +269,7 @@ bool ControlRewriter::TryRtvNest(const ForStmt* outer) {
     counts += ", " + CountExpr(m_c, *h);
   }
   Note(call);
+  if (m_c.model.forIspc && IspcRtvNest(outer, call, axes)) return true;
   SourceLocation end = Lexer::findLocationAfterToken(outer->getEndLoc(), tok::semi, m_c.ctx.getSourceManager(), m_c.ctx.getLangOpts(), false);
   CharSourceRange range = end.isValid() ? CharSourceRange::getCharRange(outer->getBeginLoc(), end) : CharSourceRange::getTokenRange(outer->getSourceRange());
   m_gpu.ReplaceText(range, md->getNameAsString() + "Cmd(a_cmd" + counts + Args(call, true) + ");");

@@ -340,7 +340,7 @@ void Tracer::kernel_Depth(uint32_t tid, const CRT_Hit* hit, float* depth) { dept
   CHECK(host.find(Squeezed("only the translated traversal reads it")) == std::string::npos);
 }
 
-TEST_CASE("On ISPC a thread loop runs as the megakernel's ISPC: one thread a lane, chunks on all cores", "[engine][modes][ispc]")
+TEST_CASE("On ISPC a thread loop runs as the megakernel's ISPC, and a loop nest around one kernel calls it, one thread a lane, chunks on all cores", "[engine][modes][ispc]")
 {
   TempClass tc("Walk", R"(#pragma once
 #include "LiteMath.h"
@@ -351,11 +351,13 @@ class Walk
 public:
   virtual ~Walk() = default;
   virtual void Run(uint32_t w, uint32_t h, int steps, [[crossrt::size("w * h")]] float4* out);
+  virtual void Scale(uint32_t w, uint32_t h, float gain, [[crossrt::size("w * h")]] float4* out);
   float4 m_step = float4(0.5f);
 protected:
   void kernel_Start(uint32_t tidX, uint32_t tidY, float4* p);
   void kernel_Step(uint32_t tidX, uint32_t tidY, int k, float4* p);
   void kernel_Store(uint32_t tidX, uint32_t tidY, uint32_t w, const float4* p, float4* out);
+  void kernel_Scale(uint32_t tidX, uint32_t tidY, uint32_t w, float gain, float4* out);
 };
 )",
                R"(#include "Walk.h"
@@ -374,6 +376,13 @@ void Walk::Run(uint32_t w, uint32_t h, int steps, float4* out)
 void Walk::kernel_Start(uint32_t tidX, uint32_t tidY, float4* p) { *p = float4(float(tidX), float(tidY), 0.0f, 1.0f); }
 void Walk::kernel_Step(uint32_t, uint32_t, int k, float4* p) { *p = *p + m_step * float(k); }
 void Walk::kernel_Store(uint32_t tidX, uint32_t tidY, uint32_t w, const float4* p, float4* out) { out[tidY * w + tidX] = *p; }
+void Walk::Scale(uint32_t w, uint32_t h, float gain, float4* out)
+{
+  for (uint32_t y = 0; y < h; y++)
+    for (uint32_t x = 0; x < w; x++)
+      kernel_Scale(x, y, w, gain, out);
+}
+void Walk::kernel_Scale(uint32_t tidX, uint32_t tidY, uint32_t w, float gain, float4* out) { out[tidY * w + tidX] *= gain; }
 )");
   const TranslateResult result = Translate(MakeRequest(tc, "Walk", Backend::Ispc));
   INFO(result.diagnostics);
@@ -397,6 +406,13 @@ void Walk::kernel_Store(uint32_t tidX, uint32_t tidY, uint32_t w, const float4* 
                            "Walk_Run_Megakernel_avx512skx})")) != std::string::npos);
   CHECK(host.find(Squeezed("crossrt::IspcPointer<ispc::float4*>(out), steps, w);")) != std::string::npos);
   CHECK(host.find(Squeezed("kernel_Start(x, y, &p);")) == std::string::npos);
+  // A loop nest around one kernel: its export function calls the kernel's thread function itself.
+  CHECK(ispc.find(Squeezed("export void Walk_Scale_kernel_Scale(uniform Walk_Data *uniform self, uniform int crt_begin, uniform int crt_end, "
+                           "uniform int crt_startX, uniform int crt_countX, uniform uint crt_w, uniform float crt_gain, uniform float4 *uniform crt_out_)")) !=
+        std::string::npos);
+  CHECK(ispc.find(Squeezed("kernel_Scale(self, (uint)crt_x, (uint)crt_y, crt_w, crt_gain, crt_out_);")) != std::string::npos);
+  CHECK(host.find(Squeezed("crossrt::IspcPick(ispc::Walk_Scale_kernel_Scale,")) != std::string::npos);
+  CHECK(host.find(Squeezed("uint32_t(w), float(gain), crossrt::IspcPointer<ispc::float4*>(out));")) != std::string::npos);
 }
 
 TEST_CASE("An error in the class's header fails the translation, on the first parse and on every reparse", "[engine]")
