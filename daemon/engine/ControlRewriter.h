@@ -101,6 +101,8 @@ private:
   // A pointer argument of a kernel in a thread loop: in the megakernel, a buffer named as the
   // kernel's parameter (its code refers to that name). Two kernels naming different buffers alike
   // would collide there.
+  // The name kernel md's thread function gives its parameter i (the definition's, as GLSL spells it).
+  std::string KernelParamName(const CXXMethodDecl* md, unsigned i) const;
   void AddMegakernelBuffer(ThreadLoop& tl, const CXXMethodDecl* md, const ParmVarDecl* p, const std::string& hostArg, const std::string& cppArg,
                            SourceLocation loc);
 

@@ -164,7 +164,7 @@ std::string ControlRewriter::KernelCallGlsl(ThreadLoop& tl, GlslPrinter& printer
         CheckNotThreadState(md, p, arg);
         CheckUniform(tl, arg, "a buffer argument", false);  // bound by the host
         AddMegakernelBuffer(tl, md, p, BufferArg(Resolve(arg)), ResolvedText(arg), arg->getBeginLoc());
-        buffers += ", " + GlslPrinter::SafeName(p->getNameAsString());
+        buffers += ", " + KernelParamName(md, i);
         continue;  // a global buffer of the megakernel, named as the kernel names it
       }
     } else {
@@ -177,6 +177,12 @@ std::string ControlRewriter::KernelCallGlsl(ThreadLoop& tl, GlslPrinter& printer
     Error(tl, call->getBeginLoc(), "'" + md->getNameAsString() + "' takes " + std::to_string(axes.size()) + " thread ids, but the thread loop around it has " +
           std::to_string(tl.loops.size()) + " loops", "give every kernel of a thread loop one thread id parameter (tidX, tidY, ...) per loop");
   return md->getNameAsString() + "(" + args + (printer.ispc ? buffers : "") + ")";
+}
+
+std::string ControlRewriter::KernelParamName(const CXXMethodDecl* md, unsigned i) const {
+  for (auto& k : m_c.model.kernels)
+    if (k.name == md->getNameAsString() && i < k.params.size()) return k.params[i].glslName;  // as the definition names it
+  return GlslPrinter::SafeName(md->getParamDecl(i)->getNameAsString());
 }
 
 void ControlRewriter::AddMegakernelBuffer(ThreadLoop& tl, const CXXMethodDecl* md, const ParmVarDecl* p, const std::string& hostArg,
