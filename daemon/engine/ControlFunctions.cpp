@@ -140,7 +140,7 @@ void AnalyzeControl(Context& c, const CXXMethodDecl* md, const FunctionDecl* def
         for (auto* a : redecl->getParamDecl(i)->specific_attrs<AnnotateAttr>())
           if (a->getAnnotation().starts_with("crossrt.size=") && cp.sizeExpr.empty())
             cp.sizeExpr = RenameIdentifiers(a->getAnnotation().substr(13).str(), declaredNames);
-      if (cp.sizeExpr.empty())
+      if (cp.sizeExpr.empty() && !c.model.forCpu)  // (an ISPC class reads the C++ memory in place: no copies to size)
         c.rep.GpuError(p->getLocation(), "pointer parameter '" + cp.name + "' of control function '" + ctrl.name + "' has no size",
                     "annotate it with its element count, e.g. '[[crossrt::size(\"n\")]] const float* " + cp.name +
                     "' or 'const float* " + cp.name + " __attribute__((size(\"n\")))'");

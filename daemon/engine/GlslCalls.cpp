@@ -394,6 +394,9 @@ std::string GlslPrinter::Call(const CallExpr* call) {
     // Member functions of plain structs (the user's, LiteMath's complex and Box4f) and of matrices.
     if (IsPlainStruct(method->getParent())) return StructMethodCall(mc);
     if (IsLiteMathType(obj->getType(), "float4x4") || IsLiteMathType(obj->getType(), "float3x3")) return MatrixMethodCall(mc);
+    if (IsStdVector(obj->getType().getNonReferenceType()))  // a vector passed to a helper, or a local one
+      return Fail(call->getBeginLoc(), "call to '" + qname + "' on a std::vector that is not a data member, in a kernel",
+                  "kernels reach vectors through the class's members: make the helper a member function that reads the member itself");
     if (IsSystemDecl(method) || method->getParent()->isInStdNamespace())
       return Fail(call->getBeginLoc(), "call to '" + qname + "' is not supported in a kernel",
                   "kernels may call LiteMath, <cmath> and std::min/max, and your own functions");

@@ -351,7 +351,7 @@ class Walk
 public:
   virtual ~Walk() = default;
   virtual void Run(uint32_t w, uint32_t h, int steps, [[crossrt::size("w * h")]] float4* out);
-  virtual void Scale(uint32_t w, uint32_t h, float gain, [[crossrt::size("w * h")]] float4* out);
+  virtual void Scale(uint32_t w, uint32_t h, float gain, float4* out);  // no size: the ISPC class reads it in place
   float4 m_step = float4(0.5f);
 protected:
   void kernel_Start(uint32_t tidX, uint32_t tidY, float4* p);
