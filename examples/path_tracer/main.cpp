@@ -1,11 +1,15 @@
 // path_tracer: renders a glTF 2.0 or OBJ scene with litept's PathTracer, as written (one thread),
-// translated for all CPU cores (PathTracer_CPU) or for Vulkan (PathTracer_Vulkan, megakernel or
+// translated for all CPU cores (PathTracer_CPU; PathTracer_ISPC, one path a SIMD lane, where ISPC
+// was found) or for Vulkan (PathTracer_Vulkan, megakernel or
 // wavefront, at virtual level 1, 2 or 3), progressively in passes of bounded size, with a progress
 // bar on stderr. Writes linear EXR or sRGB PNG; --compare prints the PSNR (8-bit sRGB) and relative
 // MSE (linear) against a reference image, such as one from scripts/cycles-reference.py.
 #include "ImageMetrics.h"
 #include "PathTracer.h"
 #include "PathTracer_CPU.h"
+#ifdef CROSSRT_LITEPT_ISPC
+#include "PathTracer_ISPC.h"
+#endif
 #include "PathTracer_Vulkan.h"
 #include "PathTracer_VulkanLevel1.h"
 #include "PathTracer_VulkanLevel3.h"
@@ -24,7 +28,7 @@ using LiteMath::float4;
 namespace {
 
 const char* kUsage =
-    "usage: path_tracer SCENE [--size WxH] [--spp N] [--depth D] [--device original|cpu|vulkan]\n"
+    "usage: path_tracer SCENE [--size WxH] [--spp N] [--depth D] [--device original|cpu|ispc|vulkan]\n"
     "                   [--mode megakernel|wavefront] [--virtual-level 1|2|3] [--accel embree|sah|lbvh]\n"
     "                   [--env FILE.exr] [--env-strength F]\n"
     "                   [--seed S] [--pass-spp K] [--compare REF.exr] --out FILE.exr|FILE.png [--out ...]\n"
@@ -32,12 +36,13 @@ const char* kUsage =
     "  --size      image size (default 256x256)            --spp     samples per pixel (default 64)\n"
     "  --depth     bounces, as Cycles counts them (default 8; 0 is direct light only)\n"
     "  --device    original: the class as written, one thread; cpu: PathTracer_CPU, all cores (default);\n"
+    "              ispc: PathTracer_ISPC, all cores, one path a SIMD lane (where ISPC was found; CrossRT's BVHs);\n"
     "              vulkan: PathTracer_Vulkan on the default Vulkan device\n"
     "  --mode      PathTracer_Vulkan's execution mode (default megakernel)\n"
     "  --virtual-level  how the GPU reaches materials and lights (paper 3.9): 1, one array of equal slots\n"
     "              (PathTracer_VulkanLevel1); 2, a buffer per class (PathTracer_Vulkan, default); 3, as 2 plus\n"
     "              callable shaders where the device has ray tracing pipelines (PathTracer_VulkanLevel3)\n"
-    "  --accel     the CPU devices' ray tracing: Embree (default) or CrossRT's BVHs; Vulkan always uses sah\n"
+    "  --accel     the CPU devices' ray tracing: Embree (default) or CrossRT's BVHs; ispc and vulkan use sah (or lbvh)\n"
     "  --env       an equirectangular environment map (linear EXR, Blender's orientation), times --env-strength\n"
     "  --seed      the random sequence (a pixel's samples depend only on pixel, sample index and seed)\n"
     "  --pass-spp  samples per pass (default 4): memory stays the same whatever --spp is (1 for megakernels on llvmpipe)\n"
@@ -128,7 +133,8 @@ Options Parse(int argc, char** argv)
   }
   if (o.scene.empty()) Usage("no scene given");
   if (o.outs.empty()) Usage("no --out file given");
-  if (o.device != "original" && o.device != "cpu" && o.device != "vulkan") Usage("--device is original, cpu or vulkan, not '" + o.device + "'");
+  if (o.device != "original" && o.device != "cpu" && o.device != "ispc" && o.device != "vulkan")
+    Usage("--device is original, cpu, ispc or vulkan, not '" + o.device + "'");
   if (o.mode != "megakernel" && o.mode != "wavefront") Usage("--mode is megakernel or wavefront, not '" + o.mode + "'");
   for (const std::string& out : o.outs)
   {
@@ -174,6 +180,16 @@ int main(int argc, char** argv)
       tracer = std::make_shared<PathTracer>();
     else if (o.device == "cpu")
       tracer = CreatePathTracer_CPU();
+    else if (o.device == "ispc")
+    {
+#ifdef CROSSRT_LITEPT_ISPC
+      tracer = CreatePathTracer_ISPC();
+      if (accel == "embree")
+        accel = "sah";  // its kernels run BVHScene's traversal, composed in
+#else
+      throw std::runtime_error("--device ispc: this build found no ISPC compiler (see the README: installing ISPC)");
+#endif
+    }
     else
     {
       auto ctx = crossrt::VulkanContext::CreateDefault();
