@@ -28,6 +28,19 @@ fig9_path = os.path.join(os.path.dirname(source) or ".", "bench_sdf_fig9.csv")
 fig9 = list(csv.DictReader(open(fig9_path))) if os.path.exists(fig9_path) else []
 fig, axes = plt.subplots(3 if fig9 else 2, len(meshes), figsize=(6 * len(meshes), 15 if fig9 else 10), squeeze=False)
 markers = {"grid": "s", "SVS": "o", "SBS": "^", "OpenVDB": "x"}
+
+
+def decorate(ax, xlabel, ylabel, title, legend_size=None):
+    """Log axes with their labels (units in them), a grid, a title and a legend."""
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=legend_size)
+
+
 for ax, mesh in zip(axes[0], meshes):
     for kind, marker in markers.items():
         pts = [r for r in rows if r["mesh"] == mesh and r["representation"] == kind]
@@ -38,13 +51,7 @@ for ax, mesh in zip(axes[0], meshes):
         ax.scatter(x, y, marker=marker, label=kind)
         for r, xi, yi in zip(pts, x, y):
             ax.annotate(r["knobs"], (xi, yi), fontsize=6, alpha=0.7)
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel("time per ray, one thread (µs)")
-    ax.set_ylabel("mean distance of hits from the mesh (box = 2 units)")
-    ax.set_title(f"{mesh}: surface error against time")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend()
+    decorate(ax, "time per ray, one thread (µs)", "mean distance of hits from the mesh (box = 2 units)", f"{mesh}: surface error against time")
 for ax, mesh in zip(axes[1], meshes):
     for kind, marker in markers.items():
         for column, style, label in (("mrays_per_s_cpu", "-", "_CPU"), ("mrays_per_s_vulkan", "--", "_Vulkan")):
@@ -56,13 +63,7 @@ for ax, mesh in zip(axes[1], meshes):
             y = [1.0 / float(r[column]) for r in pts]  # microseconds per ray
             name = f"{kind}, {label}" if kind != "OpenVDB" else "OpenVDB, all cores"
             ax.plot(x, y, style, marker=marker, label=name)
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel("model size with its BVH (MiB)")
-    ax.set_ylabel("time per camera ray (µs)")
-    ax.set_title(f"{mesh}: render time against model size")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7)
+    decorate(ax, "model size with its BVH (MiB)", "time per camera ray (µs)", f"{mesh}: render time against model size", 7)
 for ax, mesh in zip(axes[2] if fig9 else [], meshes):
     pts = sorted((r for r in fig9 if r["mesh"] == mesh), key=lambda r: float(r["sbs_bytes"]))
     x = [float(r["sbs_bytes"]) / 1048576.0 for r in pts]
@@ -72,13 +73,7 @@ for ax, mesh in zip(axes[2] if fig9 else [], meshes):
         y = [float(r[column]) for r in pts]
         if pts and all(v > 0 for v in y):
             ax.plot(x, y, style, marker="o", label=label)
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel("SBS size, brick 4, 1 B (MiB)")
-    ax.set_ylabel("GPU time per frame (ms)")
-    ax.set_title(f"{mesh}: software against hardware (Figure 9)")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7)
+    decorate(ax, "SBS size, brick 4, 1 B (MiB)", "GPU time per frame (ms)", f"{mesh}: software against hardware (Figure 9)", 7)
 fig.tight_layout()
 fig.savefig(target, dpi=120)
 print(f"wrote {target}")

@@ -17,14 +17,7 @@ namespace {
 // (crossrt::IspcPick in runtime/include/crossrt/IspcSupport.h takes them so).
 const char* const kIspcTargetSuffixes[] = {"sse4", "avx2", "avx512skx"};
 
-// Iterations of a 1D loop nest per chunk (2D and 3D nests hand out rows and slices one by one, and
-// a tiled 2D nest four rows at a time: a tile is up to 4 rows high).
-constexpr int kChunk1D = 4096;
-constexpr int kTileRows = 4;
-
-bool IsScalar(const std::string& glslType) {
-  return glslType == "float" || glslType == "int" || glslType == "uint" || glslType == "bool" || glslType == "double";
-}
+bool IsScalar(const std::string& glslType) { return IsIspcScalar(glslType); }
 
 // The identity of a reduction, in ISPC: a lane that ran no iteration changes nothing.
 std::string IspcIdentity(ReduceOp op, const std::string& glslType) {
@@ -65,6 +58,10 @@ std::string IspcCppType(const std::string& glslType) {
   return "ispc::" + IspcTypeName(glslType);
 }
 
+bool IsIspcScalar(const std::string& glslType) {
+  return glslType == "float" || glslType == "int" || glslType == "uint" || glslType == "bool" || glslType == "double";
+}
+
 std::string IspcTargetFunctions(const std::string& symbol) {
   std::string targets;
   for (const char* t : kIspcTargetSuffixes) targets += std::string(targets.empty() ? "" : ", ") + symbol + "_" + t;
@@ -79,15 +76,18 @@ std::string GenerateIspcKernels(const ClassModel& model, const GenerateOptions& 
   std::set<std::string> seen(model.glslClassStructNames.begin(), model.glslClassStructNames.end());
   std::vector<std::string> functions;
   std::string constants;
-  Data kernels = List();
-  for (const Kernel& k : model.kernels) {
-    if (k.rtv) continue;
+  auto takeDeclarations = [&](const Kernel& k) {  // what k's code needs, each once
     for (auto& s : k.structList)
       if (seen.insert(s.name).second) structs += s.text + "\n";
     for (auto& c : k.constantList)
       if (seen.insert(c.name).second) constants += c.text;
     for (auto& f : k.functionList)
       if (std::find(functions.begin(), functions.end(), f) == functions.end()) functions.push_back(f);
+  };
+  Data kernels = List();
+  for (const Kernel& k : model.kernels) {
+    if (k.rtv) continue;
+    takeDeclarations(k);
     functions.push_back(k.glslBody);
 
     Data x;
@@ -143,12 +143,7 @@ std::string GenerateIspcKernels(const ClassModel& model, const GenerateOptions& 
   std::string exports;
   for (const Kernel& mk : model.megakernels) {
     if (mk.ispcExport.empty()) continue;
-    for (auto& s : mk.structList)
-      if (seen.insert(s.name).second) structs += s.text + "\n";
-    for (auto& c : mk.constantList)
-      if (seen.insert(c.name).second) constants += c.text;
-    for (auto& f : mk.functionList)
-      if (std::find(functions.begin(), functions.end(), f) == functions.end()) functions.push_back(f);
+    takeDeclarations(mk);
     if (!mk.glslBody.empty()) functions.push_back(mk.glslBody);  // (a loop nest around one kernel calls it directly)
     exports += mk.ispcExport + "\n";
   }
@@ -180,6 +175,8 @@ std::string GenerateIspcKernels(const ClassModel& model, const GenerateOptions& 
 }
 
 void IspcHostData(const ClassModel& model, Data& d) {
+  // A plain member of the class's own that kernels set: it goes back from the ISPC class data.
+  auto writtenBack = [](const Member& m) { return m.kind == MemberKind::Plain && m.usedByKernels && m.writtenByKernels && m.composedFrom.empty(); };
   Data members = List(), vectors = List(), textures = List();
   for (auto& m : model.members) {
     if (!m.usedByKernels) continue;
@@ -213,9 +210,9 @@ void IspcHostData(const ClassModel& model, Data& d) {
     }
     x.set("loops", loops);
     x.set("outer", Axis(0, dims));
-    x.set("chunk", std::to_string(dims == 1 ? kChunk1D : k.ispcTiled ? kTileRows : 1));
-    x.set("chunkWhat", dims == 1      ? std::to_string(kChunk1D) + " iterations"
-                       : k.ispcTiled ? std::to_string(kTileRows) + " rows, in tiles of rows and columns (foreach_tiled)"
+    x.set("chunk", std::to_string(dims == 1 ? kIspcChunk1D : k.ispcTiled ? kIspcTileRows : 1));
+    x.set("chunkWhat", dims == 1      ? std::to_string(kIspcChunk1D) + " iterations"
+                       : k.ispcTiled ? std::to_string(kIspcTileRows) + " rows, in tiles of rows and columns (foreach_tiled)"
                        : dims == 2    ? "one row"
                                       : "one slice");
     x.set("innerArgs", innerArgs);
@@ -244,7 +241,7 @@ void IspcHostData(const ClassModel& model, Data& d) {
     Data written = List();
     for (auto& m : model.members) {
       const bool reduced = std::any_of(k.reductions.begin(), k.reductions.end(), [&](const Reduction& r) { return !r.local && r.member == m.name; });
-      if (m.kind != MemberKind::Plain || !m.usedByKernels || !m.writtenByKernels || !m.composedFrom.empty() || reduced) continue;
+      if (!writtenBack(m) || reduced) continue;
       Data w;
       w.set("name", m.name);
       written.push_back(w);
@@ -273,7 +270,7 @@ void IspcHostData(const ClassModel& model, Data& d) {
   d.set("ispcHasThreadLoops", !threadLoops.is_empty_list());
   Data writtenMembers = List();
   for (auto& m : model.members)
-    if (m.kind == MemberKind::Plain && m.usedByKernels && m.writtenByKernels && m.composedFrom.empty()) {
+    if (writtenBack(m)) {
       Data w;
       w.set("name", m.name);
       writtenMembers.push_back(w);

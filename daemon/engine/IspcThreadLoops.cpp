@@ -25,16 +25,11 @@ namespace crossrt::engine {
 
 namespace {
 
-constexpr int kChunk1D = 4096;  // threads per chunk of a 1D loop
-constexpr int kTileRows = 4;    // rows per chunk of a 2D loop: a foreach_tiled tile is up to 4 rows high
-
-bool IsScalarGlsl(const std::string& t) { return t == "float" || t == "int" || t == "uint" || t == "bool" || t == "double"; }
-
 // The control function's text in place of a loop nest: export function `symbol` over chunks of its
 // threads on all cores (counts[a]: the threads along axis a, x first), then the members it set.
 std::string ChunksOnAllCores(const ClassModel& model, const std::string& what, const std::string& symbol, size_t dims, const std::string counts[2],
                              const std::string& cppArgs) {
-  const std::string outer = dims == 2 ? "crt_countY" : "crt_countX", chunk = std::to_string(dims == 2 ? kTileRows : kChunk1D);
+  const std::string outer = dims == 2 ? "crt_countY" : "crt_countX", chunk = std::to_string(dims == 2 ? kIspcTileRows : kIspcChunk1D);
   std::string text = "{  // " + what + ", in SIMD lanes: " + symbol + " in " + model.generatedName + "_kernels.ispc, in chunks of " +
                      (dims == 2 ? chunk + " rows" : chunk + " threads") + " on all cores\n"
                      "const ispc::" + model.symbolPrefix + "_Data crt_self = IspcData();\n"
@@ -92,7 +87,7 @@ bool ControlRewriter::IspcThreadLoop(ThreadLoop& tl, const std::string& body, co
     if (p.isPointer) {
       param = std::string(p.isConstPointee ? "const " : "") + "uniform " + base + " *uniform " + p.glslName;
       cppArgs += ", crossrt::IspcPointer<" + std::string(p.isConstPointee ? "const " : "") + IspcCppType(p.glslType) + "*>(" + tl.cppBufferArgs[i] + ")";
-    } else if (IsScalarGlsl(p.glslType) && arrayDims.empty()) {
+    } else if (IsIspcScalar(p.glslType) && arrayDims.empty()) {
       param = "uniform " + base + " " + p.glslName;
       cppArgs += ", " + p.name;
     } else if (arrayDims.empty()) {  // structs by reference: C++ passes them so
@@ -155,7 +150,7 @@ bool ControlRewriter::IspcRtvNest(const ForStmt* outer, const CXXMemberCallExpr*
       cppArgs += ", crossrt::IspcPointer<" + std::string(p.isConstPointee ? "const " : "") + IspcCppType(p.glslType) + "*>(" + text + ")";
     } else if (!arrayDims.empty()) {
       return false;  // an array by value: the nest stays C++
-    } else if (IsScalarGlsl(p.glslType)) {
+    } else if (IsIspcScalar(p.glslType)) {
       exportHead += ", uniform " + base + " " + name;
       threadArgs += ", " + name;
       cppArgs += ", " + IspcCppType(p.glslType) + "(" + text + ")";

@@ -56,6 +56,9 @@ std::shared_ptr<ISdfLeaves> Placed(const std::shared_ptr<ISdfLeaves>& field, con
   leaves->place = place;
   return leaves;
 }
+// The box of a cube with corner lo and edge `edge`.
+CRT_AABB CubeBox(float3 lo, float edge) { return {float4(lo.x, lo.y, lo.z, 0.0f), float4(lo.x + edge, lo.y + edge, lo.z + edge, 0.0f)}; }
+
 }  // namespace
 
 // ---- The leaves' intersections, one class per representation ----
@@ -250,7 +253,7 @@ uint32_t SdfLeafScene::AddGeom_SdfGrid(const litesdf::SdfGrid& grid, uint32_t)
       continue;
     m_gridBricks.push_back(i);
     const float3 lo = grid.boxMin + edge * float3(float(i % n), float(i / n % n), float(i / (n * n)));
-    field.leafBoxes.push_back({float4(lo.x, lo.y, lo.z, 0.0f), float4(lo.x + edge, lo.y + edge, lo.z + edge, 0.0f)});
+    field.leafBoxes.push_back(CubeBox(lo, edge));
   }
   m_fields.push_back(field);
   return uint32_t(m_fields.size() - 1);
@@ -271,7 +274,7 @@ uint32_t SdfLeafScene::AddGeom_SdfSVS(const litesdf::SdfSVS& svs, uint32_t)
     m_voxels.push_back(float4(lo.x, lo.y, lo.z, edge));
     const litesdf::VoxelValues v = svs.Values(i);
     m_voxelValues.insert(m_voxelValues.end(), v.v, v.v + 8);
-    field.leafBoxes.push_back({float4(lo.x, lo.y, lo.z, 0.0f), float4(lo.x + edge, lo.y + edge, lo.z + edge, 0.0f)});
+    field.leafBoxes.push_back(CubeBox(lo, edge));
   }
   m_fields.push_back(field);
   return uint32_t(m_fields.size() - 1);
@@ -301,7 +304,7 @@ uint32_t SdfLeafScene::AddGeom_SdfSBS(const litesdf::SdfSBS& sbs, uint32_t)
           const litesdf::VoxelValues v = sbs.Values(brick, std::min(x, b - 1), std::min(y, b - 1), std::min(z, b - 1));
           m_values.push_back(v.v[(x == b ? 1 : 0) + (y == b ? 2 : 0) + (z == b ? 4 : 0)]);
         }
-    field.leafBoxes.push_back({float4(lo.x, lo.y, lo.z, 0.0f), float4(lo.x + edge, lo.y + edge, lo.z + edge, 0.0f)});
+    field.leafBoxes.push_back(CubeBox(lo, edge));
   }
   m_fields.push_back(field);
   return uint32_t(m_fields.size() - 1);
