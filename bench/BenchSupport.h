@@ -20,3 +20,11 @@ inline double MedianMs(int repeats, const std::function<void()>& work)
   std::sort(ms.begin(), ms.end());
   return ms[ms.size() / 2];
 }
+
+// The median of times measured elsewhere (interleaved rounds); 0 for none.
+inline double MedianOf(std::vector<double> ms)
+{
+  if (ms.empty()) return 0.0;
+  std::sort(ms.begin(), ms.end());
+  return ms[ms.size() / 2];
+}

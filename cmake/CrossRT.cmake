@@ -100,6 +100,14 @@ function(crossrt_add_class target class)
     set(gen ${ARG_NAME})
     list(APPEND name_args --name ${ARG_NAME})
   endif()
+  # The generated class's folder and files are named after it: one translation per name in a directory.
+  get_property(generated DIRECTORY PROPERTY CROSSRT_GENERATED_CLASSES)
+  if(gen IN_LIST generated)
+    message(FATAL_ERROR "crossrt_add_class(${target} ${class} BACKEND ${backend}): ${gen} is already generated in this directory "
+                        "(by an earlier crossrt_add_class, for this target or another): give this translation a name of its own "
+                        "with NAME, e.g. NAME ${gen}_${target}, and create it with Create${gen}_${target}()")
+  endif()
+  set_property(DIRECTORY APPEND PROPERTY CROSSRT_GENERATED_CLASSES ${gen})
 
   set(sources ${ARG_SOURCES})
   set(candidates "")

@@ -128,6 +128,9 @@ bool AnalyzeTranslationUnit(ASTContext& ctx, const IncludesSeen& includes, const
       // A method defined in a header is seen by every source file: analyse it once.
       std::string n = md->getNameAsString();
       bool isKernel = IsKernelName(n);
+      if (pass == 0 && (n.rfind("kernelBE", 0) == 0))  // kernel_slicer's block-expansion kernels
+        c.rep.Error(md->getLocation(), "'" + n + "' is one of kernel_slicer's block-expansion kernels (kernelBE1D_), which CrossRT does not translate yet",
+                    "write it as a kernel1D_ loop with one iteration per thread, and keep work that a block shares in a separate kernel or a reduction");
       if (pass == 0 && isKernel && !known(model.kernels, n)) AnalyzeKernel(c, md, def);
       if (pass == 1 && !isKernel && !known(model.controls, n) && !IsPerThreadFunction(md, cls)) {  // those run inside thread loops
         KernelCallFinder kc(cls);

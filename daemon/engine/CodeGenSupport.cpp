@@ -274,6 +274,7 @@ Data Common(const ClassModel& model, const GenerateOptions& opt) {
   for (auto& c : model.constructors) {
     Data x;
     x.set("params", c.paramsDecl);
+    x.set("paramsWithDefaults", c.paramsWithDefaults);
     x.set("args", c.argsForward);
     x.set("hasParams", !c.paramsDecl.empty());
     ctors.push_back(x);

@@ -61,7 +61,7 @@ void CheckImageParamsUnchanged(Context& c, const FunctionDecl* def, const std::s
       auto* dr = object ? dyn_cast<DeclRefExpr>(object->IgnoreParenImpCasts()) : nullptr;
       auto* p = dr ? dyn_cast<ParmVarDecl>(dr->getDecl()) : nullptr;
       if (!p || p->getDeclContext() != def || !md || md->isConst() || !IsImage2D(p->getType().getNonReferenceType().getUnqualifiedType())) return;
-      c.rep.GpuError(loc, "control function '" + control + "' changes Image2D parameter '" + p->getNameAsString() + "' on the host ('" + md->getNameAsString() + "')",
+      c.rep.RecordingError(loc, "control function '" + control + "' changes Image2D parameter '" + p->getNameAsString() + "' on the host ('" + md->getNameAsString() + "')",
                   "its GPU copy is made before the body runs: size and fill the image before calling '" + control + "', and write its texels in a kernel");
     }
     bool VisitCXXMemberCallExpr(CXXMemberCallExpr* call) {
@@ -169,6 +169,8 @@ void ControlRewriter::Run() {
   FindHostTail();
   Visit(m_def->getBody());
   CheckTemporaryUses();
+  CheckHostVectorUses();
+  SplitAtHostReads();
   MoveHostTail();
   m_ctrl.vulkanCmdBody = CanonicalCode(m_gpu.getRewrittenText(m_def->getBody()->getSourceRange()));
   m_ctrl.cpuBody = CanonicalCode(m_cpu.getRewrittenText(m_def->getBody()->getSourceRange()));
@@ -226,9 +228,20 @@ std::string ControlRewriter::BufferArg(const Expr* arg) {
         if (offset) view += "sizeof(" + t->cppType + ") * size_t(" + m_c.Text(offset->getSourceRange()) + ")";
         return view + ")";
       }
-  m_c.rep.GpuError(arg->getBeginLoc(), "pointer argument of a kernel call must be a parameter of '" + m_ctrl.name + "', 'member.data()' or a local std::vector's data() (+ offset)",
+  m_c.rep.RecordingError(arg->getBeginLoc(), "pointer argument of a kernel call must be a parameter of '" + m_ctrl.name + "', 'member.data()' or a local std::vector's data() (+ offset)",
                 "pass the control function's size-annotated pointer, a std::vector member's data(), or a std::vector declared in '" + m_ctrl.name + "'");
   return "{}";
+}
+
+void ControlRewriter::WrittenThrough(const Expr* arg) {
+  const Expr* e = arg->IgnoreParenImpCasts();
+  if (auto* bo = dyn_cast<BinaryOperator>(e); bo && bo->getOpcode() == BO_Add) e = bo->getLHS()->IgnoreParenImpCasts();
+  auto* mc = dyn_cast<CXXMemberCallExpr>(e);
+  if (!mc || !mc->getMethodDecl() || mc->getMethodDecl()->getName() != "data") return;
+  const FieldDecl* f = ThisField(mc->getImplicitObjectArgument());
+  const Member* m = f ? FindMember(m_c.model, f->getNameAsString()) : nullptr;
+  if (m && m->kind == MemberKind::Vector && std::find(m_ctrl.vectorsWritten.begin(), m_ctrl.vectorsWritten.end(), m->name) == m_ctrl.vectorsWritten.end())
+    m_ctrl.vectorsWritten.push_back(m->name);
 }
 
 const Control::LocalBuffer* ControlRewriter::Temporary(const VarDecl* vd) {
@@ -245,14 +258,14 @@ const Control::LocalBuffer* ControlRewriter::Temporary(const VarDecl* vd) {
   const unsigned args = ctor ? unsigned(std::count_if(ctor->arg_begin(), ctor->arg_end(), [](const Expr* a) { return !isa<CXXDefaultArgExpr>(a); })) : 0;
   const bool countCtor = ctor && (args == 1 || args == 2) && ctor->getArg(0)->getType()->isIntegerType();
   if (!decl || !countCtor) {
-    m_c.rep.GpuError(vd->getLocation(), "std::vector '" + local + "' is passed to a kernel, but the GPU's copy of a local vector is made only from 'std::vector<T> " + local +
+    m_c.rep.RecordingError(vd->getLocation(), "std::vector '" + local + "' is passed to a kernel, but the GPU's copy of a local vector is made only from 'std::vector<T> " + local +
                      "(n)' or '(n, value)' declared on its own at the top of '" + m_ctrl.name + "'",
                      "declare it as 'std::vector<T> " + local + "(n);' at the top of the function, or make it a member");
     return nullptr;
   }
   const ASTContext& ctx = m_c.ctx;
   if (args == 2 && ctx.getTypeSize(element) != 32) {
-    m_c.rep.GpuError(ctor->getArg(1)->getBeginLoc(), "the GPU fills a local vector with a value of 32 bits, not of " + std::to_string(ctx.getTypeSize(element)) + " bits",
+    m_c.rep.RecordingError(ctor->getArg(1)->getBeginLoc(), "the GPU fills a local vector with a value of 32 bits, not of " + std::to_string(ctx.getTypeSize(element)) + " bits",
                      "declare it as 'std::vector<T> " + local + "(n);' and fill it in a kernel");
     return nullptr;
   }
@@ -285,7 +298,7 @@ void ControlRewriter::CheckTemporaryUses() {
       auto* vd = dyn_cast<VarDecl>(dr->getDecl());
       auto it = vd ? rw.m_temporaries.find(vd) : rw.m_temporaries.end();
       if (it == rw.m_temporaries.end() || rw.m_temporaryUses.count(dr)) return true;
-      rw.m_c.rep.GpuError(dr->getLocation(), "'" + it->second.local + "' is used on the host, but the kernels of '" + rw.m_ctrl.name +
+      rw.m_c.rep.RecordingError(dr->getLocation(), "'" + it->second.local + "' is used on the host, but the kernels of '" + rw.m_ctrl.name +
                           "' read and write its GPU copy", "pass " + it->second.local + ".data() only to kernels; to read the results make it a member "
                           "(or a size-annotated parameter), which the generated class copies back");
       return true;
@@ -311,7 +324,7 @@ std::string ControlRewriter::ImageArg(const ParmVarDecl* p, const Expr* arg) {
     }
     return "crossrt::ImageView(m_images." + name + ", m_images." + name + "Width, m_images." + name + "Height)";
   }
-  m_c.rep.GpuError(arg->getBeginLoc(), "Image2D argument of a kernel call must be an Image2D parameter of '" + m_ctrl.name + "' or an Image2D member",
+  m_c.rep.RecordingError(arg->getBeginLoc(), "Image2D argument of a kernel call must be an Image2D parameter of '" + m_ctrl.name + "' or an Image2D member",
                 "an image local to '" + m_ctrl.name + "' has no GPU copy: make it a member (its GPU copy is kept between calls) or a parameter of '" +
                     m_ctrl.name + "'");
   return "{}";
@@ -328,6 +341,7 @@ std::string ControlRewriter::Args(const CXXMemberCallExpr* call, bool skipThread
     if (p->getType()->isPointerType()) CheckNotThreadState(md, p, arg);
     if (IsImageParam(p)) out += ", " + ImageArg(p, arg);
     else out += ", " + (p->getType()->isPointerType() ? BufferArg(arg) : m_c.Text(arg->getSourceRange()));
+    if (p->getType()->isPointerType() && !p->getType()->getPointeeType().isConstQualified()) WrittenThrough(arg);
   }
   return out;
 }
@@ -389,7 +403,7 @@ void ControlRewriter::CheckAppendedUses() {
       auto* f = ThisField(object);
       if (!f || !rw.m_c.appended.count(f->getNameAsString())) return;
       const std::string v = f->getNameAsString();
-      rw.m_c.rep.GpuError(loc, "control function '" + rw.m_ctrl.name + "' uses " + what + " of '" + v +
+      rw.m_c.rep.RecordingError(loc, "control function '" + rw.m_ctrl.name + "' uses " + what + " of '" + v +
                        "', which kernels append to: on the GPU its size and contents are known only after the call returns",
                        "loop to " + v + ".size() inside a kernel1D_ kernel (dispatched indirectly, with no host round trip), or read " + v +
                        " after the call; here it may only be cleared, reserved, or sorted whole with std::sort(" + v + ".begin(), " + v + ".end(), ...)");
@@ -430,7 +444,7 @@ void ControlRewriter::CheckNestedControl(const CXXMemberCallExpr* call) {
   KernelCallFinder kc(m_c.cls);
   kc.TraverseStmt(def->getBody());
   if (kc.calls.empty()) return;
-  m_c.rep.GpuError(call->getBeginLoc(), "control function '" + m_ctrl.name + "' calls control function '" + md->getNameAsString() + "'",
+  m_c.rep.RecordingError(call->getBeginLoc(), "control function '" + m_ctrl.name + "' calls control function '" + md->getNameAsString() + "'",
                 "on the GPU each control function is one submission: call its kernels directly here, or call both from outside the class");
 }
 
@@ -447,6 +461,7 @@ void ControlRewriter::Visit(const Stmt* s) {
   if (auto* ws = dyn_cast<WhileStmt>(s)) RecordMemberWrite(ws->getBody());
   if (auto* ds = dyn_cast<DoStmt>(s)) RecordMemberWrite(ds->getBody());
   if (auto* mc = dyn_cast<CXXMemberCallExpr>(s)) CheckNestedControl(mc);
+  if (auto* call = dyn_cast<CallExpr>(s); call && TrySwap(call)) return;
   if (auto* call = dyn_cast<CallExpr>(s); call && !isa<CXXMemberCallExpr>(s) && TryLibraryCall(call)) return;
   if (auto* fs = dyn_cast<ForStmt>(s); fs && (TryThreadLoop(fs) || TryRtvNest(fs))) return;
   if (auto* call = dyn_cast<CXXMemberCallExpr>(s)) {
@@ -458,7 +473,9 @@ void ControlRewriter::Visit(const Stmt* s) {
         return;
       }
       Note(call);
-      m_gpu.ReplaceText(call->getSourceRange(), md->getNameAsString() + "Cmd(a_cmd" + Args(call, false) + ")");
+      // An argument reads a member the kernels before it write: run those first (HostReads.cpp).
+      const std::string sync = m_syncCalls.count(call) ? "Synchronize(a_cmd, \"" + m_ctrl.name + "\"), " : "";
+      m_gpu.ReplaceText(call->getSourceRange(), sync + md->getNameAsString() + "Cmd(a_cmd" + Args(call, false) + ")");
       return;
     }
   }

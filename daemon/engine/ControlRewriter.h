@@ -43,6 +43,9 @@ private:
   std::string ImageArg(const ParmVarDecl* p, const Expr* arg);
 
   std::string Args(const CXXMemberCallExpr* call, bool skipThreadIds);
+  // A member vector's data() given to a kernel's non-const pointer: the kernel may write it, so
+  // the control function reads it back (Control::vectorsWritten).
+  void WrittenThrough(const Expr* arg);
 
   // A parameter that some thread loop passes a local's address to holds one value per thread on the
   // GPU; a buffer passed to it elsewhere would be read one element per thread, not as C++ reads it.
@@ -152,6 +155,20 @@ private:
   // reads), which the generated control function runs after the results are back.
   void MoveHostTail();
   std::vector<const Stmt*> m_tail;
+  // Reads of members kernels write, between kernel calls: each becomes a read after
+  // Synchronize(a_cmd, ...), which splits the recording there.
+  void SplitAtHostReads();
+  // Member vectors on the host before the last kernel call: a read of one kernels write, between
+  // them, and any change of one kernels use are errors on Vulkan (the device copies were uploaded
+  // when the call began). size(), data() and swaps are translated.
+  void CheckHostVectorUses();
+  std::vector<const MemberExpr*> m_syncReads;
+  // Kernel calls that take such a member as an argument: `Synchronize(a_cmd, ...), kernel1D_XCmd(...)`.
+  std::set<const CallExpr*> m_syncCalls;
+
+  // std::swap(m_a, m_b) or m_a.swap(m_b) of std::vector members: on Vulkan their device buffers
+  // swap too (MemberSwaps.cpp). False when the call is no such swap.
+  bool TrySwap(const CallExpr* call);
 
   // Another control function would submit its own work while this one is being recorded.
   void CheckNestedControl(const CXXMemberCallExpr* call);

@@ -49,11 +49,21 @@ public:
   }
   void SetGpuRules(bool on) { m_gpuRules = on; }
   bool GpuRules() const { return m_gpuRules; }
+  // A rule of the Vulkan class's recording (a control function's body is recorded into a command
+  // buffer before its kernels run: device copies of locals, what the host may do with data the GPU
+  // holds meanwhile): an error for Vulkan only. The CPU and ISPC classes run control functions on
+  // the host, in order, as written.
+  void RecordingError(clang::SourceLocation loc, const std::string& message, const std::string& hint = {}) {
+    if (m_recordingRules) Error(loc, message, hint);
+  }
+  void SetRecordingRules(bool on) { m_recordingRules = on; }
+  bool RecordingRules() const { return m_recordingRules; }
 
 private:
   clang::DiagnosticsEngine& m_diags;
   unsigned m_errors = 0;
   bool m_gpuRules = true;
+  bool m_recordingRules = true;
   std::string m_notes;
   std::set<std::pair<uint64_t, std::string>> m_reported;  // (location, message)
 };

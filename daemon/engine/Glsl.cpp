@@ -34,7 +34,13 @@ const std::set<std::string>& GlslKeywords() {
       "sampler3D", "samplerCube", "texture2D", "texture3D",
       // Types named like a buffer block of `image`, `sampler` or `texture` (ShaderCode's <name>Buffer).
       "imageBuffer", "iimageBuffer", "uimageBuffer", "samplerBuffer", "isamplerBuffer", "usamplerBuffer", "textureBuffer",
-      "itextureBuffer", "utextureBuffer"};
+      "itextureBuffer", "utextureBuffer",
+      // Names the generated code gives its own parameters: a user's local of that name is renamed.
+      "self",
+      // ISPC's keywords and built-ins, for the ISPC dialect of the printer.
+      "export", "task", "launch", "sync", "soa", "foreach", "foreach_tiled", "foreach_active", "foreach_unique", "programIndex",
+      "programCount", "cif", "cfor", "cdo", "cwhile", "unmasked", "new", "delete", "int8", "int16", "int32", "int64", "uint8",
+      "uint16", "uint32", "uint64", "float16", "print"};
   return words;
 }
 

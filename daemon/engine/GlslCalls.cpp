@@ -74,6 +74,8 @@ std::string GlslPrinter::Builtin(const FunctionDecl* fd, const std::vector<std::
       {"exp2", "exp2"}, {"exp2f", "exp2"}, {"log", "log"}, {"logf", "log"}, {"log2", "log2"}, {"log2f", "log2"},
       {"sin", "sin"}, {"sinf", "sin"}, {"cos", "cos"}, {"cosf", "cos"}, {"tan", "tan"}, {"tanf", "tan"},
       {"asin", "asin"}, {"asinf", "asin"}, {"acos", "acos"}, {"acosf", "acos"}, {"atan", "atan"}, {"atanf", "atan"},
+      {"sinh", "sinh"}, {"sinhf", "sinh"}, {"cosh", "cosh"}, {"coshf", "cosh"}, {"tanh", "tanh"}, {"tanhf", "tanh"},
+      {"asinh", "asinh"}, {"asinhf", "asinh"}, {"acosh", "acosh"}, {"acoshf", "acosh"}, {"atanh", "atanh"}, {"atanhf", "atanh"},
       {"atan2", "atan"}, {"atan2f", "atan"}, {"floor", "floor"}, {"floorf", "floor"}, {"ceil", "ceil"},
       {"ceilf", "ceil"}, {"trunc", "trunc"}, {"truncf", "trunc"},
       {"fract", "fract"}, {"sign", "sign"}, {"dot", "dot"}, {"cross", "cross"}, {"length", "length"},

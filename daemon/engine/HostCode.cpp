@@ -22,6 +22,8 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
   Data d = Common(model, opt);
   d.set("controls", ControlsData(model));
   d.set("hasHostTails", std::any_of(model.controls.begin(), model.controls.end(), [](const Control& c) { return c.hasHostTail; }));
+  d.set("hasVectorSwaps", std::any_of(model.controls.begin(), model.controls.end(), [](const Control& c) { return c.swapsVectors; }));
+  d.set("hasSynchronize", std::any_of(model.controls.begin(), model.controls.end(), [](const Control& c) { return c.synchronizes; }));
   const Data vectors = VectorsData(model);
   d.set("vectors", vectors);
   d.set("hasVectors", !vectors.is_empty_list());

@@ -1,11 +1,16 @@
 // Host code of a control function that uses what kernels write on the GPU: members they write,
-// and output pointer parameters. The Vulkan class records the whole body before any of it runs, so
-// such a use, done while recording, would see the value from before the call. After the last
-// statement that records GPU work the uses are sound once deferred: the ...Cmd stores those
-// statements (the host tail, `m_mean = m_sum / float(n);`) as a lambda, capturing the locals they
-// read, and the generated control function runs it after the kernels' results are back. Between
-// kernels such uses are an error. Takes a control function's body; gives Control::hasHostTail and
-// the ...Cmd's lambda.
+// member vectors they write (also through data(), and swapped ones), and output pointer parameters.
+// The Vulkan class records the whole body before any of it runs, so such a use, done while
+// recording, would see the value from before the call. After the last statement that records GPU
+// work the uses are sound once deferred: the ...Cmd stores those statements (the host tail,
+// `m_mean = m_sum / float(n);`, `m_first = m_out[0];`) as a lambda, capturing the locals they read,
+// and the generated control function runs it after the kernels' results are back. Between kernels
+// a plain member read splits the recording: the read becomes `Synchronize(a_cmd, "Solve").m_residual`,
+// which submits what was recorded, waits, reads the members back and begins a new command buffer
+// (a solver's `if (m_residual < tol) break;`). Output parameters, copied back only at the end, and
+// member vectors on the host before the last kernel are errors there. Takes a control function's
+// body; gives Control::hasHostTail, Control::synchronizes, the ...Cmd's lambda and its synchronised
+// reads.
 #include "ControlFunctions.h"
 #include "ControlRewriter.h"
 
@@ -14,6 +19,29 @@ using namespace clang;
 namespace crossrt::engine {
 
 namespace {
+
+// The call that takes `e` (through casts and parentheses): the method's name where `e` is the object
+// or an argument of a member call, the function's where it is an argument of a free function
+// ("std::swap", "ReduceAddInit"), else "".
+std::string UsingCall(ASTContext& ctx, const Expr* e) {
+  DynTypedNode node = DynTypedNode::create(*e);
+  for (;;) {
+    const auto parents = ctx.getParents(node);
+    if (parents.empty()) return "";
+    node = parents[0];
+    if (node.get<ImplicitCastExpr>() || node.get<ParenExpr>()) continue;
+    if (auto* callee = node.get<MemberExpr>()) {
+      const auto up = ctx.getParents(*callee);
+      auto* call = up.empty() ? nullptr : up[0].get<CXXMemberCallExpr>();
+      return call && call->getMethodDecl() ? call->getMethodDecl()->getNameAsString() : "";
+    }
+    if (auto* call = node.get<CXXMemberCallExpr>(); call && call->getMethodDecl())  // an argument of a method: m_a.swap(m_b)
+      return call->getMethodDecl()->getNameAsString();
+    if (auto* call = node.get<CallExpr>(); call && call->getDirectCallee())
+      return (call->getDirectCallee()->isInStdNamespace() ? "std::" : "") + call->getDirectCallee()->getNameAsString();
+    return "";
+  }
+}
 
 // What host code in `s` reads of the GPU's results: plain members of the class data that kernels
 // write (every mention but the left side of a plain assignment, `m_x = ...`, which only writes
@@ -66,6 +94,68 @@ std::vector<std::pair<const Expr*, std::string>> KernelWrittenReads(Context& c, 
   return finder.reads;
 }
 
+// The member vectors a control function's kernels may write: those kernels store to, those whose
+// data() it hands to a kernel's non-const pointer, and those it swaps (either may then hold what
+// the kernels wrote).
+std::set<std::string> VectorsKernelsWrite(Context& c, const FunctionDecl* control) {
+  std::set<std::string> written;
+  for (const Member& m : c.model.members)
+    if (m.kind == MemberKind::Vector && m.writtenByKernels) written.insert(m.name);
+  struct Finder : RecursiveASTVisitor<Finder> {
+    std::set<std::string>& written;
+    explicit Finder(std::set<std::string>& w) : written(w) {}
+    void Vector(const Expr* e) {
+      if (auto* f = ThisField(e); f && IsStdVector(f->getType().getNonReferenceType())) written.insert(f->getNameAsString());
+    }
+    bool VisitCallExpr(CallExpr* call) {
+      auto* fd = call->getDirectCallee();
+      if (!fd) return true;
+      if (fd->getName() == "swap") {  // std::swap(m_a, m_b) or m_a.swap(m_b)
+        for (const Expr* arg : call->arguments()) Vector(arg);
+        if (auto* mc = dyn_cast<CXXMemberCallExpr>(call)) Vector(mc->getImplicitObjectArgument());
+      }
+      if (auto* md = dyn_cast<CXXMethodDecl>(fd); md && IsKernelName(md->getName()))
+        for (unsigned i = 0; i < call->getNumArgs() && i < md->getNumParams(); ++i) {
+          const QualType t = md->getParamDecl(i)->getType();
+          if (!t->isPointerType() || t->getPointeeType().isConstQualified()) continue;
+          const Expr* arg = call->getArg(i)->IgnoreParenImpCasts();
+          if (auto* bo = dyn_cast<BinaryOperator>(arg); bo && bo->getOpcode() == BO_Add) arg = bo->getLHS()->IgnoreParenImpCasts();
+          if (auto* data = dyn_cast<CXXMemberCallExpr>(arg); data && data->getMethodDecl() && data->getMethodDecl()->getName() == "data")
+            Vector(data->getImplicitObjectArgument());
+        }
+      return true;
+    }
+  } finder(written);
+  finder.TraverseStmt(const_cast<Stmt*>(control->getBody()));
+  return written;
+}
+
+// Whether host code in `s` uses one of the member vectors `written` (its elements, an iterator, the
+// whole vector), other than asking its size or handing it to a kernel or a library call.
+bool UsesWrittenVector(Context& c, const std::set<std::string>& written, const Stmt* s) {
+  KernelCallFinder gpu(c.cls);
+  gpu.TraverseStmt(const_cast<Stmt*>(s));
+  auto& sm = c.ctx.getSourceManager();
+  struct Finder : RecursiveASTVisitor<Finder> {
+    std::vector<const MemberExpr*> uses;
+    bool VisitMemberExpr(MemberExpr* me) {
+      if (isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts())) uses.push_back(me);
+      return true;
+    }
+  } finder;
+  finder.TraverseStmt(const_cast<Stmt*>(s));
+  static const std::set<std::string> sizes = {"size", "capacity", "empty"};
+  for (const MemberExpr* me : finder.uses) {
+    if (!written.count(me->getMemberDecl()->getNameAsString()) || sizes.count(UsingCall(c.ctx, me))) continue;
+    const bool inGpuCall = std::any_of(gpu.calls.begin(), gpu.calls.end(), [&](const Expr* call) {
+      const SourceRange r = call->getSourceRange();
+      return !sm.isBeforeInTranslationUnit(me->getBeginLoc(), r.getBegin()) && !sm.isBeforeInTranslationUnit(r.getEnd(), me->getEndLoc());
+    });
+    if (!inGpuCall) return true;
+  }
+  return false;
+}
+
 // Where `s` first records GPU work: a kernel call (or a per-thread function's), a library call on
 // device data, LiteMath's ReduceAddInit, or clear() of a vector kernels append to. Invalid if none.
 SourceLocation FirstGpuWork(Context& c, const Stmt* s) {
@@ -107,21 +197,147 @@ void ControlRewriter::FindHostTail() {
     }
   if (last < 0) return;
   // Between the first GPU work and the last: a read after the first, or anywhere in a loop that
-  // records GPU work (its next round reads what this one's kernels write).
+  // records GPU work (its next round reads what this one's kernels write). A member read there
+  // splits the recording (m_syncReads); an output parameter, copied back only at the end, cannot.
+  KernelCallFinder kernelCalls(m_c.cls);
+  kernelCalls.TraverseStmt(const_cast<Stmt*>(m_def->getBody()));
+  auto kernelCallOf = [&](const Expr* e) -> const Expr* {
+    for (const Expr* call : kernelCalls.calls) {
+      const SourceRange r = call->getSourceRange();
+      if (!sm.isBeforeInTranslationUnit(e->getBeginLoc(), r.getBegin()) && !sm.isBeforeInTranslationUnit(r.getEnd(), e->getEndLoc())) return call;
+    }
+    return nullptr;
+  };
   for (int i = first; i <= last; ++i) {
     const bool loop = isa<ForStmt, WhileStmt, DoStmt, CXXForRangeStmt>(statements[i]) && FirstGpuWork(m_c, statements[i]).isValid();
     for (const auto& [read, name] : KernelWrittenReads(m_c, m_def, statements[i])) {
       if (!loop && !sm.isBeforeInTranslationUnit(firstWork, read->getBeginLoc())) continue;
-      m_c.rep.GpuError(read->getExprLoc(), "control function '" + m_ctrl.name + "' uses '" + name +
-                       "' between kernel calls, but kernels write it on the GPU: the calls are recorded before any runs, so this sees its value from before the call",
-                       "read it inside a kernel, which sees the GPU's copy, or after the last kernel call: code there runs once the results are back");
+      const Expr* call = kernelCallOf(read);
+      if (auto* me = dyn_cast<MemberExpr>(read); me && !call) {
+        m_syncReads.push_back(me);
+        continue;
+      }
+      // An argument of a kernel call (kernel1D_Scale(n, 1.0f / m_total)): the call synchronises first.
+      auto* kernelCall = dyn_cast_or_null<CXXMemberCallExpr>(call);
+      if (isa<MemberExpr>(read) && kernelCall && kernelCall->getMethodDecl() && IpvDims(kernelCall->getMethodDecl()->getName())) {
+        m_syncCalls.insert(kernelCall);
+        m_syncReads.push_back(cast<MemberExpr>(read));  // for the note; its text stays
+        continue;
+      }
+      if (isa<MemberExpr>(read))
+        m_c.rep.RecordingError(read->getExprLoc(), "'" + m_ctrl.name + "' passes '" + name + "', which kernels write on the GPU, to a call recorded before the kernels before it run: it would get the value from before them",
+                               "read '" + name + "' inside the kernel, which sees the GPU's copy, or pass it to a kernel1D_/kernel2D_/kernel3D_ call (which waits for it)");
+      else
+        m_c.rep.RecordingError(read->getExprLoc(), "control function '" + m_ctrl.name + "' uses '" + name +
+                                   "' between kernel calls, but kernels write it on the GPU, and it is copied back only when the call returns",
+                               "read it inside a kernel, which sees the GPU's copy, or after the last kernel call: code there runs once the results are back");
     }
   }
   // The tail moves only when it needs to: when it reads what the kernels wrote.
   bool reads = false;
-  for (size_t i = size_t(last) + 1; i < statements.size(); ++i) reads = reads || !KernelWrittenReads(m_c, m_def, statements[i]).empty();
+  const std::set<std::string> vectors = VectorsKernelsWrite(m_c, m_def);
+  for (size_t i = size_t(last) + 1; i < statements.size(); ++i)
+    reads = reads || !KernelWrittenReads(m_c, m_def, statements[i]).empty() || UsesWrittenVector(m_c, vectors, statements[i]);
   if (!reads) return;
   m_tail.assign(statements.begin() + last + 1, statements.end());
+}
+
+void ControlRewriter::CheckHostVectorUses() {
+  auto* body = dyn_cast<CompoundStmt>(m_def->getBody());
+  if (!body) return;
+  auto& sm = m_c.ctx.getSourceManager();
+  const std::vector<const Stmt*> statements(body->body_begin(), body->body_end());
+  int last = -1;
+  SourceLocation firstWork;
+  for (int i = 0; i < int(statements.size()); ++i)
+    if (SourceLocation at = FirstGpuWork(m_c, statements[i]); at.isValid()) {
+      if (firstWork.isInvalid()) firstWork = at;
+      last = i;
+    }
+  if (last < 0) return;
+  KernelCallFinder gpu(m_c.cls);  // kernel and library calls: what they take is the GPU's business
+  gpu.TraverseStmt(const_cast<Stmt*>(m_def->getBody()));
+  auto inGpuCall = [&](const Expr* e) {
+    return std::any_of(gpu.calls.begin(), gpu.calls.end(), [&](const Expr* call) {
+      const SourceRange r = call->getSourceRange();
+      return !sm.isBeforeInTranslationUnit(e->getBeginLoc(), r.getBegin()) && !sm.isBeforeInTranslationUnit(r.getEnd(), e->getEndLoc());
+    });
+  };
+  struct Uses : RecursiveASTVisitor<Uses> {
+    std::set<const Expr*> changed;  // vectors (their MemberExpr) assigned through, or changed by a method
+    std::vector<const MemberExpr*> uses;
+    void Changed(const Expr* e) {
+      for (e = e->IgnoreParenImpCasts();;) {
+        if (auto* me = dyn_cast<MemberExpr>(e); me && !isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts())) e = me->getBase()->IgnoreParenImpCasts();
+        else if (auto* op = dyn_cast<CXXOperatorCallExpr>(e); op && op->getOperator() == OO_Subscript) e = op->getArg(0)->IgnoreParenImpCasts();
+        else break;
+      }
+      changed.insert(e);
+    }
+    bool VisitBinaryOperator(BinaryOperator* bo) {
+      if (bo->isAssignmentOp()) Changed(bo->getLHS());
+      return true;
+    }
+    bool VisitUnaryOperator(UnaryOperator* uo) {
+      if (uo->isIncrementDecrementOp()) Changed(uo->getSubExpr());
+      return true;
+    }
+    bool VisitCXXOperatorCallExpr(CXXOperatorCallExpr* op) {
+      if (op->isAssignmentOp() || op->getOperator() == OO_PlusPlus || op->getOperator() == OO_MinusMinus) Changed(op->getArg(0));
+      return true;
+    }
+    bool VisitCXXMemberCallExpr(CXXMemberCallExpr* mc) {
+      static const std::set<std::string> changing = {"push_back", "emplace_back", "pop_back", "resize", "assign", "clear", "insert", "erase", "emplace", "shrink_to_fit"};
+      if (mc->getMethodDecl() && changing.count(mc->getMethodDecl()->getNameAsString())) Changed(mc->getImplicitObjectArgument());
+      return true;
+    }
+    bool VisitMemberExpr(MemberExpr* me) {
+      if (isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts())) uses.push_back(me);
+      return true;
+    }
+  };
+  // (LiteMath's ReduceAddInit and ReduceAddComplete are GPU work of their own.)
+  static const std::set<std::string> harmless = {"size", "capacity", "empty", "data", "swap", "std::swap", "reserve", "ReduceAddInit", "ReduceAddComplete"};
+  for (int i = 0; i <= last; ++i) {
+    const bool loop = isa<ForStmt, WhileStmt, DoStmt, CXXForRangeStmt>(statements[i]) && FirstGpuWork(m_c, statements[i]).isValid();
+    Uses uses;
+    uses.TraverseStmt(const_cast<Stmt*>(statements[i]));
+    for (const MemberExpr* me : uses.uses) {
+      auto* f = dyn_cast<FieldDecl>(me->getMemberDecl());
+      const Member* m = f ? FindMember(m_c.model, f->getNameAsString()) : nullptr;
+      if (!m || m->kind != MemberKind::Vector || !m->usedByKernels || m->appendedByKernels || inGpuCall(me)) continue;
+      // size(), data() and the like, and std::swap's arguments, are the translated uses.
+      if (harmless.count(UsingCall(m_c.ctx, me))) continue;
+      const bool written = m->writtenByKernels || std::find(m_ctrl.vectorsWritten.begin(), m_ctrl.vectorsWritten.end(), m->name) != m_ctrl.vectorsWritten.end();
+      const bool after = loop || sm.isBeforeInTranslationUnit(firstWork, me->getBeginLoc());
+      if (uses.changed.count(me))
+        m_c.rep.RecordingError(me->getExprLoc(), "control function '" + m_ctrl.name + "' changes '" + m->name +
+                                   "' on the host before its last kernel call, but its kernels use the device copy uploaded when the call began",
+                               "change it in a kernel, or before the call and then call CommitDeviceData(); a swap of two member vectors (std::swap(" +
+                                   m->name + ", other)) is translated");
+      else if (written && after)
+        m_c.rep.RecordingError(me->getExprLoc(), "control function '" + m_ctrl.name + "' reads '" + m->name +
+                                   "' between kernel calls, but kernels write it on the GPU, and it is copied back only when the call returns",
+                               "read it in a kernel, or after the last kernel call: code there runs once the results are back");
+    }
+  }
+}
+
+void ControlRewriter::SplitAtHostReads() {
+  if (m_syncReads.empty()) return;
+  m_ctrl.synchronizes = true;
+  std::set<std::string> named;
+  auto& sm = m_c.ctx.getSourceManager();
+  for (const MemberExpr* me : m_syncReads) {
+    const std::string name = me->getMemberDecl()->getNameAsString();
+    const bool inCall = std::any_of(m_syncCalls.begin(), m_syncCalls.end(), [&](const CallExpr* call) {
+      return !sm.isBeforeInTranslationUnit(me->getBeginLoc(), call->getBeginLoc()) && !sm.isBeforeInTranslationUnit(call->getEndLoc(), me->getEndLoc());
+    });
+    if (!inCall) m_gpu.ReplaceText(me->getSourceRange(), "Synchronize(a_cmd, \"" + m_ctrl.name + "\")." + name);
+    if (m_c.rep.RecordingRules() && named.insert(name).second)
+      m_c.rep.Note(me->getExprLoc(), "'" + m_ctrl.name + "' reads '" + name + "', which its kernels write, between kernel calls: on Vulkan the recording is split there " +
+                                         "(the work recorded so far is submitted and waited for, and the members kernels write are read back), a round trip to the GPU each time it runs");
+  }
 }
 
 void ControlRewriter::MoveHostTail() {
@@ -147,7 +363,7 @@ void ControlRewriter::MoveHostTail() {
   for (const Stmt* s : m_tail) uses.TraverseStmt(const_cast<Stmt*>(s));
   for (const auto& [vd, temporary] : m_temporaries)
     if (std::find(uses.captured.begin(), uses.captured.end(), vd->getNameAsString()) != uses.captured.end())
-      m_c.rep.GpuError(vd->getLocation(), "the code of '" + m_ctrl.name + "' after its last kernel reads '" + vd->getNameAsString() +
+      m_c.rep.RecordingError(vd->getLocation(), "the code of '" + m_ctrl.name + "' after its last kernel reads '" + vd->getNameAsString() +
                        "', whose elements are the GPU's", "make it a member, which the generated class copies back");
   std::string captures = "this";
   for (const std::string& name : uses.captured) captures += ", " + name;

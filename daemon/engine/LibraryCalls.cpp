@@ -132,12 +132,12 @@ bool ControlRewriter::ReduceAddInit(const CallExpr* call) {
   auto* f = call->getNumArgs() == 2 ? ThisField(call->getArg(0)) : nullptr;
   Member* m = f ? FindMember(m_c.model, f->getNameAsString()) : nullptr;
   if (!m || m->kind != MemberKind::Vector) {
-    m_c.rep.GpuError(call->getBeginLoc(), "ReduceAddInit of something other than a std::vector member", "pass the member vector kernels add into");
+    m_c.rep.RecordingError(call->getBeginLoc(), "ReduceAddInit of something other than a std::vector member", "pass the member vector kernels add into");
     return true;
   }
   SourceLocation end = Lexer::findLocationAfterToken(call->getEndLoc(), tok::semi, m_c.ctx.getSourceManager(), m_c.ctx.getLangOpts(), false);
   if (end.isInvalid()) {
-    m_c.rep.GpuError(call->getBeginLoc(), "ReduceAddInit used inside an expression in control function '" + m_ctrl.name + "'",
+    m_c.rep.RecordingError(call->getBeginLoc(), "ReduceAddInit used inside an expression in control function '" + m_ctrl.name + "'",
                      "call it as a statement of its own: ReduceAddInit(" + m->name + ", n);");
     return true;
   }
@@ -174,7 +174,7 @@ bool ControlRewriter::TryLibraryCall(const CallExpr* call) {
   bool inStd = fd->isInStdNamespace() || IsSystemDecl(fd);
   if (!inStd) return false;
   auto bad = [&](const std::string& why) {
-    m_c.rep.GpuError(call->getBeginLoc(), "'" + fd->getQualifiedNameAsString() + "' on device data: " + why,
+    m_c.rep.RecordingError(call->getBeginLoc(), "'" + fd->getQualifiedNameAsString() + "' on device data: " + why,
                   "use member std::vector begin()/end()/data() or size-annotated pointer parameters, with + offsets");
     return true;
   };

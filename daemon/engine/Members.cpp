@@ -104,9 +104,31 @@ void AnalyzeMembers(Context& c) {
   for (auto* ctor : c.cls->ctors()) {
     if (ctor->isImplicit() || ctor->isCopyOrMoveConstructor() || ctor->isDeleted() || ctor->getAccess() == AS_private) continue;
     Constructor k;
+    // Default arguments, for the declarations (the generated constructor and factories): as
+    // written, over the longest run of trailing parameters whose defaults name nothing in a
+    // class's scope, which the factories (free functions) could not see.
+    struct ClassScoped : RecursiveASTVisitor<ClassScoped> {
+      bool found = false;
+      bool VisitDeclRefExpr(DeclRefExpr* dr) {
+        found = found || dr->getDecl()->getDeclContext()->isRecord();
+        return true;
+      }
+    };
+    unsigned firstDefault = ctor->getNumParams();
+    while (firstDefault > 0) {
+      const ParmVarDecl* p = ctor->getParamDecl(firstDefault - 1);
+      if (!p->hasDefaultArg() || p->hasUninstantiatedDefaultArg() || p->hasUnparsedDefaultArg()) break;
+      ClassScoped scoped;
+      scoped.TraverseStmt(const_cast<Expr*>(p->getDefaultArg()));
+      if (scoped.found) break;
+      --firstDefault;
+    }
     for (unsigned i = 0; i < ctor->getNumParams(); ++i) {
-      k.paramsDecl += (i ? ", " : "") + ParamDecl(c.ctx, ctor->getParamDecl(i), i);
-      std::string n = ctor->getParamDecl(i)->getNameAsString();
+      const ParmVarDecl* p = ctor->getParamDecl(i);
+      const std::string decl = ParamDecl(c.ctx, p, i);
+      k.paramsDecl += (i ? ", " : "") + decl;
+      k.paramsWithDefaults += (i ? ", " : "") + decl + (i >= firstDefault ? " = " + c.Text(p->getDefaultArgRange()) : "");
+      std::string n = p->getNameAsString();
       k.argsForward += (i ? ", " : "") + (n.empty() ? "a_unnamed" + std::to_string(i) : n);
     }
     c.model.constructors.push_back(k);

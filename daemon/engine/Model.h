@@ -222,9 +222,13 @@ struct Control {
   // class's ...Cmd stores them as a lambda that the control function runs after the results are
   // back, not while recording (HostReads.cpp).
   bool hasHostTail = false;
+  // Host code between its kernel calls reads members kernels write (a residual, a counter): the
+  // Vulkan class's ...Cmd splits its recording there (Synchronize, HostReads.cpp).
+  bool synchronizes = false;
+  bool swapsVectors = false;        // std::swap of std::vector members (MemberSwaps.cpp)
   std::string cpuBody;              // body with RTV loops parallelised
   std::vector<std::string> kernelsCalled;
-  std::vector<std::string> vectorsWritten;  // member vectors its library calls (scan, fill, memcpy) write
+  std::vector<std::string> vectorsWritten;  // member vectors its library calls (scan, fill, memcpy), swaps and data() arguments write
   std::vector<std::string> imagesWritten;   // Image2D members it passes to kernels' non-const image parameters
   // A device buffer of the generated class that holds a local of the control function.
   struct LocalBuffer { std::string buffer, cppType, local; };
@@ -238,6 +242,7 @@ struct Control {
 
 struct Constructor {
   std::string paramsDecl;  // "int a_w, int a_h"
+  std::string paramsWithDefaults;  // "int a_w = 64, int a_h = 48": for declarations
   std::string argsForward; // "a_w, a_h"
 };
 

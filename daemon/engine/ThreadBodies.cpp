@@ -164,6 +164,7 @@ std::string ControlRewriter::KernelCallGlsl(ThreadLoop& tl, GlslPrinter& printer
         CheckNotThreadState(md, p, arg);
         CheckUniform(tl, arg, "a buffer argument", false);  // bound by the host
         AddMegakernelBuffer(tl, md, p, BufferArg(Resolve(arg)), ResolvedText(arg), arg->getBeginLoc());
+        if (!p->getType()->getPointeeType().isConstQualified()) WrittenThrough(Resolve(arg));
         buffers += ", " + KernelParamName(md, i);
         continue;  // a global buffer of the megakernel, named as the kernel names it
       }

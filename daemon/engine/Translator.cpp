@@ -175,6 +175,7 @@ AnalyzeResult Analyze(const TranslateRequest& request, AstCache* sharedCache) {
       Reporter reporter(ast->getDiagnostics());
       // A CPU class runs the user's C++ as written; ISPC kernels have the GPU's rules (and their own).
       reporter.SetGpuRules(request.backend != Backend::Cpu);
+      reporter.SetRecordingRules(request.backend == Backend::Vulkan);
       pass(*ast, reporter);
       errors += reporter.Errors();
       handle.printer().EndSourceFile();

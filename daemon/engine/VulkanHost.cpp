@@ -25,6 +25,7 @@ Data ControlsData(const ClassModel& model) {
     x.set("notVirtual", !c.isVirtual);
     x.set("cmdBody", IndentTail(c.vulkanCmdBody, ""));
     x.set("hostTail", c.hasHostTail);
+    x.set("synchronizes", c.synchronizes);
     x.set("cpuBody", IndentTail(c.cpuBody, "  "));
     x.set("sourceFile", c.sourceFile);
     Data ptrs = List(), outs = List();

@@ -747,6 +747,8 @@ uint32_t BVHScene::AddInstanceMotion(uint32_t geomId, const float4x4* matrices, 
 {
   if (matrixNumber == 0)
     throw std::invalid_argument(m_name + "::AddInstanceMotion: no matrices");
+  for (uint32_t k = 1; k < matrixNumber; k++)
+    litert_detail::ValidateInstanceMatrix((m_name + "::AddInstanceMotion").c_str(), matrices[k]);
   const uint32_t instId = AddInstance(geomId, matrices[0]);
   if (matrixNumber > 1)
     m_placed[instId].motion.assign(matrices, matrices + matrixNumber);
@@ -758,6 +760,7 @@ uint32_t BVHScene::AddInstance(uint32_t geomId, const float4x4& matrix)
   geomId &= CRT_GEOM_MASK_AABB_BIT_RM;  // box geometry's id may come with its bit
   if (geomId >= m_meshes.size())
     throw std::out_of_range(m_name + "::AddInstance: invalid geomId " + std::to_string(geomId));
+  litert_detail::ValidateInstanceMatrix((m_name + "::AddInstance").c_str(), matrix);
   m_placed.push_back({geomId, matrix, LiteMath::inverse4x4(matrix)});
   ClearDeviceData();
   return uint32_t(m_placed.size() - 1);
@@ -767,6 +770,7 @@ void BVHScene::UpdateInstance(uint32_t instanceId, const float4x4& matrix)
 {
   if (instanceId >= m_placed.size())
     throw std::out_of_range(m_name + "::UpdateInstance: invalid instanceId " + std::to_string(instanceId));
+  litert_detail::ValidateInstanceMatrix((m_name + "::UpdateInstance").c_str(), matrix);
   m_placed[instanceId].toWorld = matrix;
   m_placed[instanceId].toObject = LiteMath::inverse4x4(matrix);
   m_placed[instanceId].motion.clear();

@@ -233,6 +233,8 @@ public:
   {
     if (matrixNumber == 0)
       throw std::invalid_argument("EmbreeRT::AddInstanceMotion: no matrices");
+    for (uint32_t k = 1; k < matrixNumber; k++)
+      litert_detail::ValidateInstanceMatrix("EmbreeRT::AddInstanceMotion", matrices[k]);
     const uint32_t instId = AddInstance(geomId, matrices[0]);
     RTCGeometry inst = m_instances[instId];
     rtcSetGeometryTimeStepCount(inst, matrixNumber);  // evenly spaced over [0, 1], interpolated linearly
@@ -260,6 +262,7 @@ public:
     geomId &= CRT_GEOM_MASK_AABB_BIT_RM;  // box geometry's id may come with its bit
     if (geomId >= m_meshes.size())
       throw std::out_of_range("EmbreeRT::AddInstance: invalid geomId " + std::to_string(geomId));
+    litert_detail::ValidateInstanceMatrix("EmbreeRT::AddInstance", matrix);
     const uint32_t instId = uint32_t(m_instances.size());
     RTCGeometry    inst   = rtcNewGeometry(m_device, RTC_GEOMETRY_TYPE_INSTANCE);
     rtcSetGeometryInstancedScene(inst, m_meshes[geomId].scene);
@@ -276,6 +279,7 @@ public:
   {
     if (instanceId >= m_instances.size())
       throw std::out_of_range("EmbreeRT::UpdateInstance: invalid instanceId " + std::to_string(instanceId));
+    litert_detail::ValidateInstanceMatrix("EmbreeRT::UpdateInstance", matrix);
     setTransform(m_instances[instanceId], matrix);
     m_committed = false;
   }

@@ -11,8 +11,14 @@ namespace litert_detail
 {
 // Throws std::invalid_argument (message prefixed by `who`) for a mesh that would be read out of
 // bounds: an index count not a multiple of 3, null data, a short stride, an index >= vertNum.
+// Also a vertex that a triangle uses and that has a NaN or infinite coordinate (it would change
+// every bound it joins, or crash a builder).
 void ValidateMesh(const char* who, const float* vpos3f, size_t vertNum, const uint32_t* triIndices, size_t indNum,
                   size_t vByteStride);
+
+// Throws std::invalid_argument (prefixed by `who`) for an instance matrix with a NaN or infinite
+// entry, or one that is singular (no inverse: rays could not be moved into the object's space).
+void ValidateInstanceMatrix(const char* who, const LiteMath::float4x4& matrix);
 
 // The ray interval [tnear, tfar] a query searches, or false when the ray must miss: NaN or inf
 // in the origin, direction or tmin, a zero direction, or an empty interval (tmin >= tmax, also

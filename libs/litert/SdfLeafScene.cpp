@@ -1,5 +1,5 @@
 #include "SdfLeafScene.h"
-
+#include "SceneInput.h"
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -325,11 +325,16 @@ uint32_t SdfLeafScene::AddInstance(uint32_t geomId, const float4x4& matrix)
 {
   if (geomId >= m_fields.size())
     throw std::invalid_argument("SdfLeafScene::AddInstance: no field " + std::to_string(geomId) + " (" + std::to_string(m_fields.size()) + " added)");
+  litert_detail::ValidateInstanceMatrix("SdfLeafScene::AddInstance", matrix);
   m_instances.push_back({geomId, matrix});
   return uint32_t(m_instances.size() - 1);
 }
 
-void SdfLeafScene::UpdateInstance(uint32_t instanceId, const float4x4& matrix) { m_instances.at(instanceId).second = matrix; }
+void SdfLeafScene::UpdateInstance(uint32_t instanceId, const float4x4& matrix)
+{
+  litert_detail::ValidateInstanceMatrix("SdfLeafScene::UpdateInstance", matrix);
+  m_instances.at(instanceId).second = matrix;
+}
 
 // Per instance, its field's leaves with a placement (m_geom), and the tree over every instance's
 // world-space leaf boxes.

@@ -74,6 +74,9 @@ float BoxDistanceSquared(float3 p, float3 boxMin, float3 boxMax) {
 }  // namespace
 
 std::vector<float3> FitIntoCube(const std::vector<float>& positions, float halfExtent) {
+  for (size_t k = 0; k < positions.size(); ++k)
+    if (!std::isfinite(positions[k]))
+      throw std::invalid_argument("FitIntoCube: vertex " + std::to_string(k / 3) + " is not finite (NaN or infinite)");
   std::vector<float3> vertices(positions.size() / 3);
   for (size_t v = 0; v < vertices.size(); ++v) vertices[v] = float3(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]);
   if (vertices.empty()) return vertices;
@@ -94,6 +97,11 @@ SdfMesh::SdfMesh(std::vector<float3> vertices, std::vector<uint32_t> indices, Sd
   if (m_indices.empty() || m_indices.size() % 3 != 0) throw std::invalid_argument("a mesh needs triangles: three indices each");
   for (uint32_t i : m_indices)
     if (i >= m_vertices.size()) throw std::invalid_argument("a triangle index is out of the vertices' range");
+  for (size_t t = 0; t < m_indices.size(); ++t) {
+    const float3 v = m_vertices[m_indices[t]];
+    if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+      throw std::invalid_argument("vertex " + std::to_string(m_indices[t]) + " of triangle " + std::to_string(t / 3) + " is not finite (NaN or infinite)");
+  }
   const size_t triangles = m_indices.size() / 3;
   m_faceNormals.resize(triangles);
   m_vertexNormals.assign(m_vertices.size(), float3(0.0f, 0.0f, 0.0f));

@@ -4,8 +4,18 @@
 #include "Conformance.h"
 
 #include "LiteMath.h"
+#include <cmath>
+#include <stdexcept>
+#include <vector>
 
 // A case compiles where this build translated its class (CONFORMANCE_CLASSES); main checks that all were.
+#if __has_include("Activations_CPU.h")
+#include "Activations_CPU.h"
+#include "Activations_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "Activations_ISPC.h"
+#endif
+#endif
 #if __has_include("HashNoise_CPU.h")
 #include "HashNoise_CPU.h"
 #include "HashNoise_Vulkan.h"
@@ -221,6 +231,23 @@ Register hashNoise(MakeCase<HashNoise>(
       std::vector<float> out(37 * 23);
       h.CommitDeviceData();
       h.Run(37, 23, out.data());
+      Outputs r;
+      Append(r, out);
+      return r;
+    }));
+#endif
+
+#if __has_include("Activations_CPU.h")
+// The GPU's and ISPC's hyperbolic functions are not C++'s to the last bit: to 1e-4.
+Register activations(MakeCase<Activations>(
+    "tanh, sinh, cosh, asinh, acosh, atanh (std:: and C's f names) in a kernel", "activations.h/.cpp", 1e-4, CONFORMANCE_MAKERS(Activations),
+    [](Activations& a) {
+      a.CommitDeviceData();
+      std::vector<float> in;
+      for (float x : {0.0f, -0.0f, 1e-6f, -3e-3f, 0.02f, 0.5f, -0.75f, 1.0f, 2.5f, -4.0f, 9.0f, -20.0f}) in.push_back(x);
+      std::vector<float> out(6 * in.size());
+      a.Apply(in.data(), out.data(), int(in.size()));
+      if (std::abs(out[6 * 7] - 0.7615942f) > 1e-5f) throw std::runtime_error("tanh(1) should be 0.7615942");
       Outputs r;
       Append(r, out);
       return r;

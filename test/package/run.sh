@@ -2,6 +2,8 @@
 # Builds and runs the user project of this folder against CrossRT.
 #   run.sh install <crossrt build dir> <work dir>   : cmake --install, then find_package(CrossRT)
 #   run.sh subdirectory <crossrt source dir> <work dir> : add_subdirectory(crossrt)
+#   run.sh duplicate <crossrt build dir> <work dir>  : a class translated twice under one name is a
+#                                                      configure error that names NAME
 set -euo pipefail
 mode=$1 crossrt=$2 work=$3
 here=$(cd "$(dirname "$0")" && pwd)
@@ -9,6 +11,20 @@ rm -rf "$work" && mkdir -p "$work"
 export CROSSRT_DAEMON_IDLE_SECONDS=60
 # The daemon this build starts goes when the test ends.
 trap 'for c in "$work"/prefix/bin/crossrt "$work"/build/crossrt/bin/crossrt; do [ -x "$c" ] && "$c" daemon stop --build-dir "$work/build" > /dev/null 2>&1; done; true' EXIT
+if [ "$mode" = duplicate ]; then
+  cmake --install "$crossrt" --prefix "$work/prefix" > "$work/install.log"
+  if cmake -S "$here" -B "$work/build" -G Ninja -DCMAKE_PREFIX_PATH="$work/prefix" -DTRANSLATE_TWICE=ON > "$work/configure.log" 2>&1; then
+    echo "configuring a project that translates Heat twice under one name succeeded" >&2
+    exit 1
+  fi
+  if ! grep -q "Heat_CPU is already generated in this directory" "$work/configure.log" || ! grep -q "NAME" "$work/configure.log"; then
+    echo "the configure error does not say that Heat_CPU is generated twice and what NAME does:" >&2
+    cat "$work/configure.log" >&2
+    exit 1
+  fi
+  echo OK
+  exit 0
+fi
 if [ "$mode" = install ]; then
   cmake --install "$crossrt" --prefix "$work/prefix" > "$work/install.log"
   cmake -S "$here" -B "$work/build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$work/prefix"

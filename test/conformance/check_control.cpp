@@ -1,0 +1,80 @@
+// Host code between kernel calls, run as the CPU runs it (issue 52): a solver that reads the
+// residual its kernel reduced and stops early, swaps of member vectors, and member vectors handed
+// to kernels through data(). Each run also checks a known answer, so that backends agreeing on
+// garbage cannot pass.
+#include "Conformance.h"
+
+#include <stdexcept>
+#include <string>
+
+#if __has_include("HeatDiffusion_CPU.h")
+#include "HeatDiffusion_CPU.h"
+#include "HeatDiffusion_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "HeatDiffusion_ISPC.h"
+#endif
+#endif
+#if __has_include("PingPong_CPU.h")
+#include "PingPong_CPU.h"
+#include "PingPong_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "PingPong_ISPC.h"
+#endif
+#endif
+
+using namespace conformance;
+
+namespace {
+
+#if __has_include("HeatDiffusion_CPU.h")
+// Solve: steps until converged, the residual read between kernel calls; then again, checking
+// every 7th step only (it stops at a multiple of 7, no earlier than the first).
+Register heatDiffusion(MakeCase<HeatDiffusion>(
+    "iterate until converged: a reduced residual read between kernel calls, std::swap and .swap() of member vectors, an early break/return",
+    "solver_loops.h/.cpp", 1e-5, CONFORMANCE_MAKERS(HeatDiffusion, 24, 16), [](HeatDiffusion& d) {
+      d.CommitDeviceData();
+      Outputs r;
+      d.Solve(5000, 0.01f);
+      const int first = d.Steps();
+      if (first <= 1 || first >= 5000 || d.Residual() >= 0.01f)
+        throw std::runtime_error("Solve should stop early, below the tolerance (" + std::to_string(first) + " steps, residual " +
+                                 std::to_string(d.Residual()) + ")");
+      r.push_back(first);
+      r.push_back(d.Residual());
+      Append(r, d.Temperature());
+      d.SolveChecked(5000, 0.001f, 7);
+      if (d.Steps() % 7 != 0 || d.Steps() >= 5000 || d.Temperature()[0] != 100.0f)
+        throw std::runtime_error("SolveChecked should stop at a multiple of 7 steps with the edge at 100 (" + std::to_string(d.Steps()) + " steps)");
+      r.push_back(d.Steps());
+      r.push_back(d.Residual());
+      Append(r, d.Temperature());
+      return r;
+    }));
+#endif
+
+#if __has_include("PingPong_CPU.h")
+Register pingPong(MakeCase<PingPong>(
+    "std::swap of member vectors between kernel calls; a member's data() to a kernel that writes it", "solver_loops.h/.cpp", 0.0,
+    CONFORMANCE_MAKERS(PingPong, 100), [](PingPong& p) {
+      p.CommitDeviceData();
+      Outputs r;
+      p.Run(3);
+      if (p.m_a[0] != 3 || p.m_a[99] != 3 || p.m_b[0] != 2)
+        throw std::runtime_error("after Run(3) m_a should be 3 and m_b 2, not " + std::to_string(p.m_a[0]) + " and " + std::to_string(p.m_b[0]));
+      Append(r, p.m_a);
+      Append(r, p.m_b);
+      p.Fill(7);
+      if (p.m_a[0] != 7 || p.m_a[50] != 7) throw std::runtime_error("after Fill(7) m_a should be 7, not " + std::to_string(p.m_a[0]));
+      p.Run(2);
+      if (p.m_a[0] != 9) throw std::runtime_error("after Fill(7) and Run(2) m_a should be 9, not " + std::to_string(p.m_a[0]));
+      p.Twice();
+      if (p.m_b[0] != 18 || p.m_first != 27) throw std::runtime_error("Twice should give m_b = 18 and m_first = 27, not " + std::to_string(p.m_b[0]) +
+                                                                       " and " + std::to_string(p.m_first));
+      Append(r, p.m_a);
+      Append(r, p.m_b);
+      r.push_back(p.m_first);
+      return r;
+    }));
+#endif
+
+}  // namespace

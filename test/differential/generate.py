@@ -1,0 +1,221 @@
+#!/usr/bin/env python3
+"""Random small classes for CrossRT's differential tester.
+
+Each seed gives one class in the supported subset, written as a user writes one: member vectors,
+kernel1D_ loop nests (maps, integer maps, reductions into members, appends, a member's data() to a
+kernel), and a control function whose host code sits between the kernel calls: member writes,
+swaps of member vectors, loops that stop early on a counter the kernels reduce, and a tail that
+reads the results. The tester (differential.cpp) runs each class as written, as _CPU, as _ISPC and
+as _Vulkan and compares what they leave behind, the way Csmith and YARPGen find miscompilations.
+
+Only the C++ the generated classes run is random; everything else is fixed, so that a mismatch
+is the translator's. The programs avoid what C++ or GLSL leave undefined: integers stay small
+and masked (no overflow; % and / only of non-negative values by positive constants), floats stay
+clamped (no inf, no NaN), and control flow depends on integers only (float sums differ in their
+last bits between a sequential loop and the GPU's tree of partial sums).
+
+  generate.py --first SEED --count N --out DIR   writes DIR/diff_<seed>.h/.cpp and DIR/cases.inc
+"""
+import argparse
+import os
+import random
+
+
+class Gen:
+    def __init__(self, seed):
+        self.r = random.Random(seed)
+        self.seed = seed
+        self.name = f"Diff{seed}"
+
+    def pick(self, *options):
+        return self.r.choice(options)
+
+    # ---- expressions -------------------------------------------------------------------------
+    def fexpr(self, depth, leaves):
+        if depth == 0 or self.r.random() < 0.3:
+            return self.r.choice(leaves)
+        a, b = self.fexpr(depth - 1, leaves), self.fexpr(depth - 1, leaves)
+        form = self.r.randrange(7)
+        if form == 0:
+            return f"({a} + {b})"
+        if form == 1:
+            return f"({a} - {b})"
+        if form == 2:
+            return f"({a} * {b})"
+        if form == 3:
+            return f"std::min({a}, {b})"
+        if form == 4:
+            return f"std::max({a}, {b})"
+        if form == 5:
+            return f"std::abs({a})"
+        return f"({a} / (1.0f + std::abs({b})))"
+
+    def iexpr(self, depth, leaves):
+        if depth == 0 or self.r.random() < 0.3:
+            return self.r.choice(leaves)
+        a, b = self.iexpr(depth - 1, leaves), self.iexpr(depth - 1, leaves)
+        form = self.r.randrange(7)
+        if form == 0:
+            return f"(({a} + {b}) & 1023)"
+        if form == 1:
+            return f"(({a} - {b}) & 1023)"
+        if form == 2:
+            return f"(({a} * {b}) & 1023)"
+        if form == 3:
+            return f"({a} ^ {b})"
+        if form == 4:
+            return f"(({a} & 1023) % {self.r.randint(2, 9)})"
+        if form == 5:
+            return f"(({a} & 1023) / {self.r.randint(2, 5)})"
+        return f"std::min({a}, {b})"
+
+    # ---- the class ---------------------------------------------------------------------------
+    def make(self):
+        r = self.r
+        self.n = r.choice([1, 7, 64, 100, 255, 256, 257, 1000])
+        fleaves = ["m_a[i]", "m_b[i]", "float(i)", "a_q", "m_scale", "0.5f", "2.0f", "1.25f", "-3.0f"]
+        ileaves = ["m_i[i]", "i", "a_p", "m_k", "3", "17"]
+        kernels = []  # (name, params decl, body lines, call args)
+        body = []     # the control function's statements
+
+        def clamp(e):
+            return f"std::min(std::max({e}, -1000.0f), 1000.0f)"
+
+        def new_kernel(kind):
+            k = len(kernels)
+            name = f"kernel1D_{kind}{k}"
+            if kind == "Map":
+                dst = self.pick("m_a", "m_b")
+                line = f"{dst}[i] = {clamp(self.fexpr(3, fleaves))};"
+            elif kind == "Int":
+                line = f"m_i[i] = {self.iexpr(3, ileaves)} & 1023;"
+            elif kind == "Sum":
+                line = f"m_sum += {clamp(self.fexpr(2, fleaves))};"
+            elif kind == "Count":
+                line = f"m_count += ({self.iexpr(2, ileaves)} % {r.randint(2, 5)} == 0) ? 1 : 0;"
+            elif kind == "Max":
+                line = f"m_max = std::max(m_max, {clamp(self.fexpr(2, fleaves))});"
+            elif kind == "Found":
+                line = f"if ({self.iexpr(2, ileaves)} % {r.randint(2, 6)} == 0) m_found.push_back(i);"
+            kernels.append((name, "int n, int a_p, float a_q", [line], "n, a_p, a_q"))
+            return name
+
+        def call(kind):
+            return f"{new_kernel(kind)}(n, a_p, a_q);"
+
+        # A kernel writing through a pointer: a member's data().
+        fill = None
+        if r.random() < 0.4:
+            fill = "kernel1D_Fill"
+            kernels.append((fill, "float* a_out, float a_value, int n", ["a_out[i] = a_value + float(i % 5);"], None))
+
+        for _ in range(r.randint(2, 5)):
+            s = r.randrange(9)
+            if s <= 2:
+                body.append(call(self.pick("Map", "Map", "Int", "Sum", "Max")))
+            elif s == 3:
+                body.append(f"m_scale = {self.pick('0.5f', '1.5f', 'a_q', '-1.0f')};")
+            elif s == 4:
+                body.append(self.pick("std::swap(m_a, m_b);", "m_a.swap(m_b);"))
+            elif s == 5 and fill:
+                body.append(f"{fill}({self.pick('m_a', 'm_b')}.data(), {self.pick('0.25f', 'a_q', '-2.0f')}, n);")
+            elif s == 6:
+                body.append("m_found.clear();")
+                body.append(call("Found"))
+            elif s == 7:
+                # Iterate until a counter the kernels reduce passes a bound, at most a_p rounds.
+                limit = r.randint(1, max(1, self.n))
+                inner = [call(self.pick("Map", "Int")), "m_count = 0;", call("Count")]
+                if r.random() < 0.5:
+                    inner.append(self.pick("std::swap(m_a, m_b);", "m_a.swap(m_b);"))
+                inner.append("m_rounds++;")
+                inner.append(f"if (m_count {self.pick('>=', '<')} {limit}) break;")
+                body.append("for (int round = 0; round < a_p; ++round)")
+                body.append("{")
+                body.extend("  " + x for x in inner)
+                body.append("}")
+            else:
+                body.append("m_count = 0;")
+                body.append(call("Count"))
+                body.append(f"m_k = m_count % {r.randint(2, 7)};")
+        # The tail: reads what the kernels wrote, once they are done.
+        tail = self.pick("m_total = m_sum + float(m_count);", "m_total = m_max * 2.0f + float(m_k);", "")
+        if tail:
+            body.append(tail)
+        self.kernels, self.body = kernels, body
+
+    def header(self):
+        decls = "\n".join(f"  void {name}({params});" for name, params, _, _ in self.kernels)
+        return f"""// Generated by test/differential/generate.py, seed {self.seed}: a random class in the subset
+// CrossRT translates. Do not edit; regenerate.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+class {self.name}
+{{
+public:
+  {self.name}();
+  virtual ~{self.name}() = default;
+  virtual void CommitDeviceData() {{}}
+  virtual void Run(int n, int a_p, float a_q);
+
+  std::vector<float> m_a, m_b;
+  std::vector<int> m_i;
+  std::vector<int> m_found;
+  float m_sum = 0.0f, m_max = -1000.0f, m_scale = 1.0f, m_total = 0.0f;
+  int m_count = 0, m_k = 1, m_rounds = 0;
+
+protected:
+{decls}
+}};
+"""
+
+    def source(self):
+        out = [f'// Generated by test/differential/generate.py, seed {self.seed}.',
+               f'#include "diff_{self.seed}.h"', "", "#include <algorithm>", "#include <cmath>", "#include <utility>", "",
+               f"{self.name}::{self.name}() : m_a({self.n}), m_b({self.n}), m_i({self.n})", "{",
+               f"  m_found.reserve({self.n});",
+               f"  for (int i = 0; i < {self.n}; ++i)", "  {",
+               "    m_a[i] = 0.25f * float(i % 13) - 1.0f;", "    m_b[i] = float((i * 7) % 11);", "    m_i[i] = (i * 37) % 101;", "  }", "}", ""]
+        for name, params, lines, _ in self.kernels:
+            out += [f"void {self.name}::{name}({params})", "{", "  for (int i = 0; i < n; ++i)", "  {"]
+            out += ["    " + line for line in lines]
+            out += ["  }", "}", ""]
+        out += [f"void {self.name}::Run(int n, int a_p, float a_q)", "{"]
+        out += ["  " + s for s in self.body]
+        out += ["}", ""]
+        return "\n".join(out)
+
+    def case(self):
+        a_p = self.r.randint(1, 6)
+        a_q = self.r.choice(["0.5f", "-1.5f", "3.0f"])
+        return f"DIFFERENTIAL_CASE({self.name}, {self.seed}, {self.n}, {a_p}, {a_q})\n"
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--first", type=int, default=1, help="first seed")
+    ap.add_argument("--count", type=int, default=8, help="how many classes (seeds first .. first + count - 1)")
+    ap.add_argument("--out", required=True, help="folder for the classes and cases.inc")
+    args = ap.parse_args()
+    os.makedirs(args.out, exist_ok=True)
+    cases = []
+    for seed in range(args.first, args.first + args.count):
+        g = Gen(seed)
+        g.make()
+        for path, text in ((f"diff_{seed}.h", g.header()), (f"diff_{seed}.cpp", g.source())):
+            full = os.path.join(args.out, path)
+            if not os.path.exists(full) or open(full).read() != text:  # unchanged files keep their times
+                with open(full, "w") as f:
+                    f.write(text)
+        cases.append(g.case())
+    text = "".join(cases)
+    full = os.path.join(args.out, "cases.inc")
+    if not os.path.exists(full) or open(full).read() != text:
+        with open(full, "w") as f:
+            f.write(text)
+
+
+if __name__ == "__main__":
+    main()
