@@ -62,7 +62,7 @@ void CheckImageParamsUnchanged(Context& c, const FunctionDecl* def, const std::s
       auto* p = dr ? dyn_cast<ParmVarDecl>(dr->getDecl()) : nullptr;
       if (!p || p->getDeclContext() != def || !md || md->isConst() || !IsImage2D(p->getType().getNonReferenceType().getUnqualifiedType())) return;
       c.rep.RecordingError(loc, "control function '" + control + "' changes Image2D parameter '" + p->getNameAsString() + "' on the host ('" + md->getNameAsString() + "')",
-                  "its GPU copy is made before the body runs: size and fill the image before calling '" + control + "', and write its texels in a kernel");
+                        "its GPU copy is made before the body runs: size and fill the image before calling '" + control + "', and write its texels in a kernel");
     }
     bool VisitCXXMemberCallExpr(CXXMemberCallExpr* call) {
       Check(call->getMethodDecl(), call->getImplicitObjectArgument(), call->getBeginLoc());
@@ -229,7 +229,7 @@ std::string ControlRewriter::BufferArg(const Expr* arg) {
         return view + ")";
       }
   m_c.rep.RecordingError(arg->getBeginLoc(), "pointer argument of a kernel call must be a parameter of '" + m_ctrl.name + "', 'member.data()' or a local std::vector's data() (+ offset)",
-                "pass the control function's size-annotated pointer, a std::vector member's data(), or a std::vector declared in '" + m_ctrl.name + "'");
+                      "pass the control function's size-annotated pointer, a std::vector member's data(), or a std::vector declared in '" + m_ctrl.name + "'");
   return "{}";
 }
 
@@ -259,14 +259,14 @@ const Control::LocalBuffer* ControlRewriter::Temporary(const VarDecl* vd) {
   const bool countCtor = ctor && (args == 1 || args == 2) && ctor->getArg(0)->getType()->isIntegerType();
   if (!decl || !countCtor) {
     m_c.rep.RecordingError(vd->getLocation(), "std::vector '" + local + "' is passed to a kernel, but the GPU's copy of a local vector is made only from 'std::vector<T> " + local +
-                     "(n)' or '(n, value)' declared on its own at the top of '" + m_ctrl.name + "'",
-                     "declare it as 'std::vector<T> " + local + "(n);' at the top of the function, or make it a member");
+                           "(n)' or '(n, value)' declared on its own at the top of '" + m_ctrl.name + "'",
+                           "declare it as 'std::vector<T> " + local + "(n);' at the top of the function, or make it a member");
     return nullptr;
   }
   const ASTContext& ctx = m_c.ctx;
   if (args == 2 && ctx.getTypeSize(element) != 32) {
     m_c.rep.RecordingError(ctor->getArg(1)->getBeginLoc(), "the GPU fills a local vector with a value of 32 bits, not of " + std::to_string(ctx.getTypeSize(element)) + " bits",
-                     "declare it as 'std::vector<T> " + local + "(n);' and fill it in a kernel");
+                           "declare it as 'std::vector<T> " + local + "(n);' and fill it in a kernel");
     return nullptr;
   }
   Control::LocalBuffer t;
@@ -299,8 +299,8 @@ void ControlRewriter::CheckTemporaryUses() {
       auto it = vd ? rw.m_temporaries.find(vd) : rw.m_temporaries.end();
       if (it == rw.m_temporaries.end() || rw.m_temporaryUses.count(dr)) return true;
       rw.m_c.rep.RecordingError(dr->getLocation(), "'" + it->second.local + "' is used on the host, but the kernels of '" + rw.m_ctrl.name +
-                          "' read and write its GPU copy", "pass " + it->second.local + ".data() only to kernels; to read the results make it a member "
-                          "(or a size-annotated parameter), which the generated class copies back");
+                                "' read and write its GPU copy", "pass " + it->second.local + ".data() only to kernels; to read the results make it a member "
+                                "(or a size-annotated parameter), which the generated class copies back");
       return true;
     }
   } uses(*this);
@@ -325,8 +325,8 @@ std::string ControlRewriter::ImageArg(const ParmVarDecl* p, const Expr* arg) {
     return "crossrt::ImageView(m_images." + name + ", m_images." + name + "Width, m_images." + name + "Height)";
   }
   m_c.rep.RecordingError(arg->getBeginLoc(), "Image2D argument of a kernel call must be an Image2D parameter of '" + m_ctrl.name + "' or an Image2D member",
-                "an image local to '" + m_ctrl.name + "' has no GPU copy: make it a member (its GPU copy is kept between calls) or a parameter of '" +
-                    m_ctrl.name + "'");
+                      "an image local to '" + m_ctrl.name + "' has no GPU copy: make it a member (its GPU copy is kept between calls) or a parameter of '" +
+                          m_ctrl.name + "'");
   return "{}";
 }
 
@@ -404,9 +404,9 @@ void ControlRewriter::CheckAppendedUses() {
       if (!f || !rw.m_c.appended.count(f->getNameAsString())) return;
       const std::string v = f->getNameAsString();
       rw.m_c.rep.RecordingError(loc, "control function '" + rw.m_ctrl.name + "' uses " + what + " of '" + v +
-                       "', which kernels append to: on the GPU its size and contents are known only after the call returns",
-                       "loop to " + v + ".size() inside a kernel1D_ kernel (dispatched indirectly, with no host round trip), or read " + v +
-                       " after the call; here it may only be cleared, reserved, or sorted whole with std::sort(" + v + ".begin(), " + v + ".end(), ...)");
+                             "', which kernels append to: on the GPU its size and contents are known only after the call returns",
+                             "loop to " + v + ".size() inside a kernel1D_ kernel (dispatched indirectly, with no host round trip), or read " + v +
+                             " after the call; here it may only be cleared, reserved, or sorted whole with std::sort(" + v + ".begin(), " + v + ".end(), ...)");
     }
     bool VisitCXXMemberCallExpr(CXXMemberCallExpr* call) {
       static const std::set<std::string> allowed = {"clear", "reserve", "capacity", "data"};
@@ -445,7 +445,7 @@ void ControlRewriter::CheckNestedControl(const CXXMemberCallExpr* call) {
   kc.TraverseStmt(def->getBody());
   if (kc.calls.empty()) return;
   m_c.rep.RecordingError(call->getBeginLoc(), "control function '" + m_ctrl.name + "' calls control function '" + md->getNameAsString() + "'",
-                "on the GPU each control function is one submission: call its kernels directly here, or call both from outside the class");
+                      "on the GPU each control function is one submission: call its kernels directly here, or call both from outside the class");
 }
 
 void ControlRewriter::Visit(const Stmt* s) {

@@ -31,7 +31,8 @@ struct KernelCallFinder : RecursiveASTVisitor<KernelCallFinder> {
   bool VisitCallExpr(CallExpr* call) {
     auto* fd = call->getDirectCallee();
     static const std::set<std::string> library = {"exclusive_scan", "inclusive_scan", "fill", "memcpy", "memmove", "sort"};
-    if (!fd || !fd->isInStdNamespace() || !library.count(fd->getNameAsString()) || isa<CXXMemberCallExpr>(call)) return true;
+    // (memcpy from <string.h> is the C library's, outside std, as LibraryCalls.cpp takes it.)
+    if (!fd || !(fd->isInStdNamespace() || IsSystemDecl(fd)) || !library.count(fd->getNameAsString()) || isa<CXXMemberCallExpr>(call)) return true;
     for (auto* arg : call->arguments()) {
       auto* mc = dyn_cast<CXXMemberCallExpr>(arg->IgnoreParenImpCasts());
       if (auto* bo = dyn_cast<BinaryOperator>(arg->IgnoreParenImpCasts())) mc = dyn_cast<CXXMemberCallExpr>(bo->getLHS()->IgnoreParenImpCasts());

@@ -1,7 +1,8 @@
 // The rewriter of one control function. Its work is split by job: ControlFunctions.cpp (arguments,
 // std::vector temporaries, member writes, the visit), ThreadLoops.cpp (loops that call kernels per
 // thread), ThreadBodies.cpp (megakernel and wavefront bodies), LibraryCalls.cpp (sort, scan, copy,
-// fill), HostReads.cpp (host code that uses what kernels write).
+// fill), HostReads.cpp (host code that uses what kernels write), MemberSwaps.cpp (swaps of member
+// vectors).
 #pragma once
 #include "AnalysisContext.h"
 #include "LoopShape.h"

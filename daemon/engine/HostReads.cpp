@@ -364,7 +364,7 @@ void ControlRewriter::MoveHostTail() {
   for (const auto& [vd, temporary] : m_temporaries)
     if (std::find(uses.captured.begin(), uses.captured.end(), vd->getNameAsString()) != uses.captured.end())
       m_c.rep.RecordingError(vd->getLocation(), "the code of '" + m_ctrl.name + "' after its last kernel reads '" + vd->getNameAsString() +
-                       "', whose elements are the GPU's", "make it a member, which the generated class copies back");
+                             "', whose elements are the GPU's", "make it a member, which the generated class copies back");
   std::string captures = "this";
   for (const std::string& name : uses.captured) captures += ", " + name;
   m_ctrl.hasHostTail = true;

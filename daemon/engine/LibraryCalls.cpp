@@ -138,7 +138,7 @@ bool ControlRewriter::ReduceAddInit(const CallExpr* call) {
   SourceLocation end = Lexer::findLocationAfterToken(call->getEndLoc(), tok::semi, m_c.ctx.getSourceManager(), m_c.ctx.getLangOpts(), false);
   if (end.isInvalid()) {
     m_c.rep.RecordingError(call->getBeginLoc(), "ReduceAddInit used inside an expression in control function '" + m_ctrl.name + "'",
-                     "call it as a statement of its own: ReduceAddInit(" + m->name + ", n);");
+                           "call it as a statement of its own: ReduceAddInit(" + m->name + ", n);");
     return true;
   }
   m->usedByKernels = true;
@@ -175,7 +175,7 @@ bool ControlRewriter::TryLibraryCall(const CallExpr* call) {
   if (!inStd) return false;
   auto bad = [&](const std::string& why) {
     m_c.rep.RecordingError(call->getBeginLoc(), "'" + fd->getQualifiedNameAsString() + "' on device data: " + why,
-                  "use member std::vector begin()/end()/data() or size-annotated pointer parameters, with + offsets");
+                        "use member std::vector begin()/end()/data() or size-annotated pointer parameters, with + offsets");
     return true;
   };
   std::string replacement;

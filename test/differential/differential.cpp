@@ -1,8 +1,8 @@
 // The differential tester (issue 52): each random class generate.py wrote is run as written, as
 // <Class>_CPU, as <Class>_Vulkan (lavapipe or the device CROSSRT_DEVICE names, validation layers
 // on) and, where an ISPC compiler was found, as <Class>_ISPC. Run is called twice (the second sees
-// what the first left on the device), and everything the class holds afterwards is compared with
-// the original's: integers exactly, floats to 1e-3 of max(1, |value|) (the GPU's division may round
+// what the first left on the device), and everything the class holds after each call is compared
+// with the original's: integers exactly, floats to 1e-3 of max(1, |value|) (the GPU's division may round
 // differently), the appended vector as a set (kernels append in any order).
 //
 //   crossrt_differential [--verbose]    prints a line per mismatch and "N passed, M failed"
@@ -73,8 +73,11 @@ std::function<std::vector<Value>()> Runner(std::function<std::shared_ptr<T>()> m
     std::shared_ptr<T> c = make();
     c->CommitDeviceData();
     c->Run(n, p, q);
+    std::vector<Value> out = Outputs(*c);
+    for (Value& v : out) v.name = "after the first Run: " + v.name;
     c->Run(n, p, q);
-    return Outputs(*c);
+    for (const Value& v : Outputs(*c)) out.push_back({"after the second Run: " + v.name, v.value, v.exact});
+    return out;
   };
 }
 

@@ -183,7 +183,10 @@ TEST_CASE("BVH traversal: axis-parallel rays with +0 and -0 direction components
               const bool inside = std::fabs(a) <= 1.0f && std::fabs(b) <= 1.0f;
               INFO("axis " << axis << " sign " << sign << " at " << a << ", " << b);
               REQUIRE((h.primId != kMiss) == inside);
-              if (inside) REQUIRE(h.t == 4.0f);
+              // CrossRT's traversals are exact here; Embree, a peer, computes t its own way (one ulp off
+              // on AVX-512 AMD EPYC at the cube's corners).
+              if (inside && std::string(impl) != "embree") REQUIRE(h.t == 4.0f);
+              if (inside) REQUIRE(std::fabs(h.t - 4.0f) <= 4.0f * 2e-7f);
               ++checked;
             }
   REQUIRE(checked == 3 * 2 * 4 * 64);

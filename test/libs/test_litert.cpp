@@ -251,6 +251,54 @@ TEST_CASE("CrossRT geometry update and validation", "[litert]")
   CHECK(scene->AddGeom_Triangles3f(QUAD_VERTS, 4, QUAD_INDICES, 6) == 0);
 }
 
+TEST_CASE("CrossRT refuses non-finite vertices and singular or non-finite instance matrices", "[litert]")
+{
+  const char* impl = anyImplementation();
+  INFO(impl);
+  auto scene = makeQuadScene(impl);
+  const float inf = std::numeric_limits<float>::infinity(), nan = std::numeric_limits<float>::quiet_NaN();
+  for (float bad : {inf, -inf, nan})
+  {
+    float verts[12];
+    for (int i = 0; i < 12; i++)
+      verts[i] = QUAD_VERTS[i];
+    verts[7] = bad;  // vertex 2's y
+    try
+    {
+      scene->AddGeom_Triangles3f(verts, 4, QUAD_INDICES, 6);
+      FAIL("a vertex at " << bad << " was accepted");
+    }
+    catch (const std::invalid_argument& e)
+    {
+      CHECK(std::string(e.what()).find("vertex 2") != std::string::npos);
+      CHECK(std::string(e.what()).find("not finite") != std::string::npos);
+    }
+    CHECK_THROWS_AS(scene->UpdateGeom_Triangles3f(0, verts, 4, QUAD_INDICES, 6), std::invalid_argument);
+  }
+  // A non-finite vertex no triangle uses changes nothing: accepted.
+  float unused[15];
+  for (int i = 0; i < 12; i++)
+    unused[i] = QUAD_VERTS[i];
+  unused[12] = unused[13] = unused[14] = nan;
+  CHECK_NOTHROW(scene->AddGeom_Triangles3f(unused, 5, QUAD_INDICES, 6));
+
+  float4x4 singular = float4x4();
+  singular(2, 2) = 0.0f;  // flattens z
+  float4x4 notFinite = translate4x4(float3(0, nan, 0));
+  for (const float4x4& m : {singular, notFinite})
+  {
+    CHECK_THROWS_AS(scene->AddInstance(0, m), std::invalid_argument);
+    CHECK_THROWS_AS(scene->UpdateInstance(0, m), std::invalid_argument);
+    const float4x4 motion[2] = {float4x4(), m};
+    CHECK_THROWS_AS(scene->AddInstanceMotion(0, motion, 2), std::invalid_argument);
+  }
+  // The scene is as it was: the first quad still hit, nothing crashed.
+  scene->CommitScene();
+  const CRT_Hit h = scene->RayQuery_NearestHit(from(0.75f, 0.25f, 1.0f), down());
+  CHECK(h.primId == 0);
+  CHECK(h.instId == 0);
+}
+
 TEST_CASE("CrossRT queries before commit miss", "[litert]")
 {
   const char* impl = anyImplementation();

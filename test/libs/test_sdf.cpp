@@ -518,6 +518,22 @@ TEST_CASE("SDF from a mesh with a hole or a non-manifold edge: the fast winding 
   CHECK(AgreeWithWindingNumber(pseudo).disagreements > 0);
 }
 
+TEST_CASE("SDF from a mesh: a vertex at inf or NaN is refused with std::invalid_argument, not built", "[sdf][mesh]")
+{
+  for (float bad : {std::numeric_limits<float>::infinity(), std::numeric_limits<float>::quiet_NaN()}) {
+    Mesh m = Icosphere(1.0f, 1);
+    m.vertices[m.indices[4]].y = bad;
+    try {
+      litesdf::SdfMesh mesh(m.vertices, m.indices);
+      FAIL("a vertex at " << bad << " was accepted");
+    } catch (const std::invalid_argument& e) {
+      CHECK(std::string(e.what()).find("not finite") != std::string::npos);
+    }
+    std::vector<float> positions = {0, 0, 0, 1, 0, 0, 0, bad, 0};
+    CHECK_THROWS_AS(litesdf::FitIntoCube(positions, 1.0f), std::invalid_argument);
+  }
+}
+
 TEST_CASE("SDF from a mesh: the fast winding number stays near the exact one", "[sdf][mesh]")
 {
   const Mesh torus = TorusMesh(0.6f, 0.25f, 48, 24);

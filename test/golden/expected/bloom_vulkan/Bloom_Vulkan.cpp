@@ -108,6 +108,10 @@ bool Bloom_Vulkan::VectorMembersResized() const
 void Bloom_Vulkan::ReadVectorMembers(const char* a_funcName)
 {
   (void)a_funcName;
+  if (std::strcmp(a_funcName, "Run") == 0 && !m_bright.empty())
+    m_vdata.m_bright.Download(m_bright.data(), sizeof(LiteMath::float4) * m_bright.size());
+  if (std::strcmp(a_funcName, "Run") == 0 && !m_blurred.empty())
+    m_vdata.m_blurred.Download(m_blurred.data(), sizeof(LiteMath::float4) * m_blurred.size());
 }
 
 void Bloom_Vulkan::GetExecutionTime(const char* a_funcName, float a_out[4])
