@@ -157,7 +157,8 @@ bool UsesWrittenVector(Context& c, const std::set<std::string>& written, const S
 }
 
 // Where `s` first records GPU work: a kernel call (or a per-thread function's), a library call on
-// device data, LiteMath's ReduceAddInit, or clear() of a vector kernels append to. Invalid if none.
+// device data, LiteMath's ReduceAddInit, clear() of a vector kernels append to, or a swap of member
+// vectors. Invalid if none.
 SourceLocation FirstGpuWork(Context& c, const Stmt* s) {
   KernelCallFinder kernels(c.cls);
   kernels.TraverseStmt(const_cast<Stmt*>(s));
@@ -171,6 +172,11 @@ SourceLocation FirstGpuWork(Context& c, const Stmt* s) {
       bool gpu = fd && fd->getName() == "ReduceAddInit";
       if (auto* mc = dyn_cast<CXXMemberCallExpr>(call); mc && mc->getMethodDecl() && mc->getMethodDecl()->getName() == "clear")
         if (auto* f = ThisField(mc->getImplicitObjectArgument())) gpu = gpu || c.appended.count(f->getNameAsString());
+      // A swap of member vectors swaps their device buffers while recording (MemberSwaps.cpp): it
+      // stays in the ...Cmd, never in the host tail, which would swap the host's copies alone.
+      if (fd && fd->getName() == "swap")
+        for (const Expr* arg : call->arguments())
+          if (auto* f = ThisField(arg); f && IsStdVector(f->getType().getNonReferenceType())) gpu = true;
       if (gpu && at.isInvalid()) at = call->getBeginLoc();
       return true;
     }

@@ -54,7 +54,7 @@ Register heatDiffusion(MakeCase<HeatDiffusion>(
 
 #if __has_include("PingPong_CPU.h")
 Register pingPong(MakeCase<PingPong>(
-    "std::swap of member vectors between kernel calls; a member's data() to a kernel that writes it", "solver_loops.h/.cpp", 0.0,
+    "std::swap of member vectors between kernel calls and after the last one; a member's data() to a kernel that writes it", "solver_loops.h/.cpp", 0.0,
     CONFORMANCE_MAKERS(PingPong, 100), [](PingPong& p) {
       p.CommitDeviceData();
       Outputs r;
@@ -73,6 +73,14 @@ Register pingPong(MakeCase<PingPong>(
       Append(r, p.m_a);
       Append(r, p.m_b);
       r.push_back(p.m_first);
+      // A swap after the last kernel swaps the device buffers too: the next call sees them swapped.
+      p.FillAndSwap(4);
+      p.Run(1);
+      if (p.m_a[0] != 19 || p.m_b[0] != 18)
+        throw std::runtime_error("after FillAndSwap(4) and Run(1) m_a should be 19 and m_b 18, not " + std::to_string(p.m_a[0]) + " and " +
+                                 std::to_string(p.m_b[0]));
+      Append(r, p.m_a);
+      Append(r, p.m_b);
       return r;
     }));
 #endif

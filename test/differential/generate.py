@@ -138,6 +138,8 @@ class Gen:
                 body.append("m_count = 0;")
                 body.append(call("Count"))
                 body.append(f"m_k = m_count % {r.randint(2, 7)};")
+        if not kernels:  # a class with no kernel is refused (rightly): give it one
+            body.append(call("Map"))
         # The tail: reads what the kernels wrote, once they are done.
         tail = self.pick("m_total = m_sum + float(m_count);", "m_total = m_max * 2.0f + float(m_k);", "")
         if tail:

@@ -47,6 +47,12 @@ public:
   virtual void Fill(int a_value) { kernel1D_Fill(m_a.data(), a_value, int(m_a.size())); }
   // m_b = 2 * m_a through both data(), then the host adds the first element of each.
   virtual void Twice();
+  // m_a[i] = a_value, then a swap after the last kernel: m_b holds a_value.
+  virtual void FillAndSwap(int a_value)
+  {
+    kernel1D_Fill(m_a.data(), a_value, int(m_a.size()));
+    m_a.swap(m_b);
+  }
 
   std::vector<int> m_a, m_b;
   int m_first = 0;
