@@ -159,6 +159,16 @@ std::string CubeProblem(float3 boxMin, float boxSize, uint32_t depth, uint32_t b
   if (std::string p = DepthProblem(depth); !p.empty()) return p;
   return BytesProblem(bytesPerValue);
 }
+
+// A voxel's or brick's packed first voxel (x | y << 10 | z << 20) whose `extent` voxels per axis do
+// not fit in the 2^depth of the cube, or "".
+std::string CoordProblem(uint32_t packed, uint32_t extent, uint32_t depth) {
+  const uint32_t x = packed & 1023u, y = (packed >> 10) & 1023u, z = (packed >> 20) & 1023u, side = 1u << depth;
+  if ((packed >> 30) != 0 || x + extent > side || y + extent > side || z + extent > side)
+    return "at (" + std::to_string(x) + ", " + std::to_string(y) + ", " + std::to_string(z) + ") is outside the cube's " + std::to_string(side) +
+           "^3 voxels";
+  return "";
+}
 }  // namespace
 
 std::string Problem(const SdfGrid& grid) {
@@ -171,6 +181,8 @@ std::string Problem(const SdfSVS& svs) {
   if (std::string p = CubeProblem(svs.boxMin, svs.boxSize, svs.depth, svs.bytesPerValue); !p.empty()) return p;
   if (svs.values.size() != svs.coords.size() * 8 * svs.bytesPerValue / 4)
     return std::to_string(svs.values.size()) + " words of values for " + std::to_string(svs.coords.size()) + " voxels";
+  for (size_t i = 0; i < svs.coords.size(); ++i)
+    if (std::string p = CoordProblem(svs.coords[i], 1, svs.depth); !p.empty()) return "voxel " + std::to_string(i) + " " + p;
   return "";
 }
 
@@ -180,6 +192,8 @@ std::string Problem(const SdfSBS& sbs) {
   if (sbs.values.size() != sbs.coords.size() * sbs.WordsPerBrick())
     return std::to_string(sbs.values.size()) + " words of values for " + std::to_string(sbs.coords.size()) + " bricks of " +
            std::to_string(sbs.brickSize) + "^3 voxels";
+  for (size_t i = 0; i < sbs.coords.size(); ++i)
+    if (std::string p = CoordProblem(sbs.coords[i], sbs.brickSize, sbs.depth); !p.empty()) return "brick " + std::to_string(i) + " " + p;
   return "";
 }
 

@@ -228,5 +228,15 @@ TEST_CASE("SDF scenes: NaN and inf rays, tmin == tmax, scales from 1e-3 to 1e3, 
     CHECK_THROWS_WITH(scene->AddGeom_SdfSBS(deep), Catch::Contains("depth must be at most 10"));
     SdfGrid empty;
     CHECK_THROWS_AS(scene->AddGeom_SdfGrid(empty), std::invalid_argument);
+    // A voxel one past the cube's last, and a brick sticking out of it by one voxel.
+    REQUIRE(!fields.svs.coords.empty());
+    REQUIRE(!fields.sbs.coords.empty());
+    REQUIRE(fields.svs.depth < 10);
+    SdfSVS outside = fields.svs;
+    outside.coords[0] = 1u << fields.svs.depth;
+    CHECK_THROWS_WITH(scene->AddGeom_SdfSVS(outside), Catch::Contains("is outside the cube"));
+    SdfSBS sticking = fields.sbs;
+    sticking.coords[0] = ((1u << fields.sbs.depth) - fields.sbs.brickSize + 1) << 10;
+    CHECK_THROWS_WITH(scene->AddGeom_SdfSBS(sticking), Catch::Contains("is outside the cube"));
   }
 }
