@@ -43,6 +43,15 @@ std::string UsingCall(ASTContext& ctx, const Expr* e) {
   }
 }
 
+// The call among `calls` whose source range holds `e`, or null.
+const Expr* EnclosingCall(const SourceManager& sm, const std::vector<const Expr*>& calls, const Expr* e) {
+  for (const Expr* call : calls) {
+    const SourceRange r = call->getSourceRange();
+    if (!sm.isBeforeInTranslationUnit(e->getBeginLoc(), r.getBegin()) && !sm.isBeforeInTranslationUnit(r.getEnd(), e->getEndLoc())) return call;
+  }
+  return nullptr;
+}
+
 // What host code in `s` reads of the GPU's results: plain members of the class data that kernels
 // write (every mention but the left side of a plain assignment, `m_x = ...`, which only writes
 // it), and the control function's output pointer parameters (non-const: copied back after the
@@ -147,11 +156,7 @@ bool UsesWrittenVector(Context& c, const std::set<std::string>& written, const S
   static const std::set<std::string> sizes = {"size", "capacity", "empty"};
   for (const MemberExpr* me : finder.uses) {
     if (!written.count(me->getMemberDecl()->getNameAsString()) || sizes.count(UsingCall(c.ctx, me))) continue;
-    const bool inGpuCall = std::any_of(gpu.calls.begin(), gpu.calls.end(), [&](const Expr* call) {
-      const SourceRange r = call->getSourceRange();
-      return !sm.isBeforeInTranslationUnit(me->getBeginLoc(), r.getBegin()) && !sm.isBeforeInTranslationUnit(r.getEnd(), me->getEndLoc());
-    });
-    if (!inGpuCall) return true;
+    if (!EnclosingCall(sm, gpu.calls, me)) return true;
   }
   return false;
 }
@@ -207,18 +212,11 @@ void ControlRewriter::FindHostTail() {
   // splits the recording (m_syncReads); an output parameter, copied back only at the end, cannot.
   KernelCallFinder kernelCalls(m_c.cls);
   kernelCalls.TraverseStmt(const_cast<Stmt*>(m_def->getBody()));
-  auto kernelCallOf = [&](const Expr* e) -> const Expr* {
-    for (const Expr* call : kernelCalls.calls) {
-      const SourceRange r = call->getSourceRange();
-      if (!sm.isBeforeInTranslationUnit(e->getBeginLoc(), r.getBegin()) && !sm.isBeforeInTranslationUnit(r.getEnd(), e->getEndLoc())) return call;
-    }
-    return nullptr;
-  };
   for (int i = first; i <= last; ++i) {
     const bool loop = isa<ForStmt, WhileStmt, DoStmt, CXXForRangeStmt>(statements[i]) && FirstGpuWork(m_c, statements[i]).isValid();
     for (const auto& [read, name] : KernelWrittenReads(m_c, m_def, statements[i])) {
       if (!loop && !sm.isBeforeInTranslationUnit(firstWork, read->getBeginLoc())) continue;
-      const Expr* call = kernelCallOf(read);
+      const Expr* call = EnclosingCall(sm, kernelCalls.calls, read);
       if (auto* me = dyn_cast<MemberExpr>(read); me && !call) {
         m_syncReads.push_back(me);
         continue;
@@ -263,12 +261,6 @@ void ControlRewriter::CheckHostVectorUses() {
   if (last < 0) return;
   KernelCallFinder gpu(m_c.cls);  // kernel and library calls: what they take is the GPU's business
   gpu.TraverseStmt(const_cast<Stmt*>(m_def->getBody()));
-  auto inGpuCall = [&](const Expr* e) {
-    return std::any_of(gpu.calls.begin(), gpu.calls.end(), [&](const Expr* call) {
-      const SourceRange r = call->getSourceRange();
-      return !sm.isBeforeInTranslationUnit(e->getBeginLoc(), r.getBegin()) && !sm.isBeforeInTranslationUnit(r.getEnd(), e->getEndLoc());
-    });
-  };
   struct Uses : RecursiveASTVisitor<Uses> {
     std::set<const Expr*> changed;  // vectors (their MemberExpr) assigned through, or changed by a method
     std::vector<const MemberExpr*> uses;
@@ -311,7 +303,7 @@ void ControlRewriter::CheckHostVectorUses() {
     for (const MemberExpr* me : uses.uses) {
       auto* f = dyn_cast<FieldDecl>(me->getMemberDecl());
       const Member* m = f ? FindMember(m_c.model, f->getNameAsString()) : nullptr;
-      if (!m || m->kind != MemberKind::Vector || !m->usedByKernels || m->appendedByKernels || inGpuCall(me)) continue;
+      if (!m || m->kind != MemberKind::Vector || !m->usedByKernels || m->appendedByKernels || EnclosingCall(sm, gpu.calls, me)) continue;
       // size(), data() and the like, and std::swap's arguments, are the translated uses.
       if (harmless.count(UsingCall(m_c.ctx, me))) continue;
       const bool written = m->writtenByKernels || std::find(m_ctrl.vectorsWritten.begin(), m_ctrl.vectorsWritten.end(), m->name) != m_ctrl.vectorsWritten.end();
