@@ -2,6 +2,8 @@
 # repository root, and stops the build's translation daemon when the calling script ends.
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 ./scripts/install-deps.sh
+# Lavapipe with ray tracing (Mesa 25), in .deps/ only: the tests run on it, the system keeps its drivers.
+./scripts/install-lavapipe-rt.sh
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
 if ! grep -q '^CROSSRT_ISPC_EXECUTABLE:FILEPATH=/' build/CMakeCache.txt; then
   echo "note: no ISPC compiler found (ispc on PATH, or -DCROSSRT_ISPC_EXECUTABLE): the _ISPC classes, their tests and" \

@@ -15,9 +15,15 @@ namespace crossrt::engine {
 Data List() { return Data(Data::type::list); }
 
 std::vector<KernelVariant> Phases(const Kernel& k) {
+  // The composed implementation's GLSL names all begin with its holder's name.
+  const std::string composed = k.rayQueryHolder + "_";
+  auto traces = [&](const std::string& body) {
+    if (body.find(composed) != std::string::npos) return true;
+    return std::any_of(k.ownFunctionList.begin(), k.ownFunctionList.end(), [&](const std::string& f) { return f.find(composed) != std::string::npos; });
+  };
   std::vector<KernelVariant> phases;
-  if (!k.glslStart.empty()) phases.push_back({"_Start", false, false, false, false, "Start"});
-  if (!k.glslFinish.empty()) phases.push_back({"_Finish", false, false, false, false, "Finish"});
+  if (!k.glslStart.empty()) phases.push_back({"_Start", false, false, false, false, "Start", !k.rayQueryHolder.empty() && !traces(k.glslStart)});
+  if (!k.glslFinish.empty()) phases.push_back({"_Finish", false, false, false, false, "Finish", !k.rayQueryHolder.empty() && !traces(k.glslFinish)});
   return phases;
 }
 

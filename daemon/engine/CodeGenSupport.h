@@ -23,6 +23,10 @@ struct KernelVariant {
   // "Start" or "Finish": the one-thread shader of the statements before or after the loop nest,
   // with the bindings of the variant every device runs.
   std::string phase;
+  // A phase of a kernel with a ray query variant, whose statements do not trace: it binds the class's
+  // own vectors and functions only, as the ray query variant does, so that it runs however the scene
+  // is held (the translated traversal's buffers are not uploaded while the hardware traces).
+  bool ownVectors = false;
   bool RayGeneration() const { return callables || leaves; }  // a ray generation shader, not a compute shader
 };
 

@@ -132,7 +132,7 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
                                          : "the thread loop of " + model.className + "::" + k.megakernelOf + ", as one megakernel running " + calls);
   // The ray query variant drops the composed implementation: its functions, buffers, and the
   // structs and constants only they used.
-  const std::vector<std::string>& memberVectors = hardwareRayQuery ? k.ownMemberVectors : k.memberVectors;
+  const std::vector<std::string>& memberVectors = hardwareRayQuery || kind.ownVectors ? k.ownMemberVectors : k.memberVectors;
   std::vector<std::string> functionList = k.functionList;
   std::vector<GlslDecl> structList = k.structList, constantList = k.constantList;
   if (callables) {
@@ -143,10 +143,10 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
     functionList = k.leafFunctionList;
     structList = k.leafStructList;
   }
-  if (hardwareRayQuery) {
+  if (hardwareRayQuery || kind.ownVectors) {
     functionList = k.ownFunctionList;
-    functionList.insert(functionList.begin(), RayQueryFunctions(k.rayQueryHolder, k.composedCalls, opt));
-    std::string used = k.glslBody;
+    if (hardwareRayQuery) functionList.insert(functionList.begin(), RayQueryFunctions(k.rayQueryHolder, k.composedCalls, opt));
+    std::string used = kind.phase == "Start" ? k.glslStart : kind.phase == "Finish" ? k.glslFinish : k.glslBody;
     for (auto& f : functionList) used += f;
     for (auto& p : k.params) used += " " + p.glslType;
     for (auto& v : memberVectors)

@@ -207,11 +207,16 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
     // What each variant binds, in the order its GLSL declares it: the class data, pointer arguments,
     // member vectors, reduction partials (storage buffers), images and samplers, then per array of
     // textures its infos and (sampled from buffers) its texels. The ray query variants bind their
-    // own member vectors only, and the scene last; the texture variants bind the arrays' sets.
+    // own member vectors only, and the scene last (and so do the phases that do not trace: see
+    // KernelVariant::ownVectors); the texture variants bind the arrays' sets.
     Data variants = List();
     const std::vector<KernelVariant> kinds = Variants(k);
-    for (size_t vi = 0; vi < kinds.size(); ++vi) {
-      const KernelVariant& kind = kinds[vi];
+    struct Bindings {
+      std::string list, types, sets;
+      unsigned buffers = 0;
+      bool typed = false;  // bindings other than storage buffers
+    };
+    auto bindingsOf = [&](const KernelVariant& kind) {
       std::string list = generated::kClassData + ".View()", types = "VK_DESCRIPTOR_TYPE_STORAGE_BUFFER";
       unsigned buffers = 1;
       auto buffer = [&](const std::string& view) {
@@ -221,7 +226,7 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
       };
       for (auto& p : k.params)
         if (p.isPointer) buffer(p.name);
-      for (auto& v : kind.rayQuery ? k.ownMemberVectors : k.memberVectors) buffer(generated::kVectorCopies + "." + v + ".View()");
+      for (auto& v : kind.rayQuery || kind.ownVectors ? k.ownMemberVectors : k.memberVectors) buffer(generated::kVectorCopies + "." + v + ".View()");
       for (auto& r : k.reductions) buffer(generated::kPartials + "." + k.name + "_" + r.member + ".View()");
       bool typed = false;  // bindings other than storage buffers
       for (auto& ib : k.images) {
@@ -250,12 +255,19 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
           list += ", crossrt::Binding::SceneOf(m_scenes." + lt->member + "_leaves)";
           typed = true;
         }
+      return Bindings{list, types, sets, buffers, typed};
+    };
+    for (size_t vi = 0; vi < kinds.size(); ++vi) {
+      const KernelVariant& kind = kinds[vi];
+      const Bindings b = bindingsOf(kind);
+      const bool typed = b.typed;
+      const std::string& sets = b.sets;
       Data y;
       y.set("kernel", k.name);
       y.set("pipeline", k.name + kind.suffix);
-      y.set("bindingList", list);
-      y.set("bindingTypes", types);
-      y.set("bindingCount", std::to_string(buffers));
+      y.set("bindingList", b.list);
+      y.set("bindingTypes", b.types);
+      y.set("bindingCount", std::to_string(b.buffers));
       const bool rayGeneration = kind.RayGeneration();
       y.set("pushBuffers", !rayGeneration && !typed && !kind.textures);  // storage buffers only: the simple constructor
       y.set("pushBindings", !rayGeneration && (typed || kind.textures));
@@ -328,6 +340,10 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
     Data phases = List();
     for (const KernelVariant& v : Phases(k)) {
       Data y = variants.list_value().back();
+      const Bindings b = bindingsOf(v);
+      y.set("bindingList", b.list);
+      y.set("bindingTypes", b.types);
+      y.set("bindingCount", std::to_string(b.buffers));
       y.set("pipeline", k.name + v.suffix);
       y.set("conditional", false);
       y.set("indentCreate", "");

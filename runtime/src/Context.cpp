@@ -325,10 +325,17 @@ void VulkanContext::CreateDevice(const ContextOptions& options) {
 
   // Extensions: push descriptors (required) + the optional ones that exist. Ray query needs
   // acceleration structures, which need deferred host operations: drop a dependent whose base is missing.
+  const char* envFeatures = std::getenv("CROSSRT_DEVICE_FEATURES");
+  const DeviceFeatureMask mask = ParseDeviceFeatures(options.deviceFeatures + "," + (envFeatures ? envFeatures : ""));
+  auto hiddenExtension = [&](const char* name) {
+    return (mask.Hidden(DeviceFeature::RayQuery) && std::strcmp(name, VK_KHR_RAY_QUERY_EXTENSION_NAME) == 0) ||
+           (mask.Hidden(DeviceFeature::RayTracingPipeline) && std::strcmp(name, VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME) == 0) ||
+           (mask.Hidden(DeviceFeature::FloatAtomics) && std::strcmp(name, VK_EXT_SHADER_ATOMIC_FLOAT_EXTENSION_NAME) == 0);
+  };
   auto available = DeviceExtensions(physicalDevice);
   std::vector<const char*> extensions{VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME};
   auto wanted = [&](const char* name) {
-    return HasExtension(available, name) &&
+    return !hiddenExtension(name) && HasExtension(available, name) &&
            std::any_of(options.optionalDeviceExtensions.begin(), options.optionalDeviceExtensions.end(),
                        [&](const char* e) { return e && std::strcmp(e, name) == 0; });
   };
@@ -337,7 +344,7 @@ void VulkanContext::CreateDevice(const ContextOptions& options) {
   bool rayQuery = accel && wanted(VK_KHR_RAY_QUERY_EXTENSION_NAME);
   bool rayPipeline = accel && wanted(VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME);
   for (const char* e : options.optionalDeviceExtensions) {
-    if (!e || !HasExtension(available, e) || std::strcmp(e, VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME) == 0) continue;
+    if (!e || !HasExtension(available, e) || hiddenExtension(e) || std::strcmp(e, VK_KHR_PUSH_DESCRIPTOR_EXTENSION_NAME) == 0) continue;
     if (std::strcmp(e, VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME) == 0 && !accel) continue;
     if (std::strcmp(e, VK_KHR_RAY_QUERY_EXTENSION_NAME) == 0 && !rayQuery) continue;
     if (std::strcmp(e, VK_KHR_RAY_TRACING_PIPELINE_EXTENSION_NAME) == 0 && !rayPipeline) continue;
@@ -375,7 +382,8 @@ void VulkanContext::CreateDevice(const ContextOptions& options) {
     enable12.scalarBlockLayout = supported12.scalarBlockLayout;
     enable12.bufferDeviceAddress = supported12.bufferDeviceAddress;
     // Arrays of textures indexed per thread (TextureArray): all four or none.
-    if (supported12.runtimeDescriptorArray && supported12.shaderSampledImageArrayNonUniformIndexing &&
+    if (!mask.Hidden(DeviceFeature::TextureArrays) &&
+        supported12.runtimeDescriptorArray && supported12.shaderSampledImageArrayNonUniformIndexing &&
         supported12.descriptorBindingPartiallyBound && supported12.descriptorBindingVariableDescriptorCount) {
       enable12.runtimeDescriptorArray = enable12.shaderSampledImageArrayNonUniformIndexing = VK_TRUE;
       enable12.descriptorBindingPartiallyBound = enable12.descriptorBindingVariableDescriptorCount = VK_TRUE;
@@ -400,6 +408,18 @@ void VulkanContext::CreateDevice(const ContextOptions& options) {
     enableAf.shaderBufferFloat32AtomicAdd = VK_TRUE;
     *tail = &enableAf; tail = &enableAf.pNext;
   }
+
+  // Features CROSSRT_DEVICE_FEATURES requires: refused before the device exists.
+  const bool offered[size_t(DeviceFeature::Count)] = {
+      enableRq.rayQuery == VK_TRUE, enableRt.rayTracingPipeline == VK_TRUE, enable12.runtimeDescriptorArray == VK_TRUE,
+      enableAf.shaderBufferFloat32AtomicAdd == VK_TRUE};
+  for (size_t f = 0; f < size_t(DeviceFeature::Count); ++f)
+    if (mask.required[f] && !offered[f])
+      throw Error(std::string("CROSSRT_DEVICE_FEATURES requires ") + DeviceFeatureName(DeviceFeature(f)) +
+                  ", which the Vulkan device '" + properties.deviceName + "' (" +
+                  std::to_string(VK_API_VERSION_MAJOR(properties.apiVersion)) + "." +
+                  std::to_string(VK_API_VERSION_MINOR(properties.apiVersion)) +
+                  ") does not offer; scripts/install-lavapipe-rt.sh installs a lavapipe that has it");
 
   float priority = 1.0f;
   auto queueInfo = VkInit<VkDeviceQueueCreateInfo>(VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO);
@@ -463,7 +483,9 @@ void VulkanContext::CreateDevice(const ContextOptions& options) {
     }
   }
 
-  if (EnvFlag("CROSSRT_VERBOSE")) {  // which paths generated classes will take, once per process
+  // Which paths generated classes will take, once per process: asked for, or where the features are
+  // chosen (the hw and sw variants of the tests print them).
+  if (EnvFlag("CROSSRT_VERBOSE") || (envFeatures && *envFeatures)) {
     static std::once_flag once;
     std::call_once(once, [&] {
       std::fprintf(stderr,

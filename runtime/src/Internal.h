@@ -6,6 +6,7 @@
 #include <vulkan/vulkan.h>
 
 #include <initializer_list>
+#include <string>
 
 namespace crossrt {
 
@@ -36,6 +37,19 @@ struct Specialization {
   Specialization(const Specialization&) = delete;
   Specialization& operator=(const Specialization&) = delete;
 };
+
+// The optional device features CROSSRT_DEVICE_FEATURES (and ContextOptions::deviceFeatures) hide
+// ("-ray_query") or require ("+ray_query"); see DeviceFeatures.cpp.
+enum class DeviceFeature { RayQuery, RayTracingPipeline, TextureArrays, FloatAtomics, Count };
+struct DeviceFeatureMask {
+  bool hidden[size_t(DeviceFeature::Count)] = {};
+  bool required[size_t(DeviceFeature::Count)] = {};
+  bool Hidden(DeviceFeature f) const { return hidden[size_t(f)]; }
+  bool Required(DeviceFeature f) const { return required[size_t(f)]; }
+};
+const char* DeviceFeatureName(DeviceFeature f);
+// Throws Error naming the known features on a word it does not know.
+DeviceFeatureMask ParseDeviceFeatures(const std::string& text);
 
 // x rounded up to a multiple of a (a Vulkan alignment; 0 and 1 leave x as it is).
 inline VkDeviceSize AlignUp(VkDeviceSize x, VkDeviceSize a) { return a > 1 ? (x + a - 1) / a * a : x; }

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <utility>
 
 namespace crossrt {
@@ -127,7 +128,18 @@ void RayTracingScene::Build(const std::vector<Mesh>& meshes, const std::vector<I
     if (mesh.triangleCount > 0x7FFFFFFFu / 3) throw Error("crossrt::RayTracingScene: mesh " + std::to_string(m) + " has too many triangles");
     const size_t bytes = sizeof(float) * 9 * mesh.triangleCount;
     Buffer vertices(ctx_, bytes, input);
-    vertices.Upload(mesh.triangles, bytes);
+    // Zero-area triangles are never hit (CrossRT.h), but Vulkan leaves their intersection to the
+    // implementation (lavapipe reports hits on them): a NaN x makes them inactive, which the spec
+    // defines as never hit. Primitive indices stay as they are.
+    std::vector<float> soup(mesh.triangles, mesh.triangles + 9 * mesh.triangleCount);
+    for (size_t t = 0; t < mesh.triangleCount; ++t) {
+      const float* v = &soup[9 * t];
+      const double e1[3] = {double(v[3]) - v[0], double(v[4]) - v[1], double(v[5]) - v[2]};
+      const double e2[3] = {double(v[6]) - v[0], double(v[7]) - v[1], double(v[8]) - v[2]};
+      const double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+      if (n[0] == 0.0 && n[1] == 0.0 && n[2] == 0.0) soup[9 * t] = std::numeric_limits<float>::quiet_NaN();
+    }
+    vertices.Upload(soup.data(), bytes);
     auto geometry = VkInit<VkAccelerationStructureGeometryKHR>(VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_GEOMETRY_KHR);
     geometry.geometryType = VK_GEOMETRY_TYPE_TRIANGLES_KHR;
     geometry.flags = VK_GEOMETRY_OPAQUE_BIT_KHR;

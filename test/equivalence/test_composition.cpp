@@ -87,7 +87,7 @@ TEST_CASE("Composition of a user's interface: plain and vector members of the im
 // Listing 2 of the paper: the composed traversal (ShapeScene::Trace) calls a virtual Intersect per
 // leaf it reaches; on the GPU that call is a switch over the shape's class, whose data (16, 32 and
 // 48 bytes) sits in a buffer per class.
-TEST_CASE("Composition: virtual intersection functions called from the composed traversal", "[equivalence][composition][virtual]")
+TEST_CASE("Composition: virtual intersection functions called from the composed traversal", "[equivalence][composition][virtual][device-features]")
 {
   auto scene = std::make_shared<ShapeScene>();
   scene->Add(std::make_shared<Sphere>(float3(0.0f, 0.0f, 0.0f), 0.75f));

@@ -40,7 +40,7 @@ std::shared_ptr<SdfLeafScene> ThreeFields()
 }
 }  // namespace
 
-TEST_CASE("Intersection functions of SDF representations reach the traversal's data through `this` (paper 3.10)", "[equivalence][composition][sdf]")
+TEST_CASE("Intersection functions of SDF representations reach the traversal's data through `this` (paper 3.10)", "[equivalence][composition][sdf][device-features]")
 {
   auto scene = ThreeFields();
   REQUIRE(scene->m_geom.size() == 3);

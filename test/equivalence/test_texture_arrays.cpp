@@ -101,7 +101,7 @@ bool SamplerClose(const Shaded& a, const Shaded& b, size_t i)
 }
 }  // namespace
 
-TEST_CASE("Arrays of textures: each its own size, address modes and filter, picked per thread", "[equivalence][textures]")
+TEST_CASE("Arrays of textures: each its own size, address modes and filter, picked per thread", "[equivalence][textures][device-features]")
 {
   auto ctx = ValidatedContext();
   const Hits hits = RandomHits(4001);
@@ -156,7 +156,7 @@ TEST_CASE("Arrays of textures: each its own size, address modes and filter, pick
   RequireNoValidationMessages(ctx);
 }
 
-TEST_CASE("Arrays of textures: changed, added and emptied textures reach the GPU", "[equivalence][textures]")
+TEST_CASE("Arrays of textures: changed, added and emptied textures reach the GPU", "[equivalence][textures][device-features]")
 {
   auto ctx = ValidatedContext();
   if (!ctx) return;
@@ -195,7 +195,7 @@ TEST_CASE("Arrays of textures: changed, added and emptied textures reach the GPU
   RequireNoValidationMessages(ctx);
 }
 
-TEST_CASE("Arrays of textures: the GPU's samplers only where the device has descriptor indexing", "[equivalence][textures]")
+TEST_CASE("Arrays of textures: the GPU's samplers only where the device has descriptor indexing", "[equivalence][textures][device-features]")
 {
   auto ctx = ValidatedContext();
   if (!ctx) return;
@@ -218,7 +218,7 @@ TEST_CASE("Arrays of textures: the GPU's samplers only where the device has desc
   RequireNoValidationMessages(ctx);
 }
 
-TEST_CASE("Arrays of textures with ray queries in one kernel: the texture of the mesh each ray hits", "[equivalence][textures][composition]")
+TEST_CASE("Arrays of textures with ray queries in one kernel: the texture of the mesh each ray hits", "[equivalence][textures][composition][device-features]")
 {
   auto ctx = ValidatedContext();
   // Two meshes: a unit quad at z = 0 and a triangle in front of part of it at z = 0.5.

@@ -204,7 +204,7 @@ TEST_CASE("Virtual functions, level 1: the same kernel with every element in one
                                  [] { return CreateFlatShading_Vulkan(ValidatedContext()); });
 }
 
-TEST_CASE("Virtual functions, level 3: callable shaders on ray tracing pipelines, else the level-2 switch", "[equivalence][virtual]")
+TEST_CASE("Virtual functions, level 3: callable shaders on ray tracing pipelines, else the level-2 switch", "[equivalence][virtual][device-features]")
 {
   auto ctx = ValidatedContext();
   const auto palette = Palette();

@@ -92,13 +92,18 @@ struct Outcome
 };
 
 // The agreement stated at the top of this file, of `gpu` hits with the original's.
+// `leaks`: the device's own triangle test is not watertight (LeaksBetweenTriangles): up to 2% of the
+// rays may miss there where the original hits.
 void RequireAgreement(const char* what, const std::vector<CRT_Hit>& original, const std::vector<CRT_Hit>& gpu, const Rays& rays,
-                      float sceneSize, const TriangleMesh* mesh, bool exact)
+                      float sceneSize, const TriangleMesh* mesh, bool exact, bool leaks = false)
 {
-  size_t samePrim = 0, ties = 0, tOutside = 0, idsDiffer = 0;
+  size_t samePrim = 0, ties = 0, tOutside = 0, idsDiffer = 0, missed = 0, extra = 0;
+  std::ostringstream firstOther;  // the first ray on another triangle that is no tie
   for (size_t i = 0; i < rays.Size(); ++i)
   {
     const CRT_Hit &o = original[i], &v = gpu[i];
+    missed += o.primId != kMiss && v.primId == kMiss;
+    extra += o.primId == kMiss && v.primId != kMiss;
     samePrim += o.primId == v.primId;
     idsDiffer += o.primId == v.primId && (o.instId != v.instId || o.geomId != v.geomId);
     const float3 org = to_float3(rays.posAndNear[i]), dir = to_float3(rays.dirAndFar[i]);
@@ -110,13 +115,17 @@ void RequireAgreement(const char* what, const std::vector<CRT_Hit>& original, co
     {
       const uint32_t* tri = &mesh->indices[3 * v.primId];
       const float3 p = org + dir * v.t;
-      ties += DistanceToTriangle(p, Vertex(*mesh, tri[0]), Vertex(*mesh, tri[1]), Vertex(*mesh, tri[2])) <= tolerance * length(dir) &&
-              DistanceToTriangle(p, Vertex(*mesh, mesh->indices[3 * o.primId]), Vertex(*mesh, mesh->indices[3 * o.primId + 1]),
-                                 Vertex(*mesh, mesh->indices[3 * o.primId + 2])) <= tolerance * length(dir);
+      const bool tie = DistanceToTriangle(p, Vertex(*mesh, tri[0]), Vertex(*mesh, tri[1]), Vertex(*mesh, tri[2])) <= tolerance * length(dir) &&
+                       DistanceToTriangle(p, Vertex(*mesh, mesh->indices[3 * o.primId]), Vertex(*mesh, mesh->indices[3 * o.primId + 1]),
+                                          Vertex(*mesh, mesh->indices[3 * o.primId + 2])) <= tolerance * length(dir);
+      ties += tie;
+      if (!tie && firstOther.str().empty())
+        firstOther << "the first on another triangle: ray " << i << " primId " << o.primId << " t " << o.t << " vs " << v.primId << " t " << v.t;
     }
   }
   INFO(what << ": " << samePrim << " of " << rays.Size() << " rays on the original's primId, " << ties
-            << " more on another triangle at the same point; " << tOutside << " t outside the tolerance");
+            << " more on another triangle at the same point; " << tOutside << " t outside the tolerance; " << missed
+            << " missed where the original hit, " << extra << " hit where it missed; " << firstOther.str());
   if (exact)
   {
     REQUIRE(double(samePrim + ties) >= 0.9999 * double(rays.Size()));
@@ -124,7 +133,9 @@ void RequireAgreement(const char* what, const std::vector<CRT_Hit>& original, co
   }
   else  // the ray's shear constants are quotients: a GPU's may differ in the last bit (RoundsLikeTheCpu)
   {
-    REQUIRE(double(samePrim + ties) >= 0.999 * double(rays.Size()));
+    if (leaks)
+      REQUIRE(double(missed) <= 0.02 * double(rays.Size()));
+    REQUIRE(double(samePrim + ties + (leaks ? missed : 0)) >= 0.999 * double(rays.Size()));
     REQUIRE(double(tOutside) <= 0.001 * double(rays.Size()));
   }
   REQUIRE(idsDiffer == 0);
@@ -169,18 +180,21 @@ Outcome TraceEverywhere(const std::shared_ptr<ISceneObject>& scene, const Rays& 
   if (!ctx)
     return out;
   auto vulkan = std::make_shared<PrimaryRays_Vulkan>(ctx, 1, 1);
+  // A device with ray queries traces on them (CTest's hw variant); the translated traversal is what
+  // every other device runs (the sw variant hides ray queries: CROSSRT_DEVICE_FEATURES).
+  if (ctx->hasRayQuery && exports)
+  {
+    REQUIRE(vulkan->UsesRayTracingHardware());
+    const std::vector<CRT_Hit> hardware = Cast(*vulkan, scene, rays);
+    RequireNoValidationMessages(ctx);
+    RequireAgreement("ray tracing hardware", out.original, hardware, rays, sceneSize, mesh, false, LeaksBetweenTriangles(*ctx));
+    return out;
+  }
   vulkan->UseRayTracingHardware(false);
   out.vulkan = Cast(*vulkan, scene, rays);
   out.hasVulkan = true;
   RequireNoValidationMessages(ctx);
   RequireAgreement("translated traversal", out.original, out.vulkan, rays, sceneSize, mesh, RoundsLikeTheCpu(*ctx));
-  if (ctx->hasRayQuery && exports)
-  {
-    vulkan->UseRayTracingHardware(true);
-    const std::vector<CRT_Hit> hardware = Cast(*vulkan, scene, rays);
-    RequireNoValidationMessages(ctx);
-    RequireAgreement("ray tracing hardware", out.original, hardware, rays, sceneSize, mesh, false);
-  }
   return out;
 }
 
@@ -194,7 +208,7 @@ size_t Misses(const std::vector<CRT_Hit>& hits)
 
 }  // namespace
 
-TEST_CASE("Translated traversal: rays from inside closed meshes through vertices and edges never miss", "[bvh][composition]")
+TEST_CASE("Translated traversal: rays from inside closed meshes through vertices and edges never miss", "[bvh][composition][device-features]")
 {
   const char* impl = GENERATE(as<const char*>{}, "lbvh", "sah");
   INFO(impl);
@@ -226,7 +240,7 @@ TEST_CASE("Translated traversal: rays from inside closed meshes through vertices
   }
 }
 
-TEST_CASE("Translated traversal on tiny, huge and far-away scenes, and 1e6 sizes away", "[bvh][composition]")
+TEST_CASE("Translated traversal on tiny, huge and far-away scenes, and 1e6 sizes away", "[bvh][composition][device-features]")
 {
   const TriangleMesh mesh = BumpySphere(5);  // 8192 triangles
   struct Placement { const char* what; float4x4 toWorld; float size; };
@@ -257,7 +271,7 @@ TEST_CASE("Translated traversal on tiny, huge and far-away scenes, and 1e6 sizes
   }
 }
 
-TEST_CASE("Translated traversal: axis-parallel rays with +0 and -0 direction components", "[bvh][composition]")
+TEST_CASE("Translated traversal: axis-parallel rays with +0 and -0 direction components", "[bvh][composition][device-features]")
 {
   const TriangleMesh cube = Cube();
   const float coords[] = {-1.5f, -1.0f, -0.5f, 0.0f, 0.25f, 0.5f, 1.0f, 1.5f};
@@ -277,7 +291,7 @@ TEST_CASE("Translated traversal: axis-parallel rays with +0 and -0 direction com
               rays.Add(float3(org[0], org[1], org[2]), float3(dir[0], dir[1], dir[2]), 0.0f, 100.0f);
               inside.push_back(std::fabs(a) <= 1.0f && std::fabs(b) <= 1.0f);
             }
-  const Outcome o = TraceEverywhere(SceneOf("lbvh", cube), rays, 2.0f);
+  const Outcome o = TraceEverywhere(SceneOf("lbvh", cube), rays, 2.0f, &cube);  // rays along edges and diagonals: ties
   // Inside a face, its edges and corners included: a hit at distance exactly 4, on every backend.
   for (const auto* hits : {&o.original, &o.cpu, &o.vulkan})
     for (size_t i = 0; i < hits->size(); ++i)
@@ -289,7 +303,7 @@ TEST_CASE("Translated traversal: axis-parallel rays with +0 and -0 direction com
     }
 }
 
-TEST_CASE("Translated traversal: degenerate triangles, one shared centre, 0, 1 and 2 triangles, instances, invalid rays", "[bvh][composition]")
+TEST_CASE("Translated traversal: degenerate triangles, one shared centre, 0, 1 and 2 triangles, instances, invalid rays", "[bvh][composition][device-features]")
 {
   SECTION("zero-area triangles are never hit, and do not hide the others")
   {
@@ -386,7 +400,7 @@ TEST_CASE("Translated traversal: degenerate triangles, one shared centre, 0, 1 a
   }
 }
 
-TEST_CASE("PrimaryRays renders the same image as written, on _CPU, _ISPC and _Vulkan", "[composition]")
+TEST_CASE("PrimaryRays renders the same image as written, on _CPU, _ISPC and _Vulkan", "[composition][device-features]")
 {
   const TriangleMesh mesh = BumpySphere(4);
   auto scene = SceneOf("lbvh", mesh);
@@ -438,7 +452,7 @@ TEST_CASE("PrimaryRays renders the same image as written, on _CPU, _ISPC and _Vu
   }
 }
 
-TEST_CASE("BVHScene exports the committed scene that hardware acceleration structures are built from", "[composition]")
+TEST_CASE("BVHScene exports the committed scene that hardware acceleration structures are built from", "[composition][device-features]")
 {
   // Two meshes, three instances, one of an empty mesh; the export rebuilt as a second BVHScene must
   // give the very same hits: primIds in the order added, instance ids and matrices kept.
@@ -498,7 +512,7 @@ TEST_CASE("BVHScene exports the committed scene that hardware acceleration struc
 }
 
 TEST_CASE("Translated traversal: signed distance fields, from outside, from inside, along voxel faces, scaled, invalid rays",
-          "[sdf][composition]")
+          "[sdf][composition][device-features]")
 {
   // A rounded box at 32^3 voxels as a grid, an SVS and an SBS; the SDF leaves' code runs as written,
   // on _CPU (the same bits) and on _Vulkan. Voxel indices (primId) agree as triangles do above; t

@@ -3,6 +3,7 @@
 // and choosing the compiled target, for tests that force one.
 #pragma once
 
+#include "crossrt/ClassName.h"
 #include <cstdlib>
 #include <cstring>
 #include <initializer_list>

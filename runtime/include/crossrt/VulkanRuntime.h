@@ -3,6 +3,7 @@
 // embedded SPIR-V (push descriptors + push constants), dispatches, and times GPU work.
 #pragma once
 
+#include "crossrt/ClassName.h"
 #include "SortKey.h"
 
 #include <vulkan/vulkan.h>
@@ -66,6 +67,11 @@ struct ContextOptions {
   // Testing aid: never map device buffers, so Upload/Download take the staging path that GPUs
   // without host-visible VRAM need (lavapipe's memory is always host-visible).
   bool forceStaging = false;
+  // Optional features to hide ("-ray_query") or require ("+ray_query"), comma-separated: ray_query,
+  // ray_tracing_pipeline, texture_arrays, float_atomics. A hidden feature is not enabled, so
+  // generated classes take the path a device without it takes; a required one the device lacks
+  // makes Create throw. The environment's CROSSRT_DEVICE_FEATURES is applied after these.
+  std::string deviceFeatures;
 };
 
 class VulkanContext {
