@@ -84,7 +84,7 @@ std::string TextureArrayFunctions(const Member& array, bool hardware, bool first
   d.set("channel", array.glslType == "vec4" ? "" : ".x");
   d.set("hardware", hardware);
   d.set("software", !hardware);
-  d.set("common", !hardware && first);
+  d.set("common", first);  // both sample far-away and non-finite coordinates as LiteImage does
   return Render(opt.templateDir + "/glsl/texture_array.glsl.mustache", d);
 }
 

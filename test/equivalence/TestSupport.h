@@ -36,14 +36,6 @@ inline bool RoundsLikeTheCpu(const crossrt::VulkanContext& ctx)
   return ctx.DeviceName().find("llvmpipe") != std::string::npos;
 }
 
-// Whether the device's own ray/triangle test lets rays through the shared edges and vertices of
-// closed meshes: lavapipe's does (test/driver/vk_watertight.cpp, CTest driver.ray_triangle_watertight,
-// shows it in plain Vulkan); GPUs' are watertight.
-inline bool LeaksBetweenTriangles(const crossrt::VulkanContext& ctx)
-{
-  return ctx.DeviceName().find("llvmpipe") != std::string::npos;
-}
-
 // n floats uniform in [lo, hi), the same for a given seed.
 inline std::vector<float> RandomFloats(int n, unsigned seed, float lo, float hi)
 {

@@ -18,6 +18,9 @@
 // A GPU's division is only within 2.5 ulp, though, and the ray's shear constants are quotients: on
 // devices that do not round like the CPU (RoundsLikeTheCpu) 99.9% and 0.1% of rays outside the
 // tolerance are allowed, as for ray tracing hardware, whose own triangle test differs anyway.
+// On a device with ray queries (CTest's hw variants) PrimaryRays_Vulkan traces on them instead, and
+// rays through edges and vertices may also miss there (RequireAgreement); the sw variants hide ray
+// queries (CROSSRT_DEVICE_FEATURES), so the translated traversal runs as on any other device.
 #include <catch2/catch.hpp>
 
 #include "PrimaryRays.h"
@@ -30,6 +33,7 @@
 #include "TestMeshes.h"
 #include "TestSupport.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -92,17 +96,26 @@ struct Outcome
 };
 
 // The agreement stated at the top of this file, of `gpu` hits with the original's.
-// `leaks`: the device's own triangle test is not watertight (LeaksBetweenTriangles): up to 2% of the
-// rays may miss there where the original hits.
+// On ray tracing hardware (`exact` false) a ray through an edge or a vertex may miss where the
+// original hits (`edgeMisses`: up to `edgeMissShare` of the rays, and one ray in any case): an edge
+// no other triangle shares, or one a ray runs along, is half-open under Vulkan's tie rule, and
+// lavapipe's test is not watertight even where edges are shared (driver.ray_triangle_watertight).
+// A miss anywhere else counts against the agreement.
 void RequireAgreement(const char* what, const std::vector<CRT_Hit>& original, const std::vector<CRT_Hit>& gpu, const Rays& rays,
-                      float sceneSize, const TriangleMesh* mesh, bool exact, bool leaks = false)
+                      float sceneSize, const TriangleMesh* mesh, bool exact, double edgeMissShare = 0.02)
 {
-  size_t samePrim = 0, ties = 0, tOutside = 0, idsDiffer = 0, missed = 0, extra = 0;
+  size_t samePrim = 0, ties = 0, tOutside = 0, idsDiffer = 0, missed = 0, edgeMisses = 0, extra = 0;
   std::ostringstream firstOther;  // the first ray on another triangle that is no tie
   for (size_t i = 0; i < rays.Size(); ++i)
   {
     const CRT_Hit &o = original[i], &v = gpu[i];
-    missed += o.primId != kMiss && v.primId == kMiss;
+    if (o.primId != kMiss && v.primId == kMiss)
+    {
+      const float u = o.coords[0], w = o.coords[1];
+      const bool onEdge = std::min({u, w, 1.0f - u - w}) <= 1e-4f;
+      missed += !onEdge;
+      edgeMisses += onEdge;
+    }
     extra += o.primId == kMiss && v.primId != kMiss;
     samePrim += o.primId == v.primId;
     idsDiffer += o.primId == v.primId && (o.instId != v.instId || o.geomId != v.geomId);
@@ -124,8 +137,9 @@ void RequireAgreement(const char* what, const std::vector<CRT_Hit>& original, co
     }
   }
   INFO(what << ": " << samePrim << " of " << rays.Size() << " rays on the original's primId, " << ties
-            << " more on another triangle at the same point; " << tOutside << " t outside the tolerance; " << missed
-            << " missed where the original hit, " << extra << " hit where it missed; " << firstOther.str());
+            << " more on another triangle at the same point; " << tOutside << " t outside the tolerance; " << edgeMisses
+            << " missed through an edge or vertex and " << missed << " elsewhere where the original hit, " << extra
+            << " hit where it missed; " << firstOther.str());
   if (exact)
   {
     REQUIRE(double(samePrim + ties) >= 0.9999 * double(rays.Size()));
@@ -133,9 +147,8 @@ void RequireAgreement(const char* what, const std::vector<CRT_Hit>& original, co
   }
   else  // the ray's shear constants are quotients: a GPU's may differ in the last bit (RoundsLikeTheCpu)
   {
-    if (leaks)
-      REQUIRE(double(missed) <= 0.02 * double(rays.Size()));
-    REQUIRE(double(samePrim + ties + (leaks ? missed : 0)) >= 0.999 * double(rays.Size()));
+    REQUIRE(double(edgeMisses) <= std::max(1.0, edgeMissShare * double(rays.Size())));
+    REQUIRE(double(samePrim + ties + edgeMisses) >= 0.999 * double(rays.Size()));
     REQUIRE(double(tOutside) <= 0.001 * double(rays.Size()));
   }
   REQUIRE(idsDiffer == 0);
@@ -146,7 +159,7 @@ void RequireAgreement(const char* what, const std::vector<CRT_Hit>& original, co
 // tracing hardware; checks the agreement stated at the top of this file.
 // `mesh`, when given, is the scene's only geometry with one identity instance: ties are checked on it.
 Outcome TraceEverywhere(const std::shared_ptr<ISceneObject>& scene, const Rays& rays, float sceneSize,
-                        const TriangleMesh* mesh = nullptr, bool exports = true)
+                        const TriangleMesh* mesh = nullptr, bool exports = true, double edgeMissShare = 0.02)
 {
   Outcome out;
   for (size_t i = 0; i < rays.Size(); ++i)
@@ -187,7 +200,7 @@ Outcome TraceEverywhere(const std::shared_ptr<ISceneObject>& scene, const Rays& 
     REQUIRE(vulkan->UsesRayTracingHardware());
     const std::vector<CRT_Hit> hardware = Cast(*vulkan, scene, rays);
     RequireNoValidationMessages(ctx);
-    RequireAgreement("ray tracing hardware", out.original, hardware, rays, sceneSize, mesh, false, LeaksBetweenTriangles(*ctx));
+    RequireAgreement("ray tracing hardware", out.original, hardware, rays, sceneSize, mesh, false, edgeMissShare);
     return out;
   }
   vulkan->UseRayTracingHardware(false);
@@ -291,7 +304,10 @@ TEST_CASE("Translated traversal: axis-parallel rays with +0 and -0 direction com
               rays.Add(float3(org[0], org[1], org[2]), float3(dir[0], dir[1], dir[2]), 0.0f, 100.0f);
               inside.push_back(std::fabs(a) <= 1.0f && std::fabs(b) <= 1.0f);
             }
-  const Outcome o = TraceEverywhere(SceneOf("lbvh", cube), rays, 2.0f, &cube);  // rays along edges and diagonals: ties
+  // Rays along the cube's edges and face diagonals: ties. A ray along an edge runs in one face's
+  // plane and meets the other face exactly on its edge: on hardware (lavapipe) about half of them
+  // miss, which Vulkan's tie rule allows.
+  const Outcome o = TraceEverywhere(SceneOf("lbvh", cube), rays, 2.0f, &cube, true, 0.2);
   // Inside a face, its edges and corners included: a hit at distance exactly 4, on every backend.
   for (const auto* hits : {&o.original, &o.cpu, &o.vulkan})
     for (size_t i = 0; i < hits->size(); ++i)
@@ -592,4 +608,24 @@ TEST_CASE("Translated traversal: signed distance fields, from outside, from insi
             REQUIRE(dot(a, b) > 0.999f);
           }
     }
+}
+
+TEST_CASE("A translated class whose composed member holds another implementation says which", "[composition]")
+{
+  // PrimaryRays_Vulkan runs BVHScene's traversal, composed in: an Embree scene cannot stand in for it.
+  auto ctx = ValidatedContext();
+  if (!ctx)
+    return;
+  auto vulkan = std::make_shared<PrimaryRays_Vulkan>(ctx, 1, 1);
+  vulkan->SetScene(SceneOf("embree", Sphere(1)), {}, {});
+  Rays rays;
+  rays.Add(float3(0.0f, 0.0f, -3.0f), float3(0.0f, 0.0f, 1.0f));
+  std::vector<CRT_Hit> hits(1);
+  REQUIRE_THROWS_WITH(
+      [&] {
+        vulkan->CommitDeviceData();
+        vulkan->CastRays(rays.posAndNear.data(), rays.dirAndFar.data(), hits.data(), 1);
+      }(),
+      Catch::Contains("must hold a BVHScene") && Catch::Contains("but it holds a ") && Catch::Contains("EmbreeRT"));
+  RequireNoValidationMessages(ctx);
 }

@@ -267,7 +267,8 @@ BVHScene* PrimaryRays_Vulkan::crt_m_pAccelStruct() const
   if (impl == nullptr)
     throw crossrt::Error(std::string("PrimaryRays_Vulkan: 'm_pAccelStruct' must hold a BVHScene, the ISceneObject "
                                      "composed into the GPU code, but it holds ") +
-                         (m_pAccelStruct ? "an object of another class" : "nothing"));
+                         (m_pAccelStruct ? "a " + crossrt::ClassName(typeid(*crossrt::RawPointer(m_pAccelStruct)))
+                                         : std::string("nothing")));
   return impl;
 }
 

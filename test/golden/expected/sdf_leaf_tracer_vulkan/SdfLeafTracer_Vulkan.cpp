@@ -354,9 +354,10 @@ SdfLeafScene* SdfLeafTracer_Vulkan::crt_m_scene() const
 {
   auto* impl = dynamic_cast<SdfLeafScene*>(crossrt::RawPointer(m_scene));
   if (impl == nullptr)
-    throw crossrt::Error(std::string("SdfLeafTracer_Vulkan: 'm_scene' must hold a SdfLeafScene, the ISceneObject "
-                                     "composed into the GPU code, but it holds ") +
-                         (m_scene ? "an object of another class" : "nothing"));
+    throw crossrt::Error(
+        std::string("SdfLeafTracer_Vulkan: 'm_scene' must hold a SdfLeafScene, the ISceneObject composed into the GPU "
+                    "code, but it holds ") +
+        (m_scene ? "a " + crossrt::ClassName(typeid(*crossrt::RawPointer(m_scene))) : std::string("nothing")));
   return impl;
 }
 

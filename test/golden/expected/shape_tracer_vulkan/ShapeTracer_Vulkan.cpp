@@ -386,9 +386,10 @@ ShapeScene* ShapeTracer_Vulkan::crt_m_scene() const
 {
   auto* impl = dynamic_cast<ShapeScene*>(crossrt::RawPointer(m_scene));
   if (impl == nullptr)
-    throw crossrt::Error(std::string("ShapeTracer_Vulkan: 'm_scene' must hold a ShapeScene, the IScene composed into "
-                                     "the GPU code, but it holds ") +
-                         (m_scene ? "an object of another class" : "nothing"));
+    throw crossrt::Error(
+        std::string("ShapeTracer_Vulkan: 'm_scene' must hold a ShapeScene, the IScene composed into the GPU code, but "
+                    "it holds ") +
+        (m_scene ? "a " + crossrt::ClassName(typeid(*crossrt::RawPointer(m_scene))) : std::string("nothing")));
   return impl;
 }
 

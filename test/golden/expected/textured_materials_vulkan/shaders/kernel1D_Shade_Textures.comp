@@ -61,12 +61,76 @@ layout(push_constant) uniform kernel1D_ShadeArgs
   int n;
 };
 
+// Arrays of textures sampled in software: the address modes of LiteImage::Sampler (WRAP, MIRROR,
+// CLAMP, BORDER: 0-3) as Image2D.h maps a texel index into [0, size), -1 for the border.
+// GLSL's % is undefined for negative operands: a - b * (a / b) is C++'s remainder.
+int crt_addressTexel(int i, int size, uint mode)
+{
+  if (mode == 0u)
+  {
+    const int r = i - size * (i / size);
+    return r < 0 ? r + size : r;
+  }
+  if (mode == 1u)
+  {
+    const int period = 2 * size;
+    int m = i - period * (i / period);
+    m = m < 0 ? m + period : m;
+    return m < size ? m : period - 1 - m;
+  }
+  if (mode == 2u)
+    return clamp(i, 0, size - 1);
+  return i < 0 || i >= size ? -1 : i;
+}
+
+// A texel-space coordinate made safe to convert to int (NaN -> 0, huge values bounded), as Image2D.h does.
+float crt_sanitizeCoord(float x)
+{
+  if (isnan(x))
+    return 0.0;
+  return clamp(x, -1.0e8, 1.0e8);
+}
+
+// m_albedo[i] texel (x, y) after its sampler's address modes, read from the image itself; outside
+// a BORDER sampler's image its border colour.
+vec4 m_albedo_fetch(uint i, crt_TextureInfo t, int x, int y)
+{
+  const int xi = crt_addressTexel(x, int(t.width), t.mode & 3u);
+  const int yi = crt_addressTexel(y, int(t.height), (t.mode >> 2) & 3u);
+  if (xi < 0 || yi < 0)
+    return t.border;
+  return texelFetch(m_albedo[nonuniformEXT(i)], ivec2(xi, yi), 0);
+}
+
 // m_albedo[i].sample(uv) with the GPU's sampler (an empty texture samples as vec4(0), as on the CPU).
+// Far outside the image, and at NaN or infinity, a sampler's fixed-point coordinates lose the texel
+// (and Vulkan leaves non-finite ones undefined): there it samples as Image2D::sample does, in the
+// same float operations, from the image's texels.
 vec4 m_albedo_sample(uint i, vec2 uv)
 {
-  if (m_albedo_info[i].width == 0u || m_albedo_info[i].height == 0u)
+  const crt_TextureInfo t = m_albedo_info[i];
+  if (t.width == 0u || t.height == 0u)
     return vec4(0.0);
-  return textureLod(m_albedo[nonuniformEXT(i)], uv, 0.0);
+  precise float x = uv.x * float(t.width);
+  precise float y = uv.y * float(t.height);
+  if (abs(x) <= 65536.0 && abs(y) <= 65536.0)  // false for NaN
+    return textureLod(m_albedo[nonuniformEXT(i)], uv, 0.0);
+  x = crt_sanitizeCoord(x);
+  y = crt_sanitizeCoord(y);
+  if ((t.mode & 16u) == 0u)
+    return m_albedo_fetch(i, t, int(floor(x)), int(floor(y)));
+  precise float fx = x - 0.5, fy = y - 0.5;
+  const float x0 = floor(fx), y0 = floor(fy);
+  precise float tx = fx - x0, ty = fy - y0;
+  const int ix = int(x0), iy = int(y0);
+  const vec4 t00 = m_albedo_fetch(i, t, ix, iy);
+  const vec4 t10 = m_albedo_fetch(i, t, ix + 1, iy);
+  const vec4 t01 = m_albedo_fetch(i, t, ix, iy + 1);
+  const vec4 t11 = m_albedo_fetch(i, t, ix + 1, iy + 1);
+  precise vec4 top = t00 * (1.0 - tx) + t10 * tx;
+  precise vec4 bottom = t01 * (1.0 - tx) + t11 * tx;
+  precise vec4 result = top * (1.0 - ty) + bottom * ty;
+  return result;
 }
 
 // m_albedo[i][p]
@@ -85,12 +149,46 @@ uint m_albedo_height(uint i)
   return m_albedo_info[i].height;
 }
 
+// m_bumps[i] texel (x, y) after its sampler's address modes, read from the image itself; outside
+// a BORDER sampler's image its border colour.
+float m_bumps_fetch(uint i, crt_TextureInfo t, int x, int y)
+{
+  const int xi = crt_addressTexel(x, int(t.width), t.mode & 3u);
+  const int yi = crt_addressTexel(y, int(t.height), (t.mode >> 2) & 3u);
+  if (xi < 0 || yi < 0)
+    return t.border.x;
+  return texelFetch(m_bumps[nonuniformEXT(i)], ivec2(xi, yi), 0).x;
+}
+
 // m_bumps[i].sample(uv) with the GPU's sampler (an empty texture samples as float(0), as on the CPU).
+// Far outside the image, and at NaN or infinity, a sampler's fixed-point coordinates lose the texel
+// (and Vulkan leaves non-finite ones undefined): there it samples as Image2D::sample does, in the
+// same float operations, from the image's texels.
 float m_bumps_sample(uint i, vec2 uv)
 {
-  if (m_bumps_info[i].width == 0u || m_bumps_info[i].height == 0u)
+  const crt_TextureInfo t = m_bumps_info[i];
+  if (t.width == 0u || t.height == 0u)
     return float(0.0);
-  return textureLod(m_bumps[nonuniformEXT(i)], uv, 0.0).x;
+  precise float x = uv.x * float(t.width);
+  precise float y = uv.y * float(t.height);
+  if (abs(x) <= 65536.0 && abs(y) <= 65536.0)  // false for NaN
+    return textureLod(m_bumps[nonuniformEXT(i)], uv, 0.0).x;
+  x = crt_sanitizeCoord(x);
+  y = crt_sanitizeCoord(y);
+  if ((t.mode & 16u) == 0u)
+    return m_bumps_fetch(i, t, int(floor(x)), int(floor(y)));
+  precise float fx = x - 0.5, fy = y - 0.5;
+  const float x0 = floor(fx), y0 = floor(fy);
+  precise float tx = fx - x0, ty = fy - y0;
+  const int ix = int(x0), iy = int(y0);
+  const float t00 = m_bumps_fetch(i, t, ix, iy);
+  const float t10 = m_bumps_fetch(i, t, ix + 1, iy);
+  const float t01 = m_bumps_fetch(i, t, ix, iy + 1);
+  const float t11 = m_bumps_fetch(i, t, ix + 1, iy + 1);
+  precise float top = t00 * (1.0 - tx) + t10 * tx;
+  precise float bottom = t01 * (1.0 - tx) + t11 * tx;
+  precise float result = top * (1.0 - ty) + bottom * ty;
+  return result;
 }
 
 // m_bumps[i][p]
