@@ -78,12 +78,13 @@ int main(int argc, char** argv)
 {
   if (argc > 1 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h"))
   {
-    std::printf("usage: primary_rays [MESH | \"\"] [OUTPUT.png] [--size N] [--ao SAMPLES] [--bvh lbvh|sah]\n  Renders MESH (OFF, PLY or OBJ, also gzipped; \"\" or none: a built-in scene) with primary rays and\n  ambient occlusion through ISceneObject: Embree, the original class, PrimaryRays_CPU, PrimaryRays_ISPC\n  (where ISPC was found when CrossRT was configured) and PrimaryRays_Vulkan.\n");
+    std::printf("usage: primary_rays [MESH | \"\"] [OUTPUT.png] [--size N] [--ao SAMPLES] [--bvh lbvh|sah] [--hardware-only]\n  Renders MESH (OFF, PLY or OBJ, also gzipped; \"\" or none: a built-in scene) with primary rays and\n  ambient occlusion through ISceneObject: Embree, the original class, PrimaryRays_CPU, PrimaryRays_ISPC\n  (where ISPC was found when CrossRT was configured) and PrimaryRays_Vulkan (its translated traversal,\n  and ray queries where the device has them; --hardware-only: ray queries only).\n");
     return 0;
   }
   std::string meshPath, outPath = "primary_rays.png", bvh = "lbvh";
   int size = 512, ao = 4;
   int positional = 0;
+  bool hardwareOnly = false;
   for (int i = 1; i < argc; ++i)
   {
     const std::string a = argv[i];
@@ -94,11 +95,12 @@ int main(int argc, char** argv)
       else if (a == "--ao") ao = std::atoi(v.c_str());
       else bvh = v;
     }
+    else if (a == "--hardware-only") hardwareOnly = true;
     else if (positional == 0) meshPath = a, ++positional;
     else if (positional == 1) outPath = a, ++positional;
     else
     {
-      std::fprintf(stderr, "usage: primary_rays [mesh] [output image] [--size N] [--ao SAMPLES] [--bvh lbvh|sah]\n");
+      std::fprintf(stderr, "usage: primary_rays [mesh] [output image] [--size N] [--ao SAMPLES] [--bvh lbvh|sah] [--hardware-only]\n");
       return 2;
     }
   }
@@ -155,10 +157,15 @@ int main(int argc, char** argv)
     {
       // The translated traversal, and where the device has ray queries its ray tracing hardware.
       auto ctx = crossrt::VulkanContext::CreateDefault();
-      auto software = std::make_shared<PrimaryRays_Vulkan>(ctx, size, size);
-      software->UseRayTracingHardware(false);
-      runs.push_back({"PrimaryRays_Vulkan, " + bvh, software, {}});
-      runs.back().renderer->SetScene(bvhScene, mesh.positions, mesh.indices);
+      if (hardwareOnly && !ctx->hasRayQuery)
+        throw std::runtime_error("--hardware-only: " + ctx->DeviceName() + " has no ray queries");
+      if (!hardwareOnly)
+      {
+        auto software = std::make_shared<PrimaryRays_Vulkan>(ctx, size, size);
+        software->UseRayTracingHardware(false);
+        runs.push_back({"PrimaryRays_Vulkan, " + bvh, software, {}});
+        runs.back().renderer->SetScene(bvhScene, mesh.positions, mesh.indices);
+      }
       if (ctx->hasRayQuery)
       {
         runs.push_back({"PrimaryRays_Vulkan, ray queries", std::make_shared<PrimaryRays_Vulkan>(ctx, size, size), {}});

@@ -85,16 +85,19 @@ int main(int argc, char** argv)
   std::string meshPath, outPath = "sdf_render.png";
   int size = 256, depth = 7, bytes = 2, ao = 4;
   int positional = 0;
+  bool hardwareOnly = false;
   for (int i = 1; i < argc; ++i)
   {
     const std::string a = argv[i];
     if (a == "--help" || a == "-h")
     {
-      std::printf("usage: sdf_render [MESH | \"\"] [OUTPUT.png] [--size N] [--depth D] [--bytes 1|2|4] [--ao SAMPLES]\n"
+      std::printf("usage: sdf_render [MESH | \"\"] [OUTPUT.png] [--size N] [--depth D] [--bytes 1|2|4] [--ao SAMPLES] [--hardware-only]\n"
                   "  Builds a dense grid, a sparse voxel set and a sparse brick set (bricks of 4^3) of MESH's signed\n"
                   "  distance (\"\" or none: a built-in analytic scene) at 2^D voxels per axis, renders each with normals\n"
                   "  and ambient occlusion by the original SdfRender (BVHScene and Embree), SdfRender_CPU (all cores)\n"
-                  "  and SdfRender_Vulkan, checks that their images agree, and writes OUTPUT-grid.png, -svs.png, -sbs.png.\n");
+                  "  and SdfRender_Vulkan, checks that their images agree, and writes OUTPUT-grid.png, -svs.png, -sbs.png.\n"
+                  "  --hardware-only: on Vulkan only the intersection shaders of the ray tracing pipeline (which the\n"
+                  "  device must have), not the translated traversal nor its level-3 switch.\n");
       return 0;
     }
     if ((a == "--size" || a == "--depth" || a == "--bytes" || a == "--ao") && i + 1 < argc)
@@ -102,6 +105,8 @@ int main(int argc, char** argv)
       const int v = std::atoi(argv[++i]);
       (a == "--size" ? size : a == "--depth" ? depth : a == "--bytes" ? bytes : ao) = v;
     }
+    else if (a == "--hardware-only")
+      hardwareOnly = true;
     else if (a.rfind("--", 0) == 0)
     {
       std::fprintf(stderr, "sdf_render: unknown option %s (see --help)\n", a.c_str());
@@ -191,19 +196,24 @@ int main(int argc, char** argv)
       {
         // The translated traversal, SDF leaves included. (Ray queries take triangles only: a field
         // would need procedural boxes and an intersection in the shader.)
+        if (hardwareOnly && !ctx->hasRayTracingPipeline)
+          throw std::runtime_error("--hardware-only: " + ctx->DeviceName() + " has no ray tracing pipelines");
         for (bool hardware : {true, false})
         {
-          if (hardware && !ctx->hasRayTracingPipeline)
+          if ((hardware && !ctx->hasRayTracingPipeline) || (!hardware && hardwareOnly))
             continue;
           auto level3 = std::make_shared<SdfRender_VulkanLeaves>(ctx, size, size);
           level3->UseRayTracingPipelines(hardware);
           runs.push_back({hardware ? "VulkanLeaves, intersection shd." : "VulkanLeaves, switch", level3, false, {}, {}});
           runs.back().renderer->SetScene(leaves);
         }
-        auto vulkan = std::make_shared<SdfRender_Vulkan>(ctx, size, size);
-        vulkan->UseRayTracingHardware(false);
-        runs.push_back({"SdfRender_Vulkan", vulkan, false, {}, {}});
-        runs.back().renderer->SetScene(bvh);
+        if (!hardwareOnly)
+        {
+          auto vulkan = std::make_shared<SdfRender_Vulkan>(ctx, size, size);
+          vulkan->UseRayTracingHardware(false);
+          runs.push_back({"SdfRender_Vulkan", vulkan, false, {}, {}});
+          runs.back().renderer->SetScene(bvh);
+        }
       }
       for (Run& r : runs)
       {
