@@ -452,10 +452,10 @@ TEST_CASE("PrimaryRays renders the same image as written, on _CPU, _ISPC and _Vu
   REQUIRE(vulkan.UsesRayTracingHardware() == ctx->hasRayQuery);
   if (!ctx->hasRayQuery)
     REQUIRE_THROWS_WITH(vulkan.UseRayTracingHardware(true), Catch::Contains("has no ray queries"));
-  for (bool hardware : {false, true})
+  // The hardware where the device has ray queries (the hw variant), else the translated traversal
+  // (the sw variant hides them): lavapipe 25 compiles the traversal some 6x slower than Mesa 22.
   {
-    if (hardware && !ctx->hasRayQuery)
-      continue;
+    const bool hardware = ctx->hasRayQuery;
     vulkan.UseRayTracingHardware(hardware);
     const std::vector<uint32_t> gpu = render(vulkan);
     RequireNoValidationMessages(ctx);
@@ -528,7 +528,7 @@ TEST_CASE("BVHScene exports the committed scene that hardware acceleration struc
 }
 
 TEST_CASE("Translated traversal: signed distance fields, from outside, from inside, along voxel faces, scaled, invalid rays",
-          "[sdf][composition][device-features]")
+          "[sdf][composition]")  // fields do not export: the translated traversal only
 {
   // A rounded box at 32^3 voxels as a grid, an SVS and an SBS; the SDF leaves' code runs as written,
   // on _CPU (the same bits) and on _Vulkan. Voxel indices (primId) agree as triangles do above; t
