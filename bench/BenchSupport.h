@@ -1,8 +1,14 @@
-// Shared by the benchmarks: how a time is measured.
+// Shared by the benchmarks: how a time is measured, and what it was measured on.
 #pragma once
+#include <crossrt/IspcSupport.h>
+
 #include <algorithm>
 #include <chrono>
+#include <cstdlib>
+#include <fstream>
 #include <functional>
+#include <iterator>
+#include <string>
 #include <vector>
 
 // Median wall time in ms of `repeats` runs of `work`, after one warm-up run: first-use costs
@@ -27,4 +33,23 @@ inline double MedianOf(std::vector<double> ms)
   if (ms.empty()) return 0.0;
   std::sort(ms.begin(), ms.end());
   return ms[ms.size() / 2];
+}
+
+// The CPU's model name (/proc/cpuinfo), which every table of speed figures prints.
+inline std::string CpuModel()
+{
+  std::ifstream in("/proc/cpuinfo");
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
+  return "unknown";
+}
+
+// The ISPC target the _ISPC classes run here: CROSSRT_ISPC_TARGET, else the widest this CPU has.
+inline std::string IspcTarget()
+{
+  const char* forced = std::getenv("CROSSRT_ISPC_TARGET");
+  if (forced && *forced) return forced;
+  for (int i = int(std::size(crossrt::kIspcTargets)) - 1; i >= 0; --i)
+    if (crossrt::CpuRunsIspcTarget(i)) return crossrt::kIspcTargets[i];
+  return "none";
 }

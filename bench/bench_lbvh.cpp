@@ -204,7 +204,8 @@ int main(int argc, char** argv)
   std::shared_ptr<crossrt::VulkanContext> ctx;
   try { ctx = crossrt::VulkanContext::CreateDefault(); }
   catch (const std::exception& e) { std::printf("no Vulkan device (%s): the _Vulkan column is left out\n", e.what()); }
-  std::printf("CPU threads: %d; Vulkan device: %s\n", omp_get_max_threads(), ctx ? ctx->DeviceName().c_str() : "none");
+  std::printf("CPU: %s, %d threads; ISPC target: %s; Vulkan device: %s\n", CpuModel().c_str(), omp_get_max_threads(), IspcTarget().c_str(),
+              ctx ? ctx->DeviceName().c_str() : "none");
 
   std::printf("\nBuild time, ms (ratio = time / Embree LOW; the CPU builders' medians of 7 interleaved rounds, their ratios\n"
               "medians of the rounds' ratios; Vulkan: median of 3 wall times with copies, its ratio one of medians, [GPU time])\n");

@@ -32,23 +32,6 @@
 
 namespace {
 
-std::string CpuModel()
-{
-  std::ifstream in("/proc/cpuinfo");
-  for (std::string line; std::getline(in, line);)
-    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-  return "unknown";
-}
-
-std::string IspcTarget()
-{
-  const char* forced = std::getenv("CROSSRT_ISPC_TARGET");
-  if (forced && *forced) return forced;
-  for (int i = int(std::size(crossrt::kIspcTargets)) - 1; i >= 0; --i)
-    if (crossrt::CpuRunsIspcTarget(i)) return crossrt::kIspcTargets[i];
-  return "none";
-}
-
 struct Row {
   std::string impl, solve;
   std::function<std::shared_ptr<HeatDiffusion>()> make;

@@ -12,7 +12,8 @@
 #   lvp_icd.json   the driver's manifest, with an absolute library_path;
 #   lib/           libvulkan_lvp.so and its libdrm;
 #   env.sh         `source DIR/env.sh` points one shell's programs at this driver.
-# The build's tests use it automatically (CMake finds DIR/lvp_icd.json; see docs/ray-tracing.md).
+# The tests labelled hw run on it (CMake's CROSSRT_TEST_VULKAN_ICD, by default the default DIR's
+# lvp_icd.json; see docs/ray-tracing.md).
 # Does nothing when DIR already holds it. Needs network access and apt (Debian 12).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
