@@ -4,6 +4,7 @@
 
 #include "DaemonClient.h"
 #include "Protocol.h"
+#include "RemoteRejections.h"
 
 #include <xxhash.h>
 
@@ -75,16 +76,29 @@ private:
   size_t m_at = 0;
 };
 
-std::string Encode(const std::string& kind, const std::string& body) {
-  return std::string(kFormat) + " " + kind + " " + Hex128(body) + "\n" + body;
+// "<format> <kind> <checksum>[ <signature>]\n<body>"; the signature only with a team key.
+std::string Encode(const std::string& kind, const std::string& storageKey, const std::string& body, const TeamKey* key) {
+  std::string header = std::string(kFormat) + " " + kind + " " + Hex128(body);
+  if (key) header += " " + key->Sign(kind, storageKey, body);
+  return header + "\n" + body;
 }
-// The body of an entry of that kind whose checksum holds; false for anything else.
-bool Decode(const std::string& entry, const std::string& kind, std::string& body) {
+
+enum class Entry { Unusable, Rejected, Usable };
+// The body of an entry of that kind stored under `storageKey`. Unusable: another format or kind,
+// truncated, or its checksum fails (replaced by the next upload, silently). Rejected: with a team
+// key, the entry's signature does not verify; `why` says how.
+Entry Decode(const std::string& entry, const std::string& kind, const std::string& storageKey, const TeamKey* key,
+             std::string& body, std::string& why) {
   const std::string header = std::string(kFormat) + " " + kind + " ";
   const size_t eol = entry.find('\n');
-  if (entry.compare(0, header.size(), header) != 0 || eol == std::string::npos) return false;
+  if (entry.compare(0, header.size(), header) != 0 || eol == std::string::npos) return Entry::Unusable;
+  const std::string rest = entry.substr(header.size(), eol - header.size());
+  const size_t space = rest.find(' ');
   body = entry.substr(eol + 1);
-  return entry.substr(header.size(), eol - header.size()) == Hex128(body);
+  if (rest.substr(0, space) != Hex128(body)) return Entry::Unusable;
+  if (!key) return Entry::Usable;  // without a key, a signature is not checked (docs: "Trust")
+  why = key->Verify(space == std::string::npos ? "" : rest.substr(space + 1), kind, storageKey, body);
+  return why.empty() ? Entry::Usable : Entry::Rejected;
 }
 
 // The input sets of a manifest: each its result's key and its (portable path, content hash) pairs.
@@ -133,12 +147,21 @@ std::string TranslatorContentIdentity(const std::string& buildDir) {
 
 }  // namespace
 
-RemoteCache::RemoteCache(const std::string& storages, const std::string& sourceRoot, const std::string& buildDir)
+RemoteCache::RemoteCache(const std::string& storages, const std::string& sourceRoot, const std::string& buildDir,
+                         const std::string& keyFile)
     : m_buildDir(buildDir) {
   std::vector<std::string> errors;
   m_storages = ParseRemoteStorages(storages, errors);
   for (auto& e : errors) std::cerr << "crossrt: warning: CROSSRT_REMOTE_STORAGE: " << e << "; left out\n";
   if (m_storages.empty()) return;
+  std::string keyError;
+  m_key = TeamKey::Load(keyFile, keyError);
+  if (!keyError.empty()) {
+    // A key was meant to protect this build: going on without one would trust unsigned entries.
+    std::cerr << "crossrt: warning: remote cache key: " << keyError << "; the remote cache is off for this translation\n";
+    m_storages.clear();
+    return;
+  }
   auto add = [&](const std::string& folder, const char* placeholder) {
     if (folder.empty()) return;
     std::error_code ec;
@@ -211,6 +234,16 @@ void RemoteCache::Warn(const RemoteStorage& storage, const std::string& what, co
             << "); translating locally. Further failures in this build are not reported.\n";
 }
 
+void RemoteCache::Reject(const RemoteStorage& storage, const engine::TranslateRequest& request, const std::string& kind,
+                         const std::string& why) {
+  // Every rejection is reported: it is an entry someone wrote without this build's key.
+  const std::string what = "the " + kind + " entry for class '" + request.className + "' (" +
+                           engine::BackendName(request.backend) + ")";
+  std::cerr << "crossrt: warning: remote storage " << storage.Url() << ": rejected " << what << ": " << why
+            << "; this build takes only entries signed with key " << m_key->Id() << ". Translating locally.\n";
+  RecordRejection(m_buildDir, storage.Url(), what + ", key " + m_key->Id(), why);
+}
+
 bool RemoteCache::Fetch(const engine::TranslateRequest& request, engine::TranslateResult& result) {
   const std::string manifestKey = ManifestKey(request);
   for (auto& storage : m_storages) {
@@ -221,7 +254,11 @@ bool RemoteCache::Fetch(const engine::TranslateRequest& request, engine::Transla
       continue;
     }
     std::vector<InputSet> sets;
-    if (!manifest || !Decode(*manifest, "manifest", body) || !ParseManifest(body, m_identity, sets)) continue;
+    if (!manifest) continue;
+    std::string why;
+    const Entry decoded = Decode(*manifest, "manifest", manifestKey, Signer(), body, why);
+    if (decoded == Entry::Rejected) Reject(*storage, request, "manifest", why);
+    if (decoded != Entry::Usable || !ParseManifest(body, m_identity, sets)) continue;
     for (const InputSet& set : sets) {
       bool same = true;
       for (auto& [path, hash] : set.inputs) same = same && ContentHash(Local(path)) == hash;
@@ -231,7 +268,10 @@ bool RemoteCache::Fetch(const engine::TranslateRequest& request, engine::Transla
         Warn(*storage, "reading", error);
         break;
       }
-      if (!entry || !Decode(*entry, "result", body)) break;  // gone or corrupt: translated and stored again
+      if (!entry) break;  // gone: translated and stored again
+      const Entry decodedResult = Decode(*entry, "result", set.result, Signer(), body, why);
+      if (decodedResult == Entry::Rejected) Reject(*storage, request, "result", why);
+      if (decodedResult != Entry::Usable) break;  // corrupt or rejected: translated, and replaced by the upload
       Fields f(body);
       std::string identity, diagnostics;
       size_t inputs = 0, files = 0;
@@ -273,7 +313,7 @@ void RemoteCache::Store(const engine::TranslateRequest& request, const engine::T
   for (auto& [path, hash] : set.inputs) body += Field(path);
   body += Field(result.files.size());
   for (auto& [name, contents] : result.files) body += Field(name) + Field(Portable(contents));
-  const std::string entry = Encode("result", body);
+  const std::string entry = Encode("result", set.result, body, Signer());
 
   for (auto& storage : m_storages) {
     if (storage->Attributes().readOnly) continue;
@@ -284,9 +324,10 @@ void RemoteCache::Store(const engine::TranslateRequest& request, const engine::T
     }
     // The manifest: this input set first, then the others it held (a corrupt one is replaced).
     std::vector<InputSet> sets{set}, old;
-    std::string oldBody;
+    std::string oldBody, why;
     std::optional<std::string> manifest = storage->Get(manifestKey, error);
-    if (manifest && Decode(*manifest, "manifest", oldBody) && ParseManifest(oldBody, m_identity, old))
+    if (manifest && Decode(*manifest, "manifest", manifestKey, Signer(), oldBody, why) == Entry::Usable &&
+        ParseManifest(oldBody, m_identity, old))
       for (auto& s : old)
         if (s.result != set.result && sets.size() < kSetsPerManifest) sets.push_back(s);
     std::string manifestBody = Field(m_identity) + Field(sets.size());
@@ -295,7 +336,7 @@ void RemoteCache::Store(const engine::TranslateRequest& request, const engine::T
       for (auto& [path, hash] : s.inputs) manifestBody += Field(path) + Field(hash);
     }
     error.clear();
-    if (!storage->Put(manifestKey, Encode("manifest", manifestBody), error)) Warn(*storage, "writing", error);
+    if (!storage->Put(manifestKey, Encode("manifest", manifestKey, manifestBody, Signer()), error)) Warn(*storage, "writing", error);
   }
 }
 

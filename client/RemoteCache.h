@@ -11,12 +11,18 @@
 // byte-identical to a local one. Entries carry a format version, the translator's identity (a hash
 // of its daemon's bytes) and a checksum; anything else is ignored and replaced. A storage that fails
 // makes the build translate locally, with one warning per build, never an error.
+//
+// With a team key (TeamKey.h) every entry is signed, and an entry that is unsigned, signed with
+// another key or altered is rejected: a warning names the storage and the key, the rejection is
+// recorded for `crossrt daemon status` (RemoteRejections.h), and the class is translated locally.
 #pragma once
 #include "RemoteStorage.h"
+#include "TeamKey.h"
 #include "TranslateTypes.h"
 
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,8 +31,11 @@ namespace crossrt::client {
 class RemoteCache {
 public:
   // `storages`: the CROSSRT_REMOTE_STORAGE list; `sourceRoot`, `buildDir`: the folders whose paths
-  // entries hold relative (either may be empty).
-  RemoteCache(const std::string& storages, const std::string& sourceRoot, const std::string& buildDir);
+  // entries hold relative (either may be empty); `keyFile`: the team key's file, when the build
+  // names one (CROSSRT_REMOTE_KEY and CROSSRT_REMOTE_KEY_FILE win). A key that is configured but
+  // unusable turns the remote cache off, with a warning.
+  RemoteCache(const std::string& storages, const std::string& sourceRoot, const std::string& buildDir,
+              const std::string& keyFile = "");
   ~RemoteCache();
   bool Enabled() const { return !m_storages.empty(); }
 
@@ -42,8 +51,12 @@ private:
   std::string ManifestKey(const engine::TranslateRequest& request) const;
   std::string ContentHash(const std::string& path);  // "" when unreadable; remembered per path
   void Warn(const RemoteStorage& storage, const std::string& what, const std::string& error);
+  void Reject(const RemoteStorage& storage, const engine::TranslateRequest& request, const std::string& kind,
+              const std::string& why);
+  const TeamKey* Signer() const { return m_key ? &*m_key : nullptr; }
 
   std::vector<std::unique_ptr<RemoteStorage>> m_storages;
+  std::optional<TeamKey> m_key;
   std::vector<std::pair<std::string, std::string>> m_folders;  // folder, placeholder: longest first
   std::string m_buildDir, m_identity;
   std::map<std::string, std::string> m_hashes;

@@ -220,6 +220,11 @@ private:
     curl_easy_setopt(m_curl, CURLOPT_WRITEFUNCTION, Append);
     curl_easy_setopt(m_curl, CURLOPT_WRITEDATA, &body);
     curl_easy_setopt(m_curl, CURLOPT_HTTPHEADER, m_headers);
+    // Certificates and host names are checked (libcurl's defaults, set here so that no
+    // environment turns them off); |ca-file names the authorities to trust instead of the system's.
+    curl_easy_setopt(m_curl, CURLOPT_SSL_VERIFYPEER, 1L);
+    curl_easy_setopt(m_curl, CURLOPT_SSL_VERIFYHOST, 2L);
+    if (!Attributes().caFile.empty()) curl_easy_setopt(m_curl, CURLOPT_CAINFO, Attributes().caFile.c_str());
     if (upload) {
       curl_easy_setopt(m_curl, CURLOPT_UPLOAD, 1L);
       curl_easy_setopt(m_curl, CURLOPT_READFUNCTION, Read);
@@ -266,12 +271,17 @@ bool ParseAttribute(const std::string& text, StorageAttributes& attributes, std:
   if (name == "read-only") return attributes.readOnly = value.empty() || value == "true", true;
   if (name == "connect-timeout") return number(attributes.connectTimeoutMs);
   if (name == "operation-timeout") return number(attributes.operationTimeoutMs);
+  if (name == "ca-file") {
+    if (value.empty()) return error = "attribute 'ca-file' takes the path of a PEM file", false;
+    attributes.caFile = value;
+    return true;
+  }
   if (name == "layout") {
     if (value != "flat" && value != "bazel") return error = "layout is flat or bazel, not '" + value + "'", false;
     attributes.bazelLayout = value == "bazel";
     return true;
   }
-  error = "unknown attribute '" + name + "' (known: read-only, connect-timeout, operation-timeout, layout)";
+  error = "unknown attribute '" + name + "' (known: read-only, connect-timeout, operation-timeout, layout, ca-file)";
   return false;
 }
 
@@ -313,6 +323,10 @@ std::vector<std::unique_ptr<RemoteStorage>> ParseRemoteStorages(const std::strin
     }
     if (url.scheme == "redis") storages.push_back(std::make_unique<RedisStorage>(url, attributes));
     else if (url.scheme == "http" || url.scheme == "https") storages.push_back(std::make_unique<HttpStorage>(parts[0], url, attributes));
+    else if (url.scheme == "rediss")
+      errors.push_back(shown + ": Redis over TLS needs hiredis 1.0 with TLS, and this crossrt was built with hiredis " +
+                       std::to_string(HIREDIS_MAJOR) + "." + std::to_string(HIREDIS_MINOR) +
+                       ", which has none: use https://, or reach the server through a TLS tunnel (stunnel) with redis://");
     else errors.push_back(shown + ": unknown scheme '" + url.scheme + "' (redis, http or https)");
   }
   return storages;

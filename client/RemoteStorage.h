@@ -1,7 +1,9 @@
 // Remote storages that a team already runs, as ccache's remote storage names them: Redis
 // (redis://[[user]:password@]host[:port][/db]) and HTTP (http[s]://[user:token@]host[:port]/path,
 // plain GET and PUT of <url>/<key>: nginx's WebDAV module, ccache-style HTTP storages, or a Bazel
-// remote cache with |layout=bazel, which stores <url>/ac/<key>). A storage only moves bytes by key;
+// remote cache with |layout=bazel, which stores <url>/ac/<key>). https:// always checks the server's
+// certificate and host name. rediss:// (Redis over TLS) needs hiredis 1.0 with TLS, which Debian 12's
+// hiredis 0.14 lacks: such a URL is refused with a message saying so. A storage only moves bytes by key;
 // RemoteCache.h decides what they mean. It never throws: a failure is a message.
 #pragma once
 #include <memory>
@@ -16,6 +18,7 @@ struct StorageAttributes {
   int connectTimeoutMs = 100;     // |connect-timeout=MS
   int operationTimeoutMs = 2000;  // |operation-timeout=MS
   bool bazelLayout = false;       // |layout=bazel (HTTP only)
+  std::string caFile;             // |ca-file=PEM: the certificate authorities https:// trusts (default: the system's)
 };
 
 class RemoteStorage {

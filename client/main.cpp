@@ -1,7 +1,7 @@
 // crossrt: the command crossrt_add_class() runs.
 //
 //   crossrt translate --class NAME --backend vulkan|cpu|ispc --out DIR --source FILE... [options] [-- ARGS]
-//   crossrt daemon status [--build-dir DIR] [--json]
+//   crossrt daemon status [--build-dir DIR] [--json]      (with the remote cache's rejected entries)
 //   crossrt daemon stop [--build-dir DIR]
 //   crossrt --help | --version
 //
@@ -16,6 +16,7 @@
 #include "Outputs.h"
 #include "Protocol.h"
 #include "RemoteCache.h"
+#include "RemoteRejections.h"
 #include "SourceFinder.h"
 #include "TranslateTypes.h"
 
@@ -40,7 +41,8 @@ const char* kUsage =
     "                         [--candidate FILE... [--source-dir DIR]] [--compose INTERFACE=IMPL...] [--virtual-level 1|2|3]\n"
     "                         [--execution-mode wavefront|megakernel] [--name GENERATED] [--templates DIR]\n"
     "                         [--depfile FILE --depfile-target FILE]\n"
-    "                         [--build-dir DIR | --no-daemon] [--remote-storage URLS [--source-root DIR]]\n"
+    "                         [--build-dir DIR | --no-daemon]\n"
+    "                         [--remote-storage URLS [--source-root DIR] [--remote-key-file FILE]]\n"
     "                         [-- COMPILE_ARGS...]\n"
     "       crossrt daemon status [--build-dir DIR] [--json]\n"
     "       crossrt daemon stop [--build-dir DIR]\n"
@@ -62,10 +64,15 @@ const char* kHelp =
     "               by a team: redis://host[:port], http[s]://host/path, space-separated, each with\n"
     "               optional |read-only, |connect-timeout=MS, |operation-timeout=MS, |layout=bazel.\n"
     "               Paths under --build-dir and --source-root are stored relative to them.\n"
+    "               With a team key (CROSSRT_REMOTE_KEY, or the file that CROSSRT_REMOTE_KEY_FILE or\n"
+    "               --remote-key-file names; never the key itself on a command line) entries are\n"
+    "               signed, and entries that do not verify are rejected: translated locally instead.\n"
+    "               |ca-file=PEM trusts that certificate authority for https:// storages.\n"
     "               --name names the generated class (and its files and global symbols) instead of\n"
     "               NAME_Vulkan, NAME_CPU or NAME_ISPC, so that several translations of one class (at\n"
     "               different virtual levels, say) link into one program.\n"
-    "daemon status  prints what the build tree's daemon holds (--json for a machine).\n"
+    "daemon status  prints what the build tree's daemon holds (--json for a machine), and how many\n"
+    "               remote cache entries the build tree rejected.\n"
     "daemon stop    stops it; the next translation starts another.\n"
     "\n";
 
@@ -139,9 +146,19 @@ int DaemonCommand(const std::vector<std::string>& args) {
   if (what != "status" && what != "stop") return Usage("daemon command must be 'status' or 'stop'");
   DaemonClient daemon(buildDir);
   auto response = daemon.Call({{"command", what}}, /*start=*/false, 10);
+  // Rejected remote entries are the build tree's record, not the daemon's: shown with or without one.
+  const crossrt::client::Rejections rejections = crossrt::client::ReadRejections(buildDir);
+  const nlohmann::json rejectionsJson{{"count", rejections.count}, {"last", rejections.last}};
+  auto printRejections = [&] {
+    std::printf("  remote cache    %zu %s rejected%s%s\n", rejections.count, rejections.count == 1 ? "entry" : "entries",
+                rejections.count ? "; the last: " : "", rejections.last.c_str());
+  };
   if (!response) {
-    if (asJson) std::cout << nlohmann::json{{"running", false}, {"buildDir", buildDir}}.dump(2) << "\n";
-    else std::cout << "no daemon serves " << buildDir << "\n";
+    if (asJson) std::cout << nlohmann::json{{"running", false}, {"buildDir", buildDir}, {"remoteRejections", rejectionsJson}}.dump(2) << "\n";
+    else {
+      std::cout << "no daemon serves " << buildDir << "\n";
+      if (what == "status" && rejections.count) printRejections();
+    }
     return what == "stop" ? 0 : 1;
   }
   if (!response->value("ok", false)) {
@@ -165,6 +182,7 @@ int DaemonCommand(const std::vector<std::string>& args) {
   if (asJson) {
     nlohmann::json out = s;
     out["running"] = true;
+    out["remoteRejections"] = rejectionsJson;
     std::cout << out.dump(2) << "\n";
     return 0;
   }
@@ -177,6 +195,7 @@ int DaemonCommand(const std::vector<std::string>& args) {
               (unsigned long long)s.value("translations", 0ull), (unsigned long long)s.value("failedTranslations", 0ull));
   std::printf("  AST hit rate    %.0f%% (%llu reparses, %llu parses)\n", 100.0 * s.value("astHitRate", 0.0),
               (unsigned long long)s.value("reparses", 0ull), (unsigned long long)s.value("parses", 0ull));
+  printRejections();
   return 0;
 }
 
@@ -198,7 +217,7 @@ int main(int argc, char** argv) {
 
   engine::TranslateRequest request;
   request.templateDir = CROSSRT_DEFAULT_TEMPLATE_DIR;
-  std::string depfile, depfileTarget, backend, buildDir, sourceDir, remoteStorage, sourceRoot;
+  std::string depfile, depfileTarget, backend, buildDir, sourceDir, remoteStorage, sourceRoot, remoteKeyFile;
   bool useDaemon = std::getenv("CROSSRT_NO_DAEMON") == nullptr;
   std::vector<std::string> candidates;
   for (size_t i = 1; i < args.size(); ++i) {
@@ -250,6 +269,9 @@ int main(int argc, char** argv) {
     else if (a == "--build-dir") buildDir = v;
     else if (a == "--remote-storage") remoteStorage = v;
     else if (a == "--source-root") sourceRoot = v;
+    else if (a == "--remote-key-file") remoteKeyFile = v;
+    else if (a == "--remote-key") return Usage("the team key is never given on the command line, where other users and build logs see it: "
+                                               "set CROSSRT_REMOTE_KEY, or name a key file with --remote-key-file or CROSSRT_REMOTE_KEY_FILE");
     else return Usage("unknown option '" + a + "'");
   }
   if (request.className.empty()) return Usage("--class is required");
@@ -281,7 +303,7 @@ int main(int argc, char** argv) {
   engine::TranslateResult result;
   bool translated = false;
   if (const char* env = std::getenv("CROSSRT_REMOTE_STORAGE")) remoteStorage = env;
-  crossrt::client::RemoteCache remote(remoteStorage, sourceRoot, buildDir);
+  crossrt::client::RemoteCache remote(remoteStorage, sourceRoot, buildDir, remoteKeyFile);
   const bool fromRemote = remote.Enabled() && remote.Fetch(request, result);
   translated = fromRemote;
   if (!translated && useDaemon && !buildDir.empty()) {

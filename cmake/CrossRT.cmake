@@ -40,6 +40,10 @@
 # time, which wins): remote caches a team shares translations through, e.g.
 # "redis://cache.lab:6379 http://cache.lab/crossrt|read-only" (docs/remote-cache.md). Paths under
 # the build tree and the top-level source folder are stored relative to them.
+# CROSSRT_REMOTE_KEY_FILE (a cache variable): a file holding the team's key; with it every entry is
+# signed (HMAC-SHA256) and entries that do not verify are translated locally instead. The
+# environment's CROSSRT_REMOTE_KEY (the key) and CROSSRT_REMOTE_KEY_FILE win. Never put the key
+# itself in a CMake variable: it would land in build.ninja.
 #
 # Works from the source tree (add_subdirectory) and from an installed package (find_package).
 include_guard(GLOBAL)
@@ -51,6 +55,8 @@ set(CROSSRT_ISPC_TARGETS sse4-i32x4 avx2-i32x8 avx512skx-x16)
 
 set(CROSSRT_REMOTE_STORAGE "" CACHE STRING
     "Remote translation caches: redis://host[:port] or http[s]://host/path, space-separated, each with optional |read-only")
+set(CROSSRT_REMOTE_KEY_FILE "" CACHE FILEPATH
+    "A file holding the team key that signs and verifies remote cache entries (docs/remote-cache.md, Trust)")
 
 # Registers the source files that define Implementation's methods, so that
 # crossrt_add_class(... COMPOSE Interface=Implementation) parses them (absolute paths).
@@ -206,6 +212,7 @@ function(crossrt_add_class target class)
             --depfile ${out_dir}/${gen}.d --depfile-target ${first_output}
             --build-dir ${CMAKE_BINARY_DIR} --source-root ${CMAKE_SOURCE_DIR}
             "$<$<BOOL:${CROSSRT_REMOTE_STORAGE}>:--remote-storage;${CROSSRT_REMOTE_STORAGE}>"
+            "$<$<BOOL:${CROSSRT_REMOTE_KEY_FILE}>:--remote-key-file;${CROSSRT_REMOTE_KEY_FILE}>"
             -- ${compile_args}
     DEPENDS ${abs_sources} ${candidates} ${translator_dep}
     DEPFILE ${out_dir}/${gen}.d

@@ -13,8 +13,8 @@ PACKAGES=(
   libopenimageio-dev openimageio-tools                     # image IO
   catch2 nlohmann-json3-dev libkainjow-mustache-dev libxxhash-dev
   python3-matplotlib                                       # plots of the benchmarks' CSV tables
-  libhiredis-dev libcurl4-openssl-dev                      # the remote translation cache (Redis, HTTP)
-  redis-server nginx-light                                 # its tests' servers, on loopback ports
+  libhiredis-dev libcurl4-openssl-dev libssl-dev           # the remote translation cache (Redis, HTTP, HMAC)
+  redis-server nginx-light openssl                         # its tests' servers, on loopback ports, and TLS keys
   libopenvdb-dev                                           # bench_sdf's peer: OpenVDB level sets
 )
 missing=()
