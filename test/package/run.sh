@@ -4,6 +4,8 @@
 #   run.sh subdirectory <crossrt source dir> <work dir> : add_subdirectory(crossrt)
 #   run.sh duplicate <crossrt build dir> <work dir>  : a class translated twice under one name is a
 #                                                      configure error that names NAME
+#   run.sh remote-options <crossrt build dir> <work dir> : CROSSRT_REMOTE_STORAGE and
+#                                                      CROSSRT_REMOTE_KEY_FILE reach every translation
 set -euo pipefail
 mode=$1 crossrt=$2 work=$3
 here=$(cd "$(dirname "$0")" && pwd)
@@ -22,6 +24,22 @@ if [ "$mode" = duplicate ]; then
     cat "$work/configure.log" >&2
     exit 1
   fi
+  echo OK
+  exit 0
+fi
+if [ "$mode" = remote-options ]; then
+  # The key file's path reaches the translations; the key never does (it is not in the build).
+  cmake --install "$crossrt" --prefix "$work/prefix" > "$work/install.log"
+  printf 'k3y-never-in-the-build-0123456789abcdef\n' > "$work/team.key"
+  cmake -S "$here" -B "$work/build" -G Ninja -DCMAKE_PREFIX_PATH="$work/prefix" \
+    -DCROSSRT_REMOTE_STORAGE="redis://127.0.0.1:1|read-only" -DCROSSRT_REMOTE_KEY_FILE="$work/team.key" > "$work/configure.log"
+  translations=$(grep -c "crossrt translate" "$work/build/build.ninja" || true)
+  with_key=$(grep "crossrt translate" "$work/build/build.ninja" | grep -c -E -- "--remote-storage \"?redis://127.0.0.1:1\|read-only\"? --remote-key-file $work/team.key" || true)
+  if [ "$translations" -eq 0 ] || [ "$with_key" -ne "$translations" ]; then
+    echo "$with_key of $translations translation commands get the remote storage and the key file" >&2
+    exit 1
+  fi
+  if grep -rq k3y-never "$work/build"; then echo "the key itself is in the build tree" >&2; exit 1; fi
   echo OK
   exit 0
 fi
