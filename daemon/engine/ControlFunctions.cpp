@@ -170,6 +170,7 @@ void ControlRewriter::Run() {
   Visit(m_def->getBody());
   CheckTemporaryUses();
   CheckHostVectorUses();
+  SynchronizeHostVectors();
   SplitAtHostReads();
   MoveHostTail();
   m_ctrl.vulkanCmdBody = CanonicalCode(m_gpu.getRewrittenText(m_def->getBody()->getSourceRange()));

@@ -160,9 +160,25 @@ private:
   // Synchronize(a_cmd, ...), which splits the recording there.
   void SplitAtHostReads();
   // Member vectors on the host before the last kernel call: a read of one kernels write, between
-  // them, and any change of one kernels use are errors on Vulkan (the device copies were uploaded
-  // when the call began). size(), data() and swaps are translated.
+  // them, or any change of one kernels use, is synchronised around the statement that holds it
+  // (SynchronizeAround); resizing one, or a use inside a statement that records GPU work too, is an
+  // error on Vulkan (the device buffers were sized when the call began). size() and swaps need nothing.
   void CheckHostVectorUses();
+  // Marks the outermost statement around `use` that records no GPU work for a Synchronize before
+  // it, with `m` read back (download) and uploaded after it (upload); false where there is none.
+  bool SynchronizeAround(const MemberExpr* use, const Member& m, bool download, bool upload);
+  // Writes those: `Synchronize(a_cmd, ...); crossrt::DownloadVector(...);` before each statement,
+  // `crossrt::UploadVector(...);` after it, and a note of the round trip.
+  void SynchronizeHostVectors();
+  struct HostVectorSync {
+    std::set<std::string> downloads, uploads;
+    SourceLocation at;  // the statement's start, for the note
+  };
+  std::map<const Stmt*, HostVectorSync> m_vectorSyncs;
+  std::vector<const Stmt*> m_vectorSyncOrder;  // the statements in the order found (stable output)
+  // Vectors the kernels use that the code after the last kernel changes ("hostExpr|name"): uploaded
+  // at the end of the host tail.
+  std::set<std::string> m_tailUploads;
   std::vector<const MemberExpr*> m_syncReads;
   // Kernel calls that take such a member as an argument: `Synchronize(a_cmd, ...), kernel1D_XCmd(...)`.
   std::set<const CallExpr*> m_syncCalls;

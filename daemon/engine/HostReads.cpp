@@ -13,6 +13,7 @@
 // reads.
 #include "ControlFunctions.h"
 #include "ControlRewriter.h"
+#include "GeneratedNames.h"
 
 using namespace clang;
 
@@ -192,6 +193,85 @@ SourceLocation FirstGpuWork(Context& c, const Stmt* s) {
   return first;
 }
 
+// Whether `me` (a member vector) is only read where it stands: an element read as a value
+// (m_v[i], m_v[i].x, m_v.at(i), m_v.front()), or iterated by value or const reference. Anything
+// else (an element assigned, a non-const reference, an iterator or data() handed on) may change it.
+bool ReadOnlyUse(ASTContext& ctx, const MemberExpr* me) {
+  auto parentOf = [&](const DynTypedNode& n) { const auto p = ctx.getParents(n); return p.empty() ? DynTypedNode() : p[0]; };
+  DynTypedNode node = DynTypedNode::create(*me);
+  // Up to the element: through casts and parentheses, a subscript, at/front/back, and a field of it.
+  bool element = false;
+  for (;;) {
+    const DynTypedNode up = parentOf(node);
+    if (auto* cast = up.get<ImplicitCastExpr>()) {
+      if (cast->getCastKind() == CK_LValueToRValue) return element;
+      node = up;
+      continue;
+    }
+    if (up.get<ParenExpr>()) {
+      node = up;
+      continue;
+    }
+    if (auto* op = up.get<CXXOperatorCallExpr>(); op && op->getOperator() == OO_Subscript && !element) {
+      element = true, node = up;
+      continue;
+    }
+    if (up.get<MemberExpr>()) {  // m_v.size(), m_v.at(i), or a field of an element
+      const DynTypedNode call = parentOf(up);
+      if (auto* mc = call.get<CXXMemberCallExpr>()) {
+        const std::string method = mc->getMethodDecl() ? mc->getMethodDecl()->getNameAsString() : "";
+        if (method == "size" || method == "empty" || method == "capacity") return true;
+        if (!element && (method == "at" || method == "front" || method == "back")) {
+          element = true, node = call;
+          continue;
+        }
+        return element && mc->getMethodDecl()->isConst();  // a const method of an element
+      }
+      if (!element) return false;
+      node = up;  // m_v[i].x
+      continue;
+    }
+    // for (float v : m_v) or for (const T& v : m_v): read; for (T& v : m_v): written.
+    if (auto* range = up.get<VarDecl>(); range && !element) {
+      const DynTypedNode declStmt = parentOf(up);
+      if (auto* loop = parentOf(declStmt).get<CXXForRangeStmt>(); loop && loop->getRangeStmt() == declStmt.get<DeclStmt>()) {
+        const QualType t = loop->getLoopVariable()->getType();
+        return !t->isReferenceType() || t.getNonReferenceType().isConstQualified();
+      }
+    }
+    return false;
+  }
+}
+
+// Calls on a member vector that need nothing on the host between kernel calls (LiteMath's
+// ReduceAddInit and ReduceAddComplete are GPU work of their own), and those that resize it.
+const std::set<std::string> kHarmless = {"size", "capacity", "empty", "swap", "std::swap", "reserve", "ReduceAddInit", "ReduceAddComplete"};
+const std::set<std::string> kResizing = {"push_back", "emplace_back", "pop_back", "resize", "assign", "clear", "insert", "erase", "emplace", "shrink_to_fit"};
+
+// The member vectors kernels use (or that `alsoUsed` names: those handed to them through data() or
+// swapped) whose elements `s` may change, as "hostExpr|name". A resize is not among them: the next call gives a resized
+// vector a new device buffer, filled.
+std::set<std::string> ChangedDeviceVectors(Context& c, const std::set<std::string>& alsoUsed, const Stmt* s) {
+  struct Uses : RecursiveASTVisitor<Uses> {
+    std::vector<const MemberExpr*> uses;
+    bool VisitMemberExpr(MemberExpr* me) {
+      if (isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts())) uses.push_back(me);
+      return true;
+    }
+  } uses;
+  uses.TraverseStmt(const_cast<Stmt*>(s));
+  std::set<std::string> changed;
+  for (const MemberExpr* me : uses.uses) {
+    auto* f = dyn_cast<FieldDecl>(me->getMemberDecl());
+    const Member* m = f ? FindMember(c.model, f->getNameAsString()) : nullptr;
+    if (!m || m->kind != MemberKind::Vector || !(m->usedByKernels || alsoUsed.count(m->name)) || m->appendedByKernels) continue;
+    const std::string call = UsingCall(c.ctx, me);
+    if (kHarmless.count(call) || kResizing.count(call) || ReadOnlyUse(c.ctx, me)) continue;
+    changed.insert(m->hostExpr + "|" + m->name);
+  }
+  return changed;
+}
+
 }  // namespace
 
 void ControlRewriter::FindHostTail() {
@@ -237,14 +317,19 @@ void ControlRewriter::FindHostTail() {
                                "read it inside a kernel, which sees the GPU's copy, or after the last kernel call: code there runs once the results are back");
     }
   }
-  // The tail moves only when it needs to: when it reads what the kernels wrote.
+  // The tail moves only when it needs to: when it reads what the kernels wrote, or changes a vector
+  // they use (uploaded at its end, or the next call's kernels would see the copy from before).
   bool reads = false;
   const std::set<std::string> vectors = VectorsKernelsWrite(m_c, m_def);
-  for (size_t i = size_t(last) + 1; i < statements.size(); ++i)
+  for (size_t i = size_t(last) + 1; i < statements.size(); ++i) {
     reads = reads || !KernelWrittenReads(m_c, m_def, statements[i]).empty() || UsesWrittenVector(m_c, vectors, statements[i]);
-  if (!reads) return;
+    const std::set<std::string> changed = ChangedDeviceVectors(m_c, vectors, statements[i]);
+    m_tailUploads.insert(changed.begin(), changed.end());
+  }
+  if (!reads && m_tailUploads.empty()) return;
   m_tail.assign(statements.begin() + last + 1, statements.end());
 }
+
 
 void ControlRewriter::CheckHostVectorUses() {
   auto* body = dyn_cast<CompoundStmt>(m_def->getBody());
@@ -262,40 +347,12 @@ void ControlRewriter::CheckHostVectorUses() {
   KernelCallFinder gpu(m_c.cls);  // kernel and library calls: what they take is the GPU's business
   gpu.TraverseStmt(const_cast<Stmt*>(m_def->getBody()));
   struct Uses : RecursiveASTVisitor<Uses> {
-    std::set<const Expr*> changed;  // vectors (their MemberExpr) assigned through, or changed by a method
     std::vector<const MemberExpr*> uses;
-    void Changed(const Expr* e) {
-      for (e = e->IgnoreParenImpCasts();;) {
-        if (auto* me = dyn_cast<MemberExpr>(e); me && !isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts())) e = me->getBase()->IgnoreParenImpCasts();
-        else if (auto* op = dyn_cast<CXXOperatorCallExpr>(e); op && op->getOperator() == OO_Subscript) e = op->getArg(0)->IgnoreParenImpCasts();
-        else break;
-      }
-      changed.insert(e);
-    }
-    bool VisitBinaryOperator(BinaryOperator* bo) {
-      if (bo->isAssignmentOp()) Changed(bo->getLHS());
-      return true;
-    }
-    bool VisitUnaryOperator(UnaryOperator* uo) {
-      if (uo->isIncrementDecrementOp()) Changed(uo->getSubExpr());
-      return true;
-    }
-    bool VisitCXXOperatorCallExpr(CXXOperatorCallExpr* op) {
-      if (op->isAssignmentOp() || op->getOperator() == OO_PlusPlus || op->getOperator() == OO_MinusMinus) Changed(op->getArg(0));
-      return true;
-    }
-    bool VisitCXXMemberCallExpr(CXXMemberCallExpr* mc) {
-      static const std::set<std::string> changing = {"push_back", "emplace_back", "pop_back", "resize", "assign", "clear", "insert", "erase", "emplace", "shrink_to_fit"};
-      if (mc->getMethodDecl() && changing.count(mc->getMethodDecl()->getNameAsString())) Changed(mc->getImplicitObjectArgument());
-      return true;
-    }
     bool VisitMemberExpr(MemberExpr* me) {
       if (isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts())) uses.push_back(me);
       return true;
     }
   };
-  // (LiteMath's ReduceAddInit and ReduceAddComplete are GPU work of their own.)
-  static const std::set<std::string> harmless = {"size", "capacity", "empty", "data", "swap", "std::swap", "reserve", "ReduceAddInit", "ReduceAddComplete"};
   for (int i = 0; i <= last; ++i) {
     const bool loop = isa<ForStmt, WhileStmt, DoStmt, CXXForRangeStmt>(statements[i]) && FirstGpuWork(m_c, statements[i]).isValid();
     Uses uses;
@@ -304,20 +361,83 @@ void ControlRewriter::CheckHostVectorUses() {
       auto* f = dyn_cast<FieldDecl>(me->getMemberDecl());
       const Member* m = f ? FindMember(m_c.model, f->getNameAsString()) : nullptr;
       if (!m || m->kind != MemberKind::Vector || !m->usedByKernels || m->appendedByKernels || EnclosingCall(sm, gpu.calls, me)) continue;
-      // size(), data() and the like, and std::swap's arguments, are the translated uses.
-      if (harmless.count(UsingCall(m_c.ctx, me))) continue;
+      // size() and the like, and std::swap's arguments, are the translated uses.
+      const std::string call = UsingCall(m_c.ctx, me);
+      if (kHarmless.count(call)) continue;
+      if (kResizing.count(call)) {
+        m_c.rep.RecordingError(me->getExprLoc(), "control function '" + m_ctrl.name + "' resizes '" + m->name +
+                                   "' before its last kernel call, but its kernels use the device buffer sized when the call began",
+                               "size it before the call (the next call makes its buffer anew), or keep its size and change its elements, which is translated; "
+                               "a swap of two member vectors (std::swap(" + m->name + ", other)) is translated too");
+        continue;
+      }
       const bool written = m->writtenByKernels || std::find(m_ctrl.vectorsWritten.begin(), m_ctrl.vectorsWritten.end(), m->name) != m_ctrl.vectorsWritten.end();
       const bool after = loop || sm.isBeforeInTranslationUnit(firstWork, me->getBeginLoc());
-      if (uses.changed.count(me))
-        m_c.rep.RecordingError(me->getExprLoc(), "control function '" + m_ctrl.name + "' changes '" + m->name +
-                                   "' on the host before its last kernel call, but its kernels use the device copy uploaded when the call began",
-                               "change it in a kernel, or before the call and then call CommitDeviceData(); a swap of two member vectors (std::swap(" +
-                                   m->name + ", other)) is translated");
-      else if (written && after)
-        m_c.rep.RecordingError(me->getExprLoc(), "control function '" + m_ctrl.name + "' reads '" + m->name +
-                                   "' between kernel calls, but kernels write it on the GPU, and it is copied back only when the call returns",
-                               "read it in a kernel, or after the last kernel call: code there runs once the results are back");
+      const bool changes = !ReadOnlyUse(m_c.ctx, me);
+      if (!changes && !(written && after)) continue;  // a read of what only the host writes
+      if (!SynchronizeAround(me, *m, written, changes))
+        m_c.rep.RecordingError(me->getExprLoc(), "control function '" + m_ctrl.name + "' " + (changes ? "changes" : "reads") + " '" + m->name +
+                                   "' on the host in a statement that also records GPU work, between kernel calls",
+                               "use it in a statement of its own, before or after the kernel call (e.g. 'const auto v = " + m->name +
+                                   "[i];'): there the generated class waits for the GPU, reads the vector back and uploads it again");
     }
+  }
+}
+
+bool ControlRewriter::SynchronizeAround(const MemberExpr* use, const Member& m, bool download, bool upload) {
+  // The outermost statement around the use that records no GPU work and is one of a block's: the
+  // vector is synchronised once around it (around a whole host loop, say, not per element).
+  const Stmt* chosen = nullptr;
+  DynTypedNode node = DynTypedNode::create(*use);
+  for (;;) {
+    const auto parents = m_c.ctx.getParents(node);
+    if (parents.empty()) break;
+    if (auto* block = parents[0].get<CompoundStmt>()) {
+      const Stmt* child = node.get<Stmt>();
+      if (!child || FirstGpuWork(m_c, child).isValid()) break;
+      chosen = child;
+      if (block == m_def->getBody()) break;
+    }
+    node = parents[0];
+  }
+  if (!chosen) return false;
+  HostVectorSync& sync = m_vectorSyncs[chosen];
+  if (sync.downloads.empty() && sync.uploads.empty()) m_vectorSyncOrder.push_back(chosen);
+  if (download) sync.downloads.insert(m.name);
+  if (upload) sync.uploads.insert(m.name);
+  sync.at = chosen->getBeginLoc();
+  return true;
+}
+
+void ControlRewriter::SynchronizeHostVectors() {
+  if (m_vectorSyncs.empty()) return;
+  m_ctrl.synchronizes = true;
+  auto& sm = m_c.ctx.getSourceManager();
+  const auto& lang = m_c.ctx.getLangOpts();
+  const std::string buffers = generated::kVectorCopies + ".";
+  for (const Stmt* s : m_vectorSyncOrder) {
+    const HostVectorSync& sync = m_vectorSyncs[s];
+    std::string before = "Synchronize(a_cmd, \"" + m_ctrl.name + "\");  // crossrt: the host uses member vectors below: wait for the GPU\n";
+    std::string after, names;
+    for (const std::string& name : sync.downloads) {
+      const Member* m = FindMember(m_c.model, name);
+      before += "crossrt::DownloadVector(" + buffers + name + ", " + m->hostExpr + ");\n";
+    }
+    for (const std::string& name : sync.uploads) {
+      const Member* m = FindMember(m_c.model, name);
+      after += "\ncrossrt::UploadVector(" + buffers + name + ", " + m->hostExpr + ");  // crossrt: the host changed it above";
+    }
+    for (const std::string& name : sync.downloads) names += (names.empty() ? "'" : ", '") + name + "'";
+    std::string uploaded;
+    for (const std::string& name : sync.uploads) uploaded += (uploaded.empty() ? "'" : ", '") + name + "'";
+    m_gpu.InsertTextBefore(s->getBeginLoc(), before);
+    SourceLocation end = Lexer::findLocationAfterToken(s->getEndLoc(), tok::semi, sm, lang, false);
+    if (end.isInvalid()) end = Lexer::getLocForEndOfToken(s->getEndLoc(), 0, sm, lang);  // a block or loop
+    if (!after.empty()) m_gpu.InsertTextAfter(end, after);
+    if (m_c.rep.RecordingRules())
+      m_c.rep.Note(sync.at, "'" + m_ctrl.name + "' uses member vectors on the host between kernel calls: on Vulkan the recording is split before this statement (the work recorded so far is submitted and waited for" +
+                                (names.empty() ? "" : ", and " + names + " read back") + ")" + (uploaded.empty() ? "" : " and " + uploaded + " uploaded after it") +
+                                ", a round trip to the GPU each time it runs");
   }
 }
 
@@ -366,8 +486,13 @@ void ControlRewriter::MoveHostTail() {
   std::string captures = "this";
   for (const std::string& name : uses.captured) captures += ", " + name;
   m_ctrl.hasHostTail = true;
+  std::string uploads;
+  for (const std::string& upload : m_tailUploads) {
+    const std::string host = upload.substr(0, upload.find('|')), name = upload.substr(upload.find('|') + 1);
+    uploads += "\ncrossrt::UploadVector(" + generated::kVectorCopies + "." + name + ", " + host + ");";
+  }
   m_gpu.ReplaceText(range, "m_hostTail_" + m_ctrl.name + " = [" + captures + "]() mutable {\n" +
-                               std::string(Lexer::getSourceText(range, sm, m_c.ctx.getLangOpts())) + "\n};");
+                               std::string(Lexer::getSourceText(range, sm, m_c.ctx.getLangOpts())) + uploads + "\n};");
 }
 
 }  // namespace crossrt::engine

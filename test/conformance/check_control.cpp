@@ -14,6 +14,13 @@
 #include "HeatDiffusion_ISPC.h"
 #endif
 #endif
+#if __has_include("KMeans_CPU.h")
+#include "KMeans_CPU.h"
+#include "KMeans_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "KMeans_ISPC.h"
+#endif
+#endif
 #if __has_include("PingPong_CPU.h")
 #include "PingPong_CPU.h"
 #include "PingPong_Vulkan.h"
@@ -81,6 +88,37 @@ Register pingPong(MakeCase<PingPong>(
                                  std::to_string(p.m_b[0]));
       Append(r, p.m_a);
       Append(r, p.m_b);
+      // A change after the last kernel reaches the device copy the next call uses.
+      p.FillThenSet(5);
+      p.Run(1);
+      if (p.m_a[0] != -4 || p.m_a[1] != 6)
+        throw std::runtime_error("after FillThenSet(5) and Run(1) m_a should start -4, 6, not " + std::to_string(p.m_a[0]) + ", " + std::to_string(p.m_a[1]));
+      Append(r, p.m_a);
+      return r;
+    }));
+#endif
+
+#if __has_include("KMeans_CPU.h")
+// Fit: the host clears the counts, moves the centroids to the means and reads the number of
+// changed labels between kernel calls. Integer points: the sums are exact in any order, so every
+// backend must give the same centroids, labels and number of rounds.
+Register kMeans(MakeCase<KMeans>(
+    "k-means: member vectors read (counts, sums) and written (counts, centroids) on the host between kernel calls, an early break",
+    "clustering.h/.cpp", 1e-5, CONFORMANCE_MAKERS(KMeans, 600, 4), [](KMeans& k) {
+      k.CommitDeviceData();
+      Outputs r;
+      k.Fit(50);
+      int total = 0;
+      for (int c : k.Counts()) total += c;
+      // The four blobs are found: each cluster holds a quarter of the points, its centroid near a blob's centre.
+      if (k.Iterations() <= 2 || k.Iterations() >= 50 || total != 600 || k.Counts()[0] != 150 || k.Counts()[3] != 150)
+        throw std::runtime_error("Fit should find the four blobs of 150 points in a few rounds (" + std::to_string(k.Iterations()) + " rounds, counts " +
+                                 std::to_string(k.Counts()[0]) + " " + std::to_string(k.Counts()[1]) + " " + std::to_string(k.Counts()[2]) + " " +
+                                 std::to_string(k.Counts()[3]) + ")");
+      r.push_back(k.Iterations());
+      for (const float2& c : k.Centroids()) r.push_back(c.x), r.push_back(c.y);
+      Append(r, k.Labels());
+      Append(r, k.Counts());
       return r;
     }));
 #endif

@@ -493,10 +493,12 @@ void OutParam::Run(int n, const float* in, float* out)
   }
 }
 
-TEST_CASE("Member vectors on the host before the last kernel call are reported on Vulkan, not on the CPU backends", "[diagnostics]")
+TEST_CASE("Member vectors on the host between kernel calls: element uses are synchronised on Vulkan, resizing is reported", "[diagnostics]")
 {
   // The Vulkan class uploads member vectors when the call begins and reads back those its kernels
-  // write when it ends: the host copy in between is stale, and changes to it never reach the GPU.
+  // write when it ends. Host code between kernel calls that uses their elements gets the recording
+  // split around it (wait, read back, upload); a resize, or a use inside a statement that also
+  // records GPU work, cannot be split so and is an error. The CPU backends run it as written.
   const std::string header = R"(#pragma once
 #include <vector>
 class Counts
@@ -511,11 +513,14 @@ protected:
   void kernel1D_Twice(int n);
 };
 )";
-  const std::string source = R"(#include "Counts.h"
+  const std::string kernels = R"(#include "Counts.h"
 #include <utility>
 void Counts::kernel1D_Copy(int n) { for (int i = 0; i < n; i++) m_out[i] = m_in[i]; }
 void Counts::kernel1D_Twice(int n) { for (int i = 0; i < n; i++) m_out[i] = 2 * m_in[i]; }
-void Counts::Run(int n)
+)";
+  SECTION("refused: a resize, and a read inside a statement that records GPU work")
+  {
+    TempClass tc("Counts", header, kernels + R"(void Counts::Run(int n)
 {
   m_in[0] = 5;
   kernel1D_Copy(n);
@@ -523,26 +528,66 @@ void Counts::Run(int n)
   m_in.resize(n);
   std::swap(m_in, m_other);
   kernel1D_Twice(int(m_in.size()));
+  if (m_out[1] > 0) kernel1D_Copy(n);
   m_first = m_out[0];
 }
-)";
-  TempClass tc("Counts", header, source);
-  CommandResult r = RunCrossrt("translate --class Counts --backend vulkan --out " + (tc.dir / "out").string() + " --source " + tc.Source("Counts") +
-                               " --templates " CROSSRT_SOURCE_DIR "/templates");
-  INFO(r.output);
-  REQUIRE_FALSE(r.crashed);
-  REQUIRE(r.exitCode == 1);
-  CHECK(r.output.find("Counts.cpp:7:3: error: control function 'Run' changes 'm_in' on the host before its last kernel call") != std::string::npos);
-  CHECK(r.output.find("Counts.cpp:9:7: error: control function 'Run' reads 'm_out' between kernel calls") != std::string::npos);
-  CHECK(r.output.find("Counts.cpp:10:3: error: control function 'Run' changes 'm_in'") != std::string::npos);  // resize
-  CHECK(r.output.find("Counts.cpp:11:") == std::string::npos);   // a swap is translated
-  CHECK(r.output.find("Counts.cpp:12:") == std::string::npos);   // size() and a kernel's argument are fine
-  CHECK(r.output.find("Counts.cpp:13:") == std::string::npos);   // after the last kernel: runs once m_out is back
-  for (const char* backend : {"cpu", "ispc"}) {
-    CommandResult cpu = RunCrossrt(std::string("translate --class Counts --backend ") + backend + " --out " + (tc.dir / backend).string() +
-                                   " --source " + tc.Source("Counts") + " --templates " CROSSRT_SOURCE_DIR "/templates");
-    INFO(cpu.output);
-    CHECK(cpu.exitCode == 0);
+)");
+    CommandResult r = RunCrossrt("translate --class Counts --backend vulkan --out " + (tc.dir / "out").string() + " --source " + tc.Source("Counts") +
+                                 " --templates " CROSSRT_SOURCE_DIR "/templates");
+    INFO(r.output);
+    REQUIRE_FALSE(r.crashed);
+    REQUIRE(r.exitCode == 1);
+    CHECK(r.output.find("Counts.cpp:7:3: error") == std::string::npos);   // an element written: uploaded after it
+    CHECK(r.output.find("Counts.cpp:9:3: error") == std::string::npos);   // read back before it
+    CHECK(r.output.find("Counts.cpp:10:3: error: control function 'Run' resizes 'm_in' before its last kernel call") != std::string::npos);
+    CHECK(r.output.find("Counts.cpp:11:") == std::string::npos);   // a swap is translated
+    CHECK(r.output.find("Counts.cpp:12:") == std::string::npos);   // size() and a kernel's argument are fine
+    CHECK(r.output.find("Counts.cpp:13:7: error: control function 'Run' reads 'm_out' on the host in a statement that also records GPU work") !=
+          std::string::npos);
+    CHECK(r.output.find("use it in a statement of its own") != std::string::npos);
+    CHECK(r.output.find("Counts.cpp:14:") == std::string::npos);   // after the last kernel: runs once m_out is back
+    for (const char* backend : {"cpu", "ispc"}) {
+      CommandResult cpu = RunCrossrt(std::string("translate --class Counts --backend ") + backend + " --out " + (tc.dir / backend).string() +
+                                     " --source " + tc.Source("Counts") + " --templates " CROSSRT_SOURCE_DIR "/templates");
+      INFO(cpu.output);
+      CHECK(cpu.exitCode == 0);
+    }
+  }
+  SECTION("translated: the recording is split around each host statement, with a note")
+  {
+    TempClass tc("Counts", header, kernels + R"(void Counts::Run(int n)
+{
+  m_in[0] = 5;
+  kernel1D_Copy(n);
+  if (m_out[0] > 3) m_other[0] = m_out[1];
+  for (int& v : m_in)
+    v += 1;
+  kernel1D_Twice(n);
+  m_first = m_out[0];
+}
+)");
+    CommandResult r = RunCrossrt("translate --class Counts --backend vulkan --out " + (tc.dir / "out").string() + " --source " + tc.Source("Counts") +
+                                 " --templates " CROSSRT_SOURCE_DIR "/templates");
+    INFO(r.output);
+    REQUIRE(r.exitCode == 0);
+    CHECK(r.output.find("Counts.cpp:9:3: note: 'Run' uses member vectors on the host between kernel calls: on Vulkan the recording is split before this statement "
+                        "(the work recorded so far is submitted and waited for, and 'm_out' read back)") != std::string::npos);
+    CHECK(r.output.find("Counts.cpp:10:3: note: 'Run' uses member vectors on the host between kernel calls") != std::string::npos);  // the loop: m_in uploaded after it
+    std::ifstream source(tc.dir / "out" / "Counts_Vulkan.cpp");
+    const std::string text((std::istreambuf_iterator<char>(source)), std::istreambuf_iterator<char>());
+    const size_t cmd = text.find("void Counts_Vulkan::RunCmd(");
+    REQUIRE(cmd != std::string::npos);
+    const size_t first = text.find("Synchronize(a_cmd, \"Run\");", cmd);
+    const size_t copy = text.find("kernel1D_CopyCmd(", cmd);
+    // Before the first kernel: the element written is uploaded after the statement.
+    CHECK(first < copy);
+    CHECK(text.find("crossrt::UploadVector(m_vdata.m_in, m_in);", first) < copy);
+    // Between the kernels: m_out read back before the statement; m_other only the host uses.
+    const size_t read = text.find("crossrt::DownloadVector(m_vdata.m_out, m_out);", copy);
+    CHECK(read != std::string::npos);
+    CHECK(read < text.find("if (m_out[0] > 3)", copy));
+    CHECK(text.find("UploadVector(m_vdata.m_other") == std::string::npos);
+    CHECK(text.find("crossrt::UploadVector(m_vdata.m_in, m_in);", read) < text.find("kernel1D_TwiceCmd(", cmd));
   }
 }
 

@@ -4,8 +4,8 @@
 Each seed gives one class in the supported subset, written as a user writes one: member vectors,
 kernel1D_ loop nests (maps, integer maps, reductions into members, appends, a member's data() to a
 kernel), and a control function whose host code sits between the kernel calls: member writes,
-swaps of member vectors, loops that stop early on a counter the kernels reduce, and a tail that
-reads the results. The tester (differential.cpp) runs each class as written, as _CPU, as _ISPC and
+swaps of member vectors, member vectors' elements read and written, loops that stop early on a
+counter the kernels reduce, and a tail that reads the results. The tester (differential.cpp) runs each class as written, as _CPU, as _ISPC and
 as _Vulkan and compares what they leave behind, the way Csmith and YARPGen find miscompilations.
 
 Only the C++ the generated classes run is random; everything else is fixed, so that a mismatch
@@ -109,8 +109,17 @@ class Gen:
             fill = "kernel1D_Fill"
             kernels.append((fill, "float* a_out, float a_value, int n", ["a_out[i] = a_value + float(i % 5);"], None))
 
+        def host_vector_use():
+            # Host code between kernel calls that reads or writes member vectors' elements.
+            j = r.randrange(self.n)
+            return self.pick(f"m_a[{j}] = {clamp(f'm_b[{j}] + 1.0f')};",
+                             f"m_k = m_i[{j}] % {r.randint(2, 7)};",
+                             "for (float& v : m_b)\n  v = std::min(v, 10.0f);",
+                             f"for (int j = 0; j < n; j += {r.randint(1, 4)})\n  m_i[j] = (m_i[j] + 1) & 1023;",
+                             "m_scale = std::max(std::min(m_a[0], 4.0f), -4.0f);")
+
         for _ in range(r.randint(2, 5)):
-            s = r.randrange(9)
+            s = r.randrange(10)
             if s <= 2:
                 body.append(call(self.pick("Map", "Map", "Int", "Sum", "Max")))
             elif s == 3:
@@ -128,12 +137,16 @@ class Gen:
                 inner = [call(self.pick("Map", "Int")), "m_count = 0;", call("Count")]
                 if r.random() < 0.5:
                     inner.append(self.pick("std::swap(m_a, m_b);", "m_a.swap(m_b);"))
+                if r.random() < 0.3:
+                    inner.insert(r.randint(0, len(inner)), host_vector_use())
                 inner.append("m_rounds++;")
                 inner.append(f"if (m_count {self.pick('>=', '<')} {limit}) break;")
                 body.append("for (int round = 0; round < a_p; ++round)")
                 body.append("{")
-                body.extend("  " + x for x in inner)
+                body.extend("  " + line for x in inner for line in x.split("\n"))
                 body.append("}")
+            elif s == 9:
+                body.extend(host_vector_use().split("\n"))
             else:
                 body.append("m_count = 0;")
                 body.append(call("Count"))

@@ -452,6 +452,18 @@ T* RawPointer(T* p) { return p; }
 template <typename Smart>
 auto* RawPointer(const Smart& p) { return p.get(); }
 
+// Host code between kernel calls that uses a std::vector member (after Synchronize, the GPU idle):
+// its device copy read back whole, and uploaded whole after the host changed it. The vector keeps
+// the size its buffer was made for while the call runs (resizing there is refused).
+template <typename Vector>
+void DownloadVector(const Buffer& buffer, Vector& vector) {
+  if (!vector.empty()) buffer.Download(vector.data(), sizeof(vector[0]) * vector.size());
+}
+template <typename Vector>
+void UploadVector(Buffer& buffer, const Vector& vector) {
+  if (!vector.empty()) buffer.Upload(vector.data(), sizeof(vector[0]) * vector.size());
+}
+
 // After kernels appended to a std::vector member on the GPU: reads the count they reached (the
 // uint32_t at sizeOffset of `counts`), gives the host vector that size and the elements. The size
 // stays within the capacity, so the vector is not reallocated. Pushes past the capacity were

@@ -54,6 +54,14 @@ public:
     m_a.swap(m_b);
   }
 
+  // m_a[i] = a_value, then the host changes its first element after the last kernel: the next
+  // call's kernels see the host's value (found by the differential tester: Diff8).
+  virtual void FillThenSet(int a_value)
+  {
+    kernel1D_Fill(m_a.data(), a_value, int(m_a.size()));
+    m_a[0] = -a_value;
+  }
+
   std::vector<int> m_a, m_b;
   int m_first = 0;
 
