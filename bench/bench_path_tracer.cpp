@@ -65,7 +65,7 @@ class InspectedTracer : public PathTracer_Vulkan
 {
 public:
   using PathTracer_Vulkan::PathTracer_Vulkan;
-  std::vector<VkBool32> PipelineClasses() const { return m_pipelineClasses; }
+  std::vector<VkBool32> PipelineClasses() const { return crt_pipelineClasses; }
 };
 
 struct Setup

@@ -208,9 +208,9 @@ std::string GroupCountExpr(const Kernel& k) {
 
 std::string DispatchExpr(const Kernel& k) {
   GroupShape s = Shape(k);
-  if (k.dims == 1) return "crossrt::Dispatch1D(a_cmd, crt_countX, " + std::to_string(s.x) + ")";
-  if (k.dims == 2) return "crossrt::Dispatch2D(a_cmd, crt_countX, crt_countY, " + std::to_string(s.x) + ", " + std::to_string(s.y) + ")";
-  return "crossrt::Dispatch3D(a_cmd, crt_countX, crt_countY, crt_countZ, " + std::to_string(s.x) + ", " + std::to_string(s.y) + ", " + std::to_string(s.z) + ")";
+  if (k.dims == 1) return "crossrt::Dispatch1D(crt_cmd, crt_countX, " + std::to_string(s.x) + ")";
+  if (k.dims == 2) return "crossrt::Dispatch2D(crt_cmd, crt_countX, crt_countY, " + std::to_string(s.x) + ", " + std::to_string(s.y) + ")";
+  return "crossrt::Dispatch3D(crt_cmd, crt_countX, crt_countY, crt_countZ, " + std::to_string(s.x) + ", " + std::to_string(s.y) + ", " + std::to_string(s.z) + ")";
 }
 
 std::string LaunchSize(const Kernel& k) {

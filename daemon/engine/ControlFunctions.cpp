@@ -279,8 +279,8 @@ const Control::LocalBuffer* ControlRewriter::Temporary(const VarDecl* vd) {
   SourceLocation end = Lexer::findLocationAfterToken(decl->getEndLoc(), tok::semi, ctx.getSourceManager(), ctx.getLangOpts(), false);
   if (end.isInvalid()) end = decl->getEndLoc().getLocWithOffset(1);
   m_gpu.InsertTextAfter(end, "\n  // " + local + " on the GPU: a buffer of the class, filled as the constructor fills the vector\n"
-                        "  crossrt::EnsureSize(m_ctx, m_temporaries." + t.buffer + ", " + bytes + ");\n"
-                        "  crossrt::FillCmd(a_cmd, m_temporaries." + t.buffer + ".View(), (" + bytes + " + 3) / 4 * 4, " + bits + ");");
+                        "  crossrt::EnsureSize(crt_ctx, crt_temporaries." + t.buffer + ", " + bytes + ");\n"
+                        "  crossrt::FillCmd(crt_cmd, crt_temporaries." + t.buffer + ".View(), (" + bytes + " + 3) / 4 * 4, " + bits + ");");
   m_ctrl.temporaries.push_back(t);
   return &m_temporaries.emplace(vd, t).first->second;
 }
@@ -323,7 +323,7 @@ std::string ControlRewriter::ImageArg(const ParmVarDecl* p, const Expr* arg) {
       auto& list = m_ctrl.imagesWritten;
       if (written && std::find(list.begin(), list.end(), name) == list.end()) list.push_back(name);
     }
-    return "crossrt::ImageView(m_images." + name + ", m_images." + name + "Width, m_images." + name + "Height)";
+    return "crossrt::ImageView(crt_images." + name + ", crt_images." + name + "Width, crt_images." + name + "Height)";
   }
   m_c.rep.RecordingError(arg->getBeginLoc(), "Image2D argument of a kernel call must be an Image2D parameter of '" + m_ctrl.name + "' or an Image2D member",
                       "an image local to '" + m_ctrl.name + "' has no GPU copy: make it a member (its GPU copy is kept between calls) or a parameter of '" +
@@ -375,7 +375,7 @@ void ControlRewriter::RecordMemberWrite(const Stmt* s) {
   if (!m || m->kind != MemberKind::Plain || !m->inClassData) return;
   SourceLocation end = Lexer::findLocationAfterToken(s->getEndLoc(), tok::semi, m_c.ctx.getSourceManager(), m_c.ctx.getLangOpts(), false);
   if (end.isInvalid()) return;
-  m_gpu.InsertTextAfter(end, " UpdateMemberCmd(a_cmd, offsetof(ClassData, " + m->name + "), &" + m->name + ", sizeof(" + m->name + "));");
+  m_gpu.InsertTextAfter(end, " crt_UpdateMemberCmd(crt_cmd, offsetof(ClassData, " + m->name + "), &" + m->name + ", sizeof(" + m->name + "));");
 }
 
 bool ControlRewriter::IsWholeVector(const CallExpr* call) {
@@ -432,7 +432,7 @@ void ControlRewriter::RecordClear(const Stmt* s) {
   if (end.isInvalid()) return;
   const std::string size = f->getNameAsString() + "_size";
   m_gpu.InsertTextBefore(s->getBeginLoc(), "{ ");
-  m_gpu.InsertTextAfter(end, " const uint32_t crt_empty = 0; UpdateMemberCmd(a_cmd, offsetof(ClassData, " + size +
+  m_gpu.InsertTextAfter(end, " const uint32_t crt_empty = 0; crt_UpdateMemberCmd(crt_cmd, offsetof(ClassData, " + size +
                                  "), &crt_empty, sizeof(crt_empty)); }");
 }
 
@@ -475,8 +475,8 @@ void ControlRewriter::Visit(const Stmt* s) {
       }
       Note(call);
       // An argument reads a member the kernels before it write: run those first (HostReads.cpp).
-      const std::string sync = m_syncCalls.count(call) ? "Synchronize(a_cmd, \"" + m_ctrl.name + "\"), " : "";
-      m_gpu.ReplaceText(call->getSourceRange(), sync + md->getNameAsString() + "Cmd(a_cmd" + Args(call, false) + ")");
+      const std::string sync = m_syncCalls.count(call) ? "crt_Synchronize(crt_cmd, \"" + m_ctrl.name + "\"), " : "";
+      m_gpu.ReplaceText(call->getSourceRange(), sync + md->getNameAsString() + "Cmd(crt_cmd" + Args(call, false) + ")");
       return;
     }
   }

@@ -26,7 +26,7 @@ private:
   std::string BufferArg(const Expr* arg);
 
   // ---- std::vector locals passed to kernels: std::vector<float> temp(n[, value]); kernel1D_A(temp.data(), ...) ----
-  // On the GPU the local gets a device buffer of the generated class (m_temporaries), sized and
+  // On the GPU the local gets a device buffer of the generated class (crt_temporaries), sized and
   // filled where the local is declared, as its constructor fills the host's. The host's vector
   // stays (its size() is the buffer's); its elements are never the GPU's, so the control function
   // may only pass data() to kernels and ask for size().
@@ -157,17 +157,17 @@ private:
   void MoveHostTail();
   std::vector<const Stmt*> m_tail;
   // Reads of members kernels write, between kernel calls: each becomes a read after
-  // Synchronize(a_cmd, ...), which splits the recording there.
+  // crt_Synchronize(crt_cmd, ...), which splits the recording there.
   void SplitAtHostReads();
   // Member vectors on the host before the last kernel call: a read of one kernels write, between
   // them, or any change of one kernels use, is synchronised around the statement that holds it
   // (SynchronizeAround); resizing one, or a use inside a statement that records GPU work too, is an
   // error on Vulkan (the device buffers were sized when the call began). size() and swaps need nothing.
   void CheckHostVectorUses();
-  // Marks the outermost statement around `use` that records no GPU work for a Synchronize before
+  // Marks the outermost statement around `use` that records no GPU work for a crt_Synchronize before
   // it, with `m` read back (download) and uploaded after it (upload); false where there is none.
   bool SynchronizeAround(const MemberExpr* use, const Member& m, bool download, bool upload);
-  // Writes those: `Synchronize(a_cmd, ...); crossrt::DownloadVector(...);` before each statement,
+  // Writes those: `crt_Synchronize(crt_cmd, ...); crossrt::DownloadVector(...);` before each statement,
   // `crossrt::UploadVector(...);` after it, and a note of the round trip.
   void SynchronizeHostVectors();
   struct HostVectorSync {
@@ -180,7 +180,7 @@ private:
   // at the end of the host tail.
   std::set<std::string> m_tailUploads;
   std::vector<const MemberExpr*> m_syncReads;
-  // Kernel calls that take such a member as an argument: `Synchronize(a_cmd, ...), kernel1D_XCmd(...)`.
+  // Kernel calls that take such a member as an argument: `crt_Synchronize(crt_cmd, ...), kernel1D_XCmd(...)`.
   std::set<const CallExpr*> m_syncCalls;
 
   // std::swap(m_a, m_b) or m_a.swap(m_b) of std::vector members: on Vulkan their device buffers

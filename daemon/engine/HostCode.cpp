@@ -47,7 +47,7 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
     d.set("hasImages", std::any_of(model.members.begin(), model.members.end(), [](const Member& m) {
       return m.usedByKernels && (m.kind == MemberKind::Image || m.kind == MemberKind::Sampler);
     }));
-    // Whether anything on the GPU follows a host size (VectorMembersResized has something to compare).
+    // Whether anything on the GPU follows a host size (crt_VectorMembersResized has something to compare).
     d.set("hasResizables", !vectors.is_empty_list() || !images.is_empty_list() || !samplers.is_empty_list() ||
                                !textureArrays.is_empty_list() || !model.virtuals.empty());
     // The shaders of ray tracing pipelines besides the kernels' (virtual functions, level 3).

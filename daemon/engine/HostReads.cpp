@@ -5,7 +5,7 @@
 // work the uses are sound once deferred: the ...Cmd stores those statements (the host tail,
 // `m_mean = m_sum / float(n);`, `m_first = m_out[0];`) as a lambda, capturing the locals they read,
 // and the generated control function runs it after the kernels' results are back. Between kernels
-// a plain member read splits the recording: the read becomes `Synchronize(a_cmd, "Solve").m_residual`,
+// a plain member read splits the recording: the read becomes `crt_Synchronize(crt_cmd, "Solve").m_residual`,
 // which submits what was recorded, waits, reads the members back and begins a new command buffer
 // (a solver's `if (m_residual < tol) break;`). Output parameters, copied back only at the end, and
 // member vectors on the host before the last kernel are errors there. Takes a control function's
@@ -417,7 +417,7 @@ void ControlRewriter::SynchronizeHostVectors() {
   const std::string buffers = generated::kVectorCopies + ".";
   for (const Stmt* s : m_vectorSyncOrder) {
     const HostVectorSync& sync = m_vectorSyncs[s];
-    std::string before = "Synchronize(a_cmd, \"" + m_ctrl.name + "\");  // crossrt: the host uses member vectors below: wait for the GPU\n";
+    std::string before = "crt_Synchronize(crt_cmd, \"" + m_ctrl.name + "\");  // crossrt: the host uses member vectors below: wait for the GPU\n";
     std::string after, names;
     for (const std::string& name : sync.downloads) {
       const Member* m = FindMember(m_c.model, name);
@@ -451,7 +451,7 @@ void ControlRewriter::SplitAtHostReads() {
     const bool inCall = std::any_of(m_syncCalls.begin(), m_syncCalls.end(), [&](const CallExpr* call) {
       return !sm.isBeforeInTranslationUnit(me->getBeginLoc(), call->getBeginLoc()) && !sm.isBeforeInTranslationUnit(call->getEndLoc(), me->getEndLoc());
     });
-    if (!inCall) m_gpu.ReplaceText(me->getSourceRange(), "Synchronize(a_cmd, \"" + m_ctrl.name + "\")." + name);
+    if (!inCall) m_gpu.ReplaceText(me->getSourceRange(), "crt_Synchronize(crt_cmd, \"" + m_ctrl.name + "\")." + name);
     if (m_c.rep.RecordingRules() && named.insert(name).second)
       m_c.rep.Note(me->getExprLoc(), "'" + m_ctrl.name + "' reads '" + name + "', which its kernels write, between kernel calls: on Vulkan the recording is split there " +
                                          "(the work recorded so far is submitted and waited for, and the members kernels write are read back), a round trip to the GPU each time it runs");
@@ -491,7 +491,7 @@ void ControlRewriter::MoveHostTail() {
     const std::string host = upload.substr(0, upload.find('|')), name = upload.substr(upload.find('|') + 1);
     uploads += "\ncrossrt::UploadVector(" + generated::kVectorCopies + "." + name + ", " + host + ");";
   }
-  m_gpu.ReplaceText(range, "m_hostTail_" + m_ctrl.name + " = [" + captures + "]() mutable {\n" +
+  m_gpu.ReplaceText(range, "crt_hostTail_" + m_ctrl.name + " = [" + captures + "]() mutable {\n" +
                                std::string(Lexer::getSourceText(range, sm, m_c.ctx.getLangOpts())) + uploads + "\n};");
 }
 

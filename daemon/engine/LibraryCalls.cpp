@@ -143,7 +143,7 @@ bool ControlRewriter::ReduceAddInit(const CallExpr* call) {
   }
   m->usedByKernels = true;
   WrittenVector({"", m->name, "", {}, m});
-  m_gpu.InsertTextAfter(end, "\ncrossrt::ZeroCmd(a_cmd, m_vdata." + m->name + ", sizeof(" + m->elemCppType + ") * " + m->name + ".size(), \"" +
+  m_gpu.InsertTextAfter(end, "\ncrossrt::ZeroCmd(crt_cmd, crt_vdata." + m->name + ", sizeof(" + m->elemCppType + ") * " + m->name + ".size(), \"" +
                              m_c.cls->getNameAsString() + "::" + m->name + "\");  // its device copy starts at zero too\n");
   return true;
 }
@@ -194,7 +194,7 @@ bool ControlRewriter::TryLibraryCall(const CallExpr* call) {
     std::string elem = CppTypeName(m_c.ctx, first->element);
     std::string init = initArg ? "crossrt::Bits32(static_cast<" + elem + ">(" + m_c.Text(initArg->getSourceRange()) + "))" : "0u";
     m_c.model.usesScanner = true;
-    replacement = generated::kScanner + ".RecordCmd(a_cmd, " + ViewAt(*first) + ", " + ViewAt(*out) + ", uint32_t" + *count + ", " +
+    replacement = generated::kScanner + ".RecordCmd(crt_cmd, " + ViewAt(*first) + ", " + ViewAt(*out) + ", uint32_t" + *count + ", " +
                   (name == "inclusive_scan" ? "true" : "false") + ", crossrt::ElementType::" + type + ", " + init + ")";
     WrittenVector(*out);
   } else if (name == "sort" && (call->getNumArgs() == 2 || call->getNumArgs() == 3)) {
@@ -209,14 +209,14 @@ bool ControlRewriter::TryLibraryCall(const CallExpr* call) {
     const std::string key = "crossrt::SortKey{" + std::to_string(words) + ", " + std::to_string(order->keyWord) +
                             ", crossrt::ElementType::" + order->type + ", " + (order->descending ? "true" : "false") + "}";
     m_c.model.usesSorter = true;
-    replacement = generated::kSorter + ".RecordCmd(a_cmd, " + ViewAt(*first) + ", uint32_t" + *count + ", " + key + ")";
+    replacement = generated::kSorter + ".RecordCmd(crt_cmd, " + ViewAt(*first) + ", uint32_t" + *count + ", " + key + ")";
     // A vector that kernels append to has its size on the GPU: the sort reads it there.
     if (first->vector && m_c.appended.count(first->vector->name)) {
       if (!IsWholeVector(call)) return bad("'" + first->vector->name + "' is appended to by kernels, so its size is known only on the GPU: sort all of it, from begin() to end()");
       const std::string v = first->vector->name;
       m_c.model.usesSorter = true;
-      replacement = generated::kSorter + ".RecordCmd(a_cmd, " + first->view + ", uint32_t(" + generated::kVectorCopies + "." + v + "Capacity), " + key +
-                    ", m_classDataBuffer.View(), offsetof(ClassData, " + v + "_size))";
+      replacement = generated::kSorter + ".RecordCmd(crt_cmd, " + first->view + ", uint32_t(" + generated::kVectorCopies + "." + v + "Capacity), " + key +
+                    ", crt_classDataBuffer.View(), offsetof(ClassData, " + v + "_size))";
     }
     // The CPU backend sorts on all cores too, with the same radix sort.
     m_cpu.ReplaceText(call->getSourceRange(), "crossrt::RadixSort(" + m_c.Text(call->getArg(0)->getSourceRange()) + ", " +
@@ -225,7 +225,7 @@ bool ControlRewriter::TryLibraryCall(const CallExpr* call) {
   } else if ((name == "memcpy" || name == "memmove") && call->getNumArgs() == 3) {
     auto dst = PositionOf(call->getArg(0)), src = PositionOf(call->getArg(1));
     if (!dst || !src || dst->isEnd || src->isEnd) return bad("source and destination must be device buffers");
-    replacement = "crossrt::CopyCmd(a_cmd, " + ViewAt(*src) + ", " + ViewAt(*dst) + ", VkDeviceSize(" + m_c.Text(call->getArg(2)->getSourceRange()) + "))";
+    replacement = "crossrt::CopyCmd(crt_cmd, " + ViewAt(*src) + ", " + ViewAt(*dst) + ", VkDeviceSize(" + m_c.Text(call->getArg(2)->getSourceRange()) + "))";
     WrittenVector(*dst);
   } else if (name == "fill" && call->getNumArgs() == 3) {
     auto first = PositionOf(call->getArg(0)), last = PositionOf(call->getArg(1));
@@ -234,7 +234,7 @@ bool ControlRewriter::TryLibraryCall(const CallExpr* call) {
     if (!count) return bad("first and last must belong to the same buffer");
     if (m_c.ctx.getTypeSizeInChars(first->element).getQuantity() != 4) return bad("GPU fills take 32-bit elements");
     std::string elem = CppTypeName(m_c.ctx, first->element);
-    replacement = "crossrt::FillCmd(a_cmd, " + ViewAt(*first) + ", sizeof(" + elem + ") * VkDeviceSize" + *count +
+    replacement = "crossrt::FillCmd(crt_cmd, " + ViewAt(*first) + ", sizeof(" + elem + ") * VkDeviceSize" + *count +
                   ", crossrt::Bits32(static_cast<" + elem + ">(" + m_c.Text(call->getArg(2)->getSourceRange()) + ")))";
     WrittenVector(*first);
   } else {

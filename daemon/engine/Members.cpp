@@ -51,8 +51,8 @@ void AnalyzeMembers(Context& c) {
     if (!c.model.forCpu && (generatedMembers.count(m.name) || m.name.rfind(generated::kInOutPrefix, 0) == 0))
       c.rep.Error(f->getLocation(), "data member '" + m.name + "' has the name of a member the generated " + c.cls->getNameAsString() +
                                         "_Vulkan class declares for its GPU objects",
-                  "rename it; the generated class's own members are m_vdata, m_temporaries, m_threadState, m_inOut_*, m_scanner, "
-                  "m_sorter, m_virtual, m_images, m_textureArrays, m_partials, m_pipelines and m_classDataBuffer");
+                  "rename it; the generated class's own members are crt_vdata, crt_temporaries, crt_threadState, crt_inOut_*, crt_scanner, "
+                  "crt_sorter, crt_virtual, crt_images, crt_textureArrays, crt_partials, crt_pipelines and crt_classDataBuffer");
     m.hostExpr = m.name;
     QualType elem;
     if (IsTextureArray(f->getType(), &elem)) {

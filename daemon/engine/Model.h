@@ -223,7 +223,7 @@ struct Control {
   // back, not while recording (HostReads.cpp).
   bool hasHostTail = false;
   // Host code between its kernel calls reads members kernels write (a residual, a counter): the
-  // Vulkan class's ...Cmd splits its recording there (Synchronize, HostReads.cpp).
+  // Vulkan class's ...Cmd splits its recording there (crt_Synchronize, HostReads.cpp).
   bool synchronizes = false;
   bool swapsVectors = false;        // std::swap of std::vector members (MemberSwaps.cpp)
   std::string cpuBody;              // body with RTV loops parallelised

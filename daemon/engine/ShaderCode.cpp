@@ -350,7 +350,7 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   const std::string invocation = rayGeneration ? "gl_LaunchIDEXT" : "gl_GlobalInvocationID";
   for (size_t i = 0; i < k.threadAxes.size(); ++i) {
     unsigned a = k.threadAxes[i];
-    std::string gid = k.dims == 1 ? "int(threadId)" : "int(" + invocation + "." + GlAxis(a) + ")";
+    std::string gid = k.dims == 1 ? "int(crt_threadId)" : "int(" + invocation + "." + GlAxis(a) + ")";
     ids.push_back(idTypes[i] + "(crt_start" + Axis(a) + " + " + gid + ")");
   }
   if (!k.rtv)
@@ -384,7 +384,7 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   d.set("stateStores", stateStores);
   // The thread's element of per-thread buffers: threads in x, then rows, then slices.
   const std::string& g = invocation;
-  d.set("threadIndex", k.dims == 1 ? "threadId"
+  d.set("threadIndex", k.dims == 1 ? "crt_threadId"
                        : k.dims == 2 ? g + ".x + crt_countX * " + g + ".y"
                                      : g + ".x + crt_countX * (" + g + ".y + crt_countY * " + g + ".z)");
   for (unsigned a = 0; a < k.dims; ++a)

@@ -250,7 +250,7 @@ std::string ControlRewriter::ThreadBodyCpp(ThreadLoop& tl, const Stmt* s) {
     std::string buffer = vd ? StateBuffer(tl, vd) : "";
     args += ", " + (buffer.empty() ? BufferArg(Resolve(arg)) : generated::kThreadState + "." + buffer + ".View()");
   }
-  return md->getNameAsString() + "Cmd(a_cmd" + tl.counts + args + ");\n";
+  return md->getNameAsString() + "Cmd(crt_cmd" + tl.counts + args + ");\n";
 }
 
 }  // namespace crossrt::engine

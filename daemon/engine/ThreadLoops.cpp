@@ -163,14 +163,14 @@ bool ControlRewriter::TryThreadLoop(const ForStmt* outerLoop) {
     if (!tl.passed.count(local)) continue;  // no kernel sees it: nothing to keep between dispatches
     std::string cppType = CppTypeName(m_c.ctx, local->getType().getUnqualifiedType());
     m_ctrl.threadStates.push_back({buffer, cppType, local->getNameAsString()});
-    states += "crossrt::EnsureSize(m_ctx, m_threadState." + buffer + ", sizeof(" + cppType + ") * std::max<size_t>(1, crt_threads));\n"
-              "crossrt::FillCmd(a_cmd, m_threadState." + buffer + ".View(), sizeof(" + cppType + ") * crt_threads, 0);  // " +
+    states += "crossrt::EnsureSize(crt_ctx, crt_threadState." + buffer + ", sizeof(" + cppType + ") * std::max<size_t>(1, crt_threads));\n"
+              "crossrt::FillCmd(crt_cmd, crt_threadState." + buffer + ".View(), sizeof(" + cppType + ") * crt_threads, 0);  // " +
               local->getNameAsString() + " starts at zero\n";
   }
   std::string threads;
   for (auto& h : tl.loops) threads += (threads.empty() ? "" : " * ") + std::string("size_t(") + CountExpr(m_c, h) + ")";
   std::string text =
-      "if (m_executionMode == crossrt::ExecutionMode::Megakernel)  // the whole loop body in one shader\n" + tl.mega.name + "Cmd(a_cmd" + tl.counts + tl.hostArgs +
+      "if (crt_executionMode == crossrt::ExecutionMode::Megakernel)  // the whole loop body in one shader\n" + tl.mega.name + "Cmd(crt_cmd" + tl.counts + tl.hostArgs +
       ");\nelse  // wavefront: one dispatch per kernel call, each thread's locals in buffers between them\n{\nconst size_t crt_threads = " + threads + ";\n" + states +
       wavefront + "}\n";
   if (tl.megakernelOnly) {
@@ -179,7 +179,7 @@ bool ControlRewriter::TryThreadLoop(const ForStmt* outerLoop) {
                               m_ctrl.threadStates.end());
     text = "// A kernel's result ends a thread's loop here, at a time of the thread's own: the whole loop\n"
            "// body runs in one shader (the megakernel) in both execution modes.\n" +
-           tl.mega.name + "Cmd(a_cmd" + tl.counts + tl.hostArgs + ");\n";
+           tl.mega.name + "Cmd(crt_cmd" + tl.counts + tl.hostArgs + ");\n";
   }
   SourceLocation end = Lexer::findLocationAfterToken(outerLoop->getEndLoc(), tok::semi, m_c.ctx.getSourceManager(), m_c.ctx.getLangOpts(), false);
   CharSourceRange range = end.isValid() ? CharSourceRange::getCharRange(outerLoop->getBeginLoc(), end) : CharSourceRange::getTokenRange(outerLoop->getSourceRange());
@@ -272,7 +272,7 @@ bool ControlRewriter::TryRtvNest(const ForStmt* outer) {
   if (m_c.model.forIspc && IspcRtvNest(outer, call, axes)) return true;
   SourceLocation end = Lexer::findLocationAfterToken(outer->getEndLoc(), tok::semi, m_c.ctx.getSourceManager(), m_c.ctx.getLangOpts(), false);
   CharSourceRange range = end.isValid() ? CharSourceRange::getCharRange(outer->getBeginLoc(), end) : CharSourceRange::getTokenRange(outer->getSourceRange());
-  m_gpu.ReplaceText(range, md->getNameAsString() + "Cmd(a_cmd" + counts + Args(call, true) + ");");
+  m_gpu.ReplaceText(range, md->getNameAsString() + "Cmd(crt_cmd" + counts + Args(call, true) + ");");
   auto& sm = m_c.ctx.getSourceManager();
   unsigned col = sm.getExpansionColumnNumber(outer->getBeginLoc());
   std::string indent(col > 0 ? col - 1 : 0, ' ');

@@ -40,7 +40,7 @@ Data ControlsData(const ClassModel& model) {
       ptrs.push_back(y);
       if (!p.isConst) outs.push_back(y);
       bindDecl += (bindDecl.empty() ? "" : ", ") + std::string("crossrt::BufferView a_") + p.name;
-      bindArgs += (bindArgs.empty() ? "" : ", ") + std::string("crt_self->m_args.") + c.name + "_" + p.name + ".View()";
+      bindArgs += (bindArgs.empty() ? "" : ", ") + std::string("crt_self->crt_argCopies.") + c.name + "_" + p.name + ".View()";
     }
     Data images = List(), outImages = List();
     for (auto& p : c.params) {
@@ -53,7 +53,7 @@ Data ControlsData(const ClassModel& model) {
       images.push_back(y);
       if (!p.isConst) outImages.push_back(y);
       bindDecl += (bindDecl.empty() ? "" : ", ") + std::string("crossrt::ImageView a_") + p.name;
-      bindArgs += (bindArgs.empty() ? "" : ", ") + std::string("crossrt::ImageView(crt_self->m_args.") + c.name + "_" + p.name + ", " + p.name +
+      bindArgs += (bindArgs.empty() ? "" : ", ") + std::string("crossrt::ImageView(crt_self->crt_argCopies.") + c.name + "_" + p.name + ", " + p.name +
                   ".width(), " + p.name + ".height())";
     }
     x.set("pointerParams", ptrs);
@@ -246,13 +246,13 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
       }
       if (kind.rayQuery) {
         types += ", VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR";
-        list += ", crossrt::Binding::SceneOf(m_scenes." + k.rayQueryHolder + ")";
+        list += ", crossrt::Binding::SceneOf(crt_scenes." + k.rayQueryHolder + ")";
         typed = true;
       }
       if (kind.leaves)
         for (const LeafTraversal* lt : LeafScenes(k)) {
           types += ", VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR";
-          list += ", crossrt::Binding::SceneOf(m_scenes." + lt->member + "_leaves)";
+          list += ", crossrt::Binding::SceneOf(crt_scenes." + lt->member + "_leaves)";
           typed = true;
         }
       return Bindings{list, types, sets, buffers, typed};
@@ -297,7 +297,7 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
       // A kernel with a ray generation variant records its launch in each branch: a trace or a dispatch.
       const bool traces = RunsCallables(k) || RunsLeafShaders(k);
       std::string launch;
-      if (rayGeneration) launch = generated::kPipelines + "." + k.name + kind.suffix + ".TraceCmd(a_cmd, " + LaunchSize(k) + ")";
+      if (rayGeneration) launch = generated::kPipelines + "." + k.name + kind.suffix + ".TraceCmd(crt_cmd, " + LaunchSize(k) + ")";
       else if (traces) launch = DispatchExpr(k);
       if (launch.empty()) y.set("launch", false);  // the shared dispatch after the variants launches it
       else y.set("launch", launch);
@@ -308,19 +308,19 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
       // Which devices can create it, and when the host records it.
       std::string needs, use, why;
       if (rayGeneration) {
-        needs = "m_ctx->hasRayTracingPipeline";
-        use = "m_useRayTracingPipelines";
+        needs = "crt_ctx->hasRayTracingPipeline";
+        use = "crt_useRayTracingPipelines";
         why = kind.callables ? "virtual calls as callable shaders, in a ray tracing pipeline"
                              : "the leaves of " + LeafDisplays(k) + " as intersection shaders, in a ray tracing pipeline";
       }
       if (kind.rayQuery) {
-        needs = "m_ctx->hasRayQuery";
-        use = "m_useRayTracingHardware";
+        needs = "crt_ctx->hasRayQuery";
+        use = "crt_useRayTracingHardware";
         why = k.rayQueryHolder + "'s ray queries on the ray tracing hardware";
       }
       if (kind.textures) {
-        needs += (needs.empty() ? "" : " && ") + std::string("m_ctx->hasTextureArrays");
-        use += (use.empty() ? "" : " && ") + std::string("m_useTextureHardware");
+        needs += (needs.empty() ? "" : " && ") + std::string("crt_ctx->hasTextureArrays");
+        use += (use.empty() ? "" : " && ") + std::string("crt_useTextureHardware");
         why += (why.empty() ? "" : ", ") + std::string("textures on the GPU's samplers");
       }
       y.set("conditional", !needs.empty());

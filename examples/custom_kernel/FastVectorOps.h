@@ -10,6 +10,6 @@ public:
   int handWrittenDispatches = 0;
 
 protected:
-  void kernel1D_ScaleCmd(VkCommandBuffer a_cmd, int n, float factor, crossrt::BufferView data) override;
+  void kernel1D_ScaleCmd(VkCommandBuffer crt_cmd, int n, float factor, crossrt::BufferView data) override;
   crossrt::ComputePipeline m_scaleFast;  // created on first use (constructors cannot call overrides)
 };

@@ -21,6 +21,13 @@
 #include "KMeans_ISPC.h"
 #endif
 #endif
+#if __has_include("Ledger_CPU.h")
+#include "Ledger_CPU.h"
+#include "Ledger_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "Ledger_ISPC.h"
+#endif
+#endif
 #if __has_include("PingPong_CPU.h")
 #include "PingPong_CPU.h"
 #include "PingPong_Vulkan.h"
@@ -119,6 +126,29 @@ Register kMeans(MakeCase<KMeans>(
       for (const float2& c : k.Centroids()) r.push_back(c.x), r.push_back(c.y);
       Append(r, k.Labels());
       Append(r, k.Counts());
+      return r;
+    }));
+#endif
+
+#if __has_include("Ledger_CPU.h")
+// User names equal to the generated code's own: each keeps meaning the user's. Integer-valued
+// floats, so the GPU's sum is exact. Run twice: the second sees m_pipelines[0] the first set.
+Register ledger(MakeCase<Ledger>(
+    "user names equal to the generated code's (m_vdata, m_ctx, m_pipelines, a_cmd, Synchronize, threadId, inRange, ...)",
+    "names_in_use.h/.cpp", 0.0, CONFORMANCE_MAKERS(Ledger, 64), [](Ledger& l) {
+      l.CommitDeviceData();
+      Outputs r;
+      for (int round = 0; round < 2; ++round)
+      {
+        l.Run(100 + round, 2.0f);
+        Append(r, l.m_images);
+        Append(r, l.m_pipelines);
+        for (double v : {double(l.m_times), double(l.m_args), double(l.m_recording), double(l.m_hostTail_Run), double(l.m_ctx), double(l.m_scenes)})
+          r.push_back(v);
+      }
+      if (l.m_recording != 101 + 90 || l.m_hostTail_Run != 106 || l.m_args != 5 + int(l.m_times) || l.m_pipelines[0] != l.m_times || l.m_times == 0.0f)
+        throw std::runtime_error("Ledger's members should hold what Run computed (m_recording " + std::to_string(l.m_recording) + ", m_args " +
+                                 std::to_string(l.m_args) + ", m_times " + std::to_string(l.m_times) + ")");
       return r;
     }));
 #endif

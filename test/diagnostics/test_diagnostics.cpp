@@ -389,7 +389,7 @@ void NotVirtual::kernel1D_Fill(int n, float* out) { for (int i = 0; i < n; i++) 
   std::ifstream header(tc.dir / "out" / "NotVirtual_Vulkan.h");
   const std::string text((std::istreambuf_iterator<char>(header)), std::istreambuf_iterator<char>());
   REQUIRE(text.find("  void Run(int n, float* out);\n") != std::string::npos);  // hides it: no override
-  REQUIRE(text.find("virtual void RunCmd(VkCommandBuffer a_cmd") != std::string::npos);
+  REQUIRE(text.find("virtual void RunCmd(VkCommandBuffer crt_cmd") != std::string::npos);
 }
 
 TEST_CASE("Host code that reads what kernels write runs after the last kernel; between kernels it is reported", "[diagnostics]")
@@ -431,14 +431,14 @@ void Tail::Run(int n, const float* in, float* out)
     REQUIRE(r.exitCode == 0);
     std::ifstream source(tc.dir / "out" / "Tail_Vulkan.cpp");
     const std::string text((std::istreambuf_iterator<char>(source)), std::istreambuf_iterator<char>());
-    const size_t readBack = text.find("crt_self->ReadPlainMembers();"), run = text.find("    crt_tail();\n");
+    const size_t readBack = text.find("crt_self->crt_ReadPlainMembers();"), run = text.find("    crt_tail();\n");
     const size_t cmd = text.find("void Tail_Vulkan::RunCmd(");
     REQUIRE(readBack != std::string::npos);
     REQUIRE(run != std::string::npos);
     CHECK(readBack < run);  // Run runs the tail once the GPU's total is back
     // RunCmd stores it, with the parameter it reads, instead of running it while recording.
-    CHECK(text.find("m_hostTail_Run = [this, n]() mutable { m_mean = m_total / float(n); };", cmd) != std::string::npos);
-    CHECK(text.find("UpdateMemberCmd(a_cmd, offsetof(ClassData, m_total)", cmd) != std::string::npos);  // the zeroing before stays
+    CHECK(text.find("crt_hostTail_Run = [this, n]() mutable { m_mean = m_total / float(n); };", cmd) != std::string::npos);
+    CHECK(text.find("crt_UpdateMemberCmd(crt_cmd, offsetof(ClassData, m_total)", cmd) != std::string::npos);  // the zeroing before stays
   }
   SECTION("between kernels: the recording is split there, with a note")
   {
@@ -462,9 +462,9 @@ void Between::Run(int n, const float* in, float* out)
     std::ifstream source(tc.dir / "out" / "Between_Vulkan.cpp");
     const std::string text((std::istreambuf_iterator<char>(source)), std::istreambuf_iterator<char>());
     // A kernel's argument: the work before it runs first; a condition: the read waits.
-    CHECK(text.find("Synchronize(a_cmd, \"Run\"), kernel1D_ScaleCmd(a_cmd, n, 1.0f / m_total,") != std::string::npos);
-    CHECK(text.find("if (Synchronize(a_cmd, \"Run\").m_total > 1.0f)") != std::string::npos);
-    CHECK(text.find("crt_cmd = crt_self->m_recording;") != std::string::npos);  // Run submits the last command buffer
+    CHECK(text.find("crt_Synchronize(crt_cmd, \"Run\"), kernel1D_ScaleCmd(crt_cmd, n, 1.0f / m_total,") != std::string::npos);
+    CHECK(text.find("if (crt_Synchronize(crt_cmd, \"Run\").m_total > 1.0f)") != std::string::npos);
+    CHECK(text.find("crt_cmd = crt_self->crt_recording;") != std::string::npos);  // Run submits the last command buffer
     // The CPU classes run the body as written, in order: nothing to report, no note.
     CommandResult cpu = RunCrossrt("translate --class Between --backend cpu --out " + (tc.dir / "cpu").string() + " --source " +
                                    tc.Source("Between") + " --templates " CROSSRT_SOURCE_DIR "/templates");
@@ -577,17 +577,17 @@ void Counts::kernel1D_Twice(int n) { for (int i = 0; i < n; i++) m_out[i] = 2 * 
     const std::string text((std::istreambuf_iterator<char>(source)), std::istreambuf_iterator<char>());
     const size_t cmd = text.find("void Counts_Vulkan::RunCmd(");
     REQUIRE(cmd != std::string::npos);
-    const size_t first = text.find("Synchronize(a_cmd, \"Run\");", cmd);
+    const size_t first = text.find("crt_Synchronize(crt_cmd, \"Run\");", cmd);
     const size_t copy = text.find("kernel1D_CopyCmd(", cmd);
     // Before the first kernel: the element written is uploaded after the statement.
     CHECK(first < copy);
-    CHECK(text.find("crossrt::UploadVector(m_vdata.m_in, m_in);", first) < copy);
+    CHECK(text.find("crossrt::UploadVector(crt_vdata.m_in, m_in);", first) < copy);
     // Between the kernels: m_out read back before the statement; m_other only the host uses.
-    const size_t read = text.find("crossrt::DownloadVector(m_vdata.m_out, m_out);", copy);
+    const size_t read = text.find("crossrt::DownloadVector(crt_vdata.m_out, m_out);", copy);
     CHECK(read != std::string::npos);
     CHECK(read < text.find("if (m_out[0] > 3)", copy));
-    CHECK(text.find("UploadVector(m_vdata.m_other") == std::string::npos);
-    CHECK(text.find("crossrt::UploadVector(m_vdata.m_in, m_in);", read) < text.find("kernel1D_TwiceCmd(", cmd));
+    CHECK(text.find("UploadVector(crt_vdata.m_other") == std::string::npos);
+    CHECK(text.find("crossrt::UploadVector(crt_vdata.m_in, m_in);", read) < text.find("kernel1D_TwiceCmd(", cmd));
   }
 }
 

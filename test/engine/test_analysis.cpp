@@ -120,8 +120,8 @@ TEST_CASE("Analysis finds kernels, control functions, members and reductions", "
   CHECK(run.params[1].isConst);
   CHECK(run.params[2].sizeExpr == "n");
   CHECK_FALSE(run.params[2].isConst);
-  CHECK(run.vulkanCmdBody.find("kernel1D_ScaleCmd(a_cmd, n, m_inOut_Run.in, m_inOut_Run.out)") != std::string::npos);
-  CHECK(rtv.vulkanCmdBody.find("kernel_PixelCmd(a_cmd, w, h, w, m_inOut_RunRtv.img);") != std::string::npos);
+  CHECK(run.vulkanCmdBody.find("kernel1D_ScaleCmd(crt_cmd, n, crt_inOut_Run.in, crt_inOut_Run.out)") != std::string::npos);
+  CHECK(rtv.vulkanCmdBody.find("kernel_PixelCmd(crt_cmd, w, h, w, crt_inOut_RunRtv.img);") != std::string::npos);
   CHECK(rtv.cpuBody.find("#pragma omp parallel for") != std::string::npos);
 
   // Members: plain data and vectors; the vector of float3 needs the scalar layout to match C++.
@@ -276,8 +276,8 @@ TEST_CASE("Ray queries through ISceneObject get a variant for ray tracing hardwa
   CHECK(body(hardware) == body(software));
   // The host binds the variant where the device has ray queries.
   const std::string host = Squeezed(result.files.at("PrimaryRays_Vulkan.cpp"));
-  CHECK(host.find(Squeezed("crossrt::Binding::SceneOf(m_scenes.m_pAccelStruct)")) != std::string::npos);
-  CHECK(host.find(Squeezed("m_useRayTracingHardware = m_ctx->hasRayQuery;")) != std::string::npos);
+  CHECK(host.find(Squeezed("crossrt::Binding::SceneOf(crt_scenes.m_pAccelStruct)")) != std::string::npos);
+  CHECK(host.find(Squeezed("crt_useRayTracingHardware = crt_ctx->hasRayQuery;")) != std::string::npos);
 }
 
 TEST_CASE("A thread loop whose kernels trace through a composed ISceneObject gets a megakernel with the traversal merged in", "[engine][modes]")
@@ -333,10 +333,10 @@ void Tracer::kernel_Depth(uint32_t tid, const CRT_Hit* hit, float* depth) { dept
   CHECK(hit.find(Squeezed("hitPerThread[threadIndex] = hit;")) != std::string::npos);
   CHECK(result.files.count("shaders/kernel_Hit_RayQuery.comp") == 1);
   const std::string host = Squeezed(result.files.at("Tracer_Vulkan.cpp"));
-  CHECK(host.find(Squeezed("Trace_MegakernelCmd(a_cmd, n, m_inOut_Trace.rays, m_inOut_Trace.depth);")) != std::string::npos);
-  CHECK(host.find(Squeezed("kernel_HitCmd(a_cmd, n, m_inOut_Trace.rays, m_threadState.Trace_hit.View());")) != std::string::npos);
+  CHECK(host.find(Squeezed("Trace_MegakernelCmd(crt_cmd, n, crt_inOut_Trace.rays, crt_inOut_Trace.depth);")) != std::string::npos);
+  CHECK(host.find(Squeezed("kernel_HitCmd(crt_cmd, n, crt_inOut_Trace.rays, crt_threadState.Trace_hit.View());")) != std::string::npos);
   // The megakernel reads the traversal's buffers even while kernel_Hit uses the hardware: they stay uploaded.
-  CHECK(host.find(Squeezed("m_vdata.m_pAccelStruct_m_nodes.Upload(")) != std::string::npos);
+  CHECK(host.find(Squeezed("crt_vdata.m_pAccelStruct_m_nodes.Upload(")) != std::string::npos);
   CHECK(host.find(Squeezed("only the translated traversal reads it")) == std::string::npos);
 }
 
@@ -599,7 +599,7 @@ TEST_CASE("Level 3: a composed traversal's leaf calls become intersection shader
     CHECK(result.files.count("shaders/m_world_m_things_Intersect_Hit.rchit") == 1);
     CHECK(result.files.count("shaders/m_world_m_things_Intersect_Miss.rmiss") == 1);
     const std::string host = Squeezed(result.files.at("Leaves_Vulkan.cpp"));
-    CHECK(host.find(Squeezed("m_scenes.m_world_m_things_leaves.BuildLeaves(leaves, \"Leaves::m_world->m_things\");")) != std::string::npos);
+    CHECK(host.find(Squeezed("crt_scenes.m_world_m_things_leaves.BuildLeaves(leaves, \"Leaves::m_world->m_things\");")) != std::string::npos);
     CHECK(host.find(Squeezed("const auto lo = object->BoxMin(), hi = object->BoxMax();")) != std::string::npos);
   }
   // Two vectors of leaves, the second traced into its own hit: a trace each, on a scene, miss shader,
@@ -623,7 +623,7 @@ TEST_CASE("Level 3: a composed traversal's leaf calls become intersection shader
     // The host: both vectors' boxes; in the pipeline's shaders, miss shader 1 and hit groups 2 and
     // 3 are the lamps'.
     const std::string host = Squeezed(result.files.at("Leaves_Vulkan.cpp"));
-    CHECK(host.find(Squeezed("m_scenes.m_world_m_lamps_leaves.BuildLeaves(leaves, \"Leaves::m_world->m_lamps\");")) != std::string::npos);
+    CHECK(host.find(Squeezed("crt_scenes.m_world_m_lamps_leaves.BuildLeaves(leaves, \"Leaves::m_world->m_lamps\");")) != std::string::npos);
     const size_t shaders = host.find(Squeezed("crossrt::RayTracingShaders{"));
     REQUIRE(shaders != std::string::npos);
     std::vector<size_t> order;
@@ -808,7 +808,7 @@ TEST_CASE("Level 3 in the paper's form: a traversal passing CRT_LeafInfo and its
     // The host builds a bottom level per object over the boxes the traversal gives.
     const std::string host = Squeezed(result.files.at("Leaves_Vulkan.cpp"));
     CHECK(host.find(Squeezed("for (const auto& box : crt_m_world()->LeafBoxes(uint32_t(i)))")) != std::string::npos);
-    CHECK(host.find(Squeezed("m_scenes.m_world_m_things_leaves.BuildBoxGeometries(geometries,")) != std::string::npos);
+    CHECK(host.find(Squeezed("crt_scenes.m_world_m_things_leaves.BuildBoxGeometries(geometries,")) != std::string::npos);
   }
   // What the hardware's walk cannot give keeps the switch, and the host says why.
   const std::pair<std::string, std::string> kept[] = {

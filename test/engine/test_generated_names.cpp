@@ -21,6 +21,6 @@ TEST_CASE("Generated names: the Vulkan class template declares every member the 
     // A member declaration: `Type name;` or the closing `} name;` of a member struct.
     CHECK(std::regex_search(header, std::regex("[\\w>}] " + name + ";")));
   }
-  // The per-control-function buffers: `} m_inOut_<control>;`.
+  // The per-control-function buffers: `} crt_inOut_<control>;`.
   CHECK(header.find("} " + generated::kInOutPrefix + "{{name}};") != std::string::npos);
 }

@@ -65,10 +65,10 @@ TEST_CASE("Library calls: sort, scan, fill and memcpy on member vectors become G
   const std::string prepare = Squeezed(ControlNamed(r.model, "Prepare").vulkanCmdBody);
   INFO(prepare);
   // Each call, in the order written, on the members' device buffers; counts as the user wrote them.
-  const size_t fill = prepare.find(Squeezed("crossrt::FillCmd(a_cmd, m_vdata.m_flags.View(), sizeof(unsigned int) * VkDeviceSize(m_flags.size())"));
-  const size_t keys = prepare.find(Squeezed("kernel1D_KeysCmd(a_cmd, n)"));
-  const size_t sort = prepare.find(Squeezed("m_sorter.RecordCmd(a_cmd, m_vdata.m_keys.View(), uint32_t(n),"));
-  const size_t copy = prepare.find(Squeezed("crossrt::CopyCmd(a_cmd, m_vdata.m_keys.View(), m_vdata.m_copy.View(), VkDeviceSize(n * sizeof(uint32_t)))"));
+  const size_t fill = prepare.find(Squeezed("crossrt::FillCmd(crt_cmd, crt_vdata.m_flags.View(), sizeof(unsigned int) * VkDeviceSize(m_flags.size())"));
+  const size_t keys = prepare.find(Squeezed("kernel1D_KeysCmd(crt_cmd, n)"));
+  const size_t sort = prepare.find(Squeezed("crt_sorter.RecordCmd(crt_cmd, crt_vdata.m_keys.View(), uint32_t(n),"));
+  const size_t copy = prepare.find(Squeezed("crossrt::CopyCmd(crt_cmd, crt_vdata.m_keys.View(), crt_vdata.m_copy.View(), VkDeviceSize(n * sizeof(uint32_t)))"));
   REQUIRE(fill != std::string::npos);
   REQUIRE(keys != std::string::npos);
   REQUIRE(sort != std::string::npos);
@@ -77,7 +77,7 @@ TEST_CASE("Library calls: sort, scan, fill and memcpy on member vectors become G
   CHECK(prepare.find("std::sort") == std::string::npos);
   // The scan writes its output vector, which the host then reads back.
   const Control& compact = ControlNamed(r.model, "Compact");
-  CHECK(Squeezed(compact.vulkanCmdBody).find(Squeezed("m_scanner.RecordCmd(a_cmd, m_vdata.m_flags.View(), m_vdata.m_offsets.View(), uint32_t(n), false")) !=
+  CHECK(Squeezed(compact.vulkanCmdBody).find(Squeezed("crt_scanner.RecordCmd(crt_cmd, crt_vdata.m_flags.View(), crt_vdata.m_offsets.View(), uint32_t(n), false")) !=
         std::string::npos);
   CHECK(std::find(compact.vectorsWritten.begin(), compact.vectorsWritten.end(), "m_offsets") != compact.vectorsWritten.end());
   // The generated class holds a sorter and a scanner because control functions use them.
@@ -98,7 +98,7 @@ TEST_CASE("Library calls: the CPU class sorts on all cores and runs the rest as 
   CHECK(prepare.find(Squeezed("crossrt::RadixSort(m_keys.begin(), m_keys.begin() + n, crossrt::SortKey{1, 0, crossrt::ElementType::Uint, false})")) !=
         std::string::npos);
   CHECK(prepare.find("std::sort") == std::string::npos);
-  CHECK(prepare.find("m_sorter") == std::string::npos);
+  CHECK(prepare.find("crt_sorter") == std::string::npos);
 }
 
 TEST_CASE("Library calls: without sorts or scans the class has no sorter or scanner", "[engine][library]")
@@ -109,8 +109,8 @@ TEST_CASE("Library calls: without sorts or scans the class has no sorter or scan
   REQUIRE(r.ok);
   // Compact still scans: the scanner stays, the sorter goes.
   const std::string header = r.files.at("Library_Vulkan.h");
-  CHECK(header.find("crossrt::Scanner m_scanner;") != std::string::npos);
-  CHECK(header.find("m_sorter") == std::string::npos);
+  CHECK(header.find("crossrt::Scanner crt_scanner;") != std::string::npos);
+  CHECK(header.find("crt_sorter") == std::string::npos);
 }
 
 TEST_CASE("Library calls: a comparator the GPU sort has no key for is a diagnostic", "[engine][library]")

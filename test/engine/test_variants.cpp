@@ -67,7 +67,7 @@ TEST_CASE("Variants: each kernel gets the shaders its body needs, and a pipeline
                                "kernel1D_Mean_Finish", "kernel1D_Mean_Reduce"})
   {
     INFO(pipeline);
-    CHECK(host.find(Squeezed(std::string("m_pipelines.") + pipeline + " = crossrt::ComputePipeline(")) != std::string::npos);
+    CHECK(host.find(Squeezed(std::string("crt_pipelines.") + pipeline + " = crossrt::ComputePipeline(")) != std::string::npos);
   }
   // The embedded SPIR-V holds one array per shader.
   const std::string& spirv = r.files.at("Phases_Vulkan_shaders.cpp");
@@ -170,10 +170,10 @@ TEST_CASE("Variants: at level 3 a kernel that samples arrays of textures runs it
   CHECK(r.files.at("shaders/kernel1D_Run.comp").find("Tinted_Shade(") != std::string::npos);  // the level-2 switch calls it
   // The host creates it with its texture set where the device has both, tries it first, and binds the array.
   const std::string host = Squeezed(r.files.at("TexturedShading_Vulkan.cpp"));
-  CHECK(host.find(Squeezed("if (m_ctx->hasRayTracingPipeline && m_ctx->hasTextureArrays)")) != std::string::npos);
+  CHECK(host.find(Squeezed("if (crt_ctx->hasRayTracingPipeline && crt_ctx->hasTextureArrays)")) != std::string::npos);
   CHECK(host.find(Squeezed("\"TexturedShading::kernel1D_Run_Callables_Textures\", 1);")) != std::string::npos);
-  CHECK(host.find(Squeezed("if (m_useRayTracingPipelines && m_useTextureHardware)")) != std::string::npos);
-  CHECK(host.find(Squeezed("m_pipelines.kernel1D_Run_Callables_Textures.BindTextureArrays(a_cmd, {&m_textureArrays.m_textures});")) !=
+  CHECK(host.find(Squeezed("if (crt_useRayTracingPipelines && crt_useTextureHardware)")) != std::string::npos);
+  CHECK(host.find(Squeezed("crt_pipelines.kernel1D_Run_Callables_Textures.BindTextureArrays(crt_cmd, {&crt_textureArrays.m_textures});")) !=
         std::string::npos);
   CHECK(host.find("still switches over the objects' classes") == std::string::npos);
 }

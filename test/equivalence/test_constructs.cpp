@@ -263,7 +263,7 @@ TEST_CASE("Users keep data on the GPU: SetVulkanInOutFor_ and ...Cmd into their 
   gpu->SetVulkanInOutFor_Saxpy(xBuf.View(), yBuf.View());
   VkCommandBuffer cmd = ctx->BeginOneShot();
   gpu->SaxpyCmd(cmd, n, 2.0f, nullptr, nullptr);  // pointers are unused: the bound buffers are
-  gpu->UpdatePlainMembers();
+  gpu->crt_UpdatePlainMembers();
   ctx->SubmitAndWait(cmd);
   std::vector<float> result(n);
   yBuf.Download(result.data(), n * sizeof(float));

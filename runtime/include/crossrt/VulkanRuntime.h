@@ -452,7 +452,7 @@ T* RawPointer(T* p) { return p; }
 template <typename Smart>
 auto* RawPointer(const Smart& p) { return p.get(); }
 
-// Host code between kernel calls that uses a std::vector member (after Synchronize, the GPU idle):
+// Host code between kernel calls that uses a std::vector member (after crt_Synchronize, the GPU idle):
 // its device copy read back whole, and uploaded whole after the host changed it. The vector keeps
 // the size its buffer was made for while the call runs (resizing there is refused).
 template <typename Vector>

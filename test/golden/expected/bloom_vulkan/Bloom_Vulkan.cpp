@@ -19,11 +19,11 @@ extern const size_t Bloom_kernel2D_BlurYAndAdd_spvBytes;
 
 Bloom_Vulkan::Bloom_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx, int width, int height, int radius,
                            float sigma)
-    : Bloom(width, height, radius, sigma), m_ctx(std::move(a_ctx))
+    : Bloom(width, height, radius, sigma), crt_ctx(std::move(a_ctx))
 {
-  m_classDataBuffer = crossrt::Buffer(m_ctx, sizeof(ClassData));
-  m_gpuTimer = crossrt::GpuTimer(m_ctx);
-  InitPipelines();
+  crt_classDataBuffer = crossrt::Buffer(crt_ctx, sizeof(ClassData));
+  crt_gpuTimer = crossrt::GpuTimer(crt_ctx);
+  crt_InitPipelines();
 }
 
 std::shared_ptr<Bloom> CreateBloom_Vulkan(int width, int height, int radius, float sigma)
@@ -39,26 +39,27 @@ std::shared_ptr<Bloom> CreateBloom_Vulkan(std::shared_ptr<crossrt::VulkanContext
 
 Bloom_Vulkan::~Bloom_Vulkan() = default;
 
-void Bloom_Vulkan::InitPipelines()
+void Bloom_Vulkan::crt_InitPipelines()
 {
-  m_pipelines.kernel2D_ExtractBright =
-      crossrt::ComputePipeline(m_ctx, Bloom_kernel2D_ExtractBright_spv, Bloom_kernel2D_ExtractBright_spvBytes, 3,
+  crt_pipelines.kernel2D_ExtractBright =
+      crossrt::ComputePipeline(crt_ctx, Bloom_kernel2D_ExtractBright_spv, Bloom_kernel2D_ExtractBright_spvBytes, 3,
                                sizeof(kernel2D_ExtractBrightArgs), "Bloom::kernel2D_ExtractBright");
-  m_pipelines.kernel2D_BlurX = crossrt::ComputePipeline(m_ctx, Bloom_kernel2D_BlurX_spv, Bloom_kernel2D_BlurX_spvBytes,
-                                                        4, sizeof(kernel2D_BlurXArgs), "Bloom::kernel2D_BlurX");
-  m_pipelines.kernel2D_BlurYAndAdd =
-      crossrt::ComputePipeline(m_ctx, Bloom_kernel2D_BlurYAndAdd_spv, Bloom_kernel2D_BlurYAndAdd_spvBytes, 5,
+  crt_pipelines.kernel2D_BlurX =
+      crossrt::ComputePipeline(crt_ctx, Bloom_kernel2D_BlurX_spv, Bloom_kernel2D_BlurX_spvBytes, 4,
+                               sizeof(kernel2D_BlurXArgs), "Bloom::kernel2D_BlurX");
+  crt_pipelines.kernel2D_BlurYAndAdd =
+      crossrt::ComputePipeline(crt_ctx, Bloom_kernel2D_BlurYAndAdd_spv, Bloom_kernel2D_BlurYAndAdd_spvBytes, 5,
                                sizeof(kernel2D_BlurYAndAddArgs), "Bloom::kernel2D_BlurYAndAdd");
 }
 
-void Bloom_Vulkan::UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size)
+void Bloom_Vulkan::crt_UpdateMemberCmd(VkCommandBuffer crt_cmd, size_t a_offset, const void* a_data, size_t a_size)
 {
-  crossrt::ComputeBarrier(a_cmd);  // kernels recorded before it are done with the class data
-  vkCmdUpdateBuffer(a_cmd, m_classDataBuffer.Handle(), a_offset, a_size, a_data);
-  crossrt::TransferToComputeBarrier(a_cmd);
+  crossrt::ComputeBarrier(crt_cmd);  // kernels recorded before it are done with the class data
+  vkCmdUpdateBuffer(crt_cmd, crt_classDataBuffer.Handle(), a_offset, a_size, a_data);
+  crossrt::TransferToComputeBarrier(crt_cmd);
 }
 
-void Bloom_Vulkan::UpdatePlainMembers()
+void Bloom_Vulkan::crt_UpdatePlainMembers()
 {
   ClassData data{};
   std::memcpy(&data.m_threshold, &m_threshold, sizeof(data.m_threshold));
@@ -70,63 +71,63 @@ void Bloom_Vulkan::UpdatePlainMembers()
   data.m_bright_capacity = uint32_t(m_bright.capacity());
   data.m_blurred_size = uint32_t(m_blurred.size());
   data.m_blurred_capacity = uint32_t(m_blurred.capacity());
-  m_classDataBuffer.Upload(&data, sizeof(data));
+  crt_classDataBuffer.Upload(&data, sizeof(data));
 }
 
-void Bloom_Vulkan::ReadPlainMembers()
+void Bloom_Vulkan::crt_ReadPlainMembers()
 {
 }
 
 void Bloom_Vulkan::CommitDeviceData()
 {
   // std::vector members become buffers of their capacity; kernels see size and capacity.
-  crossrt::EnsureSize(m_ctx, m_vdata.m_weights, sizeof(float) * m_weights.capacity());
+  crossrt::EnsureSize(crt_ctx, crt_vdata.m_weights, sizeof(float) * m_weights.capacity());
   if (!m_weights.empty())
-    m_vdata.m_weights.Upload(m_weights.data(), sizeof(float) * m_weights.size());
-  m_vdata.m_weightsSize = m_weights.size();
-  crossrt::EnsureSize(m_ctx, m_vdata.m_bright, sizeof(LiteMath::float4) * m_bright.capacity());
+    crt_vdata.m_weights.Upload(m_weights.data(), sizeof(float) * m_weights.size());
+  crt_vdata.m_weightsSize = m_weights.size();
+  crossrt::EnsureSize(crt_ctx, crt_vdata.m_bright, sizeof(LiteMath::float4) * m_bright.capacity());
   if (!m_bright.empty())
-    m_vdata.m_bright.Upload(m_bright.data(), sizeof(LiteMath::float4) * m_bright.size());
-  m_vdata.m_brightSize = m_bright.size();
-  crossrt::EnsureSize(m_ctx, m_vdata.m_blurred, sizeof(LiteMath::float4) * m_blurred.capacity());
+    crt_vdata.m_bright.Upload(m_bright.data(), sizeof(LiteMath::float4) * m_bright.size());
+  crt_vdata.m_brightSize = m_bright.size();
+  crossrt::EnsureSize(crt_ctx, crt_vdata.m_blurred, sizeof(LiteMath::float4) * m_blurred.capacity());
   if (!m_blurred.empty())
-    m_vdata.m_blurred.Upload(m_blurred.data(), sizeof(LiteMath::float4) * m_blurred.size());
-  m_vdata.m_blurredSize = m_blurred.size();
-  UpdatePlainMembers();
-  m_deviceDataCommitted = true;
+    crt_vdata.m_blurred.Upload(m_blurred.data(), sizeof(LiteMath::float4) * m_blurred.size());
+  crt_vdata.m_blurredSize = m_blurred.size();
+  crt_UpdatePlainMembers();
+  crt_deviceDataCommitted = true;
 }
 
-bool Bloom_Vulkan::VectorMembersResized() const
+bool Bloom_Vulkan::crt_VectorMembersResized() const
 {
   bool resized = false;
-  resized = resized || m_weights.size() != m_vdata.m_weightsSize;
-  resized = resized || m_bright.size() != m_vdata.m_brightSize;
-  resized = resized || m_blurred.size() != m_vdata.m_blurredSize;
+  resized = resized || m_weights.size() != crt_vdata.m_weightsSize;
+  resized = resized || m_bright.size() != crt_vdata.m_brightSize;
+  resized = resized || m_blurred.size() != crt_vdata.m_blurredSize;
   return resized;
 }
 
-void Bloom_Vulkan::ReadVectorMembers(const char* a_funcName)
+void Bloom_Vulkan::crt_ReadVectorMembers(const char* a_funcName)
 {
   (void)a_funcName;
   if (std::strcmp(a_funcName, "Run") == 0 && !m_bright.empty())
-    m_vdata.m_bright.Download(m_bright.data(), sizeof(LiteMath::float4) * m_bright.size());
+    crt_vdata.m_bright.Download(m_bright.data(), sizeof(LiteMath::float4) * m_bright.size());
   if (std::strcmp(a_funcName, "Run") == 0 && !m_blurred.empty())
-    m_vdata.m_blurred.Download(m_blurred.data(), sizeof(LiteMath::float4) * m_blurred.size());
+    crt_vdata.m_blurred.Download(m_blurred.data(), sizeof(LiteMath::float4) * m_blurred.size());
 }
 
 void Bloom_Vulkan::GetExecutionTime(const char* a_funcName, float a_out[4])
 {
-  auto it = m_times.find(a_funcName);
+  auto it = crt_times.find(a_funcName);
   for (int i = 0; i < 4; ++i)
-    a_out[i] = it == m_times.end() ? 0.0f : it->second[i];
+    a_out[i] = it == crt_times.end() ? 0.0f : it->second[i];
 }
 
 // ---- Run (from Bloom::Run, Bloom.cpp) ----
 
 void Bloom_Vulkan::SetVulkanInOutFor_Run(crossrt::BufferView a_in, crossrt::BufferView a_out)
 {
-  m_inOut_Run.in = a_in;
-  m_inOut_Run.out = a_out;
+  crt_inOut_Run.in = a_in;
+  crt_inOut_Run.out = a_out;
 }
 
 void Bloom_Vulkan::Run(int width, int height, const float4* in, float4* out)
@@ -136,52 +137,52 @@ void Bloom_Vulkan::Run(int width, int height, const float4* in, float4* out)
   // std::vector members are uploaded by CommitDeviceData(): here once, and again whenever one
   // changed size (its device buffer would be too small). After changing the contents of a
   // vector without resizing it, call CommitDeviceData().
-  if (!crt_self->m_deviceDataCommitted || crt_self->VectorMembersResized())
+  if (!crt_self->crt_deviceDataCommitted || crt_self->crt_VectorMembersResized())
     crt_self->CommitDeviceData();
 
   crossrt::CpuTimer crt_copyIn;
   const size_t crt_inBytes = sizeof(float4) * size_t(width * height);
-  crossrt::EnsureSize(m_ctx, crt_self->m_args.Run_in, crt_inBytes);
+  crossrt::EnsureSize(crt_ctx, crt_self->crt_argCopies.Run_in, crt_inBytes);
   if (crt_inBytes > 0)
-    crt_self->m_args.Run_in.Upload(in, crt_inBytes);
+    crt_self->crt_argCopies.Run_in.Upload(in, crt_inBytes);
   const size_t crt_outBytes = sizeof(float4) * size_t(width * height);
-  crossrt::EnsureSize(m_ctx, crt_self->m_args.Run_out, crt_outBytes);
+  crossrt::EnsureSize(crt_ctx, crt_self->crt_argCopies.Run_out, crt_outBytes);
   if (crt_outBytes > 0)
-    crt_self->m_args.Run_out.Upload(out, crt_outBytes);
-  crt_self->SetVulkanInOutFor_Run(crt_self->m_args.Run_in.View(), crt_self->m_args.Run_out.View());
+    crt_self->crt_argCopies.Run_out.Upload(out, crt_outBytes);
+  crt_self->SetVulkanInOutFor_Run(crt_self->crt_argCopies.Run_in.View(), crt_self->crt_argCopies.Run_out.View());
   const float crt_copyInMs = crt_copyIn.ElapsedMs();
 
   // Members as they are now; host code of Run that changes one records an update in order.
-  crt_self->UpdatePlainMembers();
-  VkCommandBuffer crt_cmd = m_ctx->BeginOneShot();
-  crt_self->m_gpuTimer.Reset(crt_cmd);
-  crt_self->m_gpuTimer.Begin(crt_cmd, "Run");
+  crt_self->crt_UpdatePlainMembers();
+  VkCommandBuffer crt_cmd = crt_ctx->BeginOneShot();
+  crt_self->crt_gpuTimer.Reset(crt_cmd);
+  crt_self->crt_gpuTimer.Begin(crt_cmd, "Run");
   crt_self->RunCmd(crt_cmd, width, height, in, out);
-  crt_self->m_gpuTimer.End(crt_cmd, "Run");
-  m_ctx->SubmitAndWait(crt_cmd);
-  crt_self->m_gpuTimer.Collect();
+  crt_self->crt_gpuTimer.End(crt_cmd, "Run");
+  crt_ctx->SubmitAndWait(crt_cmd);
+  crt_self->crt_gpuTimer.Collect();
 
   crossrt::CpuTimer crt_copyOut;
-  crt_self->ReadPlainMembers();
-  crt_self->ReadVectorMembers("Run");
+  crt_self->crt_ReadPlainMembers();
+  crt_self->crt_ReadVectorMembers("Run");
   if (crt_outBytes > 0)
-    crt_self->m_args.Run_out.Download(out, crt_outBytes);
-  crt_self->m_times["Run"] = {crt_self->m_gpuTimer.LastMs("Run"), crt_copyInMs, crt_copyOut.ElapsedMs(),
-                              crt_total.ElapsedMs()};
+    crt_self->crt_argCopies.Run_out.Download(out, crt_outBytes);
+  crt_self->crt_times["Run"] = {crt_self->crt_gpuTimer.LastMs("Run"), crt_copyInMs, crt_copyOut.ElapsedMs(),
+                                crt_total.ElapsedMs()};
 }
 
 // The body of Bloom::Run, with each kernel call turned into its ...Cmd.
-void Bloom_Vulkan::RunCmd(VkCommandBuffer a_cmd, int width, int height, [[maybe_unused]] const float4* in,
+void Bloom_Vulkan::RunCmd(VkCommandBuffer crt_cmd, int width, int height, [[maybe_unused]] const float4* in,
                           [[maybe_unused]] float4* out)
 {
-  kernel2D_ExtractBrightCmd(a_cmd, width, height, m_inOut_Run.in, m_vdata.m_bright.View());
-  kernel2D_BlurXCmd(a_cmd, width, height, m_vdata.m_bright.View(), m_vdata.m_blurred.View());
-  kernel2D_BlurYAndAddCmd(a_cmd, width, height, m_vdata.m_blurred.View(), m_inOut_Run.in, m_inOut_Run.out);
+  kernel2D_ExtractBrightCmd(crt_cmd, width, height, crt_inOut_Run.in, crt_vdata.m_bright.View());
+  kernel2D_BlurXCmd(crt_cmd, width, height, crt_vdata.m_bright.View(), crt_vdata.m_blurred.View());
+  kernel2D_BlurYAndAddCmd(crt_cmd, width, height, crt_vdata.m_blurred.View(), crt_inOut_Run.in, crt_inOut_Run.out);
 }
 
 // ---- kernel2D_ExtractBright (from Bloom::kernel2D_ExtractBright, Bloom.cpp) ----
 
-void Bloom_Vulkan::kernel2D_ExtractBrightCmd(VkCommandBuffer a_cmd, int width, int height, crossrt::BufferView in,
+void Bloom_Vulkan::kernel2D_ExtractBrightCmd(VkCommandBuffer crt_cmd, int width, int height, crossrt::BufferView in,
                                              crossrt::BufferView bright)
 {
   const int crt_startX = int(0);
@@ -197,16 +198,16 @@ void Bloom_Vulkan::kernel2D_ExtractBrightCmd(VkCommandBuffer a_cmd, int width, i
   crt_args.crt_countY = crt_countY;
   crt_args.width = width;
   crt_args.height = height;
-  m_pipelines.kernel2D_ExtractBright.Bind(a_cmd);
-  m_pipelines.kernel2D_ExtractBright.PushBuffers(a_cmd, {m_classDataBuffer.View(), in, bright});
-  m_pipelines.kernel2D_ExtractBright.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  crossrt::Dispatch2D(a_cmd, crt_countX, crt_countY, 16, 16);
-  crossrt::ComputeBarrier(a_cmd);
+  crt_pipelines.kernel2D_ExtractBright.Bind(crt_cmd);
+  crt_pipelines.kernel2D_ExtractBright.PushBuffers(crt_cmd, {crt_classDataBuffer.View(), in, bright});
+  crt_pipelines.kernel2D_ExtractBright.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
+  crossrt::Dispatch2D(crt_cmd, crt_countX, crt_countY, 16, 16);
+  crossrt::ComputeBarrier(crt_cmd);
 }
 
 // ---- kernel2D_BlurX (from Bloom::kernel2D_BlurX, Bloom.cpp) ----
 
-void Bloom_Vulkan::kernel2D_BlurXCmd(VkCommandBuffer a_cmd, int width, int height, crossrt::BufferView src,
+void Bloom_Vulkan::kernel2D_BlurXCmd(VkCommandBuffer crt_cmd, int width, int height, crossrt::BufferView src,
                                      crossrt::BufferView dst)
 {
   const int crt_startX = int(0);
@@ -222,16 +223,16 @@ void Bloom_Vulkan::kernel2D_BlurXCmd(VkCommandBuffer a_cmd, int width, int heigh
   crt_args.crt_countY = crt_countY;
   crt_args.width = width;
   crt_args.height = height;
-  m_pipelines.kernel2D_BlurX.Bind(a_cmd);
-  m_pipelines.kernel2D_BlurX.PushBuffers(a_cmd, {m_classDataBuffer.View(), src, dst, m_vdata.m_weights.View()});
-  m_pipelines.kernel2D_BlurX.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  crossrt::Dispatch2D(a_cmd, crt_countX, crt_countY, 16, 16);
-  crossrt::ComputeBarrier(a_cmd);
+  crt_pipelines.kernel2D_BlurX.Bind(crt_cmd);
+  crt_pipelines.kernel2D_BlurX.PushBuffers(crt_cmd, {crt_classDataBuffer.View(), src, dst, crt_vdata.m_weights.View()});
+  crt_pipelines.kernel2D_BlurX.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
+  crossrt::Dispatch2D(crt_cmd, crt_countX, crt_countY, 16, 16);
+  crossrt::ComputeBarrier(crt_cmd);
 }
 
 // ---- kernel2D_BlurYAndAdd (from Bloom::kernel2D_BlurYAndAdd, Bloom.cpp) ----
 
-void Bloom_Vulkan::kernel2D_BlurYAndAddCmd(VkCommandBuffer a_cmd, int width, int height, crossrt::BufferView src,
+void Bloom_Vulkan::kernel2D_BlurYAndAddCmd(VkCommandBuffer crt_cmd, int width, int height, crossrt::BufferView src,
                                            crossrt::BufferView in, crossrt::BufferView out)
 {
   const int crt_startX = int(0);
@@ -247,10 +248,10 @@ void Bloom_Vulkan::kernel2D_BlurYAndAddCmd(VkCommandBuffer a_cmd, int width, int
   crt_args.crt_countY = crt_countY;
   crt_args.width = width;
   crt_args.height = height;
-  m_pipelines.kernel2D_BlurYAndAdd.Bind(a_cmd);
-  m_pipelines.kernel2D_BlurYAndAdd.PushBuffers(a_cmd,
-                                               {m_classDataBuffer.View(), src, in, out, m_vdata.m_weights.View()});
-  m_pipelines.kernel2D_BlurYAndAdd.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  crossrt::Dispatch2D(a_cmd, crt_countX, crt_countY, 16, 16);
-  crossrt::ComputeBarrier(a_cmd);
+  crt_pipelines.kernel2D_BlurYAndAdd.Bind(crt_cmd);
+  crt_pipelines.kernel2D_BlurYAndAdd.PushBuffers(
+      crt_cmd, {crt_classDataBuffer.View(), src, in, out, crt_vdata.m_weights.View()});
+  crt_pipelines.kernel2D_BlurYAndAdd.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
+  crossrt::Dispatch2D(crt_cmd, crt_countX, crt_countY, 16, 16);
+  crossrt::ComputeBarrier(crt_cmd);
 }

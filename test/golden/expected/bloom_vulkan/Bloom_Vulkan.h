@@ -26,29 +26,29 @@ public:
 
   // For data that already lives on the GPU: bind your buffers, then record into your command buffer.
   virtual void SetVulkanInOutFor_Run(crossrt::BufferView a_in, crossrt::BufferView a_out);
-  virtual void RunCmd(VkCommandBuffer a_cmd, int width, int height, const float4* in, float4* out);
+  virtual void RunCmd(VkCommandBuffer crt_cmd, int width, int height, const float4* in, float4* out);
 
   void CommitDeviceData() override;  // uploads members
   // a_out: [0] GPU ms, [1] copy-in ms, [2] copy-out ms, [3] total ms
   void GetExecutionTime(const char* a_funcName, float a_out[4]) override;
 
-  virtual void UpdatePlainMembers();  // members -> GPU (called before every control function)
-  virtual void ReadPlainMembers();    // GPU -> members the kernels write (reductions)
+  virtual void crt_UpdatePlainMembers();  // members -> GPU (called before every control function)
+  virtual void crt_ReadPlainMembers();    // GPU -> members the kernels write (reductions)
 
-  std::shared_ptr<crossrt::VulkanContext> Context() const { return m_ctx; }
+  std::shared_ptr<crossrt::VulkanContext> Context() const { return crt_ctx; }
 
 protected:
-  // One per kernel (and megakernel of a thread loop): records its dispatch (and barrier) into a_cmd.
-  virtual void kernel2D_ExtractBrightCmd(VkCommandBuffer a_cmd, int width, int height, crossrt::BufferView in,
+  // One per kernel (and megakernel of a thread loop): records its dispatch (and barrier) into crt_cmd.
+  virtual void kernel2D_ExtractBrightCmd(VkCommandBuffer crt_cmd, int width, int height, crossrt::BufferView in,
                                          crossrt::BufferView bright);
-  virtual void kernel2D_BlurXCmd(VkCommandBuffer a_cmd, int width, int height, crossrt::BufferView src,
+  virtual void kernel2D_BlurXCmd(VkCommandBuffer crt_cmd, int width, int height, crossrt::BufferView src,
                                  crossrt::BufferView dst);
-  virtual void kernel2D_BlurYAndAddCmd(VkCommandBuffer a_cmd, int width, int height, crossrt::BufferView src,
+  virtual void kernel2D_BlurYAndAddCmd(VkCommandBuffer crt_cmd, int width, int height, crossrt::BufferView src,
                                        crossrt::BufferView in, crossrt::BufferView out);
-  virtual void InitPipelines();
+  virtual void crt_InitPipelines();
   // Records an update of one member's GPU copy, ordered between the kernels around it.
-  virtual void UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size);
-  virtual void ReadVectorMembers(const char* a_funcName);  // GPU -> std::vector and Image2D members kernels write
+  virtual void crt_UpdateMemberCmd(VkCommandBuffer crt_cmd, size_t a_offset, const void* a_data, size_t a_size);
+  virtual void crt_ReadVectorMembers(const char* a_funcName);  // GPU -> std::vector and Image2D members kernels write
 
   // Push constants of each kernel: thread ranges, then its scalar arguments (std430 offsets).
   struct kernel2D_ExtractBrightArgs
@@ -93,9 +93,9 @@ protected:
     alignas(4) uint32_t m_blurred_capacity;
   };
 
-  std::shared_ptr<crossrt::VulkanContext> m_ctx;
-  crossrt::Buffer m_classDataBuffer;
-  bool m_deviceDataCommitted = false;
+  std::shared_ptr<crossrt::VulkanContext> crt_ctx;
+  crossrt::Buffer crt_classDataBuffer;
+  bool crt_deviceDataCommitted = false;
 
   struct VectorMembers  // device copies of the std::vector members kernels use
   {
@@ -105,35 +105,35 @@ protected:
     size_t m_brightSize = 0;  // elements at the last CommitDeviceData()
     crossrt::Buffer m_blurred;
     size_t m_blurredSize = 0;  // elements at the last CommitDeviceData()
-  } m_vdata;
+  } crt_vdata;
   // A std::vector or Image2D member changed size, or a sampler changed, since CommitDeviceData().
-  virtual bool VectorMembersResized() const;
+  virtual bool crt_VectorMembersResized() const;
 
   struct InOut_Run  // buffers bound by SetVulkanInOutFor_Run
   {
     crossrt::BufferView in;
     crossrt::BufferView out;
-  } m_inOut_Run;
+  } crt_inOut_Run;
 
   struct ArgumentBuffers  // device copies of pointer arguments, reused across calls
   {
     crossrt::Buffer Run_in;
     crossrt::Buffer Run_out;
-  } m_args;
+  } crt_argCopies;
 
   struct Pipelines
   {
     crossrt::ComputePipeline kernel2D_ExtractBright;
     crossrt::ComputePipeline kernel2D_BlurX;
     crossrt::ComputePipeline kernel2D_BlurYAndAdd;
-  } m_pipelines;
+  } crt_pipelines;
 
   struct Partials  // per-workgroup partial results of reductions
   {
-  } m_partials;
+  } crt_partials;
 
-  crossrt::GpuTimer m_gpuTimer;
-  std::map<std::string, std::array<float, 4>> m_times;
+  crossrt::GpuTimer crt_gpuTimer;
+  std::map<std::string, std::array<float, 4>> crt_times;
 };
 
 // Runs on the default device: CROSSRT_DEVICE (index or name) if set, else a discrete GPU, else lavapipe.

@@ -31,17 +31,17 @@ extern const uint32_t CallableShading_m_materials_Checker_Attenuate_spv[];
 extern const size_t CallableShading_m_materials_Checker_Attenuate_spvBytes;
 
 CallableShading_Vulkan::CallableShading_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx)
-    : CallableShading(), m_ctx(std::move(a_ctx))
+    : CallableShading(), crt_ctx(std::move(a_ctx))
 {
-  m_classDataBuffer = crossrt::Buffer(m_ctx, sizeof(ClassData));
-  m_gpuTimer = crossrt::GpuTimer(m_ctx);
-  m_useRayTracingPipelines = m_ctx->hasRayTracingPipeline;
-  if (m_ctx->hasRayTracingPipeline)
+  crt_classDataBuffer = crossrt::Buffer(crt_ctx, sizeof(ClassData));
+  crt_gpuTimer = crossrt::GpuTimer(crt_ctx);
+  crt_useRayTracingPipelines = crt_ctx->hasRayTracingPipeline;
+  if (crt_ctx->hasRayTracingPipeline)
   {
   }
   // Virtual functions reach each class's objects through buffer references.
-  if (!m_ctx->hasBufferDeviceAddress)
-    throw crossrt::Error("CallableShading_Vulkan: device '" + m_ctx->DeviceName() +
+  if (!crt_ctx->hasBufferDeviceAddress)
+    throw crossrt::Error("CallableShading_Vulkan: device '" + crt_ctx->DeviceName() +
                          "' lacks bufferDeviceAddress, which virtual function calls in kernels need");
   // The pipelines are made by CommitDeviceData(), for the classes the objects hold.
 }
@@ -58,16 +58,16 @@ std::shared_ptr<CallableShading> CreateCallableShading_Vulkan(std::shared_ptr<cr
 
 CallableShading_Vulkan::~CallableShading_Vulkan() = default;
 
-void CallableShading_Vulkan::InitPipelines()
+void CallableShading_Vulkan::crt_InitPipelines()
 {
-  // Kernels switch over the classes in m_pipelineClasses only (specialization constants from
+  // Kernels switch over the classes in crt_pipelineClasses only (specialization constants from
   // crossrt::kClassConstantIdBase): the driver drops the cases of the others.
   static_assert(crossrt::kClassConstantIdBase == 1800,
                 "the shaders and the runtime number the class constants differently");
-  if (m_ctx->hasRayTracingPipeline)  // virtual calls as callable shaders, in a ray tracing pipeline: the shader needs
-                                     // them even to be created
-    m_pipelines.kernel2D_Render_Callables = crossrt::RayTracingPipeline(
-        m_ctx,
+  if (crt_ctx->hasRayTracingPipeline)  // virtual calls as callable shaders, in a ray tracing pipeline: the shader needs
+                                       // them even to be created
+    crt_pipelines.kernel2D_Render_Callables = crossrt::RayTracingPipeline(
+        crt_ctx,
         crossrt::RayTracingShaders{
             {CallableShading_kernel2D_Render_Callables_spv, CallableShading_kernel2D_Render_Callables_spvBytes},
             {},
@@ -89,48 +89,49 @@ void CallableShading_Vulkan::InitPipelines()
         std::vector<VkDescriptorType>{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
                                       VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
         sizeof(kernel2D_RenderArgs), "CallableShading::kernel2D_Render_Callables");
-  m_pipelines.kernel2D_Render =
-      crossrt::ComputePipeline(m_ctx, CallableShading_kernel2D_Render_spv, CallableShading_kernel2D_Render_spvBytes, 4,
-                               sizeof(kernel2D_RenderArgs), "CallableShading::kernel2D_Render", m_pipelineClasses);
+  crt_pipelines.kernel2D_Render =
+      crossrt::ComputePipeline(crt_ctx, CallableShading_kernel2D_Render_spv, CallableShading_kernel2D_Render_spvBytes,
+                               4, sizeof(kernel2D_RenderArgs), "CallableShading::kernel2D_Render", crt_pipelineClasses);
 }
 
 void CallableShading_Vulkan::UseRayTracingPipelines(bool a_use)
 {
-  if (a_use && !m_ctx->hasRayTracingPipeline)
-    throw crossrt::Error("CallableShading_Vulkan: device '" + m_ctx->DeviceName() +
+  if (a_use && !crt_ctx->hasRayTracingPipeline)
+    throw crossrt::Error("CallableShading_Vulkan: device '" + crt_ctx->DeviceName() +
                          "' has no ray tracing pipelines (VK_KHR_ray_tracing_pipeline): its kernels switch over the "
                          "objects' classes in compute shaders");
-  m_useRayTracingPipelines = a_use;
+  crt_useRayTracingPipelines = a_use;
 }
 
 void CallableShading_Vulkan::SpecializeVirtualCalls(bool a_on)
 {
-  if (a_on != m_specializeVirtualCalls)
-    m_deviceDataCommitted = false;  // the next call commits, making the pipelines again
-  m_specializeVirtualCalls = a_on;
+  if (a_on != crt_specializeVirtualCalls)
+    crt_deviceDataCommitted = false;  // the next call commits, making the pipelines again
+  crt_specializeVirtualCalls = a_on;
 }
 
-void CallableShading_Vulkan::UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size)
+void CallableShading_Vulkan::crt_UpdateMemberCmd(VkCommandBuffer crt_cmd, size_t a_offset, const void* a_data,
+                                                 size_t a_size)
 {
-  crossrt::ComputeBarrier(a_cmd);  // kernels recorded before it are done with the class data
-  vkCmdUpdateBuffer(a_cmd, m_classDataBuffer.Handle(), a_offset, a_size, a_data);
-  crossrt::TransferToComputeBarrier(a_cmd);
+  crossrt::ComputeBarrier(crt_cmd);  // kernels recorded before it are done with the class data
+  vkCmdUpdateBuffer(crt_cmd, crt_classDataBuffer.Handle(), a_offset, a_size, a_data);
+  crossrt::TransferToComputeBarrier(crt_cmd);
 }
 
-void CallableShading_Vulkan::UpdatePlainMembers()
+void CallableShading_Vulkan::crt_UpdatePlainMembers()
 {
   ClassData data{};
   std::memcpy(&data.m_toLight, &m_toLight, sizeof(data.m_toLight));
-  data.m_materials_tags = m_virtual.m_materials_tags.Address();
-  data.m_materials_Lambert = m_virtual.m_materials_Lambert.Address();
-  data.m_materials_Phong = m_virtual.m_materials_Phong.Address();
-  data.m_materials_Checker = m_virtual.m_materials_Checker.Address();
+  data.m_materials_tags = crt_virtual.m_materials_tags.Address();
+  data.m_materials_Lambert = crt_virtual.m_materials_Lambert.Address();
+  data.m_materials_Phong = crt_virtual.m_materials_Phong.Address();
+  data.m_materials_Checker = crt_virtual.m_materials_Checker.Address();
   std::memcpy(&data.m_distanceStep, &m_distanceStep, sizeof(data.m_distanceStep));
   data.m_materials_size = uint32_t(m_materials.size());
-  m_classDataBuffer.Upload(&data, sizeof(data));
+  crt_classDataBuffer.Upload(&data, sizeof(data));
 }
 
-void CallableShading_Vulkan::ReadPlainMembers()
+void CallableShading_Vulkan::crt_ReadPlainMembers()
 {
 }
 
@@ -138,23 +139,23 @@ void CallableShading_Vulkan::CommitDeviceData()
 {
   // std::vector members become buffers of their capacity; kernels see size and capacity.
   // Objects called through virtual functions, regrouped; the classes they hold, for the pipelines.
-  std::vector<VkBool32> crt_classesHeld(3, m_specializeVirtualCalls ? VK_FALSE : VK_TRUE);
+  std::vector<VkBool32> crt_classesHeld(3, crt_specializeVirtualCalls ? VK_FALSE : VK_TRUE);
   const std::vector<uint32_t> crt_m_materialsTags = CommitVirtual_m_materials();
-  for (size_t i = 0; i < m_virtual.m_materialsSize; ++i)
+  for (size_t i = 0; i < crt_virtual.m_materialsSize; ++i)
     crt_classesHeld[0 + crt_m_materialsTags[2 * i]] = VK_TRUE;
-  if (crt_classesHeld != m_pipelineClasses)  // made for other classes, or not made yet
+  if (crt_classesHeld != crt_pipelineClasses)  // made for other classes, or not made yet
   {
-    m_pipelineClasses = crt_classesHeld;
-    InitPipelines();
+    crt_pipelineClasses = crt_classesHeld;
+    crt_InitPipelines();
   }
-  UpdatePlainMembers();
-  m_deviceDataCommitted = true;
+  crt_UpdatePlainMembers();
+  crt_deviceDataCommitted = true;
 }
 
-bool CallableShading_Vulkan::VectorMembersResized() const
+bool CallableShading_Vulkan::crt_VectorMembersResized() const
 {
   bool resized = false;
-  resized = resized || m_materials.size() != m_virtual.m_materialsSize;
+  resized = resized || m_materials.size() != crt_virtual.m_materialsSize;
   return resized;
 }
 
@@ -211,34 +212,34 @@ std::vector<uint32_t> CallableShading_Vulkan::CommitVirtual_m_materials()
                            ", which the GPU code does not know; it knows Lambert, Phong, Checker (the classes that "
                            "implement IMaterial where CallableShading is translated)");
   }
-  crossrt::EnsureSize(m_ctx, m_virtual.m_materials_tags, sizeof(uint32_t) * tags.size());
-  m_virtual.m_materials_tags.Upload(tags.data(), sizeof(uint32_t) * tags.size());
-  crossrt::EnsureSize(m_ctx, m_virtual.m_materials_Lambert,
+  crossrt::EnsureSize(crt_ctx, crt_virtual.m_materials_tags, sizeof(uint32_t) * tags.size());
+  crt_virtual.m_materials_tags.Upload(tags.data(), sizeof(uint32_t) * tags.size());
+  crossrt::EnsureSize(crt_ctx, crt_virtual.m_materials_Lambert,
                       sizeof(Lambert_Data) * std::max<size_t>(1, LambertObjects.size()));
   if (!LambertObjects.empty())
-    m_virtual.m_materials_Lambert.Upload(LambertObjects.data(), sizeof(Lambert_Data) * LambertObjects.size());
-  crossrt::EnsureSize(m_ctx, m_virtual.m_materials_Phong,
+    crt_virtual.m_materials_Lambert.Upload(LambertObjects.data(), sizeof(Lambert_Data) * LambertObjects.size());
+  crossrt::EnsureSize(crt_ctx, crt_virtual.m_materials_Phong,
                       sizeof(Phong_Data) * std::max<size_t>(1, PhongObjects.size()));
   if (!PhongObjects.empty())
-    m_virtual.m_materials_Phong.Upload(PhongObjects.data(), sizeof(Phong_Data) * PhongObjects.size());
-  crossrt::EnsureSize(m_ctx, m_virtual.m_materials_Checker,
+    crt_virtual.m_materials_Phong.Upload(PhongObjects.data(), sizeof(Phong_Data) * PhongObjects.size());
+  crossrt::EnsureSize(crt_ctx, crt_virtual.m_materials_Checker,
                       sizeof(Checker_Data) * std::max<size_t>(1, CheckerObjects.size()));
   if (!CheckerObjects.empty())
-    m_virtual.m_materials_Checker.Upload(CheckerObjects.data(), sizeof(Checker_Data) * CheckerObjects.size());
-  m_virtual.m_materialsSize = m_materials.size();
+    crt_virtual.m_materials_Checker.Upload(CheckerObjects.data(), sizeof(Checker_Data) * CheckerObjects.size());
+  crt_virtual.m_materialsSize = m_materials.size();
   return tags;
 }
 
-void CallableShading_Vulkan::ReadVectorMembers(const char* a_funcName)
+void CallableShading_Vulkan::crt_ReadVectorMembers(const char* a_funcName)
 {
   (void)a_funcName;
 }
 
 void CallableShading_Vulkan::GetExecutionTime(const char* a_funcName, float a_out[4])
 {
-  auto it = m_times.find(a_funcName);
+  auto it = crt_times.find(a_funcName);
   for (int i = 0; i < 4; ++i)
-    a_out[i] = it == m_times.end() ? 0.0f : it->second[i];
+    a_out[i] = it == crt_times.end() ? 0.0f : it->second[i];
 }
 
 // ---- Render (from CallableShading::Render, CallableShading.cpp) ----
@@ -246,9 +247,9 @@ void CallableShading_Vulkan::GetExecutionTime(const char* a_funcName, float a_ou
 void CallableShading_Vulkan::SetVulkanInOutFor_Render(crossrt::BufferView a_normals, crossrt::BufferView a_materialIds,
                                                       crossrt::BufferView a_colors)
 {
-  m_inOut_Render.normals = a_normals;
-  m_inOut_Render.materialIds = a_materialIds;
-  m_inOut_Render.colors = a_colors;
+  crt_inOut_Render.normals = a_normals;
+  crt_inOut_Render.materialIds = a_materialIds;
+  crt_inOut_Render.colors = a_colors;
 }
 
 void CallableShading_Vulkan::Render(int width, int height, const float4* normals, const uint32_t* materialIds,
@@ -259,56 +260,58 @@ void CallableShading_Vulkan::Render(int width, int height, const float4* normals
   // std::vector members are uploaded by CommitDeviceData(): here once, and again whenever one
   // changed size (its device buffer would be too small). After changing the contents of a
   // vector without resizing it, call CommitDeviceData().
-  if (!crt_self->m_deviceDataCommitted || crt_self->VectorMembersResized())
+  if (!crt_self->crt_deviceDataCommitted || crt_self->crt_VectorMembersResized())
     crt_self->CommitDeviceData();
 
   crossrt::CpuTimer crt_copyIn;
   const size_t crt_normalsBytes = sizeof(float4) * size_t(width * height);
-  crossrt::EnsureSize(m_ctx, crt_self->m_args.Render_normals, crt_normalsBytes);
+  crossrt::EnsureSize(crt_ctx, crt_self->crt_argCopies.Render_normals, crt_normalsBytes);
   if (crt_normalsBytes > 0)
-    crt_self->m_args.Render_normals.Upload(normals, crt_normalsBytes);
+    crt_self->crt_argCopies.Render_normals.Upload(normals, crt_normalsBytes);
   const size_t crt_materialIdsBytes = sizeof(uint32_t) * size_t(width * height);
-  crossrt::EnsureSize(m_ctx, crt_self->m_args.Render_materialIds, crt_materialIdsBytes);
+  crossrt::EnsureSize(crt_ctx, crt_self->crt_argCopies.Render_materialIds, crt_materialIdsBytes);
   if (crt_materialIdsBytes > 0)
-    crt_self->m_args.Render_materialIds.Upload(materialIds, crt_materialIdsBytes);
+    crt_self->crt_argCopies.Render_materialIds.Upload(materialIds, crt_materialIdsBytes);
   const size_t crt_colorsBytes = sizeof(float4) * size_t(width * height);
-  crossrt::EnsureSize(m_ctx, crt_self->m_args.Render_colors, crt_colorsBytes);
+  crossrt::EnsureSize(crt_ctx, crt_self->crt_argCopies.Render_colors, crt_colorsBytes);
   if (crt_colorsBytes > 0)
-    crt_self->m_args.Render_colors.Upload(colors, crt_colorsBytes);
-  crt_self->SetVulkanInOutFor_Render(crt_self->m_args.Render_normals.View(), crt_self->m_args.Render_materialIds.View(),
-                                     crt_self->m_args.Render_colors.View());
+    crt_self->crt_argCopies.Render_colors.Upload(colors, crt_colorsBytes);
+  crt_self->SetVulkanInOutFor_Render(crt_self->crt_argCopies.Render_normals.View(),
+                                     crt_self->crt_argCopies.Render_materialIds.View(),
+                                     crt_self->crt_argCopies.Render_colors.View());
   const float crt_copyInMs = crt_copyIn.ElapsedMs();
 
   // Members as they are now; host code of Render that changes one records an update in order.
-  crt_self->UpdatePlainMembers();
-  VkCommandBuffer crt_cmd = m_ctx->BeginOneShot();
-  crt_self->m_gpuTimer.Reset(crt_cmd);
-  crt_self->m_gpuTimer.Begin(crt_cmd, "Render");
+  crt_self->crt_UpdatePlainMembers();
+  VkCommandBuffer crt_cmd = crt_ctx->BeginOneShot();
+  crt_self->crt_gpuTimer.Reset(crt_cmd);
+  crt_self->crt_gpuTimer.Begin(crt_cmd, "Render");
   crt_self->RenderCmd(crt_cmd, width, height, normals, materialIds, colors);
-  crt_self->m_gpuTimer.End(crt_cmd, "Render");
-  m_ctx->SubmitAndWait(crt_cmd);
-  crt_self->m_gpuTimer.Collect();
+  crt_self->crt_gpuTimer.End(crt_cmd, "Render");
+  crt_ctx->SubmitAndWait(crt_cmd);
+  crt_self->crt_gpuTimer.Collect();
 
   crossrt::CpuTimer crt_copyOut;
-  crt_self->ReadPlainMembers();
-  crt_self->ReadVectorMembers("Render");
+  crt_self->crt_ReadPlainMembers();
+  crt_self->crt_ReadVectorMembers("Render");
   if (crt_colorsBytes > 0)
-    crt_self->m_args.Render_colors.Download(colors, crt_colorsBytes);
-  crt_self->m_times["Render"] = {crt_self->m_gpuTimer.LastMs("Render"), crt_copyInMs, crt_copyOut.ElapsedMs(),
-                                 crt_total.ElapsedMs()};
+    crt_self->crt_argCopies.Render_colors.Download(colors, crt_colorsBytes);
+  crt_self->crt_times["Render"] = {crt_self->crt_gpuTimer.LastMs("Render"), crt_copyInMs, crt_copyOut.ElapsedMs(),
+                                   crt_total.ElapsedMs()};
 }
 
 // The body of CallableShading::Render, with each kernel call turned into its ...Cmd.
-void CallableShading_Vulkan::RenderCmd(VkCommandBuffer a_cmd, int width, int height,
+void CallableShading_Vulkan::RenderCmd(VkCommandBuffer crt_cmd, int width, int height,
                                        [[maybe_unused]] const float4* normals,
                                        [[maybe_unused]] const uint32_t* materialIds, [[maybe_unused]] float4* colors)
 {
-  kernel2D_RenderCmd(a_cmd, width, height, m_inOut_Render.normals, m_inOut_Render.materialIds, m_inOut_Render.colors);
+  kernel2D_RenderCmd(crt_cmd, width, height, crt_inOut_Render.normals, crt_inOut_Render.materialIds,
+                     crt_inOut_Render.colors);
 }
 
 // ---- kernel2D_Render (from CallableShading::kernel2D_Render, CallableShading.cpp) ----
 
-void CallableShading_Vulkan::kernel2D_RenderCmd(VkCommandBuffer a_cmd, int width, int height,
+void CallableShading_Vulkan::kernel2D_RenderCmd(VkCommandBuffer crt_cmd, int width, int height,
                                                 crossrt::BufferView normals, crossrt::BufferView materialIds,
                                                 crossrt::BufferView colors)
 {
@@ -325,19 +328,20 @@ void CallableShading_Vulkan::kernel2D_RenderCmd(VkCommandBuffer a_cmd, int width
   crt_args.crt_countY = crt_countY;
   crt_args.width = width;
   crt_args.height = height;
-  if (m_useRayTracingPipelines)  // virtual calls as callable shaders, in a ray tracing pipeline
+  if (crt_useRayTracingPipelines)  // virtual calls as callable shaders, in a ray tracing pipeline
   {
-    m_pipelines.kernel2D_Render_Callables.Bind(a_cmd);
-    m_pipelines.kernel2D_Render_Callables.PushBuffers(a_cmd, {m_classDataBuffer.View(), normals, materialIds, colors});
-    m_pipelines.kernel2D_Render_Callables.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-    m_pipelines.kernel2D_Render_Callables.TraceCmd(a_cmd, crt_countX, crt_countY, 1);
+    crt_pipelines.kernel2D_Render_Callables.Bind(crt_cmd);
+    crt_pipelines.kernel2D_Render_Callables.PushBuffers(crt_cmd,
+                                                        {crt_classDataBuffer.View(), normals, materialIds, colors});
+    crt_pipelines.kernel2D_Render_Callables.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
+    crt_pipelines.kernel2D_Render_Callables.TraceCmd(crt_cmd, crt_countX, crt_countY, 1);
   }
   else
   {
-    m_pipelines.kernel2D_Render.Bind(a_cmd);
-    m_pipelines.kernel2D_Render.PushBuffers(a_cmd, {m_classDataBuffer.View(), normals, materialIds, colors});
-    m_pipelines.kernel2D_Render.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-    crossrt::Dispatch2D(a_cmd, crt_countX, crt_countY, 16, 16);
+    crt_pipelines.kernel2D_Render.Bind(crt_cmd);
+    crt_pipelines.kernel2D_Render.PushBuffers(crt_cmd, {crt_classDataBuffer.View(), normals, materialIds, colors});
+    crt_pipelines.kernel2D_Render.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
+    crossrt::Dispatch2D(crt_cmd, crt_countX, crt_countY, 16, 16);
   }
-  crossrt::ComputeBarrier(a_cmd);
+  crossrt::ComputeBarrier(crt_cmd);
 }

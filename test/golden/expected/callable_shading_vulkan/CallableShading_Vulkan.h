@@ -28,40 +28,40 @@ public:
   // For data that already lives on the GPU: bind your buffers, then record into your command buffer.
   virtual void SetVulkanInOutFor_Render(crossrt::BufferView a_normals, crossrt::BufferView a_materialIds,
                                         crossrt::BufferView a_colors);
-  virtual void RenderCmd(VkCommandBuffer a_cmd, int width, int height, const float4* normals,
+  virtual void RenderCmd(VkCommandBuffer crt_cmd, int width, int height, const float4* normals,
                          const uint32_t* materialIds, float4* colors);
 
   void CommitDeviceData() override;  // uploads members
   // a_out: [0] GPU ms, [1] copy-in ms, [2] copy-out ms, [3] total ms
   void GetExecutionTime(const char* a_funcName, float a_out[4]);
 
-  virtual void UpdatePlainMembers();  // members -> GPU (called before every control function)
-  virtual void ReadPlainMembers();    // GPU -> members the kernels write (reductions)
+  virtual void crt_UpdatePlainMembers();  // members -> GPU (called before every control function)
+  virtual void crt_ReadPlainMembers();    // GPU -> members the kernels write (reductions)
 
-  std::shared_ptr<crossrt::VulkanContext> Context() const { return m_ctx; }
+  std::shared_ptr<crossrt::VulkanContext> Context() const { return crt_ctx; }
 
   // Virtual functions, level 3: where the device has VK_KHR_ray_tracing_pipeline (the default there),
   // kernels' virtual calls run as callable shaders and composed traversals' leaves as intersection
   // shaders of ray tracing pipelines; elsewhere, and when turned off, the compute shaders switch over
   // the objects' classes (level 2). Same results. Turning them on throws on a device without them.
-  bool UsesRayTracingPipelines() const { return m_useRayTracingPipelines; }
+  bool UsesRayTracingPipelines() const { return crt_useRayTracingPipelines; }
   virtual void UseRayTracingPipelines(bool a_use);
 
   // Virtual calls specialised to the scene (the default): CommitDeviceData() makes the pipelines
   // for the classes of the objects in m_materials, and makes them again when those
   // change; the switch cases of the other classes are dead code that the driver drops (shorter
   // shaders, fewer registers). Off, the pipelines keep every class's case. Same results.
-  bool SpecializesVirtualCalls() const { return m_specializeVirtualCalls; }
+  bool SpecializesVirtualCalls() const { return crt_specializeVirtualCalls; }
   virtual void SpecializeVirtualCalls(bool a_on);
 
 protected:
-  // One per kernel (and megakernel of a thread loop): records its dispatch (and barrier) into a_cmd.
-  virtual void kernel2D_RenderCmd(VkCommandBuffer a_cmd, int width, int height, crossrt::BufferView normals,
+  // One per kernel (and megakernel of a thread loop): records its dispatch (and barrier) into crt_cmd.
+  virtual void kernel2D_RenderCmd(VkCommandBuffer crt_cmd, int width, int height, crossrt::BufferView normals,
                                   crossrt::BufferView materialIds, crossrt::BufferView colors);
-  virtual void InitPipelines();
+  virtual void crt_InitPipelines();
   // Records an update of one member's GPU copy, ordered between the kernels around it.
-  virtual void UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size);
-  virtual void ReadVectorMembers(const char* a_funcName);  // GPU -> std::vector and Image2D members kernels write
+  virtual void crt_UpdateMemberCmd(VkCommandBuffer crt_cmd, size_t a_offset, const void* a_data, size_t a_size);
+  virtual void crt_ReadVectorMembers(const char* a_funcName);  // GPU -> std::vector and Image2D members kernels write
 
   // Push constants of each kernel: thread ranges, then its scalar arguments (std430 offsets).
   struct kernel2D_RenderArgs
@@ -86,12 +86,12 @@ protected:
     alignas(4) uint32_t m_materials_size;
   };
 
-  std::shared_ptr<crossrt::VulkanContext> m_ctx;
-  crossrt::Buffer m_classDataBuffer;
-  bool m_deviceDataCommitted = false;
+  std::shared_ptr<crossrt::VulkanContext> crt_ctx;
+  crossrt::Buffer crt_classDataBuffer;
+  bool crt_deviceDataCommitted = false;
 
   // A std::vector or Image2D member changed size, or a sampler changed, since CommitDeviceData().
-  virtual bool VectorMembersResized() const;
+  virtual bool crt_VectorMembersResized() const;
 
   // Virtual functions through m_materials (level 2): the GPU keeps the objects of each class
   // (Lambert, Phong, Checker) in a buffer of their own and a (class, index) tag per element.
@@ -123,40 +123,40 @@ protected:
     crossrt::Buffer m_materials_Phong;
     crossrt::Buffer m_materials_Checker;
     size_t m_materialsSize = 0;  // elements at the last CommitDeviceData()
-  } m_virtual;
-  bool m_specializeVirtualCalls = true;
+  } crt_virtual;
+  bool crt_specializeVirtualCalls = true;
   // Per (vector, class), numbered as the shaders' constants crossrt::kClassConstantIdBase + i: whether
   // the pipelines switch over that class (its objects were there at the last CommitDeviceData()).
-  std::vector<VkBool32> m_pipelineClasses;
-  bool m_useRayTracingPipelines = false;  // record the kernels' _Callables and _Intersections variants
+  std::vector<VkBool32> crt_pipelineClasses;
+  bool crt_useRayTracingPipelines = false;  // record the kernels' _Callables and _Intersections variants
 
   struct InOut_Render  // buffers bound by SetVulkanInOutFor_Render
   {
     crossrt::BufferView normals;
     crossrt::BufferView materialIds;
     crossrt::BufferView colors;
-  } m_inOut_Render;
+  } crt_inOut_Render;
 
   struct ArgumentBuffers  // device copies of pointer arguments, reused across calls
   {
     crossrt::Buffer Render_normals;
     crossrt::Buffer Render_materialIds;
     crossrt::Buffer Render_colors;
-  } m_args;
+  } crt_argCopies;
 
   struct Pipelines
   {
     crossrt::RayTracingPipeline
         kernel2D_Render_Callables;  // virtual calls as callable shaders, in a ray tracing pipeline
     crossrt::ComputePipeline kernel2D_Render;
-  } m_pipelines;
+  } crt_pipelines;
 
   struct Partials  // per-workgroup partial results of reductions
   {
-  } m_partials;
+  } crt_partials;
 
-  crossrt::GpuTimer m_gpuTimer;
-  std::map<std::string, std::array<float, 4>> m_times;
+  crossrt::GpuTimer crt_gpuTimer;
+  std::map<std::string, std::array<float, 4>> crt_times;
 };
 
 // Runs on the default device: CROSSRT_DEVICE (index or name) if set, else a discrete GPU, else lavapipe.

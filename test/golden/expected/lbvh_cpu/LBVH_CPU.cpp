@@ -30,9 +30,9 @@ std::shared_ptr<LBVH> CreateLBVH_CPU()
 
 void LBVH_CPU::GetExecutionTime(const char* a_funcName, float a_out[4])
 {
-  auto it = m_times.find(a_funcName);
+  auto it = crt_times.find(a_funcName);
   for (int i = 0; i < 4; ++i)
-    a_out[i] = it == m_times.end() ? 0.0f : it->second[i];
+    a_out[i] = it == crt_times.end() ? 0.0f : it->second[i];
 }
 
 // From LBVH::Build (LBVH.cpp).
@@ -57,7 +57,7 @@ void LBVH_CPU::Build(int count, const LiteMath::Box4f* boxes)
     kernel1D_Refit(count);
   }();
   const float crt_ms = std::chrono::duration<float, std::milli>(std::chrono::steady_clock::now() - crt_start).count();
-  const_cast<LBVH_CPU*>(this)->m_times["Build"] = {0.0f, 0.0f, 0.0f, crt_ms};
+  const_cast<LBVH_CPU*>(this)->crt_times["Build"] = {0.0f, 0.0f, 0.0f, crt_ms};
 }
 
 // From LBVH::kernel1D_Bounds (LBVH.cpp): the outer loop runs on all cores.

@@ -30,7 +30,7 @@ protected:
   void kernel1D_MakeLeaves(int count, const LiteMath::Box4f* boxes);
   void kernel1D_Refit(int count);
 
-  std::map<std::string, std::array<float, 4>> m_times;
+  std::map<std::string, std::array<float, 4>> crt_times;
 };
 
 std::shared_ptr<LBVH> CreateLBVH_CPU();

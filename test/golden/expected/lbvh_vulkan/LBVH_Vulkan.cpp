@@ -32,13 +32,13 @@ extern const size_t LBVH_kernel1D_MakeLeaves_spvBytes;
 extern const uint32_t LBVH_kernel1D_Refit_spv[];
 extern const size_t LBVH_kernel1D_Refit_spvBytes;
 
-LBVH_Vulkan::LBVH_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx) : LBVH(), m_ctx(std::move(a_ctx))
+LBVH_Vulkan::LBVH_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx) : LBVH(), crt_ctx(std::move(a_ctx))
 {
-  m_classDataBuffer = crossrt::Buffer(m_ctx, sizeof(ClassData));
-  m_gpuTimer = crossrt::GpuTimer(m_ctx);
-  m_scanner = crossrt::Scanner(m_ctx);
-  m_sorter = crossrt::RadixSorter(m_ctx);
-  InitPipelines();
+  crt_classDataBuffer = crossrt::Buffer(crt_ctx, sizeof(ClassData));
+  crt_gpuTimer = crossrt::GpuTimer(crt_ctx);
+  crt_scanner = crossrt::Scanner(crt_ctx);
+  crt_sorter = crossrt::RadixSorter(crt_ctx);
+  crt_InitPipelines();
 }
 
 std::shared_ptr<LBVH> CreateLBVH_Vulkan()
@@ -53,49 +53,52 @@ std::shared_ptr<LBVH> CreateLBVH_Vulkan(std::shared_ptr<crossrt::VulkanContext> 
 
 LBVH_Vulkan::~LBVH_Vulkan() = default;
 
-void LBVH_Vulkan::InitPipelines()
+void LBVH_Vulkan::crt_InitPipelines()
 {
   // Member reductions combine partial results with subgroup arithmetic.
-  if (!m_ctx->hasSubgroupArithmetic || m_ctx->subgroupSize < 4)
-    throw crossrt::Error("LBVH_Vulkan: device '" + m_ctx->DeviceName() +
+  if (!crt_ctx->hasSubgroupArithmetic || crt_ctx->subgroupSize < 4)
+    throw crossrt::Error("LBVH_Vulkan: device '" + crt_ctx->DeviceName() +
                          "' lacks compute subgroup arithmetic with >= 4 lanes, which member reductions need");
   // Kernels with crossrt atomics take their fence switch from this specialization constant.
   static_assert(crossrt::kFenceAtomicsConstantId == 1700,
                 "the shaders and the runtime name the fence constant differently");
-  m_pipelines.kernel1D_Bounds = crossrt::ComputePipeline(m_ctx, LBVH_kernel1D_Bounds_spv, LBVH_kernel1D_Bounds_spvBytes,
-                                                         4, sizeof(kernel1D_BoundsArgs), "LBVH::kernel1D_Bounds");
-  m_pipelines.kernel1D_Bounds_Reduce =
-      crossrt::ComputePipeline(m_ctx, LBVH_kernel1D_Bounds_Reduce_spv, LBVH_kernel1D_Bounds_Reduce_spvBytes, 3,
+  crt_pipelines.kernel1D_Bounds =
+      crossrt::ComputePipeline(crt_ctx, LBVH_kernel1D_Bounds_spv, LBVH_kernel1D_Bounds_spvBytes, 4,
+                               sizeof(kernel1D_BoundsArgs), "LBVH::kernel1D_Bounds");
+  crt_pipelines.kernel1D_Bounds_Reduce =
+      crossrt::ComputePipeline(crt_ctx, LBVH_kernel1D_Bounds_Reduce_spv, LBVH_kernel1D_Bounds_Reduce_spvBytes, 3,
                                sizeof(uint32_t), "LBVH::kernel1D_Bounds_Reduce");
-  m_pipelines.kernel1D_EvalMC = crossrt::ComputePipeline(m_ctx, LBVH_kernel1D_EvalMC_spv, LBVH_kernel1D_EvalMC_spvBytes,
-                                                         3, sizeof(kernel1D_EvalMCArgs), "LBVH::kernel1D_EvalMC");
-  m_pipelines.kernel1D_AppendInit =
-      crossrt::ComputePipeline(m_ctx, LBVH_kernel1D_AppendInit_spv, LBVH_kernel1D_AppendInit_spvBytes, 4,
+  crt_pipelines.kernel1D_EvalMC =
+      crossrt::ComputePipeline(crt_ctx, LBVH_kernel1D_EvalMC_spv, LBVH_kernel1D_EvalMC_spvBytes, 3,
+                               sizeof(kernel1D_EvalMCArgs), "LBVH::kernel1D_EvalMC");
+  crt_pipelines.kernel1D_AppendInit =
+      crossrt::ComputePipeline(crt_ctx, LBVH_kernel1D_AppendInit_spv, LBVH_kernel1D_AppendInit_spvBytes, 4,
                                sizeof(kernel1D_AppendInitArgs), "LBVH::kernel1D_AppendInit");
-  m_pipelines.kernel1D_AppendComplete =
-      crossrt::ComputePipeline(m_ctx, LBVH_kernel1D_AppendComplete_spv, LBVH_kernel1D_AppendComplete_spvBytes, 7,
+  crt_pipelines.kernel1D_AppendComplete =
+      crossrt::ComputePipeline(crt_ctx, LBVH_kernel1D_AppendComplete_spv, LBVH_kernel1D_AppendComplete_spvBytes, 7,
                                sizeof(kernel1D_AppendCompleteArgs), "LBVH::kernel1D_AppendComplete");
-  m_pipelines.kernel1D_AppendComplete_Reduce = crossrt::ComputePipeline(
-      m_ctx, LBVH_kernel1D_AppendComplete_Reduce_spv, LBVH_kernel1D_AppendComplete_Reduce_spvBytes, 2, sizeof(uint32_t),
-      "LBVH::kernel1D_AppendComplete_Reduce");
-  m_pipelines.kernel1D_Karras12 =
-      crossrt::ComputePipeline(m_ctx, LBVH_kernel1D_Karras12_spv, LBVH_kernel1D_Karras12_spvBytes, 5,
+  crt_pipelines.kernel1D_AppendComplete_Reduce = crossrt::ComputePipeline(
+      crt_ctx, LBVH_kernel1D_AppendComplete_Reduce_spv, LBVH_kernel1D_AppendComplete_Reduce_spvBytes, 2,
+      sizeof(uint32_t), "LBVH::kernel1D_AppendComplete_Reduce");
+  crt_pipelines.kernel1D_Karras12 =
+      crossrt::ComputePipeline(crt_ctx, LBVH_kernel1D_Karras12_spv, LBVH_kernel1D_Karras12_spvBytes, 5,
                                sizeof(kernel1D_Karras12Args), "LBVH::kernel1D_Karras12");
-  m_pipelines.kernel1D_MakeLeaves =
-      crossrt::ComputePipeline(m_ctx, LBVH_kernel1D_MakeLeaves_spv, LBVH_kernel1D_MakeLeaves_spvBytes, 5,
+  crt_pipelines.kernel1D_MakeLeaves =
+      crossrt::ComputePipeline(crt_ctx, LBVH_kernel1D_MakeLeaves_spv, LBVH_kernel1D_MakeLeaves_spvBytes, 5,
                                sizeof(kernel1D_MakeLeavesArgs), "LBVH::kernel1D_MakeLeaves");
-  m_pipelines.kernel1D_Refit = crossrt::ComputePipeline(m_ctx, LBVH_kernel1D_Refit_spv, LBVH_kernel1D_Refit_spvBytes, 4,
-                                                        sizeof(kernel1D_RefitArgs), "LBVH::kernel1D_Refit");
+  crt_pipelines.kernel1D_Refit =
+      crossrt::ComputePipeline(crt_ctx, LBVH_kernel1D_Refit_spv, LBVH_kernel1D_Refit_spvBytes, 4,
+                               sizeof(kernel1D_RefitArgs), "LBVH::kernel1D_Refit");
 }
 
-void LBVH_Vulkan::UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size)
+void LBVH_Vulkan::crt_UpdateMemberCmd(VkCommandBuffer crt_cmd, size_t a_offset, const void* a_data, size_t a_size)
 {
-  crossrt::ComputeBarrier(a_cmd);  // kernels recorded before it are done with the class data
-  vkCmdUpdateBuffer(a_cmd, m_classDataBuffer.Handle(), a_offset, a_size, a_data);
-  crossrt::TransferToComputeBarrier(a_cmd);
+  crossrt::ComputeBarrier(crt_cmd);  // kernels recorded before it are done with the class data
+  vkCmdUpdateBuffer(crt_cmd, crt_classDataBuffer.Handle(), a_offset, a_size, a_data);
+  crossrt::TransferToComputeBarrier(crt_cmd);
 }
 
-void LBVH_Vulkan::UpdatePlainMembers()
+void LBVH_Vulkan::crt_UpdatePlainMembers()
 {
   ClassData data{};
   std::memcpy(&data.m_centerMin, &m_centerMin, sizeof(data.m_centerMin));
@@ -119,13 +122,13 @@ void LBVH_Vulkan::UpdatePlainMembers()
   data.m_parent_capacity = uint32_t(m_parent.capacity());
   data.m_arrivals_size = uint32_t(m_arrivals.size());
   data.m_arrivals_capacity = uint32_t(m_arrivals.capacity());
-  m_classDataBuffer.Upload(&data, sizeof(data));
+  crt_classDataBuffer.Upload(&data, sizeof(data));
 }
 
-void LBVH_Vulkan::ReadPlainMembers()
+void LBVH_Vulkan::crt_ReadPlainMembers()
 {
   ClassData data{};
-  m_classDataBuffer.Download(&data, sizeof(data));
+  crt_classDataBuffer.Download(&data, sizeof(data));
   std::memcpy(&m_centerMin, &data.m_centerMin, sizeof(data.m_centerMin));
   std::memcpy(&m_centerMax, &data.m_centerMax, sizeof(data.m_centerMax));
   std::memcpy(&m_leafCount, &data.m_leafCount, sizeof(data.m_leafCount));
@@ -134,96 +137,96 @@ void LBVH_Vulkan::ReadPlainMembers()
 void LBVH_Vulkan::CommitDeviceData()
 {
   // std::vector members become buffers of their capacity; kernels see size and capacity.
-  crossrt::EnsureSize(m_ctx, m_vdata.m_nodes, sizeof(BVHNode) * m_nodes.capacity());
+  crossrt::EnsureSize(crt_ctx, crt_vdata.m_nodes, sizeof(BVHNode) * m_nodes.capacity());
   if (!m_nodes.empty())
-    m_vdata.m_nodes.Upload(m_nodes.data(), sizeof(BVHNode) * m_nodes.size());
-  m_vdata.m_nodesSize = m_nodes.size();
-  crossrt::EnsureSize(m_ctx, m_vdata.m_primIndices, sizeof(unsigned int) * m_primIndices.capacity());
+    crt_vdata.m_nodes.Upload(m_nodes.data(), sizeof(BVHNode) * m_nodes.size());
+  crt_vdata.m_nodesSize = m_nodes.size();
+  crossrt::EnsureSize(crt_ctx, crt_vdata.m_primIndices, sizeof(unsigned int) * m_primIndices.capacity());
   if (!m_primIndices.empty())
-    m_vdata.m_primIndices.Upload(m_primIndices.data(), sizeof(unsigned int) * m_primIndices.size());
-  m_vdata.m_primIndicesSize = m_primIndices.size();
-  crossrt::EnsureSize(m_ctx, m_vdata.m_codes, sizeof(LiteMath::uint2) * m_codes.capacity());
+    crt_vdata.m_primIndices.Upload(m_primIndices.data(), sizeof(unsigned int) * m_primIndices.size());
+  crt_vdata.m_primIndicesSize = m_primIndices.size();
+  crossrt::EnsureSize(crt_ctx, crt_vdata.m_codes, sizeof(LiteMath::uint2) * m_codes.capacity());
   if (!m_codes.empty())
-    m_vdata.m_codes.Upload(m_codes.data(), sizeof(LiteMath::uint2) * m_codes.size());
-  m_vdata.m_codesSize = m_codes.size();
-  crossrt::EnsureSize(m_ctx, m_vdata.m_newGroup, sizeof(unsigned int) * m_newGroup.capacity());
+    crt_vdata.m_codes.Upload(m_codes.data(), sizeof(LiteMath::uint2) * m_codes.size());
+  crt_vdata.m_codesSize = m_codes.size();
+  crossrt::EnsureSize(crt_ctx, crt_vdata.m_newGroup, sizeof(unsigned int) * m_newGroup.capacity());
   if (!m_newGroup.empty())
-    m_vdata.m_newGroup.Upload(m_newGroup.data(), sizeof(unsigned int) * m_newGroup.size());
-  m_vdata.m_newGroupSize = m_newGroup.size();
-  crossrt::EnsureSize(m_ctx, m_vdata.m_groupOf, sizeof(unsigned int) * m_groupOf.capacity());
+    crt_vdata.m_newGroup.Upload(m_newGroup.data(), sizeof(unsigned int) * m_newGroup.size());
+  crt_vdata.m_newGroupSize = m_newGroup.size();
+  crossrt::EnsureSize(crt_ctx, crt_vdata.m_groupOf, sizeof(unsigned int) * m_groupOf.capacity());
   if (!m_groupOf.empty())
-    m_vdata.m_groupOf.Upload(m_groupOf.data(), sizeof(unsigned int) * m_groupOf.size());
-  m_vdata.m_groupOfSize = m_groupOf.size();
-  crossrt::EnsureSize(m_ctx, m_vdata.m_leafFirst, sizeof(unsigned int) * m_leafFirst.capacity());
+    crt_vdata.m_groupOf.Upload(m_groupOf.data(), sizeof(unsigned int) * m_groupOf.size());
+  crt_vdata.m_groupOfSize = m_groupOf.size();
+  crossrt::EnsureSize(crt_ctx, crt_vdata.m_leafFirst, sizeof(unsigned int) * m_leafFirst.capacity());
   if (!m_leafFirst.empty())
-    m_vdata.m_leafFirst.Upload(m_leafFirst.data(), sizeof(unsigned int) * m_leafFirst.size());
-  m_vdata.m_leafFirstSize = m_leafFirst.size();
-  crossrt::EnsureSize(m_ctx, m_vdata.m_leafCode, sizeof(unsigned int) * m_leafCode.capacity());
+    crt_vdata.m_leafFirst.Upload(m_leafFirst.data(), sizeof(unsigned int) * m_leafFirst.size());
+  crt_vdata.m_leafFirstSize = m_leafFirst.size();
+  crossrt::EnsureSize(crt_ctx, crt_vdata.m_leafCode, sizeof(unsigned int) * m_leafCode.capacity());
   if (!m_leafCode.empty())
-    m_vdata.m_leafCode.Upload(m_leafCode.data(), sizeof(unsigned int) * m_leafCode.size());
-  m_vdata.m_leafCodeSize = m_leafCode.size();
-  crossrt::EnsureSize(m_ctx, m_vdata.m_parent, sizeof(unsigned int) * m_parent.capacity());
+    crt_vdata.m_leafCode.Upload(m_leafCode.data(), sizeof(unsigned int) * m_leafCode.size());
+  crt_vdata.m_leafCodeSize = m_leafCode.size();
+  crossrt::EnsureSize(crt_ctx, crt_vdata.m_parent, sizeof(unsigned int) * m_parent.capacity());
   if (!m_parent.empty())
-    m_vdata.m_parent.Upload(m_parent.data(), sizeof(unsigned int) * m_parent.size());
-  m_vdata.m_parentSize = m_parent.size();
-  crossrt::EnsureSize(m_ctx, m_vdata.m_arrivals, sizeof(unsigned int) * m_arrivals.capacity());
+    crt_vdata.m_parent.Upload(m_parent.data(), sizeof(unsigned int) * m_parent.size());
+  crt_vdata.m_parentSize = m_parent.size();
+  crossrt::EnsureSize(crt_ctx, crt_vdata.m_arrivals, sizeof(unsigned int) * m_arrivals.capacity());
   if (!m_arrivals.empty())
-    m_vdata.m_arrivals.Upload(m_arrivals.data(), sizeof(unsigned int) * m_arrivals.size());
-  m_vdata.m_arrivalsSize = m_arrivals.size();
-  UpdatePlainMembers();
-  m_deviceDataCommitted = true;
+    crt_vdata.m_arrivals.Upload(m_arrivals.data(), sizeof(unsigned int) * m_arrivals.size());
+  crt_vdata.m_arrivalsSize = m_arrivals.size();
+  crt_UpdatePlainMembers();
+  crt_deviceDataCommitted = true;
 }
 
-bool LBVH_Vulkan::VectorMembersResized() const
+bool LBVH_Vulkan::crt_VectorMembersResized() const
 {
   bool resized = false;
-  resized = resized || m_nodes.size() != m_vdata.m_nodesSize;
-  resized = resized || m_primIndices.size() != m_vdata.m_primIndicesSize;
-  resized = resized || m_codes.size() != m_vdata.m_codesSize;
-  resized = resized || m_newGroup.size() != m_vdata.m_newGroupSize;
-  resized = resized || m_groupOf.size() != m_vdata.m_groupOfSize;
-  resized = resized || m_leafFirst.size() != m_vdata.m_leafFirstSize;
-  resized = resized || m_leafCode.size() != m_vdata.m_leafCodeSize;
-  resized = resized || m_parent.size() != m_vdata.m_parentSize;
-  resized = resized || m_arrivals.size() != m_vdata.m_arrivalsSize;
+  resized = resized || m_nodes.size() != crt_vdata.m_nodesSize;
+  resized = resized || m_primIndices.size() != crt_vdata.m_primIndicesSize;
+  resized = resized || m_codes.size() != crt_vdata.m_codesSize;
+  resized = resized || m_newGroup.size() != crt_vdata.m_newGroupSize;
+  resized = resized || m_groupOf.size() != crt_vdata.m_groupOfSize;
+  resized = resized || m_leafFirst.size() != crt_vdata.m_leafFirstSize;
+  resized = resized || m_leafCode.size() != crt_vdata.m_leafCodeSize;
+  resized = resized || m_parent.size() != crt_vdata.m_parentSize;
+  resized = resized || m_arrivals.size() != crt_vdata.m_arrivalsSize;
   return resized;
 }
 
-void LBVH_Vulkan::ReadVectorMembers(const char* a_funcName)
+void LBVH_Vulkan::crt_ReadVectorMembers(const char* a_funcName)
 {
   (void)a_funcName;
   if (std::strcmp(a_funcName, "Build") == 0 && !m_codes.empty())
-    m_vdata.m_codes.Download(m_codes.data(), sizeof(LiteMath::uint2) * m_codes.size());
+    crt_vdata.m_codes.Download(m_codes.data(), sizeof(LiteMath::uint2) * m_codes.size());
   if (std::strcmp(a_funcName, "Build") == 0 && !m_newGroup.empty())
-    m_vdata.m_newGroup.Download(m_newGroup.data(), sizeof(unsigned int) * m_newGroup.size());
+    crt_vdata.m_newGroup.Download(m_newGroup.data(), sizeof(unsigned int) * m_newGroup.size());
   if (std::strcmp(a_funcName, "Build") == 0 && !m_primIndices.empty())
-    m_vdata.m_primIndices.Download(m_primIndices.data(), sizeof(unsigned int) * m_primIndices.size());
+    crt_vdata.m_primIndices.Download(m_primIndices.data(), sizeof(unsigned int) * m_primIndices.size());
   if (std::strcmp(a_funcName, "Build") == 0 && !m_leafCode.empty())
-    m_vdata.m_leafCode.Download(m_leafCode.data(), sizeof(unsigned int) * m_leafCode.size());
+    crt_vdata.m_leafCode.Download(m_leafCode.data(), sizeof(unsigned int) * m_leafCode.size());
   if (std::strcmp(a_funcName, "Build") == 0 && !m_leafFirst.empty())
-    m_vdata.m_leafFirst.Download(m_leafFirst.data(), sizeof(unsigned int) * m_leafFirst.size());
+    crt_vdata.m_leafFirst.Download(m_leafFirst.data(), sizeof(unsigned int) * m_leafFirst.size());
   if (std::strcmp(a_funcName, "Build") == 0 && !m_arrivals.empty())
-    m_vdata.m_arrivals.Download(m_arrivals.data(), sizeof(unsigned int) * m_arrivals.size());
+    crt_vdata.m_arrivals.Download(m_arrivals.data(), sizeof(unsigned int) * m_arrivals.size());
   if (std::strcmp(a_funcName, "Build") == 0 && !m_nodes.empty())
-    m_vdata.m_nodes.Download(m_nodes.data(), sizeof(BVHNode) * m_nodes.size());
+    crt_vdata.m_nodes.Download(m_nodes.data(), sizeof(BVHNode) * m_nodes.size());
   if (std::strcmp(a_funcName, "Build") == 0 && !m_parent.empty())
-    m_vdata.m_parent.Download(m_parent.data(), sizeof(unsigned int) * m_parent.size());
+    crt_vdata.m_parent.Download(m_parent.data(), sizeof(unsigned int) * m_parent.size());
   if (std::strcmp(a_funcName, "Build") == 0 && !m_groupOf.empty())
-    m_vdata.m_groupOf.Download(m_groupOf.data(), sizeof(unsigned int) * m_groupOf.size());
+    crt_vdata.m_groupOf.Download(m_groupOf.data(), sizeof(unsigned int) * m_groupOf.size());
 }
 
 void LBVH_Vulkan::GetExecutionTime(const char* a_funcName, float a_out[4])
 {
-  auto it = m_times.find(a_funcName);
+  auto it = crt_times.find(a_funcName);
   for (int i = 0; i < 4; ++i)
-    a_out[i] = it == m_times.end() ? 0.0f : it->second[i];
+    a_out[i] = it == crt_times.end() ? 0.0f : it->second[i];
 }
 
 // ---- Build (from LBVH::Build, LBVH.cpp) ----
 
 void LBVH_Vulkan::SetVulkanInOutFor_Build(crossrt::BufferView a_boxes)
 {
-  m_inOut_Build.boxes = a_boxes;
+  crt_inOut_Build.boxes = a_boxes;
 }
 
 void LBVH_Vulkan::Build(int count, const LiteMath::Box4f* boxes)
@@ -233,61 +236,61 @@ void LBVH_Vulkan::Build(int count, const LiteMath::Box4f* boxes)
   // std::vector members are uploaded by CommitDeviceData(): here once, and again whenever one
   // changed size (its device buffer would be too small). After changing the contents of a
   // vector without resizing it, call CommitDeviceData().
-  if (!crt_self->m_deviceDataCommitted || crt_self->VectorMembersResized())
+  if (!crt_self->crt_deviceDataCommitted || crt_self->crt_VectorMembersResized())
     crt_self->CommitDeviceData();
 
   crossrt::CpuTimer crt_copyIn;
   const size_t crt_boxesBytes = sizeof(LiteMath::Box4f) * size_t(count);
-  crossrt::EnsureSize(m_ctx, crt_self->m_args.Build_boxes, crt_boxesBytes);
+  crossrt::EnsureSize(crt_ctx, crt_self->crt_argCopies.Build_boxes, crt_boxesBytes);
   if (crt_boxesBytes > 0)
-    crt_self->m_args.Build_boxes.Upload(boxes, crt_boxesBytes);
-  crt_self->SetVulkanInOutFor_Build(crt_self->m_args.Build_boxes.View());
+    crt_self->crt_argCopies.Build_boxes.Upload(boxes, crt_boxesBytes);
+  crt_self->SetVulkanInOutFor_Build(crt_self->crt_argCopies.Build_boxes.View());
   const float crt_copyInMs = crt_copyIn.ElapsedMs();
 
   // Members as they are now; host code of Build that changes one records an update in order.
-  crt_self->UpdatePlainMembers();
-  VkCommandBuffer crt_cmd = m_ctx->BeginOneShot();
-  crt_self->m_gpuTimer.Reset(crt_cmd);
-  crt_self->m_gpuTimer.Begin(crt_cmd, "Build");
+  crt_self->crt_UpdatePlainMembers();
+  VkCommandBuffer crt_cmd = crt_ctx->BeginOneShot();
+  crt_self->crt_gpuTimer.Reset(crt_cmd);
+  crt_self->crt_gpuTimer.Begin(crt_cmd, "Build");
   crt_self->BuildCmd(crt_cmd, count, boxes);
-  crt_self->m_gpuTimer.End(crt_cmd, "Build");
-  m_ctx->SubmitAndWait(crt_cmd);
-  crt_self->m_gpuTimer.Collect();
-  crt_self->m_scanner.ReleaseRetired();  // scratch that grew while recording
-  crt_self->m_sorter.ReleaseRetired();   // scratch that grew while recording
+  crt_self->crt_gpuTimer.End(crt_cmd, "Build");
+  crt_ctx->SubmitAndWait(crt_cmd);
+  crt_self->crt_gpuTimer.Collect();
+  crt_self->crt_scanner.ReleaseRetired();  // scratch that grew while recording
+  crt_self->crt_sorter.ReleaseRetired();   // scratch that grew while recording
 
   crossrt::CpuTimer crt_copyOut;
-  crt_self->ReadPlainMembers();
-  crt_self->ReadVectorMembers("Build");
-  crt_self->m_times["Build"] = {crt_self->m_gpuTimer.LastMs("Build"), crt_copyInMs, crt_copyOut.ElapsedMs(),
-                                crt_total.ElapsedMs()};
+  crt_self->crt_ReadPlainMembers();
+  crt_self->crt_ReadVectorMembers("Build");
+  crt_self->crt_times["Build"] = {crt_self->crt_gpuTimer.LastMs("Build"), crt_copyInMs, crt_copyOut.ElapsedMs(),
+                                  crt_total.ElapsedMs()};
 }
 
 // The body of LBVH::Build, with each kernel call turned into its ...Cmd.
-void LBVH_Vulkan::BuildCmd(VkCommandBuffer a_cmd, int count, [[maybe_unused]] const LiteMath::Box4f* boxes)
+void LBVH_Vulkan::BuildCmd(VkCommandBuffer crt_cmd, int count, [[maybe_unused]] const LiteMath::Box4f* boxes)
 {
   m_centerMin = float3(+1e30f);
-  UpdateMemberCmd(a_cmd, offsetof(ClassData, m_centerMin), &m_centerMin, sizeof(m_centerMin));
+  crt_UpdateMemberCmd(crt_cmd, offsetof(ClassData, m_centerMin), &m_centerMin, sizeof(m_centerMin));
   m_centerMax = float3(-1e30f);
-  UpdateMemberCmd(a_cmd, offsetof(ClassData, m_centerMax), &m_centerMax, sizeof(m_centerMax));
-  kernel1D_BoundsCmd(a_cmd, count, m_inOut_Build.boxes);
-  kernel1D_EvalMCCmd(a_cmd, count, m_inOut_Build.boxes);
-  m_sorter.RecordCmd(a_cmd, m_vdata.m_codes.View(), uint32_t(count),
-                     crossrt::SortKey{2, 0, crossrt::ElementType::Uint, false});
-  kernel1D_AppendInitCmd(a_cmd, count);
-  m_scanner.RecordCmd(a_cmd, m_vdata.m_newGroup.View(), m_vdata.m_groupOf.View(), uint32_t(count), false,
-                      crossrt::ElementType::Uint, crossrt::Bits32(static_cast<unsigned int>(0u)));
+  crt_UpdateMemberCmd(crt_cmd, offsetof(ClassData, m_centerMax), &m_centerMax, sizeof(m_centerMax));
+  kernel1D_BoundsCmd(crt_cmd, count, crt_inOut_Build.boxes);
+  kernel1D_EvalMCCmd(crt_cmd, count, crt_inOut_Build.boxes);
+  crt_sorter.RecordCmd(crt_cmd, crt_vdata.m_codes.View(), uint32_t(count),
+                       crossrt::SortKey{2, 0, crossrt::ElementType::Uint, false});
+  kernel1D_AppendInitCmd(crt_cmd, count);
+  crt_scanner.RecordCmd(crt_cmd, crt_vdata.m_newGroup.View(), crt_vdata.m_groupOf.View(), uint32_t(count), false,
+                        crossrt::ElementType::Uint, crossrt::Bits32(static_cast<unsigned int>(0u)));
   m_leafCount = 0;
-  UpdateMemberCmd(a_cmd, offsetof(ClassData, m_leafCount), &m_leafCount, sizeof(m_leafCount));
-  kernel1D_AppendCompleteCmd(a_cmd, count);
-  kernel1D_Karras12Cmd(a_cmd, count);
-  kernel1D_MakeLeavesCmd(a_cmd, count, m_inOut_Build.boxes);
-  kernel1D_RefitCmd(a_cmd, count);
+  crt_UpdateMemberCmd(crt_cmd, offsetof(ClassData, m_leafCount), &m_leafCount, sizeof(m_leafCount));
+  kernel1D_AppendCompleteCmd(crt_cmd, count);
+  kernel1D_Karras12Cmd(crt_cmd, count);
+  kernel1D_MakeLeavesCmd(crt_cmd, count, crt_inOut_Build.boxes);
+  kernel1D_RefitCmd(crt_cmd, count);
 }
 
 // ---- kernel1D_Bounds (from LBVH::kernel1D_Bounds, LBVH.cpp) ----
 
-void LBVH_Vulkan::kernel1D_BoundsCmd(VkCommandBuffer a_cmd, int count, crossrt::BufferView boxes)
+void LBVH_Vulkan::kernel1D_BoundsCmd(VkCommandBuffer crt_cmd, int count, crossrt::BufferView boxes)
 {
   const int crt_startX = int(0);
   const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(count)));
@@ -297,30 +300,30 @@ void LBVH_Vulkan::kernel1D_BoundsCmd(VkCommandBuffer a_cmd, int count, crossrt::
   crt_args.crt_startX = crt_startX;
   crt_args.crt_countX = crt_countX;
   crt_args.count = count;
-  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Bounds_m_centerMin,
+  crossrt::EnsureSize(crt_ctx, crt_partials.kernel1D_Bounds_m_centerMin,
                       16 * crossrt::GroupCount1D(crt_countX, 256));  // LiteMath::float3 per workgroup
-  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Bounds_m_centerMax,
+  crossrt::EnsureSize(crt_ctx, crt_partials.kernel1D_Bounds_m_centerMax,
                       16 * crossrt::GroupCount1D(crt_countX, 256));  // LiteMath::float3 per workgroup
-  m_pipelines.kernel1D_Bounds.Bind(a_cmd);
-  m_pipelines.kernel1D_Bounds.PushBuffers(a_cmd, {m_classDataBuffer.View(), boxes,
-                                                  m_partials.kernel1D_Bounds_m_centerMin.View(),
-                                                  m_partials.kernel1D_Bounds_m_centerMax.View()});
-  m_pipelines.kernel1D_Bounds.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  crossrt::Dispatch1D(a_cmd, crt_countX, 256);
-  crossrt::ComputeBarrier(a_cmd);
+  crt_pipelines.kernel1D_Bounds.Bind(crt_cmd);
+  crt_pipelines.kernel1D_Bounds.PushBuffers(crt_cmd, {crt_classDataBuffer.View(), boxes,
+                                                      crt_partials.kernel1D_Bounds_m_centerMin.View(),
+                                                      crt_partials.kernel1D_Bounds_m_centerMax.View()});
+  crt_pipelines.kernel1D_Bounds.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
+  crossrt::Dispatch1D(crt_cmd, crt_countX, 256);
+  crossrt::ComputeBarrier(crt_cmd);
   const uint32_t crt_partialCount = crossrt::GroupCount1D(crt_countX, 256);
-  m_pipelines.kernel1D_Bounds_Reduce.Bind(a_cmd);
-  m_pipelines.kernel1D_Bounds_Reduce.PushBuffers(a_cmd, {m_classDataBuffer.View(),
-                                                         m_partials.kernel1D_Bounds_m_centerMin.View(),
-                                                         m_partials.kernel1D_Bounds_m_centerMax.View()});
-  m_pipelines.kernel1D_Bounds_Reduce.PushConstants(a_cmd, &crt_partialCount, sizeof(crt_partialCount));
-  vkCmdDispatch(a_cmd, 1, 1, 1);
-  crossrt::ComputeBarrier(a_cmd);
+  crt_pipelines.kernel1D_Bounds_Reduce.Bind(crt_cmd);
+  crt_pipelines.kernel1D_Bounds_Reduce.PushBuffers(crt_cmd, {crt_classDataBuffer.View(),
+                                                             crt_partials.kernel1D_Bounds_m_centerMin.View(),
+                                                             crt_partials.kernel1D_Bounds_m_centerMax.View()});
+  crt_pipelines.kernel1D_Bounds_Reduce.PushConstants(crt_cmd, &crt_partialCount, sizeof(crt_partialCount));
+  vkCmdDispatch(crt_cmd, 1, 1, 1);
+  crossrt::ComputeBarrier(crt_cmd);
 }
 
 // ---- kernel1D_EvalMC (from LBVH::kernel1D_EvalMC, LBVH.cpp) ----
 
-void LBVH_Vulkan::kernel1D_EvalMCCmd(VkCommandBuffer a_cmd, int count, crossrt::BufferView boxes)
+void LBVH_Vulkan::kernel1D_EvalMCCmd(VkCommandBuffer crt_cmd, int count, crossrt::BufferView boxes)
 {
   const int crt_startX = int(0);
   const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(count)));
@@ -330,16 +333,16 @@ void LBVH_Vulkan::kernel1D_EvalMCCmd(VkCommandBuffer a_cmd, int count, crossrt::
   crt_args.crt_startX = crt_startX;
   crt_args.crt_countX = crt_countX;
   crt_args.count = count;
-  m_pipelines.kernel1D_EvalMC.Bind(a_cmd);
-  m_pipelines.kernel1D_EvalMC.PushBuffers(a_cmd, {m_classDataBuffer.View(), boxes, m_vdata.m_codes.View()});
-  m_pipelines.kernel1D_EvalMC.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  crossrt::Dispatch1D(a_cmd, crt_countX, 256);
-  crossrt::ComputeBarrier(a_cmd);
+  crt_pipelines.kernel1D_EvalMC.Bind(crt_cmd);
+  crt_pipelines.kernel1D_EvalMC.PushBuffers(crt_cmd, {crt_classDataBuffer.View(), boxes, crt_vdata.m_codes.View()});
+  crt_pipelines.kernel1D_EvalMC.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
+  crossrt::Dispatch1D(crt_cmd, crt_countX, 256);
+  crossrt::ComputeBarrier(crt_cmd);
 }
 
 // ---- kernel1D_AppendInit (from LBVH::kernel1D_AppendInit, LBVH.cpp) ----
 
-void LBVH_Vulkan::kernel1D_AppendInitCmd(VkCommandBuffer a_cmd, int count)
+void LBVH_Vulkan::kernel1D_AppendInitCmd(VkCommandBuffer crt_cmd, int count)
 {
   const int crt_startX = int(0);
   const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(count)));
@@ -349,17 +352,17 @@ void LBVH_Vulkan::kernel1D_AppendInitCmd(VkCommandBuffer a_cmd, int count)
   crt_args.crt_startX = crt_startX;
   crt_args.crt_countX = crt_countX;
   crt_args.count = count;
-  m_pipelines.kernel1D_AppendInit.Bind(a_cmd);
-  m_pipelines.kernel1D_AppendInit.PushBuffers(a_cmd, {m_classDataBuffer.View(), m_vdata.m_codes.View(),
-                                                      m_vdata.m_newGroup.View(), m_vdata.m_primIndices.View()});
-  m_pipelines.kernel1D_AppendInit.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  crossrt::Dispatch1D(a_cmd, crt_countX, 256);
-  crossrt::ComputeBarrier(a_cmd);
+  crt_pipelines.kernel1D_AppendInit.Bind(crt_cmd);
+  crt_pipelines.kernel1D_AppendInit.PushBuffers(crt_cmd, {crt_classDataBuffer.View(), crt_vdata.m_codes.View(),
+                                                          crt_vdata.m_newGroup.View(), crt_vdata.m_primIndices.View()});
+  crt_pipelines.kernel1D_AppendInit.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
+  crossrt::Dispatch1D(crt_cmd, crt_countX, 256);
+  crossrt::ComputeBarrier(crt_cmd);
 }
 
 // ---- kernel1D_AppendComplete (from LBVH::kernel1D_AppendComplete, LBVH.cpp) ----
 
-void LBVH_Vulkan::kernel1D_AppendCompleteCmd(VkCommandBuffer a_cmd, int count)
+void LBVH_Vulkan::kernel1D_AppendCompleteCmd(VkCommandBuffer crt_cmd, int count)
 {
   const int crt_startX = int(0);
   const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(count)));
@@ -369,28 +372,28 @@ void LBVH_Vulkan::kernel1D_AppendCompleteCmd(VkCommandBuffer a_cmd, int count)
   crt_args.crt_startX = crt_startX;
   crt_args.crt_countX = crt_countX;
   crt_args.count = count;
-  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_AppendComplete_m_leafCount,
+  crossrt::EnsureSize(crt_ctx, crt_partials.kernel1D_AppendComplete_m_leafCount,
                       4 * crossrt::GroupCount1D(crt_countX, 256));  // uint32_t per workgroup
-  m_pipelines.kernel1D_AppendComplete.Bind(a_cmd);
-  m_pipelines.kernel1D_AppendComplete.PushBuffers(a_cmd, {m_classDataBuffer.View(), m_vdata.m_codes.View(),
-                                                          m_vdata.m_groupOf.View(), m_vdata.m_leafCode.View(),
-                                                          m_vdata.m_leafFirst.View(), m_vdata.m_newGroup.View(),
-                                                          m_partials.kernel1D_AppendComplete_m_leafCount.View()});
-  m_pipelines.kernel1D_AppendComplete.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  crossrt::Dispatch1D(a_cmd, crt_countX, 256);
-  crossrt::ComputeBarrier(a_cmd);
+  crt_pipelines.kernel1D_AppendComplete.Bind(crt_cmd);
+  crt_pipelines.kernel1D_AppendComplete.PushBuffers(crt_cmd, {crt_classDataBuffer.View(), crt_vdata.m_codes.View(),
+                                                              crt_vdata.m_groupOf.View(), crt_vdata.m_leafCode.View(),
+                                                              crt_vdata.m_leafFirst.View(), crt_vdata.m_newGroup.View(),
+                                                              crt_partials.kernel1D_AppendComplete_m_leafCount.View()});
+  crt_pipelines.kernel1D_AppendComplete.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
+  crossrt::Dispatch1D(crt_cmd, crt_countX, 256);
+  crossrt::ComputeBarrier(crt_cmd);
   const uint32_t crt_partialCount = crossrt::GroupCount1D(crt_countX, 256);
-  m_pipelines.kernel1D_AppendComplete_Reduce.Bind(a_cmd);
-  m_pipelines.kernel1D_AppendComplete_Reduce.PushBuffers(
-      a_cmd, {m_classDataBuffer.View(), m_partials.kernel1D_AppendComplete_m_leafCount.View()});
-  m_pipelines.kernel1D_AppendComplete_Reduce.PushConstants(a_cmd, &crt_partialCount, sizeof(crt_partialCount));
-  vkCmdDispatch(a_cmd, 1, 1, 1);
-  crossrt::ComputeBarrier(a_cmd);
+  crt_pipelines.kernel1D_AppendComplete_Reduce.Bind(crt_cmd);
+  crt_pipelines.kernel1D_AppendComplete_Reduce.PushBuffers(
+      crt_cmd, {crt_classDataBuffer.View(), crt_partials.kernel1D_AppendComplete_m_leafCount.View()});
+  crt_pipelines.kernel1D_AppendComplete_Reduce.PushConstants(crt_cmd, &crt_partialCount, sizeof(crt_partialCount));
+  vkCmdDispatch(crt_cmd, 1, 1, 1);
+  crossrt::ComputeBarrier(crt_cmd);
 }
 
 // ---- kernel1D_Karras12 (from LBVH::kernel1D_Karras12, LBVH.cpp) ----
 
-void LBVH_Vulkan::kernel1D_Karras12Cmd(VkCommandBuffer a_cmd, int count)
+void LBVH_Vulkan::kernel1D_Karras12Cmd(VkCommandBuffer crt_cmd, int count)
 {
   const int crt_startX = int(0);
   const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(count)));
@@ -400,18 +403,18 @@ void LBVH_Vulkan::kernel1D_Karras12Cmd(VkCommandBuffer a_cmd, int count)
   crt_args.crt_startX = crt_startX;
   crt_args.crt_countX = crt_countX;
   crt_args.count = count;
-  m_pipelines.kernel1D_Karras12.Bind(a_cmd);
-  m_pipelines.kernel1D_Karras12.PushBuffers(a_cmd, {m_classDataBuffer.View(), m_vdata.m_arrivals.View(),
-                                                    m_vdata.m_leafCode.View(), m_vdata.m_nodes.View(),
-                                                    m_vdata.m_parent.View()});
-  m_pipelines.kernel1D_Karras12.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  crossrt::Dispatch1D(a_cmd, crt_countX, 256);
-  crossrt::ComputeBarrier(a_cmd);
+  crt_pipelines.kernel1D_Karras12.Bind(crt_cmd);
+  crt_pipelines.kernel1D_Karras12.PushBuffers(crt_cmd, {crt_classDataBuffer.View(), crt_vdata.m_arrivals.View(),
+                                                        crt_vdata.m_leafCode.View(), crt_vdata.m_nodes.View(),
+                                                        crt_vdata.m_parent.View()});
+  crt_pipelines.kernel1D_Karras12.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
+  crossrt::Dispatch1D(crt_cmd, crt_countX, 256);
+  crossrt::ComputeBarrier(crt_cmd);
 }
 
 // ---- kernel1D_MakeLeaves (from LBVH::kernel1D_MakeLeaves, LBVH.cpp) ----
 
-void LBVH_Vulkan::kernel1D_MakeLeavesCmd(VkCommandBuffer a_cmd, int count, crossrt::BufferView boxes)
+void LBVH_Vulkan::kernel1D_MakeLeavesCmd(VkCommandBuffer crt_cmd, int count, crossrt::BufferView boxes)
 {
   const int crt_startX = int(0);
   const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(count)));
@@ -421,17 +424,18 @@ void LBVH_Vulkan::kernel1D_MakeLeavesCmd(VkCommandBuffer a_cmd, int count, cross
   crt_args.crt_startX = crt_startX;
   crt_args.crt_countX = crt_countX;
   crt_args.count = count;
-  m_pipelines.kernel1D_MakeLeaves.Bind(a_cmd);
-  m_pipelines.kernel1D_MakeLeaves.PushBuffers(a_cmd, {m_classDataBuffer.View(), boxes, m_vdata.m_leafFirst.View(),
-                                                      m_vdata.m_nodes.View(), m_vdata.m_primIndices.View()});
-  m_pipelines.kernel1D_MakeLeaves.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  crossrt::Dispatch1D(a_cmd, crt_countX, 256);
-  crossrt::ComputeBarrier(a_cmd);
+  crt_pipelines.kernel1D_MakeLeaves.Bind(crt_cmd);
+  crt_pipelines.kernel1D_MakeLeaves.PushBuffers(crt_cmd,
+                                                {crt_classDataBuffer.View(), boxes, crt_vdata.m_leafFirst.View(),
+                                                 crt_vdata.m_nodes.View(), crt_vdata.m_primIndices.View()});
+  crt_pipelines.kernel1D_MakeLeaves.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
+  crossrt::Dispatch1D(crt_cmd, crt_countX, 256);
+  crossrt::ComputeBarrier(crt_cmd);
 }
 
 // ---- kernel1D_Refit (from LBVH::kernel1D_Refit, LBVH.cpp) ----
 
-void LBVH_Vulkan::kernel1D_RefitCmd(VkCommandBuffer a_cmd, int count)
+void LBVH_Vulkan::kernel1D_RefitCmd(VkCommandBuffer crt_cmd, int count)
 {
   const int crt_startX = int(0);
   const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(count)));
@@ -441,10 +445,10 @@ void LBVH_Vulkan::kernel1D_RefitCmd(VkCommandBuffer a_cmd, int count)
   crt_args.crt_startX = crt_startX;
   crt_args.crt_countX = crt_countX;
   crt_args.count = count;
-  m_pipelines.kernel1D_Refit.Bind(a_cmd);
-  m_pipelines.kernel1D_Refit.PushBuffers(
-      a_cmd, {m_classDataBuffer.View(), m_vdata.m_arrivals.View(), m_vdata.m_nodes.View(), m_vdata.m_parent.View()});
-  m_pipelines.kernel1D_Refit.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  crossrt::Dispatch1D(a_cmd, crt_countX, 256);
-  crossrt::ComputeBarrier(a_cmd);
+  crt_pipelines.kernel1D_Refit.Bind(crt_cmd);
+  crt_pipelines.kernel1D_Refit.PushBuffers(crt_cmd, {crt_classDataBuffer.View(), crt_vdata.m_arrivals.View(),
+                                                     crt_vdata.m_nodes.View(), crt_vdata.m_parent.View()});
+  crt_pipelines.kernel1D_Refit.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
+  crossrt::Dispatch1D(crt_cmd, crt_countX, 256);
+  crossrt::ComputeBarrier(crt_cmd);
 }

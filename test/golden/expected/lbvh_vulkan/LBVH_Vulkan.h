@@ -26,30 +26,30 @@ public:
 
   // For data that already lives on the GPU: bind your buffers, then record into your command buffer.
   virtual void SetVulkanInOutFor_Build(crossrt::BufferView a_boxes);
-  virtual void BuildCmd(VkCommandBuffer a_cmd, int count, const LiteMath::Box4f* boxes);
+  virtual void BuildCmd(VkCommandBuffer crt_cmd, int count, const LiteMath::Box4f* boxes);
 
   void CommitDeviceData() override;  // uploads members
   // a_out: [0] GPU ms, [1] copy-in ms, [2] copy-out ms, [3] total ms
   void GetExecutionTime(const char* a_funcName, float a_out[4]) override;
 
-  virtual void UpdatePlainMembers();  // members -> GPU (called before every control function)
-  virtual void ReadPlainMembers();    // GPU -> members the kernels write (reductions)
+  virtual void crt_UpdatePlainMembers();  // members -> GPU (called before every control function)
+  virtual void crt_ReadPlainMembers();    // GPU -> members the kernels write (reductions)
 
-  std::shared_ptr<crossrt::VulkanContext> Context() const { return m_ctx; }
+  std::shared_ptr<crossrt::VulkanContext> Context() const { return crt_ctx; }
 
 protected:
-  // One per kernel (and megakernel of a thread loop): records its dispatch (and barrier) into a_cmd.
-  virtual void kernel1D_BoundsCmd(VkCommandBuffer a_cmd, int count, crossrt::BufferView boxes);
-  virtual void kernel1D_EvalMCCmd(VkCommandBuffer a_cmd, int count, crossrt::BufferView boxes);
-  virtual void kernel1D_AppendInitCmd(VkCommandBuffer a_cmd, int count);
-  virtual void kernel1D_AppendCompleteCmd(VkCommandBuffer a_cmd, int count);
-  virtual void kernel1D_Karras12Cmd(VkCommandBuffer a_cmd, int count);
-  virtual void kernel1D_MakeLeavesCmd(VkCommandBuffer a_cmd, int count, crossrt::BufferView boxes);
-  virtual void kernel1D_RefitCmd(VkCommandBuffer a_cmd, int count);
-  virtual void InitPipelines();
+  // One per kernel (and megakernel of a thread loop): records its dispatch (and barrier) into crt_cmd.
+  virtual void kernel1D_BoundsCmd(VkCommandBuffer crt_cmd, int count, crossrt::BufferView boxes);
+  virtual void kernel1D_EvalMCCmd(VkCommandBuffer crt_cmd, int count, crossrt::BufferView boxes);
+  virtual void kernel1D_AppendInitCmd(VkCommandBuffer crt_cmd, int count);
+  virtual void kernel1D_AppendCompleteCmd(VkCommandBuffer crt_cmd, int count);
+  virtual void kernel1D_Karras12Cmd(VkCommandBuffer crt_cmd, int count);
+  virtual void kernel1D_MakeLeavesCmd(VkCommandBuffer crt_cmd, int count, crossrt::BufferView boxes);
+  virtual void kernel1D_RefitCmd(VkCommandBuffer crt_cmd, int count);
+  virtual void crt_InitPipelines();
   // Records an update of one member's GPU copy, ordered between the kernels around it.
-  virtual void UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size);
-  virtual void ReadVectorMembers(const char* a_funcName);  // GPU -> std::vector and Image2D members kernels write
+  virtual void crt_UpdateMemberCmd(VkCommandBuffer crt_cmd, size_t a_offset, const void* a_data, size_t a_size);
+  virtual void crt_ReadVectorMembers(const char* a_funcName);  // GPU -> std::vector and Image2D members kernels write
 
   // Push constants of each kernel: thread ranges, then its scalar arguments (std430 offsets).
   struct kernel1D_BoundsArgs
@@ -121,9 +121,9 @@ protected:
     alignas(4) uint32_t m_arrivals_capacity;
   };
 
-  std::shared_ptr<crossrt::VulkanContext> m_ctx;
-  crossrt::Buffer m_classDataBuffer;
-  bool m_deviceDataCommitted = false;
+  std::shared_ptr<crossrt::VulkanContext> crt_ctx;
+  crossrt::Buffer crt_classDataBuffer;
+  bool crt_deviceDataCommitted = false;
 
   struct VectorMembers  // device copies of the std::vector members kernels use
   {
@@ -145,19 +145,19 @@ protected:
     size_t m_parentSize = 0;  // elements at the last CommitDeviceData()
     crossrt::Buffer m_arrivals;
     size_t m_arrivalsSize = 0;  // elements at the last CommitDeviceData()
-  } m_vdata;
+  } crt_vdata;
   // A std::vector or Image2D member changed size, or a sampler changed, since CommitDeviceData().
-  virtual bool VectorMembersResized() const;
+  virtual bool crt_VectorMembersResized() const;
 
   struct InOut_Build  // buffers bound by SetVulkanInOutFor_Build
   {
     crossrt::BufferView boxes;
-  } m_inOut_Build;
+  } crt_inOut_Build;
 
   struct ArgumentBuffers  // device copies of pointer arguments, reused across calls
   {
     crossrt::Buffer Build_boxes;
-  } m_args;
+  } crt_argCopies;
 
   struct Pipelines
   {
@@ -170,19 +170,19 @@ protected:
     crossrt::ComputePipeline kernel1D_Karras12;
     crossrt::ComputePipeline kernel1D_MakeLeaves;
     crossrt::ComputePipeline kernel1D_Refit;
-  } m_pipelines;
+  } crt_pipelines;
 
   struct Partials  // per-workgroup partial results of reductions
   {
     crossrt::Buffer kernel1D_Bounds_m_centerMin;
     crossrt::Buffer kernel1D_Bounds_m_centerMax;
     crossrt::Buffer kernel1D_AppendComplete_m_leafCount;
-  } m_partials;
+  } crt_partials;
 
-  crossrt::Scanner m_scanner;     // std::exclusive_scan / std::inclusive_scan of control functions
-  crossrt::RadixSorter m_sorter;  // std::sort of control functions
-  crossrt::GpuTimer m_gpuTimer;
-  std::map<std::string, std::array<float, 4>> m_times;
+  crossrt::Scanner crt_scanner;     // std::exclusive_scan / std::inclusive_scan of control functions
+  crossrt::RadixSorter crt_sorter;  // std::sort of control functions
+  crossrt::GpuTimer crt_gpuTimer;
+  std::map<std::string, std::array<float, 4>> crt_times;
 };
 
 // Runs on the default device: CROSSRT_DEVICE (index or name) if set, else a discrete GPU, else lavapipe.

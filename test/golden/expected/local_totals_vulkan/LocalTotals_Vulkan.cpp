@@ -17,11 +17,11 @@ extern const uint32_t LocalTotals_kernel1D_Summarize_Reduce_spv[];
 extern const size_t LocalTotals_kernel1D_Summarize_Reduce_spvBytes;
 
 LocalTotals_Vulkan::LocalTotals_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx)
-    : LocalTotals(), m_ctx(std::move(a_ctx))
+    : LocalTotals(), crt_ctx(std::move(a_ctx))
 {
-  m_classDataBuffer = crossrt::Buffer(m_ctx, sizeof(ClassData));
-  m_gpuTimer = crossrt::GpuTimer(m_ctx);
-  InitPipelines();
+  crt_classDataBuffer = crossrt::Buffer(crt_ctx, sizeof(ClassData));
+  crt_gpuTimer = crossrt::GpuTimer(crt_ctx);
+  crt_InitPipelines();
 }
 
 std::shared_ptr<LocalTotals> CreateLocalTotals_Vulkan()
@@ -36,42 +36,43 @@ std::shared_ptr<LocalTotals> CreateLocalTotals_Vulkan(std::shared_ptr<crossrt::V
 
 LocalTotals_Vulkan::~LocalTotals_Vulkan() = default;
 
-void LocalTotals_Vulkan::InitPipelines()
+void LocalTotals_Vulkan::crt_InitPipelines()
 {
   // Member reductions combine partial results with subgroup arithmetic.
-  if (!m_ctx->hasSubgroupArithmetic || m_ctx->subgroupSize < 4)
-    throw crossrt::Error("LocalTotals_Vulkan: device '" + m_ctx->DeviceName() +
+  if (!crt_ctx->hasSubgroupArithmetic || crt_ctx->subgroupSize < 4)
+    throw crossrt::Error("LocalTotals_Vulkan: device '" + crt_ctx->DeviceName() +
                          "' lacks compute subgroup arithmetic with >= 4 lanes, which member reductions need");
-  m_pipelines.kernel1D_Summarize =
-      crossrt::ComputePipeline(m_ctx, LocalTotals_kernel1D_Summarize_spv, LocalTotals_kernel1D_Summarize_spvBytes, 8,
+  crt_pipelines.kernel1D_Summarize =
+      crossrt::ComputePipeline(crt_ctx, LocalTotals_kernel1D_Summarize_spv, LocalTotals_kernel1D_Summarize_spvBytes, 8,
                                sizeof(kernel1D_SummarizeArgs), "LocalTotals::kernel1D_Summarize");
-  m_pipelines.kernel1D_Summarize_Finish = crossrt::ComputePipeline(
-      m_ctx, LocalTotals_kernel1D_Summarize_Finish_spv, LocalTotals_kernel1D_Summarize_Finish_spvBytes, 8,
+  crt_pipelines.kernel1D_Summarize_Finish = crossrt::ComputePipeline(
+      crt_ctx, LocalTotals_kernel1D_Summarize_Finish_spv, LocalTotals_kernel1D_Summarize_Finish_spvBytes, 8,
       sizeof(kernel1D_SummarizeArgs), "LocalTotals::kernel1D_Summarize_Finish");
-  m_pipelines.kernel1D_Summarize_Reduce = crossrt::ComputePipeline(
-      m_ctx, LocalTotals_kernel1D_Summarize_Reduce_spv, LocalTotals_kernel1D_Summarize_Reduce_spvBytes, 6,
+  crt_pipelines.kernel1D_Summarize_Reduce = crossrt::ComputePipeline(
+      crt_ctx, LocalTotals_kernel1D_Summarize_Reduce_spv, LocalTotals_kernel1D_Summarize_Reduce_spvBytes, 6,
       sizeof(uint32_t), "LocalTotals::kernel1D_Summarize_Reduce");
 }
 
-void LocalTotals_Vulkan::UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size)
+void LocalTotals_Vulkan::crt_UpdateMemberCmd(VkCommandBuffer crt_cmd, size_t a_offset, const void* a_data,
+                                             size_t a_size)
 {
-  crossrt::ComputeBarrier(a_cmd);  // kernels recorded before it are done with the class data
-  vkCmdUpdateBuffer(a_cmd, m_classDataBuffer.Handle(), a_offset, a_size, a_data);
-  crossrt::TransferToComputeBarrier(a_cmd);
+  crossrt::ComputeBarrier(crt_cmd);  // kernels recorded before it are done with the class data
+  vkCmdUpdateBuffer(crt_cmd, crt_classDataBuffer.Handle(), a_offset, a_size, a_data);
+  crossrt::TransferToComputeBarrier(crt_cmd);
 }
 
-void LocalTotals_Vulkan::UpdatePlainMembers()
+void LocalTotals_Vulkan::crt_UpdatePlainMembers()
 {
   ClassData data{};
   std::memcpy(&data.m_mean, &m_mean, sizeof(data.m_mean));
   std::memcpy(&data.m_range, &m_range, sizeof(data.m_range));
-  m_classDataBuffer.Upload(&data, sizeof(data));
+  crt_classDataBuffer.Upload(&data, sizeof(data));
 }
 
-void LocalTotals_Vulkan::ReadPlainMembers()
+void LocalTotals_Vulkan::crt_ReadPlainMembers()
 {
   ClassData data{};
-  m_classDataBuffer.Download(&data, sizeof(data));
+  crt_classDataBuffer.Download(&data, sizeof(data));
   std::memcpy(&m_mean, &data.m_mean, sizeof(data.m_mean));
   std::memcpy(&m_range, &data.m_range, sizeof(data.m_range));
 }
@@ -79,33 +80,33 @@ void LocalTotals_Vulkan::ReadPlainMembers()
 void LocalTotals_Vulkan::CommitDeviceData()
 {
   // std::vector members become buffers of their capacity; kernels see size and capacity.
-  UpdatePlainMembers();
-  m_deviceDataCommitted = true;
+  crt_UpdatePlainMembers();
+  crt_deviceDataCommitted = true;
 }
 
-bool LocalTotals_Vulkan::VectorMembersResized() const
+bool LocalTotals_Vulkan::crt_VectorMembersResized() const
 {
   return false;  // no std::vector, Image2D or sampler member of the class is on the GPU
 }
 
-void LocalTotals_Vulkan::ReadVectorMembers(const char* a_funcName)
+void LocalTotals_Vulkan::crt_ReadVectorMembers(const char* a_funcName)
 {
   (void)a_funcName;
 }
 
 void LocalTotals_Vulkan::GetExecutionTime(const char* a_funcName, float a_out[4])
 {
-  auto it = m_times.find(a_funcName);
+  auto it = crt_times.find(a_funcName);
   for (int i = 0; i < 4; ++i)
-    a_out[i] = it == m_times.end() ? 0.0f : it->second[i];
+    a_out[i] = it == crt_times.end() ? 0.0f : it->second[i];
 }
 
 // ---- Summarize (from LocalTotals::Summarize, local_totals.cpp) ----
 
 void LocalTotals_Vulkan::SetVulkanInOutFor_Summarize(crossrt::BufferView a_a_values, crossrt::BufferView a_a_out)
 {
-  m_inOut_Summarize.a_values = a_a_values;
-  m_inOut_Summarize.a_out = a_a_out;
+  crt_inOut_Summarize.a_values = a_a_values;
+  crt_inOut_Summarize.a_out = a_a_out;
 }
 
 void LocalTotals_Vulkan::Summarize(uint32_t n, const float4* a_values, float* a_out)
@@ -115,51 +116,51 @@ void LocalTotals_Vulkan::Summarize(uint32_t n, const float4* a_values, float* a_
   // std::vector members are uploaded by CommitDeviceData(): here once, and again whenever one
   // changed size (its device buffer would be too small). After changing the contents of a
   // vector without resizing it, call CommitDeviceData().
-  if (!crt_self->m_deviceDataCommitted || crt_self->VectorMembersResized())
+  if (!crt_self->crt_deviceDataCommitted || crt_self->crt_VectorMembersResized())
     crt_self->CommitDeviceData();
 
   crossrt::CpuTimer crt_copyIn;
   const size_t crt_a_valuesBytes = sizeof(float4) * size_t(n);
-  crossrt::EnsureSize(m_ctx, crt_self->m_args.Summarize_a_values, crt_a_valuesBytes);
+  crossrt::EnsureSize(crt_ctx, crt_self->crt_argCopies.Summarize_a_values, crt_a_valuesBytes);
   if (crt_a_valuesBytes > 0)
-    crt_self->m_args.Summarize_a_values.Upload(a_values, crt_a_valuesBytes);
+    crt_self->crt_argCopies.Summarize_a_values.Upload(a_values, crt_a_valuesBytes);
   const size_t crt_a_outBytes = sizeof(float) * size_t(8);
-  crossrt::EnsureSize(m_ctx, crt_self->m_args.Summarize_a_out, crt_a_outBytes);
+  crossrt::EnsureSize(crt_ctx, crt_self->crt_argCopies.Summarize_a_out, crt_a_outBytes);
   if (crt_a_outBytes > 0)
-    crt_self->m_args.Summarize_a_out.Upload(a_out, crt_a_outBytes);
-  crt_self->SetVulkanInOutFor_Summarize(crt_self->m_args.Summarize_a_values.View(),
-                                        crt_self->m_args.Summarize_a_out.View());
+    crt_self->crt_argCopies.Summarize_a_out.Upload(a_out, crt_a_outBytes);
+  crt_self->SetVulkanInOutFor_Summarize(crt_self->crt_argCopies.Summarize_a_values.View(),
+                                        crt_self->crt_argCopies.Summarize_a_out.View());
   const float crt_copyInMs = crt_copyIn.ElapsedMs();
 
   // Members as they are now; host code of Summarize that changes one records an update in order.
-  crt_self->UpdatePlainMembers();
-  VkCommandBuffer crt_cmd = m_ctx->BeginOneShot();
-  crt_self->m_gpuTimer.Reset(crt_cmd);
-  crt_self->m_gpuTimer.Begin(crt_cmd, "Summarize");
+  crt_self->crt_UpdatePlainMembers();
+  VkCommandBuffer crt_cmd = crt_ctx->BeginOneShot();
+  crt_self->crt_gpuTimer.Reset(crt_cmd);
+  crt_self->crt_gpuTimer.Begin(crt_cmd, "Summarize");
   crt_self->SummarizeCmd(crt_cmd, n, a_values, a_out);
-  crt_self->m_gpuTimer.End(crt_cmd, "Summarize");
-  m_ctx->SubmitAndWait(crt_cmd);
-  crt_self->m_gpuTimer.Collect();
+  crt_self->crt_gpuTimer.End(crt_cmd, "Summarize");
+  crt_ctx->SubmitAndWait(crt_cmd);
+  crt_self->crt_gpuTimer.Collect();
 
   crossrt::CpuTimer crt_copyOut;
-  crt_self->ReadPlainMembers();
-  crt_self->ReadVectorMembers("Summarize");
+  crt_self->crt_ReadPlainMembers();
+  crt_self->crt_ReadVectorMembers("Summarize");
   if (crt_a_outBytes > 0)
-    crt_self->m_args.Summarize_a_out.Download(a_out, crt_a_outBytes);
-  crt_self->m_times["Summarize"] = {crt_self->m_gpuTimer.LastMs("Summarize"), crt_copyInMs, crt_copyOut.ElapsedMs(),
-                                    crt_total.ElapsedMs()};
+    crt_self->crt_argCopies.Summarize_a_out.Download(a_out, crt_a_outBytes);
+  crt_self->crt_times["Summarize"] = {crt_self->crt_gpuTimer.LastMs("Summarize"), crt_copyInMs, crt_copyOut.ElapsedMs(),
+                                      crt_total.ElapsedMs()};
 }
 
 // The body of LocalTotals::Summarize, with each kernel call turned into its ...Cmd.
-void LocalTotals_Vulkan::SummarizeCmd(VkCommandBuffer a_cmd, uint32_t n, [[maybe_unused]] const float4* a_values,
+void LocalTotals_Vulkan::SummarizeCmd(VkCommandBuffer crt_cmd, uint32_t n, [[maybe_unused]] const float4* a_values,
                                       [[maybe_unused]] float* a_out)
 {
-  kernel1D_SummarizeCmd(a_cmd, n, m_inOut_Summarize.a_values, m_inOut_Summarize.a_out);
+  kernel1D_SummarizeCmd(crt_cmd, n, crt_inOut_Summarize.a_values, crt_inOut_Summarize.a_out);
 }
 
 // ---- kernel1D_Summarize (from LocalTotals::kernel1D_Summarize, local_totals.cpp) ----
 
-void LocalTotals_Vulkan::kernel1D_SummarizeCmd(VkCommandBuffer a_cmd, uint32_t n, crossrt::BufferView a_values,
+void LocalTotals_Vulkan::kernel1D_SummarizeCmd(VkCommandBuffer crt_cmd, uint32_t n, crossrt::BufferView a_values,
                                                crossrt::BufferView a_out)
 {
   const int crt_startX = int(0);
@@ -168,52 +169,52 @@ void LocalTotals_Vulkan::kernel1D_SummarizeCmd(VkCommandBuffer a_cmd, uint32_t n
   crt_args.crt_startX = crt_startX;
   crt_args.crt_countX = crt_countX;
   crt_args.n = n;
-  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Summarize_sum,
+  crossrt::EnsureSize(crt_ctx, crt_partials.kernel1D_Summarize_sum,
                       4 * crossrt::GroupCount1D(crt_countX, 256));  // float per workgroup
-  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Summarize_lo,
+  crossrt::EnsureSize(crt_ctx, crt_partials.kernel1D_Summarize_lo,
                       4 * crossrt::GroupCount1D(crt_countX, 256));  // float per workgroup
-  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Summarize_hi,
+  crossrt::EnsureSize(crt_ctx, crt_partials.kernel1D_Summarize_hi,
                       4 * crossrt::GroupCount1D(crt_countX, 256));  // float per workgroup
-  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Summarize_total,
+  crossrt::EnsureSize(crt_ctx, crt_partials.kernel1D_Summarize_total,
                       16 * crossrt::GroupCount1D(crt_countX, 256));  // float4 per workgroup
-  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Summarize_negatives,
+  crossrt::EnsureSize(crt_ctx, crt_partials.kernel1D_Summarize_negatives,
                       4 * crossrt::GroupCount1D(crt_countX, 256));  // int per workgroup
   if (crt_countX == 0)  // no threads: only the statements around the loop nest run
   {
-    m_pipelines.kernel1D_Summarize_Finish.Bind(a_cmd);
-    m_pipelines.kernel1D_Summarize_Finish.PushBuffers(
-        a_cmd, {m_classDataBuffer.View(), a_values, a_out, m_partials.kernel1D_Summarize_sum.View(),
-                m_partials.kernel1D_Summarize_lo.View(), m_partials.kernel1D_Summarize_hi.View(),
-                m_partials.kernel1D_Summarize_total.View(), m_partials.kernel1D_Summarize_negatives.View()});
-    m_pipelines.kernel1D_Summarize_Finish.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-    vkCmdDispatch(a_cmd, 1, 1, 1);
-    crossrt::ComputeBarrier(a_cmd);
+    crt_pipelines.kernel1D_Summarize_Finish.Bind(crt_cmd);
+    crt_pipelines.kernel1D_Summarize_Finish.PushBuffers(
+        crt_cmd, {crt_classDataBuffer.View(), a_values, a_out, crt_partials.kernel1D_Summarize_sum.View(),
+                  crt_partials.kernel1D_Summarize_lo.View(), crt_partials.kernel1D_Summarize_hi.View(),
+                  crt_partials.kernel1D_Summarize_total.View(), crt_partials.kernel1D_Summarize_negatives.View()});
+    crt_pipelines.kernel1D_Summarize_Finish.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
+    vkCmdDispatch(crt_cmd, 1, 1, 1);
+    crossrt::ComputeBarrier(crt_cmd);
     return;
   }
-  m_pipelines.kernel1D_Summarize.Bind(a_cmd);
-  m_pipelines.kernel1D_Summarize.PushBuffers(
-      a_cmd, {m_classDataBuffer.View(), a_values, a_out, m_partials.kernel1D_Summarize_sum.View(),
-              m_partials.kernel1D_Summarize_lo.View(), m_partials.kernel1D_Summarize_hi.View(),
-              m_partials.kernel1D_Summarize_total.View(), m_partials.kernel1D_Summarize_negatives.View()});
-  m_pipelines.kernel1D_Summarize.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  crossrt::Dispatch1D(a_cmd, crt_countX, 256);
-  crossrt::ComputeBarrier(a_cmd);
+  crt_pipelines.kernel1D_Summarize.Bind(crt_cmd);
+  crt_pipelines.kernel1D_Summarize.PushBuffers(
+      crt_cmd, {crt_classDataBuffer.View(), a_values, a_out, crt_partials.kernel1D_Summarize_sum.View(),
+                crt_partials.kernel1D_Summarize_lo.View(), crt_partials.kernel1D_Summarize_hi.View(),
+                crt_partials.kernel1D_Summarize_total.View(), crt_partials.kernel1D_Summarize_negatives.View()});
+  crt_pipelines.kernel1D_Summarize.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
+  crossrt::Dispatch1D(crt_cmd, crt_countX, 256);
+  crossrt::ComputeBarrier(crt_cmd);
   const uint32_t crt_partialCount = crossrt::GroupCount1D(crt_countX, 256);
-  m_pipelines.kernel1D_Summarize_Reduce.Bind(a_cmd);
-  m_pipelines.kernel1D_Summarize_Reduce.PushBuffers(
-      a_cmd, {m_classDataBuffer.View(), m_partials.kernel1D_Summarize_sum.View(),
-              m_partials.kernel1D_Summarize_lo.View(), m_partials.kernel1D_Summarize_hi.View(),
-              m_partials.kernel1D_Summarize_total.View(), m_partials.kernel1D_Summarize_negatives.View()});
-  m_pipelines.kernel1D_Summarize_Reduce.PushConstants(a_cmd, &crt_partialCount, sizeof(crt_partialCount));
-  vkCmdDispatch(a_cmd, 1, 1, 1);
-  crossrt::ComputeBarrier(a_cmd);
+  crt_pipelines.kernel1D_Summarize_Reduce.Bind(crt_cmd);
+  crt_pipelines.kernel1D_Summarize_Reduce.PushBuffers(
+      crt_cmd, {crt_classDataBuffer.View(), crt_partials.kernel1D_Summarize_sum.View(),
+                crt_partials.kernel1D_Summarize_lo.View(), crt_partials.kernel1D_Summarize_hi.View(),
+                crt_partials.kernel1D_Summarize_total.View(), crt_partials.kernel1D_Summarize_negatives.View()});
+  crt_pipelines.kernel1D_Summarize_Reduce.PushConstants(crt_cmd, &crt_partialCount, sizeof(crt_partialCount));
+  vkCmdDispatch(crt_cmd, 1, 1, 1);
+  crossrt::ComputeBarrier(crt_cmd);
   // The statements after the loop nest, on one thread, after the nest's threads and reductions.
-  m_pipelines.kernel1D_Summarize_Finish.Bind(a_cmd);
-  m_pipelines.kernel1D_Summarize_Finish.PushBuffers(
-      a_cmd, {m_classDataBuffer.View(), a_values, a_out, m_partials.kernel1D_Summarize_sum.View(),
-              m_partials.kernel1D_Summarize_lo.View(), m_partials.kernel1D_Summarize_hi.View(),
-              m_partials.kernel1D_Summarize_total.View(), m_partials.kernel1D_Summarize_negatives.View()});
-  m_pipelines.kernel1D_Summarize_Finish.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  vkCmdDispatch(a_cmd, 1, 1, 1);
-  crossrt::ComputeBarrier(a_cmd);
+  crt_pipelines.kernel1D_Summarize_Finish.Bind(crt_cmd);
+  crt_pipelines.kernel1D_Summarize_Finish.PushBuffers(
+      crt_cmd, {crt_classDataBuffer.View(), a_values, a_out, crt_partials.kernel1D_Summarize_sum.View(),
+                crt_partials.kernel1D_Summarize_lo.View(), crt_partials.kernel1D_Summarize_hi.View(),
+                crt_partials.kernel1D_Summarize_total.View(), crt_partials.kernel1D_Summarize_negatives.View()});
+  crt_pipelines.kernel1D_Summarize_Finish.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
+  vkCmdDispatch(crt_cmd, 1, 1, 1);
+  crossrt::ComputeBarrier(crt_cmd);
 }

@@ -28,25 +28,25 @@ public:
 
   // For data that already lives on the GPU: bind your buffers, then record into your command buffer.
   virtual void SetVulkanInOutFor_Summarize(crossrt::BufferView a_a_values, crossrt::BufferView a_a_out);
-  virtual void SummarizeCmd(VkCommandBuffer a_cmd, uint32_t n, const float4* a_values, float* a_out);
+  virtual void SummarizeCmd(VkCommandBuffer crt_cmd, uint32_t n, const float4* a_values, float* a_out);
 
   void CommitDeviceData() override;  // uploads members
   // a_out: [0] GPU ms, [1] copy-in ms, [2] copy-out ms, [3] total ms
   void GetExecutionTime(const char* a_funcName, float a_out[4]);
 
-  virtual void UpdatePlainMembers();  // members -> GPU (called before every control function)
-  virtual void ReadPlainMembers();    // GPU -> members the kernels write (reductions)
+  virtual void crt_UpdatePlainMembers();  // members -> GPU (called before every control function)
+  virtual void crt_ReadPlainMembers();    // GPU -> members the kernels write (reductions)
 
-  std::shared_ptr<crossrt::VulkanContext> Context() const { return m_ctx; }
+  std::shared_ptr<crossrt::VulkanContext> Context() const { return crt_ctx; }
 
 protected:
-  // One per kernel (and megakernel of a thread loop): records its dispatch (and barrier) into a_cmd.
-  virtual void kernel1D_SummarizeCmd(VkCommandBuffer a_cmd, uint32_t n, crossrt::BufferView a_values,
+  // One per kernel (and megakernel of a thread loop): records its dispatch (and barrier) into crt_cmd.
+  virtual void kernel1D_SummarizeCmd(VkCommandBuffer crt_cmd, uint32_t n, crossrt::BufferView a_values,
                                      crossrt::BufferView a_out);
-  virtual void InitPipelines();
+  virtual void crt_InitPipelines();
   // Records an update of one member's GPU copy, ordered between the kernels around it.
-  virtual void UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size);
-  virtual void ReadVectorMembers(const char* a_funcName);  // GPU -> std::vector and Image2D members kernels write
+  virtual void crt_UpdateMemberCmd(VkCommandBuffer crt_cmd, size_t a_offset, const void* a_data, size_t a_size);
+  virtual void crt_ReadVectorMembers(const char* a_funcName);  // GPU -> std::vector and Image2D members kernels write
 
   // Push constants of each kernel: thread ranges, then its scalar arguments (std430 offsets).
   struct kernel1D_SummarizeArgs
@@ -63,31 +63,31 @@ protected:
     alignas(4) float m_range;
   };
 
-  std::shared_ptr<crossrt::VulkanContext> m_ctx;
-  crossrt::Buffer m_classDataBuffer;
-  bool m_deviceDataCommitted = false;
+  std::shared_ptr<crossrt::VulkanContext> crt_ctx;
+  crossrt::Buffer crt_classDataBuffer;
+  bool crt_deviceDataCommitted = false;
 
   // A std::vector or Image2D member changed size, or a sampler changed, since CommitDeviceData().
-  virtual bool VectorMembersResized() const;
+  virtual bool crt_VectorMembersResized() const;
 
   struct InOut_Summarize  // buffers bound by SetVulkanInOutFor_Summarize
   {
     crossrt::BufferView a_values;
     crossrt::BufferView a_out;
-  } m_inOut_Summarize;
+  } crt_inOut_Summarize;
 
   struct ArgumentBuffers  // device copies of pointer arguments, reused across calls
   {
     crossrt::Buffer Summarize_a_values;
     crossrt::Buffer Summarize_a_out;
-  } m_args;
+  } crt_argCopies;
 
   struct Pipelines
   {
     crossrt::ComputePipeline kernel1D_Summarize;
     crossrt::ComputePipeline kernel1D_Summarize_Finish;  // the statements after the loop nest, on one thread
     crossrt::ComputePipeline kernel1D_Summarize_Reduce;
-  } m_pipelines;
+  } crt_pipelines;
 
   struct Partials  // per-workgroup partial results of reductions
   {
@@ -96,10 +96,10 @@ protected:
     crossrt::Buffer kernel1D_Summarize_hi;
     crossrt::Buffer kernel1D_Summarize_total;
     crossrt::Buffer kernel1D_Summarize_negatives;
-  } m_partials;
+  } crt_partials;
 
-  crossrt::GpuTimer m_gpuTimer;
-  std::map<std::string, std::array<float, 4>> m_times;
+  crossrt::GpuTimer crt_gpuTimer;
+  std::map<std::string, std::array<float, 4>> crt_times;
 };
 
 // Runs on the default device: CROSSRT_DEVICE (index or name) if set, else a discrete GPU, else lavapipe.

@@ -28,9 +28,9 @@ std::shared_ptr<Particles> CreateParticles_CPU()
 
 void Particles_CPU::GetExecutionTime(const char* a_funcName, float a_out[4])
 {
-  auto it = m_times.find(a_funcName);
+  auto it = crt_times.find(a_funcName);
   for (int i = 0; i < 4; ++i)
-    a_out[i] = it == m_times.end() ? 0.0f : it->second[i];
+    a_out[i] = it == crt_times.end() ? 0.0f : it->second[i];
 }
 
 // From Particles::Step (Particles.cpp).
@@ -51,7 +51,7 @@ void Particles_CPU::Step(int n, float dt, float4* positions, float4* velocities)
     m_timeMs = std::chrono::duration<float, std::milli>(std::chrono::steady_clock::now() - start).count();
   }();
   const float crt_ms = std::chrono::duration<float, std::milli>(std::chrono::steady_clock::now() - crt_start).count();
-  const_cast<Particles_CPU*>(this)->m_times["Step"] = {0.0f, 0.0f, 0.0f, crt_ms};
+  const_cast<Particles_CPU*>(this)->crt_times["Step"] = {0.0f, 0.0f, 0.0f, crt_ms};
 }
 
 // From Particles::kernel1D_Advance (Particles.cpp): the outer loop runs on all cores.

@@ -25,7 +25,7 @@ protected:
   void kernel1D_Advance(int n, float dt, float4* positions, float4* velocities);
   void kernel1D_Measure(int n, const float4* positions, const float4* velocities);
 
-  std::map<std::string, std::array<float, 4>> m_times;
+  std::map<std::string, std::array<float, 4>> crt_times;
 };
 
 std::shared_ptr<Particles> CreateParticles_CPU();

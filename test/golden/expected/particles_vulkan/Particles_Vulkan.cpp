@@ -19,11 +19,12 @@ extern const size_t Particles_kernel1D_Measure_spvBytes;
 extern const uint32_t Particles_kernel1D_Measure_Reduce_spv[];
 extern const size_t Particles_kernel1D_Measure_Reduce_spvBytes;
 
-Particles_Vulkan::Particles_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx) : Particles(), m_ctx(std::move(a_ctx))
+Particles_Vulkan::Particles_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx)
+    : Particles(), crt_ctx(std::move(a_ctx))
 {
-  m_classDataBuffer = crossrt::Buffer(m_ctx, sizeof(ClassData));
-  m_gpuTimer = crossrt::GpuTimer(m_ctx);
-  InitPipelines();
+  crt_classDataBuffer = crossrt::Buffer(crt_ctx, sizeof(ClassData));
+  crt_gpuTimer = crossrt::GpuTimer(crt_ctx);
+  crt_InitPipelines();
 }
 
 std::shared_ptr<Particles> CreateParticles_Vulkan()
@@ -38,34 +39,34 @@ std::shared_ptr<Particles> CreateParticles_Vulkan(std::shared_ptr<crossrt::Vulka
 
 Particles_Vulkan::~Particles_Vulkan() = default;
 
-void Particles_Vulkan::InitPipelines()
+void Particles_Vulkan::crt_InitPipelines()
 {
   // Member reductions combine partial results with subgroup arithmetic.
-  if (!m_ctx->hasSubgroupArithmetic || m_ctx->subgroupSize < 4)
-    throw crossrt::Error("Particles_Vulkan: device '" + m_ctx->DeviceName() +
+  if (!crt_ctx->hasSubgroupArithmetic || crt_ctx->subgroupSize < 4)
+    throw crossrt::Error("Particles_Vulkan: device '" + crt_ctx->DeviceName() +
                          "' lacks compute subgroup arithmetic with >= 4 lanes, which member reductions need");
-  m_pipelines.kernel1D_Advance =
-      crossrt::ComputePipeline(m_ctx, Particles_kernel1D_Advance_spv, Particles_kernel1D_Advance_spvBytes, 4,
+  crt_pipelines.kernel1D_Advance =
+      crossrt::ComputePipeline(crt_ctx, Particles_kernel1D_Advance_spv, Particles_kernel1D_Advance_spvBytes, 4,
                                sizeof(kernel1D_AdvanceArgs), "Particles::kernel1D_Advance");
-  m_pipelines.kernel1D_Advance_Reduce =
-      crossrt::ComputePipeline(m_ctx, Particles_kernel1D_Advance_Reduce_spv, Particles_kernel1D_Advance_Reduce_spvBytes,
-                               2, sizeof(uint32_t), "Particles::kernel1D_Advance_Reduce");
-  m_pipelines.kernel1D_Measure =
-      crossrt::ComputePipeline(m_ctx, Particles_kernel1D_Measure_spv, Particles_kernel1D_Measure_spvBytes, 7,
+  crt_pipelines.kernel1D_Advance_Reduce = crossrt::ComputePipeline(
+      crt_ctx, Particles_kernel1D_Advance_Reduce_spv, Particles_kernel1D_Advance_Reduce_spvBytes, 2, sizeof(uint32_t),
+      "Particles::kernel1D_Advance_Reduce");
+  crt_pipelines.kernel1D_Measure =
+      crossrt::ComputePipeline(crt_ctx, Particles_kernel1D_Measure_spv, Particles_kernel1D_Measure_spvBytes, 7,
                                sizeof(kernel1D_MeasureArgs), "Particles::kernel1D_Measure");
-  m_pipelines.kernel1D_Measure_Reduce =
-      crossrt::ComputePipeline(m_ctx, Particles_kernel1D_Measure_Reduce_spv, Particles_kernel1D_Measure_Reduce_spvBytes,
-                               5, sizeof(uint32_t), "Particles::kernel1D_Measure_Reduce");
+  crt_pipelines.kernel1D_Measure_Reduce = crossrt::ComputePipeline(
+      crt_ctx, Particles_kernel1D_Measure_Reduce_spv, Particles_kernel1D_Measure_Reduce_spvBytes, 5, sizeof(uint32_t),
+      "Particles::kernel1D_Measure_Reduce");
 }
 
-void Particles_Vulkan::UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size)
+void Particles_Vulkan::crt_UpdateMemberCmd(VkCommandBuffer crt_cmd, size_t a_offset, const void* a_data, size_t a_size)
 {
-  crossrt::ComputeBarrier(a_cmd);  // kernels recorded before it are done with the class data
-  vkCmdUpdateBuffer(a_cmd, m_classDataBuffer.Handle(), a_offset, a_size, a_data);
-  crossrt::TransferToComputeBarrier(a_cmd);
+  crossrt::ComputeBarrier(crt_cmd);  // kernels recorded before it are done with the class data
+  vkCmdUpdateBuffer(crt_cmd, crt_classDataBuffer.Handle(), a_offset, a_size, a_data);
+  crossrt::TransferToComputeBarrier(crt_cmd);
 }
 
-void Particles_Vulkan::UpdatePlainMembers()
+void Particles_Vulkan::crt_UpdatePlainMembers()
 {
   ClassData data{};
   std::memcpy(&data.m_boxMin, &m_boxMin, sizeof(data.m_boxMin));
@@ -76,13 +77,13 @@ void Particles_Vulkan::UpdatePlainMembers()
   std::memcpy(&data.m_gravity, &m_gravity, sizeof(data.m_gravity));
   std::memcpy(&data.m_restitution, &m_restitution, sizeof(data.m_restitution));
   std::memcpy(&data.m_timeMs, &m_timeMs, sizeof(data.m_timeMs));
-  m_classDataBuffer.Upload(&data, sizeof(data));
+  crt_classDataBuffer.Upload(&data, sizeof(data));
 }
 
-void Particles_Vulkan::ReadPlainMembers()
+void Particles_Vulkan::crt_ReadPlainMembers()
 {
   ClassData data{};
-  m_classDataBuffer.Download(&data, sizeof(data));
+  crt_classDataBuffer.Download(&data, sizeof(data));
   std::memcpy(&m_boxMin, &data.m_boxMin, sizeof(data.m_boxMin));
   std::memcpy(&m_boxMax, &data.m_boxMax, sizeof(data.m_boxMax));
   std::memcpy(&m_momentum, &data.m_momentum, sizeof(data.m_momentum));
@@ -93,33 +94,33 @@ void Particles_Vulkan::ReadPlainMembers()
 void Particles_Vulkan::CommitDeviceData()
 {
   // std::vector members become buffers of their capacity; kernels see size and capacity.
-  UpdatePlainMembers();
-  m_deviceDataCommitted = true;
+  crt_UpdatePlainMembers();
+  crt_deviceDataCommitted = true;
 }
 
-bool Particles_Vulkan::VectorMembersResized() const
+bool Particles_Vulkan::crt_VectorMembersResized() const
 {
   return false;  // no std::vector, Image2D or sampler member of the class is on the GPU
 }
 
-void Particles_Vulkan::ReadVectorMembers(const char* a_funcName)
+void Particles_Vulkan::crt_ReadVectorMembers(const char* a_funcName)
 {
   (void)a_funcName;
 }
 
 void Particles_Vulkan::GetExecutionTime(const char* a_funcName, float a_out[4])
 {
-  auto it = m_times.find(a_funcName);
+  auto it = crt_times.find(a_funcName);
   for (int i = 0; i < 4; ++i)
-    a_out[i] = it == m_times.end() ? 0.0f : it->second[i];
+    a_out[i] = it == crt_times.end() ? 0.0f : it->second[i];
 }
 
 // ---- Step (from Particles::Step, Particles.cpp) ----
 
 void Particles_Vulkan::SetVulkanInOutFor_Step(crossrt::BufferView a_positions, crossrt::BufferView a_velocities)
 {
-  m_inOut_Step.positions = a_positions;
-  m_inOut_Step.velocities = a_velocities;
+  crt_inOut_Step.positions = a_positions;
+  crt_inOut_Step.velocities = a_velocities;
 }
 
 void Particles_Vulkan::Step(int n, float dt, float4* positions, float4* velocities)
@@ -129,66 +130,67 @@ void Particles_Vulkan::Step(int n, float dt, float4* positions, float4* velociti
   // std::vector members are uploaded by CommitDeviceData(): here once, and again whenever one
   // changed size (its device buffer would be too small). After changing the contents of a
   // vector without resizing it, call CommitDeviceData().
-  if (!crt_self->m_deviceDataCommitted || crt_self->VectorMembersResized())
+  if (!crt_self->crt_deviceDataCommitted || crt_self->crt_VectorMembersResized())
     crt_self->CommitDeviceData();
 
   crossrt::CpuTimer crt_copyIn;
   const size_t crt_positionsBytes = sizeof(float4) * size_t(n);
-  crossrt::EnsureSize(m_ctx, crt_self->m_args.Step_positions, crt_positionsBytes);
+  crossrt::EnsureSize(crt_ctx, crt_self->crt_argCopies.Step_positions, crt_positionsBytes);
   if (crt_positionsBytes > 0)
-    crt_self->m_args.Step_positions.Upload(positions, crt_positionsBytes);
+    crt_self->crt_argCopies.Step_positions.Upload(positions, crt_positionsBytes);
   const size_t crt_velocitiesBytes = sizeof(float4) * size_t(n);
-  crossrt::EnsureSize(m_ctx, crt_self->m_args.Step_velocities, crt_velocitiesBytes);
+  crossrt::EnsureSize(crt_ctx, crt_self->crt_argCopies.Step_velocities, crt_velocitiesBytes);
   if (crt_velocitiesBytes > 0)
-    crt_self->m_args.Step_velocities.Upload(velocities, crt_velocitiesBytes);
-  crt_self->SetVulkanInOutFor_Step(crt_self->m_args.Step_positions.View(), crt_self->m_args.Step_velocities.View());
+    crt_self->crt_argCopies.Step_velocities.Upload(velocities, crt_velocitiesBytes);
+  crt_self->SetVulkanInOutFor_Step(crt_self->crt_argCopies.Step_positions.View(),
+                                   crt_self->crt_argCopies.Step_velocities.View());
   const float crt_copyInMs = crt_copyIn.ElapsedMs();
 
   // Members as they are now; host code of Step that changes one records an update in order.
-  crt_self->UpdatePlainMembers();
-  VkCommandBuffer crt_cmd = m_ctx->BeginOneShot();
-  crt_self->m_gpuTimer.Reset(crt_cmd);
-  crt_self->m_gpuTimer.Begin(crt_cmd, "Step");
+  crt_self->crt_UpdatePlainMembers();
+  VkCommandBuffer crt_cmd = crt_ctx->BeginOneShot();
+  crt_self->crt_gpuTimer.Reset(crt_cmd);
+  crt_self->crt_gpuTimer.Begin(crt_cmd, "Step");
   crt_self->StepCmd(crt_cmd, n, dt, positions, velocities);
-  crt_self->m_gpuTimer.End(crt_cmd, "Step");
-  m_ctx->SubmitAndWait(crt_cmd);
-  crt_self->m_gpuTimer.Collect();
+  crt_self->crt_gpuTimer.End(crt_cmd, "Step");
+  crt_ctx->SubmitAndWait(crt_cmd);
+  crt_self->crt_gpuTimer.Collect();
 
   crossrt::CpuTimer crt_copyOut;
-  crt_self->ReadPlainMembers();
-  crt_self->ReadVectorMembers("Step");
+  crt_self->crt_ReadPlainMembers();
+  crt_self->crt_ReadVectorMembers("Step");
   if (crt_positionsBytes > 0)
-    crt_self->m_args.Step_positions.Download(positions, crt_positionsBytes);
+    crt_self->crt_argCopies.Step_positions.Download(positions, crt_positionsBytes);
   if (crt_velocitiesBytes > 0)
-    crt_self->m_args.Step_velocities.Download(velocities, crt_velocitiesBytes);
-  crt_self->m_times["Step"] = {crt_self->m_gpuTimer.LastMs("Step"), crt_copyInMs, crt_copyOut.ElapsedMs(),
-                               crt_total.ElapsedMs()};
+    crt_self->crt_argCopies.Step_velocities.Download(velocities, crt_velocitiesBytes);
+  crt_self->crt_times["Step"] = {crt_self->crt_gpuTimer.LastMs("Step"), crt_copyInMs, crt_copyOut.ElapsedMs(),
+                                 crt_total.ElapsedMs()};
 }
 
 // The body of Particles::Step, with each kernel call turned into its ...Cmd.
-void Particles_Vulkan::StepCmd(VkCommandBuffer a_cmd, int n, float dt, [[maybe_unused]] float4* positions,
+void Particles_Vulkan::StepCmd(VkCommandBuffer crt_cmd, int n, float dt, [[maybe_unused]] float4* positions,
                                [[maybe_unused]] float4* velocities)
 {
   const auto start = std::chrono::steady_clock::now();
   m_boxMin = float4(INF_POSITIVE);
-  UpdateMemberCmd(a_cmd, offsetof(ClassData, m_boxMin), &m_boxMin, sizeof(m_boxMin));
+  crt_UpdateMemberCmd(crt_cmd, offsetof(ClassData, m_boxMin), &m_boxMin, sizeof(m_boxMin));
   m_boxMax = float4(INF_NEGATIVE);
-  UpdateMemberCmd(a_cmd, offsetof(ClassData, m_boxMax), &m_boxMax, sizeof(m_boxMax));
+  crt_UpdateMemberCmd(crt_cmd, offsetof(ClassData, m_boxMax), &m_boxMax, sizeof(m_boxMax));
   m_momentum = float4(0.0f);
-  UpdateMemberCmd(a_cmd, offsetof(ClassData, m_momentum), &m_momentum, sizeof(m_momentum));
+  crt_UpdateMemberCmd(crt_cmd, offsetof(ClassData, m_momentum), &m_momentum, sizeof(m_momentum));
   m_kineticEnergy = 0.0f;
-  UpdateMemberCmd(a_cmd, offsetof(ClassData, m_kineticEnergy), &m_kineticEnergy, sizeof(m_kineticEnergy));
+  crt_UpdateMemberCmd(crt_cmd, offsetof(ClassData, m_kineticEnergy), &m_kineticEnergy, sizeof(m_kineticEnergy));
   m_bounces = 0;
-  UpdateMemberCmd(a_cmd, offsetof(ClassData, m_bounces), &m_bounces, sizeof(m_bounces));
-  kernel1D_AdvanceCmd(a_cmd, n, dt, m_inOut_Step.positions, m_inOut_Step.velocities);
-  kernel1D_MeasureCmd(a_cmd, n, m_inOut_Step.positions, m_inOut_Step.velocities);
+  crt_UpdateMemberCmd(crt_cmd, offsetof(ClassData, m_bounces), &m_bounces, sizeof(m_bounces));
+  kernel1D_AdvanceCmd(crt_cmd, n, dt, crt_inOut_Step.positions, crt_inOut_Step.velocities);
+  kernel1D_MeasureCmd(crt_cmd, n, crt_inOut_Step.positions, crt_inOut_Step.velocities);
   m_timeMs = std::chrono::duration<float, std::milli>(std::chrono::steady_clock::now() - start).count();
-  UpdateMemberCmd(a_cmd, offsetof(ClassData, m_timeMs), &m_timeMs, sizeof(m_timeMs));
+  crt_UpdateMemberCmd(crt_cmd, offsetof(ClassData, m_timeMs), &m_timeMs, sizeof(m_timeMs));
 }
 
 // ---- kernel1D_Advance (from Particles::kernel1D_Advance, Particles.cpp) ----
 
-void Particles_Vulkan::kernel1D_AdvanceCmd(VkCommandBuffer a_cmd, int n, float dt, crossrt::BufferView positions,
+void Particles_Vulkan::kernel1D_AdvanceCmd(VkCommandBuffer crt_cmd, int n, float dt, crossrt::BufferView positions,
                                            crossrt::BufferView velocities)
 {
   const int crt_startX = int(0);
@@ -200,26 +202,26 @@ void Particles_Vulkan::kernel1D_AdvanceCmd(VkCommandBuffer a_cmd, int n, float d
   crt_args.crt_countX = crt_countX;
   crt_args.n = n;
   crt_args.dt = dt;
-  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Advance_m_bounces,
+  crossrt::EnsureSize(crt_ctx, crt_partials.kernel1D_Advance_m_bounces,
                       4 * crossrt::GroupCount1D(crt_countX, 256));  // int per workgroup
-  m_pipelines.kernel1D_Advance.Bind(a_cmd);
-  m_pipelines.kernel1D_Advance.PushBuffers(
-      a_cmd, {m_classDataBuffer.View(), positions, velocities, m_partials.kernel1D_Advance_m_bounces.View()});
-  m_pipelines.kernel1D_Advance.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  crossrt::Dispatch1D(a_cmd, crt_countX, 256);
-  crossrt::ComputeBarrier(a_cmd);
+  crt_pipelines.kernel1D_Advance.Bind(crt_cmd);
+  crt_pipelines.kernel1D_Advance.PushBuffers(
+      crt_cmd, {crt_classDataBuffer.View(), positions, velocities, crt_partials.kernel1D_Advance_m_bounces.View()});
+  crt_pipelines.kernel1D_Advance.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
+  crossrt::Dispatch1D(crt_cmd, crt_countX, 256);
+  crossrt::ComputeBarrier(crt_cmd);
   const uint32_t crt_partialCount = crossrt::GroupCount1D(crt_countX, 256);
-  m_pipelines.kernel1D_Advance_Reduce.Bind(a_cmd);
-  m_pipelines.kernel1D_Advance_Reduce.PushBuffers(
-      a_cmd, {m_classDataBuffer.View(), m_partials.kernel1D_Advance_m_bounces.View()});
-  m_pipelines.kernel1D_Advance_Reduce.PushConstants(a_cmd, &crt_partialCount, sizeof(crt_partialCount));
-  vkCmdDispatch(a_cmd, 1, 1, 1);
-  crossrt::ComputeBarrier(a_cmd);
+  crt_pipelines.kernel1D_Advance_Reduce.Bind(crt_cmd);
+  crt_pipelines.kernel1D_Advance_Reduce.PushBuffers(
+      crt_cmd, {crt_classDataBuffer.View(), crt_partials.kernel1D_Advance_m_bounces.View()});
+  crt_pipelines.kernel1D_Advance_Reduce.PushConstants(crt_cmd, &crt_partialCount, sizeof(crt_partialCount));
+  vkCmdDispatch(crt_cmd, 1, 1, 1);
+  crossrt::ComputeBarrier(crt_cmd);
 }
 
 // ---- kernel1D_Measure (from Particles::kernel1D_Measure, Particles.cpp) ----
 
-void Particles_Vulkan::kernel1D_MeasureCmd(VkCommandBuffer a_cmd, int n, crossrt::BufferView positions,
+void Particles_Vulkan::kernel1D_MeasureCmd(VkCommandBuffer crt_cmd, int n, crossrt::BufferView positions,
                                            crossrt::BufferView velocities)
 {
   const int crt_startX = int(0);
@@ -230,29 +232,29 @@ void Particles_Vulkan::kernel1D_MeasureCmd(VkCommandBuffer a_cmd, int n, crossrt
   crt_args.crt_startX = crt_startX;
   crt_args.crt_countX = crt_countX;
   crt_args.n = n;
-  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Measure_m_boxMin,
+  crossrt::EnsureSize(crt_ctx, crt_partials.kernel1D_Measure_m_boxMin,
                       16 * crossrt::GroupCount1D(crt_countX, 256));  // float4 per workgroup
-  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Measure_m_boxMax,
+  crossrt::EnsureSize(crt_ctx, crt_partials.kernel1D_Measure_m_boxMax,
                       16 * crossrt::GroupCount1D(crt_countX, 256));  // float4 per workgroup
-  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Measure_m_momentum,
+  crossrt::EnsureSize(crt_ctx, crt_partials.kernel1D_Measure_m_momentum,
                       16 * crossrt::GroupCount1D(crt_countX, 256));  // float4 per workgroup
-  crossrt::EnsureSize(m_ctx, m_partials.kernel1D_Measure_m_kineticEnergy,
+  crossrt::EnsureSize(crt_ctx, crt_partials.kernel1D_Measure_m_kineticEnergy,
                       4 * crossrt::GroupCount1D(crt_countX, 256));  // float per workgroup
-  m_pipelines.kernel1D_Measure.Bind(a_cmd);
-  m_pipelines.kernel1D_Measure.PushBuffers(
-      a_cmd, {m_classDataBuffer.View(), positions, velocities, m_partials.kernel1D_Measure_m_boxMin.View(),
-              m_partials.kernel1D_Measure_m_boxMax.View(), m_partials.kernel1D_Measure_m_momentum.View(),
-              m_partials.kernel1D_Measure_m_kineticEnergy.View()});
-  m_pipelines.kernel1D_Measure.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  crossrt::Dispatch1D(a_cmd, crt_countX, 256);
-  crossrt::ComputeBarrier(a_cmd);
+  crt_pipelines.kernel1D_Measure.Bind(crt_cmd);
+  crt_pipelines.kernel1D_Measure.PushBuffers(
+      crt_cmd, {crt_classDataBuffer.View(), positions, velocities, crt_partials.kernel1D_Measure_m_boxMin.View(),
+                crt_partials.kernel1D_Measure_m_boxMax.View(), crt_partials.kernel1D_Measure_m_momentum.View(),
+                crt_partials.kernel1D_Measure_m_kineticEnergy.View()});
+  crt_pipelines.kernel1D_Measure.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
+  crossrt::Dispatch1D(crt_cmd, crt_countX, 256);
+  crossrt::ComputeBarrier(crt_cmd);
   const uint32_t crt_partialCount = crossrt::GroupCount1D(crt_countX, 256);
-  m_pipelines.kernel1D_Measure_Reduce.Bind(a_cmd);
-  m_pipelines.kernel1D_Measure_Reduce.PushBuffers(
-      a_cmd, {m_classDataBuffer.View(), m_partials.kernel1D_Measure_m_boxMin.View(),
-              m_partials.kernel1D_Measure_m_boxMax.View(), m_partials.kernel1D_Measure_m_momentum.View(),
-              m_partials.kernel1D_Measure_m_kineticEnergy.View()});
-  m_pipelines.kernel1D_Measure_Reduce.PushConstants(a_cmd, &crt_partialCount, sizeof(crt_partialCount));
-  vkCmdDispatch(a_cmd, 1, 1, 1);
-  crossrt::ComputeBarrier(a_cmd);
+  crt_pipelines.kernel1D_Measure_Reduce.Bind(crt_cmd);
+  crt_pipelines.kernel1D_Measure_Reduce.PushBuffers(
+      crt_cmd, {crt_classDataBuffer.View(), crt_partials.kernel1D_Measure_m_boxMin.View(),
+                crt_partials.kernel1D_Measure_m_boxMax.View(), crt_partials.kernel1D_Measure_m_momentum.View(),
+                crt_partials.kernel1D_Measure_m_kineticEnergy.View()});
+  crt_pipelines.kernel1D_Measure_Reduce.PushConstants(crt_cmd, &crt_partialCount, sizeof(crt_partialCount));
+  vkCmdDispatch(crt_cmd, 1, 1, 1);
+  crossrt::ComputeBarrier(crt_cmd);
 }

@@ -26,27 +26,27 @@ public:
 
   // For data that already lives on the GPU: bind your buffers, then record into your command buffer.
   virtual void SetVulkanInOutFor_Step(crossrt::BufferView a_positions, crossrt::BufferView a_velocities);
-  virtual void StepCmd(VkCommandBuffer a_cmd, int n, float dt, float4* positions, float4* velocities);
+  virtual void StepCmd(VkCommandBuffer crt_cmd, int n, float dt, float4* positions, float4* velocities);
 
   void CommitDeviceData() override;  // uploads members
   // a_out: [0] GPU ms, [1] copy-in ms, [2] copy-out ms, [3] total ms
   void GetExecutionTime(const char* a_funcName, float a_out[4]) override;
 
-  virtual void UpdatePlainMembers();  // members -> GPU (called before every control function)
-  virtual void ReadPlainMembers();    // GPU -> members the kernels write (reductions)
+  virtual void crt_UpdatePlainMembers();  // members -> GPU (called before every control function)
+  virtual void crt_ReadPlainMembers();    // GPU -> members the kernels write (reductions)
 
-  std::shared_ptr<crossrt::VulkanContext> Context() const { return m_ctx; }
+  std::shared_ptr<crossrt::VulkanContext> Context() const { return crt_ctx; }
 
 protected:
-  // One per kernel (and megakernel of a thread loop): records its dispatch (and barrier) into a_cmd.
-  virtual void kernel1D_AdvanceCmd(VkCommandBuffer a_cmd, int n, float dt, crossrt::BufferView positions,
+  // One per kernel (and megakernel of a thread loop): records its dispatch (and barrier) into crt_cmd.
+  virtual void kernel1D_AdvanceCmd(VkCommandBuffer crt_cmd, int n, float dt, crossrt::BufferView positions,
                                    crossrt::BufferView velocities);
-  virtual void kernel1D_MeasureCmd(VkCommandBuffer a_cmd, int n, crossrt::BufferView positions,
+  virtual void kernel1D_MeasureCmd(VkCommandBuffer crt_cmd, int n, crossrt::BufferView positions,
                                    crossrt::BufferView velocities);
-  virtual void InitPipelines();
+  virtual void crt_InitPipelines();
   // Records an update of one member's GPU copy, ordered between the kernels around it.
-  virtual void UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size);
-  virtual void ReadVectorMembers(const char* a_funcName);  // GPU -> std::vector and Image2D members kernels write
+  virtual void crt_UpdateMemberCmd(VkCommandBuffer crt_cmd, size_t a_offset, const void* a_data, size_t a_size);
+  virtual void crt_ReadVectorMembers(const char* a_funcName);  // GPU -> std::vector and Image2D members kernels write
 
   // Push constants of each kernel: thread ranges, then its scalar arguments (std430 offsets).
   struct kernel1D_AdvanceArgs
@@ -76,24 +76,24 @@ protected:
     alignas(4) float m_timeMs;
   };
 
-  std::shared_ptr<crossrt::VulkanContext> m_ctx;
-  crossrt::Buffer m_classDataBuffer;
-  bool m_deviceDataCommitted = false;
+  std::shared_ptr<crossrt::VulkanContext> crt_ctx;
+  crossrt::Buffer crt_classDataBuffer;
+  bool crt_deviceDataCommitted = false;
 
   // A std::vector or Image2D member changed size, or a sampler changed, since CommitDeviceData().
-  virtual bool VectorMembersResized() const;
+  virtual bool crt_VectorMembersResized() const;
 
   struct InOut_Step  // buffers bound by SetVulkanInOutFor_Step
   {
     crossrt::BufferView positions;
     crossrt::BufferView velocities;
-  } m_inOut_Step;
+  } crt_inOut_Step;
 
   struct ArgumentBuffers  // device copies of pointer arguments, reused across calls
   {
     crossrt::Buffer Step_positions;
     crossrt::Buffer Step_velocities;
-  } m_args;
+  } crt_argCopies;
 
   struct Pipelines
   {
@@ -101,7 +101,7 @@ protected:
     crossrt::ComputePipeline kernel1D_Advance_Reduce;
     crossrt::ComputePipeline kernel1D_Measure;
     crossrt::ComputePipeline kernel1D_Measure_Reduce;
-  } m_pipelines;
+  } crt_pipelines;
 
   struct Partials  // per-workgroup partial results of reductions
   {
@@ -110,10 +110,10 @@ protected:
     crossrt::Buffer kernel1D_Measure_m_boxMax;
     crossrt::Buffer kernel1D_Measure_m_momentum;
     crossrt::Buffer kernel1D_Measure_m_kineticEnergy;
-  } m_partials;
+  } crt_partials;
 
-  crossrt::GpuTimer m_gpuTimer;
-  std::map<std::string, std::array<float, 4>> m_times;
+  crossrt::GpuTimer crt_gpuTimer;
+  std::map<std::string, std::array<float, 4>> crt_times;
 };
 
 // Runs on the default device: CROSSRT_DEVICE (index or name) if set, else a discrete GPU, else lavapipe.

@@ -23,9 +23,9 @@ std::shared_ptr<PrimaryRays> CreatePrimaryRays_CPU(int width, int height)
 
 void PrimaryRays_CPU::GetExecutionTime(const char* a_funcName, float a_out[4])
 {
-  auto it = m_times.find(a_funcName);
+  auto it = crt_times.find(a_funcName);
   for (int i = 0; i < 4; ++i)
-    a_out[i] = it == m_times.end() ? 0.0f : it->second[i];
+    a_out[i] = it == crt_times.end() ? 0.0f : it->second[i];
 }
 
 // From PrimaryRays::Render (PrimaryRays.cpp).
@@ -35,7 +35,7 @@ void PrimaryRays_CPU::Render(uint32_t* pixels)
   // The body of PrimaryRays::Render, run as a lambda so that an early 'return' still gets timed.
   [&]() { kernel2D_Render(pixels, m_width, m_height); }();
   const float crt_ms = std::chrono::duration<float, std::milli>(std::chrono::steady_clock::now() - crt_start).count();
-  const_cast<PrimaryRays_CPU*>(this)->m_times["Render"] = {0.0f, 0.0f, 0.0f, crt_ms};
+  const_cast<PrimaryRays_CPU*>(this)->crt_times["Render"] = {0.0f, 0.0f, 0.0f, crt_ms};
 }
 
 // From PrimaryRays::CastRays (PrimaryRays.cpp).
@@ -45,7 +45,7 @@ void PrimaryRays_CPU::CastRays(const float4* posAndNear, const float4* dirAndFar
   // The body of PrimaryRays::CastRays, run as a lambda so that an early 'return' still gets timed.
   [&]() { kernel1D_CastRays(posAndNear, dirAndFar, hits, n); }();
   const float crt_ms = std::chrono::duration<float, std::milli>(std::chrono::steady_clock::now() - crt_start).count();
-  const_cast<PrimaryRays_CPU*>(this)->m_times["CastRays"] = {0.0f, 0.0f, 0.0f, crt_ms};
+  const_cast<PrimaryRays_CPU*>(this)->crt_times["CastRays"] = {0.0f, 0.0f, 0.0f, crt_ms};
 }
 
 // From PrimaryRays::kernel2D_Render (PrimaryRays.cpp): the outer loop runs on all cores.

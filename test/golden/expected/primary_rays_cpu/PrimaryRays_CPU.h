@@ -26,7 +26,7 @@ protected:
   void kernel2D_Render(uint32_t* pixels, int width, int height);
   void kernel1D_CastRays(const float4* posAndNear, const float4* dirAndFar, CRT_Hit* hits, int n);
 
-  std::map<std::string, std::array<float, 4>> m_times;
+  std::map<std::string, std::array<float, 4>> crt_times;
 };
 
 std::shared_ptr<PrimaryRays> CreatePrimaryRays_CPU(int width, int height);

@@ -21,16 +21,16 @@ extern const uint32_t PrimaryRays_kernel1D_CastRays_spv[];
 extern const size_t PrimaryRays_kernel1D_CastRays_spvBytes;
 
 PrimaryRays_Vulkan::PrimaryRays_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx, int width, int height)
-    : PrimaryRays(width, height), m_ctx(std::move(a_ctx))
+    : PrimaryRays(width, height), crt_ctx(std::move(a_ctx))
 {
-  m_classDataBuffer = crossrt::Buffer(m_ctx, sizeof(ClassData));
-  m_gpuTimer = crossrt::GpuTimer(m_ctx);
-  m_useRayTracingHardware = m_ctx->hasRayQuery;
-  if (m_ctx->hasRayQuery)
+  crt_classDataBuffer = crossrt::Buffer(crt_ctx, sizeof(ClassData));
+  crt_gpuTimer = crossrt::GpuTimer(crt_ctx);
+  crt_useRayTracingHardware = crt_ctx->hasRayQuery;
+  if (crt_ctx->hasRayQuery)
   {
-    m_scenes.m_pAccelStruct = crossrt::RayTracingScene(m_ctx);
+    crt_scenes.m_pAccelStruct = crossrt::RayTracingScene(crt_ctx);
   }
-  InitPipelines();
+  crt_InitPipelines();
 }
 
 std::shared_ptr<PrimaryRays> CreatePrimaryRays_Vulkan(int width, int height)
@@ -46,45 +46,45 @@ std::shared_ptr<PrimaryRays> CreatePrimaryRays_Vulkan(std::shared_ptr<crossrt::V
 
 PrimaryRays_Vulkan::~PrimaryRays_Vulkan() = default;
 
-void PrimaryRays_Vulkan::InitPipelines()
+void PrimaryRays_Vulkan::crt_InitPipelines()
 {
-  if (m_ctx->hasRayQuery)  // m_pAccelStruct's ray queries on the ray tracing hardware: the shader needs them even to be
-                           // created
-    m_pipelines.kernel2D_Render_RayQuery = crossrt::ComputePipeline(
-        m_ctx, PrimaryRays_kernel2D_Render_RayQuery_spv, PrimaryRays_kernel2D_Render_RayQuery_spvBytes,
+  if (crt_ctx->hasRayQuery)  // m_pAccelStruct's ray queries on the ray tracing hardware: the shader needs them even to
+                             // be created
+    crt_pipelines.kernel2D_Render_RayQuery = crossrt::ComputePipeline(
+        crt_ctx, PrimaryRays_kernel2D_Render_RayQuery_spv, PrimaryRays_kernel2D_Render_RayQuery_spvBytes,
         std::vector<VkDescriptorType>{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
                                       VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
                                       VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR},
         sizeof(kernel2D_RenderArgs), "PrimaryRays::kernel2D_Render_RayQuery");
-  m_pipelines.kernel2D_Render =
-      crossrt::ComputePipeline(m_ctx, PrimaryRays_kernel2D_Render_spv, PrimaryRays_kernel2D_Render_spvBytes, 12,
+  crt_pipelines.kernel2D_Render =
+      crossrt::ComputePipeline(crt_ctx, PrimaryRays_kernel2D_Render_spv, PrimaryRays_kernel2D_Render_spvBytes, 12,
                                sizeof(kernel2D_RenderArgs), "PrimaryRays::kernel2D_Render");
-  if (m_ctx->hasRayQuery)  // m_pAccelStruct's ray queries on the ray tracing hardware: the shader needs them even to be
-                           // created
-    m_pipelines.kernel1D_CastRays_RayQuery = crossrt::ComputePipeline(
-        m_ctx, PrimaryRays_kernel1D_CastRays_RayQuery_spv, PrimaryRays_kernel1D_CastRays_RayQuery_spvBytes,
+  if (crt_ctx->hasRayQuery)  // m_pAccelStruct's ray queries on the ray tracing hardware: the shader needs them even to
+                             // be created
+    crt_pipelines.kernel1D_CastRays_RayQuery = crossrt::ComputePipeline(
+        crt_ctx, PrimaryRays_kernel1D_CastRays_RayQuery_spv, PrimaryRays_kernel1D_CastRays_RayQuery_spvBytes,
         std::vector<VkDescriptorType>{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
                                       VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
                                       VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR},
         sizeof(kernel1D_CastRaysArgs), "PrimaryRays::kernel1D_CastRays_RayQuery");
-  m_pipelines.kernel1D_CastRays =
-      crossrt::ComputePipeline(m_ctx, PrimaryRays_kernel1D_CastRays_spv, PrimaryRays_kernel1D_CastRays_spvBytes, 12,
+  crt_pipelines.kernel1D_CastRays =
+      crossrt::ComputePipeline(crt_ctx, PrimaryRays_kernel1D_CastRays_spv, PrimaryRays_kernel1D_CastRays_spvBytes, 12,
                                sizeof(kernel1D_CastRaysArgs), "PrimaryRays::kernel1D_CastRays");
 }
 
 void PrimaryRays_Vulkan::UseRayTracingHardware(bool a_use)
 {
-  if (a_use && !m_ctx->hasRayQuery)
-    throw crossrt::Error("PrimaryRays_Vulkan: device '" + m_ctx->DeviceName() +
+  if (a_use && !crt_ctx->hasRayQuery)
+    throw crossrt::Error("PrimaryRays_Vulkan: device '" + crt_ctx->DeviceName() +
                          "' has no ray queries (VK_KHR_ray_query): its kernels trace with the translated traversal");
-  if (a_use != m_useRayTracingHardware)
-    m_deviceDataCommitted = false;  // the next call commits, building the scene for the hardware
-  m_useRayTracingHardware = a_use;
+  if (a_use != crt_useRayTracingHardware)
+    crt_deviceDataCommitted = false;  // the next call commits, building the scene for the hardware
+  crt_useRayTracingHardware = a_use;
 }
 
 // The scene m_pAccelStruct holds, for the ray tracing hardware: a bottom-level acceleration structure per
 // mesh and a top level over the instances, from what it exports.
-void PrimaryRays_Vulkan::CommitScene_m_pAccelStruct()
+void PrimaryRays_Vulkan::crt_CommitScene_m_pAccelStruct()
 {
   CRT_SceneExport scene;
   if (!m_pAccelStruct || !m_pAccelStruct->ExportScene(scene))
@@ -103,17 +103,18 @@ void PrimaryRays_Vulkan::CommitScene_m_pAccelStruct()
     instances[i].mesh = scene.instances[i].geomId;
     std::memcpy(instances[i].toWorldRows, scene.instances[i].toWorldRows, sizeof(instances[i].toWorldRows));
   }
-  m_scenes.m_pAccelStruct.Build(meshes, instances);
+  crt_scenes.m_pAccelStruct.Build(meshes, instances);
 }
 
-void PrimaryRays_Vulkan::UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size)
+void PrimaryRays_Vulkan::crt_UpdateMemberCmd(VkCommandBuffer crt_cmd, size_t a_offset, const void* a_data,
+                                             size_t a_size)
 {
-  crossrt::ComputeBarrier(a_cmd);  // kernels recorded before it are done with the class data
-  vkCmdUpdateBuffer(a_cmd, m_classDataBuffer.Handle(), a_offset, a_size, a_data);
-  crossrt::TransferToComputeBarrier(a_cmd);
+  crossrt::ComputeBarrier(crt_cmd);  // kernels recorded before it are done with the class data
+  vkCmdUpdateBuffer(crt_cmd, crt_classDataBuffer.Handle(), a_offset, a_size, a_data);
+  crossrt::TransferToComputeBarrier(crt_cmd);
 }
 
-void PrimaryRays_Vulkan::UpdatePlainMembers()
+void PrimaryRays_Vulkan::crt_UpdatePlainMembers()
 {
   ClassData data{};
   std::memcpy(&data.m_eye, &m_eye, sizeof(data.m_eye));
@@ -144,119 +145,119 @@ void PrimaryRays_Vulkan::UpdatePlainMembers()
   data.m_pAccelStruct_m_triangles_capacity = uint32_t(crt_m_pAccelStruct()->m_triangles.capacity());
   data.m_pAccelStruct_m_primIds_size = uint32_t(crt_m_pAccelStruct()->m_primIds.size());
   data.m_pAccelStruct_m_primIds_capacity = uint32_t(crt_m_pAccelStruct()->m_primIds.capacity());
-  m_classDataBuffer.Upload(&data, sizeof(data));
+  crt_classDataBuffer.Upload(&data, sizeof(data));
 }
 
-void PrimaryRays_Vulkan::ReadPlainMembers()
+void PrimaryRays_Vulkan::crt_ReadPlainMembers()
 {
 }
 
 void PrimaryRays_Vulkan::CommitDeviceData()
 {
   // std::vector members become buffers of their capacity; kernels see size and capacity.
-  crossrt::EnsureSize(m_ctx, m_vdata.m_vertices, sizeof(LiteMath::float4) * m_vertices.capacity());
+  crossrt::EnsureSize(crt_ctx, crt_vdata.m_vertices, sizeof(LiteMath::float4) * m_vertices.capacity());
   if (!m_vertices.empty())
-    m_vdata.m_vertices.Upload(m_vertices.data(), sizeof(LiteMath::float4) * m_vertices.size());
-  m_vdata.m_verticesSize = m_vertices.size();
-  crossrt::EnsureSize(m_ctx, m_vdata.m_indices, sizeof(unsigned int) * m_indices.capacity());
+    crt_vdata.m_vertices.Upload(m_vertices.data(), sizeof(LiteMath::float4) * m_vertices.size());
+  crt_vdata.m_verticesSize = m_vertices.size();
+  crossrt::EnsureSize(crt_ctx, crt_vdata.m_indices, sizeof(unsigned int) * m_indices.capacity());
   if (!m_indices.empty())
-    m_vdata.m_indices.Upload(m_indices.data(), sizeof(unsigned int) * m_indices.size());
-  m_vdata.m_indicesSize = m_indices.size();
-  if (!m_useRayTracingHardware)  // only the translated traversal reads it
+    crt_vdata.m_indices.Upload(m_indices.data(), sizeof(unsigned int) * m_indices.size());
+  crt_vdata.m_indicesSize = m_indices.size();
+  if (!crt_useRayTracingHardware)  // only the translated traversal reads it
   {
-    crossrt::EnsureSize(m_ctx, m_vdata.m_pAccelStruct_m_nodes,
+    crossrt::EnsureSize(crt_ctx, crt_vdata.m_pAccelStruct_m_nodes,
                         sizeof(BVH4Node) * crt_m_pAccelStruct()->m_nodes.capacity());
     if (!crt_m_pAccelStruct()->m_nodes.empty())
-      m_vdata.m_pAccelStruct_m_nodes.Upload(crt_m_pAccelStruct()->m_nodes.data(),
-                                            sizeof(BVH4Node) * crt_m_pAccelStruct()->m_nodes.size());
+      crt_vdata.m_pAccelStruct_m_nodes.Upload(crt_m_pAccelStruct()->m_nodes.data(),
+                                              sizeof(BVH4Node) * crt_m_pAccelStruct()->m_nodes.size());
   }
-  m_vdata.m_pAccelStruct_m_nodesSize = crt_m_pAccelStruct()->m_nodes.size();
-  if (!m_useRayTracingHardware)  // only the translated traversal reads it
+  crt_vdata.m_pAccelStruct_m_nodesSize = crt_m_pAccelStruct()->m_nodes.size();
+  if (!crt_useRayTracingHardware)  // only the translated traversal reads it
   {
-    crossrt::EnsureSize(m_ctx, m_vdata.m_pAccelStruct_m_instances,
+    crossrt::EnsureSize(crt_ctx, crt_vdata.m_pAccelStruct_m_instances,
                         sizeof(BVHInstance) * crt_m_pAccelStruct()->m_instances.capacity());
     if (!crt_m_pAccelStruct()->m_instances.empty())
-      m_vdata.m_pAccelStruct_m_instances.Upload(crt_m_pAccelStruct()->m_instances.data(),
-                                                sizeof(BVHInstance) * crt_m_pAccelStruct()->m_instances.size());
+      crt_vdata.m_pAccelStruct_m_instances.Upload(crt_m_pAccelStruct()->m_instances.data(),
+                                                  sizeof(BVHInstance) * crt_m_pAccelStruct()->m_instances.size());
   }
-  m_vdata.m_pAccelStruct_m_instancesSize = crt_m_pAccelStruct()->m_instances.size();
-  if (!m_useRayTracingHardware)  // only the translated traversal reads it
+  crt_vdata.m_pAccelStruct_m_instancesSize = crt_m_pAccelStruct()->m_instances.size();
+  if (!crt_useRayTracingHardware)  // only the translated traversal reads it
   {
-    crossrt::EnsureSize(m_ctx, m_vdata.m_pAccelStruct_m_motion,
+    crossrt::EnsureSize(crt_ctx, crt_vdata.m_pAccelStruct_m_motion,
                         sizeof(LiteMath::float4) * crt_m_pAccelStruct()->m_motion.capacity());
     if (!crt_m_pAccelStruct()->m_motion.empty())
-      m_vdata.m_pAccelStruct_m_motion.Upload(crt_m_pAccelStruct()->m_motion.data(),
-                                             sizeof(LiteMath::float4) * crt_m_pAccelStruct()->m_motion.size());
+      crt_vdata.m_pAccelStruct_m_motion.Upload(crt_m_pAccelStruct()->m_motion.data(),
+                                               sizeof(LiteMath::float4) * crt_m_pAccelStruct()->m_motion.size());
   }
-  m_vdata.m_pAccelStruct_m_motionSize = crt_m_pAccelStruct()->m_motion.size();
-  if (!m_useRayTracingHardware)  // only the translated traversal reads it
+  crt_vdata.m_pAccelStruct_m_motionSize = crt_m_pAccelStruct()->m_motion.size();
+  if (!crt_useRayTracingHardware)  // only the translated traversal reads it
   {
-    crossrt::EnsureSize(m_ctx, m_vdata.m_pAccelStruct_m_boxes,
+    crossrt::EnsureSize(crt_ctx, crt_vdata.m_pAccelStruct_m_boxes,
                         sizeof(BVH4Node) * crt_m_pAccelStruct()->m_boxes.capacity());
     if (!crt_m_pAccelStruct()->m_boxes.empty())
-      m_vdata.m_pAccelStruct_m_boxes.Upload(crt_m_pAccelStruct()->m_boxes.data(),
-                                            sizeof(BVH4Node) * crt_m_pAccelStruct()->m_boxes.size());
+      crt_vdata.m_pAccelStruct_m_boxes.Upload(crt_m_pAccelStruct()->m_boxes.data(),
+                                              sizeof(BVH4Node) * crt_m_pAccelStruct()->m_boxes.size());
   }
-  m_vdata.m_pAccelStruct_m_boxesSize = crt_m_pAccelStruct()->m_boxes.size();
-  if (!m_useRayTracingHardware)  // only the translated traversal reads it
+  crt_vdata.m_pAccelStruct_m_boxesSize = crt_m_pAccelStruct()->m_boxes.size();
+  if (!crt_useRayTracingHardware)  // only the translated traversal reads it
   {
-    crossrt::EnsureSize(m_ctx, m_vdata.m_pAccelStruct_m_sdfBricks,
+    crossrt::EnsureSize(crt_ctx, crt_vdata.m_pAccelStruct_m_sdfBricks,
                         sizeof(BVHSdfBrick) * crt_m_pAccelStruct()->m_sdfBricks.capacity());
     if (!crt_m_pAccelStruct()->m_sdfBricks.empty())
-      m_vdata.m_pAccelStruct_m_sdfBricks.Upload(crt_m_pAccelStruct()->m_sdfBricks.data(),
-                                                sizeof(BVHSdfBrick) * crt_m_pAccelStruct()->m_sdfBricks.size());
+      crt_vdata.m_pAccelStruct_m_sdfBricks.Upload(crt_m_pAccelStruct()->m_sdfBricks.data(),
+                                                  sizeof(BVHSdfBrick) * crt_m_pAccelStruct()->m_sdfBricks.size());
   }
-  m_vdata.m_pAccelStruct_m_sdfBricksSize = crt_m_pAccelStruct()->m_sdfBricks.size();
-  if (!m_useRayTracingHardware)  // only the translated traversal reads it
+  crt_vdata.m_pAccelStruct_m_sdfBricksSize = crt_m_pAccelStruct()->m_sdfBricks.size();
+  if (!crt_useRayTracingHardware)  // only the translated traversal reads it
   {
-    crossrt::EnsureSize(m_ctx, m_vdata.m_pAccelStruct_m_sdfWords,
+    crossrt::EnsureSize(crt_ctx, crt_vdata.m_pAccelStruct_m_sdfWords,
                         sizeof(unsigned int) * crt_m_pAccelStruct()->m_sdfWords.capacity());
     if (!crt_m_pAccelStruct()->m_sdfWords.empty())
-      m_vdata.m_pAccelStruct_m_sdfWords.Upload(crt_m_pAccelStruct()->m_sdfWords.data(),
-                                               sizeof(unsigned int) * crt_m_pAccelStruct()->m_sdfWords.size());
+      crt_vdata.m_pAccelStruct_m_sdfWords.Upload(crt_m_pAccelStruct()->m_sdfWords.data(),
+                                                 sizeof(unsigned int) * crt_m_pAccelStruct()->m_sdfWords.size());
   }
-  m_vdata.m_pAccelStruct_m_sdfWordsSize = crt_m_pAccelStruct()->m_sdfWords.size();
-  if (!m_useRayTracingHardware)  // only the translated traversal reads it
+  crt_vdata.m_pAccelStruct_m_sdfWordsSize = crt_m_pAccelStruct()->m_sdfWords.size();
+  if (!crt_useRayTracingHardware)  // only the translated traversal reads it
   {
-    crossrt::EnsureSize(m_ctx, m_vdata.m_pAccelStruct_m_triangles,
+    crossrt::EnsureSize(crt_ctx, crt_vdata.m_pAccelStruct_m_triangles,
                         sizeof(BVHTriangle4) * crt_m_pAccelStruct()->m_triangles.capacity());
     if (!crt_m_pAccelStruct()->m_triangles.empty())
-      m_vdata.m_pAccelStruct_m_triangles.Upload(crt_m_pAccelStruct()->m_triangles.data(),
-                                                sizeof(BVHTriangle4) * crt_m_pAccelStruct()->m_triangles.size());
+      crt_vdata.m_pAccelStruct_m_triangles.Upload(crt_m_pAccelStruct()->m_triangles.data(),
+                                                  sizeof(BVHTriangle4) * crt_m_pAccelStruct()->m_triangles.size());
   }
-  m_vdata.m_pAccelStruct_m_trianglesSize = crt_m_pAccelStruct()->m_triangles.size();
-  if (!m_useRayTracingHardware)  // only the translated traversal reads it
+  crt_vdata.m_pAccelStruct_m_trianglesSize = crt_m_pAccelStruct()->m_triangles.size();
+  if (!crt_useRayTracingHardware)  // only the translated traversal reads it
   {
-    crossrt::EnsureSize(m_ctx, m_vdata.m_pAccelStruct_m_primIds,
+    crossrt::EnsureSize(crt_ctx, crt_vdata.m_pAccelStruct_m_primIds,
                         sizeof(unsigned int) * crt_m_pAccelStruct()->m_primIds.capacity());
     if (!crt_m_pAccelStruct()->m_primIds.empty())
-      m_vdata.m_pAccelStruct_m_primIds.Upload(crt_m_pAccelStruct()->m_primIds.data(),
-                                              sizeof(unsigned int) * crt_m_pAccelStruct()->m_primIds.size());
+      crt_vdata.m_pAccelStruct_m_primIds.Upload(crt_m_pAccelStruct()->m_primIds.data(),
+                                                sizeof(unsigned int) * crt_m_pAccelStruct()->m_primIds.size());
   }
-  m_vdata.m_pAccelStruct_m_primIdsSize = crt_m_pAccelStruct()->m_primIds.size();
-  if (m_useRayTracingHardware)
-    CommitScene_m_pAccelStruct();
-  UpdatePlainMembers();
-  m_deviceDataCommitted = true;
+  crt_vdata.m_pAccelStruct_m_primIdsSize = crt_m_pAccelStruct()->m_primIds.size();
+  if (crt_useRayTracingHardware)
+    crt_CommitScene_m_pAccelStruct();
+  crt_UpdatePlainMembers();
+  crt_deviceDataCommitted = true;
 }
 
-bool PrimaryRays_Vulkan::VectorMembersResized() const
+bool PrimaryRays_Vulkan::crt_VectorMembersResized() const
 {
   bool resized = false;
-  resized = resized || m_vertices.size() != m_vdata.m_verticesSize;
-  resized = resized || m_indices.size() != m_vdata.m_indicesSize;
-  resized = resized || crt_m_pAccelStruct()->m_nodes.size() != m_vdata.m_pAccelStruct_m_nodesSize;
-  resized = resized || crt_m_pAccelStruct()->m_instances.size() != m_vdata.m_pAccelStruct_m_instancesSize;
-  resized = resized || crt_m_pAccelStruct()->m_motion.size() != m_vdata.m_pAccelStruct_m_motionSize;
-  resized = resized || crt_m_pAccelStruct()->m_boxes.size() != m_vdata.m_pAccelStruct_m_boxesSize;
-  resized = resized || crt_m_pAccelStruct()->m_sdfBricks.size() != m_vdata.m_pAccelStruct_m_sdfBricksSize;
-  resized = resized || crt_m_pAccelStruct()->m_sdfWords.size() != m_vdata.m_pAccelStruct_m_sdfWordsSize;
-  resized = resized || crt_m_pAccelStruct()->m_triangles.size() != m_vdata.m_pAccelStruct_m_trianglesSize;
-  resized = resized || crt_m_pAccelStruct()->m_primIds.size() != m_vdata.m_pAccelStruct_m_primIdsSize;
+  resized = resized || m_vertices.size() != crt_vdata.m_verticesSize;
+  resized = resized || m_indices.size() != crt_vdata.m_indicesSize;
+  resized = resized || crt_m_pAccelStruct()->m_nodes.size() != crt_vdata.m_pAccelStruct_m_nodesSize;
+  resized = resized || crt_m_pAccelStruct()->m_instances.size() != crt_vdata.m_pAccelStruct_m_instancesSize;
+  resized = resized || crt_m_pAccelStruct()->m_motion.size() != crt_vdata.m_pAccelStruct_m_motionSize;
+  resized = resized || crt_m_pAccelStruct()->m_boxes.size() != crt_vdata.m_pAccelStruct_m_boxesSize;
+  resized = resized || crt_m_pAccelStruct()->m_sdfBricks.size() != crt_vdata.m_pAccelStruct_m_sdfBricksSize;
+  resized = resized || crt_m_pAccelStruct()->m_sdfWords.size() != crt_vdata.m_pAccelStruct_m_sdfWordsSize;
+  resized = resized || crt_m_pAccelStruct()->m_triangles.size() != crt_vdata.m_pAccelStruct_m_trianglesSize;
+  resized = resized || crt_m_pAccelStruct()->m_primIds.size() != crt_vdata.m_pAccelStruct_m_primIdsSize;
   return resized;
 }
 
-void PrimaryRays_Vulkan::ReadVectorMembers(const char* a_funcName)
+void PrimaryRays_Vulkan::crt_ReadVectorMembers(const char* a_funcName)
 {
   (void)a_funcName;
 }
@@ -274,16 +275,16 @@ BVHScene* PrimaryRays_Vulkan::crt_m_pAccelStruct() const
 
 void PrimaryRays_Vulkan::GetExecutionTime(const char* a_funcName, float a_out[4])
 {
-  auto it = m_times.find(a_funcName);
+  auto it = crt_times.find(a_funcName);
   for (int i = 0; i < 4; ++i)
-    a_out[i] = it == m_times.end() ? 0.0f : it->second[i];
+    a_out[i] = it == crt_times.end() ? 0.0f : it->second[i];
 }
 
 // ---- Render (from PrimaryRays::Render, PrimaryRays.cpp) ----
 
 void PrimaryRays_Vulkan::SetVulkanInOutFor_Render(crossrt::BufferView a_pixels)
 {
-  m_inOut_Render.pixels = a_pixels;
+  crt_inOut_Render.pixels = a_pixels;
 }
 
 void PrimaryRays_Vulkan::Render(uint32_t* pixels)
@@ -293,40 +294,40 @@ void PrimaryRays_Vulkan::Render(uint32_t* pixels)
   // std::vector members are uploaded by CommitDeviceData(): here once, and again whenever one
   // changed size (its device buffer would be too small). After changing the contents of a
   // vector without resizing it, call CommitDeviceData().
-  if (!crt_self->m_deviceDataCommitted || crt_self->VectorMembersResized())
+  if (!crt_self->crt_deviceDataCommitted || crt_self->crt_VectorMembersResized())
     crt_self->CommitDeviceData();
 
   crossrt::CpuTimer crt_copyIn;
   const size_t crt_pixelsBytes = sizeof(uint32_t) * size_t(m_width * m_height);
-  crossrt::EnsureSize(m_ctx, crt_self->m_args.Render_pixels, crt_pixelsBytes);
+  crossrt::EnsureSize(crt_ctx, crt_self->crt_argCopies.Render_pixels, crt_pixelsBytes);
   if (crt_pixelsBytes > 0)
-    crt_self->m_args.Render_pixels.Upload(pixels, crt_pixelsBytes);
-  crt_self->SetVulkanInOutFor_Render(crt_self->m_args.Render_pixels.View());
+    crt_self->crt_argCopies.Render_pixels.Upload(pixels, crt_pixelsBytes);
+  crt_self->SetVulkanInOutFor_Render(crt_self->crt_argCopies.Render_pixels.View());
   const float crt_copyInMs = crt_copyIn.ElapsedMs();
 
   // Members as they are now; host code of Render that changes one records an update in order.
-  crt_self->UpdatePlainMembers();
-  VkCommandBuffer crt_cmd = m_ctx->BeginOneShot();
-  crt_self->m_gpuTimer.Reset(crt_cmd);
-  crt_self->m_gpuTimer.Begin(crt_cmd, "Render");
+  crt_self->crt_UpdatePlainMembers();
+  VkCommandBuffer crt_cmd = crt_ctx->BeginOneShot();
+  crt_self->crt_gpuTimer.Reset(crt_cmd);
+  crt_self->crt_gpuTimer.Begin(crt_cmd, "Render");
   crt_self->RenderCmd(crt_cmd, pixels);
-  crt_self->m_gpuTimer.End(crt_cmd, "Render");
-  m_ctx->SubmitAndWait(crt_cmd);
-  crt_self->m_gpuTimer.Collect();
+  crt_self->crt_gpuTimer.End(crt_cmd, "Render");
+  crt_ctx->SubmitAndWait(crt_cmd);
+  crt_self->crt_gpuTimer.Collect();
 
   crossrt::CpuTimer crt_copyOut;
-  crt_self->ReadPlainMembers();
-  crt_self->ReadVectorMembers("Render");
+  crt_self->crt_ReadPlainMembers();
+  crt_self->crt_ReadVectorMembers("Render");
   if (crt_pixelsBytes > 0)
-    crt_self->m_args.Render_pixels.Download(pixels, crt_pixelsBytes);
-  crt_self->m_times["Render"] = {crt_self->m_gpuTimer.LastMs("Render"), crt_copyInMs, crt_copyOut.ElapsedMs(),
-                                 crt_total.ElapsedMs()};
+    crt_self->crt_argCopies.Render_pixels.Download(pixels, crt_pixelsBytes);
+  crt_self->crt_times["Render"] = {crt_self->crt_gpuTimer.LastMs("Render"), crt_copyInMs, crt_copyOut.ElapsedMs(),
+                                   crt_total.ElapsedMs()};
 }
 
 // The body of PrimaryRays::Render, with each kernel call turned into its ...Cmd.
-void PrimaryRays_Vulkan::RenderCmd(VkCommandBuffer a_cmd, [[maybe_unused]] uint32_t* pixels)
+void PrimaryRays_Vulkan::RenderCmd(VkCommandBuffer crt_cmd, [[maybe_unused]] uint32_t* pixels)
 {
-  kernel2D_RenderCmd(a_cmd, m_inOut_Render.pixels, m_width, m_height);
+  kernel2D_RenderCmd(crt_cmd, crt_inOut_Render.pixels, m_width, m_height);
 }
 
 // ---- CastRays (from PrimaryRays::CastRays, PrimaryRays.cpp) ----
@@ -334,9 +335,9 @@ void PrimaryRays_Vulkan::RenderCmd(VkCommandBuffer a_cmd, [[maybe_unused]] uint3
 void PrimaryRays_Vulkan::SetVulkanInOutFor_CastRays(crossrt::BufferView a_posAndNear, crossrt::BufferView a_dirAndFar,
                                                     crossrt::BufferView a_hits)
 {
-  m_inOut_CastRays.posAndNear = a_posAndNear;
-  m_inOut_CastRays.dirAndFar = a_dirAndFar;
-  m_inOut_CastRays.hits = a_hits;
+  crt_inOut_CastRays.posAndNear = a_posAndNear;
+  crt_inOut_CastRays.dirAndFar = a_dirAndFar;
+  crt_inOut_CastRays.hits = a_hits;
 }
 
 void PrimaryRays_Vulkan::CastRays(const float4* posAndNear, const float4* dirAndFar, CRT_Hit* hits, int n)
@@ -346,56 +347,57 @@ void PrimaryRays_Vulkan::CastRays(const float4* posAndNear, const float4* dirAnd
   // std::vector members are uploaded by CommitDeviceData(): here once, and again whenever one
   // changed size (its device buffer would be too small). After changing the contents of a
   // vector without resizing it, call CommitDeviceData().
-  if (!crt_self->m_deviceDataCommitted || crt_self->VectorMembersResized())
+  if (!crt_self->crt_deviceDataCommitted || crt_self->crt_VectorMembersResized())
     crt_self->CommitDeviceData();
 
   crossrt::CpuTimer crt_copyIn;
   const size_t crt_posAndNearBytes = sizeof(float4) * size_t(n);
-  crossrt::EnsureSize(m_ctx, crt_self->m_args.CastRays_posAndNear, crt_posAndNearBytes);
+  crossrt::EnsureSize(crt_ctx, crt_self->crt_argCopies.CastRays_posAndNear, crt_posAndNearBytes);
   if (crt_posAndNearBytes > 0)
-    crt_self->m_args.CastRays_posAndNear.Upload(posAndNear, crt_posAndNearBytes);
+    crt_self->crt_argCopies.CastRays_posAndNear.Upload(posAndNear, crt_posAndNearBytes);
   const size_t crt_dirAndFarBytes = sizeof(float4) * size_t(n);
-  crossrt::EnsureSize(m_ctx, crt_self->m_args.CastRays_dirAndFar, crt_dirAndFarBytes);
+  crossrt::EnsureSize(crt_ctx, crt_self->crt_argCopies.CastRays_dirAndFar, crt_dirAndFarBytes);
   if (crt_dirAndFarBytes > 0)
-    crt_self->m_args.CastRays_dirAndFar.Upload(dirAndFar, crt_dirAndFarBytes);
+    crt_self->crt_argCopies.CastRays_dirAndFar.Upload(dirAndFar, crt_dirAndFarBytes);
   const size_t crt_hitsBytes = sizeof(CRT_Hit) * size_t(n);
-  crossrt::EnsureSize(m_ctx, crt_self->m_args.CastRays_hits, crt_hitsBytes);
+  crossrt::EnsureSize(crt_ctx, crt_self->crt_argCopies.CastRays_hits, crt_hitsBytes);
   if (crt_hitsBytes > 0)
-    crt_self->m_args.CastRays_hits.Upload(hits, crt_hitsBytes);
-  crt_self->SetVulkanInOutFor_CastRays(crt_self->m_args.CastRays_posAndNear.View(),
-                                       crt_self->m_args.CastRays_dirAndFar.View(),
-                                       crt_self->m_args.CastRays_hits.View());
+    crt_self->crt_argCopies.CastRays_hits.Upload(hits, crt_hitsBytes);
+  crt_self->SetVulkanInOutFor_CastRays(crt_self->crt_argCopies.CastRays_posAndNear.View(),
+                                       crt_self->crt_argCopies.CastRays_dirAndFar.View(),
+                                       crt_self->crt_argCopies.CastRays_hits.View());
   const float crt_copyInMs = crt_copyIn.ElapsedMs();
 
   // Members as they are now; host code of CastRays that changes one records an update in order.
-  crt_self->UpdatePlainMembers();
-  VkCommandBuffer crt_cmd = m_ctx->BeginOneShot();
-  crt_self->m_gpuTimer.Reset(crt_cmd);
-  crt_self->m_gpuTimer.Begin(crt_cmd, "CastRays");
+  crt_self->crt_UpdatePlainMembers();
+  VkCommandBuffer crt_cmd = crt_ctx->BeginOneShot();
+  crt_self->crt_gpuTimer.Reset(crt_cmd);
+  crt_self->crt_gpuTimer.Begin(crt_cmd, "CastRays");
   crt_self->CastRaysCmd(crt_cmd, posAndNear, dirAndFar, hits, n);
-  crt_self->m_gpuTimer.End(crt_cmd, "CastRays");
-  m_ctx->SubmitAndWait(crt_cmd);
-  crt_self->m_gpuTimer.Collect();
+  crt_self->crt_gpuTimer.End(crt_cmd, "CastRays");
+  crt_ctx->SubmitAndWait(crt_cmd);
+  crt_self->crt_gpuTimer.Collect();
 
   crossrt::CpuTimer crt_copyOut;
-  crt_self->ReadPlainMembers();
-  crt_self->ReadVectorMembers("CastRays");
+  crt_self->crt_ReadPlainMembers();
+  crt_self->crt_ReadVectorMembers("CastRays");
   if (crt_hitsBytes > 0)
-    crt_self->m_args.CastRays_hits.Download(hits, crt_hitsBytes);
-  crt_self->m_times["CastRays"] = {crt_self->m_gpuTimer.LastMs("CastRays"), crt_copyInMs, crt_copyOut.ElapsedMs(),
-                                   crt_total.ElapsedMs()};
+    crt_self->crt_argCopies.CastRays_hits.Download(hits, crt_hitsBytes);
+  crt_self->crt_times["CastRays"] = {crt_self->crt_gpuTimer.LastMs("CastRays"), crt_copyInMs, crt_copyOut.ElapsedMs(),
+                                     crt_total.ElapsedMs()};
 }
 
 // The body of PrimaryRays::CastRays, with each kernel call turned into its ...Cmd.
-void PrimaryRays_Vulkan::CastRaysCmd(VkCommandBuffer a_cmd, [[maybe_unused]] const float4* posAndNear,
+void PrimaryRays_Vulkan::CastRaysCmd(VkCommandBuffer crt_cmd, [[maybe_unused]] const float4* posAndNear,
                                      [[maybe_unused]] const float4* dirAndFar, [[maybe_unused]] CRT_Hit* hits, int n)
 {
-  kernel1D_CastRaysCmd(a_cmd, m_inOut_CastRays.posAndNear, m_inOut_CastRays.dirAndFar, m_inOut_CastRays.hits, n);
+  kernel1D_CastRaysCmd(crt_cmd, crt_inOut_CastRays.posAndNear, crt_inOut_CastRays.dirAndFar, crt_inOut_CastRays.hits,
+                       n);
 }
 
 // ---- kernel2D_Render (from PrimaryRays::kernel2D_Render, PrimaryRays.cpp) ----
 
-void PrimaryRays_Vulkan::kernel2D_RenderCmd(VkCommandBuffer a_cmd, crossrt::BufferView pixels, int width, int height)
+void PrimaryRays_Vulkan::kernel2D_RenderCmd(VkCommandBuffer crt_cmd, crossrt::BufferView pixels, int width, int height)
 {
   const int crt_startX = int(0);
   const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(width)));
@@ -410,32 +412,33 @@ void PrimaryRays_Vulkan::kernel2D_RenderCmd(VkCommandBuffer a_cmd, crossrt::Buff
   crt_args.crt_countY = crt_countY;
   crt_args.width = width;
   crt_args.height = height;
-  if (m_useRayTracingHardware)  // m_pAccelStruct's ray queries on the ray tracing hardware
+  if (crt_useRayTracingHardware)  // m_pAccelStruct's ray queries on the ray tracing hardware
   {
-    m_pipelines.kernel2D_Render_RayQuery.Bind(a_cmd);
-    m_pipelines.kernel2D_Render_RayQuery.PushBindings(a_cmd, {m_classDataBuffer.View(), pixels,
-                                                              m_vdata.m_indices.View(), m_vdata.m_vertices.View(),
-                                                              crossrt::Binding::SceneOf(m_scenes.m_pAccelStruct)});
-    m_pipelines.kernel2D_Render_RayQuery.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
+    crt_pipelines.kernel2D_Render_RayQuery.Bind(crt_cmd);
+    crt_pipelines.kernel2D_Render_RayQuery.PushBindings(
+        crt_cmd, {crt_classDataBuffer.View(), pixels, crt_vdata.m_indices.View(), crt_vdata.m_vertices.View(),
+                  crossrt::Binding::SceneOf(crt_scenes.m_pAccelStruct)});
+    crt_pipelines.kernel2D_Render_RayQuery.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
   }
   else
   {
-    m_pipelines.kernel2D_Render.Bind(a_cmd);
-    m_pipelines.kernel2D_Render.PushBuffers(
-        a_cmd, {m_classDataBuffer.View(), pixels, m_vdata.m_indices.View(), m_vdata.m_pAccelStruct_m_boxes.View(),
-                m_vdata.m_pAccelStruct_m_instances.View(), m_vdata.m_pAccelStruct_m_motion.View(),
-                m_vdata.m_pAccelStruct_m_nodes.View(), m_vdata.m_pAccelStruct_m_primIds.View(),
-                m_vdata.m_pAccelStruct_m_sdfBricks.View(), m_vdata.m_pAccelStruct_m_sdfWords.View(),
-                m_vdata.m_pAccelStruct_m_triangles.View(), m_vdata.m_vertices.View()});
-    m_pipelines.kernel2D_Render.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
+    crt_pipelines.kernel2D_Render.Bind(crt_cmd);
+    crt_pipelines.kernel2D_Render.PushBuffers(
+        crt_cmd,
+        {crt_classDataBuffer.View(), pixels, crt_vdata.m_indices.View(), crt_vdata.m_pAccelStruct_m_boxes.View(),
+         crt_vdata.m_pAccelStruct_m_instances.View(), crt_vdata.m_pAccelStruct_m_motion.View(),
+         crt_vdata.m_pAccelStruct_m_nodes.View(), crt_vdata.m_pAccelStruct_m_primIds.View(),
+         crt_vdata.m_pAccelStruct_m_sdfBricks.View(), crt_vdata.m_pAccelStruct_m_sdfWords.View(),
+         crt_vdata.m_pAccelStruct_m_triangles.View(), crt_vdata.m_vertices.View()});
+    crt_pipelines.kernel2D_Render.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
   }
-  crossrt::Dispatch2D(a_cmd, crt_countX, crt_countY, 16, 16);
-  crossrt::ComputeBarrier(a_cmd);
+  crossrt::Dispatch2D(crt_cmd, crt_countX, crt_countY, 16, 16);
+  crossrt::ComputeBarrier(crt_cmd);
 }
 
 // ---- kernel1D_CastRays (from PrimaryRays::kernel1D_CastRays, PrimaryRays.cpp) ----
 
-void PrimaryRays_Vulkan::kernel1D_CastRaysCmd(VkCommandBuffer a_cmd, crossrt::BufferView posAndNear,
+void PrimaryRays_Vulkan::kernel1D_CastRaysCmd(VkCommandBuffer crt_cmd, crossrt::BufferView posAndNear,
                                               crossrt::BufferView dirAndFar, crossrt::BufferView hits, int n)
 {
   const int crt_startX = int(0);
@@ -446,24 +449,25 @@ void PrimaryRays_Vulkan::kernel1D_CastRaysCmd(VkCommandBuffer a_cmd, crossrt::Bu
   crt_args.crt_startX = crt_startX;
   crt_args.crt_countX = crt_countX;
   crt_args.n = n;
-  if (m_useRayTracingHardware)  // m_pAccelStruct's ray queries on the ray tracing hardware
+  if (crt_useRayTracingHardware)  // m_pAccelStruct's ray queries on the ray tracing hardware
   {
-    m_pipelines.kernel1D_CastRays_RayQuery.Bind(a_cmd);
-    m_pipelines.kernel1D_CastRays_RayQuery.PushBindings(a_cmd, {m_classDataBuffer.View(), posAndNear, dirAndFar, hits,
-                                                                crossrt::Binding::SceneOf(m_scenes.m_pAccelStruct)});
-    m_pipelines.kernel1D_CastRays_RayQuery.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
+    crt_pipelines.kernel1D_CastRays_RayQuery.Bind(crt_cmd);
+    crt_pipelines.kernel1D_CastRays_RayQuery.PushBindings(crt_cmd,
+                                                          {crt_classDataBuffer.View(), posAndNear, dirAndFar, hits,
+                                                           crossrt::Binding::SceneOf(crt_scenes.m_pAccelStruct)});
+    crt_pipelines.kernel1D_CastRays_RayQuery.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
   }
   else
   {
-    m_pipelines.kernel1D_CastRays.Bind(a_cmd);
-    m_pipelines.kernel1D_CastRays.PushBuffers(
-        a_cmd, {m_classDataBuffer.View(), posAndNear, dirAndFar, hits, m_vdata.m_pAccelStruct_m_boxes.View(),
-                m_vdata.m_pAccelStruct_m_instances.View(), m_vdata.m_pAccelStruct_m_motion.View(),
-                m_vdata.m_pAccelStruct_m_nodes.View(), m_vdata.m_pAccelStruct_m_primIds.View(),
-                m_vdata.m_pAccelStruct_m_sdfBricks.View(), m_vdata.m_pAccelStruct_m_sdfWords.View(),
-                m_vdata.m_pAccelStruct_m_triangles.View()});
-    m_pipelines.kernel1D_CastRays.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
+    crt_pipelines.kernel1D_CastRays.Bind(crt_cmd);
+    crt_pipelines.kernel1D_CastRays.PushBuffers(
+        crt_cmd, {crt_classDataBuffer.View(), posAndNear, dirAndFar, hits, crt_vdata.m_pAccelStruct_m_boxes.View(),
+                  crt_vdata.m_pAccelStruct_m_instances.View(), crt_vdata.m_pAccelStruct_m_motion.View(),
+                  crt_vdata.m_pAccelStruct_m_nodes.View(), crt_vdata.m_pAccelStruct_m_primIds.View(),
+                  crt_vdata.m_pAccelStruct_m_sdfBricks.View(), crt_vdata.m_pAccelStruct_m_sdfWords.View(),
+                  crt_vdata.m_pAccelStruct_m_triangles.View()});
+    crt_pipelines.kernel1D_CastRays.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
   }
-  crossrt::Dispatch1D(a_cmd, crt_countX, 256);
-  crossrt::ComputeBarrier(a_cmd);
+  crossrt::Dispatch1D(crt_cmd, crt_countX, 256);
+  crossrt::ComputeBarrier(crt_cmd);
 }

@@ -28,36 +28,36 @@ public:
 
   // For data that already lives on the GPU: bind your buffers, then record into your command buffer.
   virtual void SetVulkanInOutFor_Render(crossrt::BufferView a_pixels);
-  virtual void RenderCmd(VkCommandBuffer a_cmd, uint32_t* pixels);
+  virtual void RenderCmd(VkCommandBuffer crt_cmd, uint32_t* pixels);
   virtual void SetVulkanInOutFor_CastRays(crossrt::BufferView a_posAndNear, crossrt::BufferView a_dirAndFar,
                                           crossrt::BufferView a_hits);
-  virtual void CastRaysCmd(VkCommandBuffer a_cmd, const float4* posAndNear, const float4* dirAndFar, CRT_Hit* hits,
+  virtual void CastRaysCmd(VkCommandBuffer crt_cmd, const float4* posAndNear, const float4* dirAndFar, CRT_Hit* hits,
                            int n);
 
   void CommitDeviceData() override;  // uploads members
   // a_out: [0] GPU ms, [1] copy-in ms, [2] copy-out ms, [3] total ms
   void GetExecutionTime(const char* a_funcName, float a_out[4]) override;
 
-  virtual void UpdatePlainMembers();  // members -> GPU (called before every control function)
-  virtual void ReadPlainMembers();    // GPU -> members the kernels write (reductions)
+  virtual void crt_UpdatePlainMembers();  // members -> GPU (called before every control function)
+  virtual void crt_ReadPlainMembers();    // GPU -> members the kernels write (reductions)
 
-  std::shared_ptr<crossrt::VulkanContext> Context() const { return m_ctx; }
+  std::shared_ptr<crossrt::VulkanContext> Context() const { return crt_ctx; }
 
   // Ray queries through m_pAccelStruct run on the GPU's ray tracing hardware where the device
   // has VK_KHR_ray_query (the default there), else as the composed implementation's traversal,
   // translated. Both give the same hits. Turning the hardware on throws on a device without it.
-  bool UsesRayTracingHardware() const { return m_useRayTracingHardware; }
+  bool UsesRayTracingHardware() const { return crt_useRayTracingHardware; }
   virtual void UseRayTracingHardware(bool a_use);
 
 protected:
-  // One per kernel (and megakernel of a thread loop): records its dispatch (and barrier) into a_cmd.
-  virtual void kernel2D_RenderCmd(VkCommandBuffer a_cmd, crossrt::BufferView pixels, int width, int height);
-  virtual void kernel1D_CastRaysCmd(VkCommandBuffer a_cmd, crossrt::BufferView posAndNear,
+  // One per kernel (and megakernel of a thread loop): records its dispatch (and barrier) into crt_cmd.
+  virtual void kernel2D_RenderCmd(VkCommandBuffer crt_cmd, crossrt::BufferView pixels, int width, int height);
+  virtual void kernel1D_CastRaysCmd(VkCommandBuffer crt_cmd, crossrt::BufferView posAndNear,
                                     crossrt::BufferView dirAndFar, crossrt::BufferView hits, int n);
-  virtual void InitPipelines();
+  virtual void crt_InitPipelines();
   // Records an update of one member's GPU copy, ordered between the kernels around it.
-  virtual void UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size);
-  virtual void ReadVectorMembers(const char* a_funcName);  // GPU -> std::vector and Image2D members kernels write
+  virtual void crt_UpdateMemberCmd(VkCommandBuffer crt_cmd, size_t a_offset, const void* a_data, size_t a_size);
+  virtual void crt_ReadVectorMembers(const char* a_funcName);  // GPU -> std::vector and Image2D members kernels write
 
   // Push constants of each kernel: thread ranges, then its scalar arguments (std430 offsets).
   struct kernel2D_RenderArgs
@@ -109,9 +109,9 @@ protected:
     alignas(4) uint32_t m_pAccelStruct_m_primIds_capacity;
   };
 
-  std::shared_ptr<crossrt::VulkanContext> m_ctx;
-  crossrt::Buffer m_classDataBuffer;
-  bool m_deviceDataCommitted = false;
+  std::shared_ptr<crossrt::VulkanContext> crt_ctx;
+  crossrt::Buffer crt_classDataBuffer;
+  bool crt_deviceDataCommitted = false;
 
   struct VectorMembers  // device copies of the std::vector members kernels use
   {
@@ -135,13 +135,13 @@ protected:
     size_t m_pAccelStruct_m_trianglesSize = 0;  // elements at the last CommitDeviceData()
     crossrt::Buffer m_pAccelStruct_m_primIds;
     size_t m_pAccelStruct_m_primIdsSize = 0;  // elements at the last CommitDeviceData()
-  } m_vdata;
+  } crt_vdata;
   // A std::vector or Image2D member changed size, or a sampler changed, since CommitDeviceData().
-  virtual bool VectorMembersResized() const;
+  virtual bool crt_VectorMembersResized() const;
   // m_pAccelStruct as the BVHScene whose traversal the kernels run and whose data they read; throws
   // when it holds another ISceneObject (or none).
   BVHScene* crt_m_pAccelStruct() const;
-  bool m_useRayTracingHardware = false;  // record the kernels' _RayQuery variants
+  bool crt_useRayTracingHardware = false;  // record the kernels' _RayQuery variants
 
   // Acceleration structures for the ray tracing hardware, rebuilt at every CommitDeviceData() while
   // it is in use: the scenes kernels trace with ray queries (from ISceneObject::ExportScene), and a
@@ -149,19 +149,19 @@ protected:
   struct RayTracingScenes
   {
     crossrt::RayTracingScene m_pAccelStruct;
-  } m_scenes;
-  virtual void CommitScene_m_pAccelStruct();
+  } crt_scenes;
+  virtual void crt_CommitScene_m_pAccelStruct();
 
   struct InOut_Render  // buffers bound by SetVulkanInOutFor_Render
   {
     crossrt::BufferView pixels;
-  } m_inOut_Render;
+  } crt_inOut_Render;
   struct InOut_CastRays  // buffers bound by SetVulkanInOutFor_CastRays
   {
     crossrt::BufferView posAndNear;
     crossrt::BufferView dirAndFar;
     crossrt::BufferView hits;
-  } m_inOut_CastRays;
+  } crt_inOut_CastRays;
 
   struct ArgumentBuffers  // device copies of pointer arguments, reused across calls
   {
@@ -169,7 +169,7 @@ protected:
     crossrt::Buffer CastRays_posAndNear;
     crossrt::Buffer CastRays_dirAndFar;
     crossrt::Buffer CastRays_hits;
-  } m_args;
+  } crt_argCopies;
 
   struct Pipelines
   {
@@ -177,14 +177,14 @@ protected:
     crossrt::ComputePipeline kernel2D_Render;
     crossrt::ComputePipeline kernel1D_CastRays_RayQuery;  // m_pAccelStruct's ray queries on the ray tracing hardware
     crossrt::ComputePipeline kernel1D_CastRays;
-  } m_pipelines;
+  } crt_pipelines;
 
   struct Partials  // per-workgroup partial results of reductions
   {
-  } m_partials;
+  } crt_partials;
 
-  crossrt::GpuTimer m_gpuTimer;
-  std::map<std::string, std::array<float, 4>> m_times;
+  crossrt::GpuTimer crt_gpuTimer;
+  std::map<std::string, std::array<float, 4>> crt_times;
 };
 
 // Runs on the default device: CROSSRT_DEVICE (index or name) if set, else a discrete GPU, else lavapipe.

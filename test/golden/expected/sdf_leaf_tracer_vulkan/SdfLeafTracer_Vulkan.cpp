@@ -23,18 +23,18 @@ extern const uint32_t SdfLeafTracer_m_scene_m_geom_Intersect_Miss_spv[];
 extern const size_t SdfLeafTracer_m_scene_m_geom_Intersect_Miss_spvBytes;
 
 SdfLeafTracer_Vulkan::SdfLeafTracer_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx)
-    : SdfLeafTracer(), m_ctx(std::move(a_ctx))
+    : SdfLeafTracer(), crt_ctx(std::move(a_ctx))
 {
-  m_classDataBuffer = crossrt::Buffer(m_ctx, sizeof(ClassData));
-  m_gpuTimer = crossrt::GpuTimer(m_ctx);
-  m_useRayTracingPipelines = m_ctx->hasRayTracingPipeline;
-  if (m_ctx->hasRayTracingPipeline)
+  crt_classDataBuffer = crossrt::Buffer(crt_ctx, sizeof(ClassData));
+  crt_gpuTimer = crossrt::GpuTimer(crt_ctx);
+  crt_useRayTracingPipelines = crt_ctx->hasRayTracingPipeline;
+  if (crt_ctx->hasRayTracingPipeline)
   {
-    m_scenes.m_scene_m_geom_leaves = crossrt::RayTracingScene(m_ctx);
+    crt_scenes.m_scene_m_geom_leaves = crossrt::RayTracingScene(crt_ctx);
   }
   // Virtual functions reach each class's objects through buffer references.
-  if (!m_ctx->hasBufferDeviceAddress)
-    throw crossrt::Error("SdfLeafTracer_Vulkan: device '" + m_ctx->DeviceName() +
+  if (!crt_ctx->hasBufferDeviceAddress)
+    throw crossrt::Error("SdfLeafTracer_Vulkan: device '" + crt_ctx->DeviceName() +
                          "' lacks bufferDeviceAddress, which virtual function calls in kernels need");
   // The pipelines are made by CommitDeviceData(), for the classes the objects hold.
 }
@@ -51,16 +51,16 @@ std::shared_ptr<SdfLeafTracer> CreateSdfLeafTracer_Vulkan(std::shared_ptr<crossr
 
 SdfLeafTracer_Vulkan::~SdfLeafTracer_Vulkan() = default;
 
-void SdfLeafTracer_Vulkan::InitPipelines()
+void SdfLeafTracer_Vulkan::crt_InitPipelines()
 {
-  // Kernels switch over the classes in m_pipelineClasses only (specialization constants from
+  // Kernels switch over the classes in crt_pipelineClasses only (specialization constants from
   // crossrt::kClassConstantIdBase): the driver drops the cases of the others.
   static_assert(crossrt::kClassConstantIdBase == 1800,
                 "the shaders and the runtime number the class constants differently");
-  if (m_ctx->hasRayTracingPipeline)  // the leaves of m_scene->m_geom as intersection shaders, in a ray tracing
-                                     // pipeline: the shader needs them even to be created
-    m_pipelines.kernel1D_Trace_Intersections = crossrt::RayTracingPipeline(
-        m_ctx,
+  if (crt_ctx->hasRayTracingPipeline)  // the leaves of m_scene->m_geom as intersection shaders, in a ray tracing
+                                       // pipeline: the shader needs them even to be created
+    crt_pipelines.kernel1D_Trace_Intersections = crossrt::RayTracingPipeline(
+        crt_ctx,
         crossrt::RayTracingShaders{
             {SdfLeafTracer_kernel1D_Trace_Intersections_spv, SdfLeafTracer_kernel1D_Trace_Intersections_spvBytes},
             {
@@ -88,20 +88,20 @@ void SdfLeafTracer_Vulkan::InitPipelines()
             VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
             VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR},
         sizeof(kernel1D_TraceArgs), "SdfLeafTracer::kernel1D_Trace_Intersections");
-  m_pipelines.kernel1D_Trace =
-      crossrt::ComputePipeline(m_ctx, SdfLeafTracer_kernel1D_Trace_spv, SdfLeafTracer_kernel1D_Trace_spvBytes, 15,
-                               sizeof(kernel1D_TraceArgs), "SdfLeafTracer::kernel1D_Trace", m_pipelineClasses);
+  crt_pipelines.kernel1D_Trace =
+      crossrt::ComputePipeline(crt_ctx, SdfLeafTracer_kernel1D_Trace_spv, SdfLeafTracer_kernel1D_Trace_spvBytes, 15,
+                               sizeof(kernel1D_TraceArgs), "SdfLeafTracer::kernel1D_Trace", crt_pipelineClasses);
 }
 
 void SdfLeafTracer_Vulkan::UseRayTracingPipelines(bool a_use)
 {
-  if (a_use && !m_ctx->hasRayTracingPipeline)
-    throw crossrt::Error("SdfLeafTracer_Vulkan: device '" + m_ctx->DeviceName() +
+  if (a_use && !crt_ctx->hasRayTracingPipeline)
+    throw crossrt::Error("SdfLeafTracer_Vulkan: device '" + crt_ctx->DeviceName() +
                          "' has no ray tracing pipelines (VK_KHR_ray_tracing_pipeline): its kernels switch over the "
                          "objects' classes in compute shaders");
-  if (a_use != m_useRayTracingPipelines)
-    m_deviceDataCommitted = false;  // the next call commits, building the leaves' boxes for the hardware
-  m_useRayTracingPipelines = a_use;
+  if (a_use != crt_useRayTracingPipelines)
+    crt_deviceDataCommitted = false;  // the next call commits, building the leaves' boxes for the hardware
+  crt_useRayTracingPipelines = a_use;
 }
 
 // The leaves of m_scene->m_geom for the ray tracing hardware (the paper's form): per element, a bottom
@@ -109,7 +109,7 @@ void SdfLeafTracer_Vulkan::UseRayTracingPipelines(bool a_use)
 // instance of it whose custom index is i (the intersection shaders take the element from it). Its
 // record offset in the shader binding table is its class (the class in its tag, from
 // CommitVirtual_m_scene_m_geom); each trace adds the first hit group of its leaf call.
-void SdfLeafTracer_Vulkan::CommitLeaves_m_scene_m_geom(const std::vector<uint32_t>& a_tags)
+void SdfLeafTracer_Vulkan::crt_CommitLeaves_m_scene_m_geom(const std::vector<uint32_t>& a_tags)
 {
   std::vector<crossrt::RayTracingScene::BoxGeometry> geometries(crt_m_scene()->m_geom.size());
   for (size_t i = 0; i < geometries.size(); ++i)
@@ -119,30 +119,31 @@ void SdfLeafTracer_Vulkan::CommitLeaves_m_scene_m_geom(const std::vector<uint32_
           {{box.boxMin.x, box.boxMin.y, box.boxMin.z}, {box.boxMax.x, box.boxMax.y, box.boxMax.z}, 0u});
     geometries[i].hitGroup = a_tags[2 * i];
   }
-  m_scenes.m_scene_m_geom_leaves.BuildBoxGeometries(geometries, "SdfLeafTracer::m_scene->m_geom");
+  crt_scenes.m_scene_m_geom_leaves.BuildBoxGeometries(geometries, "SdfLeafTracer::m_scene->m_geom");
 }
 
 void SdfLeafTracer_Vulkan::SpecializeVirtualCalls(bool a_on)
 {
-  if (a_on != m_specializeVirtualCalls)
-    m_deviceDataCommitted = false;  // the next call commits, making the pipelines again
-  m_specializeVirtualCalls = a_on;
+  if (a_on != crt_specializeVirtualCalls)
+    crt_deviceDataCommitted = false;  // the next call commits, making the pipelines again
+  crt_specializeVirtualCalls = a_on;
 }
 
-void SdfLeafTracer_Vulkan::UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size)
+void SdfLeafTracer_Vulkan::crt_UpdateMemberCmd(VkCommandBuffer crt_cmd, size_t a_offset, const void* a_data,
+                                               size_t a_size)
 {
-  crossrt::ComputeBarrier(a_cmd);  // kernels recorded before it are done with the class data
-  vkCmdUpdateBuffer(a_cmd, m_classDataBuffer.Handle(), a_offset, a_size, a_data);
-  crossrt::TransferToComputeBarrier(a_cmd);
+  crossrt::ComputeBarrier(crt_cmd);  // kernels recorded before it are done with the class data
+  vkCmdUpdateBuffer(crt_cmd, crt_classDataBuffer.Handle(), a_offset, a_size, a_data);
+  crossrt::TransferToComputeBarrier(crt_cmd);
 }
 
-void SdfLeafTracer_Vulkan::UpdatePlainMembers()
+void SdfLeafTracer_Vulkan::crt_UpdatePlainMembers()
 {
   ClassData data{};
-  data.m_scene_m_geom_tags = m_virtual.m_scene_m_geom_tags.Address();
-  data.m_scene_m_geom_SdfGridLeaves = m_virtual.m_scene_m_geom_SdfGridLeaves.Address();
-  data.m_scene_m_geom_SdfSVSLeaves = m_virtual.m_scene_m_geom_SdfSVSLeaves.Address();
-  data.m_scene_m_geom_SdfSBSLeaves = m_virtual.m_scene_m_geom_SdfSBSLeaves.Address();
+  data.m_scene_m_geom_tags = crt_virtual.m_scene_m_geom_tags.Address();
+  data.m_scene_m_geom_SdfGridLeaves = crt_virtual.m_scene_m_geom_SdfGridLeaves.Address();
+  data.m_scene_m_geom_SdfSVSLeaves = crt_virtual.m_scene_m_geom_SdfSVSLeaves.Address();
+  data.m_scene_m_geom_SdfSBSLeaves = crt_virtual.m_scene_m_geom_SdfSBSLeaves.Address();
   data.m_scene_m_geom_size = uint32_t(crt_m_scene()->m_geom.size());
   data.m_scene_m_nodeMin_size = uint32_t(crt_m_scene()->m_nodeMin.size());
   data.m_scene_m_nodeMin_capacity = uint32_t(crt_m_scene()->m_nodeMin.capacity());
@@ -166,103 +167,111 @@ void SdfLeafTracer_Vulkan::UpdatePlainMembers()
   data.m_scene_m_bricks_capacity = uint32_t(crt_m_scene()->m_bricks.capacity());
   data.m_scene_m_brickValues_size = uint32_t(crt_m_scene()->m_brickValues.size());
   data.m_scene_m_brickValues_capacity = uint32_t(crt_m_scene()->m_brickValues.capacity());
-  m_classDataBuffer.Upload(&data, sizeof(data));
+  crt_classDataBuffer.Upload(&data, sizeof(data));
 }
 
-void SdfLeafTracer_Vulkan::ReadPlainMembers()
+void SdfLeafTracer_Vulkan::crt_ReadPlainMembers()
 {
 }
 
 void SdfLeafTracer_Vulkan::CommitDeviceData()
 {
   // std::vector members become buffers of their capacity; kernels see size and capacity.
-  crossrt::EnsureSize(m_ctx, m_vdata.m_scene_m_nodeMin, sizeof(LiteMath::float4) * crt_m_scene()->m_nodeMin.capacity());
+  crossrt::EnsureSize(crt_ctx, crt_vdata.m_scene_m_nodeMin,
+                      sizeof(LiteMath::float4) * crt_m_scene()->m_nodeMin.capacity());
   if (!crt_m_scene()->m_nodeMin.empty())
-    m_vdata.m_scene_m_nodeMin.Upload(crt_m_scene()->m_nodeMin.data(),
-                                     sizeof(LiteMath::float4) * crt_m_scene()->m_nodeMin.size());
-  m_vdata.m_scene_m_nodeMinSize = crt_m_scene()->m_nodeMin.size();
-  crossrt::EnsureSize(m_ctx, m_vdata.m_scene_m_nodeMax, sizeof(LiteMath::float4) * crt_m_scene()->m_nodeMax.capacity());
+    crt_vdata.m_scene_m_nodeMin.Upload(crt_m_scene()->m_nodeMin.data(),
+                                       sizeof(LiteMath::float4) * crt_m_scene()->m_nodeMin.size());
+  crt_vdata.m_scene_m_nodeMinSize = crt_m_scene()->m_nodeMin.size();
+  crossrt::EnsureSize(crt_ctx, crt_vdata.m_scene_m_nodeMax,
+                      sizeof(LiteMath::float4) * crt_m_scene()->m_nodeMax.capacity());
   if (!crt_m_scene()->m_nodeMax.empty())
-    m_vdata.m_scene_m_nodeMax.Upload(crt_m_scene()->m_nodeMax.data(),
-                                     sizeof(LiteMath::float4) * crt_m_scene()->m_nodeMax.size());
-  m_vdata.m_scene_m_nodeMaxSize = crt_m_scene()->m_nodeMax.size();
-  crossrt::EnsureSize(m_ctx, m_vdata.m_scene_m_nodeRight, sizeof(unsigned int) * crt_m_scene()->m_nodeRight.capacity());
+    crt_vdata.m_scene_m_nodeMax.Upload(crt_m_scene()->m_nodeMax.data(),
+                                       sizeof(LiteMath::float4) * crt_m_scene()->m_nodeMax.size());
+  crt_vdata.m_scene_m_nodeMaxSize = crt_m_scene()->m_nodeMax.size();
+  crossrt::EnsureSize(crt_ctx, crt_vdata.m_scene_m_nodeRight,
+                      sizeof(unsigned int) * crt_m_scene()->m_nodeRight.capacity());
   if (!crt_m_scene()->m_nodeRight.empty())
-    m_vdata.m_scene_m_nodeRight.Upload(crt_m_scene()->m_nodeRight.data(),
-                                       sizeof(unsigned int) * crt_m_scene()->m_nodeRight.size());
-  m_vdata.m_scene_m_nodeRightSize = crt_m_scene()->m_nodeRight.size();
-  crossrt::EnsureSize(m_ctx, m_vdata.m_scene_m_nodeLeaf, sizeof(unsigned int) * crt_m_scene()->m_nodeLeaf.capacity());
+    crt_vdata.m_scene_m_nodeRight.Upload(crt_m_scene()->m_nodeRight.data(),
+                                         sizeof(unsigned int) * crt_m_scene()->m_nodeRight.size());
+  crt_vdata.m_scene_m_nodeRightSize = crt_m_scene()->m_nodeRight.size();
+  crossrt::EnsureSize(crt_ctx, crt_vdata.m_scene_m_nodeLeaf,
+                      sizeof(unsigned int) * crt_m_scene()->m_nodeLeaf.capacity());
   if (!crt_m_scene()->m_nodeLeaf.empty())
-    m_vdata.m_scene_m_nodeLeaf.Upload(crt_m_scene()->m_nodeLeaf.data(),
-                                      sizeof(unsigned int) * crt_m_scene()->m_nodeLeaf.size());
-  m_vdata.m_scene_m_nodeLeafSize = crt_m_scene()->m_nodeLeaf.size();
-  crossrt::EnsureSize(m_ctx, m_vdata.m_scene_m_leafIds, sizeof(LiteMath::uint2) * crt_m_scene()->m_leafIds.capacity());
+    crt_vdata.m_scene_m_nodeLeaf.Upload(crt_m_scene()->m_nodeLeaf.data(),
+                                        sizeof(unsigned int) * crt_m_scene()->m_nodeLeaf.size());
+  crt_vdata.m_scene_m_nodeLeafSize = crt_m_scene()->m_nodeLeaf.size();
+  crossrt::EnsureSize(crt_ctx, crt_vdata.m_scene_m_leafIds,
+                      sizeof(LiteMath::uint2) * crt_m_scene()->m_leafIds.capacity());
   if (!crt_m_scene()->m_leafIds.empty())
-    m_vdata.m_scene_m_leafIds.Upload(crt_m_scene()->m_leafIds.data(),
-                                     sizeof(LiteMath::uint2) * crt_m_scene()->m_leafIds.size());
-  m_vdata.m_scene_m_leafIdsSize = crt_m_scene()->m_leafIds.size();
-  crossrt::EnsureSize(m_ctx, m_vdata.m_scene_m_gridBricks,
+    crt_vdata.m_scene_m_leafIds.Upload(crt_m_scene()->m_leafIds.data(),
+                                       sizeof(LiteMath::uint2) * crt_m_scene()->m_leafIds.size());
+  crt_vdata.m_scene_m_leafIdsSize = crt_m_scene()->m_leafIds.size();
+  crossrt::EnsureSize(crt_ctx, crt_vdata.m_scene_m_gridBricks,
                       sizeof(unsigned int) * crt_m_scene()->m_gridBricks.capacity());
   if (!crt_m_scene()->m_gridBricks.empty())
-    m_vdata.m_scene_m_gridBricks.Upload(crt_m_scene()->m_gridBricks.data(),
-                                        sizeof(unsigned int) * crt_m_scene()->m_gridBricks.size());
-  m_vdata.m_scene_m_gridBricksSize = crt_m_scene()->m_gridBricks.size();
-  crossrt::EnsureSize(m_ctx, m_vdata.m_scene_m_values, sizeof(float) * crt_m_scene()->m_values.capacity());
+    crt_vdata.m_scene_m_gridBricks.Upload(crt_m_scene()->m_gridBricks.data(),
+                                          sizeof(unsigned int) * crt_m_scene()->m_gridBricks.size());
+  crt_vdata.m_scene_m_gridBricksSize = crt_m_scene()->m_gridBricks.size();
+  crossrt::EnsureSize(crt_ctx, crt_vdata.m_scene_m_values, sizeof(float) * crt_m_scene()->m_values.capacity());
   if (!crt_m_scene()->m_values.empty())
-    m_vdata.m_scene_m_values.Upload(crt_m_scene()->m_values.data(), sizeof(float) * crt_m_scene()->m_values.size());
-  m_vdata.m_scene_m_valuesSize = crt_m_scene()->m_values.size();
-  crossrt::EnsureSize(m_ctx, m_vdata.m_scene_m_voxels, sizeof(LiteMath::float4) * crt_m_scene()->m_voxels.capacity());
+    crt_vdata.m_scene_m_values.Upload(crt_m_scene()->m_values.data(), sizeof(float) * crt_m_scene()->m_values.size());
+  crt_vdata.m_scene_m_valuesSize = crt_m_scene()->m_values.size();
+  crossrt::EnsureSize(crt_ctx, crt_vdata.m_scene_m_voxels,
+                      sizeof(LiteMath::float4) * crt_m_scene()->m_voxels.capacity());
   if (!crt_m_scene()->m_voxels.empty())
-    m_vdata.m_scene_m_voxels.Upload(crt_m_scene()->m_voxels.data(),
-                                    sizeof(LiteMath::float4) * crt_m_scene()->m_voxels.size());
-  m_vdata.m_scene_m_voxelsSize = crt_m_scene()->m_voxels.size();
-  crossrt::EnsureSize(m_ctx, m_vdata.m_scene_m_voxelValues, sizeof(float) * crt_m_scene()->m_voxelValues.capacity());
+    crt_vdata.m_scene_m_voxels.Upload(crt_m_scene()->m_voxels.data(),
+                                      sizeof(LiteMath::float4) * crt_m_scene()->m_voxels.size());
+  crt_vdata.m_scene_m_voxelsSize = crt_m_scene()->m_voxels.size();
+  crossrt::EnsureSize(crt_ctx, crt_vdata.m_scene_m_voxelValues,
+                      sizeof(float) * crt_m_scene()->m_voxelValues.capacity());
   if (!crt_m_scene()->m_voxelValues.empty())
-    m_vdata.m_scene_m_voxelValues.Upload(crt_m_scene()->m_voxelValues.data(),
-                                         sizeof(float) * crt_m_scene()->m_voxelValues.size());
-  m_vdata.m_scene_m_voxelValuesSize = crt_m_scene()->m_voxelValues.size();
-  crossrt::EnsureSize(m_ctx, m_vdata.m_scene_m_bricks, sizeof(LiteMath::float4) * crt_m_scene()->m_bricks.capacity());
+    crt_vdata.m_scene_m_voxelValues.Upload(crt_m_scene()->m_voxelValues.data(),
+                                           sizeof(float) * crt_m_scene()->m_voxelValues.size());
+  crt_vdata.m_scene_m_voxelValuesSize = crt_m_scene()->m_voxelValues.size();
+  crossrt::EnsureSize(crt_ctx, crt_vdata.m_scene_m_bricks,
+                      sizeof(LiteMath::float4) * crt_m_scene()->m_bricks.capacity());
   if (!crt_m_scene()->m_bricks.empty())
-    m_vdata.m_scene_m_bricks.Upload(crt_m_scene()->m_bricks.data(),
-                                    sizeof(LiteMath::float4) * crt_m_scene()->m_bricks.size());
-  m_vdata.m_scene_m_bricksSize = crt_m_scene()->m_bricks.size();
-  crossrt::EnsureSize(m_ctx, m_vdata.m_scene_m_brickValues,
+    crt_vdata.m_scene_m_bricks.Upload(crt_m_scene()->m_bricks.data(),
+                                      sizeof(LiteMath::float4) * crt_m_scene()->m_bricks.size());
+  crt_vdata.m_scene_m_bricksSize = crt_m_scene()->m_bricks.size();
+  crossrt::EnsureSize(crt_ctx, crt_vdata.m_scene_m_brickValues,
                       sizeof(unsigned int) * crt_m_scene()->m_brickValues.capacity());
   if (!crt_m_scene()->m_brickValues.empty())
-    m_vdata.m_scene_m_brickValues.Upload(crt_m_scene()->m_brickValues.data(),
-                                         sizeof(unsigned int) * crt_m_scene()->m_brickValues.size());
-  m_vdata.m_scene_m_brickValuesSize = crt_m_scene()->m_brickValues.size();
+    crt_vdata.m_scene_m_brickValues.Upload(crt_m_scene()->m_brickValues.data(),
+                                           sizeof(unsigned int) * crt_m_scene()->m_brickValues.size());
+  crt_vdata.m_scene_m_brickValuesSize = crt_m_scene()->m_brickValues.size();
   // Objects called through virtual functions, regrouped; the classes they hold, for the pipelines.
-  std::vector<VkBool32> crt_classesHeld(3, m_specializeVirtualCalls ? VK_FALSE : VK_TRUE);
+  std::vector<VkBool32> crt_classesHeld(3, crt_specializeVirtualCalls ? VK_FALSE : VK_TRUE);
   const std::vector<uint32_t> crt_m_scene_m_geomTags = CommitVirtual_m_scene_m_geom();
-  for (size_t i = 0; i < m_virtual.m_scene_m_geomSize; ++i)
+  for (size_t i = 0; i < crt_virtual.m_scene_m_geomSize; ++i)
     crt_classesHeld[0 + crt_m_scene_m_geomTags[2 * i]] = VK_TRUE;
-  if (m_useRayTracingPipelines)
-    CommitLeaves_m_scene_m_geom(crt_m_scene_m_geomTags);
-  if (crt_classesHeld != m_pipelineClasses)  // made for other classes, or not made yet
+  if (crt_useRayTracingPipelines)
+    crt_CommitLeaves_m_scene_m_geom(crt_m_scene_m_geomTags);
+  if (crt_classesHeld != crt_pipelineClasses)  // made for other classes, or not made yet
   {
-    m_pipelineClasses = crt_classesHeld;
-    InitPipelines();
+    crt_pipelineClasses = crt_classesHeld;
+    crt_InitPipelines();
   }
-  UpdatePlainMembers();
-  m_deviceDataCommitted = true;
+  crt_UpdatePlainMembers();
+  crt_deviceDataCommitted = true;
 }
 
-bool SdfLeafTracer_Vulkan::VectorMembersResized() const
+bool SdfLeafTracer_Vulkan::crt_VectorMembersResized() const
 {
   bool resized = false;
-  resized = resized || crt_m_scene()->m_nodeMin.size() != m_vdata.m_scene_m_nodeMinSize;
-  resized = resized || crt_m_scene()->m_nodeMax.size() != m_vdata.m_scene_m_nodeMaxSize;
-  resized = resized || crt_m_scene()->m_nodeRight.size() != m_vdata.m_scene_m_nodeRightSize;
-  resized = resized || crt_m_scene()->m_nodeLeaf.size() != m_vdata.m_scene_m_nodeLeafSize;
-  resized = resized || crt_m_scene()->m_leafIds.size() != m_vdata.m_scene_m_leafIdsSize;
-  resized = resized || crt_m_scene()->m_gridBricks.size() != m_vdata.m_scene_m_gridBricksSize;
-  resized = resized || crt_m_scene()->m_values.size() != m_vdata.m_scene_m_valuesSize;
-  resized = resized || crt_m_scene()->m_voxels.size() != m_vdata.m_scene_m_voxelsSize;
-  resized = resized || crt_m_scene()->m_voxelValues.size() != m_vdata.m_scene_m_voxelValuesSize;
-  resized = resized || crt_m_scene()->m_bricks.size() != m_vdata.m_scene_m_bricksSize;
-  resized = resized || crt_m_scene()->m_brickValues.size() != m_vdata.m_scene_m_brickValuesSize;
-  resized = resized || crt_m_scene()->m_geom.size() != m_virtual.m_scene_m_geomSize;
+  resized = resized || crt_m_scene()->m_nodeMin.size() != crt_vdata.m_scene_m_nodeMinSize;
+  resized = resized || crt_m_scene()->m_nodeMax.size() != crt_vdata.m_scene_m_nodeMaxSize;
+  resized = resized || crt_m_scene()->m_nodeRight.size() != crt_vdata.m_scene_m_nodeRightSize;
+  resized = resized || crt_m_scene()->m_nodeLeaf.size() != crt_vdata.m_scene_m_nodeLeafSize;
+  resized = resized || crt_m_scene()->m_leafIds.size() != crt_vdata.m_scene_m_leafIdsSize;
+  resized = resized || crt_m_scene()->m_gridBricks.size() != crt_vdata.m_scene_m_gridBricksSize;
+  resized = resized || crt_m_scene()->m_values.size() != crt_vdata.m_scene_m_valuesSize;
+  resized = resized || crt_m_scene()->m_voxels.size() != crt_vdata.m_scene_m_voxelsSize;
+  resized = resized || crt_m_scene()->m_voxelValues.size() != crt_vdata.m_scene_m_voxelValuesSize;
+  resized = resized || crt_m_scene()->m_bricks.size() != crt_vdata.m_scene_m_bricksSize;
+  resized = resized || crt_m_scene()->m_brickValues.size() != crt_vdata.m_scene_m_brickValuesSize;
+  resized = resized || crt_m_scene()->m_geom.size() != crt_virtual.m_scene_m_geomSize;
   return resized;
 }
 
@@ -324,28 +333,28 @@ std::vector<uint32_t> SdfLeafTracer_Vulkan::CommitVirtual_m_scene_m_geom()
                            ", which the GPU code does not know; it knows SdfGridLeaves, SdfSVSLeaves, SdfSBSLeaves "
                            "(the classes that implement ISdfLeaves where SdfLeafTracer is translated)");
   }
-  crossrt::EnsureSize(m_ctx, m_virtual.m_scene_m_geom_tags, sizeof(uint32_t) * tags.size());
-  m_virtual.m_scene_m_geom_tags.Upload(tags.data(), sizeof(uint32_t) * tags.size());
-  crossrt::EnsureSize(m_ctx, m_virtual.m_scene_m_geom_SdfGridLeaves,
+  crossrt::EnsureSize(crt_ctx, crt_virtual.m_scene_m_geom_tags, sizeof(uint32_t) * tags.size());
+  crt_virtual.m_scene_m_geom_tags.Upload(tags.data(), sizeof(uint32_t) * tags.size());
+  crossrt::EnsureSize(crt_ctx, crt_virtual.m_scene_m_geom_SdfGridLeaves,
                       sizeof(SdfGridLeaves_Data) * std::max<size_t>(1, SdfGridLeavesObjects.size()));
   if (!SdfGridLeavesObjects.empty())
-    m_virtual.m_scene_m_geom_SdfGridLeaves.Upload(SdfGridLeavesObjects.data(),
-                                                  sizeof(SdfGridLeaves_Data) * SdfGridLeavesObjects.size());
-  crossrt::EnsureSize(m_ctx, m_virtual.m_scene_m_geom_SdfSVSLeaves,
+    crt_virtual.m_scene_m_geom_SdfGridLeaves.Upload(SdfGridLeavesObjects.data(),
+                                                    sizeof(SdfGridLeaves_Data) * SdfGridLeavesObjects.size());
+  crossrt::EnsureSize(crt_ctx, crt_virtual.m_scene_m_geom_SdfSVSLeaves,
                       sizeof(SdfSVSLeaves_Data) * std::max<size_t>(1, SdfSVSLeavesObjects.size()));
   if (!SdfSVSLeavesObjects.empty())
-    m_virtual.m_scene_m_geom_SdfSVSLeaves.Upload(SdfSVSLeavesObjects.data(),
-                                                 sizeof(SdfSVSLeaves_Data) * SdfSVSLeavesObjects.size());
-  crossrt::EnsureSize(m_ctx, m_virtual.m_scene_m_geom_SdfSBSLeaves,
+    crt_virtual.m_scene_m_geom_SdfSVSLeaves.Upload(SdfSVSLeavesObjects.data(),
+                                                   sizeof(SdfSVSLeaves_Data) * SdfSVSLeavesObjects.size());
+  crossrt::EnsureSize(crt_ctx, crt_virtual.m_scene_m_geom_SdfSBSLeaves,
                       sizeof(SdfSBSLeaves_Data) * std::max<size_t>(1, SdfSBSLeavesObjects.size()));
   if (!SdfSBSLeavesObjects.empty())
-    m_virtual.m_scene_m_geom_SdfSBSLeaves.Upload(SdfSBSLeavesObjects.data(),
-                                                 sizeof(SdfSBSLeaves_Data) * SdfSBSLeavesObjects.size());
-  m_virtual.m_scene_m_geomSize = crt_m_scene()->m_geom.size();
+    crt_virtual.m_scene_m_geom_SdfSBSLeaves.Upload(SdfSBSLeavesObjects.data(),
+                                                   sizeof(SdfSBSLeaves_Data) * SdfSBSLeavesObjects.size());
+  crt_virtual.m_scene_m_geomSize = crt_m_scene()->m_geom.size();
   return tags;
 }
 
-void SdfLeafTracer_Vulkan::ReadVectorMembers(const char* a_funcName)
+void SdfLeafTracer_Vulkan::crt_ReadVectorMembers(const char* a_funcName)
 {
   (void)a_funcName;
 }
@@ -363,9 +372,9 @@ SdfLeafScene* SdfLeafTracer_Vulkan::crt_m_scene() const
 
 void SdfLeafTracer_Vulkan::GetExecutionTime(const char* a_funcName, float a_out[4])
 {
-  auto it = m_times.find(a_funcName);
+  auto it = crt_times.find(a_funcName);
   for (int i = 0; i < 4; ++i)
-    a_out[i] = it == m_times.end() ? 0.0f : it->second[i];
+    a_out[i] = it == crt_times.end() ? 0.0f : it->second[i];
 }
 
 // ---- Trace (from SdfLeafTracer::Trace, SdfLeafTracer.cpp) ----
@@ -373,9 +382,9 @@ void SdfLeafTracer_Vulkan::GetExecutionTime(const char* a_funcName, float a_out[
 void SdfLeafTracer_Vulkan::SetVulkanInOutFor_Trace(crossrt::BufferView a_origins, crossrt::BufferView a_dirs,
                                                    crossrt::BufferView a_hits)
 {
-  m_inOut_Trace.origins = a_origins;
-  m_inOut_Trace.dirs = a_dirs;
-  m_inOut_Trace.hits = a_hits;
+  crt_inOut_Trace.origins = a_origins;
+  crt_inOut_Trace.dirs = a_dirs;
+  crt_inOut_Trace.hits = a_hits;
 }
 
 void SdfLeafTracer_Vulkan::Trace(int n, const LiteMath::float4* origins, const LiteMath::float4* dirs, CRT_Hit* hits)
@@ -385,55 +394,56 @@ void SdfLeafTracer_Vulkan::Trace(int n, const LiteMath::float4* origins, const L
   // std::vector members are uploaded by CommitDeviceData(): here once, and again whenever one
   // changed size (its device buffer would be too small). After changing the contents of a
   // vector without resizing it, call CommitDeviceData().
-  if (!crt_self->m_deviceDataCommitted || crt_self->VectorMembersResized())
+  if (!crt_self->crt_deviceDataCommitted || crt_self->crt_VectorMembersResized())
     crt_self->CommitDeviceData();
 
   crossrt::CpuTimer crt_copyIn;
   const size_t crt_originsBytes = sizeof(LiteMath::float4) * size_t(n);
-  crossrt::EnsureSize(m_ctx, crt_self->m_args.Trace_origins, crt_originsBytes);
+  crossrt::EnsureSize(crt_ctx, crt_self->crt_argCopies.Trace_origins, crt_originsBytes);
   if (crt_originsBytes > 0)
-    crt_self->m_args.Trace_origins.Upload(origins, crt_originsBytes);
+    crt_self->crt_argCopies.Trace_origins.Upload(origins, crt_originsBytes);
   const size_t crt_dirsBytes = sizeof(LiteMath::float4) * size_t(n);
-  crossrt::EnsureSize(m_ctx, crt_self->m_args.Trace_dirs, crt_dirsBytes);
+  crossrt::EnsureSize(crt_ctx, crt_self->crt_argCopies.Trace_dirs, crt_dirsBytes);
   if (crt_dirsBytes > 0)
-    crt_self->m_args.Trace_dirs.Upload(dirs, crt_dirsBytes);
+    crt_self->crt_argCopies.Trace_dirs.Upload(dirs, crt_dirsBytes);
   const size_t crt_hitsBytes = sizeof(CRT_Hit) * size_t(n);
-  crossrt::EnsureSize(m_ctx, crt_self->m_args.Trace_hits, crt_hitsBytes);
+  crossrt::EnsureSize(crt_ctx, crt_self->crt_argCopies.Trace_hits, crt_hitsBytes);
   if (crt_hitsBytes > 0)
-    crt_self->m_args.Trace_hits.Upload(hits, crt_hitsBytes);
-  crt_self->SetVulkanInOutFor_Trace(crt_self->m_args.Trace_origins.View(), crt_self->m_args.Trace_dirs.View(),
-                                    crt_self->m_args.Trace_hits.View());
+    crt_self->crt_argCopies.Trace_hits.Upload(hits, crt_hitsBytes);
+  crt_self->SetVulkanInOutFor_Trace(crt_self->crt_argCopies.Trace_origins.View(),
+                                    crt_self->crt_argCopies.Trace_dirs.View(),
+                                    crt_self->crt_argCopies.Trace_hits.View());
   const float crt_copyInMs = crt_copyIn.ElapsedMs();
 
   // Members as they are now; host code of Trace that changes one records an update in order.
-  crt_self->UpdatePlainMembers();
-  VkCommandBuffer crt_cmd = m_ctx->BeginOneShot();
-  crt_self->m_gpuTimer.Reset(crt_cmd);
-  crt_self->m_gpuTimer.Begin(crt_cmd, "Trace");
+  crt_self->crt_UpdatePlainMembers();
+  VkCommandBuffer crt_cmd = crt_ctx->BeginOneShot();
+  crt_self->crt_gpuTimer.Reset(crt_cmd);
+  crt_self->crt_gpuTimer.Begin(crt_cmd, "Trace");
   crt_self->TraceCmd(crt_cmd, n, origins, dirs, hits);
-  crt_self->m_gpuTimer.End(crt_cmd, "Trace");
-  m_ctx->SubmitAndWait(crt_cmd);
-  crt_self->m_gpuTimer.Collect();
+  crt_self->crt_gpuTimer.End(crt_cmd, "Trace");
+  crt_ctx->SubmitAndWait(crt_cmd);
+  crt_self->crt_gpuTimer.Collect();
 
   crossrt::CpuTimer crt_copyOut;
-  crt_self->ReadPlainMembers();
-  crt_self->ReadVectorMembers("Trace");
+  crt_self->crt_ReadPlainMembers();
+  crt_self->crt_ReadVectorMembers("Trace");
   if (crt_hitsBytes > 0)
-    crt_self->m_args.Trace_hits.Download(hits, crt_hitsBytes);
-  crt_self->m_times["Trace"] = {crt_self->m_gpuTimer.LastMs("Trace"), crt_copyInMs, crt_copyOut.ElapsedMs(),
-                                crt_total.ElapsedMs()};
+    crt_self->crt_argCopies.Trace_hits.Download(hits, crt_hitsBytes);
+  crt_self->crt_times["Trace"] = {crt_self->crt_gpuTimer.LastMs("Trace"), crt_copyInMs, crt_copyOut.ElapsedMs(),
+                                  crt_total.ElapsedMs()};
 }
 
 // The body of SdfLeafTracer::Trace, with each kernel call turned into its ...Cmd.
-void SdfLeafTracer_Vulkan::TraceCmd(VkCommandBuffer a_cmd, int n, [[maybe_unused]] const LiteMath::float4* origins,
+void SdfLeafTracer_Vulkan::TraceCmd(VkCommandBuffer crt_cmd, int n, [[maybe_unused]] const LiteMath::float4* origins,
                                     [[maybe_unused]] const LiteMath::float4* dirs, [[maybe_unused]] CRT_Hit* hits)
 {
-  kernel1D_TraceCmd(a_cmd, n, m_inOut_Trace.origins, m_inOut_Trace.dirs, m_inOut_Trace.hits);
+  kernel1D_TraceCmd(crt_cmd, n, crt_inOut_Trace.origins, crt_inOut_Trace.dirs, crt_inOut_Trace.hits);
 }
 
 // ---- kernel1D_Trace (from SdfLeafTracer::kernel1D_Trace, SdfLeafTracer.cpp) ----
 
-void SdfLeafTracer_Vulkan::kernel1D_TraceCmd(VkCommandBuffer a_cmd, int n, crossrt::BufferView origins,
+void SdfLeafTracer_Vulkan::kernel1D_TraceCmd(VkCommandBuffer crt_cmd, int n, crossrt::BufferView origins,
                                              crossrt::BufferView dirs, crossrt::BufferView hits)
 {
   const int crt_startX = int(0);
@@ -444,31 +454,33 @@ void SdfLeafTracer_Vulkan::kernel1D_TraceCmd(VkCommandBuffer a_cmd, int n, cross
   crt_args.crt_startX = crt_startX;
   crt_args.crt_countX = crt_countX;
   crt_args.n = n;
-  if (m_useRayTracingPipelines)  // the leaves of m_scene->m_geom as intersection shaders, in a ray tracing pipeline
+  if (crt_useRayTracingPipelines)  // the leaves of m_scene->m_geom as intersection shaders, in a ray tracing pipeline
   {
-    m_pipelines.kernel1D_Trace_Intersections.Bind(a_cmd);
-    m_pipelines.kernel1D_Trace_Intersections.PushBindings(
-        a_cmd,
-        {m_classDataBuffer.View(), origins, dirs, hits, m_vdata.m_scene_m_brickValues.View(),
-         m_vdata.m_scene_m_bricks.View(), m_vdata.m_scene_m_gridBricks.View(), m_vdata.m_scene_m_leafIds.View(),
-         m_vdata.m_scene_m_nodeLeaf.View(), m_vdata.m_scene_m_nodeMax.View(), m_vdata.m_scene_m_nodeMin.View(),
-         m_vdata.m_scene_m_nodeRight.View(), m_vdata.m_scene_m_values.View(), m_vdata.m_scene_m_voxelValues.View(),
-         m_vdata.m_scene_m_voxels.View(), crossrt::Binding::SceneOf(m_scenes.m_scene_m_geom_leaves)});
-    m_pipelines.kernel1D_Trace_Intersections.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-    m_pipelines.kernel1D_Trace_Intersections.TraceCmd(a_cmd, std::min<uint32_t>(crt_countX, 65536u),
-                                                      (crt_countX + 65535u) / 65536u, 1);
+    crt_pipelines.kernel1D_Trace_Intersections.Bind(crt_cmd);
+    crt_pipelines.kernel1D_Trace_Intersections.PushBindings(
+        crt_cmd,
+        {crt_classDataBuffer.View(), origins, dirs, hits, crt_vdata.m_scene_m_brickValues.View(),
+         crt_vdata.m_scene_m_bricks.View(), crt_vdata.m_scene_m_gridBricks.View(), crt_vdata.m_scene_m_leafIds.View(),
+         crt_vdata.m_scene_m_nodeLeaf.View(), crt_vdata.m_scene_m_nodeMax.View(), crt_vdata.m_scene_m_nodeMin.View(),
+         crt_vdata.m_scene_m_nodeRight.View(), crt_vdata.m_scene_m_values.View(),
+         crt_vdata.m_scene_m_voxelValues.View(), crt_vdata.m_scene_m_voxels.View(),
+         crossrt::Binding::SceneOf(crt_scenes.m_scene_m_geom_leaves)});
+    crt_pipelines.kernel1D_Trace_Intersections.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
+    crt_pipelines.kernel1D_Trace_Intersections.TraceCmd(crt_cmd, std::min<uint32_t>(crt_countX, 65536u),
+                                                        (crt_countX + 65535u) / 65536u, 1);
   }
   else
   {
-    m_pipelines.kernel1D_Trace.Bind(a_cmd);
-    m_pipelines.kernel1D_Trace.PushBuffers(
-        a_cmd, {m_classDataBuffer.View(), origins, dirs, hits, m_vdata.m_scene_m_brickValues.View(),
-                m_vdata.m_scene_m_bricks.View(), m_vdata.m_scene_m_gridBricks.View(), m_vdata.m_scene_m_leafIds.View(),
-                m_vdata.m_scene_m_nodeLeaf.View(), m_vdata.m_scene_m_nodeMax.View(), m_vdata.m_scene_m_nodeMin.View(),
-                m_vdata.m_scene_m_nodeRight.View(), m_vdata.m_scene_m_values.View(),
-                m_vdata.m_scene_m_voxelValues.View(), m_vdata.m_scene_m_voxels.View()});
-    m_pipelines.kernel1D_Trace.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-    crossrt::Dispatch1D(a_cmd, crt_countX, 256);
+    crt_pipelines.kernel1D_Trace.Bind(crt_cmd);
+    crt_pipelines.kernel1D_Trace.PushBuffers(
+        crt_cmd,
+        {crt_classDataBuffer.View(), origins, dirs, hits, crt_vdata.m_scene_m_brickValues.View(),
+         crt_vdata.m_scene_m_bricks.View(), crt_vdata.m_scene_m_gridBricks.View(), crt_vdata.m_scene_m_leafIds.View(),
+         crt_vdata.m_scene_m_nodeLeaf.View(), crt_vdata.m_scene_m_nodeMax.View(), crt_vdata.m_scene_m_nodeMin.View(),
+         crt_vdata.m_scene_m_nodeRight.View(), crt_vdata.m_scene_m_values.View(),
+         crt_vdata.m_scene_m_voxelValues.View(), crt_vdata.m_scene_m_voxels.View()});
+    crt_pipelines.kernel1D_Trace.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
+    crossrt::Dispatch1D(crt_cmd, crt_countX, 256);
   }
-  crossrt::ComputeBarrier(a_cmd);
+  crossrt::ComputeBarrier(crt_cmd);
 }

@@ -39,19 +39,19 @@ extern const uint32_t ShapeTracer_m_scene_m_lights_Intersect_Miss_spv[];
 extern const size_t ShapeTracer_m_scene_m_lights_Intersect_Miss_spvBytes;
 
 ShapeTracer_Vulkan::ShapeTracer_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx)
-    : ShapeTracer(), m_ctx(std::move(a_ctx))
+    : ShapeTracer(), crt_ctx(std::move(a_ctx))
 {
-  m_classDataBuffer = crossrt::Buffer(m_ctx, sizeof(ClassData));
-  m_gpuTimer = crossrt::GpuTimer(m_ctx);
-  m_useRayTracingPipelines = m_ctx->hasRayTracingPipeline;
-  if (m_ctx->hasRayTracingPipeline)
+  crt_classDataBuffer = crossrt::Buffer(crt_ctx, sizeof(ClassData));
+  crt_gpuTimer = crossrt::GpuTimer(crt_ctx);
+  crt_useRayTracingPipelines = crt_ctx->hasRayTracingPipeline;
+  if (crt_ctx->hasRayTracingPipeline)
   {
-    m_scenes.m_scene_m_shapes_leaves = crossrt::RayTracingScene(m_ctx);
-    m_scenes.m_scene_m_lights_leaves = crossrt::RayTracingScene(m_ctx);
+    crt_scenes.m_scene_m_shapes_leaves = crossrt::RayTracingScene(crt_ctx);
+    crt_scenes.m_scene_m_lights_leaves = crossrt::RayTracingScene(crt_ctx);
   }
   // Virtual functions reach each class's objects through buffer references.
-  if (!m_ctx->hasBufferDeviceAddress)
-    throw crossrt::Error("ShapeTracer_Vulkan: device '" + m_ctx->DeviceName() +
+  if (!crt_ctx->hasBufferDeviceAddress)
+    throw crossrt::Error("ShapeTracer_Vulkan: device '" + crt_ctx->DeviceName() +
                          "' lacks bufferDeviceAddress, which virtual function calls in kernels need");
   // The pipelines are made by CommitDeviceData(), for the classes the objects hold.
 }
@@ -68,16 +68,16 @@ std::shared_ptr<ShapeTracer> CreateShapeTracer_Vulkan(std::shared_ptr<crossrt::V
 
 ShapeTracer_Vulkan::~ShapeTracer_Vulkan() = default;
 
-void ShapeTracer_Vulkan::InitPipelines()
+void ShapeTracer_Vulkan::crt_InitPipelines()
 {
-  // Kernels switch over the classes in m_pipelineClasses only (specialization constants from
+  // Kernels switch over the classes in crt_pipelineClasses only (specialization constants from
   // crossrt::kClassConstantIdBase): the driver drops the cases of the others.
   static_assert(crossrt::kClassConstantIdBase == 1800,
                 "the shaders and the runtime number the class constants differently");
-  if (m_ctx->hasRayTracingPipeline)  // the leaves of m_scene->m_shapes and m_scene->m_lights as intersection shaders,
-                                     // in a ray tracing pipeline: the shader needs them even to be created
-    m_pipelines.kernel1D_Trace_Intersections = crossrt::RayTracingPipeline(
-        m_ctx,
+  if (crt_ctx->hasRayTracingPipeline)  // the leaves of m_scene->m_shapes and m_scene->m_lights as intersection shaders,
+                                       // in a ray tracing pipeline: the shader needs them even to be created
+    crt_pipelines.kernel1D_Trace_Intersections = crossrt::RayTracingPipeline(
+        crt_ctx,
         crossrt::RayTracingShaders{
             {ShapeTracer_kernel1D_Trace_Intersections_spv, ShapeTracer_kernel1D_Trace_Intersections_spvBytes},
             {
@@ -110,27 +110,27 @@ void ShapeTracer_Vulkan::InitPipelines()
             VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
             VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR},
         sizeof(kernel1D_TraceArgs), "ShapeTracer::kernel1D_Trace_Intersections");
-  m_pipelines.kernel1D_Trace =
-      crossrt::ComputePipeline(m_ctx, ShapeTracer_kernel1D_Trace_spv, ShapeTracer_kernel1D_Trace_spvBytes, 6,
-                               sizeof(kernel1D_TraceArgs), "ShapeTracer::kernel1D_Trace", m_pipelineClasses);
+  crt_pipelines.kernel1D_Trace =
+      crossrt::ComputePipeline(crt_ctx, ShapeTracer_kernel1D_Trace_spv, ShapeTracer_kernel1D_Trace_spvBytes, 6,
+                               sizeof(kernel1D_TraceArgs), "ShapeTracer::kernel1D_Trace", crt_pipelineClasses);
 }
 
 void ShapeTracer_Vulkan::UseRayTracingPipelines(bool a_use)
 {
-  if (a_use && !m_ctx->hasRayTracingPipeline)
-    throw crossrt::Error("ShapeTracer_Vulkan: device '" + m_ctx->DeviceName() +
+  if (a_use && !crt_ctx->hasRayTracingPipeline)
+    throw crossrt::Error("ShapeTracer_Vulkan: device '" + crt_ctx->DeviceName() +
                          "' has no ray tracing pipelines (VK_KHR_ray_tracing_pipeline): its kernels switch over the "
                          "objects' classes in compute shaders");
-  if (a_use != m_useRayTracingPipelines)
-    m_deviceDataCommitted = false;  // the next call commits, building the leaves' boxes for the hardware
-  m_useRayTracingPipelines = a_use;
+  if (a_use != crt_useRayTracingPipelines)
+    crt_deviceDataCommitted = false;  // the next call commits, building the leaves' boxes for the hardware
+  crt_useRayTracingPipelines = a_use;
 }
 
 // The leaves of m_scene->m_shapes for the ray tracing hardware: an instance per element, in order (the
 // intersection shaders take the element's index from it), over the box its BoxMin() and BoxMax()
 // give. Its record offset in the shader binding table is its class (the class in its tag, from
 // CommitVirtual_m_scene_m_shapes); each trace adds the first hit group of its leaf call.
-void ShapeTracer_Vulkan::CommitLeaves_m_scene_m_shapes(const std::vector<uint32_t>& a_tags)
+void ShapeTracer_Vulkan::crt_CommitLeaves_m_scene_m_shapes(const std::vector<uint32_t>& a_tags)
 {
   std::vector<crossrt::RayTracingScene::LeafBox> leaves(crt_m_scene()->m_shapes.size());
   for (size_t i = 0; i < leaves.size(); ++i)
@@ -140,14 +140,14 @@ void ShapeTracer_Vulkan::CommitLeaves_m_scene_m_shapes(const std::vector<uint32_
     const auto lo = object->BoxMin(), hi = object->BoxMax();
     leaves[i] = {{lo.x, lo.y, lo.z}, {hi.x, hi.y, hi.z}, a_tags[2 * i]};
   }
-  m_scenes.m_scene_m_shapes_leaves.BuildLeaves(leaves, "ShapeTracer::m_scene->m_shapes");
+  crt_scenes.m_scene_m_shapes_leaves.BuildLeaves(leaves, "ShapeTracer::m_scene->m_shapes");
 }
 
 // The leaves of m_scene->m_lights for the ray tracing hardware: an instance per element, in order (the
 // intersection shaders take the element's index from it), over the box its BoxMin() and BoxMax()
 // give. Its record offset in the shader binding table is its class (the class in its tag, from
 // CommitVirtual_m_scene_m_lights); each trace adds the first hit group of its leaf call.
-void ShapeTracer_Vulkan::CommitLeaves_m_scene_m_lights(const std::vector<uint32_t>& a_tags)
+void ShapeTracer_Vulkan::crt_CommitLeaves_m_scene_m_lights(const std::vector<uint32_t>& a_tags)
 {
   std::vector<crossrt::RayTracingScene::LeafBox> leaves(crt_m_scene()->m_lights.size());
   for (size_t i = 0; i < leaves.size(); ++i)
@@ -157,89 +157,90 @@ void ShapeTracer_Vulkan::CommitLeaves_m_scene_m_lights(const std::vector<uint32_
     const auto lo = object->BoxMin(), hi = object->BoxMax();
     leaves[i] = {{lo.x, lo.y, lo.z}, {hi.x, hi.y, hi.z}, a_tags[2 * i]};
   }
-  m_scenes.m_scene_m_lights_leaves.BuildLeaves(leaves, "ShapeTracer::m_scene->m_lights");
+  crt_scenes.m_scene_m_lights_leaves.BuildLeaves(leaves, "ShapeTracer::m_scene->m_lights");
 }
 
 void ShapeTracer_Vulkan::SpecializeVirtualCalls(bool a_on)
 {
-  if (a_on != m_specializeVirtualCalls)
-    m_deviceDataCommitted = false;  // the next call commits, making the pipelines again
-  m_specializeVirtualCalls = a_on;
+  if (a_on != crt_specializeVirtualCalls)
+    crt_deviceDataCommitted = false;  // the next call commits, making the pipelines again
+  crt_specializeVirtualCalls = a_on;
 }
 
-void ShapeTracer_Vulkan::UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size)
+void ShapeTracer_Vulkan::crt_UpdateMemberCmd(VkCommandBuffer crt_cmd, size_t a_offset, const void* a_data,
+                                             size_t a_size)
 {
-  crossrt::ComputeBarrier(a_cmd);  // kernels recorded before it are done with the class data
-  vkCmdUpdateBuffer(a_cmd, m_classDataBuffer.Handle(), a_offset, a_size, a_data);
-  crossrt::TransferToComputeBarrier(a_cmd);
+  crossrt::ComputeBarrier(crt_cmd);  // kernels recorded before it are done with the class data
+  vkCmdUpdateBuffer(crt_cmd, crt_classDataBuffer.Handle(), a_offset, a_size, a_data);
+  crossrt::TransferToComputeBarrier(crt_cmd);
 }
 
-void ShapeTracer_Vulkan::UpdatePlainMembers()
+void ShapeTracer_Vulkan::crt_UpdatePlainMembers()
 {
   ClassData data{};
-  data.m_scene_m_shapes_tags = m_virtual.m_scene_m_shapes_tags.Address();
-  data.m_scene_m_shapes_Sphere = m_virtual.m_scene_m_shapes_Sphere.Address();
-  data.m_scene_m_shapes_Box = m_virtual.m_scene_m_shapes_Box.Address();
-  data.m_scene_m_shapes_Disc = m_virtual.m_scene_m_shapes_Disc.Address();
-  data.m_scene_m_lights_tags = m_virtual.m_scene_m_lights_tags.Address();
-  data.m_scene_m_lights_Sphere = m_virtual.m_scene_m_lights_Sphere.Address();
-  data.m_scene_m_lights_Box = m_virtual.m_scene_m_lights_Box.Address();
-  data.m_scene_m_lights_Disc = m_virtual.m_scene_m_lights_Disc.Address();
+  data.m_scene_m_shapes_tags = crt_virtual.m_scene_m_shapes_tags.Address();
+  data.m_scene_m_shapes_Sphere = crt_virtual.m_scene_m_shapes_Sphere.Address();
+  data.m_scene_m_shapes_Box = crt_virtual.m_scene_m_shapes_Box.Address();
+  data.m_scene_m_shapes_Disc = crt_virtual.m_scene_m_shapes_Disc.Address();
+  data.m_scene_m_lights_tags = crt_virtual.m_scene_m_lights_tags.Address();
+  data.m_scene_m_lights_Sphere = crt_virtual.m_scene_m_lights_Sphere.Address();
+  data.m_scene_m_lights_Box = crt_virtual.m_scene_m_lights_Box.Address();
+  data.m_scene_m_lights_Disc = crt_virtual.m_scene_m_lights_Disc.Address();
   data.m_scene_m_shapes_size = uint32_t(crt_m_scene()->m_shapes.size());
   data.m_scene_m_lights_size = uint32_t(crt_m_scene()->m_lights.size());
   data.m_scene_m_boxes_size = uint32_t(crt_m_scene()->m_boxes.size());
   data.m_scene_m_boxes_capacity = uint32_t(crt_m_scene()->m_boxes.capacity());
   data.m_scene_m_lightBoxes_size = uint32_t(crt_m_scene()->m_lightBoxes.size());
   data.m_scene_m_lightBoxes_capacity = uint32_t(crt_m_scene()->m_lightBoxes.capacity());
-  m_classDataBuffer.Upload(&data, sizeof(data));
+  crt_classDataBuffer.Upload(&data, sizeof(data));
 }
 
-void ShapeTracer_Vulkan::ReadPlainMembers()
+void ShapeTracer_Vulkan::crt_ReadPlainMembers()
 {
 }
 
 void ShapeTracer_Vulkan::CommitDeviceData()
 {
   // std::vector members become buffers of their capacity; kernels see size and capacity.
-  crossrt::EnsureSize(m_ctx, m_vdata.m_scene_m_boxes, sizeof(LiteMath::float4) * crt_m_scene()->m_boxes.capacity());
+  crossrt::EnsureSize(crt_ctx, crt_vdata.m_scene_m_boxes, sizeof(LiteMath::float4) * crt_m_scene()->m_boxes.capacity());
   if (!crt_m_scene()->m_boxes.empty())
-    m_vdata.m_scene_m_boxes.Upload(crt_m_scene()->m_boxes.data(),
-                                   sizeof(LiteMath::float4) * crt_m_scene()->m_boxes.size());
-  m_vdata.m_scene_m_boxesSize = crt_m_scene()->m_boxes.size();
-  crossrt::EnsureSize(m_ctx, m_vdata.m_scene_m_lightBoxes,
+    crt_vdata.m_scene_m_boxes.Upload(crt_m_scene()->m_boxes.data(),
+                                     sizeof(LiteMath::float4) * crt_m_scene()->m_boxes.size());
+  crt_vdata.m_scene_m_boxesSize = crt_m_scene()->m_boxes.size();
+  crossrt::EnsureSize(crt_ctx, crt_vdata.m_scene_m_lightBoxes,
                       sizeof(LiteMath::float4) * crt_m_scene()->m_lightBoxes.capacity());
   if (!crt_m_scene()->m_lightBoxes.empty())
-    m_vdata.m_scene_m_lightBoxes.Upload(crt_m_scene()->m_lightBoxes.data(),
-                                        sizeof(LiteMath::float4) * crt_m_scene()->m_lightBoxes.size());
-  m_vdata.m_scene_m_lightBoxesSize = crt_m_scene()->m_lightBoxes.size();
+    crt_vdata.m_scene_m_lightBoxes.Upload(crt_m_scene()->m_lightBoxes.data(),
+                                          sizeof(LiteMath::float4) * crt_m_scene()->m_lightBoxes.size());
+  crt_vdata.m_scene_m_lightBoxesSize = crt_m_scene()->m_lightBoxes.size();
   // Objects called through virtual functions, regrouped; the classes they hold, for the pipelines.
-  std::vector<VkBool32> crt_classesHeld(6, m_specializeVirtualCalls ? VK_FALSE : VK_TRUE);
+  std::vector<VkBool32> crt_classesHeld(6, crt_specializeVirtualCalls ? VK_FALSE : VK_TRUE);
   const std::vector<uint32_t> crt_m_scene_m_shapesTags = CommitVirtual_m_scene_m_shapes();
-  for (size_t i = 0; i < m_virtual.m_scene_m_shapesSize; ++i)
+  for (size_t i = 0; i < crt_virtual.m_scene_m_shapesSize; ++i)
     crt_classesHeld[0 + crt_m_scene_m_shapesTags[2 * i]] = VK_TRUE;
-  if (m_useRayTracingPipelines)
-    CommitLeaves_m_scene_m_shapes(crt_m_scene_m_shapesTags);
+  if (crt_useRayTracingPipelines)
+    crt_CommitLeaves_m_scene_m_shapes(crt_m_scene_m_shapesTags);
   const std::vector<uint32_t> crt_m_scene_m_lightsTags = CommitVirtual_m_scene_m_lights();
-  for (size_t i = 0; i < m_virtual.m_scene_m_lightsSize; ++i)
+  for (size_t i = 0; i < crt_virtual.m_scene_m_lightsSize; ++i)
     crt_classesHeld[3 + crt_m_scene_m_lightsTags[2 * i]] = VK_TRUE;
-  if (m_useRayTracingPipelines)
-    CommitLeaves_m_scene_m_lights(crt_m_scene_m_lightsTags);
-  if (crt_classesHeld != m_pipelineClasses)  // made for other classes, or not made yet
+  if (crt_useRayTracingPipelines)
+    crt_CommitLeaves_m_scene_m_lights(crt_m_scene_m_lightsTags);
+  if (crt_classesHeld != crt_pipelineClasses)  // made for other classes, or not made yet
   {
-    m_pipelineClasses = crt_classesHeld;
-    InitPipelines();
+    crt_pipelineClasses = crt_classesHeld;
+    crt_InitPipelines();
   }
-  UpdatePlainMembers();
-  m_deviceDataCommitted = true;
+  crt_UpdatePlainMembers();
+  crt_deviceDataCommitted = true;
 }
 
-bool ShapeTracer_Vulkan::VectorMembersResized() const
+bool ShapeTracer_Vulkan::crt_VectorMembersResized() const
 {
   bool resized = false;
-  resized = resized || crt_m_scene()->m_boxes.size() != m_vdata.m_scene_m_boxesSize;
-  resized = resized || crt_m_scene()->m_lightBoxes.size() != m_vdata.m_scene_m_lightBoxesSize;
-  resized = resized || crt_m_scene()->m_shapes.size() != m_virtual.m_scene_m_shapesSize;
-  resized = resized || crt_m_scene()->m_lights.size() != m_virtual.m_scene_m_lightsSize;
+  resized = resized || crt_m_scene()->m_boxes.size() != crt_vdata.m_scene_m_boxesSize;
+  resized = resized || crt_m_scene()->m_lightBoxes.size() != crt_vdata.m_scene_m_lightBoxesSize;
+  resized = resized || crt_m_scene()->m_shapes.size() != crt_virtual.m_scene_m_shapesSize;
+  resized = resized || crt_m_scene()->m_lights.size() != crt_virtual.m_scene_m_lightsSize;
   return resized;
 }
 
@@ -293,20 +294,21 @@ std::vector<uint32_t> ShapeTracer_Vulkan::CommitVirtual_m_scene_m_shapes()
                            ", which the GPU code does not know; it knows Sphere, Box, Disc (the classes that implement "
                            "IShape where ShapeTracer is translated)");
   }
-  crossrt::EnsureSize(m_ctx, m_virtual.m_scene_m_shapes_tags, sizeof(uint32_t) * tags.size());
-  m_virtual.m_scene_m_shapes_tags.Upload(tags.data(), sizeof(uint32_t) * tags.size());
-  crossrt::EnsureSize(m_ctx, m_virtual.m_scene_m_shapes_Sphere,
+  crossrt::EnsureSize(crt_ctx, crt_virtual.m_scene_m_shapes_tags, sizeof(uint32_t) * tags.size());
+  crt_virtual.m_scene_m_shapes_tags.Upload(tags.data(), sizeof(uint32_t) * tags.size());
+  crossrt::EnsureSize(crt_ctx, crt_virtual.m_scene_m_shapes_Sphere,
                       sizeof(Sphere_Data) * std::max<size_t>(1, SphereObjects.size()));
   if (!SphereObjects.empty())
-    m_virtual.m_scene_m_shapes_Sphere.Upload(SphereObjects.data(), sizeof(Sphere_Data) * SphereObjects.size());
-  crossrt::EnsureSize(m_ctx, m_virtual.m_scene_m_shapes_Box, sizeof(Box_Data) * std::max<size_t>(1, BoxObjects.size()));
+    crt_virtual.m_scene_m_shapes_Sphere.Upload(SphereObjects.data(), sizeof(Sphere_Data) * SphereObjects.size());
+  crossrt::EnsureSize(crt_ctx, crt_virtual.m_scene_m_shapes_Box,
+                      sizeof(Box_Data) * std::max<size_t>(1, BoxObjects.size()));
   if (!BoxObjects.empty())
-    m_virtual.m_scene_m_shapes_Box.Upload(BoxObjects.data(), sizeof(Box_Data) * BoxObjects.size());
-  crossrt::EnsureSize(m_ctx, m_virtual.m_scene_m_shapes_Disc,
+    crt_virtual.m_scene_m_shapes_Box.Upload(BoxObjects.data(), sizeof(Box_Data) * BoxObjects.size());
+  crossrt::EnsureSize(crt_ctx, crt_virtual.m_scene_m_shapes_Disc,
                       sizeof(Disc_Data) * std::max<size_t>(1, DiscObjects.size()));
   if (!DiscObjects.empty())
-    m_virtual.m_scene_m_shapes_Disc.Upload(DiscObjects.data(), sizeof(Disc_Data) * DiscObjects.size());
-  m_virtual.m_scene_m_shapesSize = crt_m_scene()->m_shapes.size();
+    crt_virtual.m_scene_m_shapes_Disc.Upload(DiscObjects.data(), sizeof(Disc_Data) * DiscObjects.size());
+  crt_virtual.m_scene_m_shapesSize = crt_m_scene()->m_shapes.size();
   return tags;
 }
 
@@ -360,24 +362,25 @@ std::vector<uint32_t> ShapeTracer_Vulkan::CommitVirtual_m_scene_m_lights()
                            ", which the GPU code does not know; it knows Sphere, Box, Disc (the classes that implement "
                            "IShape where ShapeTracer is translated)");
   }
-  crossrt::EnsureSize(m_ctx, m_virtual.m_scene_m_lights_tags, sizeof(uint32_t) * tags.size());
-  m_virtual.m_scene_m_lights_tags.Upload(tags.data(), sizeof(uint32_t) * tags.size());
-  crossrt::EnsureSize(m_ctx, m_virtual.m_scene_m_lights_Sphere,
+  crossrt::EnsureSize(crt_ctx, crt_virtual.m_scene_m_lights_tags, sizeof(uint32_t) * tags.size());
+  crt_virtual.m_scene_m_lights_tags.Upload(tags.data(), sizeof(uint32_t) * tags.size());
+  crossrt::EnsureSize(crt_ctx, crt_virtual.m_scene_m_lights_Sphere,
                       sizeof(Sphere_Data) * std::max<size_t>(1, SphereObjects.size()));
   if (!SphereObjects.empty())
-    m_virtual.m_scene_m_lights_Sphere.Upload(SphereObjects.data(), sizeof(Sphere_Data) * SphereObjects.size());
-  crossrt::EnsureSize(m_ctx, m_virtual.m_scene_m_lights_Box, sizeof(Box_Data) * std::max<size_t>(1, BoxObjects.size()));
+    crt_virtual.m_scene_m_lights_Sphere.Upload(SphereObjects.data(), sizeof(Sphere_Data) * SphereObjects.size());
+  crossrt::EnsureSize(crt_ctx, crt_virtual.m_scene_m_lights_Box,
+                      sizeof(Box_Data) * std::max<size_t>(1, BoxObjects.size()));
   if (!BoxObjects.empty())
-    m_virtual.m_scene_m_lights_Box.Upload(BoxObjects.data(), sizeof(Box_Data) * BoxObjects.size());
-  crossrt::EnsureSize(m_ctx, m_virtual.m_scene_m_lights_Disc,
+    crt_virtual.m_scene_m_lights_Box.Upload(BoxObjects.data(), sizeof(Box_Data) * BoxObjects.size());
+  crossrt::EnsureSize(crt_ctx, crt_virtual.m_scene_m_lights_Disc,
                       sizeof(Disc_Data) * std::max<size_t>(1, DiscObjects.size()));
   if (!DiscObjects.empty())
-    m_virtual.m_scene_m_lights_Disc.Upload(DiscObjects.data(), sizeof(Disc_Data) * DiscObjects.size());
-  m_virtual.m_scene_m_lightsSize = crt_m_scene()->m_lights.size();
+    crt_virtual.m_scene_m_lights_Disc.Upload(DiscObjects.data(), sizeof(Disc_Data) * DiscObjects.size());
+  crt_virtual.m_scene_m_lightsSize = crt_m_scene()->m_lights.size();
   return tags;
 }
 
-void ShapeTracer_Vulkan::ReadVectorMembers(const char* a_funcName)
+void ShapeTracer_Vulkan::crt_ReadVectorMembers(const char* a_funcName)
 {
   (void)a_funcName;
 }
@@ -395,9 +398,9 @@ ShapeScene* ShapeTracer_Vulkan::crt_m_scene() const
 
 void ShapeTracer_Vulkan::GetExecutionTime(const char* a_funcName, float a_out[4])
 {
-  auto it = m_times.find(a_funcName);
+  auto it = crt_times.find(a_funcName);
   for (int i = 0; i < 4; ++i)
-    a_out[i] = it == m_times.end() ? 0.0f : it->second[i];
+    a_out[i] = it == crt_times.end() ? 0.0f : it->second[i];
 }
 
 // ---- Trace (from ShapeTracer::Trace, ShapeTracer.cpp) ----
@@ -405,9 +408,9 @@ void ShapeTracer_Vulkan::GetExecutionTime(const char* a_funcName, float a_out[4]
 void ShapeTracer_Vulkan::SetVulkanInOutFor_Trace(crossrt::BufferView a_origins, crossrt::BufferView a_dirs,
                                                  crossrt::BufferView a_hits)
 {
-  m_inOut_Trace.origins = a_origins;
-  m_inOut_Trace.dirs = a_dirs;
-  m_inOut_Trace.hits = a_hits;
+  crt_inOut_Trace.origins = a_origins;
+  crt_inOut_Trace.dirs = a_dirs;
+  crt_inOut_Trace.hits = a_hits;
 }
 
 void ShapeTracer_Vulkan::Trace(int n, const LiteMath::float4* origins, const LiteMath::float4* dirs, float far,
@@ -418,56 +421,57 @@ void ShapeTracer_Vulkan::Trace(int n, const LiteMath::float4* origins, const Lit
   // std::vector members are uploaded by CommitDeviceData(): here once, and again whenever one
   // changed size (its device buffer would be too small). After changing the contents of a
   // vector without resizing it, call CommitDeviceData().
-  if (!crt_self->m_deviceDataCommitted || crt_self->VectorMembersResized())
+  if (!crt_self->crt_deviceDataCommitted || crt_self->crt_VectorMembersResized())
     crt_self->CommitDeviceData();
 
   crossrt::CpuTimer crt_copyIn;
   const size_t crt_originsBytes = sizeof(LiteMath::float4) * size_t(n);
-  crossrt::EnsureSize(m_ctx, crt_self->m_args.Trace_origins, crt_originsBytes);
+  crossrt::EnsureSize(crt_ctx, crt_self->crt_argCopies.Trace_origins, crt_originsBytes);
   if (crt_originsBytes > 0)
-    crt_self->m_args.Trace_origins.Upload(origins, crt_originsBytes);
+    crt_self->crt_argCopies.Trace_origins.Upload(origins, crt_originsBytes);
   const size_t crt_dirsBytes = sizeof(LiteMath::float4) * size_t(n);
-  crossrt::EnsureSize(m_ctx, crt_self->m_args.Trace_dirs, crt_dirsBytes);
+  crossrt::EnsureSize(crt_ctx, crt_self->crt_argCopies.Trace_dirs, crt_dirsBytes);
   if (crt_dirsBytes > 0)
-    crt_self->m_args.Trace_dirs.Upload(dirs, crt_dirsBytes);
+    crt_self->crt_argCopies.Trace_dirs.Upload(dirs, crt_dirsBytes);
   const size_t crt_hitsBytes = sizeof(ShapeHit) * size_t(n);
-  crossrt::EnsureSize(m_ctx, crt_self->m_args.Trace_hits, crt_hitsBytes);
+  crossrt::EnsureSize(crt_ctx, crt_self->crt_argCopies.Trace_hits, crt_hitsBytes);
   if (crt_hitsBytes > 0)
-    crt_self->m_args.Trace_hits.Upload(hits, crt_hitsBytes);
-  crt_self->SetVulkanInOutFor_Trace(crt_self->m_args.Trace_origins.View(), crt_self->m_args.Trace_dirs.View(),
-                                    crt_self->m_args.Trace_hits.View());
+    crt_self->crt_argCopies.Trace_hits.Upload(hits, crt_hitsBytes);
+  crt_self->SetVulkanInOutFor_Trace(crt_self->crt_argCopies.Trace_origins.View(),
+                                    crt_self->crt_argCopies.Trace_dirs.View(),
+                                    crt_self->crt_argCopies.Trace_hits.View());
   const float crt_copyInMs = crt_copyIn.ElapsedMs();
 
   // Members as they are now; host code of Trace that changes one records an update in order.
-  crt_self->UpdatePlainMembers();
-  VkCommandBuffer crt_cmd = m_ctx->BeginOneShot();
-  crt_self->m_gpuTimer.Reset(crt_cmd);
-  crt_self->m_gpuTimer.Begin(crt_cmd, "Trace");
+  crt_self->crt_UpdatePlainMembers();
+  VkCommandBuffer crt_cmd = crt_ctx->BeginOneShot();
+  crt_self->crt_gpuTimer.Reset(crt_cmd);
+  crt_self->crt_gpuTimer.Begin(crt_cmd, "Trace");
   crt_self->TraceCmd(crt_cmd, n, origins, dirs, far, hits);
-  crt_self->m_gpuTimer.End(crt_cmd, "Trace");
-  m_ctx->SubmitAndWait(crt_cmd);
-  crt_self->m_gpuTimer.Collect();
+  crt_self->crt_gpuTimer.End(crt_cmd, "Trace");
+  crt_ctx->SubmitAndWait(crt_cmd);
+  crt_self->crt_gpuTimer.Collect();
 
   crossrt::CpuTimer crt_copyOut;
-  crt_self->ReadPlainMembers();
-  crt_self->ReadVectorMembers("Trace");
+  crt_self->crt_ReadPlainMembers();
+  crt_self->crt_ReadVectorMembers("Trace");
   if (crt_hitsBytes > 0)
-    crt_self->m_args.Trace_hits.Download(hits, crt_hitsBytes);
-  crt_self->m_times["Trace"] = {crt_self->m_gpuTimer.LastMs("Trace"), crt_copyInMs, crt_copyOut.ElapsedMs(),
-                                crt_total.ElapsedMs()};
+    crt_self->crt_argCopies.Trace_hits.Download(hits, crt_hitsBytes);
+  crt_self->crt_times["Trace"] = {crt_self->crt_gpuTimer.LastMs("Trace"), crt_copyInMs, crt_copyOut.ElapsedMs(),
+                                  crt_total.ElapsedMs()};
 }
 
 // The body of ShapeTracer::Trace, with each kernel call turned into its ...Cmd.
-void ShapeTracer_Vulkan::TraceCmd(VkCommandBuffer a_cmd, int n, [[maybe_unused]] const LiteMath::float4* origins,
+void ShapeTracer_Vulkan::TraceCmd(VkCommandBuffer crt_cmd, int n, [[maybe_unused]] const LiteMath::float4* origins,
                                   [[maybe_unused]] const LiteMath::float4* dirs, float far,
                                   [[maybe_unused]] ShapeHit* hits)
 {
-  kernel1D_TraceCmd(a_cmd, n, m_inOut_Trace.origins, m_inOut_Trace.dirs, far, m_inOut_Trace.hits);
+  kernel1D_TraceCmd(crt_cmd, n, crt_inOut_Trace.origins, crt_inOut_Trace.dirs, far, crt_inOut_Trace.hits);
 }
 
 // ---- kernel1D_Trace (from ShapeTracer::kernel1D_Trace, ShapeTracer.cpp) ----
 
-void ShapeTracer_Vulkan::kernel1D_TraceCmd(VkCommandBuffer a_cmd, int n, crossrt::BufferView origins,
+void ShapeTracer_Vulkan::kernel1D_TraceCmd(VkCommandBuffer crt_cmd, int n, crossrt::BufferView origins,
                                            crossrt::BufferView dirs, float far, crossrt::BufferView hits)
 {
   const int crt_startX = int(0);
@@ -479,26 +483,26 @@ void ShapeTracer_Vulkan::kernel1D_TraceCmd(VkCommandBuffer a_cmd, int n, crossrt
   crt_args.crt_countX = crt_countX;
   crt_args.n = n;
   crt_args.far = far;
-  if (m_useRayTracingPipelines)  // the leaves of m_scene->m_shapes and m_scene->m_lights as intersection shaders, in a
-                                 // ray tracing pipeline
+  if (crt_useRayTracingPipelines)  // the leaves of m_scene->m_shapes and m_scene->m_lights as intersection shaders, in
+                                   // a ray tracing pipeline
   {
-    m_pipelines.kernel1D_Trace_Intersections.Bind(a_cmd);
-    m_pipelines.kernel1D_Trace_Intersections.PushBindings(
-        a_cmd, {m_classDataBuffer.View(), origins, dirs, hits, m_vdata.m_scene_m_boxes.View(),
-                m_vdata.m_scene_m_lightBoxes.View(), crossrt::Binding::SceneOf(m_scenes.m_scene_m_shapes_leaves),
-                crossrt::Binding::SceneOf(m_scenes.m_scene_m_lights_leaves)});
-    m_pipelines.kernel1D_Trace_Intersections.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-    m_pipelines.kernel1D_Trace_Intersections.TraceCmd(a_cmd, std::min<uint32_t>(crt_countX, 65536u),
-                                                      (crt_countX + 65535u) / 65536u, 1);
+    crt_pipelines.kernel1D_Trace_Intersections.Bind(crt_cmd);
+    crt_pipelines.kernel1D_Trace_Intersections.PushBindings(
+        crt_cmd, {crt_classDataBuffer.View(), origins, dirs, hits, crt_vdata.m_scene_m_boxes.View(),
+                  crt_vdata.m_scene_m_lightBoxes.View(), crossrt::Binding::SceneOf(crt_scenes.m_scene_m_shapes_leaves),
+                  crossrt::Binding::SceneOf(crt_scenes.m_scene_m_lights_leaves)});
+    crt_pipelines.kernel1D_Trace_Intersections.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
+    crt_pipelines.kernel1D_Trace_Intersections.TraceCmd(crt_cmd, std::min<uint32_t>(crt_countX, 65536u),
+                                                        (crt_countX + 65535u) / 65536u, 1);
   }
   else
   {
-    m_pipelines.kernel1D_Trace.Bind(a_cmd);
-    m_pipelines.kernel1D_Trace.PushBuffers(a_cmd,
-                                           {m_classDataBuffer.View(), origins, dirs, hits,
-                                            m_vdata.m_scene_m_boxes.View(), m_vdata.m_scene_m_lightBoxes.View()});
-    m_pipelines.kernel1D_Trace.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-    crossrt::Dispatch1D(a_cmd, crt_countX, 256);
+    crt_pipelines.kernel1D_Trace.Bind(crt_cmd);
+    crt_pipelines.kernel1D_Trace.PushBuffers(crt_cmd,
+                                             {crt_classDataBuffer.View(), origins, dirs, hits,
+                                              crt_vdata.m_scene_m_boxes.View(), crt_vdata.m_scene_m_lightBoxes.View()});
+    crt_pipelines.kernel1D_Trace.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
+    crossrt::Dispatch1D(crt_cmd, crt_countX, 256);
   }
-  crossrt::ComputeBarrier(a_cmd);
+  crossrt::ComputeBarrier(crt_cmd);
 }

@@ -28,40 +28,40 @@ public:
   // For data that already lives on the GPU: bind your buffers, then record into your command buffer.
   virtual void SetVulkanInOutFor_Trace(crossrt::BufferView a_origins, crossrt::BufferView a_dirs,
                                        crossrt::BufferView a_hits);
-  virtual void TraceCmd(VkCommandBuffer a_cmd, int n, const LiteMath::float4* origins, const LiteMath::float4* dirs,
+  virtual void TraceCmd(VkCommandBuffer crt_cmd, int n, const LiteMath::float4* origins, const LiteMath::float4* dirs,
                         float far, ShapeHit* hits);
 
   void CommitDeviceData() override;  // uploads members
   // a_out: [0] GPU ms, [1] copy-in ms, [2] copy-out ms, [3] total ms
   void GetExecutionTime(const char* a_funcName, float a_out[4]);
 
-  virtual void UpdatePlainMembers();  // members -> GPU (called before every control function)
-  virtual void ReadPlainMembers();    // GPU -> members the kernels write (reductions)
+  virtual void crt_UpdatePlainMembers();  // members -> GPU (called before every control function)
+  virtual void crt_ReadPlainMembers();    // GPU -> members the kernels write (reductions)
 
-  std::shared_ptr<crossrt::VulkanContext> Context() const { return m_ctx; }
+  std::shared_ptr<crossrt::VulkanContext> Context() const { return crt_ctx; }
 
   // Virtual functions, level 3: where the device has VK_KHR_ray_tracing_pipeline (the default there),
   // kernels' virtual calls run as callable shaders and composed traversals' leaves as intersection
   // shaders of ray tracing pipelines; elsewhere, and when turned off, the compute shaders switch over
   // the objects' classes (level 2). Same results. Turning them on throws on a device without them.
-  bool UsesRayTracingPipelines() const { return m_useRayTracingPipelines; }
+  bool UsesRayTracingPipelines() const { return crt_useRayTracingPipelines; }
   virtual void UseRayTracingPipelines(bool a_use);
 
   // Virtual calls specialised to the scene (the default): CommitDeviceData() makes the pipelines
   // for the classes of the objects in m_scene->m_shapes, m_scene->m_lights, and makes them again when those
   // change; the switch cases of the other classes are dead code that the driver drops (shorter
   // shaders, fewer registers). Off, the pipelines keep every class's case. Same results.
-  bool SpecializesVirtualCalls() const { return m_specializeVirtualCalls; }
+  bool SpecializesVirtualCalls() const { return crt_specializeVirtualCalls; }
   virtual void SpecializeVirtualCalls(bool a_on);
 
 protected:
-  // One per kernel (and megakernel of a thread loop): records its dispatch (and barrier) into a_cmd.
-  virtual void kernel1D_TraceCmd(VkCommandBuffer a_cmd, int n, crossrt::BufferView origins, crossrt::BufferView dirs,
+  // One per kernel (and megakernel of a thread loop): records its dispatch (and barrier) into crt_cmd.
+  virtual void kernel1D_TraceCmd(VkCommandBuffer crt_cmd, int n, crossrt::BufferView origins, crossrt::BufferView dirs,
                                  float far, crossrt::BufferView hits);
-  virtual void InitPipelines();
+  virtual void crt_InitPipelines();
   // Records an update of one member's GPU copy, ordered between the kernels around it.
-  virtual void UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size);
-  virtual void ReadVectorMembers(const char* a_funcName);  // GPU -> std::vector and Image2D members kernels write
+  virtual void crt_UpdateMemberCmd(VkCommandBuffer crt_cmd, size_t a_offset, const void* a_data, size_t a_size);
+  virtual void crt_ReadVectorMembers(const char* a_funcName);  // GPU -> std::vector and Image2D members kernels write
 
   // Push constants of each kernel: thread ranges, then its scalar arguments (std430 offsets).
   struct kernel1D_TraceArgs
@@ -91,9 +91,9 @@ protected:
     alignas(4) uint32_t m_scene_m_lights_size;
   };
 
-  std::shared_ptr<crossrt::VulkanContext> m_ctx;
-  crossrt::Buffer m_classDataBuffer;
-  bool m_deviceDataCommitted = false;
+  std::shared_ptr<crossrt::VulkanContext> crt_ctx;
+  crossrt::Buffer crt_classDataBuffer;
+  bool crt_deviceDataCommitted = false;
 
   struct VectorMembers  // device copies of the std::vector members kernels use
   {
@@ -101,9 +101,9 @@ protected:
     size_t m_scene_m_boxesSize = 0;  // elements at the last CommitDeviceData()
     crossrt::Buffer m_scene_m_lightBoxes;
     size_t m_scene_m_lightBoxesSize = 0;  // elements at the last CommitDeviceData()
-  } m_vdata;
+  } crt_vdata;
   // A std::vector or Image2D member changed size, or a sampler changed, since CommitDeviceData().
-  virtual bool VectorMembersResized() const;
+  virtual bool crt_VectorMembersResized() const;
 
   // Virtual functions through m_scene->m_shapes (level 2): the GPU keeps the objects of each class
   // (Sphere, Box, Disc) in a buffer of their own and a (class, index) tag per element.
@@ -143,15 +143,15 @@ protected:
     crossrt::Buffer m_scene_m_lights_Box;
     crossrt::Buffer m_scene_m_lights_Disc;
     size_t m_scene_m_lightsSize = 0;  // elements at the last CommitDeviceData()
-  } m_virtual;
-  bool m_specializeVirtualCalls = true;
+  } crt_virtual;
+  bool crt_specializeVirtualCalls = true;
   // Per (vector, class), numbered as the shaders' constants crossrt::kClassConstantIdBase + i: whether
   // the pipelines switch over that class (its objects were there at the last CommitDeviceData()).
-  std::vector<VkBool32> m_pipelineClasses;
+  std::vector<VkBool32> crt_pipelineClasses;
   // m_scene as the ShapeScene whose traversal the kernels run and whose data they read; throws
   // when it holds another IScene (or none).
   ShapeScene* crt_m_scene() const;
-  bool m_useRayTracingPipelines = false;  // record the kernels' _Callables and _Intersections variants
+  bool crt_useRayTracingPipelines = false;  // record the kernels' _Callables and _Intersections variants
 
   // Acceleration structures for the ray tracing hardware, rebuilt at every CommitDeviceData() while
   // it is in use: the scenes kernels trace with ray queries (from ISceneObject::ExportScene), and a
@@ -160,37 +160,37 @@ protected:
   {
     crossrt::RayTracingScene m_scene_m_shapes_leaves;
     crossrt::RayTracingScene m_scene_m_lights_leaves;
-  } m_scenes;
-  virtual void CommitLeaves_m_scene_m_shapes(const std::vector<uint32_t>& a_tags);
-  virtual void CommitLeaves_m_scene_m_lights(const std::vector<uint32_t>& a_tags);
+  } crt_scenes;
+  virtual void crt_CommitLeaves_m_scene_m_shapes(const std::vector<uint32_t>& a_tags);
+  virtual void crt_CommitLeaves_m_scene_m_lights(const std::vector<uint32_t>& a_tags);
 
   struct InOut_Trace  // buffers bound by SetVulkanInOutFor_Trace
   {
     crossrt::BufferView origins;
     crossrt::BufferView dirs;
     crossrt::BufferView hits;
-  } m_inOut_Trace;
+  } crt_inOut_Trace;
 
   struct ArgumentBuffers  // device copies of pointer arguments, reused across calls
   {
     crossrt::Buffer Trace_origins;
     crossrt::Buffer Trace_dirs;
     crossrt::Buffer Trace_hits;
-  } m_args;
+  } crt_argCopies;
 
   struct Pipelines
   {
     crossrt::RayTracingPipeline kernel1D_Trace_Intersections;  // the leaves of m_scene->m_shapes and m_scene->m_lights
                                                                // as intersection shaders, in a ray tracing pipeline
     crossrt::ComputePipeline kernel1D_Trace;
-  } m_pipelines;
+  } crt_pipelines;
 
   struct Partials  // per-workgroup partial results of reductions
   {
-  } m_partials;
+  } crt_partials;
 
-  crossrt::GpuTimer m_gpuTimer;
-  std::map<std::string, std::array<float, 4>> m_times;
+  crossrt::GpuTimer crt_gpuTimer;
+  std::map<std::string, std::array<float, 4>> crt_times;
 };
 
 // Runs on the default device: CROSSRT_DEVICE (index or name) if set, else a discrete GPU, else lavapipe.

@@ -11,12 +11,13 @@ extern const size_t SortPairs_kernel1D_Make_spvBytes;
 extern const uint32_t SortPairs_kernel1D_Copy_spv[];
 extern const size_t SortPairs_kernel1D_Copy_spvBytes;
 
-SortPairs_Vulkan::SortPairs_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx) : SortPairs(), m_ctx(std::move(a_ctx))
+SortPairs_Vulkan::SortPairs_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx)
+    : SortPairs(), crt_ctx(std::move(a_ctx))
 {
-  m_classDataBuffer = crossrt::Buffer(m_ctx, sizeof(ClassData));
-  m_gpuTimer = crossrt::GpuTimer(m_ctx);
-  m_sorter = crossrt::RadixSorter(m_ctx);
-  InitPipelines();
+  crt_classDataBuffer = crossrt::Buffer(crt_ctx, sizeof(ClassData));
+  crt_gpuTimer = crossrt::GpuTimer(crt_ctx);
+  crt_sorter = crossrt::RadixSorter(crt_ctx);
+  crt_InitPipelines();
 }
 
 std::shared_ptr<SortPairs> CreateSortPairs_Vulkan()
@@ -31,72 +32,72 @@ std::shared_ptr<SortPairs> CreateSortPairs_Vulkan(std::shared_ptr<crossrt::Vulka
 
 SortPairs_Vulkan::~SortPairs_Vulkan() = default;
 
-void SortPairs_Vulkan::InitPipelines()
+void SortPairs_Vulkan::crt_InitPipelines()
 {
-  m_pipelines.kernel1D_Make =
-      crossrt::ComputePipeline(m_ctx, SortPairs_kernel1D_Make_spv, SortPairs_kernel1D_Make_spvBytes, 2,
+  crt_pipelines.kernel1D_Make =
+      crossrt::ComputePipeline(crt_ctx, SortPairs_kernel1D_Make_spv, SortPairs_kernel1D_Make_spvBytes, 2,
                                sizeof(kernel1D_MakeArgs), "SortPairs::kernel1D_Make");
-  m_pipelines.kernel1D_Copy =
-      crossrt::ComputePipeline(m_ctx, SortPairs_kernel1D_Copy_spv, SortPairs_kernel1D_Copy_spvBytes, 3,
+  crt_pipelines.kernel1D_Copy =
+      crossrt::ComputePipeline(crt_ctx, SortPairs_kernel1D_Copy_spv, SortPairs_kernel1D_Copy_spvBytes, 3,
                                sizeof(kernel1D_CopyArgs), "SortPairs::kernel1D_Copy");
 }
 
-void SortPairs_Vulkan::UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size)
+void SortPairs_Vulkan::crt_UpdateMemberCmd(VkCommandBuffer crt_cmd, size_t a_offset, const void* a_data, size_t a_size)
 {
-  crossrt::ComputeBarrier(a_cmd);  // kernels recorded before it are done with the class data
-  vkCmdUpdateBuffer(a_cmd, m_classDataBuffer.Handle(), a_offset, a_size, a_data);
-  crossrt::TransferToComputeBarrier(a_cmd);
+  crossrt::ComputeBarrier(crt_cmd);  // kernels recorded before it are done with the class data
+  vkCmdUpdateBuffer(crt_cmd, crt_classDataBuffer.Handle(), a_offset, a_size, a_data);
+  crossrt::TransferToComputeBarrier(crt_cmd);
 }
 
-void SortPairs_Vulkan::UpdatePlainMembers()
+void SortPairs_Vulkan::crt_UpdatePlainMembers()
 {
   ClassData data{};
   data.m_pairs_size = uint32_t(m_pairs.size());
   data.m_pairs_capacity = uint32_t(m_pairs.capacity());
-  m_classDataBuffer.Upload(&data, sizeof(data));
+  crt_classDataBuffer.Upload(&data, sizeof(data));
 }
 
-void SortPairs_Vulkan::ReadPlainMembers()
+void SortPairs_Vulkan::crt_ReadPlainMembers()
 {
 }
 
 void SortPairs_Vulkan::CommitDeviceData()
 {
   // std::vector members become buffers of their capacity; kernels see size and capacity.
-  crossrt::EnsureSize(m_ctx, m_vdata.m_pairs, sizeof(LiteMath::uint2) * m_pairs.capacity());
+  crossrt::EnsureSize(crt_ctx, crt_vdata.m_pairs, sizeof(LiteMath::uint2) * m_pairs.capacity());
   if (!m_pairs.empty())
-    m_vdata.m_pairs.Upload(m_pairs.data(), sizeof(LiteMath::uint2) * m_pairs.size());
-  m_vdata.m_pairsSize = m_pairs.size();
-  UpdatePlainMembers();
-  m_deviceDataCommitted = true;
+    crt_vdata.m_pairs.Upload(m_pairs.data(), sizeof(LiteMath::uint2) * m_pairs.size());
+  crt_vdata.m_pairsSize = m_pairs.size();
+  crt_UpdatePlainMembers();
+  crt_deviceDataCommitted = true;
 }
 
-bool SortPairs_Vulkan::VectorMembersResized() const
+bool SortPairs_Vulkan::crt_VectorMembersResized() const
 {
   bool resized = false;
-  resized = resized || m_pairs.size() != m_vdata.m_pairsSize;
+  resized = resized || m_pairs.size() != crt_vdata.m_pairsSize;
   return resized;
 }
 
-void SortPairs_Vulkan::ReadVectorMembers(const char* a_funcName)
+void SortPairs_Vulkan::crt_ReadVectorMembers(const char* a_funcName)
 {
   (void)a_funcName;
   if (std::strcmp(a_funcName, "MakeAndSort") == 0 && !m_pairs.empty())
-    m_vdata.m_pairs.Download(m_pairs.data(), sizeof(LiteMath::uint2) * m_pairs.size());
+    crt_vdata.m_pairs.Download(m_pairs.data(), sizeof(LiteMath::uint2) * m_pairs.size());
 }
 
 void SortPairs_Vulkan::GetExecutionTime(const char* a_funcName, float a_out[4])
 {
-  auto it = m_times.find(a_funcName);
+  auto it = crt_times.find(a_funcName);
   for (int i = 0; i < 4; ++i)
-    a_out[i] = it == m_times.end() ? 0.0f : it->second[i];
+    a_out[i] = it == crt_times.end() ? 0.0f : it->second[i];
 }
 
 // ---- MakeAndSort (from SortPairs::MakeAndSort, sort_pairs.cpp) ----
 
 void SortPairs_Vulkan::SetVulkanInOutFor_MakeAndSort(crossrt::BufferView a_a_out)
 {
-  m_inOut_MakeAndSort.a_out = a_a_out;
+  crt_inOut_MakeAndSort.a_out = a_a_out;
 }
 
 void SortPairs_Vulkan::MakeAndSort(uint32_t a_seed, uint2* a_out)
@@ -106,49 +107,49 @@ void SortPairs_Vulkan::MakeAndSort(uint32_t a_seed, uint2* a_out)
   // std::vector members are uploaded by CommitDeviceData(): here once, and again whenever one
   // changed size (its device buffer would be too small). After changing the contents of a
   // vector without resizing it, call CommitDeviceData().
-  if (!crt_self->m_deviceDataCommitted || crt_self->VectorMembersResized())
+  if (!crt_self->crt_deviceDataCommitted || crt_self->crt_VectorMembersResized())
     crt_self->CommitDeviceData();
 
   crossrt::CpuTimer crt_copyIn;
   const size_t crt_a_outBytes = sizeof(uint2) * size_t(1000);
-  crossrt::EnsureSize(m_ctx, crt_self->m_args.MakeAndSort_a_out, crt_a_outBytes);
+  crossrt::EnsureSize(crt_ctx, crt_self->crt_argCopies.MakeAndSort_a_out, crt_a_outBytes);
   if (crt_a_outBytes > 0)
-    crt_self->m_args.MakeAndSort_a_out.Upload(a_out, crt_a_outBytes);
-  crt_self->SetVulkanInOutFor_MakeAndSort(crt_self->m_args.MakeAndSort_a_out.View());
+    crt_self->crt_argCopies.MakeAndSort_a_out.Upload(a_out, crt_a_outBytes);
+  crt_self->SetVulkanInOutFor_MakeAndSort(crt_self->crt_argCopies.MakeAndSort_a_out.View());
   const float crt_copyInMs = crt_copyIn.ElapsedMs();
 
   // Members as they are now; host code of MakeAndSort that changes one records an update in order.
-  crt_self->UpdatePlainMembers();
-  VkCommandBuffer crt_cmd = m_ctx->BeginOneShot();
-  crt_self->m_gpuTimer.Reset(crt_cmd);
-  crt_self->m_gpuTimer.Begin(crt_cmd, "MakeAndSort");
+  crt_self->crt_UpdatePlainMembers();
+  VkCommandBuffer crt_cmd = crt_ctx->BeginOneShot();
+  crt_self->crt_gpuTimer.Reset(crt_cmd);
+  crt_self->crt_gpuTimer.Begin(crt_cmd, "MakeAndSort");
   crt_self->MakeAndSortCmd(crt_cmd, a_seed, a_out);
-  crt_self->m_gpuTimer.End(crt_cmd, "MakeAndSort");
-  m_ctx->SubmitAndWait(crt_cmd);
-  crt_self->m_gpuTimer.Collect();
-  crt_self->m_sorter.ReleaseRetired();  // scratch that grew while recording
+  crt_self->crt_gpuTimer.End(crt_cmd, "MakeAndSort");
+  crt_ctx->SubmitAndWait(crt_cmd);
+  crt_self->crt_gpuTimer.Collect();
+  crt_self->crt_sorter.ReleaseRetired();  // scratch that grew while recording
 
   crossrt::CpuTimer crt_copyOut;
-  crt_self->ReadPlainMembers();
-  crt_self->ReadVectorMembers("MakeAndSort");
+  crt_self->crt_ReadPlainMembers();
+  crt_self->crt_ReadVectorMembers("MakeAndSort");
   if (crt_a_outBytes > 0)
-    crt_self->m_args.MakeAndSort_a_out.Download(a_out, crt_a_outBytes);
-  crt_self->m_times["MakeAndSort"] = {crt_self->m_gpuTimer.LastMs("MakeAndSort"), crt_copyInMs, crt_copyOut.ElapsedMs(),
-                                      crt_total.ElapsedMs()};
+    crt_self->crt_argCopies.MakeAndSort_a_out.Download(a_out, crt_a_outBytes);
+  crt_self->crt_times["MakeAndSort"] = {crt_self->crt_gpuTimer.LastMs("MakeAndSort"), crt_copyInMs,
+                                        crt_copyOut.ElapsedMs(), crt_total.ElapsedMs()};
 }
 
 // The body of SortPairs::MakeAndSort, with each kernel call turned into its ...Cmd.
-void SortPairs_Vulkan::MakeAndSortCmd(VkCommandBuffer a_cmd, uint32_t a_seed, [[maybe_unused]] uint2* a_out)
+void SortPairs_Vulkan::MakeAndSortCmd(VkCommandBuffer crt_cmd, uint32_t a_seed, [[maybe_unused]] uint2* a_out)
 {
-  kernel1D_MakeCmd(a_cmd, uint32_t(m_pairs.size()), a_seed);
-  m_sorter.RecordCmd(a_cmd, m_vdata.m_pairs.View(), uint32_t(m_pairs.size()),
-                     crossrt::SortKey{2, 0, crossrt::ElementType::Uint, false});
-  kernel1D_CopyCmd(a_cmd, uint32_t(m_pairs.size()), m_inOut_MakeAndSort.a_out);
+  kernel1D_MakeCmd(crt_cmd, uint32_t(m_pairs.size()), a_seed);
+  crt_sorter.RecordCmd(crt_cmd, crt_vdata.m_pairs.View(), uint32_t(m_pairs.size()),
+                       crossrt::SortKey{2, 0, crossrt::ElementType::Uint, false});
+  kernel1D_CopyCmd(crt_cmd, uint32_t(m_pairs.size()), crt_inOut_MakeAndSort.a_out);
 }
 
 // ---- kernel1D_Make (from SortPairs::kernel1D_Make, sort_pairs.cpp) ----
 
-void SortPairs_Vulkan::kernel1D_MakeCmd(VkCommandBuffer a_cmd, uint32_t n, uint32_t a_seed)
+void SortPairs_Vulkan::kernel1D_MakeCmd(VkCommandBuffer crt_cmd, uint32_t n, uint32_t a_seed)
 {
   const int crt_startX = int(0);
   const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(n)));
@@ -159,16 +160,16 @@ void SortPairs_Vulkan::kernel1D_MakeCmd(VkCommandBuffer a_cmd, uint32_t n, uint3
   crt_args.crt_countX = crt_countX;
   crt_args.n = n;
   crt_args.a_seed = a_seed;
-  m_pipelines.kernel1D_Make.Bind(a_cmd);
-  m_pipelines.kernel1D_Make.PushBuffers(a_cmd, {m_classDataBuffer.View(), m_vdata.m_pairs.View()});
-  m_pipelines.kernel1D_Make.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  crossrt::Dispatch1D(a_cmd, crt_countX, 256);
-  crossrt::ComputeBarrier(a_cmd);
+  crt_pipelines.kernel1D_Make.Bind(crt_cmd);
+  crt_pipelines.kernel1D_Make.PushBuffers(crt_cmd, {crt_classDataBuffer.View(), crt_vdata.m_pairs.View()});
+  crt_pipelines.kernel1D_Make.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
+  crossrt::Dispatch1D(crt_cmd, crt_countX, 256);
+  crossrt::ComputeBarrier(crt_cmd);
 }
 
 // ---- kernel1D_Copy (from SortPairs::kernel1D_Copy, sort_pairs.cpp) ----
 
-void SortPairs_Vulkan::kernel1D_CopyCmd(VkCommandBuffer a_cmd, uint32_t n, crossrt::BufferView a_out)
+void SortPairs_Vulkan::kernel1D_CopyCmd(VkCommandBuffer crt_cmd, uint32_t n, crossrt::BufferView a_out)
 {
   const int crt_startX = int(0);
   const uint32_t crt_countX = uint32_t(std::max<int64_t>(0, int64_t(n)));
@@ -178,9 +179,9 @@ void SortPairs_Vulkan::kernel1D_CopyCmd(VkCommandBuffer a_cmd, uint32_t n, cross
   crt_args.crt_startX = crt_startX;
   crt_args.crt_countX = crt_countX;
   crt_args.n = n;
-  m_pipelines.kernel1D_Copy.Bind(a_cmd);
-  m_pipelines.kernel1D_Copy.PushBuffers(a_cmd, {m_classDataBuffer.View(), a_out, m_vdata.m_pairs.View()});
-  m_pipelines.kernel1D_Copy.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  crossrt::Dispatch1D(a_cmd, crt_countX, 256);
-  crossrt::ComputeBarrier(a_cmd);
+  crt_pipelines.kernel1D_Copy.Bind(crt_cmd);
+  crt_pipelines.kernel1D_Copy.PushBuffers(crt_cmd, {crt_classDataBuffer.View(), a_out, crt_vdata.m_pairs.View()});
+  crt_pipelines.kernel1D_Copy.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
+  crossrt::Dispatch1D(crt_cmd, crt_countX, 256);
+  crossrt::ComputeBarrier(crt_cmd);
 }

@@ -29,9 +29,9 @@ std::shared_ptr<SpherePaths> CreateSpherePaths_ISPC()
 
 void SpherePaths_ISPC::GetExecutionTime(const char* a_funcName, float a_out[4])
 {
-  auto it = m_times.find(a_funcName);
+  auto it = crt_times.find(a_funcName);
   for (int i = 0; i < 4; ++i)
-    a_out[i] = it == m_times.end() ? 0.0f : it->second[i];
+    a_out[i] = it == crt_times.end() ? 0.0f : it->second[i];
 }
 
 // The plain members the kernels of thread loops set (flags), copied back after the loop.
@@ -69,7 +69,7 @@ void SpherePaths_ISPC::Render(uint32_t width, uint32_t height, int samples, floa
     m_timeMs = std::chrono::duration<float, std::milli>(std::chrono::steady_clock::now() - start).count();
   }();
   const float crt_ms = std::chrono::duration<float, std::milli>(std::chrono::steady_clock::now() - crt_start).count();
-  const_cast<SpherePaths_ISPC*>(this)->m_times["Render"] = {0.0f, 0.0f, 0.0f, crt_ms};
+  const_cast<SpherePaths_ISPC*>(this)->crt_times["Render"] = {0.0f, 0.0f, 0.0f, crt_ms};
 }
 
 // The members the ISPC kernels read, as SpherePaths_ISPC_kernels.ispc declares them.

@@ -32,7 +32,7 @@ protected:
   // The plain members the kernels of thread loops set (flags), copied back from the ISPC class data.
   void IspcWrittenBack(const ispc::SpherePaths_Data& data);
 
-  std::map<std::string, std::array<float, 4>> m_times;
+  std::map<std::string, std::array<float, 4>> crt_times;
 };
 
 std::shared_ptr<SpherePaths> CreateSpherePaths_ISPC();

@@ -23,11 +23,11 @@ extern const uint32_t SpherePaths_Render_Megakernel_spv[];
 extern const size_t SpherePaths_Render_Megakernel_spvBytes;
 
 SpherePaths_Vulkan::SpherePaths_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx)
-    : SpherePaths(), m_ctx(std::move(a_ctx))
+    : SpherePaths(), crt_ctx(std::move(a_ctx))
 {
-  m_classDataBuffer = crossrt::Buffer(m_ctx, sizeof(ClassData));
-  m_gpuTimer = crossrt::GpuTimer(m_ctx);
-  InitPipelines();
+  crt_classDataBuffer = crossrt::Buffer(crt_ctx, sizeof(ClassData));
+  crt_gpuTimer = crossrt::GpuTimer(crt_ctx);
+  crt_InitPipelines();
 }
 
 std::shared_ptr<SpherePaths> CreateSpherePaths_Vulkan()
@@ -42,33 +42,34 @@ std::shared_ptr<SpherePaths> CreateSpherePaths_Vulkan(std::shared_ptr<crossrt::V
 
 SpherePaths_Vulkan::~SpherePaths_Vulkan() = default;
 
-void SpherePaths_Vulkan::InitPipelines()
+void SpherePaths_Vulkan::crt_InitPipelines()
 {
-  m_pipelines.kernel_InitEyeRay =
-      crossrt::ComputePipeline(m_ctx, SpherePaths_kernel_InitEyeRay_spv, SpherePaths_kernel_InitEyeRay_spvBytes, 4,
+  crt_pipelines.kernel_InitEyeRay =
+      crossrt::ComputePipeline(crt_ctx, SpherePaths_kernel_InitEyeRay_spv, SpherePaths_kernel_InitEyeRay_spvBytes, 4,
                                sizeof(kernel_InitEyeRayArgs), "SpherePaths::kernel_InitEyeRay");
-  m_pipelines.kernel_RayTrace =
-      crossrt::ComputePipeline(m_ctx, SpherePaths_kernel_RayTrace_spv, SpherePaths_kernel_RayTrace_spvBytes, 6,
+  crt_pipelines.kernel_RayTrace =
+      crossrt::ComputePipeline(crt_ctx, SpherePaths_kernel_RayTrace_spv, SpherePaths_kernel_RayTrace_spvBytes, 6,
                                sizeof(kernel_RayTraceArgs), "SpherePaths::kernel_RayTrace");
-  m_pipelines.kernel_NextBounce =
-      crossrt::ComputePipeline(m_ctx, SpherePaths_kernel_NextBounce_spv, SpherePaths_kernel_NextBounce_spvBytes, 7,
+  crt_pipelines.kernel_NextBounce =
+      crossrt::ComputePipeline(crt_ctx, SpherePaths_kernel_NextBounce_spv, SpherePaths_kernel_NextBounce_spvBytes, 7,
                                sizeof(kernel_NextBounceArgs), "SpherePaths::kernel_NextBounce");
-  m_pipelines.kernel_Contribute =
-      crossrt::ComputePipeline(m_ctx, SpherePaths_kernel_Contribute_spv, SpherePaths_kernel_Contribute_spvBytes, 3,
+  crt_pipelines.kernel_Contribute =
+      crossrt::ComputePipeline(crt_ctx, SpherePaths_kernel_Contribute_spv, SpherePaths_kernel_Contribute_spvBytes, 3,
                                sizeof(kernel_ContributeArgs), "SpherePaths::kernel_Contribute");
-  m_pipelines.Render_Megakernel =
-      crossrt::ComputePipeline(m_ctx, SpherePaths_Render_Megakernel_spv, SpherePaths_Render_Megakernel_spvBytes, 3,
+  crt_pipelines.Render_Megakernel =
+      crossrt::ComputePipeline(crt_ctx, SpherePaths_Render_Megakernel_spv, SpherePaths_Render_Megakernel_spvBytes, 3,
                                sizeof(Render_MegakernelArgs), "SpherePaths::Render_Megakernel");
 }
 
-void SpherePaths_Vulkan::UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size)
+void SpherePaths_Vulkan::crt_UpdateMemberCmd(VkCommandBuffer crt_cmd, size_t a_offset, const void* a_data,
+                                             size_t a_size)
 {
-  crossrt::ComputeBarrier(a_cmd);  // kernels recorded before it are done with the class data
-  vkCmdUpdateBuffer(a_cmd, m_classDataBuffer.Handle(), a_offset, a_size, a_data);
-  crossrt::TransferToComputeBarrier(a_cmd);
+  crossrt::ComputeBarrier(crt_cmd);  // kernels recorded before it are done with the class data
+  vkCmdUpdateBuffer(crt_cmd, crt_classDataBuffer.Handle(), a_offset, a_size, a_data);
+  crossrt::TransferToComputeBarrier(crt_cmd);
 }
 
-void SpherePaths_Vulkan::UpdatePlainMembers()
+void SpherePaths_Vulkan::crt_UpdatePlainMembers()
 {
   ClassData data{};
   std::memcpy(&data.m_cameraPos, &m_cameraPos, sizeof(data.m_cameraPos));
@@ -77,48 +78,48 @@ void SpherePaths_Vulkan::UpdatePlainMembers()
   std::memcpy(&data.m_timeMs, &m_timeMs, sizeof(data.m_timeMs));
   data.m_spheres_size = uint32_t(m_spheres.size());
   data.m_spheres_capacity = uint32_t(m_spheres.capacity());
-  m_classDataBuffer.Upload(&data, sizeof(data));
+  crt_classDataBuffer.Upload(&data, sizeof(data));
 }
 
-void SpherePaths_Vulkan::ReadPlainMembers()
+void SpherePaths_Vulkan::crt_ReadPlainMembers()
 {
 }
 
 void SpherePaths_Vulkan::CommitDeviceData()
 {
   // std::vector members become buffers of their capacity; kernels see size and capacity.
-  crossrt::EnsureSize(m_ctx, m_vdata.m_spheres, sizeof(Sphere) * m_spheres.capacity());
+  crossrt::EnsureSize(crt_ctx, crt_vdata.m_spheres, sizeof(Sphere) * m_spheres.capacity());
   if (!m_spheres.empty())
-    m_vdata.m_spheres.Upload(m_spheres.data(), sizeof(Sphere) * m_spheres.size());
-  m_vdata.m_spheresSize = m_spheres.size();
-  UpdatePlainMembers();
-  m_deviceDataCommitted = true;
+    crt_vdata.m_spheres.Upload(m_spheres.data(), sizeof(Sphere) * m_spheres.size());
+  crt_vdata.m_spheresSize = m_spheres.size();
+  crt_UpdatePlainMembers();
+  crt_deviceDataCommitted = true;
 }
 
-bool SpherePaths_Vulkan::VectorMembersResized() const
+bool SpherePaths_Vulkan::crt_VectorMembersResized() const
 {
   bool resized = false;
-  resized = resized || m_spheres.size() != m_vdata.m_spheresSize;
+  resized = resized || m_spheres.size() != crt_vdata.m_spheresSize;
   return resized;
 }
 
-void SpherePaths_Vulkan::ReadVectorMembers(const char* a_funcName)
+void SpherePaths_Vulkan::crt_ReadVectorMembers(const char* a_funcName)
 {
   (void)a_funcName;
 }
 
 void SpherePaths_Vulkan::GetExecutionTime(const char* a_funcName, float a_out[4])
 {
-  auto it = m_times.find(a_funcName);
+  auto it = crt_times.find(a_funcName);
   for (int i = 0; i < 4; ++i)
-    a_out[i] = it == m_times.end() ? 0.0f : it->second[i];
+    a_out[i] = it == crt_times.end() ? 0.0f : it->second[i];
 }
 
 // ---- Render (from SpherePaths::Render, SpherePaths.cpp) ----
 
 void SpherePaths_Vulkan::SetVulkanInOutFor_Render(crossrt::BufferView a_out_color)
 {
-  m_inOut_Render.out_color = a_out_color;
+  crt_inOut_Render.out_color = a_out_color;
 }
 
 void SpherePaths_Vulkan::Render(uint32_t width, uint32_t height, int samples, float4* out_color)
@@ -128,79 +129,80 @@ void SpherePaths_Vulkan::Render(uint32_t width, uint32_t height, int samples, fl
   // std::vector members are uploaded by CommitDeviceData(): here once, and again whenever one
   // changed size (its device buffer would be too small). After changing the contents of a
   // vector without resizing it, call CommitDeviceData().
-  if (!crt_self->m_deviceDataCommitted || crt_self->VectorMembersResized())
+  if (!crt_self->crt_deviceDataCommitted || crt_self->crt_VectorMembersResized())
     crt_self->CommitDeviceData();
 
   crossrt::CpuTimer crt_copyIn;
   const size_t crt_out_colorBytes = sizeof(float4) * size_t(width * height);
-  crossrt::EnsureSize(m_ctx, crt_self->m_args.Render_out_color, crt_out_colorBytes);
+  crossrt::EnsureSize(crt_ctx, crt_self->crt_argCopies.Render_out_color, crt_out_colorBytes);
   if (crt_out_colorBytes > 0)
-    crt_self->m_args.Render_out_color.Upload(out_color, crt_out_colorBytes);
-  crt_self->SetVulkanInOutFor_Render(crt_self->m_args.Render_out_color.View());
+    crt_self->crt_argCopies.Render_out_color.Upload(out_color, crt_out_colorBytes);
+  crt_self->SetVulkanInOutFor_Render(crt_self->crt_argCopies.Render_out_color.View());
   const float crt_copyInMs = crt_copyIn.ElapsedMs();
 
   // Members as they are now; host code of Render that changes one records an update in order.
-  crt_self->UpdatePlainMembers();
-  VkCommandBuffer crt_cmd = m_ctx->BeginOneShot();
-  crt_self->m_gpuTimer.Reset(crt_cmd);
-  crt_self->m_gpuTimer.Begin(crt_cmd, "Render");
+  crt_self->crt_UpdatePlainMembers();
+  VkCommandBuffer crt_cmd = crt_ctx->BeginOneShot();
+  crt_self->crt_gpuTimer.Reset(crt_cmd);
+  crt_self->crt_gpuTimer.Begin(crt_cmd, "Render");
   crt_self->RenderCmd(crt_cmd, width, height, samples, out_color);
-  crt_self->m_gpuTimer.End(crt_cmd, "Render");
-  m_ctx->SubmitAndWait(crt_cmd);
-  crt_self->m_gpuTimer.Collect();
+  crt_self->crt_gpuTimer.End(crt_cmd, "Render");
+  crt_ctx->SubmitAndWait(crt_cmd);
+  crt_self->crt_gpuTimer.Collect();
 
   crossrt::CpuTimer crt_copyOut;
-  crt_self->ReadPlainMembers();
-  crt_self->ReadVectorMembers("Render");
+  crt_self->crt_ReadPlainMembers();
+  crt_self->crt_ReadVectorMembers("Render");
   if (crt_out_colorBytes > 0)
-    crt_self->m_args.Render_out_color.Download(out_color, crt_out_colorBytes);
-  crt_self->m_times["Render"] = {crt_self->m_gpuTimer.LastMs("Render"), crt_copyInMs, crt_copyOut.ElapsedMs(),
-                                 crt_total.ElapsedMs()};
+    crt_self->crt_argCopies.Render_out_color.Download(out_color, crt_out_colorBytes);
+  crt_self->crt_times["Render"] = {crt_self->crt_gpuTimer.LastMs("Render"), crt_copyInMs, crt_copyOut.ElapsedMs(),
+                                   crt_total.ElapsedMs()};
 }
 
 // The body of SpherePaths::Render, with each kernel call turned into its ...Cmd.
-void SpherePaths_Vulkan::RenderCmd(VkCommandBuffer a_cmd, uint32_t width, uint32_t height, int samples,
+void SpherePaths_Vulkan::RenderCmd(VkCommandBuffer crt_cmd, uint32_t width, uint32_t height, int samples,
                                    [[maybe_unused]] float4* out_color)
 {
   const auto start = std::chrono::steady_clock::now();
-  if (m_executionMode == crossrt::ExecutionMode::Megakernel)
-    Render_MegakernelCmd(a_cmd, width, height, m_inOut_Render.out_color, samples, width, height);
+  if (crt_executionMode == crossrt::ExecutionMode::Megakernel)
+    Render_MegakernelCmd(crt_cmd, width, height, crt_inOut_Render.out_color, samples, width, height);
   else
   {
     const size_t crt_threads = size_t(height) * size_t(width);
-    crossrt::EnsureSize(m_ctx, m_threadState.Render_rayPos, sizeof(float4) * std::max<size_t>(1, crt_threads));
-    crossrt::FillCmd(a_cmd, m_threadState.Render_rayPos.View(), sizeof(float4) * crt_threads, 0);
-    crossrt::EnsureSize(m_ctx, m_threadState.Render_rayDir, sizeof(float4) * std::max<size_t>(1, crt_threads));
-    crossrt::FillCmd(a_cmd, m_threadState.Render_rayDir.View(), sizeof(float4) * crt_threads, 0);
-    crossrt::EnsureSize(m_ctx, m_threadState.Render_throughput, sizeof(float4) * std::max<size_t>(1, crt_threads));
-    crossrt::FillCmd(a_cmd, m_threadState.Render_throughput.View(), sizeof(float4) * crt_threads, 0);
-    crossrt::EnsureSize(m_ctx, m_threadState.Render_color, sizeof(float4) * std::max<size_t>(1, crt_threads));
-    crossrt::FillCmd(a_cmd, m_threadState.Render_color.View(), sizeof(float4) * crt_threads, 0);
-    crossrt::EnsureSize(m_ctx, m_threadState.Render_hit, sizeof(SphereHit) * std::max<size_t>(1, crt_threads));
-    crossrt::FillCmd(a_cmd, m_threadState.Render_hit.View(), sizeof(SphereHit) * crt_threads, 0);
+    crossrt::EnsureSize(crt_ctx, crt_threadState.Render_rayPos, sizeof(float4) * std::max<size_t>(1, crt_threads));
+    crossrt::FillCmd(crt_cmd, crt_threadState.Render_rayPos.View(), sizeof(float4) * crt_threads, 0);
+    crossrt::EnsureSize(crt_ctx, crt_threadState.Render_rayDir, sizeof(float4) * std::max<size_t>(1, crt_threads));
+    crossrt::FillCmd(crt_cmd, crt_threadState.Render_rayDir.View(), sizeof(float4) * crt_threads, 0);
+    crossrt::EnsureSize(crt_ctx, crt_threadState.Render_throughput, sizeof(float4) * std::max<size_t>(1, crt_threads));
+    crossrt::FillCmd(crt_cmd, crt_threadState.Render_throughput.View(), sizeof(float4) * crt_threads, 0);
+    crossrt::EnsureSize(crt_ctx, crt_threadState.Render_color, sizeof(float4) * std::max<size_t>(1, crt_threads));
+    crossrt::FillCmd(crt_cmd, crt_threadState.Render_color.View(), sizeof(float4) * crt_threads, 0);
+    crossrt::EnsureSize(crt_ctx, crt_threadState.Render_hit, sizeof(SphereHit) * std::max<size_t>(1, crt_threads));
+    crossrt::FillCmd(crt_cmd, crt_threadState.Render_hit.View(), sizeof(SphereHit) * crt_threads, 0);
     for (int sample = 0; sample < samples; sample++)
     {
-      kernel_InitEyeRayCmd(a_cmd, width, height, width, height, sample, m_threadState.Render_rayPos.View(),
-                           m_threadState.Render_rayDir.View(), m_threadState.Render_throughput.View());
+      kernel_InitEyeRayCmd(crt_cmd, width, height, width, height, sample, crt_threadState.Render_rayPos.View(),
+                           crt_threadState.Render_rayDir.View(), crt_threadState.Render_throughput.View());
       for (int bounce = 0; bounce < m_maxDepth; bounce++)
       {
-        kernel_RayTraceCmd(a_cmd, width, height, m_threadState.Render_rayPos.View(), m_threadState.Render_rayDir.View(),
-                           m_threadState.Render_throughput.View(), m_threadState.Render_hit.View());
-        kernel_NextBounceCmd(a_cmd, width, height, width, sample, bounce, m_threadState.Render_hit.View(),
-                             m_threadState.Render_rayPos.View(), m_threadState.Render_rayDir.View(),
-                             m_threadState.Render_throughput.View(), m_threadState.Render_color.View());
+        kernel_RayTraceCmd(crt_cmd, width, height, crt_threadState.Render_rayPos.View(),
+                           crt_threadState.Render_rayDir.View(), crt_threadState.Render_throughput.View(),
+                           crt_threadState.Render_hit.View());
+        kernel_NextBounceCmd(crt_cmd, width, height, width, sample, bounce, crt_threadState.Render_hit.View(),
+                             crt_threadState.Render_rayPos.View(), crt_threadState.Render_rayDir.View(),
+                             crt_threadState.Render_throughput.View(), crt_threadState.Render_color.View());
       }
     }
-    kernel_ContributeCmd(a_cmd, width, height, width, samples, m_threadState.Render_color.View(),
-                         m_inOut_Render.out_color);
+    kernel_ContributeCmd(crt_cmd, width, height, width, samples, crt_threadState.Render_color.View(),
+                         crt_inOut_Render.out_color);
   }
   m_timeMs = std::chrono::duration<float, std::milli>(std::chrono::steady_clock::now() - start).count();
-  UpdateMemberCmd(a_cmd, offsetof(ClassData, m_timeMs), &m_timeMs, sizeof(m_timeMs));
+  crt_UpdateMemberCmd(crt_cmd, offsetof(ClassData, m_timeMs), &m_timeMs, sizeof(m_timeMs));
 }
 
 // ---- kernel_InitEyeRay (from SpherePaths::kernel_InitEyeRay, SpherePaths.cpp) ----
 
-void SpherePaths_Vulkan::kernel_InitEyeRayCmd(VkCommandBuffer a_cmd, uint32_t a_threadsX, uint32_t a_threadsY,
+void SpherePaths_Vulkan::kernel_InitEyeRayCmd(VkCommandBuffer crt_cmd, uint32_t a_threadsX, uint32_t a_threadsY,
                                               uint32_t width, uint32_t height, int sample, crossrt::BufferView rayPos,
                                               crossrt::BufferView rayDir, crossrt::BufferView throughput)
 {
@@ -218,16 +220,16 @@ void SpherePaths_Vulkan::kernel_InitEyeRayCmd(VkCommandBuffer a_cmd, uint32_t a_
   crt_args.width = width;
   crt_args.height = height;
   crt_args.sample_ = sample;
-  m_pipelines.kernel_InitEyeRay.Bind(a_cmd);
-  m_pipelines.kernel_InitEyeRay.PushBuffers(a_cmd, {m_classDataBuffer.View(), rayPos, rayDir, throughput});
-  m_pipelines.kernel_InitEyeRay.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  crossrt::Dispatch2D(a_cmd, crt_countX, crt_countY, 16, 16);
-  crossrt::ComputeBarrier(a_cmd);
+  crt_pipelines.kernel_InitEyeRay.Bind(crt_cmd);
+  crt_pipelines.kernel_InitEyeRay.PushBuffers(crt_cmd, {crt_classDataBuffer.View(), rayPos, rayDir, throughput});
+  crt_pipelines.kernel_InitEyeRay.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
+  crossrt::Dispatch2D(crt_cmd, crt_countX, crt_countY, 16, 16);
+  crossrt::ComputeBarrier(crt_cmd);
 }
 
 // ---- kernel_RayTrace (from SpherePaths::kernel_RayTrace, SpherePaths.cpp) ----
 
-void SpherePaths_Vulkan::kernel_RayTraceCmd(VkCommandBuffer a_cmd, uint32_t a_threadsX, uint32_t a_threadsY,
+void SpherePaths_Vulkan::kernel_RayTraceCmd(VkCommandBuffer crt_cmd, uint32_t a_threadsX, uint32_t a_threadsY,
                                             crossrt::BufferView rayPos, crossrt::BufferView rayDir,
                                             crossrt::BufferView throughput, crossrt::BufferView hit)
 {
@@ -242,17 +244,17 @@ void SpherePaths_Vulkan::kernel_RayTraceCmd(VkCommandBuffer a_cmd, uint32_t a_th
   crt_args.crt_startY = crt_startY;
   crt_args.crt_countX = crt_countX;
   crt_args.crt_countY = crt_countY;
-  m_pipelines.kernel_RayTrace.Bind(a_cmd);
-  m_pipelines.kernel_RayTrace.PushBuffers(
-      a_cmd, {m_classDataBuffer.View(), rayPos, rayDir, throughput, hit, m_vdata.m_spheres.View()});
-  m_pipelines.kernel_RayTrace.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  crossrt::Dispatch2D(a_cmd, crt_countX, crt_countY, 16, 16);
-  crossrt::ComputeBarrier(a_cmd);
+  crt_pipelines.kernel_RayTrace.Bind(crt_cmd);
+  crt_pipelines.kernel_RayTrace.PushBuffers(
+      crt_cmd, {crt_classDataBuffer.View(), rayPos, rayDir, throughput, hit, crt_vdata.m_spheres.View()});
+  crt_pipelines.kernel_RayTrace.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
+  crossrt::Dispatch2D(crt_cmd, crt_countX, crt_countY, 16, 16);
+  crossrt::ComputeBarrier(crt_cmd);
 }
 
 // ---- kernel_NextBounce (from SpherePaths::kernel_NextBounce, SpherePaths.cpp) ----
 
-void SpherePaths_Vulkan::kernel_NextBounceCmd(VkCommandBuffer a_cmd, uint32_t a_threadsX, uint32_t a_threadsY,
+void SpherePaths_Vulkan::kernel_NextBounceCmd(VkCommandBuffer crt_cmd, uint32_t a_threadsX, uint32_t a_threadsY,
                                               uint32_t width, int sample, int bounce, crossrt::BufferView hit,
                                               crossrt::BufferView rayPos, crossrt::BufferView rayDir,
                                               crossrt::BufferView throughput, crossrt::BufferView color)
@@ -271,17 +273,17 @@ void SpherePaths_Vulkan::kernel_NextBounceCmd(VkCommandBuffer a_cmd, uint32_t a_
   crt_args.width = width;
   crt_args.sample_ = sample;
   crt_args.bounce = bounce;
-  m_pipelines.kernel_NextBounce.Bind(a_cmd);
-  m_pipelines.kernel_NextBounce.PushBuffers(
-      a_cmd, {m_classDataBuffer.View(), hit, rayPos, rayDir, throughput, color, m_vdata.m_spheres.View()});
-  m_pipelines.kernel_NextBounce.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  crossrt::Dispatch2D(a_cmd, crt_countX, crt_countY, 16, 16);
-  crossrt::ComputeBarrier(a_cmd);
+  crt_pipelines.kernel_NextBounce.Bind(crt_cmd);
+  crt_pipelines.kernel_NextBounce.PushBuffers(
+      crt_cmd, {crt_classDataBuffer.View(), hit, rayPos, rayDir, throughput, color, crt_vdata.m_spheres.View()});
+  crt_pipelines.kernel_NextBounce.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
+  crossrt::Dispatch2D(crt_cmd, crt_countX, crt_countY, 16, 16);
+  crossrt::ComputeBarrier(crt_cmd);
 }
 
 // ---- kernel_Contribute (from SpherePaths::kernel_Contribute, SpherePaths.cpp) ----
 
-void SpherePaths_Vulkan::kernel_ContributeCmd(VkCommandBuffer a_cmd, uint32_t a_threadsX, uint32_t a_threadsY,
+void SpherePaths_Vulkan::kernel_ContributeCmd(VkCommandBuffer crt_cmd, uint32_t a_threadsX, uint32_t a_threadsY,
                                               uint32_t width, int samples, crossrt::BufferView color,
                                               crossrt::BufferView out_color)
 {
@@ -298,16 +300,16 @@ void SpherePaths_Vulkan::kernel_ContributeCmd(VkCommandBuffer a_cmd, uint32_t a_
   crt_args.crt_countY = crt_countY;
   crt_args.width = width;
   crt_args.samples = samples;
-  m_pipelines.kernel_Contribute.Bind(a_cmd);
-  m_pipelines.kernel_Contribute.PushBuffers(a_cmd, {m_classDataBuffer.View(), color, out_color});
-  m_pipelines.kernel_Contribute.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  crossrt::Dispatch2D(a_cmd, crt_countX, crt_countY, 16, 16);
-  crossrt::ComputeBarrier(a_cmd);
+  crt_pipelines.kernel_Contribute.Bind(crt_cmd);
+  crt_pipelines.kernel_Contribute.PushBuffers(crt_cmd, {crt_classDataBuffer.View(), color, out_color});
+  crt_pipelines.kernel_Contribute.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
+  crossrt::Dispatch2D(crt_cmd, crt_countX, crt_countY, 16, 16);
+  crossrt::ComputeBarrier(crt_cmd);
 }
 
 // ---- Render_Megakernel (from the thread loop of SpherePaths::Render, SpherePaths.cpp) ----
 
-void SpherePaths_Vulkan::Render_MegakernelCmd(VkCommandBuffer a_cmd, uint32_t a_threadsX, uint32_t a_threadsY,
+void SpherePaths_Vulkan::Render_MegakernelCmd(VkCommandBuffer crt_cmd, uint32_t a_threadsX, uint32_t a_threadsY,
                                               crossrt::BufferView out_color, int samples, uint32_t width,
                                               uint32_t height)
 {
@@ -325,9 +327,10 @@ void SpherePaths_Vulkan::Render_MegakernelCmd(VkCommandBuffer a_cmd, uint32_t a_
   crt_args.samples = samples;
   crt_args.width = width;
   crt_args.height = height;
-  m_pipelines.Render_Megakernel.Bind(a_cmd);
-  m_pipelines.Render_Megakernel.PushBuffers(a_cmd, {m_classDataBuffer.View(), out_color, m_vdata.m_spheres.View()});
-  m_pipelines.Render_Megakernel.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  crossrt::Dispatch2D(a_cmd, crt_countX, crt_countY, 16, 16);
-  crossrt::ComputeBarrier(a_cmd);
+  crt_pipelines.Render_Megakernel.Bind(crt_cmd);
+  crt_pipelines.Render_Megakernel.PushBuffers(crt_cmd,
+                                              {crt_classDataBuffer.View(), out_color, crt_vdata.m_spheres.View()});
+  crt_pipelines.Render_Megakernel.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
+  crossrt::Dispatch2D(crt_cmd, crt_countX, crt_countY, 16, 16);
+  crossrt::ComputeBarrier(crt_cmd);
 }

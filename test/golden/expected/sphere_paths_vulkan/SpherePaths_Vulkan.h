@@ -26,42 +26,42 @@ public:
 
   // For data that already lives on the GPU: bind your buffers, then record into your command buffer.
   virtual void SetVulkanInOutFor_Render(crossrt::BufferView a_out_color);
-  virtual void RenderCmd(VkCommandBuffer a_cmd, uint32_t width, uint32_t height, int samples, float4* out_color);
+  virtual void RenderCmd(VkCommandBuffer crt_cmd, uint32_t width, uint32_t height, int samples, float4* out_color);
 
   void CommitDeviceData() override;  // uploads members
   // a_out: [0] GPU ms, [1] copy-in ms, [2] copy-out ms, [3] total ms
   void GetExecutionTime(const char* a_funcName, float a_out[4]) override;
 
-  virtual void UpdatePlainMembers();  // members -> GPU (called before every control function)
-  virtual void ReadPlainMembers();    // GPU -> members the kernels write (reductions)
+  virtual void crt_UpdatePlainMembers();  // members -> GPU (called before every control function)
+  virtual void crt_ReadPlainMembers();    // GPU -> members the kernels write (reductions)
 
-  std::shared_ptr<crossrt::VulkanContext> Context() const { return m_ctx; }
+  std::shared_ptr<crossrt::VulkanContext> Context() const { return crt_ctx; }
 
   // Thread loops that call several kernels run as one megakernel each, or as one dispatch per
   // kernel call with each thread's locals in buffers between them (wavefront). Same results.
-  crossrt::ExecutionMode GetExecutionMode() const { return m_executionMode; }
-  virtual void SetExecutionMode(crossrt::ExecutionMode a_mode) { m_executionMode = a_mode; }
+  crossrt::ExecutionMode GetExecutionMode() const { return crt_executionMode; }
+  virtual void SetExecutionMode(crossrt::ExecutionMode a_mode) { crt_executionMode = a_mode; }
 
 protected:
-  // One per kernel (and megakernel of a thread loop): records its dispatch (and barrier) into a_cmd.
-  virtual void kernel_InitEyeRayCmd(VkCommandBuffer a_cmd, uint32_t a_threadsX, uint32_t a_threadsY, uint32_t width,
+  // One per kernel (and megakernel of a thread loop): records its dispatch (and barrier) into crt_cmd.
+  virtual void kernel_InitEyeRayCmd(VkCommandBuffer crt_cmd, uint32_t a_threadsX, uint32_t a_threadsY, uint32_t width,
                                     uint32_t height, int sample, crossrt::BufferView rayPos, crossrt::BufferView rayDir,
                                     crossrt::BufferView throughput);
-  virtual void kernel_RayTraceCmd(VkCommandBuffer a_cmd, uint32_t a_threadsX, uint32_t a_threadsY,
+  virtual void kernel_RayTraceCmd(VkCommandBuffer crt_cmd, uint32_t a_threadsX, uint32_t a_threadsY,
                                   crossrt::BufferView rayPos, crossrt::BufferView rayDir,
                                   crossrt::BufferView throughput, crossrt::BufferView hit);
-  virtual void kernel_NextBounceCmd(VkCommandBuffer a_cmd, uint32_t a_threadsX, uint32_t a_threadsY, uint32_t width,
+  virtual void kernel_NextBounceCmd(VkCommandBuffer crt_cmd, uint32_t a_threadsX, uint32_t a_threadsY, uint32_t width,
                                     int sample, int bounce, crossrt::BufferView hit, crossrt::BufferView rayPos,
                                     crossrt::BufferView rayDir, crossrt::BufferView throughput,
                                     crossrt::BufferView color);
-  virtual void kernel_ContributeCmd(VkCommandBuffer a_cmd, uint32_t a_threadsX, uint32_t a_threadsY, uint32_t width,
+  virtual void kernel_ContributeCmd(VkCommandBuffer crt_cmd, uint32_t a_threadsX, uint32_t a_threadsY, uint32_t width,
                                     int samples, crossrt::BufferView color, crossrt::BufferView out_color);
-  virtual void Render_MegakernelCmd(VkCommandBuffer a_cmd, uint32_t a_threadsX, uint32_t a_threadsY,
+  virtual void Render_MegakernelCmd(VkCommandBuffer crt_cmd, uint32_t a_threadsX, uint32_t a_threadsY,
                                     crossrt::BufferView out_color, int samples, uint32_t width, uint32_t height);
-  virtual void InitPipelines();
+  virtual void crt_InitPipelines();
   // Records an update of one member's GPU copy, ordered between the kernels around it.
-  virtual void UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size);
-  virtual void ReadVectorMembers(const char* a_funcName);  // GPU -> std::vector and Image2D members kernels write
+  virtual void crt_UpdateMemberCmd(VkCommandBuffer crt_cmd, size_t a_offset, const void* a_data, size_t a_size);
+  virtual void crt_ReadVectorMembers(const char* a_funcName);  // GPU -> std::vector and Image2D members kernels write
 
   // Push constants of each kernel: thread ranges, then its scalar arguments (std430 offsets).
   struct kernel_InitEyeRayArgs
@@ -122,23 +122,23 @@ protected:
     alignas(4) uint32_t m_spheres_capacity;
   };
 
-  std::shared_ptr<crossrt::VulkanContext> m_ctx;
-  crossrt::ExecutionMode m_executionMode = crossrt::ExecutionMode::Wavefront;
-  crossrt::Buffer m_classDataBuffer;
-  bool m_deviceDataCommitted = false;
+  std::shared_ptr<crossrt::VulkanContext> crt_ctx;
+  crossrt::ExecutionMode crt_executionMode = crossrt::ExecutionMode::Wavefront;
+  crossrt::Buffer crt_classDataBuffer;
+  bool crt_deviceDataCommitted = false;
 
   struct VectorMembers  // device copies of the std::vector members kernels use
   {
     crossrt::Buffer m_spheres;
     size_t m_spheresSize = 0;  // elements at the last CommitDeviceData()
-  } m_vdata;
+  } crt_vdata;
   // A std::vector or Image2D member changed size, or a sampler changed, since CommitDeviceData().
-  virtual bool VectorMembersResized() const;
+  virtual bool crt_VectorMembersResized() const;
 
   struct InOut_Render  // buffers bound by SetVulkanInOutFor_Render
   {
     crossrt::BufferView out_color;
-  } m_inOut_Render;
+  } crt_inOut_Render;
 
   struct ThreadState  // wavefront mode: the per-thread locals of thread loops, one element per thread
   {
@@ -147,12 +147,12 @@ protected:
     crossrt::Buffer Render_throughput;  // float4 throughput of Render
     crossrt::Buffer Render_color;       // float4 color of Render
     crossrt::Buffer Render_hit;         // SphereHit hit of Render
-  } m_threadState;
+  } crt_threadState;
 
   struct ArgumentBuffers  // device copies of pointer arguments, reused across calls
   {
     crossrt::Buffer Render_out_color;
-  } m_args;
+  } crt_argCopies;
 
   struct Pipelines
   {
@@ -161,14 +161,14 @@ protected:
     crossrt::ComputePipeline kernel_NextBounce;
     crossrt::ComputePipeline kernel_Contribute;
     crossrt::ComputePipeline Render_Megakernel;
-  } m_pipelines;
+  } crt_pipelines;
 
   struct Partials  // per-workgroup partial results of reductions
   {
-  } m_partials;
+  } crt_partials;
 
-  crossrt::GpuTimer m_gpuTimer;
-  std::map<std::string, std::array<float, 4>> m_times;
+  crossrt::GpuTimer crt_gpuTimer;
+  std::map<std::string, std::array<float, 4>> crt_times;
 };
 
 // Runs on the default device: CROSSRT_DEVICE (index or name) if set, else a discrete GPU, else lavapipe.

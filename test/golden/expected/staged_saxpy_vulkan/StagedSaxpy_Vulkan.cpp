@@ -12,11 +12,11 @@ extern const uint32_t StagedSaxpy_kernel1D_Add_spv[];
 extern const size_t StagedSaxpy_kernel1D_Add_spvBytes;
 
 StagedSaxpy_Vulkan::StagedSaxpy_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx)
-    : StagedSaxpy(), m_ctx(std::move(a_ctx))
+    : StagedSaxpy(), crt_ctx(std::move(a_ctx))
 {
-  m_classDataBuffer = crossrt::Buffer(m_ctx, sizeof(ClassData));
-  m_gpuTimer = crossrt::GpuTimer(m_ctx);
-  InitPipelines();
+  crt_classDataBuffer = crossrt::Buffer(crt_ctx, sizeof(ClassData));
+  crt_gpuTimer = crossrt::GpuTimer(crt_ctx);
+  crt_InitPipelines();
 }
 
 std::shared_ptr<StagedSaxpy> CreateStagedSaxpy_Vulkan()
@@ -31,55 +31,56 @@ std::shared_ptr<StagedSaxpy> CreateStagedSaxpy_Vulkan(std::shared_ptr<crossrt::V
 
 StagedSaxpy_Vulkan::~StagedSaxpy_Vulkan() = default;
 
-void StagedSaxpy_Vulkan::InitPipelines()
+void StagedSaxpy_Vulkan::crt_InitPipelines()
 {
-  m_pipelines.kernel1D_Mult =
-      crossrt::ComputePipeline(m_ctx, StagedSaxpy_kernel1D_Mult_spv, StagedSaxpy_kernel1D_Mult_spvBytes, 4,
+  crt_pipelines.kernel1D_Mult =
+      crossrt::ComputePipeline(crt_ctx, StagedSaxpy_kernel1D_Mult_spv, StagedSaxpy_kernel1D_Mult_spvBytes, 4,
                                sizeof(kernel1D_MultArgs), "StagedSaxpy::kernel1D_Mult");
-  m_pipelines.kernel1D_Add =
-      crossrt::ComputePipeline(m_ctx, StagedSaxpy_kernel1D_Add_spv, StagedSaxpy_kernel1D_Add_spvBytes, 4,
+  crt_pipelines.kernel1D_Add =
+      crossrt::ComputePipeline(crt_ctx, StagedSaxpy_kernel1D_Add_spv, StagedSaxpy_kernel1D_Add_spvBytes, 4,
                                sizeof(kernel1D_AddArgs), "StagedSaxpy::kernel1D_Add");
 }
 
-void StagedSaxpy_Vulkan::UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size)
+void StagedSaxpy_Vulkan::crt_UpdateMemberCmd(VkCommandBuffer crt_cmd, size_t a_offset, const void* a_data,
+                                             size_t a_size)
 {
-  crossrt::ComputeBarrier(a_cmd);  // kernels recorded before it are done with the class data
-  vkCmdUpdateBuffer(a_cmd, m_classDataBuffer.Handle(), a_offset, a_size, a_data);
-  crossrt::TransferToComputeBarrier(a_cmd);
+  crossrt::ComputeBarrier(crt_cmd);  // kernels recorded before it are done with the class data
+  vkCmdUpdateBuffer(crt_cmd, crt_classDataBuffer.Handle(), a_offset, a_size, a_data);
+  crossrt::TransferToComputeBarrier(crt_cmd);
 }
 
-void StagedSaxpy_Vulkan::UpdatePlainMembers()
+void StagedSaxpy_Vulkan::crt_UpdatePlainMembers()
 {
   ClassData data{};
-  m_classDataBuffer.Upload(&data, sizeof(data));
+  crt_classDataBuffer.Upload(&data, sizeof(data));
 }
 
-void StagedSaxpy_Vulkan::ReadPlainMembers()
+void StagedSaxpy_Vulkan::crt_ReadPlainMembers()
 {
 }
 
 void StagedSaxpy_Vulkan::CommitDeviceData()
 {
   // std::vector members become buffers of their capacity; kernels see size and capacity.
-  UpdatePlainMembers();
-  m_deviceDataCommitted = true;
+  crt_UpdatePlainMembers();
+  crt_deviceDataCommitted = true;
 }
 
-bool StagedSaxpy_Vulkan::VectorMembersResized() const
+bool StagedSaxpy_Vulkan::crt_VectorMembersResized() const
 {
   return false;  // no std::vector, Image2D or sampler member of the class is on the GPU
 }
 
-void StagedSaxpy_Vulkan::ReadVectorMembers(const char* a_funcName)
+void StagedSaxpy_Vulkan::crt_ReadVectorMembers(const char* a_funcName)
 {
   (void)a_funcName;
 }
 
 void StagedSaxpy_Vulkan::GetExecutionTime(const char* a_funcName, float a_out[4])
 {
-  auto it = m_times.find(a_funcName);
+  auto it = crt_times.find(a_funcName);
   for (int i = 0; i < 4; ++i)
-    a_out[i] = it == m_times.end() ? 0.0f : it->second[i];
+    a_out[i] = it == crt_times.end() ? 0.0f : it->second[i];
 }
 
 // ---- Run (from StagedSaxpy::Run, staged_saxpy.cpp) ----
@@ -87,9 +88,9 @@ void StagedSaxpy_Vulkan::GetExecutionTime(const char* a_funcName, float a_out[4]
 void StagedSaxpy_Vulkan::SetVulkanInOutFor_Run(crossrt::BufferView a_a_x, crossrt::BufferView a_a_y,
                                                crossrt::BufferView a_a_out)
 {
-  m_inOut_Run.a_x = a_a_x;
-  m_inOut_Run.a_y = a_a_y;
-  m_inOut_Run.a_out = a_a_out;
+  crt_inOut_Run.a_x = a_a_x;
+  crt_inOut_Run.a_y = a_a_y;
+  crt_inOut_Run.a_out = a_a_out;
 }
 
 void StagedSaxpy_Vulkan::Run(const float* a_x, const float* a_y, float* a_out, uint32_t n)
@@ -99,69 +100,69 @@ void StagedSaxpy_Vulkan::Run(const float* a_x, const float* a_y, float* a_out, u
   // std::vector members are uploaded by CommitDeviceData(): here once, and again whenever one
   // changed size (its device buffer would be too small). After changing the contents of a
   // vector without resizing it, call CommitDeviceData().
-  if (!crt_self->m_deviceDataCommitted || crt_self->VectorMembersResized())
+  if (!crt_self->crt_deviceDataCommitted || crt_self->crt_VectorMembersResized())
     crt_self->CommitDeviceData();
 
   crossrt::CpuTimer crt_copyIn;
   const size_t crt_a_xBytes = sizeof(float) * size_t(n);
-  crossrt::EnsureSize(m_ctx, crt_self->m_args.Run_a_x, crt_a_xBytes);
+  crossrt::EnsureSize(crt_ctx, crt_self->crt_argCopies.Run_a_x, crt_a_xBytes);
   if (crt_a_xBytes > 0)
-    crt_self->m_args.Run_a_x.Upload(a_x, crt_a_xBytes);
+    crt_self->crt_argCopies.Run_a_x.Upload(a_x, crt_a_xBytes);
   const size_t crt_a_yBytes = sizeof(float) * size_t(n);
-  crossrt::EnsureSize(m_ctx, crt_self->m_args.Run_a_y, crt_a_yBytes);
+  crossrt::EnsureSize(crt_ctx, crt_self->crt_argCopies.Run_a_y, crt_a_yBytes);
   if (crt_a_yBytes > 0)
-    crt_self->m_args.Run_a_y.Upload(a_y, crt_a_yBytes);
+    crt_self->crt_argCopies.Run_a_y.Upload(a_y, crt_a_yBytes);
   const size_t crt_a_outBytes = sizeof(float) * size_t(n);
-  crossrt::EnsureSize(m_ctx, crt_self->m_args.Run_a_out, crt_a_outBytes);
+  crossrt::EnsureSize(crt_ctx, crt_self->crt_argCopies.Run_a_out, crt_a_outBytes);
   if (crt_a_outBytes > 0)
-    crt_self->m_args.Run_a_out.Upload(a_out, crt_a_outBytes);
-  crt_self->SetVulkanInOutFor_Run(crt_self->m_args.Run_a_x.View(), crt_self->m_args.Run_a_y.View(),
-                                  crt_self->m_args.Run_a_out.View());
+    crt_self->crt_argCopies.Run_a_out.Upload(a_out, crt_a_outBytes);
+  crt_self->SetVulkanInOutFor_Run(crt_self->crt_argCopies.Run_a_x.View(), crt_self->crt_argCopies.Run_a_y.View(),
+                                  crt_self->crt_argCopies.Run_a_out.View());
   const float crt_copyInMs = crt_copyIn.ElapsedMs();
 
   // Members as they are now; host code of Run that changes one records an update in order.
-  crt_self->UpdatePlainMembers();
-  VkCommandBuffer crt_cmd = m_ctx->BeginOneShot();
-  crt_self->m_gpuTimer.Reset(crt_cmd);
-  crt_self->m_gpuTimer.Begin(crt_cmd, "Run");
+  crt_self->crt_UpdatePlainMembers();
+  VkCommandBuffer crt_cmd = crt_ctx->BeginOneShot();
+  crt_self->crt_gpuTimer.Reset(crt_cmd);
+  crt_self->crt_gpuTimer.Begin(crt_cmd, "Run");
   crt_self->RunCmd(crt_cmd, a_x, a_y, a_out, n);
-  crt_self->m_gpuTimer.End(crt_cmd, "Run");
-  m_ctx->SubmitAndWait(crt_cmd);
-  crt_self->m_gpuTimer.Collect();
+  crt_self->crt_gpuTimer.End(crt_cmd, "Run");
+  crt_ctx->SubmitAndWait(crt_cmd);
+  crt_self->crt_gpuTimer.Collect();
 
   crossrt::CpuTimer crt_copyOut;
-  crt_self->ReadPlainMembers();
-  crt_self->ReadVectorMembers("Run");
+  crt_self->crt_ReadPlainMembers();
+  crt_self->crt_ReadVectorMembers("Run");
   if (crt_a_outBytes > 0)
-    crt_self->m_args.Run_a_out.Download(a_out, crt_a_outBytes);
-  crt_self->m_times["Run"] = {crt_self->m_gpuTimer.LastMs("Run"), crt_copyInMs, crt_copyOut.ElapsedMs(),
-                              crt_total.ElapsedMs()};
+    crt_self->crt_argCopies.Run_a_out.Download(a_out, crt_a_outBytes);
+  crt_self->crt_times["Run"] = {crt_self->crt_gpuTimer.LastMs("Run"), crt_copyInMs, crt_copyOut.ElapsedMs(),
+                                crt_total.ElapsedMs()};
 }
 
 // The body of StagedSaxpy::Run, with each kernel call turned into its ...Cmd.
-void StagedSaxpy_Vulkan::RunCmd(VkCommandBuffer a_cmd, [[maybe_unused]] const float* a_x,
+void StagedSaxpy_Vulkan::RunCmd(VkCommandBuffer crt_cmd, [[maybe_unused]] const float* a_x,
                                 [[maybe_unused]] const float* a_y, [[maybe_unused]] float* a_out, uint32_t n)
 {
   std::vector<float> product(n);
-  crossrt::EnsureSize(m_ctx, m_temporaries.Run_product, sizeof(float) * product.size());
-  crossrt::FillCmd(a_cmd, m_temporaries.Run_product.View(), (sizeof(float) * product.size() + 3) / 4 * 4, 0u);
+  crossrt::EnsureSize(crt_ctx, crt_temporaries.Run_product, sizeof(float) * product.size());
+  crossrt::FillCmd(crt_cmd, crt_temporaries.Run_product.View(), (sizeof(float) * product.size() + 3) / 4 * 4, 0u);
   std::vector<float> twos(n, 2.0f);
-  crossrt::EnsureSize(m_ctx, m_temporaries.Run_twos, sizeof(float) * twos.size());
-  crossrt::FillCmd(a_cmd, m_temporaries.Run_twos.View(), (sizeof(float) * twos.size() + 3) / 4 * 4,
+  crossrt::EnsureSize(crt_ctx, crt_temporaries.Run_twos, sizeof(float) * twos.size());
+  crossrt::FillCmd(crt_cmd, crt_temporaries.Run_twos.View(), (sizeof(float) * twos.size() + 3) / 4 * 4,
                    crossrt::Bits32(float(2.0f)));
   std::vector<float> both(2 * n);
-  crossrt::EnsureSize(m_ctx, m_temporaries.Run_both, sizeof(float) * both.size());
-  crossrt::FillCmd(a_cmd, m_temporaries.Run_both.View(), (sizeof(float) * both.size() + 3) / 4 * 4, 0u);
-  kernel1D_MultCmd(a_cmd, m_temporaries.Run_product.View(), m_inOut_Run.a_x, m_inOut_Run.a_y, n);
-  kernel1D_AddCmd(a_cmd, m_temporaries.Run_both.View(sizeof(float) * size_t(n)), m_temporaries.Run_product.View(),
-                  m_temporaries.Run_twos.View(), uint32_t(twos.size()));
-  kernel1D_AddCmd(a_cmd, m_inOut_Run.a_out, m_temporaries.Run_both.View(sizeof(float) * size_t(n)),
-                  m_temporaries.Run_both.View(), n);
+  crossrt::EnsureSize(crt_ctx, crt_temporaries.Run_both, sizeof(float) * both.size());
+  crossrt::FillCmd(crt_cmd, crt_temporaries.Run_both.View(), (sizeof(float) * both.size() + 3) / 4 * 4, 0u);
+  kernel1D_MultCmd(crt_cmd, crt_temporaries.Run_product.View(), crt_inOut_Run.a_x, crt_inOut_Run.a_y, n);
+  kernel1D_AddCmd(crt_cmd, crt_temporaries.Run_both.View(sizeof(float) * size_t(n)), crt_temporaries.Run_product.View(),
+                  crt_temporaries.Run_twos.View(), uint32_t(twos.size()));
+  kernel1D_AddCmd(crt_cmd, crt_inOut_Run.a_out, crt_temporaries.Run_both.View(sizeof(float) * size_t(n)),
+                  crt_temporaries.Run_both.View(), n);
 }
 
 // ---- kernel1D_Mult (from StagedSaxpy::kernel1D_Mult, staged_saxpy.cpp) ----
 
-void StagedSaxpy_Vulkan::kernel1D_MultCmd(VkCommandBuffer a_cmd, crossrt::BufferView a_res, crossrt::BufferView a_in1,
+void StagedSaxpy_Vulkan::kernel1D_MultCmd(VkCommandBuffer crt_cmd, crossrt::BufferView a_res, crossrt::BufferView a_in1,
                                           crossrt::BufferView a_in2, uint32_t a_size)
 {
   const int crt_startX = int(0);
@@ -172,16 +173,16 @@ void StagedSaxpy_Vulkan::kernel1D_MultCmd(VkCommandBuffer a_cmd, crossrt::Buffer
   crt_args.crt_startX = crt_startX;
   crt_args.crt_countX = crt_countX;
   crt_args.a_size = a_size;
-  m_pipelines.kernel1D_Mult.Bind(a_cmd);
-  m_pipelines.kernel1D_Mult.PushBuffers(a_cmd, {m_classDataBuffer.View(), a_res, a_in1, a_in2});
-  m_pipelines.kernel1D_Mult.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  crossrt::Dispatch1D(a_cmd, crt_countX, 256);
-  crossrt::ComputeBarrier(a_cmd);
+  crt_pipelines.kernel1D_Mult.Bind(crt_cmd);
+  crt_pipelines.kernel1D_Mult.PushBuffers(crt_cmd, {crt_classDataBuffer.View(), a_res, a_in1, a_in2});
+  crt_pipelines.kernel1D_Mult.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
+  crossrt::Dispatch1D(crt_cmd, crt_countX, 256);
+  crossrt::ComputeBarrier(crt_cmd);
 }
 
 // ---- kernel1D_Add (from StagedSaxpy::kernel1D_Add, staged_saxpy.cpp) ----
 
-void StagedSaxpy_Vulkan::kernel1D_AddCmd(VkCommandBuffer a_cmd, crossrt::BufferView a_res, crossrt::BufferView a_in1,
+void StagedSaxpy_Vulkan::kernel1D_AddCmd(VkCommandBuffer crt_cmd, crossrt::BufferView a_res, crossrt::BufferView a_in1,
                                          crossrt::BufferView a_in2, uint32_t a_size)
 {
   const int crt_startX = int(0);
@@ -192,9 +193,9 @@ void StagedSaxpy_Vulkan::kernel1D_AddCmd(VkCommandBuffer a_cmd, crossrt::BufferV
   crt_args.crt_startX = crt_startX;
   crt_args.crt_countX = crt_countX;
   crt_args.a_size = a_size;
-  m_pipelines.kernel1D_Add.Bind(a_cmd);
-  m_pipelines.kernel1D_Add.PushBuffers(a_cmd, {m_classDataBuffer.View(), a_res, a_in1, a_in2});
-  m_pipelines.kernel1D_Add.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
-  crossrt::Dispatch1D(a_cmd, crt_countX, 256);
-  crossrt::ComputeBarrier(a_cmd);
+  crt_pipelines.kernel1D_Add.Bind(crt_cmd);
+  crt_pipelines.kernel1D_Add.PushBuffers(crt_cmd, {crt_classDataBuffer.View(), a_res, a_in1, a_in2});
+  crt_pipelines.kernel1D_Add.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
+  crossrt::Dispatch1D(crt_cmd, crt_countX, 256);
+  crossrt::ComputeBarrier(crt_cmd);
 }

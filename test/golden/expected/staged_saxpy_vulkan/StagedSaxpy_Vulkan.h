@@ -26,27 +26,27 @@ public:
 
   // For data that already lives on the GPU: bind your buffers, then record into your command buffer.
   virtual void SetVulkanInOutFor_Run(crossrt::BufferView a_a_x, crossrt::BufferView a_a_y, crossrt::BufferView a_a_out);
-  virtual void RunCmd(VkCommandBuffer a_cmd, const float* a_x, const float* a_y, float* a_out, uint32_t n);
+  virtual void RunCmd(VkCommandBuffer crt_cmd, const float* a_x, const float* a_y, float* a_out, uint32_t n);
 
   void CommitDeviceData() override;  // uploads members
   // a_out: [0] GPU ms, [1] copy-in ms, [2] copy-out ms, [3] total ms
   void GetExecutionTime(const char* a_funcName, float a_out[4]);
 
-  virtual void UpdatePlainMembers();  // members -> GPU (called before every control function)
-  virtual void ReadPlainMembers();    // GPU -> members the kernels write (reductions)
+  virtual void crt_UpdatePlainMembers();  // members -> GPU (called before every control function)
+  virtual void crt_ReadPlainMembers();    // GPU -> members the kernels write (reductions)
 
-  std::shared_ptr<crossrt::VulkanContext> Context() const { return m_ctx; }
+  std::shared_ptr<crossrt::VulkanContext> Context() const { return crt_ctx; }
 
 protected:
-  // One per kernel (and megakernel of a thread loop): records its dispatch (and barrier) into a_cmd.
-  virtual void kernel1D_MultCmd(VkCommandBuffer a_cmd, crossrt::BufferView a_res, crossrt::BufferView a_in1,
+  // One per kernel (and megakernel of a thread loop): records its dispatch (and barrier) into crt_cmd.
+  virtual void kernel1D_MultCmd(VkCommandBuffer crt_cmd, crossrt::BufferView a_res, crossrt::BufferView a_in1,
                                 crossrt::BufferView a_in2, uint32_t a_size);
-  virtual void kernel1D_AddCmd(VkCommandBuffer a_cmd, crossrt::BufferView a_res, crossrt::BufferView a_in1,
+  virtual void kernel1D_AddCmd(VkCommandBuffer crt_cmd, crossrt::BufferView a_res, crossrt::BufferView a_in1,
                                crossrt::BufferView a_in2, uint32_t a_size);
-  virtual void InitPipelines();
+  virtual void crt_InitPipelines();
   // Records an update of one member's GPU copy, ordered between the kernels around it.
-  virtual void UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size);
-  virtual void ReadVectorMembers(const char* a_funcName);  // GPU -> std::vector and Image2D members kernels write
+  virtual void crt_UpdateMemberCmd(VkCommandBuffer crt_cmd, size_t a_offset, const void* a_data, size_t a_size);
+  virtual void crt_ReadVectorMembers(const char* a_funcName);  // GPU -> std::vector and Image2D members kernels write
 
   // Push constants of each kernel: thread ranges, then its scalar arguments (std430 offsets).
   struct kernel1D_MultArgs
@@ -68,46 +68,46 @@ protected:
     alignas(4) uint32_t dummy;
   };
 
-  std::shared_ptr<crossrt::VulkanContext> m_ctx;
-  crossrt::Buffer m_classDataBuffer;
-  bool m_deviceDataCommitted = false;
+  std::shared_ptr<crossrt::VulkanContext> crt_ctx;
+  crossrt::Buffer crt_classDataBuffer;
+  bool crt_deviceDataCommitted = false;
 
   // A std::vector or Image2D member changed size, or a sampler changed, since CommitDeviceData().
-  virtual bool VectorMembersResized() const;
+  virtual bool crt_VectorMembersResized() const;
 
   struct InOut_Run  // buffers bound by SetVulkanInOutFor_Run
   {
     crossrt::BufferView a_x;
     crossrt::BufferView a_y;
     crossrt::BufferView a_out;
-  } m_inOut_Run;
+  } crt_inOut_Run;
 
   struct ArgumentBuffers  // device copies of pointer arguments, reused across calls
   {
     crossrt::Buffer Run_a_x;
     crossrt::Buffer Run_a_y;
     crossrt::Buffer Run_a_out;
-  } m_args;
+  } crt_argCopies;
 
   struct Temporaries  // device copies of the std::vector locals control functions pass to kernels
   {
     crossrt::Buffer Run_product;  // std::vector<float> product of Run
     crossrt::Buffer Run_both;     // std::vector<float> both of Run
     crossrt::Buffer Run_twos;     // std::vector<float> twos of Run
-  } m_temporaries;
+  } crt_temporaries;
 
   struct Pipelines
   {
     crossrt::ComputePipeline kernel1D_Mult;
     crossrt::ComputePipeline kernel1D_Add;
-  } m_pipelines;
+  } crt_pipelines;
 
   struct Partials  // per-workgroup partial results of reductions
   {
-  } m_partials;
+  } crt_partials;
 
-  crossrt::GpuTimer m_gpuTimer;
-  std::map<std::string, std::array<float, 4>> m_times;
+  crossrt::GpuTimer crt_gpuTimer;
+  std::map<std::string, std::array<float, 4>> crt_times;
 };
 
 // Runs on the default device: CROSSRT_DEVICE (index or name) if set, else a discrete GPU, else lavapipe.

@@ -17,17 +17,17 @@ extern const uint32_t TexturedMaterials_kernel1D_Shade_spv[];
 extern const size_t TexturedMaterials_kernel1D_Shade_spvBytes;
 
 TexturedMaterials_Vulkan::TexturedMaterials_Vulkan(std::shared_ptr<crossrt::VulkanContext> a_ctx)
-    : TexturedMaterials(), m_ctx(std::move(a_ctx))
+    : TexturedMaterials(), crt_ctx(std::move(a_ctx))
 {
-  m_classDataBuffer = crossrt::Buffer(m_ctx, sizeof(ClassData));
-  m_gpuTimer = crossrt::GpuTimer(m_ctx);
-  m_useTextureHardware = m_ctx->hasTextureArrays;
-  if (m_ctx->hasTextureArrays)
+  crt_classDataBuffer = crossrt::Buffer(crt_ctx, sizeof(ClassData));
+  crt_gpuTimer = crossrt::GpuTimer(crt_ctx);
+  crt_useTextureHardware = crt_ctx->hasTextureArrays;
+  if (crt_ctx->hasTextureArrays)
   {
-    m_textureArrays.m_albedo = crossrt::TextureArray(m_ctx, "TexturedMaterials::m_albedo");
-    m_textureArrays.m_bumps = crossrt::TextureArray(m_ctx, "TexturedMaterials::m_bumps");
+    crt_textureArrays.m_albedo = crossrt::TextureArray(crt_ctx, "TexturedMaterials::m_albedo");
+    crt_textureArrays.m_bumps = crossrt::TextureArray(crt_ctx, "TexturedMaterials::m_bumps");
   }
-  InitPipelines();
+  crt_InitPipelines();
 }
 
 std::shared_ptr<TexturedMaterials> CreateTexturedMaterials_Vulkan()
@@ -42,48 +42,48 @@ std::shared_ptr<TexturedMaterials> CreateTexturedMaterials_Vulkan(std::shared_pt
 
 TexturedMaterials_Vulkan::~TexturedMaterials_Vulkan() = default;
 
-void TexturedMaterials_Vulkan::InitPipelines()
+void TexturedMaterials_Vulkan::crt_InitPipelines()
 {
-  if (m_ctx->hasTextureArrays)  // textures on the GPU's samplers: the shader needs them even to be created
-    m_pipelines.kernel1D_Shade_Textures = crossrt::ComputePipeline(
-        m_ctx, TexturedMaterials_kernel1D_Shade_Textures_spv, TexturedMaterials_kernel1D_Shade_Textures_spvBytes,
+  if (crt_ctx->hasTextureArrays)  // textures on the GPU's samplers: the shader needs them even to be created
+    crt_pipelines.kernel1D_Shade_Textures = crossrt::ComputePipeline(
+        crt_ctx, TexturedMaterials_kernel1D_Shade_Textures_spv, TexturedMaterials_kernel1D_Shade_Textures_spvBytes,
         std::vector<VkDescriptorType>{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
                                       VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
                                       VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
                                       VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
         sizeof(kernel1D_ShadeArgs), "TexturedMaterials::kernel1D_Shade_Textures", 2);
-  m_pipelines.kernel1D_Shade =
-      crossrt::ComputePipeline(m_ctx, TexturedMaterials_kernel1D_Shade_spv, TexturedMaterials_kernel1D_Shade_spvBytes,
+  crt_pipelines.kernel1D_Shade =
+      crossrt::ComputePipeline(crt_ctx, TexturedMaterials_kernel1D_Shade_spv, TexturedMaterials_kernel1D_Shade_spvBytes,
                                10, sizeof(kernel1D_ShadeArgs), "TexturedMaterials::kernel1D_Shade");
 }
 
 void TexturedMaterials_Vulkan::UseTextureHardware(bool a_use)
 {
-  if (a_use && !m_ctx->hasTextureArrays)
-    throw crossrt::Error("TexturedMaterials_Vulkan: device '" + m_ctx->DeviceName() +
+  if (a_use && !crt_ctx->hasTextureArrays)
+    throw crossrt::Error("TexturedMaterials_Vulkan: device '" + crt_ctx->DeviceName() +
                          "' has no arrays of textures (descriptor indexing): its kernels sample textures from buffers");
-  if (a_use != m_useTextureHardware)
-    m_deviceDataCommitted = false;  // the next call commits the textures the other way
-  m_useTextureHardware = a_use;
+  if (a_use != crt_useTextureHardware)
+    crt_deviceDataCommitted = false;  // the next call commits the textures the other way
+  crt_useTextureHardware = a_use;
 }
 
-void TexturedMaterials_Vulkan::UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data,
-                                               size_t a_size)
+void TexturedMaterials_Vulkan::crt_UpdateMemberCmd(VkCommandBuffer crt_cmd, size_t a_offset, const void* a_data,
+                                                   size_t a_size)
 {
-  crossrt::ComputeBarrier(a_cmd);  // kernels recorded before it are done with the class data
-  vkCmdUpdateBuffer(a_cmd, m_classDataBuffer.Handle(), a_offset, a_size, a_data);
-  crossrt::TransferToComputeBarrier(a_cmd);
+  crossrt::ComputeBarrier(crt_cmd);  // kernels recorded before it are done with the class data
+  vkCmdUpdateBuffer(crt_cmd, crt_classDataBuffer.Handle(), a_offset, a_size, a_data);
+  crossrt::TransferToComputeBarrier(crt_cmd);
 }
 
-void TexturedMaterials_Vulkan::UpdatePlainMembers()
+void TexturedMaterials_Vulkan::crt_UpdatePlainMembers()
 {
   ClassData data{};
   data.m_albedo_size = uint32_t(m_albedo.size());
   data.m_bumps_size = uint32_t(m_bumps.size());
-  m_classDataBuffer.Upload(&data, sizeof(data));
+  crt_classDataBuffer.Upload(&data, sizeof(data));
 }
 
-void TexturedMaterials_Vulkan::ReadPlainMembers()
+void TexturedMaterials_Vulkan::crt_ReadPlainMembers()
 {
 }
 
@@ -92,48 +92,48 @@ void TexturedMaterials_Vulkan::CommitDeviceData()
   // std::vector members become buffers of their capacity; kernels see size and capacity.
   // Arrays of textures: for the GPU's samplers an image each, else their texels in a buffer; both
   // ways each texture's size and sampler in another.
-  if (m_useTextureHardware && m_albedo.size() > m_ctx->maxTextureArraySize)
+  if (crt_useTextureHardware && m_albedo.size() > crt_ctx->maxTextureArraySize)
     throw crossrt::Error("TexturedMaterials_Vulkan: m_albedo holds " + std::to_string(m_albedo.size()) +
-                         " textures, but device '" + m_ctx->DeviceName() + "' binds at most " +
-                         std::to_string(m_ctx->maxTextureArraySize) +
+                         " textures, but device '" + crt_ctx->DeviceName() + "' binds at most " +
+                         std::to_string(crt_ctx->maxTextureArraySize) +
                          " in an array: call UseTextureHardware(false) to sample them from buffers");
-  if (m_useTextureHardware)
-    crossrt::AssignTextures(m_textureArrays.m_albedo, VK_FORMAT_R32G32B32A32_SFLOAT, m_albedo);
-  crossrt::CommitTextureBuffers(m_ctx, m_albedo, m_textureArrays.m_albedo_info,
-                                m_useTextureHardware ? nullptr : &m_textureArrays.m_albedo_texels);
-  m_textureArrays.m_albedoSize = m_albedo.size();
-  if (m_useTextureHardware && m_bumps.size() > m_ctx->maxTextureArraySize)
+  if (crt_useTextureHardware)
+    crossrt::AssignTextures(crt_textureArrays.m_albedo, VK_FORMAT_R32G32B32A32_SFLOAT, m_albedo);
+  crossrt::CommitTextureBuffers(crt_ctx, m_albedo, crt_textureArrays.m_albedo_info,
+                                crt_useTextureHardware ? nullptr : &crt_textureArrays.m_albedo_texels);
+  crt_textureArrays.m_albedoSize = m_albedo.size();
+  if (crt_useTextureHardware && m_bumps.size() > crt_ctx->maxTextureArraySize)
     throw crossrt::Error("TexturedMaterials_Vulkan: m_bumps holds " + std::to_string(m_bumps.size()) +
-                         " textures, but device '" + m_ctx->DeviceName() + "' binds at most " +
-                         std::to_string(m_ctx->maxTextureArraySize) +
+                         " textures, but device '" + crt_ctx->DeviceName() + "' binds at most " +
+                         std::to_string(crt_ctx->maxTextureArraySize) +
                          " in an array: call UseTextureHardware(false) to sample them from buffers");
-  if (m_useTextureHardware)
-    crossrt::AssignTextures(m_textureArrays.m_bumps, VK_FORMAT_R32_SFLOAT, m_bumps);
-  crossrt::CommitTextureBuffers(m_ctx, m_bumps, m_textureArrays.m_bumps_info,
-                                m_useTextureHardware ? nullptr : &m_textureArrays.m_bumps_texels);
-  m_textureArrays.m_bumpsSize = m_bumps.size();
-  UpdatePlainMembers();
-  m_deviceDataCommitted = true;
+  if (crt_useTextureHardware)
+    crossrt::AssignTextures(crt_textureArrays.m_bumps, VK_FORMAT_R32_SFLOAT, m_bumps);
+  crossrt::CommitTextureBuffers(crt_ctx, m_bumps, crt_textureArrays.m_bumps_info,
+                                crt_useTextureHardware ? nullptr : &crt_textureArrays.m_bumps_texels);
+  crt_textureArrays.m_bumpsSize = m_bumps.size();
+  crt_UpdatePlainMembers();
+  crt_deviceDataCommitted = true;
 }
 
-bool TexturedMaterials_Vulkan::VectorMembersResized() const
+bool TexturedMaterials_Vulkan::crt_VectorMembersResized() const
 {
   bool resized = false;
-  resized = resized || m_albedo.size() != m_textureArrays.m_albedoSize;
-  resized = resized || m_bumps.size() != m_textureArrays.m_bumpsSize;
+  resized = resized || m_albedo.size() != crt_textureArrays.m_albedoSize;
+  resized = resized || m_bumps.size() != crt_textureArrays.m_bumpsSize;
   return resized;
 }
 
-void TexturedMaterials_Vulkan::ReadVectorMembers(const char* a_funcName)
+void TexturedMaterials_Vulkan::crt_ReadVectorMembers(const char* a_funcName)
 {
   (void)a_funcName;
 }
 
 void TexturedMaterials_Vulkan::GetExecutionTime(const char* a_funcName, float a_out[4])
 {
-  auto it = m_times.find(a_funcName);
+  auto it = crt_times.find(a_funcName);
   for (int i = 0; i < 4; ++i)
-    a_out[i] = it == m_times.end() ? 0.0f : it->second[i];
+    a_out[i] = it == crt_times.end() ? 0.0f : it->second[i];
 }
 
 // ---- Shade (from TexturedMaterials::Shade, TexturedMaterials.cpp) ----
@@ -142,11 +142,11 @@ void TexturedMaterials_Vulkan::SetVulkanInOutFor_Shade(crossrt::BufferView a_tex
                                                        crossrt::BufferView a_colors, crossrt::BufferView a_heights,
                                                        crossrt::BufferView a_texels)
 {
-  m_inOut_Shade.texIds = a_texIds;
-  m_inOut_Shade.uvs = a_uvs;
-  m_inOut_Shade.colors = a_colors;
-  m_inOut_Shade.heights = a_heights;
-  m_inOut_Shade.texels = a_texels;
+  crt_inOut_Shade.texIds = a_texIds;
+  crt_inOut_Shade.uvs = a_uvs;
+  crt_inOut_Shade.colors = a_colors;
+  crt_inOut_Shade.heights = a_heights;
+  crt_inOut_Shade.texels = a_texels;
 }
 
 void TexturedMaterials_Vulkan::Shade(int n, const uint32_t* texIds, const LiteMath::float2* uvs,
@@ -157,71 +157,72 @@ void TexturedMaterials_Vulkan::Shade(int n, const uint32_t* texIds, const LiteMa
   // std::vector members are uploaded by CommitDeviceData(): here once, and again whenever one
   // changed size (its device buffer would be too small). After changing the contents of a
   // vector without resizing it, call CommitDeviceData().
-  if (!crt_self->m_deviceDataCommitted || crt_self->VectorMembersResized())
+  if (!crt_self->crt_deviceDataCommitted || crt_self->crt_VectorMembersResized())
     crt_self->CommitDeviceData();
 
   crossrt::CpuTimer crt_copyIn;
   const size_t crt_texIdsBytes = sizeof(uint32_t) * size_t(n);
-  crossrt::EnsureSize(m_ctx, crt_self->m_args.Shade_texIds, crt_texIdsBytes);
+  crossrt::EnsureSize(crt_ctx, crt_self->crt_argCopies.Shade_texIds, crt_texIdsBytes);
   if (crt_texIdsBytes > 0)
-    crt_self->m_args.Shade_texIds.Upload(texIds, crt_texIdsBytes);
+    crt_self->crt_argCopies.Shade_texIds.Upload(texIds, crt_texIdsBytes);
   const size_t crt_uvsBytes = sizeof(LiteMath::float2) * size_t(n);
-  crossrt::EnsureSize(m_ctx, crt_self->m_args.Shade_uvs, crt_uvsBytes);
+  crossrt::EnsureSize(crt_ctx, crt_self->crt_argCopies.Shade_uvs, crt_uvsBytes);
   if (crt_uvsBytes > 0)
-    crt_self->m_args.Shade_uvs.Upload(uvs, crt_uvsBytes);
+    crt_self->crt_argCopies.Shade_uvs.Upload(uvs, crt_uvsBytes);
   const size_t crt_colorsBytes = sizeof(LiteMath::float4) * size_t(n);
-  crossrt::EnsureSize(m_ctx, crt_self->m_args.Shade_colors, crt_colorsBytes);
+  crossrt::EnsureSize(crt_ctx, crt_self->crt_argCopies.Shade_colors, crt_colorsBytes);
   if (crt_colorsBytes > 0)
-    crt_self->m_args.Shade_colors.Upload(colors, crt_colorsBytes);
+    crt_self->crt_argCopies.Shade_colors.Upload(colors, crt_colorsBytes);
   const size_t crt_heightsBytes = sizeof(float) * size_t(n);
-  crossrt::EnsureSize(m_ctx, crt_self->m_args.Shade_heights, crt_heightsBytes);
+  crossrt::EnsureSize(crt_ctx, crt_self->crt_argCopies.Shade_heights, crt_heightsBytes);
   if (crt_heightsBytes > 0)
-    crt_self->m_args.Shade_heights.Upload(heights, crt_heightsBytes);
+    crt_self->crt_argCopies.Shade_heights.Upload(heights, crt_heightsBytes);
   const size_t crt_texelsBytes = sizeof(LiteMath::float4) * size_t(n);
-  crossrt::EnsureSize(m_ctx, crt_self->m_args.Shade_texels, crt_texelsBytes);
+  crossrt::EnsureSize(crt_ctx, crt_self->crt_argCopies.Shade_texels, crt_texelsBytes);
   if (crt_texelsBytes > 0)
-    crt_self->m_args.Shade_texels.Upload(texels, crt_texelsBytes);
-  crt_self->SetVulkanInOutFor_Shade(crt_self->m_args.Shade_texIds.View(), crt_self->m_args.Shade_uvs.View(),
-                                    crt_self->m_args.Shade_colors.View(), crt_self->m_args.Shade_heights.View(),
-                                    crt_self->m_args.Shade_texels.View());
+    crt_self->crt_argCopies.Shade_texels.Upload(texels, crt_texelsBytes);
+  crt_self->SetVulkanInOutFor_Shade(
+      crt_self->crt_argCopies.Shade_texIds.View(), crt_self->crt_argCopies.Shade_uvs.View(),
+      crt_self->crt_argCopies.Shade_colors.View(), crt_self->crt_argCopies.Shade_heights.View(),
+      crt_self->crt_argCopies.Shade_texels.View());
   const float crt_copyInMs = crt_copyIn.ElapsedMs();
 
   // Members as they are now; host code of Shade that changes one records an update in order.
-  crt_self->UpdatePlainMembers();
-  VkCommandBuffer crt_cmd = m_ctx->BeginOneShot();
-  crt_self->m_gpuTimer.Reset(crt_cmd);
-  crt_self->m_gpuTimer.Begin(crt_cmd, "Shade");
+  crt_self->crt_UpdatePlainMembers();
+  VkCommandBuffer crt_cmd = crt_ctx->BeginOneShot();
+  crt_self->crt_gpuTimer.Reset(crt_cmd);
+  crt_self->crt_gpuTimer.Begin(crt_cmd, "Shade");
   crt_self->ShadeCmd(crt_cmd, n, texIds, uvs, colors, heights, texels);
-  crt_self->m_gpuTimer.End(crt_cmd, "Shade");
-  m_ctx->SubmitAndWait(crt_cmd);
-  crt_self->m_gpuTimer.Collect();
+  crt_self->crt_gpuTimer.End(crt_cmd, "Shade");
+  crt_ctx->SubmitAndWait(crt_cmd);
+  crt_self->crt_gpuTimer.Collect();
 
   crossrt::CpuTimer crt_copyOut;
-  crt_self->ReadPlainMembers();
-  crt_self->ReadVectorMembers("Shade");
+  crt_self->crt_ReadPlainMembers();
+  crt_self->crt_ReadVectorMembers("Shade");
   if (crt_colorsBytes > 0)
-    crt_self->m_args.Shade_colors.Download(colors, crt_colorsBytes);
+    crt_self->crt_argCopies.Shade_colors.Download(colors, crt_colorsBytes);
   if (crt_heightsBytes > 0)
-    crt_self->m_args.Shade_heights.Download(heights, crt_heightsBytes);
+    crt_self->crt_argCopies.Shade_heights.Download(heights, crt_heightsBytes);
   if (crt_texelsBytes > 0)
-    crt_self->m_args.Shade_texels.Download(texels, crt_texelsBytes);
-  crt_self->m_times["Shade"] = {crt_self->m_gpuTimer.LastMs("Shade"), crt_copyInMs, crt_copyOut.ElapsedMs(),
-                                crt_total.ElapsedMs()};
+    crt_self->crt_argCopies.Shade_texels.Download(texels, crt_texelsBytes);
+  crt_self->crt_times["Shade"] = {crt_self->crt_gpuTimer.LastMs("Shade"), crt_copyInMs, crt_copyOut.ElapsedMs(),
+                                  crt_total.ElapsedMs()};
 }
 
 // The body of TexturedMaterials::Shade, with each kernel call turned into its ...Cmd.
-void TexturedMaterials_Vulkan::ShadeCmd(VkCommandBuffer a_cmd, int n, [[maybe_unused]] const uint32_t* texIds,
+void TexturedMaterials_Vulkan::ShadeCmd(VkCommandBuffer crt_cmd, int n, [[maybe_unused]] const uint32_t* texIds,
                                         [[maybe_unused]] const LiteMath::float2* uvs,
                                         [[maybe_unused]] LiteMath::float4* colors, [[maybe_unused]] float* heights,
                                         [[maybe_unused]] LiteMath::float4* texels)
 {
-  kernel1D_ShadeCmd(a_cmd, n, m_inOut_Shade.texIds, m_inOut_Shade.uvs, m_inOut_Shade.colors, m_inOut_Shade.heights,
-                    m_inOut_Shade.texels);
+  kernel1D_ShadeCmd(crt_cmd, n, crt_inOut_Shade.texIds, crt_inOut_Shade.uvs, crt_inOut_Shade.colors,
+                    crt_inOut_Shade.heights, crt_inOut_Shade.texels);
 }
 
 // ---- kernel1D_Shade (from TexturedMaterials::kernel1D_Shade, TexturedMaterials.cpp) ----
 
-void TexturedMaterials_Vulkan::kernel1D_ShadeCmd(VkCommandBuffer a_cmd, int n, crossrt::BufferView texIds,
+void TexturedMaterials_Vulkan::kernel1D_ShadeCmd(VkCommandBuffer crt_cmd, int n, crossrt::BufferView texIds,
                                                  crossrt::BufferView uvs, crossrt::BufferView colors,
                                                  crossrt::BufferView heights, crossrt::BufferView texels)
 {
@@ -233,24 +234,25 @@ void TexturedMaterials_Vulkan::kernel1D_ShadeCmd(VkCommandBuffer a_cmd, int n, c
   crt_args.crt_startX = crt_startX;
   crt_args.crt_countX = crt_countX;
   crt_args.n = n;
-  if (m_useTextureHardware)  // textures on the GPU's samplers
+  if (crt_useTextureHardware)  // textures on the GPU's samplers
   {
-    m_pipelines.kernel1D_Shade_Textures.Bind(a_cmd);
-    m_pipelines.kernel1D_Shade_Textures.PushBuffers(a_cmd, {m_classDataBuffer.View(), texIds, uvs, colors, heights,
-                                                            texels, m_textureArrays.m_albedo_info.View(),
-                                                            m_textureArrays.m_bumps_info.View()});
-    m_pipelines.kernel1D_Shade_Textures.BindTextureArrays(a_cmd, {&m_textureArrays.m_albedo, &m_textureArrays.m_bumps});
-    m_pipelines.kernel1D_Shade_Textures.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
+    crt_pipelines.kernel1D_Shade_Textures.Bind(crt_cmd);
+    crt_pipelines.kernel1D_Shade_Textures.PushBuffers(crt_cmd, {crt_classDataBuffer.View(), texIds, uvs, colors,
+                                                                heights, texels, crt_textureArrays.m_albedo_info.View(),
+                                                                crt_textureArrays.m_bumps_info.View()});
+    crt_pipelines.kernel1D_Shade_Textures.BindTextureArrays(crt_cmd,
+                                                            {&crt_textureArrays.m_albedo, &crt_textureArrays.m_bumps});
+    crt_pipelines.kernel1D_Shade_Textures.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
   }
   else
   {
-    m_pipelines.kernel1D_Shade.Bind(a_cmd);
-    m_pipelines.kernel1D_Shade.PushBuffers(
-        a_cmd, {m_classDataBuffer.View(), texIds, uvs, colors, heights, texels, m_textureArrays.m_albedo_info.View(),
-                m_textureArrays.m_albedo_texels.View(), m_textureArrays.m_bumps_info.View(),
-                m_textureArrays.m_bumps_texels.View()});
-    m_pipelines.kernel1D_Shade.PushConstants(a_cmd, &crt_args, sizeof(crt_args));
+    crt_pipelines.kernel1D_Shade.Bind(crt_cmd);
+    crt_pipelines.kernel1D_Shade.PushBuffers(
+        crt_cmd, {crt_classDataBuffer.View(), texIds, uvs, colors, heights, texels,
+                  crt_textureArrays.m_albedo_info.View(), crt_textureArrays.m_albedo_texels.View(),
+                  crt_textureArrays.m_bumps_info.View(), crt_textureArrays.m_bumps_texels.View()});
+    crt_pipelines.kernel1D_Shade.PushConstants(crt_cmd, &crt_args, sizeof(crt_args));
   }
-  crossrt::Dispatch1D(a_cmd, crt_countX, 256);
-  crossrt::ComputeBarrier(a_cmd);
+  crossrt::Dispatch1D(crt_cmd, crt_countX, 256);
+  crossrt::ComputeBarrier(crt_cmd);
 }

@@ -29,34 +29,34 @@ public:
   virtual void SetVulkanInOutFor_Shade(crossrt::BufferView a_texIds, crossrt::BufferView a_uvs,
                                        crossrt::BufferView a_colors, crossrt::BufferView a_heights,
                                        crossrt::BufferView a_texels);
-  virtual void ShadeCmd(VkCommandBuffer a_cmd, int n, const uint32_t* texIds, const LiteMath::float2* uvs,
+  virtual void ShadeCmd(VkCommandBuffer crt_cmd, int n, const uint32_t* texIds, const LiteMath::float2* uvs,
                         LiteMath::float4* colors, float* heights, LiteMath::float4* texels);
 
   void CommitDeviceData() override;  // uploads members
   // a_out: [0] GPU ms, [1] copy-in ms, [2] copy-out ms, [3] total ms
   void GetExecutionTime(const char* a_funcName, float a_out[4]);
 
-  virtual void UpdatePlainMembers();  // members -> GPU (called before every control function)
-  virtual void ReadPlainMembers();    // GPU -> members the kernels write (reductions)
+  virtual void crt_UpdatePlainMembers();  // members -> GPU (called before every control function)
+  virtual void crt_ReadPlainMembers();    // GPU -> members the kernels write (reductions)
 
-  std::shared_ptr<crossrt::VulkanContext> Context() const { return m_ctx; }
+  std::shared_ptr<crossrt::VulkanContext> Context() const { return crt_ctx; }
 
   // Arrays of textures (m_albedo m_bumps ) are sampled by the GPU's samplers where the device
   // has descriptor indexing (the default there), else from buffers by the kernels themselves, as
   // LiteImage samples on the CPU: bit for bit the CPU's texels, at the cost of the filtering done in
   // the shader. The GPU's bilinear weights have its sub-texel precision (8 bits on most devices).
   // Turning the samplers on throws on a device without descriptor indexing.
-  bool UsesTextureHardware() const { return m_useTextureHardware; }
+  bool UsesTextureHardware() const { return crt_useTextureHardware; }
   virtual void UseTextureHardware(bool a_use);
 
 protected:
-  // One per kernel (and megakernel of a thread loop): records its dispatch (and barrier) into a_cmd.
-  virtual void kernel1D_ShadeCmd(VkCommandBuffer a_cmd, int n, crossrt::BufferView texIds, crossrt::BufferView uvs,
+  // One per kernel (and megakernel of a thread loop): records its dispatch (and barrier) into crt_cmd.
+  virtual void kernel1D_ShadeCmd(VkCommandBuffer crt_cmd, int n, crossrt::BufferView texIds, crossrt::BufferView uvs,
                                  crossrt::BufferView colors, crossrt::BufferView heights, crossrt::BufferView texels);
-  virtual void InitPipelines();
+  virtual void crt_InitPipelines();
   // Records an update of one member's GPU copy, ordered between the kernels around it.
-  virtual void UpdateMemberCmd(VkCommandBuffer a_cmd, size_t a_offset, const void* a_data, size_t a_size);
-  virtual void ReadVectorMembers(const char* a_funcName);  // GPU -> std::vector and Image2D members kernels write
+  virtual void crt_UpdateMemberCmd(VkCommandBuffer crt_cmd, size_t a_offset, const void* a_data, size_t a_size);
+  virtual void crt_ReadVectorMembers(const char* a_funcName);  // GPU -> std::vector and Image2D members kernels write
 
   // Push constants of each kernel: thread ranges, then its scalar arguments (std430 offsets).
   struct kernel1D_ShadeArgs
@@ -73,15 +73,15 @@ protected:
     alignas(4) uint32_t m_bumps_size;
   };
 
-  std::shared_ptr<crossrt::VulkanContext> m_ctx;
-  crossrt::Buffer m_classDataBuffer;
-  bool m_deviceDataCommitted = false;
+  std::shared_ptr<crossrt::VulkanContext> crt_ctx;
+  crossrt::Buffer crt_classDataBuffer;
+  bool crt_deviceDataCommitted = false;
 
   // A std::vector or Image2D member changed size, or a sampler changed, since CommitDeviceData().
-  virtual bool VectorMembersResized() const;
+  virtual bool crt_VectorMembersResized() const;
 
-  // Arrays of textures, committed by CommitDeviceData() the way m_useTextureHardware picks.
-  bool m_useTextureHardware = false;
+  // Arrays of textures, committed by CommitDeviceData() the way crt_useTextureHardware picks.
+  bool crt_useTextureHardware = false;
   struct TextureArrays
   {
     crossrt::TextureArray m_albedo;                  // for the GPU's samplers
@@ -90,7 +90,7 @@ protected:
     crossrt::TextureArray m_bumps;                   // for the GPU's samplers
     crossrt::Buffer m_bumps_info, m_bumps_texels;    // each texture's size and sampler; texels for the shader's sampler
     size_t m_bumpsSize = 0;                          // textures at the last CommitDeviceData()
-  } m_textureArrays;
+  } crt_textureArrays;
 
   struct InOut_Shade  // buffers bound by SetVulkanInOutFor_Shade
   {
@@ -99,7 +99,7 @@ protected:
     crossrt::BufferView colors;
     crossrt::BufferView heights;
     crossrt::BufferView texels;
-  } m_inOut_Shade;
+  } crt_inOut_Shade;
 
   struct ArgumentBuffers  // device copies of pointer arguments, reused across calls
   {
@@ -108,20 +108,20 @@ protected:
     crossrt::Buffer Shade_colors;
     crossrt::Buffer Shade_heights;
     crossrt::Buffer Shade_texels;
-  } m_args;
+  } crt_argCopies;
 
   struct Pipelines
   {
     crossrt::ComputePipeline kernel1D_Shade_Textures;  // textures on the GPU's samplers
     crossrt::ComputePipeline kernel1D_Shade;
-  } m_pipelines;
+  } crt_pipelines;
 
   struct Partials  // per-workgroup partial results of reductions
   {
-  } m_partials;
+  } crt_partials;
 
-  crossrt::GpuTimer m_gpuTimer;
-  std::map<std::string, std::array<float, 4>> m_times;
+  crossrt::GpuTimer crt_gpuTimer;
+  std::map<std::string, std::array<float, 4>> crt_times;
 };
 
 // Runs on the default device: CROSSRT_DEVICE (index or name) if set, else a discrete GPU, else lavapipe.

@@ -52,8 +52,8 @@ void kernel2D_ExtractBright(int x, int y)
 
 void main()
 {
-  const bool inRange = gl_GlobalInvocationID.x < crt_countX && gl_GlobalInvocationID.y < crt_countY;
-  if (inRange)
+  const bool crt_inRange = gl_GlobalInvocationID.x < crt_countX && gl_GlobalInvocationID.y < crt_countY;
+  if (crt_inRange)
     kernel2D_ExtractBright(int(crt_startX + int(gl_GlobalInvocationID.x)),
                            int(crt_startY + int(gl_GlobalInvocationID.y)));
 }

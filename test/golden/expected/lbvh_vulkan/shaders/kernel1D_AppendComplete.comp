@@ -91,10 +91,10 @@ void kernel1D_AppendComplete(int i)
 void main()
 {
   // 1D dispatches may be spread over y when they exceed the device's group-count limit.
-  const uint threadId = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x;
-  const bool inRange = threadId < crt_countX;
-  if (inRange)
-    kernel1D_AppendComplete(int(crt_startX + int(threadId)));
+  const uint crt_threadId = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x;
+  const bool crt_inRange = crt_threadId < crt_countX;
+  if (crt_inRange)
+    kernel1D_AppendComplete(int(crt_startX + int(crt_threadId)));
 
   const uint m_leafCountSubgroup = subgroupAdd(m_leafCountLocal);
   if (subgroupElect())
@@ -104,11 +104,11 @@ void main()
   barrier();
   if (gl_LocalInvocationIndex == 0)
   {
-    const uint groupId =
+    const uint crt_groupId =
         gl_WorkGroupID.x + gl_NumWorkGroups.x * (gl_WorkGroupID.y + gl_NumWorkGroups.y * gl_WorkGroupID.z);
     uint m_leafCountGroup = m_leafCountShared[0];
     for (uint s = 1; s < gl_NumSubgroups; ++s)
       m_leafCountGroup = m_leafCountGroup + m_leafCountShared[s];
-    m_leafCountPartials[groupId] = m_leafCountGroup;
+    m_leafCountPartials[crt_groupId] = m_leafCountGroup;
   }
 }

@@ -85,10 +85,10 @@ void kernel1D_Bounds(int i)
 void main()
 {
   // 1D dispatches may be spread over y when they exceed the device's group-count limit.
-  const uint threadId = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x;
-  const bool inRange = threadId < crt_countX;
-  if (inRange)
-    kernel1D_Bounds(int(crt_startX + int(threadId)));
+  const uint crt_threadId = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x;
+  const bool crt_inRange = crt_threadId < crt_countX;
+  if (crt_inRange)
+    kernel1D_Bounds(int(crt_startX + int(crt_threadId)));
 
   const vec3 m_centerMinSubgroup = subgroupMin(m_centerMinLocal);
   const vec3 m_centerMaxSubgroup = subgroupMax(m_centerMaxLocal);
@@ -100,15 +100,15 @@ void main()
   barrier();
   if (gl_LocalInvocationIndex == 0)
   {
-    const uint groupId =
+    const uint crt_groupId =
         gl_WorkGroupID.x + gl_NumWorkGroups.x * (gl_WorkGroupID.y + gl_NumWorkGroups.y * gl_WorkGroupID.z);
     vec3 m_centerMinGroup = m_centerMinShared[0];
     for (uint s = 1; s < gl_NumSubgroups; ++s)
       m_centerMinGroup = min(m_centerMinGroup, m_centerMinShared[s]);
-    m_centerMinPartials[groupId] = m_centerMinGroup;
+    m_centerMinPartials[crt_groupId] = m_centerMinGroup;
     vec3 m_centerMaxGroup = m_centerMaxShared[0];
     for (uint s = 1; s < gl_NumSubgroups; ++s)
       m_centerMaxGroup = max(m_centerMaxGroup, m_centerMaxShared[s]);
-    m_centerMaxPartials[groupId] = m_centerMaxGroup;
+    m_centerMaxPartials[crt_groupId] = m_centerMaxGroup;
   }
 }

@@ -77,10 +77,10 @@ void kernel1D_Summarize(uint i)
 void main()
 {
   // 1D dispatches may be spread over y when they exceed the device's group-count limit.
-  const uint threadId = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x;
-  const bool inRange = threadId < crt_countX;
-  if (inRange)
-    kernel1D_Summarize(uint(crt_startX + int(threadId)));
+  const uint crt_threadId = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x;
+  const bool crt_inRange = crt_threadId < crt_countX;
+  if (crt_inRange)
+    kernel1D_Summarize(uint(crt_startX + int(crt_threadId)));
 
   const float sumSubgroup = subgroupAdd(sumLocal);
   const float loSubgroup = subgroupMin(loLocal);
@@ -98,27 +98,27 @@ void main()
   barrier();
   if (gl_LocalInvocationIndex == 0)
   {
-    const uint groupId =
+    const uint crt_groupId =
         gl_WorkGroupID.x + gl_NumWorkGroups.x * (gl_WorkGroupID.y + gl_NumWorkGroups.y * gl_WorkGroupID.z);
     float sumGroup = sumShared[0];
     for (uint s = 1; s < gl_NumSubgroups; ++s)
       sumGroup = sumGroup + sumShared[s];
-    sumPartials[groupId] = sumGroup;
+    sumPartials[crt_groupId] = sumGroup;
     float loGroup = loShared[0];
     for (uint s = 1; s < gl_NumSubgroups; ++s)
       loGroup = min(loGroup, loShared[s]);
-    loPartials[groupId] = loGroup;
+    loPartials[crt_groupId] = loGroup;
     float hiGroup = hiShared[0];
     for (uint s = 1; s < gl_NumSubgroups; ++s)
       hiGroup = max(hiGroup, hiShared[s]);
-    hiPartials[groupId] = hiGroup;
+    hiPartials[crt_groupId] = hiGroup;
     vec4 totalGroup = totalShared[0];
     for (uint s = 1; s < gl_NumSubgroups; ++s)
       totalGroup = totalGroup + totalShared[s];
-    totalPartials[groupId] = totalGroup;
+    totalPartials[crt_groupId] = totalGroup;
     int negativesGroup = negativesShared[0];
     for (uint s = 1; s < gl_NumSubgroups; ++s)
       negativesGroup = negativesGroup + negativesShared[s];
-    negativesPartials[groupId] = negativesGroup;
+    negativesPartials[crt_groupId] = negativesGroup;
   }
 }

@@ -63,10 +63,10 @@ void kernel1D_Advance(int i)
 void main()
 {
   // 1D dispatches may be spread over y when they exceed the device's group-count limit.
-  const uint threadId = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x;
-  const bool inRange = threadId < crt_countX;
-  if (inRange)
-    kernel1D_Advance(int(crt_startX + int(threadId)));
+  const uint crt_threadId = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x;
+  const bool crt_inRange = crt_threadId < crt_countX;
+  if (crt_inRange)
+    kernel1D_Advance(int(crt_startX + int(crt_threadId)));
 
   const int m_bouncesSubgroup = subgroupAdd(m_bouncesLocal);
   if (subgroupElect())
@@ -76,11 +76,11 @@ void main()
   barrier();
   if (gl_LocalInvocationIndex == 0)
   {
-    const uint groupId =
+    const uint crt_groupId =
         gl_WorkGroupID.x + gl_NumWorkGroups.x * (gl_WorkGroupID.y + gl_NumWorkGroups.y * gl_WorkGroupID.z);
     int m_bouncesGroup = m_bouncesShared[0];
     for (uint s = 1; s < gl_NumSubgroups; ++s)
       m_bouncesGroup = m_bouncesGroup + m_bouncesShared[s];
-    m_bouncesPartials[groupId] = m_bouncesGroup;
+    m_bouncesPartials[crt_groupId] = m_bouncesGroup;
   }
 }

@@ -76,10 +76,10 @@ void kernel1D_Measure(int i)
 void main()
 {
   // 1D dispatches may be spread over y when they exceed the device's group-count limit.
-  const uint threadId = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x;
-  const bool inRange = threadId < crt_countX;
-  if (inRange)
-    kernel1D_Measure(int(crt_startX + int(threadId)));
+  const uint crt_threadId = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x;
+  const bool crt_inRange = crt_threadId < crt_countX;
+  if (crt_inRange)
+    kernel1D_Measure(int(crt_startX + int(crt_threadId)));
 
   const vec4 m_boxMinSubgroup = subgroupMin(m_boxMinLocal);
   const vec4 m_boxMaxSubgroup = subgroupMax(m_boxMaxLocal);
@@ -95,23 +95,23 @@ void main()
   barrier();
   if (gl_LocalInvocationIndex == 0)
   {
-    const uint groupId =
+    const uint crt_groupId =
         gl_WorkGroupID.x + gl_NumWorkGroups.x * (gl_WorkGroupID.y + gl_NumWorkGroups.y * gl_WorkGroupID.z);
     vec4 m_boxMinGroup = m_boxMinShared[0];
     for (uint s = 1; s < gl_NumSubgroups; ++s)
       m_boxMinGroup = min(m_boxMinGroup, m_boxMinShared[s]);
-    m_boxMinPartials[groupId] = m_boxMinGroup;
+    m_boxMinPartials[crt_groupId] = m_boxMinGroup;
     vec4 m_boxMaxGroup = m_boxMaxShared[0];
     for (uint s = 1; s < gl_NumSubgroups; ++s)
       m_boxMaxGroup = max(m_boxMaxGroup, m_boxMaxShared[s]);
-    m_boxMaxPartials[groupId] = m_boxMaxGroup;
+    m_boxMaxPartials[crt_groupId] = m_boxMaxGroup;
     vec4 m_momentumGroup = m_momentumShared[0];
     for (uint s = 1; s < gl_NumSubgroups; ++s)
       m_momentumGroup = m_momentumGroup + m_momentumShared[s];
-    m_momentumPartials[groupId] = m_momentumGroup;
+    m_momentumPartials[crt_groupId] = m_momentumGroup;
     float m_kineticEnergyGroup = m_kineticEnergyShared[0];
     for (uint s = 1; s < gl_NumSubgroups; ++s)
       m_kineticEnergyGroup = m_kineticEnergyGroup + m_kineticEnergyShared[s];
-    m_kineticEnergyPartials[groupId] = m_kineticEnergyGroup;
+    m_kineticEnergyPartials[crt_groupId] = m_kineticEnergyGroup;
   }
 }

@@ -908,8 +908,8 @@ void kernel1D_CastRays(int i)
 void main()
 {
   // 1D dispatches may be spread over y when they exceed the device's group-count limit.
-  const uint threadId = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x;
-  const bool inRange = threadId < crt_countX;
-  if (inRange)
-    kernel1D_CastRays(int(crt_startX + int(threadId)));
+  const uint crt_threadId = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * gl_WorkGroupSize.x;
+  const bool crt_inRange = crt_threadId < crt_countX;
+  if (crt_inRange)
+    kernel1D_CastRays(int(crt_startX + int(crt_threadId)));
 }

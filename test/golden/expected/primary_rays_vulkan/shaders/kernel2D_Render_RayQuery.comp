@@ -208,7 +208,7 @@ void kernel2D_Render(int x, int y)
 
 void main()
 {
-  const bool inRange = gl_GlobalInvocationID.x < crt_countX && gl_GlobalInvocationID.y < crt_countY;
-  if (inRange)
+  const bool crt_inRange = gl_GlobalInvocationID.x < crt_countX && gl_GlobalInvocationID.y < crt_countY;
+  if (crt_inRange)
     kernel2D_Render(int(crt_startX + int(gl_GlobalInvocationID.x)), int(crt_startY + int(gl_GlobalInvocationID.y)));
 }

@@ -188,8 +188,8 @@ void Render_Megakernel(uint x, uint y, int samples, uint width, uint height)
 
 void main()
 {
-  const bool inRange = gl_GlobalInvocationID.x < crt_countX && gl_GlobalInvocationID.y < crt_countY;
-  if (inRange)
+  const bool crt_inRange = gl_GlobalInvocationID.x < crt_countX && gl_GlobalInvocationID.y < crt_countY;
+  if (crt_inRange)
     Render_Megakernel(uint(crt_startX + int(gl_GlobalInvocationID.x)), uint(crt_startY + int(gl_GlobalInvocationID.y)),
                       samples, width, height);
 }

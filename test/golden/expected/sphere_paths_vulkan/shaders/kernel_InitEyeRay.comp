@@ -76,8 +76,8 @@ void kernel_InitEyeRay(uint tidX, uint tidY, uint width, uint height, int sample
 
 void main()
 {
-  const bool inRange = gl_GlobalInvocationID.x < crt_countX && gl_GlobalInvocationID.y < crt_countY;
-  if (inRange)
+  const bool crt_inRange = gl_GlobalInvocationID.x < crt_countX && gl_GlobalInvocationID.y < crt_countY;
+  if (crt_inRange)
   {
     // This thread's values, kept between the kernels of the thread loop (wavefront mode).
     const uint threadIndex = gl_GlobalInvocationID.x + crt_countX * gl_GlobalInvocationID.y;

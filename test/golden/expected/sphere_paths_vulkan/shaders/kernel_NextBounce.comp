@@ -124,8 +124,8 @@ void kernel_NextBounce(uint tidX, uint tidY, uint width, int sample_, int bounce
 
 void main()
 {
-  const bool inRange = gl_GlobalInvocationID.x < crt_countX && gl_GlobalInvocationID.y < crt_countY;
-  if (inRange)
+  const bool crt_inRange = gl_GlobalInvocationID.x < crt_countX && gl_GlobalInvocationID.y < crt_countY;
+  if (crt_inRange)
   {
     // This thread's values, kept between the kernels of the thread loop (wavefront mode).
     const uint threadIndex = gl_GlobalInvocationID.x + crt_countX * gl_GlobalInvocationID.y;
