@@ -140,12 +140,8 @@ std::set<std::string> VectorsKernelsWrite(Context& c, const FunctionDecl* contro
   return written;
 }
 
-// Whether host code in `s` uses one of the member vectors `written` (its elements, an iterator, the
-// whole vector), other than asking its size or handing it to a kernel or a library call.
-bool UsesWrittenVector(Context& c, const std::set<std::string>& written, const Stmt* s) {
-  KernelCallFinder gpu(c.cls);
-  gpu.TraverseStmt(const_cast<Stmt*>(s));
-  auto& sm = c.ctx.getSourceManager();
+// The uses of this object's members in `s` (m_x, this->m_x), in the order written.
+std::vector<const MemberExpr*> ThisMemberUses(const Stmt* s) {
   struct Finder : RecursiveASTVisitor<Finder> {
     std::vector<const MemberExpr*> uses;
     bool VisitMemberExpr(MemberExpr* me) {
@@ -154,8 +150,17 @@ bool UsesWrittenVector(Context& c, const std::set<std::string>& written, const S
     }
   } finder;
   finder.TraverseStmt(const_cast<Stmt*>(s));
+  return finder.uses;
+}
+
+// Whether host code in `s` uses one of the member vectors `written` (its elements, an iterator, the
+// whole vector), other than asking its size or handing it to a kernel or a library call.
+bool UsesWrittenVector(Context& c, const std::set<std::string>& written, const Stmt* s) {
+  KernelCallFinder gpu(c.cls);
+  gpu.TraverseStmt(const_cast<Stmt*>(s));
+  auto& sm = c.ctx.getSourceManager();
   static const std::set<std::string> sizes = {"size", "capacity", "empty"};
-  for (const MemberExpr* me : finder.uses) {
+  for (const MemberExpr* me : ThisMemberUses(s)) {
     if (!written.count(me->getMemberDecl()->getNameAsString()) || sizes.count(UsingCall(c.ctx, me))) continue;
     if (!EnclosingCall(sm, gpu.calls, me)) return true;
   }
@@ -249,19 +254,11 @@ const std::set<std::string> kHarmless = {"size", "capacity", "empty", "swap", "s
 const std::set<std::string> kResizing = {"push_back", "emplace_back", "pop_back", "resize", "assign", "clear", "insert", "erase", "emplace", "shrink_to_fit"};
 
 // The member vectors kernels use (or that `alsoUsed` names: those handed to them through data() or
-// swapped) whose elements `s` may change, as "hostExpr|name". A resize is not among them: the next call gives a resized
-// vector a new device buffer, filled.
+// swapped) whose elements `s` may change, as "hostExpr|name". A resize is not among them: the next
+// call gives a resized vector a new device buffer, filled.
 std::set<std::string> ChangedDeviceVectors(Context& c, const std::set<std::string>& alsoUsed, const Stmt* s) {
-  struct Uses : RecursiveASTVisitor<Uses> {
-    std::vector<const MemberExpr*> uses;
-    bool VisitMemberExpr(MemberExpr* me) {
-      if (isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts())) uses.push_back(me);
-      return true;
-    }
-  } uses;
-  uses.TraverseStmt(const_cast<Stmt*>(s));
   std::set<std::string> changed;
-  for (const MemberExpr* me : uses.uses) {
+  for (const MemberExpr* me : ThisMemberUses(s)) {
     auto* f = dyn_cast<FieldDecl>(me->getMemberDecl());
     const Member* m = f ? FindMember(c.model, f->getNameAsString()) : nullptr;
     if (!m || m->kind != MemberKind::Vector || !(m->usedByKernels || alsoUsed.count(m->name)) || m->appendedByKernels) continue;
@@ -346,18 +343,9 @@ void ControlRewriter::CheckHostVectorUses() {
   if (last < 0) return;
   KernelCallFinder gpu(m_c.cls);  // kernel and library calls: what they take is the GPU's business
   gpu.TraverseStmt(const_cast<Stmt*>(m_def->getBody()));
-  struct Uses : RecursiveASTVisitor<Uses> {
-    std::vector<const MemberExpr*> uses;
-    bool VisitMemberExpr(MemberExpr* me) {
-      if (isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts())) uses.push_back(me);
-      return true;
-    }
-  };
   for (int i = 0; i <= last; ++i) {
     const bool loop = isa<ForStmt, WhileStmt, DoStmt, CXXForRangeStmt>(statements[i]) && FirstGpuWork(m_c, statements[i]).isValid();
-    Uses uses;
-    uses.TraverseStmt(const_cast<Stmt*>(statements[i]));
-    for (const MemberExpr* me : uses.uses) {
+    for (const MemberExpr* me : ThisMemberUses(statements[i])) {
       auto* f = dyn_cast<FieldDecl>(me->getMemberDecl());
       const Member* m = f ? FindMember(m_c.model, f->getNameAsString()) : nullptr;
       if (!m || m->kind != MemberKind::Vector || !m->usedByKernels || m->appendedByKernels || EnclosingCall(sm, gpu.calls, me)) continue;
