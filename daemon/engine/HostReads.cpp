@@ -248,6 +248,44 @@ bool ReadOnlyUse(ASTContext& ctx, const MemberExpr* me) {
   }
 }
 
+// Whether the host may reach the elements `me` names after the statement that holds it: through a
+// lambda around it, or a local reference, pointer or iterator bound to the vector or an element
+// (`auto& v = m_v;`, `float* p = m_v.data();`). Says how, or "" when it cannot.
+std::string LaterAccess(ASTContext& ctx, const MemberExpr* me) {
+  auto parentOf = [&](const DynTypedNode& n) { const auto p = ctx.getParents(n); return p.empty() ? DynTypedNode() : p[0]; };
+  for (DynTypedNode n = parentOf(DynTypedNode::create(*me)); !n.getNodeKind().isNone(); n = parentOf(n))
+    if (n.get<LambdaExpr>()) return "a lambda, which may run after the statement";
+  DynTypedNode node = DynTypedNode::create(*me);
+  for (;;) {
+    const DynTypedNode up = parentOf(node);
+    if (up.get<ImplicitCastExpr>() || up.get<ParenExpr>() || up.get<MaterializeTemporaryExpr>() || up.get<CXXBindTemporaryExpr>() ||
+        up.get<ExprWithCleanups>() || up.get<CXXConstructExpr>()) {
+      node = up;
+      continue;
+    }
+    if (auto* uo = up.get<UnaryOperator>(); uo && uo->getOpcode() == UO_AddrOf) {
+      node = up;
+      continue;
+    }
+    if (auto* op = up.get<CXXOperatorCallExpr>(); op && op->getOperator() == OO_Subscript) {
+      node = up;
+      continue;
+    }
+    if (up.get<MemberExpr>()) {  // m_v.data(), m_v.begin(), m_v.at(i), a field of an element
+      const DynTypedNode call = parentOf(up);
+      node = call.get<CXXMemberCallExpr>() ? call : up;
+      continue;
+    }
+    auto* var = up.get<VarDecl>();
+    if (!var || var->isImplicit()) return "";  // used where it stands (or a range-for's own range)
+    const QualType t = var->getType();
+    const bool mutableAlias = (t->isReferenceType() && !t.getNonReferenceType().isConstQualified()) ||
+                              (t->isPointerType() && !t->getPointeeType().isConstQualified()) ||
+                              (t->isRecordType() && t.getAsString().find("iterator") != std::string::npos);
+    return mutableAlias ? "the local '" + var->getNameAsString() + "', which may change it after the statement" : "";
+  }
+}
+
 // Calls on a member vector that need nothing on the host between kernel calls (LiteMath's
 // ReduceAddInit and ReduceAddComplete are GPU work of their own), and those that resize it.
 const std::set<std::string> kHarmless = {"size", "capacity", "empty", "swap", "std::swap", "reserve", "ReduceAddInit", "ReduceAddComplete"};
@@ -363,6 +401,12 @@ void ControlRewriter::CheckHostVectorUses() {
       const bool after = loop || sm.isBeforeInTranslationUnit(firstWork, me->getBeginLoc());
       const bool changes = !ReadOnlyUse(m_c.ctx, me);
       if (!changes && !(written && after)) continue;  // a read of what only the host writes
+      if (const std::string how = changes ? LaterAccess(m_c.ctx, me) : ""; !how.empty()) {
+        m_c.rep.RecordingError(me->getExprLoc(), "control function '" + m_ctrl.name + "' lets host code reach '" + m->name + "' between kernel calls through " +
+                                   how + ": the generated class cannot tell when to upload it",
+                               "index '" + m->name + "' itself in the statements that change it (" + m->name + "[i] = ...): each is then synchronised with the GPU");
+        continue;
+      }
       if (!SynchronizeAround(me, *m, written, changes))
         m_c.rep.RecordingError(me->getExprLoc(), "control function '" + m_ctrl.name + "' " + (changes ? "changes" : "reads") + " '" + m->name +
                                    "' on the host in a statement that also records GPU work, between kernel calls",

@@ -553,6 +553,31 @@ void Counts::kernel1D_Twice(int n) { for (int i = 0; i < n; i++) m_out[i] = 2 * 
       CHECK(cpu.exitCode == 0);
     }
   }
+  SECTION("refused: a local reference or a lambda that reaches a vector after its statement")
+  {
+    TempClass tc("Counts", header, kernels + R"(void Counts::Run(int n)
+{
+  auto& in = m_in;
+  kernel1D_Copy(n);
+  in[0] = m_out[0];
+  auto bump = [&]() { m_in[1] += 1; };
+  bump();
+  kernel1D_Twice(n);
+}
+)");
+    CommandResult r = RunCrossrt("translate --class Counts --backend vulkan --out " + (tc.dir / "out").string() + " --source " + tc.Source("Counts") +
+                                 " --templates " CROSSRT_SOURCE_DIR "/templates");
+    INFO(r.output);
+    REQUIRE_FALSE(r.crashed);
+    REQUIRE(r.exitCode == 1);
+    CHECK(r.output.find("Counts.cpp:7:14: error: control function 'Run' lets host code reach 'm_in' between kernel calls through the local 'in'") !=
+          std::string::npos);
+    CHECK(r.output.find("Counts.cpp:10:23: error: control function 'Run' lets host code reach 'm_in' between kernel calls through a lambda") !=
+          std::string::npos);
+    CommandResult cpu = RunCrossrt("translate --class Counts --backend cpu --out " + (tc.dir / "cpu").string() + " --source " + tc.Source("Counts") +
+                                   " --templates " CROSSRT_SOURCE_DIR "/templates");
+    CHECK(cpu.exitCode == 0);
+  }
   SECTION("translated: the recording is split around each host statement, with a note")
   {
     TempClass tc("Counts", header, kernels + R"(void Counts::Run(int n)

@@ -36,6 +36,7 @@ std::vector<Value> Outputs(T& c) {
   for (size_t i = 0; i < c.m_a.size(); ++i) out.push_back({"m_a[" + std::to_string(i) + "]", c.m_a[i], false});
   for (size_t i = 0; i < c.m_b.size(); ++i) out.push_back({"m_b[" + std::to_string(i) + "]", c.m_b[i], false});
   for (size_t i = 0; i < c.m_i.size(); ++i) out.push_back({"m_i[" + std::to_string(i) + "]", double(c.m_i[i]), true});
+  for (size_t i = 0; i < c.m_hist.size(); ++i) out.push_back({"m_hist[" + std::to_string(i) + "]", double(c.m_hist[i]), true});
   std::vector<int> found = c.m_found;
   std::sort(found.begin(), found.end());
   out.push_back({"m_found.size()", double(found.size()), true});
