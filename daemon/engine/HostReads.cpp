@@ -4,13 +4,17 @@
 // recording, would see the value from before the call. After the last statement that records GPU
 // work the uses are sound once deferred: the ...Cmd stores those statements (the host tail,
 // `m_mean = m_sum / float(n);`, `m_first = m_out[0];`) as a lambda, capturing the locals they read,
-// and the generated control function runs it after the kernels' results are back. Between kernels
-// a plain member read splits the recording: the read becomes `crt_Synchronize(crt_cmd, "Solve").m_residual`,
-// which submits what was recorded, waits, reads the members back and begins a new command buffer
-// (a solver's `if (m_residual < tol) break;`). Output parameters, copied back only at the end, and
-// member vectors on the host before the last kernel are errors there. Takes a control function's
-// body; gives Control::hasHostTail, Control::synchronizes, the ...Cmd's lambda and its synchronised
-// reads.
+// and the generated control function runs it after the kernels' results are back; when the tail
+// changes a vector the kernels use, it uploads it at its end. Between kernels a plain member read
+// splits the recording: the read becomes `crt_Synchronize(crt_cmd, "Solve").m_residual`, which
+// submits what was recorded, waits, reads the members back and begins a new command buffer (a
+// solver's `if (m_residual < tol) break;`). A host statement there that uses member vectors'
+// elements (k-means moving its centroids) is split around likewise: crt_Synchronize before it, the
+// vectors the kernels write read back, those it changes uploaded after it. Output parameters
+// (copied back only at the end), resizing such a vector, a use inside a statement that also records
+// GPU work, and a reference or lambda that reaches one later are errors there. Takes a control
+// function's body; gives Control::hasHostTail, Control::synchronizes, the ...Cmd's lambda, its
+// synchronised reads and the statements split around.
 #include "ControlFunctions.h"
 #include "ControlRewriter.h"
 #include "GeneratedNames.h"
