@@ -283,7 +283,7 @@ std::string GlslPrinter::AtomicCall(const FunctionDecl* fd, const CallExpr* call
         {"AtomicXor", "atomic_xor_global"}, {"AtomicExchange", "atomic_swap_global"}, {"AtomicMin", "atomic_min_global"},
         {"AtomicMax", "atomic_max_global"}, {"AtomicCompareExchange", "atomic_compare_exchange_global"}};
     std::string s = ispcNames.at(name) + "(&" + args[0];
-    for (size_t i = 1; i < args.size(); ++i) s += ", " + args[i];
+    for (size_t i = 1; i < args.size(); ++i) s += ", crt_perLane(" + args[i] + ")";  // once per lane, as threads do
     return s + ")";
   }
   // The fences of acquire-release order (the kernel template defines crt_release/crt_acquire):
@@ -419,7 +419,8 @@ std::string GlslPrinter::Call(const CallExpr* call) {
     if (std::string problem = AtomicTargetProblem(call->getArg(0)); !problem.empty())
       return Fail(call->getArg(0)->getExprLoc(), "the target of " + name + " is not in device memory: " + problem,
                   "make the target an element of a std::vector member, a data member, or an element of a kernel's pointer parameter");
-    const std::string add = "atomic_add_global(&" + Expr(call->getArg(0)) + ", " + Expr(call->getArg(1)) + ")";
+    // crt_perLane: a uniform value on a uniform target would be added once per gang, not per lane.
+    const std::string add = "atomic_add_global(&" + Expr(call->getArg(0)) + ", crt_perLane(" + Expr(call->getArg(1)) + "))";
     return call->getNumArgs() == 3 ? Expr(call->getArg(2)) + " = " + add : add;
   }
   if (ispc && interlocked) return IspcInterlockedCall(fd, call);
