@@ -202,16 +202,21 @@ SourceLocation FirstGpuWork(Context& c, const Stmt* s) {
   return first;
 }
 
+// The first parent of `n`, or an empty node at the top.
+DynTypedNode ParentOf(ASTContext& ctx, const DynTypedNode& n) {
+  const auto parents = ctx.getParents(n);
+  return parents.empty() ? DynTypedNode() : parents[0];
+}
+
 // Whether `me` (a member vector) is only read where it stands: an element read as a value
 // (m_v[i], m_v[i].x, m_v.at(i), m_v.front()), or iterated by value or const reference. Anything
 // else (an element assigned, a non-const reference, an iterator or data() handed on) may change it.
 bool ReadOnlyUse(ASTContext& ctx, const MemberExpr* me) {
-  auto parentOf = [&](const DynTypedNode& n) { const auto p = ctx.getParents(n); return p.empty() ? DynTypedNode() : p[0]; };
   DynTypedNode node = DynTypedNode::create(*me);
   // Up to the element: through casts and parentheses, a subscript, at/front/back, and a field of it.
   bool element = false;
   for (;;) {
-    const DynTypedNode up = parentOf(node);
+    const DynTypedNode up = ParentOf(ctx, node);
     if (auto* cast = up.get<ImplicitCastExpr>()) {
       if (cast->getCastKind() == CK_LValueToRValue) return element;
       node = up;
@@ -226,7 +231,7 @@ bool ReadOnlyUse(ASTContext& ctx, const MemberExpr* me) {
       continue;
     }
     if (up.get<MemberExpr>()) {  // m_v.size(), m_v.at(i), or a field of an element
-      const DynTypedNode call = parentOf(up);
+      const DynTypedNode call = ParentOf(ctx, up);
       if (auto* mc = call.get<CXXMemberCallExpr>()) {
         const std::string method = mc->getMethodDecl() ? mc->getMethodDecl()->getNameAsString() : "";
         if (method == "size" || method == "empty" || method == "capacity") return true;
@@ -242,8 +247,8 @@ bool ReadOnlyUse(ASTContext& ctx, const MemberExpr* me) {
     }
     // for (float v : m_v) or for (const T& v : m_v): read; for (T& v : m_v): written.
     if (auto* range = up.get<VarDecl>(); range && !element) {
-      const DynTypedNode declStmt = parentOf(up);
-      if (auto* loop = parentOf(declStmt).get<CXXForRangeStmt>(); loop && loop->getRangeStmt() == declStmt.get<DeclStmt>()) {
+      const DynTypedNode declStmt = ParentOf(ctx, up);
+      if (auto* loop = ParentOf(ctx, declStmt).get<CXXForRangeStmt>(); loop && loop->getRangeStmt() == declStmt.get<DeclStmt>()) {
         const QualType t = loop->getLoopVariable()->getType();
         return !t->isReferenceType() || t.getNonReferenceType().isConstQualified();
       }
@@ -256,12 +261,11 @@ bool ReadOnlyUse(ASTContext& ctx, const MemberExpr* me) {
 // lambda around it, or a local reference, pointer or iterator bound to the vector or an element
 // (`auto& v = m_v;`, `float* p = m_v.data();`). Says how, or "" when it cannot.
 std::string LaterAccess(ASTContext& ctx, const MemberExpr* me) {
-  auto parentOf = [&](const DynTypedNode& n) { const auto p = ctx.getParents(n); return p.empty() ? DynTypedNode() : p[0]; };
-  for (DynTypedNode n = parentOf(DynTypedNode::create(*me)); !n.getNodeKind().isNone(); n = parentOf(n))
+  for (DynTypedNode n = ParentOf(ctx, DynTypedNode::create(*me)); !n.getNodeKind().isNone(); n = ParentOf(ctx, n))
     if (n.get<LambdaExpr>()) return "a lambda, which may run after the statement";
   DynTypedNode node = DynTypedNode::create(*me);
   for (;;) {
-    const DynTypedNode up = parentOf(node);
+    const DynTypedNode up = ParentOf(ctx, node);
     if (up.get<ImplicitCastExpr>() || up.get<ParenExpr>() || up.get<MaterializeTemporaryExpr>() || up.get<CXXBindTemporaryExpr>() ||
         up.get<ExprWithCleanups>() || up.get<CXXConstructExpr>()) {
       node = up;
@@ -276,7 +280,7 @@ std::string LaterAccess(ASTContext& ctx, const MemberExpr* me) {
       continue;
     }
     if (up.get<MemberExpr>()) {  // m_v.data(), m_v.begin(), m_v.at(i), a field of an element
-      const DynTypedNode call = parentOf(up);
+      const DynTypedNode call = ParentOf(ctx, up);
       node = call.get<CXXMemberCallExpr>() ? call : up;
       continue;
     }
