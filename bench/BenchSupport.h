@@ -3,12 +3,15 @@
 #include <crossrt/IspcSupport.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <functional>
 #include <iterator>
 #include <string>
+#include <thread>
 #include <vector>
 
 // Median wall time in ms of `repeats` runs of `work`, after one warm-up run: first-use costs
@@ -52,4 +55,44 @@ inline std::string IspcTarget()
   for (int i = int(std::size(crossrt::kIspcTargets)) - 1; i >= 0; --i)
     if (crossrt::CpuRunsIspcTarget(i)) return crossrt::kIspcTargets[i];
   return "none";
+}
+
+// N threads that keep a core each busy for as long as this object lives: `--load N`, the other
+// work on a user's machine (an IDE, a browser, a build) beside a measurement. Each spins on
+// arithmetic without sleeping, as `yes > /dev/null` does.
+class BusyThreads
+{
+public:
+  explicit BusyThreads(int n)
+  {
+    for (int i = 0; i < n; ++i)
+      m_threads.emplace_back([this] {
+        volatile unsigned x = 1;
+        while (!m_stop.load(std::memory_order_relaxed))
+          for (int k = 0; k < 4096; ++k) x = x * 1664525u + 1013904223u;
+      });
+  }
+  ~BusyThreads()
+  {
+    m_stop = true;
+    for (auto& t : m_threads) t.join();
+  }
+  int Count() const { return int(m_threads.size()); }
+
+private:
+  std::atomic<bool> m_stop{false};
+  std::vector<std::thread> m_threads;
+};
+
+// The value of `--load N` (0 to 256): exits with a message for anything else.
+inline int LoadThreads(const char* program, const char* value)
+{
+  char* end = nullptr;
+  const long n = value ? std::strtol(value, &end, 10) : -1;
+  if (!value || *end != '\0' || n < 0 || n > 256)
+  {
+    std::fprintf(stderr, "%s: --load takes a number of busy threads from 0 to 256, not '%s'\n", program, value ? value : "");
+    std::exit(2);
+  }
+  return int(n);
 }

@@ -6,7 +6,9 @@
 // bench/plot_examples.py plots.
 // SpherePaths runs on Vulkan in both execution modes: wavefront (one dispatch per kernel call) and
 // megakernel (its thread loop as one shader).
-//   bench_examples [particles] [bloom side] [paths side] [CSV]
+//   bench_examples [--load N] [particles] [bloom side] [paths side] [CSV]
+// --load N runs N busy threads beside the measurement, and a warning row follows the table for
+// each translated CPU class slower than the original (or _ISPC slower than _CPU).
 #include "BenchSupport.h"
 #include "Bloom.h"
 #include "Bloom_CPU.h"
@@ -39,8 +41,13 @@ namespace {
 
 std::ofstream g_csv;  // example,implementation,ms_per_call,speedup_vs_original,gpu_ms_per_call
 
+std::vector<std::string> g_slower;  // the translated CPU classes slower than the original, for the warning rows
+
 void Row(const char* example, const char* impl, double ms, double baseMs, double gpuMs)
 {
+  const std::string name = impl;
+  if (ms > baseMs && (name.find("_CPU") != std::string::npos || name.find("_ISPC") != std::string::npos))
+    g_slower.push_back(name + " takes " + std::to_string(ms / baseMs).substr(0, 4) + "x the time of the original " + example);
   char gpu[32] = "";
   if (gpuMs > 0.0) std::snprintf(gpu, sizeof gpu, "%.2f", gpuMs);
   std::printf("| %-10s | %-18s | %10.2f | %8.2fx | %12s |\n", example, impl, ms, baseMs / ms, gpu);
@@ -50,6 +57,8 @@ void Row(const char* example, const char* impl, double ms, double baseMs, double
 // _ISPC against _CPU, both measured above in this run.
 void IspcAgainstCpu(const char* example, double cpuMs, double ispcMs)
 {
+  if (cpuMs > 0.0 && ispcMs > cpuMs)
+    g_slower.push_back(std::string(example) + ": _ISPC takes " + std::to_string(ispcMs / cpuMs).substr(0, 4) + "x the time of _CPU");
   if (cpuMs > 0.0 && ispcMs > 0.0) std::printf("| %-10s | %-18s | %10s | %8.2fx | %12s |\n", example, "_ISPC vs _CPU", "", cpuMs / ispcMs, "");
 }
 
@@ -57,18 +66,43 @@ void IspcAgainstCpu(const char* example, double cpuMs, double ispcMs)
 
 int main(int argc, char** argv)
 {
-  if (argc > 1 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h"))
+  std::vector<std::string> positional;
+  int load = 0;
+  for (int i = 1; i < argc; ++i)
   {
-    std::printf("usage: bench_examples [PARTICLES (default 1048576)] [IMAGE_SIDE (default 1024)] [PATH_SIDE (default 256)] [CSV (default "
-                "out/bench_examples.csv)]\n  Times the examples as written, as _CPU, _ISPC and _Vulkan, and prints ratios; the table goes to CSV "
-                "too (bench/plot_examples.py plots it).\n");
-    return 0;
+    const std::string a = argv[i];
+    if (a == "--help" || a == "-h")
+    {
+      std::printf("usage: bench_examples [--load N] [PARTICLES (default 1048576)] [IMAGE_SIDE (default 1024)] [PATH_SIDE (default 256)] [CSV (default "
+                  "out/bench_examples.csv)]\n  Times the examples as written, as _CPU, _ISPC and _Vulkan, and prints ratios; the table goes to CSV "
+                  "too (bench/plot_examples.py plots it).\n  --load N   N busy threads run beside every measurement (a user's machine is never quiet)\n");
+      return 0;
+    }
+    if (a == "--load")
+      load = LoadThreads("bench_examples", i + 1 < argc ? argv[++i] : nullptr);
+    else if (a.size() > 1 && a[0] == '-')
+    {
+      std::fprintf(stderr, "bench_examples: unknown option '%s' (see bench_examples --help)\n", a.c_str());
+      return 2;
+    }
+    else
+      positional.push_back(a);
   }
-  const int particles = argc > 1 ? std::atoi(argv[1]) : 1 << 20;
-  const int side = argc > 2 ? std::atoi(argv[2]) : 1024;
-  const int pathSide = argc > 3 ? std::atoi(argv[3]) : 256;
+  if (positional.size() > 4)
+  {
+    std::fprintf(stderr, "bench_examples: too many arguments (see bench_examples --help)\n");
+    return 2;
+  }
+  const int particles = positional.size() > 0 ? std::atoi(positional[0].c_str()) : 1 << 20;
+  const int side = positional.size() > 1 ? std::atoi(positional[1].c_str()) : 1024;
+  const int pathSide = positional.size() > 2 ? std::atoi(positional[2].c_str()) : 256;
+  if (particles <= 0 || side <= 0 || pathSide <= 0)
+  {
+    std::fprintf(stderr, "bench_examples: the sizes are positive numbers (see bench_examples --help)\n");
+    return 2;
+  }
   const int pathSamples = 8;
-  const std::string csvPath = argc > 4 ? argv[4] : "out/bench_examples.csv";
+  const std::string csvPath = positional.size() > 3 ? positional[3] : "out/bench_examples.csv";
   if (std::filesystem::path(csvPath).has_parent_path()) std::filesystem::create_directories(std::filesystem::path(csvPath).parent_path());
   g_csv.open(csvPath);
   if (!g_csv)
@@ -84,7 +118,9 @@ int main(int argc, char** argv)
   try { ctx = crossrt::VulkanContext::CreateDefault(); }
   catch (const std::exception& e) { std::fprintf(stderr, "no Vulkan device, the _Vulkan rows are skipped: %s\n", e.what()); }
 
-  std::printf("CPU threads: %u; Vulkan device: %s\n\n", std::thread::hardware_concurrency(), ctx ? ctx->DeviceName().c_str() : "none");
+  const BusyThreads busy(load);
+  std::printf("CPU: %s, %u threads; ISPC target: %s; Vulkan device: %s; load: %d busy threads beside the measurement\n\n", CpuModel().c_str(),
+              std::thread::hardware_concurrency(), IspcTarget().c_str(), ctx ? ctx->DeviceName().c_str() : "none", busy.Count());
   std::printf("| %-10s | %-18s | %10s | %9s | %12s |\n|%s|\n", "example", "implementation", "ms/call", "vs orig", "GPU ms/call", std::string(73, '-').c_str());
 
   {  // particles: two 1D kernels, one with 4 member reductions
@@ -166,6 +202,11 @@ int main(int argc, char** argv)
       if (std::string(name) == "Vulkan megakernel") std::printf("| %-10s | %-18s | %10s | %8.2fx | %12s |\n", "paths", "mega vs wavefront", "", wavefrontMs / ms, "");
     }
     IspcAgainstCpu("paths", cpuMs, ispcMs);
+  }
+  if (!g_slower.empty())
+  {
+    std::printf("\nWARNING: translated classes slower than they should be (load: %d busy threads):\n", busy.Count());
+    for (auto& line : g_slower) std::printf("| WARNING | %s |\n", line.c_str());
   }
   std::printf("\nparticles: %d particles per step; bloom: %dx%d image, radius 12; paths: %dx%d pixels, %d paths per pixel, 4 bounces.\n", particles, side,
               side, pathSide, pathSide, pathSamples);

@@ -11,7 +11,9 @@
 // Then the speed-against-quality trade of LBVH against binned SAH, as a table and as CSV, which
 // bench/plot_bvh_tradeoff.py plots with matplotlib.
 //
-//   bench_lbvh [MESH_DIR (default build/data/meshes)] [TRADEOFF.csv (default out/bvh_tradeoff.csv)]
+//   bench_lbvh [--load N] [--meshes NAME,...] [MESH_DIR (default build/data/meshes)] [TRADEOFF.csv (default out/bvh_tradeoff.csv)]
+// --load N runs N busy threads beside the measurement; warning rows at the end name each translated
+// builder or tracer slower than the original (on one thread) or _ISPC slower than _CPU.
 #include "BenchSupport.h"
 #include "BVHScene.h"
 #include "CrossRT.h"
@@ -173,17 +175,35 @@ void WriteTradeOffCsv(const std::vector<TradeOff>& rows, const std::string& path
 int main(int argc, char** argv)
 {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // tables appear as they are measured
-  std::vector<std::string> positional;
+  std::vector<std::string> positional, only;
+  int load = 0;
   for (int i = 1; i < argc; ++i)
   {
     const std::string a = argv[i];
     if (a == "--help" || a == "-h")
     {
-      std::printf("usage: bench_lbvh [MESH_DIR] [TRADEOFF.csv]\n"
+      std::printf("usage: bench_lbvh [--load N] [--meshes NAME,...] [MESH_DIR] [TRADEOFF.csv]\n"
                   "  BVH build and traversal against Embree on the meshes scripts/fetch-meshes.sh cached in MESH_DIR\n"
                   "  (default build/data/meshes), in the form of the paper's Tables 1 and 3. The speed-against-quality\n"
-                  "  table goes to TRADEOFF.csv too (default out/bvh_tradeoff.csv); bench/plot_bvh_tradeoff.py plots it.\n");
+                  "  table goes to TRADEOFF.csv too (default out/bvh_tradeoff.csv); bench/plot_bvh_tradeoff.py plots it.\n"
+                  "  --load N           N busy threads run beside every measurement (a user's machine is never quiet)\n"
+                  "  --meshes A,B       only the meshes whose file names start with A or B (e.g. teapot,dragon_vrip_res4)\n");
       return 0;
+    }
+    if (a == "--load")
+    {
+      load = LoadThreads("bench_lbvh", i + 1 < argc ? argv[++i] : nullptr);
+      continue;
+    }
+    if (a == "--meshes" && i + 1 < argc)
+    {
+      for (std::string list = argv[++i]; !list.empty();)
+      {
+        const size_t comma = list.find(',');
+        only.push_back(list.substr(0, comma));
+        list = comma == std::string::npos ? "" : list.substr(comma + 1);
+      }
+      continue;
     }
     if (a.size() > 1 && a[0] == '-')
     {
@@ -199,13 +219,21 @@ int main(int argc, char** argv)
   }
   const std::string dir = positional.size() > 0 ? positional[0] : "build/data/meshes";
   const std::string csvPath = positional.size() > 1 ? positional[1] : "out/bvh_tradeoff.csv";
+  auto chosen = [&](const std::string& name) {
+    if (only.empty()) return true;
+    for (auto& prefix : only)
+      if (name.rfind(prefix, 0) == 0) return true;
+    return false;
+  };
   const char* names[] = {"teapot.obj", "dragon_vrip_res4.ply.gz", "dragon_vrip_res3.ply.gz", "armadillo.off", "bunny00.off",
                          "dragon_vrip_res2.ply.gz", "dragon_vrip.ply.gz"};
   std::shared_ptr<crossrt::VulkanContext> ctx;
   try { ctx = crossrt::VulkanContext::CreateDefault(); }
   catch (const std::exception& e) { std::printf("no Vulkan device (%s): the _Vulkan column is left out\n", e.what()); }
-  std::printf("CPU: %s, %d threads; ISPC target: %s; Vulkan device: %s\n", CpuModel().c_str(), omp_get_max_threads(), IspcTarget().c_str(),
-              ctx ? ctx->DeviceName().c_str() : "none");
+  const BusyThreads busy(load);
+  std::printf("CPU: %s, %d threads; ISPC target: %s; Vulkan device: %s; load: %d busy threads beside the measurement\n", CpuModel().c_str(),
+              omp_get_max_threads(), IspcTarget().c_str(), ctx ? ctx->DeviceName().c_str() : "none", busy.Count());
+  std::vector<std::string> slower;  // translated classes slower than the original, for the warning rows at the end
 
   std::printf("\nBuild time, ms (ratio = time / Embree LOW; the CPU builders' medians of 7 interleaved rounds, their ratios\n"
               "medians of the rounds' ratios; Vulkan: median of 3 wall times with copies, its ratio one of medians, [GPU time])\n");
@@ -223,6 +251,7 @@ int main(int argc, char** argv)
   std::shared_ptr<LBVH> lbvhGpu = ctx ? CreateLBVH_Vulkan(ctx) : nullptr;
   for (const char* name : names)
   {
+    if (!chosen(name)) continue;
     const std::string path = dir + "/" + name;
     if (!std::filesystem::exists(path))
     {
@@ -278,6 +307,18 @@ int main(int argc, char** argv)
     std::printf("| %-22s | %9d | %10.1f | %6.1f (%4.2fx) | %7.1f (%5.2fx) | %7.1f (%5.2fx) | %15s | %23s | %7.1f (%5.2fx) |\n", name, n, low,
                 medium, PairedRatio(cpuMs[1], cpuMs[0]), originalMs, PairedRatio(cpuMs[2], cpuMs[0]), row.lbvhCpuMs,
                 PairedRatio(cpuMs[3], cpuMs[0]), ispc, gpu, row.sahMs, PairedRatio(cpuMs[4], cpuMs[0]));
+    // Warning rows: a translated builder slower than the original (one thread), or _ISPC slower than _CPU.
+    auto slowerThan = [&](int work, int base, const char* what, const char* than) {
+      const double ratio = PairedRatio(cpuMs[work], cpuMs[base]);
+      if (ratio > 1.0)
+        slower.push_back(std::string(name) + ": " + what + " builds at " + std::to_string(ratio).substr(0, 4) + "x the time of " + than);
+    };
+    slowerThan(3, 2, "LBVH_CPU", "the original");
+    if (lbvhIspc)
+    {
+      slowerThan(5, 2, "LBVH_ISPC", "the original");
+      slowerThan(5, 3, "LBVH_ISPC", "LBVH_CPU");
+    }
     rows.push_back(std::move(row));
   }
 
@@ -471,6 +512,18 @@ int main(int argc, char** argv)
                 againstEmbree1(3), mrays(castCpuMs), againstEmbree1(4), ispcCast, mrays(sahMs), againstEmbree1(5), ispcSahCast, gpuCast, gpuHardware,
                 SAHCost(row.lbvh), SAHCost(row.sah), 100.0 * same / pixels);
     trade.push_back({row.name, row.lbvhCpuMs, mrays(lbvhMs), row.sahMs, mrays(sahMs)});
+    // Warning rows: a translated tracer slower than the original traversal on one thread, or _ISPC below _CPU.
+    auto slowerTrace = [&](int work, int base, const char* what, const char* than) {
+      const double ratio = PairedRatio(traceMs[work], traceMs[base]);
+      if (ratio > 1.0)
+        slower.push_back(row.name + ": " + what + " traces at " + std::to_string(1.0 / ratio).substr(0, 4) + "x the speed of " + than);
+    };
+    slowerTrace(4, 3, "LBVH _CPU", "the original on one thread");
+    if (castIspc)
+    {
+      slowerTrace(6, 3, "LBVH _ISPC", "the original on one thread");
+      slowerTrace(6, 4, "LBVH _ISPC", "LBVH _CPU");
+    }
   }
 
   std::printf("\nSpeed against quality: LBVH (LBVH_CPU build) against binned SAH\n");
@@ -487,6 +540,11 @@ int main(int argc, char** argv)
     else std::snprintf(after, sizeof(after), "%.1f Mrays", breakEven / 1e6);
     std::printf("| %-22s | %14.1f | %14.2f | %14.1f | %14.2f | %22s |\n", t.mesh.c_str(), t.lbvhBuildMs, t.lbvhMrays, t.sahBuildMs,
                 t.sahMrays, after);
+  }
+  if (!slower.empty())
+  {
+    std::printf("\nWARNING: translated classes slower than they should be (load: %d busy threads):\n", busy.Count());
+    for (auto& line : slower) std::printf("| WARNING | %s |\n", line.c_str());
   }
   WriteTradeOffCsv(trade, csvPath);
   std::printf("table: %s (plot it: bench/plot_bvh_tradeoff.py %s out/bvh_tradeoff.png)\n", csvPath.c_str(), csvPath.c_str());
