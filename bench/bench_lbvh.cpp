@@ -176,7 +176,8 @@ int main(int argc, char** argv)
 {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // tables appear as they are measured
   std::vector<std::string> positional, only;
-  int load = 0;
+  int load = 0, buildRounds = 7;
+  bool buildsOnly = false;
   for (int i = 1; i < argc; ++i)
   {
     const std::string a = argv[i];
@@ -187,12 +188,29 @@ int main(int argc, char** argv)
                   "  (default build/data/meshes), in the form of the paper's Tables 1 and 3. The speed-against-quality\n"
                   "  table goes to TRADEOFF.csv too (default out/bvh_tradeoff.csv); bench/plot_bvh_tradeoff.py plots it.\n"
                   "  --load N           N busy threads run beside every measurement (a user's machine is never quiet)\n"
-                  "  --meshes A,B       only the meshes whose file names start with A or B (e.g. teapot,dragon_vrip_res4)\n");
+                  "  --meshes A,B       only the meshes whose file names start with A or B (e.g. teapot,dragon_vrip_res4)\n"
+                  "  --builds-only      the build table alone (no traversal, no trade-off table or CSV)\n"
+                  "  --build-rounds N   interleaved rounds of the CPU builders (default 7): more for a loaded machine\n");
       return 0;
     }
     if (a == "--load")
     {
       load = LoadThreads("bench_lbvh", i + 1 < argc ? argv[++i] : nullptr);
+      continue;
+    }
+    if (a == "--builds-only")
+    {
+      buildsOnly = true;
+      continue;
+    }
+    if (a == "--build-rounds")
+    {
+      buildRounds = i + 1 < argc ? std::atoi(argv[++i]) : 0;
+      if (buildRounds < 1 || buildRounds > 1000)
+      {
+        std::fprintf(stderr, "bench_lbvh: --build-rounds takes a number from 1 to 1000\n");
+        return 2;
+      }
       continue;
     }
     if (a == "--meshes" && i + 1 < argc)
@@ -235,8 +253,9 @@ int main(int argc, char** argv)
               omp_get_max_threads(), IspcTarget().c_str(), ctx ? ctx->DeviceName().c_str() : "none", busy.Count());
   std::vector<std::string> slower;  // translated classes slower than the original, for the warning rows at the end
 
-  std::printf("\nBuild time, ms (ratio = time / Embree LOW; the CPU builders' medians of 7 interleaved rounds, their ratios\n"
-              "medians of the rounds' ratios; Vulkan: median of 3 wall times with copies, its ratio one of medians, [GPU time])\n");
+  std::printf("\nBuild time, ms (ratio = time / Embree LOW; the CPU builders' medians of %d interleaved rounds, their ratios\n"
+              "medians of the rounds' ratios; Vulkan: median of 3 wall times with copies, its ratio one of medians, [GPU time])\n",
+              buildRounds);
   std::printf("| %-22s | %9s | %10s | %12s | %15s | %15s | %15s | %23s | %15s |\n", "mesh", "triangles", "Embree LOW", "Embree MEDIUM",
               "LBVH original", "LBVH_CPU", "LBVH_ISPC", "LBVH_Vulkan", "binned SAH");
   std::printf("|%s|\n", std::string(164, '-').c_str());
@@ -271,7 +290,7 @@ int main(int argc, char** argv)
       lbvhIspc->Reserve(n);
       lbvhIspc->CommitDeviceData();
     }
-    // The CPU builders in 7 interleaved rounds; ratios to Embree LOW are medians of per-round ratios.
+    // The CPU builders in interleaved rounds (7 unless --build-rounds); ratios to Embree LOW are medians of per-round ratios.
     const auto cpuMs = InterleavedMs({[&] { embree.Build(row.mesh, RTC_BUILD_QUALITY_LOW); },
                                       [&] { embree.Build(row.mesh, RTC_BUILD_QUALITY_MEDIUM); },
                                       [&] { original.Build(n, boxes.data()); }, [&] { lbvhCpu->Build(n, boxes.data()); },
@@ -280,12 +299,12 @@ int main(int argc, char** argv)
                                         if (lbvhIspc)
                                           lbvhIspc->Build(n, boxes.data());
                                       }},
-                                     7);
+                                     buildRounds);
     const double low = Median(cpuMs[0]), medium = Median(cpuMs[1]), originalMs = Median(cpuMs[2]);
     row.lbvh = original.Tree(n);
     row.lbvhCpuMs = Median(cpuMs[3]);
     char gpu[64] = "n/a";
-    if (lbvhGpu)
+    if (lbvhGpu && !buildsOnly)
     {
       lbvhGpu->Reserve(n);
       lbvhGpu->CommitDeviceData();
@@ -320,6 +339,18 @@ int main(int argc, char** argv)
       slowerThan(5, 3, "LBVH_ISPC", "LBVH_CPU");
     }
     rows.push_back(std::move(row));
+  }
+
+  // The warning rows, after the last table this run prints.
+  auto printSlower = [&] {
+    if (slower.empty()) return;
+    std::printf("\nWARNING: translated classes slower than they should be (load: %d busy threads):\n", busy.Count());
+    for (auto& line : slower) std::printf("| WARNING | %s |\n", line.c_str());
+  };
+  if (buildsOnly)
+  {
+    printSlower();
+    return 0;
   }
 
   std::printf("\nTraversal of %dx%d primary rays, Mrays/s, all %d threads but 1T (ratio against Embree rtcIntersect1 on all\n"
@@ -541,11 +572,7 @@ int main(int argc, char** argv)
     std::printf("| %-22s | %14.1f | %14.2f | %14.1f | %14.2f | %22s |\n", t.mesh.c_str(), t.lbvhBuildMs, t.lbvhMrays, t.sahBuildMs,
                 t.sahMrays, after);
   }
-  if (!slower.empty())
-  {
-    std::printf("\nWARNING: translated classes slower than they should be (load: %d busy threads):\n", busy.Count());
-    for (auto& line : slower) std::printf("| WARNING | %s |\n", line.c_str());
-  }
+  printSlower();
   WriteTradeOffCsv(trade, csvPath);
   std::printf("table: %s (plot it: bench/plot_bvh_tradeoff.py %s out/bvh_tradeoff.png)\n", csvPath.c_str(), csvPath.c_str());
   return 0;
