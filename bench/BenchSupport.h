@@ -38,6 +38,31 @@ inline double MedianOf(std::vector<double> ms)
   return ms[ms.size() / 2];
 }
 
+// Wall times of several works measured in rounds, each round running every work once, after a
+// warm-up round: a burst of load on a shared machine then slows them alike, and the ratio of two
+// works taken round by round keeps its meaning. Returns each work's times, in ms.
+inline std::vector<std::vector<double>> InterleavedMs(const std::vector<std::function<void()>>& works, int rounds)
+{
+  for (auto& work : works) work();
+  std::vector<std::vector<double>> ms(works.size());
+  for (int r = 0; r < rounds; ++r)
+    for (size_t w = 0; w < works.size(); ++w)
+    {
+      const auto t0 = std::chrono::steady_clock::now();
+      works[w]();
+      ms[w].push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    }
+  return ms;
+}
+
+// The median over the rounds of a[r] / b[r] (times of InterleavedMs).
+inline double PairedRatio(const std::vector<double>& a, const std::vector<double>& b)
+{
+  std::vector<double> r;
+  for (size_t i = 0; i < a.size() && i < b.size(); ++i) r.push_back(a[i] / b[i]);
+  return MedianOf(r);
+}
+
 // The CPU's model name (/proc/cpuinfo), which every table of speed figures prints.
 inline std::string CpuModel()
 {

@@ -1,8 +1,10 @@
 // Benchmark: each example class as the original single-threaded C++, as <Class>_CPU (OpenMP on
 // all cores), as <Class>_ISPC (all cores, SIMD lanes on each; where ISPC is found) and as
 // <Class>_Vulkan on the default device. Every figure comes from this one run; ratios are against
-// the original, and _ISPC's also against _CPU. Each time is the median of the repeats after a
-// warm-up. The table goes to CSV too (default out/bench_examples.csv), which
+// the original, and _ISPC's also against _CPU. The CPU classes run in interleaved rounds after a
+// warm-up round (7 for particles, 5 for the others), so that load on the machine slows them alike:
+// each time is a median, each ratio the median of the rounds' ratios to the original. The GPU
+// classes: medians of as many calls after a warm-up. The table goes to CSV too (default out/bench_examples.csv), which
 // bench/plot_examples.py plots.
 // SpherePaths runs on Vulkan in both execution modes: wavefront (one dispatch per kernel call) and
 // megakernel (its thread loop as one shader).
@@ -27,6 +29,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <cstdlib>
 #include <memory>
@@ -41,25 +44,63 @@ namespace {
 
 std::ofstream g_csv;  // example,implementation,ms_per_call,speedup_vs_original,gpu_ms_per_call
 
-std::vector<std::string> g_slower;  // the translated CPU classes slower than the original, for the warning rows
+std::vector<std::string> g_slower;  // the translated CPU classes slower than they should be, for the warning rows
 
-void Row(const char* example, const char* impl, double ms, double baseMs, double gpuMs)
+// One implementation of an example: its name, one call, and for a GPU class its timestamp-measured
+// kernel time of the last call.
+struct Impl
 {
-  const std::string name = impl;
-  if (ms > baseMs && (name.find("_CPU") != std::string::npos || name.find("_ISPC") != std::string::npos))
-    g_slower.push_back(name + " takes " + std::to_string(ms / baseMs).substr(0, 4) + "x the time of the original " + example);
+  std::string name;
+  std::function<void()> call;
+  std::function<double()> gpuMs;  // empty on the CPU
+};
+
+void Row(const char* example, const std::string& impl, double ms, double speedup, double gpuMs)
+{
   char gpu[32] = "";
   if (gpuMs > 0.0) std::snprintf(gpu, sizeof gpu, "%.2f", gpuMs);
-  std::printf("| %-10s | %-18s | %10.2f | %8.2fx | %12s |\n", example, impl, ms, baseMs / ms, gpu);
-  g_csv << example << "," << impl << "," << ms << "," << baseMs / ms << "," << gpuMs << "\n";
+  std::printf("| %-10s | %-18s | %10.2f | %8.2fx | %12s |\n", example, impl.c_str(), ms, speedup, gpu);
+  g_csv << example << "," << impl << "," << ms << "," << speedup << "," << gpuMs << "\n";
 }
 
-// _ISPC against _CPU, both measured above in this run.
-void IspcAgainstCpu(const char* example, double cpuMs, double ispcMs)
+// The CPU implementations (the original first) in `rounds` interleaved rounds, so that load on the
+// machine slows them alike: each ratio is the median of the rounds' ratios to the original. Then
+// each GPU implementation, median of `rounds` calls after a warm-up, its ratio one of medians.
+void Measure(const char* example, const std::vector<Impl>& impls, int rounds)
 {
-  if (cpuMs > 0.0 && ispcMs > cpuMs)
-    g_slower.push_back(std::string(example) + ": _ISPC takes " + std::to_string(ispcMs / cpuMs).substr(0, 4) + "x the time of _CPU");
-  if (cpuMs > 0.0 && ispcMs > 0.0) std::printf("| %-10s | %-18s | %10s | %8.2fx | %12s |\n", example, "_ISPC vs _CPU", "", cpuMs / ispcMs, "");
+  std::vector<std::function<void()>> cpuCalls;
+  std::vector<const Impl*> cpu;
+  for (auto& impl : impls)
+    if (!impl.gpuMs) cpuCalls.push_back(impl.call), cpu.push_back(&impl);
+  const auto ms = InterleavedMs(cpuCalls, rounds);
+  size_t cpuClass = cpu.size(), ispcClass = cpu.size();
+  for (size_t i = 0; i < cpu.size(); ++i)
+  {
+    const double speedup = PairedRatio(ms[0], ms[i]);
+    Row(example, cpu[i]->name, MedianOf(ms[i]), speedup, 0.0);
+    if (i > 0 && speedup < 1.0)
+      g_slower.push_back(cpu[i]->name + " takes " + std::to_string(1.0 / speedup).substr(0, 4) + "x the time of the original " + example);
+    if (cpu[i]->name.find("_CPU") != std::string::npos) cpuClass = i;
+    if (cpu[i]->name.find("_ISPC") != std::string::npos) ispcClass = i;
+  }
+  if (cpuClass < cpu.size() && ispcClass < cpu.size())
+  {
+    const double ispcSpeedup = PairedRatio(ms[cpuClass], ms[ispcClass]);
+    std::printf("| %-10s | %-18s | %10s | %8.2fx | %12s |\n", example, "_ISPC vs _CPU", "", ispcSpeedup, "");
+    if (ispcSpeedup < 1.0)
+      g_slower.push_back(std::string(example) + ": _ISPC takes " + std::to_string(1.0 / ispcSpeedup).substr(0, 4) + "x the time of _CPU");
+  }
+  const double originalMs = MedianOf(ms[0]);
+  double wavefrontMs = 0.0;
+  for (auto& impl : impls)
+  {
+    if (!impl.gpuMs) continue;
+    const double wall = MedianMs(rounds, impl.call);
+    Row(example, impl.name, wall, originalMs / wall, impl.gpuMs());
+    if (impl.name == "Vulkan wavefront") wavefrontMs = wall;
+    if (impl.name == "Vulkan megakernel" && wavefrontMs > 0.0)
+      std::printf("| %-10s | %-18s | %10s | %8.2fx | %12s |\n", example, "mega vs wavefront", "", wavefrontMs / wall, "");
+  }
 }
 
 }  // namespace
@@ -101,7 +142,7 @@ int main(int argc, char** argv)
     std::fprintf(stderr, "bench_examples: the sizes are positive numbers (see bench_examples --help)\n");
     return 2;
   }
-  const int pathSamples = 8;
+  constexpr int pathSamples = 8;
   const std::string csvPath = positional.size() > 3 ? positional[3] : "out/bench_examples.csv";
   if (std::filesystem::path(csvPath).has_parent_path()) std::filesystem::create_directories(std::filesystem::path(csvPath).parent_path());
   g_csv.open(csvPath);
@@ -128,80 +169,64 @@ int main(int argc, char** argv)
     std::uniform_real_distribution<float> u(-1.0f, 1.0f);
     std::vector<float4> pos0(particles), vel0(particles);
     for (int i = 0; i < particles; ++i) { pos0[i] = float4(u(rng), 5.0f + u(rng), u(rng), 0.0f); vel0[i] = float4(u(rng), u(rng), u(rng), 0.0f); }
-    std::vector<std::pair<const char*, std::shared_ptr<Particles>>> impls = {{"original", std::make_shared<Particles>()}, {"Particles_CPU", CreateParticles_CPU()}};
+    std::vector<std::pair<std::string, std::shared_ptr<Particles>>> classes = {{"original", std::make_shared<Particles>()}, {"Particles_CPU", CreateParticles_CPU()}};
 #ifdef CROSSRT_HAS_ISPC
-    impls.push_back({"Particles_ISPC", CreateParticles_ISPC()});
+    classes.push_back({"Particles_ISPC", CreateParticles_ISPC()});
 #endif
-    if (ctx) impls.push_back({"Particles_Vulkan", CreateParticles_Vulkan(ctx)});
-    double base = 0.0, cpuMs = 0.0, ispcMs = 0.0;
-    for (auto& [name, p] : impls)
+    if (ctx) classes.push_back({"Particles_Vulkan", CreateParticles_Vulkan(ctx)});
+    // Each steps its own copy of the particles.
+    std::vector<std::vector<float4>> pos(classes.size(), pos0), vel(classes.size(), vel0);
+    std::vector<Impl> impls;
+    for (size_t c = 0; c < classes.size(); ++c)
     {
-      std::vector<float4> pos = pos0, vel = vel0;
+      auto p = classes[c].second;
       p->CommitDeviceData();
-      const double ms = MedianMs(7, [&] { p->Step(particles, 0.001f, pos.data(), vel.data()); });
-      float t[4];
-      p->GetExecutionTime("Step", t);
-      if (base == 0.0) base = ms;
-      Row("particles", name, ms, base, ctx && std::string(name) == "Particles_Vulkan" ? t[0] : 0.0);
-      if (std::string(name) == "Particles_CPU") cpuMs = ms;
-      if (std::string(name) == "Particles_ISPC") ispcMs = ms;
+      impls.push_back({classes[c].first, [p, &pos, &vel, c, particles] { p->Step(particles, 0.001f, pos[c].data(), vel[c].data()); }, nullptr});
+      if (classes[c].first == "Particles_Vulkan") impls.back().gpuMs = [p] { float t[4]; p->GetExecutionTime("Step", t); return double(t[0]); };
     }
-    IspcAgainstCpu("particles", cpuMs, ispcMs);
+    Measure("particles", impls, 7);
   }
   {  // bloom: three 2D kernels, a 25-tap separable blur
     std::vector<float4> in(size_t(side) * side), out(in.size());
     for (int y = 0; y < side; ++y)
       for (int x = 0; x < side; ++x) in[size_t(y) * side + x] = float4(float(x % 64) / 16.0f, float(y % 32) / 8.0f, 0.5f, 1.0f);
-    std::vector<std::pair<const char*, std::shared_ptr<Bloom>>> impls = {{"original", std::make_shared<Bloom>(side, side, 12, 5.0f)}, {"Bloom_CPU", CreateBloom_CPU(side, side, 12, 5.0f)}};
+    std::vector<std::pair<std::string, std::shared_ptr<Bloom>>> classes = {{"original", std::make_shared<Bloom>(side, side, 12, 5.0f)}, {"Bloom_CPU", CreateBloom_CPU(side, side, 12, 5.0f)}};
 #ifdef CROSSRT_HAS_ISPC
-    impls.push_back({"Bloom_ISPC", CreateBloom_ISPC(side, side, 12, 5.0f)});
+    classes.push_back({"Bloom_ISPC", CreateBloom_ISPC(side, side, 12, 5.0f)});
 #endif
-    if (ctx) impls.push_back({"Bloom_Vulkan", CreateBloom_Vulkan(ctx, side, side, 12, 5.0f)});
-    double base = 0.0, cpuMs = 0.0, ispcMs = 0.0;
-    for (auto& [name, b] : impls)
+    if (ctx) classes.push_back({"Bloom_Vulkan", CreateBloom_Vulkan(ctx, side, side, 12, 5.0f)});
+    std::vector<Impl> impls;
+    for (auto& [name, b] : classes)
     {
       b->CommitDeviceData();
-      const double ms = MedianMs(5, [&] { b->Run(side, side, in.data(), out.data()); });
-      float t[4];
-      b->GetExecutionTime("Run", t);
-      if (base == 0.0) base = ms;
-      Row("bloom", name, ms, base, ctx && std::string(name) == "Bloom_Vulkan" ? t[0] : 0.0);
-      if (std::string(name) == "Bloom_CPU") cpuMs = ms;
-      if (std::string(name) == "Bloom_ISPC") ispcMs = ms;
+      impls.push_back({name, [b = b, &in, &out, side] { b->Run(side, side, in.data(), out.data()); }, nullptr});
+      if (name == "Bloom_Vulkan") impls.back().gpuMs = [b = b] { float t[4]; b->GetExecutionTime("Run", t); return double(t[0]); };
     }
-    IspcAgainstCpu("bloom", cpuMs, ispcMs);
+    Measure("bloom", impls, 5);
   }
   {  // paths: a 2D thread loop of four kernels, 8 samples x 4 bounces = 65 kernel calls per pixel
     const uint32_t w = uint32_t(pathSide);
     std::vector<float4> out(size_t(w) * w);
-    std::vector<std::pair<const char*, std::shared_ptr<SpherePaths>>> impls = {{"original", std::make_shared<SpherePaths>()}, {"SpherePaths_CPU", CreateSpherePaths_CPU()}};
+    std::vector<std::pair<std::string, std::shared_ptr<SpherePaths>>> classes = {{"original", std::make_shared<SpherePaths>()}, {"SpherePaths_CPU", CreateSpherePaths_CPU()}};
 #ifdef CROSSRT_HAS_ISPC
-    impls.push_back({"SpherePaths_ISPC", CreateSpherePaths_ISPC()});
+    classes.push_back({"SpherePaths_ISPC", CreateSpherePaths_ISPC()});
 #endif
     if (ctx)
     {
       auto wavefront = std::make_shared<SpherePaths_Vulkan>(ctx), megakernel = std::make_shared<SpherePaths_Vulkan>(ctx);
       wavefront->SetExecutionMode(crossrt::ExecutionMode::Wavefront);
       megakernel->SetExecutionMode(crossrt::ExecutionMode::Megakernel);
-      impls.push_back({"Vulkan wavefront", wavefront});
-      impls.push_back({"Vulkan megakernel", megakernel});
+      classes.push_back({"Vulkan wavefront", wavefront});
+      classes.push_back({"Vulkan megakernel", megakernel});
     }
-    double base = 0.0, wavefrontMs = 0.0, cpuMs = 0.0, ispcMs = 0.0;
-    for (auto& [name, p] : impls)
+    std::vector<Impl> impls;
+    for (auto& [name, p] : classes)
     {
       p->CommitDeviceData();
-      const double ms = MedianMs(5, [&] { p->Render(w, w, pathSamples, out.data()); });
-      float t[4];
-      p->GetExecutionTime("Render", t);
-      if (base == 0.0) base = ms;
-      const bool gpu = std::string(name).rfind("Vulkan", 0) == 0;
-      Row("paths", name, ms, base, gpu ? t[0] : 0.0);
-      if (std::string(name) == "Vulkan wavefront") wavefrontMs = ms;
-      if (std::string(name) == "SpherePaths_CPU") cpuMs = ms;
-      if (std::string(name) == "SpherePaths_ISPC") ispcMs = ms;
-      if (std::string(name) == "Vulkan megakernel") std::printf("| %-10s | %-18s | %10s | %8.2fx | %12s |\n", "paths", "mega vs wavefront", "", wavefrontMs / ms, "");
+      impls.push_back({name, [p = p, &out, w] { p->Render(w, w, pathSamples, out.data()); }, nullptr});
+      if (name.rfind("Vulkan", 0) == 0) impls.back().gpuMs = [p = p] { float t[4]; p->GetExecutionTime("Render", t); return double(t[0]); };
     }
-    IspcAgainstCpu("paths", cpuMs, ispcMs);
+    Measure("paths", impls, 5);
   }
   if (!g_slower.empty())
   {
@@ -210,6 +235,7 @@ int main(int argc, char** argv)
   }
   std::printf("\nparticles: %d particles per step; bloom: %dx%d image, radius 12; paths: %dx%d pixels, %d paths per pixel, 4 bounces.\n", particles, side,
               side, pathSide, pathSide, pathSamples);
+  std::printf("ms/call: medians of interleaved rounds (CPU classes); vs orig: medians of the rounds' ratios (GPU: ratios of medians).\n");
   std::printf("_Vulkan ms/call includes copying the arguments in and out; 'GPU ms' is the timestamp-measured kernel time.\n");
   std::printf("table: %s (plot it: bench/plot_examples.py %s out/bench_examples.png)\n", csvPath.c_str(), csvPath.c_str());
   return 0;

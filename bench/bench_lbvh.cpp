@@ -53,37 +53,6 @@ constexpr int kTraceRounds = 5;  // interleaved rounds of the CPU tracers
 
 double Ms(std::chrono::steady_clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); }
 
-// Wall times of several works measured in rounds, each round running every work once after a
-// warm-up round: a burst of load on this shared machine then slows them alike, and the ratio of
-// two works taken round by round keeps its meaning. Returns each work's times.
-std::vector<std::vector<double>> InterleavedMs(const std::vector<std::function<void()>>& works, int rounds)
-{
-  for (auto& work : works) work();
-  std::vector<std::vector<double>> ms(works.size());
-  for (int r = 0; r < rounds; ++r)
-    for (size_t w = 0; w < works.size(); ++w)
-    {
-      auto t0 = std::chrono::steady_clock::now();
-      works[w]();
-      ms[w].push_back(Ms(std::chrono::steady_clock::now() - t0));
-    }
-  return ms;
-}
-
-double Median(std::vector<double> v)
-{
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
-// Median over the rounds of a[r] / b[r].
-double PairedRatio(const std::vector<double>& a, const std::vector<double>& b)
-{
-  std::vector<double> r;
-  for (size_t i = 0; i < a.size(); ++i) r.push_back(a[i] / b[i]);
-  return Median(r);
-}
-
 struct Camera
 {
   float3 eye, forward, right, up;
@@ -300,9 +269,9 @@ int main(int argc, char** argv)
                                           lbvhIspc->Build(n, boxes.data());
                                       }},
                                      buildRounds);
-    const double low = Median(cpuMs[0]), medium = Median(cpuMs[1]), originalMs = Median(cpuMs[2]);
+    const double low = MedianOf(cpuMs[0]), medium = MedianOf(cpuMs[1]), originalMs = MedianOf(cpuMs[2]);
     row.lbvh = original.Tree(n);
-    row.lbvhCpuMs = Median(cpuMs[3]);
+    row.lbvhCpuMs = MedianOf(cpuMs[3]);
     char gpu[64] = "n/a";
     if (lbvhGpu && !buildsOnly)
     {
@@ -313,7 +282,7 @@ int main(int argc, char** argv)
       lbvhGpu->GetExecutionTime("Build", times);
       std::snprintf(gpu, sizeof(gpu), "%7.1f (%4.2fx) [%6.1f]", wall, wall / low, times[0]);
     }
-    row.sahMs = Median(cpuMs[4]);
+    row.sahMs = MedianOf(cpuMs[4]);
     char ispc[24] = "no ISPC";
     if (lbvhIspc)
     {
@@ -321,7 +290,7 @@ int main(int argc, char** argv)
       if (tree.nodes.size() != row.lbvh.nodes.size() ||
           std::memcmp(tree.nodes.data(), row.lbvh.nodes.data(), tree.nodes.size() * sizeof(BVHNode)) != 0)
         std::fprintf(stderr, "bench_lbvh: %s: LBVH_ISPC built another tree than the original\n", name);
-      std::snprintf(ispc, sizeof(ispc), "%7.1f (%5.2fx)", Median(cpuMs[5]), PairedRatio(cpuMs[5], cpuMs[0]));
+      std::snprintf(ispc, sizeof(ispc), "%7.1f (%5.2fx)", MedianOf(cpuMs[5]), PairedRatio(cpuMs[5], cpuMs[0]));
     }
     std::printf("| %-22s | %9d | %10.1f | %6.1f (%4.2fx) | %7.1f (%5.2fx) | %7.1f (%5.2fx) | %15s | %23s | %7.1f (%5.2fx) |\n", name, n, low,
                 medium, PairedRatio(cpuMs[1], cpuMs[0]), originalMs, PairedRatio(cpuMs[2], cpuMs[0]), row.lbvhCpuMs,
@@ -495,8 +464,8 @@ int main(int argc, char** argv)
                                             castIspcSah->CastRays(rayPos.data(), rayDir.data(), ispcSahHits.data(), pixels);
                                         }},
                                        kTraceRounds);
-    const double embree1 = Median(traceMs[0]), embree16 = Median(traceMs[1]), lbvhMs = Median(traceMs[2]), lbvh1T = Median(traceMs[3]),
-                 castCpuMs = Median(traceMs[4]), sahMs = Median(traceMs[5]);
+    const double embree1 = MedianOf(traceMs[0]), embree16 = MedianOf(traceMs[1]), lbvhMs = MedianOf(traceMs[2]), lbvh1T = MedianOf(traceMs[3]),
+                 castCpuMs = MedianOf(traceMs[4]), sahMs = MedianOf(traceMs[5]);
     auto againstEmbree1 = [&](int work) { return PairedRatio(traceMs[0], traceMs[work]); };  // throughput ratio
     size_t translatedDiffer = 0;
     for (int i = 0; i < pixels; ++i) translatedDiffer += castHits[i].primId != ourHits[i].primId;
@@ -504,8 +473,8 @@ int main(int argc, char** argv)
     if (castIspc)
     {
       for (int i = 0; i < pixels; ++i) translatedDiffer += (ispcHits[i].primId != ourHits[i].primId) + (ispcSahHits[i].primId != sahHits[i].primId);
-      std::snprintf(ispcCast, sizeof(ispcCast), "%6.2f (%5.2fx)", mrays(Median(traceMs[6])), againstEmbree1(6));
-      std::snprintf(ispcSahCast, sizeof(ispcSahCast), "%6.2f (%5.2fx)", mrays(Median(traceMs[7])), againstEmbree1(7));
+      std::snprintf(ispcCast, sizeof(ispcCast), "%6.2f (%5.2fx)", mrays(MedianOf(traceMs[6])), againstEmbree1(6));
+      std::snprintf(ispcSahCast, sizeof(ispcSahCast), "%6.2f (%5.2fx)", mrays(MedianOf(traceMs[7])), againstEmbree1(7));
       castIspc->SetScene(nullptr, {}, {});
       castIspcSah->SetScene(nullptr, {}, {});
     }

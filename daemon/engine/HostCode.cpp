@@ -111,6 +111,7 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
     if (model.forIspc) continue;  // IspcHostData's
     Data x = CpuKernelData(k);
     x.set("loopNest", IndentTail(k.cpuLoopNest, "  "));
+    x.set("iterations", k.loops.empty() ? "1" : k.loops[0].countCpp);  // the outer loop's, which OpenMP shares out
     // Dynamic chunks: iterations may cost very different amounts (a ray that hits against one that
     // misses). With static halves PrimaryRays_CPU cast the bunny's rays at 0.57-0.63x of Embree,
     // with chunks of 1024 at 0.71-0.75x (bench_lbvh, 2 threads). 2D kernels hand out rows.

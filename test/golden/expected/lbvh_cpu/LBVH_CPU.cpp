@@ -60,12 +60,15 @@ void LBVH_CPU::Build(int count, const LiteMath::Box4f* boxes)
   const_cast<LBVH_CPU*>(this)->crt_times["Build"] = {0.0f, 0.0f, 0.0f, crt_ms};
 }
 
-// From LBVH::kernel1D_Bounds (LBVH.cpp): the outer loop runs on all cores.
+// From LBVH::kernel1D_Bounds (LBVH.cpp): the outer loop runs on all cores (or on this
+// thread while that has been faster: crossrt::ParallelChoice).
 void LBVH_CPU::kernel1D_Bounds(int count, const LiteMath::Box4f* boxes)
 {
   auto m_centerMinLocal = m_centerMin;
   auto m_centerMaxLocal = m_centerMax;
-#pragma omp parallel for schedule(dynamic, 1024) reduction(crossrt_min_vec3 : m_centerMinLocal) \
+  static crossrt::ParallelChoice crt_choice;
+  const auto crt_loop = crt_choice.Begin(count);
+#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1024) reduction(crossrt_min_vec3 : m_centerMinLocal) \
     reduction(crossrt_max_vec3 : m_centerMaxLocal)
   for (int i = 0; i < count; i++)
   {
@@ -73,14 +76,18 @@ void LBVH_CPU::kernel1D_Bounds(int count, const LiteMath::Box4f* boxes)
     m_centerMinLocal = min(m_centerMinLocal, center);
     m_centerMaxLocal = max(m_centerMaxLocal, center);
   }
+  crt_choice.End(crt_loop);
   m_centerMin = m_centerMinLocal;
   m_centerMax = m_centerMaxLocal;
 }
 
-// From LBVH::kernel1D_EvalMC (LBVH.cpp): the outer loop runs on all cores.
+// From LBVH::kernel1D_EvalMC (LBVH.cpp): the outer loop runs on all cores (or on this
+// thread while that has been faster: crossrt::ParallelChoice).
 void LBVH_CPU::kernel1D_EvalMC(int count, const LiteMath::Box4f* boxes)
 {
-#pragma omp parallel for schedule(dynamic, 1024)
+  static crossrt::ParallelChoice crt_choice;
+  const auto crt_loop = crt_choice.Begin(count);
+#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1024)
   for (int i = 0; i < count; i++)
   {
     const float3 center = 0.5f * (to_float3(boxes[i].boxMin) + to_float3(boxes[i].boxMax));
@@ -93,24 +100,32 @@ void LBVH_CPU::kernel1D_EvalMC(int count, const LiteMath::Box4f* boxes)
                           MortonExpandBits(uint32_t(cell.z));
     m_codes[i] = uint2(code, uint32_t(i));
   }
+  crt_choice.End(crt_loop);
 }
 
-// From LBVH::kernel1D_AppendInit (LBVH.cpp): the outer loop runs on all cores.
+// From LBVH::kernel1D_AppendInit (LBVH.cpp): the outer loop runs on all cores (or on this
+// thread while that has been faster: crossrt::ParallelChoice).
 void LBVH_CPU::kernel1D_AppendInit(int count)
 {
-#pragma omp parallel for schedule(dynamic, 1024)
+  static crossrt::ParallelChoice crt_choice;
+  const auto crt_loop = crt_choice.Begin(count);
+#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1024)
   for (int i = 0; i < count; i++)
   {
     m_newGroup[i] = (i == 0 || m_codes[i].x != m_codes[i - 1].x) ? 1u : 0u;
     m_primIndices[i] = m_codes[i].y;
   }
+  crt_choice.End(crt_loop);
 }
 
-// From LBVH::kernel1D_AppendComplete (LBVH.cpp): the outer loop runs on all cores.
+// From LBVH::kernel1D_AppendComplete (LBVH.cpp): the outer loop runs on all cores (or on this
+// thread while that has been faster: crossrt::ParallelChoice).
 void LBVH_CPU::kernel1D_AppendComplete(int count)
 {
   auto m_leafCountLocal = m_leafCount;
-#pragma omp parallel for schedule(dynamic, 1024) reduction(+ : m_leafCountLocal)
+  static crossrt::ParallelChoice crt_choice;
+  const auto crt_loop = crt_choice.Begin(count);
+#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1024) reduction(+ : m_leafCountLocal)
   for (int i = 0; i < count; i++)
   {
     if (m_newGroup[i] != 0u)
@@ -121,13 +136,17 @@ void LBVH_CPU::kernel1D_AppendComplete(int count)
     if (i == count - 1)
       m_leafCountLocal += m_groupOf[i] + m_newGroup[i];
   }
+  crt_choice.End(crt_loop);
   m_leafCount = m_leafCountLocal;
 }
 
-// From LBVH::kernel1D_Karras12 (LBVH.cpp): the outer loop runs on all cores.
+// From LBVH::kernel1D_Karras12 (LBVH.cpp): the outer loop runs on all cores (or on this
+// thread while that has been faster: crossrt::ParallelChoice).
 void LBVH_CPU::kernel1D_Karras12(int count)
 {
-#pragma omp parallel for schedule(dynamic, 1024)
+  static crossrt::ParallelChoice crt_choice;
+  const auto crt_loop = crt_choice.Begin(count);
+#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1024)
   for (int i = 0; i < count; i++)
   {
     const int leaves = int(m_leafCount);
@@ -163,12 +182,16 @@ void LBVH_CPU::kernel1D_Karras12(int count)
     m_parent[right] = uint32_t(i);
     m_arrivals[i] = 0u;
   }
+  crt_choice.End(crt_loop);
 }
 
-// From LBVH::kernel1D_MakeLeaves (LBVH.cpp): the outer loop runs on all cores.
+// From LBVH::kernel1D_MakeLeaves (LBVH.cpp): the outer loop runs on all cores (or on this
+// thread while that has been faster: crossrt::ParallelChoice).
 void LBVH_CPU::kernel1D_MakeLeaves(int count, const LiteMath::Box4f* boxes)
 {
-#pragma omp parallel for schedule(dynamic, 1024)
+  static crossrt::ParallelChoice crt_choice;
+  const auto crt_loop = crt_choice.Begin(count);
+#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1024)
   for (int leaf = 0; leaf < count; leaf++)
   {
     if (uint32_t(leaf) >= m_leafCount)
@@ -188,12 +211,16 @@ void LBVH_CPU::kernel1D_MakeLeaves(int count, const LiteMath::Box4f* boxes)
     m_nodes[node].left = kLeafFlag | first;
     m_nodes[node].right = last - first;
   }
+  crt_choice.End(crt_loop);
 }
 
-// From LBVH::kernel1D_Refit (LBVH.cpp): the outer loop runs on all cores.
+// From LBVH::kernel1D_Refit (LBVH.cpp): the outer loop runs on all cores (or on this
+// thread while that has been faster: crossrt::ParallelChoice).
 void LBVH_CPU::kernel1D_Refit(int count)
 {
-#pragma omp parallel for schedule(dynamic, 1024)
+  static crossrt::ParallelChoice crt_choice;
+  const auto crt_loop = crt_choice.Begin(count);
+#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1024)
   for (int leaf = 0; leaf < count; leaf++)
   {
     if (uint32_t(leaf) >= m_leafCount)
@@ -222,4 +249,5 @@ void LBVH_CPU::kernel1D_Refit(int count)
       node = parent;
     }
   }
+  crt_choice.End(crt_loop);
 }

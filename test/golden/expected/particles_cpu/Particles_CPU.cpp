@@ -54,11 +54,14 @@ void Particles_CPU::Step(int n, float dt, float4* positions, float4* velocities)
   const_cast<Particles_CPU*>(this)->crt_times["Step"] = {0.0f, 0.0f, 0.0f, crt_ms};
 }
 
-// From Particles::kernel1D_Advance (Particles.cpp): the outer loop runs on all cores.
+// From Particles::kernel1D_Advance (Particles.cpp): the outer loop runs on all cores (or on this
+// thread while that has been faster: crossrt::ParallelChoice).
 void Particles_CPU::kernel1D_Advance(int n, float dt, float4* positions, float4* velocities)
 {
   auto m_bouncesLocal = m_bounces;
-#pragma omp parallel for schedule(dynamic, 1024) reduction(+ : m_bouncesLocal)
+  static crossrt::ParallelChoice crt_choice;
+  const auto crt_loop = crt_choice.Begin(n);
+#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1024) reduction(+ : m_bouncesLocal)
   for (int i = 0; i < n; i++)
   {
     float4 v = velocities[i];
@@ -73,17 +76,21 @@ void Particles_CPU::kernel1D_Advance(int n, float dt, float4* positions, float4*
     positions[i] = p;
     velocities[i] = v;
   }
+  crt_choice.End(crt_loop);
   m_bounces = m_bouncesLocal;
 }
 
-// From Particles::kernel1D_Measure (Particles.cpp): the outer loop runs on all cores.
+// From Particles::kernel1D_Measure (Particles.cpp): the outer loop runs on all cores (or on this
+// thread while that has been faster: crossrt::ParallelChoice).
 void Particles_CPU::kernel1D_Measure(int n, const float4* positions, const float4* velocities)
 {
   auto m_boxMinLocal = m_boxMin;
   auto m_boxMaxLocal = m_boxMax;
   auto m_momentumLocal = m_momentum;
   auto m_kineticEnergyLocal = m_kineticEnergy;
-#pragma omp parallel for schedule(dynamic, 1024) reduction(crossrt_min_vec4 : m_boxMinLocal) \
+  static crossrt::ParallelChoice crt_choice;
+  const auto crt_loop = crt_choice.Begin(n);
+#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1024) reduction(crossrt_min_vec4 : m_boxMinLocal) \
     reduction(crossrt_max_vec4 : m_boxMaxLocal) reduction(crossrt_add_vec4 : m_momentumLocal) \
     reduction(+ : m_kineticEnergyLocal)
   for (int i = 0; i < n; i++)
@@ -95,6 +102,7 @@ void Particles_CPU::kernel1D_Measure(int n, const float4* positions, const float
     m_momentumLocal += v;
     m_kineticEnergyLocal += 0.5f * dot(v, v);
   }
+  crt_choice.End(crt_loop);
   m_boxMin = m_boxMinLocal;
   m_boxMax = m_boxMaxLocal;
   m_momentum = m_momentumLocal;

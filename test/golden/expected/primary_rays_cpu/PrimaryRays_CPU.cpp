@@ -48,10 +48,13 @@ void PrimaryRays_CPU::CastRays(const float4* posAndNear, const float4* dirAndFar
   const_cast<PrimaryRays_CPU*>(this)->crt_times["CastRays"] = {0.0f, 0.0f, 0.0f, crt_ms};
 }
 
-// From PrimaryRays::kernel2D_Render (PrimaryRays.cpp): the outer loop runs on all cores.
+// From PrimaryRays::kernel2D_Render (PrimaryRays.cpp): the outer loop runs on all cores (or on this
+// thread while that has been faster: crossrt::ParallelChoice).
 void PrimaryRays_CPU::kernel2D_Render(uint32_t* pixels, int width, int height)
 {
-#pragma omp parallel for schedule(dynamic, 1)
+  static crossrt::ParallelChoice crt_choice;
+  const auto crt_loop = crt_choice.Begin(height);
+#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1)
   for (int y = 0; y < height; ++y)
   {
     for (int x = 0; x < width; ++x)
@@ -64,12 +67,17 @@ void PrimaryRays_CPU::kernel2D_Render(uint32_t* pixels, int width, int height)
       pixels[pixel] = PackRGBA8(Shade(hit, to_float3(m_eye), to_float3(dir), pixel));
     }
   }
+  crt_choice.End(crt_loop);
 }
 
-// From PrimaryRays::kernel1D_CastRays (PrimaryRays.cpp): the outer loop runs on all cores.
+// From PrimaryRays::kernel1D_CastRays (PrimaryRays.cpp): the outer loop runs on all cores (or on this
+// thread while that has been faster: crossrt::ParallelChoice).
 void PrimaryRays_CPU::kernel1D_CastRays(const float4* posAndNear, const float4* dirAndFar, CRT_Hit* hits, int n)
 {
-#pragma omp parallel for schedule(dynamic, 1024)
+  static crossrt::ParallelChoice crt_choice;
+  const auto crt_loop = crt_choice.Begin(n);
+#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1024)
   for (int i = 0; i < n; ++i)
     hits[i] = m_pAccelStruct->RayQuery_NearestHit(posAndNear[i], dirAndFar[i]);
+  crt_choice.End(crt_loop);
 }
