@@ -91,6 +91,10 @@ private:
   static std::string StateBuffer(const ThreadLoop& tl, const VarDecl* vd);
 
   void Error(ThreadLoop& tl, SourceLocation loc, const std::string& message, const std::string& hint);
+  // The _CPU class's loop over threads (of `nest` loops, `outer` the outermost, its header
+  // `outermost`): an OpenMP loop on all cores, or on this thread while that has been faster
+  // (crossrt::ParallelChoice), in a block of its own.
+  void ParallelOnCpu(const ForStmt* outer, const LoopHeader& outermost, size_t nest);
 
   // Checks that `e` does not depend on the thread (host code and by-value kernel arguments run once
   // for all threads in wavefront mode) and collects the control function's variables it reads.

@@ -36,10 +36,13 @@ std::string ChunksOnAllCores(const ClassModel& model, const std::string& what, c
                      "const int crt_countX = std::max(0, int(" + counts[0] + "));\n";
   if (dims == 2) text += "const int crt_countY = std::max(0, int(" + counts[1] + "));\n";
   text += "static const auto crt_run = crossrt::IspcPick(ispc::" + symbol + ", {" + IspcTargetFunctions(symbol) + "});\n"
-          "#pragma omp parallel for schedule(dynamic, 1)\n"
+          "static crossrt::ParallelChoice crt_choice;  // all cores, or this thread while that has been faster\n"
+          "const auto crt_loop = crt_choice.Begin(" + outer + ");\n"
+          "#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1)\n"
           "for (int crt_chunk = 0; crt_chunk < (" + outer + " + " + chunk + " - 1) / " + chunk + "; ++crt_chunk)\n"
           "  crt_run(const_cast<ispc::" + model.symbolPrefix + "_Data*>(&crt_self), crt_chunk * " + chunk + ", std::min(" + outer + ", (crt_chunk + 1) * " + chunk + ")" +
           (dims == 2 ? ", 0, crt_countX" : "") + cppArgs + ");\n"
+          "crt_choice.End(crt_loop);\n"
           "IspcWrittenBack(crt_self);  // members the kernels set\n}\n";
   return text;
 }

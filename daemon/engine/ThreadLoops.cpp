@@ -185,10 +185,7 @@ bool ControlRewriter::TryThreadLoop(const ForStmt* outerLoop) {
   CharSourceRange range = end.isValid() ? CharSourceRange::getCharRange(outerLoop->getBeginLoc(), end) : CharSourceRange::getTokenRange(outerLoop->getSourceRange());
   m_gpu.ReplaceText(range, text);
   // CPU: the loop as written, its threads on all cores (the locals are private to each iteration).
-  unsigned col = m_c.ctx.getSourceManager().getExpansionColumnNumber(outerLoop->getBeginLoc());
-  std::string pragma = "#pragma omp parallel for schedule(dynamic, 16)";
-  if (tl.loops.size() > 1) pragma += " collapse(" + std::to_string(tl.loops.size()) + ")";
-  m_cpu.InsertTextBefore(outerLoop->getBeginLoc(), pragma + "\n" + std::string(col > 0 ? col - 1 : 0, ' '));
+  ParallelOnCpu(outerLoop, tl.loops.front(), tl.loops.size());
   m_inlined.clear();
   return true;
 }
@@ -273,13 +270,23 @@ bool ControlRewriter::TryRtvNest(const ForStmt* outer) {
   SourceLocation end = Lexer::findLocationAfterToken(outer->getEndLoc(), tok::semi, m_c.ctx.getSourceManager(), m_c.ctx.getLangOpts(), false);
   CharSourceRange range = end.isValid() ? CharSourceRange::getCharRange(outer->getBeginLoc(), end) : CharSourceRange::getTokenRange(outer->getSourceRange());
   m_gpu.ReplaceText(range, md->getNameAsString() + "Cmd(crt_cmd" + counts + Args(call, true) + ");");
-  auto& sm = m_c.ctx.getSourceManager();
-  unsigned col = sm.getExpansionColumnNumber(outer->getBeginLoc());
-  std::string indent(col > 0 ? col - 1 : 0, ' ');
-  std::string pragma = "#pragma omp parallel for schedule(dynamic, 16)";
-  if (loops.size() > 1) pragma += " collapse(" + std::to_string(loops.size()) + ")";
-  m_cpu.InsertTextBefore(outer->getBeginLoc(), pragma + "\n" + indent);
+  ParallelOnCpu(outer, loops.front(), loops.size());
   return true;
+}
+
+void ControlRewriter::ParallelOnCpu(const ForStmt* outer, const LoopHeader& outermost, size_t nest) {
+  auto& sm = m_c.ctx.getSourceManager();
+  const unsigned col = sm.getExpansionColumnNumber(outer->getBeginLoc());
+  const std::string indent(col > 0 ? col - 1 : 0, ' ');
+  std::string pragma = "#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 16)";
+  if (nest > 1) pragma += " collapse(" + std::to_string(nest) + ")";
+  m_cpu.InsertTextBefore(outer->getBeginLoc(), "{  // crossrt: on all cores, or on this thread while that has been faster\n" + indent +
+                                                   "static crossrt::ParallelChoice crt_choice;\n" + indent + "const auto crt_loop = crt_choice.Begin(" +
+                                                   CountExpr(m_c, outermost) + ");\n" + indent + pragma + "\n" + indent);
+  const std::string after = "\n" + indent + "crt_choice.End(crt_loop);\n" + indent + "}";
+  const SourceLocation semi = Lexer::findLocationAfterToken(outer->getEndLoc(), tok::semi, sm, m_c.ctx.getLangOpts(), false);
+  if (semi.isValid()) m_cpu.InsertTextAfter(semi, after);  // a body of one statement: after its ';'
+  else m_cpu.InsertTextAfterToken(outer->getEndLoc(), after);
 }
 
 }  // namespace crossrt::engine

@@ -749,7 +749,7 @@ TEST_CASE("CPU radix sort: stable for keys that need 0, 1, 2 and 3 passes, small
 }
 
 // crossrt::ParallelChoice, with the times given: the way that measured faster is taken, the other
-// is tried again after 8 calls, then 16..., a long loop runs on one core only once its parallel
+// is tried again after 16 calls, then 64..., a long loop runs on one core only once its parallel
 // runs have been slowed, and a loop of one iteration never runs on all cores.
 TEST_CASE("ParallelChoice takes the faster way and tries the other now and then", "[runtime][parallel]")
 {
@@ -771,14 +771,15 @@ TEST_CASE("ParallelChoice takes the faster way and tries the other now and then"
     REQUIRE_FALSE(choice.Choose(1000));  // then one run on this thread, cheap (1 ms)
     choice.Record(false, 1000, 0.5);
     REQUIRE(choice.Mean(false) == Approx(0.0005f));
-    // One core wins: of the next 8 calls, one tries all cores again; after that try lost, 16
+    // One core wins: of the next 16 calls, one tries all cores again; after that try lost, 64
     // calls pass before the next.
-    CHECK(count(choice, 8, 1.0, 0.5) == 1);
-    CHECK(count(choice, 15, 1.0, 0.5) == 0);
+    CHECK(count(choice, 16, 1.0, 0.5) == 1);
+    CHECK(count(choice, 63, 1.0, 0.5) == 0);
     CHECK(count(choice, 1, 1.0, 0.5) == 1);
-    // The load goes away: all cores become faster, and once tried they win (after at most 32
-    // calls) and keep winning but for the tries of one core (8 calls, then 16).
-    CHECK(count(choice, 64, 0.1, 0.5) >= 64 - 32 - 2);
+    // The load goes away: all cores become faster. Tried after 256 calls, they win, and keep
+    // winning but for the tries of one core (after 16 calls, then 64).
+    CHECK(count(choice, 256, 0.1, 0.5) == 1);
+    CHECK(count(choice, 64, 0.1, 0.5) == 63);
   }
   SECTION("a long loop on a quiet machine always runs on all cores") {
     crossrt::ParallelChoice choice;
@@ -790,7 +791,7 @@ TEST_CASE("ParallelChoice takes the faster way and tries the other now and then"
     CHECK(count(choice, 4, 8.0, 16.0) == 4);
     CHECK(count(choice, 3, 30.0, 16.0) < 3);  // slowed past 1.5x the fastest: one core tried
     CHECK(choice.Mean(false) == Approx(0.016f));
-    CHECK(count(choice, 7, 30.0, 16.0) == 0);
+    CHECK(count(choice, 15, 30.0, 16.0) == 0);
   }
   SECTION("nothing to share") {
     crossrt::ParallelChoice choice;

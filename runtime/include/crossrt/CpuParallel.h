@@ -5,6 +5,7 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstddef>
@@ -104,7 +105,7 @@ void RadixSort(Iterator first, Iterator last, const SortKey& key) {
 //
 // So each loop runs the way that has been faster here, as measured: the mean time per iteration
 // of each way (an exponential moving average, outliers and all, since the waits are what is being
-// measured). The slower way is tried again now and then, after 8 calls, then 16, 32... up to 256
+// measured). The slower way is tried again now and then, after 16 calls, then 64, 256, up to 1024
 // while it keeps losing (its mean starts afresh from that run), so that the choice follows the
 // machine's load. On a quiet machine one core costs as many parallel runs as there are other
 // threads, so it is tried only where that is cheap (under kCheapMs) or where the parallel runs
@@ -118,6 +119,9 @@ void RadixSort(Iterator first, Iterator last, const SortKey& key) {
 class ParallelChoice {
  public:
   static constexpr double kCheapMs = 2.0;  // what a try on one core may cost on a quiet machine
+  // Calls between tries of the slower way: the first wait, 4x longer after each try it lost, up to
+  // the longest. A try of all cores on a loaded machine may meet the wait it is there to avoid.
+  static constexpr unsigned kFirstWait = 16, kLongestWait = 1024;
 
   struct Run {
     bool parallel;
@@ -163,7 +167,7 @@ class ParallelChoice {
       const float serial = Mean(false);
       const bool parallelFaster = serial < 0.0f || Mean(true) <= serial;
       const unsigned wait = m_nextTry.load(std::memory_order_relaxed);
-      m_nextTry.store(parallelFaster == parallel ? 8u : (wait < 256u ? wait * 2u : 256u), std::memory_order_relaxed);
+      m_nextTry.store(parallelFaster == parallel ? kFirstWait : std::min(wait * 4u, kLongestWait), std::memory_order_relaxed);
     }
   }
 
@@ -191,7 +195,7 @@ class ParallelChoice {
   std::atomic<float> m_msPerIteration[2] = {-1.0f, -1.0f};  // one core, all cores
   std::atomic<float> m_fastestParallel{3.0e38f};
   std::atomic<unsigned> m_calls{0};
-  std::atomic<unsigned> m_nextTry{8};
+  std::atomic<unsigned> m_nextTry{kFirstWait};
   std::atomic<bool> m_tryingOther{false};
 };
 

@@ -59,11 +59,14 @@ void SpherePaths_ISPC::Render(uint32_t width, uint32_t height, int samples, floa
       static const auto crt_run = crossrt::IspcPick(
           ispc::SpherePaths_Render_Megakernel, {SpherePaths_Render_Megakernel_sse4, SpherePaths_Render_Megakernel_avx2,
                                                 SpherePaths_Render_Megakernel_avx512skx});
-#pragma omp parallel for schedule(dynamic, 1)
+      static crossrt::ParallelChoice crt_choice;
+      const auto crt_loop = crt_choice.Begin(crt_countY);
+#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1)
       for (int crt_chunk = 0; crt_chunk < (crt_countY + 4 - 1) / 4; ++crt_chunk)
         crt_run(const_cast<ispc::SpherePaths_Data*>(&crt_self), crt_chunk * 4,
                 std::min(crt_countY, (crt_chunk + 1) * 4), 0, crt_countX,
                 crossrt::IspcPointer<ispc::float4*>(out_color), samples, width, height);
+      crt_choice.End(crt_loop);
       IspcWrittenBack(crt_self);
     }
     m_timeMs = std::chrono::duration<float, std::milli>(std::chrono::steady_clock::now() - start).count();
