@@ -15,9 +15,10 @@
 set -u
 glslang=$1 spirvval=$2 spirvdis=$3 build=$4
 shift 4
-# The package tests build user projects under test/package-* at the same time: not searched, their
-# shaders may be half written.
-mapfile -t shaders < <(find "$build" -path "$build/test/package-*" -prune -o \( -name '*_RayQuery.comp' -o -name '*_Textures.comp' \
+# The package tests build user projects under test/package-*, and the parallel-build test a whole
+# tree under test/parallel-build, at the same time: not searched, their shaders may be half written
+# or already removed.
+mapfile -t shaders < <(find "$build" \( -path "$build/test/package-*" -o -path "$build/test/parallel-build" \) -prune -o \( -name '*_RayQuery.comp' -o -name '*_Textures.comp' \
                          -o -name '*.rgen' -o -name '*.rcall' -o -name '*.rint' -o -name '*.rchit' -o -name '*.rmiss' \) -path '*/shaders/*' -print | sort -u)
 status=0
 for expected in "$@"; do
