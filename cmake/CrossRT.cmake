@@ -263,8 +263,13 @@ function(crossrt_add_class target class)
       target_sources(${target} PRIVATE ${ispc_objects} ${ispc_header})
     endif()
   endif()
+  get_target_property(linked_type ${target} TYPE)
   if(suffix STREQUAL "Vulkan")
     target_link_libraries(${target} PRIVATE crossrt::runtime)
+  elseif(linked_type MATCHES "^(STATIC|OBJECT)_LIBRARY$")
+    # The executables that link a static library of CPU classes get the runtime's usage
+    # requirements too: passive OpenMP waits (src/CpuWaitPolicy.cpp of the runtime).
+    target_link_libraries(${target} PUBLIC crossrt::cpu_runtime)
   else()
     target_link_libraries(${target} PRIVATE crossrt::cpu_runtime)
   endif()
