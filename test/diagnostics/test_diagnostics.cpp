@@ -518,6 +518,11 @@ protected:
 void Counts::kernel1D_Copy(int n) { for (int i = 0; i < n; i++) m_out[i] = m_in[i]; }
 void Counts::kernel1D_Twice(int n) { for (int i = 0; i < n; i++) m_out[i] = 2 * m_in[i]; }
 )";
+  // crossrt translate of Counts in `tc` for a backend, into a folder of that name.
+  auto translate = [](const TempClass& tc, const std::string& backend) {
+    return RunCrossrt("translate --class Counts --backend " + backend + " --out " + (tc.dir / backend).string() + " --source " + tc.Source("Counts") +
+                      " --templates " CROSSRT_SOURCE_DIR "/templates");
+  };
   SECTION("refused: a resize, and a read inside a statement that records GPU work")
   {
     TempClass tc("Counts", header, kernels + R"(void Counts::Run(int n)
@@ -532,8 +537,7 @@ void Counts::kernel1D_Twice(int n) { for (int i = 0; i < n; i++) m_out[i] = 2 * 
   m_first = m_out[0];
 }
 )");
-    CommandResult r = RunCrossrt("translate --class Counts --backend vulkan --out " + (tc.dir / "out").string() + " --source " + tc.Source("Counts") +
-                                 " --templates " CROSSRT_SOURCE_DIR "/templates");
+    CommandResult r = translate(tc, "vulkan");
     INFO(r.output);
     REQUIRE_FALSE(r.crashed);
     REQUIRE(r.exitCode == 1);
@@ -547,8 +551,7 @@ void Counts::kernel1D_Twice(int n) { for (int i = 0; i < n; i++) m_out[i] = 2 * 
     CHECK(r.output.find("use it in a statement of its own") != std::string::npos);
     CHECK(r.output.find("Counts.cpp:14:") == std::string::npos);   // after the last kernel: runs once m_out is back
     for (const char* backend : {"cpu", "ispc"}) {
-      CommandResult cpu = RunCrossrt(std::string("translate --class Counts --backend ") + backend + " --out " + (tc.dir / backend).string() +
-                                     " --source " + tc.Source("Counts") + " --templates " CROSSRT_SOURCE_DIR "/templates");
+      CommandResult cpu = translate(tc, backend);
       INFO(cpu.output);
       CHECK(cpu.exitCode == 0);
     }
@@ -565,8 +568,7 @@ void Counts::kernel1D_Twice(int n) { for (int i = 0; i < n; i++) m_out[i] = 2 * 
   kernel1D_Twice(n);
 }
 )");
-    CommandResult r = RunCrossrt("translate --class Counts --backend vulkan --out " + (tc.dir / "out").string() + " --source " + tc.Source("Counts") +
-                                 " --templates " CROSSRT_SOURCE_DIR "/templates");
+    CommandResult r = translate(tc, "vulkan");
     INFO(r.output);
     REQUIRE_FALSE(r.crashed);
     REQUIRE(r.exitCode == 1);
@@ -574,8 +576,7 @@ void Counts::kernel1D_Twice(int n) { for (int i = 0; i < n; i++) m_out[i] = 2 * 
           std::string::npos);
     CHECK(r.output.find("Counts.cpp:10:23: error: control function 'Run' lets host code reach 'm_in' between kernel calls through a lambda") !=
           std::string::npos);
-    CommandResult cpu = RunCrossrt("translate --class Counts --backend cpu --out " + (tc.dir / "cpu").string() + " --source " + tc.Source("Counts") +
-                                   " --templates " CROSSRT_SOURCE_DIR "/templates");
+    CommandResult cpu = translate(tc, "cpu");
     CHECK(cpu.exitCode == 0);
   }
   SECTION("translated: the recording is split around each host statement, with a note")
@@ -591,14 +592,13 @@ void Counts::kernel1D_Twice(int n) { for (int i = 0; i < n; i++) m_out[i] = 2 * 
   m_first = m_out[0];
 }
 )");
-    CommandResult r = RunCrossrt("translate --class Counts --backend vulkan --out " + (tc.dir / "out").string() + " --source " + tc.Source("Counts") +
-                                 " --templates " CROSSRT_SOURCE_DIR "/templates");
+    CommandResult r = translate(tc, "vulkan");
     INFO(r.output);
     REQUIRE(r.exitCode == 0);
     CHECK(r.output.find("Counts.cpp:9:3: note: 'Run' uses member vectors on the host between kernel calls: on Vulkan the recording is split before this statement "
                         "(the work recorded so far is submitted and waited for, and 'm_out' read back)") != std::string::npos);
     CHECK(r.output.find("Counts.cpp:10:3: note: 'Run' uses member vectors on the host between kernel calls") != std::string::npos);  // the loop: m_in uploaded after it
-    std::ifstream source(tc.dir / "out" / "Counts_Vulkan.cpp");
+    std::ifstream source(tc.dir / "vulkan" / "Counts_Vulkan.cpp");
     const std::string text((std::istreambuf_iterator<char>(source)), std::istreambuf_iterator<char>());
     const size_t cmd = text.find("void Counts_Vulkan::RunCmd(");
     REQUIRE(cmd != std::string::npos);
