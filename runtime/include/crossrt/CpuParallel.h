@@ -99,9 +99,9 @@ void RadixSort(Iterator first, Iterator last, const SortKey& key) {
 // cores busy, the scheduler takes a worker off its core for a time slice (milliseconds) now and
 // then, and the loop waits for it. A loop of a few hundred microseconds then takes ten or a
 // hundred times that: beside one busy thread on 2 cores (AMD EPYC, bench_lbvh --load 1), the
-// LBVH_CPU build of an 11,102-triangle mesh (eight kernel calls) took 4.8 ms, and 54 ms in one run
-// of two, against 0.9 ms quiet and 1.9 ms for the single-threaded original. OMP_WAIT_POLICY does
-// not help: passive waits collapsed the same way.
+// LBVH_CPU build of an 11,102-triangle mesh (eight kernel calls) took 4.3-4.8 ms, and 54 ms in some
+// runs, against 1.0 ms quiet and 1.9 ms for the single-threaded original. Passive waits alone
+// (OMP_WAIT_POLICY) collapsed the same way; beside this choice they help (runtime/src/CpuWaitPolicy.cpp).
 //
 // So each loop runs the way that has been faster here, as measured: the mean time per iteration
 // of each way (an exponential moving average, outliers and all, since the waits are what is being
