@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 
 namespace crossrt::client {
@@ -72,6 +73,20 @@ void WriteManifest(const engine::TranslateRequest& request, const engine::Transl
   std::string path = ManifestPath(request), tmp = path + ".tmp";
   std::ofstream(tmp) << m.dump(1) << "\n";
   std::filesystem::rename(tmp, path);
+}
+
+std::string RequestPath(const engine::TranslateRequest& r) { return r.outputDir + "/.crossrt-request.json"; }
+
+void RecordRequest(const engine::TranslateRequest& request) {
+  const std::string text = protocol::ToJson(request).dump(1) + "\n", path = RequestPath(request);
+  std::ifstream old(path);
+  std::string previous((std::istreambuf_iterator<char>(old)), std::istreambuf_iterator<char>());
+  if (previous == text) return;
+  std::error_code ec;
+  std::filesystem::create_directories(request.outputDir, ec);
+  const std::string tmp = path + ".tmp";
+  std::ofstream(tmp) << text;
+  std::filesystem::rename(tmp, path, ec);  // best effort: a build never fails for the editor's sake
 }
 
 }  // namespace crossrt::client

@@ -24,4 +24,10 @@ std::string ManifestPath(const engine::TranslateRequest& request);
 bool UpToDate(const engine::TranslateRequest& request);
 void WriteManifest(const engine::TranslateRequest& request, const engine::TranslateResult& result);
 
+// The request itself, as the daemon receives it, in <outputDir>/.crossrt-request.json: the language
+// server (crossrtd --lsp) learns the build tree's classes from these. Written on every translation,
+// failed ones too (the class the user is fixing), and only when its bytes change.
+std::string RequestPath(const engine::TranslateRequest& request);
+void RecordRequest(const engine::TranslateRequest& request);
+
 }  // namespace crossrt::client

@@ -105,17 +105,19 @@ struct AstCache::Handle::Entry {
   // The last parse. EndParse() drops it action first: the action ends the source file while the
   // compiler and the main file's buffer still live.
   std::unique_ptr<llvm::MemoryBuffer> mainBuffer;
+  std::vector<std::unique_ptr<llvm::MemoryBuffer>> unsavedBuffers;  // the headers' unsaved text
   std::unique_ptr<ParsedFile> parsed;
   std::unique_ptr<clang::SyntaxOnlyAction> action;
   bool failed = false;
 
   ~Entry() { EndParse(); }
-  bool Parse(const std::string& file, const std::vector<std::string>& args);
+  bool Parse(const std::string& file, const std::map<std::string, std::string>& unsaved);
   void EndParse() {
     if (action) action->EndSourceFile();
     action.reset();
     parsed.reset();
     mainBuffer.reset();
+    unsavedBuffers.clear();
   }
 };
 
@@ -136,15 +138,27 @@ AstCache::~AstCache() = default;
 // Parses the file over its preamble, building (or rebuilding, when a header or the #include
 // block changed) the preamble first. A preamble with errors is dropped, so that the parse reports
 // them. Returns false when the file cannot be read or the compiler cannot be set up.
-bool AstCache::Handle::Entry::Parse(const std::string& file, const std::vector<std::string>& args) {
+// Unsaved headers are remapped files: the preamble's reuse check compares their text (its hash), not
+// a modification time that an editor's buffer does not have.
+bool AstCache::Handle::Entry::Parse(const std::string& file, const std::map<std::string, std::string>& unsaved) {
   Entry& entry = *this;
-  auto buffer = llvm::MemoryBuffer::getFile(file);
-  if (!buffer) {
-    entry.diagStream << "error: cannot read '" << file << "': " << buffer.getError().message() << "\n";
-    return false;
+  if (auto text = unsaved.find(file); text != unsaved.end()) {
+    entry.mainBuffer = llvm::MemoryBuffer::getMemBufferCopy(text->second, file);
+  } else {
+    auto buffer = llvm::MemoryBuffer::getFile(file);
+    if (!buffer) {
+      entry.diagStream << "error: cannot read '" << file << "': " << buffer.getError().message() << "\n";
+      return false;
+    }
+    entry.mainBuffer = std::move(*buffer);
   }
-  entry.mainBuffer = std::move(*buffer);
   auto invocation = std::make_shared<clang::CompilerInvocation>(*entry.invocation);
+  for (auto& [path, text] : unsaved)
+    if (path != file) {
+      entry.unsavedBuffers.push_back(llvm::MemoryBuffer::getMemBufferCopy(text, path));
+      invocation->getPreprocessorOpts().addRemappedFile(path, entry.unsavedBuffers.back().get());
+    }
+  invocation->getPreprocessorOpts().RetainRemappedFileBuffers = true;  // the entry owns the buffers
   llvm::IntrusiveRefCntPtr<llvm::vfs::FileSystem> vfs = llvm::vfs::getRealFileSystem();
   auto bounds = clang::ComputePreambleBounds(invocation->getLangOpts(), *entry.mainBuffer, 0);
   if (!entry.preamble || !entry.preamble->CanReuse(*invocation, *entry.mainBuffer, bounds, *vfs)) {
@@ -162,7 +176,6 @@ bool AstCache::Handle::Entry::Parse(const std::string& file, const std::vector<s
   }
   if (entry.preamble) entry.preamble->AddImplicitPreamble(*invocation, vfs, entry.mainBuffer.get());
   else invocation->getPreprocessorOpts().addRemappedFile(file, entry.mainBuffer.get());
-  invocation->getPreprocessorOpts().RetainRemappedFileBuffers = true;  // the entry owns the buffer
 
   auto compiler = std::make_unique<clang::CompilerInstance>(std::make_shared<clang::PCHContainerOperations>());
   compiler->setInvocation(std::move(invocation));
@@ -187,7 +200,8 @@ bool AstCache::Handle::Entry::Parse(const std::string& file, const std::vector<s
   return true;
 }
 
-AstCache::Handle AstCache::Get(const std::string& file, const std::vector<std::string>& args) {
+AstCache::Handle AstCache::Get(const std::string& file, const std::vector<std::string>& args,
+                               const std::map<std::string, std::string>& unsaved) {
   std::string key = file;
   for (auto& a : args) key += '\x1f' + a;
 
@@ -235,7 +249,7 @@ AstCache::Handle AstCache::Get(const std::string& file, const std::vector<std::s
   }
   entry->printer->clear();
   entry->printer->errors = 0;
-  entry->failed = !entry->invocation || !entry->Parse(file, args) || entry->printer->errors > 0;
+  entry->failed = !entry->invocation || !entry->Parse(file, unsaved) || entry->printer->errors > 0;
   std::lock_guard<std::mutex> guard(m_mutex);
   ++(reparse ? m_reparses : m_parses);
   return handle;

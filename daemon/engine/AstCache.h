@@ -80,8 +80,11 @@ public:
     std::unique_lock<std::mutex> m_lock;  // held while the handle lives
   };
 
-  // Parses `file` with `args` (compiler flags, without the file), or reparses a cached AST.
-  Handle Get(const std::string& file, const std::vector<std::string>& args);
+  // Parses `file` with `args` (compiler flags, without the file), or reparses a cached AST. Files
+  // named in `unsaved` (absolute path -> text: an editor's buffers) are read from there, not from
+  // disk; the preamble is rebuilt when a header's unsaved text changes.
+  Handle Get(const std::string& file, const std::vector<std::string>& args,
+             const std::map<std::string, std::string>& unsaved = {});
 
   AstCacheStats Stats() const;
 

@@ -28,6 +28,12 @@ std::string FileOf(const ASTContext& ctx, SourceLocation loc) {
   return entry ? entry->getName().str() : std::string();
 }
 
+SourcePlace PlaceOf(const ASTContext& ctx, SourceLocation loc) {
+  auto& sm = ctx.getSourceManager();
+  const SourceLocation at = sm.getExpansionLoc(loc);
+  return {FileOf(ctx, at), sm.getExpansionLineNumber(at), sm.getExpansionColumnNumber(at)};
+}
+
 namespace {
 
 // "[[crossrt::size("n")]] const float* in" -> "const float* in"

@@ -16,6 +16,9 @@ std::string Text(const ASTContext& ctx, SourceRange range);
 // The name of the file that holds `loc` (its expansion), as Clang opened it; "" for none.
 std::string FileOf(const ASTContext& ctx, SourceLocation loc);
 
+// `loc`'s expansion as file, line and column.
+SourcePlace PlaceOf(const ASTContext& ctx, SourceLocation loc);
+
 std::string ParamDecl(const ASTContext& ctx, const ParmVarDecl* p, unsigned index);
 
 // A parameter as the declaration `p` writes its type (valid where the class is declared), named

@@ -104,6 +104,7 @@ void AnalyzeControl(Context& c, const CXXMethodDecl* md, const FunctionDecl* def
   Control ctrl;
   ctrl.name = md->getNameAsString();
   ctrl.sourceFile = BaseName(FileOf(c.ctx, def->getLocation()));
+  ctrl.definedAt = PlaceOf(c.ctx, def->getLocation());
   ctrl.isConst = md->isConst();
   ctrl.isVirtual = md->isVirtual();
   if (!ctrl.isVirtual)

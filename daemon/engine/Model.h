@@ -7,6 +7,13 @@
 
 namespace crossrt::engine {
 
+// Where the user wrote something: the file as Clang opened it, 1-based line and column (an editor
+// shows the user's kernels and control functions with what they become: crossrtd --lsp).
+struct SourcePlace {
+  std::string file;
+  unsigned line = 0, column = 0;
+};
+
 // A field of a block shared by C++ and GLSL (class data, push constants).
 struct BlockField {
   std::string name;
@@ -156,6 +163,7 @@ struct Kernel {
   // own dispatched before and after the kernel's threads (and their reductions). Empty when none.
   std::string glslStart, glslFinish;
   std::string sourceFile;             // where the kernel is defined (for comments)
+  SourcePlace definedAt;              // its definition's name
   // The GLSL prelude: structs it needs beyond the class's, constants and helper functions, in an
   // order GLSL accepts (composed code is merged in ahead of the kernel's own).
   std::vector<GlslDecl> structList, constantList;
@@ -238,6 +246,7 @@ struct Control {
   // filled as the local's constructor fills it.
   std::vector<LocalBuffer> temporaries;
   std::string sourceFile;
+  SourcePlace definedAt;  // its definition's name
 };
 
 struct Constructor {

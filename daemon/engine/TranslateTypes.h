@@ -39,6 +39,10 @@ struct TranslateRequest {
   // prefixes the generated global symbols (SPIR-V arrays, ISPC kernels), so that several
   // translations of one class (at different virtual levels, say) link into one program.
   std::string generatedName;
+  // In-process only (the language server; never sent to the daemon): editor buffers that stand for
+  // files on disk, by absolute path. The sources and the headers they include are read from here
+  // first, so that a translation sees what the user is typing before it is saved.
+  std::map<std::string, std::string> unsavedFiles;
 };
 
 struct TranslateResult {
@@ -47,6 +51,8 @@ struct TranslateResult {
   std::map<std::string, std::string> files;     // file name (relative to outputDir) -> contents
   std::vector<std::string> inputs;              // every file the translation read (for depfiles)
   std::map<std::string, double> timingsMs;      // parse, analyze, generate, spirv
+  // The sources did not parse: the diagnostics are the compiler's own, not the translator's (in-process only).
+  bool parseFailed = false;
 };
 
 }  // namespace crossrt::engine

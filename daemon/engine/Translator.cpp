@@ -144,15 +144,18 @@ AnalyzeResult Analyze(const TranslateRequest& request, AstCache* sharedCache) {
   std::string diagText;
   bool parseErrors = false;
   for (auto& s : sources) {
-    handles.push_back(cache.Get(s, args));
+    handles.push_back(cache.Get(s, args, request.unsavedFiles));
     diagText += handles.back().diagnostics();
     parseErrors |= handles.back().failed();
   }
   if (parseErrors) {
     result.diagnostics = diagText.empty() ? "error: parsing failed\n" : diagText;
+    result.parseFailed = true;
     return result;
   }
   result.timingsMs["parse"] = MsSince(t0);
+  const std::set<std::string> inputs = InputsRead(handles);  // failed analyses too: an editor maps headers to classes
+  result.inputs.assign(inputs.begin(), inputs.end());
   t0 = std::chrono::steady_clock::now();
 
   // Analyse: one pass over every AST, with its diagnostics printed against that AST's sources.
@@ -205,20 +208,21 @@ AnalyzeResult Analyze(const TranslateRequest& request, AstCache* sharedCache) {
   FinishModel(model);  // the class data layout, the megakernels' merged code
   result.timingsMs["analyze"] = MsSince(t0);
 
-  const std::set<std::string> inputs = InputsRead(handles);
-  result.inputs.assign(inputs.begin(), inputs.end());
   result.diagnostics = diagText;  // warnings, if any
   result.ok = true;
   return result;
 }
 
-TranslateResult Translate(const TranslateRequest& request, AstCache* cache, SpirvCache* spirvCache) {
+TranslateResult Translate(const TranslateRequest& request, AstCache* cache, SpirvCache* spirvCache, ClassModel* modelOut) {
   TranslateResult result;
   AnalyzeResult analysis = Analyze(request, cache);
   result.diagnostics = analysis.diagnostics;
   result.timingsMs = analysis.timingsMs;
+  result.parseFailed = analysis.parseFailed;
+  result.inputs = analysis.inputs;
   if (!analysis.ok) return result;
   const ClassModel& model = analysis.model;
+  if (modelOut) *modelOut = model;
   const bool vulkan = request.backend == Backend::Vulkan;
   GenerateOptions options;
   options.templateDir = request.templateDir;
@@ -254,7 +258,6 @@ TranslateResult Translate(const TranslateRequest& request, AstCache* cache, Spir
     return result;
   }
   // Inputs: every file the ASTs read, and the templates (editing one regenerates).
-  result.inputs = analysis.inputs;
   for (const char* t : {"glsl/kernel.comp.mustache", "glsl/reduce.comp.mustache", "glsl/ray_query.glsl.mustache", "glsl/dispatcher.glsl.mustache",
                         "glsl/callable_dispatcher.glsl.mustache", "glsl/callable_payload.glsl.mustache",
                         "glsl/leaf_trace.glsl.mustache", "glsl/virtual_objects.glsl.mustache",

@@ -15,6 +15,7 @@ namespace crossrt::engine {
 
 struct AnalyzeResult {
   bool ok = false;
+  bool parseFailed = false;  // the diagnostics are the compiler's
   std::string diagnostics;
   ClassModel model;
   std::vector<std::string> inputs;
@@ -27,8 +28,10 @@ class AstCache;
 // are kept and reparsed (the daemon); without, they are parsed and dropped.
 AnalyzeResult Analyze(const TranslateRequest& request, AstCache* cache = nullptr);
 
-// Parses, analyses and generates. Does not write anything.
-TranslateResult Translate(const TranslateRequest& request, AstCache* cache = nullptr, SpirvCache* spirvCache = nullptr);
+// Parses, analyses and generates. Does not write anything. With `model`, the analysis's model is
+// copied there when the analysis succeeded (the language server describes kernels from it).
+TranslateResult Translate(const TranslateRequest& request, AstCache* cache = nullptr, SpirvCache* spirvCache = nullptr,
+                          ClassModel* model = nullptr);
 
 inline const char* TranslatorVersion() { return kTranslatorVersion; }
 

@@ -3,6 +3,9 @@
 // class costs a reparse of the edited file, not a parse of the standard library.
 //
 //   crossrtd --build-dir DIR [--log FILE] [--idle-seconds N] [--max-asts N]
+//   crossrtd --lsp [--build-dir DIR...] [--log FILE] [--debounce-ms N]
+//
+// With --lsp it is instead a language server for an editor, on stdin and stdout (../lsp).
 //
 // It exits after N idle seconds (default 900), on `crossrt daemon stop`, or when a client of
 // another version asks (so that the client can start its own).
@@ -11,6 +14,7 @@
 // translate request (accepted, read, parsed, translated, responding), or hang with "hang", to
 // test client recovery.
 #include "AstCache.h"
+#include "LanguageServer.h"
 #include "Protocol.h"
 #include "Translator.h"
 
@@ -199,14 +203,54 @@ void Serve(Daemon& d, int fd) {
 
 }  // namespace
 
+const char* kUsage =
+    "usage: crossrtd --build-dir DIR [--log FILE] [--idle-seconds N] [--max-asts N]\n"
+    "       crossrtd --lsp [--build-dir DIR]... [--log FILE] [--debounce-ms N]\n";
+
+// crossrtd --lsp: the language server (LanguageServer.h) on stdin and stdout.
+int LanguageServerMain(int argc, char** argv) {
+  crossrt::lsp::ServerOptions options;
+  for (int i = 1; i < argc; ++i) {
+    std::string a = argv[i];
+    if (a == "--lsp") continue;
+    if (i + 1 >= argc) {
+      std::cerr << "crossrtd: option '" << a << "' needs a value\n" << kUsage;
+      return 2;
+    }
+    std::string v = argv[++i];
+    if (a == "--build-dir") options.buildDirs.push_back(v);
+    else if (a == "--log") options.logPath = v;
+    else if (a == "--debounce-ms") {
+      char* end = nullptr;
+      long ms = std::strtol(v.c_str(), &end, 10);
+      if (v.empty() || *end || ms < 0 || ms > 10000) {
+        std::cerr << "crossrtd: --debounce-ms takes milliseconds from 0 to 10000, not '" << v << "'\n";
+        return 2;
+      }
+      options.debounceMs = int(ms);
+    } else {
+      std::cerr << "crossrtd: unknown option '" << a << "' with --lsp\n" << kUsage;
+      return 2;
+    }
+  }
+  signal(SIGPIPE, SIG_IGN);  // a client gone: writes fail, and the server exits
+  return crossrt::lsp::RunLanguageServer(options, STDIN_FILENO, STDOUT_FILENO);
+}
+
 int main(int argc, char** argv) {
   Daemon d;
   if (argc > 1 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h")) {
-    std::cout << "usage: crossrtd --build-dir DIR [--log FILE] [--idle-seconds N] [--max-asts N]\n"
-                 "  The translation daemon of one build tree: keeps parsed ASTs warm and answers the crossrt client.\n"
-                 "  crossrt starts it on demand; you rarely run it by hand.\n";
+    std::cout << kUsage
+              << "  The translation daemon of one build tree: keeps parsed ASTs warm and answers the crossrt client.\n"
+                 "  crossrt starts it on demand; you rarely run it by hand.\n"
+                 "  --lsp: a language server for editors (beside clangd) on stdin and stdout: the translator's\n"
+                 "  diagnostics while you type, hovers and code lenses on kernels, quick fixes. It learns the\n"
+                 "  classes from the build trees (--build-dir, the client's initializationOptions.buildDirectory,\n"
+                 "  or the workspace folder and its subfolders holding CMakeCache.txt). docs/editors.md sets it up.\n";
     return 0;
   }
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--lsp") return LanguageServerMain(argc, argv);
   for (int i = 1; i + 1 < argc; i += 2) {
     std::string a = argv[i], v = argv[i + 1];
     if (a == "--build-dir") d.buildDir = v;
@@ -219,7 +263,7 @@ int main(int argc, char** argv) {
     }
   }
   if (d.buildDir.empty()) {
-    std::cerr << "usage: crossrtd --build-dir DIR [--log FILE] [--idle-seconds N] [--max-asts N]\n";
+    std::cerr << kUsage;
     return 2;
   }
   if (const char* crash = std::getenv("CROSSRT_DAEMON_CRASH_AT")) d.crashAt = crash;

@@ -1,0 +1,84 @@
+// Finds the build trees and the class requests recorded in them (BuildTree.h).
+#include "BuildTree.h"
+
+#include "Protocol.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+
+namespace fs = std::filesystem;
+
+namespace crossrt::lsp {
+
+std::string RealPath(const std::string& path) {
+  std::error_code ec;
+  fs::path p = fs::weakly_canonical(fs::absolute(path, ec), ec);
+  return ec ? fs::path(path).lexically_normal().string() : p.string();
+}
+
+std::vector<std::string> FindBuildTrees(const std::string& workspace) {
+  std::vector<std::string> trees;
+  std::error_code ec;
+  if (workspace.empty() || !fs::is_directory(workspace, ec)) return trees;
+  if (fs::exists(fs::path(workspace) / "CMakeCache.txt", ec)) trees.push_back(RealPath(workspace));
+  for (auto it = fs::directory_iterator(workspace, ec); !ec && it != fs::directory_iterator(); it.increment(ec))
+    if (it->is_directory(ec) && fs::exists(it->path() / "CMakeCache.txt", ec)) trees.push_back(RealPath(it->path().string()));
+  std::sort(trees.begin(), trees.end());
+  trees.erase(std::unique(trees.begin(), trees.end()), trees.end());
+  return trees;
+}
+
+namespace {
+
+nlohmann::json ReadJson(const fs::path& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error("cannot read it");
+  return nlohmann::json::parse(in);
+}
+
+// A build tree's folders that cannot hold a translation's output: CMake's own, fetched
+// dependencies, version control.
+bool Skipped(const fs::path& dir) {
+  const std::string name = dir.filename().string();
+  return name == "CMakeFiles" || name == "_deps" || name == ".git" || name == "Testing";
+}
+
+}  // namespace
+
+std::vector<ClassRequest> FindClassRequests(const std::vector<std::string>& buildTrees, std::string& problems) {
+  std::vector<ClassRequest> found;
+  std::set<std::string> keys;
+  for (const std::string& tree : buildTrees) {
+    std::error_code ec;
+    fs::recursive_directory_iterator it(tree, fs::directory_options::skip_permission_denied, ec), end;
+    for (; !ec && it != end; it.increment(ec)) {
+      if (it->is_directory(ec)) {
+        if (Skipped(it->path())) it.disable_recursion_pending();
+        continue;
+      }
+      if (it->path().filename() != ".crossrt-request.json") continue;
+      ClassRequest c;
+      try {
+        c.request = protocol::RequestFromJson(ReadJson(it->path()));
+      } catch (const std::exception& e) {
+        problems += it->path().string() + ": " + e.what() + "\n";
+        continue;
+      }
+      c.key = RealPath(c.request.outputDir);
+      if (!keys.insert(c.key).second) continue;
+      for (auto& s : c.request.sources) c.inputs.insert(RealPath(s));
+      try {  // what the last translation read: the class's headers among them
+        const nlohmann::json manifest = ReadJson(it->path().parent_path() / ".crossrt-manifest.json");
+        for (auto& input : manifest.at("inputs")) c.inputs.insert(input.at(0).get<std::string>());
+      } catch (const std::exception&) {
+        // none yet: the class never translated; its sources are enough to start
+      }
+      found.push_back(std::move(c));
+    }
+  }
+  std::sort(found.begin(), found.end(), [](const ClassRequest& a, const ClassRequest& b) { return a.key < b.key; });
+  return found;
+}
+
+}  // namespace crossrt::lsp
