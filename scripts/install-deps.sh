@@ -16,6 +16,7 @@ PACKAGES=(
   libhiredis-dev libcurl4-openssl-dev libssl-dev           # the remote translation cache (Redis, HTTP, HMAC)
   redis-server nginx-light openssl                         # its tests' servers, on loopback ports, and TLS keys
   libopenvdb-dev                                           # bench_sdf's peer: OpenVDB level sets
+  neovim                                                   # the language server's test drives Neovim's LSP client
 )
 missing=()
 for p in "${PACKAGES[@]}"; do

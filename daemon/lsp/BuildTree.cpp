@@ -77,7 +77,11 @@ std::vector<ClassRequest> FindClassRequests(const std::vector<std::string>& buil
       found.push_back(std::move(c));
     }
   }
-  std::sort(found.begin(), found.end(), [](const ClassRequest& a, const ClassRequest& b) { return a.key < b.key; });
+  // Vulkan's rules are the strictest: an edit's errors show soonest when its translations go first.
+  auto rank = [](const ClassRequest& c) { return c.request.backend == engine::Backend::Vulkan ? 0 : c.request.backend == engine::Backend::Ispc ? 1 : 2; };
+  std::sort(found.begin(), found.end(), [&](const ClassRequest& a, const ClassRequest& b) {
+    return rank(a) != rank(b) ? rank(a) < rank(b) : a.key < b.key;
+  });
   return found;
 }
 

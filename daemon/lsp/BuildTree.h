@@ -23,8 +23,9 @@ struct ClassRequest {
 // Build trees under `workspace` (absolute path), or none.
 std::vector<std::string> FindBuildTrees(const std::string& workspace);
 
-// Every recorded request under the build trees, in a stable order. Unreadable records are skipped
-// with a line in `problems`.
+// Every recorded request under the build trees: Vulkan's, then ISPC's, then the CPU's (the order the
+// server translates them in), each by output folder. Unreadable records are skipped with a line in
+// `problems`.
 std::vector<ClassRequest> FindClassRequests(const std::vector<std::string>& buildTrees, std::string& problems);
 
 // `path` made absolute and normal, with symbolic links followed where it exists.

@@ -69,6 +69,12 @@ std::string ReadFile(const std::string& path) {
   return in ? std::string(std::istreambuf_iterator<char>(in), {}) : std::string();
 }
 
+std::string Phases(const std::map<std::string, double>& timings) {
+  std::string out;
+  for (auto& [phase, ms] : timings) out += (out.empty() ? "" : ", ") + phase + " " + std::to_string(int(ms));
+  return out;
+}
+
 const char* BackendLabel(engine::Backend b) {
   return b == engine::Backend::Vulkan ? "Vulkan" : b == engine::Backend::Cpu ? "CPU" : "ISPC";
 }
@@ -517,7 +523,7 @@ void Server::RunJob(std::shared_ptr<Job> held, std::unique_lock<std::mutex>& loc
   lock.lock();
   Log("translated " + request.className + " (" + engine::BackendName(request.backend) + "): " +
       (result.ok ? "ok" : result.parseFailed ? "does not parse" : "errors") + ", " + std::to_string(diagnostics.size()) +
-      " diagnostics, " + std::to_string(int(ms)) + " ms");
+      " diagnostics, " + std::to_string(int(ms)) + " ms (" + Phases(result.timingsMs) + ")");
   for (auto& in : result.inputs) job.cls.inputs.insert(in);
   job.translatedHere = true;
   if (result.parseFailed) return;  // clangd shows the compiler's errors; the translator's stay until it parses

@@ -87,12 +87,14 @@ class Client:
     def call(self, method, params=None, timeout=60.0):
         return self.response(self.request(method, params), timeout)
 
-    def diagnostics(self, path, predicate=lambda d: True, timeout=60.0):
-        """The next diagnostics published for path whose list satisfies predicate: (time, list)."""
+    def diagnostics(self, path, predicate=lambda d: True, timeout=60.0, version=None):
+        """The next diagnostics published for path (of that document version, if given) whose list
+        satisfies predicate: (time, list)."""
         target = uri(path)
 
         def match(m):
             return (m.get("method") == "textDocument/publishDiagnostics" and m["params"]["uri"] == target
+                    and (version is None or m["params"].get("version") == version)
                     and predicate(m["params"]["diagnostics"]))
         t, m = self.wait(match, timeout, "diagnostics for " + path)
         return t, m["params"]["diagnostics"]
