@@ -74,7 +74,7 @@ def run(crossrt, crossrtd, work, rounds, csv_path, plot_path):
         out = os.path.join(work, "build", "crossrt", "Bloom_" + suffix)
         shutil.rmtree(out, ignore_errors=True)
         t0 = time.monotonic()
-        subprocess.run([crossrt, "translate", "--no-daemon", "--class", "Bloom", "--backend", backend, "--out", out,
+        subprocess.run([crossrt, "translate", "--no-daemon", "--build-dir", os.path.join(work, "build"), "--class", "Bloom", "--backend", backend, "--out", out,
                         "--source", source, "--templates", os.path.join(ROOT, "templates")] + flags, check=True,
                        capture_output=True)
         return (time.monotonic() - t0) * 1000

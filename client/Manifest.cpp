@@ -75,15 +75,18 @@ void WriteManifest(const engine::TranslateRequest& request, const engine::Transl
   std::filesystem::rename(tmp, path);
 }
 
-std::string RequestPath(const engine::TranslateRequest& r) { return r.outputDir + "/.crossrt-request.json"; }
+std::string RequestPath(const engine::TranslateRequest& r, const std::string& buildDir) {
+  return buildDir + "/.crossrt/requests/" + Hex(XXH64(r.outputDir.data(), r.outputDir.size(), 0)) + ".json";
+}
 
-void RecordRequest(const engine::TranslateRequest& request) {
-  const std::string text = protocol::ToJson(request).dump(1) + "\n", path = RequestPath(request);
+void RecordRequest(const engine::TranslateRequest& request, const std::string& buildDir) {
+  if (buildDir.empty()) return;  // by hand, outside a build tree: no editor to tell
+  const std::string text = protocol::ToJson(request).dump(1) + "\n", path = RequestPath(request, buildDir);
   std::ifstream old(path);
   std::string previous((std::istreambuf_iterator<char>(old)), std::istreambuf_iterator<char>());
   if (previous == text) return;
   std::error_code ec;
-  std::filesystem::create_directories(request.outputDir, ec);
+  std::filesystem::create_directories(std::filesystem::path(path).parent_path(), ec);
   const std::string tmp = path + ".tmp";
   std::ofstream(tmp) << text;
   std::filesystem::rename(tmp, path, ec);  // best effort: a build never fails for the editor's sake

@@ -24,10 +24,11 @@ std::string ManifestPath(const engine::TranslateRequest& request);
 bool UpToDate(const engine::TranslateRequest& request);
 void WriteManifest(const engine::TranslateRequest& request, const engine::TranslateResult& result);
 
-// The request itself, as the daemon receives it, in <outputDir>/.crossrt-request.json: the language
+// The request itself, as the daemon receives it, in <buildDir>/.crossrt/requests/: the language
 // server (crossrtd --lsp) learns the build tree's classes from these. Written on every translation,
-// failed ones too (the class the user is fixing), and only when its bytes change.
-std::string RequestPath(const engine::TranslateRequest& request);
-void RecordRequest(const engine::TranslateRequest& request);
+// failed ones too (the class the user is fixing), only when its bytes change, and never into the
+// output folder (a failed translation writes nothing there).
+std::string RequestPath(const engine::TranslateRequest& request, const std::string& buildDir);
+void RecordRequest(const engine::TranslateRequest& request, const std::string& buildDir);
 
 }  // namespace crossrt::client

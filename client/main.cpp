@@ -297,7 +297,7 @@ int main(int argc, char** argv) {
   }
 
   MakePathsAbsolute(request);
-  crossrt::client::RecordRequest(request);  // for the language server
+  crossrt::client::RecordRequest(request, buildDir);  // for the language server
   // Unchanged key: nothing to translate, nothing to write.
   if (crossrt::client::UpToDate(request)) return 0;
 

@@ -37,13 +37,6 @@ nlohmann::json ReadJson(const fs::path& path) {
   return nlohmann::json::parse(in);
 }
 
-// A build tree's folders that cannot hold a translation's output: CMake's own, fetched
-// dependencies, version control.
-bool Skipped(const fs::path& dir) {
-  const std::string name = dir.filename().string();
-  return name == "CMakeFiles" || name == "_deps" || name == ".git" || name == "Testing";
-}
-
 }  // namespace
 
 std::vector<ClassRequest> FindClassRequests(const std::vector<std::string>& buildTrees, std::string& problems) {
@@ -51,25 +44,23 @@ std::vector<ClassRequest> FindClassRequests(const std::vector<std::string>& buil
   std::set<std::string> keys;
   for (const std::string& tree : buildTrees) {
     std::error_code ec;
-    fs::recursive_directory_iterator it(tree, fs::directory_options::skip_permission_denied, ec), end;
-    for (; !ec && it != end; it.increment(ec)) {
-      if (it->is_directory(ec)) {
-        if (Skipped(it->path())) it.disable_recursion_pending();
-        continue;
-      }
-      if (it->path().filename() != ".crossrt-request.json") continue;
+    std::vector<fs::path> records;
+    for (fs::directory_iterator it(fs::path(tree) / ".crossrt" / "requests", ec), end; !ec && it != end; it.increment(ec))
+      if (it->path().extension() == ".json") records.push_back(it->path());
+    std::sort(records.begin(), records.end());
+    for (const fs::path& record : records) {
       ClassRequest c;
       try {
-        c.request = protocol::RequestFromJson(ReadJson(it->path()));
+        c.request = protocol::RequestFromJson(ReadJson(record));
       } catch (const std::exception& e) {
-        problems += it->path().string() + ": " + e.what() + "\n";
+        problems += record.string() + ": " + e.what() + "\n";
         continue;
       }
       c.key = RealPath(c.request.outputDir);
       if (!keys.insert(c.key).second) continue;
       for (auto& s : c.request.sources) c.inputs.insert(RealPath(s));
       try {  // what the last translation read: the class's headers among them
-        const nlohmann::json manifest = ReadJson(it->path().parent_path() / ".crossrt-manifest.json");
+        const nlohmann::json manifest = ReadJson(fs::path(c.request.outputDir) / ".crossrt-manifest.json");
         for (auto& input : manifest.at("inputs")) c.inputs.insert(input.at(0).get<std::string>());
       } catch (const std::exception&) {
         // none yet: the class never translated; its sources are enough to start

@@ -1,6 +1,7 @@
 // The classes a build tree translates, as the language server learns them: every
-// crossrt_add_class records its request (.crossrt-request.json) in its output folder when the build
-// translates it (client/Manifest.h), and its manifest lists the files the last translation read.
+// crossrt_add_class records its request in <build tree>/.crossrt/requests/ when the build translates
+// it (client/Manifest.h), and the manifest in its output folder lists the files the last successful
+// translation read.
 //
 // Build trees are named (--build-dir, the client's initializationOptions.buildDirectory) or found
 // under the workspace's folders as clangd finds compile_commands.json: the folder itself and its

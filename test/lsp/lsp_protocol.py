@@ -32,13 +32,16 @@ def setup(crossrt, templates, work):
     open(os.path.join(work, "build", "CMakeCache.txt"), "w").close()
     for backend, suffix in (("vulkan", "Vulkan"), ("cpu", "CPU")):
         out = os.path.join(work, "build", "crossrt", "Scale_" + suffix)
-        r = subprocess.run([crossrt, "translate", "--no-daemon", "--class", "Scale", "--backend", backend, "--out", out,
+        r = subprocess.run([crossrt, "translate", "--no-daemon", "--build-dir", os.path.join(work, "build"),
+                            "--class", "Scale", "--backend", backend, "--out", out,
                             "--source", os.path.join(work, "ScaleImpl.cpp"), "--templates", templates, "--", "-std=c++17"],
                            capture_output=True, text=True)
-        check(os.path.exists(os.path.join(out, ".crossrt-request.json")),
-              "crossrt translate records the %s request (exit %d), failed or not" % (backend, r.returncode))
+        records = os.listdir(os.path.join(work, "build", ".crossrt", "requests"))
+        check(len(records) == (1 if backend == "vulkan" else 2),
+              "crossrt translate records the %s request in the build tree (exit %d), failed or not" % (backend, r.returncode))
         if backend == "vulkan":
             check(r.returncode != 0 and "has no size" in r.stderr, "the build's Vulkan translation fails: the pointers have no size")
+            check(not os.path.exists(out), "and writes nothing into its output folder")
 
 
 def server(crossrtd, work, *extra):
