@@ -25,6 +25,7 @@
 #include <iterator>
 #include <map>
 #include <memory>
+#include <regex>
 #include <set>
 #include <thread>
 
@@ -691,12 +692,16 @@ json Server::Hover(const std::string& path, unsigned line, unsigned character) {
   const std::string text = TextOf(path);
   std::string body;
   json range;
+  std::set<std::string> said;  // a build tree may translate a class alike in several places
   for (const Function& f : FunctionsIn(path)) {
     if (f.at->line != line + 1) continue;
     const unsigned from = CharacterOfColumn(text, line, f.at->column - 1), to = from + unsigned(f.name.size());
     if (character < from || character > to) continue;
+    const std::string description = Describe(f, *f.job);
+    static const std::regex link(R"(\]\(file://[^)]*\))");  // the same words, linking another folder's files
+    if (!said.insert(std::regex_replace(description, link, "]")).second) continue;
     if (body.empty()) body = "**" + f.name + "**: a " + f.kind + " of " + f.job->model.className + " that CrossRT translates\n";
-    body += "\n" + Describe(f, *f.job);
+    body += "\n" + description;
     range = Range(line, from, to);
   }
   if (body.empty()) return nullptr;
@@ -706,14 +711,16 @@ json Server::Hover(const std::string& path, unsigned line, unsigned character) {
 json Server::CodeLenses(const std::string& path) {
   const std::string text = TextOf(path);
   json lenses = json::array();
+  std::set<std::pair<unsigned, std::string>> said;  // (line, title): one lens for a class translated alike twice
   for (const Function& f : FunctionsIn(path)) {
     auto [file, line] = GeneratedPlace(*f.job, f.job->model.className + "::" + f.name, f.kernel != nullptr);
     if (file.empty()) continue;
+    const std::string title = std::string("CrossRT ") + BackendLabel(f.job->cls.request.backend) + ": " + std::filesystem::path(file).filename().string();
+    if (!said.insert({f.at->line, title}).second) continue;
     const unsigned from = CharacterOfColumn(text, f.at->line - 1, f.at->column - 1);
     lenses.push_back({{"range", Range(f.at->line - 1, from, from + unsigned(f.name.size()))},
                       {"command",
-                       {{"title", std::string("CrossRT ") + BackendLabel(f.job->cls.request.backend) + ": " +
-                                      std::filesystem::path(file).filename().string()},
+                       {{"title", title},
                         {"command", "crossrt.showGenerated"},
                         {"arguments", {{{"uri", UriOfPath(f.job->folder + "/" + file)}, {"line", line}}}}}}});
   }
