@@ -6,6 +6,7 @@ malformed, hostile or vanishing client does to the server (nothing).
 usage: lsp_protocol.py CROSSRT CROSSRTD TEMPLATES WORKDIR
 """
 import os
+import random
 import shutil
 import subprocess
 import sys
@@ -155,6 +156,49 @@ def main_session(crossrtd, work):
     for method, params in hostile:
         reply = c.call(method, params)
         check("result" in reply or "error" in reply, "a hostile %s is answered: %s" % (method, str(reply.get("error", reply.get("result")))[:60]))
+    # Random requests and notifications of the methods the server knows, with parameters of random
+    # shapes (seeded: the same 400 every run).
+    rng = random.Random(55)
+    methods = ["textDocument/hover", "textDocument/codeLens", "textDocument/definition", "textDocument/codeAction",
+               "workspace/executeCommand", "textDocument/didChange", "textDocument/didOpen", "textDocument/didSave",
+               "$/cancelRequest", "initialize"]
+
+    def junk(depth=0):
+        kinds = ["int", "str", "uri", "null", "float", "bool"] + (["list", "dict", "doc", "pos"] if depth < 3 else [])
+        k = rng.choice(kinds)
+        if k == "int":
+            return rng.choice([0, -1, 1, 2 ** 31, -2 ** 63, 2 ** 64, rng.randint(-5, 500)])
+        if k == "str":
+            return rng.choice(["", "x", "\u0000", "file://", "%zz", "\U0001F600" * 3, "a" * 1000])
+        if k == "uri":
+            return rng.choice([uri(source), uri(header), "file:///nonexistent/a.cpp", "file://%2e%2e/x", "http://x/y"])
+        if k == "null":
+            return None
+        if k == "float":
+            return rng.choice([0.5, 1e308, -0.0])
+        if k == "bool":
+            return rng.choice([True, False])
+        if k == "list":
+            return [junk(depth + 1) for _ in range(rng.randint(0, 3))]
+        if k == "doc":
+            return {"uri": junk(depth + 1), "version": junk(depth + 1), "text": junk(depth + 1)}
+        if k == "pos":
+            return {"line": junk(depth + 1), "character": junk(depth + 1)}
+        return {rng.choice(["textDocument", "position", "context", "contentChanges", "range", "command", "arguments", "id",
+                            "text", "diagnostics"]): junk(depth + 1) for _ in range(rng.randint(0, 4))}
+    ids = []
+    for i in range(400):
+        message = {"jsonrpc": "2.0", "method": rng.choice(methods), "params": junk()}
+        if rng.random() < 0.5 and message["method"] not in ("textDocument/didOpen", "textDocument/didChange"):
+            message["id"] = 10000 + i
+            ids.append(10000 + i)
+        c.send(message)
+    for rid in ids:
+        c.response(rid)
+    check(c.proc.poll() is None, "400 random messages: every request answered, the server alive")
+    # didOpen of junk may have replaced the documents' text: put them back as they are on disk.
+    for path in (header, source):
+        open_file(c, path)
     for params in ({"textDocument": {"uri": uri(source)}, "contentChanges": [{"range": {"start": {"line": 10 ** 9}}, "text": "x"}]},
                    {"textDocument": {"uri": uri("/nonexistent.cpp")}, "contentChanges": "x"}, None, 17):
         c.send({"jsonrpc": "2.0", "method": "textDocument/didChange", "params": params})
