@@ -103,28 +103,22 @@ def run(crossrt, crossrtd, work, rounds, csv_path, plot_path):
         return t
 
     rows = []  # (scenario, round, ms)
+
+    def break_and_fix(name, path, line, base, edited, r):
+        """Times line `line` of `path` changed from base to edited (diagnostics shown) and back (cleared)."""
+        for what, old, new, shown in (("diagnostic shown", base, edited, True), ("diagnostic cleared", edited, base, False)):
+            t = change(path, line, old, new)
+            t1, _ = c.diagnostics(path, lambda d: (len(d) > 0) == shown, version=versions[path])
+            rows.append((name + ": " + what, r, (t1 - t) * 1000))
+
     src_lines = open(source).read().split("\n")
     kline = next(i for i, l in enumerate(src_lines) if "const float4 c = in[y * width + x];" in l)
     hdr_lines = open(header).read().split("\n")
     hline = next(i for i, l in enumerate(hdr_lines) if '[[crossrt::size("width*height")]] const float4* in' in l)
     for r in range(rounds):
-        base = src_lines[kline]
-        edited = base + " float4* scratch = new float4[%d]; delete[] scratch;" % (r + 1)
-        t = change(source, kline, base, edited)
-        t1, d = c.diagnostics(source, lambda d: len(d) > 0, version=versions[source])
-        rows.append(("kernel body: diagnostic shown", r, (t1 - t) * 1000))
-        t = change(source, kline, edited, base)
-        t1, d = c.diagnostics(source, lambda d: len(d) == 0, version=versions[source])
-        rows.append(("kernel body: diagnostic cleared", r, (t1 - t) * 1000))
-
-        base = hdr_lines[hline]
-        edited = base.replace('[[crossrt::size("width*height")]] ', "")
-        t = change(header, hline, base, edited)
-        t1, d = c.diagnostics(header, lambda d: len(d) > 0, version=versions[header])
-        rows.append(("header: diagnostic shown", r, (t1 - t) * 1000))
-        t = change(header, hline, edited, base)
-        t1, d = c.diagnostics(header, lambda d: len(d) == 0, version=versions[header])
-        rows.append(("header: diagnostic cleared", r, (t1 - t) * 1000))
+        break_and_fix("kernel body", source, kline, src_lines[kline],
+                      src_lines[kline] + " float4* scratch = new float4[%d]; delete[] scratch;" % (r + 1), r)
+        break_and_fix("header", header, hline, hdr_lines[hline], hdr_lines[hline].replace('[[crossrt::size("width*height")]] ', ""), r)
     c.call("shutdown")
     c.notify("exit")
     c.proc.wait(30)

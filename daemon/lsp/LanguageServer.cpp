@@ -134,7 +134,8 @@ private:
   // Under the lock.
   void Rescan(bool force);
   void MarkDirty(const std::string& path, Clock::time_point due);
-  void Publish(const std::set<std::string>& paths);
+  // `versions`: the documents' versions the diagnostics were computed from (default: the current ones).
+  void Publish(const std::set<std::string>& paths, const std::map<std::string, long long>* versions = nullptr);
   std::string TextOf(const std::string& path);
   std::vector<Function> FunctionsIn(const std::string& path);
   std::string Resolve(const std::string& file, const Job& job);
@@ -300,6 +301,7 @@ bool Server::OnNotification(const std::string& method, const json& params) {
     const json& id = Field(params, "id");
     if (id.is_number_integer() || id.is_string()) {
       std::lock_guard<std::mutex> guard(m_mutex);
+      if (m_cancelled.size() > 4096) m_cancelled.clear();  // cancels of requests long answered
       m_cancelled.insert(id.dump());
     }
     return true;
@@ -507,7 +509,11 @@ void Server::Work() {
 void Server::RunJob(std::shared_ptr<Job> held, std::unique_lock<std::mutex>& lock) {
   Job& job = *held;
   engine::TranslateRequest request = job.cls.request;
-  for (auto& [path, doc] : m_docs) request.unsavedFiles[path] = doc.text;
+  std::map<std::string, long long> versions;  // of the text translated: an edit may arrive meanwhile
+  for (auto& [path, doc] : m_docs) {
+    request.unsavedFiles[path] = doc.text;
+    versions[path] = doc.version;
+  }
   job.dirty = false;
   const std::string folder = GeneratedFolder(job.cls.key);
   lock.unlock();
@@ -542,14 +548,14 @@ void Server::RunJob(std::shared_ptr<Job> held, std::unique_lock<std::mutex>& loc
     job.files = result.files;
     job.folder = folder;
   }
-  Publish(touched);
+  Publish(touched, &versions);
   lock.unlock();
   Send();
   if (result.ok) WriteGenerated(folder, result.files);
   lock.lock();
 }
 
-void Server::Publish(const std::set<std::string>& paths) {
+void Server::Publish(const std::set<std::string>& paths, const std::map<std::string, long long>* versions) {
   for (const std::string& path : paths) {
     if (path.empty()) continue;
     // One diagnostic per place and message, however many backends report it.
@@ -599,7 +605,12 @@ void Server::Publish(const std::set<std::string>& paths) {
     last = list;
     auto doc = m_docs.find(path);
     json params = {{"uri", doc != m_docs.end() ? doc->second.uri : UriOfPath(path)}, {"diagnostics", list}};
-    if (doc != m_docs.end()) params["version"] = doc->second.version;
+    if (doc != m_docs.end()) {
+      long long version = doc->second.version;
+      if (versions)
+        if (auto translated = versions->find(path); translated != versions->end()) version = translated->second;
+      params["version"] = version;
+    }
     Queue({{"jsonrpc", "2.0"}, {"method", "textDocument/publishDiagnostics"}, {"params", params}});
   }
 }
