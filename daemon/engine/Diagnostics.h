@@ -2,6 +2,7 @@
 #pragma once
 #include <clang/Basic/Diagnostic.h>
 #include <clang/Basic/SourceLocation.h>
+#include <clang/Basic/SourceManager.h>
 #include <cstdint>
 #include <set>
 #include <string>
@@ -22,6 +23,7 @@ public:
       unsigned noteId = m_diags.getCustomDiagID(clang::DiagnosticsEngine::Note, "hint: %0");
       m_diags.Report(loc, noteId) << hint;
     }
+    NoteWhereReached(loc);
   }
   // Translates, but the user should know: e.g. a control function the generated class cannot override.
   void Warning(clang::SourceLocation loc, const std::string& message, const std::string& hint = {}) {
@@ -32,6 +34,7 @@ public:
       unsigned noteId = m_diags.getCustomDiagID(clang::DiagnosticsEngine::Note, "hint: %0");
       m_diags.Report(loc, noteId) << hint;
     }
+    NoteWhereReached(loc);
   }
   // A fact about the translation worth a line, e.g. a type that changes width on the GPU. (Clang
   // drops a note that follows no error or warning, so the reporter prints it itself: Notes().)
@@ -59,8 +62,41 @@ public:
   void SetRecordingRules(bool on) { m_recordingRules = on; }
   bool RecordingRules() const { return m_recordingRules; }
 
+  // While a pass analyses one kernel: an error or warning it finds outside the kernel's own body (in
+  // a helper the kernel calls, a header's function) gets a note that points back at the kernel, the
+  // other place involved (an editor shows it as related information).
+  class ReachedFrom {
+  public:
+    ReachedFrom(Reporter& reporter, clang::SourceLocation at, const std::string& what, clang::SourceRange body)
+        : m_reporter(reporter), m_saved(reporter.m_from) {
+      reporter.m_from = {at, what, body};
+    }
+    ~ReachedFrom() { m_reporter.m_from = m_saved; }
+    ReachedFrom(const ReachedFrom&) = delete;
+    ReachedFrom& operator=(const ReachedFrom&) = delete;
+
+  private:
+    Reporter& m_reporter;
+    struct Origin {
+      clang::SourceLocation at;
+      std::string what;
+      clang::SourceRange body;
+    } m_saved;
+    friend class Reporter;
+  };
+
 private:
+  void NoteWhereReached(clang::SourceLocation loc) {
+    if (m_from.at.isInvalid() || loc.isInvalid()) return;
+    const clang::SourceManager& sm = m_diags.getSourceManager();
+    if (sm.isPointWithin(sm.getExpansionLoc(loc), sm.getExpansionLoc(m_from.body.getBegin()), sm.getExpansionLoc(m_from.body.getEnd())))
+      return;
+    unsigned id = m_diags.getCustomDiagID(clang::DiagnosticsEngine::Note, "reached from %0");
+    m_diags.Report(m_from.at, id) << m_from.what;
+  }
+
   clang::DiagnosticsEngine& m_diags;
+  ReachedFrom::Origin m_from;
   unsigned m_errors = 0;
   bool m_gpuRules = true;
   bool m_recordingRules = true;

@@ -110,6 +110,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   k.rtv = k.dims == 0;
   k.sourceFile = BaseName(FileOf(c.ctx, def->getLocation()));
   k.definedAt = PlaceOf(c.ctx, def->getLocation());
+  Reporter::ReachedFrom reachedFrom(c.rep, def->getLocation(), "kernel '" + k.name + "'", def->getSourceRange());
   // A kernel_ function may return bool, for its thread loop to leave a loop: if (!kernel_X(...)) break;
   k.returnsBool = k.rtv && md->getReturnType()->isBooleanType();
   if (!md->getReturnType()->isVoidType() && !k.returnsBool) {

@@ -134,6 +134,24 @@ def main_session(crossrtd, work):
     answer = c.response(rid)
     check(answer.get("error", {}).get("code") == -32800, "a cancelled request is answered RequestCancelled")
 
+    # An error in a helper the kernel calls: related information points back at the kernel.
+    text = open(source).read()
+    helper = "static float Twice(float v) { float* p = new float[1]; p[0] = v; const float r = 2.0f * p[0]; delete[] p; return r; }\n\n"
+    broken = text.replace("void Scale::kernel1D_Scale", helper + "void Scale::kernel1D_Scale").replace("in[i] * m_factor", "Twice(in[i]) * m_factor")
+    c.notify("textDocument/didChange", {"textDocument": {"uri": uri(source), "version": 3}, "contentChanges": [{"text": broken}]})
+    _, diags = c.diagnostics(source, lambda d: len(d) > 0, version=3)
+    new = next(d for d in diags if "'new'" in d["message"])
+    lines = broken.split("\n")
+    check(lines[new["range"]["start"]["line"]].startswith("static float Twice"), "the error is on the helper's line")
+    related = new.get("relatedInformation", [])
+    kernel_line = next(i for i, l in enumerate(lines) if "Scale::kernel1D_Scale" in l)
+    check(len(related) == 1 and related[0]["message"] == "reached from kernel 'kernel1D_Scale'"
+          and related[0]["location"]["range"]["start"]["line"] == kernel_line,
+          "its related information points at the kernel that calls it: %s" % related)
+    c.notify("textDocument/didChange", {"textDocument": {"uri": uri(source), "version": 4}, "contentChanges": [{"text": text}]})
+    c.diagnostics(source, lambda d: len(d) == 0, version=4)
+    check(True, "and it clears when the helper goes")
+
     # Unknown methods and malformed messages: answered, and the server goes on.
     check(c.call("textDocument/rename", {})["error"]["code"] == -32601, "an unknown method: MethodNotFound")
     c.notify("$/unknownNotification", {"x": 1})
