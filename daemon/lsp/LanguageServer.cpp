@@ -455,7 +455,7 @@ std::string Server::TextOf(const std::string& path) {
 // or (no file) the class's first source.
 std::string Server::Resolve(const std::string& file, const Job& job) {
   if (file.empty()) return job.cls.request.sources.empty() ? "" : RealPath(job.cls.request.sources.front());
-  if (!file.empty() && file[0] == '/') return RealPath(file);
+  if (file[0] == '/') return RealPath(file);
   for (auto& input : job.cls.inputs)
     if (std::filesystem::path(input).filename() == file) return input;
   return job.cls.request.sources.empty() ? "" : RealPath(job.cls.request.sources.front());
