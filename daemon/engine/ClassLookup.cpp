@@ -6,6 +6,7 @@
 #include "ControlFunctions.h"
 #include "Kernels.h"
 #include "Members.h"
+#include "ReservedNames.h"
 #include "Naming.h"
 
 #include <llvm/Support/FileSystem.h>
@@ -50,6 +51,7 @@ bool AnalyzeTranslationUnit(ASTContext& ctx, const IncludesSeen& includes, const
     model.headerFile = FileOf(ctx, cls->getLocation());
     AnalyzeMembers(c);
   }
+  CheckReservedNames(c, first);
   // Locals a control function passes to kernels by address are per-thread values on the GPU: find
   // them before analysing the kernels, whose GLSL signatures they change.
   {

@@ -98,6 +98,8 @@ const Case kCases[] = {
      "a lambda used other than by calling it", "keep it in a local and call it", 8},
     {"a reference whose element changes", "    int k = i; float& r = data[k]; k = 0; r += 1.0f; x = r;", "", "",
      "non-const reference variable in a kernel: 'k', which picks what it refers to, changes after it", "write through the original expression", 8},
+    {"a local under the generated code's prefix", "    float crt_sum = x; x = crt_sum * 2.0f;", "", "",
+     "variable 'crt_sum' begins with crt_, which CrossRT keeps for the names of the code it generates", "rename it", 8},
     {"nested control", "", "  virtual void Outer(int n, [[crossrt::size(\"n\")]] float* data);", "void Bad::Outer(int n, float* data) { kernel1D_Bad(n, data); Run(n, data); }\n",
      "control function 'Outer' calls control function 'Run'", "one submission", 12},
 };
