@@ -193,8 +193,9 @@ int DaemonCommand(const std::vector<std::string>& args) {
   std::printf("  memory          %.1f MiB resident\n", double(s.value("residentBytes", size_t(0))) / (1024.0 * 1024.0));
   std::printf("  requests served %llu (%llu translations, %llu failed)\n", (unsigned long long)s.value("requestsServed", 0ull),
               (unsigned long long)s.value("translations", 0ull), (unsigned long long)s.value("failedTranslations", 0ull));
-  std::printf("  AST hit rate    %.0f%% (%llu reparses, %llu parses)\n", 100.0 * s.value("astHitRate", 0.0),
-              (unsigned long long)s.value("reparses", 0ull), (unsigned long long)s.value("parses", 0ull));
+  std::printf("  AST hit rate    %.0f%% (%llu reparses, %llu of them ASTs used as they were, %llu parses)\n",
+              100.0 * s.value("astHitRate", 0.0), (unsigned long long)s.value("reparses", 0ull),
+              (unsigned long long)s.value("reuses", 0ull), (unsigned long long)s.value("parses", 0ull));
   printRejections();
   return 0;
 }

@@ -109,9 +109,16 @@ struct AstCache::Handle::Entry {
   std::unique_ptr<ParsedFile> parsed;
   std::unique_ptr<clang::SyntaxOnlyAction> action;
   bool failed = false;
+  // What the last parse read, to tell whether the next request may use its AST as it is: the
+  // unsaved buffers, and the size and time of every file it read from disk.
+  bool reusable = false;
+  std::map<std::string, std::string> parsedUnsaved;
+  std::vector<std::pair<std::string, std::pair<uint64_t, llvm::sys::TimePoint<>>>> parsedFiles;
 
   ~Entry() { EndParse(); }
   bool Parse(const std::string& file, const std::map<std::string, std::string>& unsaved);
+  void RecordWhatWasRead(const std::map<std::string, std::string>& unsaved);
+  bool Unchanged(const std::string& file, const std::map<std::string, std::string>& unsaved) const;
   void EndParse() {
     if (action) action->EndSourceFile();
     action.reset();
@@ -200,6 +207,35 @@ bool AstCache::Handle::Entry::Parse(const std::string& file, const std::map<std:
   return true;
 }
 
+void AstCache::Handle::Entry::RecordWhatWasRead(const std::map<std::string, std::string>& unsaved) {
+  reusable = false;
+  parsedUnsaved = unsaved;
+  parsedFiles.clear();
+  if (!parsed) return;
+  for (const std::string& name : parsed->Includes().files) {
+    if (unsaved.count(name)) continue;
+    llvm::sys::fs::file_status status;
+    if (llvm::sys::fs::status(name, status)) return;  // cannot tell whether it changes: parse again next time
+    parsedFiles.push_back({name, {status.getSize(), status.getLastModificationTime()}});
+  }
+  reusable = true;
+}
+
+bool AstCache::Handle::Entry::Unchanged(const std::string& file, const std::map<std::string, std::string>& unsaved) const {
+  if (!reusable || !parsed || failed || !mainBuffer || unsaved != parsedUnsaved) return false;
+  if (auto text = unsaved.find(file); text != unsaved.end()) {
+    if (text->second != mainBuffer->getBuffer()) return false;
+  } else {
+    auto buffer = llvm::MemoryBuffer::getFile(file);
+    if (!buffer || (*buffer)->getBuffer() != mainBuffer->getBuffer()) return false;
+  }
+  for (auto& [name, seen] : parsedFiles) {
+    llvm::sys::fs::file_status status;
+    if (llvm::sys::fs::status(name, status) || status.getSize() != seen.first || status.getLastModificationTime() != seen.second) return false;
+  }
+  return true;
+}
+
 AstCache::Handle AstCache::Get(const std::string& file, const std::vector<std::string>& args,
                                const std::map<std::string, std::string>& unsaved) {
   std::string key = file;
@@ -230,6 +266,17 @@ AstCache::Handle AstCache::Get(const std::string& file, const std::vector<std::s
   Handle handle(entry);  // waits while another translation uses this AST
   entry->diagStream.flush();
   entry->diagText.clear();
+  if (entry->Unchanged(file, unsaved)) {
+    // The same text and headers as the last parse: its AST serves as it is, with its diagnostics
+    // engine cleared of what the last translation reported.
+    entry->printer->clear();
+    entry->printer->errors = 0;
+    entry->parsed->getDiagnostics().Reset(/*soft=*/true);
+    std::lock_guard<std::mutex> guard(m_mutex);
+    ++m_reparses;
+    ++m_reuses;
+    return handle;
+  }
   // Decided under the entry's lock: another request may have parsed it meanwhile. A file whose last
   // parse failed starts again from its arguments.
   const bool reparse = entry->parsed && !entry->failed;
@@ -250,6 +297,7 @@ AstCache::Handle AstCache::Get(const std::string& file, const std::vector<std::s
   entry->printer->clear();
   entry->printer->errors = 0;
   entry->failed = !entry->invocation || !entry->Parse(file, unsaved) || entry->printer->errors > 0;
+  entry->RecordWhatWasRead(unsaved);
   std::lock_guard<std::mutex> guard(m_mutex);
   ++(reparse ? m_reparses : m_parses);
   return handle;
@@ -257,7 +305,7 @@ AstCache::Handle AstCache::Get(const std::string& file, const std::vector<std::s
 
 AstCacheStats AstCache::Stats() const {
   std::lock_guard<std::mutex> guard(m_mutex);
-  return {m_entries.size(), m_capacity, m_parses, m_reparses};
+  return {m_entries.size(), m_capacity, m_parses, m_reparses, m_reuses};
 }
 
 }  // namespace crossrt::engine

@@ -52,6 +52,7 @@ struct AstCacheStats {
   size_t entries = 0, capacity = 0;
   uint64_t parses = 0;     // from scratch
   uint64_t reparses = 0;   // reusing a cached AST and its preamble
+  uint64_t reuses = 0;     // of those, an AST used as it was: nothing it read had changed
 };
 
 class AstCache {
@@ -80,9 +81,10 @@ public:
     std::unique_lock<std::mutex> m_lock;  // held while the handle lives
   };
 
-  // Parses `file` with `args` (compiler flags, without the file), or reparses a cached AST. Files
-  // named in `unsaved` (absolute path -> text: an editor's buffers) are read from there, not from
-  // disk; the preamble is rebuilt when a header's unsaved text changes.
+  // Parses `file` with `args` (compiler flags, without the file), or reparses a cached AST, or hands
+  // out the cached AST as it is when nothing it read has changed (the same class translated for
+  // another backend). Files named in `unsaved` (absolute path -> text: an editor's buffers) are read
+  // from there, not from disk; the preamble is rebuilt when a header's unsaved text changes.
   Handle Get(const std::string& file, const std::vector<std::string>& args,
              const std::map<std::string, std::string>& unsaved = {});
 
@@ -91,7 +93,7 @@ public:
 private:
   mutable std::mutex m_mutex;
   size_t m_capacity;
-  uint64_t m_parses = 0, m_reparses = 0;
+  uint64_t m_parses = 0, m_reparses = 0, m_reuses = 0;
   std::map<std::string, std::shared_ptr<Handle::Entry>> m_entries;
   std::list<std::string> m_lru;  // most recently used first
 };

@@ -115,6 +115,7 @@ json Status(Daemon& d) {
           {"parses", stats.parses},
           {"cachedShaders", d.spirv.Size()},
           {"reparses", stats.reparses},
+          {"reuses", stats.reuses},
           {"astHitRate", lookups ? double(stats.reparses) / double(lookups) : 0.0}};
 }
 
