@@ -699,24 +699,37 @@ std::string Server::Describe(const Function& f, const Job& job) {
   return s;
 }
 
+// On the name of a kernel or control function of a class this file belongs to: where it is
+// defined, declared or called.
 json Server::Hover(const std::string& path, unsigned line, unsigned character) {
   const std::string text = TextOf(path);
+  const size_t lineStart = OffsetOfPosition(text, line, 0), at = OffsetOfPosition(text, line, character);
+  auto word = [&](size_t i) { return i < text.size() && (std::isalnum((unsigned char)text[i]) || text[i] == '_'); };
+  size_t begin = at, end = at;
+  while (begin > lineStart && word(begin - 1)) --begin;
+  while (word(end)) ++end;
+  if (begin == end) return nullptr;
+  const std::string name = text.substr(begin, end - begin);
   std::string body;
-  json range;
   std::set<std::string> said;  // a build tree may translate a class alike in several places
-  for (const Function& f : FunctionsIn(path)) {
-    if (f.at->line != line + 1) continue;
-    const unsigned from = CharacterOfColumn(text, line, f.at->column - 1), to = from + unsigned(f.name.size());
-    if (character < from || character > to) continue;
-    const std::string description = Describe(f, *f.job);
-    static const std::regex link(R"(\]\(file://[^)]*\))");  // the same words, linking another folder's files
-    if (!said.insert(std::regex_replace(description, link, "]")).second) continue;
-    if (body.empty()) body = "**" + f.name + "**: a " + f.kind + " of " + f.job->model.className + " that CrossRT translates\n";
-    body += "\n" + description;
-    range = Range(line, from, to);
+  for (auto& job : m_jobs) {
+    if (!job->hasModel || !job->cls.inputs.count(path)) continue;
+    std::vector<Function> named;
+    for (auto& k : job->model.kernels)
+      if (k.name == name) named.push_back({job.get(), k.name, "kernel", &k.definedAt, &k, nullptr});
+    for (auto& c : job->model.controls)
+      if (c.name == name) named.push_back({job.get(), c.name, "control function", &c.definedAt, nullptr, &c});
+    for (const Function& f : named) {
+      const std::string description = Describe(f, *f.job);
+      static const std::regex link(R"(\]\(file://[^)]*\))");  // the same words, linking another folder's files
+      if (!said.insert(std::regex_replace(description, link, "]")).second) continue;
+      if (body.empty()) body = "**" + f.name + "**: a " + f.kind + " of " + f.job->model.className + " that CrossRT translates\n";
+      body += "\n" + description;
+    }
   }
   if (body.empty()) return nullptr;
-  return {{"contents", {{"kind", "markdown"}, {"value", body}}}, {"range", range}};
+  const unsigned from = CharacterOfColumn(text, line, unsigned(begin - lineStart)), to = CharacterOfColumn(text, line, unsigned(end - lineStart));
+  return {{"contents", {{"kind", "markdown"}, {"value", body}}}, {"range", Range(line, from, to)}};
 }
 
 json Server::CodeLenses(const std::string& path) {

@@ -8,7 +8,8 @@
 // - textDocument/publishDiagnostics after open, change (debounced) and save: each translation
 //   error, warning and note at its place, its backends named, its hint in the message, the other
 //   places involved as related information; cleared when fixed;
-// - hover on a kernel or control function's definition: what it becomes on each backend;
+// - hover on the name of a kernel or control function (defined, declared or called): what it
+//   becomes on each backend;
 // - code lenses on them that open the generated code (crossrt.showGenerated), and
 //   textDocument/definition from a generated line back to the user's function;
 // - quick fixes where a hint names an exact edit (QuickFixes.h).

@@ -105,6 +105,10 @@ def main_session(crossrtd, work):
     value = hover["contents"]["value"] if hover else ""
     check("**Vulkan**" in value and "**CPU**" in value, "hover on kernel1D_Scale describes both backends")
     check("workgroups of 256x1x1" in value and "buffer 1: parameter 'in' (`in_[]`, read-only)" in value, "on Vulkan: its workgroups and what it binds:\n" + value)
+    cline = next(i for i, l in enumerate(src) if "{ kernel1D_Scale(n, in, out); }" in l)
+    call = c.call("textDocument/hover", {"textDocument": {"uri": uri(source)},
+                                         "position": {"line": cline, "character": src[cline].index("kernel1D_Scale(") + 1}})["result"]
+    check(call and call["contents"]["value"] == value, "hover on the kernel's call in Run says the same")
     nothing = c.call("textDocument/hover", {"textDocument": {"uri": uri(source)}, "position": {"line": 0, "character": 0}})["result"]
     check(nothing is None, "hover elsewhere is clangd's: null")
 
