@@ -161,6 +161,7 @@ def run(crossrt, crossrtd, work, rounds, csv_path, plot_path):
     ax.axhline(100, color="green", linestyle=":", label="goal, kernel body (100 ms)")
     ax.set_xticks(range(len(scenarios)))
     ax.set_xticklabels([s.replace(": ", ":\n") for s in scenarios], fontsize=8)
+    ax.set_xlabel("edit scenario (each round: the edit, then its undo)")
     ax.set_ylabel("edit to diagnostics (ms)")
     ax.set_title("crossrtd --lsp latency, examples/bloom, 3 backends\n%s" % cpu_model(), fontsize=10)
     ax.legend(fontsize=7)

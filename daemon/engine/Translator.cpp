@@ -80,7 +80,7 @@ void ParentsOfUserCodeOnly(clang::ASTContext& ctx) {
   const clang::SourceManager& sm = ctx.getSourceManager();
   for (clang::Decl* d : ctx.getTranslationUnitDecl()->decls())
     if (!sm.isInSystemHeader(sm.getExpansionLoc(d->getLocation()))) scope.push_back(d);
-  ctx.setTraversalScope(scope);
+  if (ctx.getTraversalScope() != scope) ctx.setTraversalScope(scope);  // (setting it drops the map: an AST used again keeps it)
 }
 
 // "ISceneObject=BVHScene" -> {ISceneObject: BVHScene}, or a diagnostic.

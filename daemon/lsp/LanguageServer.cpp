@@ -97,8 +97,7 @@ struct Job {
   std::vector<CompilerDiagnostic> diagnostics;  // their files are real paths
   bool hasModel = false;                        // from the last translation that analysed
   engine::ClassModel model;
-  std::map<std::string, std::string> files;     // generated, by name
-  std::string folder;                           // where they are written (GeneratedCode.h)
+  std::map<std::string, std::string> files;     // generated, by name, written to GeneratedFolder(cls.key)
 };
 
 // A user function the models know: a kernel or a control function.
@@ -546,7 +545,6 @@ void Server::RunJob(std::shared_ptr<Job> held, std::unique_lock<std::mutex>& loc
     job.model = std::move(*model);
     job.hasModel = true;
     job.files = result.files;
-    job.folder = folder;
   }
   Publish(touched, &versions);
   lock.unlock();
@@ -662,7 +660,7 @@ std::string Server::Describe(const Function& f, const Job& job) {
   const std::string qualified = job.model.className + "::" + f.name;
   auto [file, line] = GeneratedPlace(job, qualified, f.kernel != nullptr);
   const std::string link = file.empty() ? "" : " ([" + std::filesystem::path(file).filename().string() + "](" +
-                                                   UriOfPath(job.folder + "/" + file) + "#L" + std::to_string(line) + "))";
+                                                   UriOfPath(GeneratedFolder(job.cls.key) + "/" + file) + "#L" + std::to_string(line) + "))";
   std::string s = "- **" + std::string(BackendLabel(job.cls.request.backend)) + "** (" + job.model.generatedName + "): ";
   const bool vulkan = job.cls.request.backend == engine::Backend::Vulkan;
   if (const engine::Kernel* k = f.kernel) {
@@ -746,7 +744,7 @@ json Server::CodeLenses(const std::string& path) {
                       {"command",
                        {{"title", title},
                         {"command", "crossrt.showGenerated"},
-                        {"arguments", {{{"uri", UriOfPath(f.job->folder + "/" + file)}, {"line", line}}}}}}});
+                        {"arguments", {{{"uri", UriOfPath(GeneratedFolder(f.job->cls.key) + "/" + file)}, {"line", line}}}}}}});
   }
   return lenses;
 }
@@ -781,9 +779,7 @@ json Server::CodeActions(const std::string& uri, const std::string& path, const 
     if (StringField(d, "source").rfind("crossrt", 0) != 0) continue;
     const json& start = Field(Field(d, "range"), "start");
     const unsigned line = NumberField(start, "line");
-    const size_t at = OffsetOfPosition(text, line, NumberField(start, "character"));
-    const size_t lineStart = OffsetOfPosition(text, line, 0);
-    auto fix = QuickFixFor(StringField(d, "message"), text, line, unsigned(at - lineStart));
+    auto fix = QuickFixFor(StringField(d, "message"), text, OffsetOfPosition(text, line, NumberField(start, "character")));
     if (!fix) continue;
     const unsigned character = CharacterOfColumn(text, fix->line, fix->column);
     json edits = json::array();

@@ -9,16 +9,6 @@ namespace crossrt::lsp {
 
 namespace {
 
-size_t OffsetOf(const std::string& text, unsigned line, unsigned column) {
-  size_t at = 0;
-  for (unsigned l = 0; l < line; ++l) {
-    at = text.find('\n', at);
-    if (at == std::string::npos) return std::string::npos;
-    ++at;
-  }
-  return at + column <= text.size() ? at + column : std::string::npos;
-}
-
 // [[crossrt::size("n")]] before a pointer parameter with none, its count the first integer parameter.
 std::optional<TextEdit> SizeAttribute(const std::string& text, size_t nameAt) {
   // The declaration starts after the '(' or ',' before the name.
@@ -42,12 +32,11 @@ std::optional<TextEdit> SizeAttribute(const std::string& text, size_t nameAt) {
 
 }  // namespace
 
-std::optional<TextEdit> QuickFixFor(const std::string& message, const std::string& text, unsigned line, unsigned column) {
+std::optional<TextEdit> QuickFixFor(const std::string& message, const std::string& text, size_t at) {
   static const std::regex noSize(R"(pointer parameter '(\w+)' of control function '\w+' has no size)");
   std::smatch m;
   if (!std::regex_search(message, m, noSize)) return std::nullopt;
-  const size_t at = OffsetOf(text, line, column);
-  if (at == std::string::npos || text.compare(at, m[1].length(), m[1].str()) != 0) return std::nullopt;  // the text moved on
+  if (at > text.size() || text.compare(at, m[1].length(), m[1].str()) != 0) return std::nullopt;  // the text moved on
   return SizeAttribute(text, at);
 }
 

@@ -15,7 +15,7 @@ struct TextEdit {
   std::string title;
 };
 
-// The fix for `message` reported at 0-based (line, column) of `text`, if it has one.
-std::optional<TextEdit> QuickFixFor(const std::string& message, const std::string& text, unsigned line, unsigned column);
+// The fix for `message` reported at byte offset `at` of `text`, if it has one.
+std::optional<TextEdit> QuickFixFor(const std::string& message, const std::string& text, size_t at);
 
 }  // namespace crossrt::lsp

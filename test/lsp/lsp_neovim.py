@@ -13,6 +13,9 @@ from lsp_protocol import setup  # noqa: E402
 
 
 def main():
+    if len(sys.argv) != 5 or sys.argv[1] in ("--help", "-h"):
+        print(__doc__.strip())
+        sys.exit(0 if sys.argv[1:2] in (["--help"], ["-h"]) else 2)
     crossrt, crossrtd, templates, work = (os.path.abspath(a) for a in sys.argv[1:5])
     nvim = shutil.which("nvim")
     if not nvim:
