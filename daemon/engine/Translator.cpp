@@ -3,14 +3,14 @@
 // naming a pass; the passes live in files of their own (README.md lists them).
 #include "Translator.h"
 
-#include "Analysis.h"
-#include "Arguments.h"
-#include "AstCache.h"
-#include "Canonical.h"
-#include "CodeGen.h"
-#include "CodeGenSupport.h"
-#include "NoContraction.h"
-#include "Spirv.h"
+#include "analyse/Analysis.h"
+#include "parse/Arguments.h"
+#include "parse/AstCache.h"
+#include "generate/Canonical.h"
+#include "generate/CodeGen.h"
+#include "generate/CodeGenSupport.h"
+#include "compile/NoContraction.h"
+#include "compile/Spirv.h"
 
 #include <clang/AST/ASTContext.h>
 #include <clang/Basic/SourceManager.h>

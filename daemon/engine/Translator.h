@@ -2,9 +2,9 @@
 // It knows nothing about sockets or processes: the daemon hosts it, and the client loads it
 // (EnginePlugin.cpp) to translate in-process when no daemon can answer.
 #pragma once
-#include "Arguments.h"
+#include "parse/Arguments.h"
 #include "Model.h"
-#include "Spirv.h"
+#include "compile/Spirv.h"
 #include "TranslateTypes.h"
 
 #include <map>

@@ -4,13 +4,13 @@
 // slow to read never stalls the reading of its own messages.
 #include "LanguageServer.h"
 
-#include "AstCache.h"
+#include "parse/AstCache.h"
 #include "BuildTree.h"
 #include "CompilerText.h"
 #include "GeneratedCode.h"
 #include "Model.h"
 #include "QuickFixes.h"
-#include "Spirv.h"
+#include "compile/Spirv.h"
 #include "Text.h"
 #include "Translator.h"
 #include "Transport.h"

@@ -13,7 +13,7 @@
 // Test hook: CROSSRT_DAEMON_CRASH_AT=<stage> makes it SIGKILL itself at that stage of a
 // translate request (accepted, read, parsed, translated, responding), or hang with "hang", to
 // test client recovery.
-#include "AstCache.h"
+#include "parse/AstCache.h"
 #include "LanguageServer.h"
 #include "Protocol.h"
 #include "Translator.h"

@@ -1,5 +1,5 @@
 // What the analysis finds in small input classes parsed with the real standard library.
-#include "AstCache.h"
+#include "parse/AstCache.h"
 #include "EngineSupport.h"
 #include <algorithm>
 

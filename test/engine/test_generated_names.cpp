@@ -2,7 +2,7 @@
 // names the Vulkan class template declares: a rename on one side only would generate code that
 // does not compile.
 #include "EngineSupport.h"
-#include "GeneratedNames.h"
+#include "generate/GeneratedNames.h"
 
 #include <regex>
 

@@ -2,8 +2,8 @@
 // divide and negate of a generated shader carries NoContraction, the module stays valid, and a
 // class compiled with -ffp-contract=fast or -ffast-math lets the GPU fuse them.
 #include "EngineSupport.h"
-#include "NoContraction.h"
-#include "Spirv.h"
+#include "compile/NoContraction.h"
+#include "compile/Spirv.h"
 
 #include <cstdio>
 #include <fstream>

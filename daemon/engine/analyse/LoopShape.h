@@ -1,0 +1,46 @@
+// The shape of a kernel's loop nest: one parser of `for (int i = begin; i < end; ++i)` headers
+// (ParseLoop, quiet or reporting), their thread counts, and what may stand before and after the nest.
+#pragma once
+#include "analyse/AnalysisContext.h"
+
+namespace crossrt::engine {
+
+// The statements before a kernelND_'s loop nest that do nothing but set locals declared before it
+// (`float4x4 m = m_xf; m(0, 3) = 0.5f;`): every thread evaluates them, in order with the
+// declarations, as the C++ class evaluated them once. `reduced` are the locals the nest reduces,
+// whose threads start from the identity instead.
+std::set<const Stmt*> StatementsSettingLocals(const std::vector<const Stmt*>& before, const std::set<const VarDecl*>& reduced);
+
+// The statements before and after a kernelND_'s loop nest run on one thread, around the threads of
+// the nest: before them (the GPU's <kernel>_Start) and after them (<kernel>_Finish). Every thread
+// evaluates the declarations before the nest for itself, and the statements that only set those
+// locals (`settingLocals`); any other statement before the nest may not change those locals, and
+// neither may the threads (a race on the CPU too). A 'return' before the nest would skip it on the
+// CPU but not on the GPU.
+bool CheckLoopEnds(Context& c, const std::string& kernel, const std::vector<const Stmt*>& before,
+                   const std::vector<const Stmt*>& after, const Stmt* threadBody, const std::set<const Expr*>& reductionTargets,
+                   const std::set<const Stmt*>& settingLocals);
+
+struct LoopHeader {
+  const VarDecl* var = nullptr;
+  const Expr* start = nullptr;
+  const Expr* end = nullptr;
+  bool inclusive = false;
+};
+
+// The one parser of loop headers, for kernels' loop nests, thread loops and leaves' loops: why `fs`
+// is not `for (T i = a; i < b; ++i)` (also i++, i += 1, <=; T an integer), or "" when it is, with
+// `h` filled in.
+std::string LoopShapeProblem(ASTContext& ctx, const ForStmt* fs, LoopHeader& h);
+
+// Accepts `for (T i = a; i < b; ++i)` (also i++, i += 1, <=). Returns false and reports otherwise.
+bool ParseLoop(Context& c, const ForStmt* fs, LoopHeader& h, const std::string& kernel);
+
+// Casts the host-side C++ count to the loop variable's range: (end) - (start) [+ 1].
+// `expr` as an operand of a wider expression: in parentheses only where an operator inside it
+// needs them (`n`, `m_v.size()`, `(n - 1)`).
+std::string AsOperand(const std::string& expr);
+
+std::string CountExpr(Context& c, const LoopHeader& h);
+
+}  // namespace crossrt::engine

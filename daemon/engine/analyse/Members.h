@@ -1,0 +1,20 @@
+// The class's data members: which become buffers (std::vector), class data, images, samplers,
+// textures or vectors of objects, with their C++ and GLSL types. Takes the class; fills model.members
+// and model.constructors.
+#pragma once
+#include "analyse/AnalysisContext.h"
+
+namespace crossrt::engine {
+
+// A single member of the class-data block: the C++ mirror declares it with alignas(std430
+// alignment), so a lone float3 matches; float3x3, bool and arrays of float3 do not.
+bool FitsClassData(ASTContext& ctx, QualType t);
+
+// The pass: every data member of the class (bases first) into model.members; constructors too.
+void AnalyzeMembers(Context& c);
+
+// The structs the class-wide prelude declares (the class data block needs them): other printers
+// do not declare them again.
+std::set<std::string> ClassStructNames(const ClassModel& model);
+
+}  // namespace crossrt::engine

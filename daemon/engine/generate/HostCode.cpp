@@ -1,0 +1,172 @@
+// The generated class's header and host source, for the Vulkan class or the CPU class: the entry
+// point that fills the templates of templates/ from the model.
+#include "generate/CodeGenSupport.h"
+#include "generate/VulkanHost.h"
+#include "generate/CodeGen.h"
+#include "print/Glsl.h"
+
+#include <fstream>
+#include <set>
+#include <stdexcept>
+
+namespace crossrt::engine {
+
+namespace {
+
+std::string ScalarOmpOp(ReduceOp op) { return op == ReduceOp::Min ? "min" : op == ReduceOp::Max ? "max" : "+"; }
+
+}  // namespace
+
+std::map<std::string, std::string> GenerateHost(const ClassModel& model, const GenerateOptions& opt, bool vulkan) {
+  std::map<std::string, std::string> files;
+  Data d = Common(model, opt);
+  d.set("controls", ControlsData(model));
+  d.set("hasHostTails", std::any_of(model.controls.begin(), model.controls.end(), [](const Control& c) { return c.hasHostTail; }));
+  d.set("hasVectorSwaps", std::any_of(model.controls.begin(), model.controls.end(), [](const Control& c) { return c.swapsVectors; }));
+  d.set("hasSynchronize", std::any_of(model.controls.begin(), model.controls.end(), [](const Control& c) { return c.synchronizes; }));
+  const Data vectors = VectorsData(model);
+  d.set("vectors", vectors);
+  d.set("hasVectors", !vectors.is_empty_list());
+  if (vulkan) {
+    d.set("usesScanner", model.usesScanner);
+    d.set("usesSorter", model.usesSorter);
+    Data images = ImagesData(model, MemberKind::Image), samplers = ImagesData(model, MemberKind::Sampler);
+    d.set("images", images);
+    d.set("samplers", samplers);
+    Data textureArrays = List();
+    for (auto& m : model.members) {
+      if (m.kind != MemberKind::TextureArray || !m.usedByKernels) continue;
+      Data x;
+      x.set("name", m.name);
+      x.set("host", m.hostExpr);
+      x.set("vkFormat", m.vkFormat);
+      textureArrays.push_back(x);
+    }
+    d.set("hasTextureArrays", !textureArrays.is_empty_list());
+    d.set("textureArrays", textureArrays);
+    d.set("hasImages", std::any_of(model.members.begin(), model.members.end(), [](const Member& m) {
+      return m.usedByKernels && (m.kind == MemberKind::Image || m.kind == MemberKind::Sampler);
+    }));
+    // Whether anything on the GPU follows a host size (crt_VectorMembersResized has something to compare).
+    d.set("hasResizables", !vectors.is_empty_list() || !images.is_empty_list() || !samplers.is_empty_list() ||
+                               !textureArrays.is_empty_list() || !model.virtuals.empty());
+    // The shaders of ray tracing pipelines besides the kernels' (virtual functions, level 3).
+    Data stageShaders = List();
+    const std::vector<const StageShader*> stages = ExecutedStageShaders(model);
+    for (const StageShader* c : stages) {
+      Data x;
+      x.set("name", c->name);
+      stageShaders.push_back(x);
+    }
+    d.set("stageShaders", stageShaders);
+    d.set("hasRayTracingPipelines", !stages.empty());
+    // Per vector whose elements are leaves of a traversal the hardware runs: its boxes' scene.
+    Data leafScenes = List();
+    std::set<std::string> leafMembers;
+    for (const Kernel& k : model.kernels) {
+      if (!RunsLeafShaders(k)) continue;
+      for (const LeafTraversal* lt : LeafScenes(k)) {
+        if (!leafMembers.insert(lt->member).second) continue;
+        Data x;
+        x.set("member", lt->member);
+        x.set("host", lt->hostExpr);
+        x.set("display", lt->display);
+        x.set("interface", lt->interfaceName);
+        auto vm = std::find_if(model.virtuals.begin(), model.virtuals.end(), [&](const VirtualMember& v) { return v.member == lt->member; });
+        x.set("interfaceType", vm != model.virtuals.end() ? vm->interfaceCpp : lt->interfaceName);
+        if (lt->leafBoxes.empty()) x.set("leafBoxes", false);
+        else x.set("leafBoxes", lt->leafBoxes);
+        leafScenes.push_back(x);
+      }
+    }
+    d.set("leafScenes", leafScenes);
+    d.set("hasLeafScenes", !leafScenes.is_empty_list());
+    d.set("hasScenes", !leafScenes.is_empty_list() || std::any_of(model.kernels.begin(), model.kernels.end(), [](const Kernel& k) { return !k.rayQueryHolder.empty(); }));
+    unsigned indirectSlots = 0;
+    d.set("kernels", VulkanKernelsData(model, indirectSlots));
+    d.set("indirectSlots", std::to_string(indirectSlots));
+    d.set("hasIndirect", indirectSlots > 0);
+    bool anyReductions = false;
+    for (auto& k : model.kernels) anyReductions |= !k.reductions.empty();
+    d.set("anyReductions", anyReductions);
+    d.set("anyAtomics", std::any_of(model.kernels.begin(), model.kernels.end(), [](const Kernel& k) { return k.atomics; }));
+    d.set("anyFloatAtomics", std::any_of(model.kernels.begin(), model.kernels.end(), [](const Kernel& k) { return k.floatAtomics; }));
+    d.set("fenceConstantId", kFenceAtomicsConstantId);
+    files[model.generatedName + ".h"] = Render(opt.templateDir + "/vulkan/class.h.mustache", d);
+    files[model.generatedName + ".cpp"] = Render(opt.templateDir + "/vulkan/class.cpp.mustache", d);
+    return files;
+  }
+  const std::string derived = model.generatedName;
+  d.set("derived", derived);
+  d.set("ispc", model.forIspc);
+  d.set("whatRuns", model.forIspc ? "The loop nests of " + model.className + "'s kernels, and the thread loops\n"
+                                        "// of its control functions (one or two thread ids), run here as ISPC (" + model.generatedName +
+                                        "_kernels.ispc), on all CPU cores,\n// each in SIMD lanes; everything else is inherited unchanged."
+                                  : "The kernels of " + model.className + " run here on all\n// CPU cores with OpenMP; everything else is inherited unchanged.");
+  if (model.forIspc) IspcHostData(model, d);
+  Data kernels = List(), ompReductions = List();
+  std::set<std::string> declared;
+  for (auto& k : model.kernels) {
+    if (k.rtv) continue;  // kernel_* bodies are inherited; their loops are parallelised in the control function
+    if (model.forIspc) continue;  // IspcHostData's
+    Data x = CpuKernelData(k);
+    x.set("loopNest", IndentTail(k.cpuLoopNest, "  "));
+    x.set("iterations", k.loops.empty() ? "1" : k.loops[0].countCpp);  // the outer loop's, which OpenMP shares out
+    // Dynamic chunks: iterations may cost very different amounts (a ray that hits against one that
+    // misses). With static halves PrimaryRays_CPU cast the bunny's rays at 0.57-0.63x of Embree,
+    // with chunks of 1024 at 0.71-0.75x (bench_lbvh, 2 threads). 2D kernels hand out rows.
+    x.set("schedule", k.dims == 1 ? "dynamic, 1024" : "dynamic, 1");
+    std::string clauses;
+    Data reds = List();
+    for (auto& r : k.reductions) {
+      // A member is reduced through a local copy (<member>Local); a local is reduced itself.
+      const std::string reduced = r.local ? r.member : r.member + "Local";
+      if (!r.local) {
+        Data y;
+        y.set("member", r.member);
+        reds.push_back(y);
+      }
+      std::string cppType = ReductionCppType(model, r);
+      bool scalar = r.glslType == "float" || r.glslType == "int" || r.glslType == "uint";
+      if (scalar) {
+        clauses += " reduction(" + ScalarOmpOp(r.op) + ":" + reduced + ")";
+        continue;
+      }
+      // LiteMath vectors need a declared reduction.
+      std::string opName = std::string(r.op == ReduceOp::Min ? "min" : r.op == ReduceOp::Max ? "max" : "add");
+      std::string name = "crossrt_" + opName + "_" + SplitArray(r.glslType).first;
+      clauses += " reduction(" + name + ":" + reduced + ")";
+      if (declared.insert(name).second) {
+        Data o;
+        o.set("name", name);
+        o.set("cppType", cppType);
+        o.set("combine", r.op == ReduceOp::Min ? "LiteMath::min(omp_out, omp_in)" : r.op == ReduceOp::Max ? "LiteMath::max(omp_out, omp_in)" : "omp_out + omp_in");
+        o.set("init", r.op == ReduceOp::Min || r.op == ReduceOp::Max ? "omp_orig" : cppType + "()");
+        ompReductions.push_back(o);
+      }
+    }
+    x.set("reductions", reds);
+    x.set("ompClauses", clauses);
+    kernels.push_back(x);
+  }
+  d.set("kernels", kernels);
+  d.set("ompReductions", ompReductions);
+  Data copies = List();
+  for (auto& lc : model.lockedCopies) {
+    Data x;
+    x.set("name", lc.name);
+    x.set("sourceFile", lc.sourceFile);
+    x.set("declaration", lc.declaration);
+    x.set("definitionHead", lc.definitionHead);
+    x.set("body", lc.body);
+    x.set("keepOverloads", lc.keepOverloads);
+    copies.push_back(x);
+  }
+  d.set("lockedCopies", copies);
+  d.set("hasLockedCopies", !model.lockedCopies.empty());
+  files[derived + ".h"] = Render(opt.templateDir + "/cpu/class.h.mustache", d);
+  files[derived + ".cpp"] = Render(opt.templateDir + "/cpu/class.cpp.mustache", d);
+  return files;
+}
+
+}  // namespace crossrt::engine

@@ -1,0 +1,311 @@
+// Parsed translation units, kept between translations (AstCache.h says how): build a precompiled
+// preamble once, then parse the main file over it for each request; least recently used entries
+// are evicted.
+#include "parse/AstCache.h"
+
+#include <clang/AST/ASTContext.h>
+#include <clang/AST/Decl.h>
+#include <clang/Basic/DiagnosticOptions.h>
+#include <clang/Basic/SourceManager.h>
+#include <clang/Frontend/CompilerInstance.h>
+#include <clang/Frontend/CompilerInvocation.h>
+#include <clang/Frontend/FrontendActions.h>
+#include <clang/Frontend/PrecompiledPreamble.h>
+#include <clang/Frontend/TextDiagnosticPrinter.h>
+#include <clang/Frontend/Utils.h>
+#include <clang/Lex/PPCallbacks.h>
+#include <clang/Lex/Preprocessor.h>
+#include <clang/Lex/PreprocessorOptions.h>
+#include <clang/Serialization/PCHContainerOperations.h>
+#include <llvm/ADT/SmallString.h>
+#include <llvm/Support/FileSystem.h>
+#include <llvm/Support/MemoryBuffer.h>
+#include <llvm/Support/Path.h>
+#include <llvm/Support/VirtualFileSystem.h>
+#include <llvm/Support/raw_ostream.h>
+
+#include <algorithm>
+#include <optional>
+
+#ifndef CROSSRT_CLANG_RESOURCE_DIR
+#error "CROSSRT_CLANG_RESOURCE_DIR must point at Clang's resource directory"
+#endif
+
+namespace crossrt::engine {
+
+namespace {
+// Counts the errors it prints, in a count only Get() resets. The consumer's own count does not
+// survive the parse: an error in a header (the preamble) would read as a clean parse.
+class ErrorCountingPrinter : public clang::TextDiagnosticPrinter {
+public:
+  using TextDiagnosticPrinter::TextDiagnosticPrinter;
+  void HandleDiagnostic(clang::DiagnosticsEngine::Level level, const clang::Diagnostic& info) override {
+    if (level >= clang::DiagnosticsEngine::Error) ++errors;
+    TextDiagnosticPrinter::HandleDiagnostic(level, info);
+  }
+  unsigned errors = 0;
+};
+
+// Records what the #include directives it sees found: in the preamble's build, and in the parse
+// after it (an #include below the first declaration).
+class IncludeRecorder : public clang::PPCallbacks {
+public:
+  IncludeRecorder(const clang::SourceManager& sm, IncludesSeen& seen) : m_sm(sm), m_seen(seen) {}
+  void InclusionDirective(clang::SourceLocation hashLoc, const clang::Token&, llvm::StringRef, bool, clang::CharSourceRange,
+                          clang::OptionalFileEntryRef file, llvm::StringRef, llvm::StringRef, const clang::Module*, bool,
+                          clang::SrcMgr::CharacteristicKind) override {
+    if (!file) return;
+    m_seen.files.insert(file->getName().str());
+    if (m_sm.isWrittenInMainFile(hashLoc)) m_seen.mainFile[m_sm.getSpellingLineNumber(hashLoc)] = file->getName().str();
+  }
+
+private:
+  const clang::SourceManager& m_sm;
+  IncludesSeen& m_seen;
+};
+
+// The preamble keeps the bodies of the user's functions (kernels call helpers from headers) and
+// drops those in system headers: the C++ library's templates are most of a preamble and most of
+// each parse's work (their instantiations), and kernels treat a system header's functions as a
+// library's, by name (IsSystemDecl), never printing their bodies.
+class PreambleBodies : public clang::PreambleCallbacks {
+public:
+  explicit PreambleBodies(IncludesSeen& seen) : m_seen(seen) {}
+  void BeforeExecute(clang::CompilerInstance& compiler) override { m_sm = &compiler.getSourceManager(); }
+  std::unique_ptr<clang::PPCallbacks> createPPCallbacks() override { return std::make_unique<IncludeRecorder>(*m_sm, m_seen); }
+  bool shouldSkipFunctionBody(clang::Decl* decl) override {
+    const clang::SourceManager& sm = decl->getASTContext().getSourceManager();
+    return sm.isInSystemHeader(sm.getExpansionLoc(decl->getLocation()));
+  }
+
+private:
+  IncludesSeen& m_seen;
+  const clang::SourceManager* m_sm = nullptr;
+};
+}  // namespace
+
+ParsedFile::ParsedFile(std::unique_ptr<clang::CompilerInstance> compiler, IncludesSeen includes)
+    : m_compiler(std::move(compiler)), m_includes(std::move(includes)) {}
+ParsedFile::~ParsedFile() = default;
+clang::ASTContext& ParsedFile::getASTContext() const { return m_compiler->getASTContext(); }
+clang::SourceManager& ParsedFile::getSourceManager() const { return m_compiler->getSourceManager(); }
+clang::Preprocessor& ParsedFile::getPreprocessor() const { return m_compiler->getPreprocessor(); }
+const clang::LangOptions& ParsedFile::getLangOpts() const { return m_compiler->getLangOpts(); }
+clang::DiagnosticsEngine& ParsedFile::getDiagnostics() const { return m_compiler->getDiagnostics(); }
+
+struct AstCache::Handle::Entry {
+  std::mutex inUse;  // one translation at a time per AST
+  std::string diagText;
+  llvm::raw_string_ostream diagStream{diagText};
+  llvm::IntrusiveRefCntPtr<clang::DiagnosticOptions> diagOptions;
+  std::unique_ptr<ErrorCountingPrinter> printer;
+  std::shared_ptr<clang::CompilerInvocation> invocation;  // from the arguments, before any preamble
+  std::optional<clang::PrecompiledPreamble> preamble;
+  IncludesSeen preambleIncludes;  // what the preamble's #include lines found
+  // The last parse. EndParse() drops it action first: the action ends the source file while the
+  // compiler and the main file's buffer still live.
+  std::unique_ptr<llvm::MemoryBuffer> mainBuffer;
+  std::vector<std::unique_ptr<llvm::MemoryBuffer>> unsavedBuffers;  // the headers' unsaved text
+  std::unique_ptr<ParsedFile> parsed;
+  std::unique_ptr<clang::SyntaxOnlyAction> action;
+  bool failed = false;
+  // What the last parse read, to tell whether the next request may use its AST as it is: the
+  // unsaved buffers, and the size and time of every file it read from disk.
+  bool reusable = false;
+  std::map<std::string, std::string> parsedUnsaved;
+  std::vector<std::pair<std::string, std::pair<uint64_t, llvm::sys::TimePoint<>>>> parsedFiles;
+
+  ~Entry() { EndParse(); }
+  bool Parse(const std::string& file, const std::map<std::string, std::string>& unsaved);
+  void RecordWhatWasRead(const std::map<std::string, std::string>& unsaved);
+  bool Unchanged(const std::string& file, const std::map<std::string, std::string>& unsaved) const;
+  void EndParse() {
+    if (action) action->EndSourceFile();
+    action.reset();
+    parsed.reset();
+    mainBuffer.reset();
+    unsavedBuffers.clear();
+  }
+};
+
+AstCache::Handle::Handle(std::shared_ptr<Entry> entry) : m_entry(std::move(entry)), m_lock(m_entry->inUse) {}
+AstCache::Handle::Handle(Handle&& other) noexcept : m_entry(std::move(other.m_entry)), m_lock(std::move(other.m_lock)) {}
+AstCache::Handle::~Handle() = default;
+ParsedFile* AstCache::Handle::ast() const { return m_entry->parsed.get(); }
+clang::TextDiagnosticPrinter& AstCache::Handle::printer() const { return *m_entry->printer; }
+const std::string& AstCache::Handle::diagnostics() const {
+  m_entry->diagStream.flush();
+  return m_entry->diagText;
+}
+bool AstCache::Handle::failed() const { return m_entry->failed || !m_entry->parsed; }
+
+AstCache::AstCache(size_t capacity) : m_capacity(std::max<size_t>(1, capacity)) {}
+AstCache::~AstCache() = default;
+
+// Parses the file over its preamble, building (or rebuilding, when a header or the #include
+// block changed) the preamble first. A preamble with errors is dropped, so that the parse reports
+// them. Returns false when the file cannot be read or the compiler cannot be set up.
+// Unsaved headers are remapped files: the preamble's reuse check compares their text (its hash), not
+// a modification time that an editor's buffer does not have.
+bool AstCache::Handle::Entry::Parse(const std::string& file, const std::map<std::string, std::string>& unsaved) {
+  Entry& entry = *this;
+  if (auto text = unsaved.find(file); text != unsaved.end()) {
+    entry.mainBuffer = llvm::MemoryBuffer::getMemBufferCopy(text->second, file);
+  } else {
+    auto buffer = llvm::MemoryBuffer::getFile(file);
+    if (!buffer) {
+      entry.diagStream << "error: cannot read '" << file << "': " << buffer.getError().message() << "\n";
+      return false;
+    }
+    entry.mainBuffer = std::move(*buffer);
+  }
+  auto invocation = std::make_shared<clang::CompilerInvocation>(*entry.invocation);
+  for (auto& [path, text] : unsaved)
+    if (path != file) {
+      entry.unsavedBuffers.push_back(llvm::MemoryBuffer::getMemBufferCopy(text, path));
+      invocation->getPreprocessorOpts().addRemappedFile(path, entry.unsavedBuffers.back().get());
+    }
+  invocation->getPreprocessorOpts().RetainRemappedFileBuffers = true;  // the entry owns the buffers
+  llvm::IntrusiveRefCntPtr<llvm::vfs::FileSystem> vfs = llvm::vfs::getRealFileSystem();
+  auto bounds = clang::ComputePreambleBounds(invocation->getLangOpts(), *entry.mainBuffer, 0);
+  if (!entry.preamble || !entry.preamble->CanReuse(*invocation, *entry.mainBuffer, bounds, *vfs)) {
+    entry.preamble.reset();
+    clang::CompilerInvocation preambleInvocation(*invocation);
+    preambleInvocation.getFrontendOpts().SkipFunctionBodies = true;  // as PreambleBodies decides
+    clang::IgnoringDiagConsumer ignore;  // the parse without a preamble reports them
+    auto diags = clang::CompilerInstance::createDiagnostics(entry.diagOptions.get(), &ignore, /*ShouldOwnClient=*/false);
+    entry.preambleIncludes = {};
+    PreambleBodies bodies(entry.preambleIncludes);
+    auto built = clang::PrecompiledPreamble::Build(preambleInvocation, entry.mainBuffer.get(), bounds, *diags, vfs,
+                                                   std::make_shared<clang::PCHContainerOperations>(),
+                                                   /*StoreInMemory=*/true, /*StoragePath=*/"", bodies);
+    if (built && !diags->hasErrorOccurred()) entry.preamble.emplace(std::move(*built));
+  }
+  if (entry.preamble) entry.preamble->AddImplicitPreamble(*invocation, vfs, entry.mainBuffer.get());
+  else invocation->getPreprocessorOpts().addRemappedFile(file, entry.mainBuffer.get());
+
+  auto compiler = std::make_unique<clang::CompilerInstance>(std::make_shared<clang::PCHContainerOperations>());
+  compiler->setInvocation(std::move(invocation));
+  compiler->createDiagnostics(entry.printer.get(), /*ShouldOwnClient=*/false);
+  compiler->createFileManager(vfs);
+  if (!compiler->createTarget()) return false;
+  entry.action = std::make_unique<clang::SyntaxOnlyAction>();
+  if (!entry.action->BeginSourceFile(*compiler, compiler->getFrontendOpts().Inputs[0])) {
+    entry.action.reset();
+    return false;
+  }
+  IncludesSeen includes = entry.preamble ? entry.preambleIncludes : IncludesSeen{};
+  includes.files.insert(file);
+  compiler->getPreprocessor().addPPCallbacks(std::make_unique<IncludeRecorder>(compiler->getSourceManager(), includes));
+  if (llvm::Error error = entry.action->Execute()) {
+    entry.diagStream << "error: " << llvm::toString(std::move(error)) << "\n";
+    entry.action->EndSourceFile();
+    entry.action.reset();
+    return false;
+  }
+  entry.parsed = std::make_unique<ParsedFile>(std::move(compiler), std::move(includes));
+  return true;
+}
+
+void AstCache::Handle::Entry::RecordWhatWasRead(const std::map<std::string, std::string>& unsaved) {
+  reusable = false;
+  parsedUnsaved = unsaved;
+  parsedFiles.clear();
+  if (!parsed) return;
+  for (const std::string& name : parsed->Includes().files) {
+    if (unsaved.count(name)) continue;
+    llvm::sys::fs::file_status status;
+    if (llvm::sys::fs::status(name, status)) return;  // cannot tell whether it changes: parse again next time
+    parsedFiles.push_back({name, {status.getSize(), status.getLastModificationTime()}});
+  }
+  reusable = true;
+}
+
+bool AstCache::Handle::Entry::Unchanged(const std::string& file, const std::map<std::string, std::string>& unsaved) const {
+  if (!reusable || !parsed || failed || !mainBuffer || unsaved != parsedUnsaved) return false;
+  if (auto text = unsaved.find(file); text != unsaved.end()) {
+    if (text->second != mainBuffer->getBuffer()) return false;
+  } else {
+    auto buffer = llvm::MemoryBuffer::getFile(file);
+    if (!buffer || (*buffer)->getBuffer() != mainBuffer->getBuffer()) return false;
+  }
+  for (auto& [name, seen] : parsedFiles) {
+    llvm::sys::fs::file_status status;
+    if (llvm::sys::fs::status(name, status) || status.getSize() != seen.first || status.getLastModificationTime() != seen.second) return false;
+  }
+  return true;
+}
+
+AstCache::Handle AstCache::Get(const std::string& file, const std::vector<std::string>& args,
+                               const std::map<std::string, std::string>& unsaved) {
+  std::string key = file;
+  for (auto& a : args) key += '\x1f' + a;
+
+  std::shared_ptr<Handle::Entry> entry;
+  {
+    std::lock_guard<std::mutex> guard(m_mutex);
+    auto it = m_entries.find(key);
+    if (it == m_entries.end()) {
+      entry = std::make_shared<Handle::Entry>();
+      m_entries[key] = entry;
+    } else {
+      entry = it->second;
+    }
+    m_lru.remove(key);
+    m_lru.push_front(key);
+    // Evict the least recently used entries that nobody is using.
+    for (auto victim = m_lru.end(); m_entries.size() > m_capacity && victim != m_lru.begin();) {
+      --victim;
+      auto e = m_entries.find(*victim);
+      if (e->second == entry || e->second.use_count() > 1) continue;
+      m_entries.erase(e);
+      victim = m_lru.erase(victim);
+    }
+  }
+
+  Handle handle(entry);  // waits while another translation uses this AST
+  entry->diagStream.flush();
+  entry->diagText.clear();
+  if (entry->Unchanged(file, unsaved)) {
+    // The same text and headers as the last parse: its AST serves as it is, with its diagnostics
+    // engine cleared of what the last translation reported.
+    entry->printer->clear();
+    entry->printer->errors = 0;
+    entry->parsed->getDiagnostics().Reset(/*soft=*/true);
+    std::lock_guard<std::mutex> guard(m_mutex);
+    ++m_reparses;
+    ++m_reuses;
+    return handle;
+  }
+  // Decided under the entry's lock: another request may have parsed it meanwhile. A file whose last
+  // parse failed starts again from its arguments.
+  const bool reparse = entry->parsed && !entry->failed;
+  entry->EndParse();
+  if (!reparse) {
+    entry->preamble.reset();
+    entry->diagOptions = new clang::DiagnosticOptions();
+    entry->diagOptions->ShowColors = false;
+    entry->printer = std::make_unique<ErrorCountingPrinter>(entry->diagStream, entry->diagOptions.get());
+    std::vector<const char*> argv = {"clang++"};
+    for (auto& a : args) argv.push_back(a.c_str());
+    argv.push_back(file.c_str());
+    clang::CreateInvocationOptions options;
+    options.Diags = clang::CompilerInstance::createDiagnostics(entry->diagOptions.get(), entry->printer.get(), false);
+    entry->invocation = clang::createInvocation(argv, options);
+    if (entry->invocation) entry->invocation->getHeaderSearchOpts().ResourceDir = CROSSRT_CLANG_RESOURCE_DIR;
+  }
+  entry->printer->clear();
+  entry->printer->errors = 0;
+  entry->failed = !entry->invocation || !entry->Parse(file, unsaved) || entry->printer->errors > 0;
+  entry->RecordWhatWasRead(unsaved);
+  std::lock_guard<std::mutex> guard(m_mutex);
+  ++(reparse ? m_reparses : m_parses);
+  return handle;
+}
+
+AstCacheStats AstCache::Stats() const {
+  std::lock_guard<std::mutex> guard(m_mutex);
+  return {m_entries.size(), m_capacity, m_parses, m_reparses, m_reuses};
+}
+
+}  // namespace crossrt::engine

@@ -1,0 +1,562 @@
+// The printer's calls: user functions (printed once, callees first), LiteMath and <cmath> built-ins,
+// numeric limits, crossrt::Atomic* and LiteMath's InterlockedAdd family, and what kernels may not
+// call (I/O, the heap). Part of GlslPrinter (Glsl.h).
+#include "print/Glsl.h"
+#include "analyse/AstQueries.h"
+#include "print/GlslParts.h"
+
+#include <clang/AST/RecordLayout.h>
+#include <clang/Basic/SourceManager.h>
+#include <clang/Lex/Lexer.h>
+
+#include <cstdio>
+#include <map>
+#include <set>
+#include <sstream>
+
+using namespace clang;
+
+namespace crossrt::engine {
+
+namespace {
+bool IsIoFunction(const std::string& n) {
+  static const std::set<std::string> io = {"printf", "fprintf", "puts", "fputs", "putchar", "fopen", "fclose",
+      "fread", "fwrite", "fscanf", "scanf", "sprintf", "snprintf", "fflush", "perror", "getchar"};
+  return io.count(n) > 0;
+}
+bool IsHeapFunction(const std::string& n) {
+  return n == "malloc" || n == "calloc" || n == "realloc" || n == "free" || n == "aligned_alloc";
+}
+
+// std::numeric_limits<float, int or uint>::infinity(), max() and the like as GLSL constant
+// expressions, which global constants need. GLSL has no literal for infinity and NaN; glslang
+// folds 1.0 / 0.0 to +inf and 0.0 / 0.0 to NaN. Empty for anything else.
+std::string NumericLimit(const FunctionDecl* fd) {
+  auto* spec = dyn_cast_or_null<ClassTemplateSpecializationDecl>(fd->getDeclContext());
+  if (!spec || spec->getName() != "numeric_limits" || !spec->isInStdNamespace() || spec->getTemplateArgs().size() != 1)
+    return "";
+  const QualType t = spec->getTemplateArgs()[0].getAsType().getCanonicalType();
+  const std::string n = fd->getNameAsString();
+  if (t->isSpecificBuiltinType(BuiltinType::Float)) {
+    // Nine significant digits: each literal rounds to exactly the float it names.
+    static const std::map<std::string, std::string> values = {
+        {"infinity", "(1.0 / 0.0)"},      {"quiet_NaN", "(0.0 / 0.0)"},  {"max", "3.40282347e+38"},
+        {"lowest", "-3.40282347e+38"},    {"min", "1.17549435e-38"},    {"epsilon", "1.1920929e-07"},
+        {"denorm_min", "1.40129846e-45"}};
+    auto it = values.find(n);
+    return it == values.end() ? "" : it->second;
+  }
+  if (t->isSpecificBuiltinType(BuiltinType::Int)) {
+    if (n == "max") return "0x7FFFFFFF";
+    if (n == "min" || n == "lowest") return "(-2147483647 - 1)";
+  }
+  if (t->isSpecificBuiltinType(BuiltinType::UInt)) {
+    if (n == "max") return "0xFFFFFFFFu";
+    if (n == "min" || n == "lowest") return "0u";
+  }
+  return "";
+}
+}  // namespace
+
+// Library functions with a GLSL counterpart: LiteMath, <cmath>, std::min/max, std::numeric_limits.
+std::string GlslPrinter::Builtin(const FunctionDecl* fd, const std::vector<std::string>& a, const CallExpr* call) {
+  std::string n = fd->getNameAsString();
+  if (std::string limit = NumericLimit(fd); !limit.empty()) return limit;
+  auto join = [&](const std::string& f) {
+    std::string s = f + "(";
+    for (size_t i = 0; i < a.size(); ++i) s += (i ? ", " : "") + a[i];
+    return s + ")";
+  };
+  static const std::map<std::string, std::string> same = {
+      {"sqrt", "sqrt"}, {"sqrtf", "sqrt"}, {"abs", "abs"}, {"fabs", "abs"}, {"fabsf", "abs"},
+      {"min", "min"}, {"max", "max"}, {"fmin", "min"}, {"fminf", "min"}, {"fmax", "max"}, {"fmaxf", "max"},
+      {"clamp", "clamp"}, {"pow", "pow"}, {"powf", "pow"}, {"exp", "exp"}, {"expf", "exp"},
+      {"exp2", "exp2"}, {"exp2f", "exp2"}, {"log", "log"}, {"logf", "log"}, {"log2", "log2"}, {"log2f", "log2"},
+      {"sin", "sin"}, {"sinf", "sin"}, {"cos", "cos"}, {"cosf", "cos"}, {"tan", "tan"}, {"tanf", "tan"},
+      {"asin", "asin"}, {"asinf", "asin"}, {"acos", "acos"}, {"acosf", "acos"}, {"atan", "atan"}, {"atanf", "atan"},
+      {"sinh", "sinh"}, {"sinhf", "sinh"}, {"cosh", "cosh"}, {"coshf", "cosh"}, {"tanh", "tanh"}, {"tanhf", "tanh"},
+      {"asinh", "asinh"}, {"asinhf", "asinh"}, {"acosh", "acosh"}, {"acoshf", "acosh"}, {"atanh", "atanh"}, {"atanhf", "atanh"},
+      {"atan2", "atan"}, {"atan2f", "atan"}, {"floor", "floor"}, {"floorf", "floor"}, {"ceil", "ceil"},
+      {"ceilf", "ceil"}, {"trunc", "trunc"}, {"truncf", "trunc"},
+      {"fract", "fract"}, {"sign", "sign"}, {"dot", "dot"}, {"cross", "cross"}, {"length", "length"},
+      {"normalize", "normalize"}, {"distance", "distance"}, {"reflect", "reflect"}, {"refract", "refract"},
+      {"mix", "mix"}, {"lerp", "mix"}, {"step", "step"}, {"smoothstep", "smoothstep"},
+      {"inversesqrt", "inversesqrt"}, {"transpose", "transpose"}, {"inverse", "inverse"},
+      {"inverse4x4", "inverse"}, {"isnan", "isnan"}, {"isinf", "isinf"}, {"fma", "fma"}, {"fmaf", "fma"},
+      {"make_float2", "vec2"}, {"make_float3", "vec3"}, {"make_float4", "vec4"}, {"make_int2", "ivec2"},
+      {"make_int3", "ivec3"}, {"make_int4", "ivec4"}, {"make_uint2", "uvec2"}, {"make_uint3", "uvec3"},
+      {"make_uint4", "uvec4"}, {"to_float2", "vec2"}, {"to_int2", "ivec2"}, {"to_int3", "ivec3"},
+      {"to_int4", "ivec4"}, {"to_uint2", "uvec2"}, {"to_uint3", "uvec3"}, {"to_uint4", "uvec4"},
+      {"to_float4", "vec4"}, {"mod", "mod"}, {"faceforward", "faceforward"}, {"outerProduct", "outerProduct"},
+      {"determinant", "determinant"}, {"inverse3x3", "inverse"}};
+  // GCC/Clang bit builtins (C++ leaves clz and ctz of 0 undefined).
+  if (fd->getBuiltinID() != 0) {
+    const std::string u = ispc ? "((uint)(" + a[0] + "))" : "uint(" + a[0] + ")";
+    if (n == "__builtin_clz") return "(31 - findMSB(" + u + "))";
+    if (n == "__builtin_ctz") return "findLSB(" + u + ")";
+    if (n == "__builtin_popcount") return "bitCount(" + u + ")";
+  }
+  bool library = IsSystemDecl(fd) || InNamespace(fd, "LiteMath");
+  if (!library) return "";
+  if (ispc) return IspcBuiltin(fd, a, call, same);
+  const std::string arg0Type = call->getNumArgs() ? GlslTypeOf(call->getArg(0)->getType()).value_or("") : "";
+  if (n == "to_float4" && call->getNumArgs() == 1 && IsLiteMathType(call->getArg(0)->getType(), "half4"))
+    return "vec4(unpackHalf2x16((" + a[0] + ").x), unpackHalf2x16((" + a[0] + ").y))";
+  if (n == "to_float2" && call->getNumArgs() == 1 && IsLiteMathType(call->getArg(0)->getType(), "half2")) return "unpackHalf2x16(" + a[0] + ")";
+  if (n == "to_float3" && arg0Type == "vec4") return "(" + a[0] + ").xyz";
+  if (n == "to_float3") return "vec3(" + a[0] + ")";  // from int3/uint3: a conversion
+  if (n == "to_float2" && (arg0Type == "vec4" || arg0Type == "vec3")) return "(" + a[0] + ").xy";
+  // C++ rounds halves away from zero; GLSL's round() may round them to even.
+  if (n == "round" || n == "roundf") return "(sign(" + a[0] + ") * floor(abs(" + a[0] + ") + 0.5))";
+  if (n == "as_int") return "floatBitsToInt(" + a[0] + ")";
+  if (n == "as_uint") return "floatBitsToUint(" + a[0] + ")";
+  if (n == "as_float") {
+    auto t = GlslTypeOf(call->getArg(0)->getType()).value_or("int");
+    return (t[0] == 'u' ? "uintBitsToFloat(" : "intBitsToFloat(") + a[0] + ")";
+  }
+  if (n == "hmin" || n == "hmax") {
+    auto t = GlslTypeOf(call->getArg(0)->getType()).value_or("vec3");
+    const char* f = n == "hmin" ? "min" : "max";
+    std::string v = "(" + a[0] + ")";
+    std::string r = std::string(f) + "(" + v + ".x, " + v + ".y)";
+    if (t.back() == '3' || t.back() == '4') r = std::string(f) + "(" + r + ", " + v + ".z)";
+    if (t.back() == '4') r = std::string(f) + "(" + r + ", " + v + ".w)";
+    return r;
+  }
+  // The lanes' bits as the sum of their weights: one compare of four lanes, each argument read once.
+  if (n == "lane_mask_le")
+    return "uint(dot(vec4(lessThanEqual(" + a[0] + ", " + a[1] + ")), vec4(1.0, 2.0, 4.0, 8.0)))";
+  if (n == "mul4x3") return "(" + a[0] + " * vec4(" + a[1] + ", 1.0)).xyz";
+  if (n == "mul3x3") return "(mat3(" + a[0] + ") * " + a[1] + ")";
+  if (n == "fmod" || n == "fmodf") return "(" + a[0] + " - " + a[1] + " * trunc(" + a[0] + " / " + a[1] + "))";
+  // The magnitude of the first and the sign bit of the second, as C++ has it (signed zeros, NaNs too).
+  if (n == "copysign" || n == "copysignf")
+    return "uintBitsToFloat((floatBitsToUint(" + a[0] + ") & 0x7FFFFFFFu) | (floatBitsToUint(" + a[1] + ") & 0x80000000u))";
+  // LiteMath's float4 as a 3-vector and a w: the cross product of the xyz parts, w = 0.
+  if ((n == "cross3" || n == "cross") && arg0Type == "vec4") return "vec4(cross((" + a[0] + ").xyz, (" + a[1] + ").xyz), 0.0)";
+  if (n == "mul4x4x4" || (n == "mul" && call->getNumArgs() == 2 && arg0Type.rfind("mat", 0) == 0)) {
+    const std::string arg1Type = GlslTypeOf(call->getArg(1)->getType()).value_or("");
+    if (arg0Type == "mat4" && arg1Type == "vec3") return "(" + a[0] + " * vec4(" + a[1] + ", 1.0)).xyz";
+    return "(" + a[0] + " * " + a[1] + ")";
+  }
+  if (n == "make_float4x4_from_rows" || n == "make_float3x3_from_rows" || n == "make_float3x3")
+    return std::string("transpose(") + (n == "make_float4x4_from_rows" ? "mat4(" : "mat3(") + a[0] + ", " + a[1] + ", " + a[2] + (a.size() > 3 ? ", " + a[3] : "") + "))";
+  if (n == "make_float4x4_from_cols" || n == "make_float3x3_from_cols" || n == "make_float3x3_by_columns")
+    return std::string(n == "make_float4x4_from_cols" ? "mat4(" : "mat3(") + a[0] + ", " + a[1] + ", " + a[2] + (a.size() > 3 ? ", " + a[3] : "") + ")";
+  if (n == "rcp") return "(1.0 / " + a[0] + ")";
+  if (n == "isfinite") return "!(isinf(" + a[0] + ") || isnan(" + a[0] + "))";
+  auto it = same.find(n);
+  if (it != same.end()) return join(it->second);
+  return "";
+}
+
+// The same for ISPC: LiteMath.isph has LiteMath's constructors and conversions under their own
+// names (make_float3, to_float3), GLSL's functions under GLSL's (`same`), and LiteMath's matrices.
+std::string GlslPrinter::IspcBuiltin(const FunctionDecl* fd, const std::vector<std::string>& a, const CallExpr* call,
+                                     const std::map<std::string, std::string>& same) {
+  const std::string n = fd->getNameAsString();
+  auto join = [&](const std::string& f) {
+    std::string s = f + "(";
+    for (size_t i = 0; i < a.size(); ++i) s += (i ? ", " : "") + a[i];
+    return s + ")";
+  };
+  static const std::set<std::string> ownNames = {
+      "make_float2", "make_float3", "make_float4", "make_int2", "make_int3", "make_int4", "make_uint2", "make_uint3",
+      "make_uint4", "to_float2", "to_float3", "to_float4", "to_int2", "to_int3", "to_int4", "to_uint2", "to_uint3", "to_uint4"};
+  const std::string arg0Type = call->getNumArgs() ? GlslTypeOf(call->getArg(0)->getType()).value_or("") : "";
+  if (n == "to_float4" && call->getNumArgs() == 1 && IsLiteMathType(call->getArg(0)->getType(), "half4")) return "crt_half4_to_float4(" + a[0] + ")";
+  if (n == "to_float2" && call->getNumArgs() == 1 && IsLiteMathType(call->getArg(0)->getType(), "half2")) return "crt_half2_to_float2(" + a[0] + ")";
+  if (n.find("half") != std::string::npos) return IspcFail(call->getBeginLoc(), "LiteMath's '" + n + "'");
+  // to_int3(v), to_float3(int3): a conversion (as many components); to_float3(float4): a part.
+  if (n.rfind("to_", 0) == 0 && call->getNumArgs() == 1 && !arg0Type.empty() && arg0Type.back() == n.back())
+    return "make_" + n.substr(3) + "(" + a[0] + ")";
+  if (ownNames.count(n)) return join(n);
+  if (n == "round" || n == "roundf") return "(sign(" + a[0] + ") * floor(abs(" + a[0] + ") + 0.5f))";
+  if (n == "as_int") return "floatBitsToInt(" + a[0] + ")";
+  if (n == "as_uint") return "floatBitsToUint(" + a[0] + ")";
+  if (n == "as_float") return (arg0Type[0] == 'u' ? "uintBitsToFloat(" : "intBitsToFloat(") + a[0] + ")";
+  if (n == "hmin" || n == "hmax") {  // in LiteMath's order of std::min/max
+    const std::string f = n == "hmin" ? "crt_min(" : "crt_max(";
+    const std::string v = "(" + a[0] + ")";
+    const char last = arg0Type.back();
+    const std::string r = last == '2'   ? f + v + ".x, " + v + ".y)"
+                          : last == '3' ? f + v + ".x, " + f + v + ".y, " + v + ".z))"
+                                        : f + f + v + ".x, " + v + ".y), " + f + v + ".z, " + v + ".w))";
+    return call->getArg(0)->HasSideEffects(m_ctx) ? IspcFail(call->getBeginLoc(), "hmin/hmax of an expression with side effects") : r;
+  }
+  // As C++ compares (LiteMath.isph): a NaN or a signed zero comes out as in the C++ class.
+  if (n == "min" || n == "max" || n == "clamp") return join("crt_" + n);
+  if (n == "fmod" || n == "fmodf") return "(" + a[0] + " - " + a[1] + " * trunc(" + a[0] + " / " + a[1] + "))";
+  if (n == "rcp") return "(1.0f / " + a[0] + ")";
+  if (n == "isfinite") return "!(isinf(" + a[0] + ") || isnan(" + a[0] + "))";
+  if (n == "copysign" || n == "copysignf")
+    return "uintBitsToFloat((floatBitsToUint(" + a[0] + ") & 0x7FFFFFFFu) | (floatBitsToUint(" + a[1] + ") & 0x80000000u))";
+  if ((n == "cross3" || n == "cross") && arg0Type == "vec4")
+    return "make_float4(cross(to_float3(" + a[0] + "), to_float3(" + a[1] + ")), 0.0f)";
+  // LiteMath.isph has the matrices' arithmetic and constructors by LiteMath's names.
+  static const std::set<std::string> matrixNames = {
+      "make_float3x3", "make_float3x3_from_rows", "make_float3x3_from_cols", "make_float3x3_by_columns", "make_float4x4_from_rows",
+      "make_float4x4_from_cols", "transpose", "inverse", "inverse4x4", "determinant", "outerProduct", "mul", "mul4x3", "mul3x3",
+      "mul4x4x4", "lane_mask_le"};
+  if (matrixNames.count(n)) return join(n);
+  if (arg0Type.rfind("mat", 0) == 0 || n.find("float4x4") != std::string::npos || n.find("float3x3") != std::string::npos)
+    return IspcFail(call->getBeginLoc(), "'" + fd->getQualifiedNameAsString() + "'");
+  if (n == "atan2" || n == "atan2f") return join("atan2");
+  if (n == "sqrt" || n == "sqrtf") return join("sqrt");
+  auto it = same.find(n);
+  if (it != same.end()) return join(it->second);
+  return "";
+}
+
+// ---- crossrt::Atomic* (Atomics.h): GLSL atomics between buffer memory barriers ----
+
+bool IsCrossrtAtomic(const FunctionDecl* fd) {
+  static const std::set<std::string> names = {"AtomicAdd", "AtomicAnd", "AtomicOr", "AtomicXor", "AtomicExchange",
+                                              "AtomicMin", "AtomicMax", "AtomicCompareExchange"};
+  return fd && InNamespace(fd, "crossrt") && names.count(fd->getNameAsString()) > 0;
+}
+
+// GLSL atomics take a buffer (or shared) variable itself, never a copy: the target must be a
+// path of indexing and field selection from a buffer the kernel binds. Empty when it is.
+std::string GlslPrinter::AtomicTargetProblem(const clang::Expr* e) const {
+  while (true) {
+    e = e->IgnoreParenImpCasts();
+    if (auto* me = dyn_cast<MemberExpr>(e)) {
+      const clang::Expr* base = me->getBase()->IgnoreParenImpCasts();
+      if (isa<CXXThisExpr>(base)) {
+        if (selfClass) return "it is a member of an object reached through a virtual call, which kernels only read";
+        if (IsImage2D(me->getType())) return "it is a texel of an image";
+        return "";  // a data member (the class-data block) or an element of a member vector
+      }
+      if (me->isArrow()) {  // p->field: p must be a kernel's pointer parameter
+        e = base;
+        break;
+      }
+      e = base;
+      continue;
+    }
+    if (auto* op = dyn_cast<CXXOperatorCallExpr>(e); op && op->getOperator() == OO_Subscript) {
+      if (!IsStdVector(op->getArg(0)->getType())) return "it is an element of a container kernels cannot index atomically";
+      e = op->getArg(0);
+      continue;
+    }
+    if (auto* as = dyn_cast<ArraySubscriptExpr>(e)) {
+      const clang::Expr* base = as->getBase()->IgnoreParenImpCasts();
+      if (base->getType()->isPointerType()) {
+        e = base;
+        break;
+      }
+      e = base;  // a fixed-size array inside an element
+      continue;
+    }
+    if (auto* uo = dyn_cast<UnaryOperator>(e); uo && uo->getOpcode() == UO_Deref) {
+      e = uo->getSubExpr()->IgnoreParenImpCasts();
+      break;
+    }
+    break;
+  }
+  // What remains names the root: a pointer parameter of the kernel is a buffer, anything else a copy.
+  auto* dr = dyn_cast<DeclRefExpr>(e);
+  auto* param = dr ? dyn_cast<ParmVarDecl>(dr->getDecl()) : nullptr;
+  if (param && param->getType()->isPointerType()) {
+    if (valueParams.count(param)) return "parameter '" + param->getNameAsString() + "' holds one value per thread (a local of the control function's thread loop)";
+    return "";
+  }
+  if (param && param->getType()->isReferenceType())
+    return "reference parameter '" + param->getNameAsString() + "' is a copy on the GPU (GLSL passes it in and out)";
+  if (dr) return "'" + dr->getDecl()->getNameAsString() + "' is a local variable, private to each GPU thread";
+  return "it is not a variable in device memory";
+}
+
+std::string GlslPrinter::AtomicCall(const FunctionDecl* fd, const CallExpr* call) {
+  const std::string name = fd->getNameAsString();
+  if (std::string problem = AtomicTargetProblem(call->getArg(0)); !problem.empty())
+    return Fail(call->getArg(0)->getExprLoc(), "the target of crossrt::" + name + " is not in device memory: " + problem,
+                "make the target an element of a std::vector member, a data member, or an element of a kernel's pointer parameter");
+  m_uses.atomics = true;
+  std::vector<std::string> args;
+  for (auto* arg : call->arguments()) args.push_back(Expr(arg));
+  // ISPC: its global atomics, on the target's address (a lane at a time where lanes share one).
+  if (ispc) {
+    static const std::map<std::string, std::string> ispcNames = {
+        {"AtomicAdd", "atomic_add_global"}, {"AtomicAnd", "atomic_and_global"},       {"AtomicOr", "atomic_or_global"},
+        {"AtomicXor", "atomic_xor_global"}, {"AtomicExchange", "atomic_swap_global"}, {"AtomicMin", "atomic_min_global"},
+        {"AtomicMax", "atomic_max_global"}, {"AtomicCompareExchange", "atomic_compare_exchange_global"}};
+    std::string s = ispcNames.at(name) + "(&" + args[0];
+    for (size_t i = 1; i < args.size(); ++i) s += ", crt_perLane(" + args[i] + ")";  // once per lane, as threads do
+    return s + ")";
+  }
+  // The fences of acquire-release order (the kernel template defines crt_release/crt_acquire):
+  // the last argument passes a release fence before the atomic runs, the result an acquire fence
+  // after. crossrt::AtomicCompareExchange is atomicCompSwap; the others keep their name.
+  std::string s = "crt_acquire(" + (name == "AtomicCompareExchange" ? std::string("atomicCompSwap") : "atomic" + name.substr(6)) + "(";
+  for (size_t i = 0; i < args.size(); ++i) {
+    s += i ? ", " : "";
+    s += i + 1 == args.size() ? "crt_release(" + args[i] + ")" : args[i];
+  }
+  return s + "))";
+}
+std::string GlslPrinter::Call(const CallExpr* call) {
+  const FunctionDecl* fd = call->getDirectCallee();
+  if (!fd) return Fail(call->getBeginLoc(), "indirect call in a kernel", "call functions directly; lambdas and function pointers are not supported");
+  std::string name = fd->getNameAsString();
+  std::string qname = fd->getQualifiedNameAsString();
+
+  // Members of the user's class: helpers become GLSL functions.
+  if (auto* mc = dyn_cast<CXXMemberCallExpr>(call)) {
+    const clang::Expr* obj = mc->getImplicitObjectArgument()->IgnoreParenImpCasts();
+    auto* method = mc->getMethodDecl();
+    if (isa<CXXThisExpr>(obj) && m_structSelf) {  // another member function of the struct being printed
+      std::map<unsigned, std::string> bindings;
+      std::vector<std::string> args = HelperArgs(method, call, bindings);
+      std::string s = EmitHelper(method, call->getBeginLoc(), false, bindings, m_structSelf) + "(self";
+      for (auto& a : args) s += ", " + a;
+      return s + ")";
+    }
+    if (isa<CXXThisExpr>(obj)) {
+      if (StringRef(name).starts_with("kernel"))
+        return Fail(call->getBeginLoc(), "kernel '" + name + "' is called from inside a kernel", "call kernels only from control functions");
+      std::vector<std::string> args;
+      if (ispc && !selfClass && !method->isStatic()) args.push_back("self");  // the class's data, as kernels have it
+      if (selfClass) {
+        args.push_back("self");
+        // The object's exact class is known: a virtual call on it is static.
+        if (auto* overrider = method->getCorrespondingMethodInClass(selfClass); overrider && method->isVirtual()) {
+          for (auto* arg : call->arguments()) args.push_back(Expr(arg));
+          std::string s = EmitHelper(overrider, call->getBeginLoc(), true) + "(";
+          for (size_t i = 0; i < args.size(); ++i) s += (i ? ", " : "") + args[i];
+          return s + ")";
+        }
+      }
+      std::map<unsigned, std::string> bindings;
+      for (auto& a : HelperArgs(method, call, bindings)) args.push_back(a);
+      // In composed code, the implementation is the one COMPOSE names: a virtual method it calls on
+      // itself is its own (AnyHit calling NearestHit), as the GPU has no other.
+      const CXXMethodDecl* own = !selfClass && !composedPrefix.empty() && method->isVirtual() ? method->getCorrespondingMethodInClass(m_class) : nullptr;
+      std::string callee = own ? EmitHelper(own, call->getBeginLoc(), true, bindings) : EmitHelper(method, call->getBeginLoc(), false, bindings);
+      std::string s = callee + "(";
+      for (size_t i = 0; i < args.size(); ++i) s += (i ? ", " : "") + args[i];
+      return s + ")";
+    }
+    // Calls on an Image2D member or parameter: texel loads and stores, samples, its size.
+    if (auto* image = ImageOf(obj)) return ispc ? IspcImageCall(image, mc) : ImageCall(image, mc);
+    // Calls on a texture of an array of textures.
+    const clang::Expr* textureIndex = nullptr;
+    if (auto* array = TextureElement(obj, &textureIndex))
+      return ispc ? IspcTextureCall(array, textureIndex, mc) : TextureCall(array, textureIndex, mc);
+    // Calls of the traversal passed to an object's method: scene->Helper(...).
+    if (OwnerParamOf(obj)) return OwnerCall(mc);
+    // Calls through a member holding an interface: composition.
+    std::string composed = ComposedCall(mc);
+    if (!composed.empty()) return composed;
+    // Calls through an element of a vector of objects: dynamic dispatch.
+    std::string dispatched = VirtualCall(mc);
+    if (!dispatched.empty()) return dispatched;
+    // Calls on a std::vector member.
+    if (auto* me = dyn_cast<MemberExpr>(obj); me && IsStdVector(me->getType())) {
+      auto* field = dyn_cast<FieldDecl>(me->getMemberDecl());
+      if (field && isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts()) && IsTextureArray(field->getType())) {
+        if (name == "size" && UsableTextures(field, call->getBeginLoc())) return ispc ? IspcMember(field->getNameAsString() + "_size") : field->getNameAsString() + "_size";
+        return Fail(call->getBeginLoc(), "std::vector::" + name + " of an array of textures in a kernel",
+                    "kernels read its size() and use its textures: " + field->getNameAsString() + "[i].sample(uv)");
+      }
+      QualType element;
+      if (field && isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts()) && name == "size" && IsStdVector(field->getType(), &element) &&
+          PolymorphicPointee(element)) {
+        m_uses.objectSizeReads.emplace(field, call->getBeginLoc());
+        return ispc ? IspcMember(field->getNameAsString() + "_size") : composedPrefix + field->getNameAsString() + "_size";
+      }
+      if (field && isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts())) {
+        m_uses.memberVectors.insert(field);
+        if (name == "size" || name == "empty") {
+          m_uses.sizeReads.emplace(field, call->getBeginLoc());
+          const std::string size = ispc ? IspcMember(field->getNameAsString() + "_size") : composedPrefix + field->getNameAsString() + "_size";
+          return name == "size" ? size : "(" + size + (ispc ? " == 0)" : " == 0u)");
+        }
+        if (ispc && name == "push_back" && call->getNumArgs() == 1 && composedPrefix.empty())
+          return EmitAppend(field, call) + "(self, " + Expr(call->getArg(0)) + ")";
+        if (name == "capacity") return ispc ? IspcMember(field->getNameAsString() + "_capacity") : composedPrefix + field->getNameAsString() + "_capacity";
+        if (ispc) return IspcFail(call->getBeginLoc(), "std::vector::" + name + " of a member in a kernel");
+        // Emptied by the one thread before a loop nest: the appends that follow count from 0.
+        const bool empties = name == "clear" || (name == "resize" && call->getNumArgs() == 1 && call->getArg(0)->isIntegerConstantExpr(m_ctx) &&
+                                                  call->getArg(0)->EvaluateKnownConstInt(m_ctx) == 0);
+        if (empties && singleThread && composedPrefix.empty()) {
+          m_uses.emptiedVectors.insert(field);
+          return field->getNameAsString() + "_size = 0u";
+        }
+        if (name == "push_back" && call->getNumArgs() == 1 && composedPrefix.empty())
+          return EmitAppend(field, call) + "(" + Expr(call->getArg(0)) + ")";
+      }
+      return Fail(call->getBeginLoc(), "std::vector::" + name + " is not supported in kernels",
+                  "kernels may index member vectors, call size() and capacity(), and push_back() to a member vector");
+    }
+    // std::array<T, N>, held as T[N]: its size is N.
+    if (uint64_t n = 0; IsStdArray(obj->getType(), nullptr, &n) && (name == "size" || name == "max_size") && call->getNumArgs() == 0)
+      return std::to_string(n) + (ispc ? "" : "u");
+    // Member functions of plain structs (the user's, LiteMath's complex and Box4f) and of matrices.
+    if (IsPlainStruct(method->getParent())) return StructMethodCall(mc);
+    if (IsLiteMathType(obj->getType(), "float4x4") || IsLiteMathType(obj->getType(), "float3x3")) return MatrixMethodCall(mc);
+    if (IsStdVector(obj->getType().getNonReferenceType()))  // a vector passed to a helper, or a local one
+      return Fail(call->getBeginLoc(), "call to '" + qname + "' on a std::vector that is not a data member, in a kernel",
+                  "kernels reach vectors through the class's members: make the helper a member function that reads the member itself");
+    if (IsSystemDecl(method) || method->getParent()->isInStdNamespace())
+      return Fail(call->getBeginLoc(), "call to '" + qname + "' is not supported in a kernel",
+                  "kernels may call LiteMath, <cmath> and std::min/max, and your own functions");
+    return Fail(call->getBeginLoc(), "member function call '" + qname + "' on an object is not supported in kernels",
+                "make it a free function or a member of the class that takes the object as a parameter");
+  }
+
+  if (IsHeapFunction(name))
+    return Fail(call->getBeginLoc(), "heap allocation ('" + name + "') in a kernel",
+                "GPU threads cannot allocate: use a fixed-size local array or a std::vector member sized before the call");
+  if (IsIoFunction(name))
+    return Fail(call->getBeginLoc(), "I/O ('" + name + "') in a kernel",
+                "kernels cannot do I/O: write results to an output buffer and print them in the control function");
+
+  const bool interlocked = InNamespace(fd, "LiteMath") && (name == "InterlockedAdd" || name == "atomicAdd" || name == "InterlockedAdd3f" || name == "ReduceAdd");
+  if (ispc && interlocked && (name == "InterlockedAdd" || name == "atomicAdd") && call->getNumArgs() >= 2) {
+    // ISPC's global atomic add (int, uint and float), on the target's address.
+    if (std::string problem = AtomicTargetProblem(call->getArg(0)); !problem.empty())
+      return Fail(call->getArg(0)->getExprLoc(), "the target of " + name + " is not in device memory: " + problem,
+                  "make the target an element of a std::vector member, a data member, or an element of a kernel's pointer parameter");
+    // crt_perLane: a uniform value on a uniform target would be added once per gang, not per lane.
+    const std::string add = "atomic_add_global(&" + Expr(call->getArg(0)) + ", crt_perLane(" + Expr(call->getArg(1)) + "))";
+    return call->getNumArgs() == 3 ? Expr(call->getArg(2)) + " = " + add : add;
+  }
+  if (ispc && interlocked) return IspcInterlockedCall(fd, call);
+  if (IsCrossrtAtomic(fd)) return AtomicCall(fd, call);
+  if (interlocked) return InterlockedCall(fd, call);
+  // std::min({a, b, c}) and std::max({...}): folded pairwise, left to right.
+  if (fd->isInStdNamespace() && (name == "min" || name == "max") && call->getNumArgs() >= 1)
+    if (auto* list = dyn_cast<CXXStdInitializerListExpr>(call->getArg(0)->IgnoreImplicit())) {
+      auto* init = dyn_cast<InitListExpr>(list->getSubExpr()->IgnoreImplicit());
+      if (!init || init->getNumInits() == 0 || call->getNumArgs() != 1)
+        return Fail(call->getBeginLoc(), "std::" + name + " of a list with a comparator in a kernel", "fold it with std::" + name + "(a, b)");
+      std::string folded = Expr(init->getInit(0));
+      for (unsigned i = 1; i < init->getNumInits(); ++i)
+        folded = (ispc ? "crt_" + name : name) + "(" + folded + ", " + Expr(init->getInit(i)) + ")";
+      return folded;
+    }
+  std::vector<std::string> args;
+  const bool library = IsSystemDecl(fd) || fd->isInStdNamespace() || InNamespace(fd, "LiteMath");
+  std::map<unsigned, std::string> bindings;
+  if (library)
+    for (auto* arg : call->arguments()) args.push_back(Expr(arg));
+  else
+    args = HelperArgs(fd, call, bindings);
+  std::string b = Builtin(fd, args, call);
+  if (!b.empty()) return b;
+  // A system header outside the compiler's and the C library's folders is the user's, reached with -isystem.
+  const std::string file = IsSystemDecl(fd) ? FileOf(m_ctx, fd->getLocation()) : "";
+  const bool usersSystemHeader = !file.empty() && file.rfind("/usr/include/", 0) != 0 && file.rfind("/usr/lib/", 0) != 0;
+  if (fd->isInStdNamespace() || (IsSystemDecl(fd) && !usersSystemHeader))
+    return Fail(call->getBeginLoc(), "unsupported library call '" + qname + "' in a kernel",
+                "kernels may call LiteMath, <cmath> and std::min/max/abs, and your own functions with visible bodies");
+  if (usersSystemHeader)
+    return Fail(call->getBeginLoc(), "'" + qname + "' is declared in a system header: kernels treat those as libraries",
+                "pass the folder of the helper's header with -I, not -isystem");
+  // The user's own free function.
+  std::string callee = EmitHelper(fd, call->getBeginLoc(), false, bindings);
+  std::string s = callee + "(";
+  for (size_t i = 0; i < args.size(); ++i) s += (i ? ", " : "") + args[i];
+  return s + ")";
+}
+
+// LiteMath's InterlockedAdd(mem, v[, before]) and atomicAdd(mem, v) are GLSL's atomicAdd (relaxed,
+// as LiteMath's); its
+// ReduceAdd(vector, index, v) adds a finite v to the element (kernel_slicer's ReduceAdd family),
+// through a function per member vector.
+std::string GlslPrinter::InterlockedCall(const FunctionDecl* fd, const CallExpr* call) {
+  const std::string name = fd->getNameAsString();
+  if (name == "InterlockedAdd" || name == "atomicAdd") {
+    if (call->getNumArgs() < 2) return Fail(call->getBeginLoc(), name + " needs a target and a value", "");
+    if (std::string problem = AtomicTargetProblem(call->getArg(0)); !problem.empty())
+      return Fail(call->getArg(0)->getExprLoc(), "the target of " + name + " is not in device memory: " + problem,
+                  "make the target an element of a std::vector member, a data member, or an element of a kernel's pointer parameter");
+    m_uses.floatAtomics |= call->getArg(0)->getType()->isRealFloatingType();
+    const std::string add = "atomicAdd(" + Expr(call->getArg(0)) + ", " + Expr(call->getArg(1)) + ")";
+    return call->getNumArgs() == 3 ? Expr(call->getArg(2)) + " = " + add : add;
+  }
+  if (name == "InterlockedAdd3f") {  // (array, offset, float3): three atomic adds to array[offset], [offset + 1], [offset + 2]
+    if (call->getNumArgs() != 3) return Fail(call->getBeginLoc(), "InterlockedAdd3f takes an array, an offset and a float3", "");
+    auto t = Pointer(call->getArg(0));
+    if (!t) return "/*error*/";
+    if (!t->value.empty() || t->local)
+      return Fail(call->getArg(0)->getExprLoc(), "the array of InterlockedAdd3f is not in device memory",
+                  "pass a kernel's pointer parameter or a std::vector member's data()");
+    m_uses.floatAtomics = true;
+    const std::string at = (t->offset.empty() ? "" : t->offset + " + ") + "(" + Expr(call->getArg(1)) + ")", value = "(" + Expr(call->getArg(2)) + ")";
+    return "atomicAdd(" + t->array + "[" + at + "], " + value + ".x), atomicAdd(" + t->array + "[" + at + " + 1], " + value +
+           ".y), atomicAdd(" + t->array + "[" + at + " + 2], " + value + ".z)";
+  }
+  const FieldDecl* field = ThisMemberField(call->getArg(0));
+  QualType element;
+  if (!field || !IsStdVector(field->getType(), &element))
+    return Fail(call->getArg(0)->getBeginLoc(), "ReduceAdd in a kernel adds into a std::vector member", "pass the member vector itself");
+  m_uses.memberVectors.insert(field);
+  const std::string vector = field->getNameAsString(), helper = vector + "_ReduceAdd";
+  const bool isFloat = element->isRealFloatingType();
+  m_uses.floatAtomics |= isFloat;
+  if (!std::count(m_reduceAddVectors.begin(), m_reduceAddVectors.end(), vector)) {
+    m_reduceAddVectors.push_back(vector);
+    std::ostringstream os;
+    os << "// ReduceAdd(" << vector << ", offset, value) from any number of threads: " << (isFloat ? "a finite value" : "the value")
+       << " added to the element\n"
+       << "void " << helper << "(uint offset, " << Declare(element, "value", call->getBeginLoc()) << ")\n{\n"
+       << (isFloat ? "  if (!(isinf(value) || isnan(value)))\n    " : "  ") << "atomicAdd(" << vector << "[offset], value);\n}\n";
+    m_functions.push_back(os.str());
+  }
+  const clang::Expr* value = call->getArg(call->getNumArgs() - 1);
+  return helper + "(uint(" + Expr(call->getArg(1)) + "), " + Expr(value) + ")";
+}
+
+}  // namespace crossrt::engine
+
+namespace crossrt::engine {
+
+// LiteMath's ReduceAdd(vector, index, v) and InterlockedAdd3f(array, offset, v) in ISPC: its global
+// atomic adds, each lane's to its own element (a finite v only, for ReduceAdd, as LiteMath's;
+// InterlockedAdd3f is LiteMath.isph's).
+std::string GlslPrinter::IspcInterlockedCall(const FunctionDecl* fd, const CallExpr* call) {
+  const std::string name = fd->getNameAsString();
+  if (name == "InterlockedAdd3f") {
+    if (call->getNumArgs() != 3) return Fail(call->getBeginLoc(), "InterlockedAdd3f takes an array, an offset and a float3", "");
+    // The array: a kernel's pointer parameter, or a member vector's data().
+    const clang::Expr* array = call->getArg(0)->IgnoreParenImpCasts();
+    std::string base;
+    if (auto* dr = dyn_cast<DeclRefExpr>(array); dr && isa<ParmVarDecl>(dr->getDecl()) && dr->getType()->isPointerType() && !m_pointers.count(dr->getDecl()))
+      base = Expr(array);
+    else if (auto* mc = dyn_cast<CXXMemberCallExpr>(array); mc && mc->getMethodDecl() && mc->getMethodDecl()->getName() == "data")
+      if (auto* f = ThisMemberField(mc->getImplicitObjectArgument()); f && IsStdVector(f->getType())) {
+        m_uses.memberVectors.insert(f);
+        base = IspcMember(f->getNameAsString());
+      }
+    if (base.empty())
+      return Fail(call->getArg(0)->getExprLoc(), "the array of InterlockedAdd3f is not in device memory",
+                  "pass a kernel's pointer parameter or a std::vector member's data()");
+    return "InterlockedAdd3f(" + base + ", (int)(" + Expr(call->getArg(1)) + "), " + Expr(call->getArg(2)) + ")";  // LiteMath.isph
+  }
+  if (name != "ReduceAdd") return IspcFail(call->getBeginLoc(), "LiteMath's '" + fd->getQualifiedNameAsString() + "'");
+  const FieldDecl* field = ThisMemberField(call->getArg(0));
+  QualType element;
+  if (!field || !IsStdVector(field->getType(), &element))
+    return Fail(call->getArg(0)->getBeginLoc(), "ReduceAdd in a kernel adds into a std::vector member", "pass the member vector itself");
+  if (!element->isRealFloatingType() && !element->isIntegerType())
+    return IspcFail(call->getBeginLoc(), "ReduceAdd into a vector of '" + element.getAsString(m_ctx.getPrintingPolicy()) + "'");
+  m_uses.memberVectors.insert(field);
+  const std::string vector = field->getNameAsString(), helper = vector + "_ReduceAdd";
+  const bool isFloat = element->isRealFloatingType();
+  if (!std::count(m_reduceAddVectors.begin(), m_reduceAddVectors.end(), vector)) {
+    m_reduceAddVectors.push_back(vector);
+    std::ostringstream os;
+    os << "// ReduceAdd(" << vector << ", offset, value) from the lanes: " << (isFloat ? "a finite value" : "the value")
+       << " added to each lane's element\n"
+       << "static void " << helper << "(uniform " << DataStruct() << " *uniform self, uint offset, " << Declare(element, "value", call->getBeginLoc()) << ")\n{\n"
+       << (isFloat ? "  if (!(isinf(value) || isnan(value)))\n    " : "  ") << "atomic_add_global(&" << IspcMember(vector) << "[offset], value);\n}\n";
+    m_functions.push_back(os.str());
+  }
+  const clang::Expr* value = call->getArg(call->getNumArgs() - 1);
+  return helper + "(self, ((" + IspcVariability(call->getArg(1)) + "uint)(" + Expr(call->getArg(1)) + ")), " + Expr(value) + ")";
+}
+
+}  // namespace crossrt::engine
