@@ -3,7 +3,7 @@
 #pragma once
 #include "analyse/Analysis.h"
 #include "generate/Canonical.h"
-#include "print/Glsl.h"
+#include "print/KernelPrinter.h"
 
 #include <clang/AST/ParentMapContext.h>
 #include <clang/AST/RecursiveASTVisitor.h>

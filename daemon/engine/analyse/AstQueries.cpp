@@ -78,7 +78,7 @@ const FieldDecl* ThisField(const Expr* e) {
 }
 
 // The initialiser a local reference `T& r = init;` names, or null for anything else. Kernels print
-// r as init (GlslPrinter::ReferenceAlias), so what is written through r is written to init's root.
+// r as init (KernelPrinter::ReferenceAlias), so what is written through r is written to init's root.
 static const Expr* ReferredTo(const Expr* e) {
   auto* dr = dyn_cast<DeclRefExpr>(e);
   auto* vd = dr ? dyn_cast<VarDecl>(dr->getDecl()) : nullptr;

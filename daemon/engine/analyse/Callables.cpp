@@ -1,6 +1,8 @@
 // The code of virtual calls: per implementation its data struct and methods printed with `self`, per
 // method a dispatcher that switches over the object's class (levels 1-2), or at level 3 a callable
 // shader per implementation and the call that the ray generation shader makes.
+#include "print/Printers.h"
+#include "print/glsl/GlslPrinter.h"
 #include "analyse/Callables.h"
 #include "generate/CodeGenSupport.h"
 
@@ -24,7 +26,7 @@ void AddCallableShader(ASTContext& ctx, Reporter& rep, ClassModel& model, const 
                        const std::string& objectsReference, const std::string& payload) {
   const std::string name = vm.member + "_" + vi.name + "_" + method->getNameAsString();
   if (std::any_of(model.callables.begin(), model.callables.end(), [&](const StageShader& c) { return c.name == name; })) return;
-  GlslPrinter printer(ctx, impl, rep);
+  GlslPrinter printer(ctx, impl, rep);  // a callable shader of the ray tracing pipeline
   printer.selfClass = impl;
   printer.composedPrefix = vi.name + "_";
   for (auto& sn : ClassStructNames(model)) printer.predeclaredStructs.insert(sn);
@@ -53,7 +55,7 @@ void AddCallableShader(ASTContext& ctx, Reporter& rep, ClassModel& model, const 
 // Level 3: `m` called through `vm` from a kernel's ray generation shader. Its payload, and a
 // dispatcher that fills it and executes the callable shader of the object's class (numbered after
 // the kernel's callables so far); each implementation's callable shader joins the model.
-void CallableDispatcher(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& k, GlslPrinter& kernelPrinter, const VirtualMember& vm,
+void CallableDispatcher(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& k, KernelPrinter& kernelPrinter, const VirtualMember& vm,
                         const std::vector<const CXXRecordDecl*>& impls, const CXXMethodDecl* m, SourceLocation callLoc,
                         const std::map<std::string, std::pair<GlslDecl, GlslDecl>>& implData, CallableCode& out) {
   const std::string method = m->getNameAsString(), callName = vm.member + "_" + method, variable = callName + "_call";
@@ -100,7 +102,7 @@ void CallableDispatcher(ASTContext& ctx, Reporter& rep, ClassModel& model, Kerne
   d.set("returnType", retType);
   d.set("returnsVoid", retType == "void");
   d.set("callName", callName);
-  d.set("params", DispatcherParams(kernelPrinter, m));
+  d.set("params", DispatcherParams(kernelPrinter, m, model.forIspc));
   d.set("member", vm.member);
   d.set("variable", variable);
   Data classes = List(), arguments = List();
@@ -126,7 +128,7 @@ void CallableDispatcher(ASTContext& ctx, Reporter& rep, ClassModel& model, Kerne
 
 }  // namespace
 
-void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& k, GlslPrinter& kernelPrinter, const VirtualOwner& owner,
+void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& k, KernelPrinter& kernelPrinter, const VirtualOwner& owner,
                      std::vector<GlslDecl>& structs, std::vector<std::string>& functions, CallableCode* callable) {
   // Vectors and methods in source order: the generated code must not depend on where the AST
   // happens to sit in memory (the daemon reparses).
@@ -220,7 +222,7 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
       known = model.virtuals.end() - 1;
     }
     const VirtualMember& vm = *known;
-    const bool ispc = kernelPrinter.ispc;  // ISPC: the class data points at the tags and at each class's objects
+    const bool ispc = model.forIspc;  // ISPC: the class data points at the tags and at each class's objects
     if (!ispc) {
       k.bufferReferences = true;
       // Data structs and buffer references, then each implementation's methods.
@@ -234,9 +236,9 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
     for (auto* impl : impls) {
       auto vi = std::find_if(vm.impls.begin(), vm.impls.end(), [&](const VirtualImpl& x) { return x.name == impl->getNameAsString(); });
       if (vi == vm.impls.end()) continue;
-      GlslPrinter printer(ctx, impl, rep);
+      std::unique_ptr<KernelPrinter> implPrinter = MakePrinter(model, ctx, impl, rep);
+      KernelPrinter& printer = *implPrinter;
       printer.selfClass = impl;
-      printer.ispc = ispc;
       printer.composedPrefix = vi->name + "_";
       printer.owner = &kernelPrinter;  // what the methods read through a pointer to the caller
       for (auto& sn : ClassStructNames(model)) printer.predeclaredStructs.insert(sn);
@@ -265,7 +267,7 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
       d.set("returnType", retType);
       d.set("returnsVoid", retType == "void");
       d.set("member", member);
-      d.set("params", DispatcherParams(kernelPrinter, m));
+      d.set("params", DispatcherParams(kernelPrinter, m, model.forIspc));
       d.set("dataStruct", kernelPrinter.DataStruct());
       Data cases = List();
       for (size_t t = 0; t < vm.impls.size(); ++t) {
@@ -275,7 +277,7 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
         const std::string address = member + (model.virtualLevel == 1 ? std::string("_objects") : "_" + vi.name);
         std::string args = ispc ? "self->" + member + "_" + vi.name + "[slot]" : member + "_" + vi.name + "Objects(" + address + ").objects[tag.y]";
         for (unsigned i = 0; i < m->getNumParams(); ++i)  // the caller itself: GLSL leaves it out, ISPC passes the class data
-          if (!GlslPrinter::PointsTo(m->getParamDecl(i)->getType(), kernelPrinter.Class())) args += ", " + CallArgumentName(m, i);
+          if (!KernelPrinter::PointsTo(m->getParamDecl(i)->getType(), kernelPrinter.Class())) args += ", " + CallArgumentName(m, i);
           else if (ispc) args += ", self";
         Data x;
         x.set("tag", std::to_string(t));

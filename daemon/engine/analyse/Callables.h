@@ -20,7 +20,7 @@ struct CallableCode {
 // functions to put ahead of the calling code go to `structs` and `functions`; at level 3, with
 // `callable` given, also the callable shaders of the implementations and what the ray generation
 // shader calls them with.
-void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& k, GlslPrinter& kernelPrinter, const VirtualOwner& owner,
+void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& k, KernelPrinter& kernelPrinter, const VirtualOwner& owner,
                      std::vector<GlslDecl>& structs, std::vector<std::string>& functions, CallableCode* callable = nullptr);
 
 }  // namespace crossrt::engine

@@ -1,6 +1,7 @@
 // Composition (paper 3.6): a member of an interface type with an implementation given by COMPOSE. The
 // implementation's methods that kernels call are printed into the kernels, its data becomes buffers and
 // class data reached through the holder. Takes the implementation's AST; adds to the kernels.
+#include "print/Printers.h"
 #include "analyse/Composition.h"
 
 #include "analyse/AstQueries.h"
@@ -65,9 +66,9 @@ bool ComposeFromTranslationUnit(ASTContext& ctx, Reporter& reporter, ClassModel&
     comp.implHeader = FileOf(ctx, impl->getLocation());
     std::string holderPrefix = comp.holder + "_";
     for (auto& k : model.kernels) {
-      GlslPrinter printer(ctx, impl, reporter);
-      printer.ispc = model.forIspc;
-      printer.ispcDataStruct = model.symbolPrefix + "_Data";
+      std::unique_ptr<KernelPrinter> implPrinter = MakePrinter(model, ctx, impl, reporter);
+      KernelPrinter& printer = *implPrinter;
+      printer.dataStruct = model.symbolPrefix + "_Data";
       printer.composedPrefix = holderPrefix;
       for (auto& s : classStructs) printer.predeclaredStructs.insert(s);
       for (auto& [holder, method] : k.composedCalls) {

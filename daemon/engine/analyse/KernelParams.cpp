@@ -26,7 +26,7 @@ void CheckKernelParams(Context& c, const CXXMethodDecl* md, const FunctionDecl* 
     // A parameter the definition leaves unnamed (unused there) takes the declaration's name (tidX
     // still names a thread id), or one of its own.
     if (kp.name.empty()) kp.name = p->getName().empty() ? "crt_unnamed" + std::to_string(i) : p->getNameAsString();
-    kp.glslName = GlslPrinter::SafeName(kp.name);
+    kp.glslName = KernelPrinter::SafeName(kp.name);
     QualType t = p->getType();
     kp.isThreadId = k.rtv && IsThreadIdName(kp.name);
     QualType texel;

@@ -1,6 +1,7 @@
 // One kernel from start to end: its loop nest, parameters, writes and reductions, the GLSL of its body
 // through the printer, and the CPU copy with its OpenMP pragma. Takes a kernel's method; adds a Kernel
 // to the model.
+#include "print/Printers.h"
 #include "analyse/Kernels.h"
 
 #include "analyse/AnalysisContext.h"
@@ -96,7 +97,7 @@ static bool CallsComposedCode(const Stmt* s, const CXXRecordDecl* cls, std::set<
 // calls) is inlined into its export function, which then runs it with all lanes on in full gangs:
 // called, it got the execution mask as an argument, and ran every load masked and every uniform
 // branch as a varying one. Bloom_ISPC went from 1.74x to 2.1-2.4x of Bloom_CPU's speed.
-static void IspcInlineBody(Kernel& k, const GlslPrinter& printer) {
+static void IspcInlineBody(Kernel& k, const KernelPrinter& printer) {
   const auto& uses = printer.Uses();
   if (!uses.helpers.empty() || !uses.virtualCalls.empty() || !uses.composedCalls.empty()) return;
   const std::string plain = "\nstatic void " + k.name + "(";
@@ -122,10 +123,10 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   // The definition's parameter names: its body uses them (a declaration may name them otherwise).
   CheckKernelParams(c, md, def, k);
   for (unsigned i = 0; i < def->getNumParams(); ++i) k.cppParamsDecl += (i ? ", " : "") + ParamDecl(c.ctx, md->getParamDecl(i), def->getParamDecl(i), i);
-  GlslPrinter printer(c.ctx, c.cls, c.rep);
+  std::unique_ptr<KernelPrinter> kernelPrinter = MakePrinter(c.model, c.ctx, c.cls, c.rep);
+  KernelPrinter& printer = *kernelPrinter;
   // The ISPC class runs kernelND_ loop nests as ISPC, and kernel_ functions as the thread functions
   // its thread loops' ISPC bodies call (ThreadLoops.cpp).
-  printer.ispc = c.model.forIspc;
   printer.compositions = c.compositions;
   printer.threadReturnsValue = k.returnsBool;
   for (auto& s : ClassStructNames(c.model)) printer.predeclaredStructs.insert(s);
@@ -217,7 +218,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
       loop.startCpp = c.Text(h.start->getSourceRange());
       loop.countCpp = CountExpr(c, h);
       k.loops.push_back(loop);
-      threadParams.push_back({loop.glslType, GlslPrinter::SafeName(loop.var)});
+      threadParams.push_back({loop.glslType, KernelPrinter::SafeName(loop.var)});
       cur = fs->getBody();
       if (d + 1 < k.dims)
         if (auto* cs = dyn_cast<CompoundStmt>(cur); cs && cs->size() == 1) cur = cs->body_front();
@@ -246,7 +247,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
 
   // ISPC: what every lane of a gang shares (IspcUniform.cpp): the kernel's scalar parameters, and
   // the outer loops' variables of a 2D or 3D nest, except where a 2D nest runs in tiles.
-  if (printer.ispc && !k.rtv) {  // (a kernel_ function's arguments may differ per lane)
+  if (c.model.forIspc && !k.rtv) {  // (a kernel_ function's arguments may differ per lane)
     for (unsigned i = 0; i < k.params.size() && i < def->getNumParams(); ++i)
       if (!k.params[i].isPointer && !k.params[i].isImage && !k.params[i].isThreadId && def->getParamDecl(i)->getType()->isArithmeticType())
         printer.uniformValues.insert(def->getParamDecl(i));
@@ -344,9 +345,9 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   // GLSL: the thread function. ISPC: the same, its uniform arguments passed in (IspcThreadHead).
   std::ostringstream os;
   os << "// from " << c.cls->getNameAsString() << "::" << k.name << " (" << k.sourceFile << ")\n";
-  if (printer.ispc && k.rtv) {
+  if (c.model.forIspc && k.rtv) {
     os << IspcRtvHead(c, k, threadParams);
-  } else if (printer.ispc) {
+  } else if (c.model.forIspc) {
     for (auto& [type, name] : threadParams) type = IspcTypeName(type);
     os << IspcThreadHead(c, k, threadParams, def);
   } else {
@@ -363,12 +364,12 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     os << printer.ThreadBody(threadBody, 1, !k.rtv);
   os << "}\n";
   k.glslBody = os.str();
-  if (printer.ispc) IspcInlineBody(k, printer);
+  if (c.model.forIspc) IspcInlineBody(k, printer);
   // The statements around the loop nest, as functions one thread runs before and after the others.
   // (The ISPC class runs them on the host, as the CPU class does.)
   // (Statements that only set locals need no thread of their own: every thread evaluated them.)
   const bool startRuns = std::any_of(before.begin(), before.end(), [&](const Stmt* s) { return !isa<DeclStmt>(s) && !settingLocals.count(s); });
-  if (!printer.ispc && (startRuns || !after.empty())) {
+  if (!c.model.forIspc && (startRuns || !after.empty())) {
     const auto sizeReadsInLoop = printer.Uses().sizeReads;  // after the loop a vector's final size is known
     const auto renames = printer.renames;
     for (auto& r : k.reductions)

@@ -2,6 +2,7 @@
 // functions, and traversals that call them with a CRT_LeafInfo at their leaves (the paper's listing
 // 2), become traces of a ray tracing pipeline, with an intersection shader per leaf class and a hit
 // and a miss shader per call. Takes the traversal's loops; gives Kernel::leaves and the shaders.
+#include "print/glsl/GlslPrinter.h"
 #include "analyse/LeafShaders.h"
 #include "generate/CodeGenSupport.h"
 
@@ -151,7 +152,7 @@ std::string LeafInfoFrom(const CXXRecordDecl* info, const std::string& var) {
   std::string out;
   for (auto* f : info->fields()) {
     auto known = builtins.find(f->getNameAsString());
-    out += "  " + var + "." + GlslPrinter::SafeName(f->getNameAsString()) + " = " + (known != builtins.end() ? known->second : ZeroOf(f->getType())) + ";\n";
+    out += "  " + var + "." + KernelPrinter::SafeName(f->getNameAsString()) + " = " + (known != builtins.end() ? known->second : ZeroOf(f->getType())) + ";\n";
   }
   return out;
 }
@@ -197,7 +198,7 @@ const CXXMethodDecl* LeafBoxesMethod(const CXXRecordDecl* impl) {
 // (its vector and method, shared by other calls of both) joins `sites`, and its intersection,
 // closest-hit and miss shaders join `shaders`. Returns why not, or "".
 std::string TraceLeafCall(ASTContext& ctx, Reporter& rep, const ClassModel& model, const Composition& comp, const CXXRecordDecl* implClass,
-                          const std::string& kernel, const CXXMemberCallExpr* call, GlslPrinter& hardware, std::vector<LeafTraversal>& sites, std::vector<GlslDecl>& payloads,
+                          const std::string& kernel, const CXXMemberCallExpr* call, KernelPrinter& hardware, std::vector<LeafTraversal>& sites, std::vector<GlslDecl>& payloads,
                           std::vector<StageShader>& shaders) {
   SourceManager& sm = ctx.getSourceManager();
   auto at = [&](SourceLocation loc) {
@@ -256,7 +257,7 @@ std::string TraceLeafCall(ASTContext& ctx, Reporter& rep, const ClassModel& mode
     if (f == distance) continue;  // the ray's end, set after
     const std::string zero = ZeroOf(f->getType());
     if (zero.empty()) return "the hit " + hitRecord->getNameAsString() + " has a field, '" + f->getNameAsString() + "', that is not a scalar, vector or array of them";
-    zeroHit += "  hit." + GlslPrinter::SafeName(f->getNameAsString()) + " = " + zero + ";\n";
+    zeroHit += "  hit." + KernelPrinter::SafeName(f->getNameAsString()) + " = " + zero + ";\n";
   }
   // Arguments: the ray and the hit as the traversal has them before the loop; the index as the leaf.
   if (!paperForm && NamedVar(indexExpr) != loopVar)
@@ -283,7 +284,7 @@ std::string TraceLeafCall(ASTContext& ctx, Reporter& rep, const ClassModel& mode
     else if (i == 1) args.push_back(paperForm ? "vec4(gl_ObjectRayDirectionEXT, gl_RayTmaxEXT)" : "vec4(gl_WorldRayDirectionEXT, gl_RayTmaxEXT)");
     else if (int(i) == infoIndex) args.push_back("crt_info");
     else if (int(i) == hitIndex) args.push_back("hit");
-    else if (GlslPrinter::PointsTo(method->getParamDecl(i)->getType(), implClass) && isa<CXXThisExpr>(arg)) continue;
+    else if (KernelPrinter::PointsTo(method->getParamDecl(i)->getType(), implClass) && isa<CXXThisExpr>(arg)) continue;
     else if (!paperForm && NamedVar(arg) == loopVar && type) args.push_back(*type + "(gl_InstanceID)");
     else if (isa<IntegerLiteral, FloatingLiteral, CXXBoolLiteralExpr>(arg) && type) args.push_back(*type + "(" + literals.Expr(arg) + ")");
     else return "argument " + std::to_string(i + 1) + " of " + callText + " is neither " + (paperForm ? "`this`" : "the leaf's index") + " nor a constant";
@@ -321,7 +322,7 @@ std::string TraceLeafCall(ASTContext& ctx, Reporter& rep, const ClassModel& mode
   }
   const std::string payload = member + "_" + methodName + "_hit", scene = member + "_leaves";
   const std::string p = hardware.Expr(call->getArg(0)), d = hardware.Expr(call->getArg(1)), h = hardware.Expr(call->getArg(unsigned(hitIndex)));
-  const std::string t = h + "." + GlslPrinter::SafeName(distance->getNameAsString()), number = std::to_string(lt.missIndex);
+  const std::string t = h + "." + KernelPrinter::SafeName(distance->getNameAsString()), number = std::to_string(lt.missIndex);
   // The trace (templates/glsl/leaf_trace.glsl.mustache) stands where the loop was.
   Data trace;
   trace.set("traversal", comp.implName + "::" + leaf.fn->getNameAsString());
@@ -391,7 +392,7 @@ std::string TraceLeafCall(ASTContext& ctx, Reporter& rep, const ClassModel& mode
     for (auto& x : object.Functions()) s.functions += x + "\n";
     std::string callArgs = "self";
     for (auto& a : args) callArgs += ", " + a;
-    const std::string dist = GlslPrinter::SafeName(distance->getNameAsString());
+    const std::string dist = KernelPrinter::SafeName(distance->getNameAsString());
     std::string leafInfo;
     if (paperForm) {
       const auto* info = method->getParamDecl(unsigned(infoIndex))->getType().getNonReferenceType()->getAsCXXRecordDecl();
@@ -437,7 +438,7 @@ std::string TraceLeafCall(ASTContext& ctx, Reporter& rep, const ClassModel& mode
 }  // namespace
 
 void AnalyzeLeafTraversal(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& k, const Composition& comp, const CXXRecordDecl* implClass,
-                          const std::string& holderPrefix, const GlslPrinter& printer) {
+                          const std::string& holderPrefix, const KernelPrinter& printer) {
   if (std::any_of(k.composedCalls.begin(), k.composedCalls.end(), [&](const auto& c) { return c.first != comp.holder; })) {
     k.whyNoLeafShaders = "it calls code composed through more than one member";
     return;

@@ -12,6 +12,6 @@ namespace crossrt::engine {
 // intersection shader per class of leaf. Otherwise the reason goes to k.whyNoLeafShaders and the
 // kernel keeps the switch.
 void AnalyzeLeafTraversal(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& k, const Composition& comp, const CXXRecordDecl* implClass,
-                          const std::string& holderPrefix, const GlslPrinter& printer);
+                          const std::string& holderPrefix, const KernelPrinter& printer);
 
 }  // namespace crossrt::engine

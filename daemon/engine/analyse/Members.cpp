@@ -1,6 +1,7 @@
 // The class's data members: which become buffers (std::vector), class data, images, samplers,
 // textures or vectors of objects, with their C++ and GLSL types. Takes the class; fills model.members
 // and model.constructors.
+#include "print/Printers.h"
 #include "analyse/Members.h"
 
 #include "analyse/AnalysisContext.h"
@@ -37,8 +38,8 @@ bool IspcDouble(const Context& c, QualType t) { return c.model.forIspc && t.getC
 }  // namespace
 
 void AnalyzeMembers(Context& c) {
-  GlslPrinter structs(c.ctx, c.cls, c.rep);
-  structs.ispc = c.model.forIspc;
+  std::unique_ptr<KernelPrinter> structPrinter = MakePrinter(c.model, c.ctx, c.cls, c.rep);
+  KernelPrinter& structs = *structPrinter;
   // The generated Vulkan class keeps its GPU objects in members of these names: a data member of
   // the same name would be hidden by them.
   static const std::set<std::string> generatedMembers = {

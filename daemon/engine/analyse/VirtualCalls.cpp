@@ -52,7 +52,7 @@ std::optional<std::vector<uint64_t>> MirrorOffsets(ASTContext& ctx, const std::v
   return offsets;
 }
 
-std::string ImplementationMethod(Reporter& rep, GlslPrinter& printer, const CXXRecordDecl* impl, const CXXMethodDecl* method, SourceLocation callLoc) {
+std::string ImplementationMethod(Reporter& rep, KernelPrinter& printer, const CXXRecordDecl* impl, const CXXMethodDecl* method, SourceLocation callLoc) {
   const CXXMethodDecl* overrider = method->getCorrespondingMethodInClass(impl);
   const FunctionDecl* def = nullptr;
   if (!overrider || overrider->isPureVirtual() || !overrider->hasBody(def) || !def) {
@@ -78,7 +78,7 @@ void RequirePublicForComposition(Reporter& rep, const FieldDecl* f, const std::s
 
 std::string CallArgumentName(const CXXMethodDecl* m, unsigned i) {
   const ParmVarDecl* p = m->getParamDecl(i);
-  return p->getName().empty() ? "arg" + std::to_string(i) : GlslPrinter::SafeName(p->getNameAsString());
+  return p->getName().empty() ? "arg" + std::to_string(i) : KernelPrinter::SafeName(p->getNameAsString());
 }
 
 bool WrittenBack(const CXXMethodDecl* m, unsigned i) {
@@ -86,12 +86,12 @@ bool WrittenBack(const CXXMethodDecl* m, unsigned i) {
   return pt->isReferenceType() && !pt.getNonReferenceType().isConstQualified();
 }
 
-std::string DispatcherParams(GlslPrinter& printer, const CXXMethodDecl* m) {
+std::string DispatcherParams(KernelPrinter& printer, const CXXMethodDecl* m, bool forIspc) {
   std::string out;
   for (unsigned i = 0; i < m->getNumParams(); ++i) {
-    if (GlslPrinter::PointsTo(m->getParamDecl(i)->getType(), printer.Class())) continue;  // the caller, left out (GlslOwner.cpp)
+    if (KernelPrinter::PointsTo(m->getParamDecl(i)->getType(), printer.Class())) continue;  // the caller, left out (GlslOwner.cpp)
     std::string declared = printer.Declare(m->getParamDecl(i)->getType(), CallArgumentName(m, i), m->getParamDecl(i)->getLocation());
-    if (WrittenBack(m, i) && printer.ispc) declared.insert(declared.rfind(' ') + 1, "&");  // ISPC: a reference
+    if (WrittenBack(m, i) && forIspc) declared.insert(declared.rfind(' ') + 1, "&");  // ISPC: a reference
     else if (WrittenBack(m, i)) declared = "inout " + declared;
     out += ", " + declared;
   }
@@ -125,16 +125,16 @@ std::vector<GlslDecl> ClassConstants(const ClassModel& model, const VirtualMembe
 
 std::string ClassConstantName(const VirtualMember& vm, size_t t) { return "crt_" + vm.member + "_holds" + vm.impls[t].name; }
 
-GlslDecl ImplDataStruct(const ClassModel& model, GlslPrinter& printer, const CXXRecordDecl* impl, const VirtualMember& vm, const VirtualImpl& vi) {
+GlslDecl ImplDataStruct(const ClassModel& model, KernelPrinter& printer, const CXXRecordDecl* impl, const VirtualMember& vm, const VirtualImpl& vi) {
   Data d, fields = List();
   d.set("data", true);
   d.set("class", vi.name);
-  d.set("dataStruct", printer.ispc ? IspcObjectStruct(vi.cppName) : vi.name + "_Data");
+  d.set("dataStruct", model.forIspc ? IspcObjectStruct(vi.cppName) : vi.name + "_Data");
   std::vector<const FieldDecl*> members;
   CollectObjectFields(impl, members);
   for (auto* f : members) {
     Data x;
-    x.set("declaration", printer.Declare(f->getType(), GlslPrinter::SafeName(f->getNameAsString()), f->getLocation()));
+    x.set("declaration", printer.Declare(f->getType(), KernelPrinter::SafeName(f->getNameAsString()), f->getLocation()));
     fields.push_back(x);
   }
   d.set("fields", fields);
@@ -142,7 +142,7 @@ GlslDecl ImplDataStruct(const ClassModel& model, GlslPrinter& printer, const CXX
   else d.set("paddingWords", false);
   d.set("interface", vm.interfaceName);
   d.set("slotBytes", std::to_string(vm.slotBytes));
-  return {printer.ispc ? IspcObjectStruct(vi.cppName) : vi.name + "_Data", Render(model.templateDir + (printer.ispc ? "/ispc/virtual_objects.ispc.mustache" : "/glsl/virtual_objects.glsl.mustache"), d)};
+  return {model.forIspc ? IspcObjectStruct(vi.cppName) : vi.name + "_Data", Render(model.templateDir + (model.forIspc ? "/ispc/virtual_objects.ispc.mustache" : "/glsl/virtual_objects.glsl.mustache"), d)};
 }
 
 GlslDecl ObjectsReference(const ClassModel& model, const VirtualMember& vm, const VirtualImpl& vi) {
@@ -154,14 +154,14 @@ GlslDecl ObjectsReference(const ClassModel& model, const VirtualMember& vm, cons
   return {vm.member + "_" + vi.name + "Objects", Render(model.templateDir + "/glsl/virtual_objects.glsl.mustache", d)};
 }
 
-void CheckObjectSizeReads(Reporter& rep, const GlslPrinter& printer) {
+void CheckObjectSizeReads(Reporter& rep, const KernelPrinter& printer) {
   for (auto& [field, loc] : printer.Uses().objectSizeReads)
     if (std::none_of(printer.Uses().virtualCalls.begin(), printer.Uses().virtualCalls.end(), [&](const auto& call) { return call.first == field; }))
       rep.GpuError(loc, "the kernel reads the size of '" + field->getNameAsString() + "', a vector of objects it calls no virtual function through",
                 "keep the count in a plain member, or read the size where the kernel also calls through the vector");
 }
 
-void AnalyzeVirtualCalls(Context& c, Kernel& k, GlslPrinter& kernelPrinter) {
+void AnalyzeVirtualCalls(Context& c, Kernel& k, KernelPrinter& kernelPrinter) {
   std::vector<GlslDecl> structs;
   std::vector<std::string> functions;
   CallableCode callable;

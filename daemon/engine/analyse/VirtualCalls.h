@@ -17,7 +17,7 @@ void CollectObjectFields(const CXXRecordDecl* rd, std::vector<const FieldDecl*>&
 std::optional<std::vector<uint64_t>> MirrorOffsets(ASTContext& ctx, const std::vector<const FieldDecl*>& fields, int layout /* 0 C++, 1 std430, 2 scalar */);
 
 // The implementation of `method` the GPU runs for objects of `impl`: its GLSL name, or "" (reported).
-std::string ImplementationMethod(Reporter& rep, GlslPrinter& printer, const CXXRecordDecl* impl, const CXXMethodDecl* method, SourceLocation callLoc);
+std::string ImplementationMethod(Reporter& rep, KernelPrinter& printer, const CXXRecordDecl* impl, const CXXMethodDecl* method, SourceLocation callLoc);
 
 // The generated class derives from `cls` and names member `f`: a private one is an error.
 void RequireReachable(Reporter& rep, const FieldDecl* f, const CXXRecordDecl* cls);
@@ -33,7 +33,7 @@ std::string CallArgumentName(const CXXMethodDecl* m, unsigned i);
 bool WrittenBack(const CXXMethodDecl* m, unsigned i);
 
 // ", vec3 normal, inout float weight": a dispatcher's parameters after the element's index.
-std::string DispatcherParams(GlslPrinter& printer, const CXXMethodDecl* m);
+std::string DispatcherParams(KernelPrinter& printer, const CXXMethodDecl* m, bool forIspc);
 
 // The specialization constants that say which classes a vector's objects hold (kClassConstantIdBase),
 // one per class: a dispatcher's case for a class the scene lacks is dead code in the pipeline.
@@ -44,17 +44,17 @@ std::string ClassConstantName(const VirtualMember& vm, size_t t);  // crt_m_mate
 GlslDecl TagsReference(const ClassModel& model, const VirtualMember& vm);
 
 // The GLSL mirror of the data of an implementation's objects (printed by its object-mode printer).
-GlslDecl ImplDataStruct(const ClassModel& model, GlslPrinter& printer, const CXXRecordDecl* impl, const VirtualMember& vm, const VirtualImpl& vi);
+GlslDecl ImplDataStruct(const ClassModel& model, KernelPrinter& printer, const CXXRecordDecl* impl, const VirtualMember& vm, const VirtualImpl& vi);
 
 // The buffer reference to the objects of one implementation (level 2 and 3).
 GlslDecl ObjectsReference(const ClassModel& model, const VirtualMember& vm, const VirtualImpl& vi);
 
 // The size of a vector of objects is in the class data next to the vector's tags, which exist for
 // vectors the kernel calls through.
-void CheckObjectSizeReads(Reporter& rep, const GlslPrinter& printer);
+void CheckObjectSizeReads(Reporter& rep, const KernelPrinter& printer);
 
 // The kernel's own code calls virtual functions through the class's vectors of objects.
-void AnalyzeVirtualCalls(Context& c, Kernel& k, GlslPrinter& kernelPrinter);
+void AnalyzeVirtualCalls(Context& c, Kernel& k, KernelPrinter& kernelPrinter);
 
 // Where the vectors of objects that code calls virtual functions through live: the translated
 // class (its own members), or a composed implementation (the code of listing 2 of the paper: a

@@ -101,10 +101,10 @@ private:
   void CheckUniform(ThreadLoop& tl, const Expr* e, const std::string& where, bool readOnGpu = true);
 
   // The GLSL of the thread loop's body (the megakernel) and, alongside, the checks of what may be in it.
-  std::string ThreadBodyGlsl(ThreadLoop& tl, GlslPrinter& printer, const Stmt* s, int indent);
+  std::string ThreadBodyGlsl(ThreadLoop& tl, KernelPrinter& printer, const Stmt* s, int indent);
 
   // A kernel call in the thread loop's body, as the megakernel calls the kernel's thread function.
-  std::string KernelCallGlsl(ThreadLoop& tl, GlslPrinter& printer, const CXXMemberCallExpr* call);
+  std::string KernelCallGlsl(ThreadLoop& tl, KernelPrinter& printer, const CXXMemberCallExpr* call);
 
   // A pointer argument of a kernel in a thread loop: in the megakernel, a buffer named as the
   // kernel's parameter (its code refers to that name). Two kernels naming different buffers alike

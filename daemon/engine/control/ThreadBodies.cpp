@@ -30,7 +30,7 @@ static std::string IspcZero(const std::string& glslType) {
   return "";
 }
 
-std::string ControlRewriter::ThreadBodyGlsl(ThreadLoop& tl, GlslPrinter& printer, const Stmt* s, int indent) {
+std::string ControlRewriter::ThreadBodyGlsl(ThreadLoop& tl, KernelPrinter& printer, const Stmt* s, int indent) {
   const std::string pad(2 * indent, ' ');
   if (auto* cs = dyn_cast<CompoundStmt>(s)) {
     std::string out;
@@ -58,8 +58,8 @@ std::string ControlRewriter::ThreadBodyGlsl(ThreadLoop& tl, GlslPrinter& printer
       }
       tl.stateBuffers.push_back({vd, m_ctrl.name + (m_threadLoops > 1 ? std::to_string(m_threadLoops) : "") + "_" + vd->getNameAsString()});
       static const std::regex zeroable(R"(^(float|int|uint|[iu]?vec[234]|mat[234])$)");
-      std::string name = GlslPrinter::SafeName(vd->getNameAsString());
-      if (printer.ispc) {  // LiteMath's types start at zero in C++ too
+      std::string name = KernelPrinter::SafeName(vd->getNameAsString());
+      if (m_c.model.forIspc) {  // LiteMath's types start at zero in C++ too
         out += pad + IspcTypeName(*g) + " " + name + IspcZero(*g) + ";\n";
         continue;
       }
@@ -79,7 +79,7 @@ std::string ControlRewriter::ThreadBodyGlsl(ThreadLoop& tl, GlslPrinter& printer
     CheckUniform(tl, var->getInit(), "the loop's start");
     CheckUniform(tl, fs->getCond(), "the loop's condition");
     CheckUniform(tl, fs->getInc(), "the loop's step");
-    std::string header = "for (" + (printer.ispc ? IspcTypeName(*GlslTypeOf(var->getType())) : *GlslTypeOf(var->getType())) + " " + GlslPrinter::SafeName(var->getNameAsString()) + " = " + printer.Expr(var->getInit()) + "; " +
+    std::string header = "for (" + (m_c.model.forIspc ? IspcTypeName(*GlslTypeOf(var->getType())) : *GlslTypeOf(var->getType())) + " " + KernelPrinter::SafeName(var->getNameAsString()) + " = " + printer.Expr(var->getInit()) + "; " +
                          printer.Expr(fs->getCond()) + "; " + printer.Expr(fs->getInc()) + ")";
     m_hostLoopDepth++;
     const std::string loopBody = ThreadBodyGlsl(tl, printer, fs->getBody(), indent + 1);
@@ -118,12 +118,12 @@ std::string ControlRewriter::ThreadBodyGlsl(ThreadLoop& tl, GlslPrinter& printer
   return pad + KernelCallGlsl(tl, printer, call) + ";\n";
 }
 
-std::string ControlRewriter::KernelCallGlsl(ThreadLoop& tl, GlslPrinter& printer, const CXXMemberCallExpr* call) {
+std::string ControlRewriter::KernelCallGlsl(ThreadLoop& tl, KernelPrinter& printer, const CXXMemberCallExpr* call) {
   auto* md = call->getMethodDecl();
   Note(call);
   auto& calls = tl.mega.megakernelCalls;
   if (std::find(calls.begin(), calls.end(), md->getNameAsString()) == calls.end()) calls.push_back(md->getNameAsString());
-  std::string args = printer.ispc ? "self" : "", buffers;  // ISPC: the class data first, the buffers last (IspcRtvHead)
+  std::string args = m_c.model.forIspc ? "self" : "", buffers;  // ISPC: the class data first, the buffers last (IspcRtvHead)
   std::set<unsigned> axes;
   for (unsigned i = 0; i < call->getNumArgs() && i < md->getNumParams(); ++i) {
     auto* p = md->getParamDecl(i);
@@ -145,8 +145,8 @@ std::string ControlRewriter::KernelCallGlsl(ThreadLoop& tl, GlslPrinter& printer
               "pass each loop variable as the same thread id (tidX, tidY, tidZ) to every kernel");
       axes.insert(axis);
       std::string type = GlslTypeOf(p->getType()).value_or("uint"), varType = GlslTypeOf(vd->getType()).value_or("int");
-      std::string name = GlslPrinter::SafeName(vd->getNameAsString());
-      a = type == varType ? name : printer.ispc ? "((" + IspcTypeName(type) + ")(" + name + "))" : type + "(" + name + ")";
+      std::string name = KernelPrinter::SafeName(vd->getNameAsString());
+      a = type == varType ? name : m_c.model.forIspc ? "((" + IspcTypeName(type) + ")(" + name + "))" : type + "(" + name + ")";
     } else if (IsImageParam(p)) {
       Error(tl, arg->getBeginLoc(), "Image2D argument of '" + md->getNameAsString() + "' in a thread loop that calls several kernels",
             "the megakernel binds members only: make the image a member of the class, or give the kernel a thread loop of its own");
@@ -155,7 +155,7 @@ std::string ControlRewriter::KernelCallGlsl(ThreadLoop& tl, GlslPrinter& printer
       auto* vd = AddressedVar(arg);
       if (vd && !StateBuffer(tl, vd).empty()) {
         tl.passed.insert(vd);
-        a = GlslPrinter::SafeName(vd->getNameAsString());
+        a = KernelPrinter::SafeName(vd->getNameAsString());
       } else if (vd) {
         Error(tl, arg->getBeginLoc(), "'&" + vd->getNameAsString() + "' passed to '" + md->getNameAsString() + "' is not a per-thread local declared in the thread loop",
               "declare the variable inside the thread loop's body");
@@ -177,13 +177,13 @@ std::string ControlRewriter::KernelCallGlsl(ThreadLoop& tl, GlslPrinter& printer
   if (axes.size() != tl.loops.size())
     Error(tl, call->getBeginLoc(), "'" + md->getNameAsString() + "' takes " + std::to_string(axes.size()) + " thread ids, but the thread loop around it has " +
           std::to_string(tl.loops.size()) + " loops", "give every kernel of a thread loop one thread id parameter (tidX, tidY, ...) per loop");
-  return md->getNameAsString() + "(" + args + (printer.ispc ? buffers : "") + ")";
+  return md->getNameAsString() + "(" + args + (m_c.model.forIspc ? buffers : "") + ")";
 }
 
 std::string ControlRewriter::KernelParamName(const CXXMethodDecl* md, unsigned i) const {
   for (auto& k : m_c.model.kernels)
     if (k.name == md->getNameAsString() && i < k.params.size()) return k.params[i].glslName;  // as the definition names it
-  return GlslPrinter::SafeName(md->getParamDecl(i)->getNameAsString());
+  return KernelPrinter::SafeName(md->getParamDecl(i)->getNameAsString());
 }
 
 void ControlRewriter::AddMegakernelBuffer(ThreadLoop& tl, const CXXMethodDecl* md, const ParmVarDecl* p, const std::string& hostArg,

@@ -2,6 +2,7 @@
 // called per thread. One nest of one kernel is one dispatch; several kernels sharing per-thread locals
 // are a megakernel or a wavefront of dispatches (paper 2.1, 4.4).
 
+#include "print/Printers.h"
 #include "analyse/AnalysisContext.h"
 #include "analyse/AstQueries.h"
 #include "control/ControlFunctions.h"
@@ -88,8 +89,9 @@ bool ControlRewriter::TryThreadLoop(const ForStmt* outerLoop) {
   tl.mega.megakernelOf = m_ctrl.name;
   tl.mega.sourceFile = m_ctrl.sourceFile;
   tl.mega.dims = unsigned(tl.loops.size());
-  GlslPrinter printer(m_c.ctx, m_c.cls, m_c.rep);
-  printer.ispc = m_c.model.forIspc;  // the ISPC class runs the body in SIMD lanes (IspcThreadLoops.cpp)
+  // The ISPC class runs the body in SIMD lanes (IspcThreadLoops.cpp).
+  std::unique_ptr<KernelPrinter> bodyPrinter = MakePrinter(m_c.model, m_c.ctx, m_c.cls, m_c.rep);
+  KernelPrinter& printer = *bodyPrinter;
   for (auto& s : ClassStructNames(m_c.model)) printer.predeclaredStructs.insert(s);
   for (auto& [param, arg] : m_inlined) printer.renames[param] = printer.Expr(Resolve(arg));  // read through
   std::string glsl = ThreadBodyGlsl(tl, printer, body, 1);
@@ -115,7 +117,7 @@ bool ControlRewriter::TryThreadLoop(const ForStmt* outerLoop) {
   for (unsigned a = 0; a < byAxis.size(); ++a) {
     KernelParam id;
     id.name = byAxis[a]->getNameAsString();
-    id.glslName = GlslPrinter::SafeName(id.name);
+    id.glslName = KernelPrinter::SafeName(id.name);
     id.glslType = GlslTypeOf(byAxis[a]->getType()).value_or("int");
     id.isThreadId = true;
     tl.mega.params.push_back(id);
@@ -136,7 +138,7 @@ bool ControlRewriter::TryThreadLoop(const ForStmt* outerLoop) {
     }
     KernelParam v;
     v.name = vd->getNameAsString();
-    v.glslName = GlslPrinter::SafeName(v.name);
+    v.glslName = KernelPrinter::SafeName(v.name);
     v.glslType = *g;
     v.valueCppType = v.cppType = CppTypeName(m_c.ctx, t);
     v.std430Align = unsigned(layout->align);

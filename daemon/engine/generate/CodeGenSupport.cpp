@@ -2,7 +2,7 @@
 // every generated file gets (Common), a kernel's shader variants and its dispatch sizes.
 #include "generate/CodeGenSupport.h"
 #include "generate/CodeGen.h"
-#include "print/Glsl.h"
+#include "print/KernelPrinter.h"
 
 #include <fstream>
 #include <regex>

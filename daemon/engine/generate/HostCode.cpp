@@ -3,7 +3,7 @@
 #include "generate/CodeGenSupport.h"
 #include "generate/VulkanHost.h"
 #include "generate/CodeGen.h"
-#include "print/Glsl.h"
+#include "print/KernelPrinter.h"
 
 #include <fstream>
 #include <set>

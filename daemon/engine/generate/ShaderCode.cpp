@@ -3,7 +3,7 @@
 // gives one ShaderSource per shader.
 #include "generate/CodeGenSupport.h"
 #include "generate/CodeGen.h"
-#include "print/Glsl.h"
+#include "print/KernelPrinter.h"
 
 #include <cctype>
 #include <fstream>
@@ -181,7 +181,7 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
     b.set("access", p.isConstPointee ? "readonly " : coherent);
     // A per-thread value: main() loads this thread's element, passes it, and stores it back.
     const std::string name = p.threadState ? p.glslName + "PerThread" : p.glslName;
-    b.set("blockName", GlslPrinter::SafeName(name + "Buffer"));  // `image`'s is not GLSL's imageBuffer
+    b.set("blockName", KernelPrinter::SafeName(name + "Buffer"));  // `image`'s is not GLSL's imageBuffer
     b.set("type", p.glslType);
     b.set("name", name);
     b.set("comment", p.threadState ? "parameter '" + p.name + "': one value per thread, kept between the kernels of a thread loop"
@@ -195,7 +195,7 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
     scalarAny |= m && m->scalarLayout;
     b.set("binding", std::to_string(binding++));
     b.set("access", coherent);
-    b.set("blockName", GlslPrinter::SafeName(v + "Buffer"));
+    b.set("blockName", KernelPrinter::SafeName(v + "Buffer"));
     b.set("type", m ? m->glslType : "float");
     b.set("name", v);
     b.set("comment", m && !m->composedFrom.empty() ? "composed: std::vector " + m->composedFrom : "member std::vector " + v);
@@ -418,7 +418,7 @@ std::string StageGlsl(const ClassModel& model, const StageShader& c, const Gener
     b.set("layout", m && m->scalarLayout ? "scalar" : "std430");
     scalar |= m && m->scalarLayout;
     b.set("binding", std::to_string(1 + pointers + (at - k->memberVectors.begin())));
-    b.set("blockName", GlslPrinter::SafeName(v + "Buffer"));
+    b.set("blockName", KernelPrinter::SafeName(v + "Buffer"));
     b.set("type", m ? m->glslType : "float");
     b.set("name", v);
     b.set("comment", m && !m->composedFrom.empty() ? "composed: std::vector " + m->composedFrom : "member std::vector " + v);

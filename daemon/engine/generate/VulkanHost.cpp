@@ -5,7 +5,7 @@
 #include "generate/VulkanHost.h"
 #include "generate/CodeGenSupport.h"
 #include "generate/CodeGen.h"
-#include "print/Glsl.h"
+#include "print/KernelPrinter.h"
 
 #include <fstream>
 #include <set>
@@ -166,7 +166,7 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
         field("4", "uint32_t", p.name + "_height", p.name + ".height()");
         continue;
       }
-      field(std::to_string(p.std430Align), p.valueCppType, GlslPrinter::SafeName(p.name), p.narrowed ? p.valueCppType + "(" + p.name + ")" : p.name);
+      field(std::to_string(p.std430Align), p.valueCppType, KernelPrinter::SafeName(p.name), p.narrowed ? p.valueCppType + "(" + p.name + ")" : p.name);
     }
     x.set("pushFields", fields);
     // Image parameters it samples linearly: their format must allow it on this device.

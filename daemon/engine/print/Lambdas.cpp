@@ -4,7 +4,7 @@
 // (kernel1D_Run_f), whose parameters are the lambda's and then its captures: by copy as values,
 // by reference as inout (GLSL) or references (ISPC), `this` as the class data it reaches. The
 // local itself prints as nothing.
-#include "print/Glsl.h"
+#include "print/KernelPrinter.h"
 
 #include "analyse/AstQueries.h"
 
@@ -32,7 +32,7 @@ const LambdaExpr* CalledLambda(const clang::Expr* callee, const VarDecl** holder
 
 }  // namespace
 
-std::string GlslPrinter::LambdaCall(const CXXOperatorCallExpr* op) {
+std::string KernelPrinter::LambdaCall(const CXXOperatorCallExpr* op) {
   const VarDecl* holder = nullptr;
   const LambdaExpr* lambda = CalledLambda(op->getArg(0), &holder);
   if (!lambda)
@@ -45,7 +45,7 @@ std::string GlslPrinter::LambdaCall(const CXXOperatorCallExpr* op) {
   for (unsigned i = 1; i < op->getNumArgs(); ++i) args += (args.empty() ? "" : ", ") + Expr(op->getArg(i));
   for (const LambdaCapture& capture : lambda->captures()) {
     if (capture.capturesThis()) {
-      if (ispc) args = "self" + std::string(args.empty() ? "" : ", ") + args;
+      if (std::string data = ClassDataArgument(); !data.empty()) args = data + std::string(args.empty() ? "" : ", ") + args;
       continue;
     }
     if (capture.capturesVariable()) args += (args.empty() ? "" : ", ") + SafeName(capture.getCapturedVar()->getNameAsString());
@@ -53,7 +53,7 @@ std::string GlslPrinter::LambdaCall(const CXXOperatorCallExpr* op) {
   return name + "(" + args + ")";
 }
 
-std::string GlslPrinter::EmitLambda(const LambdaExpr* lambda, const std::string& name) {
+std::string KernelPrinter::EmitLambda(const LambdaExpr* lambda, const std::string& name) {
   if (auto known = m_lambdaNames.find(lambda); known != m_lambdaNames.end()) return known->second;
   const CXXMethodDecl* call = lambda->getCallOperator();
   if (lambda->isGenericLambda())
@@ -66,12 +66,12 @@ std::string GlslPrinter::EmitLambda(const LambdaExpr* lambda, const std::string&
              ? cast<FunctionDecl>(lambda->getLambdaClass()->getDeclContext())->getQualifiedNameAsString()
              : std::string("the kernel"))
      << "\n"
-     << (ispc ? "static inline " : "") << (ret ? *ret : "void") << " " << name << "(";
+     << FunctionQualifiers() << (ret ? *ret : "void") << " " << name << "(";
   std::string params;
   auto add = [&](const std::string& p) { params += (params.empty() ? "" : ", ") + p; };
   bool capturesThis = false;
   for (const LambdaCapture& capture : lambda->captures()) capturesThis = capturesThis || capture.capturesThis();
-  if (capturesThis && ispc) add("uniform " + DataStruct() + " *uniform self");
+  if (std::string data = ClassDataParameter(); capturesThis && !data.empty()) add(data);
   for (const ParmVarDecl* p : call->parameters()) {
     const QualType t = p->getType();
     if (t->isPointerType()) return Fail(p->getLocation(), "a lambda with a pointer parameter in a kernel", "pass the element, or an index into the buffer");

@@ -7,7 +7,7 @@
 // data, which holds the traversal's, and the dispatcher passes its own), and what is read through it
 // prints as the traversal's own code prints it, under the traversal's prefix, into the traversal's
 // Uses (which decide the kernel's buffers).
-#include "print/Glsl.h"
+#include "print/KernelPrinter.h"
 
 #include "analyse/AstQueries.h"
 
@@ -17,7 +17,7 @@ using namespace clang;
 
 namespace crossrt::engine {
 
-bool GlslPrinter::PointsTo(QualType t, const CXXRecordDecl* cls) {
+bool KernelPrinter::PointsTo(QualType t, const CXXRecordDecl* cls) {
   if (!cls) return false;
   t = t.getNonReferenceType();
   if (t->isPointerType()) t = t->getPointeeType();
@@ -25,15 +25,15 @@ bool GlslPrinter::PointsTo(QualType t, const CXXRecordDecl* cls) {
   return rd && rd->getCanonicalDecl() == cls->getCanonicalDecl();
 }
 
-bool GlslPrinter::IsOwnerParam(const ParmVarDecl* p) const { return p && owner && PointsTo(p->getType(), owner->m_class); }
+bool KernelPrinter::IsOwnerParam(const ParmVarDecl* p) const { return p && owner && PointsTo(p->getType(), owner->m_class); }
 
-bool GlslPrinter::PassesSelf(const ParmVarDecl* p, const clang::Expr* arg) const {
+bool KernelPrinter::PassesSelf(const ParmVarDecl* p, const clang::Expr* arg) const {
   const clang::Expr* e = arg->IgnoreParenImpCasts();
   if (auto* uo = dyn_cast<UnaryOperator>(e); uo && uo->getOpcode() == UO_Deref) e = uo->getSubExpr()->IgnoreParenImpCasts();  // *this
   return p && isa<CXXThisExpr>(e) && PointsTo(p->getType(), m_class);
 }
 
-const ParmVarDecl* GlslPrinter::OwnerParamOf(const clang::Expr* e) const {
+const ParmVarDecl* KernelPrinter::OwnerParamOf(const clang::Expr* e) const {
   if (!owner) return nullptr;
   auto* dr = dyn_cast<DeclRefExpr>(e->IgnoreParenImpCasts());
   auto* p = dr ? dyn_cast<ParmVarDecl>(dr->getDecl()) : nullptr;
@@ -43,20 +43,20 @@ const ParmVarDecl* GlslPrinter::OwnerParamOf(const clang::Expr* e) const {
 // `scene->Helper(args)`: the traversal's method, printed by a printer of the traversal's class under
 // its prefix, with what it reads recorded in the owner's Uses. Its functions (and structs) go ahead of
 // the object's, which call them: each shader that holds the object's code holds them too.
-std::string GlslPrinter::OwnerCall(const CXXMemberCallExpr* call) {
+std::string KernelPrinter::OwnerCall(const CXXMemberCallExpr* call) {
   const CXXMethodDecl* method = call->getMethodDecl();
   if (method->isVirtual())
     return Fail(call->getBeginLoc(), "virtual call of " + method->getQualifiedNameAsString() + " through the traversal passed to an object's method",
                 "call a non-virtual helper of the traversal");
-  GlslPrinter helper(m_ctx, owner->m_class, m_reporter);
+  std::unique_ptr<KernelPrinter> sibling = Sibling(owner->m_class);
+  KernelPrinter& helper = *sibling;
   helper.composedPrefix = owner->composedPrefix;
-  helper.ispc = ispc;
-  helper.ispcDataStruct = owner->DataStruct();
+  helper.dataStruct = owner->DataStruct();
   helper.predeclaredStructs = predeclaredStructs;
   for (auto& x : m_structs) helper.predeclaredStructs.insert(x.name);  // declared here already
   std::map<unsigned, std::string> bindings;
   std::vector<std::string> args = HelperArgs(method, call, bindings);
-  if (ispc && !method->isStatic())  // the traversal's methods take the class data first, as `self`
+  if (!ClassDataArgument().empty() && !method->isStatic())  // the traversal's methods take the class data first, as `self`
     args.insert(args.begin(), SafeName(OwnerParamOf(call->getImplicitObjectArgument())->getNameAsString()));
   const std::string callee = helper.EmitHelper(method, call->getBeginLoc(), false, bindings);
   if (!helper.m_uses.virtualCalls.empty())

@@ -1,5 +1,8 @@
-// The GLSL printer: C++ (Clang AST) to GLSL for the code one kernel reaches, collecting the helper
-// functions, structs, members and images it uses. Types and layouts are in GlslTypes.h.
+// The kernel printer: the walk over the C++ (Clang AST) that one kernel reaches, collecting the helper
+// functions, structs, members and images it uses. What a target language spells differently is a
+// virtual function of KernelPrinter, implemented once per language: glsl/GlslPrinter.h for Vulkan's
+// shaders, ispc/IspcPrinter.h for the ISPC backend (Printers.h makes one). Types and layouts are
+// GlslTypes.h's: the GPU's types, spelled as GLSL spells them, are the walk's common vocabulary.
 #pragma once
 #include "Diagnostics.h"
 #include "print/GlslTypes.h"
@@ -13,6 +16,7 @@
 #include <clang/AST/Stmt.h>
 
 #include <map>
+#include <memory>
 #include <optional>
 #include <set>
 #include <string>
@@ -69,10 +73,14 @@ struct PrintedUses {
 };
 
 // Prints the code one kernel reaches. One instance per kernel; it collects the helper functions,
-// structs and constants the kernel needs, in an order GLSL accepts (callees before callers).
-class GlslPrinter {
+// structs and constants the kernel needs, in the order a shading language accepts (callees before
+// callers). Abstract: the language's spellings are the pure virtual functions below.
+class KernelPrinter {
 public:
-  GlslPrinter(clang::ASTContext& ctx, const clang::CXXRecordDecl* cls, Reporter& reporter);
+  KernelPrinter(clang::ASTContext& ctx, const clang::CXXRecordDecl* cls, Reporter& reporter);
+  virtual ~KernelPrinter() = default;
+  // A printer of the same language for another class (the traversal a composed object calls back).
+  virtual std::unique_ptr<KernelPrinter> Sibling(const clang::CXXRecordDecl* cls) const = 0;
 
   // Names that print differently: reduction members -> their per-thread accumulator, pointer params.
   std::map<const clang::ValueDecl*, std::string> renames;
@@ -82,10 +90,10 @@ public:
   // The kernel's Image2D reference parameters (the definition's): images bound per call, used in
   // the kernel's own body as member images are.
   OrderedSet<const clang::ValueDecl*> imageParams;
-  // ISPC: the values every lane of a gang shares (a kernel's scalar parameters, the outer loops'
-  // variables of a 2D or 3D nest), and loop variables found uniform from them (IspcUniformLoop).
+  // The values every thread of a group shares (a kernel's scalar parameters, the outer loops'
+  // variables of a 2D or 3D nest), as the analysis found them; a language whose threads run in
+  // lockstep declares them so (and loop variables found uniform from them).
   std::set<const clang::ValueDecl*> uniformValues;
-  bool IspcUniform(const clang::Expr* e) const;
 
   // Composition (paper 3.6). In a kernel's printer: interfaces with an implementation
   // ("ISceneObject" -> "BVHScene"); a call through a member holding one prints as
@@ -109,7 +117,7 @@ public:
   // GlslOwner.cpp. In an object's printer: the traversal's printer. The parameter is left out of
   // the GPU's functions, and what is read through it (scene->m_values[i], scene->Helper(...))
   // prints as the traversal's own code does, under the traversal's prefix and in its Uses().
-  GlslPrinter* owner = nullptr;
+  KernelPrinter* owner = nullptr;
   // A parameter (or the type of one) pointing at the class this printer's `owner` prints, or, with
   // no owner, at this printer's own class: an argument the GPU leaves out.
   static bool PointsTo(clang::QualType t, const clang::CXXRecordDecl* cls);
@@ -117,16 +125,13 @@ public:
   bool PassesSelf(const clang::ParmVarDecl* p, const clang::Expr* arg) const;  // `this` for such a parameter
   const clang::CXXRecordDecl* Class() const { return m_class; }
 
-  // ISPC instead of GLSL (the ISPC backend, IspcCode.cpp): LiteMath's type names, make_T(...)
-  // constructors, C casts, references for inout parameters, members read through `self` (a pointer
-  // to <Class>_Data, which the class's methods take first), and the built-ins of LiteMath.isph.
-  bool ispc = false;
-  // The ISPC data struct's name and the text of a member through it ("self->m_x"). A composed
-  // implementation's printer names the class's (ispcDataStruct): its members are the class's too.
-  std::string ispcDataStruct;
+  // The class data's struct name ("<Class>_Data"). A composed implementation's printer names the
+  // class's (dataStruct): its members are the class's too.
+  std::string dataStruct;
   std::string DataStruct() const;
-  std::string IspcMember(const std::string& name) const { return ispcSelf + "->" + composedPrefix + name; }
-  std::string ispcSelf = "self";  // what points at the class data (an object's method: its traversal parameter)
+  // What points at the class data where a function is passed it (an object's method: its traversal
+  // parameter).
+  std::string dataPointer = "self";
 
   // Printing statements one thread runs (before or after a kernel's loop nest): a member vector that
   // kernels append to may be emptied there (its count restarts).
@@ -161,64 +166,142 @@ public:
   std::set<std::string> predeclaredStructs;
   static std::string SafeName(const std::string& name);  // renames GLSL keywords
 
-private:
+protected:
+  // What a pointer in a kernel points at (Pointers.cpp).
+  struct PointerTarget {
+    std::string array;   // the array it points into (as the printed code names it), or "" for one variable
+    std::string offset;  // its element offset in `array` ("" is 0)
+    std::string value;   // one variable: its lvalue
+    bool local = false;  // the array is a local one (a copy of a helper cannot reach it)
+    std::string perThread;  // a thread loop's local passed by address (for messages)
+  };
+
+  // ---- what each language spells differently (glsl/GlslPrinter.cpp, ispc/IspcPrinter.cpp) ----
+  // Types: a double where the language has one (else nullopt: refused); a GPU type (GLSL's
+  // spelling, GlslTypes.h) as the language spells it (nullopt, reported, where it has none).
+  virtual std::optional<std::string> DoubleType(clang::QualType t) = 0;
+  virtual std::optional<std::string> SpellType(clang::QualType t, const std::string& gpuType, clang::SourceLocation loc) = 0;
+  // A struct's fields and closing brace (and whatever builds one), after `struct Name {`.
+  virtual std::string StructBody(const clang::RecordDecl* rd) = 0;
+  virtual std::string ConstantQualifier() const = 0;  // before a constant's type
+  virtual std::string FloatSuffix(const clang::FloatingLiteral* literal) const = 0;
+  // Conversions: a double narrowed to float, an integer made real (`conversion` is the cast node),
+  // a value converted to a GPU type (`target`, GLSL's spelling) other than bool.
+  virtual std::string NarrowedDouble(const clang::Expr* sub) = 0;
+  virtual std::string IntegerToReal(const clang::Expr* sub, const clang::Expr* conversion) = 0;
+  virtual std::string ConvertedTo(const std::string& target, const clang::Expr* sub) = 0;
+  // Construction of a value of type t (spelled `type`) from args, past copies (Construct); of
+  // LiteMath's half2 and half4; of an array or struct from an initializer list; a std::array's
+  // elements (`list`) as a value of type `type`.
+  virtual std::string ConstructValue(clang::QualType t, const std::string& type, const std::vector<const clang::Expr*>& args,
+                                     clang::SourceLocation loc) = 0;
+  virtual std::string HalfConstruct(clang::QualType t, const std::vector<const clang::Expr*>& args, clang::SourceLocation loc) = 0;
+  virtual std::string ListConstruct(clang::QualType t, const std::string& base, const std::string& dims,
+                                    const std::vector<const clang::Expr*>& args, clang::SourceLocation loc) = 0;
+  virtual std::string ArrayValue(const std::string& type, const std::string& list) = 0;
+  // Functions: what precedes a function's return type; the class data as the first parameter of the
+  // class's methods and as the first argument of their calls ("" where it is global); a struct's
+  // method's writable `self`; an object's data struct; the traversal passed to an object's method
+  // ("" where it is left out); whether buffers are passed to helpers (else each copy of a helper
+  // indexes the buffers it is bound to), and such a buffer's parameter; a writable parameter.
+  virtual std::string FunctionQualifiers() const = 0;
+  virtual std::string ClassDataParameter() const = 0;
+  virtual std::string ClassDataArgument() const = 0;
+  virtual std::string WritableSelf(const std::string& structName) const = 0;
+  virtual std::string ObjectDataStruct(const clang::CXXRecordDecl* cls) const = 0;
+  virtual std::string OwnerParameter(const clang::ParmVarDecl* p) = 0;
+  virtual bool PassesBuffers() const = 0;
+  virtual std::string BufferParameter(const clang::ParmVarDecl* p, const std::string& name) = 0;
+  virtual std::string WritableParam(clang::QualType type, const std::string& name, clang::SourceLocation loc) = 0;
+  // Members of the class data, by name; a vector's size as an int; whether a size is 0; a size as
+  // an unsigned literal; the index of an element of a vector of objects (its expression, or the text
+  // a local pointing at one holds).
+  virtual std::string MemberAccess(const std::string& name) const = 0;
+  virtual std::string SizeAsInt(const std::string& size) const = 0;
+  virtual std::string EmptyTest(const std::string& size) const = 0;
+  virtual std::string SizeLiteral(uint64_t n) const = 0;
+  virtual std::string ObjectIndex(const clang::Expr* index) = 0;
+  virtual std::string ObjectLocalIndex(const std::string& index) const = 0;
+  // push_back to a member vector: the function `name` that appends (written once per vector); a
+  // member vector's other methods where the language handles them itself ("" to go on).
+  virtual std::string AppendFunction(const clang::FieldDecl* field, const clang::CallExpr* call, const std::string& name) = 0;
+  virtual std::string VectorMethod(const clang::FieldDecl* field, const clang::CXXMemberCallExpr* call, const std::string& name) = 0;
+  // Calls: library functions (`same`: those spelled as GLSL spells them); an unsigned conversion
+  // of a bit builtin's argument; crossrt::Atomic* with its printed arguments; LiteMath's
+  // InterlockedAdd and ReduceAdd; the function std::min and std::max of a list fold with.
+  virtual std::string LibraryCall(const clang::FunctionDecl* fd, const std::vector<std::string>& args, const clang::CallExpr* call,
+                                  const std::map<std::string, std::string>& same) = 0;
+  virtual std::string BitArgument(const std::string& value) const = 0;
+  virtual std::string AtomicOperation(const std::string& name, const std::vector<std::string>& args) = 0;
+  virtual std::string InterlockedCall(const clang::FunctionDecl* fd, const clang::CallExpr* call) = 0;
+  virtual std::string FoldFunction(const std::string& name) const = 0;
+  // Images and arrays of textures: a texel read (img[p]), the image's methods, a texture's.
+  virtual std::string TexelRead(const clang::CXXOperatorCallExpr* op, const clang::ValueDecl* image) = 0;
+  virtual std::string ImageCall(const clang::ValueDecl* image, const clang::CXXMemberCallExpr* call) = 0;
+  virtual std::string TextureCall(const clang::FieldDecl* array, const clang::Expr* index, const clang::CXXMemberCallExpr* call) = 0;
+  virtual std::string TextureTexel(const clang::FieldDecl* array, const clang::Expr* index, const clang::Expr* coord, clang::SourceLocation loc) = 0;
+  // Operators the language prints its own way, or "" for the common spelling: LiteMath's vector
+  // operators; an element of a member vector; a store through a pointer; an assignment to a texel
+  // (an operator call or built in); any assignment; an element read through a pointer.
+  virtual std::string VectorOperator(const clang::CXXOperatorCallExpr* op) = 0;
+  virtual std::string ElementRead(const clang::CXXOperatorCallExpr* op) = 0;
+  virtual std::string WholeStore(const clang::CXXOperatorCallExpr* op) = 0;
+  virtual std::string TexelAssignment(const clang::CXXOperatorCallExpr* op) = 0;
+  virtual std::string Assignment(const clang::BinaryOperator* bo) = 0;
+  virtual std::string PointerRead(const clang::ArraySubscriptExpr* as, const PointerTarget& t) = 0;
+  // The divisor of an integer division or remainder; a LiteMath matrix's columns (as an expression
+  // and as the object of a method); a matrix's row (get_row), or "" for the common spelling.
+  virtual std::string Divisor(const clang::BinaryOperator* bo) = 0;
+  virtual std::string MatrixColumns(const std::string& matrix) const = 0;
+  virtual std::string MatrixObject(const std::string& matrix) const = 0;
+  virtual std::string MatrixRow(const clang::CXXMemberCallExpr* call) = 0;
+  // Statements: a range-for's counter type (`exits`: the body may leave early); a for loop's
+  // init statement; a copy of a std::array into a local (the statements after its declaration,
+  // or "" where arrays copy whole).
+  virtual std::string RangeCounter(bool exits) const = 0;
+  virtual std::string LoopInit(const clang::ForStmt* fs, const std::string& init) = 0;
+  virtual std::string ArrayCopy(const clang::VarDecl* vd, const clang::CXXConstructExpr* copy, const std::string& pad) = 0;
+
+  // ---- the walk ----
   // The per-thread value parameter `e` reads (*p, p[0]; with pointerItself, p), or null.
   const clang::ValueDecl* ValueParamOf(const clang::Expr* e, bool pointerItself = false) const;
   std::string Call(const clang::CallExpr* call);
   std::string Builtin(const clang::FunctionDecl* fd, const std::vector<std::string>& args, const clang::CallExpr* call);
-  std::string IspcBuiltin(const clang::FunctionDecl* fd, const std::vector<std::string>& args, const clang::CallExpr* call,
-                          const std::map<std::string, std::string>& same);
   std::string Construct(clang::QualType t, const std::vector<const clang::Expr*>& args, clang::SourceLocation loc);
-  std::string IspcConstruct(clang::QualType t, const std::string& type, const std::vector<const clang::Expr*>& args, clang::SourceLocation loc);
-  std::string HalfConstruct(clang::QualType t, const std::vector<const clang::Expr*>& args, clang::SourceLocation loc);
   std::string Literal(const clang::Expr* e);
   std::string Cast(clang::QualType to, const clang::Expr* sub);
   // Image2D members and parameters: the image an expression names (m_img, or a kernel's image
   // parameter), or null; a texel expression (img[p], img.at(x, y)) as its image (and coordinate);
-  // loads, stores and the image's other calls.
+  // whether an image's texel type can be stored; the sampler a sample() call uses.
   const clang::ValueDecl* ImageOf(const clang::Expr* e) const;
   const clang::ValueDecl* ImageTexel(const clang::Expr* e, std::string* coord = nullptr);
   std::optional<ImageFormat> UsableImage(const clang::ValueDecl* image, clang::SourceLocation use);  // reports why not
   const clang::FieldDecl* SampledWith(const clang::ValueDecl* image, const ImageFormat& format, const clang::CXXMemberCallExpr* call);
-  std::string ImageStore(const clang::Expr* lhs, const std::string& value, const clang::Expr* whole);
-  std::string ImageCall(const clang::ValueDecl* image, const clang::CXXMemberCallExpr* call);
-  // Arrays of textures: the array of an element expression (m_textures[i]) and its index; calls on
-  // an element (sample, width, height) and texel reads (m_textures[i][p]).
+  // Arrays of textures: the array of an element expression (m_textures[i]) and its index.
   const clang::FieldDecl* TextureElement(const clang::Expr* e, const clang::Expr** index = nullptr);
-  std::string TextureCall(const clang::FieldDecl* array, const clang::Expr* index, const clang::CXXMemberCallExpr* call);
-  std::string TextureTexel(const clang::FieldDecl* array, const clang::Expr* index, const clang::Expr* coord, clang::SourceLocation loc);
   bool UsableTextures(const clang::FieldDecl* array, clang::SourceLocation use);  // reports why not
   std::string AtomicCall(const clang::FunctionDecl* fd, const clang::CallExpr* call);
-  std::string InterlockedCall(const clang::FunctionDecl* fd, const clang::CallExpr* call);  // LiteMath's InterlockedAdd, ReduceAdd
-  std::string IspcImage(const clang::ValueDecl* image) const;              // ISPC: an image member or parameter
-  std::string IspcTexel(const clang::Expr* texel);                          // ISPC: img[p], img.at(x, y) as an lvalue
-  std::string IspcImageCall(const clang::ValueDecl* image, const clang::CXXMemberCallExpr* call);  // ISPC: width(), sample(), ...
-  std::string IspcTextureCall(const clang::FieldDecl* array, const clang::Expr* index, const clang::CXXMemberCallExpr* call);
-  std::string IspcTextureTexel(const clang::FieldDecl* array, const clang::Expr* index, const clang::Expr* coord, clang::SourceLocation loc);
-  const clang::VarDecl* IspcUniformLoop(const clang::ForStmt* fs) const;
-  std::string IspcInterlockedCall(const clang::FunctionDecl* fd, const clang::CallExpr* call);  // the same in ISPC
   std::string AtomicTargetProblem(const clang::Expr* target) const;
   std::string EmitAppend(const clang::FieldDecl* field, const clang::CallExpr* call);
   // `T& r = a[i].f;` in a kernel or helper: the text its uses print as (GLSL has no references), when
   // the referred lvalue stays the same through r's scope (no side effects; its indices' variables
-  // not written after r is declared). Else nullopt, and `why` says why not (GlslPointers.cpp).
+  // not written after r is declared). Else nullopt, and `why` says why not (Pointers.cpp).
   std::optional<std::string> ReferenceAlias(const clang::VarDecl* vd, const clang::DeclStmt* decl, std::string& why);
-  // A parameter the callee may write: GLSL's inout, ISPC's reference.
-  std::string WritableParam(clang::QualType type, const std::string& name, clang::SourceLocation loc);
   // A function's body (a helper's, a lambda's), printed apart from the kernel's thread body.
   std::string FunctionBody(const clang::Stmt* body);
-  // ---- lambdas in kernels (GlslLambdas.cpp) ----
+  // ---- lambdas in kernels (Lambdas.cpp) ----
   // `f(args)` where f is a local lambda, or a lambda called where it is written: a call of the
   // lambda as a function of its own (EmitLambda), its captures passed after the arguments.
   std::string LambdaCall(const clang::CXXOperatorCallExpr* op);
   std::string EmitLambda(const clang::LambdaExpr* lambda, const std::string& name);
   std::map<const clang::LambdaExpr*, std::string> m_lambdaNames;
-  // A user function as a GLSL function, once; with `bufferBindings` (parameter index -> buffer), a copy
-  // of it whose pointer parameters index those buffers from an offset (see GlslPointers.cpp).
-  // With `structSelf`, a member function of that plain struct: the object comes first, as `self`.
+  // A user function as a function of the kernel's code, once; with `bufferBindings` (parameter
+  // index -> buffer), a copy of it whose pointer parameters index those buffers from an offset (see
+  // Pointers.cpp). With `structSelf`, a member function of that plain struct: the object comes
+  // first, as `self`.
   std::string EmitHelper(const clang::FunctionDecl* fd, clang::SourceLocation callLoc, bool composedEntry = false,
                          const std::map<unsigned, std::string>& bufferBindings = {}, const clang::CXXRecordDecl* structSelf = nullptr);
-  // ---- plain structs' member functions, operators and constructors (GlslStructs.cpp) ----
+  // ---- plain structs' member functions, operators and constructors (Structs.cpp) ----
   bool IsPlainStruct(const clang::CXXRecordDecl* rd) const;
   std::string FunctionName(const clang::FunctionDecl* fd, const clang::CXXRecordDecl* structSelf) const;
   std::string StructMethodCall(const clang::CXXMemberCallExpr* call);
@@ -229,14 +312,7 @@ private:
   std::string MatrixMethodCall(const clang::CXXMemberCallExpr* call);
   const clang::CXXRecordDecl* m_structSelf = nullptr;  // printing a member function of this struct: `this` is `self`
   bool m_inConstructor = false;                         // ... a constructor, which returns `self`
-  // ---- pointers (GlslPointers.cpp) ----
-  struct PointerTarget {
-    std::string array;   // the array it points into (as GLSL names it), or "" for one variable
-    std::string offset;  // its element offset in `array` ("" is 0)
-    std::string value;   // one variable: its GLSL lvalue
-    bool local = false;  // the array is a local one (a copy of a helper cannot reach it)
-    std::string perThread;  // a thread loop's local passed by address (for messages)
-  };
+  // ---- pointers (Pointers.cpp; PointerTarget is above) ----
   std::optional<PointerTarget> Pointer(const clang::Expr* e);  // what e points at; nullopt (reported) when unknown
   std::string Pointee(const PointerTarget& t, const clang::Expr* index, clang::SourceLocation loc);  // *p, p[index]
   std::vector<std::string> HelperArgs(const clang::FunctionDecl* fd, const clang::CallExpr* call, std::map<unsigned, std::string>& bindings);
@@ -245,46 +321,24 @@ private:
   std::map<const clang::ValueDecl*, PointerTarget> m_pointers;  // pointer locals and helper parameters in scope
   std::map<const clang::ValueDecl*, const clang::FieldDecl*> m_objectLocals;  // `T* p = m_v[i]`: p holds i (ObjectLocal)
   std::set<std::string> m_emittedCopies;                         // helpers bound to buffers, by name
-  std::vector<std::string> m_coherentLoads;                      // struct types with an ISPC load helper
-  std::set<std::string> m_ispcHelpers;                       // ISPC helpers written so far: crt_<op>_assign_<type>, crt_store_<Struct>
   const clang::Expr* m_fieldBase = nullptr;                      // the base of the field access being printed
   std::vector<std::string> m_reduceAddVectors;                   // member vectors with a ReduceAdd function
 
 public:
   bool PointerIsValueOnly(const clang::FunctionDecl* fn, const clang::ParmVarDecl* p);
 
-private:
+protected:
   // A member of this printer's class as `this->f` prints (its prefix, its Uses); OwnerMember and
-  // OwnerCall print `scene->f` and `scene->Helper(...)` through the owner (GlslOwner.cpp).
+  // OwnerCall print `scene->f` and `scene->Helper(...)` through the owner (Owner.cpp).
   std::string SelfMember(const clang::MemberExpr* me, const clang::FieldDecl* field);
   const clang::ParmVarDecl* OwnerParamOf(const clang::Expr* e) const;
   std::string OwnerCall(const clang::CXXMemberCallExpr* call);
   std::string ComposedCall(const clang::CXXMemberCallExpr* call);
   std::string VirtualCall(const clang::CXXMemberCallExpr* call);
   void NeedStruct(const clang::RecordDecl* rd);
-  std::string IspcStructMaker(const clang::RecordDecl* rd) const;
-  std::string NeedConstant(const clang::VarDecl* vd);  // its GLSL name
+  std::string NeedConstant(const clang::VarDecl* vd);  // its name in the printed code
   std::string ConstantName(const clang::VarDecl* vd) const;
   std::string Fail(clang::SourceLocation loc, const std::string& message, const std::string& hint);
-  // What ISPC has no counterpart for (yet): an error with the hint to use the Vulkan or CPU class.
-  std::string IspcFail(clang::SourceLocation loc, const std::string& what);
-  // `a op= b` on LiteMath vectors (ISPC overloads no compound assignment), `-v`.
-  std::string IspcVectorOperator(const clang::CXXOperatorCallExpr* op);
-  // `v[i] = a`, `v[i] op= a` with i known only at run time, `m(r, c) = a`; "" for other assignments.
-  std::string IspcComponentAssignment(const clang::BinaryOperator* bo);
-  // A member vector's struct element read whole at a per-lane index, through a helper that loads what
-  // the lanes agree on once (IspcLoads.cpp); "" where a plain subscript is printed.
-  std::string IspcCoherentLoad(const clang::CXXOperatorCallExpr* op);
-  // A float4, int4 or uint4 read whole through a pointer at a per-lane index, through LiteMath.isph's
-  // crt_load4 (vector loads where the lanes read consecutive elements, IspcLoads.cpp); "" otherwise.
-  std::string IspcConsecutiveLoad(const clang::ArraySubscriptExpr* as, const PointerTarget& t);
-  std::string IspcConsecutiveStore(const clang::CXXOperatorCallExpr* op);
-  std::string IspcVariability(const clang::Expr* sub) const;
-  std::string IspcCompoundAssignOnce(const clang::CXXOperatorCallExpr* op);
-  // IspcDoubles.cpp: where a kernel computes in double on ISPC.
-  bool IspcDeclaredDouble(const clang::Expr* e) const;
-  bool IspcInDoubleContext(const clang::Expr* e) const;
-  bool ReadWhole(const clang::Expr* e);  // e's value is copied or passed by value or const reference
 
   clang::ASTContext& m_ctx;
   const clang::CXXRecordDecl* m_class;

@@ -1,9 +1,11 @@
-// What the printer's files (Glsl.cpp, GlslCalls.cpp, GlslImages.cpp) share besides GlslPrinter.
+// What the printers' files (the walk's, and each language's) share besides KernelPrinter.
 #pragma once
-#include "print/Glsl.h"
+#include "print/KernelPrinter.h"
 
 namespace crossrt::engine {
 
+// The source text of a range, as written (for comments that say where generated code came from).
+std::string TrimmedSourceText(const clang::ASTContext& ctx, clang::SourceRange range);
 // The field of `this` that `e` names (this->f or f), or null.
 const clang::FieldDecl* ThisMemberField(const clang::Expr* e);
 // How a texel of the image's type becomes the C++ value: images hold 4 channels on the GPU.

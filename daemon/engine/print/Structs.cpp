@@ -6,7 +6,7 @@
 //   complex(re, im)   -> complex_ctor(re, im)        a user-provided constructor, which builds `self`
 // The struct's members read and write `self`. LiteMath's vectors and matrices are GLSL's own types
 // and keep GLSL's operators; their few member functions (get_col, ...) are mapped by name.
-#include "print/Glsl.h"
+#include "print/KernelPrinter.h"
 
 #include <clang/AST/DeclCXX.h>
 
@@ -46,7 +46,7 @@ std::string OperatorWord(OverloadedOperatorKind k, unsigned params) {
 
 }  // namespace
 
-bool GlslPrinter::IsPlainStruct(const CXXRecordDecl* rd) const {
+bool KernelPrinter::IsPlainStruct(const CXXRecordDecl* rd) const {
   if (!rd || !rd->hasDefinition() || rd == m_class || rd->isPolymorphic() || rd->isUnion() || rd->getName().empty()) return false;
   QualType t = m_ctx.getRecordType(rd);
   if (IsLiteMathType(t) || IsStdVector(t) || IsImage2D(t) || IsImageSampler(t) || IsSystemDecl(rd)) return false;
@@ -62,14 +62,14 @@ bool GlslPrinter::IsPlainStruct(const CXXRecordDecl* rd) const {
 }
 
 // The GLSL name of a function that is a member or an operator: complex_norm, complex_op_mul, op_mul.
-std::string GlslPrinter::FunctionName(const FunctionDecl* fd, const CXXRecordDecl* structSelf) const {
+std::string KernelPrinter::FunctionName(const FunctionDecl* fd, const CXXRecordDecl* structSelf) const {
   std::string base = fd->isOverloadedOperator() ? "op_" + OperatorWord(fd->getOverloadedOperator(), fd->getNumParams() + (structSelf ? 1 : 0))
                                                 : fd->getNameAsString();
   return structSelf ? structSelf->getNameAsString() + "_" + base : base;
 }
 
 // obj.method(args), on a plain struct.
-std::string GlslPrinter::StructMethodCall(const CXXMemberCallExpr* call) {
+std::string KernelPrinter::StructMethodCall(const CXXMemberCallExpr* call) {
   const CXXMethodDecl* method = call->getMethodDecl();
   std::map<unsigned, std::string> bindings;
   std::vector<std::string> args = HelperArgs(method, call, bindings);
@@ -79,7 +79,7 @@ std::string GlslPrinter::StructMethodCall(const CXXMemberCallExpr* call) {
 }
 
 // a OP b where OP is the struct's own (a member or a free function): a call of its GLSL function.
-std::string GlslPrinter::StructOperatorCall(const CXXOperatorCallExpr* op) {
+std::string KernelPrinter::StructOperatorCall(const CXXOperatorCallExpr* op) {
   auto* fd = op->getDirectCallee();
   std::map<unsigned, std::string> bindings;
   std::vector<std::string> args = HelperArgs(fd, op, bindings);
@@ -95,7 +95,7 @@ std::string GlslPrinter::StructOperatorCall(const CXXOperatorCallExpr* op) {
 
 // Whether an operator call runs the user's code (a struct's operator) rather than GLSL's own (on
 // numbers, LiteMath vectors and matrices).
-bool GlslPrinter::IsStructOperator(const CXXOperatorCallExpr* op) const {
+bool KernelPrinter::IsStructOperator(const CXXOperatorCallExpr* op) const {
   auto* fd = op->getDirectCallee();
   if (!fd || !fd->isOverloadedOperator()) return false;
   // Implicit and defaulted ones (copy assignment) are GLSL's assignment.
@@ -106,7 +106,7 @@ bool GlslPrinter::IsStructOperator(const CXXOperatorCallExpr* op) const {
 }
 
 // A struct's user-provided constructor: R R_ctor(params) { R self; members initialised; body; return self; }.
-std::string GlslPrinter::ConstructorCall(const CXXConstructorDecl* ctor, const std::vector<const clang::Expr*>& args, SourceLocation loc) {
+std::string KernelPrinter::ConstructorCall(const CXXConstructorDecl* ctor, const std::vector<const clang::Expr*>& args, SourceLocation loc) {
   const CXXRecordDecl* rd = ctor->getParent();
   const std::string type = rd->getNameAsString(), name = type + "_ctor";
   std::string call = name + "(";
@@ -159,16 +159,16 @@ std::string GlslPrinter::ConstructorCall(const CXXConstructorDecl* ctor, const s
 
 // A constructor the translator must run as code: written by the user (not implicit, defaulted or a
 // copy), of a plain struct.
-bool GlslPrinter::IsUserConstructor(const CXXConstructorDecl* ctor) const {
+bool KernelPrinter::IsUserConstructor(const CXXConstructorDecl* ctor) const {
   return ctor && IsPlainStruct(ctor->getParent()) && ctor->isUserProvided() && !ctor->isCopyOrMoveConstructor();
 }
 
-// LiteMath matrices' member functions: GLSL's matrix indexing, or the columns of LiteMath.isph's structs.
-std::string GlslPrinter::MatrixMethodCall(const CXXMemberCallExpr* call) {
+// LiteMath matrices' member functions: the columns of the language's matrices (MatrixObject).
+std::string KernelPrinter::MatrixMethodCall(const CXXMemberCallExpr* call) {
   const std::string n = call->getMethodDecl()->getNameAsString();
   std::string m = Expr(call->getImplicitObjectArgument());
-  if (ispc) m = "(" + m + ").m_col";  // LiteMath.isph's matrices are structs of columns
-  if (ispc && n == "get_row" && call->getNumArgs() == 1) return "transpose(" + Expr(call->getImplicitObjectArgument()) + ").m_col[" + Expr(call->getArg(0)) + "]";
+  m = MatrixObject(m);
+  if (std::string row = n == "get_row" && call->getNumArgs() == 1 ? MatrixRow(call) : ""; !row.empty()) return row;
   if ((n == "get_col" || n == "col") && call->getNumArgs() == 1) return m + "[" + Expr(call->getArg(0)) + "]";
   if (n == "get_row" && call->getNumArgs() == 1) return "transpose(" + m + ")[" + Expr(call->getArg(0)) + "]";
   if (n == "set_col" && call->getNumArgs() == 2) return m + "[" + Expr(call->getArg(0)) + "] = " + Expr(call->getArg(1));

@@ -1,8 +1,9 @@
-// The statement and expression printer: C++ (Clang AST) to GLSL, one kernel's reach at a time.
-// Calls (GlslCalls.cpp) and images (GlslImages.cpp) have files of their own; types and layouts are
+// The walk over the statements and expressions one kernel reaches, language by language through
+// KernelPrinter's virtual functions. Calls (Calls.cpp), images (Images.cpp), pointers, structs,
+// lambdas and the owner of composed objects have files of their own; types and layouts are
 // GlslTypes.cpp's.
-#include "print/Glsl.h"
-#include "print/GlslParts.h"
+#include "print/KernelPrinter.h"
+#include "print/PrinterParts.h"
 
 #include <clang/AST/ParentMapContext.h>
 #include <clang/AST/RecordLayout.h>
@@ -58,34 +59,31 @@ bool IsGlslBuiltinFunction(const std::string& name) {
   return names.count(name) > 0;
 }
 
+
+}  // namespace
+
 std::string TrimmedSourceText(const ASTContext& ctx, SourceRange range) {
   auto& sm = ctx.getSourceManager();
   return Lexer::getSourceText(CharSourceRange::getTokenRange(range), sm, ctx.getLangOpts()).str();
 }
 
-}  // namespace
-
-GlslPrinter::GlslPrinter(ASTContext& ctx, const CXXRecordDecl* cls, Reporter& reporter)
+KernelPrinter::KernelPrinter(ASTContext& ctx, const CXXRecordDecl* cls, Reporter& reporter)
     : m_ctx(ctx), m_class(cls), m_reporter(reporter) {}
 
 // A variable or field named like a GLSL keyword, or like a built-in function (which it would hide
 // in GLSL, and shadow in ISPC's standard library: `float distance` in Attenuate), takes a '_'.
-std::string GlslPrinter::SafeName(const std::string& name) {
+std::string KernelPrinter::SafeName(const std::string& name) {
   return GlslKeywords().count(name) || IsGlslBuiltinFunction(name) ? name + "_" : name;
 }
 
-std::string GlslPrinter::Fail(SourceLocation loc, const std::string& message, const std::string& hint) {
+std::string KernelPrinter::Fail(SourceLocation loc, const std::string& message, const std::string& hint) {
   m_reporter.GpuError(loc, message, hint);
   return "/*error*/";
 }
 
-std::string GlslPrinter::IspcFail(SourceLocation loc, const std::string& what) {
-  return Fail(loc, what + " is not translated to ISPC yet", "translate this class with BACKEND cpu (OpenMP) or vulkan");
-}
+std::string KernelPrinter::DataStruct() const { return dataStruct.empty() ? m_class->getNameAsString() + "_Data" : dataStruct; }
 
-std::string GlslPrinter::DataStruct() const { return ispcDataStruct.empty() ? m_class->getNameAsString() + "_Data" : ispcDataStruct; }
-
-std::optional<std::string> GlslPrinter::Type(QualType t, SourceLocation loc) {
+std::optional<std::string> KernelPrinter::Type(QualType t, SourceLocation loc) {
   QualType base = t.getNonReferenceType();
   for (QualType element;;) {  // to the elements of arrays, std::array's too
     if (auto* arr = dyn_cast<ConstantArrayType>(base.getCanonicalType().getTypePtr())) base = arr->getElementType();
@@ -103,12 +101,8 @@ std::optional<std::string> GlslPrinter::Type(QualType t, SourceLocation loc) {
          "use int or uint32_t in kernels (and mask explicitly where the wrap-around matters)");
     return std::nullopt;
   }
-  if (ispc && base->isSpecificBuiltinType(BuiltinType::Double)) {  // C's double, which ISPC has: double, double[2][3]
-    std::string dims;
-    for (QualType a = t.getNonReferenceType(); auto* arr = dyn_cast<ConstantArrayType>(a.getCanonicalType().getTypePtr()); a = arr->getElementType())
-      dims += "[" + std::to_string(arr->getSize().getZExtValue()) + "]";
-    return "double" + dims;
-  }
+  if (base->isSpecificBuiltinType(BuiltinType::Double))
+    if (auto spelled = DoubleType(t)) return spelled;
   if (auto* bt = base->getAs<BuiltinType>(); bt && bt->isFloatingPoint() && bt->getKind() != BuiltinType::Float) {
     Fail(loc, DoubleRefusal(t.getAsString(m_ctx.getPrintingPolicy())), DoubleRefusalHint());
     return std::nullopt;
@@ -125,69 +119,24 @@ std::optional<std::string> GlslPrinter::Type(QualType t, SourceLocation loc) {
     return std::nullopt;
   }
   if (auto* rd = base->getAsCXXRecordDecl(); rd && !IsLiteMathType(base, nullptr)) NeedStruct(rd);
-  if (ispc) {
-    if (g->find("bvec") != std::string::npos) {
-      IspcFail(loc, "type '" + t.getAsString(m_ctx.getPrintingPolicy()) + "'");
-      return std::nullopt;
-    }
-    return IspcTypeName(*g);
-  }
-  return g;
+  return SpellType(t, *g, loc);
 }
 
-std::string GlslPrinter::Declare(QualType t, const std::string& name, SourceLocation loc) {
+std::string KernelPrinter::Declare(QualType t, const std::string& name, SourceLocation loc) {
   auto g = Type(t, loc);
   if (!g) return "/*error*/ " + name;
   auto [base, dims] = SplitArray(*g);
   return base + " " + SafeName(name) + dims;
 }
 
-// ISPC: the function that builds a struct from its fields, make_S, or crt_make_S where the user's
-// code has a make_S of its own (which then comes along as the user wrote it).
-std::string GlslPrinter::IspcStructMaker(const RecordDecl* rd) const {
-  const std::string maker = "make_" + rd->getName().str();
-  auto& idents = m_ctx.Idents;
-  for (const DeclContext* dc : {rd->getDeclContext()->getRedeclContext(), static_cast<const DeclContext*>(m_ctx.getTranslationUnitDecl())})
-    for (auto* d : dc->lookup(&idents.get(maker)))
-      if (isa<FunctionDecl>(d)) return "crt_" + maker;
-  return maker;
-}
-
-void GlslPrinter::NeedStruct(const RecordDecl* rd) {
+void KernelPrinter::NeedStruct(const RecordDecl* rd) {
   rd = rd->getDefinition() ? rd->getDefinition() : rd;
   if (m_emitted.count(rd) || m_inProgress.count(rd) || predeclaredStructs.count(rd->getNameAsString())) return;
   m_inProgress.insert(rd);
   std::ostringstream os;
   if (rd->getQualifiedNameAsString() != rd->getName()) os << "// " << rd->getQualifiedNameAsString() << "\n";
   os << "struct " << rd->getName().str() << " {\n";
-  if (ispc) {
-    // ISPC aligns every member of these types to 4 bytes; C++ may align more (LiteMath's float4 to
-    // 16): explicit padding puts each field where C++ has it, so that buffers are shared as they are.
-    const ASTRecordLayout& layout = m_ctx.getASTRecordLayout(rd);
-    uint64_t at = 0;
-    unsigned index = 0, pads = 0;
-    std::string params, assigns;
-    bool constructible = true;
-    for (auto* f : rd->fields()) {
-      const uint64_t offset = layout.getFieldOffset(index++) / 8;
-      if (offset > at) os << "  uint8 crt_pad" << pads++ << "[" << (offset - at) << "];\n";
-      os << "  " << Declare(f->getType(), f->getName().str(), f->getLocation()) << ";\n";
-      at = offset + m_ctx.getTypeSizeInChars(f->getType()).getQuantity();
-      constructible &= !f->getType()->isArrayType();
-      auto type = Type(f->getType(), f->getLocation());
-      params += (params.empty() ? "" : ", ") + type.value_or("int") + " " + SafeName(f->getName().str());
-      assigns += " r." + SafeName(f->getName().str()) + " = " + SafeName(f->getName().str()) + ";";
-    }
-    const uint64_t size = layout.getSize().getQuantity();
-    if (size > at) os << "  uint8 crt_pad" << pads++ << "[" << (size - at) << "];\n";
-    os << "};\n";
-    if (constructible)
-      os << "static inline " << rd->getName().str() << " " << IspcStructMaker(rd) << "(" << params << ")\n{\n  "
-         << rd->getName().str() << " r;" << assigns << "\n  return r;\n}\n";
-  } else {
-    for (auto* f : rd->fields()) os << "  " << Declare(f->getType(), f->getName().str(), f->getLocation()) << ";\n";
-    os << "};\n";
-  }
+  os << StructBody(rd);
   m_inProgress.erase(rd);
   m_emitted.insert(rd);
   m_structs.push_back({rd->getName().str(), os.str()});
@@ -195,28 +144,28 @@ void GlslPrinter::NeedStruct(const RecordDecl* rd) {
 
 // Composed code's constants keep its holder's prefix; the namespace-scope constants that objects'
 // methods use are shared, as the free functions calling them are (a class's static members are not).
-std::string GlslPrinter::ConstantName(const VarDecl* vd) const {
+std::string KernelPrinter::ConstantName(const VarDecl* vd) const {
   return (selfClass && !vd->isStaticDataMember() ? "" : composedPrefix) + vd->getName().str();
 }
 
-std::string GlslPrinter::NeedConstant(const VarDecl* vd) {
+std::string KernelPrinter::NeedConstant(const VarDecl* vd) {
   const std::string name = ConstantName(vd);
   if (m_emitted.count(vd)) return name;
   m_emitted.insert(vd);
   const clang::Expr* init = vd->getAnyInitializer();
   std::string value = init ? Expr(init) : "0";
-  m_constants.push_back({name, std::string(ispc ? "static const uniform " : "const ") +  // ISPC: one per object file, not a global symbol
+  m_constants.push_back({name, ConstantQualifier() +
                                    Declare(vd->getType(), name, vd->getLocation()) + " = " + value + ";\n"});
   return name;
 }
 
-std::string GlslPrinter::PreludeTypes() const {
+std::string KernelPrinter::PreludeTypes() const {
   std::string out;
   for (auto& s : m_structs) out += s.text + "\n";
   return out;
 }
 
-std::string GlslPrinter::Literal(const clang::Expr* e) {
+std::string KernelPrinter::Literal(const clang::Expr* e) {
   if (auto* il = dyn_cast<IntegerLiteral>(e)) {
     bool isUnsigned = il->getType()->isUnsignedIntegerType();
     auto v = il->getValue();
@@ -235,36 +184,29 @@ std::string GlslPrinter::Literal(const clang::Expr* e) {
       if (text.find_first_of(".eEin") == std::string::npos) text += ".0";
     }
     if (text.find_first_of(".eE") == std::string::npos) text += ".0";
-    if (IspcInDoubleContext(fl)) text += "d";  // ISPC's double literal (an unsuffixed one is a float)
-    return text;
+    return text + FloatSuffix(fl);
   }
   if (auto* bl = dyn_cast<CXXBoolLiteralExpr>(e)) return bl->getValue() ? "true" : "false";
   if (auto* cl = dyn_cast<CharacterLiteral>(e)) return std::to_string(cl->getValue());
   return "/*literal*/";
 }
 
-// "uniform " where an ISPC cast's operand is one value for all lanes: a cast with no variability
-// takes its operand's, and ISPC warns of such a cast where it is an argument (its operator overloads
-// included). Else "" (varying, the default).
-std::string GlslPrinter::IspcVariability(const clang::Expr* sub) const { return IspcUniform(sub) ? "uniform " : ""; }
-
 // An explicit or implicit conversion. GLSL converts implicitly only int->uint->float, so spell
 // the others out, and fold integer literals into the target type so the code stays readable.
-std::string GlslPrinter::Cast(QualType to, const clang::Expr* sub) {
+std::string KernelPrinter::Cast(QualType to, const clang::Expr* sub) {
   // On the GPU double precision only arises from promotions such as `x * 0.5` (explicit double
-  // variables are refused), and the arithmetic stays in float. ISPC computes in double where the
-  // kernel declared a double (IspcDoubles.cpp).
+  // variables are refused), and the arithmetic stays in float; a language with doubles may compute
+  // in double where the kernel declared one (NarrowedDouble, IntegerToReal).
   if (to->isRealFloatingType() && !to->isSpecificBuiltinType(BuiltinType::Float) && sub->getType()->isFloatingType())
     return Expr(sub);
   if (to->isSpecificBuiltinType(BuiltinType::Float) && sub->getType()->isRealFloatingType() &&
       !sub->getType()->isSpecificBuiltinType(BuiltinType::Float))
-    return ispc && IspcDeclaredDouble(sub) ? "((float)(" + Expr(sub) + "))" : Expr(sub);
+    return NarrowedDouble(sub);
   if (to->isRealFloatingType() && !to->isSpecificBuiltinType(BuiltinType::Float) && sub->getType()->isIntegerType()) {
     const clang::Expr* self = nullptr;  // the conversion itself, to see where its value goes
     for (const auto& parent : m_ctx.getParents(*sub))
       if (auto* cast = parent.get<CastExpr>()) self = cast;
-    if (ispc && self && IspcInDoubleContext(self)) return "((double)(" + Expr(sub) + "))";
-    return ispc ? "((" + IspcVariability(sub) + "float)(" + Expr(sub) + "))" : "float(" + Expr(sub) + ")";
+    return IntegerToReal(sub, self);
   }
   auto target = GlslTypeOf(to);
   auto source = GlslTypeOf(sub->getType());
@@ -281,15 +223,10 @@ std::string GlslPrinter::Cast(QualType to, const clang::Expr* sub) {
     if (source && (*source == "float")) return "((" + Expr(sub) + ") != 0.0)";
     return "((" + Expr(sub) + ") != 0)";
   }
-  if (ispc) {  // C's cast of a scalar, LiteMath's make_T of a vector
-    const std::string name = IspcTypeName(*target);
-    if (target->find("vec") != std::string::npos) return "make_" + name + "(" + Expr(sub) + ")";
-    return "((" + IspcVariability(sub) + name + ")(" + Expr(sub) + "))";
-  }
-  return *target + "(" + Expr(sub) + ")";
+  return ConvertedTo(*target, sub);
 }
 
-std::string GlslPrinter::Construct(QualType t, const std::vector<const clang::Expr*>& args, SourceLocation loc) {
+std::string KernelPrinter::Construct(QualType t, const std::vector<const clang::Expr*>& args, SourceLocation loc) {
   auto g = Type(t, loc);
   if (!g) return "/*error*/";
   std::vector<const clang::Expr*> real;
@@ -298,145 +235,17 @@ std::string GlslPrinter::Construct(QualType t, const std::vector<const clang::Ex
   // Copies and moves are plain values in GLSL.
   if (real.size() == 1 && GlslTypeOf(real[0]->getType()) == GlslTypeOf(t) && IsLiteMathType(real[0]->getType(), "half4") == IsLiteMathType(t, "half4"))
     return Expr(real[0]);
-  if (ispc) return IspcConstruct(t, *g, real, loc);
-  if (IsLiteMathType(t, "half4") || IsLiteMathType(t, "half2") || (real.size() == 1 && IsLiteMathType(real[0]->getType(), "half4")))
-    return HalfConstruct(t, real, loc);
-  auto [base, dims] = SplitArray(*g);
-  bool matrix = IsLiteMathType(t, "float4x4") || IsLiteMathType(t, "float3x3");
-  std::string out = base + dims + "(";
-  if (real.empty()) {
-    if (matrix) return base + "(1.0)";  // LiteMath matrices start as the identity
-    if (auto* arr = dyn_cast<ConstantArrayType>(t.getCanonicalType().getTypePtr())) {
-      // Every element default-constructed, as C++ does for an array of class type.
-      const std::string element = Construct(arr->getElementType(), {}, loc);
-      std::string list;
-      for (uint64_t i = 0; i < arr->getSize().getZExtValue(); ++i) list += (i ? ", " : "") + element;
-      return base + dims + "(" + list + ")";
-    }
-    if (IsLiteMathType(t)) return base + "(0)";
-    auto* rd = t.getCanonicalType()->getAsCXXRecordDecl();
-    if (!rd) return base + "(0)";  // a value-initialised scalar
-    // Value-initialised struct: default member initialisers, else zero.
-    bool first = true;
-    for (auto* f : rd->fields()) {
-      auto fg = Type(f->getType(), loc);
-      std::string value = f->hasInClassInitializer() && f->getInClassInitializer() ? Expr(f->getInClassInitializer())
-                          : fg ? SplitArray(*fg).first + SplitArray(*fg).second + "(0)" : "0";
-      out += (first ? "" : ", ") + value;
-      first = false;
-    }
-    return out + ")";
-  }
-  for (size_t i = 0; i < real.size(); ++i) out += (i ? ", " : "") + Expr(real[i]);
-  out += ")";
-  // LiteMath lists matrix elements row by row; GLSL constructors take them column by column.
-  if (matrix && real.size() > 1) return "transpose(" + out + ")";
-  return out;
+  return ConstructValue(t, *g, real, loc);
 }
 
-// ISPC has no constructor calls: LiteMath's make_float3(...), the struct's make_S(...) that NeedStruct
-// writes, a cast of a scalar, and an initializer list of an array (which only a declaration takes).
-std::string GlslPrinter::IspcConstruct(QualType t, const std::string& type, const std::vector<const clang::Expr*>& args, SourceLocation loc) {
-  if (IsLiteMathType(t, "half4") || IsLiteMathType(t, "half2") || (args.size() == 1 && IsLiteMathType(args[0]->getType(), "half4")))
-    return HalfConstruct(t, args, loc);
-  auto list = [&](const std::vector<std::string>& items) {
-    std::string out;
-    for (size_t i = 0; i < items.size(); ++i) out += (i ? ", " : "") + items[i];
-    return out;
-  };
-  std::vector<std::string> values;
-  for (auto* a : args) values.push_back(Expr(a));
-  if (auto* arr = dyn_cast<ConstantArrayType>(t.getCanonicalType().getTypePtr())) {
-    if (values.empty())
-      values.assign(arr->getSize().getZExtValue(), Construct(arr->getElementType(), {}, loc));
-    return "{" + list(values) + "}";
-  }
-  auto* rd = t.getCanonicalType()->getAsCXXRecordDecl();
-  if (!rd && values.empty())  // a scalar's zero: a literal, varying or uniform as its use needs
-    return type == "float" ? "0.0f" : type == "uint" ? "0u" : type == "bool" ? "false" : type == "int" ? "0" : "((" + type + ")0)";
-  if (!rd) return "((" + type + ")(" + values[0] + "))";
-  if (values.empty() && !IsLiteMathType(t))  // value-initialised struct: default member initialisers, else zero
-    for (auto* f : rd->fields())
-      values.push_back(f->hasInClassInitializer() && f->getInClassInitializer() ? Expr(f->getInClassInitializer())
-                                                                                : Construct(f->getType(), {}, loc));
-  return (rd && !IsLiteMathType(t) ? IspcStructMaker(rd) : "make_" + type) + "(" + list(values) + ")";
-}
-
-// LiteMath's half2 and half4 hold their 16-bit floats two per uint (packHalf2x16; in ISPC the
-// crt_ conversions of LiteMath.isph); float4(h) and to_float4(h) unpack them. Their components are
-// reached only through that conversion.
-std::string GlslPrinter::HalfConstruct(QualType t, const std::vector<const clang::Expr*>& args, SourceLocation loc) {
-  const bool four = IsLiteMathType(t, "half4");
-  if (IsLiteMathType(t, "float4")) {  // float4(half4)
-    const std::string h = Expr(args[0]);
-    return ispc ? "crt_half4_to_float4(" + h + ")" : "vec4(unpackHalf2x16((" + h + ").x), unpackHalf2x16((" + h + ").y))";
-  }
-  std::vector<std::string> a;
-  for (auto* arg : args) a.push_back(Expr(arg));
-  if (ispc) {  // through a float2 or float4 of the values
-    const std::string to = four ? "crt_float4_to_half4(" : "crt_float2_to_half2(", vec = four ? "make_float4(" : "make_float2(";
-    if (args.empty()) return four ? "make_uint2(0u)" : "0u";
-    if (args.size() == 1 && IsLiteMathType(args[0]->getType(), four ? "float4" : "float2")) return to + a[0] + ")";
-    if (args.size() == 1 && args[0]->getType()->isArithmeticType()) return to + vec + "(float)(" + a[0] + ")))";
-    if (args.size() == (four ? 4u : 2u)) {
-      std::string list;
-      for (size_t i = 0; i < a.size(); ++i) list += (i ? ", " : "") + std::string("(float)(") + a[i] + ")";
-      return to + vec + list + "))";
-    }
-  } else {
-    auto pair = [](const std::string& x, const std::string& y) { return "packHalf2x16(vec2(" + x + ", " + y + "))"; };
-    if (args.empty()) return four ? "uvec2(0u)" : "0u";
-    if (args.size() == 1 && IsLiteMathType(args[0]->getType(), "float4")) return "uvec2(packHalf2x16((" + a[0] + ").xy), packHalf2x16((" + a[0] + ").zw))";
-    if (args.size() == 1 && IsLiteMathType(args[0]->getType(), "float2")) return "packHalf2x16(" + a[0] + ")";
-    if (args.size() == 1 && args[0]->getType()->isArithmeticType()) return four ? "uvec2(" + pair(a[0], a[0]) + ")" : pair(a[0], a[0]);
-    if (four && args.size() == 4) return "uvec2(" + pair(a[0], a[1]) + ", " + pair(a[2], a[3]) + ")";
-    if (!four && args.size() == 2) return pair(a[0], a[1]);
-  }
-  return Fail(loc, "this construction of LiteMath::" + t.getUnqualifiedType().getAsString(m_ctx.getPrintingPolicy()) + " is not supported in kernels",
-              "build it from a float4 (half4(v)) or from four floats");
-}
-
-// push_back to a member vector: every thread takes a slot from an atomic counter, the vector's size
-// in the class-data block. A push past the capacity is counted but not stored; the generated class
-// reports it when it reads the size back.
-std::string GlslPrinter::EmitAppend(const FieldDecl* field, const CallExpr* call) {
+// push_back to a member vector: the function that appends, written once per vector.
+std::string KernelPrinter::EmitAppend(const FieldDecl* field, const CallExpr* call) {
   const std::string vector = field->getNameAsString(), name = vector + "_push_back";
   if (!m_emitted.insert(field).second) return name;
-  QualType element;
-  IsStdVector(field->getType(), &element);
-  std::ostringstream os;
-  if (ispc) {
-    // The ISPC class appends on the host, under its lock, as the _CPU class's threads do: no
-    // capacity to reserve. A gang hands over its active lanes' values at once, in lane order.
-    const std::string cls = DataStruct().substr(0, DataStruct().size() - std::string("_Data").size());
-    const std::string type = Type(element, call->getBeginLoc()).value_or("uint"), host = cls + "_append_" + vector;
-    os << "// " << vector << ".push_back(value): " << cls << "_ISPC::IspcAppend_" << vector << " appends the values (C++, under a lock)\n"
-       << "extern \"C\" void " << host << "(int8 *uniform owner, const uniform " << type << " *uniform values, uniform int count);\n\n"
-       << "// " << vector << ".push_back(value) from the active lanes, in lane order\n"
-       << "static void " << name << "(uniform " << DataStruct() << " *uniform self, " << type << " value)\n"
-       << "{\n"
-       << "  uniform " << type << " lanes[programCount], packed[programCount];\n"
-       << "  lanes[programIndex] = value;\n"
-       << "  uniform int count = 0;\n"
-       << "  foreach_active (lane)\n"
-       << "    packed[count++] = lanes[lane];\n"
-       << "  " << host << "(self->crt_owner, packed, count);\n"
-       << "}\n";
-    m_functions.push_back(os.str());
-    return name;
-  }
-  os << "// " << vector << ".push_back(value), from any number of threads at once\n"
-     << "void " << name << "(" << Declare(element, "value", call->getBeginLoc()) << ")\n"
-     << "{\n"
-     << "  const uint slot = atomicAdd(" << vector << "_size, 1u);\n"
-     << "  if (slot < " << vector << "_capacity)\n"
-     << "    " << vector << "[slot] = value;\n"
-     << "}\n";
-  m_functions.push_back(os.str());
-  return name;
+  return AppendFunction(field, call, name);
 }
 
-std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callLoc, bool composedEntry,
+std::string KernelPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callLoc, bool composedEntry,
                                     const std::map<unsigned, std::string>& bufferBindings, const CXXRecordDecl* structSelf) {
   const FunctionDecl* def = nullptr;
   if (!fd->hasBody(def) || !def) {
@@ -447,10 +256,10 @@ std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callL
   // Methods printed for an object (virtual calls) are per class; free functions are shared.
   std::string name = (selfClass && !isa<CXXMethodDecl>(fd) ? "" : composedPrefix) + FunctionName(fd, structSelf);
   if (IsGlslBuiltinFunction(name)) name += "_";  // GLSL forbids overloading its built-in functions
-  // GLSL: a copy per buffer its pointers index (buffers are globals there). ISPC passes the buffer
-  // itself, so one copy serves them all: named after the parameters that point into a buffer.
+  // A copy per buffer its pointers index where buffers are globals (GLSL); where buffers are passed
+  // (ISPC), one copy serves them all: named after the parameters that point into a buffer.
   for (auto& [index, buffer] : bufferBindings)
-    name += ispc ? "_at_" + SafeName(def->getParamDecl(index)->getNameAsString()) : "_" + buffer;
+    name += PassesBuffers() ? "_at_" + SafeName(def->getParamDecl(index)->getNameAsString()) : "_" + buffer;
   if (m_inProgress.count(def))
     return Fail(callLoc, "recursive call to '" + fd->getQualifiedNameAsString() + "' in a kernel",
                 "GPUs have no call stack: rewrite the recursion as a loop with an explicit stack array");
@@ -460,24 +269,26 @@ std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callL
   m_inProgress.insert(def);
   std::ostringstream os;
   auto ret = Type(def->getReturnType(), def->getLocation());
-  os << "// from " << def->getQualifiedNameAsString() << "\n" << (ispc ? "static inline " : "") << (ret ? *ret : "void") << " " << name << "(";
-  // ISPC: the class's own methods reach its members through `self`, as the kernels do.
-  const bool ispcSelf = ispc && !selfClass && !structSelf && isa<CXXMethodDecl>(def) && !cast<CXXMethodDecl>(def)->isStatic();
-  const bool withSelf = ((selfClass || structSelf) && isa<CXXMethodDecl>(def) && !cast<CXXMethodDecl>(def)->isStatic()) || ispcSelf;
-  if (ispcSelf) os << "uniform " << DataStruct() << " *uniform self";
+  os << "// from " << def->getQualifiedNameAsString() << "\n" << FunctionQualifiers() << (ret ? *ret : "void") << " " << name << "(";
+  // The class's own methods reach its members as the kernels do: through the class data where the
+  // language passes it (ClassDataParameter).
+  const bool method = isa<CXXMethodDecl>(def) && !cast<CXXMethodDecl>(def)->isStatic();
+  const std::string classData = !selfClass && !structSelf && method ? ClassDataParameter() : "";
+  const bool withSelf = ((selfClass || structSelf) && method) || !classData.empty();
+  if (!classData.empty()) os << classData;
   else if (withSelf && structSelf) {
     if (cast<CXXMethodDecl>(def)->isConst()) os << structSelf->getNameAsString() << " self";
-    else if (ispc) os << structSelf->getNameAsString() << " &self";
-    else os << "inout " << structSelf->getNameAsString() << " self";
-  } else if (withSelf) os << (ispc ? IspcObjectStruct(selfClass->getQualifiedNameAsString()) : selfClass->getNameAsString() + "_Data") << " self";
+    else os << WritableSelf(structSelf->getNameAsString());
+  } else if (withSelf) os << ObjectDataStruct(selfClass) << " self";
   const auto outerPointers = m_pointers;  // this function's pointer parameters shadow the caller's names
   bool first = !withSelf;
   for (unsigned i = 0; i < def->getNumParams(); ++i) {
     auto* p = def->getParamDecl(i);
-    if (IsOwnerParam(p) && !ispc) continue;  // the traversal passed to an object's method: its data are globals (GlslOwner.cpp)
     QualType pt = p->getType();
-    if (IsOwnerParam(p)) {  // ISPC: the class data, which holds the traversal's (GlslOwner.cpp)
-      os << (first ? "" : ", ") << "uniform " << owner->DataStruct() << " *uniform " << SafeName(p->getNameAsString());
+    if (IsOwnerParam(p)) {  // the traversal passed to an object's method (Owner.cpp): left out where its data are globals
+      const std::string declared = OwnerParameter(p);
+      if (declared.empty()) continue;
+      os << (first ? "" : ", ") << declared;
       first = false;
       continue;
     }
@@ -494,14 +305,9 @@ std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callL
       PointerTarget t;
       const std::string name = SafeName(p->getNameAsString());
       if (auto bound = bufferBindings.find(i); bound != bufferBindings.end()) {
-        t.array = ispc ? name : bound->second;
+        t.array = PassesBuffers() ? name : bound->second;
         t.offset = name + "_offset";
-        if (ispc) {
-          auto element = Type(pt->getPointeeType().getUnqualifiedType(), p->getLocation());
-          os << (pt->getPointeeType().isConstQualified() ? "const " : "") << "uniform " << (element ? *element : "int") << " *uniform "
-             << name << ", ";
-        }
-        os << "uint " << t.offset;
+        os << BufferParameter(p, name) << "uint " << t.offset;
       } else {
         t.value = name;
         os << (pt->getPointeeType().isConstQualified() ? Declare(pt->getPointeeType(), p->getNameAsString(), p->getLocation())
@@ -525,15 +331,7 @@ std::string GlslPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation callL
   return name;
 }
 
-std::string GlslPrinter::WritableParam(QualType type, const std::string& name, SourceLocation loc) {
-  const std::string declared = Declare(type, name, loc);
-  if (!ispc) return "inout " + declared;
-  if (declared.back() == ']') return declared;  // arrays are passed by reference already
-  const size_t space = declared.rfind(' ');
-  return declared.substr(0, space) + " &" + declared.substr(space + 1);
-}
-
-std::string GlslPrinter::FunctionBody(const clang::Stmt* body) {
+std::string KernelPrinter::FunctionBody(const clang::Stmt* body) {
   const int savedDepth = m_loopDepth;
   const bool savedThread = m_inThreadBody, savedLoopBody = m_inLoopBody;
   m_loopDepth = 0;
@@ -545,13 +343,13 @@ std::string GlslPrinter::FunctionBody(const clang::Stmt* body) {
   return out;
 }
 
-std::string GlslPrinter::EmitComposedMethod(const CXXMethodDecl* method) {
+std::string KernelPrinter::EmitComposedMethod(const CXXMethodDecl* method) {
   return EmitHelper(method, method->getLocation(), true);
 }
 
 // `m_holder->Method(args)` where m_holder is a shared_ptr, unique_ptr or pointer to a polymorphic
 // class: the composed implementation's function, or "" when the call is not of that form.
-std::string GlslPrinter::ComposedCall(const CXXMemberCallExpr* mc) {
+std::string KernelPrinter::ComposedCall(const CXXMemberCallExpr* mc) {
   const clang::Expr* obj = mc->getImplicitObjectArgument()->IgnoreParenImpCasts();
   if (auto* op = dyn_cast<CXXOperatorCallExpr>(obj); op && op->getOperator() == OO_Arrow) obj = op->getArg(0)->IgnoreParenImpCasts();
   auto* me = dyn_cast<MemberExpr>(obj);
@@ -567,7 +365,7 @@ std::string GlslPrinter::ComposedCall(const CXXMemberCallExpr* mc) {
                 "name the implementation the GPU runs: crossrt_add_class(... COMPOSE " + interface +
                 "=<Implementation>), e.g. ISceneObject=BVHScene, and list its source file in SOURCES");
   std::vector<std::string> args;
-  if (ispc) args.push_back("self");  // the implementation's data is the class's, under the holder's prefix
+  if (std::string data = ClassDataArgument(); !data.empty()) args.push_back(data);  // the implementation's data is the class's, under the holder's prefix
   for (auto* arg : mc->arguments()) args.push_back(Expr(arg));
   Type(mc->getType(), mc->getBeginLoc());  // declares a returned struct (CRT_Hit)
   m_uses.composedCalls.insert({holder, method});
@@ -613,7 +411,7 @@ const FieldDecl* VirtualCallTarget(const CXXMemberCallExpr* mc, const clang::Exp
   return ObjectElement(obj, index);
 }
 
-std::string GlslPrinter::VirtualCall(const CXXMemberCallExpr* mc) {
+std::string KernelPrinter::VirtualCall(const CXXMemberCallExpr* mc) {
   const clang::Expr* indexExpr = nullptr;
   const FieldDecl* field = VirtualCallTarget(mc, &indexExpr);
   if (!field) return "";
@@ -623,9 +421,8 @@ std::string GlslPrinter::VirtualCall(const CXXMemberCallExpr* mc) {
                 "the GPU picks the implementation by the object's type: make the method virtual in the interface");
   auto* local = dyn_cast<DeclRefExpr>(indexExpr);
   std::vector<std::string> args = {local && m_objectLocals.count(local->getDecl()) ? SafeName(local->getDecl()->getNameAsString())  // already the index
-                                   : ispc ? "((" + IspcVariability(indexExpr) + "uint)(" + Expr(indexExpr) + "))"
-                                          : "uint(" + Expr(indexExpr) + ")"};
-  if (ispc) args.insert(args.begin(), "self");  // the dispatcher finds the tags and the objects in the class data
+                                                                      : ObjectIndex(indexExpr)};
+  if (std::string data = ClassDataArgument(); !data.empty()) args.insert(args.begin(), data);  // the dispatcher finds the tags and the objects in the class data
   for (unsigned i = 0; i < mc->getNumArgs(); ++i) {
     const ParmVarDecl* p = i < method->getNumParams() ? method->getParamDecl(i) : nullptr;
     if (p && PointsTo(p->getType(), m_class)) {  // the caller itself, left out on the GPU (GlslOwner.cpp)
@@ -654,7 +451,7 @@ const CXXRecordDecl* PolymorphicPointee(QualType t) {
   return pointee && pointee->hasDefinition() && pointee->isPolymorphic() ? pointee->getDefinition() : nullptr;
 }
 
-const ValueDecl* GlslPrinter::ValueParamOf(const clang::Expr* e, bool pointerItself) const {
+const ValueDecl* KernelPrinter::ValueParamOf(const clang::Expr* e, bool pointerItself) const {
   e = e->IgnoreParenImpCasts();
   if (pointerItself) {
     auto* dr = dyn_cast<DeclRefExpr>(e);
@@ -670,7 +467,7 @@ const ValueDecl* GlslPrinter::ValueParamOf(const clang::Expr* e, bool pointerIts
 
 // `this->f` in the class this printer prints: an object's field (`self`), a member vector (a buffer),
 // a plain member (the class data), under the composed prefix.
-std::string GlslPrinter::SelfMember(const MemberExpr* me, const FieldDecl* field) {
+std::string KernelPrinter::SelfMember(const MemberExpr* me, const FieldDecl* field) {
   if (auto it = renames.find(me->getMemberDecl()); it != renames.end()) return it->second;
   if (!field) return Fail(me->getBeginLoc(), "member '" + me->getMemberDecl()->getNameAsString() + "' cannot be used here", "");
   if (selfClass) {  // a method of an object the kernel reached through a virtual call: its data is `self`
@@ -685,8 +482,7 @@ std::string GlslPrinter::SelfMember(const MemberExpr* me, const FieldDecl* field
                 field->getNameAsString() + "[i][p], " + field->getNameAsString() + "[i].width(), " + field->getNameAsString() + ".size()");
   if (IsStdVector(field->getType())) {
     m_uses.memberVectors.insert(field);
-    if (ispc) return IspcMember(field->getNameAsString());
-    return composedPrefix + field->getNameAsString();
+    return MemberAccess(field->getNameAsString());
   }
   if (IsImage2D(field->getType()))
     return Fail(me->getBeginLoc(), "Image2D member '" + field->getNameAsString() + "' used as a value in a kernel",
@@ -695,16 +491,15 @@ std::string GlslPrinter::SelfMember(const MemberExpr* me, const FieldDecl* field
   if (IsImageSampler(field->getType()))
     return Fail(me->getBeginLoc(), "sampler member '" + field->getNameAsString() + "' used as a value in a kernel",
                 "pass it straight to an Image2D member's sample(" + field->getNameAsString() + ", uv)");
-  const bool ispcDouble = ispc && field->getType().getCanonicalType()->isSpecificBuiltinType(BuiltinType::Double);
-  if (field->getType()->isPointerType() || (!GlslTypeOf(field->getType()) && !ispcDouble))
+  const bool spelledDouble = field->getType().getCanonicalType()->isSpecificBuiltinType(BuiltinType::Double) && DoubleType(field->getType());
+  if (field->getType()->isPointerType() || (!GlslTypeOf(field->getType()) && !spelledDouble))
     return Fail(me->getBeginLoc(), "member '" + field->getNameAsString() + "' of type '" + field->getType().getAsString(m_ctx.getPrintingPolicy()) +
                 "' cannot be used in a kernel", "kernels may use plain data members and std::vector members");
   m_uses.plainMembers.insert(field);
-  if (ispc) return IspcMember(field->getNameAsString());
-  return composedPrefix + field->getNameAsString();
+  return MemberAccess(field->getNameAsString());
 }
 
-std::string GlslPrinter::Expr(const clang::Expr* e) {
+std::string KernelPrinter::Expr(const clang::Expr* e) {
   if (!e) return "";
   if (auto* p = dyn_cast<ParenExpr>(e)) return "(" + Expr(p->getSubExpr()) + ")";
   if (isa<IntegerLiteral, FloatingLiteral, CXXBoolLiteralExpr, CharacterLiteral>(e)) return Literal(e);
@@ -783,10 +578,10 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
     }
     if (isa<CXXThisExpr>(base)) return SelfMember(me, field);
     if (const ParmVarDecl* p = OwnerParamOf(base)) {  // scene->f: as the traversal prints this->f
-      const std::string saved = owner->ispcSelf;
-      owner->ispcSelf = SafeName(p->getNameAsString());  // ISPC: the parameter is the class data
+      const std::string saved = owner->dataPointer;
+      owner->dataPointer = SafeName(p->getNameAsString());  // where the class data is passed, the parameter holds it
       const std::string member = owner->SelfMember(me, field);
-      owner->ispcSelf = saved;
+      owner->dataPointer = saved;
       return member;
     }
     if (!field) return Fail(e->getBeginLoc(), "member function used as a value", "");
@@ -795,7 +590,7 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
                   "convert it first: to_float4(h).x, float4(h)");
     // LiteMath's matrices keep their columns in m_col, which GLSL's matrices index directly.
     if (field->getName() == "m_col" && (IsLiteMathType(me->getBase()->getType(), "float4x4") || IsLiteMathType(me->getBase()->getType(), "float3x3")))
-      return ispc ? Expr(me->getBase()) + ".m_col" : Expr(me->getBase());
+      return MatrixColumns(Expr(me->getBase()));
     if (me->isArrow()) {  // p->f: the field of what p points at
       auto t = Pointer(me->getBase());
       return t ? Pointee(*t, nullptr, e->getBeginLoc()) + "." + SafeName(field->getNameAsString()) : "/*error*/";
@@ -810,33 +605,21 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
     if (!array && as->getBase()->getType()->isPointerType()) {
       auto t = Pointer(as->getBase());
       if (!t) return "/*error*/";
-      if (std::string load = IspcConsecutiveLoad(as, *t); !load.empty()) return load;
+      if (std::string load = PointerRead(as, *t); !load.empty()) return load;
       return Pointee(*t, as->getIdx(), e->getBeginLoc());
     }
     return Expr(as->getBase()) + "[" + Expr(as->getIdx()) + "]";
   }
   if (auto* op = dyn_cast<CXXOperatorCallExpr>(e)) {
     if (IsStructOperator(op)) return StructOperatorCall(op);  // a struct's own operator: its code
-    if (ispc)
-      if (std::string vector = IspcVectorOperator(op); !vector.empty()) return vector;
+    if (std::string vector = VectorOperator(op); !vector.empty()) return vector;
     auto kind = op->getOperator();
-    std::string coord;
-    if (kind == OO_Subscript && ispc)
-      if (const ValueDecl* image = ImageTexel(op)) {
-        m_uses.loadedImages.insert(image);  // (ISPC binds no images: loads and stores are alike)
-        return IspcTexel(op);
-      }
     if (kind == OO_Subscript)
-      if (auto* image = ImageTexel(op, &coord)) {
-        auto format = UsableImage(image, e->getBeginLoc());
-        if (!format) return "/*error*/";
-        m_uses.loadedImages.insert(image);
-        return TexelOf(*format, "imageLoad(" + ImageName(image) + ", " + coord + ")");
-      }
+      if (const ValueDecl* image = ImageTexel(op)) return TexelRead(op, image);
     const clang::Expr* textureIndex = nullptr;
     if (kind == OO_Subscript)
       if (auto* array = TextureElement(op->getArg(0), &textureIndex))
-        return ispc ? IspcTextureTexel(array, textureIndex, op->getArg(1), e->getBeginLoc()) : TextureTexel(array, textureIndex, op->getArg(1), e->getBeginLoc());
+        return TextureTexel(array, textureIndex, op->getArg(1), e->getBeginLoc());
     if (kind == OO_Subscript) {
       // A LiteMath vector's component by a constant index past its end: undefined in C++, an error in GLSL.
       clang::Expr::EvalResult index;
@@ -848,18 +631,12 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
           return Fail(op->getArg(1)->getBeginLoc(), "index " + std::to_string(i) + " is out of range of a " + std::to_string(n) +
                       "-component vector (undefined behaviour in C++, rejected by GLSL)", "index components 0 to " + std::to_string(n - 1));
       }
-      if (std::string load = IspcCoherentLoad(op); !load.empty()) return load;
+      if (std::string load = ElementRead(op); !load.empty()) return load;
       return Expr(op->getArg(0)) + "[" + Expr(op->getArg(1)) + "]";
     }
-    if (!ispc && op->isAssignmentOp() && op->getNumArgs() == 2 && ImageTexel(op->getArg(0))) {  // (ISPC's texels are lvalues)
-      if (kind == OO_Equal) return ImageStore(op->getArg(0), Expr(op->getArg(1)), e);
-      if (op->getArg(0)->HasSideEffects(m_ctx, /*IncludePossibleEffects=*/false))  // it is printed twice
-        return Fail(e->getBeginLoc(), "compound assignment to a texel whose coordinate has side effects", "compute the coordinate into a variable first");
-      std::string spelling = getOperatorSpelling(kind);
-      return ImageStore(op->getArg(0), Expr(op->getArg(0)) + " " + spelling.substr(0, spelling.size() - 1) + " (" + Expr(op->getArg(1)) + ")", e);
-    }
-    if (ispc && kind == OO_Equal)  // a struct stored whole at a per-lane index (LiteMath's vectors: IspcVectorOperator)
-      if (std::string store = IspcConsecutiveStore(op); !store.empty()) return store;
+    if (std::string store = TexelAssignment(op); !store.empty()) return store;
+    if (kind == OO_Equal)
+      if (std::string store = WholeStore(op); !store.empty()) return store;
     if (kind == OO_Call && op->getNumArgs() == 3) {  // LiteMath's m(row, col): GLSL's matrices index the column first
       const auto glsl = GlslTypeOf(op->getArg(0)->getType().getNonReferenceType());
       if (glsl && glsl->rfind("mat", 0) == 0) {
@@ -883,30 +660,10 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
     return Fail(e->getBeginLoc(), "operator not supported in kernels", "");
   }
   if (auto* bo = dyn_cast<BinaryOperator>(e)) {
-    if (ispc && bo->isAssignmentOp())
-      if (std::string set = IspcComponentAssignment(bo); !set.empty()) return set;
-    if (!ispc && bo->isAssignmentOp()) {  // m_img[p].x = v: the analysis reports it for members; parameters here
-      const clang::Expr* part = bo->getLHS()->IgnoreParenImpCasts();
-      while (auto* me = dyn_cast<MemberExpr>(part)) part = me->getBase()->IgnoreParenImpCasts();
-      if (part != bo->getLHS()->IgnoreParenImpCasts())
-        if (auto* image = ImageTexel(part); image && !isa<FieldDecl>(image))
-          return Fail(e->getBeginLoc(), "kernel writes part of a texel of " + Described(image),
-                      "GPU images store whole texels: read the texel into a variable, change it, and write it back with " +
-                          image->getNameAsString() + "[p] = value");
-    }
-    if (!ispc && bo->isAssignmentOp() && ImageTexel(bo->getLHS())) {  // a texel of a float or uint image
-      if (bo->getOpcode() == BO_Assign) return ImageStore(bo->getLHS(), Expr(bo->getRHS()), e);
-      if (bo->getLHS()->HasSideEffects(m_ctx, /*IncludePossibleEffects=*/false))  // it is printed twice
-        return Fail(e->getBeginLoc(), "compound assignment to a texel whose coordinate has side effects", "compute the coordinate into a variable first");
-      std::string spelling = BinaryOperator::getOpcodeStr(BinaryOperator::getOpForCompoundAssignment(bo->getOpcode())).str();
-      return ImageStore(bo->getLHS(), Expr(bo->getLHS()) + " " + spelling + " (" + Expr(bo->getRHS()) + ")", e);
-    }
-    // ISPC divides the masked-off lanes too, whose divisor may be 0 (a masked gather's): a per-lane
-    // integer divisor goes through crt_divisor (LiteMath.isph), which gives those lanes 1.
+    if (bo->isAssignmentOp())
+      if (std::string set = Assignment(bo); !set.empty()) return set;
     const bool division = bo->getOpcode() == BO_Div || bo->getOpcode() == BO_Rem || bo->getOpcode() == BO_DivAssign || bo->getOpcode() == BO_RemAssign;
-    const bool guarded = ispc && division && bo->getRHS()->getType()->isIntegerType() && !bo->getRHS()->isIntegerConstantExpr(m_ctx) &&
-                         !IspcUniform(bo->getRHS());
-    const std::string rhs = guarded ? "crt_divisor(" + Expr(bo->getRHS()) + ")" : Expr(bo->getRHS());
+    const std::string rhs = division ? Divisor(bo) : Expr(bo->getRHS());
     // C++ gives the remainder the dividend's sign; GLSL's % is undefined for negative operands.
     if ((bo->getOpcode() == BO_Rem || bo->getOpcode() == BO_RemAssign) && bo->getType()->isSignedIntegerType()) {
       std::string a = Expr(bo->getLHS()), b = "(" + rhs + ")";
@@ -949,7 +706,7 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
       std::string zero = Construct(arrayElement, none, e->getBeginLoc()), out;
       for (uint64_t i = 0; i < arraySize; ++i) out += (i ? ", " : "") + zero;
       auto g = Type(il->getType(), e->getBeginLoc());
-      return ispc ? "{" + out + "}" : (g ? *g : "float") + "(" + out + ")";
+      return ArrayValue(g ? *g : "float", out);
     }
     // The semantic form lists every field (missing ones as ImplicitValueInitExpr), as GLSL needs.
     std::vector<const clang::Expr*> args(il->inits().begin(), il->inits().end());
@@ -960,10 +717,7 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
       // `float a[4] = {1}`: GLSL needs every element; the rest come from the array filler.
       if (auto* arr = dyn_cast<ConstantArrayType>(il->getType().getCanonicalType().getTypePtr()); arr && il->hasArrayFiller())
         while (args.size() < arr->getSize().getZExtValue()) args.push_back(il->getArrayFiller());
-      if (ispc) return IspcConstruct(il->getType(), base, args, e->getBeginLoc());
-      std::string out = base + dims + "(";
-      for (size_t i = 0; i < args.size(); ++i) out += (i ? ", " : "") + Expr(args[i]);
-      return out + ")";
+      return ListConstruct(il->getType(), base, dims, args, e->getBeginLoc());
     }
     return Construct(il->getType(), args, e->getBeginLoc());
   }
@@ -983,69 +737,7 @@ std::string GlslPrinter::Expr(const clang::Expr* e) {
               "rewrite it with the constructs of the paper's kernels: arithmetic, locals, loops, calls of helpers and members");
 }
 
-// LiteMath's vector and matrix operators that ISPC's struct operators cannot be: compound assignment
-// (written out, the target printed twice), negation (LiteMath.isph's neg), a component by index (a
-// constant: the field; else LiteMath.isph's crt_get), a matrix's column m[i] and element m(r, c).
-std::string GlslPrinter::IspcVectorOperator(const CXXOperatorCallExpr* op) {
-  if (op->getNumArgs() == 0 || !IsLiteMathType(op->getArg(0)->getType().getNonReferenceType())) return "";
-  const auto kind = op->getOperator();
-  if (std::string store = IspcConsecutiveStore(op); !store.empty()) return store;
-  const bool matrix = IsLiteMathType(op->getArg(0)->getType().getNonReferenceType(), "float4x4") ||
-                      IsLiteMathType(op->getArg(0)->getType().getNonReferenceType(), "float3x3");
-  if (kind == OO_Minus && op->getNumArgs() == 1 && matrix) return "((" + Expr(op->getArg(0)) + ") * -1.0f)";
-  if (kind == OO_Minus && op->getNumArgs() == 1) return "neg(" + Expr(op->getArg(0)) + ")";
-  if (kind == OO_Plus && op->getNumArgs() == 1) return Expr(op->getArg(0));
-  if ((kind == OO_PlusEqual || kind == OO_MinusEqual || kind == OO_StarEqual || kind == OO_SlashEqual) && op->getNumArgs() == 2) {
-    if (op->getArg(0)->HasSideEffects(m_ctx, /*IncludePossibleEffects=*/false)) {  // v[k++] += a: the address once
-      if (std::string once = IspcCompoundAssignOnce(op); !once.empty()) return once;
-      return IspcFail(op->getBeginLoc(), "compound assignment to a vector whose address has side effects, other than an element of a buffer, member vector or local array,");
-    }
-    const std::string target = Expr(op->getArg(0)), spelling = getOperatorSpelling(kind);
-    return target + " = " + target + " " + spelling.substr(0, 1) + " (" + Expr(op->getArg(1)) + ")";
-  }
-  if (kind == OO_Subscript && matrix) return "(" + Expr(op->getArg(0)) + ").m_col[" + Expr(op->getArg(1)) + "]";  // column i
-  if (kind == OO_Call && matrix && op->getNumArgs() == 3)  // m(row, col)
-    return "crt_get((" + Expr(op->getArg(0)) + ").m_col[" + Expr(op->getArg(2)) + "], " + Expr(op->getArg(1)) + ")";
-  if (kind == OO_Subscript) {
-    clang::Expr::EvalResult index;
-    if (!op->getArg(1)->EvaluateAsInt(index, m_ctx))
-      return "crt_get(" + Expr(op->getArg(0)) + ", " + Expr(op->getArg(1)) + ")";  // LiteMath.isph: a select per component
-    if (index.Val.getInt().getExtValue() < 0 || index.Val.getInt().getExtValue() > 3)
-      return IspcFail(op->getBeginLoc(), "a vector's component by an index out of its range");
-    return "(" + Expr(op->getArg(0)) + ")." + std::string(1, "xyzw"[index.Val.getInt().getExtValue()]);
-  }
-  if (kind == OO_EqualEqual || kind == OO_ExclaimEqual) return IspcFail(op->getBeginLoc(), "comparison of whole vectors");
-  return "";
-}
-
-// v[i] = a and v[i] op= a, where v is a LiteMath vector and i known only at run time, and a matrix's
-// m(r, c) = a: ISPC's structs have no subscript, so LiteMath.isph's crt_set writes the component
-// (v and i printed twice for op=).
-std::string GlslPrinter::IspcComponentAssignment(const BinaryOperator* bo) {
-  auto* op = dyn_cast<CXXOperatorCallExpr>(bo->getLHS()->IgnoreParenImpCasts());
-  if (!op) return "";
-  std::string v, i;
-  const auto glsl = GlslTypeOf(op->getArg(0)->getType().getNonReferenceType());
-  clang::Expr::EvalResult index;
-  if (op->getOperator() == OO_Call && op->getNumArgs() == 3 && glsl && glsl->rfind("mat", 0) == 0) {  // m(row, col) = a
-    v = "(" + Expr(op->getArg(0)) + ").m_col[" + Expr(op->getArg(2)) + "]";
-    i = Expr(op->getArg(1));
-  } else if (op->getOperator() == OO_Subscript && op->getNumArgs() == 2 && glsl && glsl->find("vec") != std::string::npos &&
-             !op->getArg(1)->EvaluateAsInt(index, m_ctx)) {
-    v = Expr(op->getArg(0));
-    i = Expr(op->getArg(1));
-  } else {
-    return "";
-  }
-  if (bo->getOpcode() == BO_Assign) return "crt_set(" + v + ", " + i + ", " + Expr(bo->getRHS()) + ")";
-  for (unsigned a = 0; a < op->getNumArgs(); ++a)
-    if (op->getArg(a)->HasSideEffects(m_ctx, false))
-      return IspcFail(bo->getBeginLoc(), "compound assignment to a vector's component whose vector or index has side effects");
-  const std::string spelling = BinaryOperator::getOpcodeStr(BinaryOperator::getOpForCompoundAssignment(bo->getOpcode())).str();
-  return "crt_set(" + v + ", " + i + ", crt_get(" + v + ", " + i + ") " + spelling + " (" + Expr(bo->getRHS()) + "))";
-}
-
-std::string GlslPrinter::ThreadBody(const clang::Stmt* body, int indent, bool loopBody) {
+std::string KernelPrinter::ThreadBody(const clang::Stmt* body, int indent, bool loopBody) {
   m_inThreadBody = true;
   m_inLoopBody = loopBody;
   m_loopDepth = 0;
@@ -1054,7 +746,7 @@ std::string GlslPrinter::ThreadBody(const clang::Stmt* body, int indent, bool lo
   return out;
 }
 
-std::string GlslPrinter::RangeFor(const CXXForRangeStmt* rf, int indent) {
+std::string KernelPrinter::RangeFor(const CXXForRangeStmt* rf, int indent) {
   const std::string pad(indent * 2, ' ');
   const clang::Expr* range = rf->getRangeInit();
   const VarDecl* var = rf->getLoopVariable();
@@ -1084,7 +776,7 @@ std::string GlslPrinter::RangeFor(const CXXForRangeStmt* rf, int indent) {
   else {
     m_uses.memberVectors.insert(field);
     m_uses.sizeReads.emplace(field, rf->getColonLoc());
-    n = ispc ? IspcMember(field->getNameAsString() + "_size") : "int(" + composedPrefix + field->getNameAsString() + "_size)";
+    n = SizeAsInt(MemberAccess(field->getNameAsString() + "_size"));
   }
   const std::string element = pad + "  " + (t.getNonReferenceType().isConstQualified() ? "const " : "") + Declare(t, var->getNameAsString(), var->getLocation()) +
                               " = " + Expr(range) + "[" + k + "];\n";
@@ -1096,8 +788,8 @@ std::string GlslPrinter::RangeFor(const CXXForRangeStmt* rf, int indent) {
   else
     inner = Stmt(body, indent + 1);
   --m_loopDepth;
-  // ISPC: the count is the same in every lane, so the counter is uniform unless the body may leave
-  // the loop early in some lanes only (as IspcUniformLoop decides for counted loops).
+  // The count is the same in every thread: a language whose threads run in lockstep may share the
+  // counter unless the body may leave the loop early in some threads only.
   struct Exits : RecursiveASTVisitor<Exits> {
     bool found = false;
     bool VisitBreakStmt(BreakStmt*) { return !(found = true); }
@@ -1106,12 +798,12 @@ std::string GlslPrinter::RangeFor(const CXXForRangeStmt* rf, int indent) {
     bool VisitGotoStmt(GotoStmt*) { return !(found = true); }
   } exits;
   exits.TraverseStmt(const_cast<clang::Stmt*>(body));
-  const std::string counter = ispc && !exits.found ? "uniform int " : "int ";
+  const std::string counter = RangeCounter(exits.found);
   return pad + "for (" + counter + k + " = 0; " + k + " < " + n + "; ++" + k + ")  // for (" + var->getNameAsString() + " : " +
          TrimmedSourceText(m_ctx, range->getSourceRange()) + ")\n" + pad + "{\n" + element + inner + pad + "}\n";
 }
 
-std::string GlslPrinter::Stmt(const clang::Stmt* s, int indent) {
+std::string KernelPrinter::Stmt(const clang::Stmt* s, int indent) {
   std::string pad(indent * 2, ' ');
   if (!s) return pad + ";\n";
   if (auto replaced = replacedStatements.find(s); replaced != replacedStatements.end()) {
@@ -1178,14 +870,11 @@ std::string GlslPrinter::Stmt(const clang::Stmt* s, int indent) {
           const std::string n = std::to_string(arr->getSize().getZExtValue()), name = SafeName(vd->getNameAsString());
           after = pad + "for (int crt_i = 0; crt_i < " + n + "; ++crt_i)  // each element default-constructed, as in C++\n" + pad + "  " +
                   name + "[crt_i] = " + Construct(arr->getElementType(), {}, vd->getLocation()) + ";\n";
-        } else if (ispc && cons && cons->getNumArgs() == 1 && IsStdArray(t) && cons->getConstructor()->isCopyOrMoveConstructor()) {
-          // ISPC arrays do not copy whole (C's rule): element by element, into a variable that is not const.
-          const std::string name = SafeName(vd->getNameAsString());
-          if (!cnst.empty()) out = pad + decl;
-          uint64_t n = 0;
-          IsStdArray(t, nullptr, &n);
-          after = pad + "for (uniform int crt_i = 0; crt_i < " + std::to_string(n) + "; ++crt_i)  // a copy of " + TrimmedSourceText(m_ctx, cons->getArg(0)->getSourceRange()) +
-                  "\n" + pad + "  " + name + "[crt_i] = " + Expr(cons->getArg(0)) + "[crt_i];\n";
+        } else if (std::string copy = cons && cons->getNumArgs() == 1 && IsStdArray(t) && cons->getConstructor()->isCopyOrMoveConstructor()
+                                          ? ArrayCopy(vd, cons, pad) : "";
+                   !copy.empty()) {
+          if (!cnst.empty()) out = pad + decl;  // into a variable that is not const
+          after = copy;
         } else if (!trivialDefault) {
           out += " = " + Expr(init);
         }
@@ -1219,11 +908,7 @@ std::string GlslPrinter::Stmt(const clang::Stmt* s, int indent) {
     } else if (fs->getInit()) {
       init = Stmt(fs->getInit(), 0);
       while (!init.empty() && (init.back() == '\n' || init.back() == ';')) init.pop_back();
-      if (ispc)
-        if (const VarDecl* shared = IspcUniformLoop(fs)) {  // IspcUniform.cpp: the gang runs it once
-          uniformValues.insert(shared);
-          init = "uniform " + init;
-        }
+      init = LoopInit(fs, init);
     }
     return pad + "for (" + init + "; " + Expr(fs->getCond()) + "; " + Expr(fs->getInc()) + ")\n" + loopBody(fs->getBody());
   }

@@ -11,7 +11,7 @@
 //   Particle& p = m_particles[i];   prints nothing but a comment; p.vel, p prints as m_particles[i].vel
 //                                   (a reference is the lvalue it names, as long as that stays one).
 #include "analyse/AstQueries.h"
-#include "print/Glsl.h"
+#include "print/KernelPrinter.h"
 #include "analyse/WriteVisitor.h"
 
 #include <clang/AST/RecursiveASTVisitor.h>
@@ -29,7 +29,7 @@ bool IsZero(const clang::Expr* e, ASTContext& ctx) {
 }
 }  // namespace
 
-std::optional<GlslPrinter::PointerTarget> GlslPrinter::Pointer(const clang::Expr* e) {
+std::optional<KernelPrinter::PointerTarget> KernelPrinter::Pointer(const clang::Expr* e) {
   e = e->IgnoreParens();
   if (auto* ic = dyn_cast<ImplicitCastExpr>(e)) {
     if (ic->getCastKind() == CK_ArrayToPointerDecay) {  // an array used as a pointer to its first element
@@ -113,7 +113,7 @@ std::optional<GlslPrinter::PointerTarget> GlslPrinter::Pointer(const clang::Expr
   return std::nullopt;
 }
 
-std::string GlslPrinter::Pointee(const PointerTarget& t, const clang::Expr* index, SourceLocation loc) {
+std::string KernelPrinter::Pointee(const PointerTarget& t, const clang::Expr* index, SourceLocation loc) {
   if (!t.value.empty()) {
     if (index && !IsZero(index, m_ctx) && !t.perThread.empty())
       return Fail(loc, "'" + t.perThread + "' holds one value per thread (a local of the control function's thread loop), used here as a pointer",
@@ -129,11 +129,11 @@ std::string GlslPrinter::Pointee(const PointerTarget& t, const clang::Expr* inde
 
 // A helper's pointer parameter is a value (GLSL inout) when the helper only follows it to one
 // element: *p, p->f, p[0], or hands it on to a helper of the same kind.
-bool GlslPrinter::PointerIsValueOnly(const FunctionDecl* fn, const ParmVarDecl* p) {
+bool KernelPrinter::PointerIsValueOnly(const FunctionDecl* fn, const ParmVarDecl* p) {
   struct Uses : RecursiveASTVisitor<Uses> {
-    const ParmVarDecl* p; ASTContext& ctx; GlslPrinter& printer;
+    const ParmVarDecl* p; ASTContext& ctx; KernelPrinter& printer;
     unsigned all = 0, asValue = 0;
-    Uses(const ParmVarDecl* pp, ASTContext& c, GlslPrinter& pr) : p(pp), ctx(c), printer(pr) {}
+    Uses(const ParmVarDecl* pp, ASTContext& c, KernelPrinter& pr) : p(pp), ctx(c), printer(pr) {}
     bool Names(const clang::Expr* e) const {
       auto* dr = dyn_cast<DeclRefExpr>(e->IgnoreParenImpCasts());
       return dr && dr->getDecl() == p;
@@ -160,7 +160,7 @@ bool GlslPrinter::PointerIsValueOnly(const FunctionDecl* fn, const ParmVarDecl* 
 // The arguments of a call to a helper: a pointer argument is the value it points at (inout), or,
 // where the helper indexes the pointer, the offset into the buffer it points into, for a copy of the
 // helper bound to that buffer (`bindings`: parameter index -> buffer).
-std::vector<std::string> GlslPrinter::HelperArgs(const FunctionDecl* fd, const CallExpr* call, std::map<unsigned, std::string>& bindings) {
+std::vector<std::string> KernelPrinter::HelperArgs(const FunctionDecl* fd, const CallExpr* call, std::map<unsigned, std::string>& bindings) {
   const FunctionDecl* def = nullptr;
   if (!fd->hasBody(def) || !def) def = fd;
   std::vector<std::string> args;
@@ -180,8 +180,8 @@ std::vector<std::string> GlslPrinter::HelperArgs(const FunctionDecl* fd, const C
     }
     // ISPC binds no reference to a buffer's element (one per lane, at different addresses): a helper
     // that writes through its pointer gets the buffer and the offset there.
-    const bool ispcBufferElement = ispc && !t->array.empty() && !t->local && !p->getType()->getPointeeType().isConstQualified();
-    if (PointerIsValueOnly(def, p) && !ispcBufferElement) {
+    const bool passedBufferElement = PassesBuffers() && !t->array.empty() && !t->local && !p->getType()->getPointeeType().isConstQualified();
+    if (PointerIsValueOnly(def, p) && !passedBufferElement) {
       args.push_back(Pointee(*t, nullptr, arg->getBeginLoc()));
       continue;
     }
@@ -193,7 +193,7 @@ std::vector<std::string> GlslPrinter::HelperArgs(const FunctionDecl* fd, const C
       continue;
     }
     bindings[pi] = t->array;
-    if (ispc) args.push_back(t->array);  // ISPC: the buffer itself, then the offset into it
+    if (PassesBuffers()) args.push_back(t->array);  // the buffer itself, then the offset into it
     args.push_back(t->offset.empty() ? "0u" : t->offset);
   }
   return args;
@@ -201,7 +201,7 @@ std::vector<std::string> GlslPrinter::HelperArgs(const FunctionDecl* fd, const C
 
 // `T* p = <pointer>;` in a kernel or helper: p follows what it was set to; an offset is fixed where
 // p is set (later changes of its variables do not move p, as in C++).
-std::string GlslPrinter::PointerLocal(const VarDecl* vd, const std::string& pad) {
+std::string KernelPrinter::PointerLocal(const VarDecl* vd, const std::string& pad) {
   const clang::Expr* init = vd->getInit();
   if (!init) return Fail(vd->getLocation(), "pointer '" + vd->getNameAsString() + "' declared without a value in a kernel", "set it where it is declared"), "";
   struct Reassigned : RecursiveASTVisitor<Reassigned> {
@@ -223,7 +223,7 @@ std::string GlslPrinter::PointerLocal(const VarDecl* vd, const std::string& pad)
   if (const FieldDecl* objects = ObjectLocal(vd, &objectIndex)) {
     m_objectLocals[vd] = objects;
     const std::string index = Expr(objectIndex);
-    return pad + "const uint " + SafeName(vd->getNameAsString()) + " = " + (ispc ? "(uint)(" + index + ")" : "uint(" + index + ")") + ";  // " +
+    return pad + "const uint " + SafeName(vd->getNameAsString()) + " = " + ObjectLocalIndex(index) + ";  // " +
            vd->getNameAsString() + " points at " + objects->getNameAsString() + "[" + SafeName(vd->getNameAsString()) + "]\n";
   }
   auto t = Pointer(init);
@@ -243,12 +243,12 @@ std::string GlslPrinter::PointerLocal(const VarDecl* vd, const std::string& pad)
   return out;
 }
 
-std::string GlslPrinter::TextOf(const clang::Expr* e) const {
+std::string KernelPrinter::TextOf(const clang::Expr* e) const {
   auto& sm = m_ctx.getSourceManager();
   return Lexer::getSourceText(CharSourceRange::getTokenRange(sm.getExpansionRange(e->getSourceRange()).getAsRange()), sm, m_ctx.getLangOpts()).str();
 }
 
-std::optional<std::string> GlslPrinter::ReferenceAlias(const VarDecl* vd, const DeclStmt* decl, std::string& why) {
+std::optional<std::string> KernelPrinter::ReferenceAlias(const VarDecl* vd, const DeclStmt* decl, std::string& why) {
   const clang::Expr* init = vd->getInit();
   if (!init) return why = "it has no initialiser", std::nullopt;
   init = init->IgnoreParenImpCasts();

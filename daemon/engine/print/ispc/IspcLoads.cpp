@@ -17,10 +17,10 @@
 // own that packs the words for crt_store_words8: eight vector stores instead of eight scatters.
 //
 // And a vector updated through an address with side effects, p[k++] += v: the address found once.
-// Part of GlslPrinter (Glsl.h).
+// Part of IspcPrinter (IspcPrinter.h).
 #include "analyse/AstQueries.h"
-#include "print/Glsl.h"
-#include "print/GlslParts.h"
+#include "print/ispc/IspcPrinter.h"
+#include "print/PrinterParts.h"
 #include "print/GlslTypes.h"
 
 #include <clang/AST/ParentMapContext.h>
@@ -39,12 +39,12 @@ constexpr int kAgreedValues = 4;             // values loaded once before the re
 
 }  // namespace
 
-std::string GlslPrinter::IspcCoherentLoad(const clang::CXXOperatorCallExpr* op) {
-  if (!ispc || op->getOperator() != OO_Subscript || op == m_fieldBase) return "";
+std::string IspcPrinter::CoherentLoad(const clang::CXXOperatorCallExpr* op) {
+  if (op->getOperator() != OO_Subscript || op == m_fieldBase) return "";
   const FieldDecl* field = ThisMemberField(op->getArg(0));
   const QualType element = op->getType().getCanonicalType();
   if (!field || !IsStdVector(field->getType()) || !element.isConstQualified() || !element->isRecordType() ||
-      element->isIncompleteType() || m_ctx.getTypeSizeInChars(element).getQuantity() < kCoherentLoadBytes || IspcUniform(op->getArg(1)))
+      element->isIncompleteType() || m_ctx.getTypeSizeInChars(element).getQuantity() < kCoherentLoadBytes || Uniform(op->getArg(1)))
     return "";
   const auto glsl = GlslTypeOf(element.getUnqualifiedType());
   if (!glsl) return "";
@@ -65,13 +65,13 @@ std::string GlslPrinter::IspcCoherentLoad(const clang::CXXOperatorCallExpr* op) 
        << "  return e;\n}\n";
     m_functions.push_back(os.str());
   }
-  return helper + "(" + Expr(op->getArg(0)) + ", ((" + IspcVariability(op->getArg(1)) + "uint)(" + Expr(op->getArg(1)) + ")))";
+  return helper + "(" + Expr(op->getArg(0)) + ", ((" + Variability(op->getArg(1)) + "uint)(" + Expr(op->getArg(1)) + ")))";
 }
 
 // Whether e's value is only read, as a whole: copied into a new value, or passed to a function by
 // value or by const reference (LiteMath's operators take const float4&). Not the target of an
 // assignment, a non-const reference, or the object of a non-const method.
-bool GlslPrinter::ReadWhole(const clang::Expr* e) {
+bool IspcPrinter::ReadWhole(const clang::Expr* e) {
   const clang::Stmt* child = e;
   while (true) {
     const auto parents = m_ctx.getParents(*child);
@@ -105,8 +105,8 @@ bool GlslPrinter::ReadWhole(const clang::Expr* e) {
   }
 }
 
-std::string GlslPrinter::IspcConsecutiveLoad(const clang::ArraySubscriptExpr* as, const PointerTarget& t) {
-  if (!ispc || !t.value.empty() || as == m_fieldBase || IspcUniform(as->getIdx())) return "";
+std::string IspcPrinter::ConsecutiveLoad(const clang::ArraySubscriptExpr* as, const PointerTarget& t) {
+  if (!t.value.empty() || as == m_fieldBase || Uniform(as->getIdx())) return "";
   const QualType element = as->getType();
   if (!IsLiteMathType(element, "float4") && !IsLiteMathType(element, "int4") && !IsLiteMathType(element, "uint4")) return "";
   if (!ReadWhole(as)) return "";
@@ -117,7 +117,7 @@ std::string GlslPrinter::IspcConsecutiveLoad(const clang::ArraySubscriptExpr* as
 // v[k++] += a for a LiteMath vector element of a buffer, a member vector or a local array: ISPC
 // structs have no +=, so it is a[i] = a[i] + v, in a helper that takes the array and the index,
 // computed once. A local array is the thread's own (varying elements, each lane its own index).
-std::string GlslPrinter::IspcCompoundAssignOnce(const clang::CXXOperatorCallExpr* op) {
+std::string IspcPrinter::CompoundAssignOnce(const clang::CXXOperatorCallExpr* op) {
   const clang::Expr* target = op->getArg(0)->IgnoreParenImpCasts();
   std::string array, index, pointee = "uniform ", helperKind;
   const VarDecl* localArray = nullptr;
@@ -158,7 +158,7 @@ std::string GlslPrinter::IspcCompoundAssignOnce(const clang::CXXOperatorCallExpr
   const std::string type = IspcTypeName(*glsl), spelling = getOperatorSpelling(op->getOperator());
   const char* names[] = {"add", "sub", "mul", "div"};
   const std::string name = std::string("crt_") + names[std::string("+-*/").find(spelling[0])] + "_assign_" + type + helperKind;
-  if (m_ispcHelpers.insert(name).second)
+  if (m_helpers.insert(name).second)
     m_functions.push_back("// a[i] " + spelling + " v, a[i] found once" + (helperKind.empty() ? "" : " (a: a thread's local array)") + "\nstatic inline " + type +
                           " " + name + "(" + pointee + type + " *uniform a, int i, " + type + " v)\n{\n  a[i] = a[i] " + spelling.substr(0, 1) +
                           " v;\n  return a[i];\n}\n");
@@ -190,10 +190,10 @@ static std::vector<std::string> EightWords(ASTContext& ctx, QualType type) {
   return words.size() == 8 ? words : std::vector<std::string>{};
 }
 
-std::string GlslPrinter::IspcConsecutiveStore(const clang::CXXOperatorCallExpr* op) {
-  if (!ispc || op->getOperator() != OO_Equal || op->getNumArgs() != 2) return "";
+std::string IspcPrinter::ConsecutiveStore(const clang::CXXOperatorCallExpr* op) {
+  if (op->getOperator() != OO_Equal || op->getNumArgs() != 2) return "";
   const auto* as = dyn_cast<ArraySubscriptExpr>(op->getArg(0)->IgnoreParenImpCasts());
-  if (!as || !as->getBase()->getType()->isPointerType() || IspcUniform(as->getIdx())) return "";
+  if (!as || !as->getBase()->getType()->isPointerType() || Uniform(as->getIdx())) return "";
   const QualType element = as->getType().getUnqualifiedType();
   // A struct of eight words (a CRT_Hit) goes through a helper of its own: crt_store_words8 after
   // packing its fields, or the scatters.
@@ -205,7 +205,7 @@ std::string GlslPrinter::IspcConsecutiveStore(const clang::CXXOperatorCallExpr* 
     if (!glsl) return "";
     const std::string type = IspcTypeName(*glsl);
     store = "crt_store_" + type;
-    if (m_ispcHelpers.insert(store).second) {
+    if (m_helpers.insert(store).second) {
       std::string packed;
       for (const auto& w : words) packed += ", " + w;
       m_functions.push_back("// a[i] = v for each lane, " + type + " being eight 32-bit words: vector stores where the lanes write\n"
