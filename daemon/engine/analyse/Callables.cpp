@@ -1,10 +1,10 @@
 // The code of virtual calls: per implementation its data struct and methods printed with `self`, per
 // method a dispatcher that switches over the object's class (levels 1-2), or at level 3 a callable
 // shader per implementation and the call that the ray generation shader makes.
-#include "print/Printers.h"
-#include "print/glsl/GlslPrinter.h"
 #include "analyse/Callables.h"
 #include "generate/CodeGenSupport.h"
+#include "print/Printers.h"
+#include "print/glsl/GlslPrinter.h"
 
 #include "analyse/AstQueries.h"
 #include "analyse/Members.h"

@@ -1,7 +1,6 @@
 // Composition (paper 3.6): a member of an interface type with an implementation given by COMPOSE. The
 // implementation's methods that kernels call are printed into the kernels, its data becomes buffers and
 // class data reached through the holder. Takes the implementation's AST; adds to the kernels.
-#include "print/Printers.h"
 #include "analyse/Composition.h"
 
 #include "analyse/AstQueries.h"
@@ -10,6 +9,7 @@
 #include "analyse/Members.h"
 #include "analyse/VirtualCalls.h"
 #include "analyse/WriteVisitor.h"
+#include "print/Printers.h"
 
 #include <algorithm>
 

@@ -1,7 +1,6 @@
 // One kernel from start to end: its loop nest, parameters, writes and reductions, the GLSL of its body
 // through the printer, and the CPU copy with its OpenMP pragma. Takes a kernel's method; adds a Kernel
 // to the model.
-#include "print/Printers.h"
 #include "analyse/Kernels.h"
 
 #include "analyse/AnalysisContext.h"
@@ -13,6 +12,8 @@
 #include "analyse/Naming.h"
 #include "analyse/VirtualCalls.h"
 #include "analyse/Writes.h"
+#include "print/ispc/IspcTypes.h"
+#include "print/Printers.h"
 
 #include <algorithm>
 #include <sstream>

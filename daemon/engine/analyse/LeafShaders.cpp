@@ -2,9 +2,9 @@
 // functions, and traversals that call them with a CRT_LeafInfo at their leaves (the paper's listing
 // 2), become traces of a ray tracing pipeline, with an intersection shader per leaf class and a hit
 // and a miss shader per call. Takes the traversal's loops; gives Kernel::leaves and the shaders.
-#include "print/glsl/GlslPrinter.h"
 #include "analyse/LeafShaders.h"
 #include "generate/CodeGenSupport.h"
+#include "print/glsl/GlslPrinter.h"
 
 #include "analyse/AstQueries.h"
 #include "analyse/Composition.h"

@@ -1,12 +1,12 @@
 // The class's data members: which become buffers (std::vector), class data, images, samplers,
 // textures or vectors of objects, with their C++ and GLSL types. Takes the class; fills model.members
 // and model.constructors.
-#include "print/Printers.h"
 #include "analyse/Members.h"
 
 #include "analyse/AnalysisContext.h"
 #include "analyse/AstQueries.h"
 #include "generate/GeneratedNames.h"
+#include "print/Printers.h"
 
 #include <algorithm>
 #include <set>

@@ -5,6 +5,7 @@
 
 #include "analyse/AnalysisContext.h"
 #include "analyse/Callables.h"
+#include "print/ispc/IspcTypes.h"
 
 #include <algorithm>
 #include <sstream>

@@ -12,6 +12,7 @@
 #include "control/ControlFunctions.h"
 #include "control/ControlRewriter.h"
 #include "print/GlslTypes.h"
+#include "print/ispc/IspcTypes.h"
 #include "analyse/LoopShape.h"
 #include "analyse/Naming.h"
 

@@ -11,6 +11,7 @@
 #include "analyse/LoopShape.h"
 #include "analyse/Naming.h"
 #include "print/GlslTypes.h"
+#include "print/ispc/IspcTypes.h"
 
 #include <algorithm>
 #include <regex>

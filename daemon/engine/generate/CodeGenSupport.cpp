@@ -3,6 +3,7 @@
 #include "generate/CodeGenSupport.h"
 #include "generate/CodeGen.h"
 #include "print/KernelPrinter.h"
+#include "print/ispc/IspcTypes.h"
 
 #include <fstream>
 #include <regex>

@@ -5,6 +5,7 @@
 #include "generate/CodeGen.h"
 #include "generate/CodeGenSupport.h"
 #include "print/GlslTypes.h"
+#include "print/ispc/IspcTypes.h"
 
 #include <algorithm>
 #include <set>

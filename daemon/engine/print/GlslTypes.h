@@ -17,13 +17,6 @@ namespace crossrt::engine {
 std::optional<std::string> GlslTypeOf(clang::QualType type);
 // "float[4]" -> {"float", "[4]"}
 std::pair<std::string, std::string> SplitArray(const std::string& glslType);
-// The ISPC name of a GLSL type name: LiteMath's (vec3 -> float3, uvec2 -> uint2, mat4 -> float4x4),
-// the scalars and structs as they are; arrays keep their dimensions.
-std::string IspcTypeName(const std::string& glslType);
-// The ISPC struct of the data of a class reached through virtual calls: its qualified name with '_'
-// for '::' and "_Data" (litept::Lambert -> litept_Lambert_Data). ISPC's header drops namespaces, and
-// two classes of one name from two namespaces may meet in one program.
-std::string IspcObjectStruct(const std::string& qualifiedName);
 
 bool IsLiteMathType(clang::QualType type, const char* name = nullptr);
 bool IsStdVector(clang::QualType type, clang::QualType* element = nullptr);

@@ -1,6 +1,7 @@
 // ISPC's library calls: LiteMath.isph's names for LiteMath and <cmath>, ISPC's global atomics for
 // crossrt::Atomic*, LiteMath's InterlockedAdd and ReduceAdd.
 #include "print/ispc/IspcPrinter.h"
+#include "print/ispc/IspcTypes.h"
 #include "analyse/AstQueries.h"
 #include "print/GlslTypes.h"
 #include "print/PrinterParts.h"

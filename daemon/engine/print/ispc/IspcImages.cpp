@@ -1,6 +1,7 @@
 // ISPC's images: Image2D members and parameters as the class data's texel arrays (loads and stores
 // alike, texels are lvalues), samples through LiteMath.isph, and arrays of textures.
 #include "print/ispc/IspcPrinter.h"
+#include "print/ispc/IspcTypes.h"
 #include "analyse/AstQueries.h"
 #include "print/GlslTypes.h"
 #include "print/PrinterParts.h"

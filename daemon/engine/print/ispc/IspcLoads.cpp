@@ -20,6 +20,7 @@
 // Part of IspcPrinter (IspcPrinter.h).
 #include "analyse/AstQueries.h"
 #include "print/ispc/IspcPrinter.h"
+#include "print/ispc/IspcTypes.h"
 #include "print/PrinterParts.h"
 #include "print/GlslTypes.h"
 

@@ -1,6 +1,7 @@
 // ISPC's spellings of what KernelPrinter walks: types and padded structs, C casts and make_T(...),
 // the class data through `self`, uniform values, appends on the host, vectors' operators (IspcPrinter.h).
 #include "print/ispc/IspcPrinter.h"
+#include "print/ispc/IspcTypes.h"
 #include "analyse/AstQueries.h"
 #include "print/GlslTypes.h"
 #include "print/PrinterParts.h"
