@@ -316,7 +316,7 @@ struct StageShader {
   bool scalarLayout = false;          // the class's objects need GL_EXT_scalar_block_layout
   bool classData = false;             // it reads the class-data block (binding 0): where the objects are
   // Buffers of a composed traversal it reads (an object's method reading them through `this` of the
-  // traversal, GlslOwner.cpp), bound as kernel `kernel` binds them.
+  // traversal, print/Owner.cpp), bound as kernel `kernel` binds them.
   std::vector<std::string> buffers;
   std::string kernel;
   std::string constants, structs, functions;  // the implementation's code and the payload, in GLSL order

@@ -1,4 +1,4 @@
-// The GLSL printer (Glsl.cpp, GlslCalls.cpp): what a kernel's C++ becomes, on a small class with a
+// The GLSL printer (print/KernelPrinter.cpp, print/glsl/GlslPrinter.cpp): what a kernel's C++ becomes, on a small class with a
 // user struct, a member helper, a static helper of the .cpp, a local array, a switch, casts and
 // the standard library. The expectations are GLSL's spellings of the same C++.
 #include "EngineSupport.h"

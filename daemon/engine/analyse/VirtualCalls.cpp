@@ -90,7 +90,7 @@ bool WrittenBack(const CXXMethodDecl* m, unsigned i) {
 std::string DispatcherParams(KernelPrinter& printer, const CXXMethodDecl* m, bool forIspc) {
   std::string out;
   for (unsigned i = 0; i < m->getNumParams(); ++i) {
-    if (KernelPrinter::PointsTo(m->getParamDecl(i)->getType(), printer.Class())) continue;  // the caller, left out (GlslOwner.cpp)
+    if (KernelPrinter::PointsTo(m->getParamDecl(i)->getType(), printer.Class())) continue;  // the caller, left out (print/Owner.cpp)
     std::string declared = printer.Declare(m->getParamDecl(i)->getType(), CallArgumentName(m, i), m->getParamDecl(i)->getLocation());
     if (WrittenBack(m, i) && forIspc) declared.insert(declared.rfind(' ') + 1, "&");  // ISPC: a reference
     else if (WrittenBack(m, i)) declared = "inout " + declared;

@@ -425,7 +425,7 @@ std::string KernelPrinter::VirtualCall(const CXXMemberCallExpr* mc) {
   if (std::string data = ClassDataArgument(); !data.empty()) args.insert(args.begin(), data);  // the dispatcher finds the tags and the objects in the class data
   for (unsigned i = 0; i < mc->getNumArgs(); ++i) {
     const ParmVarDecl* p = i < method->getNumParams() ? method->getParamDecl(i) : nullptr;
-    if (p && PointsTo(p->getType(), m_class)) {  // the caller itself, left out on the GPU (GlslOwner.cpp)
+    if (p && PointsTo(p->getType(), m_class)) {  // the caller itself, left out on the GPU (print/Owner.cpp)
       if (!PassesSelf(p, mc->getArg(i)))
         return Fail(mc->getArg(i)->getBeginLoc(), "argument " + std::to_string(i + 1) + " of " + method->getNameAsString() + " points at a " +
                     m_class->getNameAsString() + " other than the caller", "pass `this`: on the GPU the caller's data are the only ones");
@@ -846,7 +846,7 @@ std::string KernelPrinter::Stmt(const clang::Stmt* s, int indent) {
       }
       if (t->isReferenceType() && !t.getNonReferenceType().isConstQualified()) {
         std::string why;
-        if (auto alias = ReferenceAlias(vd, ds, why)) {  // GlslPointers.cpp: its uses print as what it refers to
+        if (auto alias = ReferenceAlias(vd, ds, why)) {  // print/Pointers.cpp: its uses print as what it refers to
           renames[vd] = *alias;
           out += pad + "// " + SafeName(vd->getNameAsString()) + " is " + *alias + " (a reference)\n";
           continue;

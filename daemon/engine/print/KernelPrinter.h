@@ -114,7 +114,7 @@ public:
 
   // The composed implementation passed to an object's method (paper 3.10: a traversal's leaf
   // call `m_geom[g]->Intersect(ray, info, hit, this)` with `Intersect(..., const BVHRT* scene)`),
-  // GlslOwner.cpp. In an object's printer: the traversal's printer. The parameter is left out of
+  // print/Owner.cpp. In an object's printer: the traversal's printer. The parameter is left out of
   // the GPU's functions, and what is read through it (scene->m_values[i], scene->Helper(...))
   // prints as the traversal's own code does, under the traversal's prefix and in its Uses().
   KernelPrinter* owner = nullptr;
