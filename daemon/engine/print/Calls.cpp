@@ -59,6 +59,12 @@ std::string NumericLimit(const FunctionDecl* fd) {
 }
 }  // namespace
 
+std::string CallText(const std::string& f, const std::vector<std::string>& args) {
+  std::string s = f + "(";
+  for (size_t i = 0; i < args.size(); ++i) s += (i ? ", " : "") + args[i];
+  return s + ")";
+}
+
 // Library functions with a counterpart in the kernel's language: LiteMath, <cmath>, std::min/max,
 // std::numeric_limits (the limits and the bit builtins here, the rest by the language: LibraryCall).
 std::string KernelPrinter::Builtin(const FunctionDecl* fd, const std::vector<std::string>& a, const CallExpr* call) {

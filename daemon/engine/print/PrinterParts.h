@@ -6,6 +6,8 @@ namespace crossrt::engine {
 
 // The source text of a range, as written (for comments that say where generated code came from).
 std::string TrimmedSourceText(const clang::ASTContext& ctx, clang::SourceRange range);
+// A call of f with the printed arguments: "f(a, b)".
+std::string CallText(const std::string& f, const std::vector<std::string>& args);
 // The field of `this` that `e` names (this->f or f), or null.
 const clang::FieldDecl* ThisMemberField(const clang::Expr* e);
 // How a texel of the image's type becomes the C++ value: images hold 4 channels on the GPU.

@@ -67,11 +67,7 @@ std::string GlslPrinter::InterlockedCall(const FunctionDecl* fd, const CallExpr*
 std::string GlslPrinter::LibraryCall(const FunctionDecl* fd, const std::vector<std::string>& a, const CallExpr* call,
                                      const std::map<std::string, std::string>& same) {
   const std::string n = fd->getNameAsString();
-  auto join = [&](const std::string& f) {
-    std::string s = f + "(";
-    for (size_t i = 0; i < a.size(); ++i) s += (i ? ", " : "") + a[i];
-    return s + ")";
-  };
+  auto join = [&](const std::string& f) { return CallText(f, a); };
   const std::string arg0Type = call->getNumArgs() ? GlslTypeOf(call->getArg(0)->getType()).value_or("") : "";
   if (n == "to_float4" && call->getNumArgs() == 1 && IsLiteMathType(call->getArg(0)->getType(), "half4"))
     return "vec4(unpackHalf2x16((" + a[0] + ").x), unpackHalf2x16((" + a[0] + ").y))";

@@ -16,16 +16,12 @@ using namespace clang;
 
 namespace crossrt::engine {
 
-// The same for ISPC: LiteMath.isph has LiteMath's constructors and conversions under their own
+// LiteMath.isph has LiteMath's constructors and conversions under their own
 // names (make_float3, to_float3), GLSL's functions under GLSL's (`same`), and LiteMath's matrices.
-std::string IspcPrinter::Builtin(const FunctionDecl* fd, const std::vector<std::string>& a, const CallExpr* call,
+std::string IspcPrinter::LibraryCall(const FunctionDecl* fd, const std::vector<std::string>& a, const CallExpr* call,
                                      const std::map<std::string, std::string>& same) {
   const std::string n = fd->getNameAsString();
-  auto join = [&](const std::string& f) {
-    std::string s = f + "(";
-    for (size_t i = 0; i < a.size(); ++i) s += (i ? ", " : "") + a[i];
-    return s + ")";
-  };
+  auto join = [&](const std::string& f) { return CallText(f, a); };
   static const std::set<std::string> ownNames = {
       "make_float2", "make_float3", "make_float4", "make_int2", "make_int3", "make_int4", "make_uint2", "make_uint3",
       "make_uint4", "to_float2", "to_float3", "to_float4", "to_int2", "to_int3", "to_int4", "to_uint2", "to_uint3", "to_uint4"};
@@ -117,11 +113,6 @@ std::string IspcPrinter::Interlocked(const FunctionDecl* fd, const CallExpr* cal
   }
   const clang::Expr* value = call->getArg(call->getNumArgs() - 1);
   return helper + "(self, ((" + Variability(call->getArg(1)) + "uint)(" + Expr(call->getArg(1)) + ")), " + Expr(value) + ")";
-}
-
-std::string IspcPrinter::LibraryCall(const FunctionDecl* fd, const std::vector<std::string>& args, const CallExpr* call,
-                                     const std::map<std::string, std::string>& same) {
-  return Builtin(fd, args, call, same);
 }
 
 // ISPC's global atomics, on the target's address (a lane at a time where lanes share one).

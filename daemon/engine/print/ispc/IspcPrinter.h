@@ -82,9 +82,7 @@ private:
   std::string StructMaker(const clang::RecordDecl* rd) const;
   // No constructor calls in ISPC: make_T(...), a struct's maker, a C cast, a braced list.
   std::string MakeValue(clang::QualType t, const std::string& type, const std::vector<const clang::Expr*>& args, clang::SourceLocation loc);
-  // LiteMath.isph's spellings of library functions; of LiteMath's InterlockedAdd and ReduceAdd.
-  std::string Builtin(const clang::FunctionDecl* fd, const std::vector<std::string>& args, const clang::CallExpr* call,
-                      const std::map<std::string, std::string>& same);
+  // LiteMath's InterlockedAdd3f and ReduceAdd.
   std::string Interlocked(const clang::FunctionDecl* fd, const clang::CallExpr* call);
   // Images (IspcImages.cpp): an image member or parameter; img[p] or img.at(x, y) as an lvalue.
   std::string Image(const clang::ValueDecl* image) const;
