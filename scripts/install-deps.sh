@@ -17,6 +17,7 @@ PACKAGES=(
   redis-server nginx-light openssl                         # its tests' servers, on loopback ports, and TLS keys
   libopenvdb-dev                                           # bench_sdf's peer: OpenVDB level sets
   neovim                                                   # the language server's test drives Neovim's LSP client
+  libcli11-dev                                             # the programs' command lines (CLI11)
 )
 missing=()
 for p in "${PACKAGES[@]}"; do

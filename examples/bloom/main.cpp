@@ -10,6 +10,8 @@
 #include "Bloom_Vulkan.h"
 #include "Image2D.h"
 
+#include "CommandLine.h"
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -41,20 +43,21 @@ static LiteImage::Image2D<float4> RenderTestScene(int w, int h)
 
 int main(int argc, char** argv)
 {
-  if (argc > 1 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h"))
-  {
-    std::printf("usage: bloom [INPUT_IMAGE | \"\"] [OUTPUT.png]\n  Bloom of INPUT_IMAGE (\"\" or none: a built-in scene) by the original class, Bloom_CPU, Bloom_ISPC (where built) and Bloom_Vulkan;\n  writes OUTPUT.png (default bloom.png) and a table of times. Exits non-zero when they differ.\n");
-    return 0;
-  }
+  std::string inPath, outPath = "bloom.png";
+  crossrt::CommandLine app("bloom",
+                           "Bloom of INPUT_IMAGE (\"\" or none: a built-in scene) by the original class, Bloom_CPU, Bloom_ISPC\n"
+                           "(where built) and Bloom_Vulkan; writes OUTPUT.png and a table of times. Exits non-zero when they differ.");
+  app.add_option("INPUT_IMAGE", inPath, "the image to filter (\"\": the built-in scene)");
+  app.add_option("OUTPUT.png", outPath, "the filtered image");
+  if (const int status = crossrt::ParseCommandLine(app, argc, argv); status >= 0) return status;
   LiteImage::Image2D<float4> input;
-  const bool photo = argc > 1 && argv[1][0] != '\0';  // "" asks for the built-in scene
+  const bool photo = !inPath.empty();  // "" asks for the built-in scene
   if (photo)
   {
-    if (!LiteImage::LoadImage(argv[1], input)) return 1;
+    if (!LiteImage::LoadImage(inPath.c_str(), input)) return 1;
   }
   else
     input = RenderTestScene(512, 512);
-  const std::string outPath = argc > 2 ? argv[2] : "bloom.png";
   const int w = int(input.width()), h = int(input.height());
 
   struct Run { const char* name; std::shared_ptr<Bloom> impl; std::vector<float4> out; double ms = 0.0; };

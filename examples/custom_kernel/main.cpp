@@ -2,6 +2,8 @@
 // both results and whether the hand-written kernel ran.
 #include "FastVectorOps.h"
 
+#include "CommandLine.h"
+
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -9,12 +11,10 @@
 
 int main(int argc, char** argv)
 {
-  if (argc > 1)  // no arguments: --help prints what it does, anything else is an error
-  {
-    const bool help = std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h";
-    std::fprintf(help ? stdout : stderr, "usage: custom_kernel\n  Runs VectorOps as written and FastVectorOps (the generated class with a hand-written kernel), prints\n  both results and whether the hand-written kernel ran.\n");
-    return help ? 0 : 2;
-  }
+  crossrt::CommandLine app("custom_kernel",
+                           "Runs VectorOps as written and FastVectorOps (the generated class with a hand-written kernel),\n"
+                           "prints both results and whether the hand-written kernel ran.");
+  if (const int status = crossrt::ParseCommandLine(app, argc, argv); status >= 0) return status;
   const int n = 10001;
   std::vector<float> expected(n), actual(n);
   for (int i = 0; i < n; ++i) expected[i] = actual[i] = 0.001f * float(i);

@@ -7,6 +7,8 @@
 #endif
 #include "Particles_Vulkan.h"
 
+#include "CommandLine.h"
+
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -28,13 +30,13 @@ struct Run
 
 int main(int argc, char** argv)
 {
-  if (argc > 1 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h"))
-  {
-    std::printf("usage: particles [N (default 1048576)] [STEPS (default 10)]\n  Moves N particles STEPS times with the original class, Particles_CPU, Particles_ISPC (where built) and Particles_Vulkan, and prints\n  a table of times. Exits non-zero when their results differ.\n");
-    return 0;
-  }
-  const int n = argc > 1 ? std::atoi(argv[1]) : 1 << 20;
-  const int steps = argc > 2 ? std::atoi(argv[2]) : 10;
+  int n = 1 << 20, steps = 10;
+  crossrt::CommandLine app("particles",
+                           "Moves N particles STEPS times with the original class, Particles_CPU, Particles_ISPC (where built)\n"
+                           "and Particles_Vulkan, and prints a table of times. Exits non-zero when their results differ.");
+  app.add_option("N", n, "particles")->check(crossrt::Positive());
+  app.add_option("STEPS", steps, "steps")->check(crossrt::NonNegative());
+  if (const int status = crossrt::ParseCommandLine(app, argc, argv); status >= 0) return status;
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> u(-1.0f, 1.0f);
   std::vector<float4> pos(n), vel(n);

@@ -15,6 +15,8 @@
 #include "PathTracer_VulkanLevel3.h"
 #include "SceneLoader.h"
 
+#include "CommandLine.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -26,28 +28,6 @@
 using LiteMath::float4;
 
 namespace {
-
-const char* kUsage =
-    "usage: path_tracer SCENE [--size WxH] [--spp N] [--depth D] [--device original|cpu|ispc|vulkan]\n"
-    "                   [--mode megakernel|wavefront] [--virtual-level 1|2|3] [--accel embree|sah|lbvh]\n"
-    "                   [--env FILE.exr] [--env-strength F]\n"
-    "                   [--seed S] [--pass-spp K] [--compare REF.exr] --out FILE.exr|FILE.png [--out ...]\n"
-    "  Path traces SCENE (.gltf, .glb or .obj) with next-event estimation and multiple importance sampling.\n"
-    "  --size      image size (default 256x256)            --spp     samples per pixel (default 64)\n"
-    "  --depth     bounces, as Cycles counts them (default 8; 0 is direct light only)\n"
-    "  --device    original: the class as written, one thread; cpu: PathTracer_CPU, all cores (default);\n"
-    "              ispc: PathTracer_ISPC, all cores, one path a SIMD lane (where ISPC was found; CrossRT's BVHs);\n"
-    "              vulkan: PathTracer_Vulkan on the default Vulkan device\n"
-    "  --mode      PathTracer_Vulkan's execution mode (default megakernel)\n"
-    "  --virtual-level  how the GPU reaches materials and lights (paper 3.9): 1, one array of equal slots\n"
-    "              (PathTracer_VulkanLevel1); 2, a buffer per class (PathTracer_Vulkan, default); 3, as 2 plus\n"
-    "              callable shaders where the device has ray tracing pipelines (PathTracer_VulkanLevel3)\n"
-    "  --accel     the CPU devices' ray tracing: Embree (default) or CrossRT's BVHs; ispc and vulkan use sah (or lbvh)\n"
-    "  --env       an equirectangular environment map (linear EXR, Blender's orientation), times --env-strength\n"
-    "  --seed      the random sequence (a pixel's samples depend only on pixel, sample index and seed)\n"
-    "  --pass-spp  samples per pass (default 4): memory stays the same whatever --spp is (1 for megakernels on llvmpipe)\n"
-    "  --compare   prints PSNR (8-bit sRGB) and relative MSE (linear) of the image against REF\n"
-    "  --out       .exr: linear radiance; .png: sRGB, clamped (several --out: the same image to each)\n";
 
 struct Options
 {
@@ -68,15 +48,15 @@ std::shared_ptr<PathTracer> VulkanTracer(std::shared_ptr<crossrt::VulkanContext>
 
 [[noreturn]] void Usage(const std::string& problem)
 {
-  std::fprintf(stderr, "path_tracer: error: %s\n%s", problem.c_str(), kUsage);
+  std::fprintf(stderr, "path_tracer: error: %s (see --help)\n", problem.c_str());
   std::exit(2);
 }
 
-uint32_t Positive(const std::string& flag, const char* text)
+uint32_t Positive(const std::string& flag, const std::string& text)
 {
   char* end = nullptr;
-  const long v = std::strtol(text, &end, 10);
-  if (*end != '\0' || v <= 0 || v > (1 << 24))
+  const long v = std::strtol(text.c_str(), &end, 10);
+  if (text.empty() || *end != '\0' || v <= 0 || v > (1 << 24))
     Usage(flag + " takes a positive integer, not '" + text + "'");
   return uint32_t(v);
 }
@@ -84,58 +64,38 @@ uint32_t Positive(const std::string& flag, const char* text)
 Options Parse(int argc, char** argv)
 {
   Options o;
-  for (int i = 1; i < argc; ++i)
-  {
-    const std::string a = argv[i];
-    if (a == "--help" || a == "-h")
-    {
-      std::printf("%s", kUsage);
-      std::exit(0);
-    }
-    const bool takesValue = a.rfind("--", 0) == 0;
-    if (takesValue && i + 1 >= argc)
-      Usage(a + " needs a value");
-    if (a == "--size")
-    {
-      const std::string v = argv[++i];
-      const size_t x = v.find('x');
-      if (x == std::string::npos)
-        Usage("--size takes WxH, not '" + v + "'");
-      o.width = Positive(a, v.substr(0, x).c_str());
-      o.height = Positive(a, v.substr(x + 1).c_str());
-    }
-    else if (a == "--spp") o.spp = Positive(a, argv[++i]);
-    else if (a == "--pass-spp") o.passSpp = Positive(a, argv[++i]);
-    else if (a == "--seed") o.seed = uint32_t(std::strtoul(argv[++i], nullptr, 10));
-    else if (a == "--depth")
-    {
-      o.depth = std::atoi(argv[++i]);
-      if (o.depth < 0 || o.depth > 64)
-        Usage("--depth takes 0 to 64");
-    }
-    else if (a == "--device") o.device = argv[++i];
-    else if (a == "--mode") o.mode = argv[++i];
-    else if (a == "--virtual-level")
-    {
-      const std::string v = argv[++i];
-      if (v != "1" && v != "2" && v != "3")
-        Usage("--virtual-level is 1, 2 or 3, not '" + v + "'");
-      o.virtualLevel = std::stoi(v);
-    }
-    else if (a == "--accel") o.accel = argv[++i];
-    else if (a == "--env") o.env = argv[++i];
-    else if (a == "--env-strength") o.envStrength = float(std::atof(argv[++i]));
-    else if (a == "--compare") o.compare = argv[++i];
-    else if (a == "--out") o.outs.push_back(argv[++i]);
-    else if (takesValue) Usage("unknown option " + a);
-    else if (o.scene.empty()) o.scene = a;
-    else Usage("more than one scene: '" + o.scene + "' and '" + a + "'");
-  }
-  if (o.scene.empty()) Usage("no scene given");
-  if (o.outs.empty()) Usage("no --out file given");
-  if (o.device != "original" && o.device != "cpu" && o.device != "ispc" && o.device != "vulkan")
-    Usage("--device is original, cpu, ispc or vulkan, not '" + o.device + "'");
-  if (o.mode != "megakernel" && o.mode != "wavefront") Usage("--mode is megakernel or wavefront, not '" + o.mode + "'");
+  std::string size = "256x256";
+  crossrt::CommandLine app("path_tracer",
+                           "Path traces SCENE (.gltf, .glb or .obj) with next-event estimation and multiple importance sampling.");
+  app.add_option("SCENE", o.scene, "the scene: .gltf, .glb or .obj")->required();
+  app.add_option("--size", size, "image size, WxH");
+  app.add_option("--spp", o.spp, "samples per pixel")->check(crossrt::Positive());
+  app.add_option("--depth", o.depth, "bounces, as Cycles counts them (0 is direct light only)")->check(CLI::Range(0, 64));
+  app.add_option("--device", o.device,
+                 "original: the class as written, one thread; cpu: PathTracer_CPU, all cores; ispc: PathTracer_ISPC, all\n"
+                 "cores, one path a SIMD lane (where ISPC was found; CrossRT's BVHs); vulkan: PathTracer_Vulkan on the\n"
+                 "default Vulkan device")
+      ->check(CLI::IsMember({"original", "cpu", "ispc", "vulkan"}));
+  app.add_option("--mode", o.mode, "PathTracer_Vulkan's execution mode")->check(CLI::IsMember({"megakernel", "wavefront"}));
+  app.add_option("--virtual-level", o.virtualLevel,
+                 "how the GPU reaches materials and lights (paper 3.9): 1, one array of equal slots\n"
+                 "(PathTracer_VulkanLevel1); 2, a buffer per class (PathTracer_Vulkan); 3, as 2 plus callable shaders\n"
+                 "where the device has ray tracing pipelines (PathTracer_VulkanLevel3)");
+  app.add_option("--accel", o.accel, "the CPU devices' ray tracing: Embree or CrossRT's BVHs; ispc and vulkan use sah (or lbvh)")
+      ->check(CLI::IsMember({"embree", "sah", "lbvh"}));
+  app.add_option("--env", o.env, "an equirectangular environment map (linear EXR, Blender's orientation), times --env-strength");
+  app.add_option("--env-strength", o.envStrength, "the environment map's strength");
+  app.add_option("--seed", o.seed, "the random sequence (a pixel's samples depend only on pixel, sample index and seed)");
+  app.add_option("--pass-spp", o.passSpp, "samples per pass: memory stays the same whatever --spp is (1 for megakernels on llvmpipe)")
+      ->check(crossrt::Positive());
+  app.add_option("--compare", o.compare, "prints PSNR (8-bit sRGB) and relative MSE (linear) of the image against this reference");
+  app.add_option("--out", o.outs, ".exr: linear radiance; .png: sRGB, clamped (several --out: the same image to each)")->required();
+  if (const int status = crossrt::ParseCommandLine(app, argc, argv); status >= 0) std::exit(status);
+  const size_t x = size.find('x');
+  if (x == std::string::npos) Usage("--size takes WxH, not '" + size + "'");
+  o.width = Positive("--size", size.substr(0, x));
+  o.height = Positive("--size", size.substr(x + 1));
+  if (o.virtualLevel < 1 || o.virtualLevel > 3) Usage("--virtual-level is 1, 2 or 3, not '" + std::to_string(o.virtualLevel) + "'");
   for (const std::string& out : o.outs)
   {
     const std::string ext = out.size() > 4 ? out.substr(out.size() - 4) : "";

@@ -14,6 +14,8 @@
 #include "PrimaryRays_ISPC.h"
 #endif
 
+#include "CommandLine.h"
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -76,39 +78,21 @@ size_t DifferingPixels(const std::vector<uint32_t>& a, const std::vector<uint32_
 
 int main(int argc, char** argv)
 {
-  if (argc > 1 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h"))
-  {
-    std::printf("usage: primary_rays [MESH | \"\"] [OUTPUT.png] [--size N] [--ao SAMPLES] [--bvh lbvh|sah] [--hardware-only]\n  Renders MESH (OFF, PLY or OBJ, also gzipped; \"\" or none: a built-in scene) with primary rays and\n  ambient occlusion through ISceneObject: Embree, the original class, PrimaryRays_CPU, PrimaryRays_ISPC\n  (where ISPC was found when CrossRT was configured) and PrimaryRays_Vulkan (its translated traversal,\n  and ray queries where the device has them; --hardware-only: ray queries only).\n");
-    return 0;
-  }
   std::string meshPath, outPath = "primary_rays.png", bvh = "lbvh";
   int size = 512, ao = 4;
-  int positional = 0;
   bool hardwareOnly = false;
-  for (int i = 1; i < argc; ++i)
-  {
-    const std::string a = argv[i];
-    if ((a == "--size" || a == "--ao" || a == "--bvh") && i + 1 < argc)
-    {
-      const std::string v = argv[++i];
-      if (a == "--size") size = std::atoi(v.c_str());
-      else if (a == "--ao") ao = std::atoi(v.c_str());
-      else bvh = v;
-    }
-    else if (a == "--hardware-only") hardwareOnly = true;
-    else if (positional == 0) meshPath = a, ++positional;
-    else if (positional == 1) outPath = a, ++positional;
-    else
-    {
-      std::fprintf(stderr, "usage: primary_rays [mesh] [output image] [--size N] [--ao SAMPLES] [--bvh lbvh|sah] [--hardware-only]\n");
-      return 2;
-    }
-  }
-  if (size <= 0 || ao < 0)
-  {
-    std::fprintf(stderr, "primary_rays: --size must be positive and --ao not negative\n");
-    return 2;
-  }
+  crossrt::CommandLine app("primary_rays",
+                           "Renders MESH (OFF, PLY or OBJ, also gzipped; \"\" or none: a built-in scene) with primary rays and\n"
+                           "ambient occlusion through ISceneObject: Embree, the original class, PrimaryRays_CPU, PrimaryRays_ISPC\n"
+                           "(where ISPC was found when CrossRT was configured) and PrimaryRays_Vulkan (its translated traversal,\n"
+                           "and ray queries where the device has them).");
+  app.add_option("MESH", meshPath, "the mesh (\"\": the built-in scene)");
+  app.add_option("OUTPUT.png", outPath, "the image");
+  app.add_option("--size", size, "width and height in pixels")->check(crossrt::Positive());
+  app.add_option("--ao", ao, "ambient occlusion rays per pixel")->check(crossrt::NonNegative());
+  app.add_option("--bvh", bvh, "the BVH the original and CPU classes build")->check(CLI::IsMember({"lbvh", "sah"}));
+  app.add_flag("--hardware-only", hardwareOnly, "on Vulkan, ray queries only");
+  if (const int status = crossrt::ParseCommandLine(app, argc, argv); status >= 0) return status;
   TriangleMesh mesh;
   try
   {

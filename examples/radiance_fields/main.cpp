@@ -10,6 +10,8 @@
 #include "ReluField_CPU.h"
 #include "ReluField_Vulkan.h"
 
+#include "CommandLine.h"
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -28,32 +30,6 @@ using LiteMath::float4;
 
 namespace {
 
-void Usage(FILE* to)
-{
-  std::fprintf(to,
-               "usage: radiance_fields train DATASET_DIR --out MODEL [--device original|cpu|vulkan] [--grid N] [--iters K]\n"
-               "                             [--batch B] [--sh 0|1|2] [--lr RATE] [--seed S]\n"
-               "       radiance_fields render MODEL --dataset DATASET_DIR --out DIR [--split test] [--device original|cpu|vulkan]\n"
-               "                             [--method bvh|march] [--stop T]\n"
-               "       radiance_fields synthetic DIR [--views N] [--size S]\n"
-               "\n"
-               "train   fits a ReLU field (density and colour as spherical harmonics on a grid) to the dataset's\n"
-               "        transforms_train.json images: stages of N/8, N/4, N/2 and N cells (--grid, default 64; at\n"
-               "        least 8 cells a stage), K iterations each (--iters, default 300) of B random rays (--batch,\n"
-               "        default 4096). A progress bar on stderr gives the stage, loss, iterations per second and the\n"
-               "        PSNR of one held-out view (transforms_val.json, else the first test view).\n"
-               "render  renders every frame of a split (--split, default test) to DIR/<the frame's file name>.png at\n"
-               "        the dataset image's size, prints each view's PSNR against the dataset's image, the mean and\n"
-               "        the milliseconds per frame. --method bvh visits the occupied cells front to back, one\n"
-               "        sample each (the default); march takes constant steps of half a cell. --stop ends a ray\n"
-               "        once its transmittance falls below T (default 0.01).\n"
-               "synthetic writes transforms_train.json (N views, default 60) and transforms_test.json (8 views) of\n"
-               "        an analytic scene, a shaded sphere and a box, S x S pixels (default 64), rendered exactly.\n"
-               "\n"
-               "--device picks the class as written (original), ReluField_CPU (cpu, the default) or\n"
-               "ReluField_Vulkan (vulkan, the default Vulkan device).\n");
-}
-
 [[noreturn]] void Fail(const std::string& message)
 {
   std::fprintf(stderr, "radiance_fields: error: %s\n", message.c_str());
@@ -68,61 +44,6 @@ struct Args
   float lr = 0.01f, stop = 0.01f;
   uint32_t seed = 1;
 };
-
-int IntArg(const char* name, const char* text)
-{
-  char* end = nullptr;
-  const long v = std::strtol(text, &end, 10);
-  if (!*text || *end || v < 0 || v > 1 << 24)
-    Fail(std::string(name) + " takes a non-negative integer, not '" + text + "'");
-  return int(v);
-}
-
-float FloatArg(const char* name, const char* text)
-{
-  char* end = nullptr;
-  const float v = std::strtof(text, &end);
-  if (!*text || *end || !std::isfinite(v) || v < 0.0f)
-    Fail(std::string(name) + " takes a non-negative number, not '" + text + "'");
-  return v;
-}
-
-Args Parse(int argc, char** argv)
-{
-  Args a;
-  for (int i = 2; i < argc; ++i)
-  {
-    const std::string s = argv[i];
-    auto value = [&]() -> const char* {
-      if (i + 1 >= argc)
-        Fail(s + " needs a value");
-      return argv[++i];
-    };
-    if (s == "--out") a.out = value();
-    else if (s == "--device") a.device = value();
-    else if (s == "--dataset") a.dataset = value();
-    else if (s == "--split") a.split = value();
-    else if (s == "--method") a.method = value();
-    else if (s == "--grid") a.grid = IntArg("--grid", value());
-    else if (s == "--iters") a.iterations = IntArg("--iters", value());
-    else if (s == "--batch") a.batch = IntArg("--batch", value());
-    else if (s == "--sh") a.sh = IntArg("--sh", value());
-    else if (s == "--views") a.views = IntArg("--views", value());
-    else if (s == "--size") a.size = IntArg("--size", value());
-    else if (s == "--seed") a.seed = uint32_t(IntArg("--seed", value()));
-    else if (s == "--lr") a.lr = FloatArg("--lr", value());
-    else if (s == "--stop") a.stop = FloatArg("--stop", value());
-    else if (!s.empty() && s[0] == '-') Fail("unknown option " + s + " (see --help)");
-    else a.positional.push_back(s);
-  }
-  if (a.device != "original" && a.device != "cpu" && a.device != "vulkan")
-    Fail("--device takes original, cpu or vulkan, not '" + a.device + "'");
-  if (a.method != "bvh" && a.method != "march")
-    Fail("--method takes bvh or march, not '" + a.method + "'");
-  if (a.sh > 2)
-    Fail("--sh takes 0, 1 or 2");
-  return a;
-}
 
 // The field on the device asked for.
 std::shared_ptr<ReluField> MakeField(const std::string& device, int width, int height)
@@ -255,19 +176,51 @@ int Synthetic(const Args& a)
 
 int main(int argc, char** argv)
 {
-  if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h"))
-  {
-    Usage(argc < 2 ? stderr : stdout);
-    return argc < 2 ? 2 : 0;
-  }
-  for (int i = 2; i < argc; ++i)
-    if (!std::strcmp(argv[i], "--help") || !std::strcmp(argv[i], "-h"))
-    {
-      Usage(stdout);
-      return 0;
-    }
-  const std::string command = argv[1];
-  const Args a = Parse(argc, argv);
+  Args a;
+  crossrt::CommandLine app("radiance_fields",
+                           "Fits, renders and makes radiance fields (ReLU fields: density and colour as spherical harmonics on a grid)\n"
+                           "with the class as written (--device original), ReluField_CPU (cpu) or ReluField_Vulkan (vulkan, the\n"
+                           "default Vulkan device).");
+  app.require_subcommand(1);
+  auto device = [&](CLI::App* command) {
+    command->add_option("--device", a.device, "the class that runs it")->check(CLI::IsMember({"original", "cpu", "vulkan"}));
+  };
+  CLI::App* train = app.add_subcommand(
+      "train",
+      "fits a ReLU field to the dataset's transforms_train.json images: stages of N/8, N/4, N/2 and N cells\n"
+      "(--grid; at least 8 cells a stage), K iterations each (--iters) of B random rays (--batch). A progress bar\n"
+      "on stderr gives the stage, loss, iterations per second and the PSNR of one held-out view\n"
+      "(transforms_val.json, else the first test view).");
+  train->add_option("DATASET_DIR", a.positional, "the dataset (the NeRF format: transforms_*.json and images)");
+  train->add_option("--out", a.out, "the model file to write");
+  device(train);
+  train->add_option("--grid", a.grid, "cells per axis, N")->check(crossrt::NonNegative());
+  train->add_option("--iters", a.iterations, "iterations per stage, K")->check(crossrt::NonNegative());
+  train->add_option("--batch", a.batch, "rays per iteration, B")->check(crossrt::NonNegative());
+  train->add_option("--sh", a.sh, "degree of the spherical harmonics")->check(CLI::Range(0, 2));
+  train->add_option("--lr", a.lr, "learning rate")->check(CLI::NonNegativeNumber);
+  train->add_option("--seed", a.seed, "the random sequence of rays");
+  CLI::App* render = app.add_subcommand(
+      "render",
+      "renders every frame of a split to DIR/<the frame's file name>.png at the dataset image's size, prints each\n"
+      "view's PSNR against the dataset's image, the mean and the milliseconds per frame.");
+  render->add_option("MODEL", a.positional, "the model file");
+  render->add_option("--dataset", a.dataset, "the dataset whose views are rendered");
+  render->add_option("--out", a.out, "the folder of images to write");
+  render->add_option("--split", a.split, "the dataset's split");
+  device(render);
+  render->add_option("--method", a.method, "bvh: the occupied cells front to back, one sample each; march: constant steps of half a cell")
+      ->check(CLI::IsMember({"bvh", "march"}));
+  render->add_option("--stop", a.stop, "a ray ends once its transmittance falls below this")->check(CLI::NonNegativeNumber);
+  CLI::App* synthetic = app.add_subcommand(
+      "synthetic",
+      "writes transforms_train.json (N views) and transforms_test.json (8 views) of an analytic scene, a shaded sphere\n"
+      "and a box, S x S pixels, rendered exactly.");
+  synthetic->add_option("DIR", a.positional, "the dataset folder to write");
+  synthetic->add_option("--views", a.views, "training views, N")->check(crossrt::NonNegative());
+  synthetic->add_option("--size", a.size, "width and height in pixels, S")->check(crossrt::NonNegative());
+  if (const int status = crossrt::ParseCommandLine(app, argc, argv); status >= 0) return status;
+  const std::string command = app.get_subcommands().front()->get_name();
   try
   {
     if (command == "train")
@@ -281,5 +234,5 @@ int main(int argc, char** argv)
   {
     Fail(e.what());
   }
-  Fail("unknown command '" + command + "': train, render or synthetic (see --help)");
+  Fail("unknown command '" + command + "'");
 }

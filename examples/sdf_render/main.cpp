@@ -16,6 +16,8 @@
 
 #include "Image2D.h"
 
+#include "CommandLine.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -84,44 +86,22 @@ int main(int argc, char** argv)
 {
   std::string meshPath, outPath = "sdf_render.png";
   int size = 256, depth = 7, bytes = 2, ao = 4;
-  int positional = 0;
   bool hardwareOnly = false;
-  for (int i = 1; i < argc; ++i)
-  {
-    const std::string a = argv[i];
-    if (a == "--help" || a == "-h")
-    {
-      std::printf("usage: sdf_render [MESH | \"\"] [OUTPUT.png] [--size N] [--depth D] [--bytes 1|2|4] [--ao SAMPLES] [--hardware-only]\n"
-                  "  Builds a dense grid, a sparse voxel set and a sparse brick set (bricks of 4^3) of MESH's signed\n"
-                  "  distance (\"\" or none: a built-in analytic scene) at 2^D voxels per axis, renders each with normals\n"
-                  "  and ambient occlusion by the original SdfRender (BVHScene and Embree), SdfRender_CPU (all cores)\n"
-                  "  and SdfRender_Vulkan, checks that their images agree, and writes OUTPUT-grid.png, -svs.png, -sbs.png.\n"
-                  "  --hardware-only: on Vulkan only the intersection shaders of the ray tracing pipeline (which the\n"
-                  "  device must have), not the translated traversal nor its level-3 switch.\n");
-      return 0;
-    }
-    if ((a == "--size" || a == "--depth" || a == "--bytes" || a == "--ao") && i + 1 < argc)
-    {
-      const int v = std::atoi(argv[++i]);
-      (a == "--size" ? size : a == "--depth" ? depth : a == "--bytes" ? bytes : ao) = v;
-    }
-    else if (a == "--hardware-only")
-      hardwareOnly = true;
-    else if (a.rfind("--", 0) == 0)
-    {
-      std::fprintf(stderr, "sdf_render: unknown option %s (see --help)\n", a.c_str());
-      return 2;
-    }
-    else if (positional == 0)
-      meshPath = a, ++positional;
-    else
-      outPath = a, ++positional;
-  }
-  if (size < 1 || depth < 2 || depth > 10 || (bytes != 1 && bytes != 2 && bytes != 4) || ao < 0 || ao > 16)
-  {
-    std::fprintf(stderr, "sdf_render: --size must be positive, --depth 2..10, --bytes 1, 2 or 4, --ao 0..16\n");
-    return 2;
-  }
+  crossrt::CommandLine app("sdf_render",
+                           "Builds a dense grid, a sparse voxel set and a sparse brick set (bricks of 4^3) of MESH's signed\n"
+                           "distance (\"\" or none: a built-in analytic scene) at 2^D voxels per axis, renders each with normals\n"
+                           "and ambient occlusion by the original SdfRender (BVHScene and Embree), SdfRender_CPU (all cores)\n"
+                           "and SdfRender_Vulkan, checks that their images agree, and writes OUTPUT-grid.png, -svs.png, -sbs.png.");
+  app.add_option("MESH", meshPath, "the mesh (\"\": the built-in scene)");
+  app.add_option("OUTPUT.png", outPath, "the images' name");
+  app.add_option("--size", size, "width and height in pixels")->check(crossrt::Positive());
+  app.add_option("--depth", depth, "2^D voxels per axis")->check(CLI::Range(2, 10));
+  app.add_option("--bytes", bytes, "bytes per distance")->check(CLI::IsMember({1, 2, 4}));
+  app.add_option("--ao", ao, "ambient occlusion rays per pixel")->check(CLI::Range(0, 16));
+  app.add_flag("--hardware-only", hardwareOnly,
+               "on Vulkan only the intersection shaders of the ray tracing pipeline (which the device must have), not the\n"
+               "translated traversal nor its level-3 switch");
+  if (const int status = crossrt::ParseCommandLine(app, argc, argv); status >= 0) return status;
 
   std::unique_ptr<litesdf::ISdf> field;
   std::string what = "the built-in scene";

@@ -8,6 +8,8 @@
 #include "SpherePaths_CPU.h"
 #include "SpherePaths_Vulkan.h"
 
+#include "CommandLine.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -53,35 +55,16 @@ size_t DifferingPixels(const std::vector<float4>& a, const std::vector<float4>& 
 
 int main(int argc, char** argv)
 {
-  if (argc > 1 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h"))
-  {
-    std::printf("usage: sphere_paths [OUTPUT.png] [--size N] [--samples S] [--depth D]\n  Path traces spheres with the original class, SpherePaths_CPU and SpherePaths_Vulkan (megakernel and\n  wavefront); writes OUTPUT.png (default sphere_paths.png). Exits non-zero when they differ.\n");
-    return 0;
-  }
   std::string outPath = "sphere_paths.png";
   int size = 256, samples = 16, depth = 4;
-  bool havePath = false;
-  for (int i = 1; i < argc; ++i)
-  {
-    const std::string a = argv[i];
-    if ((a == "--size" || a == "--samples" || a == "--depth") && i + 1 < argc)
-    {
-      const int v = std::atoi(argv[++i]);
-      (a == "--size" ? size : a == "--samples" ? samples : depth) = v;
-    }
-    else if (!havePath && a.rfind("--", 0) != 0)
-      outPath = a, havePath = true;
-    else
-    {
-      std::fprintf(stderr, "usage: sphere_paths [output image] [--size N] [--samples S] [--depth D]\n");
-      return 2;
-    }
-  }
-  if (size <= 0 || samples <= 0 || depth < 0)
-  {
-    std::fprintf(stderr, "sphere_paths: --size and --samples must be positive, --depth not negative\n");
-    return 2;
-  }
+  crossrt::CommandLine app("sphere_paths",
+                           "Path traces spheres with the original class, SpherePaths_CPU and SpherePaths_Vulkan (megakernel and\n"
+                           "wavefront); writes OUTPUT.png. Exits non-zero when they differ.");
+  app.add_option("OUTPUT.png", outPath, "the image");
+  app.add_option("--size", size, "width and height in pixels")->check(crossrt::Positive());
+  app.add_option("--samples", samples, "paths per pixel")->check(crossrt::Positive());
+  app.add_option("--depth", depth, "bounces")->check(crossrt::NonNegative());
+  if (const int status = crossrt::ParseCommandLine(app, argc, argv); status >= 0) return status;
 
   std::vector<Run> runs;
   runs.push_back({"original (1 thread)", std::make_shared<SpherePaths>(), {}});
