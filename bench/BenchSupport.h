@@ -108,16 +108,3 @@ private:
   std::atomic<bool> m_stop{false};
   std::vector<std::thread> m_threads;
 };
-
-// The value of `--load N` (0 to 256): exits with a message for anything else.
-inline int LoadThreads(const char* program, const char* value)
-{
-  char* end = nullptr;
-  const long n = value ? std::strtol(value, &end, 10) : -1;
-  if (!value || *end != '\0' || n < 0 || n > 256)
-  {
-    std::fprintf(stderr, "%s: --load takes a number of busy threads from 0 to 256, not '%s'\n", program, value ? value : "");
-    std::exit(2);
-  }
-  return int(n);
-}

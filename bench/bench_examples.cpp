@@ -26,6 +26,7 @@
 #include "SpherePaths.h"
 #include "SpherePaths_CPU.h"
 #include "SpherePaths_Vulkan.h"
+#include "CommandLine.h"
 
 #include <cstdio>
 #include <filesystem>
@@ -107,43 +108,18 @@ void Measure(const char* example, const std::vector<Impl>& impls, int rounds)
 
 int main(int argc, char** argv)
 {
-  std::vector<std::string> positional;
-  int load = 0;
-  for (int i = 1; i < argc; ++i)
-  {
-    const std::string a = argv[i];
-    if (a == "--help" || a == "-h")
-    {
-      std::printf("usage: bench_examples [--load N] [PARTICLES (default 1048576)] [IMAGE_SIDE (default 1024)] [PATH_SIDE (default 256)] [CSV (default "
-                  "out/bench_examples.csv)]\n  Times the examples as written, as _CPU, _ISPC and _Vulkan, and prints ratios; the table goes to CSV "
-                  "too (bench/plot_examples.py plots it).\n  --load N   N busy threads run beside every measurement (a user's machine is never quiet)\n");
-      return 0;
-    }
-    if (a == "--load")
-      load = LoadThreads("bench_examples", i + 1 < argc ? argv[++i] : nullptr);
-    else if (a.size() > 1 && a[0] == '-')
-    {
-      std::fprintf(stderr, "bench_examples: unknown option '%s' (see bench_examples --help)\n", a.c_str());
-      return 2;
-    }
-    else
-      positional.push_back(a);
-  }
-  if (positional.size() > 4)
-  {
-    std::fprintf(stderr, "bench_examples: too many arguments (see bench_examples --help)\n");
-    return 2;
-  }
-  const int particles = positional.size() > 0 ? std::atoi(positional[0].c_str()) : 1 << 20;
-  const int side = positional.size() > 1 ? std::atoi(positional[1].c_str()) : 1024;
-  const int pathSide = positional.size() > 2 ? std::atoi(positional[2].c_str()) : 256;
-  if (particles <= 0 || side <= 0 || pathSide <= 0)
-  {
-    std::fprintf(stderr, "bench_examples: the sizes are positive numbers (see bench_examples --help)\n");
-    return 2;
-  }
+  int load = 0, particles = 1 << 20, side = 1024, pathSide = 256;
+  std::string csvPath = "out/bench_examples.csv";
+  crossrt::CommandLine app("bench_examples",
+                           "Times the examples as written, as _CPU, _ISPC and _Vulkan, and prints ratios; the table goes to CSV too\n"
+                           "(bench/plot_examples.py plots it).");
+  app.add_option("PARTICLES", particles, "particles")->check(crossrt::Positive());
+  app.add_option("IMAGE_SIDE", side, "the bloom image's side")->check(crossrt::Positive());
+  app.add_option("PATH_SIDE", pathSide, "the path traced image's side")->check(crossrt::Positive());
+  app.add_option("CSV", csvPath, "the table's CSV file");
+  app.add_option("--load", load, "busy threads beside every measurement (a user's machine is never quiet)")->check(CLI::Range(0, 256));
+  if (const int status = crossrt::ParseCommandLine(app, argc, argv); status >= 0) return status;
   constexpr int pathSamples = 8;
-  const std::string csvPath = positional.size() > 3 ? positional[3] : "out/bench_examples.csv";
   if (std::filesystem::path(csvPath).has_parent_path()) std::filesystem::create_directories(std::filesystem::path(csvPath).parent_path());
   g_csv.open(csvPath);
   if (!g_csv)

@@ -30,6 +30,7 @@
 #endif
 #include "PrimaryRays_Vulkan.h"
 #include "SAHBuilder.h"
+#include "CommandLine.h"
 
 #include <embree3/rtcore.h>
 #include <omp.h>
@@ -144,68 +145,21 @@ void WriteTradeOffCsv(const std::vector<TradeOff>& rows, const std::string& path
 int main(int argc, char** argv)
 {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // tables appear as they are measured
-  std::vector<std::string> positional, only;
+  std::vector<std::string> only;
   int load = 0, buildRounds = 7;
   bool buildsOnly = false;
-  for (int i = 1; i < argc; ++i)
-  {
-    const std::string a = argv[i];
-    if (a == "--help" || a == "-h")
-    {
-      std::printf("usage: bench_lbvh [--load N] [--meshes NAME,...] [MESH_DIR] [TRADEOFF.csv]\n"
-                  "  BVH build and traversal against Embree on the meshes scripts/fetch-meshes.sh cached in MESH_DIR\n"
-                  "  (default build/data/meshes), in the form of the paper's Tables 1 and 3. The speed-against-quality\n"
-                  "  table goes to TRADEOFF.csv too (default out/bvh_tradeoff.csv); bench/plot_bvh_tradeoff.py plots it.\n"
-                  "  --load N           N busy threads run beside every measurement (a user's machine is never quiet)\n"
-                  "  --meshes A,B       only the meshes whose file names start with A or B (e.g. teapot,dragon_vrip_res4)\n"
-                  "  --builds-only      the build table alone (no traversal, no trade-off table or CSV)\n"
-                  "  --build-rounds N   interleaved rounds of the CPU builders (default 7): more for a loaded machine\n");
-      return 0;
-    }
-    if (a == "--load")
-    {
-      load = LoadThreads("bench_lbvh", i + 1 < argc ? argv[++i] : nullptr);
-      continue;
-    }
-    if (a == "--builds-only")
-    {
-      buildsOnly = true;
-      continue;
-    }
-    if (a == "--build-rounds")
-    {
-      buildRounds = i + 1 < argc ? std::atoi(argv[++i]) : 0;
-      if (buildRounds < 1 || buildRounds > 1000)
-      {
-        std::fprintf(stderr, "bench_lbvh: --build-rounds takes a number from 1 to 1000\n");
-        return 2;
-      }
-      continue;
-    }
-    if (a == "--meshes" && i + 1 < argc)
-    {
-      for (std::string list = argv[++i]; !list.empty();)
-      {
-        const size_t comma = list.find(',');
-        only.push_back(list.substr(0, comma));
-        list = comma == std::string::npos ? "" : list.substr(comma + 1);
-      }
-      continue;
-    }
-    if (a.size() > 1 && a[0] == '-')
-    {
-      std::fprintf(stderr, "bench_lbvh: unknown option '%s' (see bench_lbvh --help)\n", a.c_str());
-      return 2;
-    }
-    positional.push_back(a);
-  }
-  if (positional.size() > 2)
-  {
-    std::fprintf(stderr, "bench_lbvh: too many arguments (see bench_lbvh --help)\n");
-    return 2;
-  }
-  const std::string dir = positional.size() > 0 ? positional[0] : "build/data/meshes";
-  const std::string csvPath = positional.size() > 1 ? positional[1] : "out/bvh_tradeoff.csv";
+  std::string dir = "build/data/meshes", csvPath = "out/bvh_tradeoff.csv";
+  crossrt::CommandLine app("bench_lbvh",
+                           "BVH build and traversal against Embree on the meshes scripts/fetch-meshes.sh cached in MESH_DIR, in the\n"
+                           "form of the paper's Tables 1 and 3. The speed-against-quality table goes to TRADEOFF.csv too;\n"
+                           "bench/plot_bvh_tradeoff.py plots it.");
+  app.add_option("MESH_DIR", dir, "the meshes' folder");
+  app.add_option("TRADEOFF.csv", csvPath, "the trade-off table's CSV file");
+  app.add_option("--load", load, "busy threads beside every measurement (a user's machine is never quiet)")->check(CLI::Range(0, 256));
+  app.add_option("--meshes", only, "only the meshes whose file names start with one of these (e.g. teapot,dragon_vrip_res4)")->delimiter(',');
+  app.add_flag("--builds-only", buildsOnly, "the build table alone (no traversal, no trade-off table or CSV)");
+  app.add_option("--build-rounds", buildRounds, "interleaved rounds of the CPU builders: more for a loaded machine")->check(CLI::Range(1, 1000));
+  if (const int status = crossrt::ParseCommandLine(app, argc, argv); status >= 0) return status;
   auto chosen = [&](const std::string& name) {
     if (only.empty()) return true;
     for (auto& prefix : only)

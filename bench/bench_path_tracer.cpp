@@ -26,6 +26,7 @@
 #include "PathTracer_VulkanLevel1.h"
 #include "PathTracer_VulkanLevel3.h"
 #include "SceneLoader.h"
+#include "CommandLine.h"
 
 #include <algorithm>
 #include <chrono>
@@ -46,12 +47,6 @@ extern const uint32_t PathTracer_RenderPass_Megakernel_spv[];
 extern const size_t PathTracer_RenderPass_Megakernel_spvBytes;
 
 namespace {
-
-const char* kUsage =
-    "usage: bench_path_tracer [SCENE (default: the build's Cornell box)] [--size N (128)] [--depth D (8)] [--rounds R (3)]\n"
-    "                         [--reference REF.exr --cycles-log CSV] [--max-spp N (1024)] [--csv FILE] [--no-vulkan]\n"
-    "  Prints the path tracer's samples per second per implementation and mode, the gain from specialising virtual\n"
-    "  calls to the scene, and (with a converged reference and Cycles' time log) the time to 30 and 35 dB against Cycles.\n";
 
 double Seconds(const std::function<void()>& work)
 {
@@ -175,37 +170,19 @@ int main(int argc, char** argv)
   std::string scenePath = CROSSRT_CORNELL_BOX, reference, cyclesLog, csvPath = "out/bench_path_tracer.csv";
   int rounds = 3, maxSpp = 1024;
   bool vulkan = true;
-  for (int i = 1; i < argc; ++i)
-  {
-    const std::string a = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc)
-      {
-        std::fprintf(stderr, "bench_path_tracer: error: %s needs a value\n%s", a.c_str(), kUsage);
-        std::exit(2);
-      }
-      return argv[++i];
-    };
-    if (a == "--help" || a == "-h")
-    {
-      std::printf("%s", kUsage);
-      return 0;
-    }
-    else if (a == "--size") s.size = uint32_t(std::max(8, std::atoi(value().c_str())));
-    else if (a == "--depth") s.depth = std::atoi(value().c_str());
-    else if (a == "--rounds") rounds = std::max(1, std::atoi(value().c_str()));
-    else if (a == "--max-spp") maxSpp = std::max(1, std::atoi(value().c_str()));
-    else if (a == "--reference") reference = value();
-    else if (a == "--cycles-log") cyclesLog = value();
-    else if (a == "--csv") csvPath = value();
-    else if (a == "--no-vulkan") vulkan = false;
-    else if (a.rfind("--", 0) == 0)
-    {
-      std::fprintf(stderr, "bench_path_tracer: error: unknown option %s\n%s", a.c_str(), kUsage);
-      return 2;
-    }
-    else scenePath = a;
-  }
+  crossrt::CommandLine app("bench_path_tracer",
+                           "Prints the path tracer's samples per second per implementation and mode, the gain from specialising virtual\n"
+                           "calls to the scene, and (with a converged reference and Cycles' time log) the time to 30 and 35 dB against Cycles.");
+  app.add_option("SCENE", scenePath, "the scene (default: the build's Cornell box)");
+  app.add_option("--size", s.size, "width and height in pixels")->check(CLI::Range(8, 1 << 14));
+  app.add_option("--depth", s.depth, "bounces")->check(CLI::Range(0, 64));
+  app.add_option("--rounds", rounds, "interleaved rounds")->check(crossrt::Positive());
+  app.add_option("--max-spp", maxSpp, "samples per pixel at most, in the time-to-quality table")->check(crossrt::Positive());
+  app.add_option("--reference", reference, "a converged reference image (EXR)");
+  app.add_option("--cycles-log", cyclesLog, "Cycles' time log (CSV), beside --reference");
+  app.add_option("--csv", csvPath, "the table's CSV file");
+  app.add_flag("!--no-vulkan", vulkan, "leave out PathTracer_Vulkan");
+  if (const int status = crossrt::ParseCommandLine(app, argc, argv); status >= 0) return status;
   try
   {
     s.scene = LoadScene(scenePath);

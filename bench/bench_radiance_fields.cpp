@@ -13,6 +13,7 @@
 #include "ReluField.h"
 #include "ReluField_CPU.h"
 #include "ReluField_Vulkan.h"
+#include "CommandLine.h"
 
 #include <algorithm>
 #include <chrono>
@@ -37,18 +38,6 @@ struct Options
   int views = 64, size = 100, iterations = 200;
   std::string csv = "out/bench_radiance_fields.csv";
 };
-
-void Usage(FILE* to)
-{
-  std::fprintf(to,
-               "usage: bench_radiance_fields [--quick] [--views N] [--size S] [--iters K] [--csv FILE]\n"
-               "  ReLU fields on the original class, ReluField_CPU and ReluField_Vulkan: training time per iteration,\n"
-               "  render time at 800x800 and 1024x1024 for marching and the occupied-cell tree, and test PSNR, render\n"
-               "  time, training time and memory over grid resolution, SH degree and the early-termination threshold.\n"
-               "  Trains on N views (default 64) of S x S pixels (default 100) of an exactly rendered analytic scene,\n"
-               "  K iterations per coarse-to-fine stage (default 200). --quick: smaller everything, for a smoke run.\n"
-               "  Writes FILE (default out/bench_radiance_fields.csv); bench/plot_radiance_fields.py plots it.\n");
-}
 
 double Seconds(const std::function<void()>& f)
 {
@@ -100,29 +89,23 @@ int main(int argc, char** argv)
 {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // each table row as it is measured, even if the run is cut short
   Options opt;
-  for (int i = 1; i < argc; ++i)
+  crossrt::CommandLine app("bench_radiance_fields",
+                           "ReLU fields on the original class, ReluField_CPU and ReluField_Vulkan: training time per iteration,\n"
+                           "render time at 800x800 and 1024x1024 for marching and the occupied-cell tree, and test PSNR, render\n"
+                           "time, training time and memory over grid resolution, SH degree and the early-termination threshold,\n"
+                           "trained on N views of S x S pixels of an exactly rendered analytic scene. bench/plot_radiance_fields.py\n"
+                           "plots the CSV file.");
+  app.add_flag("--quick", opt.quick, "smaller everything, for a smoke run (16 views of 48x48, 40 iterations)");
+  app.add_option("--views", opt.views, "training views, N")->check(crossrt::Positive());
+  app.add_option("--size", opt.size, "width and height of the views, S")->check(CLI::Range(8, 1 << 14));
+  app.add_option("--iters", opt.iterations, "iterations per coarse-to-fine stage")->check(crossrt::Positive());
+  app.add_option("--csv", opt.csv, "the table's CSV file");
+  if (const int status = crossrt::ParseCommandLine(app, argc, argv); status >= 0) return status;
+  if (opt.quick)  // what --quick makes smaller, unless given
   {
-    const std::string a = argv[i];
-    auto value = [&]() -> std::string {
-      if (i + 1 >= argc)
-      {
-        std::fprintf(stderr, "bench_radiance_fields: %s needs a value\n", a.c_str());
-        std::exit(2);
-      }
-      return argv[++i];
-    };
-    if (a == "--help" || a == "-h") { Usage(stdout); return 0; }
-    else if (a == "--quick") { opt.quick = true; opt.views = 16; opt.size = 48; opt.iterations = 40; }
-    else if (a == "--views") opt.views = std::atoi(value().c_str());
-    else if (a == "--size") opt.size = std::atoi(value().c_str());
-    else if (a == "--iters") opt.iterations = std::atoi(value().c_str());
-    else if (a == "--csv") opt.csv = value();
-    else { std::fprintf(stderr, "bench_radiance_fields: unknown argument '%s'\n", a.c_str()); Usage(stderr); return 2; }
-  }
-  if (opt.views < 1 || opt.size < 8 || opt.iterations < 1)
-  {
-    std::fprintf(stderr, "bench_radiance_fields: needs at least 1 view, 8 pixels and 1 iteration\n");
-    return 2;
+    if (!app.count("--views")) opt.views = 16;
+    if (!app.count("--size")) opt.size = 48;
+    if (!app.count("--iters")) opt.iterations = 40;
   }
 
   std::vector<Backend> backends = {{"original", [](int w, int h) { return std::make_shared<ReluField>(w, h); }},

@@ -4,6 +4,8 @@
 // GPU time of the recorded work; medians of 5 after a warm-up, all measured in this run. Every
 // GPU result is compared with the CPU's. A last table prices the sort of an appended vector,
 // whose count only the GPU has.
+#include "CommandLine.h"
+
 #include <crossrt/VulkanRuntime.h>
 
 #include <algorithm>
@@ -56,12 +58,10 @@ void Row(uint32_t n, Timing t)
 
 int main(int argc, char** argv)
 {
-  if (argc > 1)  // no arguments: --help prints what it does, anything else is an error
-  {
-    const bool help = std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h";
-    std::fprintf(help ? stdout : stderr, "usage: bench_scan\n  The GPU exclusive scan and radix sort against the standard library on one core, 2^10 .. 2^22 elements;\n  prints keys/s and ratios.\n");
-    return help ? 0 : 2;
-  }
+  crossrt::CommandLine app("bench_scan",
+                           "The GPU exclusive scan and radix sort against the standard library on one core, 2^10 .. 2^22\n"
+                           "elements; prints keys/s and ratios.");
+  if (const int status = crossrt::ParseCommandLine(app, argc, argv); status >= 0) return status;
   auto ctx = crossrt::VulkanContext::CreateDefault();
   crossrt::GpuTimer timer(ctx);
   std::printf("device: %s\n", ctx->DeviceName().c_str());

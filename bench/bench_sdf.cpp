@@ -27,6 +27,7 @@
 #include "SdfRender_VulkanLeaves.h"
 #include "SdfLeafScene.h"
 #include "SdfTrace.h"
+#include "CommandLine.h"
 
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/MeshToVolume.h>
@@ -171,18 +172,12 @@ void TimeTranslated(Translated& tr, const std::function<uint32_t(ISceneObject&)>
 int main(int argc, char** argv) {
   int size = 160;
   std::vector<std::string> meshes;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--help" || a == "-h") {
-      std::cout << "usage: bench_sdf [--size N] [MESH...]\n"
-                   "  SDF grid, sparse voxel and brick sets against OpenVDB: build time, bytes, Mrays/s (one thread),\n"
-                   "  surface error and image PSNR against the exact mesh distance. Default meshes: bunny, armadillo\n"
-                   "  and dragon from build/data/meshes (scripts/fetch-meshes.sh). Writes out/bench_sdf.csv.\n";
-      return 0;
-    }
-    if (a == "--size" && i + 1 < argc) size = std::atoi(argv[++i]);
-    else meshes.push_back(a);
-  }
+  crossrt::CommandLine app("bench_sdf",
+                           "SDF grid, sparse voxel and brick sets against OpenVDB: build time, bytes, Mrays/s (one thread),\n"
+                           "surface error and image PSNR against the exact mesh distance. Writes out/bench_sdf.csv.");
+  app.add_option("MESH", meshes, "meshes (default: bunny, armadillo and dragon from build/data/meshes, scripts/fetch-meshes.sh)");
+  app.add_option("--size", size, "width and height of the images in pixels")->check(crossrt::Positive());
+  if (const int status = crossrt::ParseCommandLine(app, argc, argv); status >= 0) return status;
   if (meshes.empty())
     for (const char* name : {"bunny00.off", "armadillo.off", "dragon_vrip_res2.ply.gz"})
       if (std::filesystem::exists(std::string("build/data/meshes/") + name)) meshes.push_back(std::string("build/data/meshes/") + name);

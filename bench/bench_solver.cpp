@@ -15,6 +15,7 @@
 #ifdef CROSSRT_HAS_ISPC
 #include "HeatDiffusion_ISPC.h"
 #endif
+#include "CommandLine.h"
 
 #include <crossrt/IspcSupport.h>
 
@@ -44,21 +45,15 @@ struct Row {
 
 int main(int argc, char** argv)
 {
-  if (argc > 1 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h"))
-  {
-    std::printf("usage: bench_solver [SIDE (default 64)] [ROUNDS (default 3)] [CSV (default out/bench_solver.csv)]\n"
-                "Times HeatDiffusion's solve to convergence (at most 5000 steps) with the residual read every step and\n"
-                "every k steps, on the original class, _CPU, _ISPC and _Vulkan, in interleaved rounds.\n");
-    return 0;
-  }
-  const int side = argc > 1 ? std::atoi(argv[1]) : 64;
-  const int rounds = argc > 2 ? std::atoi(argv[2]) : 3;
-  const std::string csvPath = argc > 3 ? argv[3] : "out/bench_solver.csv";
-  if (side < 3 || rounds < 1)
-  {
-    std::fprintf(stderr, "bench_solver: SIDE must be at least 3 and ROUNDS at least 1\n");
-    return 2;
-  }
+  int side = 64, rounds = 3;
+  std::string csvPath = "out/bench_solver.csv";
+  crossrt::CommandLine app("bench_solver",
+                           "Times HeatDiffusion's solve to convergence (at most 5000 steps) with the residual read every step and\n"
+                           "every k steps, on the original class, _CPU, _ISPC and _Vulkan, in interleaved rounds.");
+  app.add_option("SIDE", side, "grid cells per side")->check(CLI::Range(3, 1 << 14));
+  app.add_option("ROUNDS", rounds, "interleaved rounds")->check(crossrt::Positive());
+  app.add_option("CSV", csvPath, "the table's CSV file");
+  if (const int status = crossrt::ParseCommandLine(app, argc, argv); status >= 0) return status;
   std::filesystem::create_directories(std::filesystem::path(csvPath).parent_path().empty() ? "." : std::filesystem::path(csvPath).parent_path());
   std::ofstream csv(csvPath);
   if (!csv)

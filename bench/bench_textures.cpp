@@ -9,6 +9,7 @@
 #include "TexturedMaterials.h"
 #include "TexturedMaterials_CPU.h"
 #include "TexturedMaterials_Vulkan.h"
+#include "CommandLine.h"
 
 #include <algorithm>
 #include <cmath>
@@ -51,14 +52,13 @@ void Fill(TexturedMaterials& m, int textures, uint32_t side)
 
 int main(int argc, char** argv)
 {
-  if (argc > 1 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h"))
-  {
-    std::printf("usage: bench_textures [N (default 1048576)] [TEXTURES (default 16)] [SIDE (default 512)]\n  Samples arrays of textures from buffers against the GPU samplers, and prints ratios.\n");
-    return 0;
-  }
-  const int n = argc > 1 ? std::atoi(argv[1]) : 1 << 20;
-  const int textures = argc > 2 ? std::atoi(argv[2]) : 16;
-  const uint32_t side = argc > 3 ? uint32_t(std::atoi(argv[3])) : 512;
+  int n = 1 << 20, textures = 16;
+  uint32_t side = 512;
+  crossrt::CommandLine app("bench_textures", "Samples arrays of textures from buffers against the GPU samplers, and prints ratios.");
+  app.add_option("N", n, "samples")->check(crossrt::Positive());
+  app.add_option("TEXTURES", textures, "textures in the array")->check(crossrt::Positive());
+  app.add_option("SIDE", side, "each texture's width and height")->check(crossrt::Positive());
+  if (const int status = crossrt::ParseCommandLine(app, argc, argv); status >= 0) return status;
   const int repeats = 5;
 
   std::mt19937 rng(7);
