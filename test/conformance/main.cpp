@@ -4,6 +4,7 @@
 // has (_CPU, _Vulkan, and _ISPC where an ISPC compiler was found), and every refusal by design is
 // the diagnostic the case expects.
 #include "Conformance.h"
+#include "CommandLine.h"
 
 #include <algorithm>
 #include <cmath>
@@ -100,16 +101,12 @@ std::string Cell(const std::string& s, size_t width) { return s.size() > width ?
 
 int main(int argc, char** argv) {
   std::string csvPath;
-  for (int i = 1; i < argc; ++i) {
-    if (std::strcmp(argv[i], "--csv") == 0 && i + 1 < argc) csvPath = argv[++i];
-    else {
-      std::printf("usage: crossrt_conformance [--csv FILE]\n"
-                  "Runs the conformance classes (test/conformance/cases) as written, as _CPU, as _Vulkan and (where the\n"
-                  "build found an ISPC compiler) as _ISPC, and prints which constructs translate, run and agree.\n"
-                  "CROSSRT_DEVICE picks the Vulkan device.\n");
-      return std::strcmp(argv[i], "--help") == 0 ? 0 : 2;
-    }
-  }
+  crossrt::CommandLine app("crossrt_conformance",
+                           "Runs the conformance classes (test/conformance/cases) as written, as _CPU, as _Vulkan and (where the\n"
+                           "build found an ISPC compiler) as _ISPC, and prints which constructs translate, run and agree.\n"
+                           "CROSSRT_DEVICE picks the Vulkan device.");
+  app.add_option("--csv", csvPath, "the table as CSV too");
+  if (const int status = crossrt::ParseCommandLine(app, argc, argv); status >= 0) return status;
   auto& cases = conformance::Registry();
   std::sort(cases.begin(), cases.end(), [](const Case& a, const Case& b) { return a.files < b.files; });
   auto ctx = conformance::Context();

@@ -6,6 +6,8 @@
 // differently), the appended vector as a set (kernels append in any order).
 //
 //   crossrt_differential [--verbose]    prints a line per mismatch and "N passed, M failed"
+#include "CommandLine.h"
+
 #include <crossrt/VulkanRuntime.h>
 
 #include <algorithm>
@@ -107,14 +109,9 @@ std::vector<Case> Cases() {
 
 int main(int argc, char** argv) {
   bool verbose = false;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--verbose")) verbose = true;
-    else {
-      std::printf("usage: crossrt_differential [--verbose]\n"
-                  "Runs each random class of this build as written, as _CPU, _Vulkan and _ISPC, and compares.\n");
-      return std::strcmp(argv[i], "--help") == 0 ? 0 : 2;
-    }
-  }
+  crossrt::CommandLine app("crossrt_differential", "Runs each random class of this build as written, as _CPU, _Vulkan and _ISPC, and compares.");
+  app.add_flag("--verbose", verbose, "print every case, not only mismatches");
+  if (const int status = crossrt::ParseCommandLine(app, argc, argv); status >= 0) return status;
   int passed = 0, failed = 0;
   for (const Case& c : Cases()) {
     const std::vector<Value> expected = c.original();

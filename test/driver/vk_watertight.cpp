@@ -12,6 +12,7 @@
 #include <cstdint>
 
 #include "watertight.spv.h"
+#include "CommandLine.h"
 
 #include <vulkan/vulkan.h>
 
@@ -262,12 +263,11 @@ Level Build(const Device& d, VkCommandPool pool, VkAccelerationStructureTypeKHR 
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc > 1 && (std::strcmp(argv[1], "--help") == 0 || std::strcmp(argv[1], "-h") == 0)) {
-    std::printf("usage: vk_watertight\n  Traces rays with ray queries from inside a closed mesh (an icosphere) through its vertices,\n"
-                "  its edges' midpoints and random directions on the first Vulkan device with ray queries, and\n"
-                "  prints how many leave the mesh without a hit: 'watertight: yes' when none does.\n");
-    return 0;
-  }
+  crossrt::CommandLine app("vk_watertight",
+                           "Traces rays with ray queries from inside a closed mesh (an icosphere) through its vertices, its edges'\n"
+                           "midpoints and random directions on the first Vulkan device with ray queries, and prints how many leave\n"
+                           "the mesh without a hit: 'watertight: yes' when none does.");
+  if (const int status = crossrt::ParseCommandLine(app, argc, argv); status >= 0) return status;
   Device d;
   if (!OpenDevice(d)) {
     std::printf("vk_watertight: no Vulkan device with ray queries: skipped\n");
