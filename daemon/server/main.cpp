@@ -13,6 +13,7 @@
 // Test hook: CROSSRT_DAEMON_CRASH_AT=<stage> makes it SIGKILL itself at that stage of a
 // translate request (accepted, read, parsed, translated, responding), or hang with "hang", to
 // test client recovery.
+#include "CommandLine.h"
 #include "parse/AstCache.h"
 #include "LanguageServer.h"
 #include "Protocol.h"
@@ -204,69 +205,46 @@ void Serve(Daemon& d, int fd) {
 
 }  // namespace
 
-const char* kUsage =
-    "usage: crossrtd --build-dir DIR [--log FILE] [--idle-seconds N] [--max-asts N]\n"
-    "       crossrtd --lsp [--build-dir DIR]... [--log FILE] [--debounce-ms N]\n";
-
 // crossrtd --lsp: the language server (LanguageServer.h) on stdin and stdout.
-int LanguageServerMain(int argc, char** argv) {
-  crossrt::lsp::ServerOptions options;
-  for (int i = 1; i < argc; ++i) {
-    std::string a = argv[i];
-    if (a == "--lsp") continue;
-    if (i + 1 >= argc) {
-      std::cerr << "crossrtd: option '" << a << "' needs a value\n" << kUsage;
-      return 2;
-    }
-    std::string v = argv[++i];
-    if (a == "--build-dir") options.buildDirs.push_back(v);
-    else if (a == "--log") options.logPath = v;
-    else if (a == "--debounce-ms") {
-      char* end = nullptr;
-      long ms = std::strtol(v.c_str(), &end, 10);
-      if (v.empty() || *end || ms < 0 || ms > 10000) {
-        std::cerr << "crossrtd: --debounce-ms takes milliseconds from 0 to 10000, not '" << v << "'\n";
-        return 2;
-      }
-      options.debounceMs = int(ms);
-    } else {
-      std::cerr << "crossrtd: unknown option '" << a << "' with --lsp\n" << kUsage;
-      return 2;
-    }
-  }
+int LanguageServerMain(const crossrt::lsp::ServerOptions& options) {
   signal(SIGPIPE, SIG_IGN);  // a client gone: writes fail, and the server exits
   return crossrt::lsp::RunLanguageServer(options, STDIN_FILENO, STDOUT_FILENO);
 }
 
 int main(int argc, char** argv) {
   Daemon d;
-  if (argc > 1 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h")) {
-    std::cout << kUsage
-              << "  The translation daemon of one build tree: keeps parsed ASTs warm and answers the crossrt client.\n"
-                 "  crossrt starts it on demand; you rarely run it by hand.\n"
-                 "  --lsp: a language server for editors (beside clangd) on stdin and stdout: the translator's\n"
-                 "  diagnostics while you type, hovers and code lenses on kernels, quick fixes. It learns the\n"
-                 "  classes from the build trees (--build-dir, the client's initializationOptions.buildDirectory,\n"
-                 "  or the workspace folder and its subfolders holding CMakeCache.txt). docs/editors.md sets it up.\n";
-    return 0;
+  crossrt::lsp::ServerOptions lsp;
+  std::vector<std::string> buildDirs;
+  std::string logPath;
+  bool languageServer = false;
+  crossrt::CommandLine app("crossrtd",
+                           "The translation daemon of one build tree: keeps parsed ASTs warm and answers the crossrt client.\n"
+                           "crossrt starts it on demand; you rarely run it by hand.\n"
+                           "With --lsp, a language server for editors (beside clangd) on stdin and stdout: the translator's\n"
+                           "diagnostics while you type, hovers and code lenses on kernels, quick fixes. It learns the classes\n"
+                           "from the build trees (--build-dir, the client's initializationOptions.buildDirectory, or the\n"
+                           "workspace folder and its subfolders holding CMakeCache.txt). docs/editors.md sets it up.");
+  app.add_option("--build-dir", buildDirs, "the build tree it serves (with --lsp: build trees to learn classes from, any number)");
+  app.add_option("--log", logPath, "a log of what it does");
+  CLI::Option* idle = app.add_option("--idle-seconds", d.idleSeconds, "exits after this long without a request")->check(crossrt::Positive());
+  CLI::Option* asts = app.add_option("--max-asts", d.maxAsts, "parsed translation units kept warm")->check(crossrt::Positive());
+  CLI::Option* serveLsp = app.add_flag("--lsp", languageServer, "serve the Language Server Protocol on stdin and stdout instead");
+  app.add_option("--debounce-ms", lsp.debounceMs, "with --lsp: after a change, wait this long before translating")
+      ->check(CLI::Range(0, 10000))
+      ->needs(serveLsp);
+  serveLsp->excludes(idle)->excludes(asts);
+  if (const int status = crossrt::ParseCommandLine(app, argc, argv); status >= 0) return status;
+  if (languageServer) {
+    lsp.buildDirs = buildDirs;
+    lsp.logPath = logPath;
+    return LanguageServerMain(lsp);
   }
-  for (int i = 1; i < argc; ++i)
-    if (std::string(argv[i]) == "--lsp") return LanguageServerMain(argc, argv);
-  for (int i = 1; i + 1 < argc; i += 2) {
-    std::string a = argv[i], v = argv[i + 1];
-    if (a == "--build-dir") d.buildDir = v;
-    else if (a == "--log") d.logPath = v;
-    else if (a == "--idle-seconds") d.idleSeconds = std::max(1, std::atoi(v.c_str()));
-    else if (a == "--max-asts") d.maxAsts = size_t(std::max(1, std::atoi(v.c_str())));
-    else {
-      std::cerr << "crossrtd: unknown option '" << a << "'\n";
-      return 2;
-    }
-  }
-  if (d.buildDir.empty()) {
-    std::cerr << kUsage;
+  if (buildDirs.size() != 1) {
+    std::cerr << "crossrtd: give one --build-dir, the build tree to serve (see --help)\n";
     return 2;
   }
+  d.buildDir = buildDirs.front();
+  d.logPath = logPath;
   if (const char* crash = std::getenv("CROSSRT_DAEMON_CRASH_AT")) d.crashAt = crash;
   signal(SIGPIPE, SIG_IGN);
 
