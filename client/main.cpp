@@ -10,6 +10,7 @@
 // tree's daemon (starting it when absent) and, when the daemon cannot answer for any reason,
 // translates in-process: the build never fails because of the daemon or a remote storage. A local
 // translation is uploaded. Outputs are written atomically, only where their bytes changed.
+#include "CommandLine.h"
 #include "DaemonClient.h"
 #include "InProcess.h"
 #include "Manifest.h"
@@ -36,45 +37,24 @@ using crossrt::client::DaemonClient;
 
 namespace {
 
-const char* kUsage =
-    "usage: crossrt translate --class NAME --backend vulkan|cpu|ispc --out DIR --source FILE [--source FILE...]\n"
-    "                         [--candidate FILE... [--source-dir DIR]] [--compose INTERFACE=IMPL...] [--virtual-level 1|2|3]\n"
-    "                         [--execution-mode wavefront|megakernel] [--name GENERATED] [--templates DIR]\n"
-    "                         [--depfile FILE --depfile-target FILE]\n"
-    "                         [--build-dir DIR | --no-daemon]\n"
-    "                         [--remote-storage URLS [--source-root DIR] [--remote-key-file FILE]]\n"
-    "                         [-- COMPILE_ARGS...]\n"
-    "       crossrt daemon status [--build-dir DIR] [--json]\n"
-    "       crossrt daemon stop [--build-dir DIR]\n"
-    "       crossrt --help | --version\n";
-
-const char* kHelp =
+const char* kDescription =
     "crossrt: translates a C++ class into a class that runs its kernels on Vulkan (NAME_Vulkan), on\n"
     "all CPU cores (NAME_CPU), or on all cores in SIMD lanes (NAME_ISPC, whose NAME_ISPC_kernels.ispc\n"
     "the ISPC compiler compiles). crossrt_add_class() in CMake runs it; you rarely call it by hand.\n"
-    "\n"
-    "translate      translates class NAME, whose member functions the --source files define, into DIR.\n"
-    "               Of the --candidate files (a target's sources), those that define NAME's member\n"
-    "               functions are parsed too, whatever their names (relative ones are found from\n"
-    "               --source-dir).\n"
-    "               Compile arguments (-I, -D, -std=...) follow '--'. The build tree's daemon (crossrtd)\n"
-    "               translates, and is started when absent; --no-daemon (or CROSSRT_NO_DAEMON=1)\n"
-    "               translates in this process. An unchanged class writes nothing.\n"
-    "               --remote-storage (or CROSSRT_REMOTE_STORAGE, which wins) names remote caches shared\n"
-    "               by a team: redis://host[:port], http[s]://host/path, space-separated, each with\n"
-    "               optional |read-only, |connect-timeout=MS, |operation-timeout=MS, |layout=bazel.\n"
-    "               Paths under --build-dir and --source-root are stored relative to them.\n"
-    "               With a team key (CROSSRT_REMOTE_KEY, or the file that CROSSRT_REMOTE_KEY_FILE or\n"
-    "               --remote-key-file names; never the key itself on a command line) entries are\n"
-    "               signed, and entries that do not verify are rejected: translated locally instead.\n"
-    "               |ca-file=PEM trusts that certificate authority for https:// storages.\n"
-    "               --name names the generated class (and its files and global symbols) instead of\n"
-    "               NAME_Vulkan, NAME_CPU or NAME_ISPC, so that several translations of one class (at\n"
-    "               different virtual levels, say) link into one program.\n"
-    "daemon status  prints what the build tree's daemon holds (--json for a machine), and how many\n"
-    "               remote cache entries the build tree rejected.\n"
-    "daemon stop    stops it; the next translation starts another.\n"
-    "\n";
+    "crossrt COMMAND --help describes a command.";
+const char* kTranslate =
+    "translates class NAME, whose member functions the --source files define, into DIR. Of the --candidate\n"
+    "files (a target's sources), those that define NAME's member functions are parsed too, whatever their\n"
+    "names. Compile arguments (-I, -D, -std=...) follow '--'. The build tree's daemon (crossrtd) translates,\n"
+    "and is started when absent; --no-daemon (or CROSSRT_NO_DAEMON=1) translates in this process. An\n"
+    "unchanged class writes nothing.\n"
+    "--remote-storage (or CROSSRT_REMOTE_STORAGE, which wins) names remote caches shared by a team:\n"
+    "redis://host[:port], http[s]://host/path, space-separated, each with optional |read-only,\n"
+    "|connect-timeout=MS, |operation-timeout=MS, |layout=bazel, |ca-file=PEM (trusts that certificate\n"
+    "authority for https:// storages). Paths under --build-dir and --source-root are stored relative to\n"
+    "them. With a team key (CROSSRT_REMOTE_KEY, or the file that CROSSRT_REMOTE_KEY_FILE or\n"
+    "--remote-key-file names; never the key itself on a command line) entries are signed, and entries\n"
+    "that do not verify are rejected: translated locally instead.";
 
 // Relative paths in the request, made absolute from this process's folder: the daemon that
 // translates runs elsewhere.
@@ -104,7 +84,7 @@ void MakePathsAbsolute(engine::TranslateRequest& request) {
 }
 
 int Usage(const std::string& message) {
-  std::cerr << "crossrt: error: " << message << "\n" << kUsage;
+  std::cerr << "crossrt: error: " << message << " (see --help)\n";
   return 2;
 }
 
@@ -135,15 +115,8 @@ std::string CurrentDir() {
   return getcwd(buf, sizeof buf) ? buf : ".";
 }
 
-int DaemonCommand(const std::vector<std::string>& args) {
-  std::string buildDir = CurrentDir(), what = args.size() > 1 ? args[1] : "";
-  bool asJson = false;
-  for (size_t i = 2; i < args.size(); ++i) {
-    if (args[i] == "--json") asJson = true;
-    else if (args[i] == "--build-dir" && i + 1 < args.size()) buildDir = args[++i];
-    else return Usage("unknown option '" + args[i] + "'");
-  }
-  if (what != "status" && what != "stop") return Usage("daemon command must be 'status' or 'stop'");
+// crossrt daemon status|stop.
+int DaemonCommand(const std::string& what, const std::string& buildDir, bool asJson) {
   DaemonClient daemon(buildDir);
   auto response = daemon.Call({{"command", what}}, /*start=*/false, 10);
   // Rejected remote entries are the build tree's record, not the daemon's: shown with or without one.
@@ -203,80 +176,82 @@ int DaemonCommand(const std::vector<std::string>& args) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<std::string> args(argv + 1, argv + argc);
-  if (args.empty()) return Usage("no command given");
-  if (args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
-    std::cout << kHelp << kUsage;
-    return 0;
-  }
-  if (args[0] == "--version") {
-    std::cout << "crossrt " << engine::kTranslatorVersion << "\n";
-    return 0;
-  }
-  if (args[0] == "daemon") return DaemonCommand(args);
-  if (args[0] != "translate") return Usage("unknown command '" + args[0] + "'");
-
+  // The team key never on a command line, where other users and build logs see it: refused before
+  // anything reads it.
+  for (int i = 1; i < argc; ++i)
+    if (std::string a = argv[i]; a == "--remote-key" || a.rfind("--remote-key=", 0) == 0)
+      return Usage("the team key is never given on the command line, where other users and build logs see it: "
+                   "set CROSSRT_REMOTE_KEY, or name a key file with --remote-key-file or CROSSRT_REMOTE_KEY_FILE");
   engine::TranslateRequest request;
   request.templateDir = CROSSRT_DEFAULT_TEMPLATE_DIR;
   std::string depfile, depfileTarget, backend, buildDir, sourceDir, remoteStorage, sourceRoot, remoteKeyFile;
-  bool useDaemon = std::getenv("CROSSRT_NO_DAEMON") == nullptr;
+  std::string virtualLevel, executionMode, daemonDir = CurrentDir();
+  bool noDaemon = false, asJson = false, version = false;
   std::vector<std::string> candidates;
-  for (size_t i = 1; i < args.size(); ++i) {
-    const std::string& a = args[i];
-    if (a == "--") {
-      request.compileArgs.assign(args.begin() + i + 1, args.end());
-      break;
-    }
-    if (a == "--no-daemon") {
-      useDaemon = false;
-      continue;
-    }
-    if (a == "--help" || a == "-h") {
-      std::cout << kHelp << kUsage;
-      return 0;
-    }
-    if (i + 1 >= args.size()) return Usage("option '" + a + "' needs a value");
-    const std::string& v = args[++i];
-    if (a == "--class") request.className = v;
-    else if (a == "--backend") backend = v;
-    else if (a == "--out") request.outputDir = v;
-    else if (a == "--source") request.sources.push_back(v);
-    else if (a == "--source-dir") sourceDir = v;
-    else if (a == "--candidate") candidates.push_back(v);
-    else if (a == "--templates") request.templateDir = v;
-    else if (a == "--compose") {
-      if (v.find('=') == std::string::npos || v.front() == '=' || v.back() == '=')
-        return Usage("--compose takes Interface=Implementation, e.g. ISceneObject=BVHScene, not '" + v + "'");
-      request.compositions.push_back(v);
-    }
-    else if (a == "--virtual-level") {
-      if (v != "1" && v != "2" && v != "3")
-        return Usage("--virtual-level takes 1 (one array of equal slots), 2 (a buffer per class) or 3 (2, plus callable and intersection shaders), not '" + v + "'");
-      request.virtualLevel = std::stoi(v);
-    }
-    else if (a == "--execution-mode") {
-      if (v != "megakernel" && v != "wavefront")
-        return Usage("--execution-mode takes megakernel (one shader per thread loop) or wavefront (one dispatch per kernel call), not '" + v + "'");
-      request.megakernel = v == "megakernel";
-    }
-    else if (a == "--name") {
-      if (v.empty() || !(std::isalpha((unsigned char)v[0]) || v[0] == '_') ||
-          v.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") != std::string::npos)
-        return Usage("--name takes a C++ identifier (the generated class's name), not '" + v + "'");
-      request.generatedName = v;
-    }
-    else if (a == "--depfile") depfile = v;
-    else if (a == "--depfile-target") depfileTarget = v;
-    else if (a == "--build-dir") buildDir = v;
-    else if (a == "--remote-storage") remoteStorage = v;
-    else if (a == "--source-root") sourceRoot = v;
-    else if (a == "--remote-key-file") remoteKeyFile = v;
-    else if (a == "--remote-key") return Usage("the team key is never given on the command line, where other users and build logs see it: "
-                                               "set CROSSRT_REMOTE_KEY, or name a key file with --remote-key-file or CROSSRT_REMOTE_KEY_FILE");
-    else return Usage("unknown option '" + a + "'");
+
+  crossrt::CommandLine app("crossrt", kDescription);
+  app.add_flag("--version", version, "prints the translator's version");
+  app.require_subcommand(0, 1);
+  CLI::App* translate = app.add_subcommand("translate", kTranslate);
+  auto one = [](CLI::Option* o) { return o->allow_extra_args(false); };  // one value per occurrence
+  translate->add_option("--class", request.className, "the class, NAME")->required();
+  translate->add_option("--backend", backend, "vulkan, cpu or ispc")->required();
+  translate->add_option("--out", request.outputDir, "the folder of the generated files, DIR")->required();
+  one(translate->add_option("--source", request.sources, "a file that defines NAME's member functions"));
+  one(translate->add_option("--candidate", candidates, "a file of the target, parsed when it defines NAME's member functions"));
+  translate->add_option("--source-dir", sourceDir, "where relative --candidate files are");
+  one(translate->add_option("--compose", request.compositions, "INTERFACE=IMPLEMENTATION: the implementation the GPU runs (paper 3.6)"));
+  translate->add_option("--virtual-level", virtualLevel,
+                        "1 (one array of equal slots), 2 (a buffer per class) or 3 (2, plus callable and intersection shaders)");
+  translate->add_option("--execution-mode", executionMode,
+                        "megakernel (one shader per thread loop) or wavefront (one dispatch per kernel call)");
+  translate->add_option("--name", request.generatedName,
+                        "the generated class's name (and its files' and global symbols') instead of NAME_Vulkan, NAME_CPU or\n"
+                        "NAME_ISPC, so that several translations of one class link into one program");
+  translate->add_option("--templates", request.templateDir, "the templates' folder");
+  translate->add_option("--depfile", depfile, "a make-style depfile of the translation's inputs");
+  translate->add_option("--depfile-target", depfileTarget, "the depfile's target");
+  translate->add_option("--build-dir", buildDir, "the build tree, whose daemon translates");
+  translate->add_flag("--no-daemon", noDaemon, "translates in this process");
+  translate->add_option("--remote-storage", remoteStorage, "remote caches shared by a team (see above)");
+  translate->add_option("--source-root", sourceRoot, "paths under it are stored relative to it in remote caches");
+  translate->add_option("--remote-key-file", remoteKeyFile, "the file that holds the team key");
+  translate->add_option("COMPILE_ARGS", request.compileArgs, "compile arguments, after '--'");
+  CLI::App* daemon = app.add_subcommand("daemon", "the build tree's daemon (crossrtd)");
+  daemon->require_subcommand(1);
+  CLI::App* status = daemon->add_subcommand("status", "prints what the build tree's daemon holds, and how many remote cache entries the build tree rejected");
+  status->add_option("--build-dir", daemonDir, "the build tree");
+  status->add_flag("--json", asJson, "for a machine");
+  CLI::App* stop = daemon->add_subcommand("stop", "stops it; the next translation starts another");
+  stop->add_option("--build-dir", daemonDir, "the build tree");
+  if (const int status = crossrt::ParseCommandLine(app, argc, argv); status >= 0) return status;
+
+  if (version) {
+    std::cout << "crossrt " << engine::kTranslatorVersion << "\n";
+    return 0;
   }
-  if (request.className.empty()) return Usage("--class is required");
-  if (request.outputDir.empty()) return Usage("--out is required");
+  if (daemon->parsed()) return DaemonCommand(status->parsed() ? "status" : "stop", daemonDir, asJson);
+  if (!translate->parsed()) return Usage("no command given");
+  const bool useDaemon = !noDaemon && std::getenv("CROSSRT_NO_DAEMON") == nullptr;
+  for (const std::string& v : request.compositions)
+    if (v.find('=') == std::string::npos || v.front() == '=' || v.back() == '=')
+      return Usage("--compose takes Interface=Implementation, e.g. ISceneObject=BVHScene, not '" + v + "'");
+  if (!virtualLevel.empty()) {
+    if (virtualLevel != "1" && virtualLevel != "2" && virtualLevel != "3")
+      return Usage("--virtual-level takes 1 (one array of equal slots), 2 (a buffer per class) or 3 (2, plus callable and intersection shaders), not '" +
+                   virtualLevel + "'");
+    request.virtualLevel = std::stoi(virtualLevel);
+  }
+  if (!executionMode.empty()) {
+    if (executionMode != "megakernel" && executionMode != "wavefront")
+      return Usage("--execution-mode takes megakernel (one shader per thread loop) or wavefront (one dispatch per kernel call), not '" +
+                   executionMode + "'");
+    request.megakernel = executionMode == "megakernel";
+  }
+  if (const std::string& v = request.generatedName;
+      translate->count("--name") && (v.empty() || !(std::isalpha((unsigned char)v[0]) || v[0] == '_') ||
+                                     v.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") != std::string::npos))
+    return Usage("--name takes a C++ identifier (the generated class's name), not '" + v + "'");
   if (request.sources.empty() && candidates.empty()) return Usage("at least one --source (or --candidate) is required");
   if (!engine::ParseBackend(backend, request.backend)) return Usage("--backend must be 'vulkan', 'cpu' or 'ispc', not '" + backend + "'");
   if (!candidates.empty()) {
