@@ -95,11 +95,11 @@ std::string GlslPrinter::TexelAssignment(const CXXOperatorCallExpr* op) {
   if (!op->isAssignmentOp() || op->getNumArgs() != 2 || !ImageTexel(op->getArg(0))) return "";
   const auto kind = op->getOperator();
   const clang::Expr* e = op;
-    if (kind == OO_Equal) return ImageStore(op->getArg(0), Expr(op->getArg(1)), e);
-    if (op->getArg(0)->HasSideEffects(m_ctx, /*IncludePossibleEffects=*/false))  // it is printed twice
-      return Fail(e->getBeginLoc(), "compound assignment to a texel whose coordinate has side effects", "compute the coordinate into a variable first");
-    std::string spelling = getOperatorSpelling(kind);
-    return ImageStore(op->getArg(0), Expr(op->getArg(0)) + " " + spelling.substr(0, spelling.size() - 1) + " (" + Expr(op->getArg(1)) + ")", e);
+  if (kind == OO_Equal) return ImageStore(op->getArg(0), Expr(op->getArg(1)), e);
+  if (op->getArg(0)->HasSideEffects(m_ctx, /*IncludePossibleEffects=*/false))  // it is printed twice
+    return Fail(e->getBeginLoc(), "compound assignment to a texel whose coordinate has side effects", "compute the coordinate into a variable first");
+  std::string spelling = getOperatorSpelling(kind);
+  return ImageStore(op->getArg(0), Expr(op->getArg(0)) + " " + spelling.substr(0, spelling.size() - 1) + " (" + Expr(op->getArg(1)) + ")", e);
 }
 
 }  // namespace crossrt::engine

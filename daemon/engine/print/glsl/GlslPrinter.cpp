@@ -149,15 +149,14 @@ std::string GlslPrinter::SizeLiteral(uint64_t n) const { return std::to_string(n
 // An assignment to a texel of a float or uint image (imageStore), or to part of one (refused).
 std::string GlslPrinter::Assignment(const BinaryOperator* bo) {
   const clang::Expr* e = bo;
-  {  // m_img[p].x = v: the analysis reports it for members; parameters here
-    const clang::Expr* part = bo->getLHS()->IgnoreParenImpCasts();
-    while (auto* me = dyn_cast<MemberExpr>(part)) part = me->getBase()->IgnoreParenImpCasts();
-    if (part != bo->getLHS()->IgnoreParenImpCasts())
-      if (auto* image = ImageTexel(part); image && !isa<FieldDecl>(image))
-        return Fail(e->getBeginLoc(), "kernel writes part of a texel of " + Described(image),
-                    "GPU images store whole texels: read the texel into a variable, change it, and write it back with " +
-                        image->getNameAsString() + "[p] = value");
-  }
+  // m_img[p].x = v: the analysis reports it for members; parameters here.
+  const clang::Expr* part = bo->getLHS()->IgnoreParenImpCasts();
+  while (auto* me = dyn_cast<MemberExpr>(part)) part = me->getBase()->IgnoreParenImpCasts();
+  if (part != bo->getLHS()->IgnoreParenImpCasts())
+    if (auto* image = ImageTexel(part); image && !isa<FieldDecl>(image))
+      return Fail(e->getBeginLoc(), "kernel writes part of a texel of " + Described(image),
+                  "GPU images store whole texels: read the texel into a variable, change it, and write it back with " +
+                      image->getNameAsString() + "[p] = value");
   if (ImageTexel(bo->getLHS())) {  // a texel of a float or uint image
     if (bo->getOpcode() == BO_Assign) return ImageStore(bo->getLHS(), Expr(bo->getRHS()), e);
     if (bo->getLHS()->HasSideEffects(m_ctx, /*IncludePossibleEffects=*/false))  // it is printed twice
