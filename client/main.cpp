@@ -192,6 +192,8 @@ int main(int argc, char** argv) {
   crossrt::CommandLine app("crossrt", kDescription);
   app.add_flag("--version", version, "prints the translator's version");
   app.require_subcommand(0, 1);
+  // `crossrt help`, as before CLI11: the same as --help (hidden from the list of commands).
+  CLI::App* help = app.add_subcommand("help", "")->group("")->allow_extras();
   CLI::App* translate = app.add_subcommand("translate", kTranslate);
   auto one = [](CLI::Option* o) { return o->allow_extra_args(false); };  // one value per occurrence
   translate->add_option("--class", request.className, "the class, NAME")->required();
@@ -226,6 +228,10 @@ int main(int argc, char** argv) {
   stop->add_option("--build-dir", daemonDir, "the build tree");
   if (const int status = crossrt::ParseCommandLine(app, argc, argv); status >= 0) return status;
 
+  if (help->parsed()) {  // crossrt's own help (app.help() would describe the help command)
+    std::fputs(app.get_formatter()->make_help(&app, app.get_name(), CLI::AppFormatMode::Normal).c_str(), stdout);
+    return 0;
+  }
   if (version) {
     std::cout << "crossrt " << engine::kTranslatorVersion << "\n";
     return 0;
