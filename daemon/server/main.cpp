@@ -117,6 +117,8 @@ json Status(Daemon& d) {
           {"cachedShaders", d.spirv.Size()},
           {"reparses", stats.reparses},
           {"reuses", stats.reuses},
+          {"systemLayers", stats.layers},
+          {"layeredPreambles", stats.layeredPreambles},
           {"astHitRate", lookups ? double(stats.reparses) / double(lookups) : 0.0}};
 }
 

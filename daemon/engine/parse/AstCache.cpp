@@ -3,6 +3,9 @@
 // are evicted.
 #include "parse/AstCache.h"
 
+#include "parse/SystemLayer.h"
+#include "parse/SystemPrefix.h"
+
 #include <clang/AST/ASTContext.h>
 #include <clang/AST/Decl.h>
 #include <clang/Basic/DiagnosticOptions.h>
@@ -68,10 +71,14 @@ private:
 // drops those in system headers: the C++ library's templates are most of a preamble and most of
 // each parse's work (their instantiations), and kernels treat a system header's functions as a
 // library's, by name (IsSystemDecl), never printing their bodies.
+// It also records the preamble's system prefix (SystemPrefix.h).
 class PreambleBodies : public clang::PreambleCallbacks {
 public:
-  explicit PreambleBodies(IncludesSeen& seen) : m_seen(seen) {}
-  void BeforeExecute(clang::CompilerInstance& compiler) override { m_sm = &compiler.getSourceManager(); }
+  PreambleBodies(IncludesSeen& seen, SystemPrefix& prefix) : m_seen(seen), m_prefix(prefix) {}
+  void BeforeExecute(clang::CompilerInstance& compiler) override {
+    m_sm = &compiler.getSourceManager();
+    RecordSystemPrefix(compiler.getPreprocessor(), m_prefix);
+  }
   std::unique_ptr<clang::PPCallbacks> createPPCallbacks() override { return std::make_unique<IncludeRecorder>(*m_sm, m_seen); }
   bool shouldSkipFunctionBody(clang::Decl* decl) override {
     const clang::SourceManager& sm = decl->getASTContext().getSourceManager();
@@ -80,6 +87,7 @@ public:
 
 private:
   IncludesSeen& m_seen;
+  SystemPrefix& m_prefix;
   const clang::SourceManager* m_sm = nullptr;
 };
 }  // namespace
@@ -100,8 +108,15 @@ struct AstCache::Handle::Entry {
   llvm::IntrusiveRefCntPtr<clang::DiagnosticOptions> diagOptions;
   std::unique_ptr<ErrorCountingPrinter> printer;
   std::shared_ptr<clang::CompilerInvocation> invocation;  // from the arguments, before any preamble
+  std::string flagsKey;                                    // the arguments, for the system layers' cache
   std::optional<clang::PrecompiledPreamble> preamble;
   IncludesSeen preambleIncludes;  // what the preamble's #include lines found
+  // The preamble's system prefix as its last one-layer build found it, and the layer the preamble
+  // is built over (null: a one-layer preamble).
+  SystemPrefix prefix;
+  std::shared_ptr<const SystemLayer> layer;
+  bool layersRefused = false;
+  bool builtOverLayer = false;  // the last Parse built a preamble over a layer (for the statistics)
   // The last parse. EndParse() drops it action first: the action ends the source file while the
   // compiler and the main file's buffer still live.
   std::unique_ptr<llvm::MemoryBuffer> mainBuffer;
@@ -116,7 +131,14 @@ struct AstCache::Handle::Entry {
   std::vector<std::pair<std::string, std::pair<uint64_t, llvm::sys::TimePoint<>>>> parsedFiles;
 
   ~Entry() { EndParse(); }
-  bool Parse(const std::string& file, const std::map<std::string, std::string>& unsaved);
+  bool Parse(const std::string& file, const std::map<std::string, std::string>& unsaved, SystemLayerCache& layers);
+  void BuildPreamble(const clang::CompilerInvocation& invocation, const clang::PreambleBounds& bounds,
+                     SystemLayerCache& layers);
+  bool BuildPreambleOver(const clang::CompilerInvocation& invocation, const clang::PreambleBounds& bounds,
+                         const SystemLayer* layer, SystemPrefix& prefix);
+  llvm::IntrusiveRefCntPtr<llvm::vfs::FileSystem> Files() const {
+    return layer ? layer->FileSystem() : llvm::vfs::getRealFileSystem();
+  }
   void RecordWhatWasRead(const std::map<std::string, std::string>& unsaved);
   bool Unchanged(const std::string& file, const std::map<std::string, std::string>& unsaved) const;
   void EndParse() {
@@ -139,7 +161,8 @@ const std::string& AstCache::Handle::diagnostics() const {
 }
 bool AstCache::Handle::failed() const { return m_entry->failed || !m_entry->parsed; }
 
-AstCache::AstCache(size_t capacity) : m_capacity(std::max<size_t>(1, capacity)) {}
+AstCache::AstCache(size_t capacity)
+    : m_capacity(std::max<size_t>(1, capacity)), m_layers(std::make_unique<SystemLayerCache>()) {}
 AstCache::~AstCache() = default;
 
 // Parses the file over its preamble, building (or rebuilding, when a header or the #include
@@ -147,7 +170,8 @@ AstCache::~AstCache() = default;
 // them. Returns false when the file cannot be read or the compiler cannot be set up.
 // Unsaved headers are remapped files: the preamble's reuse check compares their text (its hash), not
 // a modification time that an editor's buffer does not have.
-bool AstCache::Handle::Entry::Parse(const std::string& file, const std::map<std::string, std::string>& unsaved) {
+bool AstCache::Handle::Entry::Parse(const std::string& file, const std::map<std::string, std::string>& unsaved,
+                                    SystemLayerCache& layers) {
   Entry& entry = *this;
   if (auto text = unsaved.find(file); text != unsaved.end()) {
     entry.mainBuffer = llvm::MemoryBuffer::getMemBufferCopy(text->second, file);
@@ -166,23 +190,17 @@ bool AstCache::Handle::Entry::Parse(const std::string& file, const std::map<std:
       invocation->getPreprocessorOpts().addRemappedFile(path, entry.unsavedBuffers.back().get());
     }
   invocation->getPreprocessorOpts().RetainRemappedFileBuffers = true;  // the entry owns the buffers
-  llvm::IntrusiveRefCntPtr<llvm::vfs::FileSystem> vfs = llvm::vfs::getRealFileSystem();
   auto bounds = clang::ComputePreambleBounds(invocation->getLangOpts(), *entry.mainBuffer, 0);
-  if (!entry.preamble || !entry.preamble->CanReuse(*invocation, *entry.mainBuffer, bounds, *vfs)) {
-    entry.preamble.reset();
-    clang::CompilerInvocation preambleInvocation(*invocation);
-    preambleInvocation.getFrontendOpts().SkipFunctionBodies = true;  // as PreambleBodies decides
-    clang::IgnoringDiagConsumer ignore;  // the parse without a preamble reports them
-    auto diags = clang::CompilerInstance::createDiagnostics(entry.diagOptions.get(), &ignore, /*ShouldOwnClient=*/false);
-    entry.preambleIncludes = {};
-    PreambleBodies bodies(entry.preambleIncludes);
-    auto built = clang::PrecompiledPreamble::Build(preambleInvocation, entry.mainBuffer.get(), bounds, *diags, vfs,
-                                                   std::make_shared<clang::PCHContainerOperations>(),
-                                                   /*StoreInMemory=*/true, /*StoragePath=*/"", bodies);
-    if (built && !diags->hasErrorOccurred()) entry.preamble.emplace(std::move(*built));
+  if (!entry.preamble || (entry.layer && entry.layer->Stale()) ||
+      !entry.preamble->CanReuse(*invocation, *entry.mainBuffer, bounds, *entry.Files()))
+    entry.BuildPreamble(*invocation, bounds, layers);
+  llvm::IntrusiveRefCntPtr<llvm::vfs::FileSystem> vfs = entry.Files();
+  if (entry.preamble) {
+    entry.preamble->AddImplicitPreamble(*invocation, vfs, entry.mainBuffer.get());
+  } else {
+    invocation->getPreprocessorOpts().addRemappedFile(file, entry.mainBuffer.get());
+    if (entry.layer) invocation->getPreprocessorOpts().ImplicitPCHInclude = entry.layer->PchPath();
   }
-  if (entry.preamble) entry.preamble->AddImplicitPreamble(*invocation, vfs, entry.mainBuffer.get());
-  else invocation->getPreprocessorOpts().addRemappedFile(file, entry.mainBuffer.get());
 
   auto compiler = std::make_unique<clang::CompilerInstance>(std::make_shared<clang::PCHContainerOperations>());
   compiler->setInvocation(std::move(invocation));
@@ -194,7 +212,7 @@ bool AstCache::Handle::Entry::Parse(const std::string& file, const std::map<std:
     entry.action.reset();
     return false;
   }
-  IncludesSeen includes = entry.preamble ? entry.preambleIncludes : IncludesSeen{};
+  IncludesSeen includes = entry.preamble || entry.layer ? entry.preambleIncludes : IncludesSeen{};
   includes.files.insert(file);
   compiler->getPreprocessor().addPPCallbacks(std::make_unique<IncludeRecorder>(compiler->getSourceManager(), includes));
   if (llvm::Error error = entry.action->Execute()) {
@@ -204,6 +222,57 @@ bool AstCache::Handle::Entry::Parse(const std::string& file, const std::map<std:
     return false;
   }
   entry.parsed = std::make_unique<ParsedFile>(std::move(compiler), std::move(includes));
+  return true;
+}
+
+// Builds the preamble over the system layer of the prefix that the last one-layer build found, and
+// keeps it if its build finds the same prefix (SystemPrefix.h says why that makes it exact); else,
+// or without a prefix, builds it in one layer and records the prefix for the next build.
+void AstCache::Handle::Entry::BuildPreamble(const clang::CompilerInvocation& invocation,
+                                            const clang::PreambleBounds& bounds, SystemLayerCache& layers) {
+  preamble.reset();
+  layer.reset();
+  if (!prefix.includes.empty()) {
+    if (auto over = layers.Get(flagsKey, *this->invocation, prefix)) {
+      SystemPrefix seen;
+      const bool built = BuildPreambleOver(invocation, bounds, over.get(), seen);
+      if (seen == over->Prefix()) {
+        // The layer fits. A preamble with errors is dropped, and the file is parsed over the layer
+        // alone, which reports them.
+        layer = std::move(over);
+        builtOverLayer = true;
+        if (!built) preambleIncludes = {};
+        preambleIncludes.files.insert(layer->Headers().begin(), layer->Headers().end());
+        return;
+      }
+      preamble.reset();
+    }
+  }
+  SystemPrefix seen;
+  if (!BuildPreambleOver(invocation, bounds, nullptr, seen)) return;
+  // A layer that its own prefix does not fit is not tried again for this source.
+  if (!prefix.includes.empty() && seen == prefix) layersRefused = true;
+  prefix = layersRefused ? SystemPrefix{} : seen;
+}
+
+// One build of the preamble, over `layer` when there is one; `prefix` gets the system prefix the
+// build saw. False when the build failed or had errors (then there is no preamble).
+bool AstCache::Handle::Entry::BuildPreambleOver(const clang::CompilerInvocation& invocation,
+                                                const clang::PreambleBounds& bounds, const SystemLayer* over,
+                                                SystemPrefix& seen) {
+  clang::CompilerInvocation preambleInvocation(invocation);
+  preambleInvocation.getFrontendOpts().SkipFunctionBodies = true;  // as PreambleBodies decides
+  if (over) preambleInvocation.getPreprocessorOpts().ImplicitPCHInclude = over->PchPath();
+  clang::IgnoringDiagConsumer ignore;  // the parse without a preamble reports them
+  auto diags = clang::CompilerInstance::createDiagnostics(diagOptions.get(), &ignore, /*ShouldOwnClient=*/false);
+  preambleIncludes = {};
+  PreambleBodies bodies(preambleIncludes, seen);
+  auto built = clang::PrecompiledPreamble::Build(preambleInvocation, mainBuffer.get(), bounds, *diags,
+                                                 over ? over->FileSystem() : llvm::vfs::getRealFileSystem(),
+                                                 std::make_shared<clang::PCHContainerOperations>(),
+                                                 /*StoreInMemory=*/true, /*StoragePath=*/"", bodies);
+  if (!built || diags->hasErrorOccurred()) return false;
+  preamble.emplace(std::move(*built));
   return true;
 }
 
@@ -292,20 +361,23 @@ AstCache::Handle AstCache::Get(const std::string& file, const std::vector<std::s
     clang::CreateInvocationOptions options;
     options.Diags = clang::CompilerInstance::createDiagnostics(entry->diagOptions.get(), entry->printer.get(), false);
     entry->invocation = clang::createInvocation(argv, options);
+    entry->flagsKey = key.substr(file.size());
     if (entry->invocation) entry->invocation->getHeaderSearchOpts().ResourceDir = CROSSRT_CLANG_RESOURCE_DIR;
   }
   entry->printer->clear();
   entry->printer->errors = 0;
-  entry->failed = !entry->invocation || !entry->Parse(file, unsaved) || entry->printer->errors > 0;
+  entry->failed = !entry->invocation || !entry->Parse(file, unsaved, *m_layers) || entry->printer->errors > 0;
   entry->RecordWhatWasRead(unsaved);
   std::lock_guard<std::mutex> guard(m_mutex);
   ++(reparse ? m_reparses : m_parses);
+  if (entry->builtOverLayer) ++m_layeredPreambles;
+  entry->builtOverLayer = false;
   return handle;
 }
 
 AstCacheStats AstCache::Stats() const {
   std::lock_guard<std::mutex> guard(m_mutex);
-  return {m_entries.size(), m_capacity, m_parses, m_reparses, m_reuses};
+  return {m_entries.size(), m_capacity, m_parses, m_reparses, m_reuses, m_layers->Builds(), m_layeredPreambles};
 }
 
 }  // namespace crossrt::engine

@@ -30,6 +30,8 @@ class TextDiagnosticPrinter;
 
 namespace crossrt::engine {
 
+class SystemLayerCache;
+
 // One parsed source file: the compiler instance that holds its AST, and the accessors the
 // translator uses (named as clang::ASTUnit names them).
 class ParsedFile {
@@ -53,6 +55,8 @@ struct AstCacheStats {
   uint64_t parses = 0;     // from scratch
   uint64_t reparses = 0;   // reusing a cached AST and its preamble
   uint64_t reuses = 0;     // of those, an AST used as it was: nothing it read had changed
+  uint64_t layers = 0;             // system layers built (SystemLayer.h)
+  uint64_t layeredPreambles = 0;   // preambles built over one
 };
 
 class AstCache {
@@ -93,9 +97,10 @@ public:
 private:
   mutable std::mutex m_mutex;
   size_t m_capacity;
-  uint64_t m_parses = 0, m_reparses = 0, m_reuses = 0;
+  uint64_t m_parses = 0, m_reparses = 0, m_reuses = 0, m_layeredPreambles = 0;
   std::map<std::string, std::shared_ptr<Handle::Entry>> m_entries;
   std::list<std::string> m_lru;  // most recently used first
+  std::unique_ptr<SystemLayerCache> m_layers;  // the system headers' layers of preambles, shared
 };
 
 }  // namespace crossrt::engine

@@ -1,0 +1,158 @@
+// Builds and keeps the system headers' layers of preambles (SystemLayer.h says what one is): a PCH
+// of a header that includes the prefix, written into memory with Clang's PCH generator.
+#include "parse/SystemLayer.h"
+
+#include <clang/Basic/Diagnostic.h>
+#include <clang/Frontend/CompilerInstance.h>
+#include <clang/Frontend/CompilerInvocation.h>
+#include <clang/Frontend/FrontendActions.h>
+#include <clang/Lex/PPCallbacks.h>
+#include <clang/Lex/Preprocessor.h>
+#include <clang/Lex/PreprocessorOptions.h>
+#include <clang/Serialization/ASTWriter.h>
+#include <clang/Serialization/PCHContainerOperations.h>
+#include <llvm/Support/FileSystem.h>
+#include <llvm/Support/MemoryBuffer.h>
+#include <llvm/Support/VirtualFileSystem.h>
+
+#include <atomic>
+
+namespace crossrt::engine {
+
+namespace {
+
+// A PCH generated into a buffer rather than a file.
+class LayerAction : public clang::GeneratePCHAction {
+public:
+  explicit LayerAction(std::shared_ptr<clang::PCHBuffer> buffer) : m_buffer(std::move(buffer)) {}
+
+protected:
+  std::unique_ptr<clang::ASTConsumer> CreateASTConsumer(clang::CompilerInstance& compiler, llvm::StringRef) override {
+    std::string sysroot;
+    if (!ComputeASTConsumerArguments(compiler, sysroot)) return nullptr;
+    if (!compiler.getFrontendOpts().RelocatablePCH) sysroot.clear();
+    return std::make_unique<clang::PCHGenerator>(compiler.getPreprocessor(), compiler.getModuleCache(), "", sysroot,
+                                                 m_buffer, llvm::ArrayRef<std::shared_ptr<clang::ModuleFileExtension>>());
+  }
+
+private:
+  std::shared_ptr<clang::PCHBuffer> m_buffer;
+};
+
+// The headers the layer's build reads; a user's among them makes the layer unusable (the layer
+// skips every function body, and the user's edits to it would go unseen).
+class LayerHeaders : public clang::PPCallbacks {
+public:
+  LayerHeaders(std::set<std::string>& headers, bool& readUserFile) : m_headers(headers), m_readUserFile(readUserFile) {}
+  void InclusionDirective(clang::SourceLocation, const clang::Token&, llvm::StringRef, bool, clang::CharSourceRange,
+                          clang::OptionalFileEntryRef file, llvm::StringRef, llvm::StringRef, const clang::Module*, bool,
+                          clang::SrcMgr::CharacteristicKind kind) override {
+    if (!file) return;
+    m_headers.insert(file->getName().str());
+    if (!clang::SrcMgr::isSystem(kind)) m_readUserFile = true;
+  }
+
+private:
+  std::set<std::string>& m_headers;
+  bool& m_readUserFile;
+};
+
+}  // namespace
+
+std::shared_ptr<const SystemLayer> SystemLayer::Build(const clang::CompilerInvocation& base, const SystemPrefix& prefix) {
+  static std::atomic<uint64_t> serial{0};
+  const std::string folder = "/__crossrt_system_layer__/" + std::to_string(++serial);
+  const std::string header = folder + "/prefix.h";
+  std::string text = "// The system headers that the preamble over this layer starts with.\n";
+  for (const std::string& name : prefix.includes) text += "#include <" + name + ">\n";
+  auto memory = llvm::makeIntrusiveRefCnt<llvm::vfs::InMemoryFileSystem>();
+  memory->addFile(header, 0, llvm::MemoryBuffer::getMemBufferCopy(text, header));
+  auto files = llvm::makeIntrusiveRefCnt<llvm::vfs::OverlayFileSystem>(llvm::vfs::getRealFileSystem());
+  files->pushOverlay(memory);
+
+  auto invocation = std::make_shared<clang::CompilerInvocation>(base);
+  clang::FrontendOptions& frontend = invocation->getFrontendOpts();
+  const clang::InputKind kind = frontend.Inputs.empty() ? clang::InputKind(clang::Language::CXX) : frontend.Inputs[0].getKind();
+  frontend.Inputs = {clang::FrontendInputFile(header, kind)};
+  frontend.ProgramAction = clang::frontend::GeneratePCH;
+  frontend.SkipFunctionBodies = true;
+  frontend.OutputFile.clear();
+  invocation->getPreprocessorOpts().ImplicitPCHInclude.clear();
+  invocation->getPreprocessorOpts().clearRemappedFiles();
+
+  clang::CompilerInstance compiler(std::make_shared<clang::PCHContainerOperations>());
+  compiler.setInvocation(invocation);
+  clang::IgnoringDiagConsumer ignore;
+  compiler.createDiagnostics(&ignore, /*ShouldOwnClient=*/false);
+  compiler.createFileManager(files);
+  if (!compiler.createTarget()) return nullptr;
+  auto pch = std::make_shared<clang::PCHBuffer>();
+  LayerAction action(pch);
+  if (!action.BeginSourceFile(compiler, frontend.Inputs[0])) return nullptr;
+  auto layer = std::shared_ptr<SystemLayer>(new SystemLayer());
+  bool readUserFile = false;
+  compiler.getPreprocessor().addPPCallbacks(std::make_unique<LayerHeaders>(layer->m_headers, readUserFile));
+  llvm::Error error = action.Execute();
+  action.EndSourceFile();
+  if (error) {
+    llvm::consumeError(std::move(error));
+    return nullptr;
+  }
+  if (compiler.getDiagnostics().hasErrorOccurred() || !pch->IsComplete || readUserFile) return nullptr;
+
+  layer->m_prefix = prefix;
+  layer->m_pchPath = folder + "/prefix.pch";
+  memory->addFile(layer->m_pchPath, 0,
+                  llvm::MemoryBuffer::getMemBufferCopy(llvm::StringRef(pch->Data.data(), pch->Data.size()), layer->m_pchPath));
+  layer->m_files = files;
+  for (const std::string& name : layer->m_headers) {
+    llvm::sys::fs::file_status status;
+    if (llvm::sys::fs::status(name, status)) return nullptr;  // cannot tell when it changes
+    layer->m_headerStatus.push_back({name, {status.getSize(), status.getLastModificationTime()}});
+  }
+  return layer;
+}
+
+llvm::IntrusiveRefCntPtr<llvm::vfs::FileSystem> SystemLayer::FileSystem() const { return m_files; }
+
+bool SystemLayer::Stale() const {
+  for (auto& [name, seen] : m_headerStatus) {
+    llvm::sys::fs::file_status status;
+    if (llvm::sys::fs::status(name, status) || status.getSize() != seen.first || status.getLastModificationTime() != seen.second)
+      return true;
+  }
+  return false;
+}
+
+std::shared_ptr<const SystemLayer> SystemLayerCache::Get(const std::string& flagsKey, const clang::CompilerInvocation& base,
+                                                         const SystemPrefix& prefix) {
+  std::string key = flagsKey;
+  for (const std::string& name : prefix.includes) key += '\x1e' + name;
+  std::lock_guard<std::mutex> guard(m_mutex);  // one build at a time: a second asker waits for the first's layer
+  for (auto it = m_layers.begin(); it != m_layers.end(); ++it) {
+    if (it->first != key) continue;
+    if (it->second->Stale()) {
+      m_layers.erase(it);
+      break;
+    }
+    m_layers.splice(m_layers.begin(), m_layers, it);
+    return m_layers.front().second;
+  }
+  if (m_refused.count(key)) return nullptr;
+  std::shared_ptr<const SystemLayer> layer = SystemLayer::Build(base, prefix);
+  ++m_builds;
+  if (!layer) {
+    m_refused.insert(key);  // not tried again: such a source keeps the one-layer preamble
+    return nullptr;
+  }
+  m_layers.emplace_front(key, layer);
+  if (m_layers.size() > m_capacity) m_layers.pop_back();
+  return layer;
+}
+
+uint64_t SystemLayerCache::Builds() const {
+  std::lock_guard<std::mutex> guard(m_mutex);
+  return m_builds;
+}
+
+}  // namespace crossrt::engine
