@@ -6,7 +6,7 @@ undone, on examples/bloom translated for Vulkan, the CPU and ISPC (three transla
 ratios to a cold translation (a new crossrt process translating Bloom for Vulkan in-process, as
 bench_daemon.sh's "cold"). Scenarios:
   kernel body: a heap allocation typed into a kernel (an error on Vulkan and ISPC), then removed;
-  header:      the size annotation of Run's pointer deleted from Bloom.h (the preamble is rebuilt),
+  header:      the size annotation of Run's pointer deleted from Bloom.h (the preamble's user part is rebuilt),
                then restored.
 Latency runs from the moment the change is sent to the moment the diagnostics arrive, the server's
 debounce (50 ms) included. Writes a CSV of every round and plots it.

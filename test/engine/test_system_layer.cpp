@@ -93,6 +93,16 @@ TEST_CASE("A header edit rebuilds the preamble over a kept layer of the system h
   REQUIRE(cache.Stats().layeredPreambles == 1);
   CHECK(std::any_of(r.inputs.begin(), r.inputs.end(), [](const std::string& f) { return f.find("/bits/stl_vector.h") != std::string::npos; }));
 
+  SECTION("a long-lived cache prepares the layer in the background after the first parse; the edit uses it")
+  {
+    layered.Write(header);
+    AstCache prepared(32, /*prepareLayers=*/true);
+    REQUIRE(Translate(layered.Request(), &prepared).ok);
+    std::ofstream(layered.tc.dir / "user.h", std::ios::app) << "// edited\n";
+    RequireSameAsCold(layered.Request(), prepared);
+    CHECK(prepared.Stats().layers == 1);  // built once, whichever asked first
+    CHECK(prepared.Stats().layeredPreambles == 1);
+  }
   SECTION("an include guard opens the prefix as #pragma once does")
   {
     stats = EditAndCompare(layered, "#ifndef USER_H\n#define USER_H\n#include <real.h>\n#include <vector>\ntypedef real_t value_t;\n"

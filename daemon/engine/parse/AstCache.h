@@ -61,7 +61,10 @@ struct AstCacheStats {
 
 class AstCache {
 public:
-  explicit AstCache(size_t capacity = 32);
+  // `prepareLayers`: a cache that lives for many translations (the daemon's, the language server's)
+  // builds a source's system layer in the background after its first parse, so that even the first
+  // header edit finds it ready (SystemLayer.h).
+  explicit AstCache(size_t capacity = 32, bool prepareLayers = false);
   ~AstCache();
   AstCache(const AstCache&) = delete;
   AstCache& operator=(const AstCache&) = delete;
@@ -97,6 +100,7 @@ public:
 private:
   mutable std::mutex m_mutex;
   size_t m_capacity;
+  bool m_prepareLayers;
   uint64_t m_parses = 0, m_reparses = 0, m_reuses = 0, m_layeredPreambles = 0;
   std::map<std::string, std::shared_ptr<Handle::Entry>> m_entries;
   std::list<std::string> m_lru;  // most recently used first

@@ -124,20 +124,35 @@ bool SystemLayer::Stale() const {
   return false;
 }
 
-std::shared_ptr<const SystemLayer> SystemLayerCache::Get(const std::string& flagsKey, const clang::CompilerInvocation& base,
-                                                         const SystemPrefix& prefix) {
+SystemLayerCache::~SystemLayerCache() {
+  std::lock_guard<std::mutex> guard(m_backgroundMutex);
+  for (std::thread& build : m_background) build.join();
+}
+
+std::string SystemLayerCache::Key(const std::string& flagsKey, const SystemPrefix& prefix) {
   std::string key = flagsKey;
   for (const std::string& name : prefix.includes) key += '\x1e' + name;
-  std::lock_guard<std::mutex> guard(m_mutex);  // one build at a time: a second asker waits for the first's layer
+  return key;
+}
+
+std::shared_ptr<const SystemLayer> SystemLayerCache::Cached(const std::string& key) {
   for (auto it = m_layers.begin(); it != m_layers.end(); ++it) {
     if (it->first != key) continue;
     if (it->second->Stale()) {
       m_layers.erase(it);
-      break;
+      return nullptr;
     }
     m_layers.splice(m_layers.begin(), m_layers, it);
     return m_layers.front().second;
   }
+  return nullptr;
+}
+
+std::shared_ptr<const SystemLayer> SystemLayerCache::Get(const std::string& flagsKey, const clang::CompilerInvocation& base,
+                                                         const SystemPrefix& prefix) {
+  const std::string key = Key(flagsKey, prefix);
+  std::lock_guard<std::mutex> guard(m_mutex);  // one build at a time: a second asker waits for the first's layer
+  if (auto layer = Cached(key)) return layer;
   if (m_refused.count(key)) return nullptr;
   std::shared_ptr<const SystemLayer> layer = SystemLayer::Build(base, prefix);
   ++m_builds;
@@ -148,6 +163,18 @@ std::shared_ptr<const SystemLayer> SystemLayerCache::Get(const std::string& flag
   m_layers.emplace_front(key, layer);
   if (m_layers.size() > m_capacity) m_layers.pop_back();
   return layer;
+}
+
+void SystemLayerCache::Prepare(const std::string& flagsKey, std::shared_ptr<const clang::CompilerInvocation> base,
+                               const SystemPrefix& prefix) {
+  {
+    std::unique_lock<std::mutex> lock(m_mutex, std::try_to_lock);
+    if (!lock.owns_lock()) return;  // a build is under way
+    const std::string key = Key(flagsKey, prefix);
+    if (m_refused.count(key) || Cached(key)) return;
+  }
+  std::lock_guard<std::mutex> guard(m_backgroundMutex);
+  m_background.emplace_back([this, flagsKey, base = std::move(base), prefix] { Get(flagsKey, *base, prefix); });
 }
 
 uint64_t SystemLayerCache::Builds() const {

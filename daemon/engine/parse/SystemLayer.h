@@ -18,6 +18,7 @@
 #include <mutex>
 #include <set>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -55,13 +56,23 @@ private:
 class SystemLayerCache {
 public:
   explicit SystemLayerCache(size_t capacity = 4) : m_capacity(capacity) {}
+  ~SystemLayerCache();  // waits for the layers being built in the background
   // The layer for these flags (`flagsKey` names them) and this prefix: the cached one unless a
   // header it read changed, else a new one. Null when it cannot be built (and not tried again).
   std::shared_ptr<const SystemLayer> Get(const std::string& flagsKey, const clang::CompilerInvocation& base,
                                          const SystemPrefix& prefix);
+  // Starts building that layer on a thread of its own, unless it is cached, refused or a build is
+  // under way; never waits. A Get for it meanwhile waits for that build.
+  void Prepare(const std::string& flagsKey, std::shared_ptr<const clang::CompilerInvocation> base,
+               const SystemPrefix& prefix);
   uint64_t Builds() const;
 
 private:
+  static std::string Key(const std::string& flagsKey, const SystemPrefix& prefix);
+  std::shared_ptr<const SystemLayer> Cached(const std::string& key);  // with m_mutex held
+
+  std::mutex m_backgroundMutex;
+  std::vector<std::thread> m_background;
   mutable std::mutex m_mutex;
   size_t m_capacity;
   uint64_t m_builds = 0;
