@@ -331,10 +331,10 @@ void Tracer::kernel_Depth(uint32_t tid, const CRT_Hit* hit, float* depth) { dept
   CHECK(mega.find(Squeezed("void kernel_Hit(uint tid, inout CRT_Hit hit)")) != std::string::npos);
   CHECK(mega.find(Squeezed("void kernel_Depth(uint tid, CRT_Hit hit)")) != std::string::npos);
   CHECK(mega.find(Squeezed("  CRT_Hit hit;\n  kernel_Hit(i, hit);\n  kernel_Depth(i, hit);\n")) != std::string::npos);
-  CHECK(mega.find(Squeezed("readonly buffer raysBuffer")) != std::string::npos);
+  CHECK(mega.find(Squeezed("readonly buffer crt_raysBuffer")) != std::string::npos);
   // Wavefront: kernel_Hit keeps the hit of each thread in a buffer; only it may use the hardware.
   const std::string hit = Squeezed(result.files.at("shaders/kernel_Hit.comp"));
-  CHECK(hit.find(Squeezed("buffer hitPerThreadBuffer { CRT_Hit hitPerThread[]; }")) != std::string::npos);
+  CHECK(hit.find(Squeezed("buffer crt_hitPerThreadBuffer { CRT_Hit hitPerThread[]; }")) != std::string::npos);
   CHECK(hit.find(Squeezed("hitPerThread[threadIndex] = hit;")) != std::string::npos);
   CHECK(result.files.count("shaders/kernel_Hit_RayQuery.comp") == 1);
   const std::string host = Squeezed(result.files.at("Tracer_Vulkan.cpp"));
@@ -853,7 +853,7 @@ TEST_CASE("Level 3 in the paper's form: a traversal passing CRT_LeafInfo and its
     CHECK(rint.find(Squeezed("crt_info.geomId = crt_element;")) != std::string::npos);
     CHECK(rint.find(Squeezed("Slab_Intersect(self, vec4(gl_ObjectRayOriginEXT, gl_RayTminEXT), vec4(gl_ObjectRayDirectionEXT, gl_RayTmaxEXT), crt_info, hit);")) !=
           std::string::npos);
-    const size_t inComp = comp.find(Squeezed("buffer m_world_m_depthsBuffer")), inRint = rint.find(Squeezed("buffer m_world_m_depthsBuffer"));
+    const size_t inComp = comp.find(Squeezed("buffer crt_m_world_m_depthsBuffer")), inRint = rint.find(Squeezed("buffer crt_m_world_m_depthsBuffer"));
     REQUIRE(inComp != std::string::npos);
     REQUIRE(inRint != std::string::npos);
     const auto bindingBefore = [](const std::string& text, size_t at) {  // "binding=N)"
@@ -915,7 +915,7 @@ void Names::kernel1D_Run(int n, const Tap* taps, uint32_t* image)
   INFO(r.diagnostics);
   REQUIRE(r.ok);
   const std::string glsl = Squeezed(r.files.at("shaders/kernel1D_Run.comp"));
-  CHECK(glsl.find(Squeezed("buffer imageBuffer_")) != std::string::npos);  // imageBuffer is a GLSL type
+  CHECK(glsl.find(Squeezed("buffer crt_imageBuffer")) != std::string::npos);  // not GLSL's imageBuffer type: prefixed
   CHECK(glsl.find(Squeezed("float sample_;")) != std::string::npos);
   CHECK(glsl.find(Squeezed("const float length_ = taps[i].sample_ + length(vec2(taps[i].step_, 1.0));")) != std::string::npos);
   CHECK(glsl.find(Squeezed("image[i] = uint(length_);")) != std::string::npos);

@@ -60,8 +60,8 @@ void FinishModel(ClassModel& model) {
       fields.push_back({m.name, m.cppType, m.glslType, m.std430Align, m.hostExpr, ""});
   for (auto& m : model.members) {
     if (!m.usedByKernels || m.kind != MemberKind::Vector) continue;
-    fields.push_back({m.name + "_size", "uint32_t", "uint", 4, "", ""});
-    fields.push_back({m.name + "_capacity", "uint32_t", "uint", 4, "", ""});
+    fields.push_back({generated::SizeField(m.name), "uint32_t", "uint", 4, "", ""});
+    fields.push_back({generated::CapacityField(m.name), "uint32_t", "uint", 4, "", ""});
   }
   for (auto& m : model.members) {
     if (!m.usedByKernels || m.kind != MemberKind::Image) continue;
@@ -69,11 +69,11 @@ void FinishModel(ClassModel& model) {
     fields.push_back({m.name + "_height", "uint32_t", "uint", 4, "", m.hostExpr + ".height()"});
   }
   for (auto& m : model.members)
-    if (m.usedByKernels && m.kind == MemberKind::TextureArray) fields.push_back({m.name + "_size", "uint32_t", "uint", 4, "", "uint32_t(" + m.hostExpr + ".size())"});
+    if (m.usedByKernels && m.kind == MemberKind::TextureArray) fields.push_back({generated::SizeField(m.name), "uint32_t", "uint", 4, "", "uint32_t(" + m.hostExpr + ".size())"});
   // Virtual functions: where each vector's tags and each implementation's objects are on the device.
   for (auto& v : model.virtuals) {
     fields.push_back({v.member + "_tags", "uint64_t", "uvec2", 8, "", generated::kVirtualObjects + "." + v.member + "_tags.Address()"});
-    fields.push_back({v.member + "_size", "uint32_t", "uint", 4, "", "uint32_t(" + v.hostExpr + ".size())"});
+    fields.push_back({generated::SizeField(v.member), "uint32_t", "uint", 4, "", "uint32_t(" + v.hostExpr + ".size())"});
     if (model.virtualLevel == 1) fields.push_back({v.member + "_objects", "uint64_t", "uvec2", 8, "", generated::kVirtualObjects + "." + v.member + "_objects.Address()"});
     for (auto& impl : v.impls)
       if (model.virtualLevel >= 2)

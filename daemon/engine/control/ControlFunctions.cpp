@@ -431,7 +431,7 @@ void ControlRewriter::RecordClear(const Stmt* s) {
   if (!f || !m_c.appended.count(f->getNameAsString())) return;
   SourceLocation end = Lexer::findLocationAfterToken(s->getEndLoc(), tok::semi, m_c.ctx.getSourceManager(), m_c.ctx.getLangOpts(), false);
   if (end.isInvalid()) return;
-  const std::string size = f->getNameAsString() + "_size";
+  const std::string size = generated::SizeField(f->getNameAsString());
   m_gpu.InsertTextBefore(s->getBeginLoc(), "{ ");
   m_gpu.InsertTextAfter(end, " const uint32_t crt_empty = 0; crt_UpdateMemberCmd(crt_cmd, offsetof(ClassData, " + size +
                                  "), &crt_empty, sizeof(crt_empty)); }");

@@ -216,7 +216,7 @@ bool ControlRewriter::TryLibraryCall(const CallExpr* call) {
       const std::string v = first->vector->name;
       m_c.model.usesSorter = true;
       replacement = generated::kSorter + ".RecordCmd(crt_cmd, " + first->view + ", uint32_t(" + generated::kVectorCopies + "." + v + "Capacity), " + key +
-                    ", crt_classDataBuffer.View(), offsetof(ClassData, " + v + "_size))";
+                    ", crt_classDataBuffer.View(), offsetof(ClassData, " + generated::SizeField(v) + "))";
     }
     // The CPU backend sorts on all cores too, with the same radix sort.
     m_cpu.ReplaceText(call->getSourceRange(), "crossrt::RadixSort(" + m_c.Text(call->getArg(0)->getSourceRange()) + ", " +

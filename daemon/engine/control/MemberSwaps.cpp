@@ -45,8 +45,8 @@ bool ControlRewriter::TrySwap(const CallExpr* call) {
   }
   const std::string buffers = generated::kVectorCopies + ".";
   m_gpu.InsertTextAfter(end, " std::swap(" + buffers + ma->name + ", " + buffers + mb->name + "); std::swap(" + buffers + ma->name + "Size, " + buffers +
-                                 mb->name + "Size); crt_UpdateVectorSizeCmd(crt_cmd, offsetof(ClassData, " + ma->name + "_size), " + ma->hostExpr +
-                                 "); crt_UpdateVectorSizeCmd(crt_cmd, offsetof(ClassData, " + mb->name + "_size), " + mb->hostExpr + ");");
+                                 mb->name + "Size); crt_UpdateVectorSizeCmd(crt_cmd, offsetof(ClassData, " + generated::SizeField(ma->name) + "), " + ma->hostExpr +
+                                 "); crt_UpdateVectorSizeCmd(crt_cmd, offsetof(ClassData, " + generated::SizeField(mb->name) + "), " + mb->hostExpr + ");");
   m_ctrl.swapsVectors = true;
   return true;
 }

@@ -20,4 +20,11 @@ inline const std::string kPipelines = "crt_pipelines";        // one per shader
 inline const std::string kClassData = "crt_classDataBuffer";  // the class data block
 inline const std::string kPipelineClasses = "crt_pipelineClasses";  // the classes the pipelines switch over
 
+// Names derived from the user's names carry the reserved prefix too, so that none can equal a user's
+// name (analyse/ReservedNames.cpp refuses user names under it): a member vector's size and capacity
+// in the class data (GLSL, ISPC and C++), and the GLSL blocks that hold a buffer.
+inline std::string SizeField(const std::string& vector) { return "crt_" + vector + "_size"; }
+inline std::string CapacityField(const std::string& vector) { return "crt_" + vector + "_capacity"; }
+inline std::string BlockName(const std::string& variable) { return "crt_" + variable + "Buffer"; }
+
 }  // namespace crossrt::engine::generated

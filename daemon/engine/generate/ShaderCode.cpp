@@ -2,6 +2,7 @@
 // generation), reduction passes and stage shaders, rendered from templates/glsl. Takes the model;
 // gives one ShaderSource per shader.
 #include "generate/CodeGenSupport.h"
+#include "generate/GeneratedNames.h"
 #include "generate/CodeGen.h"
 #include "print/KernelPrinter.h"
 
@@ -181,7 +182,7 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
     b.set("access", p.isConstPointee ? "readonly " : coherent);
     // A per-thread value: main() loads this thread's element, passes it, and stores it back.
     const std::string name = p.threadState ? p.glslName + "PerThread" : p.glslName;
-    b.set("blockName", KernelPrinter::SafeName(name + "Buffer"));  // `image`'s is not GLSL's imageBuffer
+    b.set("blockName", generated::BlockName(name));
     b.set("type", p.glslType);
     b.set("name", name);
     b.set("comment", p.threadState ? "parameter '" + p.name + "': one value per thread, kept between the kernels of a thread loop"
@@ -195,7 +196,7 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
     scalarAny |= m && m->scalarLayout;
     b.set("binding", std::to_string(binding++));
     b.set("access", coherent);
-    b.set("blockName", KernelPrinter::SafeName(v + "Buffer"));
+    b.set("blockName", generated::BlockName(v));
     b.set("type", m ? m->glslType : "float");
     b.set("name", v);
     b.set("comment", m && !m->composedFrom.empty() ? "composed: std::vector " + m->composedFrom : "member std::vector " + v);
@@ -207,7 +208,7 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
     b.set("layout", "std430");
     b.set("binding", std::to_string(binding++));
     b.set("access", r.local ? "" : "writeonly ");  // a local's total is read back after the nest
-    b.set("blockName", r.member + "PartialsBlock");
+    b.set("blockName", generated::BlockName(r.member + "Partials"));
     b.set("type", r.glslType);
     b.set("name", r.member + "Partials");
     b.set("comment", "per-workgroup partial results of the reduction of " + std::string(r.local ? "local " : "") + r.member);
@@ -393,7 +394,7 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   d.set("activeTest", active);
   // A kernel dispatched indirectly runs to the count the GPU holds (capped at the vector's capacity).
   const std::string& v = k.indirectVector;
-  d.set("countLimit", v.empty() ? std::string("crt_countX") : "min(" + v + "_size, " + v + "_capacity)");
+  d.set("countLimit", v.empty() ? std::string("crt_countX") : "min(" + generated::SizeField(v) + ", " + generated::CapacityField(v) + ")");
   d.set("indirect", !v.empty());
   d.set("indirectVector", v);
   return Render(opt.templateDir + "/glsl/kernel.comp.mustache", d);
@@ -418,7 +419,7 @@ std::string StageGlsl(const ClassModel& model, const StageShader& c, const Gener
     b.set("layout", m && m->scalarLayout ? "scalar" : "std430");
     scalar |= m && m->scalarLayout;
     b.set("binding", std::to_string(1 + pointers + (at - k->memberVectors.begin())));
-    b.set("blockName", KernelPrinter::SafeName(v + "Buffer"));
+    b.set("blockName", generated::BlockName(v));
     b.set("type", m ? m->glslType : "float");
     b.set("name", v);
     b.set("comment", m && !m->composedFrom.empty() ? "composed: std::vector " + m->composedFrom : "member std::vector " + v);

@@ -3,6 +3,7 @@
 // call (I/O, the heap). Part of KernelPrinter (KernelPrinter.h); each language's
 // library calls are its printer's (glsl/GlslCalls.cpp, ispc/IspcCalls.cpp).
 #include "print/KernelPrinter.h"
+#include "generate/GeneratedNames.h"
 #include "analyse/AstQueries.h"
 #include "print/PrinterParts.h"
 
@@ -235,7 +236,7 @@ std::string KernelPrinter::Call(const CallExpr* call) {
     if (auto* me = dyn_cast<MemberExpr>(obj); me && IsStdVector(me->getType())) {
       auto* field = dyn_cast<FieldDecl>(me->getMemberDecl());
       if (field && isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts()) && IsTextureArray(field->getType())) {
-        if (name == "size" && UsableTextures(field, call->getBeginLoc())) return MemberAccess(field->getNameAsString() + "_size");
+        if (name == "size" && UsableTextures(field, call->getBeginLoc())) return MemberAccess(generated::SizeField(field->getNameAsString()));
         return Fail(call->getBeginLoc(), "std::vector::" + name + " of an array of textures in a kernel",
                     "kernels read its size() and use its textures: " + field->getNameAsString() + "[i].sample(uv)");
       }
@@ -243,23 +244,23 @@ std::string KernelPrinter::Call(const CallExpr* call) {
       if (field && isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts()) && name == "size" && IsStdVector(field->getType(), &element) &&
           PolymorphicPointee(element)) {
         m_uses.objectSizeReads.emplace(field, call->getBeginLoc());
-        return MemberAccess(field->getNameAsString() + "_size");
+        return MemberAccess(generated::SizeField(field->getNameAsString()));
       }
       if (field && isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts())) {
         m_uses.memberVectors.insert(field);
         if (name == "size" || name == "empty") {
           m_uses.sizeReads.emplace(field, call->getBeginLoc());
-          const std::string size = MemberAccess(field->getNameAsString() + "_size");
+          const std::string size = MemberAccess(generated::SizeField(field->getNameAsString()));
           return name == "size" ? size : EmptyTest(size);
         }
-        if (name == "capacity") return MemberAccess(field->getNameAsString() + "_capacity");
+        if (name == "capacity") return MemberAccess(generated::CapacityField(field->getNameAsString()));
         if (std::string handled = VectorMethod(field, mc, name); !handled.empty()) return handled;
         // Emptied by the one thread before a loop nest: the appends that follow count from 0.
         const bool empties = name == "clear" || (name == "resize" && call->getNumArgs() == 1 && call->getArg(0)->isIntegerConstantExpr(m_ctx) &&
                                                   call->getArg(0)->EvaluateKnownConstInt(m_ctx) == 0);
         if (empties && singleThread && composedPrefix.empty()) {
           m_uses.emptiedVectors.insert(field);
-          return field->getNameAsString() + "_size = 0u";
+          return generated::SizeField(field->getNameAsString()) + " = 0u";
         }
         if (name == "push_back" && call->getNumArgs() == 1 && composedPrefix.empty())
           return EmitAppend(field, call) + "(" + Expr(call->getArg(0)) + ")";

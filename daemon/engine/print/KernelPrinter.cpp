@@ -3,6 +3,7 @@
 // lambdas and the owner of composed objects have files of their own; types and layouts are
 // GlslTypes.cpp's.
 #include "print/KernelPrinter.h"
+#include "generate/GeneratedNames.h"
 #include "print/PrinterParts.h"
 
 #include <clang/AST/ParentMapContext.h>
@@ -776,7 +777,7 @@ std::string KernelPrinter::RangeFor(const CXXForRangeStmt* rf, int indent) {
   else {
     m_uses.memberVectors.insert(field);
     m_uses.sizeReads.emplace(field, rf->getColonLoc());
-    n = SizeAsInt(MemberAccess(field->getNameAsString() + "_size"));
+    n = SizeAsInt(MemberAccess(generated::SizeField(field->getNameAsString())));
   }
   const std::string element = pad + "  " + (t.getNonReferenceType().isConstQualified() ? "const " : "") + Declare(t, var->getNameAsString(), var->getLocation()) +
                               " = " + Expr(range) + "[" + k + "];\n";

@@ -102,6 +102,11 @@ public:
   std::map<std::string, std::string> compositions;
   // In an implementation's printer: the prefix its members and functions get ("m_pAccelStruct_").
   std::string composedPrefix;
+  // A member's name with that prefix; a generated name keeps the reserved prefix first
+  // (crt_m_nodes_size -> crt_m_pAccelStruct_m_nodes_size, as the class data names it).
+  std::string ComposedName(const std::string& name) const {
+    return name.rfind("crt_", 0) == 0 ? "crt_" + composedPrefix + name.substr(4) : composedPrefix + name;
+  }
   // Prints the implementation of an interface method, called from kernels as <prefix><name>.
   std::string EmitComposedMethod(const clang::CXXMethodDecl* method);
 

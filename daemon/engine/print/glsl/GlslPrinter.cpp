@@ -2,6 +2,7 @@
 // functions' parameters, members of the class data, vectors and operators (GlslPrinter.h).
 #include "print/glsl/GlslPrinter.h"
 #include "analyse/AstQueries.h"
+#include "generate/GeneratedNames.h"
 #include "print/GlslTypes.h"
 #include "print/PrinterParts.h"
 
@@ -110,8 +111,8 @@ std::string GlslPrinter::AppendFunction(const FieldDecl* field, const CallExpr* 
   os << "// " << vector << ".push_back(value), from any number of threads at once\n"
      << "void " << name << "(" << Declare(element, "value", call->getBeginLoc()) << ")\n"
      << "{\n"
-     << "  const uint slot = atomicAdd(" << vector << "_size, 1u);\n"
-     << "  if (slot < " << vector << "_capacity)\n"
+     << "  const uint slot = atomicAdd(" << generated::SizeField(vector) << ", 1u);\n"
+     << "  if (slot < " << generated::CapacityField(vector) << ")\n"
      << "    " << vector << "[slot] = value;\n"
      << "}\n";
   m_functions.push_back(os.str());
@@ -138,7 +139,7 @@ std::string GlslPrinter::ObjectIndex(const clang::Expr* index) { return "uint(" 
 
 std::string GlslPrinter::ObjectLocalIndex(const std::string& index) const { return "uint(" + index + ")"; }
 
-std::string GlslPrinter::MemberAccess(const std::string& name) const { return composedPrefix + name; }
+std::string GlslPrinter::MemberAccess(const std::string& name) const { return ComposedName(name); }
 
 std::string GlslPrinter::SizeAsInt(const std::string& size) const { return "int(" + size + ")"; }
 

@@ -70,7 +70,7 @@ protected:
 
 private:
   // A member of the class data through the data pointer ("self->m_x").
-  std::string Member(const std::string& name) const { return dataPointer + "->" + composedPrefix + name; }
+  std::string Member(const std::string& name) const { return dataPointer + "->" + ComposedName(name); }
   // Whether every lane of a gang shares e's value (IspcUniform.cpp), "uniform " for a cast of it,
   // and loop variables the gang runs together.
   bool Uniform(const clang::Expr* e) const;

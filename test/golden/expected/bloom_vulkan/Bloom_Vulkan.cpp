@@ -65,12 +65,12 @@ void Bloom_Vulkan::crt_UpdatePlainMembers()
   std::memcpy(&data.m_threshold, &m_threshold, sizeof(data.m_threshold));
   std::memcpy(&data.m_strength, &m_strength, sizeof(data.m_strength));
   std::memcpy(&data.m_radius, &m_radius, sizeof(data.m_radius));
-  data.m_weights_size = uint32_t(m_weights.size());
-  data.m_weights_capacity = uint32_t(m_weights.capacity());
-  data.m_bright_size = uint32_t(m_bright.size());
-  data.m_bright_capacity = uint32_t(m_bright.capacity());
-  data.m_blurred_size = uint32_t(m_blurred.size());
-  data.m_blurred_capacity = uint32_t(m_blurred.capacity());
+  data.crt_m_weights_size = uint32_t(m_weights.size());
+  data.crt_m_weights_capacity = uint32_t(m_weights.capacity());
+  data.crt_m_bright_size = uint32_t(m_bright.size());
+  data.crt_m_bright_capacity = uint32_t(m_bright.capacity());
+  data.crt_m_blurred_size = uint32_t(m_blurred.size());
+  data.crt_m_blurred_capacity = uint32_t(m_blurred.capacity());
   crt_classDataBuffer.Upload(&data, sizeof(data));
 }
 

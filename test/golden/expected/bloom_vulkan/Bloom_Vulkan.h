@@ -85,12 +85,12 @@ protected:
     alignas(4) float m_threshold;
     alignas(4) float m_strength;
     alignas(4) int m_radius;
-    alignas(4) uint32_t m_weights_size;
-    alignas(4) uint32_t m_weights_capacity;
-    alignas(4) uint32_t m_bright_size;
-    alignas(4) uint32_t m_bright_capacity;
-    alignas(4) uint32_t m_blurred_size;
-    alignas(4) uint32_t m_blurred_capacity;
+    alignas(4) uint32_t crt_m_weights_size;
+    alignas(4) uint32_t crt_m_weights_capacity;
+    alignas(4) uint32_t crt_m_bright_size;
+    alignas(4) uint32_t crt_m_bright_capacity;
+    alignas(4) uint32_t crt_m_blurred_size;
+    alignas(4) uint32_t crt_m_blurred_capacity;
   };
 
   std::shared_ptr<crossrt::VulkanContext> crt_ctx;

@@ -127,7 +127,7 @@ void CallableShading_Vulkan::crt_UpdatePlainMembers()
   data.m_materials_Phong = crt_virtual.m_materials_Phong.Address();
   data.m_materials_Checker = crt_virtual.m_materials_Checker.Address();
   std::memcpy(&data.m_distanceStep, &m_distanceStep, sizeof(data.m_distanceStep));
-  data.m_materials_size = uint32_t(m_materials.size());
+  data.crt_m_materials_size = uint32_t(m_materials.size());
   crt_classDataBuffer.Upload(&data, sizeof(data));
 }
 

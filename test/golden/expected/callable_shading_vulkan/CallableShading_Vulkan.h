@@ -83,7 +83,7 @@ protected:
     alignas(8) uint64_t m_materials_Phong;
     alignas(8) uint64_t m_materials_Checker;
     alignas(4) float m_distanceStep;
-    alignas(4) uint32_t m_materials_size;
+    alignas(4) uint32_t crt_m_materials_size;
   };
 
   std::shared_ptr<crossrt::VulkanContext> crt_ctx;

@@ -186,12 +186,12 @@ void ShapeTracer_Vulkan::crt_UpdatePlainMembers()
   data.m_scene_m_lights_Sphere = crt_virtual.m_scene_m_lights_Sphere.Address();
   data.m_scene_m_lights_Box = crt_virtual.m_scene_m_lights_Box.Address();
   data.m_scene_m_lights_Disc = crt_virtual.m_scene_m_lights_Disc.Address();
-  data.m_scene_m_shapes_size = uint32_t(crt_m_scene()->m_shapes.size());
-  data.m_scene_m_lights_size = uint32_t(crt_m_scene()->m_lights.size());
-  data.m_scene_m_boxes_size = uint32_t(crt_m_scene()->m_boxes.size());
-  data.m_scene_m_boxes_capacity = uint32_t(crt_m_scene()->m_boxes.capacity());
-  data.m_scene_m_lightBoxes_size = uint32_t(crt_m_scene()->m_lightBoxes.size());
-  data.m_scene_m_lightBoxes_capacity = uint32_t(crt_m_scene()->m_lightBoxes.capacity());
+  data.crt_m_scene_m_shapes_size = uint32_t(crt_m_scene()->m_shapes.size());
+  data.crt_m_scene_m_lights_size = uint32_t(crt_m_scene()->m_lights.size());
+  data.crt_m_scene_m_boxes_size = uint32_t(crt_m_scene()->m_boxes.size());
+  data.crt_m_scene_m_boxes_capacity = uint32_t(crt_m_scene()->m_boxes.capacity());
+  data.crt_m_scene_m_lightBoxes_size = uint32_t(crt_m_scene()->m_lightBoxes.size());
+  data.crt_m_scene_m_lightBoxes_capacity = uint32_t(crt_m_scene()->m_lightBoxes.capacity());
   crt_classDataBuffer.Upload(&data, sizeof(data));
 }
 

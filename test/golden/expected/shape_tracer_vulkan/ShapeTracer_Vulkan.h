@@ -83,12 +83,12 @@ protected:
     alignas(8) uint64_t m_scene_m_lights_Sphere;
     alignas(8) uint64_t m_scene_m_lights_Box;
     alignas(8) uint64_t m_scene_m_lights_Disc;
-    alignas(4) uint32_t m_scene_m_boxes_size;
-    alignas(4) uint32_t m_scene_m_boxes_capacity;
-    alignas(4) uint32_t m_scene_m_lightBoxes_size;
-    alignas(4) uint32_t m_scene_m_lightBoxes_capacity;
-    alignas(4) uint32_t m_scene_m_shapes_size;
-    alignas(4) uint32_t m_scene_m_lights_size;
+    alignas(4) uint32_t crt_m_scene_m_boxes_size;
+    alignas(4) uint32_t crt_m_scene_m_boxes_capacity;
+    alignas(4) uint32_t crt_m_scene_m_lightBoxes_size;
+    alignas(4) uint32_t crt_m_scene_m_lightBoxes_capacity;
+    alignas(4) uint32_t crt_m_scene_m_shapes_size;
+    alignas(4) uint32_t crt_m_scene_m_lights_size;
   };
 
   std::shared_ptr<crossrt::VulkanContext> crt_ctx;

@@ -52,8 +52,8 @@ void SortPairs_Vulkan::crt_UpdateMemberCmd(VkCommandBuffer crt_cmd, size_t a_off
 void SortPairs_Vulkan::crt_UpdatePlainMembers()
 {
   ClassData data{};
-  data.m_pairs_size = uint32_t(m_pairs.size());
-  data.m_pairs_capacity = uint32_t(m_pairs.capacity());
+  data.crt_m_pairs_size = uint32_t(m_pairs.size());
+  data.crt_m_pairs_capacity = uint32_t(m_pairs.capacity());
   crt_classDataBuffer.Upload(&data, sizeof(data));
 }
 

@@ -66,8 +66,8 @@ protected:
   // Mirror of the GLSL block SortPairsData (std430: alignas keeps the offsets equal).
   struct ClassData
   {
-    alignas(4) uint32_t m_pairs_size;
-    alignas(4) uint32_t m_pairs_capacity;
+    alignas(4) uint32_t crt_m_pairs_size;
+    alignas(4) uint32_t crt_m_pairs_capacity;
   };
 
   std::shared_ptr<crossrt::VulkanContext> crt_ctx;

@@ -84,7 +84,7 @@ ispc::SpherePaths_Data SpherePaths_ISPC::IspcData() const
   crossrt::IspcCopy(data.m_cameraPos, m_cameraPos);
   crossrt::IspcCopy(data.m_tanHalfFov, m_tanHalfFov);
   data.m_spheres = crossrt::IspcPointer<decltype(data.m_spheres)>(m_spheres.data());
-  data.m_spheres_size = uint32_t(m_spheres.size());
-  data.m_spheres_capacity = uint32_t(m_spheres.capacity());
+  data.crt_m_spheres_size = uint32_t(m_spheres.size());
+  data.crt_m_spheres_capacity = uint32_t(m_spheres.capacity());
   return data;
 }

@@ -37,8 +37,8 @@ struct SpherePaths_Data
   float4 m_cameraPos;
   float m_tanHalfFov;
   uniform Sphere *m_spheres;
-  uint m_spheres_size;
-  uint m_spheres_capacity;
+  uint crt_m_spheres_size;
+  uint crt_m_spheres_capacity;
 };
 
 // from (anonymous namespace)::Hash
@@ -78,7 +78,7 @@ static inline void kernel_RayTrace(uniform SpherePaths_Data *uniform self, uint 
   const float3 origin = to_float3(rayPos);
   const float3 dir = to_float3(rayDir);
   float nearest = 1e30;
-  for (int i = 0; i < ((uniform int)(self->m_spheres_size)); i++)
+  for (int i = 0; i < ((uniform int)(self->crt_m_spheres_size)); i++)
   {
     const float3 center = to_float3(self->m_spheres[((uint)(i))].centerRadius);
     const float radius = self->m_spheres[((uint)(i))].centerRadius.w;

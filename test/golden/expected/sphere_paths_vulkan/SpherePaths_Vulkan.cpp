@@ -76,8 +76,8 @@ void SpherePaths_Vulkan::crt_UpdatePlainMembers()
   std::memcpy(&data.m_maxDepth, &m_maxDepth, sizeof(data.m_maxDepth));
   std::memcpy(&data.m_tanHalfFov, &m_tanHalfFov, sizeof(data.m_tanHalfFov));
   std::memcpy(&data.m_timeMs, &m_timeMs, sizeof(data.m_timeMs));
-  data.m_spheres_size = uint32_t(m_spheres.size());
-  data.m_spheres_capacity = uint32_t(m_spheres.capacity());
+  data.crt_m_spheres_size = uint32_t(m_spheres.size());
+  data.crt_m_spheres_capacity = uint32_t(m_spheres.capacity());
   crt_classDataBuffer.Upload(&data, sizeof(data));
 }
 

@@ -118,8 +118,8 @@ protected:
     alignas(4) int m_maxDepth;
     alignas(4) float m_tanHalfFov;
     alignas(4) float m_timeMs;
-    alignas(4) uint32_t m_spheres_size;
-    alignas(4) uint32_t m_spheres_capacity;
+    alignas(4) uint32_t crt_m_spheres_size;
+    alignas(4) uint32_t crt_m_spheres_capacity;
   };
 
   std::shared_ptr<crossrt::VulkanContext> crt_ctx;

@@ -78,8 +78,8 @@ void TexturedMaterials_Vulkan::crt_UpdateMemberCmd(VkCommandBuffer crt_cmd, size
 void TexturedMaterials_Vulkan::crt_UpdatePlainMembers()
 {
   ClassData data{};
-  data.m_albedo_size = uint32_t(m_albedo.size());
-  data.m_bumps_size = uint32_t(m_bumps.size());
+  data.crt_m_albedo_size = uint32_t(m_albedo.size());
+  data.crt_m_bumps_size = uint32_t(m_bumps.size());
   crt_classDataBuffer.Upload(&data, sizeof(data));
 }
 

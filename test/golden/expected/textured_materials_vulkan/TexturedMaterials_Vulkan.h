@@ -69,8 +69,8 @@ protected:
   // Mirror of the GLSL block TexturedMaterialsData (std430: alignas keeps the offsets equal).
   struct ClassData
   {
-    alignas(4) uint32_t m_albedo_size;
-    alignas(4) uint32_t m_bumps_size;
+    alignas(4) uint32_t crt_m_albedo_size;
+    alignas(4) uint32_t crt_m_bumps_size;
   };
 
   std::shared_ptr<crossrt::VulkanContext> crt_ctx;

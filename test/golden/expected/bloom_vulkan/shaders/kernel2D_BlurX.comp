@@ -5,32 +5,32 @@
 layout(local_size_x = 16, local_size_y = 16, local_size_z = 1) in;
 
 // Data members of Bloom, uploaded before every control function call.
-layout(std430, binding = 0) buffer BloomData
+layout(std430, binding = 0) buffer crt_BloomData
 {
   float m_threshold;
   float m_strength;
   int m_radius;
-  uint m_weights_size;
-  uint m_weights_capacity;
-  uint m_bright_size;
-  uint m_bright_capacity;
-  uint m_blurred_size;
-  uint m_blurred_capacity;
+  uint crt_m_weights_size;
+  uint crt_m_weights_capacity;
+  uint crt_m_bright_size;
+  uint crt_m_bright_capacity;
+  uint crt_m_blurred_size;
+  uint crt_m_blurred_capacity;
 };
-layout(std430, binding = 1) readonly buffer srcBuffer
+layout(std430, binding = 1) readonly buffer crt_srcBuffer
 {
   vec4 src[];
 };  // parameter 'src'
-layout(std430, binding = 2) buffer dstBuffer
+layout(std430, binding = 2) buffer crt_dstBuffer
 {
   vec4 dst[];
 };  // parameter 'dst'
-layout(std430, binding = 3) buffer m_weightsBuffer
+layout(std430, binding = 3) buffer crt_m_weightsBuffer
 {
   float m_weights[];
 };  // member std::vector m_weights
 
-layout(push_constant) uniform kernel2D_BlurXArgs
+layout(push_constant) uniform crt_kernel2D_BlurXArgs
 {
   int crt_startX;
   int crt_startY;

@@ -5,28 +5,28 @@
 layout(local_size_x = 16, local_size_y = 16, local_size_z = 1) in;
 
 // Data members of Bloom, uploaded before every control function call.
-layout(std430, binding = 0) buffer BloomData
+layout(std430, binding = 0) buffer crt_BloomData
 {
   float m_threshold;
   float m_strength;
   int m_radius;
-  uint m_weights_size;
-  uint m_weights_capacity;
-  uint m_bright_size;
-  uint m_bright_capacity;
-  uint m_blurred_size;
-  uint m_blurred_capacity;
+  uint crt_m_weights_size;
+  uint crt_m_weights_capacity;
+  uint crt_m_bright_size;
+  uint crt_m_bright_capacity;
+  uint crt_m_blurred_size;
+  uint crt_m_blurred_capacity;
 };
-layout(std430, binding = 1) readonly buffer in_Buffer
+layout(std430, binding = 1) readonly buffer crt_in_Buffer
 {
   vec4 in_[];
 };  // parameter 'in'
-layout(std430, binding = 2) buffer brightBuffer
+layout(std430, binding = 2) buffer crt_brightBuffer
 {
   vec4 bright[];
 };  // parameter 'bright'
 
-layout(push_constant) uniform kernel2D_ExtractBrightArgs
+layout(push_constant) uniform crt_kernel2D_ExtractBrightArgs
 {
   int crt_startX;
   int crt_startY;

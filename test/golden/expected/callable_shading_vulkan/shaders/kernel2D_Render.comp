@@ -61,7 +61,7 @@ layout(buffer_reference, scalar, buffer_reference_align = 4) readonly buffer m_m
 };
 
 // Data members of CallableShading, uploaded before every control function call.
-layout(std430, binding = 0) buffer CallableShadingData
+layout(std430, binding = 0) buffer crt_CallableShadingData
 {
   vec3 m_toLight;
   uvec2 m_materials_tags;
@@ -69,22 +69,22 @@ layout(std430, binding = 0) buffer CallableShadingData
   uvec2 m_materials_Phong;
   uvec2 m_materials_Checker;
   float m_distanceStep;
-  uint m_materials_size;
+  uint crt_m_materials_size;
 };
-layout(std430, binding = 1) readonly buffer normalsBuffer
+layout(std430, binding = 1) readonly buffer crt_normalsBuffer
 {
   vec4 normals[];
 };  // parameter 'normals'
-layout(std430, binding = 2) readonly buffer materialIdsBuffer
+layout(std430, binding = 2) readonly buffer crt_materialIdsBuffer
 {
   uint materialIds[];
 };  // parameter 'materialIds'
-layout(std430, binding = 3) buffer colorsBuffer
+layout(std430, binding = 3) buffer crt_colorsBuffer
 {
   vec4 colors[];
 };  // parameter 'colors'
 
-layout(push_constant) uniform kernel2D_RenderArgs
+layout(push_constant) uniform crt_kernel2D_RenderArgs
 {
   int crt_startX;
   int crt_startY;

@@ -20,40 +20,40 @@ struct Box4f
 };
 
 // Data members of LBVH, uploaded before every control function call.
-layout(std430, binding = 0) buffer LBVHData
+layout(std430, binding = 0) buffer crt_LBVHData
 {
   vec3 m_centerMin;
   vec3 m_centerMax;
   uint m_leafCount;
-  uint m_nodes_size;
-  uint m_nodes_capacity;
-  uint m_primIndices_size;
-  uint m_primIndices_capacity;
-  uint m_codes_size;
-  uint m_codes_capacity;
-  uint m_newGroup_size;
-  uint m_newGroup_capacity;
-  uint m_groupOf_size;
-  uint m_groupOf_capacity;
-  uint m_leafFirst_size;
-  uint m_leafFirst_capacity;
-  uint m_leafCode_size;
-  uint m_leafCode_capacity;
-  uint m_parent_size;
-  uint m_parent_capacity;
-  uint m_arrivals_size;
-  uint m_arrivals_capacity;
+  uint crt_m_nodes_size;
+  uint crt_m_nodes_capacity;
+  uint crt_m_primIndices_size;
+  uint crt_m_primIndices_capacity;
+  uint crt_m_codes_size;
+  uint crt_m_codes_capacity;
+  uint crt_m_newGroup_size;
+  uint crt_m_newGroup_capacity;
+  uint crt_m_groupOf_size;
+  uint crt_m_groupOf_capacity;
+  uint crt_m_leafFirst_size;
+  uint crt_m_leafFirst_capacity;
+  uint crt_m_leafCode_size;
+  uint crt_m_leafCode_capacity;
+  uint crt_m_parent_size;
+  uint crt_m_parent_capacity;
+  uint crt_m_arrivals_size;
+  uint crt_m_arrivals_capacity;
 };
-layout(std430, binding = 1) readonly buffer boxesBuffer
+layout(std430, binding = 1) readonly buffer crt_boxesBuffer
 {
   Box4f boxes[];
 };  // parameter 'boxes'
-layout(std430, binding = 2) buffer m_codesBuffer
+layout(std430, binding = 2) buffer crt_m_codesBuffer
 {
   uvec2 m_codes[];
 };  // member std::vector m_codes
 
-layout(push_constant) uniform kernel1D_EvalMCArgs
+layout(push_constant) uniform crt_kernel1D_EvalMCArgs
 {
   int crt_startX;
   uint crt_countX;

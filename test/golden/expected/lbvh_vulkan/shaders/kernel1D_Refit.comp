@@ -13,44 +13,44 @@ struct BVHNode
 };
 
 // Data members of LBVH, uploaded before every control function call.
-layout(std430, binding = 0) coherent buffer LBVHData
+layout(std430, binding = 0) coherent buffer crt_LBVHData
 {
   vec3 m_centerMin;
   vec3 m_centerMax;
   uint m_leafCount;
-  uint m_nodes_size;
-  uint m_nodes_capacity;
-  uint m_primIndices_size;
-  uint m_primIndices_capacity;
-  uint m_codes_size;
-  uint m_codes_capacity;
-  uint m_newGroup_size;
-  uint m_newGroup_capacity;
-  uint m_groupOf_size;
-  uint m_groupOf_capacity;
-  uint m_leafFirst_size;
-  uint m_leafFirst_capacity;
-  uint m_leafCode_size;
-  uint m_leafCode_capacity;
-  uint m_parent_size;
-  uint m_parent_capacity;
-  uint m_arrivals_size;
-  uint m_arrivals_capacity;
+  uint crt_m_nodes_size;
+  uint crt_m_nodes_capacity;
+  uint crt_m_primIndices_size;
+  uint crt_m_primIndices_capacity;
+  uint crt_m_codes_size;
+  uint crt_m_codes_capacity;
+  uint crt_m_newGroup_size;
+  uint crt_m_newGroup_capacity;
+  uint crt_m_groupOf_size;
+  uint crt_m_groupOf_capacity;
+  uint crt_m_leafFirst_size;
+  uint crt_m_leafFirst_capacity;
+  uint crt_m_leafCode_size;
+  uint crt_m_leafCode_capacity;
+  uint crt_m_parent_size;
+  uint crt_m_parent_capacity;
+  uint crt_m_arrivals_size;
+  uint crt_m_arrivals_capacity;
 };
-layout(std430, binding = 1) coherent buffer m_arrivalsBuffer
+layout(std430, binding = 1) coherent buffer crt_m_arrivalsBuffer
 {
   uint m_arrivals[];
 };  // member std::vector m_arrivals
-layout(std430, binding = 2) coherent buffer m_nodesBuffer
+layout(std430, binding = 2) coherent buffer crt_m_nodesBuffer
 {
   BVHNode m_nodes[];
 };  // member std::vector m_nodes
-layout(std430, binding = 3) coherent buffer m_parentBuffer
+layout(std430, binding = 3) coherent buffer crt_m_parentBuffer
 {
   uint m_parent[];
 };  // member std::vector m_parent
 
-layout(push_constant) uniform kernel1D_RefitArgs
+layout(push_constant) uniform crt_kernel1D_RefitArgs
 {
   int crt_startX;
   uint crt_countX;

@@ -7,41 +7,41 @@
 layout(local_size_x = 256, local_size_y = 1, local_size_z = 1) in;
 
 // Data members of LocalTotals, uploaded before every control function call.
-layout(std430, binding = 0) buffer LocalTotalsData
+layout(std430, binding = 0) buffer crt_LocalTotalsData
 {
   float m_mean;
   float m_range;
 };
-layout(std430, binding = 1) readonly buffer a_valuesBuffer
+layout(std430, binding = 1) readonly buffer crt_a_valuesBuffer
 {
   vec4 a_values[];
 };  // parameter 'a_values'
-layout(std430, binding = 2) buffer a_outBuffer
+layout(std430, binding = 2) buffer crt_a_outBuffer
 {
   float a_out[];
 };  // parameter 'a_out'
-layout(std430, binding = 3) buffer sumPartialsBlock
+layout(std430, binding = 3) buffer crt_sumPartialsBuffer
 {
   float sumPartials[];
 };  // per-workgroup partial results of the reduction of local sum
-layout(std430, binding = 4) buffer loPartialsBlock
+layout(std430, binding = 4) buffer crt_loPartialsBuffer
 {
   float loPartials[];
 };  // per-workgroup partial results of the reduction of local lo
-layout(std430, binding = 5) buffer hiPartialsBlock
+layout(std430, binding = 5) buffer crt_hiPartialsBuffer
 {
   float hiPartials[];
 };  // per-workgroup partial results of the reduction of local hi
-layout(std430, binding = 6) buffer totalPartialsBlock
+layout(std430, binding = 6) buffer crt_totalPartialsBuffer
 {
   vec4 totalPartials[];
 };  // per-workgroup partial results of the reduction of local total
-layout(std430, binding = 7) buffer negativesPartialsBlock
+layout(std430, binding = 7) buffer crt_negativesPartialsBuffer
 {
   int negativesPartials[];
 };  // per-workgroup partial results of the reduction of local negatives
 
-layout(push_constant) uniform kernel1D_SummarizeArgs
+layout(push_constant) uniform crt_kernel1D_SummarizeArgs
 {
   int crt_startX;
   uint crt_countX;

@@ -6,33 +6,33 @@
 layout(local_size_x = 256) in;
 #define CRT_INFINITY uintBitsToFloat(0x7F800000u)  // the identity of min over floats (max: -CRT_INFINITY)
 
-layout(std430, binding = 0) buffer LocalTotalsData
+layout(std430, binding = 0) buffer crt_LocalTotalsData
 {
   float m_mean;
   float m_range;
 };
-layout(std430, binding = 1) buffer sumPartialsBlock
+layout(std430, binding = 1) buffer crt_sumPartialsBuffer
 {
   float sumPartials[];
 };
-layout(std430, binding = 2) buffer loPartialsBlock
+layout(std430, binding = 2) buffer crt_loPartialsBuffer
 {
   float loPartials[];
 };
-layout(std430, binding = 3) buffer hiPartialsBlock
+layout(std430, binding = 3) buffer crt_hiPartialsBuffer
 {
   float hiPartials[];
 };
-layout(std430, binding = 4) buffer totalPartialsBlock
+layout(std430, binding = 4) buffer crt_totalPartialsBuffer
 {
   vec4 totalPartials[];
 };
-layout(std430, binding = 5) buffer negativesPartialsBlock
+layout(std430, binding = 5) buffer crt_negativesPartialsBuffer
 {
   int negativesPartials[];
 };
 
-layout(push_constant) uniform kernel1D_Summarize_ReduceArgs
+layout(push_constant) uniform crt_kernel1D_Summarize_ReduceArgs
 {
   uint partialCount;
 };

@@ -6,7 +6,7 @@
 layout(local_size_x = 256, local_size_y = 1, local_size_z = 1) in;
 
 // Data members of Particles, uploaded before every control function call.
-layout(std430, binding = 0) buffer ParticlesData
+layout(std430, binding = 0) buffer crt_ParticlesData
 {
   vec4 m_boxMin;
   vec4 m_boxMax;
@@ -17,20 +17,20 @@ layout(std430, binding = 0) buffer ParticlesData
   float m_restitution;
   float m_timeMs;
 };
-layout(std430, binding = 1) buffer positionsBuffer
+layout(std430, binding = 1) buffer crt_positionsBuffer
 {
   vec4 positions[];
 };  // parameter 'positions'
-layout(std430, binding = 2) buffer velocitiesBuffer
+layout(std430, binding = 2) buffer crt_velocitiesBuffer
 {
   vec4 velocities[];
 };  // parameter 'velocities'
-layout(std430, binding = 3) writeonly buffer m_bouncesPartialsBlock
+layout(std430, binding = 3) writeonly buffer crt_m_bouncesPartialsBuffer
 {
   int m_bouncesPartials[];
 };  // per-workgroup partial results of the reduction of m_bounces
 
-layout(push_constant) uniform kernel1D_AdvanceArgs
+layout(push_constant) uniform crt_kernel1D_AdvanceArgs
 {
   int crt_startX;
   uint crt_countX;

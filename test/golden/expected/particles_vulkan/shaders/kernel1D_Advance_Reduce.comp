@@ -6,7 +6,7 @@
 
 layout(local_size_x = 256) in;
 
-layout(std430, binding = 0) buffer ParticlesData
+layout(std430, binding = 0) buffer crt_ParticlesData
 {
   vec4 m_boxMin;
   vec4 m_boxMax;
@@ -17,12 +17,12 @@ layout(std430, binding = 0) buffer ParticlesData
   float m_restitution;
   float m_timeMs;
 };
-layout(std430, binding = 1) readonly buffer m_bouncesPartialsBlock
+layout(std430, binding = 1) readonly buffer crt_m_bouncesPartialsBuffer
 {
   int m_bouncesPartials[];
 };
 
-layout(push_constant) uniform kernel1D_Advance_ReduceArgs
+layout(push_constant) uniform crt_kernel1D_Advance_ReduceArgs
 {
   uint partialCount;
 };

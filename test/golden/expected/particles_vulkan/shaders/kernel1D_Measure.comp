@@ -7,7 +7,7 @@
 layout(local_size_x = 256, local_size_y = 1, local_size_z = 1) in;
 
 // Data members of Particles, uploaded before every control function call.
-layout(std430, binding = 0) buffer ParticlesData
+layout(std430, binding = 0) buffer crt_ParticlesData
 {
   vec4 m_boxMin;
   vec4 m_boxMax;
@@ -18,32 +18,32 @@ layout(std430, binding = 0) buffer ParticlesData
   float m_restitution;
   float m_timeMs;
 };
-layout(std430, binding = 1) readonly buffer positionsBuffer
+layout(std430, binding = 1) readonly buffer crt_positionsBuffer
 {
   vec4 positions[];
 };  // parameter 'positions'
-layout(std430, binding = 2) readonly buffer velocitiesBuffer
+layout(std430, binding = 2) readonly buffer crt_velocitiesBuffer
 {
   vec4 velocities[];
 };  // parameter 'velocities'
-layout(std430, binding = 3) writeonly buffer m_boxMinPartialsBlock
+layout(std430, binding = 3) writeonly buffer crt_m_boxMinPartialsBuffer
 {
   vec4 m_boxMinPartials[];
 };  // per-workgroup partial results of the reduction of m_boxMin
-layout(std430, binding = 4) writeonly buffer m_boxMaxPartialsBlock
+layout(std430, binding = 4) writeonly buffer crt_m_boxMaxPartialsBuffer
 {
   vec4 m_boxMaxPartials[];
 };  // per-workgroup partial results of the reduction of m_boxMax
-layout(std430, binding = 5) writeonly buffer m_momentumPartialsBlock
+layout(std430, binding = 5) writeonly buffer crt_m_momentumPartialsBuffer
 {
   vec4 m_momentumPartials[];
 };  // per-workgroup partial results of the reduction of m_momentum
-layout(std430, binding = 6) writeonly buffer m_kineticEnergyPartialsBlock
+layout(std430, binding = 6) writeonly buffer crt_m_kineticEnergyPartialsBuffer
 {
   float m_kineticEnergyPartials[];
 };  // per-workgroup partial results of the reduction of m_kineticEnergy
 
-layout(push_constant) uniform kernel1D_MeasureArgs
+layout(push_constant) uniform crt_kernel1D_MeasureArgs
 {
   int crt_startX;
   uint crt_countX;

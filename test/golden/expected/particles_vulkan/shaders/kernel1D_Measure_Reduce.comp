@@ -7,7 +7,7 @@
 layout(local_size_x = 256) in;
 #define CRT_INFINITY uintBitsToFloat(0x7F800000u)  // the identity of min over floats (max: -CRT_INFINITY)
 
-layout(std430, binding = 0) buffer ParticlesData
+layout(std430, binding = 0) buffer crt_ParticlesData
 {
   vec4 m_boxMin;
   vec4 m_boxMax;
@@ -18,24 +18,24 @@ layout(std430, binding = 0) buffer ParticlesData
   float m_restitution;
   float m_timeMs;
 };
-layout(std430, binding = 1) readonly buffer m_boxMinPartialsBlock
+layout(std430, binding = 1) readonly buffer crt_m_boxMinPartialsBuffer
 {
   vec4 m_boxMinPartials[];
 };
-layout(std430, binding = 2) readonly buffer m_boxMaxPartialsBlock
+layout(std430, binding = 2) readonly buffer crt_m_boxMaxPartialsBuffer
 {
   vec4 m_boxMaxPartials[];
 };
-layout(std430, binding = 3) readonly buffer m_momentumPartialsBlock
+layout(std430, binding = 3) readonly buffer crt_m_momentumPartialsBuffer
 {
   vec4 m_momentumPartials[];
 };
-layout(std430, binding = 4) readonly buffer m_kineticEnergyPartialsBlock
+layout(std430, binding = 4) readonly buffer crt_m_kineticEnergyPartialsBuffer
 {
   float m_kineticEnergyPartials[];
 };
 
-layout(push_constant) uniform kernel1D_Measure_ReduceArgs
+layout(push_constant) uniform crt_kernel1D_Measure_ReduceArgs
 {
   uint partialCount;
 };

@@ -108,7 +108,7 @@ struct BVHTriangle4
 };
 
 // Data members of PrimaryRays, uploaded before every control function call.
-layout(std430, binding = 0) buffer PrimaryRaysData
+layout(std430, binding = 0) buffer crt_PrimaryRaysData
 {
   vec4 m_eye;
   vec4 m_forward;
@@ -118,73 +118,73 @@ layout(std430, binding = 0) buffer PrimaryRaysData
   int m_height;
   int m_aoSamples;
   float m_aoDistance;
-  uint m_vertices_size;
-  uint m_vertices_capacity;
-  uint m_indices_size;
-  uint m_indices_capacity;
-  uint m_pAccelStruct_m_nodes_size;
-  uint m_pAccelStruct_m_nodes_capacity;
-  uint m_pAccelStruct_m_instances_size;
-  uint m_pAccelStruct_m_instances_capacity;
-  uint m_pAccelStruct_m_motion_size;
-  uint m_pAccelStruct_m_motion_capacity;
-  uint m_pAccelStruct_m_boxes_size;
-  uint m_pAccelStruct_m_boxes_capacity;
-  uint m_pAccelStruct_m_sdfBricks_size;
-  uint m_pAccelStruct_m_sdfBricks_capacity;
-  uint m_pAccelStruct_m_sdfWords_size;
-  uint m_pAccelStruct_m_sdfWords_capacity;
-  uint m_pAccelStruct_m_triangles_size;
-  uint m_pAccelStruct_m_triangles_capacity;
-  uint m_pAccelStruct_m_primIds_size;
-  uint m_pAccelStruct_m_primIds_capacity;
+  uint crt_m_vertices_size;
+  uint crt_m_vertices_capacity;
+  uint crt_m_indices_size;
+  uint crt_m_indices_capacity;
+  uint crt_m_pAccelStruct_m_nodes_size;
+  uint crt_m_pAccelStruct_m_nodes_capacity;
+  uint crt_m_pAccelStruct_m_instances_size;
+  uint crt_m_pAccelStruct_m_instances_capacity;
+  uint crt_m_pAccelStruct_m_motion_size;
+  uint crt_m_pAccelStruct_m_motion_capacity;
+  uint crt_m_pAccelStruct_m_boxes_size;
+  uint crt_m_pAccelStruct_m_boxes_capacity;
+  uint crt_m_pAccelStruct_m_sdfBricks_size;
+  uint crt_m_pAccelStruct_m_sdfBricks_capacity;
+  uint crt_m_pAccelStruct_m_sdfWords_size;
+  uint crt_m_pAccelStruct_m_sdfWords_capacity;
+  uint crt_m_pAccelStruct_m_triangles_size;
+  uint crt_m_pAccelStruct_m_triangles_capacity;
+  uint crt_m_pAccelStruct_m_primIds_size;
+  uint crt_m_pAccelStruct_m_primIds_capacity;
 };
-layout(std430, binding = 1) readonly buffer posAndNearBuffer
+layout(std430, binding = 1) readonly buffer crt_posAndNearBuffer
 {
   vec4 posAndNear[];
 };  // parameter 'posAndNear'
-layout(std430, binding = 2) readonly buffer dirAndFarBuffer
+layout(std430, binding = 2) readonly buffer crt_dirAndFarBuffer
 {
   vec4 dirAndFar[];
 };  // parameter 'dirAndFar'
-layout(std430, binding = 3) buffer hitsBuffer
+layout(std430, binding = 3) buffer crt_hitsBuffer
 {
   CRT_Hit hits[];
 };  // parameter 'hits'
-layout(std430, binding = 4) buffer m_pAccelStruct_m_boxesBuffer
+layout(std430, binding = 4) buffer crt_m_pAccelStruct_m_boxesBuffer
 {
   BVH4Node m_pAccelStruct_m_boxes[];
 };  // composed: std::vector BVHScene::m_boxes through m_pAccelStruct
-layout(std430, binding = 5) buffer m_pAccelStruct_m_instancesBuffer
+layout(std430, binding = 5) buffer crt_m_pAccelStruct_m_instancesBuffer
 {
   BVHInstance m_pAccelStruct_m_instances[];
 };  // composed: std::vector BVHScene::m_instances through m_pAccelStruct
-layout(std430, binding = 6) buffer m_pAccelStruct_m_motionBuffer
+layout(std430, binding = 6) buffer crt_m_pAccelStruct_m_motionBuffer
 {
   vec4 m_pAccelStruct_m_motion[];
 };  // composed: std::vector BVHScene::m_motion through m_pAccelStruct
-layout(std430, binding = 7) buffer m_pAccelStruct_m_nodesBuffer
+layout(std430, binding = 7) buffer crt_m_pAccelStruct_m_nodesBuffer
 {
   BVH4Node m_pAccelStruct_m_nodes[];
 };  // composed: std::vector BVHScene::m_nodes through m_pAccelStruct
-layout(std430, binding = 8) buffer m_pAccelStruct_m_primIdsBuffer
+layout(std430, binding = 8) buffer crt_m_pAccelStruct_m_primIdsBuffer
 {
   uint m_pAccelStruct_m_primIds[];
 };  // composed: std::vector BVHScene::m_primIds through m_pAccelStruct
-layout(std430, binding = 9) buffer m_pAccelStruct_m_sdfBricksBuffer
+layout(std430, binding = 9) buffer crt_m_pAccelStruct_m_sdfBricksBuffer
 {
   BVHSdfBrick m_pAccelStruct_m_sdfBricks[];
 };  // composed: std::vector BVHScene::m_sdfBricks through m_pAccelStruct
-layout(std430, binding = 10) buffer m_pAccelStruct_m_sdfWordsBuffer
+layout(std430, binding = 10) buffer crt_m_pAccelStruct_m_sdfWordsBuffer
 {
   uint m_pAccelStruct_m_sdfWords[];
 };  // composed: std::vector BVHScene::m_sdfWords through m_pAccelStruct
-layout(std430, binding = 11) buffer m_pAccelStruct_m_trianglesBuffer
+layout(std430, binding = 11) buffer crt_m_pAccelStruct_m_trianglesBuffer
 {
   BVHTriangle4 m_pAccelStruct_m_triangles[];
 };  // composed: std::vector BVHScene::m_triangles through m_pAccelStruct
 
-layout(push_constant) uniform kernel1D_CastRaysArgs
+layout(push_constant) uniform crt_kernel1D_CastRaysArgs
 {
   int crt_startX;
   uint crt_countX;
@@ -825,10 +825,10 @@ bool m_pAccelStruct_Trace(vec4 posAndNear, vec4 dirAndFar, float time, bool anyH
 {
   float tnear = 0.0;
   float tfar = 0.0;
-  if (m_pAccelStruct_m_nodes_size == 0u || !m_pAccelStruct_RayInterval(posAndNear, dirAndFar, tnear, tfar))
+  if (crt_m_pAccelStruct_m_nodes_size == 0u || !m_pAccelStruct_RayInterval(posAndNear, dirAndFar, tnear, tfar))
     return false;
   const BVHTraceRay worldRay = m_pAccelStruct_Prepare((posAndNear).xyz, (dirAndFar).xyz, tnear);
-  if (m_pAccelStruct_m_instances_size == 1u)
+  if (crt_m_pAccelStruct_m_instances_size == 1u)
     return m_pAccelStruct_TraceInstance(0u, worldRay, time, anyHit, tfar, hit);
   uint stack[64];
   float stackEntry[64];

@@ -16,7 +16,7 @@ struct CRT_Hit
 };
 
 // Data members of PrimaryRays, uploaded before every control function call.
-layout(std430, binding = 0) buffer PrimaryRaysData
+layout(std430, binding = 0) buffer crt_PrimaryRaysData
 {
   vec4 m_eye;
   vec4 m_forward;
@@ -26,43 +26,43 @@ layout(std430, binding = 0) buffer PrimaryRaysData
   int m_height;
   int m_aoSamples;
   float m_aoDistance;
-  uint m_vertices_size;
-  uint m_vertices_capacity;
-  uint m_indices_size;
-  uint m_indices_capacity;
-  uint m_pAccelStruct_m_nodes_size;
-  uint m_pAccelStruct_m_nodes_capacity;
-  uint m_pAccelStruct_m_instances_size;
-  uint m_pAccelStruct_m_instances_capacity;
-  uint m_pAccelStruct_m_motion_size;
-  uint m_pAccelStruct_m_motion_capacity;
-  uint m_pAccelStruct_m_boxes_size;
-  uint m_pAccelStruct_m_boxes_capacity;
-  uint m_pAccelStruct_m_sdfBricks_size;
-  uint m_pAccelStruct_m_sdfBricks_capacity;
-  uint m_pAccelStruct_m_sdfWords_size;
-  uint m_pAccelStruct_m_sdfWords_capacity;
-  uint m_pAccelStruct_m_triangles_size;
-  uint m_pAccelStruct_m_triangles_capacity;
-  uint m_pAccelStruct_m_primIds_size;
-  uint m_pAccelStruct_m_primIds_capacity;
+  uint crt_m_vertices_size;
+  uint crt_m_vertices_capacity;
+  uint crt_m_indices_size;
+  uint crt_m_indices_capacity;
+  uint crt_m_pAccelStruct_m_nodes_size;
+  uint crt_m_pAccelStruct_m_nodes_capacity;
+  uint crt_m_pAccelStruct_m_instances_size;
+  uint crt_m_pAccelStruct_m_instances_capacity;
+  uint crt_m_pAccelStruct_m_motion_size;
+  uint crt_m_pAccelStruct_m_motion_capacity;
+  uint crt_m_pAccelStruct_m_boxes_size;
+  uint crt_m_pAccelStruct_m_boxes_capacity;
+  uint crt_m_pAccelStruct_m_sdfBricks_size;
+  uint crt_m_pAccelStruct_m_sdfBricks_capacity;
+  uint crt_m_pAccelStruct_m_sdfWords_size;
+  uint crt_m_pAccelStruct_m_sdfWords_capacity;
+  uint crt_m_pAccelStruct_m_triangles_size;
+  uint crt_m_pAccelStruct_m_triangles_capacity;
+  uint crt_m_pAccelStruct_m_primIds_size;
+  uint crt_m_pAccelStruct_m_primIds_capacity;
 };
-layout(std430, binding = 1) readonly buffer posAndNearBuffer
+layout(std430, binding = 1) readonly buffer crt_posAndNearBuffer
 {
   vec4 posAndNear[];
 };  // parameter 'posAndNear'
-layout(std430, binding = 2) readonly buffer dirAndFarBuffer
+layout(std430, binding = 2) readonly buffer crt_dirAndFarBuffer
 {
   vec4 dirAndFar[];
 };  // parameter 'dirAndFar'
-layout(std430, binding = 3) buffer hitsBuffer
+layout(std430, binding = 3) buffer crt_hitsBuffer
 {
   CRT_Hit hits[];
 };  // parameter 'hits'
 layout(binding = 4) uniform accelerationStructureEXT
     m_pAccelStruct_scene;  // the scene m_pAccelStruct holds, built for the ray tracing hardware
 
-layout(push_constant) uniform kernel1D_CastRaysArgs
+layout(push_constant) uniform crt_kernel1D_CastRaysArgs
 {
   int crt_startX;
   uint crt_countX;

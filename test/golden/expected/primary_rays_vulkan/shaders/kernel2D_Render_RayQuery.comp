@@ -16,7 +16,7 @@ struct CRT_Hit
 };
 
 // Data members of PrimaryRays, uploaded before every control function call.
-layout(std430, binding = 0) buffer PrimaryRaysData
+layout(std430, binding = 0) buffer crt_PrimaryRaysData
 {
   vec4 m_eye;
   vec4 m_forward;
@@ -26,43 +26,43 @@ layout(std430, binding = 0) buffer PrimaryRaysData
   int m_height;
   int m_aoSamples;
   float m_aoDistance;
-  uint m_vertices_size;
-  uint m_vertices_capacity;
-  uint m_indices_size;
-  uint m_indices_capacity;
-  uint m_pAccelStruct_m_nodes_size;
-  uint m_pAccelStruct_m_nodes_capacity;
-  uint m_pAccelStruct_m_instances_size;
-  uint m_pAccelStruct_m_instances_capacity;
-  uint m_pAccelStruct_m_motion_size;
-  uint m_pAccelStruct_m_motion_capacity;
-  uint m_pAccelStruct_m_boxes_size;
-  uint m_pAccelStruct_m_boxes_capacity;
-  uint m_pAccelStruct_m_sdfBricks_size;
-  uint m_pAccelStruct_m_sdfBricks_capacity;
-  uint m_pAccelStruct_m_sdfWords_size;
-  uint m_pAccelStruct_m_sdfWords_capacity;
-  uint m_pAccelStruct_m_triangles_size;
-  uint m_pAccelStruct_m_triangles_capacity;
-  uint m_pAccelStruct_m_primIds_size;
-  uint m_pAccelStruct_m_primIds_capacity;
+  uint crt_m_vertices_size;
+  uint crt_m_vertices_capacity;
+  uint crt_m_indices_size;
+  uint crt_m_indices_capacity;
+  uint crt_m_pAccelStruct_m_nodes_size;
+  uint crt_m_pAccelStruct_m_nodes_capacity;
+  uint crt_m_pAccelStruct_m_instances_size;
+  uint crt_m_pAccelStruct_m_instances_capacity;
+  uint crt_m_pAccelStruct_m_motion_size;
+  uint crt_m_pAccelStruct_m_motion_capacity;
+  uint crt_m_pAccelStruct_m_boxes_size;
+  uint crt_m_pAccelStruct_m_boxes_capacity;
+  uint crt_m_pAccelStruct_m_sdfBricks_size;
+  uint crt_m_pAccelStruct_m_sdfBricks_capacity;
+  uint crt_m_pAccelStruct_m_sdfWords_size;
+  uint crt_m_pAccelStruct_m_sdfWords_capacity;
+  uint crt_m_pAccelStruct_m_triangles_size;
+  uint crt_m_pAccelStruct_m_triangles_capacity;
+  uint crt_m_pAccelStruct_m_primIds_size;
+  uint crt_m_pAccelStruct_m_primIds_capacity;
 };
-layout(std430, binding = 1) buffer pixelsBuffer
+layout(std430, binding = 1) buffer crt_pixelsBuffer
 {
   uint pixels[];
 };  // parameter 'pixels'
-layout(std430, binding = 2) buffer m_indicesBuffer
+layout(std430, binding = 2) buffer crt_m_indicesBuffer
 {
   uint m_indices[];
 };  // member std::vector m_indices
-layout(std430, binding = 3) buffer m_verticesBuffer
+layout(std430, binding = 3) buffer crt_m_verticesBuffer
 {
   vec4 m_vertices[];
 };  // member std::vector m_vertices
 layout(binding = 4) uniform accelerationStructureEXT
     m_pAccelStruct_scene;  // the scene m_pAccelStruct holds, built for the ray tracing hardware
 
-layout(push_constant) uniform kernel2D_RenderArgs
+layout(push_constant) uniform crt_kernel2D_RenderArgs
 {
   int crt_startX;
   int crt_startY;

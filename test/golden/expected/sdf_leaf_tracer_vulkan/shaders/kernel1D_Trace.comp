@@ -128,94 +128,94 @@ layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer m_s
 };
 
 // Data members of SdfLeafTracer, uploaded before every control function call.
-layout(std430, binding = 0) buffer SdfLeafTracerData
+layout(std430, binding = 0) buffer crt_SdfLeafTracerData
 {
   uvec2 m_scene_m_geom_tags;
   uvec2 m_scene_m_geom_SdfGridLeaves;
   uvec2 m_scene_m_geom_SdfSVSLeaves;
   uvec2 m_scene_m_geom_SdfSBSLeaves;
-  uint m_scene_m_nodeMin_size;
-  uint m_scene_m_nodeMin_capacity;
-  uint m_scene_m_nodeMax_size;
-  uint m_scene_m_nodeMax_capacity;
-  uint m_scene_m_nodeRight_size;
-  uint m_scene_m_nodeRight_capacity;
-  uint m_scene_m_nodeLeaf_size;
-  uint m_scene_m_nodeLeaf_capacity;
-  uint m_scene_m_leafIds_size;
-  uint m_scene_m_leafIds_capacity;
-  uint m_scene_m_gridBricks_size;
-  uint m_scene_m_gridBricks_capacity;
-  uint m_scene_m_values_size;
-  uint m_scene_m_values_capacity;
-  uint m_scene_m_voxels_size;
-  uint m_scene_m_voxels_capacity;
-  uint m_scene_m_voxelValues_size;
-  uint m_scene_m_voxelValues_capacity;
-  uint m_scene_m_bricks_size;
-  uint m_scene_m_bricks_capacity;
-  uint m_scene_m_brickValues_size;
-  uint m_scene_m_brickValues_capacity;
-  uint m_scene_m_geom_size;
+  uint crt_m_scene_m_nodeMin_size;
+  uint crt_m_scene_m_nodeMin_capacity;
+  uint crt_m_scene_m_nodeMax_size;
+  uint crt_m_scene_m_nodeMax_capacity;
+  uint crt_m_scene_m_nodeRight_size;
+  uint crt_m_scene_m_nodeRight_capacity;
+  uint crt_m_scene_m_nodeLeaf_size;
+  uint crt_m_scene_m_nodeLeaf_capacity;
+  uint crt_m_scene_m_leafIds_size;
+  uint crt_m_scene_m_leafIds_capacity;
+  uint crt_m_scene_m_gridBricks_size;
+  uint crt_m_scene_m_gridBricks_capacity;
+  uint crt_m_scene_m_values_size;
+  uint crt_m_scene_m_values_capacity;
+  uint crt_m_scene_m_voxels_size;
+  uint crt_m_scene_m_voxels_capacity;
+  uint crt_m_scene_m_voxelValues_size;
+  uint crt_m_scene_m_voxelValues_capacity;
+  uint crt_m_scene_m_bricks_size;
+  uint crt_m_scene_m_bricks_capacity;
+  uint crt_m_scene_m_brickValues_size;
+  uint crt_m_scene_m_brickValues_capacity;
+  uint crt_m_scene_m_geom_size;
 };
-layout(std430, binding = 1) readonly buffer originsBuffer
+layout(std430, binding = 1) readonly buffer crt_originsBuffer
 {
   vec4 origins[];
 };  // parameter 'origins'
-layout(std430, binding = 2) readonly buffer dirsBuffer
+layout(std430, binding = 2) readonly buffer crt_dirsBuffer
 {
   vec4 dirs[];
 };  // parameter 'dirs'
-layout(std430, binding = 3) buffer hitsBuffer
+layout(std430, binding = 3) buffer crt_hitsBuffer
 {
   CRT_Hit hits[];
 };  // parameter 'hits'
-layout(std430, binding = 4) buffer m_scene_m_brickValuesBuffer
+layout(std430, binding = 4) buffer crt_m_scene_m_brickValuesBuffer
 {
   uint m_scene_m_brickValues[];
 };  // composed: std::vector SdfLeafScene::m_brickValues through m_scene
-layout(std430, binding = 5) buffer m_scene_m_bricksBuffer
+layout(std430, binding = 5) buffer crt_m_scene_m_bricksBuffer
 {
   vec4 m_scene_m_bricks[];
 };  // composed: std::vector SdfLeafScene::m_bricks through m_scene
-layout(std430, binding = 6) buffer m_scene_m_gridBricksBuffer
+layout(std430, binding = 6) buffer crt_m_scene_m_gridBricksBuffer
 {
   uint m_scene_m_gridBricks[];
 };  // composed: std::vector SdfLeafScene::m_gridBricks through m_scene
-layout(std430, binding = 7) buffer m_scene_m_leafIdsBuffer
+layout(std430, binding = 7) buffer crt_m_scene_m_leafIdsBuffer
 {
   uvec2 m_scene_m_leafIds[];
 };  // composed: std::vector SdfLeafScene::m_leafIds through m_scene
-layout(std430, binding = 8) buffer m_scene_m_nodeLeafBuffer
+layout(std430, binding = 8) buffer crt_m_scene_m_nodeLeafBuffer
 {
   uint m_scene_m_nodeLeaf[];
 };  // composed: std::vector SdfLeafScene::m_nodeLeaf through m_scene
-layout(std430, binding = 9) buffer m_scene_m_nodeMaxBuffer
+layout(std430, binding = 9) buffer crt_m_scene_m_nodeMaxBuffer
 {
   vec4 m_scene_m_nodeMax[];
 };  // composed: std::vector SdfLeafScene::m_nodeMax through m_scene
-layout(std430, binding = 10) buffer m_scene_m_nodeMinBuffer
+layout(std430, binding = 10) buffer crt_m_scene_m_nodeMinBuffer
 {
   vec4 m_scene_m_nodeMin[];
 };  // composed: std::vector SdfLeafScene::m_nodeMin through m_scene
-layout(std430, binding = 11) buffer m_scene_m_nodeRightBuffer
+layout(std430, binding = 11) buffer crt_m_scene_m_nodeRightBuffer
 {
   uint m_scene_m_nodeRight[];
 };  // composed: std::vector SdfLeafScene::m_nodeRight through m_scene
-layout(std430, binding = 12) buffer m_scene_m_valuesBuffer
+layout(std430, binding = 12) buffer crt_m_scene_m_valuesBuffer
 {
   float m_scene_m_values[];
 };  // composed: std::vector SdfLeafScene::m_values through m_scene
-layout(std430, binding = 13) buffer m_scene_m_voxelValuesBuffer
+layout(std430, binding = 13) buffer crt_m_scene_m_voxelValuesBuffer
 {
   float m_scene_m_voxelValues[];
 };  // composed: std::vector SdfLeafScene::m_voxelValues through m_scene
-layout(std430, binding = 14) buffer m_scene_m_voxelsBuffer
+layout(std430, binding = 14) buffer crt_m_scene_m_voxelsBuffer
 {
   vec4 m_scene_m_voxels[];
 };  // composed: std::vector SdfLeafScene::m_voxels through m_scene
 
-layout(push_constant) uniform kernel1D_TraceArgs
+layout(push_constant) uniform crt_kernel1D_TraceArgs
 {
   int crt_startX;
   uint crt_countX;
@@ -798,7 +798,7 @@ CRT_Hit m_scene_RayQuery_NearestHit(vec4 posAndNear, vec4 dirAndFar)
       m_scene_Finite(posAndNear) && m_scene_Finite(dirAndFar) && dot(dir, dir) > 0.0 && posAndNear.w < dirAndFar.w;
   uint stack[64];
   int top = 0;
-  if (valid && !(m_scene_m_nodeMin_size == 0u))
+  if (valid && !(crt_m_scene_m_nodeMin_size == 0u))
     stack[top++] = 0u;
   while (top > 0)
   {

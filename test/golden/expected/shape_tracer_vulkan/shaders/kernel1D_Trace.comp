@@ -98,7 +98,7 @@ layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer m_s
 };
 
 // Data members of ShapeTracer, uploaded before every control function call.
-layout(std430, binding = 0) buffer ShapeTracerData
+layout(std430, binding = 0) buffer crt_ShapeTracerData
 {
   uvec2 m_scene_m_shapes_tags;
   uvec2 m_scene_m_shapes_Sphere;
@@ -108,35 +108,35 @@ layout(std430, binding = 0) buffer ShapeTracerData
   uvec2 m_scene_m_lights_Sphere;
   uvec2 m_scene_m_lights_Box;
   uvec2 m_scene_m_lights_Disc;
-  uint m_scene_m_boxes_size;
-  uint m_scene_m_boxes_capacity;
-  uint m_scene_m_lightBoxes_size;
-  uint m_scene_m_lightBoxes_capacity;
-  uint m_scene_m_shapes_size;
-  uint m_scene_m_lights_size;
+  uint crt_m_scene_m_boxes_size;
+  uint crt_m_scene_m_boxes_capacity;
+  uint crt_m_scene_m_lightBoxes_size;
+  uint crt_m_scene_m_lightBoxes_capacity;
+  uint crt_m_scene_m_shapes_size;
+  uint crt_m_scene_m_lights_size;
 };
-layout(std430, binding = 1) readonly buffer originsBuffer
+layout(std430, binding = 1) readonly buffer crt_originsBuffer
 {
   vec4 origins[];
 };  // parameter 'origins'
-layout(std430, binding = 2) readonly buffer dirsBuffer
+layout(std430, binding = 2) readonly buffer crt_dirsBuffer
 {
   vec4 dirs[];
 };  // parameter 'dirs'
-layout(std430, binding = 3) buffer hitsBuffer
+layout(std430, binding = 3) buffer crt_hitsBuffer
 {
   ShapeHit hits[];
 };  // parameter 'hits'
-layout(std430, binding = 4) buffer m_scene_m_boxesBuffer
+layout(std430, binding = 4) buffer crt_m_scene_m_boxesBuffer
 {
   vec4 m_scene_m_boxes[];
 };  // composed: std::vector ShapeScene::m_boxes through m_scene
-layout(std430, binding = 5) buffer m_scene_m_lightBoxesBuffer
+layout(std430, binding = 5) buffer crt_m_scene_m_lightBoxesBuffer
 {
   vec4 m_scene_m_lightBoxes[];
 };  // composed: std::vector ShapeScene::m_lightBoxes through m_scene
 
-layout(push_constant) uniform kernel1D_TraceArgs
+layout(push_constant) uniform crt_kernel1D_TraceArgs
 {
   int crt_startX;
   uint crt_countX;
@@ -320,13 +320,13 @@ ShapeHit m_scene_Trace(vec4 posAndNear, vec4 dirAndFar)
   hit.shape = ~0u;
   hit.nx = hit.ny = hit.nz = 0.0;
   hit.pad0 = hit.pad1 = hit.pad2 = 0.0;
-  const uint count = m_scene_m_boxes_size / 2u;
+  const uint count = crt_m_scene_m_boxes_size / 2u;
   for (uint i = 0u; i < count; ++i)
     if (m_scene_HitsBox(posAndNear, dirAndFar, hit.t, m_scene_m_boxes[2u * i], m_scene_m_boxes[2u * i + 1u]))
       m_scene_m_shapes_Intersect(uint(i), posAndNear, dirAndFar, i, hit);
   ShapeHit light = hit;
   light.shape = ~0u;
-  for (uint i = 0u; i < m_scene_m_lights_size; ++i)
+  for (uint i = 0u; i < crt_m_scene_m_lights_size; ++i)
     if (m_scene_HitsBox(posAndNear, dirAndFar, light.t, m_scene_m_lightBoxes[2u * i],
                         m_scene_m_lightBoxes[2u * i + 1u]))
       m_scene_m_lights_Intersect(uint(i), posAndNear, dirAndFar, i, light);

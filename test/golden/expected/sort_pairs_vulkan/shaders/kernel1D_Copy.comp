@@ -5,21 +5,21 @@
 layout(local_size_x = 256, local_size_y = 1, local_size_z = 1) in;
 
 // Data members of SortPairs, uploaded before every control function call.
-layout(std430, binding = 0) buffer SortPairsData
+layout(std430, binding = 0) buffer crt_SortPairsData
 {
-  uint m_pairs_size;
-  uint m_pairs_capacity;
+  uint crt_m_pairs_size;
+  uint crt_m_pairs_capacity;
 };
-layout(std430, binding = 1) buffer a_outBuffer
+layout(std430, binding = 1) buffer crt_a_outBuffer
 {
   uvec2 a_out[];
 };  // parameter 'a_out'
-layout(std430, binding = 2) buffer m_pairsBuffer
+layout(std430, binding = 2) buffer crt_m_pairsBuffer
 {
   uvec2 m_pairs[];
 };  // member std::vector m_pairs
 
-layout(push_constant) uniform kernel1D_CopyArgs
+layout(push_constant) uniform crt_kernel1D_CopyArgs
 {
   int crt_startX;
   uint crt_countX;

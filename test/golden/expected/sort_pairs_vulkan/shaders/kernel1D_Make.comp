@@ -5,17 +5,17 @@
 layout(local_size_x = 256, local_size_y = 1, local_size_z = 1) in;
 
 // Data members of SortPairs, uploaded before every control function call.
-layout(std430, binding = 0) buffer SortPairsData
+layout(std430, binding = 0) buffer crt_SortPairsData
 {
-  uint m_pairs_size;
-  uint m_pairs_capacity;
+  uint crt_m_pairs_size;
+  uint crt_m_pairs_capacity;
 };
-layout(std430, binding = 1) buffer m_pairsBuffer
+layout(std430, binding = 1) buffer crt_m_pairsBuffer
 {
   uvec2 m_pairs[];
 };  // member std::vector m_pairs
 
-layout(push_constant) uniform kernel1D_MakeArgs
+layout(push_constant) uniform crt_kernel1D_MakeArgs
 {
   int crt_startX;
   uint crt_countX;

@@ -19,25 +19,25 @@ struct SphereHit
 };
 
 // Data members of SpherePaths, uploaded before every control function call.
-layout(std430, binding = 0) buffer SpherePathsData
+layout(std430, binding = 0) buffer crt_SpherePathsData
 {
   vec4 m_cameraPos;
   int m_maxDepth;
   float m_tanHalfFov;
   float m_timeMs;
-  uint m_spheres_size;
-  uint m_spheres_capacity;
+  uint crt_m_spheres_size;
+  uint crt_m_spheres_capacity;
 };
-layout(std430, binding = 1) buffer out_colorBuffer
+layout(std430, binding = 1) buffer crt_out_colorBuffer
 {
   vec4 out_color[];
 };  // parameter 'out_color' of the kernels that name it so
-layout(std430, binding = 2) buffer m_spheresBuffer
+layout(std430, binding = 2) buffer crt_m_spheresBuffer
 {
   Sphere m_spheres[];
 };  // member std::vector m_spheres
 
-layout(push_constant) uniform Render_MegakernelArgs
+layout(push_constant) uniform crt_Render_MegakernelArgs
 {
   int crt_startX;
   int crt_startY;
@@ -87,7 +87,7 @@ void kernel_RayTrace(uint tidX, uint tidY, vec4 rayPos, vec4 rayDir, vec4 throug
   const vec3 origin = (rayPos).xyz;
   const vec3 dir = (rayDir).xyz;
   float nearest = 1e30;
-  for (int i = 0; i < int(m_spheres_size); i++)
+  for (int i = 0; i < int(crt_m_spheres_size); i++)
   {
     const vec3 center = (m_spheres[uint(i)].centerRadius).xyz;
     const float radius = m_spheres[uint(i)].centerRadius.w;

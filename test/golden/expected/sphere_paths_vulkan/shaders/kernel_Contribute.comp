@@ -11,25 +11,25 @@ struct Sphere
 };
 
 // Data members of SpherePaths, uploaded before every control function call.
-layout(std430, binding = 0) buffer SpherePathsData
+layout(std430, binding = 0) buffer crt_SpherePathsData
 {
   vec4 m_cameraPos;
   int m_maxDepth;
   float m_tanHalfFov;
   float m_timeMs;
-  uint m_spheres_size;
-  uint m_spheres_capacity;
+  uint crt_m_spheres_size;
+  uint crt_m_spheres_capacity;
 };
-layout(std430, binding = 1) readonly buffer colorPerThreadBuffer
+layout(std430, binding = 1) readonly buffer crt_colorPerThreadBuffer
 {
   vec4 colorPerThread[];
 };  // parameter 'color': one value per thread, kept between the kernels of a thread loop
-layout(std430, binding = 2) buffer out_colorBuffer
+layout(std430, binding = 2) buffer crt_out_colorBuffer
 {
   vec4 out_color[];
 };  // parameter 'out_color'
 
-layout(push_constant) uniform kernel_ContributeArgs
+layout(push_constant) uniform crt_kernel_ContributeArgs
 {
   int crt_startX;
   int crt_startY;

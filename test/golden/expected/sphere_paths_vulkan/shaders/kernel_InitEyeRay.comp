@@ -11,29 +11,29 @@ struct Sphere
 };
 
 // Data members of SpherePaths, uploaded before every control function call.
-layout(std430, binding = 0) buffer SpherePathsData
+layout(std430, binding = 0) buffer crt_SpherePathsData
 {
   vec4 m_cameraPos;
   int m_maxDepth;
   float m_tanHalfFov;
   float m_timeMs;
-  uint m_spheres_size;
-  uint m_spheres_capacity;
+  uint crt_m_spheres_size;
+  uint crt_m_spheres_capacity;
 };
-layout(std430, binding = 1) buffer rayPosPerThreadBuffer
+layout(std430, binding = 1) buffer crt_rayPosPerThreadBuffer
 {
   vec4 rayPosPerThread[];
 };  // parameter 'rayPos': one value per thread, kept between the kernels of a thread loop
-layout(std430, binding = 2) buffer rayDirPerThreadBuffer
+layout(std430, binding = 2) buffer crt_rayDirPerThreadBuffer
 {
   vec4 rayDirPerThread[];
 };  // parameter 'rayDir': one value per thread, kept between the kernels of a thread loop
-layout(std430, binding = 3) buffer throughputPerThreadBuffer
+layout(std430, binding = 3) buffer crt_throughputPerThreadBuffer
 {
   vec4 throughputPerThread[];
 };  // parameter 'throughput': one value per thread, kept between the kernels of a thread loop
 
-layout(push_constant) uniform kernel_InitEyeRayArgs
+layout(push_constant) uniform crt_kernel_InitEyeRayArgs
 {
   int crt_startX;
   int crt_startY;

@@ -18,41 +18,41 @@ struct SphereHit
 };
 
 // Data members of SpherePaths, uploaded before every control function call.
-layout(std430, binding = 0) buffer SpherePathsData
+layout(std430, binding = 0) buffer crt_SpherePathsData
 {
   vec4 m_cameraPos;
   int m_maxDepth;
   float m_tanHalfFov;
   float m_timeMs;
-  uint m_spheres_size;
-  uint m_spheres_capacity;
+  uint crt_m_spheres_size;
+  uint crt_m_spheres_capacity;
 };
-layout(std430, binding = 1) readonly buffer hitPerThreadBuffer
+layout(std430, binding = 1) readonly buffer crt_hitPerThreadBuffer
 {
   SphereHit hitPerThread[];
 };  // parameter 'hit': one value per thread, kept between the kernels of a thread loop
-layout(std430, binding = 2) buffer rayPosPerThreadBuffer
+layout(std430, binding = 2) buffer crt_rayPosPerThreadBuffer
 {
   vec4 rayPosPerThread[];
 };  // parameter 'rayPos': one value per thread, kept between the kernels of a thread loop
-layout(std430, binding = 3) buffer rayDirPerThreadBuffer
+layout(std430, binding = 3) buffer crt_rayDirPerThreadBuffer
 {
   vec4 rayDirPerThread[];
 };  // parameter 'rayDir': one value per thread, kept between the kernels of a thread loop
-layout(std430, binding = 4) buffer throughputPerThreadBuffer
+layout(std430, binding = 4) buffer crt_throughputPerThreadBuffer
 {
   vec4 throughputPerThread[];
 };  // parameter 'throughput': one value per thread, kept between the kernels of a thread loop
-layout(std430, binding = 5) buffer colorPerThreadBuffer
+layout(std430, binding = 5) buffer crt_colorPerThreadBuffer
 {
   vec4 colorPerThread[];
 };  // parameter 'color': one value per thread, kept between the kernels of a thread loop
-layout(std430, binding = 6) buffer m_spheresBuffer
+layout(std430, binding = 6) buffer crt_m_spheresBuffer
 {
   Sphere m_spheres[];
 };  // member std::vector m_spheres
 
-layout(push_constant) uniform kernel_NextBounceArgs
+layout(push_constant) uniform crt_kernel_NextBounceArgs
 {
   int crt_startX;
   int crt_startY;

@@ -18,37 +18,37 @@ struct SphereHit
 };
 
 // Data members of SpherePaths, uploaded before every control function call.
-layout(std430, binding = 0) buffer SpherePathsData
+layout(std430, binding = 0) buffer crt_SpherePathsData
 {
   vec4 m_cameraPos;
   int m_maxDepth;
   float m_tanHalfFov;
   float m_timeMs;
-  uint m_spheres_size;
-  uint m_spheres_capacity;
+  uint crt_m_spheres_size;
+  uint crt_m_spheres_capacity;
 };
-layout(std430, binding = 1) readonly buffer rayPosPerThreadBuffer
+layout(std430, binding = 1) readonly buffer crt_rayPosPerThreadBuffer
 {
   vec4 rayPosPerThread[];
 };  // parameter 'rayPos': one value per thread, kept between the kernels of a thread loop
-layout(std430, binding = 2) readonly buffer rayDirPerThreadBuffer
+layout(std430, binding = 2) readonly buffer crt_rayDirPerThreadBuffer
 {
   vec4 rayDirPerThread[];
 };  // parameter 'rayDir': one value per thread, kept between the kernels of a thread loop
-layout(std430, binding = 3) readonly buffer throughputPerThreadBuffer
+layout(std430, binding = 3) readonly buffer crt_throughputPerThreadBuffer
 {
   vec4 throughputPerThread[];
 };  // parameter 'throughput': one value per thread, kept between the kernels of a thread loop
-layout(std430, binding = 4) buffer hitPerThreadBuffer
+layout(std430, binding = 4) buffer crt_hitPerThreadBuffer
 {
   SphereHit hitPerThread[];
 };  // parameter 'hit': one value per thread, kept between the kernels of a thread loop
-layout(std430, binding = 5) buffer m_spheresBuffer
+layout(std430, binding = 5) buffer crt_m_spheresBuffer
 {
   Sphere m_spheres[];
 };  // member std::vector m_spheres
 
-layout(push_constant) uniform kernel_RayTraceArgs
+layout(push_constant) uniform crt_kernel_RayTraceArgs
 {
   int crt_startX;
   int crt_startY;
@@ -65,7 +65,7 @@ void kernel_RayTrace(uint tidX, uint tidY, vec4 rayPos, vec4 rayDir, vec4 throug
   const vec3 origin = (rayPos).xyz;
   const vec3 dir = (rayDir).xyz;
   float nearest = 1e30;
-  for (int i = 0; i < int(m_spheres_size); i++)
+  for (int i = 0; i < int(crt_m_spheres_size); i++)
   {
     const vec3 center = (m_spheres[uint(i)].centerRadius).xyz;
     const float radius = m_spheres[uint(i)].centerRadius.w;

@@ -5,24 +5,24 @@
 layout(local_size_x = 256, local_size_y = 1, local_size_z = 1) in;
 
 // Data members of StagedSaxpy, uploaded before every control function call.
-layout(std430, binding = 0) buffer StagedSaxpyData
+layout(std430, binding = 0) buffer crt_StagedSaxpyData
 {
   uint dummy;
 };
-layout(std430, binding = 1) buffer a_resBuffer
+layout(std430, binding = 1) buffer crt_a_resBuffer
 {
   float a_res[];
 };  // parameter 'a_res'
-layout(std430, binding = 2) readonly buffer a_in1Buffer
+layout(std430, binding = 2) readonly buffer crt_a_in1Buffer
 {
   float a_in1[];
 };  // parameter 'a_in1'
-layout(std430, binding = 3) readonly buffer a_in2Buffer
+layout(std430, binding = 3) readonly buffer crt_a_in2Buffer
 {
   float a_in2[];
 };  // parameter 'a_in2'
 
-layout(push_constant) uniform kernel1D_MultArgs
+layout(push_constant) uniform crt_kernel1D_MultArgs
 {
   int crt_startX;
   uint crt_countX;

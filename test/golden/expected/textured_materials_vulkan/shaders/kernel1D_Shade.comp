@@ -17,49 +17,49 @@ struct crt_TextureInfo
 };
 
 // Data members of TexturedMaterials, uploaded before every control function call.
-layout(std430, binding = 0) buffer TexturedMaterialsData
+layout(std430, binding = 0) buffer crt_TexturedMaterialsData
 {
-  uint m_albedo_size;
-  uint m_bumps_size;
+  uint crt_m_albedo_size;
+  uint crt_m_bumps_size;
 };
-layout(std430, binding = 1) readonly buffer texIdsBuffer
+layout(std430, binding = 1) readonly buffer crt_texIdsBuffer
 {
   uint texIds[];
 };  // parameter 'texIds'
-layout(std430, binding = 2) readonly buffer uvsBuffer
+layout(std430, binding = 2) readonly buffer crt_uvsBuffer
 {
   vec2 uvs[];
 };  // parameter 'uvs'
-layout(std430, binding = 3) buffer colorsBuffer
+layout(std430, binding = 3) buffer crt_colorsBuffer
 {
   vec4 colors[];
 };  // parameter 'colors'
-layout(std430, binding = 4) buffer heightsBuffer
+layout(std430, binding = 4) buffer crt_heightsBuffer
 {
   float heights[];
 };  // parameter 'heights'
-layout(std430, binding = 5) buffer texelsBuffer
+layout(std430, binding = 5) buffer crt_texelsBuffer
 {
   vec4 texels[];
 };  // parameter 'texels'
-layout(std430, binding = 6) readonly buffer m_albedoInfoBuffer
+layout(std430, binding = 6) readonly buffer crt_m_albedoInfoBuffer
 {
   crt_TextureInfo m_albedo_info[];
 };  // member std::vector<LiteImage::Texture2D<LiteMath::float4>> m_albedo: its textures' sizes and samplers
-layout(std430, binding = 7) readonly buffer m_albedoTexelBuffer
+layout(std430, binding = 7) readonly buffer crt_m_albedoTexelBuffer
 {
   vec4 m_albedo_texels[];
 };  // their texels, one texture after the other
-layout(std430, binding = 8) readonly buffer m_bumpsInfoBuffer
+layout(std430, binding = 8) readonly buffer crt_m_bumpsInfoBuffer
 {
   crt_TextureInfo m_bumps_info[];
 };  // member std::vector<LiteImage::Texture2D<float>> m_bumps: its textures' sizes and samplers
-layout(std430, binding = 9) readonly buffer m_bumpsTexelBuffer
+layout(std430, binding = 9) readonly buffer crt_m_bumpsTexelBuffer
 {
   float m_bumps_texels[];
 };  // their texels, one texture after the other
 
-layout(push_constant) uniform kernel1D_ShadeArgs
+layout(push_constant) uniform crt_kernel1D_ShadeArgs
 {
   int crt_startX;
   uint crt_countX;
@@ -211,9 +211,9 @@ vec4 Albedo(uint a_texId, vec2 a_uv)
 // from TexturedMaterials::kernel1D_Shade (TexturedMaterials.cpp)
 void kernel1D_Shade(int i)
 {
-  const uint id = texIds[i] % m_albedo_size;
+  const uint id = texIds[i] % crt_m_albedo_size;
   colors[i] = Albedo(id, uvs[i]);
-  const uint bump = texIds[i] % m_bumps_size;
+  const uint bump = texIds[i] % crt_m_bumps_size;
   heights[i] = m_bumps_sample(bump, uvs[i]) + float(m_bumps_width(bump));
   const ivec2 p = ivec2((i - (int(m_albedo_width(0u))) * (i / (int(m_albedo_width(0u))))),
                         ((i / 3) - (int(m_albedo_height(0u))) * ((i / 3) / (int(m_albedo_height(0u))))));

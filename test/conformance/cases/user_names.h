@@ -1,0 +1,30 @@
+// A class whose names are those the generated code used to derive from its names (issue 52): a
+// member vector's size and capacity in the class data (m_a_size, m_a_capacity), the GLSL block of
+// a buffer (a parameter's name + "Buffer"), the class data's block (the class's name + "Data").
+// Each once collided in the generated code; derived names now carry the reserved prefix crt_.
+#pragma once
+#include <cstdint>
+#include <vector>
+
+struct LookalikesData  // the class data's block was named so
+{
+  float bias;
+};
+
+class Lookalikes
+{
+public:
+  explicit Lookalikes(int n);
+  virtual ~Lookalikes() = default;
+  virtual void Run(int n, [[crossrt::size("n")]] const float* src, [[crossrt::size("n")]] float* srcBuffer);
+  virtual void CommitDeviceData() {}
+
+  std::vector<float> m_a;
+  uint32_t m_a_size = 7;      // m_a.size() in the class data was m_a_size
+  uint32_t m_a_capacity = 9;  // and its capacity m_a_capacity
+  LookalikesData m_data{0.25f};
+  float m_total = 0.0f;
+
+protected:
+  void kernel1D_Fill(int n, const float* src, float* srcBuffer);  // src's block was srcBuffer
+};
