@@ -169,7 +169,7 @@ private:
   std::set<std::string> m_toldUnknown;       // files said to belong to no class
   bool m_initialized = false, m_shutdown = false, m_stop = false, m_showDocument = false;
   int m_nextRequest = 1;
-  engine::AstCache m_cache{64, /*prepareLayers=*/true};
+  engine::AstCache m_cache{64, engine::AstCache::LayerPreparation::AfterParse};
   engine::SpirvCache m_spirv;
   std::mutex m_logMutex;
   std::ofstream m_log;

@@ -281,7 +281,7 @@ int main(int argc, char** argv) {
     std::cerr << "crossrtd: cannot listen on " << ep.socket << ": " << std::strerror(errno) << "\n";
     return 1;
   }
-  d.cache = std::make_unique<engine::AstCache>(d.maxAsts, /*prepareLayers=*/true);
+  d.cache = std::make_unique<engine::AstCache>(d.maxAsts, engine::AstCache::LayerPreparation::AfterReparse);
   d.Log("serving " + d.buildDir + " on " + ep.socket + " (idle timeout " + std::to_string(d.idleSeconds) +
         " s, at most " + std::to_string(d.maxAsts) + " cached ASTs)");
 

@@ -93,15 +93,27 @@ TEST_CASE("A header edit rebuilds the preamble over a kept layer of the system h
   REQUIRE(cache.Stats().layeredPreambles == 1);
   CHECK(std::any_of(r.inputs.begin(), r.inputs.end(), [](const std::string& f) { return f.find("/bits/stl_vector.h") != std::string::npos; }));
 
-  SECTION("a long-lived cache prepares the layer in the background after the first parse; the edit uses it")
+  SECTION("a long-lived cache prepares the layer in the background, after the first parse or the first reparse")
   {
     layered.Write(header);
-    AstCache prepared(32, /*prepareLayers=*/true);
+    AstCache prepared(32, AstCache::LayerPreparation::AfterParse);
     REQUIRE(Translate(layered.Request(), &prepared).ok);
     std::ofstream(layered.tc.dir / "user.h", std::ios::app) << "// edited\n";
     RequireSameAsCold(layered.Request(), prepared);
     CHECK(prepared.Stats().layers == 1);  // built once, whichever asked first
     CHECK(prepared.Stats().layeredPreambles == 1);
+    // The build daemon's cache: a class translated once (a cold build) costs no layer.
+    layered.Write(header);
+    AstCache daemon(32, AstCache::LayerPreparation::AfterReparse);
+    REQUIRE(Translate(layered.Request(), &daemon).ok);
+    REQUIRE(Translate(layered.Request(), &daemon).ok);  // the same text: the AST serves as it is
+    CHECK(daemon.Stats().layers == 0);
+    std::ofstream(layered.tc.dir / "Layered.cpp", std::ios::app) << "// a kernel file edit: parsed again\n";
+    REQUIRE(Translate(layered.Request(), &daemon).ok);
+    std::ofstream(layered.tc.dir / "user.h", std::ios::app) << "// then a header edit\n";
+    RequireSameAsCold(layered.Request(), daemon);
+    CHECK(daemon.Stats().layers == 1);
+    CHECK(daemon.Stats().layeredPreambles == 1);
   }
   SECTION("an include guard opens the prefix as #pragma once does")
   {

@@ -161,8 +161,8 @@ const std::string& AstCache::Handle::diagnostics() const {
 }
 bool AstCache::Handle::failed() const { return m_entry->failed || !m_entry->parsed; }
 
-AstCache::AstCache(size_t capacity, bool prepareLayers)
-    : m_capacity(std::max<size_t>(1, capacity)), m_prepareLayers(prepareLayers), m_layers(std::make_unique<SystemLayerCache>()) {}
+AstCache::AstCache(size_t capacity, LayerPreparation prepare)
+    : m_capacity(std::max<size_t>(1, capacity)), m_prepare(prepare), m_layers(std::make_unique<SystemLayerCache>()) {}
 AstCache::~AstCache() = default;
 
 // Parses the file over its preamble, building (or rebuilding, when a header or the #include
@@ -240,7 +240,7 @@ void AstCache::Handle::Entry::BuildPreamble(const clang::CompilerInvocation& inv
         // The layer fits. A preamble with errors is dropped, and the file is parsed over the layer
         // alone, which reports them.
         layer = std::move(over);
-        builtOverLayer = true;
+        builtOverLayer = built;
         if (!built) preambleIncludes = {};
         preambleIncludes.files.insert(layer->Headers().begin(), layer->Headers().end());
         return;
@@ -368,7 +368,8 @@ AstCache::Handle AstCache::Get(const std::string& file, const std::vector<std::s
   entry->printer->errors = 0;
   entry->failed = !entry->invocation || !entry->Parse(file, unsaved, *m_layers) || entry->printer->errors > 0;
   entry->RecordWhatWasRead(unsaved);
-  if (m_prepareLayers && !entry->layer && !entry->prefix.includes.empty())
+  const bool prepare = m_prepare == LayerPreparation::AfterParse || (m_prepare == LayerPreparation::AfterReparse && reparse);
+  if (prepare && !entry->layer && !entry->prefix.includes.empty())
     m_layers->Prepare(entry->flagsKey, std::make_shared<const clang::CompilerInvocation>(*entry->invocation), entry->prefix);
   std::lock_guard<std::mutex> guard(m_mutex);
   ++(reparse ? m_reparses : m_parses);

@@ -55,16 +55,19 @@ struct AstCacheStats {
   uint64_t parses = 0;     // from scratch
   uint64_t reparses = 0;   // reusing a cached AST and its preamble
   uint64_t reuses = 0;     // of those, an AST used as it was: nothing it read had changed
-  uint64_t layers = 0;             // system layers built (SystemLayer.h)
+  uint64_t layers = 0;             // system layers built or tried (SystemLayer.h)
   uint64_t layeredPreambles = 0;   // preambles built over one
 };
 
 class AstCache {
 public:
-  // `prepareLayers`: a cache that lives for many translations (the daemon's, the language server's)
-  // builds a source's system layer in the background after its first parse, so that even the first
-  // header edit finds it ready (SystemLayer.h).
-  explicit AstCache(size_t capacity = 32, bool prepareLayers = false);
+  // When a cache that lives for many translations builds a source's system layer (SystemLayer.h)
+  // in the background, so that a header edit finds it ready: never (the layer is built by the first
+  // header edit), once the source is parsed again (it is being edited: the build daemon's choice,
+  // whose cold builds parse hundreds of classes once each), or after its first parse (an editor has
+  // opened it: the language server's).
+  enum class LayerPreparation { None, AfterReparse, AfterParse };
+  explicit AstCache(size_t capacity = 32, LayerPreparation prepare = LayerPreparation::None);
   ~AstCache();
   AstCache(const AstCache&) = delete;
   AstCache& operator=(const AstCache&) = delete;
@@ -100,7 +103,7 @@ public:
 private:
   mutable std::mutex m_mutex;
   size_t m_capacity;
-  bool m_prepareLayers;
+  LayerPreparation m_prepare;
   uint64_t m_parses = 0, m_reparses = 0, m_reuses = 0, m_layeredPreambles = 0;
   std::map<std::string, std::shared_ptr<Handle::Entry>> m_entries;
   std::list<std::string> m_lru;  // most recently used first

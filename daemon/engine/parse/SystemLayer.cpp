@@ -80,9 +80,9 @@ std::shared_ptr<const SystemLayer> SystemLayer::Build(const clang::CompilerInvoc
   invocation->getPreprocessorOpts().ImplicitPCHInclude.clear();
   invocation->getPreprocessorOpts().clearRemappedFiles();
 
+  clang::IgnoringDiagConsumer ignore;  // a prefix that does not compile alone gets no layer
   clang::CompilerInstance compiler(std::make_shared<clang::PCHContainerOperations>());
   compiler.setInvocation(invocation);
-  clang::IgnoringDiagConsumer ignore;
   compiler.createDiagnostics(&ignore, /*ShouldOwnClient=*/false);
   compiler.createFileManager(files);
   if (!compiler.createTarget()) return nullptr;

@@ -8,13 +8,14 @@
 #include <clang/Lex/Preprocessor.h>
 #include <llvm/ADT/DenseMap.h>
 
+#include <cctype>
 #include <optional>
 
 namespace crossrt::engine {
 
 namespace {
 
-// True when nothing but white space and comments follows the line that `from` starts in.
+// True when nothing but white space and comments follows the line that `text` starts in.
 bool OnlyCommentsAfterLine(llvm::StringRef text) {
   size_t i = text.find('\n');
   if (i == llvm::StringRef::npos) return true;
@@ -35,7 +36,7 @@ bool OnlyCommentsAfterLine(llvm::StringRef text) {
   return true;
 }
 
-// True for `#pragma once` written at `hash`.
+// True for `#pragma once` written at the start of `text`.
 bool IsPragmaOnce(llvm::StringRef text) {
   text = text.ltrim();
   if (text.consume_front("#")) text = text.ltrim();
