@@ -57,7 +57,7 @@ row() { printf '| %-44s | %8d | %8d | %8.3f |\n' "$1" "$2" "$3" "$(echo "$3 / $2
 c=$(cold none); w=$(warm none);          row "no change (warm: manifest, daemon not asked)" "$c" "$w"
 w=$(warm none reparse);                   row "no change, manifest removed (daemon reparse)" "$c" "$w"
 c=$(cold kernel); w=$(warm kernel);      row "kernel body edit" "$c" "$w"
-c=$(cold header); w=$(warm header);      row "header edit (user part of the preamble rebuilt)" "$c" "$w"
+c=$(cold header); w=$(warm header);      row "header edit (user part of preamble rebuilt)" "$c" "$w"
 c=$(cold comment); w=$(warm comment);    row "comment-only edit (outputs byte-identical)" "$c" "$w"
 
 # A no-op build of an example: nothing changed, nothing runs.

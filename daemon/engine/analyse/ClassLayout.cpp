@@ -65,8 +65,8 @@ void FinishModel(ClassModel& model) {
   }
   for (auto& m : model.members) {
     if (!m.usedByKernels || m.kind != MemberKind::Image) continue;
-    fields.push_back({m.name + "_width", "uint32_t", "uint", 4, "", m.hostExpr + ".width()"});
-    fields.push_back({m.name + "_height", "uint32_t", "uint", 4, "", m.hostExpr + ".height()"});
+    fields.push_back({generated::ImageSizeField(m.name, "width"), "uint32_t", "uint", 4, "", m.hostExpr + ".width()"});
+    fields.push_back({generated::ImageSizeField(m.name, "height"), "uint32_t", "uint", 4, "", m.hostExpr + ".height()"});
   }
   for (auto& m : model.members)
     if (m.usedByKernels && m.kind == MemberKind::TextureArray) fields.push_back({generated::SizeField(m.name), "uint32_t", "uint", 4, "", "uint32_t(" + m.hostExpr + ".size())"});

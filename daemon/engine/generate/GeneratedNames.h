@@ -22,9 +22,12 @@ inline const std::string kPipelineClasses = "crt_pipelineClasses";  // the class
 
 // Names derived from the user's names carry the reserved prefix too, so that none can equal a user's
 // name (analyse/ReservedNames.cpp refuses user names under it): a member vector's size and capacity
-// in the class data (GLSL, ISPC and C++), and the GLSL blocks that hold a buffer.
+// in the class data (GLSL, ISPC and C++), an image's size (in the class data for a member, in the
+// push constants for a parameter) and its texture in GLSL, and the GLSL blocks that hold a buffer.
 inline std::string SizeField(const std::string& vector) { return "crt_" + vector + "_size"; }
 inline std::string CapacityField(const std::string& vector) { return "crt_" + vector + "_capacity"; }
+inline std::string ImageSizeField(const std::string& image, const std::string& widthOrHeight) { return "crt_" + image + "_" + widthOrHeight; }
+inline std::string TextureName(const std::string& image) { return "crt_" + image + "_texture"; }
 inline std::string BlockName(const std::string& variable) { return "crt_" + variable + "Buffer"; }
 
 }  // namespace crossrt::engine::generated

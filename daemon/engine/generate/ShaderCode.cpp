@@ -248,7 +248,7 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
     } else if (ib.use == ImageUse::Texture) {
       x.set("texture", true);
       x.set("prefix", prefix);
-      x.set("name", ib.member + "_texture");
+      x.set("name", generated::TextureName(ib.member));
       x.set("comment", what + ": sampled");
     } else {
       x.set("sampler", true);
@@ -315,9 +315,9 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
     if (p.isPointer || p.isThreadId) continue;
     Data s;
     if (p.isImage) {  // its size, as the host image has it (an empty image's device copy has one texel)
-      s.set("decl", "uint " + p.name + "_width");
+      s.set("decl", "uint " + generated::ImageSizeField(p.name, "width"));
       push.push_back(s);
-      s.set("decl", "uint " + p.name + "_height");
+      s.set("decl", "uint " + generated::ImageSizeField(p.name, "height"));
       push.push_back(s);
       continue;
     }

@@ -162,8 +162,8 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
     for (auto& p : k.params) {
       if (p.isPointer || p.isThreadId) continue;
       if (p.isImage) {
-        field("4", "uint32_t", p.name + "_width", p.name + ".width()");
-        field("4", "uint32_t", p.name + "_height", p.name + ".height()");
+        field("4", "uint32_t", generated::ImageSizeField(p.name, "width"), p.name + ".width()");
+        field("4", "uint32_t", generated::ImageSizeField(p.name, "height"), p.name + ".height()");
         continue;
       }
       field(std::to_string(p.std430Align), p.valueCppType, KernelPrinter::SafeName(p.name), p.narrowed ? p.valueCppType + "(" + p.name + ")" : p.name);

@@ -29,7 +29,7 @@ const FieldDecl* ThisMemberField(const clang::Expr* e) {
 std::string TexelOf(const ImageFormat& f, const std::string& load) { return f.texel == "vec4" ? load : load + ".x"; }
 
 // How GLSL names an image's storage image: a member by its name, a parameter by its name made safe
-// for GLSL. Its texture and size add "_texture", "_width", "_height" to the name as written.
+// for GLSL. Its texture and size are generated::TextureName and ImageSizeField of the name as written.
 std::string ImageName(const ValueDecl* image) {
   return isa<FieldDecl>(image) ? image->getNameAsString() : KernelPrinter::SafeName(image->getNameAsString());
 }

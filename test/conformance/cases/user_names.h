@@ -1,8 +1,12 @@
 // A class whose names are those the generated code used to derive from its names (issue 52): a
-// member vector's size and capacity in the class data (m_a_size, m_a_capacity), the GLSL block of
-// a buffer (a parameter's name + "Buffer"), the class data's block (the class's name + "Data").
-// Each once collided in the generated code; derived names now carry the reserved prefix crt_.
+// member vector's size and capacity in the class data (m_a_size, m_a_capacity), an image's width
+// (m_img_width), the GLSL block of a buffer (a parameter's name + "Buffer"), the class data's block
+// (the class's name + "Data"). Each once collided in the generated code; derived names now carry
+// the reserved prefix crt_.
 #pragma once
+#include "Image2d.h"
+#include "LiteMath.h"
+
 #include <cstdint>
 #include <vector>
 
@@ -23,6 +27,8 @@ public:
   uint32_t m_a_size = 7;      // m_a.size() in the class data was m_a_size
   uint32_t m_a_capacity = 9;  // and its capacity m_a_capacity
   LookalikesData m_data{0.25f};
+  LiteImage::Image2D<LiteMath::float4> m_img;
+  uint32_t m_img_width = 3;  // m_img.width() in the class data was m_img_width
   float m_total = 0.0f;
 
 protected:

@@ -2,6 +2,7 @@
 // textures sampled with a LiteImage::Sampler, and arrays of textures (descriptor indexing).
 #include "print/glsl/GlslPrinter.h"
 #include "analyse/AstQueries.h"
+#include "generate/GeneratedNames.h"
 #include "print/GlslTypes.h"
 #include "print/PrinterParts.h"
 
@@ -39,7 +40,7 @@ std::string GlslPrinter::ImageCall(const ValueDecl* image, const CXXMemberCallEx
   if (!format) return "/*error*/";
   if (method == "width" || method == "height") {
     m_uses.sizedImages.insert(image);
-    return image->getNameAsString() + "_" + method;
+    return generated::ImageSizeField(image->getNameAsString(), method);
   }
   if (method == "at") {
     std::string coord;
@@ -57,7 +58,7 @@ std::string GlslPrinter::ImageCall(const ValueDecl* image, const CXXMemberCallEx
     const FieldDecl* sampler = SampledWith(image, *format, call);
     if (!sampler) return "/*error*/";
     // Compute shaders have no derivatives: sample the one mip level explicitly.
-    return TexelOf(*format, "textureLod(sampler2D(" + image->getNameAsString() + "_texture, " + sampler->getNameAsString() + "), " + Expr(call->getArg(1)) + ", 0.0)");
+    return TexelOf(*format, "textureLod(sampler2D(" + generated::TextureName(image->getNameAsString()) + ", " + sampler->getNameAsString() + "), " + Expr(call->getArg(1)) + ", 0.0)");
   }
   return Fail(call->getBeginLoc(), "Image2D::" + method + " is not supported in kernels",
               "kernels read texels (" + image->getNameAsString() + "[p], at(x, y), sample(sampler, uv)), write them (" + image->getNameAsString() +
