@@ -3,10 +3,11 @@
 // Each entry is a ParsedFile keyed by (source file, compile arguments). The first request builds a
 // precompiled preamble (the #include block) in memory and parses the file over it; later ones parse
 // the file again over the same preamble as long as no header changed: milliseconds instead of a
-// few hundred. The preamble skips the bodies of functions in system headers (the C++ library), which
-// kernels call by name, if at all; the user's headers keep theirs. The cache
-// holds at most `capacity` entries and evicts the least recently used. An AstCache that a single
-// translation creates and drops gives plain, uncached parsing.
+// few hundred. A header edit rebuilds only the user's part of the preamble, over a kept PCH of the
+// system headers the source starts with (SystemLayer.h). The preamble skips the bodies of functions
+// in system headers (the C++ library), which kernels call by name, if at all; the user's headers
+// keep theirs. The cache holds at most `capacity` entries and evicts the least recently used. An
+// AstCache that a single translation creates and drops gives plain, uncached parsing.
 #pragma once
 #include "parse/IncludesSeen.h"
 
