@@ -66,4 +66,4 @@ t=(); for i in 1 2 3 4 5; do t+=("$(time_ms cmake --build "$build" --target bloo
 noop=$(median "${t[@]}")
 echo
 echo "no-op 'cmake --build --target bloom' (2 translated classes): ${noop} ms, $(( noop / 2 )) ms per class"
-"$crossrt" daemon status --build-dir "$work" | sed -n '1p;/cached ASTs/p;/AST hit rate/p'
+"$crossrt" daemon status --build-dir "$work" | sed -n '1p;/cached ASTs/p;/AST hit rate/p;/preambles/p'

@@ -169,7 +169,7 @@ int DaemonCommand(const std::string& what, const std::string& buildDir, bool asJ
   std::printf("  AST hit rate    %.0f%% (%llu reparses, %llu of them ASTs used as they were, %llu parses)\n",
               100.0 * s.value("astHitRate", 0.0), (unsigned long long)s.value("reparses", 0ull),
               (unsigned long long)s.value("reuses", 0ull), (unsigned long long)s.value("parses", 0ull));
-  std::printf("  preambles       %llu built over the %llu system-header layers built\n",
+  std::printf("  preambles       %llu built over a layer of system headers (%llu layers built)\n",
               (unsigned long long)s.value("layeredPreambles", 0ull), (unsigned long long)s.value("systemLayers", 0ull));
   printRejections();
   return 0;
