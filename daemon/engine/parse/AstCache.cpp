@@ -3,6 +3,7 @@
 // are evicted.
 #include "parse/AstCache.h"
 
+#include "parse/FileStamps.h"
 #include "parse/SystemLayer.h"
 #include "parse/SystemPrefix.h"
 
@@ -21,7 +22,6 @@
 #include <clang/Lex/PreprocessorOptions.h>
 #include <clang/Serialization/PCHContainerOperations.h>
 #include <llvm/ADT/SmallString.h>
-#include <llvm/Support/FileSystem.h>
 #include <llvm/Support/MemoryBuffer.h>
 #include <llvm/Support/Path.h>
 #include <llvm/Support/VirtualFileSystem.h>
@@ -128,7 +128,7 @@ struct AstCache::Handle::Entry {
   // unsaved buffers, and the size and time of every file it read from disk.
   bool reusable = false;
   std::map<std::string, std::string> parsedUnsaved;
-  std::vector<std::pair<std::string, std::pair<uint64_t, llvm::sys::TimePoint<>>>> parsedFiles;
+  FileStamps parsedFiles;
 
   ~Entry() { EndParse(); }
   bool Parse(const std::string& file, const std::map<std::string, std::string>& unsaved, SystemLayerCache& layers);
@@ -279,14 +279,10 @@ bool AstCache::Handle::Entry::BuildPreambleOver(const clang::CompilerInvocation&
 void AstCache::Handle::Entry::RecordWhatWasRead(const std::map<std::string, std::string>& unsaved) {
   reusable = false;
   parsedUnsaved = unsaved;
-  parsedFiles.clear();
+  parsedFiles.Clear();
   if (!parsed) return;
-  for (const std::string& name : parsed->Includes().files) {
-    if (unsaved.count(name)) continue;
-    llvm::sys::fs::file_status status;
-    if (llvm::sys::fs::status(name, status)) return;  // cannot tell whether it changes: parse again next time
-    parsedFiles.push_back({name, {status.getSize(), status.getLastModificationTime()}});
-  }
+  for (const std::string& name : parsed->Includes().files)
+    if (!unsaved.count(name) && !parsedFiles.Add(name)) return;  // cannot tell whether it changes: parse again next time
   reusable = true;
 }
 
@@ -298,11 +294,7 @@ bool AstCache::Handle::Entry::Unchanged(const std::string& file, const std::map<
     auto buffer = llvm::MemoryBuffer::getFile(file);
     if (!buffer || (*buffer)->getBuffer() != mainBuffer->getBuffer()) return false;
   }
-  for (auto& [name, seen] : parsedFiles) {
-    llvm::sys::fs::file_status status;
-    if (llvm::sys::fs::status(name, status) || status.getSize() != seen.first || status.getLastModificationTime() != seen.second) return false;
-  }
-  return true;
+  return !parsedFiles.AnyChanged();
 }
 
 AstCache::Handle AstCache::Get(const std::string& file, const std::vector<std::string>& args,

@@ -11,7 +11,6 @@
 #include <clang/Lex/PreprocessorOptions.h>
 #include <clang/Serialization/ASTWriter.h>
 #include <clang/Serialization/PCHContainerOperations.h>
-#include <llvm/Support/FileSystem.h>
 #include <llvm/Support/MemoryBuffer.h>
 #include <llvm/Support/VirtualFileSystem.h>
 
@@ -105,24 +104,14 @@ std::shared_ptr<const SystemLayer> SystemLayer::Build(const clang::CompilerInvoc
   memory->addFile(layer->m_pchPath, 0,
                   llvm::MemoryBuffer::getMemBufferCopy(llvm::StringRef(pch->Data.data(), pch->Data.size()), layer->m_pchPath));
   layer->m_files = files;
-  for (const std::string& name : layer->m_headers) {
-    llvm::sys::fs::file_status status;
-    if (llvm::sys::fs::status(name, status)) return nullptr;  // cannot tell when it changes
-    layer->m_headerStatus.push_back({name, {status.getSize(), status.getLastModificationTime()}});
-  }
+  for (const std::string& name : layer->m_headers)
+    if (!layer->m_headerStamps.Add(name)) return nullptr;  // cannot tell when it changes
   return layer;
 }
 
 llvm::IntrusiveRefCntPtr<llvm::vfs::FileSystem> SystemLayer::FileSystem() const { return m_files; }
 
-bool SystemLayer::Stale() const {
-  for (auto& [name, seen] : m_headerStatus) {
-    llvm::sys::fs::file_status status;
-    if (llvm::sys::fs::status(name, status) || status.getSize() != seen.first || status.getLastModificationTime() != seen.second)
-      return true;
-  }
-  return false;
-}
+bool SystemLayer::Stale() const { return m_headerStamps.AnyChanged(); }
 
 SystemLayerCache::~SystemLayerCache() {
   std::lock_guard<std::mutex> guard(m_backgroundMutex);

@@ -7,10 +7,10 @@
 // through the layer's file system. Like the preamble, the layer skips the bodies of functions (all
 // of them are in system headers).
 #pragma once
+#include "parse/FileStamps.h"
 #include "parse/SystemPrefix.h"
 
 #include <llvm/ADT/IntrusiveRefCntPtr.h>
-#include <llvm/Support/Chrono.h>
 
 #include <cstdint>
 #include <list>
@@ -48,7 +48,7 @@ private:
   std::string m_pchPath;
   llvm::IntrusiveRefCntPtr<llvm::vfs::FileSystem> m_files;
   std::set<std::string> m_headers;
-  std::vector<std::pair<std::string, std::pair<uint64_t, llvm::sys::TimePoint<>>>> m_headerStatus;
+  FileStamps m_headerStamps;
 };
 
 // The layers built so far, shared between the AST cache's entries; the least recently used is
