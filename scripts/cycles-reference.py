@@ -7,7 +7,8 @@ Usage (everything after "--" belongs to this script):
         [--size WxH] [--spp N] [--depth D] [--seed S] \\
         [--env FILE.exr] [--env-strength F] [--threads T] \\
         [--time-log CSV] [--default-camera] [--camera NAME] \\
-        [--lighting-mode SPEC|COMPAT|RAW] [--cycles-lights]
+        [--lighting-mode SPEC|COMPAT|RAW] [--cycles-lights] \\
+        [--materials matched|imported|imported-burley]
 
     blender -b --factory-startup --python scripts/cycles-reference.py -- --help
 
@@ -21,7 +22,10 @@ What it does
      (io_scene_gltf2; numpy.bool is aliased first, the importer needs it).
   2. Picks the camera: --camera NAME, else the first glTF node (in node index
      order) that has a camera, else the default camera (see below).
-  3. Material fix-ups so Cycles renders what CrossRT models:
+  3. Material fix-ups so Cycles renders what CrossRT models (--materials
+     matched, the default; --materials imported leaves the importer's
+     Principled BSDFs as they are, and imported-burley only sets Specular 0
+     on its non-metals, to measure its diffuse model alone):
      * "Pure diffuse" materials -- metallicFactor 0, no transmission (absent
        or transmissionFactor 0), KHR_materials_specular.specularFactor 0, and
        no clearcoat/sheen -- are Lambertian in CrossRT.  The importer turns
@@ -207,6 +211,15 @@ def parse_args():
                    default="SPEC",
                    help="glTF importer's punctual light unit conversion "
                         "(default SPEC)")
+    p.add_argument("--materials", choices=("matched", "imported", "imported-burley"),
+                   default="matched",
+                   help="matched (default): the material fix-ups of step 3, "
+                        "so that Cycles renders glTF's BRDF as CrossRT does; "
+                        "imported: the importer's Principled BSDFs as they "
+                        "come (Blender 3.4: Burley's diffuse with a specular "
+                        "layer added on top), as a user who imports the file "
+                        "sees them; imported-burley: the same with Specular 0 "
+                        "on non-metals (Burley's diffuse alone)")
     return p.parse_args(argv)
 
 
@@ -511,27 +524,63 @@ def lambert(tree, p):
     return diffuse.outputs["BSDF"]
 
 
+# Ours weighs the base of glTF's dielectric by 1 - F(v.h), with Schlick's F of
+# the microfacet normal h = normalize(v + l).  Averaged over the directions l
+# light comes from (cosine-weighted), that is 1 - F0 - (1 - F0) g(n.v), with
+#   g(mu) = integral over the hemisphere of (1 - v.h)^5 cos(l) / pi dl,
+# which depends on the view alone.  These are a fit of g in t = 1 - mu
+# (numerical integration, 800 x 1600 directions; the fit is within 8e-6 of it;
+# g(1) = 0.00008, g(0.5) = 0.0050, g(0) = 0.028).
+BASE_FRESNEL_FIT = (8.95188019e-03, 7.79726926e-03, 9.30993250e-03,
+                    2.02211075e-03, 8.23312910e-05)
+
+
+def math_node(tree, operation, a, b=None, c=None):
+    """A Math node; each input is a socket or a number."""
+    node = tree.nodes.new("ShaderNodeMath")
+    node.operation = operation
+    for i, value in enumerate((a, b, c)):
+        if value is None:
+            continue
+        if isinstance(value, (int, float)):
+            node.inputs[i].default_value = value
+        else:
+            tree.links.new(value, node.inputs[i])
+    return node.outputs["Value"]
+
+
+def base_fresnel(tree, p, f0):
+    """The share of light the base of glTF's dielectric loses to its
+    specular layer, seen from the view direction: F0 + (1 - F0) g(n.v)."""
+    geometry = tree.nodes.new("ShaderNodeNewGeometry")
+    geometry.location = (p.location[0] - 400, p.location[1] + 150)
+    normal = geometry.outputs["Normal"]
+    if p.inputs["Normal"].is_linked:
+        normal = p.inputs["Normal"].links[0].from_socket
+    dot = tree.nodes.new("ShaderNodeVectorMath")
+    dot.operation = "DOT_PRODUCT"
+    tree.links.new(geometry.outputs["Incoming"], dot.inputs[0])
+    tree.links.new(normal, dot.inputs[1])
+    mu = math_node(tree, "ABSOLUTE", dot.outputs["Value"])
+    t = math_node(tree, "SUBTRACT", 1.0, mu)
+    g = BASE_FRESNEL_FIT[0]
+    for c in BASE_FRESNEL_FIT[1:]:  # Horner: g = g t + c
+        g = math_node(tree, "MULTIPLY_ADD", g, t, c)
+    return math_node(tree, "MULTIPLY_ADD", g, 1.0 - f0, f0)
+
+
 def gltf_dielectric(tree, p, ior, specular):
     """glTF 2.0's dielectric BRDF as CrossRT evaluates it: a GGX reflection
     whose Fresnel follows the microfacet normal (the Principled BSDF itself,
     black, so that only its specular layer is left: Specular = F0 / 0.08 for
     F0 from the IOR times KHR_materials_specular's factor) plus a Lambert base
-    weighted by 1 - Fresnel.  Cycles' weight is the Fresnel of the shading
-    normal, CrossRT's that of the microfacet normal: the same at roughness 0,
-    a few percent apart in the base at roughness 1."""
+    weighted by 1 - F(v.h) averaged over the light's directions (see
+    base_fresnel): exact for light that comes from all directions alike, as in
+    a room; a Fresnel node (of the shading normal) would take the base away
+    at grazing views, where CrossRT keeps 97% of it."""
     base = lambert(tree, p)
-    fresnel = tree.nodes.new("ShaderNodeFresnel")
-    fresnel.location = (p.location[0], p.location[1] + 150)
-    fresnel.inputs["IOR"].default_value = ior
-    if p.inputs["Normal"].is_linked:
-        copy_input(tree, p.inputs["Normal"], fresnel.inputs["Normal"])
-    weight = fresnel.outputs["Fac"]
-    if specular != 1.0:
-        scale = tree.nodes.new("ShaderNodeMath")
-        scale.operation = "MULTIPLY"
-        tree.links.new(weight, scale.inputs[0])
-        scale.inputs[1].default_value = specular
-        weight = scale.outputs["Value"]
+    f0 = ((ior - 1.0) / (ior + 1.0)) ** 2 * specular
+    weight = base_fresnel(tree, p, f0)
     under = tree.nodes.new("ShaderNodeMixShader")  # (1 - F) base + F nothing
     under.location = (p.location[0] + 200, p.location[1])
     tree.links.new(weight, under.inputs["Fac"])
@@ -541,7 +590,6 @@ def gltf_dielectric(tree, p, ior, specular):
     coat.distribution = "GGX"
     coat.inputs["Base Color"].default_value = (0.0, 0.0, 0.0, 1.0)
     coat.inputs["Metallic"].default_value = 0.0
-    f0 = ((ior - 1.0) / (ior + 1.0)) ** 2 * specular
     coat.inputs["Specular"].default_value = f0 / 0.08
     coat.inputs["Specular Tint"].default_value = 0.0
     coat.inputs["Sheen"].default_value = 0.0
@@ -603,7 +651,20 @@ def replace_principled(mat, surface, kind):
     return "+".join(parts)
 
 
-def fix_materials(scene, gltf):
+def fix_materials(scene, gltf, mode):
+    if mode != "matched":
+        unlayered = []
+        for m in bpy.data.materials:
+            for n in (m.node_tree.nodes if m.node_tree else []):
+                if n.bl_idname == "ShaderNodeBsdfPrincipled" and \
+                        mode == "imported-burley" and \
+                        not n.inputs["Metallic"].is_linked and \
+                        n.inputs["Metallic"].default_value == 0.0:
+                    n.inputs["Specular"].default_value = 0.0
+                    unlayered.append(m.name)
+        note("materials as imported%s" % (
+            "; Specular 0 on %s" % ", ".join(unlayered) if unlayered else ""))
+        return
     classes, f0 = {}, {}
     for i, m in enumerate(gltf.get("materials", [])):
         name = m.get("name") or "Material_%d" % i
@@ -813,7 +874,7 @@ def main():
             camera.data.clip_end))
 
     fix_lights(scene, not args.cycles_lights)
-    fix_materials(scene, gltf)
+    fix_materials(scene, gltf, args.materials)
     configure_render(scene, args)
     configure_world(scene, args.env, args.env_strength)
     note("Cycles: depth %d, seed %d, sampling pattern %s, threads %s"
