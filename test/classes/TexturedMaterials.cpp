@@ -18,7 +18,7 @@ void TexturedMaterials::kernel1D_Shade(int n, const uint32_t* texIds, const floa
     const uint32_t id = texIds[i] % uint32_t(m_albedo.size());
     colors[i] = Albedo(id, uvs[i]);
     const uint32_t bump = texIds[i] % uint32_t(m_bumps.size());
-    heights[i] = m_bumps[bump].sample(uvs[i]) + float(m_bumps[bump].width());
+    heights[i] = m_bumps[bump].sample(uvs[i]) + float(m_bumps[bump].width()) + m_bumps_sample + m_bumps_texel + m_bumps_width + m_bumps_info + m_bumps_texels;
     const int2 p = int2(i % int(m_albedo[0].width()), (i / 3) % int(m_albedo[0].height()));
     texels[i] = m_albedo[0][p];
   }

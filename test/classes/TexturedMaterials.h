@@ -23,6 +23,9 @@ public:
 
   std::vector<LiteImage::Texture2D<LiteMath::float4>> m_albedo;
   std::vector<LiteImage::Texture2D<float>> m_bumps;
+  // Names the GLSL once gave the functions and buffers of the array m_bumps (issue 52): kernels read
+  // them as the members they are.
+  float m_bumps_sample = 0.5f, m_bumps_texel = 0.25f, m_bumps_width = 0.125f, m_bumps_info = 0.0625f, m_bumps_texels = 0.03125f;
 
 protected:
   void kernel1D_Shade(int n, const uint32_t* texIds, const LiteMath::float2* uvs, LiteMath::float4* colors, float* heights,

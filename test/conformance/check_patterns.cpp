@@ -187,16 +187,16 @@ Register movingBoxes(MakeCase<MovingBoxes>(
 
 #if __has_include("Lookalikes_CPU.h")
 Register lookalikes(MakeCase<Lookalikes>(
-    "user names equal to names the generated code derived (m_a_size beside m_a, m_img_width beside m_img, a parameter srcBuffer beside src, a struct LookalikesData)",
+    "user names equal to names the generated code derived (m_a_size beside m_a, m_img_width beside m_img, a parameter srcBuffer beside src, a struct LookalikesData, m_totalLocal and m_totalShared beside a reduction of m_total)",
     "user_names.h/.cpp", 1e-6, CONFORMANCE_MAKERS(Lookalikes, 40), [](Lookalikes& l) {
       l.CommitDeviceData();
       std::vector<float> src(100), out(100, -1.0f);
       for (size_t i = 0; i < src.size(); i++) src[i] = 0.125f * float(i);
       l.Run(int(src.size()), src.data(), out.data());
       // a known answer: 7 (m_a_size) + 4.5 (m_a_capacity / 2) + 40 (m_a.size()) + 0.25 (bias) + 4 (m_img.width())
-      // + 3 (m_img_width) = 58.75, and a texel, 0.5 * (i % 4)
+      // + 3 (m_img_width) + 62 (m_totalLocal ... m_totalSubgroup) = 120.75, and a texel, 0.5 * (i % 4)
       for (size_t i = 0; i < out.size(); i++)
-        if (out[i] != src[i] + float(i % 40 % 5) + 58.75f + 0.5f * float(i % 4)) throw std::runtime_error("srcBuffer[" + std::to_string(i) + "] is " + std::to_string(out[i]));
+        if (out[i] != src[i] + float(i % 40 % 5) + 120.75f + 0.5f * float(i % 4)) throw std::runtime_error("srcBuffer[" + std::to_string(i) + "] is " + std::to_string(out[i]));
       Outputs r;
       Append(r, out);
       r.push_back(l.m_total);

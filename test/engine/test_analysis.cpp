@@ -204,12 +204,12 @@ TEST_CASE("The CPU backend parallelises kernels with OpenMP", "[engine]")
   REQUIRE(r.ok);
   const std::string cpp = Squeezed(r.files.at("Finder_CPU.cpp"));
   // (The formatter may continue the pragma on a second line.)
-  CHECK(cpp.find(Squeezed("#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1024) reduction(+:m_totalLocal)")) != std::string::npos);
-  CHECK(cpp.find(Squeezed("reduction(crossrt_min_vec3:m_loLocal) for (int i = 0; i < n; i++)")) != std::string::npos);
+  CHECK(cpp.find(Squeezed("#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1024) reduction(+:crt_m_totalLocal)")) != std::string::npos);
+  CHECK(cpp.find(Squeezed("reduction(crossrt_min_vec3:crt_m_loLocal) for (int i = 0; i < n; i++)")) != std::string::npos);
   // On all cores, or on this thread while that has been faster here (crossrt::ParallelChoice).
   CHECK(cpp.find(Squeezed("static crossrt::ParallelChoice crt_choice;")) != std::string::npos);
   CHECK(cpp.find(Squeezed("crt_choice.End(crt_loop);")) != std::string::npos);
-  CHECK(cpp.find(Squeezed("m_totalLocal += out[i];")) != std::string::npos);
+  CHECK(cpp.find(Squeezed("crt_m_totalLocal += out[i];")) != std::string::npos);
 }
 
 TEST_CASE("Target compile options: meaning-changing flags are kept, GCC-only ones dropped", "[engine]")

@@ -6,7 +6,9 @@
 //   - every BRDF is reciprocal, and the rough dielectric's BTDF obeys the generalised reciprocity of
 //     radiance scaled by 1 / eta^2 (Veach 1997, 5.2);
 //   - no NaN or inf at grazing and exactly tangent directions, zero roughness and the ends of the
-//     unit interval.
+//     unit interval;
+//   - the glTF dielectric's base keeps (1 - F0)(1 - g(n.v)) of a Lambertian base, the weight that
+//     scripts/cycles-reference.py gives Cycles to render the same BRDF.
 #include "Materials.h"
 
 #include <catch2/catch.hpp>
@@ -278,5 +280,41 @@ TEST_CASE("materials: no NaN or inf at grazing angles, zero roughness and the en
     }
     INFO(m.name << ": " << bad << " of " << evaluated << " results not finite");
     CHECK(bad == 0);
+  }
+}
+
+// glTF 2.0's dielectric weighs its Lambertian base by 1 - F(v.h), Schlick's Fresnel of the microfacet
+// normal. Seen from a view at cosine mu, the base then keeps (1 - F0)(1 - g(mu)) of the light that
+// comes from all directions alike, g(mu) being the integral of (1 - v.h)^5 cos / pi over the
+// hemisphere. scripts/cycles-reference.py weighs Cycles' Lambert base so, to render the same BRDF
+// (a Fresnel of the shading normal would leave nothing of the base at grazing views); these values
+// of g come from a numerical integration in Python (800 x 1600 directions), not from this code.
+TEST_CASE("materials: the glTF dielectric's base keeps (1 - F0)(1 - g(n.v)) of a Lambertian base", "[materials]")
+{
+  struct Expected { float mu, g; };
+  const Expected expected[] = {{1.0f, 8.19e-5f}, {0.8f, 9.35e-4f}, {0.5f, 4.957e-3f}, {0.2f, 1.5315e-2f}, {0.05f, 2.4386e-2f}};
+  GltfMetalRough white, black;
+  white.metallic = black.metallic = 0.0f;
+  white.roughness = black.roughness = 1.0f;
+  white.baseColor = float4(1.0f);
+  black.baseColor = float4(0.0f, 0.0f, 0.0f, 1.0f);
+  const MaterialInputs in = Untextured();
+  for (const Expected& e : expected)
+  {
+    // The base's share: the white material's albedo less the black one's (its specular layer),
+    // integrated over the hemisphere by the midpoint rule in (cos theta, phi).
+    const float3 wo = Direction(e.mu, 0.3f);
+    constexpr int kCos = 400, kPhi = 400;
+    double base = 0.0;
+    for (int a = 0; a < kCos; ++a)
+      for (int b = 0; b < kPhi; ++b)
+      {
+        const float3 wi = Direction((a + 0.5f) / kCos, (b + 0.5f) * 2.0f * kPi / kPhi);
+        base += double(white.Evaluate(wo, wi, in).x - black.Evaluate(wo, wi, in).x);
+      }
+    base *= (1.0 / kCos) * (2.0 * kPi / kPhi);  // d(omega) = d(cos theta) d(phi)
+    const double f0 = white.specularF0;
+    INFO("n.v " << e.mu << ": the base keeps " << base);
+    CHECK(std::fabs(base - (1.0 - f0) * (1.0 - e.g)) < 2e-4);
   }
 }

@@ -3,6 +3,7 @@
 // shader per implementation and the call that the ray generation shader makes.
 #include "analyse/Callables.h"
 #include "generate/CodeGenSupport.h"
+#include "generate/GeneratedNames.h"
 #include "print/Printers.h"
 #include "print/glsl/GlslPrinter.h"
 
@@ -58,7 +59,7 @@ void AddCallableShader(ASTContext& ctx, Reporter& rep, ClassModel& model, const 
 void CallableDispatcher(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& k, KernelPrinter& kernelPrinter, const VirtualMember& vm,
                         const std::vector<const CXXRecordDecl*>& impls, const CXXMethodDecl* m, SourceLocation callLoc,
                         const std::map<std::string, std::pair<GlslDecl, GlslDecl>>& implData, CallableCode& out) {
-  const std::string method = m->getNameAsString(), callName = vm.member + "_" + method, variable = callName + "_call";
+  const std::string method = m->getNameAsString(), callName = generated::VirtualDispatcher(vm.member, method), variable = callName + "_call";
   const std::string display = vm.display + "[index]->" + method + (m->getNumParams() ? "(...)" : "()");
   auto ret = kernelPrinter.Type(m->getReturnType(), m->getLocation());
   const std::string retType = ret ? *ret : "void";
@@ -274,8 +275,8 @@ void VirtualCallCode(ASTContext& ctx, Reporter& rep, ClassModel& model, Kernel& 
         const auto& vi = vm.impls[t];
         // Level 1: all elements in one array of equal slots; level 2: each class's objects apart.
         // (ISPC, at every level: an array per class that the class data points at.)
-        const std::string address = member + (model.virtualLevel == 1 ? std::string("_objects") : "_" + vi.name);
-        std::string args = ispc ? "self->" + member + "_" + vi.name + "[slot]" : member + "_" + vi.name + "Objects(" + address + ").objects[tag.y]";
+        const std::string address = model.virtualLevel == 1 ? generated::VirtualSlotsField(member) : generated::VirtualClassField(member, vi.name);
+        std::string args = ispc ? "self->" + generated::VirtualClassField(member, vi.name) + "[slot]" : member + "_" + vi.name + "Objects(" + address + ").objects[tag.y]";
         for (unsigned i = 0; i < m->getNumParams(); ++i)  // the caller itself: GLSL leaves it out, ISPC passes the class data
           if (!KernelPrinter::PointsTo(m->getParamDecl(i)->getType(), kernelPrinter.Class())) args += ", " + CallArgumentName(m, i);
           else if (ispc) args += ", self";

@@ -72,12 +72,12 @@ void FinishModel(ClassModel& model) {
     if (m.usedByKernels && m.kind == MemberKind::TextureArray) fields.push_back({generated::SizeField(m.name), "uint32_t", "uint", 4, "", "uint32_t(" + m.hostExpr + ".size())"});
   // Virtual functions: where each vector's tags and each implementation's objects are on the device.
   for (auto& v : model.virtuals) {
-    fields.push_back({v.member + "_tags", "uint64_t", "uvec2", 8, "", generated::kVirtualObjects + "." + v.member + "_tags.Address()"});
+    fields.push_back({generated::VirtualTagsField(v.member), "uint64_t", "uvec2", 8, "", generated::kVirtualObjects + "." + v.member + "_tags.Address()"});
     fields.push_back({generated::SizeField(v.member), "uint32_t", "uint", 4, "", "uint32_t(" + v.hostExpr + ".size())"});
-    if (model.virtualLevel == 1) fields.push_back({v.member + "_objects", "uint64_t", "uvec2", 8, "", generated::kVirtualObjects + "." + v.member + "_objects.Address()"});
+    if (model.virtualLevel == 1) fields.push_back({generated::VirtualSlotsField(v.member), "uint64_t", "uvec2", 8, "", generated::kVirtualObjects + "." + v.member + "_objects.Address()"});
     for (auto& impl : v.impls)
       if (model.virtualLevel >= 2)
-        fields.push_back({v.member + "_" + impl.name, "uint64_t", "uvec2", 8, "", generated::kVirtualObjects + "." + v.member + "_" + impl.name + ".Address()"});
+        fields.push_back({generated::VirtualClassField(v.member, impl.name), "uint64_t", "uvec2", 8, "", generated::kVirtualObjects + "." + v.member + "_" + impl.name + ".Address()"});
   }
   std::stable_sort(fields.begin(), fields.end(), [](const BlockField& a, const BlockField& b) { return a.std430Align > b.std430Align; });
   if (fields.empty()) fields.push_back({"dummy", "uint32_t", "uint", 4, "", ""});  // a block needs a member

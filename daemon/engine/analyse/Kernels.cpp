@@ -12,6 +12,7 @@
 #include "analyse/Naming.h"
 #include "analyse/VirtualCalls.h"
 #include "analyse/Writes.h"
+#include "generate/GeneratedNames.h"
 #include "print/ispc/IspcTypes.h"
 #include "print/Printers.h"
 
@@ -50,7 +51,7 @@ static std::string IspcThreadHead(Context& c, const Kernel& k, const std::vector
     if (p.isPointer) head += std::string(", ") + (p.isConstPointee ? "const " : "") + "uniform " + base + " *uniform " + p.glslName;
     else head += ", uniform " + base + " " + p.glslName + dims;
   }
-  for (auto& r : k.reductions) head += ", " + IspcTypeName(r.glslType) + " &" + r.member + "Local";
+  for (auto& r : k.reductions) head += ", " + IspcTypeName(r.glslType) + " &" + generated::ReductionLocal(r.member);
   return head + ")";
 }
 
@@ -309,7 +310,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
       r.identity = Identity(r.op, r.glslType);
       r.local = true;
       r.cppType = vd->getType().getUnqualifiedType().getAsString(c.ctx.getPrintingPolicy());
-      printer.renames[vd] = r.member + "Local";
+      printer.renames[vd] = generated::ReductionLocal(r.member);
       k.reductions.push_back(r);
     }
   if (k.rtv && !ws.reductions.empty()) {
@@ -330,7 +331,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     r.op = op;
     r.glslType = ReductionType(c, field->getType());
     r.identity = Identity(op, r.glslType);
-    printer.renames[field] = r.member + "Local";
+    printer.renames[field] = generated::ReductionLocal(r.member);
     k.reductions.push_back(r);
   }
   // After printing, the printer knows the helpers the kernel reaches: their writes count too.
@@ -393,7 +394,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
       for (unsigned a = 0; a < k.dims; ++a) anyThreads += std::string(a ? " && " : "") + "crt_count" + "XYZ"[a] + " != 0u";
       for (auto& r : k.reductions)
         if (r.local) {
-          const std::string total = r.member + "Partials[0]";
+          const std::string total = generated::ReductionPartials(r.member) + "[0]";
           const std::string combined = r.op == ReduceOp::Min ? "min(" + r.member + ", " + total + ")"
                                        : r.op == ReduceOp::Max ? "max(" + r.member + ", " + total + ")" : r.member + " + " + total;
           k.glslFinish += "  if (" + anyThreads + ")\n    " + r.member + " = " + combined + ";  // the threads' total\n";
@@ -513,8 +514,8 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
       Renamer(Rewriter& r, const std::map<const FieldDecl*, ReduceOp>& m) : rw(r), red(m) {}
       bool VisitMemberExpr(MemberExpr* me) {
         auto* f = dyn_cast<FieldDecl>(me->getMemberDecl());
-        if (f && red.count(f) && me->isImplicitAccess()) rw.ReplaceText(me->getMemberLoc(), f->getName().size(), f->getNameAsString() + "Local");
-        else if (f && red.count(f)) rw.ReplaceText(me->getSourceRange(), f->getNameAsString() + "Local");
+        if (f && red.count(f) && me->isImplicitAccess()) rw.ReplaceText(me->getMemberLoc(), f->getName().size(), generated::ReductionLocal(f->getNameAsString()));
+        else if (f && red.count(f)) rw.ReplaceText(me->getSourceRange(), generated::ReductionLocal(f->getNameAsString()));
         return true;
       }
     } renamer(rw, ws.reductions);

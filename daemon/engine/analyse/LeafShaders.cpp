@@ -4,6 +4,7 @@
 // and a miss shader per call. Takes the traversal's loops; gives Kernel::leaves and the shaders.
 #include "analyse/LeafShaders.h"
 #include "generate/CodeGenSupport.h"
+#include "generate/GeneratedNames.h"
 #include "print/glsl/GlslPrinter.h"
 
 #include "analyse/AstQueries.h"
@@ -402,8 +403,8 @@ std::string TraceLeafCall(ASTContext& ctx, Reporter& rep, const ClassModel& mode
     s.mainBody = (paperForm ? "  // The leaf is box gl_PrimitiveID of element gl_InstanceCustomIndexEXT of " + vm->display +
                                   " (an instance per element over its LeafBoxes).\n  const uint crt_element = uint(gl_InstanceCustomIndexEXT);\n"
                             : "  // The leaf is element gl_InstanceID of " + vm->display + " (one instance per element, in order).\n") +
-                 "  const uvec2 tag = " + member + "_Tags(" + member + "_tags).tags[" + (paperForm ? "crt_element" : "gl_InstanceID") + "];\n"
-                 "  const " + vi.name + "_Data self = " + member + "_" + vi.name + "Objects(" + member + "_" + vi.name + ").objects[tag.y];\n" + leafInfo +
+                 "  const uvec2 tag = " + member + "_Tags(" + generated::VirtualTagsField(member) + ").tags[" + (paperForm ? "crt_element" : "gl_InstanceID") + "];\n"
+                 "  const " + vi.name + "_Data self = " + member + "_" + vi.name + "Objects(" + generated::VirtualClassField(member, vi.name) + ").objects[tag.y];\n" + leafInfo +
                  "  // Nearer than the ray's end (the nearest hit so far) or nothing: the other fields start at zero.\n"
                  "  " + hitType + " hit;\n" + zeroHit + "  hit." + dist + " = gl_RayTmaxEXT;\n"
                  "  " + function + "(" + callArgs + ");\n"

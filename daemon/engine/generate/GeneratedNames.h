@@ -29,5 +29,22 @@ inline std::string CapacityField(const std::string& vector) { return "crt_" + ve
 inline std::string ImageSizeField(const std::string& image, const std::string& widthOrHeight) { return "crt_" + image + "_" + widthOrHeight; }
 inline std::string TextureName(const std::string& image) { return "crt_" + image + "_texture"; }
 inline std::string BlockName(const std::string& variable) { return "crt_" + variable + "Buffer"; }
+// A reduction of `member` (a member or a kernel local): the per-thread (per-lane, per-chunk) copy the
+// loop body adds to, the workgroup's shared array, one workgroup's total, and the per-workgroup (per
+// chunk) totals. templates/glsl/{kernel,reduce}.comp, ispc/kernels.ispc and cpu/class.cpp write the
+// same names as crt_{{member}}Local, ...Shared, ...Group and ...Partials.
+inline std::string ReductionLocal(const std::string& member) { return "crt_" + member + "Local"; }
+inline std::string ReductionShared(const std::string& member) { return "crt_" + member + "Shared"; }
+inline std::string ReductionGroup(const std::string& member) { return "crt_" + member + "Group"; }
+inline std::string ReductionPartials(const std::string& member) { return "crt_" + member + "Partials"; }
+// A vector of objects with virtual functions, in the class data (GLSL, ISPC): each element's class
+// and slot, the slots of all classes (level 1) and each class's objects (level 2 and ISPC). The
+// templates write crt_{{member}}_tags and crt_{{member}}_{{impl}}.
+inline std::string VirtualTagsField(const std::string& vector) { return "crt_" + vector + "_tags"; }
+inline std::string VirtualSlotsField(const std::string& vector) { return "crt_" + vector + "_objects"; }
+inline std::string VirtualClassField(const std::string& vector, const std::string& impl) { return "crt_" + vector + "_" + impl; }
+// The function that calls `method` on an element of such a vector, whichever its class (GLSL, ISPC;
+// the templates' dispatchers are crt_{{member}}_{{method}}).
+inline std::string VirtualDispatcher(const std::string& vector, const std::string& method) { return "crt_" + vector + "_" + method; }
 
 }  // namespace crossrt::engine::generated

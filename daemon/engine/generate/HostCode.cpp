@@ -1,6 +1,7 @@
 // The generated class's header and host source, for the Vulkan class or the CPU class: the entry
 // point that fills the templates of templates/ from the model.
 #include "generate/CodeGenSupport.h"
+#include "generate/GeneratedNames.h"
 #include "generate/VulkanHost.h"
 #include "generate/CodeGen.h"
 #include "print/KernelPrinter.h"
@@ -119,8 +120,8 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
     std::string clauses;
     Data reds = List();
     for (auto& r : k.reductions) {
-      // A member is reduced through a local copy (<member>Local); a local is reduced itself.
-      const std::string reduced = r.local ? r.member : r.member + "Local";
+      // A member is reduced through a local copy (crt_<member>Local); a local is reduced itself.
+      const std::string reduced = r.local ? r.member : generated::ReductionLocal(r.member);
       if (!r.local) {
         Data y;
         y.set("member", r.member);

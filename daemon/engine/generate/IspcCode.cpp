@@ -4,6 +4,7 @@
 // the class data it fills, the chunks it hands to the cores and how it folds their reductions).
 #include "generate/CodeGen.h"
 #include "generate/CodeGenSupport.h"
+#include "generate/GeneratedNames.h"
 #include "print/GlslTypes.h"
 #include "print/ispc/IspcTypes.h"
 
@@ -124,13 +125,13 @@ std::string GenerateIspcKernels(const ClassModel& model, const GenerateOptions& 
     }
     Data reds = List();
     for (auto& r : k.reductions) {
-      params += ", uniform " + IspcTypeName(r.glslType) + " *uniform " + r.member + "Partial";
-      args += ", " + r.member + "Local";
+      params += ", uniform " + IspcTypeName(r.glslType) + " *uniform " + generated::ReductionPartials(r.member);
+      args += ", " + generated::ReductionLocal(r.member);
       Data y;
       y.set("member", r.member);
       y.set("type", IspcTypeName(r.glslType));
       y.set("identity", IspcIdentity(r.op, r.glslType));
-      y.set("reduced", IspcLaneReduce(r.op, r.glslType, r.member + "Local", r.member + "Partial"));
+      y.set("reduced", IspcLaneReduce(r.op, r.glslType, generated::ReductionLocal(r.member), generated::ReductionPartials(r.member)));
       reds.push_back(y);
     }
     x.set("params", innerParams + params);
@@ -227,7 +228,7 @@ void IspcHostData(const ClassModel& model, Data& d) {
     Data reds = List();
     for (auto& r : k.reductions) {
       const std::string cppType = ReductionCppType(model, r);
-      args += ", crossrt::IspcPointer<" + IspcCppType(r.glslType) + "*>(&" + r.member + "Partials[crt_chunk])";
+      args += ", crossrt::IspcPointer<" + IspcCppType(r.glslType) + "*>(&" + generated::ReductionPartials(r.member) + "[crt_chunk])";
       Data y;
       y.set("member", r.member);
       y.set("cppType", cppType);

@@ -208,16 +208,16 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
     b.set("layout", "std430");
     b.set("binding", std::to_string(binding++));
     b.set("access", r.local ? "" : "writeonly ");  // a local's total is read back after the nest
-    b.set("blockName", generated::BlockName(r.member + "Partials"));
+    b.set("blockName", generated::BlockName(r.member + "Partials"));  // crt_<member>PartialsBuffer
     b.set("type", r.glslType);
-    b.set("name", r.member + "Partials");
+    b.set("name", generated::ReductionPartials(r.member));
     b.set("comment", "per-workgroup partial results of the reduction of " + std::string(r.local ? "local " : "") + r.member);
     buffers.push_back(b);
     Data x;
     x.set("type", r.glslType);
     x.set("member", r.member);
     x.set("identity", r.identity);
-    x.set("combineGroup", Combine(r.op, r.member + "Group", r.member + "Shared[s]"));
+    x.set("combineGroup", Combine(r.op, generated::ReductionGroup(r.member), generated::ReductionShared(r.member) + "[s]"));
     x.set("subgroupOp", r.op == ReduceOp::Min ? "subgroupMin" : r.op == ReduceOp::Max ? "subgroupMax" : "subgroupAdd");
     reductions.push_back(x);
   }
@@ -454,9 +454,10 @@ std::string ReduceGlsl(const ClassModel& model, const Kernel& k, const GenerateO
     x.set("member", r.member);
     x.set("identity", r.identity);
     x.set("binding", std::to_string(binding++));
-    x.set("combineShared", Combine(r.op, r.member + "Shared[local]", r.member + "Shared[local + stride]"));
-    x.set("combinePartial", Combine(r.op, r.member + "Local", r.member + "Partials[i]"));
-    x.set("combineMember", Combine(r.op, r.member, r.member + "Shared[0]"));
+    const std::string shared = generated::ReductionShared(r.member);
+    x.set("combineShared", Combine(r.op, shared + "[local]", shared + "[local + stride]"));
+    x.set("combinePartial", Combine(r.op, generated::ReductionLocal(r.member), generated::ReductionPartials(r.member) + "[i]"));
+    x.set("combineMember", Combine(r.op, r.member, shared + "[0]"));
     x.set("local", r.local);  // its total goes to element 0 of its partials, for <kernel>_Finish
     x.set("access", r.local ? "" : "readonly ");
     reductions.push_back(x);

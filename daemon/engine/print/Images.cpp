@@ -100,7 +100,7 @@ const FieldDecl* KernelPrinter::SampledWith(const ValueDecl* image, const ImageF
 }
 
 // ---- arrays of textures: std::vector<LiteImage::Texture2D<T>> members ----
-// Kernels call <array>_sample, _texel, _width and _height (templates/glsl/texture_array.glsl), which
+// Kernels call crt_<array>_sample, _texel, _width and _height (templates/glsl/texture_array.glsl), which
 // each variant of the shader defines its own way: GPU samplers, or buffers and LiteImage's sampling.
 
 const FieldDecl* KernelPrinter::TextureElement(const clang::Expr* e, const clang::Expr** index) {

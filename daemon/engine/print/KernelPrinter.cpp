@@ -437,7 +437,7 @@ std::string KernelPrinter::VirtualCall(const CXXMemberCallExpr* mc) {
   Type(mc->getType(), mc->getBeginLoc());  // declares a returned struct
   m_uses.virtualCalls.insert({field, method->getCanonicalDecl()});
   m_uses.virtualCallSites.push_back(mc);
-  std::string s = composedPrefix + field->getNameAsString() + "_" + method->getNameAsString() + "(";
+  std::string s = generated::VirtualDispatcher(composedPrefix + field->getNameAsString(), method->getNameAsString()) + "(";
   for (size_t i = 0; i < args.size(); ++i) s += (i ? ", " : "") + args[i];
   return s + ")";
 }

@@ -19,6 +19,7 @@ void ShadedSpheres::kernel1D_Shade(uint32_t n, const float4* a_normals, float4* 
     const uint32_t id = uint32_t(a_normals[i].w) % uint32_t(m_materials.size());
     const IMaterial* material = m_materials[id].get();  // a local pointer to the element, called through
     const float3 next = m_materials[(id + 1) % uint32_t(m_materials.size())]->Shade(normal, m_light);
-    a_out[i] = to_float4(material->Shade(normal, m_light), next.x + next.z);
+    a_out[i] = to_float4(material->Shade(normal, m_light), next.x + next.z + m_materials_tags + m_materials_objects + m_materials_Lambert + m_materials_Mirror +
+                         m_materials_Shade);
   }
 }

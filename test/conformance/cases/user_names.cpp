@@ -17,7 +17,8 @@ void Lookalikes::kernel1D_Fill(int n, const float* src, float* srcBuffer)
   for (int i = 0; i < n; i++)
   {
     const float value = src[i] + m_a[uint32_t(i) % uint32_t(m_a.size())] + float(m_a_size) + 0.5f * float(m_a_capacity) + float(m_a.size()) + m_data.bias +
-                        float(m_img.width()) + float(m_img_width) + m_img[LiteMath::int2(i % int(m_img.width()), 1)].x;
+                        float(m_img.width()) + float(m_img_width) + m_img[LiteMath::int2(i % int(m_img.width()), 1)].x +
+                        m_totalLocal + m_totalShared + m_totalPartials + m_totalGroup + m_totalSubgroup;
     srcBuffer[i] = value;
     m_total += value;
   }

@@ -206,8 +206,8 @@ std::string IspcPrinter::AppendFunction(const FieldDecl* field, const CallExpr* 
   IsStdVector(field->getType(), &element);
   std::ostringstream os;
   const std::string cls = DataStruct().substr(0, DataStruct().size() - std::string("_Data").size());
-  const std::string type = Type(element, call->getBeginLoc()).value_or("uint"), host = cls + "_append_" + vector;
-  os << "// " << vector << ".push_back(value): " << cls << "_ISPC::IspcAppend_" << vector << " appends the values (C++, under a lock)\n"
+  const std::string type = Type(element, call->getBeginLoc()).value_or("uint"), host = "crt_" + cls + "_append_" + vector;
+  os << "// " << vector << ".push_back(value): " << cls << "_ISPC::crt_IspcAppend_" << vector << " appends the values (C++, under a lock)\n"
      << "extern \"C\" void " << host << "(int8 *uniform owner, const uniform " << type << " *uniform values, uniform int count);\n\n"
      << "// " << vector << ".push_back(value) from the active lanes, in lane order\n"
      << "static void " << name << "(uniform " << DataStruct() << " *uniform self, " << type << " value)\n"

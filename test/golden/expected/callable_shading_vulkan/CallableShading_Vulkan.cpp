@@ -122,10 +122,10 @@ void CallableShading_Vulkan::crt_UpdatePlainMembers()
 {
   ClassData data{};
   std::memcpy(&data.m_toLight, &m_toLight, sizeof(data.m_toLight));
-  data.m_materials_tags = crt_virtual.m_materials_tags.Address();
-  data.m_materials_Lambert = crt_virtual.m_materials_Lambert.Address();
-  data.m_materials_Phong = crt_virtual.m_materials_Phong.Address();
-  data.m_materials_Checker = crt_virtual.m_materials_Checker.Address();
+  data.crt_m_materials_tags = crt_virtual.m_materials_tags.Address();
+  data.crt_m_materials_Lambert = crt_virtual.m_materials_Lambert.Address();
+  data.crt_m_materials_Phong = crt_virtual.m_materials_Phong.Address();
+  data.crt_m_materials_Checker = crt_virtual.m_materials_Checker.Address();
   std::memcpy(&data.m_distanceStep, &m_distanceStep, sizeof(data.m_distanceStep));
   data.crt_m_materials_size = uint32_t(m_materials.size());
   crt_classDataBuffer.Upload(&data, sizeof(data));

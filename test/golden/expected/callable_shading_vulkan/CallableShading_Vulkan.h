@@ -78,10 +78,10 @@ protected:
   struct ClassData
   {
     alignas(16) float3 m_toLight;
-    alignas(8) uint64_t m_materials_tags;
-    alignas(8) uint64_t m_materials_Lambert;
-    alignas(8) uint64_t m_materials_Phong;
-    alignas(8) uint64_t m_materials_Checker;
+    alignas(8) uint64_t crt_m_materials_tags;
+    alignas(8) uint64_t crt_m_materials_Lambert;
+    alignas(8) uint64_t crt_m_materials_Phong;
+    alignas(8) uint64_t crt_m_materials_Checker;
     alignas(4) float m_distanceStep;
     alignas(4) uint32_t crt_m_materials_size;
   };

@@ -64,21 +64,21 @@ void LBVH_CPU::Build(int count, const LiteMath::Box4f* boxes)
 // thread while that has been faster: crossrt::ParallelChoice).
 void LBVH_CPU::kernel1D_Bounds(int count, const LiteMath::Box4f* boxes)
 {
-  auto m_centerMinLocal = m_centerMin;
-  auto m_centerMaxLocal = m_centerMax;
+  auto crt_m_centerMinLocal = m_centerMin;
+  auto crt_m_centerMaxLocal = m_centerMax;
   static crossrt::ParallelChoice crt_choice;
   const auto crt_loop = crt_choice.Begin(count);
-#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1024) reduction(crossrt_min_vec3 : m_centerMinLocal) \
-    reduction(crossrt_max_vec3 : m_centerMaxLocal)
+#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1024) \
+    reduction(crossrt_min_vec3 : crt_m_centerMinLocal) reduction(crossrt_max_vec3 : crt_m_centerMaxLocal)
   for (int i = 0; i < count; i++)
   {
     const float3 center = 0.5f * (to_float3(boxes[i].boxMin) + to_float3(boxes[i].boxMax));
-    m_centerMinLocal = min(m_centerMinLocal, center);
-    m_centerMaxLocal = max(m_centerMaxLocal, center);
+    crt_m_centerMinLocal = min(crt_m_centerMinLocal, center);
+    crt_m_centerMaxLocal = max(crt_m_centerMaxLocal, center);
   }
   crt_choice.End(crt_loop);
-  m_centerMin = m_centerMinLocal;
-  m_centerMax = m_centerMaxLocal;
+  m_centerMin = crt_m_centerMinLocal;
+  m_centerMax = crt_m_centerMaxLocal;
 }
 
 // From LBVH::kernel1D_EvalMC (LBVH.cpp): the outer loop runs on all cores (or on this
@@ -122,10 +122,10 @@ void LBVH_CPU::kernel1D_AppendInit(int count)
 // thread while that has been faster: crossrt::ParallelChoice).
 void LBVH_CPU::kernel1D_AppendComplete(int count)
 {
-  auto m_leafCountLocal = m_leafCount;
+  auto crt_m_leafCountLocal = m_leafCount;
   static crossrt::ParallelChoice crt_choice;
   const auto crt_loop = crt_choice.Begin(count);
-#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1024) reduction(+ : m_leafCountLocal)
+#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1024) reduction(+ : crt_m_leafCountLocal)
   for (int i = 0; i < count; i++)
   {
     if (m_newGroup[i] != 0u)
@@ -134,10 +134,10 @@ void LBVH_CPU::kernel1D_AppendComplete(int count)
       m_leafCode[m_groupOf[i]] = m_codes[i].x;
     }
     if (i == count - 1)
-      m_leafCountLocal += m_groupOf[i] + m_newGroup[i];
+      crt_m_leafCountLocal += m_groupOf[i] + m_newGroup[i];
   }
   crt_choice.End(crt_loop);
-  m_leafCount = m_leafCountLocal;
+  m_leafCount = crt_m_leafCountLocal;
 }
 
 // From LBVH::kernel1D_Karras12 (LBVH.cpp): the outer loop runs on all cores (or on this

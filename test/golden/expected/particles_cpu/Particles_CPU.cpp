@@ -58,10 +58,10 @@ void Particles_CPU::Step(int n, float dt, float4* positions, float4* velocities)
 // thread while that has been faster: crossrt::ParallelChoice).
 void Particles_CPU::kernel1D_Advance(int n, float dt, float4* positions, float4* velocities)
 {
-  auto m_bouncesLocal = m_bounces;
+  auto crt_m_bouncesLocal = m_bounces;
   static crossrt::ParallelChoice crt_choice;
   const auto crt_loop = crt_choice.Begin(n);
-#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1024) reduction(+ : m_bouncesLocal)
+#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1024) reduction(+ : crt_m_bouncesLocal)
   for (int i = 0; i < n; i++)
   {
     float4 v = velocities[i];
@@ -71,40 +71,40 @@ void Particles_CPU::kernel1D_Advance(int n, float dt, float4* positions, float4*
     {
       p.y = -p.y * m_restitution;
       v.y = -v.y * m_restitution;
-      m_bouncesLocal += 1;
+      crt_m_bouncesLocal += 1;
     }
     positions[i] = p;
     velocities[i] = v;
   }
   crt_choice.End(crt_loop);
-  m_bounces = m_bouncesLocal;
+  m_bounces = crt_m_bouncesLocal;
 }
 
 // From Particles::kernel1D_Measure (Particles.cpp): the outer loop runs on all cores (or on this
 // thread while that has been faster: crossrt::ParallelChoice).
 void Particles_CPU::kernel1D_Measure(int n, const float4* positions, const float4* velocities)
 {
-  auto m_boxMinLocal = m_boxMin;
-  auto m_boxMaxLocal = m_boxMax;
-  auto m_momentumLocal = m_momentum;
-  auto m_kineticEnergyLocal = m_kineticEnergy;
+  auto crt_m_boxMinLocal = m_boxMin;
+  auto crt_m_boxMaxLocal = m_boxMax;
+  auto crt_m_momentumLocal = m_momentum;
+  auto crt_m_kineticEnergyLocal = m_kineticEnergy;
   static crossrt::ParallelChoice crt_choice;
   const auto crt_loop = crt_choice.Begin(n);
-#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1024) reduction(crossrt_min_vec4 : m_boxMinLocal) \
-    reduction(crossrt_max_vec4 : m_boxMaxLocal) reduction(crossrt_add_vec4 : m_momentumLocal) \
-    reduction(+ : m_kineticEnergyLocal)
+#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1024) \
+    reduction(crossrt_min_vec4 : crt_m_boxMinLocal) reduction(crossrt_max_vec4 : crt_m_boxMaxLocal) \
+    reduction(crossrt_add_vec4 : crt_m_momentumLocal) reduction(+ : crt_m_kineticEnergyLocal)
   for (int i = 0; i < n; i++)
   {
     const float4 p = positions[i];
     const float4 v = velocities[i];
-    m_boxMinLocal = min(m_boxMinLocal, p);
-    m_boxMaxLocal = max(m_boxMaxLocal, p);
-    m_momentumLocal += v;
-    m_kineticEnergyLocal += 0.5f * dot(v, v);
+    crt_m_boxMinLocal = min(crt_m_boxMinLocal, p);
+    crt_m_boxMaxLocal = max(crt_m_boxMaxLocal, p);
+    crt_m_momentumLocal += v;
+    crt_m_kineticEnergyLocal += 0.5f * dot(v, v);
   }
   crt_choice.End(crt_loop);
-  m_boxMin = m_boxMinLocal;
-  m_boxMax = m_boxMaxLocal;
-  m_momentum = m_momentumLocal;
-  m_kineticEnergy = m_kineticEnergyLocal;
+  m_boxMin = crt_m_boxMinLocal;
+  m_boxMax = crt_m_boxMaxLocal;
+  m_momentum = crt_m_momentumLocal;
+  m_kineticEnergy = crt_m_kineticEnergyLocal;
 }

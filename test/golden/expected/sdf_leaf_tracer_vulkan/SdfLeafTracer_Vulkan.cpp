@@ -140,10 +140,10 @@ void SdfLeafTracer_Vulkan::crt_UpdateMemberCmd(VkCommandBuffer crt_cmd, size_t a
 void SdfLeafTracer_Vulkan::crt_UpdatePlainMembers()
 {
   ClassData data{};
-  data.m_scene_m_geom_tags = crt_virtual.m_scene_m_geom_tags.Address();
-  data.m_scene_m_geom_SdfGridLeaves = crt_virtual.m_scene_m_geom_SdfGridLeaves.Address();
-  data.m_scene_m_geom_SdfSVSLeaves = crt_virtual.m_scene_m_geom_SdfSVSLeaves.Address();
-  data.m_scene_m_geom_SdfSBSLeaves = crt_virtual.m_scene_m_geom_SdfSBSLeaves.Address();
+  data.crt_m_scene_m_geom_tags = crt_virtual.m_scene_m_geom_tags.Address();
+  data.crt_m_scene_m_geom_SdfGridLeaves = crt_virtual.m_scene_m_geom_SdfGridLeaves.Address();
+  data.crt_m_scene_m_geom_SdfSVSLeaves = crt_virtual.m_scene_m_geom_SdfSVSLeaves.Address();
+  data.crt_m_scene_m_geom_SdfSBSLeaves = crt_virtual.m_scene_m_geom_SdfSBSLeaves.Address();
   data.crt_m_scene_m_geom_size = uint32_t(crt_m_scene()->m_geom.size());
   data.crt_m_scene_m_nodeMin_size = uint32_t(crt_m_scene()->m_nodeMin.size());
   data.crt_m_scene_m_nodeMin_capacity = uint32_t(crt_m_scene()->m_nodeMin.capacity());

@@ -75,10 +75,10 @@ protected:
   // Mirror of the GLSL block SdfLeafTracerData (std430: alignas keeps the offsets equal).
   struct ClassData
   {
-    alignas(8) uint64_t m_scene_m_geom_tags;
-    alignas(8) uint64_t m_scene_m_geom_SdfGridLeaves;
-    alignas(8) uint64_t m_scene_m_geom_SdfSVSLeaves;
-    alignas(8) uint64_t m_scene_m_geom_SdfSBSLeaves;
+    alignas(8) uint64_t crt_m_scene_m_geom_tags;
+    alignas(8) uint64_t crt_m_scene_m_geom_SdfGridLeaves;
+    alignas(8) uint64_t crt_m_scene_m_geom_SdfSVSLeaves;
+    alignas(8) uint64_t crt_m_scene_m_geom_SdfSBSLeaves;
     alignas(4) uint32_t crt_m_scene_m_nodeMin_size;
     alignas(4) uint32_t crt_m_scene_m_nodeMin_capacity;
     alignas(4) uint32_t crt_m_scene_m_nodeMax_size;

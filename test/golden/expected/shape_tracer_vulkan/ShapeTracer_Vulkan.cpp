@@ -178,14 +178,14 @@ void ShapeTracer_Vulkan::crt_UpdateMemberCmd(VkCommandBuffer crt_cmd, size_t a_o
 void ShapeTracer_Vulkan::crt_UpdatePlainMembers()
 {
   ClassData data{};
-  data.m_scene_m_shapes_tags = crt_virtual.m_scene_m_shapes_tags.Address();
-  data.m_scene_m_shapes_Sphere = crt_virtual.m_scene_m_shapes_Sphere.Address();
-  data.m_scene_m_shapes_Box = crt_virtual.m_scene_m_shapes_Box.Address();
-  data.m_scene_m_shapes_Disc = crt_virtual.m_scene_m_shapes_Disc.Address();
-  data.m_scene_m_lights_tags = crt_virtual.m_scene_m_lights_tags.Address();
-  data.m_scene_m_lights_Sphere = crt_virtual.m_scene_m_lights_Sphere.Address();
-  data.m_scene_m_lights_Box = crt_virtual.m_scene_m_lights_Box.Address();
-  data.m_scene_m_lights_Disc = crt_virtual.m_scene_m_lights_Disc.Address();
+  data.crt_m_scene_m_shapes_tags = crt_virtual.m_scene_m_shapes_tags.Address();
+  data.crt_m_scene_m_shapes_Sphere = crt_virtual.m_scene_m_shapes_Sphere.Address();
+  data.crt_m_scene_m_shapes_Box = crt_virtual.m_scene_m_shapes_Box.Address();
+  data.crt_m_scene_m_shapes_Disc = crt_virtual.m_scene_m_shapes_Disc.Address();
+  data.crt_m_scene_m_lights_tags = crt_virtual.m_scene_m_lights_tags.Address();
+  data.crt_m_scene_m_lights_Sphere = crt_virtual.m_scene_m_lights_Sphere.Address();
+  data.crt_m_scene_m_lights_Box = crt_virtual.m_scene_m_lights_Box.Address();
+  data.crt_m_scene_m_lights_Disc = crt_virtual.m_scene_m_lights_Disc.Address();
   data.crt_m_scene_m_shapes_size = uint32_t(crt_m_scene()->m_shapes.size());
   data.crt_m_scene_m_lights_size = uint32_t(crt_m_scene()->m_lights.size());
   data.crt_m_scene_m_boxes_size = uint32_t(crt_m_scene()->m_boxes.size());

@@ -75,14 +75,14 @@ protected:
   // Mirror of the GLSL block ShapeTracerData (std430: alignas keeps the offsets equal).
   struct ClassData
   {
-    alignas(8) uint64_t m_scene_m_shapes_tags;
-    alignas(8) uint64_t m_scene_m_shapes_Sphere;
-    alignas(8) uint64_t m_scene_m_shapes_Box;
-    alignas(8) uint64_t m_scene_m_shapes_Disc;
-    alignas(8) uint64_t m_scene_m_lights_tags;
-    alignas(8) uint64_t m_scene_m_lights_Sphere;
-    alignas(8) uint64_t m_scene_m_lights_Box;
-    alignas(8) uint64_t m_scene_m_lights_Disc;
+    alignas(8) uint64_t crt_m_scene_m_shapes_tags;
+    alignas(8) uint64_t crt_m_scene_m_shapes_Sphere;
+    alignas(8) uint64_t crt_m_scene_m_shapes_Box;
+    alignas(8) uint64_t crt_m_scene_m_shapes_Disc;
+    alignas(8) uint64_t crt_m_scene_m_lights_tags;
+    alignas(8) uint64_t crt_m_scene_m_lights_Sphere;
+    alignas(8) uint64_t crt_m_scene_m_lights_Box;
+    alignas(8) uint64_t crt_m_scene_m_lights_Disc;
     alignas(4) uint32_t crt_m_scene_m_boxes_size;
     alignas(4) uint32_t crt_m_scene_m_boxes_capacity;
     alignas(4) uint32_t crt_m_scene_m_lightBoxes_size;

@@ -78,6 +78,11 @@ void TexturedMaterials_Vulkan::crt_UpdateMemberCmd(VkCommandBuffer crt_cmd, size
 void TexturedMaterials_Vulkan::crt_UpdatePlainMembers()
 {
   ClassData data{};
+  std::memcpy(&data.m_bumps_sample, &m_bumps_sample, sizeof(data.m_bumps_sample));
+  std::memcpy(&data.m_bumps_texel, &m_bumps_texel, sizeof(data.m_bumps_texel));
+  std::memcpy(&data.m_bumps_width, &m_bumps_width, sizeof(data.m_bumps_width));
+  std::memcpy(&data.m_bumps_info, &m_bumps_info, sizeof(data.m_bumps_info));
+  std::memcpy(&data.m_bumps_texels, &m_bumps_texels, sizeof(data.m_bumps_texels));
   data.crt_m_albedo_size = uint32_t(m_albedo.size());
   data.crt_m_bumps_size = uint32_t(m_bumps.size());
   crt_classDataBuffer.Upload(&data, sizeof(data));

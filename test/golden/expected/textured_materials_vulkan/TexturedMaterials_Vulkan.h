@@ -69,6 +69,11 @@ protected:
   // Mirror of the GLSL block TexturedMaterialsData (std430: alignas keeps the offsets equal).
   struct ClassData
   {
+    alignas(4) float m_bumps_sample;
+    alignas(4) float m_bumps_texel;
+    alignas(4) float m_bumps_width;
+    alignas(4) float m_bumps_info;
+    alignas(4) float m_bumps_texels;
     alignas(4) uint32_t crt_m_albedo_size;
     alignas(4) uint32_t crt_m_bumps_size;
   };

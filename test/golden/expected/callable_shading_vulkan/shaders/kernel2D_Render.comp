@@ -64,10 +64,10 @@ layout(buffer_reference, scalar, buffer_reference_align = 4) readonly buffer m_m
 layout(std430, binding = 0) buffer crt_CallableShadingData
 {
   vec3 m_toLight;
-  uvec2 m_materials_tags;
-  uvec2 m_materials_Lambert;
-  uvec2 m_materials_Phong;
-  uvec2 m_materials_Checker;
+  uvec2 crt_m_materials_tags;
+  uvec2 crt_m_materials_Lambert;
+  uvec2 crt_m_materials_Phong;
+  uvec2 crt_m_materials_Checker;
   float m_distanceStep;
   uint crt_m_materials_size;
 };
@@ -164,22 +164,22 @@ void Checker_Attenuate(Checker_Data self, inout vec3 color, float distance_)
 }
 
 // m_materials[index]->Shade(...): the object's class picks the implementation
-vec3 m_materials_Shade(uint index, vec3 normal, vec3 toLight)
+vec3 crt_m_materials_Shade(uint index, vec3 normal, vec3 toLight)
 {
-  const uvec2 tag = m_materials_Tags(m_materials_tags).tags[index];
+  const uvec2 tag = m_materials_Tags(crt_m_materials_tags).tags[index];
   switch (tag.x)
   {
   case 0u:  // dead code in a pipeline made for objects without a Lambert
     if (crt_m_materials_holdsLambert)
-      return Lambert_Shade(m_materials_LambertObjects(m_materials_Lambert).objects[tag.y], normal, toLight);
+      return Lambert_Shade(m_materials_LambertObjects(crt_m_materials_Lambert).objects[tag.y], normal, toLight);
     break;
   case 1u:  // dead code in a pipeline made for objects without a Phong
     if (crt_m_materials_holdsPhong)
-      return Phong_Shade(m_materials_PhongObjects(m_materials_Phong).objects[tag.y], normal, toLight);
+      return Phong_Shade(m_materials_PhongObjects(crt_m_materials_Phong).objects[tag.y], normal, toLight);
     break;
   case 2u:  // dead code in a pipeline made for objects without a Checker
     if (crt_m_materials_holdsChecker)
-      return Checker_Shade(m_materials_CheckerObjects(m_materials_Checker).objects[tag.y], normal, toLight);
+      return Checker_Shade(m_materials_CheckerObjects(crt_m_materials_Checker).objects[tag.y], normal, toLight);
     break;
   }
   vec3 none;  // not reached: every element holds one of these classes
@@ -187,22 +187,22 @@ vec3 m_materials_Shade(uint index, vec3 normal, vec3 toLight)
 }
 
 // m_materials[index]->Opacity(): the object's class picks the implementation
-float m_materials_Opacity(uint index)
+float crt_m_materials_Opacity(uint index)
 {
-  const uvec2 tag = m_materials_Tags(m_materials_tags).tags[index];
+  const uvec2 tag = m_materials_Tags(crt_m_materials_tags).tags[index];
   switch (tag.x)
   {
   case 0u:  // dead code in a pipeline made for objects without a Lambert
     if (crt_m_materials_holdsLambert)
-      return Lambert_Opacity(m_materials_LambertObjects(m_materials_Lambert).objects[tag.y]);
+      return Lambert_Opacity(m_materials_LambertObjects(crt_m_materials_Lambert).objects[tag.y]);
     break;
   case 1u:  // dead code in a pipeline made for objects without a Phong
     if (crt_m_materials_holdsPhong)
-      return Phong_Opacity(m_materials_PhongObjects(m_materials_Phong).objects[tag.y]);
+      return Phong_Opacity(m_materials_PhongObjects(crt_m_materials_Phong).objects[tag.y]);
     break;
   case 2u:  // dead code in a pipeline made for objects without a Checker
     if (crt_m_materials_holdsChecker)
-      return Checker_Opacity(m_materials_CheckerObjects(m_materials_Checker).objects[tag.y]);
+      return Checker_Opacity(m_materials_CheckerObjects(crt_m_materials_Checker).objects[tag.y]);
     break;
   }
   float none;  // not reached: every element holds one of these classes
@@ -210,27 +210,27 @@ float m_materials_Opacity(uint index)
 }
 
 // m_materials[index]->Attenuate(...): the object's class picks the implementation
-void m_materials_Attenuate(uint index, inout vec3 color, float distance_)
+void crt_m_materials_Attenuate(uint index, inout vec3 color, float distance_)
 {
-  const uvec2 tag = m_materials_Tags(m_materials_tags).tags[index];
+  const uvec2 tag = m_materials_Tags(crt_m_materials_tags).tags[index];
   switch (tag.x)
   {
   case 0u:  // dead code in a pipeline made for objects without a Lambert
     if (crt_m_materials_holdsLambert)
     {
-      Lambert_Attenuate(m_materials_LambertObjects(m_materials_Lambert).objects[tag.y], color, distance_);
+      Lambert_Attenuate(m_materials_LambertObjects(crt_m_materials_Lambert).objects[tag.y], color, distance_);
     }
     return;
   case 1u:  // dead code in a pipeline made for objects without a Phong
     if (crt_m_materials_holdsPhong)
     {
-      Phong_Attenuate(m_materials_PhongObjects(m_materials_Phong).objects[tag.y], color, distance_);
+      Phong_Attenuate(m_materials_PhongObjects(crt_m_materials_Phong).objects[tag.y], color, distance_);
     }
     return;
   case 2u:  // dead code in a pipeline made for objects without a Checker
     if (crt_m_materials_holdsChecker)
     {
-      Checker_Attenuate(m_materials_CheckerObjects(m_materials_Checker).objects[tag.y], color, distance_);
+      Checker_Attenuate(m_materials_CheckerObjects(crt_m_materials_Checker).objects[tag.y], color, distance_);
     }
     return;
   }
@@ -240,9 +240,9 @@ void m_materials_Attenuate(uint index, inout vec3 color, float distance_)
 void kernel2D_Render(int x, int y)
 {
   const int i = y * width + x;
-  vec3 color = m_materials_Shade(uint(materialIds[i]), (normals[i]).xyz, m_toLight);
-  m_materials_Attenuate(uint(materialIds[i]), color, m_distanceStep * float(x + y));
-  colors[i] = vec4(color, m_materials_Opacity(uint(materialIds[i])));
+  vec3 color = crt_m_materials_Shade(uint(materialIds[i]), (normals[i]).xyz, m_toLight);
+  crt_m_materials_Attenuate(uint(materialIds[i]), color, m_distanceStep * float(x + y));
+  colors[i] = vec4(color, crt_m_materials_Opacity(uint(materialIds[i])));
 }
 
 void main()

@@ -60,7 +60,7 @@ layout(std430, binding = 5) buffer crt_m_newGroupBuffer
 };  // member std::vector m_newGroup
 layout(std430, binding = 6) writeonly buffer crt_m_leafCountPartialsBuffer
 {
-  uint m_leafCountPartials[];
+  uint crt_m_leafCountPartials[];
 };  // per-workgroup partial results of the reduction of m_leafCount
 
 layout(push_constant) uniform crt_kernel1D_AppendCompleteArgs
@@ -73,8 +73,8 @@ layout(push_constant) uniform crt_kernel1D_AppendCompleteArgs
 // Reductions: each thread accumulates locally, subgroups combine with subgroup arithmetic, the
 // first thread combines the subgroups' results in a fixed order and writes one partial result
 // per workgroup; kernel1D_AppendComplete_Reduce then folds the partials into the member.
-uint m_leafCountLocal = 0u;
-shared uint m_leafCountShared[256 / 4];  // one per subgroup (subgroups have >= 4 threads)
+uint crt_m_leafCountLocal = 0u;
+shared uint crt_m_leafCountShared[256 / 4];  // one per subgroup (subgroups have >= 4 threads)
 
 // from LBVH::kernel1D_AppendComplete (LBVH.cpp)
 void kernel1D_AppendComplete(int i)
@@ -85,7 +85,7 @@ void kernel1D_AppendComplete(int i)
     m_leafCode[m_groupOf[uint(i)]] = m_codes[uint(i)].x;
   }
   if (i == count - 1)
-    m_leafCountLocal += m_groupOf[uint(i)] + m_newGroup[uint(i)];
+    crt_m_leafCountLocal += m_groupOf[uint(i)] + m_newGroup[uint(i)];
 }
 
 void main()
@@ -96,19 +96,19 @@ void main()
   if (crt_inRange)
     kernel1D_AppendComplete(int(crt_startX + int(crt_threadId)));
 
-  const uint m_leafCountSubgroup = subgroupAdd(m_leafCountLocal);
+  const uint crt_m_leafCountSubgroup = subgroupAdd(crt_m_leafCountLocal);
   if (subgroupElect())
   {
-    m_leafCountShared[gl_SubgroupID] = m_leafCountSubgroup;
+    crt_m_leafCountShared[gl_SubgroupID] = crt_m_leafCountSubgroup;
   }
   barrier();
   if (gl_LocalInvocationIndex == 0)
   {
     const uint crt_groupId =
         gl_WorkGroupID.x + gl_NumWorkGroups.x * (gl_WorkGroupID.y + gl_NumWorkGroups.y * gl_WorkGroupID.z);
-    uint m_leafCountGroup = m_leafCountShared[0];
+    uint crt_m_leafCountGroup = crt_m_leafCountShared[0];
     for (uint s = 1; s < gl_NumSubgroups; ++s)
-      m_leafCountGroup = m_leafCountGroup + m_leafCountShared[s];
-    m_leafCountPartials[crt_groupId] = m_leafCountGroup;
+      crt_m_leafCountGroup = crt_m_leafCountGroup + crt_m_leafCountShared[s];
+    crt_m_leafCountPartials[crt_groupId] = crt_m_leafCountGroup;
   }
 }

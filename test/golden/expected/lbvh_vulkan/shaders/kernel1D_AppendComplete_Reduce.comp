@@ -40,7 +40,7 @@ layout(std430, binding = 0) buffer crt_LBVHData
 };
 layout(std430, binding = 1) readonly buffer crt_m_leafCountPartialsBuffer
 {
-  uint m_leafCountPartials[];
+  uint crt_m_leafCountPartials[];
 };
 
 layout(push_constant) uniform crt_kernel1D_AppendComplete_ReduceArgs
@@ -48,26 +48,26 @@ layout(push_constant) uniform crt_kernel1D_AppendComplete_ReduceArgs
   uint partialCount;
 };
 
-shared uint m_leafCountShared[256];
+shared uint crt_m_leafCountShared[256];
 
 void main()
 {
   const uint local = gl_LocalInvocationIndex;
-  uint m_leafCountLocal = 0u;
+  uint crt_m_leafCountLocal = 0u;
   for (uint i = local; i < partialCount; i += 256)
-    m_leafCountLocal = m_leafCountLocal + m_leafCountPartials[i];
-  m_leafCountShared[local] = m_leafCountLocal;
+    crt_m_leafCountLocal = crt_m_leafCountLocal + crt_m_leafCountPartials[i];
+  crt_m_leafCountShared[local] = crt_m_leafCountLocal;
   barrier();
   for (uint stride = 256 / 2; stride > 0; stride /= 2)
   {
     if (local < stride)
     {
-      m_leafCountShared[local] = m_leafCountShared[local] + m_leafCountShared[local + stride];
+      crt_m_leafCountShared[local] = crt_m_leafCountShared[local] + crt_m_leafCountShared[local + stride];
     }
     barrier();
   }
   if (local == 0)
   {
-    m_leafCount = m_leafCount + m_leafCountShared[0];
+    m_leafCount = m_leafCount + crt_m_leafCountShared[0];
   }
 }

@@ -52,11 +52,11 @@ layout(std430, binding = 1) readonly buffer crt_boxesBuffer
 };  // parameter 'boxes'
 layout(std430, binding = 2) writeonly buffer crt_m_centerMinPartialsBuffer
 {
-  vec3 m_centerMinPartials[];
+  vec3 crt_m_centerMinPartials[];
 };  // per-workgroup partial results of the reduction of m_centerMin
 layout(std430, binding = 3) writeonly buffer crt_m_centerMaxPartialsBuffer
 {
-  vec3 m_centerMaxPartials[];
+  vec3 crt_m_centerMaxPartials[];
 };  // per-workgroup partial results of the reduction of m_centerMax
 
 layout(push_constant) uniform crt_kernel1D_BoundsArgs
@@ -69,17 +69,17 @@ layout(push_constant) uniform crt_kernel1D_BoundsArgs
 // Reductions: each thread accumulates locally, subgroups combine with subgroup arithmetic, the
 // first thread combines the subgroups' results in a fixed order and writes one partial result
 // per workgroup; kernel1D_Bounds_Reduce then folds the partials into the member.
-vec3 m_centerMinLocal = vec3(CRT_INFINITY);
-shared vec3 m_centerMinShared[256 / 4];  // one per subgroup (subgroups have >= 4 threads)
-vec3 m_centerMaxLocal = vec3(-CRT_INFINITY);
-shared vec3 m_centerMaxShared[256 / 4];  // one per subgroup (subgroups have >= 4 threads)
+vec3 crt_m_centerMinLocal = vec3(CRT_INFINITY);
+shared vec3 crt_m_centerMinShared[256 / 4];  // one per subgroup (subgroups have >= 4 threads)
+vec3 crt_m_centerMaxLocal = vec3(-CRT_INFINITY);
+shared vec3 crt_m_centerMaxShared[256 / 4];  // one per subgroup (subgroups have >= 4 threads)
 
 // from LBVH::kernel1D_Bounds (LBVH.cpp)
 void kernel1D_Bounds(int i)
 {
   const vec3 center = 0.5 * ((boxes[i].boxMin).xyz + (boxes[i].boxMax).xyz);
-  m_centerMinLocal = min(m_centerMinLocal, center);
-  m_centerMaxLocal = max(m_centerMaxLocal, center);
+  crt_m_centerMinLocal = min(crt_m_centerMinLocal, center);
+  crt_m_centerMaxLocal = max(crt_m_centerMaxLocal, center);
 }
 
 void main()
@@ -90,25 +90,25 @@ void main()
   if (crt_inRange)
     kernel1D_Bounds(int(crt_startX + int(crt_threadId)));
 
-  const vec3 m_centerMinSubgroup = subgroupMin(m_centerMinLocal);
-  const vec3 m_centerMaxSubgroup = subgroupMax(m_centerMaxLocal);
+  const vec3 crt_m_centerMinSubgroup = subgroupMin(crt_m_centerMinLocal);
+  const vec3 crt_m_centerMaxSubgroup = subgroupMax(crt_m_centerMaxLocal);
   if (subgroupElect())
   {
-    m_centerMinShared[gl_SubgroupID] = m_centerMinSubgroup;
-    m_centerMaxShared[gl_SubgroupID] = m_centerMaxSubgroup;
+    crt_m_centerMinShared[gl_SubgroupID] = crt_m_centerMinSubgroup;
+    crt_m_centerMaxShared[gl_SubgroupID] = crt_m_centerMaxSubgroup;
   }
   barrier();
   if (gl_LocalInvocationIndex == 0)
   {
     const uint crt_groupId =
         gl_WorkGroupID.x + gl_NumWorkGroups.x * (gl_WorkGroupID.y + gl_NumWorkGroups.y * gl_WorkGroupID.z);
-    vec3 m_centerMinGroup = m_centerMinShared[0];
+    vec3 crt_m_centerMinGroup = crt_m_centerMinShared[0];
     for (uint s = 1; s < gl_NumSubgroups; ++s)
-      m_centerMinGroup = min(m_centerMinGroup, m_centerMinShared[s]);
-    m_centerMinPartials[crt_groupId] = m_centerMinGroup;
-    vec3 m_centerMaxGroup = m_centerMaxShared[0];
+      crt_m_centerMinGroup = min(crt_m_centerMinGroup, crt_m_centerMinShared[s]);
+    crt_m_centerMinPartials[crt_groupId] = crt_m_centerMinGroup;
+    vec3 crt_m_centerMaxGroup = crt_m_centerMaxShared[0];
     for (uint s = 1; s < gl_NumSubgroups; ++s)
-      m_centerMaxGroup = max(m_centerMaxGroup, m_centerMaxShared[s]);
-    m_centerMaxPartials[crt_groupId] = m_centerMaxGroup;
+      crt_m_centerMaxGroup = max(crt_m_centerMaxGroup, crt_m_centerMaxShared[s]);
+    crt_m_centerMaxPartials[crt_groupId] = crt_m_centerMaxGroup;
   }
 }

@@ -41,11 +41,11 @@ layout(std430, binding = 0) buffer crt_LBVHData
 };
 layout(std430, binding = 1) readonly buffer crt_m_centerMinPartialsBuffer
 {
-  vec3 m_centerMinPartials[];
+  vec3 crt_m_centerMinPartials[];
 };
 layout(std430, binding = 2) readonly buffer crt_m_centerMaxPartialsBuffer
 {
-  vec3 m_centerMaxPartials[];
+  vec3 crt_m_centerMaxPartials[];
 };
 
 layout(push_constant) uniform crt_kernel1D_Bounds_ReduceArgs
@@ -53,33 +53,33 @@ layout(push_constant) uniform crt_kernel1D_Bounds_ReduceArgs
   uint partialCount;
 };
 
-shared vec3 m_centerMinShared[256];
-shared vec3 m_centerMaxShared[256];
+shared vec3 crt_m_centerMinShared[256];
+shared vec3 crt_m_centerMaxShared[256];
 
 void main()
 {
   const uint local = gl_LocalInvocationIndex;
-  vec3 m_centerMinLocal = vec3(CRT_INFINITY);
+  vec3 crt_m_centerMinLocal = vec3(CRT_INFINITY);
   for (uint i = local; i < partialCount; i += 256)
-    m_centerMinLocal = min(m_centerMinLocal, m_centerMinPartials[i]);
-  m_centerMinShared[local] = m_centerMinLocal;
-  vec3 m_centerMaxLocal = vec3(-CRT_INFINITY);
+    crt_m_centerMinLocal = min(crt_m_centerMinLocal, crt_m_centerMinPartials[i]);
+  crt_m_centerMinShared[local] = crt_m_centerMinLocal;
+  vec3 crt_m_centerMaxLocal = vec3(-CRT_INFINITY);
   for (uint i = local; i < partialCount; i += 256)
-    m_centerMaxLocal = max(m_centerMaxLocal, m_centerMaxPartials[i]);
-  m_centerMaxShared[local] = m_centerMaxLocal;
+    crt_m_centerMaxLocal = max(crt_m_centerMaxLocal, crt_m_centerMaxPartials[i]);
+  crt_m_centerMaxShared[local] = crt_m_centerMaxLocal;
   barrier();
   for (uint stride = 256 / 2; stride > 0; stride /= 2)
   {
     if (local < stride)
     {
-      m_centerMinShared[local] = min(m_centerMinShared[local], m_centerMinShared[local + stride]);
-      m_centerMaxShared[local] = max(m_centerMaxShared[local], m_centerMaxShared[local + stride]);
+      crt_m_centerMinShared[local] = min(crt_m_centerMinShared[local], crt_m_centerMinShared[local + stride]);
+      crt_m_centerMaxShared[local] = max(crt_m_centerMaxShared[local], crt_m_centerMaxShared[local + stride]);
     }
     barrier();
   }
   if (local == 0)
   {
-    m_centerMin = min(m_centerMin, m_centerMinShared[0]);
-    m_centerMax = max(m_centerMax, m_centerMaxShared[0]);
+    m_centerMin = min(m_centerMin, crt_m_centerMinShared[0]);
+    m_centerMax = max(m_centerMax, crt_m_centerMaxShared[0]);
   }
 }

@@ -22,23 +22,23 @@ layout(std430, binding = 2) buffer crt_a_outBuffer
 };  // parameter 'a_out'
 layout(std430, binding = 3) buffer crt_sumPartialsBuffer
 {
-  float sumPartials[];
+  float crt_sumPartials[];
 };  // per-workgroup partial results of the reduction of local sum
 layout(std430, binding = 4) buffer crt_loPartialsBuffer
 {
-  float loPartials[];
+  float crt_loPartials[];
 };  // per-workgroup partial results of the reduction of local lo
 layout(std430, binding = 5) buffer crt_hiPartialsBuffer
 {
-  float hiPartials[];
+  float crt_hiPartials[];
 };  // per-workgroup partial results of the reduction of local hi
 layout(std430, binding = 6) buffer crt_totalPartialsBuffer
 {
-  vec4 totalPartials[];
+  vec4 crt_totalPartials[];
 };  // per-workgroup partial results of the reduction of local total
 layout(std430, binding = 7) buffer crt_negativesPartialsBuffer
 {
-  int negativesPartials[];
+  int crt_negativesPartials[];
 };  // per-workgroup partial results of the reduction of local negatives
 
 layout(push_constant) uniform crt_kernel1D_SummarizeArgs
@@ -51,27 +51,27 @@ layout(push_constant) uniform crt_kernel1D_SummarizeArgs
 // Reductions: each thread accumulates locally, subgroups combine with subgroup arithmetic, the
 // first thread combines the subgroups' results in a fixed order and writes one partial result
 // per workgroup; kernel1D_Summarize_Reduce then folds the partials into the member.
-float sumLocal = 0.0;
-shared float sumShared[256 / 4];  // one per subgroup (subgroups have >= 4 threads)
-float loLocal = CRT_INFINITY;
-shared float loShared[256 / 4];  // one per subgroup (subgroups have >= 4 threads)
-float hiLocal = -CRT_INFINITY;
-shared float hiShared[256 / 4];  // one per subgroup (subgroups have >= 4 threads)
-vec4 totalLocal = vec4(0.0);
-shared vec4 totalShared[256 / 4];  // one per subgroup (subgroups have >= 4 threads)
-int negativesLocal = 0;
-shared int negativesShared[256 / 4];  // one per subgroup (subgroups have >= 4 threads)
+float crt_sumLocal = 0.0;
+shared float crt_sumShared[256 / 4];  // one per subgroup (subgroups have >= 4 threads)
+float crt_loLocal = CRT_INFINITY;
+shared float crt_loShared[256 / 4];  // one per subgroup (subgroups have >= 4 threads)
+float crt_hiLocal = -CRT_INFINITY;
+shared float crt_hiShared[256 / 4];  // one per subgroup (subgroups have >= 4 threads)
+vec4 crt_totalLocal = vec4(0.0);
+shared vec4 crt_totalShared[256 / 4];  // one per subgroup (subgroups have >= 4 threads)
+int crt_negativesLocal = 0;
+shared int crt_negativesShared[256 / 4];  // one per subgroup (subgroups have >= 4 threads)
 
 // from LocalTotals::kernel1D_Summarize (local_totals.cpp)
 void kernel1D_Summarize(uint i)
 {
   const float v = a_values[i].x;
-  sumLocal += v;
-  loLocal = min(loLocal, v);
-  hiLocal = max(v, hiLocal);
-  totalLocal += a_values[i];
+  crt_sumLocal += v;
+  crt_loLocal = min(crt_loLocal, v);
+  crt_hiLocal = max(v, crt_hiLocal);
+  crt_totalLocal += a_values[i];
   if (v < 0.0)
-    negativesLocal++;
+    crt_negativesLocal++;
 }
 
 void main()
@@ -82,43 +82,43 @@ void main()
   if (crt_inRange)
     kernel1D_Summarize(uint(crt_startX + int(crt_threadId)));
 
-  const float sumSubgroup = subgroupAdd(sumLocal);
-  const float loSubgroup = subgroupMin(loLocal);
-  const float hiSubgroup = subgroupMax(hiLocal);
-  const vec4 totalSubgroup = subgroupAdd(totalLocal);
-  const int negativesSubgroup = subgroupAdd(negativesLocal);
+  const float crt_sumSubgroup = subgroupAdd(crt_sumLocal);
+  const float crt_loSubgroup = subgroupMin(crt_loLocal);
+  const float crt_hiSubgroup = subgroupMax(crt_hiLocal);
+  const vec4 crt_totalSubgroup = subgroupAdd(crt_totalLocal);
+  const int crt_negativesSubgroup = subgroupAdd(crt_negativesLocal);
   if (subgroupElect())
   {
-    sumShared[gl_SubgroupID] = sumSubgroup;
-    loShared[gl_SubgroupID] = loSubgroup;
-    hiShared[gl_SubgroupID] = hiSubgroup;
-    totalShared[gl_SubgroupID] = totalSubgroup;
-    negativesShared[gl_SubgroupID] = negativesSubgroup;
+    crt_sumShared[gl_SubgroupID] = crt_sumSubgroup;
+    crt_loShared[gl_SubgroupID] = crt_loSubgroup;
+    crt_hiShared[gl_SubgroupID] = crt_hiSubgroup;
+    crt_totalShared[gl_SubgroupID] = crt_totalSubgroup;
+    crt_negativesShared[gl_SubgroupID] = crt_negativesSubgroup;
   }
   barrier();
   if (gl_LocalInvocationIndex == 0)
   {
     const uint crt_groupId =
         gl_WorkGroupID.x + gl_NumWorkGroups.x * (gl_WorkGroupID.y + gl_NumWorkGroups.y * gl_WorkGroupID.z);
-    float sumGroup = sumShared[0];
+    float crt_sumGroup = crt_sumShared[0];
     for (uint s = 1; s < gl_NumSubgroups; ++s)
-      sumGroup = sumGroup + sumShared[s];
-    sumPartials[crt_groupId] = sumGroup;
-    float loGroup = loShared[0];
+      crt_sumGroup = crt_sumGroup + crt_sumShared[s];
+    crt_sumPartials[crt_groupId] = crt_sumGroup;
+    float crt_loGroup = crt_loShared[0];
     for (uint s = 1; s < gl_NumSubgroups; ++s)
-      loGroup = min(loGroup, loShared[s]);
-    loPartials[crt_groupId] = loGroup;
-    float hiGroup = hiShared[0];
+      crt_loGroup = min(crt_loGroup, crt_loShared[s]);
+    crt_loPartials[crt_groupId] = crt_loGroup;
+    float crt_hiGroup = crt_hiShared[0];
     for (uint s = 1; s < gl_NumSubgroups; ++s)
-      hiGroup = max(hiGroup, hiShared[s]);
-    hiPartials[crt_groupId] = hiGroup;
-    vec4 totalGroup = totalShared[0];
+      crt_hiGroup = max(crt_hiGroup, crt_hiShared[s]);
+    crt_hiPartials[crt_groupId] = crt_hiGroup;
+    vec4 crt_totalGroup = crt_totalShared[0];
     for (uint s = 1; s < gl_NumSubgroups; ++s)
-      totalGroup = totalGroup + totalShared[s];
-    totalPartials[crt_groupId] = totalGroup;
-    int negativesGroup = negativesShared[0];
+      crt_totalGroup = crt_totalGroup + crt_totalShared[s];
+    crt_totalPartials[crt_groupId] = crt_totalGroup;
+    int crt_negativesGroup = crt_negativesShared[0];
     for (uint s = 1; s < gl_NumSubgroups; ++s)
-      negativesGroup = negativesGroup + negativesShared[s];
-    negativesPartials[crt_groupId] = negativesGroup;
+      crt_negativesGroup = crt_negativesGroup + crt_negativesShared[s];
+    crt_negativesPartials[crt_groupId] = crt_negativesGroup;
   }
 }

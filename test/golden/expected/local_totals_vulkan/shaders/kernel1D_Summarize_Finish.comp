@@ -22,23 +22,23 @@ layout(std430, binding = 2) buffer crt_a_outBuffer
 };  // parameter 'a_out'
 layout(std430, binding = 3) buffer crt_sumPartialsBuffer
 {
-  float sumPartials[];
+  float crt_sumPartials[];
 };  // per-workgroup partial results of the reduction of local sum
 layout(std430, binding = 4) buffer crt_loPartialsBuffer
 {
-  float loPartials[];
+  float crt_loPartials[];
 };  // per-workgroup partial results of the reduction of local lo
 layout(std430, binding = 5) buffer crt_hiPartialsBuffer
 {
-  float hiPartials[];
+  float crt_hiPartials[];
 };  // per-workgroup partial results of the reduction of local hi
 layout(std430, binding = 6) buffer crt_totalPartialsBuffer
 {
-  vec4 totalPartials[];
+  vec4 crt_totalPartials[];
 };  // per-workgroup partial results of the reduction of local total
 layout(std430, binding = 7) buffer crt_negativesPartialsBuffer
 {
-  int negativesPartials[];
+  int crt_negativesPartials[];
 };  // per-workgroup partial results of the reduction of local negatives
 
 layout(push_constant) uniform crt_kernel1D_SummarizeArgs
@@ -58,15 +58,15 @@ void kernel1D_Summarize_Finish()
   vec4 total = vec4(1.0, 2.0, 3.0, 4.0);
   int negatives = 0;
   if (crt_countX != 0u)
-    sum = sum + sumPartials[0];  // the threads' total
+    sum = sum + crt_sumPartials[0];  // the threads' total
   if (crt_countX != 0u)
-    lo = min(lo, loPartials[0]);  // the threads' total
+    lo = min(lo, crt_loPartials[0]);  // the threads' total
   if (crt_countX != 0u)
-    hi = max(hi, hiPartials[0]);  // the threads' total
+    hi = max(hi, crt_hiPartials[0]);  // the threads' total
   if (crt_countX != 0u)
-    total = total + totalPartials[0];  // the threads' total
+    total = total + crt_totalPartials[0];  // the threads' total
   if (crt_countX != 0u)
-    negatives = negatives + negativesPartials[0];  // the threads' total
+    negatives = negatives + crt_negativesPartials[0];  // the threads' total
   m_mean = n > 0u ? sum / float(n) : 0.0;
   m_range = hi - lo;
   a_out[0] = sum;

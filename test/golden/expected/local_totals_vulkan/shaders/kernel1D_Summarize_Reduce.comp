@@ -13,23 +13,23 @@ layout(std430, binding = 0) buffer crt_LocalTotalsData
 };
 layout(std430, binding = 1) buffer crt_sumPartialsBuffer
 {
-  float sumPartials[];
+  float crt_sumPartials[];
 };
 layout(std430, binding = 2) buffer crt_loPartialsBuffer
 {
-  float loPartials[];
+  float crt_loPartials[];
 };
 layout(std430, binding = 3) buffer crt_hiPartialsBuffer
 {
-  float hiPartials[];
+  float crt_hiPartials[];
 };
 layout(std430, binding = 4) buffer crt_totalPartialsBuffer
 {
-  vec4 totalPartials[];
+  vec4 crt_totalPartials[];
 };
 layout(std430, binding = 5) buffer crt_negativesPartialsBuffer
 {
-  int negativesPartials[];
+  int crt_negativesPartials[];
 };
 
 layout(push_constant) uniform crt_kernel1D_Summarize_ReduceArgs
@@ -37,54 +37,54 @@ layout(push_constant) uniform crt_kernel1D_Summarize_ReduceArgs
   uint partialCount;
 };
 
-shared float sumShared[256];
-shared float loShared[256];
-shared float hiShared[256];
-shared vec4 totalShared[256];
-shared int negativesShared[256];
+shared float crt_sumShared[256];
+shared float crt_loShared[256];
+shared float crt_hiShared[256];
+shared vec4 crt_totalShared[256];
+shared int crt_negativesShared[256];
 
 void main()
 {
   const uint local = gl_LocalInvocationIndex;
-  float sumLocal = 0.0;
+  float crt_sumLocal = 0.0;
   for (uint i = local; i < partialCount; i += 256)
-    sumLocal = sumLocal + sumPartials[i];
-  sumShared[local] = sumLocal;
-  float loLocal = CRT_INFINITY;
+    crt_sumLocal = crt_sumLocal + crt_sumPartials[i];
+  crt_sumShared[local] = crt_sumLocal;
+  float crt_loLocal = CRT_INFINITY;
   for (uint i = local; i < partialCount; i += 256)
-    loLocal = min(loLocal, loPartials[i]);
-  loShared[local] = loLocal;
-  float hiLocal = -CRT_INFINITY;
+    crt_loLocal = min(crt_loLocal, crt_loPartials[i]);
+  crt_loShared[local] = crt_loLocal;
+  float crt_hiLocal = -CRT_INFINITY;
   for (uint i = local; i < partialCount; i += 256)
-    hiLocal = max(hiLocal, hiPartials[i]);
-  hiShared[local] = hiLocal;
-  vec4 totalLocal = vec4(0.0);
+    crt_hiLocal = max(crt_hiLocal, crt_hiPartials[i]);
+  crt_hiShared[local] = crt_hiLocal;
+  vec4 crt_totalLocal = vec4(0.0);
   for (uint i = local; i < partialCount; i += 256)
-    totalLocal = totalLocal + totalPartials[i];
-  totalShared[local] = totalLocal;
-  int negativesLocal = 0;
+    crt_totalLocal = crt_totalLocal + crt_totalPartials[i];
+  crt_totalShared[local] = crt_totalLocal;
+  int crt_negativesLocal = 0;
   for (uint i = local; i < partialCount; i += 256)
-    negativesLocal = negativesLocal + negativesPartials[i];
-  negativesShared[local] = negativesLocal;
+    crt_negativesLocal = crt_negativesLocal + crt_negativesPartials[i];
+  crt_negativesShared[local] = crt_negativesLocal;
   barrier();
   for (uint stride = 256 / 2; stride > 0; stride /= 2)
   {
     if (local < stride)
     {
-      sumShared[local] = sumShared[local] + sumShared[local + stride];
-      loShared[local] = min(loShared[local], loShared[local + stride]);
-      hiShared[local] = max(hiShared[local], hiShared[local + stride]);
-      totalShared[local] = totalShared[local] + totalShared[local + stride];
-      negativesShared[local] = negativesShared[local] + negativesShared[local + stride];
+      crt_sumShared[local] = crt_sumShared[local] + crt_sumShared[local + stride];
+      crt_loShared[local] = min(crt_loShared[local], crt_loShared[local + stride]);
+      crt_hiShared[local] = max(crt_hiShared[local], crt_hiShared[local + stride]);
+      crt_totalShared[local] = crt_totalShared[local] + crt_totalShared[local + stride];
+      crt_negativesShared[local] = crt_negativesShared[local] + crt_negativesShared[local + stride];
     }
     barrier();
   }
   if (local == 0)
   {
-    sumPartials[0] = sumShared[0];              // the total of local sum, for kernel1D_Summarize_Finish
-    loPartials[0] = loShared[0];                // the total of local lo, for kernel1D_Summarize_Finish
-    hiPartials[0] = hiShared[0];                // the total of local hi, for kernel1D_Summarize_Finish
-    totalPartials[0] = totalShared[0];          // the total of local total, for kernel1D_Summarize_Finish
-    negativesPartials[0] = negativesShared[0];  // the total of local negatives, for kernel1D_Summarize_Finish
+    crt_sumPartials[0] = crt_sumShared[0];              // the total of local sum, for kernel1D_Summarize_Finish
+    crt_loPartials[0] = crt_loShared[0];                // the total of local lo, for kernel1D_Summarize_Finish
+    crt_hiPartials[0] = crt_hiShared[0];                // the total of local hi, for kernel1D_Summarize_Finish
+    crt_totalPartials[0] = crt_totalShared[0];          // the total of local total, for kernel1D_Summarize_Finish
+    crt_negativesPartials[0] = crt_negativesShared[0];  // the total of local negatives, for kernel1D_Summarize_Finish
   }
 }

@@ -27,7 +27,7 @@ layout(std430, binding = 2) buffer crt_velocitiesBuffer
 };  // parameter 'velocities'
 layout(std430, binding = 3) writeonly buffer crt_m_bouncesPartialsBuffer
 {
-  int m_bouncesPartials[];
+  int crt_m_bouncesPartials[];
 };  // per-workgroup partial results of the reduction of m_bounces
 
 layout(push_constant) uniform crt_kernel1D_AdvanceArgs
@@ -41,8 +41,8 @@ layout(push_constant) uniform crt_kernel1D_AdvanceArgs
 // Reductions: each thread accumulates locally, subgroups combine with subgroup arithmetic, the
 // first thread combines the subgroups' results in a fixed order and writes one partial result
 // per workgroup; kernel1D_Advance_Reduce then folds the partials into the member.
-int m_bouncesLocal = 0;
-shared int m_bouncesShared[256 / 4];  // one per subgroup (subgroups have >= 4 threads)
+int crt_m_bouncesLocal = 0;
+shared int crt_m_bouncesShared[256 / 4];  // one per subgroup (subgroups have >= 4 threads)
 
 // from Particles::kernel1D_Advance (Particles.cpp)
 void kernel1D_Advance(int i)
@@ -54,7 +54,7 @@ void kernel1D_Advance(int i)
   {
     p.y = -p.y * m_restitution;
     v.y = -v.y * m_restitution;
-    m_bouncesLocal += 1;
+    crt_m_bouncesLocal += 1;
   }
   positions[i] = p;
   velocities[i] = v;
@@ -68,19 +68,19 @@ void main()
   if (crt_inRange)
     kernel1D_Advance(int(crt_startX + int(crt_threadId)));
 
-  const int m_bouncesSubgroup = subgroupAdd(m_bouncesLocal);
+  const int crt_m_bouncesSubgroup = subgroupAdd(crt_m_bouncesLocal);
   if (subgroupElect())
   {
-    m_bouncesShared[gl_SubgroupID] = m_bouncesSubgroup;
+    crt_m_bouncesShared[gl_SubgroupID] = crt_m_bouncesSubgroup;
   }
   barrier();
   if (gl_LocalInvocationIndex == 0)
   {
     const uint crt_groupId =
         gl_WorkGroupID.x + gl_NumWorkGroups.x * (gl_WorkGroupID.y + gl_NumWorkGroups.y * gl_WorkGroupID.z);
-    int m_bouncesGroup = m_bouncesShared[0];
+    int crt_m_bouncesGroup = crt_m_bouncesShared[0];
     for (uint s = 1; s < gl_NumSubgroups; ++s)
-      m_bouncesGroup = m_bouncesGroup + m_bouncesShared[s];
-    m_bouncesPartials[crt_groupId] = m_bouncesGroup;
+      crt_m_bouncesGroup = crt_m_bouncesGroup + crt_m_bouncesShared[s];
+    crt_m_bouncesPartials[crt_groupId] = crt_m_bouncesGroup;
   }
 }

@@ -19,7 +19,7 @@ layout(std430, binding = 0) buffer crt_ParticlesData
 };
 layout(std430, binding = 1) readonly buffer crt_m_bouncesPartialsBuffer
 {
-  int m_bouncesPartials[];
+  int crt_m_bouncesPartials[];
 };
 
 layout(push_constant) uniform crt_kernel1D_Advance_ReduceArgs
@@ -27,26 +27,26 @@ layout(push_constant) uniform crt_kernel1D_Advance_ReduceArgs
   uint partialCount;
 };
 
-shared int m_bouncesShared[256];
+shared int crt_m_bouncesShared[256];
 
 void main()
 {
   const uint local = gl_LocalInvocationIndex;
-  int m_bouncesLocal = 0;
+  int crt_m_bouncesLocal = 0;
   for (uint i = local; i < partialCount; i += 256)
-    m_bouncesLocal = m_bouncesLocal + m_bouncesPartials[i];
-  m_bouncesShared[local] = m_bouncesLocal;
+    crt_m_bouncesLocal = crt_m_bouncesLocal + crt_m_bouncesPartials[i];
+  crt_m_bouncesShared[local] = crt_m_bouncesLocal;
   barrier();
   for (uint stride = 256 / 2; stride > 0; stride /= 2)
   {
     if (local < stride)
     {
-      m_bouncesShared[local] = m_bouncesShared[local] + m_bouncesShared[local + stride];
+      crt_m_bouncesShared[local] = crt_m_bouncesShared[local] + crt_m_bouncesShared[local + stride];
     }
     barrier();
   }
   if (local == 0)
   {
-    m_bounces = m_bounces + m_bouncesShared[0];
+    m_bounces = m_bounces + crt_m_bouncesShared[0];
   }
 }

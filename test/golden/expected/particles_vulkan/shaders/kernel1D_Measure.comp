@@ -28,19 +28,19 @@ layout(std430, binding = 2) readonly buffer crt_velocitiesBuffer
 };  // parameter 'velocities'
 layout(std430, binding = 3) writeonly buffer crt_m_boxMinPartialsBuffer
 {
-  vec4 m_boxMinPartials[];
+  vec4 crt_m_boxMinPartials[];
 };  // per-workgroup partial results of the reduction of m_boxMin
 layout(std430, binding = 4) writeonly buffer crt_m_boxMaxPartialsBuffer
 {
-  vec4 m_boxMaxPartials[];
+  vec4 crt_m_boxMaxPartials[];
 };  // per-workgroup partial results of the reduction of m_boxMax
 layout(std430, binding = 5) writeonly buffer crt_m_momentumPartialsBuffer
 {
-  vec4 m_momentumPartials[];
+  vec4 crt_m_momentumPartials[];
 };  // per-workgroup partial results of the reduction of m_momentum
 layout(std430, binding = 6) writeonly buffer crt_m_kineticEnergyPartialsBuffer
 {
-  float m_kineticEnergyPartials[];
+  float crt_m_kineticEnergyPartials[];
 };  // per-workgroup partial results of the reduction of m_kineticEnergy
 
 layout(push_constant) uniform crt_kernel1D_MeasureArgs
@@ -53,24 +53,24 @@ layout(push_constant) uniform crt_kernel1D_MeasureArgs
 // Reductions: each thread accumulates locally, subgroups combine with subgroup arithmetic, the
 // first thread combines the subgroups' results in a fixed order and writes one partial result
 // per workgroup; kernel1D_Measure_Reduce then folds the partials into the member.
-vec4 m_boxMinLocal = vec4(CRT_INFINITY);
-shared vec4 m_boxMinShared[256 / 4];  // one per subgroup (subgroups have >= 4 threads)
-vec4 m_boxMaxLocal = vec4(-CRT_INFINITY);
-shared vec4 m_boxMaxShared[256 / 4];  // one per subgroup (subgroups have >= 4 threads)
-vec4 m_momentumLocal = vec4(0.0);
-shared vec4 m_momentumShared[256 / 4];  // one per subgroup (subgroups have >= 4 threads)
-float m_kineticEnergyLocal = 0.0;
-shared float m_kineticEnergyShared[256 / 4];  // one per subgroup (subgroups have >= 4 threads)
+vec4 crt_m_boxMinLocal = vec4(CRT_INFINITY);
+shared vec4 crt_m_boxMinShared[256 / 4];  // one per subgroup (subgroups have >= 4 threads)
+vec4 crt_m_boxMaxLocal = vec4(-CRT_INFINITY);
+shared vec4 crt_m_boxMaxShared[256 / 4];  // one per subgroup (subgroups have >= 4 threads)
+vec4 crt_m_momentumLocal = vec4(0.0);
+shared vec4 crt_m_momentumShared[256 / 4];  // one per subgroup (subgroups have >= 4 threads)
+float crt_m_kineticEnergyLocal = 0.0;
+shared float crt_m_kineticEnergyShared[256 / 4];  // one per subgroup (subgroups have >= 4 threads)
 
 // from Particles::kernel1D_Measure (Particles.cpp)
 void kernel1D_Measure(int i)
 {
   const vec4 p = positions[i];
   const vec4 v = velocities[i];
-  m_boxMinLocal = min(m_boxMinLocal, p);
-  m_boxMaxLocal = max(m_boxMaxLocal, p);
-  m_momentumLocal += v;
-  m_kineticEnergyLocal += 0.5 * dot(v, v);
+  crt_m_boxMinLocal = min(crt_m_boxMinLocal, p);
+  crt_m_boxMaxLocal = max(crt_m_boxMaxLocal, p);
+  crt_m_momentumLocal += v;
+  crt_m_kineticEnergyLocal += 0.5 * dot(v, v);
 }
 
 void main()
@@ -81,37 +81,37 @@ void main()
   if (crt_inRange)
     kernel1D_Measure(int(crt_startX + int(crt_threadId)));
 
-  const vec4 m_boxMinSubgroup = subgroupMin(m_boxMinLocal);
-  const vec4 m_boxMaxSubgroup = subgroupMax(m_boxMaxLocal);
-  const vec4 m_momentumSubgroup = subgroupAdd(m_momentumLocal);
-  const float m_kineticEnergySubgroup = subgroupAdd(m_kineticEnergyLocal);
+  const vec4 crt_m_boxMinSubgroup = subgroupMin(crt_m_boxMinLocal);
+  const vec4 crt_m_boxMaxSubgroup = subgroupMax(crt_m_boxMaxLocal);
+  const vec4 crt_m_momentumSubgroup = subgroupAdd(crt_m_momentumLocal);
+  const float crt_m_kineticEnergySubgroup = subgroupAdd(crt_m_kineticEnergyLocal);
   if (subgroupElect())
   {
-    m_boxMinShared[gl_SubgroupID] = m_boxMinSubgroup;
-    m_boxMaxShared[gl_SubgroupID] = m_boxMaxSubgroup;
-    m_momentumShared[gl_SubgroupID] = m_momentumSubgroup;
-    m_kineticEnergyShared[gl_SubgroupID] = m_kineticEnergySubgroup;
+    crt_m_boxMinShared[gl_SubgroupID] = crt_m_boxMinSubgroup;
+    crt_m_boxMaxShared[gl_SubgroupID] = crt_m_boxMaxSubgroup;
+    crt_m_momentumShared[gl_SubgroupID] = crt_m_momentumSubgroup;
+    crt_m_kineticEnergyShared[gl_SubgroupID] = crt_m_kineticEnergySubgroup;
   }
   barrier();
   if (gl_LocalInvocationIndex == 0)
   {
     const uint crt_groupId =
         gl_WorkGroupID.x + gl_NumWorkGroups.x * (gl_WorkGroupID.y + gl_NumWorkGroups.y * gl_WorkGroupID.z);
-    vec4 m_boxMinGroup = m_boxMinShared[0];
+    vec4 crt_m_boxMinGroup = crt_m_boxMinShared[0];
     for (uint s = 1; s < gl_NumSubgroups; ++s)
-      m_boxMinGroup = min(m_boxMinGroup, m_boxMinShared[s]);
-    m_boxMinPartials[crt_groupId] = m_boxMinGroup;
-    vec4 m_boxMaxGroup = m_boxMaxShared[0];
+      crt_m_boxMinGroup = min(crt_m_boxMinGroup, crt_m_boxMinShared[s]);
+    crt_m_boxMinPartials[crt_groupId] = crt_m_boxMinGroup;
+    vec4 crt_m_boxMaxGroup = crt_m_boxMaxShared[0];
     for (uint s = 1; s < gl_NumSubgroups; ++s)
-      m_boxMaxGroup = max(m_boxMaxGroup, m_boxMaxShared[s]);
-    m_boxMaxPartials[crt_groupId] = m_boxMaxGroup;
-    vec4 m_momentumGroup = m_momentumShared[0];
+      crt_m_boxMaxGroup = max(crt_m_boxMaxGroup, crt_m_boxMaxShared[s]);
+    crt_m_boxMaxPartials[crt_groupId] = crt_m_boxMaxGroup;
+    vec4 crt_m_momentumGroup = crt_m_momentumShared[0];
     for (uint s = 1; s < gl_NumSubgroups; ++s)
-      m_momentumGroup = m_momentumGroup + m_momentumShared[s];
-    m_momentumPartials[crt_groupId] = m_momentumGroup;
-    float m_kineticEnergyGroup = m_kineticEnergyShared[0];
+      crt_m_momentumGroup = crt_m_momentumGroup + crt_m_momentumShared[s];
+    crt_m_momentumPartials[crt_groupId] = crt_m_momentumGroup;
+    float crt_m_kineticEnergyGroup = crt_m_kineticEnergyShared[0];
     for (uint s = 1; s < gl_NumSubgroups; ++s)
-      m_kineticEnergyGroup = m_kineticEnergyGroup + m_kineticEnergyShared[s];
-    m_kineticEnergyPartials[crt_groupId] = m_kineticEnergyGroup;
+      crt_m_kineticEnergyGroup = crt_m_kineticEnergyGroup + crt_m_kineticEnergyShared[s];
+    crt_m_kineticEnergyPartials[crt_groupId] = crt_m_kineticEnergyGroup;
   }
 }

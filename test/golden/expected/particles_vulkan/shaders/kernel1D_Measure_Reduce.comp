@@ -20,19 +20,19 @@ layout(std430, binding = 0) buffer crt_ParticlesData
 };
 layout(std430, binding = 1) readonly buffer crt_m_boxMinPartialsBuffer
 {
-  vec4 m_boxMinPartials[];
+  vec4 crt_m_boxMinPartials[];
 };
 layout(std430, binding = 2) readonly buffer crt_m_boxMaxPartialsBuffer
 {
-  vec4 m_boxMaxPartials[];
+  vec4 crt_m_boxMaxPartials[];
 };
 layout(std430, binding = 3) readonly buffer crt_m_momentumPartialsBuffer
 {
-  vec4 m_momentumPartials[];
+  vec4 crt_m_momentumPartials[];
 };
 layout(std430, binding = 4) readonly buffer crt_m_kineticEnergyPartialsBuffer
 {
-  float m_kineticEnergyPartials[];
+  float crt_m_kineticEnergyPartials[];
 };
 
 layout(push_constant) uniform crt_kernel1D_Measure_ReduceArgs
@@ -40,47 +40,47 @@ layout(push_constant) uniform crt_kernel1D_Measure_ReduceArgs
   uint partialCount;
 };
 
-shared vec4 m_boxMinShared[256];
-shared vec4 m_boxMaxShared[256];
-shared vec4 m_momentumShared[256];
-shared float m_kineticEnergyShared[256];
+shared vec4 crt_m_boxMinShared[256];
+shared vec4 crt_m_boxMaxShared[256];
+shared vec4 crt_m_momentumShared[256];
+shared float crt_m_kineticEnergyShared[256];
 
 void main()
 {
   const uint local = gl_LocalInvocationIndex;
-  vec4 m_boxMinLocal = vec4(CRT_INFINITY);
+  vec4 crt_m_boxMinLocal = vec4(CRT_INFINITY);
   for (uint i = local; i < partialCount; i += 256)
-    m_boxMinLocal = min(m_boxMinLocal, m_boxMinPartials[i]);
-  m_boxMinShared[local] = m_boxMinLocal;
-  vec4 m_boxMaxLocal = vec4(-CRT_INFINITY);
+    crt_m_boxMinLocal = min(crt_m_boxMinLocal, crt_m_boxMinPartials[i]);
+  crt_m_boxMinShared[local] = crt_m_boxMinLocal;
+  vec4 crt_m_boxMaxLocal = vec4(-CRT_INFINITY);
   for (uint i = local; i < partialCount; i += 256)
-    m_boxMaxLocal = max(m_boxMaxLocal, m_boxMaxPartials[i]);
-  m_boxMaxShared[local] = m_boxMaxLocal;
-  vec4 m_momentumLocal = vec4(0.0);
+    crt_m_boxMaxLocal = max(crt_m_boxMaxLocal, crt_m_boxMaxPartials[i]);
+  crt_m_boxMaxShared[local] = crt_m_boxMaxLocal;
+  vec4 crt_m_momentumLocal = vec4(0.0);
   for (uint i = local; i < partialCount; i += 256)
-    m_momentumLocal = m_momentumLocal + m_momentumPartials[i];
-  m_momentumShared[local] = m_momentumLocal;
-  float m_kineticEnergyLocal = 0.0;
+    crt_m_momentumLocal = crt_m_momentumLocal + crt_m_momentumPartials[i];
+  crt_m_momentumShared[local] = crt_m_momentumLocal;
+  float crt_m_kineticEnergyLocal = 0.0;
   for (uint i = local; i < partialCount; i += 256)
-    m_kineticEnergyLocal = m_kineticEnergyLocal + m_kineticEnergyPartials[i];
-  m_kineticEnergyShared[local] = m_kineticEnergyLocal;
+    crt_m_kineticEnergyLocal = crt_m_kineticEnergyLocal + crt_m_kineticEnergyPartials[i];
+  crt_m_kineticEnergyShared[local] = crt_m_kineticEnergyLocal;
   barrier();
   for (uint stride = 256 / 2; stride > 0; stride /= 2)
   {
     if (local < stride)
     {
-      m_boxMinShared[local] = min(m_boxMinShared[local], m_boxMinShared[local + stride]);
-      m_boxMaxShared[local] = max(m_boxMaxShared[local], m_boxMaxShared[local + stride]);
-      m_momentumShared[local] = m_momentumShared[local] + m_momentumShared[local + stride];
-      m_kineticEnergyShared[local] = m_kineticEnergyShared[local] + m_kineticEnergyShared[local + stride];
+      crt_m_boxMinShared[local] = min(crt_m_boxMinShared[local], crt_m_boxMinShared[local + stride]);
+      crt_m_boxMaxShared[local] = max(crt_m_boxMaxShared[local], crt_m_boxMaxShared[local + stride]);
+      crt_m_momentumShared[local] = crt_m_momentumShared[local] + crt_m_momentumShared[local + stride];
+      crt_m_kineticEnergyShared[local] = crt_m_kineticEnergyShared[local] + crt_m_kineticEnergyShared[local + stride];
     }
     barrier();
   }
   if (local == 0)
   {
-    m_boxMin = min(m_boxMin, m_boxMinShared[0]);
-    m_boxMax = max(m_boxMax, m_boxMaxShared[0]);
-    m_momentum = m_momentum + m_momentumShared[0];
-    m_kineticEnergy = m_kineticEnergy + m_kineticEnergyShared[0];
+    m_boxMin = min(m_boxMin, crt_m_boxMinShared[0]);
+    m_boxMax = max(m_boxMax, crt_m_boxMaxShared[0]);
+    m_momentum = m_momentum + crt_m_momentumShared[0];
+    m_kineticEnergy = m_kineticEnergy + crt_m_kineticEnergyShared[0];
   }
 }

@@ -130,10 +130,10 @@ layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer m_s
 // Data members of SdfLeafTracer, uploaded before every control function call.
 layout(std430, binding = 0) buffer crt_SdfLeafTracerData
 {
-  uvec2 m_scene_m_geom_tags;
-  uvec2 m_scene_m_geom_SdfGridLeaves;
-  uvec2 m_scene_m_geom_SdfSVSLeaves;
-  uvec2 m_scene_m_geom_SdfSBSLeaves;
+  uvec2 crt_m_scene_m_geom_tags;
+  uvec2 crt_m_scene_m_geom_SdfGridLeaves;
+  uvec2 crt_m_scene_m_geom_SdfSVSLeaves;
+  uvec2 crt_m_scene_m_geom_SdfSBSLeaves;
   uint crt_m_scene_m_nodeMin_size;
   uint crt_m_scene_m_nodeMin_capacity;
   uint crt_m_scene_m_nodeMax_size;
@@ -720,30 +720,30 @@ void SdfSBSLeaves_Intersect(SdfSBSLeaves_Data self, vec4 posAndNear, vec4 dirAnd
 }
 
 // m_scene->m_geom[index]->Intersect(...): the object's class picks the implementation
-void m_scene_m_geom_Intersect(uint index, vec4 posAndNear, vec4 dirAndFar, CRT_LeafInfo info, inout CRT_Hit hit)
+void crt_m_scene_m_geom_Intersect(uint index, vec4 posAndNear, vec4 dirAndFar, CRT_LeafInfo info, inout CRT_Hit hit)
 {
-  const uvec2 tag = m_scene_m_geom_Tags(m_scene_m_geom_tags).tags[index];
+  const uvec2 tag = m_scene_m_geom_Tags(crt_m_scene_m_geom_tags).tags[index];
   switch (tag.x)
   {
   case 0u:  // dead code in a pipeline made for objects without a SdfGridLeaves
     if (crt_m_scene_m_geom_holdsSdfGridLeaves)
     {
-      SdfGridLeaves_Intersect(m_scene_m_geom_SdfGridLeavesObjects(m_scene_m_geom_SdfGridLeaves).objects[tag.y],
+      SdfGridLeaves_Intersect(m_scene_m_geom_SdfGridLeavesObjects(crt_m_scene_m_geom_SdfGridLeaves).objects[tag.y],
                               posAndNear, dirAndFar, info, hit);
     }
     return;
   case 1u:  // dead code in a pipeline made for objects without a SdfSVSLeaves
     if (crt_m_scene_m_geom_holdsSdfSVSLeaves)
     {
-      SdfSVSLeaves_Intersect(m_scene_m_geom_SdfSVSLeavesObjects(m_scene_m_geom_SdfSVSLeaves).objects[tag.y], posAndNear,
-                             dirAndFar, info, hit);
+      SdfSVSLeaves_Intersect(m_scene_m_geom_SdfSVSLeavesObjects(crt_m_scene_m_geom_SdfSVSLeaves).objects[tag.y],
+                             posAndNear, dirAndFar, info, hit);
     }
     return;
   case 2u:  // dead code in a pipeline made for objects without a SdfSBSLeaves
     if (crt_m_scene_m_geom_holdsSdfSBSLeaves)
     {
-      SdfSBSLeaves_Intersect(m_scene_m_geom_SdfSBSLeavesObjects(m_scene_m_geom_SdfSBSLeaves).objects[tag.y], posAndNear,
-                             dirAndFar, info, hit);
+      SdfSBSLeaves_Intersect(m_scene_m_geom_SdfSBSLeavesObjects(crt_m_scene_m_geom_SdfSBSLeaves).objects[tag.y],
+                             posAndNear, dirAndFar, info, hit);
     }
     return;
   }
@@ -821,7 +821,7 @@ CRT_Hit m_scene_RayQuery_NearestHit(vec4 posAndNear, vec4 dirAndFar)
     info.geomId = m_scene_m_leafIds[m_scene_m_nodeLeaf[node] - 1u].x;
     info.rayxId = 0u;
     info.rayyId = 0u;
-    m_scene_m_geom_Intersect(uint(info.geomId), posAndNear, dirAndFar, info, hit);
+    crt_m_scene_m_geom_Intersect(uint(info.geomId), posAndNear, dirAndFar, info, hit);
   }
   return hit;
 }

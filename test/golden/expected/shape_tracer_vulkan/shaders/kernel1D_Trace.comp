@@ -100,14 +100,14 @@ layout(buffer_reference, std430, buffer_reference_align = 4) readonly buffer m_s
 // Data members of ShapeTracer, uploaded before every control function call.
 layout(std430, binding = 0) buffer crt_ShapeTracerData
 {
-  uvec2 m_scene_m_shapes_tags;
-  uvec2 m_scene_m_shapes_Sphere;
-  uvec2 m_scene_m_shapes_Box;
-  uvec2 m_scene_m_shapes_Disc;
-  uvec2 m_scene_m_lights_tags;
-  uvec2 m_scene_m_lights_Sphere;
-  uvec2 m_scene_m_lights_Box;
-  uvec2 m_scene_m_lights_Disc;
+  uvec2 crt_m_scene_m_shapes_tags;
+  uvec2 crt_m_scene_m_shapes_Sphere;
+  uvec2 crt_m_scene_m_shapes_Box;
+  uvec2 crt_m_scene_m_shapes_Disc;
+  uvec2 crt_m_scene_m_lights_tags;
+  uvec2 crt_m_scene_m_lights_Sphere;
+  uvec2 crt_m_scene_m_lights_Box;
+  uvec2 crt_m_scene_m_lights_Disc;
   uint crt_m_scene_m_boxes_size;
   uint crt_m_scene_m_boxes_capacity;
   uint crt_m_scene_m_lightBoxes_size;
@@ -226,60 +226,60 @@ void Disc_Intersect(Disc_Data self, vec4 posAndNear, vec4 dirAndFar, uint shapeI
 }
 
 // m_scene->m_shapes[index]->Intersect(...): the object's class picks the implementation
-void m_scene_m_shapes_Intersect(uint index, vec4 posAndNear, vec4 dirAndFar, uint shapeId, inout ShapeHit hit)
+void crt_m_scene_m_shapes_Intersect(uint index, vec4 posAndNear, vec4 dirAndFar, uint shapeId, inout ShapeHit hit)
 {
-  const uvec2 tag = m_scene_m_shapes_Tags(m_scene_m_shapes_tags).tags[index];
+  const uvec2 tag = m_scene_m_shapes_Tags(crt_m_scene_m_shapes_tags).tags[index];
   switch (tag.x)
   {
   case 0u:  // dead code in a pipeline made for objects without a Sphere
     if (crt_m_scene_m_shapes_holdsSphere)
     {
-      Sphere_Intersect(m_scene_m_shapes_SphereObjects(m_scene_m_shapes_Sphere).objects[tag.y], posAndNear, dirAndFar,
-                       shapeId, hit);
+      Sphere_Intersect(m_scene_m_shapes_SphereObjects(crt_m_scene_m_shapes_Sphere).objects[tag.y], posAndNear,
+                       dirAndFar, shapeId, hit);
     }
     return;
   case 1u:  // dead code in a pipeline made for objects without a Box
     if (crt_m_scene_m_shapes_holdsBox)
     {
-      Box_Intersect(m_scene_m_shapes_BoxObjects(m_scene_m_shapes_Box).objects[tag.y], posAndNear, dirAndFar, shapeId,
-                    hit);
+      Box_Intersect(m_scene_m_shapes_BoxObjects(crt_m_scene_m_shapes_Box).objects[tag.y], posAndNear, dirAndFar,
+                    shapeId, hit);
     }
     return;
   case 2u:  // dead code in a pipeline made for objects without a Disc
     if (crt_m_scene_m_shapes_holdsDisc)
     {
-      Disc_Intersect(m_scene_m_shapes_DiscObjects(m_scene_m_shapes_Disc).objects[tag.y], posAndNear, dirAndFar, shapeId,
-                     hit);
+      Disc_Intersect(m_scene_m_shapes_DiscObjects(crt_m_scene_m_shapes_Disc).objects[tag.y], posAndNear, dirAndFar,
+                     shapeId, hit);
     }
     return;
   }
 }
 
 // m_scene->m_lights[index]->Intersect(...): the object's class picks the implementation
-void m_scene_m_lights_Intersect(uint index, vec4 posAndNear, vec4 dirAndFar, uint shapeId, inout ShapeHit hit)
+void crt_m_scene_m_lights_Intersect(uint index, vec4 posAndNear, vec4 dirAndFar, uint shapeId, inout ShapeHit hit)
 {
-  const uvec2 tag = m_scene_m_lights_Tags(m_scene_m_lights_tags).tags[index];
+  const uvec2 tag = m_scene_m_lights_Tags(crt_m_scene_m_lights_tags).tags[index];
   switch (tag.x)
   {
   case 0u:  // dead code in a pipeline made for objects without a Sphere
     if (crt_m_scene_m_lights_holdsSphere)
     {
-      Sphere_Intersect(m_scene_m_lights_SphereObjects(m_scene_m_lights_Sphere).objects[tag.y], posAndNear, dirAndFar,
-                       shapeId, hit);
+      Sphere_Intersect(m_scene_m_lights_SphereObjects(crt_m_scene_m_lights_Sphere).objects[tag.y], posAndNear,
+                       dirAndFar, shapeId, hit);
     }
     return;
   case 1u:  // dead code in a pipeline made for objects without a Box
     if (crt_m_scene_m_lights_holdsBox)
     {
-      Box_Intersect(m_scene_m_lights_BoxObjects(m_scene_m_lights_Box).objects[tag.y], posAndNear, dirAndFar, shapeId,
-                    hit);
+      Box_Intersect(m_scene_m_lights_BoxObjects(crt_m_scene_m_lights_Box).objects[tag.y], posAndNear, dirAndFar,
+                    shapeId, hit);
     }
     return;
   case 2u:  // dead code in a pipeline made for objects without a Disc
     if (crt_m_scene_m_lights_holdsDisc)
     {
-      Disc_Intersect(m_scene_m_lights_DiscObjects(m_scene_m_lights_Disc).objects[tag.y], posAndNear, dirAndFar, shapeId,
-                     hit);
+      Disc_Intersect(m_scene_m_lights_DiscObjects(crt_m_scene_m_lights_Disc).objects[tag.y], posAndNear, dirAndFar,
+                     shapeId, hit);
     }
     return;
   }
@@ -323,13 +323,13 @@ ShapeHit m_scene_Trace(vec4 posAndNear, vec4 dirAndFar)
   const uint count = crt_m_scene_m_boxes_size / 2u;
   for (uint i = 0u; i < count; ++i)
     if (m_scene_HitsBox(posAndNear, dirAndFar, hit.t, m_scene_m_boxes[2u * i], m_scene_m_boxes[2u * i + 1u]))
-      m_scene_m_shapes_Intersect(uint(i), posAndNear, dirAndFar, i, hit);
+      crt_m_scene_m_shapes_Intersect(uint(i), posAndNear, dirAndFar, i, hit);
   ShapeHit light = hit;
   light.shape = ~0u;
   for (uint i = 0u; i < crt_m_scene_m_lights_size; ++i)
     if (m_scene_HitsBox(posAndNear, dirAndFar, light.t, m_scene_m_lightBoxes[2u * i],
                         m_scene_m_lightBoxes[2u * i + 1u]))
-      m_scene_m_lights_Intersect(uint(i), posAndNear, dirAndFar, i, light);
+      crt_m_scene_m_lights_Intersect(uint(i), posAndNear, dirAndFar, i, light);
   if (light.shape != ~0u)
   {
     hit = light;

@@ -19,6 +19,11 @@ struct crt_TextureInfo
 // Data members of TexturedMaterials, uploaded before every control function call.
 layout(std430, binding = 0) buffer crt_TexturedMaterialsData
 {
+  float m_bumps_sample;
+  float m_bumps_texel;
+  float m_bumps_width;
+  float m_bumps_info;
+  float m_bumps_texels;
   uint crt_m_albedo_size;
   uint crt_m_bumps_size;
 };
@@ -44,19 +49,19 @@ layout(std430, binding = 5) buffer crt_texelsBuffer
 };  // parameter 'texels'
 layout(std430, binding = 6) readonly buffer crt_m_albedoInfoBuffer
 {
-  crt_TextureInfo m_albedo_info[];
+  crt_TextureInfo crt_m_albedo_info[];
 };  // member std::vector<LiteImage::Texture2D<LiteMath::float4>> m_albedo: its textures' sizes and samplers
 layout(std430, binding = 7) readonly buffer crt_m_albedoTexelBuffer
 {
-  vec4 m_albedo_texels[];
+  vec4 crt_m_albedo_texels[];
 };  // their texels, one texture after the other
 layout(std430, binding = 8) readonly buffer crt_m_bumpsInfoBuffer
 {
-  crt_TextureInfo m_bumps_info[];
+  crt_TextureInfo crt_m_bumps_info[];
 };  // member std::vector<LiteImage::Texture2D<float>> m_bumps: its textures' sizes and samplers
 layout(std430, binding = 9) readonly buffer crt_m_bumpsTexelBuffer
 {
-  float m_bumps_texels[];
+  float crt_m_bumps_texels[];
 };  // their texels, one texture after the other
 
 layout(push_constant) uniform crt_kernel1D_ShadeArgs
@@ -97,35 +102,35 @@ float crt_sanitizeCoord(float x)
 }
 
 // m_albedo[i] texel (x, y) after its sampler's address modes; outside a BORDER sampler's image its border colour.
-vec4 m_albedo_fetch(crt_TextureInfo t, int x, int y)
+vec4 crt_m_albedo_fetch(crt_TextureInfo t, int x, int y)
 {
   const int xi = crt_addressTexel(x, int(t.width), t.mode & 3u);
   const int yi = crt_addressTexel(y, int(t.height), (t.mode >> 2) & 3u);
   if (xi < 0 || yi < 0)
     return t.border;
-  return m_albedo_texels[t.offset + uint(yi) * t.width + uint(xi)];
+  return crt_m_albedo_texels[t.offset + uint(yi) * t.width + uint(xi)];
 }
 
 // m_albedo[i].sample(uv): Image2D::sample in the same float operations, so the result is the CPU's.
-vec4 m_albedo_sample(uint i, vec2 uv)
+vec4 crt_m_albedo_sample(uint i, vec2 uv)
 {
-  const crt_TextureInfo t = m_albedo_info[i];
+  const crt_TextureInfo t = crt_m_albedo_info[i];
   if (t.width == 0u || t.height == 0u)
     return vec4(0.0);
   // `precise`: no fused multiply-adds, which the CPU does not do.
   precise float x = crt_sanitizeCoord(uv.x * float(t.width));
   precise float y = crt_sanitizeCoord(uv.y * float(t.height));
   if ((t.mode & 16u) == 0u)
-    return m_albedo_fetch(t, int(floor(x)), int(floor(y)));
+    return crt_m_albedo_fetch(t, int(floor(x)), int(floor(y)));
   // Bilinear: integer positions are texel centres.
   precise float fx = x - 0.5, fy = y - 0.5;
   const float x0 = floor(fx), y0 = floor(fy);
   precise float tx = fx - x0, ty = fy - y0;
   const int ix = int(x0), iy = int(y0);
-  const vec4 t00 = m_albedo_fetch(t, ix, iy);
-  const vec4 t10 = m_albedo_fetch(t, ix + 1, iy);
-  const vec4 t01 = m_albedo_fetch(t, ix, iy + 1);
-  const vec4 t11 = m_albedo_fetch(t, ix + 1, iy + 1);
+  const vec4 t00 = crt_m_albedo_fetch(t, ix, iy);
+  const vec4 t10 = crt_m_albedo_fetch(t, ix + 1, iy);
+  const vec4 t01 = crt_m_albedo_fetch(t, ix, iy + 1);
+  const vec4 t11 = crt_m_albedo_fetch(t, ix + 1, iy + 1);
   precise vec4 top = t00 * (1.0 - tx) + t10 * tx;
   precise vec4 bottom = t01 * (1.0 - tx) + t11 * tx;
   precise vec4 result = top * (1.0 - ty) + bottom * ty;
@@ -133,52 +138,52 @@ vec4 m_albedo_sample(uint i, vec2 uv)
 }
 
 // m_albedo[i][p]
-vec4 m_albedo_texel(uint i, ivec2 p)
+vec4 crt_m_albedo_texel(uint i, ivec2 p)
 {
-  const crt_TextureInfo t = m_albedo_info[i];
-  return m_albedo_texels[t.offset + uint(p.y) * t.width + uint(p.x)];
+  const crt_TextureInfo t = crt_m_albedo_info[i];
+  return crt_m_albedo_texels[t.offset + uint(p.y) * t.width + uint(p.x)];
 }
 
-uint m_albedo_width(uint i)
+uint crt_m_albedo_width(uint i)
 {
-  return m_albedo_info[i].width;
+  return crt_m_albedo_info[i].width;
 }
 
-uint m_albedo_height(uint i)
+uint crt_m_albedo_height(uint i)
 {
-  return m_albedo_info[i].height;
+  return crt_m_albedo_info[i].height;
 }
 
 // m_bumps[i] texel (x, y) after its sampler's address modes; outside a BORDER sampler's image its border colour.
-float m_bumps_fetch(crt_TextureInfo t, int x, int y)
+float crt_m_bumps_fetch(crt_TextureInfo t, int x, int y)
 {
   const int xi = crt_addressTexel(x, int(t.width), t.mode & 3u);
   const int yi = crt_addressTexel(y, int(t.height), (t.mode >> 2) & 3u);
   if (xi < 0 || yi < 0)
     return t.border.x;
-  return m_bumps_texels[t.offset + uint(yi) * t.width + uint(xi)];
+  return crt_m_bumps_texels[t.offset + uint(yi) * t.width + uint(xi)];
 }
 
 // m_bumps[i].sample(uv): Image2D::sample in the same float operations, so the result is the CPU's.
-float m_bumps_sample(uint i, vec2 uv)
+float crt_m_bumps_sample(uint i, vec2 uv)
 {
-  const crt_TextureInfo t = m_bumps_info[i];
+  const crt_TextureInfo t = crt_m_bumps_info[i];
   if (t.width == 0u || t.height == 0u)
     return float(0.0);
   // `precise`: no fused multiply-adds, which the CPU does not do.
   precise float x = crt_sanitizeCoord(uv.x * float(t.width));
   precise float y = crt_sanitizeCoord(uv.y * float(t.height));
   if ((t.mode & 16u) == 0u)
-    return m_bumps_fetch(t, int(floor(x)), int(floor(y)));
+    return crt_m_bumps_fetch(t, int(floor(x)), int(floor(y)));
   // Bilinear: integer positions are texel centres.
   precise float fx = x - 0.5, fy = y - 0.5;
   const float x0 = floor(fx), y0 = floor(fy);
   precise float tx = fx - x0, ty = fy - y0;
   const int ix = int(x0), iy = int(y0);
-  const float t00 = m_bumps_fetch(t, ix, iy);
-  const float t10 = m_bumps_fetch(t, ix + 1, iy);
-  const float t01 = m_bumps_fetch(t, ix, iy + 1);
-  const float t11 = m_bumps_fetch(t, ix + 1, iy + 1);
+  const float t00 = crt_m_bumps_fetch(t, ix, iy);
+  const float t10 = crt_m_bumps_fetch(t, ix + 1, iy);
+  const float t01 = crt_m_bumps_fetch(t, ix, iy + 1);
+  const float t11 = crt_m_bumps_fetch(t, ix + 1, iy + 1);
   precise float top = t00 * (1.0 - tx) + t10 * tx;
   precise float bottom = t01 * (1.0 - tx) + t11 * tx;
   precise float result = top * (1.0 - ty) + bottom * ty;
@@ -186,26 +191,26 @@ float m_bumps_sample(uint i, vec2 uv)
 }
 
 // m_bumps[i][p]
-float m_bumps_texel(uint i, ivec2 p)
+float crt_m_bumps_texel(uint i, ivec2 p)
 {
-  const crt_TextureInfo t = m_bumps_info[i];
-  return m_bumps_texels[t.offset + uint(p.y) * t.width + uint(p.x)];
+  const crt_TextureInfo t = crt_m_bumps_info[i];
+  return crt_m_bumps_texels[t.offset + uint(p.y) * t.width + uint(p.x)];
 }
 
-uint m_bumps_width(uint i)
+uint crt_m_bumps_width(uint i)
 {
-  return m_bumps_info[i].width;
+  return crt_m_bumps_info[i].width;
 }
 
-uint m_bumps_height(uint i)
+uint crt_m_bumps_height(uint i)
 {
-  return m_bumps_info[i].height;
+  return crt_m_bumps_info[i].height;
 }
 
 // from TexturedMaterials::Albedo
 vec4 Albedo(uint a_texId, vec2 a_uv)
 {
-  return m_albedo_sample(a_texId, a_uv);
+  return crt_m_albedo_sample(a_texId, a_uv);
 }
 
 // from TexturedMaterials::kernel1D_Shade (TexturedMaterials.cpp)
@@ -214,10 +219,11 @@ void kernel1D_Shade(int i)
   const uint id = texIds[i] % crt_m_albedo_size;
   colors[i] = Albedo(id, uvs[i]);
   const uint bump = texIds[i] % crt_m_bumps_size;
-  heights[i] = m_bumps_sample(bump, uvs[i]) + float(m_bumps_width(bump));
-  const ivec2 p = ivec2((i - (int(m_albedo_width(0u))) * (i / (int(m_albedo_width(0u))))),
-                        ((i / 3) - (int(m_albedo_height(0u))) * ((i / 3) / (int(m_albedo_height(0u))))));
-  texels[i] = m_albedo_texel(0u, p);
+  heights[i] = crt_m_bumps_sample(bump, uvs[i]) + float(crt_m_bumps_width(bump)) + m_bumps_sample + m_bumps_texel +
+               m_bumps_width + m_bumps_info + m_bumps_texels;
+  const ivec2 p = ivec2((i - (int(crt_m_albedo_width(0u))) * (i / (int(crt_m_albedo_width(0u))))),
+                        ((i / 3) - (int(crt_m_albedo_height(0u))) * ((i / 3) / (int(crt_m_albedo_height(0u))))));
+  texels[i] = crt_m_albedo_texel(0u, p);
 }
 
 void main()

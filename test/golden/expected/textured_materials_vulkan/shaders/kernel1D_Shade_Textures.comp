@@ -20,6 +20,11 @@ struct crt_TextureInfo
 // Data members of TexturedMaterials, uploaded before every control function call.
 layout(std430, binding = 0) buffer crt_TexturedMaterialsData
 {
+  float m_bumps_sample;
+  float m_bumps_texel;
+  float m_bumps_width;
+  float m_bumps_info;
+  float m_bumps_texels;
   uint crt_m_albedo_size;
   uint crt_m_bumps_size;
 };
@@ -45,12 +50,12 @@ layout(std430, binding = 5) buffer crt_texelsBuffer
 };  // parameter 'texels'
 layout(std430, binding = 6) readonly buffer crt_m_albedoInfoBuffer
 {
-  crt_TextureInfo m_albedo_info[];
+  crt_TextureInfo crt_m_albedo_info[];
 };  // member std::vector<LiteImage::Texture2D<LiteMath::float4>> m_albedo: its textures' sizes and samplers
 layout(set = 1, binding = 0) uniform sampler2D m_albedo[];  // its textures, with their samplers
 layout(std430, binding = 7) readonly buffer crt_m_bumpsInfoBuffer
 {
-  crt_TextureInfo m_bumps_info[];
+  crt_TextureInfo crt_m_bumps_info[];
 };  // member std::vector<LiteImage::Texture2D<float>> m_bumps: its textures' sizes and samplers
 layout(set = 2, binding = 0) uniform sampler2D m_bumps[];  // its textures, with their samplers
 
@@ -93,7 +98,7 @@ float crt_sanitizeCoord(float x)
 
 // m_albedo[i] texel (x, y) after its sampler's address modes, read from the image itself; outside
 // a BORDER sampler's image its border colour.
-vec4 m_albedo_fetch(uint i, crt_TextureInfo t, int x, int y)
+vec4 crt_m_albedo_fetch(uint i, crt_TextureInfo t, int x, int y)
 {
   const int xi = crt_addressTexel(x, int(t.width), t.mode & 3u);
   const int yi = crt_addressTexel(y, int(t.height), (t.mode >> 2) & 3u);
@@ -106,9 +111,9 @@ vec4 m_albedo_fetch(uint i, crt_TextureInfo t, int x, int y)
 // Far outside the image, and at NaN or infinity, a sampler's fixed-point coordinates lose the texel
 // (and Vulkan leaves non-finite ones undefined): there it samples as Image2D::sample does, in the
 // same float operations, from the image's texels.
-vec4 m_albedo_sample(uint i, vec2 uv)
+vec4 crt_m_albedo_sample(uint i, vec2 uv)
 {
-  const crt_TextureInfo t = m_albedo_info[i];
+  const crt_TextureInfo t = crt_m_albedo_info[i];
   if (t.width == 0u || t.height == 0u)
     return vec4(0.0);
   precise float x = uv.x * float(t.width);
@@ -118,15 +123,15 @@ vec4 m_albedo_sample(uint i, vec2 uv)
   x = crt_sanitizeCoord(x);
   y = crt_sanitizeCoord(y);
   if ((t.mode & 16u) == 0u)
-    return m_albedo_fetch(i, t, int(floor(x)), int(floor(y)));
+    return crt_m_albedo_fetch(i, t, int(floor(x)), int(floor(y)));
   precise float fx = x - 0.5, fy = y - 0.5;
   const float x0 = floor(fx), y0 = floor(fy);
   precise float tx = fx - x0, ty = fy - y0;
   const int ix = int(x0), iy = int(y0);
-  const vec4 t00 = m_albedo_fetch(i, t, ix, iy);
-  const vec4 t10 = m_albedo_fetch(i, t, ix + 1, iy);
-  const vec4 t01 = m_albedo_fetch(i, t, ix, iy + 1);
-  const vec4 t11 = m_albedo_fetch(i, t, ix + 1, iy + 1);
+  const vec4 t00 = crt_m_albedo_fetch(i, t, ix, iy);
+  const vec4 t10 = crt_m_albedo_fetch(i, t, ix + 1, iy);
+  const vec4 t01 = crt_m_albedo_fetch(i, t, ix, iy + 1);
+  const vec4 t11 = crt_m_albedo_fetch(i, t, ix + 1, iy + 1);
   precise vec4 top = t00 * (1.0 - tx) + t10 * tx;
   precise vec4 bottom = t01 * (1.0 - tx) + t11 * tx;
   precise vec4 result = top * (1.0 - ty) + bottom * ty;
@@ -134,24 +139,24 @@ vec4 m_albedo_sample(uint i, vec2 uv)
 }
 
 // m_albedo[i][p]
-vec4 m_albedo_texel(uint i, ivec2 p)
+vec4 crt_m_albedo_texel(uint i, ivec2 p)
 {
   return texelFetch(m_albedo[nonuniformEXT(i)], p, 0);
 }
 
-uint m_albedo_width(uint i)
+uint crt_m_albedo_width(uint i)
 {
-  return m_albedo_info[i].width;
+  return crt_m_albedo_info[i].width;
 }
 
-uint m_albedo_height(uint i)
+uint crt_m_albedo_height(uint i)
 {
-  return m_albedo_info[i].height;
+  return crt_m_albedo_info[i].height;
 }
 
 // m_bumps[i] texel (x, y) after its sampler's address modes, read from the image itself; outside
 // a BORDER sampler's image its border colour.
-float m_bumps_fetch(uint i, crt_TextureInfo t, int x, int y)
+float crt_m_bumps_fetch(uint i, crt_TextureInfo t, int x, int y)
 {
   const int xi = crt_addressTexel(x, int(t.width), t.mode & 3u);
   const int yi = crt_addressTexel(y, int(t.height), (t.mode >> 2) & 3u);
@@ -164,9 +169,9 @@ float m_bumps_fetch(uint i, crt_TextureInfo t, int x, int y)
 // Far outside the image, and at NaN or infinity, a sampler's fixed-point coordinates lose the texel
 // (and Vulkan leaves non-finite ones undefined): there it samples as Image2D::sample does, in the
 // same float operations, from the image's texels.
-float m_bumps_sample(uint i, vec2 uv)
+float crt_m_bumps_sample(uint i, vec2 uv)
 {
-  const crt_TextureInfo t = m_bumps_info[i];
+  const crt_TextureInfo t = crt_m_bumps_info[i];
   if (t.width == 0u || t.height == 0u)
     return float(0.0);
   precise float x = uv.x * float(t.width);
@@ -176,15 +181,15 @@ float m_bumps_sample(uint i, vec2 uv)
   x = crt_sanitizeCoord(x);
   y = crt_sanitizeCoord(y);
   if ((t.mode & 16u) == 0u)
-    return m_bumps_fetch(i, t, int(floor(x)), int(floor(y)));
+    return crt_m_bumps_fetch(i, t, int(floor(x)), int(floor(y)));
   precise float fx = x - 0.5, fy = y - 0.5;
   const float x0 = floor(fx), y0 = floor(fy);
   precise float tx = fx - x0, ty = fy - y0;
   const int ix = int(x0), iy = int(y0);
-  const float t00 = m_bumps_fetch(i, t, ix, iy);
-  const float t10 = m_bumps_fetch(i, t, ix + 1, iy);
-  const float t01 = m_bumps_fetch(i, t, ix, iy + 1);
-  const float t11 = m_bumps_fetch(i, t, ix + 1, iy + 1);
+  const float t00 = crt_m_bumps_fetch(i, t, ix, iy);
+  const float t10 = crt_m_bumps_fetch(i, t, ix + 1, iy);
+  const float t01 = crt_m_bumps_fetch(i, t, ix, iy + 1);
+  const float t11 = crt_m_bumps_fetch(i, t, ix + 1, iy + 1);
   precise float top = t00 * (1.0 - tx) + t10 * tx;
   precise float bottom = t01 * (1.0 - tx) + t11 * tx;
   precise float result = top * (1.0 - ty) + bottom * ty;
@@ -192,25 +197,25 @@ float m_bumps_sample(uint i, vec2 uv)
 }
 
 // m_bumps[i][p]
-float m_bumps_texel(uint i, ivec2 p)
+float crt_m_bumps_texel(uint i, ivec2 p)
 {
   return texelFetch(m_bumps[nonuniformEXT(i)], p, 0).x;
 }
 
-uint m_bumps_width(uint i)
+uint crt_m_bumps_width(uint i)
 {
-  return m_bumps_info[i].width;
+  return crt_m_bumps_info[i].width;
 }
 
-uint m_bumps_height(uint i)
+uint crt_m_bumps_height(uint i)
 {
-  return m_bumps_info[i].height;
+  return crt_m_bumps_info[i].height;
 }
 
 // from TexturedMaterials::Albedo
 vec4 Albedo(uint a_texId, vec2 a_uv)
 {
-  return m_albedo_sample(a_texId, a_uv);
+  return crt_m_albedo_sample(a_texId, a_uv);
 }
 
 // from TexturedMaterials::kernel1D_Shade (TexturedMaterials.cpp)
@@ -219,10 +224,11 @@ void kernel1D_Shade(int i)
   const uint id = texIds[i] % crt_m_albedo_size;
   colors[i] = Albedo(id, uvs[i]);
   const uint bump = texIds[i] % crt_m_bumps_size;
-  heights[i] = m_bumps_sample(bump, uvs[i]) + float(m_bumps_width(bump));
-  const ivec2 p = ivec2((i - (int(m_albedo_width(0u))) * (i / (int(m_albedo_width(0u))))),
-                        ((i / 3) - (int(m_albedo_height(0u))) * ((i / 3) / (int(m_albedo_height(0u))))));
-  texels[i] = m_albedo_texel(0u, p);
+  heights[i] = crt_m_bumps_sample(bump, uvs[i]) + float(crt_m_bumps_width(bump)) + m_bumps_sample + m_bumps_texel +
+               m_bumps_width + m_bumps_info + m_bumps_texels;
+  const ivec2 p = ivec2((i - (int(crt_m_albedo_width(0u))) * (i / (int(crt_m_albedo_width(0u))))),
+                        ((i / 3) - (int(crt_m_albedo_height(0u))) * ((i / 3) / (int(crt_m_albedo_height(0u))))));
+  texels[i] = crt_m_albedo_texel(0u, p);
 }
 
 void main()
