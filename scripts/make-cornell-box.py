@@ -443,25 +443,32 @@ def add_shape_lights(gltf):
     gltf["scenes"][0]["nodes"] += [first, first + 1]
 
 
-def main(argv):
-    usage = (__doc__.split("\n\n")[1] + "\n\n"
-             "Writes a deterministic Cornell box glTF 2.0 scene (embedded "
-             "buffer) to OUT.gltf.\n")
+def command_line(argv, usage, help_text, flag, build, with_flag):
+    """[flag] OUT.gltf: writes build(), changed by with_flag(gltf) when the
+    flag is given (make-room.py's command line too)."""
     if argv in (["-h"], ["--help"]):
-        sys.stdout.write(usage)
+        sys.stdout.write(help_text)
         return 0
-    shape_lights = "--shape-lights" in argv
-    argv = [a for a in argv if a != "--shape-lights"]
+    flagged = flag in argv
+    argv = [a for a in argv if a != flag]
     if len(argv) != 1 or argv[0].startswith("-"):
         sys.stderr.write(usage)
         return 2
-    gltf = build_gltf()
-    if shape_lights:
-        add_shape_lights(gltf)
+    gltf = build()
+    if flagged:
+        with_flag(gltf)
     text = json.dumps(gltf, indent=1) + "\n"
     with open(argv[0], "w", encoding="ascii", newline="\n") as f:
         f.write(text)
     return 0
+
+
+def main(argv):
+    usage = (__doc__.split("\n\n")[1] + "\n\n"
+             "Writes a deterministic Cornell box glTF 2.0 scene (embedded "
+             "buffer) to OUT.gltf.\n")
+    return command_line(argv, usage, usage, "--shape-lights", build_gltf,
+                        add_shape_lights)
 
 
 if __name__ == "__main__":

@@ -33,7 +33,6 @@ Scene (Y up, metres):
 """
 
 import importlib.util
-import json
 import math
 import os
 import sys
@@ -180,22 +179,8 @@ def without_specular_layers(gltf):
 
 
 def main(argv):
-    usage = __doc__.split("\n\n")[1] + "\n"
-    if argv in (["-h"], ["--help"]):
-        sys.stdout.write(__doc__)
-        return 0
-    lambert = "--lambert" in argv
-    argv = [a for a in argv if a != "--lambert"]
-    if len(argv) != 1 or argv[0].startswith("-"):
-        sys.stderr.write(usage)
-        return 2
-    gltf = build_gltf()
-    if lambert:
-        without_specular_layers(gltf)
-    text = json.dumps(gltf, indent=1) + "\n"
-    with open(argv[0], "w", encoding="ascii", newline="\n") as f:
-        f.write(text)
-    return 0
+    return cb.command_line(argv, __doc__.split("\n\n")[1] + "\n", __doc__,
+                           "--lambert", build_gltf, without_specular_layers)
 
 
 if __name__ == "__main__":
