@@ -90,6 +90,11 @@ scenes=(
   "room_imported|$out/room.gltf|192x192|1024|-|-|imported"
   "room_imported_burley|$out/room_lambert.gltf|192x192|1024|-|-|imported-burley"
 )
+known=","
+for s in "${scenes[@]}"; do known+="${s%%|*},"; done
+for name in ${only//,/ }; do
+  [[ "$known" == *",$name,"* ]] || die "--only: no scene named '$name' (the scenes: ${known:1:-1})"
+done
 for s in "${scenes[@]}"; do
   IFS='|' read -r name file size spp env goal materials <<<"$s"
   [ -z "$only" ] || [[ "$only" == *",$name,"* ]] || continue
