@@ -46,11 +46,13 @@ What it does
        13% brighter): the specular layer is a black Principled BSDF (its
        Fresnel follows the microfacet normal; Specular = F0 / 0.08 for F0 from
        KHR_materials_ior's IOR, 1.5, times KHR_materials_specular's factor),
-       plus a Lambert Diffuse BSDF of the base colour weighted by 1 - F by a
-       Mix Shader, F from a Fresnel node.  Cycles weighs the base by the
-       Fresnel of the shading normal, CrossRT by that of the microfacet
-       normal.  A KHR_materials_clearcoat layer is left out, as CrossRT leaves
-       it out.
+       plus a Lambert Diffuse BSDF of the base colour weighted by a Mix
+       Shader by (1 - F0)(1 - g(n.v)): what CrossRT's 1 - F(v.h) leaves of the
+       base, averaged over the light's directions (see base_fresnel; a
+       Fresnel node of the shading normal took the whole base away at grazing
+       views, and rendered a closed room of rough walls 4-8% darker than
+       CrossRT).  A KHR_materials_clearcoat layer is left out, as CrossRT
+       leaves it out.
      * Every remaining Principled BSDF gets distribution 'GGX' (single
        scattering), not multiscatter GGX.
      * Punctual lights get radius 0 (point/spot shadow_soft_size, sun angle;
