@@ -1,5 +1,6 @@
 // Shared by the benchmarks: how a time is measured, and what it was measured on.
 #pragma once
+#include <crossrt/CpuParallel.h>
 #include <crossrt/IspcSupport.h>
 
 #include <algorithm>
@@ -80,6 +81,18 @@ inline std::string IspcTarget()
   for (int i = int(std::size(crossrt::kIspcTargets)) - 1; i >= 0; --i)
     if (crossrt::CpuRunsIspcTarget(i)) return crossrt::kIspcTargets[i];
   return "none";
+}
+
+// How the _ISPC classes' kernels pick between SIMD lanes and their scalar loop (CROSSRT_ISPC_LANES,
+// crossrt::LaneChoice): "lanes or scalar, measured", "lanes always" or "scalar always".
+inline const char* IspcLanes()
+{
+  switch (crossrt::LaneChoice::LanesMode())
+  {
+  case crossrt::LaneChoice::Mode::Always: return "lanes always";
+  case crossrt::LaneChoice::Mode::Never: return "scalar always";
+  default: return "lanes or scalar, measured";
+  }
 }
 
 // N threads that keep a core each busy for as long as this object lives: `--load N`, the other

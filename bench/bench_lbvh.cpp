@@ -172,8 +172,8 @@ int main(int argc, char** argv)
   try { ctx = crossrt::VulkanContext::CreateDefault(); }
   catch (const std::exception& e) { std::printf("no Vulkan device (%s): the _Vulkan column is left out\n", e.what()); }
   const BusyThreads busy(load);
-  std::printf("CPU: %s, %d threads; ISPC target: %s; Vulkan device: %s; load: %d busy threads beside the measurement\n", CpuModel().c_str(),
-              omp_get_max_threads(), IspcTarget().c_str(), ctx ? ctx->DeviceName().c_str() : "none", busy.Count());
+  std::printf("CPU: %s, %d threads; ISPC target: %s (%s); Vulkan device: %s; load: %d busy threads beside the measurement\n", CpuModel().c_str(),
+              omp_get_max_threads(), IspcTarget().c_str(), IspcLanes(), ctx ? ctx->DeviceName().c_str() : "none", busy.Count());
   std::vector<std::string> slower;  // translated classes slower than the original, for the warning rows at the end
 
   std::printf("\nBuild time, ms (ratio = time / Embree LOW; the CPU builders' medians of %d interleaved rounds, their ratios\n"

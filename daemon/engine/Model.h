@@ -136,6 +136,7 @@ struct Kernel {
   unsigned dims = 1;
   std::vector<KernelParam> params;
   std::string cppParamsDecl;          // the parameter list as the user wrote it
+  std::string cppArgs;                // its names, as arguments (an _ISPC kernel passes them on to its two ways)
   std::vector<unsigned> threadAxes;   // axis (0=x,1=y,2=z) of each thread-function parameter
   std::vector<Loop> loops;            // IPV: outermost first
   // ISPC: a 2D nest whose iterations call composed code (a traversal) runs foreach_tiled, its lanes

@@ -345,7 +345,7 @@ void Tracer::kernel_Depth(uint32_t tid, const CRT_Hit* hit, float* depth) { dept
   CHECK(host.find(Squeezed("only the translated traversal reads it")) == std::string::npos);
 }
 
-TEST_CASE("On ISPC a thread loop runs as the megakernel's ISPC, and a loop nest around one kernel calls it, one thread a lane, chunks on all cores", "[engine][modes][ispc]")
+TEST_CASE("On ISPC a thread loop runs as the megakernel's ISPC, and a loop nest around one kernel calls it, one thread a lane, chunks on all cores, or as the CPU class runs them", "[engine][modes][ispc]")
 {
   TempClass tc("Walk", R"(#pragma once
 #include "LiteMath.h"
@@ -410,7 +410,14 @@ void Walk::kernel_Scale(uint32_t tidX, uint32_t tidY, uint32_t w, float gain, fl
   CHECK(host.find(Squeezed("crossrt::IspcPick(ispc::Walk_Run_Megakernel, {Walk_Run_Megakernel_sse4, Walk_Run_Megakernel_avx2, "
                            "Walk_Run_Megakernel_avx512skx})")) != std::string::npos);
   CHECK(host.find(Squeezed("crossrt::IspcPointer<ispc::float4*>(out), steps, w);")) != std::string::npos);
-  CHECK(host.find(Squeezed("kernel_Start(x, y, &p);")) == std::string::npos);
+  // Or, where that has been faster here (crossrt::LaneChoice), the loop as the _CPU class runs it:
+  // the lanes' chunks first, then the loop as written, on all cores.
+  const size_t choice = host.find(Squeezed("static crossrt::LaneChoice crt_lanes; crossrt::LaneChoice::Run crt_way = crt_lanes.Begin();"));
+  const size_t lanes = host.find(Squeezed("if (crt_way.lanes) {"));
+  const size_t scalar = host.find(Squeezed("kernel_Start(x, y, &p);"));
+  CHECK(choice != std::string::npos);
+  CHECK((choice < lanes && lanes != std::string::npos && lanes < scalar && scalar != std::string::npos));
+  CHECK(host.find(Squeezed("#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 16) collapse(2)"), lanes) < scalar);
   // A loop nest around one kernel: its export function calls the kernel's thread function itself.
   CHECK(ispc.find(Squeezed("export void Walk_Scale_kernel_Scale(uniform Walk_Data *uniform self, uniform int crt_begin, uniform int crt_end, "
                            "uniform int crt_startX, uniform int crt_countX, uniform uint crt_w, uniform float crt_gain, uniform float4 *uniform crt_out_)")) !=

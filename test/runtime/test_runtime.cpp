@@ -794,3 +794,54 @@ TEST_CASE("ParallelChoice takes the faster way and tries the other now and then"
   }
   omp_set_num_threads(threadsBefore);
 }
+
+// crossrt::LaneChoice, with the times given: an _ISPC kernel runs in SIMD lanes on its first two
+// calls (the first not counted), tries its scalar loop on the third, then takes the faster way and
+// tries the other after 16 calls, then 64... while it loses; a call that ran no loop counts for nothing.
+TEST_CASE("LaneChoice runs a kernel in lanes or as a scalar loop, whichever has been faster", "[runtime][parallel]")
+{
+  if (crossrt::LaneChoice::LanesMode() != crossrt::LaneChoice::Mode::Measure) {
+    WARN("CROSSRT_ISPC_LANES is set: the choice is off");
+    return;
+  }
+  auto count = [](crossrt::LaneChoice& choice, int calls, double lanesMs, double scalarMs) {
+    int lanes = 0;
+    for (int i = 0; i < calls; ++i) {
+      const bool l = choice.Choose();
+      choice.Record(l, 1000, l ? lanesMs : scalarMs);
+      lanes += l;
+    }
+    return lanes;
+  };
+  SECTION("the scalar loop wins on this CPU") {
+    crossrt::LaneChoice choice;
+    REQUIRE(choice.Choose());
+    choice.Record(true, 1000, 50.0);  // the first call: memory touched, not counted
+    CHECK(choice.Mean(1) < 0.0f);
+    REQUIRE(choice.Choose());
+    choice.Record(true, 1000, 3.0);
+    CHECK(choice.Mean(1) == Approx(0.003f));
+    REQUIRE_FALSE(choice.Choose());  // the scalar loop, once
+    choice.Record(false, 1000, 1.0);
+    CHECK(count(choice, 16, 3.0, 1.0) == 1);  // lanes tried once in 16 calls, and lost
+    CHECK(count(choice, 63, 3.0, 1.0) == 0);
+    CHECK(count(choice, 1, 3.0, 1.0) == 1);
+  }
+  SECTION("lanes win: the scalar loop, having lost, is tried again after 64 calls") {
+    crossrt::LaneChoice choice;
+    CHECK(count(choice, 2, 1.0, 3.0) == 2);
+    CHECK(count(choice, 1, 1.0, 3.0) == 0);
+    CHECK(count(choice, 16, 1.0, 3.0) == 16);
+    CHECK(count(choice, 64, 1.0, 3.0) == 63);
+    CHECK(choice.Mean(0) == Approx(0.003f));
+  }
+  SECTION("a call with an empty loop counts for nothing") {
+    crossrt::LaneChoice choice;
+    for (int i = 0; i < 5; ++i) {
+      REQUIRE(choice.Choose());
+      choice.Record(true, 0, 1.0);
+    }
+    CHECK(choice.Mean(1) < 0.0f);
+    CHECK(choice.Mean(0) < 0.0f);
+  }
+}

@@ -124,7 +124,11 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   }
   // The definition's parameter names: its body uses them (a declaration may name them otherwise).
   CheckKernelParams(c, md, def, k);
-  for (unsigned i = 0; i < def->getNumParams(); ++i) k.cppParamsDecl += (i ? ", " : "") + ParamDecl(c.ctx, md->getParamDecl(i), def->getParamDecl(i), i);
+  for (unsigned i = 0; i < def->getNumParams(); ++i) {
+    k.cppParamsDecl += (i ? ", " : "") + ParamDecl(c.ctx, md->getParamDecl(i), def->getParamDecl(i), i);
+    const std::string name = def->getParamDecl(i)->getNameAsString(), declared = md->getParamDecl(i)->getNameAsString();
+    k.cppArgs += (i ? ", " : "") + (!name.empty() ? name : !declared.empty() ? declared : "a_unnamed" + std::to_string(i));
+  }
   std::unique_ptr<KernelPrinter> kernelPrinter = MakePrinter(c.model, c.ctx, c.cls, c.rep);
   KernelPrinter& printer = *kernelPrinter;
   // The ISPC class runs kernelND_ loop nests as ISPC, and kernel_ functions as the thread functions
@@ -535,12 +539,9 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     SourceLocation end = Lexer::findLocationAfterToken(outer->getEndLoc(), tok::semi, c.ctx.getSourceManager(), c.ctx.getLangOpts(), false);
     k.cpuLoopNest = CanonicalCode(end.isValid() ? rw.getRewrittenText(CharSourceRange::getCharRange(outer->getBeginLoc(), end))
                                                 : rw.getRewrittenText(outer->getSourceRange()));
-    // The CPU class copies the loop nest and what it uses; the ISPC class only the statements around
-    // it, which run on the host (the nest runs as ISPC).
-    if (c.model.forCpu && !c.model.forIspc) CopySourceDeclarations(c, def->getBody(), "kernel '" + k.name + "'");
-    if (c.model.forIspc)
-      for (auto* list : {&before, &after})
-        for (auto* s : *list) CopySourceDeclarations(c, s, "kernel '" + k.name + "'");
+    // The CPU class copies the loop nest and what it uses; so does the ISPC class, whose kernels run
+    // the nest as the CPU class does when that has been faster than SIMD lanes (crossrt::LaneChoice).
+    if (c.model.forCpu) CopySourceDeclarations(c, def->getBody(), "kernel '" + k.name + "'");
     for (auto* s : before) k.cpuPreamble += StatementText(c, s) + "\n";
     for (auto* s : before)
       if (auto* ds = dyn_cast<DeclStmt>(s))

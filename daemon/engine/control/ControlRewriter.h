@@ -95,6 +95,8 @@ private:
   // `outermost`): an OpenMP loop on all cores, or on this thread while that has been faster
   // (crossrt::ParallelChoice), in a block of its own.
   void ParallelOnCpu(const ForStmt* outer, const LoopHeader& outermost, size_t nest);
+  // What ParallelOnCpu writes before and after the loop nest.
+  std::pair<std::string, std::string> ParallelChoiceAround(const ForStmt* outer, const LoopHeader& outermost, size_t nest);
 
   // Checks that `e` does not depend on the thread (host code and by-value kernel arguments run once
   // for all threads in wavefront mode) and collects the control function's variables it reads.
@@ -121,10 +123,13 @@ private:
   // The ISPC class: a loop nest around one kernel call, as an export function calling the kernel's
   // thread function over a chunk, and the chunks on all cores in place of the nest. False where
   // the nest stays C++ (three axes, a default or array argument, a kernel returning bool).
-  bool IspcRtvNest(const ForStmt* outer, const CXXMemberCallExpr* call, const std::map<unsigned, const LoopHeader*>& axes);
+  bool IspcRtvNest(const ForStmt* outer, const CXXMemberCallExpr* call, const std::map<unsigned, const LoopHeader*>& axes,
+                   const LoopHeader& outermost, size_t nestDepth);
   unsigned m_ispcNests = 0;
-  // The CPU class's control function: `text` in place of the loop (its closing ';' included).
-  void ReplaceLoopForCpu(const ForStmt* loop, const std::string& text);
+  // The ISPC class's control function: in place of the loop nest (its closing ';' included), the
+  // chunks in SIMD lanes (`lanes`) or the nest as the _CPU class runs it, whichever has been faster
+  // here (crossrt::LaneChoice); `threads` counts the nest's iterations.
+  void LanesOrScalarLoop(const ForStmt* loop, const LoopHeader& outermost, size_t nest, const std::string& lanes, const std::string& threads);
 
   // The wavefront version of the thread loop's body: host loops as written, each kernel call a
   // dispatch over all threads, per-thread locals bound as their buffers.

@@ -3,7 +3,8 @@
 // by ThreadBodyGlsl in the ISPC dialect, becomes a function of one thread that calls the kernels'
 // ISPC thread functions (Kernels.cpp: IspcRtvHead); an export function runs it over a chunk of the
 // threads (a 2D loop in tiles of rows and columns, as foreach_tiled spreads them); and the control
-// function hands the chunks to all cores, in place of the loop. A loop nest around one kernel call
+// function hands the chunks to all cores, in place of the loop, or runs the loop as the _CPU class
+// does where that has been faster here (crossrt::LaneChoice). A loop nest around one kernel call
 // (for (y) for (x) kernel_X(x, y, ...)) gets the same: its export function calls the kernel's
 // thread function directly.
 
@@ -46,6 +47,11 @@ std::string ChunksOnAllCores(const ClassModel& model, const std::string& what, c
           "crt_choice.End(crt_loop);\n"
           "IspcWrittenBack(crt_self);  // members the kernels set\n}\n";
   return text;
+}
+
+// The threads of a loop nest of `dims` axes whose counts are counts[] (x first), as C++.
+std::string Threads(const std::string counts[2], size_t dims) {
+  return dims == 2 ? "(long long)std::max(0, int(" + counts[0] + ")) * std::max(0, int(" + counts[1] + "))" : "std::max(0, int(" + counts[0] + "))";
 }
 
 // The export function's loop over a chunk: x (and y) run across the lanes.
@@ -119,11 +125,13 @@ bool ControlRewriter::IspcThreadLoop(ThreadLoop& tl, const std::string& body, co
   std::string counts[2];
   for (auto& h : tl.loops)
     if (auto axis = tl.axisOf.find(h.var); axis != tl.axisOf.end() && axis->second < dims) counts[axis->second] = CountExpr(m_c, h);
-  ReplaceLoopForCpu(outerLoop, ChunksOnAllCores(m_c.model, "the thread loop", symbol, dims, counts, cppArgs));
+  LanesOrScalarLoop(outerLoop, tl.loops.front(), tl.loops.size(), ChunksOnAllCores(m_c.model, "the thread loop", symbol, dims, counts, cppArgs),
+                    Threads(counts, dims));
   return true;
 }
 
-bool ControlRewriter::IspcRtvNest(const ForStmt* outer, const CXXMemberCallExpr* call, const std::map<unsigned, const LoopHeader*>& axes) {
+bool ControlRewriter::IspcRtvNest(const ForStmt* outer, const CXXMemberCallExpr* call, const std::map<unsigned, const LoopHeader*>& axes,
+                                  const LoopHeader& outermost, size_t nestDepth) {
   const size_t dims = axes.size();
   auto* md = call->getMethodDecl();
   auto k = std::find_if(m_c.model.kernels.begin(), m_c.model.kernels.end(), [&](const Kernel& x) { return x.name == md->getNameAsString(); });
@@ -171,14 +179,22 @@ bool ControlRewriter::IspcRtvNest(const ForStmt* outer, const CXXMemberCallExpr*
   std::string counts[2];
   for (auto& [axis, h] : axes)
     if (axis < dims) counts[axis] = CountExpr(m_c, *h);
-  ReplaceLoopForCpu(outer, ChunksOnAllCores(m_c.model, "the loop nest", symbol, dims, counts, cppArgs));
+  LanesOrScalarLoop(outer, outermost, nestDepth, ChunksOnAllCores(m_c.model, "the loop nest", symbol, dims, counts, cppArgs), Threads(counts, dims));
   return true;
 }
 
-void ControlRewriter::ReplaceLoopForCpu(const ForStmt* loop, const std::string& text) {
+void ControlRewriter::LanesOrScalarLoop(const ForStmt* loop, const LoopHeader& outermost, size_t nest, const std::string& lanes, const std::string& threads) {
   SourceLocation end = Lexer::findLocationAfterToken(loop->getEndLoc(), tok::semi, m_c.ctx.getSourceManager(), m_c.ctx.getLangOpts(), false);
   CharSourceRange range = end.isValid() ? CharSourceRange::getCharRange(loop->getBeginLoc(), end) : CharSourceRange::getTokenRange(loop->getSourceRange());
-  m_cpu.ReplaceText(range, text);
+  const auto [before, after] = ParallelChoiceAround(loop, outermost, nest);
+  std::string scalar = before + m_cpu.getRewrittenText(range) + after + "\n";
+  if (!m_c.model.virtuals.empty())  // as the lanes' class data does: an element without an object throws
+    scalar = "{\n(void)IspcData();  // checks the vectors of objects as the lanes' way does\n" + scalar + "}\n";
+  m_cpu.ReplaceText(range, "{  // in SIMD lanes, or as the _CPU class runs it, whichever has been faster here (crossrt::LaneChoice)\n"
+                           "static crossrt::LaneChoice crt_lanes;\n"
+                           "crossrt::LaneChoice::Run crt_way = crt_lanes.Begin();\n"
+                           "crt_way.iterations = " + threads + ";\n"
+                           "if (crt_way.lanes)\n" + lanes + "else\n" + scalar + "crt_lanes.End(crt_way);\n}\n");
 }
 
 }  // namespace crossrt::engine

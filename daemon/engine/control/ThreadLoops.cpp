@@ -268,7 +268,7 @@ bool ControlRewriter::TryRtvNest(const ForStmt* outer) {
     counts += ", " + CountExpr(m_c, *h);
   }
   Note(call);
-  if (m_c.model.forIspc && IspcRtvNest(outer, call, axes)) return true;
+  if (m_c.model.forIspc && IspcRtvNest(outer, call, axes, loops.front(), loops.size())) return true;
   SourceLocation end = Lexer::findLocationAfterToken(outer->getEndLoc(), tok::semi, m_c.ctx.getSourceManager(), m_c.ctx.getLangOpts(), false);
   CharSourceRange range = end.isValid() ? CharSourceRange::getCharRange(outer->getBeginLoc(), end) : CharSourceRange::getTokenRange(outer->getSourceRange());
   m_gpu.ReplaceText(range, md->getNameAsString() + "Cmd(crt_cmd" + counts + Args(call, true) + ");");
@@ -276,17 +276,20 @@ bool ControlRewriter::TryRtvNest(const ForStmt* outer) {
   return true;
 }
 
-void ControlRewriter::ParallelOnCpu(const ForStmt* outer, const LoopHeader& outermost, size_t nest) {
-  auto& sm = m_c.ctx.getSourceManager();
-  const unsigned col = sm.getExpansionColumnNumber(outer->getBeginLoc());
+std::pair<std::string, std::string> ControlRewriter::ParallelChoiceAround(const ForStmt* outer, const LoopHeader& outermost, size_t nest) {
+  const unsigned col = m_c.ctx.getSourceManager().getExpansionColumnNumber(outer->getBeginLoc());
   const std::string indent(col > 0 ? col - 1 : 0, ' ');
   std::string pragma = "#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 16)";
   if (nest > 1) pragma += " collapse(" + std::to_string(nest) + ")";
-  m_cpu.InsertTextBefore(outer->getBeginLoc(), "{  // crossrt: on all cores, or on this thread while that has been faster\n" + indent +
-                                                   "static crossrt::ParallelChoice crt_choice;\n" + indent + "const auto crt_loop = crt_choice.Begin(" +
-                                                   CountExpr(m_c, outermost) + ");\n" + indent + pragma + "\n" + indent);
-  const std::string after = "\n" + indent + "crt_choice.End(crt_loop);\n" + indent + "}";
-  const SourceLocation semi = Lexer::findLocationAfterToken(outer->getEndLoc(), tok::semi, sm, m_c.ctx.getLangOpts(), false);
+  return {"{  // crossrt: on all cores, or on this thread while that has been faster\n" + indent + "static crossrt::ParallelChoice crt_choice;\n" + indent +
+              "const auto crt_loop = crt_choice.Begin(" + CountExpr(m_c, outermost) + ");\n" + indent + pragma + "\n" + indent,
+          "\n" + indent + "crt_choice.End(crt_loop);\n" + indent + "}"};
+}
+
+void ControlRewriter::ParallelOnCpu(const ForStmt* outer, const LoopHeader& outermost, size_t nest) {
+  const auto [before, after] = ParallelChoiceAround(outer, outermost, nest);
+  m_cpu.InsertTextBefore(outer->getBeginLoc(), before);
+  const SourceLocation semi = Lexer::findLocationAfterToken(outer->getEndLoc(), tok::semi, m_c.ctx.getSourceManager(), m_c.ctx.getLangOpts(), false);
   if (semi.isValid()) m_cpu.InsertTextAfter(semi, after);  // a body of one statement: after its ';'
   else m_cpu.InsertTextAfterToken(outer->getEndLoc(), after);
 }

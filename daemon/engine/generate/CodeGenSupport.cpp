@@ -264,6 +264,8 @@ Data CpuKernelData(const Kernel& k) {
   return x;
 }
 
+std::string KernelWayParam(const Kernel& k) { return std::string("crossrt::LaneChoice::Run& crt_way") + (k.cppParamsDecl.empty() ? "" : ", "); }
+
 Data Common(const ClassModel& model, const GenerateOptions& opt) {
   Data d;
   d.set("className", model.className);

@@ -100,6 +100,9 @@ Data Common(const ClassModel& model, const GenerateOptions& opt);
 // What the CPU and ISPC classes' kernel functions share: name, source, parameters, and the
 // statements before and after the loop nest that the host runs.
 Data CpuKernelData(const Kernel& k);
+// The first parameter of an _ISPC kernel's two ways (crossrt::LaneChoice's run, which each tells its
+// iterations), with the comma before the kernel's own.
+std::string KernelWayParam(const Kernel& k);
 // The ISPC class's host data (IspcCode.cpp): the members it passes, its kernels' chunks and reductions.
 void IspcHostData(const ClassModel& model, Data& d);
 

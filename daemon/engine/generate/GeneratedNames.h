@@ -46,5 +46,9 @@ inline std::string VirtualClassField(const std::string& vector, const std::strin
 // The function that calls `method` on an element of such a vector, whichever its class (GLSL, ISPC;
 // the templates' dispatchers are crt_{{member}}_{{method}}).
 inline std::string VirtualDispatcher(const std::string& vector, const std::string& method) { return "crt_" + vector + "_" + method; }
+// An _ISPC class's kernel runs one of two methods, whichever has been faster (crossrt::LaneChoice):
+// its loop nest as ISPC, in SIMD lanes, or its loop nest as the _CPU class runs it.
+inline std::string LanesMethod(const std::string& kernel) { return "crt_" + kernel + "_InLanes"; }
+inline std::string ScalarMethod(const std::string& kernel) { return "crt_" + kernel + "_Scalar"; }
 
 }  // namespace crossrt::engine::generated

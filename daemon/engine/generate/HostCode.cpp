@@ -102,15 +102,18 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
   d.set("ispc", model.forIspc);
   d.set("whatRuns", model.forIspc ? "The loop nests of " + model.className + "'s kernels, and the thread loops\n"
                                         "// of its control functions (one or two thread ids), run here as ISPC (" + model.generatedName +
-                                        "_kernels.ispc), on all CPU cores,\n// each in SIMD lanes; everything else is inherited unchanged."
+                                        "_kernels.ispc), on all CPU cores,\n// each in SIMD lanes (a kernel as the _CPU class runs it where "
+                                        "that has been faster here);\n// everything else is inherited unchanged."
                                   : "The kernels of " + model.className + " run here on all\n// CPU cores with OpenMP; everything else is inherited unchanged.");
   if (model.forIspc) IspcHostData(model, d);
   Data kernels = List(), ompReductions = List();
   std::set<std::string> declared;
   for (auto& k : model.kernels) {
     if (k.rtv) continue;  // kernel_* bodies are inherited; their loops are parallelised in the control function
-    if (model.forIspc) continue;  // IspcHostData's
     Data x = CpuKernelData(k);
+    // The _ISPC class keeps this form as the scalar way of a kernel (IspcHostData has the other).
+    x.set("method", model.forIspc ? generated::ScalarMethod(k.name) : k.name);
+    x.set("wayParam", model.forIspc ? KernelWayParam(k) : "");
     x.set("loopNest", IndentTail(k.cpuLoopNest, "  "));
     x.set("iterations", k.loops.empty() ? "1" : k.loops[0].countCpp);  // the outer loop's, which OpenMP shares out
     // Dynamic chunks: iterations may cost very different amounts (a ray that hits against one that

@@ -257,6 +257,11 @@ void IspcHostData(const ClassModel& model, Data& d) {
     for (auto& l : k.preambleLocals) unused += "(void)" + l + "; ";
     x.set("preambleLocals", unused.empty() ? "" : unused + " // the ISPC kernel computes its own");
     x.set("targetFunctions", IspcTargetFunctions(model.symbolPrefix + "_" + k.name));
+    // The kernel runs one of two ways (crossrt::LaneChoice): this one, or HostCode's scalar loop.
+    x.set("lanesMethod", generated::LanesMethod(k.name));
+    x.set("scalarMethod", generated::ScalarMethod(k.name));
+    x.set("wayParam", KernelWayParam(k));
+    x.set("wayArgs", "crt_way" + std::string(k.cppArgs.empty() ? "" : ", ") + k.cppArgs);
     kernels.push_back(x);
   }
   // The thread loops that run in SIMD lanes: their export functions, per target.
@@ -289,6 +294,7 @@ void IspcHostData(const ClassModel& model, Data& d) {
     }
   d.set("ispcAppends", appends);
   d.set("ispcKernels", kernels);
+  d.set("ispcHasKernelWays", !kernels.is_empty_list());
 }
 
 }  // namespace crossrt::engine

@@ -1,5 +1,6 @@
 // The CPU backend's versions of library calls in control functions, and of push_back in kernels,
-// and the choice of each kernel's loop between all cores and one (header only; OpenMP).
+// the choice of each kernel's loop between all cores and one, and an _ISPC kernel's between SIMD
+// lanes and its scalar loop (header only; OpenMP).
 #pragma once
 #include "SortKey.h"
 
@@ -88,6 +89,52 @@ void RadixSort(Iterator first, Iterator last, const SortKey& key) {
   RadixSortWords(reinterpret_cast<uint32_t*>(&*first), size_t(n), key);
 }
 
+// Two ways of running one loop, way 1 the one it is written for and way 0 the other, each with
+// its mean time per iteration as measured (an exponential moving average, outliers and all). The
+// slower way is tried again now and then, after 16 calls, then 64, 256, up to 1024 while it keeps
+// losing (its mean starts afresh from that run), so that the choice follows the machine. The
+// choices below decide when each way runs; this keeps their times.
+class MeasuredWays {
+ public:
+  // Calls between tries of the slower way: the first wait, 4x longer after each try it lost, up to
+  // the longest.
+  static constexpr unsigned kFirstWait = 16, kLongestWait = 1024;
+
+  // The mean ms per iteration measured for a way (-1 before the first), for tests and benchmarks.
+  float Mean(int way) const { return m_msPerIteration[way ? 1 : 0].load(std::memory_order_relaxed); }
+
+ protected:
+  // The next run is a try of the way that is not the faster one (or has not run yet).
+  void Try() { m_tryingOther.store(true, std::memory_order_relaxed); }
+
+  // Counts a call that keeps to the faster way; true when the slower one is due for a try.
+  bool TimeToTry() {
+    if (m_calls.fetch_add(1, std::memory_order_relaxed) + 1 < m_nextTry.load(std::memory_order_relaxed)) return false;
+    m_calls.store(0, std::memory_order_relaxed);
+    Try();
+    return true;
+  }
+
+  void Record(int way, float msPerIteration) {
+    const int w = way ? 1 : 0;
+    const bool tried = m_tryingOther.exchange(false, std::memory_order_relaxed);
+    const float before = Mean(w);
+    // A way tried again after a while starts its mean afresh: what it measured then is stale.
+    m_msPerIteration[w].store(before < 0.0f || tried ? msPerIteration : before + 0.3f * (msPerIteration - before), std::memory_order_relaxed);
+    if (tried) {  // when the way tried still loses, the next try waits four times as long
+      const int faster = Mean(0) < 0.0f || Mean(1) <= Mean(0) ? 1 : 0;
+      const unsigned wait = m_nextTry.load(std::memory_order_relaxed);
+      m_nextTry.store(faster == w ? kFirstWait : std::min(wait * 4u, kLongestWait), std::memory_order_relaxed);
+    }
+  }
+
+ private:
+  std::atomic<float> m_msPerIteration[2] = {-1.0f, -1.0f};
+  std::atomic<unsigned> m_calls{0};
+  std::atomic<unsigned> m_nextTry{kFirstWait};
+  std::atomic<bool> m_tryingOther{false};
+};
+
 // Whether a kernel's loop runs on all cores this call, or on the calling thread alone: each
 // generated _CPU and _ISPC kernel keeps one (a static of its method) and asks it before the loop,
 //   static crossrt::ParallelChoice crt_choice;
@@ -103,29 +150,23 @@ void RadixSort(Iterator first, Iterator last, const SortKey& key) {
 // runs, against 1.0 ms quiet and 1.9 ms for the single-threaded original. Passive waits alone
 // (OMP_WAIT_POLICY) collapsed the same way; beside this choice they help (runtime/src/CpuWaitPolicy.cpp).
 //
-// So each loop runs the way that has been faster here, as measured: the mean time per iteration
-// of each way (an exponential moving average, outliers and all, since the waits are what is being
-// measured). The slower way is tried again now and then, after 16 calls, then 64, 256, up to 1024
-// while it keeps losing (its mean starts afresh from that run), so that the choice follows the
-// machine's load. One core can only win where the wait for a descheduled thread (a time slice,
-// kSliceMs) is more than what the other threads save, so only loops whose fastest parallel run,
-// times the other threads, is below it are ever tried on one core: a long loop always runs on all
-// cores (with one core busy, Bloom_CPU's 25-tap blur measured 1.18x and 1.53x of the original when
-// its loops could be tried on one core once slowed, 1.69x and 1.60x on all cores). Loops inside a
-// parallel region run on their thread, as OpenMP would.
+// So each loop runs the way that has been faster here, as measured (MeasuredWays: all cores are
+// way 1, one core way 0). One core can only win where the wait for a descheduled thread (a time
+// slice, kSliceMs) is more than what the other threads save, so only loops whose fastest parallel
+// run, times the other threads, is below it are ever tried on one core: a long loop always runs on
+// all cores (with one core busy, Bloom_CPU's 25-tap blur measured 1.18x and 1.53x of the original
+// when its loops could be tried on one core once slowed, 1.69x and 1.60x on all cores). Loops
+// inside a parallel region run on their thread, as OpenMP would.
 // CROSSRT_CPU_PARALLEL=always turns the choice off: every loop runs on all cores.
 //
 // Both ways compute the same loop: the _ISPC classes fold their chunks in order, so their results
 // do not change with the number of threads; the _CPU classes' reductions already differ in their
 // last bits from run to run (the dynamic schedule hands out iterations in any order).
-class ParallelChoice {
+class ParallelChoice : public MeasuredWays {
  public:
   // A time slice of a loaded Linux scheduler (CFS gives 3-4 ms each to two runnable threads on a
   // core): the most a parallel loop waits for a descheduled thread, so the most one core can save.
   static constexpr double kSliceMs = 4.0;
-  // Calls between tries of the slower way: the first wait, 4x longer after each try it lost, up to
-  // the longest. A try of all cores on a loaded machine may meet the wait it is there to avoid.
-  static constexpr unsigned kFirstWait = 16, kLongestWait = 1024;
 
   struct Run {
     bool parallel;
@@ -152,7 +193,7 @@ class ParallelChoice {
     const double saved = double(m_fastestParallel.load(std::memory_order_relaxed)) * double(iterations) * double(threads - 1);
     if (saved > kSliceMs) return true;
     if (serial < 0.0f) {  // one core, once, to compare
-      m_tryingOther.store(true, std::memory_order_relaxed);
+      Try();
       return false;
     }
     return !TimeToTry();
@@ -161,21 +202,9 @@ class ParallelChoice {
   void Record(bool parallel, long long iterations, double ms) {
     if (iterations < 2 || omp_in_parallel() || omp_get_max_threads() < 2) return;
     const float now = float(ms / double(iterations));
-    const bool tried = m_tryingOther.exchange(false, std::memory_order_relaxed);
-    const float before = Mean(parallel);
-    // A way tried again after a while starts its mean afresh: what it measured then is stale.
-    m_msPerIteration[parallel ? 1 : 0].store(before < 0.0f || tried ? now : before + 0.3f * (now - before), std::memory_order_relaxed);
+    MeasuredWays::Record(parallel, now);
     if (parallel && now < m_fastestParallel.load(std::memory_order_relaxed)) m_fastestParallel.store(now, std::memory_order_relaxed);
-    if (tried) {  // when the way tried still loses, the next try waits twice as long
-      const float serial = Mean(false);
-      const bool parallelFaster = serial < 0.0f || Mean(true) <= serial;
-      const unsigned wait = m_nextTry.load(std::memory_order_relaxed);
-      m_nextTry.store(parallelFaster == parallel ? kFirstWait : std::min(wait * 4u, kLongestWait), std::memory_order_relaxed);
-    }
   }
-
-  // The mean ms per iteration measured for a way (-1 before the first), for tests and benchmarks.
-  float Mean(bool parallel) const { return m_msPerIteration[parallel ? 1 : 0].load(std::memory_order_relaxed); }
 
   // CROSSRT_CPU_PARALLEL=always: every loop on all cores, as OpenMP alone would (to compare).
   static bool AlwaysAllCores() {
@@ -187,19 +216,81 @@ class ParallelChoice {
   }
 
  private:
-  // Counts a call that keeps to the faster way; true when the slower one is due for a try.
-  bool TimeToTry() {
-    if (m_calls.fetch_add(1, std::memory_order_relaxed) + 1 < m_nextTry.load(std::memory_order_relaxed)) return false;
-    m_calls.store(0, std::memory_order_relaxed);
-    m_tryingOther.store(true, std::memory_order_relaxed);
-    return true;
+  std::atomic<float> m_fastestParallel{3.0e38f};
+};
+
+// Whether an _ISPC class's kernel runs its loop nest in SIMD lanes (the ISPC function) this call,
+// or as the _CPU class runs it, one iteration at a time per core: each kernel of an _ISPC class
+// keeps one and asks it first,
+//   static crossrt::LaneChoice crt_lanes;
+//   crossrt::LaneChoice::Run crt_way = crt_lanes.Begin();
+//   if (crt_way.lanes) crt_<kernel>_InLanes(crt_way, ...); else crt_<kernel>_Scalar(crt_way, ...);
+//   crt_lanes.End(crt_way);  // (each way sets crt_way.iterations to its outer loop's count)
+//
+// Why: lanes are not faster on every CPU and for every loop. On an AMD EPYC with AVX2, per-lane
+// gathers of 128-byte BVH nodes made PrimaryRays_ISPC trace at 0.27-0.38x of PrimaryRays_CPU, the
+// LBVH_ISPC build took 2.0-2.8x LBVH_CPU's time (a divergent climb with per-lane atomics), and
+// Bloom_ISPC ran at 0.51-0.57x of Bloom_CPU (a transpose of float4 pixels per tap). A user who asks
+// for the SIMD class should never get less than the scalar one.
+//
+// So each kernel runs the way that has been faster here (MeasuredWays: lanes are way 1, the scalar
+// loop way 0). Lanes run first, twice: the first call pays for touching memory and is not counted.
+// The third call tries the scalar loop once; after that the faster way runs, the other tried again
+// after 16, 64, ... 1024 calls. A kernel called once or twice always runs in lanes.
+// CROSSRT_ISPC_LANES=always keeps every kernel in lanes (as before this choice), =never runs every
+// kernel's scalar loop (to test or compare it).
+//
+// Both ways compute the same loop nest: the differential tests compare each with the original.
+// Their reductions may differ in the last bits, as the _CPU class's do between runs.
+class LaneChoice : public MeasuredWays {
+ public:
+  enum class Mode { Measure, Always, Never };
+
+  struct Run {
+    bool lanes;
+    long long iterations;  // set by the way that runs: its outer loop's count
+    std::chrono::steady_clock::time_point start;
+  };
+
+  Run Begin() { return {Choose(), 0, std::chrono::steady_clock::now()}; }
+
+  void End(const Run& run) {
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - run.start).count();
+    Record(run.lanes, run.iterations, ms);
   }
 
-  std::atomic<float> m_msPerIteration[2] = {-1.0f, -1.0f};  // one core, all cores
-  std::atomic<float> m_fastestParallel{3.0e38f};
-  std::atomic<unsigned> m_calls{0};
-  std::atomic<unsigned> m_nextTry{kFirstWait};
-  std::atomic<bool> m_tryingOther{false};
+  // The decision and the measurement apart, for tests.
+  bool Choose() {
+    if (LanesMode() != Mode::Measure) return LanesMode() == Mode::Always;
+    const float scalar = Mean(0), lanes = Mean(1);
+    if (lanes < 0.0f) return true;  // first the lanes, the way this class is for
+    if (scalar < 0.0f) {  // then the scalar loop, once, to compare
+      Try();
+      return false;
+    }
+    if (scalar < lanes) return TimeToTry();  // the scalar loop has been faster: lanes now and then
+    return !TimeToTry();
+  }
+
+  void Record(bool lanes, long long iterations, double ms) {
+    if (iterations < 1 || LanesMode() != Mode::Measure) return;  // (an early return ran no loop)
+    if (lanes && !m_warm.exchange(true, std::memory_order_relaxed)) return;  // the first run touched the memory
+    MeasuredWays::Record(lanes, float(ms / double(iterations)));
+  }
+
+  // CROSSRT_ISPC_LANES: always, never, or (unset) measure.
+  static Mode LanesMode() {
+    static const Mode mode = [] {
+      const char* v = std::getenv("CROSSRT_ISPC_LANES");
+      if (v != nullptr && std::strcmp(v, "always") == 0) return Mode::Always;
+      if (v != nullptr && std::strcmp(v, "never") == 0) return Mode::Never;
+      return Mode::Measure;
+    }();
+    return mode;
+  }
+
+ private:
+  std::atomic<bool> m_warm{false};
 };
 
 // `v.push_back(x)` in a kernel whose loop runs on all cores: the generated code calls

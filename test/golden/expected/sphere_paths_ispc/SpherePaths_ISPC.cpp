@@ -53,21 +53,52 @@ void SpherePaths_ISPC::Render(uint32_t width, uint32_t height, int samples, floa
   {
     const auto start = std::chrono::steady_clock::now();
     {
-      const ispc::SpherePaths_Data crt_self = IspcData();
-      const int crt_countX = std::max(0, int(width));
-      const int crt_countY = std::max(0, int(height));
-      static const auto crt_run = crossrt::IspcPick(
-          ispc::SpherePaths_Render_Megakernel, {SpherePaths_Render_Megakernel_sse4, SpherePaths_Render_Megakernel_avx2,
-                                                SpherePaths_Render_Megakernel_avx512skx});
-      static crossrt::ParallelChoice crt_choice;
-      const auto crt_loop = crt_choice.Begin(crt_countY);
+      static crossrt::LaneChoice crt_lanes;
+      crossrt::LaneChoice::Run crt_way = crt_lanes.Begin();
+      crt_way.iterations = (long long)std::max(0, int(width)) * std::max(0, int(height));
+      if (crt_way.lanes)
+      {
+        const ispc::SpherePaths_Data crt_self = IspcData();
+        const int crt_countX = std::max(0, int(width));
+        const int crt_countY = std::max(0, int(height));
+        static const auto crt_run =
+            crossrt::IspcPick(ispc::SpherePaths_Render_Megakernel,
+                              {SpherePaths_Render_Megakernel_sse4, SpherePaths_Render_Megakernel_avx2,
+                               SpherePaths_Render_Megakernel_avx512skx});
+        static crossrt::ParallelChoice crt_choice;
+        const auto crt_loop = crt_choice.Begin(crt_countY);
 #pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1)
-      for (int crt_chunk = 0; crt_chunk < (crt_countY + 4 - 1) / 4; ++crt_chunk)
-        crt_run(const_cast<ispc::SpherePaths_Data*>(&crt_self), crt_chunk * 4,
-                std::min(crt_countY, (crt_chunk + 1) * 4), 0, crt_countX,
-                crossrt::IspcPointer<ispc::float4*>(out_color), samples, width, height);
-      crt_choice.End(crt_loop);
-      IspcWrittenBack(crt_self);
+        for (int crt_chunk = 0; crt_chunk < (crt_countY + 4 - 1) / 4; ++crt_chunk)
+          crt_run(const_cast<ispc::SpherePaths_Data*>(&crt_self), crt_chunk * 4,
+                  std::min(crt_countY, (crt_chunk + 1) * 4), 0, crt_countX,
+                  crossrt::IspcPointer<ispc::float4*>(out_color), samples, width, height);
+        crt_choice.End(crt_loop);
+        IspcWrittenBack(crt_self);
+      }
+      else
+      {
+        static crossrt::ParallelChoice crt_choice;
+        const auto crt_loop = crt_choice.Begin(height);
+#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 16) collapse(2)
+        for (uint32_t y = 0; y < height; y++)
+          for (uint32_t x = 0; x < width; x++)
+          {
+            float4 rayPos, rayDir, throughput, color;
+            SphereHit hit;
+            for (int sample = 0; sample < samples; sample++)
+            {
+              kernel_InitEyeRay(x, y, width, height, sample, &rayPos, &rayDir, &throughput);
+              for (int bounce = 0; bounce < m_maxDepth; bounce++)
+              {
+                kernel_RayTrace(x, y, &rayPos, &rayDir, &throughput, &hit);
+                kernel_NextBounce(x, y, width, sample, bounce, &hit, &rayPos, &rayDir, &throughput, &color);
+              }
+            }
+            kernel_Contribute(x, y, width, samples, &color, out_color);
+          }
+        crt_choice.End(crt_loop);
+      }
+      crt_lanes.End(crt_way);
     }
     m_timeMs = std::chrono::duration<float, std::milli>(std::chrono::steady_clock::now() - start).count();
   }();
