@@ -39,12 +39,15 @@ inline double MedianOf(std::vector<double> ms)
   return ms[ms.size() / 2];
 }
 
-// Wall times of several works measured in rounds, each round running every work once, after a
-// warm-up round: a burst of load on a shared machine then slows them alike, and the ratio of two
-// works taken round by round keeps its meaning. Returns each work's times, in ms.
+// Wall times of several works measured in rounds, each round running every work once, after three
+// warm-up rounds: a burst of load on a shared machine then slows them alike, and the ratio of two
+// works taken round by round keeps its meaning. Three, as a program's first calls: by then an _ISPC
+// class has run each kernel in SIMD lanes and once as its scalar loop, and keeps the faster
+// (crossrt::LaneChoice). Returns each work's times, in ms.
 inline std::vector<std::vector<double>> InterleavedMs(const std::vector<std::function<void()>>& works, int rounds)
 {
-  for (auto& work : works) work();
+  for (int warm = 0; warm < 3; ++warm)
+    for (auto& work : works) work();
   std::vector<std::vector<double>> ms(works.size());
   for (int r = 0; r < rounds; ++r)
     for (size_t w = 0; w < works.size(); ++w)

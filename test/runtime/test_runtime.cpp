@@ -797,18 +797,19 @@ TEST_CASE("ParallelChoice takes the faster way and tries the other now and then"
 
 // crossrt::LaneChoice, with the times given: an _ISPC kernel runs in SIMD lanes on its first two
 // calls (the first not counted), tries its scalar loop on the third, then takes the faster way and
-// tries the other after 16 calls, then 64... while it loses; a call that ran no loop counts for nothing.
+// tries the other after 16 calls, then 64... while it loses; sizes a factor of 4 apart are chosen
+// apart; a call that ran no loop counts for nothing.
 TEST_CASE("LaneChoice runs a kernel in lanes or as a scalar loop, whichever has been faster", "[runtime][parallel]")
 {
   if (crossrt::LaneChoice::LanesMode() != crossrt::LaneChoice::Mode::Measure) {
     WARN("CROSSRT_ISPC_LANES is set: the choice is off");
     return;
   }
-  auto count = [](crossrt::LaneChoice& choice, int calls, double lanesMs, double scalarMs) {
+  auto count = [](crossrt::LaneChoice& choice, int calls, double lanesMs, double scalarMs, long long iterations = 1000) {
     int lanes = 0;
     for (int i = 0; i < calls; ++i) {
       const bool l = choice.Choose();
-      choice.Record(l, 1000, l ? lanesMs : scalarMs);
+      choice.Record(l, iterations, l ? lanesMs : scalarMs);
       lanes += l;
     }
     return lanes;
@@ -834,6 +835,19 @@ TEST_CASE("LaneChoice runs a kernel in lanes or as a scalar loop, whichever has 
     CHECK(count(choice, 16, 1.0, 3.0) == 16);
     CHECK(count(choice, 64, 1.0, 3.0) == 63);
     CHECK(choice.Mean(0) == Approx(0.003f));
+  }
+  SECTION("each size class has its own choice") {
+    crossrt::LaneChoice choice;
+    CHECK(count(choice, 3, 3.0, 1.0) == 2);  // small loops: the scalar loop wins
+    CHECK(count(choice, 10, 3.0, 1.0) == 0);
+    // Large loops (100x the iterations): lanes win there. The first large call still runs as the
+    // call before it did; then lanes, then one try of the scalar loop.
+    CHECK(count(choice, 40, 100.0, 300.0, 100000) >= 37);
+    CHECK(choice.Mean(1) == Approx(0.001f));
+    // Small again: the first call runs as the large ones did, then the scalar loop as before.
+    CHECK(count(choice, 10, 3.0, 1.0) <= 2);
+    CHECK(crossrt::LaneChoice::SizeClass(1100) == crossrt::LaneChoice::SizeClass(4000));  // [4^5, 4^6)
+    CHECK(crossrt::LaneChoice::SizeClass(1000) != crossrt::LaneChoice::SizeClass(100000));
   }
   SECTION("a call with an empty loop counts for nothing") {
     crossrt::LaneChoice choice;

@@ -103,7 +103,6 @@ class MeasuredWays {
   // The mean ms per iteration measured for a way (-1 before the first), for tests and benchmarks.
   float Mean(int way) const { return m_msPerIteration[way ? 1 : 0].load(std::memory_order_relaxed); }
 
- protected:
   // The next run is a try of the way that is not the faster one (or has not run yet).
   void Try() { m_tryingOther.store(true, std::memory_order_relaxed); }
 
@@ -225,7 +224,7 @@ class ParallelChoice : public MeasuredWays {
 //   static crossrt::LaneChoice crt_lanes;
 //   crossrt::LaneChoice::Run crt_way = crt_lanes.Begin();
 //   if (crt_way.lanes) crt_<kernel>_InLanes(crt_way, ...); else crt_<kernel>_Scalar(crt_way, ...);
-//   crt_lanes.End(crt_way);  // (each way sets crt_way.iterations to its outer loop's count)
+//   crt_lanes.End(crt_way);  // (each way sets crt_way.iterations to its loop's count)
 //
 // Why: lanes are not faster on every CPU and for every loop. On an AMD EPYC with AVX2, per-lane
 // gathers of 128-byte BVH nodes made PrimaryRays_ISPC trace at 0.27-0.38x of PrimaryRays_CPU, the
@@ -234,21 +233,25 @@ class ParallelChoice : public MeasuredWays {
 // for the SIMD class should never get less than the scalar one.
 //
 // So each kernel runs the way that has been faster here (MeasuredWays: lanes are way 1, the scalar
-// loop way 0). Lanes run first, twice: the first call pays for touching memory and is not counted.
-// The third call tries the scalar loop once; after that the faster way runs, the other tried again
-// after 16, 64, ... 1024 calls. A kernel called once or twice always runs in lanes.
+// loop way 0), per size class: loops within a factor of 4 of each other in iterations share one,
+// and a call is taken to be of the size of the call before it (what is small may run best one way
+// and what is large the other). Lanes run first; the very first call pays for touching memory and
+// is not counted. The next call of a size class whose lanes have a time tries the scalar loop
+// once; after that the faster way runs, the other tried again after 16, 64, ... 1024 calls. A
+// kernel called once or twice always runs in lanes.
 // CROSSRT_ISPC_LANES=always keeps every kernel in lanes (as before this choice), =never runs every
 // kernel's scalar loop (to test or compare it).
 //
 // Both ways compute the same loop nest: the differential tests compare each with the original.
 // Their reductions may differ in the last bits, as the _CPU class's do between runs.
-class LaneChoice : public MeasuredWays {
+class LaneChoice {
  public:
   enum class Mode { Measure, Always, Never };
+  static constexpr int kSizeClasses = 16;  // iterations [4^c, 4^(c+1)), the last open-ended
 
   struct Run {
     bool lanes;
-    long long iterations;  // set by the way that runs: its outer loop's count
+    long long iterations;  // set by the way that runs: its loop's count
     std::chrono::steady_clock::time_point start;
   };
 
@@ -262,20 +265,32 @@ class LaneChoice : public MeasuredWays {
   // The decision and the measurement apart, for tests.
   bool Choose() {
     if (LanesMode() != Mode::Measure) return LanesMode() == Mode::Always;
-    const float scalar = Mean(0), lanes = Mean(1);
+    MeasuredWays& ways = m_bySize[m_lastSize.load(std::memory_order_relaxed)];
+    const float scalar = ways.Mean(0), lanes = ways.Mean(1);
     if (lanes < 0.0f) return true;  // first the lanes, the way this class is for
     if (scalar < 0.0f) {  // then the scalar loop, once, to compare
-      Try();
+      ways.Try();
       return false;
     }
-    if (scalar < lanes) return TimeToTry();  // the scalar loop has been faster: lanes now and then
-    return !TimeToTry();
+    if (scalar < lanes) return ways.TimeToTry();  // the scalar loop has been faster: lanes now and then
+    return !ways.TimeToTry();
   }
 
   void Record(bool lanes, long long iterations, double ms) {
     if (iterations < 1 || LanesMode() != Mode::Measure) return;  // (an early return ran no loop)
+    const int size = SizeClass(iterations);
+    m_lastSize.store(size, std::memory_order_relaxed);
     if (lanes && !m_warm.exchange(true, std::memory_order_relaxed)) return;  // the first run touched the memory
-    MeasuredWays::Record(lanes, float(ms / double(iterations)));
+    m_bySize[size].Record(lanes, float(ms / double(iterations)));
+  }
+
+  // The mean ms per iteration of a way in the size class of the last call (-1 before the first).
+  float Mean(int way) const { return m_bySize[m_lastSize.load(std::memory_order_relaxed)].Mean(way); }
+
+  static int SizeClass(long long iterations) {
+    int c = 0;
+    for (long long n = iterations; n >= 4 && c + 1 < kSizeClasses; n /= 4) ++c;
+    return c;
   }
 
   // CROSSRT_ISPC_LANES: always, never, or (unset) measure.
@@ -290,6 +305,8 @@ class LaneChoice : public MeasuredWays {
   }
 
  private:
+  MeasuredWays m_bySize[kSizeClasses];
+  std::atomic<int> m_lastSize{0};
   std::atomic<bool> m_warm{false};
 };
 
