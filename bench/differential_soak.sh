@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # The differential tester's soak: random classes (test/differential/generate.py) in batches, each
 # built as _CPU, _Vulkan and _ISPC in the build tree's test/differential folder and run against the
-# class as written. Prints a line per batch and a summary: classes tried, batches that did not build
-# (a refusal or generated code that does not compile: each a bug, loud rather than silent), and
-# mismatches (silent wrong answers). The build tree is set back to CTest's seeds at the end.
+# class as written, the _ISPC kernels both in SIMD lanes and as their scalar loops. Prints a line
+# per batch and a summary: classes tried, batches that did not build (a refusal or generated code
+# that does not compile: each a bug, loud rather than silent), and mismatches (silent wrong
+# answers). The build tree is set back to CTest's seeds at the end.
 #   bench/differential_soak.sh [BUILD_DIR (default build)] [FIRST_SEED (default 1000)] [CLASSES (default 200)] [BATCH (default 20)]
 set -uo pipefail
 if [ "${1:-}" = "--help" ] || [ "${1:-}" = "-h" ]; then
@@ -26,12 +27,16 @@ for ((seed = first; seed < first + classes; seed += batch)); do
     grep -E "error:" "$log/build_$seed.log" | sort -u | head -5
     continue
   fi
-  out=$("$build/test/differential/crossrt_differential" 2>&1)
-  echo "$out" | grep MISMATCH
-  summary=$(echo "$out" | tail -1)
-  echo "seeds $seed..$((seed + n - 1)): $summary"
-  agreements=$((agreements + $(echo "$summary" | awk '{print $1}')))
-  mismatches=$((mismatches + $(echo "$summary" | awk '{print $3}')))
+  # Twice: the _ISPC classes' kernels in SIMD lanes (a class runs once, too few calls to leave
+  # them), and as their scalar loops (crossrt::LaneChoice).
+  for lanes in measure never; do
+    out=$(CROSSRT_ISPC_LANES=$lanes "$build/test/differential/crossrt_differential" 2>&1)
+    echo "$out" | grep MISMATCH
+    summary=$(echo "$out" | tail -1)
+    echo "seeds $seed..$((seed + n - 1)), ISPC lanes $lanes: $summary"
+    agreements=$((agreements + $(echo "$summary" | awk '{print $1}')))
+    mismatches=$((mismatches + $(echo "$summary" | awk '{print $3}')))
+  done
 done
 echo "differential soak: $tried random classes from seed $first; $broken batches did not build; $agreements backend runs agreed, $mismatches mismatched"
 [ "$broken" -eq 0 ] && [ "$mismatches" -eq 0 ]
