@@ -250,6 +250,7 @@ void IspcHostData(const ClassModel& model, Data& d) {
     }
     x.set("args", args);
     x.set("reductions", reds);
+    x.set("hasReductions", !reds.is_empty_list());
     x.set("writtenMembers", written);
     // The loop nest's own copies of the locals declared before it are computed in the ISPC kernel:
     // the host's may go unused (by the statements after the nest, or a reduction into them).
