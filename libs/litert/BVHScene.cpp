@@ -1,5 +1,6 @@
 #include "BVHScene.h"
 
+#include "Gang.h"
 #include "SceneInput.h"
 #include "SdfStructures.h"
 
@@ -37,6 +38,7 @@ static_assert(kWiden == 1.0f + 2.0f * (3.0f * std::numeric_limits<float>::epsilo
                                    (1.0f - 3.0f * std::numeric_limits<float>::epsilon() * 0.5f),
               "kWiden is 1 + 2 gamma(3)");
 constexpr float kMissed = -1.0f;  // an exit before every entry (entries are >= 0): a missed box
+constexpr float kNotEntered = std::numeric_limits<float>::infinity();  // a ray's entry into a subtree it does not enter
 
 BVHTraceRay Prepare(float3 org, float3 dir, float tnear)
 {
@@ -917,23 +919,26 @@ bool BVHScene::ExportScene(CRT_SceneExport& out) const
 // Watertight ray/triangle test (Woop, Benthin and Wald 2013), both sides, of the four triangles of
 // m_triangles[group] at once. Returns the lanes hit within [tnear, tfar] as bits, with their distances t and
 // Embree-style barycentrics (u weights corner 1, v corner 2).
-uint32_t BVHScene::IntersectGroup(const BVHTraceRay& r, uint32_t group, float tfar, float4& t, float4& u, float4& v) const
+// kx, ky and kz are the ray's axes (r.kx, r.ky, r.kz), passed apart so that packet traversal can pass
+// the ones its gang shares: the corners are then one load for all lanes, not a gather.
+uint32_t BVHScene::IntersectGroup(const BVHTraceRay& r, uint32_t group, int kx, int ky, int kz, float tfar, float4& t, float4& u,
+                                  float4& v) const
 {
   // The corners relative to the origin, sheared so that the ray runs along +z from (0, 0). Each
   // coordinate is read from m_triangles where it is used: a copy of the group would be a local
   // array, which GPU compilers index in scratch memory.
-  const float ox = r.org[r.kx];
-  const float oy = r.org[r.ky];
-  const float oz = r.org[r.kz];
-  const float4 az = m_triangles[group].coord[r.kz] - oz;
-  const float4 bz = m_triangles[group].coord[3 + r.kz] - oz;
-  const float4 cz = m_triangles[group].coord[6 + r.kz] - oz;
-  const float4 ax = (m_triangles[group].coord[r.kx] - ox) - r.sx * az;
-  const float4 ay = (m_triangles[group].coord[r.ky] - oy) - r.sy * az;
-  const float4 bx = (m_triangles[group].coord[3 + r.kx] - ox) - r.sx * bz;
-  const float4 by = (m_triangles[group].coord[3 + r.ky] - oy) - r.sy * bz;
-  const float4 cx = (m_triangles[group].coord[6 + r.kx] - ox) - r.sx * cz;
-  const float4 cy = (m_triangles[group].coord[6 + r.ky] - oy) - r.sy * cz;
+  const float ox = r.org[kx];
+  const float oy = r.org[ky];
+  const float oz = r.org[kz];
+  const float4 az = m_triangles[group].coord[kz] - oz;
+  const float4 bz = m_triangles[group].coord[3 + kz] - oz;
+  const float4 cz = m_triangles[group].coord[6 + kz] - oz;
+  const float4 ax = (m_triangles[group].coord[kx] - ox) - r.sx * az;
+  const float4 ay = (m_triangles[group].coord[ky] - oy) - r.sy * az;
+  const float4 bx = (m_triangles[group].coord[3 + kx] - ox) - r.sx * bz;
+  const float4 by = (m_triangles[group].coord[3 + ky] - oy) - r.sy * bz;
+  const float4 cx = (m_triangles[group].coord[6 + kx] - ox) - r.sx * cz;
+  const float4 cy = (m_triangles[group].coord[6 + ky] - oy) - r.sy * cz;
   float4 eu = cx * by - cy * bx;
   float4 ev = ax * cy - ay * cx;
   float4 ew = bx * ay - by * ax;
@@ -1097,6 +1102,11 @@ bool BVHScene::IntersectSdfBrick(const BVHTraceRay& r, uint32_t brick, float tEn
 // barycentrics, and returns true (at the first hit when anyHit).
 bool BVHScene::TraceMesh(const BVHTraceRay& ray, uint32_t root, uint32_t leaves, bool anyHit, float& tfar, CRT_Hit& hit) const
 {
+  // The rays of a SIMD gang (ISPC's lanes) in one mesh of triangles, along the same axes (a camera's,
+  // shadow rays to one light): together. Others, and a gang of one, walk alone.
+  if (crossrt::GangSize() > 1 && crossrt::AllLanes(leaves == 0u && root == crossrt::FirstLane(root) && ray.kx == crossrt::FirstLane(ray.kx) &&
+                                                    ray.kz == crossrt::FirstLane(ray.kz)))
+    return TraceMeshTogether(ray, root, anyHit, tfar, hit);
   uint32_t stack[kStackSize];    // node indices and leaf references
   float stackEntry[kStackSize];  // their entry distances, to skip those beyond a hit found since
   int top = 0;
@@ -1147,19 +1157,10 @@ bool BVHScene::TraceMesh(const BVHTraceRay& ray, uint32_t root, uint32_t leaves,
           float4 t;
           float4 u;
           float4 v;
-          uint32_t hits = IntersectGroup(ray, g, tfar, t, u, v);
-          while (hits != 0u)
+          const uint32_t hits = IntersectGroup(ray, g, ray.kx, ray.ky, ray.kz, tfar, t, u, v);
+          if (TakeNearestHit(g, hits, t, u, v, anyHit, tfar, hit))
           {
-            const int lane = __builtin_ctz(hits);
-            hits = hits & (hits - 1u);
-            if (t[lane] > tfar)
-              continue;  // behind a lane of this group taken before it
             found = true;
-            tfar = t[lane];
-            hit.t = t[lane];
-            hit.primId = m_primIds[4 * g + lane];
-            hit.coords[0] = u[lane];
-            hit.coords[1] = v[lane];
             if (anyHit)
               return true;
           }
@@ -1174,6 +1175,129 @@ bool BVHScene::TraceMesh(const BVHTraceRay& ray, uint32_t root, uint32_t leaves,
       top = top - 1;
     } while (stackEntry[top] > tfar);
     node = stack[top];
+  }
+}
+
+// Takes what IntersectGroup found in group g: a hit nearer than tfar, or as near with a lower primId, so
+// that the order in which a walk visits the groups never changes the answer (packet traversal visits
+// them in another order than a ray alone). Sets tfar and the hit's t, primId and barycentrics, and
+// returns whether it took one (the first when anyHit).
+bool BVHScene::TakeNearestHit(uint32_t g, uint32_t hits, const float4& t, const float4& u, const float4& v, bool anyHit, float& tfar,
+                              CRT_Hit& hit) const
+{
+  bool taken = false;
+  while (hits != 0u)
+  {
+    const int lane = __builtin_ctz(hits);
+    hits = hits & (hits - 1u);
+    const uint32_t primId = m_primIds[4 * g + lane];
+    if (t[lane] > tfar || (t[lane] == tfar && primId >= hit.primId))
+      continue;  // behind a hit taken before it
+    taken = true;
+    tfar = t[lane];
+    hit.t = t[lane];
+    hit.primId = primId;
+    hit.coords[0] = u[lane];
+    hit.coords[1] = v[lane];
+    if (anyHit)
+      return true;
+  }
+  return taken;
+}
+
+// Packet traversal (Wald, Slusallek, Benthin and Wagner 2001; Embree's rtcIntersect16 walks so): the
+// rays of a gang that share a root and their axes walk the tree together. The node, the stack and the
+// order of descent are the gang's (CRT_UNIFORM, Gang.h): a node is loaded once and tested against
+// every ray, the lanes some ray enters are taken nearest first by the least entry of any ray, and
+// each ray keeps its own entry into every subtree on the stack and takes part in a subtree only while
+// that entry is within its tfar. Each ray gets the hit TraceMesh would give it alone: the triangles
+// it can reach are all tested, and TakeNearestHit's answer does not depend on their order.
+bool BVHScene::TraceMeshTogether(const BVHTraceRay& ray, uint32_t root, bool anyHit, float& tfar, CRT_Hit& hit) const
+{
+  CRT_UNIFORM uint32_t stack[kStackSize];
+  float stackEntry[kStackSize];  // this ray's entry into each subtree on the stack, kNotEntered if it does not enter it
+  CRT_UNIFORM int top = 0;
+  CRT_UNIFORM uint32_t node = crossrt::FirstLane(root);
+  CRT_UNIFORM const int kx = crossrt::FirstLane(ray.kx);
+  CRT_UNIFORM const int ky = crossrt::FirstLane(ray.ky);
+  CRT_UNIFORM const int kz = crossrt::FirstLane(ray.kz);
+  float entry = ray.tnear;  // this ray's entry into `node`: it takes part while entry <= tfar
+  bool found = false;
+  while (true)
+  {
+    while ((node & kLeafFlag) == 0)
+    {
+      float4 exits;
+      const float4 entries = SlabEntries(ray, m_nodes[node], tfar, exits);
+      const uint32_t mask = entry <= tfar ? lane_mask_le(entries, exits) : 0u;
+      // The lanes of the node some ray enters: their children, the least entry of any ray, and this ray's.
+      CRT_UNIFORM uint32_t children[4];
+      CRT_UNIFORM float nearest[4];
+      float entered[4];
+      CRT_UNIFORM int count = 0;
+      for (int lane = 0; lane < 4; ++lane)
+      {
+        const bool enters = ((mask >> lane) & 1u) != 0u;
+        if (crossrt::AnyLane(enters))
+        {
+          children[count] = m_nodes[node].child[lane];
+          entered[count] = enters ? entries[lane] : kNotEntered;
+          nearest[count] = crossrt::MinOverLanes(entered[count]);
+          count = count + 1;
+        }
+      }
+      if (count == 0)
+      {
+        node = kNoChild;
+        break;
+      }
+      for (int i = 1; i < count; ++i)  // nearest first: an insertion sort of at most four
+        for (int j = i; j > 0; --j)
+          if (nearest[j] < nearest[j - 1])
+          {
+            CRT_UNIFORM const float n = nearest[j];
+            nearest[j] = nearest[j - 1];
+            nearest[j - 1] = n;
+            CRT_UNIFORM const uint32_t c = children[j];
+            children[j] = children[j - 1];
+            children[j - 1] = c;
+            const float e = entered[j];
+            entered[j] = entered[j - 1];
+            entered[j - 1] = e;
+          }
+      for (int i = count - 1; i > 0; --i)  // the farthest lowest on the stack
+      {
+        stack[top] = children[i];
+        stackEntry[top] = entered[i];
+        top = top + 1;
+      }
+      node = children[0];
+      entry = entered[0];
+    }
+    if (node != kNoChild && entry <= tfar)
+    {
+      CRT_UNIFORM const uint32_t first = (node & ~kLeafFlag) >> 3;
+      CRT_UNIFORM const uint32_t last = first + (node & 7u);
+      for (uint32_t g = first; g <= last; ++g)
+      {
+        float4 t;
+        float4 u;
+        float4 v;
+        const uint32_t hits = IntersectGroup(ray, g, kx, ky, kz, tfar, t, u, v);
+        found = TakeNearestHit(g, hits, t, u, v, anyHit, tfar, hit) || found;
+      }
+      if (anyHit && found)
+        return true;  // after the leaf: a return inside would make its loop one per lane on ISPC
+    }
+    // Pop the next subtree that some ray may still find something nearer in.
+    do
+    {
+      if (top == 0)
+        return found;
+      top = top - 1;
+    } while (!crossrt::AnyLane(stackEntry[top] <= tfar));
+    node = stack[top];
+    entry = stackEntry[top];
   }
 }
 
@@ -1298,5 +1422,6 @@ bool BVHScene::AnyHit(float4 posAndNear, float4 dirAndFar, float time) const
 {
   CRT_Hit unused;
   unused.t = dirAndFar.w;
+  unused.primId = kNoId;  // TakeNearestHit compares it
   return Trace(posAndNear, dirAndFar, time, true, unused);
 }

@@ -25,6 +25,7 @@ std::string Header(const Case& c)
   return std::string(R"(#pragma once
 #include "LiteMath.h"
 #include "Atomics.h"
+#include "Gang.h"
 #include <vector>
 #include <cstdio>
 #include <cstdlib>
@@ -146,6 +147,17 @@ TEST_CASE("What the ISPC backend does not translate yet is an error at the user'
       {"a column of an array's matrix updated through an index with side effects",
        "    LiteMath::float4x4 ms[2]; int k = 0; ms[1][k++] += LiteMath::float4(x); x = ms[1](0, 0);", "",
        "", "compound assignment to a vector whose address has side effects, other than an element of a buffer, member vector or local array, is not translated to ISPC yet", "BACKEND cpu (OpenMP) or vulkan", 8},
+      // The gang (Gang.h): what a CRT_UNIFORM local holds must be the same in every lane.
+      {"a per-lane value kept in a CRT_UNIFORM local", "    CRT_UNIFORM int k = 0;\n    k = i;\n    x += float(k);", "", "",
+       "a value that may differ between the lanes of an ISPC gang is assigned to CRT_UNIFORM 'k'", "crossrt::AnyLane, FirstLane or MinOverLanes", 9},
+      {"a per-lane value starting a CRT_UNIFORM local", "    CRT_UNIFORM const float y = x;\n    x += y;", "", "",
+       "a value that may differ between the lanes of an ISPC gang is assigned to CRT_UNIFORM 'y'", "declare 'y' without CRT_UNIFORM", 8},
+      {"a CRT_UNIFORM array written at a per-lane index", "    CRT_UNIFORM float a[4] = {0.0f, 0.0f, 0.0f, 0.0f};\n    a[i % 4] = 1.0f;\n    x += a[0];", "", "",
+       "an index that may differ between the lanes of an ISPC gang into CRT_UNIFORM 'a'", "crossrt::AnyLane", 9},
+      {"a CRT_UNIFORM struct", "    CRT_UNIFORM LiteMath::float4 v(1.0f);\n    x += v.x;", "", "",
+       "CRT_UNIFORM local 'v' of type 'LiteMath::float4'", "declare the struct's fields as CRT_UNIFORM locals", 8},
+      {"the first lane of a vector", "    x += crossrt::FirstLane(LiteMath::float2(x, x)).x;", "", "",
+       "crossrt::FirstLane of a 'LiteMath::float2'", "one field at a time", 8},
   };
   for (const Case& c : ispcCases)
   {
@@ -206,6 +218,57 @@ void Loops::kernel1D_Run(int n, int taps, float* data)
   REQUIRE(text.find("for (uniform int t = 0; t < taps * k; t += 2)") != std::string::npos);  // a parameter, an outer uniform loop
   REQUIRE(text.find("for (int j = 0;") != std::string::npos);  // a bound per lane
   REQUIRE(text.find("for (int e = 0;") != std::string::npos);  // some lanes may leave early
+}
+
+TEST_CASE("ISPC: CRT_UNIFORM locals are uniform, and crossrt::AnyLane, AllLanes, FirstLane, MinOverLanes and GangSize are the gang's",
+          "[diagnostics][ispc]")
+{
+  TempClass tc("Packets", R"(#pragma once
+#include "Gang.h"
+#include <vector>
+class Packets
+{
+public:
+  virtual ~Packets() = default;
+  virtual void Run(int n, [[crossrt::size("n")]] float* data);
+  std::vector<unsigned> m_next;
+protected:
+  void kernel1D_Run(int n, float* data);
+};
+)",
+               R"(#include "Packets.h"
+void Packets::Run(int n, float* data) { kernel1D_Run(n, data); }
+void Packets::kernel1D_Run(int n, float* data)
+{
+  for (int i = 0; i < n; i++)
+  {
+    CRT_UNIFORM unsigned node = crossrt::FirstLane(unsigned(i) % 4u);
+    CRT_UNIFORM float stack[4] = {0.0f, 1.0f, 2.0f, 3.0f};
+    CRT_UNIFORM int top = 0;
+    float x = data[i];
+    while (crossrt::AnyLane(x > 0.0f) && top < 4)
+    {
+      stack[top] = crossrt::MinOverLanes(x);
+      node = m_next[node];
+      top = top + 1;
+      x = x - 1.0f;
+    }
+    if (crossrt::GangSize() > 1 && crossrt::AllLanes(x <= 0.0f))
+      x = stack[0] + float(node);
+    data[i] = x;
+  }
+}
+)");
+  const std::string text = IspcKernelsOf(tc, "Packets");
+  INFO(text);
+  REQUIRE(text.find("uniform uint node = crt_first_lane(((uint)(i)) % 4u);") != std::string::npos);
+  REQUIRE(text.find("uniform float stack[4] = {0.0, 1.0, 2.0, 3.0};") != std::string::npos);
+  REQUIRE(text.find("uniform int top = 0;") != std::string::npos);
+  REQUIRE(text.find("while (any(x > 0.0) && top < 4)") != std::string::npos);
+  REQUIRE(text.find("stack[top] = reduce_min(x);") != std::string::npos);
+  REQUIRE(text.find("node = self->m_next[node];") != std::string::npos);  // a member's element at a shared index: shared
+  REQUIRE(text.find("if (programCount > 1 && all(x <= 0.0))") != std::string::npos);
+  REQUIRE(text.find("x = stack[0] + ((uniform float)(node));") != std::string::npos);  // a shared value's conversion stays shared
 }
 
 TEST_CASE("ISPC: a struct of 32 bytes or more read whole at a per-lane index in a const method loads what the lanes agree on once",

@@ -66,7 +66,7 @@ TEST_CASE("BVH traversal: rays from inside closed meshes never miss, and cross t
     std::mt19937 rng(1);
     std::uniform_real_distribution<float> u(-1.0f, 1.0f);
     std::uniform_int_distribution<uint32_t> pick(0, uint32_t(mesh.indices.size() - 1));
-    size_t misses = 0, inconsistent = 0, rays = 0;
+    size_t misses = 0, inconsistent = 0, inwardTies = 0, rays = 0;
     for (int i = 0; i < 6000; ++i)
     {
       float3 org;
@@ -83,7 +83,7 @@ TEST_CASE("BVH traversal: rays from inside closed meshes never miss, and cross t
       // triangle) or entries (-1). At a shared vertex or edge each triangle there may report the
       // same crossing a few ulps apart, so runs of equal facing count as one crossing.
       int crossings = 0, lastFacing = 0, firstFacing = 0;
-      float tnear = 0.0f;
+      float tnear = 0.0f, lastT = 0.0f;
       while (true)
       {
         const CRT_Hit h = scene->RayQuery_NearestHit(float4(org.x, org.y, org.z, tnear), float4(dir.x, dir.y, dir.z, 1e30f));
@@ -92,18 +92,25 @@ TEST_CASE("BVH traversal: rays from inside closed meshes never miss, and cross t
         crossings += facing != lastFacing;
         if (firstFacing == 0) firstFacing = facing;
         lastFacing = facing;
+        lastT = h.t;
         tnear = std::nextafter(h.t, std::numeric_limits<float>::infinity());
       }
       misses += crossings == 0;
       // The last hit always leaves the mesh. A ray in a random direction also leaves first and
       // crosses an odd number of times. A ray through a vertex or an edge may meet the surface
       // there at a silhouette, where the triangle reported may face either way: only the last
-      // hit is certain for those.
-      inconsistent += lastFacing != 1 || (i % 3 == 0 && (crossings % 2 == 0 || firstFacing != 1));
+      // hit is certain for those, unless it is at the vertex or edge aimed at (t == 1): the triangles
+      // meeting there tie, and of hits at one distance the lowest primId is reported
+      // (BVHScene::TakeNearestHit, whatever order a traversal visits them in), which on a bumpy
+      // surface may face inwards.
+      const bool tiedAtTarget = i % 3 != 0 && lastT == 1.0f;
+      inconsistent += (lastFacing != 1 && !tiedAtTarget) || (i % 3 == 0 && (crossings % 2 == 0 || firstFacing != 1));
+      inwardTies += lastFacing != 1 && tiedAtTarget;
     }
     REQUIRE(rays > 5900);
     REQUIRE(misses == 0);
     REQUIRE(inconsistent == 0);
+    REQUIRE(inwardTies * 100 < rays);  // rare: most aimed rays leave through an outward triangle
   }
 }
 

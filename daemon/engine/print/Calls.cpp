@@ -106,6 +106,20 @@ std::string KernelPrinter::Builtin(const FunctionDecl* fd, const std::vector<std
   return LibraryCall(fd, a, call, same);
 }
 
+// ---- crossrt::GangSize, AnyLane, ... (Gang.h): each language's GangCall ----
+
+bool IsGangFunction(const FunctionDecl* fd) {
+  static const std::set<std::string> names = {"GangSize", "AnyLane", "AllLanes", "FirstLane", "MinOverLanes"};
+  return fd && InNamespace(fd, "crossrt") && names.count(fd->getNameAsString()) > 0;
+}
+
+bool IsUniformLocal(const VarDecl* vd) {
+  if (!vd || !vd->isLocalVarDecl()) return false;
+  for (const auto* a : vd->specific_attrs<AnnotateAttr>())
+    if (a->getAnnotation() == "crossrt::uniform") return true;
+  return false;
+}
+
 // ---- crossrt::Atomic* (Atomics.h): GLSL atomics between buffer memory barriers ----
 
 bool IsCrossrtAtomic(const FunctionDecl* fd) {
@@ -294,6 +308,7 @@ std::string KernelPrinter::Call(const CallExpr* call) {
   const bool interlocked = InNamespace(fd, "LiteMath") && (name == "InterlockedAdd" || name == "atomicAdd" || name == "InterlockedAdd3f" || name == "ReduceAdd");
   if (interlocked) return InterlockedCall(fd, call);
   if (IsCrossrtAtomic(fd)) return AtomicCall(fd, call);
+  if (IsGangFunction(fd)) return GangCall(fd, call);
   // std::min({a, b, c}) and std::max({...}): folded pairwise, left to right.
   if (fd->isInStdNamespace() && (name == "min" || name == "max") && call->getNumArgs() >= 1)
     if (auto* list = dyn_cast<CXXStdInitializerListExpr>(call->getArg(0)->IgnoreImplicit())) {

@@ -857,7 +857,7 @@ std::string KernelPrinter::Stmt(const clang::Stmt* s, int indent) {
       }
       std::string decl = Declare(t, vd->getNameAsString(), vd->getLocation());
       std::string cnst = t.getNonReferenceType().isConstQualified() && !t->isArrayType() ? "const " : "";
-      out += pad + cnst + decl;
+      out += pad + cnst + LocalQualifier(vd) + decl;
       std::string after;
       if (auto* init = vd->getInit()) {
         const clang::Expr* bare = init->IgnoreImplicit();

@@ -26,6 +26,10 @@ namespace crossrt::engine {
 
 // crossrt::AtomicAdd and the other read-modify-write operations of Atomics.h.
 bool IsCrossrtAtomic(const clang::FunctionDecl* fd);
+// crossrt::GangSize, AnyLane, AllLanes, FirstLane and MinOverLanes of Gang.h; a local declared
+// CRT_UNIFORM (annotated "crossrt::uniform"), which the gang shares.
+bool IsGangFunction(const clang::FunctionDecl* fd);
+bool IsUniformLocal(const clang::VarDecl* vd);
 
 // The polymorphic class a shared_ptr, unique_ptr or plain pointer type points to, or null.
 const clang::CXXRecordDecl* PolymorphicPointee(clang::QualType type);
@@ -266,6 +270,10 @@ protected:
   virtual std::string RangeCounter(bool exits) const = 0;
   virtual std::string LoopInit(const clang::ForStmt* fs, const std::string& init) = 0;
   virtual std::string ArrayCopy(const clang::VarDecl* vd, const clang::CXXConstructExpr* copy, const std::string& pad) = 0;
+  // The gang (Gang.h): crossrt::GangSize, AnyLane, AllLanes, FirstLane and MinOverLanes; what a
+  // local's declaration starts with besides `const` (ISPC's `uniform` for a CRT_UNIFORM local).
+  virtual std::string GangCall(const clang::FunctionDecl* fd, const clang::CallExpr* call) = 0;
+  virtual std::string LocalQualifier(const clang::VarDecl* vd) = 0;
 
   // ---- the walk ----
   // The per-thread value parameter `e` reads (*p, p[0]; with pointerItself, p), or null.

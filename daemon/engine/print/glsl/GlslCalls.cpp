@@ -119,6 +119,15 @@ std::string GlslPrinter::LibraryCall(const FunctionDecl* fd, const std::vector<s
   return "";
 }
 
+// The gang (Gang.h): a GPU thread here is a gang of one, so each function is what one thread alone
+// does, and a CRT_UNIFORM local is a thread's own.
+std::string GlslPrinter::GangCall(const FunctionDecl* fd, const CallExpr* call) {
+  if (fd->getName() == "GangSize") return "1";
+  return "(" + Expr(call->getArg(0)) + ")";
+}
+
+std::string GlslPrinter::LocalQualifier(const VarDecl*) { return ""; }
+
 std::string GlslPrinter::AtomicOperation(const std::string& name, const std::vector<std::string>& args) {
   // The fences of acquire-release order (the kernel template defines crt_release/crt_acquire):
   // the last argument passes a release fence before the atomic runs, the result an acquire fence

@@ -66,6 +66,8 @@ protected:
   std::string RangeCounter(bool exits) const override;
   std::string LoopInit(const clang::ForStmt* fs, const std::string& init) override;
   std::string ArrayCopy(const clang::VarDecl* vd, const clang::CXXConstructExpr* copy, const std::string& pad) override;
+  std::string GangCall(const clang::FunctionDecl* fd, const clang::CallExpr* call) override;
+  std::string LocalQualifier(const clang::VarDecl* vd) override;
 
 private:
   // A texel stored whole (imageStore) of a storage image.

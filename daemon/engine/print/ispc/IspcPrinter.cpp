@@ -260,7 +260,10 @@ std::string IspcPrinter::SizeLiteral(uint64_t n) const { return std::to_string(n
 
 std::string IspcPrinter::TexelAssignment(const CXXOperatorCallExpr*) { return ""; }  // ISPC's texels are lvalues
 
-std::string IspcPrinter::Assignment(const BinaryOperator* bo) { return ComponentAssignment(bo); }
+std::string IspcPrinter::Assignment(const BinaryOperator* bo) {
+  CheckSharedAssignment(bo->getLHS(), bo->getRHS());
+  return ComponentAssignment(bo);
+}
 
 // ISPC divides the masked-off lanes too, whose divisor may be 0 (a masked gather's): a per-lane
 // integer divisor goes through crt_divisor (LiteMath.isph), which gives those lanes 1.

@@ -67,6 +67,8 @@ protected:
   std::string RangeCounter(bool exits) const override;
   std::string LoopInit(const clang::ForStmt* fs, const std::string& init) override;
   std::string ArrayCopy(const clang::VarDecl* vd, const clang::CXXConstructExpr* copy, const std::string& pad) override;
+  std::string GangCall(const clang::FunctionDecl* fd, const clang::CallExpr* call) override;
+  std::string LocalQualifier(const clang::VarDecl* vd) override;
 
 private:
   // A member of the class data through the data pointer ("self->m_x").
@@ -74,6 +76,11 @@ private:
   // Whether every lane of a gang shares e's value (IspcUniform.cpp), "uniform " for a cast of it,
   // and loop variables the gang runs together.
   bool Uniform(const clang::Expr* e) const;
+  bool SharedPlace(const clang::Expr* e) const;
+  // CRT_UNIFORM locals (Gang.h): an assignment to one (or to its element) of a value, or at an index, the
+  // lanes may not share is reported at the user's line.
+  void CheckSharedAssignment(const clang::Expr* target, const clang::Expr* value);
+  void SharedValueExpected(const clang::VarDecl* vd, const clang::Expr* where, bool isIndex);
   std::string Variability(const clang::Expr* sub) const;
   const clang::VarDecl* UniformLoop(const clang::ForStmt* fs) const;
   // What ISPC has no counterpart for (yet): an error with the hint to use the Vulkan or CPU class.

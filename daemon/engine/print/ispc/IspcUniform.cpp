@@ -2,7 +2,12 @@
 // loop variable `uniform` when its start, bound and step are shared (a kernel's scalar parameters,
 // members, the outer loops of a 2D or 3D nest, constants) and nothing else changes it: the loop
 // then runs once per gang, and what it indexes with the variable (m_weights[k + m_radius]) is one
-// load for all lanes instead of a gather, and a shared value. Part of IspcPrinter (IspcPrinter.h).
+// load for all lanes instead of a gather, and a shared value.
+//
+// And the gang of Gang.h: a CRT_UNIFORM local is `uniform`, and every value assigned to it must be
+// shared (reported at the user's line otherwise, not as an ISPC error in the generated file);
+// crossrt::AnyLane, AllLanes, FirstLane, MinOverLanes and GangSize are ISPC's any, all, extract at
+// the lowest active lane, reduce_min and programCount. Part of IspcPrinter (IspcPrinter.h).
 #include "analyse/AstQueries.h"
 #include "print/ispc/IspcPrinter.h"
 #include "print/PrinterParts.h"
@@ -13,9 +18,29 @@ using namespace clang;
 
 namespace crossrt::engine {
 
+// Storage the gang shares: a uniform local (CRT_UNIFORM, a uniform loop's variable), an element of a
+// member vector at a shared index, and a field, an array element or a vector component of those at
+// shared indices.
+bool IspcPrinter::SharedPlace(const clang::Expr* e) const {
+  e = e->IgnoreParenImpCasts();
+  if (auto* dr = dyn_cast<DeclRefExpr>(e)) return uniformValues.count(dr->getDecl()) > 0;
+  if (auto* me = dyn_cast<MemberExpr>(e)) return !me->isArrow() && SharedPlace(me->getBase());
+  if (auto* as = dyn_cast<ArraySubscriptExpr>(e)) return SharedPlace(as->getBase()) && Uniform(as->getIdx());
+  auto* op = dyn_cast<CXXOperatorCallExpr>(e);
+  if (!op || op->getOperator() != OO_Subscript || op->getNumArgs() != 2 || !Uniform(op->getArg(1))) return false;
+  if (IsLiteMathType(op->getArg(0)->getType().getNonReferenceType(), nullptr)) return SharedPlace(op->getArg(0));  // v[i]
+  auto* f = ThisMemberField(op->getArg(0));
+  return f && IsStdVector(f->getType()) && !selfClass && !m_structSelf;
+}
+
 bool IspcPrinter::Uniform(const clang::Expr* e) const {
   e = e->IgnoreParenImpCasts();
   if (isa<IntegerLiteral, FloatingLiteral, CXXBoolLiteralExpr, CharacterLiteral>(e)) return true;
+  if (auto* call = dyn_cast<CallExpr>(e); call && IsGangFunction(call->getDirectCallee())) {
+    const std::string name = call->getDirectCallee()->getNameAsString();
+    return name != "FirstLane" && name != "MinOverLanes" ? true : call->getArg(0)->getType()->isArithmeticType();
+  }
+  if ((isa<MemberExpr, ArraySubscriptExpr, CXXOperatorCallExpr>(e)) && e->getType()->isArithmeticType() && SharedPlace(e)) return true;
   if (auto* c = dyn_cast<CStyleCastExpr>(e)) return c->getType()->isArithmeticType() && Uniform(c->getSubExpr());
   if (auto* c = dyn_cast<CXXFunctionalCastExpr>(e)) return c->getType()->isArithmeticType() && Uniform(c->getSubExpr());
   if (auto* dr = dyn_cast<DeclRefExpr>(e)) {
@@ -86,6 +111,66 @@ const VarDecl* IspcPrinter::UniformLoop(const ForStmt* fs) const {
   body.v = v;
   body.TraverseStmt(const_cast<clang::Stmt*>(fs->getBody()));
   return body.bad ? nullptr : v;
+}
+
+// ---- the gang (Gang.h) ----
+
+std::string IspcPrinter::GangCall(const FunctionDecl* fd, const CallExpr* call) {
+  const std::string name = fd->getNameAsString();
+  if (name == "GangSize") return "programCount";
+  const std::string value = Expr(call->getArg(0));
+  if (name == "AnyLane") return "any(" + value + ")";
+  if (name == "AllLanes") return "all(" + value + ")";
+  // FirstLane and MinOverLanes: of a 32-bit number (a bool too, for FirstLane).
+  const QualType t = call->getArg(0)->getType().getCanonicalType().getUnqualifiedType();
+  const bool bit32 = t->isArithmeticType() && !t->isBooleanType() && m_ctx.getTypeSize(t) == 32;
+  if (!bit32 && !(name == "FirstLane" && t->isBooleanType()))
+    return Fail(call->getArg(0)->getExprLoc(), "crossrt::" + name + " of a '" + t.getAsString(m_ctx.getPrintingPolicy()) + "'",
+                "pass an int, unsigned, float" + std::string(name == "FirstLane" ? " or bool" : "") + ", one field at a time");
+  return (name == "FirstLane" ? "crt_first_lane(" : "reduce_min(") + value + ")";
+}
+
+// A CRT_UNIFORM local: `uniform`, if it holds numbers and starts shared.
+std::string IspcPrinter::LocalQualifier(const VarDecl* vd) {
+  if (!IsUniformLocal(vd)) return "";
+  const QualType t = vd->getType();
+  if (t->isReferenceType() || !m_ctx.getBaseElementType(t)->isArithmeticType()) {
+    Fail(vd->getLocation(), "CRT_UNIFORM local '" + vd->getNameAsString() + "' of type '" + t.getAsString(m_ctx.getPrintingPolicy()) + "'",
+         "a gang shares numbers and arrays of numbers: declare the struct's fields as CRT_UNIFORM locals of their own");
+    return "";
+  }
+  if (const clang::Expr* init = vd->getInit()) {
+    std::vector<const clang::Expr*> values = {init};
+    if (auto* list = dyn_cast<InitListExpr>(init->IgnoreImplicit())) values.assign(list->inits().begin(), list->inits().end());
+    for (const clang::Expr* value : values)
+      if (!isa<ImplicitValueInitExpr>(value) && !Uniform(value)) SharedValueExpected(vd, value, false);
+  }
+  uniformValues.insert(vd);
+  return "uniform ";
+}
+
+// `target = value` (or op=) where target is a CRT_UNIFORM local or its element: value, and the
+// element's index, must be shared.
+void IspcPrinter::CheckSharedAssignment(const clang::Expr* target, const clang::Expr* value) {
+  target = target->IgnoreParenImpCasts();
+  const clang::Expr* index = nullptr;
+  if (auto* as = dyn_cast<ArraySubscriptExpr>(target)) {
+    index = as->getIdx();
+    target = as->getBase()->IgnoreParenImpCasts();
+  }
+  auto* dr = dyn_cast<DeclRefExpr>(target);
+  auto* vd = dr ? dyn_cast<VarDecl>(dr->getDecl()) : nullptr;
+  if (!IsUniformLocal(vd)) return;
+  if (index && !Uniform(index)) SharedValueExpected(vd, index, true);
+  else if (!Uniform(value)) SharedValueExpected(vd, value, false);
+}
+
+void IspcPrinter::SharedValueExpected(const VarDecl* vd, const clang::Expr* where, bool isIndex) {
+  Fail(where->getExprLoc(),
+       std::string(isIndex ? "an index" : "a value") + " that may differ between the lanes of an ISPC gang " + (isIndex ? "into" : "is assigned to") +
+           " CRT_UNIFORM '" + vd->getNameAsString() + "'",
+       "assign what every lane shares (constants, members, CRT_UNIFORM locals, crossrt::AnyLane, FirstLane or MinOverLanes of a "
+       "value), or declare '" + vd->getNameAsString() + "' without CRT_UNIFORM");
 }
 
 }  // namespace crossrt::engine

@@ -90,6 +90,11 @@ struct Cubic
   float c3;
 };
 
+struct BVHTriangle4
+{
+  vec4 coord[9];
+};
+
 struct BVHSdfBrick
 {
   vec4 minAndVoxelSize;
@@ -100,11 +105,6 @@ struct BVHSdfBrick
   uint localId;
   uint occupied[2];
   uint unused;
-};
-
-struct BVHTriangle4
-{
-  vec4 coord[9];
 };
 
 // Data members of PrimaryRays, uploaded before every control function call.
@@ -128,16 +128,16 @@ layout(std430, binding = 0) buffer crt_PrimaryRaysData
   uint crt_m_pAccelStruct_m_instances_capacity;
   uint crt_m_pAccelStruct_m_motion_size;
   uint crt_m_pAccelStruct_m_motion_capacity;
+  uint crt_m_pAccelStruct_m_triangles_size;
+  uint crt_m_pAccelStruct_m_triangles_capacity;
+  uint crt_m_pAccelStruct_m_primIds_size;
+  uint crt_m_pAccelStruct_m_primIds_capacity;
   uint crt_m_pAccelStruct_m_boxes_size;
   uint crt_m_pAccelStruct_m_boxes_capacity;
   uint crt_m_pAccelStruct_m_sdfBricks_size;
   uint crt_m_pAccelStruct_m_sdfBricks_capacity;
   uint crt_m_pAccelStruct_m_sdfWords_size;
   uint crt_m_pAccelStruct_m_sdfWords_capacity;
-  uint crt_m_pAccelStruct_m_triangles_size;
-  uint crt_m_pAccelStruct_m_triangles_capacity;
-  uint crt_m_pAccelStruct_m_primIds_size;
-  uint crt_m_pAccelStruct_m_primIds_capacity;
 };
 layout(std430, binding = 1) buffer crt_pixelsBuffer
 {
@@ -194,17 +194,18 @@ layout(push_constant) uniform crt_kernel2D_RenderArgs
   int height;
 };
 
+const uint m_pAccelStruct_kNoId = 4294967295u;
 const uint m_pAccelStruct_kInstanceSdf = 8u;
 const uint m_pAccelStruct_kInstanceBoxes = 2u;
 const float m_pAccelStruct_kMissed = -1.0;
 const float m_pAccelStruct_kWiden = 1.00000036;
+const float m_pAccelStruct_kNotEntered = (1.0 / 0.0);
 const uint m_pAccelStruct_kNoChild = 4294967295u;
 const uint m_pAccelStruct_kLeafFlag = 2147483648u;
 const uint m_pAccelStruct_kSdfMaskedVoxels = 4u;
 const int m_pAccelStruct_kSdfNewtonIterations = 4;
 const uint m_pAccelStruct_kInstanceMotion = 4u;
 const uint m_pAccelStruct_kInstanceIdentity = 1u;
-const uint m_pAccelStruct_kNoId = 4294967295u;
 const float kCameraFar = 1e30;
 const uint kMissId = 4294967295u;
 
@@ -294,6 +295,173 @@ vec4 m_pAccelStruct_SlabEntries(BVHTraceRay r, BVH4Node n, float tfar, inout vec
   const vec4 farZ = ((r.invDir.z < 0.0 ? n.minZ : n.maxZ) - r.org.z) * r.invDir.z;
   exits = min(min(min(farX, farY), farZ) * m_pAccelStruct_kWiden, vec4(tfar));
   return max(max(nearX, nearY), max(nearZ, vec4(r.tnear)));
+}
+
+// from (anonymous namespace)::DifferenceOfProducts
+float m_pAccelStruct_DifferenceOfProducts(float a, float b, float c, float d)
+{
+  const float cd = c * d;
+  const float error = fma(-c, d, cd);
+  return fma(a, b, -cd) + error;
+}
+
+// from (anonymous namespace)::DifferenceOfProducts
+vec4 m_pAccelStruct_DifferenceOfProducts(vec4 a, vec4 b, vec4 c, vec4 d)
+{
+  return vec4(
+      m_pAccelStruct_DifferenceOfProducts(a.x, b.x, c.x, d.x), m_pAccelStruct_DifferenceOfProducts(a.y, b.y, c.y, d.y),
+      m_pAccelStruct_DifferenceOfProducts(a.z, b.z, c.z, d.z), m_pAccelStruct_DifferenceOfProducts(a.w, b.w, c.w, d.w));
+}
+
+// from BVHScene::IntersectGroup
+uint m_pAccelStruct_IntersectGroup(BVHTraceRay r, uint group, int kx, int ky, int kz, float tfar, inout vec4 t,
+                                   inout vec4 u, inout vec4 v)
+{
+  const float ox = r.org[kx];
+  const float oy = r.org[ky];
+  const float oz = r.org[kz];
+  const vec4 az = m_pAccelStruct_m_triangles[group].coord[kz] - oz;
+  const vec4 bz = m_pAccelStruct_m_triangles[group].coord[3 + kz] - oz;
+  const vec4 cz = m_pAccelStruct_m_triangles[group].coord[6 + kz] - oz;
+  const vec4 ax = (m_pAccelStruct_m_triangles[group].coord[kx] - ox) - r.sx * az;
+  const vec4 ay = (m_pAccelStruct_m_triangles[group].coord[ky] - oy) - r.sy * az;
+  const vec4 bx = (m_pAccelStruct_m_triangles[group].coord[3 + kx] - ox) - r.sx * bz;
+  const vec4 by = (m_pAccelStruct_m_triangles[group].coord[3 + ky] - oy) - r.sy * bz;
+  const vec4 cx = (m_pAccelStruct_m_triangles[group].coord[6 + kx] - ox) - r.sx * cz;
+  const vec4 cy = (m_pAccelStruct_m_triangles[group].coord[6 + ky] - oy) - r.sy * cz;
+  vec4 eu = cx * by - cy * bx;
+  vec4 ev = ax * cy - ay * cx;
+  vec4 ew = bx * ay - by * ax;
+  const vec4 zero = vec4(0.0);
+  if (uint(dot(vec4(lessThanEqual(min(min(abs(eu), abs(ev)), abs(ew)), zero)), vec4(1.0, 2.0, 4.0, 8.0))) != 0u)
+  {
+    eu = m_pAccelStruct_DifferenceOfProducts(cx, by, cy, bx);
+    ev = m_pAccelStruct_DifferenceOfProducts(ax, cy, ay, cx);
+    ew = m_pAccelStruct_DifferenceOfProducts(bx, ay, by, ax);
+  }
+  uint hits = uint(dot(vec4(lessThanEqual(zero, min(min(eu, ev), ew))), vec4(1.0, 2.0, 4.0, 8.0))) |
+              uint(dot(vec4(lessThanEqual(max(max(eu, ev), ew), zero)), vec4(1.0, 2.0, 4.0, 8.0)));
+  const vec4 det = eu + ev + ew;
+  hits = hits & ~(uint(dot(vec4(lessThanEqual(det, zero)), vec4(1.0, 2.0, 4.0, 8.0))) &
+                  uint(dot(vec4(lessThanEqual(zero, det)), vec4(1.0, 2.0, 4.0, 8.0))));
+  t = (eu * (r.sz * az) + ev * (r.sz * bz) + ew * (r.sz * cz)) / det;
+  hits = hits & uint(dot(vec4(lessThanEqual(vec4(r.tnear), t)), vec4(1.0, 2.0, 4.0, 8.0))) &
+         uint(dot(vec4(lessThanEqual(t, vec4(tfar))), vec4(1.0, 2.0, 4.0, 8.0)));
+  u = ev / det;
+  v = ew / det;
+  return hits;
+}
+
+// from BVHScene::TakeNearestHit
+bool m_pAccelStruct_TakeNearestHit(uint g, uint hits, vec4 t, vec4 u, vec4 v, bool anyHit, inout float tfar,
+                                   inout CRT_Hit hit)
+{
+  bool taken = false;
+  while (hits != 0u)
+  {
+    const int lane = findLSB(uint(hits));
+    hits = hits & (hits - 1u);
+    const uint primId = m_pAccelStruct_m_primIds[4u * g + uint(lane)];
+    if (t[lane] > tfar || (t[lane] == tfar && primId >= hit.primId))
+      continue;
+    taken = true;
+    tfar = t[lane];
+    hit.t = t[lane];
+    hit.primId = primId;
+    hit.coords[0] = u[lane];
+    hit.coords[1] = v[lane];
+    if (anyHit)
+      return true;
+  }
+  return taken;
+}
+
+// from BVHScene::TraceMeshTogether
+bool m_pAccelStruct_TraceMeshTogether(BVHTraceRay ray, uint root, bool anyHit, inout float tfar, inout CRT_Hit hit)
+{
+  uint stack[64];
+  float stackEntry[64];
+  int top = 0;
+  uint node = (root);
+  const int kx = (ray.kx);
+  const int ky = (ray.ky);
+  const int kz = (ray.kz);
+  float entry = ray.tnear;
+  bool found = false;
+  while (true)
+  {
+    while ((node & m_pAccelStruct_kLeafFlag) == 0u)
+    {
+      vec4 exits = vec4(0);
+      const vec4 entries = m_pAccelStruct_SlabEntries(ray, m_pAccelStruct_m_nodes[node], tfar, exits);
+      const uint mask = entry <= tfar ? uint(dot(vec4(lessThanEqual(entries, exits)), vec4(1.0, 2.0, 4.0, 8.0))) : 0u;
+      uint children[4];
+      float nearest[4];
+      float entered[4];
+      int count = 0;
+      for (int lane = 0; lane < 4; ++lane)
+      {
+        const bool enters = ((mask >> lane) & 1u) != 0u;
+        if ((enters))
+        {
+          children[count] = m_pAccelStruct_m_nodes[node].child[lane];
+          entered[count] = enters ? entries[lane] : m_pAccelStruct_kNotEntered;
+          nearest[count] = (entered[count]);
+          count = count + 1;
+        }
+      }
+      if (count == 0)
+      {
+        node = m_pAccelStruct_kNoChild;
+        break;
+      }
+      for (int i = 1; i < count; ++i)
+        for (int j = i; j > 0; --j)
+          if (nearest[j] < nearest[j - 1])
+          {
+            const float n = nearest[j];
+            nearest[j] = nearest[j - 1];
+            nearest[j - 1] = n;
+            const uint c = children[j];
+            children[j] = children[j - 1];
+            children[j - 1] = c;
+            const float e = entered[j];
+            entered[j] = entered[j - 1];
+            entered[j - 1] = e;
+          }
+      for (int i = count - 1; i > 0; --i)
+      {
+        stack[top] = children[i];
+        stackEntry[top] = entered[i];
+        top = top + 1;
+      }
+      node = children[0];
+      entry = entered[0];
+    }
+    if (node != m_pAccelStruct_kNoChild && entry <= tfar)
+    {
+      const uint first = (node & ~m_pAccelStruct_kLeafFlag) >> 3;
+      const uint last = first + (node & 7u);
+      for (uint g = first; g <= last; ++g)
+      {
+        vec4 t = vec4(0);
+        vec4 u = vec4(0);
+        vec4 v = vec4(0);
+        const uint hits = m_pAccelStruct_IntersectGroup(ray, g, kx, ky, kz, tfar, t, u, v);
+        found = m_pAccelStruct_TakeNearestHit(g, hits, t, u, v, anyHit, tfar, hit) || found;
+      }
+      if (anyHit && found)
+        return true;
+    }
+    do
+    {
+      if (top == 0)
+        return found;
+      top = top - 1;
+    } while (!(stackEntry[top] <= tfar));
+    node = stack[top];
+    entry = stackEntry[top];
+  }
 }
 
 // from (anonymous namespace)::OrderLanes
@@ -644,63 +812,11 @@ bool m_pAccelStruct_IntersectBoxes(BVHTraceRay r, uint group, bool sdf, inout fl
   return found;
 }
 
-// from (anonymous namespace)::DifferenceOfProducts
-float m_pAccelStruct_DifferenceOfProducts(float a, float b, float c, float d)
-{
-  const float cd = c * d;
-  const float error = fma(-c, d, cd);
-  return fma(a, b, -cd) + error;
-}
-
-// from (anonymous namespace)::DifferenceOfProducts
-vec4 m_pAccelStruct_DifferenceOfProducts(vec4 a, vec4 b, vec4 c, vec4 d)
-{
-  return vec4(
-      m_pAccelStruct_DifferenceOfProducts(a.x, b.x, c.x, d.x), m_pAccelStruct_DifferenceOfProducts(a.y, b.y, c.y, d.y),
-      m_pAccelStruct_DifferenceOfProducts(a.z, b.z, c.z, d.z), m_pAccelStruct_DifferenceOfProducts(a.w, b.w, c.w, d.w));
-}
-
-// from BVHScene::IntersectGroup
-uint m_pAccelStruct_IntersectGroup(BVHTraceRay r, uint group, float tfar, inout vec4 t, inout vec4 u, inout vec4 v)
-{
-  const float ox = r.org[r.kx];
-  const float oy = r.org[r.ky];
-  const float oz = r.org[r.kz];
-  const vec4 az = m_pAccelStruct_m_triangles[group].coord[r.kz] - oz;
-  const vec4 bz = m_pAccelStruct_m_triangles[group].coord[3 + r.kz] - oz;
-  const vec4 cz = m_pAccelStruct_m_triangles[group].coord[6 + r.kz] - oz;
-  const vec4 ax = (m_pAccelStruct_m_triangles[group].coord[r.kx] - ox) - r.sx * az;
-  const vec4 ay = (m_pAccelStruct_m_triangles[group].coord[r.ky] - oy) - r.sy * az;
-  const vec4 bx = (m_pAccelStruct_m_triangles[group].coord[3 + r.kx] - ox) - r.sx * bz;
-  const vec4 by = (m_pAccelStruct_m_triangles[group].coord[3 + r.ky] - oy) - r.sy * bz;
-  const vec4 cx = (m_pAccelStruct_m_triangles[group].coord[6 + r.kx] - ox) - r.sx * cz;
-  const vec4 cy = (m_pAccelStruct_m_triangles[group].coord[6 + r.ky] - oy) - r.sy * cz;
-  vec4 eu = cx * by - cy * bx;
-  vec4 ev = ax * cy - ay * cx;
-  vec4 ew = bx * ay - by * ax;
-  const vec4 zero = vec4(0.0);
-  if (uint(dot(vec4(lessThanEqual(min(min(abs(eu), abs(ev)), abs(ew)), zero)), vec4(1.0, 2.0, 4.0, 8.0))) != 0u)
-  {
-    eu = m_pAccelStruct_DifferenceOfProducts(cx, by, cy, bx);
-    ev = m_pAccelStruct_DifferenceOfProducts(ax, cy, ay, cx);
-    ew = m_pAccelStruct_DifferenceOfProducts(bx, ay, by, ax);
-  }
-  uint hits = uint(dot(vec4(lessThanEqual(zero, min(min(eu, ev), ew))), vec4(1.0, 2.0, 4.0, 8.0))) |
-              uint(dot(vec4(lessThanEqual(max(max(eu, ev), ew), zero)), vec4(1.0, 2.0, 4.0, 8.0)));
-  const vec4 det = eu + ev + ew;
-  hits = hits & ~(uint(dot(vec4(lessThanEqual(det, zero)), vec4(1.0, 2.0, 4.0, 8.0))) &
-                  uint(dot(vec4(lessThanEqual(zero, det)), vec4(1.0, 2.0, 4.0, 8.0))));
-  t = (eu * (r.sz * az) + ev * (r.sz * bz) + ew * (r.sz * cz)) / det;
-  hits = hits & uint(dot(vec4(lessThanEqual(vec4(r.tnear), t)), vec4(1.0, 2.0, 4.0, 8.0))) &
-         uint(dot(vec4(lessThanEqual(t, vec4(tfar))), vec4(1.0, 2.0, 4.0, 8.0)));
-  u = ev / det;
-  v = ew / det;
-  return hits;
-}
-
 // from BVHScene::TraceMesh
 bool m_pAccelStruct_TraceMesh(BVHTraceRay ray, uint root, uint leaves, bool anyHit, inout float tfar, inout CRT_Hit hit)
 {
+  if (1 > 1 && (leaves == 0u && root == (root) && ray.kx == (ray.kx) && ray.kz == (ray.kz)))
+    return m_pAccelStruct_TraceMeshTogether(ray, root, anyHit, tfar, hit);
   uint stack[64];
   float stackEntry[64];
   int top = 0;
@@ -746,19 +862,10 @@ bool m_pAccelStruct_TraceMesh(BVHTraceRay ray, uint root, uint leaves, bool anyH
           vec4 t = vec4(0);
           vec4 u = vec4(0);
           vec4 v = vec4(0);
-          uint hits = m_pAccelStruct_IntersectGroup(ray, g, tfar, t, u, v);
-          while (hits != 0u)
+          const uint hits = m_pAccelStruct_IntersectGroup(ray, g, ray.kx, ray.ky, ray.kz, tfar, t, u, v);
+          if (m_pAccelStruct_TakeNearestHit(g, hits, t, u, v, anyHit, tfar, hit))
           {
-            const int lane = findLSB(uint(hits));
-            hits = hits & (hits - 1u);
-            if (t[lane] > tfar)
-              continue;
             found = true;
-            tfar = t[lane];
-            hit.t = t[lane];
-            hit.primId = m_pAccelStruct_m_primIds[4u * g + uint(lane)];
-            hit.coords[0] = u[lane];
-            hit.coords[1] = v[lane];
             if (anyHit)
               return true;
           }
@@ -887,6 +994,7 @@ bool m_pAccelStruct_AnyHit(vec4 posAndNear, vec4 dirAndFar, float time)
 {
   CRT_Hit unused;
   unused.t = dirAndFar.w;
+  unused.primId = m_pAccelStruct_kNoId;
   return m_pAccelStruct_Trace(posAndNear, dirAndFar, time, true, unused);
 }
 

@@ -1,0 +1,48 @@
+// The gang: what kernels may say about the threads that run beside them, in plain C++.
+//
+// On the ISPC backend a kernel runs in a gang of SIMD lanes (8 or 16 threads in step); on the CPU
+// and in the original class one thread is a gang of one; Vulkan's GLSL runs each thread as a gang
+// of one too. These functions let a kernel walk a structure together with its gang (packet
+// traversal: one node loaded for all lanes, one stack), and in a gang of one they are what a
+// single thread would do:
+//
+//   GangSize()        the lanes of the gang: programCount on ISPC, 1 elsewhere
+//   AnyLane(b)        b holds in some active lane          (ISPC's any; b itself in a gang of one)
+//   AllLanes(b)       b holds in every active lane         (ISPC's all)
+//   FirstLane(v)      v in the first active lane, for all  (ISPC's extract at the lowest lane)
+//   MinOverLanes(v)   the least v over the active lanes    (ISPC's reduce_min)
+//
+// CRT_UNIFORM before a local variable's declaration says the gang shares one copy of it (ISPC's
+// `uniform`): it may only be assigned values every active lane agrees on (the results of the
+// functions above, constants, members, members' elements at such indices, other CRT_UNIFORM
+// variables), and the translator reports any other assignment at its line. Assigned under a
+// condition that differs between lanes, it changes for the whole gang.
+//
+// The contract: these decide how the lanes of a gang go together, never what a lane computes. A
+// kernel must give every thread the result it would give alone (BVHScene's packet traversal finds
+// each ray's nearest hit whichever rays share its gang), or the ISPC class and the others disagree.
+#pragma once
+
+#if defined(__clang__)
+#define CRT_UNIFORM [[clang::annotate("crossrt::uniform")]]
+#else
+#define CRT_UNIFORM
+#endif
+
+namespace crossrt {
+
+inline int GangSize() { return 1; }
+inline bool AnyLane(bool b) { return b; }
+inline bool AllLanes(bool b) { return b; }
+template <typename T>
+inline T FirstLane(T v)
+{
+  return v;
+}
+template <typename T>
+inline T MinOverLanes(T v)
+{
+  return v;
+}
+
+}  // namespace crossrt
