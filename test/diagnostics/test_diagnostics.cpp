@@ -156,6 +156,9 @@ TEST_CASE("What the ISPC backend does not translate yet is an error at the user'
        "an index that may differ between the lanes of an ISPC gang into CRT_UNIFORM 'a'", "crossrt::AnyLane", 9},
       {"a CRT_UNIFORM struct", "    CRT_UNIFORM LiteMath::float4 v(1.0f);\n    x += v.x;", "", "",
        "CRT_UNIFORM local 'v' of type 'LiteMath::float4'", "declare the struct's fields as CRT_UNIFORM locals", 8},
+      {"a CRT_UNIFORM local passed by reference", "    CRT_UNIFORM int k = 0;\n    Bump(k);\n    x += float(k);",
+       "  void Bump(int& k) const;", "void Bad::Bump(int& k) const { k = k + 1; }\n",
+       "CRT_UNIFORM 'k' is passed to reference parameter 'k', which holds one value per lane on ISPC", "return the new value", 9},
       {"the first lane of a vector", "    x += crossrt::FirstLane(LiteMath::float2(x, x)).x;", "", "",
        "crossrt::FirstLane of a 'LiteMath::float2'", "one field at a time", 8},
   };

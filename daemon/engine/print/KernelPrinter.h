@@ -274,6 +274,9 @@ protected:
   // local's declaration starts with besides `const` (ISPC's `uniform` for a CRT_UNIFORM local).
   virtual std::string GangCall(const clang::FunctionDecl* fd, const clang::CallExpr* call) = 0;
   virtual std::string LocalQualifier(const clang::VarDecl* vd) = 0;
+  // An argument bound to a helper's non-const reference parameter (ISPC reports a CRT_UNIFORM local
+  // there: a lane's reference cannot bind the gang's variable).
+  virtual void ReferenceArgument(const clang::ParmVarDecl*, const clang::Expr*) {}
 
   // ---- the walk ----
   // The per-thread value parameter `e` reads (*p, p[0]; with pointerItself, p), or null.

@@ -170,6 +170,7 @@ std::vector<std::string> KernelPrinter::HelperArgs(const FunctionDecl* fd, const
     const unsigned pi = i - first;
     const ParmVarDecl* p = pi < def->getNumParams() ? def->getParamDecl(pi) : nullptr;
     if (!p || !p->getType()->isPointerType()) {
+      if (p && p->getType()->isReferenceType() && !p->getType().getNonReferenceType().isConstQualified()) ReferenceArgument(p, arg);
       args.push_back(Expr(arg));
       continue;
     }

@@ -69,6 +69,7 @@ protected:
   std::string ArrayCopy(const clang::VarDecl* vd, const clang::CXXConstructExpr* copy, const std::string& pad) override;
   std::string GangCall(const clang::FunctionDecl* fd, const clang::CallExpr* call) override;
   std::string LocalQualifier(const clang::VarDecl* vd) override;
+  void ReferenceArgument(const clang::ParmVarDecl* p, const clang::Expr* arg) override;
 
 private:
   // A member of the class data through the data pointer ("self->m_x").

@@ -165,6 +165,17 @@ void IspcPrinter::CheckSharedAssignment(const clang::Expr* target, const clang::
   else if (!Uniform(value)) SharedValueExpected(vd, value, false);
 }
 
+void IspcPrinter::ReferenceArgument(const ParmVarDecl* p, const clang::Expr* arg) {
+  const clang::Expr* named = arg->IgnoreParenImpCasts();
+  if (auto* as = dyn_cast<ArraySubscriptExpr>(named)) named = as->getBase()->IgnoreParenImpCasts();
+  auto* dr = dyn_cast<DeclRefExpr>(named);
+  auto* vd = dr ? dyn_cast<VarDecl>(dr->getDecl()) : nullptr;
+  if (IsUniformLocal(vd))
+    Fail(arg->getExprLoc(), "CRT_UNIFORM '" + vd->getNameAsString() + "' is passed to reference parameter '" + p->getNameAsString() +
+                                "', which holds one value per lane on ISPC",
+         "return the new value and assign it, or copy it into a local without CRT_UNIFORM around the call");
+}
+
 void IspcPrinter::SharedValueExpected(const VarDecl* vd, const clang::Expr* where, bool isIndex) {
   Fail(where->getExprLoc(),
        std::string(isIndex ? "an index" : "a value") + " that may differ between the lanes of an ISPC gang " + (isIndex ? "into" : "is assigned to") +
