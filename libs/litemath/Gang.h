@@ -15,8 +15,9 @@
 // CRT_UNIFORM before a local variable's declaration says the gang shares one copy of it (ISPC's
 // `uniform`): it may only be assigned values every active lane agrees on (the results of the
 // functions above, constants, members, members' elements at such indices, other CRT_UNIFORM
-// variables), and the translator reports any other assignment at its line. Assigned under a
-// condition that differs between lanes, it changes for the whole gang.
+// variables); translated to ISPC, any other assignment, an element written at a per-lane index, or
+// the local passed to a helper's non-const reference parameter is an error at its line. Assigned
+// under a condition that differs between lanes, it changes for the whole gang.
 //
 // The contract: these decide how the lanes of a gang go together, never what a lane computes. A
 // kernel must give every thread the result it would give alone (BVHScene's packet traversal finds

@@ -47,9 +47,17 @@ class Client:
         self.proc.stdin.write(data)
         self.proc.stdin.flush()
 
-    def send(self, message):
+    @staticmethod
+    def frame(message):
         body = json.dumps(message).encode()
-        self.send_raw(b"Content-Length: %d\r\n\r\n" % len(body) + body)
+        return b"Content-Length: %d\r\n\r\n" % len(body) + body
+
+    def send(self, message):
+        self.send_raw(self.frame(message))
+
+    def send_together(self, messages):
+        """Writes several messages in one write, so that the server reads them back to back."""
+        self.send_raw(b"".join(self.frame(m) for m in messages))
 
     def request(self, method, params=None):
         rid = self.next_id

@@ -130,11 +130,17 @@ def main_session(crossrtd, work):
     check(back and back["uri"] == uri(source) and back["range"]["start"]["line"] == kline,
           "definition from a generated line leads back to the user's kernel")
 
-    # Cancellation: a request queued behind a translation, cancelled before its answer.
-    c.notify("textDocument/didChange", {"textDocument": {"uri": uri(source), "version": 2},
-                                        "contentChanges": [{"text": open(source).read() + "\n// edited\n"}]})
-    rid = c.request("textDocument/hover", {"textDocument": {"uri": uri(source)}, "position": {"line": kline, "character": kchar}})
-    c.notify("$/cancelRequest", {"id": rid})
+    # Cancellation: a request queued behind a translation, cancelled before its answer. The edit, the
+    # request and the cancel go in one write: sent apart, a loaded machine could finish the edit's
+    # translation and answer the request before the cancel arrived (which the protocol allows).
+    rid = c.next_id
+    c.next_id += 1
+    c.send_together([
+        {"jsonrpc": "2.0", "method": "textDocument/didChange",
+         "params": {"textDocument": {"uri": uri(source), "version": 2}, "contentChanges": [{"text": open(source).read() + "\n// edited\n"}]}},
+        {"jsonrpc": "2.0", "id": rid, "method": "textDocument/hover",
+         "params": {"textDocument": {"uri": uri(source)}, "position": {"line": kline, "character": kchar}}},
+        {"jsonrpc": "2.0", "method": "$/cancelRequest", "params": {"id": rid}}])
     answer = c.response(rid)
     check(answer.get("error", {}).get("code") == -32800, "a cancelled request is answered RequestCancelled")
 
