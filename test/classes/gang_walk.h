@@ -1,0 +1,30 @@
+// A user's class that walks a sorted table together with its gang (Gang.h), written as a new user
+// would: in a file not named after the class, a static helper in the .cpp, a sum set up before the
+// kernel and a mean written after it. Each query counts the keys at or below it. The gang moves past
+// whole blocks of keys together while any of its queries lies beyond them (one load of a block's
+// last key for all lanes on ISPC); each query then steps back alone to its own block and counts in
+// it, so its count never depends on the queries beside it (test/equivalence/test_gang.cpp).
+#pragma once
+#include "Gang.h"
+
+#include <cstdint>
+#include <vector>
+
+class KeyCounter
+{
+public:
+  explicit KeyCounter(std::vector<float> sortedKeys) : m_keys(std::move(sortedKeys)) {}
+  virtual ~KeyCounter() = default;
+
+  // counts[i] = the keys <= queries[i]; m_total their sum, m_mean their mean.
+  virtual void Count(int n, [[crossrt::size("n")]] const float* queries, [[crossrt::size("n")]] uint32_t* counts);
+  virtual void CommitDeviceData() {}
+
+  static constexpr int kBlock = 8;
+  std::vector<float> m_keys;  // ascending
+  uint32_t m_total = 0;
+  float m_mean = 0.0f;
+
+protected:
+  void kernel1D_Count(int n, const float* queries, uint32_t* counts);
+};
