@@ -62,7 +62,9 @@ class InspectedTracer : public PathTracer_Vulkan
 {
 public:
   using PathTracer_Vulkan::PathTracer_Vulkan;
-  std::vector<VkBool32> PipelineClasses() const { return crt_pipelineClasses; }
+  // Per (vector, class), whether the pipelines switch over it; then the CRT_SPECIALIZE members' values.
+  std::vector<uint32_t> PipelineConstants() const { return crt_pipelineConstants; }
+  static constexpr size_t kClassConstants = crt_classConstants;
 };
 
 struct Setup
@@ -116,17 +118,19 @@ double Median(std::vector<double> v)
   return v[v.size() / 2];
 }
 
-// The megakernel's SPIR-V size after spirv-opt sets the class constants as `held` and optimises
-// (what a driver does with the specialisation); 0 when spirv-opt is missing.
-size_t SpecialisedSpirvBytes(const std::vector<VkBool32>& held)
+// The megakernel's SPIR-V size after spirv-opt sets the specialization constants as `constants`
+// (the classes held, true or false, then the CRT_SPECIALIZE members' values) and optimises (what a
+// driver does with the specialisation); 0 when spirv-opt is missing.
+size_t SpecialisedSpirvBytes(const std::vector<uint32_t>& constants)
 {
   const std::filesystem::path dir = std::filesystem::temp_directory_path();
   const std::string in = (dir / "bench_path_tracer_megakernel.spv").string(), out = (dir / "bench_path_tracer_megakernel_opt.spv").string();
   std::ofstream(in, std::ios::binary).write(reinterpret_cast<const char*>(PathTracer_RenderPass_Megakernel_spv),
                                             std::streamsize(PathTracer_RenderPass_Megakernel_spvBytes));
   std::string values;
-  for (size_t i = 0; i < held.size(); ++i)
-    values += (i ? " " : "") + std::to_string(crossrt::kClassConstantIdBase + i) + ":" + (held[i] ? "true" : "false");
+  for (size_t i = 0; i < constants.size(); ++i)
+    values += (i ? " " : "") + std::to_string(crossrt::kClassConstantIdBase + i) + ":" +
+              (i >= InspectedTracer::kClassConstants ? std::to_string(constants[i]) : constants[i] ? "true" : "false");
   const std::string cmd = "spirv-opt --set-spec-const-default-value \"" + values + "\" --freeze-spec-const -O " + in + " -o " + out + " 2>/dev/null";
   if (std::system(cmd.c_str()) != 0)
     return 0;
@@ -334,10 +338,11 @@ int main(int argc, char** argv)
         std::vector<double> t;
         for (int round = 0; round < rounds; ++round)
           t.push_back(Seconds([&] { Render(*gpu, s, 4); }));
-        const std::vector<VkBool32> held = gpu->PipelineClasses();
-        const size_t count = size_t(std::count(held.begin(), held.end(), VkBool32(VK_TRUE)));
-        const size_t bytes = SpecialisedSpirvBytes(held);
-        std::printf("| %s | %zu of %zu | %.2f | %.2f | %zu |\n", specialise ? "specialised to the scene" : "every class", count, held.size(), make,
+        const std::vector<uint32_t> constants = gpu->PipelineConstants();
+        const auto classes = constants.begin() + std::ptrdiff_t(InspectedTracer::kClassConstants);
+        const size_t count = size_t(std::count(constants.begin(), classes, uint32_t(VK_TRUE)));
+        const size_t bytes = SpecialisedSpirvBytes(constants);
+        std::printf("| %s | %zu of %zu | %.2f | %.2f | %zu |\n", specialise ? "specialised to the scene" : "every class", count, InspectedTracer::kClassConstants, make,
                     4.0 / Median(t), bytes);
         csv << "specialisation," << (specialise ? "specialised" : "all classes") << ",megakernel,4," << Median(t) << "," << 4.0 / Median(t) << ","
             << 4.0 / Median(t) * paths * 1e-6 << ",," << bytes << ",\n";

@@ -44,6 +44,7 @@ struct Member {
   bool appendedByKernels = false;  // vector: kernels push_back to it (its size counts on the GPU)
   bool inClassData = false;     // plain: accessible, and its C++ layout matches std430
   unsigned std430Align = 4;     // plain: alignment in a std430 block
+  bool specialized = false;     // plain: CRT_SPECIALIZE (Specialize.h), a specialization constant in GLSL
 };
 
 enum class ReduceOp { Add, Sub, Min, Max };

@@ -508,6 +508,7 @@ void BVHScene::ClearDeviceData()
   m_motion.clear();
   m_sdfBricks.clear();
   m_sdfWords.clear();
+  m_sceneKinds = 0;
 }
 
 void BVHScene::ClearGeom()
@@ -869,6 +870,8 @@ void BVHScene::CommitScene(uint32_t)
     inst.root = meshRoot[placed.geomId];
     inst.flags = (IsIdentity(placed.toObject) && placed.motion.empty() ? kInstanceIdentity : 0u) | (boxes ? kInstanceBoxes : 0u) |
                  (sdf ? kInstanceSdf : 0u) | (placed.motion.empty() ? 0u : kInstanceMotion);
+    m_sceneKinds |= (inst.flags & (kInstanceBoxes | kInstanceSdf | kInstanceMotion)) | (boxes ? 0u : kSceneTriangles) |
+                    ((inst.flags & (kInstanceIdentity | kInstanceMotion)) == 0u ? kSceneTransformed : 0u);
     inst.motionFirst = uint32_t(m_motion.size());
     inst.motionSteps = uint32_t(placed.motion.size());
     inst.unused0 = inst.unused1 = 0u;
@@ -978,7 +981,7 @@ bool BVHScene::IntersectBoxes(const BVHTraceRay& r, uint32_t group, bool sdf, fl
     hits = hits & (hits - 1u);
     if (entries[lane] > tfar)
       continue;  // behind a box of this group taken before it
-    if (sdf)
+    if ((m_sceneKinds & kInstanceSdf) != 0u && sdf)
     {
       found = IntersectSdfBrick(r, m_boxes[group].child[lane], entries[lane], exits[lane], tfar, hit) || found;
       continue;
@@ -1142,8 +1145,9 @@ bool BVHScene::TraceMesh(const BVHTraceRay& ray, uint32_t root, uint32_t leaves,
       for (uint32_t g = first; g <= last; ++g)
       {
         // Boxes or triangles, as if and else: rays in SIMD lanes that all took one branch skip the
-        // other (after a `continue`, ISPC's SSE4 code read triangles for lanes that had left).
-        if ((leaves & kInstanceBoxes) != 0u)
+        // other (after a `continue`, ISPC's SSE4 code read triangles for lanes that had left). A
+        // kind the scene does not hold is no branch at all in a shader specialised to it.
+        if ((m_sceneKinds & kInstanceBoxes) != 0u && (leaves & kInstanceBoxes) != 0u)
         {
           if (IntersectBoxes(ray, g, (leaves & kInstanceSdf) != 0u, tfar, hit))
           {
@@ -1152,7 +1156,7 @@ bool BVHScene::TraceMesh(const BVHTraceRay& ray, uint32_t root, uint32_t leaves,
               return true;
           }
         }
-        else
+        else if ((m_sceneKinds & kSceneTriangles) != 0u)
         {
           float4 t;
           float4 u;
@@ -1308,7 +1312,8 @@ bool BVHScene::TraceInstance(uint32_t k, const BVHTraceRay& worldRay, float time
   const BVHInstance& inst = m_instances[k];
   const uint32_t leaves = inst.flags & (kInstanceBoxes | kInstanceSdf);
   bool found = false;
-  if ((inst.flags & kInstanceMotion) != 0u)
+  // Branches on kinds the scene does not hold (m_sceneKinds) vanish from a specialised shader.
+  if ((m_sceneKinds & kInstanceMotion) != 0u && (inst.flags & kInstanceMotion) != 0u)
   {
     // Its object-to-world matrix at the ray's time, between the two steps around it, inverted.
     const float f = clamp(time, 0.0f, 1.0f) * float(inst.motionSteps - 1u);
@@ -1322,7 +1327,7 @@ bool BVHScene::TraceInstance(uint32_t k, const BVHTraceRay& worldRay, float time
     const float3 org = toObject * (worldRay.org - float3(row0.w, row1.w, row2.w));
     found = TraceMesh(Prepare(org, toObject * worldRay.dir, worldRay.tnear), inst.root, leaves, anyHit, tfar, hit);
   }
-  else if ((inst.flags & kInstanceIdentity) != 0u)
+  else if ((m_sceneKinds & kSceneTransformed) == 0u || (inst.flags & kInstanceIdentity) != 0u)
     found = TraceMesh(worldRay, inst.root, leaves, anyHit, tfar, hit);
   else
     found = TraceMesh(Prepare(ToObjectPoint(inst, worldRay.org), ToObjectVector(inst, worldRay.dir), worldRay.tnear), inst.root, leaves,

@@ -10,6 +10,7 @@
 #pragma once
 #include "BVHNode.h"
 #include "CrossRT.h"
+#include "Specialize.h"
 
 #include <functional>
 #include <string>
@@ -52,6 +53,10 @@ constexpr uint32_t kInstanceIdentity = 1u;  // toObject is the identity: the wor
 constexpr uint32_t kInstanceBoxes = 2u;     // its geometry is boxes (AddGeom_AABB): leaves index m_boxes
 constexpr uint32_t kInstanceMotion = 4u;    // it moves: toObject comes from m_motion at the ray's time
 constexpr uint32_t kInstanceSdf = 8u;       // its geometry is a signed distance field: leaves' boxes are m_sdfBricks
+// What a scene holds, for the traversal to leave out the rest (BVHScene::m_sceneKinds): the instance
+// flags above that some instance has (kInstanceBoxes also for fields, whose bricks are boxes), and:
+constexpr uint32_t kSceneTriangles = 16u;    // an instance of a triangle mesh
+constexpr uint32_t kSceneTransformed = 32u;  // a still instance whose matrix is not the identity
 struct BVHInstance
 {
   LiteMath::float4 toObjectRow0, toObjectRow1, toObjectRow2;
@@ -139,6 +144,10 @@ public:
   std::vector<LiteMath::float4> m_motion; // moving instances' object-to-world rows 0-2, per time step
   std::vector<BVHSdfBrick> m_sdfBricks;   // every signed distance field's bricks (an SDF's box lanes index here)
   std::vector<uint32_t> m_sdfWords;       // their corner values, packed
+  // The kinds of geometry and instances the committed scene holds (kScene*). A _Vulkan class composing
+  // BVHScene compiles its traversal for these (CRT_SPECIALIZE): a scene of still triangle meshes gets
+  // no code for boxes, fields or motion. Everywhere else it only skips tests that would fail anyway.
+  CRT_SPECIALIZE uint32_t m_sceneKinds = 0;
 
 private:
   struct Mesh

@@ -20,19 +20,19 @@ T VkInit(VkStructureType sType) {
 }
 
 // The specialization every pipeline's shaders get: crt_fenceAtomics (kFenceAtomicsConstantId) from
-// the context and, for kernels with virtual calls, the classes the scene holds (kClassConstantIdBase
-// + i); shaders without a constant ignore it. `info` points into the object, which therefore stays
-// where it was made while the pipeline is created.
+// the context, then `constants` as kClassConstantIdBase + i (the classes the scene holds, the
+// CRT_SPECIALIZE members' values); shaders without a constant ignore it. `info` points into the
+// object, which therefore stays where it was made while the pipeline is created.
 struct Specialization {
-  std::vector<VkBool32> values;
+  std::vector<uint32_t> values;
   std::vector<VkSpecializationMapEntry> entries;
   VkSpecializationInfo info{};
-  Specialization(bool fence, const std::vector<VkBool32>& classesHeld) {
+  Specialization(bool fence, const std::vector<uint32_t>& constants) {
     values.push_back(fence ? VK_TRUE : VK_FALSE);
-    for (VkBool32 held : classesHeld) values.push_back(held ? VK_TRUE : VK_FALSE);
+    values.insert(values.end(), constants.begin(), constants.end());
     for (uint32_t i = 0; i < values.size(); ++i)
-      entries.push_back({i == 0 ? kFenceAtomicsConstantId : kClassConstantIdBase + i - 1, uint32_t(sizeof(VkBool32) * i), sizeof(VkBool32)});
-    info = {uint32_t(entries.size()), entries.data(), sizeof(VkBool32) * values.size(), values.data()};
+      entries.push_back({i == 0 ? kFenceAtomicsConstantId : kClassConstantIdBase + i - 1, uint32_t(sizeof(uint32_t) * i), sizeof(uint32_t)});
+    info = {uint32_t(entries.size()), entries.data(), sizeof(uint32_t) * values.size(), values.data()};
   }
   Specialization(const Specialization&) = delete;
   Specialization& operator=(const Specialization&) = delete;

@@ -177,14 +177,14 @@ void Pipeline::PushConstants(VkCommandBuffer cmd, const void* data, uint32_t byt
 
 ComputePipeline::ComputePipeline(std::shared_ptr<VulkanContext> ctx, const uint32_t* spirv, size_t spirvBytes,
                                  uint32_t storageBufferBindings, uint32_t pushConstantBytes, const char* debugName,
-                                 const std::vector<VkBool32>& classesHeld)
+                                 const std::vector<uint32_t>& constants)
     : ComputePipeline(std::move(ctx), spirv, spirvBytes,
                       std::vector<VkDescriptorType>(storageBufferBindings, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER), pushConstantBytes,
-                      debugName, 0, classesHeld) {}
+                      debugName, 0, constants) {}
 
 ComputePipeline::ComputePipeline(std::shared_ptr<VulkanContext> ctx, const uint32_t* spirv, size_t spirvBytes,
                                  std::vector<VkDescriptorType> bindingTypes, uint32_t pushConstantBytes, const char* debugName,
-                                 uint32_t textureArraySets, const std::vector<VkBool32>& classesHeld)
+                                 uint32_t textureArraySets, const std::vector<uint32_t>& constants)
     : Pipeline("ComputePipeline", VK_PIPELINE_BIND_POINT_COMPUTE, VK_SHADER_STAGE_COMPUTE_BIT, std::move(ctx), std::move(bindingTypes),
                pushConstantBytes, debugName, textureArraySets) {
   try {
@@ -194,7 +194,7 @@ ComputePipeline::ComputePipeline(std::shared_ptr<VulkanContext> ctx, const uint3
     info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
     info.stage.module = module;
     info.stage.pName = "main";
-    const Specialization specialization(ctx_->fenceAtomics, classesHeld);
+    const Specialization specialization(ctx_->fenceAtomics, constants);
     info.stage.pSpecializationInfo = &specialization.info;
     info.layout = layout_;
     VkResult r = vkCreateComputePipelines(ctx_->device, ctx_->pipelineCache, 1, &info, nullptr, &pipeline_);

@@ -32,7 +32,7 @@ std::shared_ptr<VulkanContext> WithRayTracingPipelines(std::shared_ptr<VulkanCon
 
 RayTracingPipeline::RayTracingPipeline(std::shared_ptr<VulkanContext> ctx, const RayTracingShaders& shaders,
                                        std::vector<VkDescriptorType> bindingTypes, uint32_t pushConstantBytes, const char* debugName,
-                                       uint32_t textureArraySets)
+                                       uint32_t textureArraySets, const std::vector<uint32_t>& constants)
     : Pipeline("RayTracingPipeline", VK_PIPELINE_BIND_POINT_RAY_TRACING_KHR, StagesOf(shaders), WithRayTracingPipelines(std::move(ctx), debugName),
                std::move(bindingTypes), pushConstantBytes, debugName, textureArraySets) {
   std::vector<VkShaderModule> modules;
@@ -41,7 +41,7 @@ RayTracingPipeline::RayTracingPipeline(std::shared_ptr<VulkanContext> ctx, const
     // the callables.
     std::vector<VkPipelineShaderStageCreateInfo> stages;
     std::vector<VkRayTracingShaderGroupCreateInfoKHR> groups;
-    const Specialization specialization(ctx_->fenceAtomics, {});  // kernels with atomics read it
+    const Specialization specialization(ctx_->fenceAtomics, constants);  // kernels with atomics read the fence switch
     auto stage = [&](ShaderCode code, VkShaderStageFlagBits bit) {
       modules.push_back(CreateModule(code.spirv, code.bytes));
       auto s = VkInit<VkPipelineShaderStageCreateInfo>(VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO);

@@ -433,6 +433,93 @@ void NoSize::kernel1D_Copy(int n, const float* in, float* out) { for (int i = 0;
   REQUIRE(r.output.find("[[crossrt::size(\"n\")]]") != std::string::npos);
 }
 
+TEST_CASE("CRT_SPECIALIZE members are specialization constants in GLSL: written by a kernel, changed between kernel calls, or of another type, an error on Vulkan only",
+          "[diagnostics][specialize]")
+{
+  // Line 10 of the header: the member's type; line 5 of the source: the kernel's write; line 3: the
+  // control function's change between its kernel calls.
+  auto header = [](const std::string& type) {
+    return R"(#pragma once
+#include "Specialize.h"
+#include <vector>
+class Modes
+{
+public:
+  virtual ~Modes() = default;
+  virtual void Run(int n, [[crossrt::size("n")]] float* data);
+  virtual void Twice(int n, [[crossrt::size("n")]] float* data);
+  CRT_SPECIALIZE )" + type + R"( m_mode{};
+  CRT_SPECIALIZE bool m_flip = false;
+  CRT_SPECIALIZE unsigned m_last = 0u;
+protected:
+  void kernel1D_Scale(int n, float* data);
+};
+)";
+  };
+  auto source = [](const std::string& kernelWrite, const std::string& between) {
+    return R"(#include "Modes.h"
+void Modes::Run(int n, float* data) { kernel1D_Scale(n, data); }
+void Modes::Twice(int n, float* data) { kernel1D_Scale(n, data); )" + between + R"( kernel1D_Scale(n, data); }
+void Modes::kernel1D_Scale(int n, float* data) { for (int i = 0; i < n; i++) {
+  )" + kernelWrite + R"(
+  data[i] = m_flip ? -data[i] * float(m_mode) : data[i] * float(m_mode); } }
+)";
+  };
+  auto translate = [](const TempClass& tc, const std::string& backend) {
+    return RunCrossrt("translate --class Modes --backend " + backend + " --out " + (tc.dir / ("out_" + backend)).string() + " --source " +
+                      tc.Source("Modes") + " --templates " CROSSRT_SOURCE_DIR "/templates -- -I" CROSSRT_SOURCE_DIR "/libs/litemath");
+  };
+  SECTION("read as specialization constants, numbered from kClassConstantIdBase in member order")
+  {
+    TempClass tc("Modes", header("int"), source("", ""));
+    CommandResult r = translate(tc, "vulkan");
+    INFO(r.output);
+    REQUIRE(r.exitCode == 0);
+    std::ifstream file(tc.dir / "out_vulkan" / "shaders" / "kernel1D_Scale.comp");
+    const std::string glsl((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+    INFO(glsl);
+    REQUIRE(glsl.find("layout(constant_id = 1800) const int crt_m_mode_specialized = 0;") != std::string::npos);
+    REQUIRE(glsl.find("layout(constant_id = 1801) const bool crt_m_flip_specialized = false;") != std::string::npos);
+    REQUIRE(glsl.find("crt_m_flip_specialized ? -data[i] * float(crt_m_mode_specialized)") != std::string::npos);
+  }
+  const struct
+  {
+    const char* what;
+    std::string type, kernelWrite, between;
+    std::string where, message, hint;
+  } errors[] = {
+      {"written by a kernel", "int", "m_last = 1u;", "", "Modes.cpp:5:10: error: ", "kernel 'kernel1D_Scale' writes member 'm_last', which is CRT_SPECIALIZE",
+       "set it on the host before calling the control function"},
+      {"changed between kernel calls", "int", "", "m_flip = !m_flip;", "Modes.cpp:3:",
+       "control function 'Twice' changes member 'm_flip', which is CRT_SPECIALIZE, before or between its kernel calls", "set it before calling 'Twice'"},
+      {"of a type no specialization constant holds", "double", "", "", "Modes.h:10:", "member 'm_mode' is CRT_SPECIALIZE but of type 'double'",
+       "CRT_SPECIALIZE takes a bool, int, uint32_t, float or enum member"},
+  };
+  for (const auto& e : errors)
+  {
+    SECTION(e.what)
+    {
+      TempClass tc("Modes", header(e.type), source(e.kernelWrite, e.between));
+      CommandResult r = translate(tc, "vulkan");
+      INFO(r.output);
+      REQUIRE_FALSE(r.crashed);
+      REQUIRE(r.exitCode == 1);
+      REQUIRE(r.output.find(e.where) != std::string::npos);
+      REQUIRE(r.output.find(e.message) != std::string::npos);
+      REQUIRE(r.output.find("note: hint: " + e.hint) != std::string::npos);
+      REQUIRE_FALSE(fs::exists(tc.dir / "out_vulkan"));
+      // A rule of the GPU's pipelines: the CPU and ISPC classes read the member as any other.
+      for (const char* backend : {"cpu", "ispc"})
+      {
+        CommandResult other = translate(tc, backend);
+        INFO(backend << ": " << other.output);
+        REQUIRE(other.exitCode == 0);
+        REQUIRE(other.output.find("CRT_SPECIALIZE") == std::string::npos);
+      }
+    }
+  }
+}
+
 TEST_CASE("A control function that is not virtual translates with a warning, and the generated one hides it", "[diagnostics]")
 {
   TempClass tc("NotVirtual", R"(#pragma once

@@ -15,7 +15,7 @@ TEST_CASE("Generated names: the Vulkan class template declares every member the 
   const std::string header((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   for (const std::string& name : {generated::kVectorCopies, generated::kTemporaries, generated::kThreadState, generated::kScanner, generated::kSorter,
                                   generated::kVirtualObjects, generated::kImages, generated::kTextures, generated::kPartials, generated::kPipelines,
-                                  generated::kClassData, generated::kPipelineClasses})
+                                  generated::kClassData, generated::kPipelineConstants})
   {
     INFO(name);
     // A member declaration: `Type name;` or the closing `} name;` of a member struct.

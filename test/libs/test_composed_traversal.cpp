@@ -629,3 +629,78 @@ TEST_CASE("A translated class whose composed member holds another implementation
       Catch::Contains("must hold a BVHScene") && Catch::Contains("but it holds a ") && Catch::Contains("EmbreeRT"));
   RequireNoValidationMessages(ctx);
 }
+
+namespace {
+
+// PrimaryRays_Vulkan as a user subclasses it: the specialization its pipelines were made with.
+class InspectedPrimaryRays : public PrimaryRays_Vulkan
+{
+public:
+  using PrimaryRays_Vulkan::PrimaryRays_Vulkan;
+  std::vector<uint32_t> PipelineConstants() const { return crt_pipelineConstants; }
+};
+
+}  // namespace
+
+TEST_CASE("Translated traversal specialised to the scene: a scene that gains transforms, fields and motion between frames",
+          "[bvh][composition][specialize]")
+{
+  // One PrimaryRays_Vulkan over one BVHScene, whose kinds (m_sceneKinds, CRT_SPECIALIZE) grow frame
+  // by frame: still triangles at the identity, then a transformed instance, a signed distance field,
+  // a moving instance. Each frame's pipelines hold the scene's kinds, and the hits agree with
+  // BVHScene as written: a shader still made for the earlier kinds would have no code for the new
+  // geometry and would miss it.
+  auto ctx = ValidatedContext();
+  if (!ctx)
+    return;
+  auto scene = MakeSceneRT("sah");
+  auto* bvh = dynamic_cast<BVHScene*>(scene.get());
+  REQUIRE(bvh);
+  const TriangleMesh mesh = Sphere(3);
+  const uint32_t sphere = scene->AddGeom_Triangles3f(mesh.positions.data(), mesh.VertexCount(), mesh.indices.data(), mesh.indices.size());
+  const litesdf::SdfRoundedBox box(float3(0.0f), float3(0.5f), 0.1f);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  Rays rays;
+  for (int i = 0; i < 3000; ++i)
+  {
+    const float3 from(0.0f, 0.5f, -12.0f), to(7.0f * u(rng), 2.0f * u(rng), 0.0f);
+    rays.Add(from, to - from);
+  }
+  auto vulkan = std::make_shared<InspectedPrimaryRays>(ctx, 1, 1);
+  vulkan->UseRayTracingHardware(false);
+  vulkan->SetScene(scene, {}, {});
+  const float4x4 steps[2] = {translate4x4(float3(-5.0f, 0.0f, 0.0f)), translate4x4(float3(-5.0f, 1.0f, 0.0f))};
+  const struct
+  {
+    const char* added;
+    uint32_t kinds;
+  } frames[] = {
+      {"a sphere at the identity", kSceneTriangles},
+      {"a second sphere, moved and scaled", kSceneTriangles | kSceneTransformed},
+      {"a signed distance field", kSceneTriangles | kSceneTransformed | kInstanceBoxes | kInstanceSdf},
+      {"a moving sphere", kSceneTriangles | kSceneTransformed | kInstanceBoxes | kInstanceSdf | kInstanceMotion},
+  };
+  std::set<uint32_t> instancesHit;
+  for (int f = 0; f < 4; ++f)
+  {
+    INFO("frame " << f << ": " << frames[f].added);
+    if (f == 0) scene->AddInstance(sphere, float4x4());
+    if (f == 1) scene->AddInstance(sphere, translate4x4(float3(2.5f, 0.0f, 0.0f)) * scale4x4(float3(0.7f)));
+    if (f == 2) scene->AddInstance(scene->AddGeom_SdfGrid(litesdf::BuildGrid(box, float3(-1.0f), 2.0f, 17)), translate4x4(float3(5.0f, 0.0f, 0.0f)));
+    if (f == 3) scene->AddInstanceMotion(sphere, steps, 2);
+    scene->CommitScene();
+    REQUIRE(bvh->m_sceneKinds == frames[f].kinds);
+    std::vector<CRT_Hit> original, hits(rays.Size());
+    for (size_t i = 0; i < rays.Size(); ++i)
+      original.push_back(scene->RayQuery_NearestHit(rays.posAndNear[i], rays.dirAndFar[i]));
+    vulkan->CastRays(rays.posAndNear.data(), rays.dirAndFar.data(), hits.data(), int(rays.Size()));  // commits by itself
+    REQUIRE(vulkan->PipelineConstants() == std::vector<uint32_t>{frames[f].kinds});
+    RequireNoValidationMessages(ctx);
+    RequireAgreement("translated traversal", original, hits, rays, 12.0f, nullptr, RoundsLikeTheCpu(*ctx));
+    for (const CRT_Hit& h : original)
+      if (h.primId != kMiss)
+        instancesHit.insert(h.instId);
+    REQUIRE(instancesHit.size() == size_t(f + 1));  // each frame's new instance is in the rays' way
+  }
+}

@@ -11,6 +11,7 @@
 #include "analyse/Members.h"
 #include "analyse/Naming.h"
 #include "analyse/VirtualCalls.h"
+#include "analyse/WriteVisitor.h"
 #include "analyse/Writes.h"
 #include "generate/GeneratedNames.h"
 #include "print/ispc/IspcTypes.h"
@@ -346,6 +347,22 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   };
   markVectorWrites(ws);
   markVectorWrites(ends);
+  // A CRT_SPECIALIZE member is a constant of the GPU's pipelines: kernels only read it.
+  struct SpecializedWrites : WriteVisitor<SpecializedWrites> {
+    std::vector<std::pair<const FieldDecl*, SourceLocation>> found;
+    void Written(const Expr* target, SourceLocation loc) {
+      if (auto* f = RootField(target); f && IsSpecializedMember(f)) found.push_back({f, loc});
+    }
+    bool VisitCallExpr(CallExpr* call) {
+      if (IsCrossrtAtomic(call->getDirectCallee()) && call->getNumArgs() > 0) Written(call->getArg(0), call->getExprLoc());
+      return true;
+    }
+  } specializedWrites;
+  specializedWrites.TraverseStmt(def->getBody());
+  for (auto& [f, loc] : specializedWrites.found)
+    c.rep.RecordingError(loc, "kernel '" + k.name + "' writes member '" + f->getNameAsString() +
+                         "', which is CRT_SPECIALIZE: the GPU compiles the kernel's pipeline for the value it holds",
+                         "set it on the host before calling the control function, or drop CRT_SPECIALIZE");
   for (auto& [field, loc] : ends.appends) ws.appends.emplace(field, loc);
 
   // GLSL: the thread function. ISPC: the same, its uniform arguments passed in (IspcThreadHead).
@@ -501,7 +518,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   for (auto* f : printer.Uses().plainMembers) {
     auto* m = FindMember(c.model, f->getNameAsString());
     if (m) m->usedByKernels = true;
-    if (m && !m->inClassData && f->getAccess() != AS_private)
+    if (m && !m->inClassData && !m->specialized && f->getAccess() != AS_private)
       c.rep.GpuError(f->getLocation(), "member '" + f->getNameAsString() + "' of type '" + f->getType().getAsString(c.ctx.getPrintingPolicy()) + "' has a C++ layout that a GPU buffer cannot reproduce",
                   "use int instead of bool, float4x4 instead of float3x3, or reorder struct fields so 16-byte types come first");
     RequireReachable(c.rep, f, c.cls);

@@ -37,6 +37,20 @@ bool IspcDouble(const Context& c, QualType t) { return c.model.forIspc && t.getC
 
 }  // namespace
 
+// A CRT_SPECIALIZE member must have a type a specialization constant holds: bool, or a 32-bit int,
+// unsigned int, float or enum of one of those.
+bool CheckSpecialized(Reporter& rep, const FieldDecl* f) {
+  QualType t = f->getType().getCanonicalType().getUnqualifiedType();
+  if (auto* e = t->getAs<EnumType>()) t = e->getDecl()->getIntegerType().getCanonicalType();
+  if (t->isSpecificBuiltinType(BuiltinType::Bool) || t->isSpecificBuiltinType(BuiltinType::Int) ||
+      t->isSpecificBuiltinType(BuiltinType::UInt) || t->isSpecificBuiltinType(BuiltinType::Float))
+    return true;
+  rep.RecordingError(f->getLocation(), "member '" + f->getNameAsString() + "' is CRT_SPECIALIZE but of type '" +
+                     f->getType().getAsString(f->getASTContext().getPrintingPolicy()) + "', which a specialization constant cannot hold",
+                     "CRT_SPECIALIZE takes a bool, int, uint32_t, float or enum member");
+  return false;
+}
+
 void AnalyzeMembers(Context& c) {
   std::unique_ptr<KernelPrinter> structPrinter = MakePrinter(c.model, c.ctx, c.cls, c.rep);
   KernelPrinter& structs = *structPrinter;
@@ -45,10 +59,11 @@ void AnalyzeMembers(Context& c) {
   static const std::set<std::string> generatedMembers = {
       generated::kVectorCopies, generated::kTemporaries,    generated::kThreadState, generated::kScanner,
       generated::kSorter,       generated::kVirtualObjects, generated::kImages,      generated::kTextures,
-      generated::kPartials,     generated::kPipelines,      generated::kClassData,   generated::kPipelineClasses};
+      generated::kPartials,     generated::kPipelines,      generated::kClassData,   generated::kPipelineConstants};
   for (auto* f : ClassFields(c.cls)) {
     Member m;
     m.name = f->getNameAsString();
+    m.specialized = IsSpecializedMember(f) && CheckSpecialized(c.rep, f);
     if (!c.model.forCpu && (generatedMembers.count(m.name) || m.name.rfind(generated::kInOutPrefix, 0) == 0))
       c.rep.Error(f->getLocation(), "data member '" + m.name + "' has the name of a member the generated " + c.cls->getNameAsString() +
                                         "_Vulkan class declares for its GPU objects",

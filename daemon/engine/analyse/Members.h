@@ -10,6 +10,9 @@ namespace crossrt::engine {
 // alignment), so a lone float3 matches; float3x3, bool and arrays of float3 do not.
 bool FitsClassData(ASTContext& ctx, QualType t);
 
+// A CRT_SPECIALIZE member's type is one a specialization constant can hold (else an error at it).
+bool CheckSpecialized(Reporter& rep, const FieldDecl* f);
+
 // The pass: every data member of the class (bases first) into model.members; constructors too.
 void AnalyzeMembers(Context& c);
 

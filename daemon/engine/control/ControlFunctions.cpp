@@ -373,6 +373,12 @@ void ControlRewriter::RecordMemberWrite(const Stmt* s) {
   if (auto* uo = dyn_cast_or_null<UnaryOperator>(s); uo && uo->isIncrementDecrementOp()) lhs = uo->getSubExpr();
   const FieldDecl* f = lhs ? ThisField(lhs) : nullptr;
   const Member* m = f ? FindMember(m_c.model, f->getNameAsString()) : nullptr;
+  if (m && m->specialized) {
+    m_c.rep.RecordingError(s->getBeginLoc(), "control function '" + m_ctrl.name + "' changes member '" + m->name +
+                           "', which is CRT_SPECIALIZE, before or between its kernel calls: their pipelines are made for its value before the commands are recorded",
+                           "set it before calling '" + m_ctrl.name + "' (the call then makes the pipelines again), or after its last kernel call");
+    return;
+  }
   if (!m || m->kind != MemberKind::Plain || !m->inClassData) return;
   SourceLocation end = Lexer::findLocationAfterToken(s->getEndLoc(), tok::semi, m_c.ctx.getSourceManager(), m_c.ctx.getLangOpts(), false);
   if (end.isInvalid()) return;

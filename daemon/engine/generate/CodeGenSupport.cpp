@@ -390,19 +390,44 @@ Data Common(const ClassModel& model, const GenerateOptions& opt) {
   }
   d.set("virtuals", virtuals);
   d.set("hasVirtuals", !model.virtuals.empty());
-  unsigned classConstants = 0;
   std::string displays;
-  for (auto& v : model.virtuals) {
-    classConstants += unsigned(v.impls.size());
-    displays += (displays.empty() ? "" : ", ") + v.display;
-  }
+  for (auto& v : model.virtuals) displays += (displays.empty() ? "" : ", ") + v.display;
   d.set("virtualDisplays", displays);
+  const unsigned classConstants = ClassConstantCount(model);
   d.set("classConstantCount", std::to_string(classConstants));
+  Data specialized = List();
+  const std::vector<const Member*> specializedMembers = SpecializedMembers(model);
+  for (size_t i = 0; i < specializedMembers.size(); ++i) {
+    Data x;
+    x.set("name", specializedMembers[i]->name);
+    x.set("host", specializedMembers[i]->hostExpr);
+    x.set("constant", std::to_string(classConstants + i));  // its index in crt_pipelineConstants
+    x.set("origin", specializedMembers[i]->composedFrom.empty() ? model.className + "::" + specializedMembers[i]->name
+                                                                : specializedMembers[i]->composedFrom);
+    specialized.push_back(x);
+  }
+  d.set("specializedMembers", specialized);
+  d.set("hasSpecializedMembers", !specializedMembers.empty());
+  d.set("hasSpecialization", classConstants > 0 || !specializedMembers.empty());
+  d.set("constantCount", std::to_string(classConstants + specializedMembers.size()));
   d.set("classConstantBase", std::to_string(kClassConstantIdBase));
   d.set("virtualIncludes", implIncludes);
   d.set("hiddenMembers", hiddenMembers);
   d.set("hasHiddenMembers", !hiddenMembers.is_empty_list());
   return d;
+}
+
+unsigned ClassConstantCount(const ClassModel& model) {
+  unsigned count = 0;
+  for (auto& v : model.virtuals) count += unsigned(v.impls.size());
+  return count;
+}
+
+std::vector<const Member*> SpecializedMembers(const ClassModel& model) {
+  std::vector<const Member*> out;
+  for (auto& m : model.members)
+    if (m.specialized && m.usedByKernels) out.push_back(&m);
+  return out;
 }
 
 }  // namespace crossrt::engine

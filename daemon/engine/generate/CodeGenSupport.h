@@ -30,6 +30,12 @@ struct KernelVariant {
   bool RayGeneration() const { return callables || leaves; }  // a ray generation shader, not a compute shader
 };
 
+// The specialization constants from kClassConstantIdBase: one per class of each vector of objects
+// called through virtual functions (ClassConstantCount of them), then the CRT_SPECIALIZE members
+// kernels read, in member order (constant id kClassConstantIdBase + ClassConstantCount + index).
+unsigned ClassConstantCount(const ClassModel& model);
+std::vector<const Member*> SpecializedMembers(const ClassModel& model);
+
 // The one-thread shaders of a kernel's statements before and after its loop nest (loop_start, loop_end).
 std::vector<KernelVariant> Phases(const Kernel& k);
 

@@ -18,7 +18,7 @@ inline const std::string kTextures = "crt_textureArrays";     // arrays of textu
 inline const std::string kPartials = "crt_partials";          // per-workgroup partial results of reductions
 inline const std::string kPipelines = "crt_pipelines";        // one per shader
 inline const std::string kClassData = "crt_classDataBuffer";  // the class data block
-inline const std::string kPipelineClasses = "crt_pipelineClasses";  // the classes the pipelines switch over
+inline const std::string kPipelineConstants = "crt_pipelineConstants";  // the specialization the pipelines were made with
 
 // Names derived from the user's names carry the reserved prefix too, so that none can equal a user's
 // name (analyse/ReservedNames.cpp refuses user names under it): a member vector's size and capacity
@@ -29,6 +29,8 @@ inline std::string CapacityField(const std::string& vector) { return "crt_" + ve
 inline std::string ImageSizeField(const std::string& image, const std::string& widthOrHeight) { return "crt_" + image + "_" + widthOrHeight; }
 inline std::string TextureName(const std::string& image) { return "crt_" + image + "_texture"; }
 inline std::string BlockName(const std::string& variable) { return "crt_" + variable + "Buffer"; }
+// A CRT_SPECIALIZE member (Specialize.h) as GLSL reads it: a specialization constant.
+inline std::string SpecializedConstant(const std::string& member) { return "crt_" + member + "_specialized"; }
 // A reduction of `member` (a member or a kernel local): the per-thread (per-lane, per-chunk) copy the
 // loop body adds to, the workgroup's shared array, one workgroup's total, and the per-workgroup (per
 // chunk) totals. templates/glsl/{kernel,reduce}.comp, ispc/kernels.ispc and cpu/class.cpp write the

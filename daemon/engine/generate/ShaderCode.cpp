@@ -75,6 +75,25 @@ std::vector<GlslDecl> KeepMentioned(const std::vector<GlslDecl>& chunks, std::st
   return kept;
 }
 
+// The CRT_SPECIALIZE members that `used` (a shader's code) reads, as specialization constants.
+// The host makes every pipeline with their values (crt_pipelineConstants), so the defaults here are
+// never what a kernel reads.
+std::string SpecializedConstants(const ClassModel& model, const std::string& used) {
+  std::string out;
+  const std::vector<const Member*> members = SpecializedMembers(model);
+  for (size_t i = 0; i < members.size(); ++i) {
+    const Member& m = *members[i];
+    const std::string name = generated::SpecializedConstant(m.name);
+    if (!MentionsWord(used, name)) continue;
+    const std::string zero = m.glslType == "bool" ? "false" : m.glslType == "uint" ? "0u" : m.glslType == "float" ? "0.0" : "0";
+    out += "// " + (m.composedFrom.empty() ? model.className + "::" + m.name : m.composedFrom) +
+           " (CRT_SPECIALIZE): its value when the pipeline was made, which the driver folds into the code\n";
+    out += "layout(constant_id = " + std::to_string(kClassConstantIdBase + ClassConstantCount(model) + i) + ") const " + m.glslType + " " + name +
+           " = " + zero + ";\n";
+  }
+  return out;
+}
+
 // The functions kernels call on an array of textures (<array>_sample, ...): with the GPU's
 // samplers (hardware) or over buffers, as LiteImage samples (the helpers they share come once).
 std::string TextureArrayFunctions(const Member& array, bool hardware, bool first, const GenerateOptions& opt) {
@@ -329,6 +348,9 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   std::string helpers;
   for (auto& x : constantList) helpers += x.text;
   if (!constantList.empty()) helpers += "\n";
+  std::string code = kind.phase == "Start" ? k.glslStart : kind.phase == "Finish" ? k.glslFinish : k.glslBody;
+  for (auto& x : functionList) code += x;
+  if (const std::string specialized = SpecializedConstants(model, code); !specialized.empty()) helpers += specialized + "\n";
   for (auto& x : functionList) helpers += x + "\n";
   d.set("helpers", helpers);
   d.set("body", kind.phase == "Start" ? k.glslStart : kind.phase == "Finish" ? k.glslFinish : k.glslBody);
@@ -433,7 +455,7 @@ std::string StageGlsl(const ClassModel& model, const StageShader& c, const Gener
   d.set("bufferReferences", c.stage == "rcall" || c.stage == "rint");  // they reach the objects through them
   d.set("classStructs", c.stage == "rmiss" ? std::string() : model.glslClassStructs);
   d.set("hasClassData", c.classData);
-  d.set("constants", c.constants);
+  d.set("constants", c.constants + SpecializedConstants(model, c.functions + c.mainBody));
   d.set("structs", c.structs);
   d.set("functions", c.functions);
   d.set("mainBody", c.mainBody);

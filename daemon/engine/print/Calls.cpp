@@ -120,6 +120,13 @@ bool IsUniformLocal(const VarDecl* vd) {
   return false;
 }
 
+bool IsSpecializedMember(const FieldDecl* field) {
+  if (!field) return false;
+  for (const auto* a : field->specific_attrs<AnnotateAttr>())
+    if (a->getAnnotation() == "crossrt::specialize") return true;
+  return false;
+}
+
 // ---- crossrt::Atomic* (Atomics.h): GLSL atomics between buffer memory barriers ----
 
 bool IsCrossrtAtomic(const FunctionDecl* fd) {

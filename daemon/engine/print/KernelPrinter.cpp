@@ -497,6 +497,7 @@ std::string KernelPrinter::SelfMember(const MemberExpr* me, const FieldDecl* fie
     return Fail(me->getBeginLoc(), "member '" + field->getNameAsString() + "' of type '" + field->getType().getAsString(m_ctx.getPrintingPolicy()) +
                 "' cannot be used in a kernel", "kernels may use plain data members and std::vector members");
   m_uses.plainMembers.insert(field);
+  if (IsSpecializedMember(field)) return SpecializedAccess(field->getNameAsString());
   return MemberAccess(field->getNameAsString());
 }
 
@@ -547,7 +548,11 @@ std::string KernelPrinter::Expr(const clang::Expr* e) {
     if (valueParams.count(d))
       return Fail(e->getBeginLoc(), "'" + d->getNameAsString() + "' holds one value per thread (a local of the control function's thread loop), used here as a pointer",
                   "read and write it as *" + d->getNameAsString() + " or " + d->getNameAsString() + "->field");
-    if (auto* ec = dyn_cast<EnumConstantDecl>(d)) return std::to_string(ec->getInitVal().getSExtValue());
+    if (auto* ec = dyn_cast<EnumConstantDecl>(d)) {  // its value, unsigned as its enum's type may be
+      const auto* ed = dyn_cast<EnumDecl>(ec->getDeclContext());
+      if (ed && ed->getIntegerType()->isUnsignedIntegerType()) return std::to_string(ec->getInitVal().getZExtValue()) + "u";
+      return std::to_string(ec->getInitVal().getSExtValue());
+    }
     if (auto object = m_objectLocals.find(d); object != m_objectLocals.end())
       return Fail(e->getBeginLoc(), "'" + d->getNameAsString() + "' points at an element of " + object->second->getNameAsString() +
                                         ", which kernels hold as its index: it can only call virtual methods here",

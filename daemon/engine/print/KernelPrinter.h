@@ -30,6 +30,9 @@ bool IsCrossrtAtomic(const clang::FunctionDecl* fd);
 // CRT_UNIFORM (annotated "crossrt::uniform"), which the gang shares.
 bool IsGangFunction(const clang::FunctionDecl* fd);
 bool IsUniformLocal(const clang::VarDecl* vd);
+// A data member declared CRT_SPECIALIZE (Specialize.h; annotated "crossrt::specialize"), which GLSL
+// reads as a specialization constant.
+bool IsSpecializedMember(const clang::FieldDecl* field);
 
 // The polymorphic class a shared_ptr, unique_ptr or plain pointer type points to, or null.
 const clang::CXXRecordDecl* PolymorphicPointee(clang::QualType type);
@@ -226,6 +229,7 @@ protected:
   // an unsigned literal; the index of an element of a vector of objects (its expression, or the text
   // a local pointing at one holds).
   virtual std::string MemberAccess(const std::string& name) const = 0;
+  virtual std::string SpecializedAccess(const std::string& name) const = 0;  // a CRT_SPECIALIZE member's value
   virtual std::string SizeAsInt(const std::string& size) const = 0;
   virtual std::string EmptyTest(const std::string& size) const = 0;
   virtual std::string SizeLiteral(uint64_t n) const = 0;

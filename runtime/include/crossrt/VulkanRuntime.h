@@ -27,11 +27,26 @@ namespace crossrt {
 // the translator writes it into the shaders, and generated classes static_assert that it matches.
 constexpr uint32_t kFenceAtomicsConstantId = 1700;
 
-// Virtual calls specialised to the scene: specialization constant kClassConstantIdBase + i of a
-// generated kernel is true while the objects its virtual calls reach include one of class i (the
-// generated class numbers the (vector, class) pairs); a switch case whose constant is false is dead
-// code, which the driver removes from the pipeline.
+// Shaders specialised to the scene, from specialization constant kClassConstantIdBase on. First the
+// virtual calls': constant kClassConstantIdBase + i of a generated kernel is true while the objects
+// its virtual calls reach include one of class i (the generated class numbers the (vector, class)
+// pairs); a switch case whose constant is false is dead code, which the driver removes from the
+// pipeline. Then one per CRT_SPECIALIZE member (Specialize.h) the kernels read, holding its value.
+// A pipeline gets them all as one vector of 32-bit values (ComputePipeline, RayTracingPipeline).
 constexpr uint32_t kClassConstantIdBase = 1800;
+
+// A CRT_SPECIALIZE member's value as its specialization constant holds it: 32 bits, a bool as VkBool32.
+template <class T>
+uint32_t SpecializationValue(T value) {
+  static_assert(sizeof(T) == 4 || std::is_same_v<T, bool>, "specialization constants hold bools and 32-bit values");
+  if constexpr (std::is_same_v<T, bool>) {
+    return value ? 1u : 0u;
+  } else {
+    uint32_t bits = 0;
+    std::memcpy(&bits, &value, sizeof(bits));
+    return bits;
+  }
+}
 
 struct Error : std::runtime_error {
   using std::runtime_error::runtime_error;
@@ -636,13 +651,14 @@ public:
   // storageBufferBindings: bindings 0..n-1 in set 0; pushConstantBytes may be 0.
   ComputePipeline(std::shared_ptr<VulkanContext> ctx, const uint32_t* spirv, size_t spirvBytes,
                   uint32_t storageBufferBindings, uint32_t pushConstantBytes, const char* debugName,
-                  const std::vector<VkBool32>& classesHeld = {});
+                  const std::vector<uint32_t>& constants = {});
   // Binding i of set 0 has bindingTypes[i] (storage buffers, storage images, sampled images, samplers);
   // sets 1..textureArraySets are arrays of textures (throws unless ctx->hasTextureArrays).
-  // classesHeld: the values of the constants kClassConstantIdBase + i (none given: their defaults, true).
+  // constants: the values of the specialization constants kClassConstantIdBase + i (none given: the
+  // shader's defaults).
   ComputePipeline(std::shared_ptr<VulkanContext> ctx, const uint32_t* spirv, size_t spirvBytes,
                   std::vector<VkDescriptorType> bindingTypes, uint32_t pushConstantBytes, const char* debugName,
-                  uint32_t textureArraySets = 0, const std::vector<VkBool32>& classesHeld = {});
+                  uint32_t textureArraySets = 0, const std::vector<uint32_t>& constants = {});
 };
 
 // SPIR-V code of one shader: a pointer into the generated arrays, and its size in bytes.
@@ -673,8 +689,10 @@ struct RayTracingShaders {
 class RayTracingPipeline : public Pipeline {
 public:
   RayTracingPipeline() = default;
+  // constants: as ComputePipeline's, for every stage.
   RayTracingPipeline(std::shared_ptr<VulkanContext> ctx, const RayTracingShaders& shaders, std::vector<VkDescriptorType> bindingTypes,
-                     uint32_t pushConstantBytes, const char* debugName, uint32_t textureArraySets = 0);
+                     uint32_t pushConstantBytes, const char* debugName, uint32_t textureArraySets = 0,
+                     const std::vector<uint32_t>& constants = {});
   // Launches width x height x depth ray generation threads (gl_LaunchIDEXT), behind and ahead of
   // barriers to and from the compute and transfer stages the other commands use.
   void TraceCmd(VkCommandBuffer cmd, uint32_t width, uint32_t height, uint32_t depth) const;

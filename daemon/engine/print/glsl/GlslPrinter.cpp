@@ -141,6 +141,8 @@ std::string GlslPrinter::ObjectLocalIndex(const std::string& index) const { retu
 
 std::string GlslPrinter::MemberAccess(const std::string& name) const { return ComposedName(name); }
 
+std::string GlslPrinter::SpecializedAccess(const std::string& name) const { return generated::SpecializedConstant(ComposedName(name)); }
+
 std::string GlslPrinter::SizeAsInt(const std::string& size) const { return "int(" + size + ")"; }
 
 std::string GlslPrinter::EmptyTest(const std::string& size) const { return "(" + size + " == 0u)"; }

@@ -36,6 +36,7 @@ protected:
   std::string BufferParameter(const clang::ParmVarDecl* p, const std::string& name) override;
   std::string WritableParam(clang::QualType type, const std::string& name, clang::SourceLocation loc) override;
   std::string MemberAccess(const std::string& name) const override;
+  std::string SpecializedAccess(const std::string& name) const override;
   std::string SizeAsInt(const std::string& size) const override;
   std::string EmptyTest(const std::string& size) const override;
   std::string SizeLiteral(uint64_t n) const override;

@@ -252,6 +252,9 @@ std::string IspcPrinter::ObjectLocalIndex(const std::string& index) const { retu
 
 std::string IspcPrinter::MemberAccess(const std::string& name) const { return Member(name); }
 
+// CRT_SPECIALIZE changes what the GPU compiles: ISPC reads the member from the class data, as any other.
+std::string IspcPrinter::SpecializedAccess(const std::string& name) const { return Member(name); }
+
 std::string IspcPrinter::SizeAsInt(const std::string& size) const { return size; }
 
 std::string IspcPrinter::EmptyTest(const std::string& size) const { return "(" + size + " == 0)"; }

@@ -43,7 +43,7 @@ CallableShading_Vulkan::CallableShading_Vulkan(std::shared_ptr<crossrt::VulkanCo
   if (!crt_ctx->hasBufferDeviceAddress)
     throw crossrt::Error("CallableShading_Vulkan: device '" + crt_ctx->DeviceName() +
                          "' lacks bufferDeviceAddress, which virtual function calls in kernels need");
-  // The pipelines are made by CommitDeviceData(), for the classes the objects hold.
+  // The pipelines are made by CommitDeviceData(), for the scene it finds (the classes the objects hold).
 }
 
 std::shared_ptr<CallableShading> CreateCallableShading_Vulkan()
@@ -60,10 +60,11 @@ CallableShading_Vulkan::~CallableShading_Vulkan() = default;
 
 void CallableShading_Vulkan::crt_InitPipelines()
 {
-  // Kernels switch over the classes in crt_pipelineClasses only (specialization constants from
-  // crossrt::kClassConstantIdBase): the driver drops the cases of the others.
+  // The shaders are specialised to crt_pipelineConstants (specialization constants from
+  // crossrt::kClassConstantIdBase): the driver drops the code those values never reach, the cases of
+  // classes the objects do not hold.
   static_assert(crossrt::kClassConstantIdBase == 1800,
-                "the shaders and the runtime number the class constants differently");
+                "the shaders and the runtime number the specialization constants differently");
   if (crt_ctx->hasRayTracingPipeline)  // virtual calls as callable shaders, in a ray tracing pipeline: the shader needs
                                        // them even to be created
     crt_pipelines.kernel2D_Render_Callables = crossrt::RayTracingPipeline(
@@ -88,10 +89,10 @@ void CallableShading_Vulkan::crt_InitPipelines()
             }},
         std::vector<VkDescriptorType>{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
                                       VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER},
-        sizeof(kernel2D_RenderArgs), "CallableShading::kernel2D_Render_Callables");
-  crt_pipelines.kernel2D_Render =
-      crossrt::ComputePipeline(crt_ctx, CallableShading_kernel2D_Render_spv, CallableShading_kernel2D_Render_spvBytes,
-                               4, sizeof(kernel2D_RenderArgs), "CallableShading::kernel2D_Render", crt_pipelineClasses);
+        sizeof(kernel2D_RenderArgs), "CallableShading::kernel2D_Render_Callables", 0, crt_pipelineConstants);
+  crt_pipelines.kernel2D_Render = crossrt::ComputePipeline(
+      crt_ctx, CallableShading_kernel2D_Render_spv, CallableShading_kernel2D_Render_spvBytes, 4,
+      sizeof(kernel2D_RenderArgs), "CallableShading::kernel2D_Render", crt_pipelineConstants);
 }
 
 void CallableShading_Vulkan::UseRayTracingPipelines(bool a_use)
@@ -139,13 +140,13 @@ void CallableShading_Vulkan::CommitDeviceData()
 {
   // std::vector members become buffers of their capacity; kernels see size and capacity.
   // Objects called through virtual functions, regrouped; the classes they hold, for the pipelines.
-  std::vector<VkBool32> crt_classesHeld(3, crt_specializeVirtualCalls ? VK_FALSE : VK_TRUE);
+  std::vector<uint32_t> crt_constants(crt_classConstants, crt_specializeVirtualCalls ? VK_FALSE : VK_TRUE);
   const std::vector<uint32_t> crt_m_materialsTags = CommitVirtual_m_materials();
   for (size_t i = 0; i < crt_virtual.m_materialsSize; ++i)
-    crt_classesHeld[0 + crt_m_materialsTags[2 * i]] = VK_TRUE;
-  if (crt_classesHeld != crt_pipelineClasses)  // made for other classes, or not made yet
+    crt_constants[0 + crt_m_materialsTags[2 * i]] = VK_TRUE;
+  if (crt_constants != crt_pipelineConstants)  // made for another scene, or not made yet
   {
-    crt_pipelineClasses = crt_classesHeld;
+    crt_pipelineConstants = crt_constants;
     crt_InitPipelines();
   }
   crt_UpdatePlainMembers();

@@ -125,10 +125,12 @@ protected:
     size_t m_materialsSize = 0;  // elements at the last CommitDeviceData()
   } crt_virtual;
   bool crt_specializeVirtualCalls = true;
-  // Per (vector, class), numbered as the shaders' constants crossrt::kClassConstantIdBase + i: whether
-  // the pipelines switch over that class (its objects were there at the last CommitDeviceData()).
-  std::vector<VkBool32> crt_pipelineClasses;
-  bool crt_useRayTracingPipelines = false;  // record the kernels' _Callables and _Intersections variants
+  // The specialization the pipelines were made with by the last CommitDeviceData(), numbered as the
+  // shaders' constants crossrt::kClassConstantIdBase + i (3):
+  //   [0, 3) per (vector, class): whether the kernels switch over that class (its objects were there);
+  std::vector<uint32_t> crt_pipelineConstants;
+  static constexpr size_t crt_classConstants = 3;  // the (vector, class) constants first
+  bool crt_useRayTracingPipelines = false;         // record the kernels' _Callables and _Intersections variants
 
   struct InOut_Render  // buffers bound by SetVulkanInOutFor_Render
   {

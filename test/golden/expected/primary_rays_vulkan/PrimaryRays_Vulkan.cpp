@@ -30,7 +30,7 @@ PrimaryRays_Vulkan::PrimaryRays_Vulkan(std::shared_ptr<crossrt::VulkanContext> a
   {
     crt_scenes.m_pAccelStruct = crossrt::RayTracingScene(crt_ctx);
   }
-  crt_InitPipelines();
+  // The pipelines are made by CommitDeviceData(), for the scene it finds (the CRT_SPECIALIZE members' values).
 }
 
 std::shared_ptr<PrimaryRays> CreatePrimaryRays_Vulkan(int width, int height)
@@ -48,6 +48,10 @@ PrimaryRays_Vulkan::~PrimaryRays_Vulkan() = default;
 
 void PrimaryRays_Vulkan::crt_InitPipelines()
 {
+  // The shaders are specialised to crt_pipelineConstants (specialization constants from
+  // crossrt::kClassConstantIdBase): the driver drops the code those values never reach.
+  static_assert(crossrt::kClassConstantIdBase == 1800,
+                "the shaders and the runtime number the specialization constants differently");
   if (crt_ctx->hasRayQuery)  // m_pAccelStruct's ray queries on the ray tracing hardware: the shader needs them even to
                              // be created
     crt_pipelines.kernel2D_Render_RayQuery = crossrt::ComputePipeline(
@@ -55,10 +59,10 @@ void PrimaryRays_Vulkan::crt_InitPipelines()
         std::vector<VkDescriptorType>{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
                                       VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
                                       VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR},
-        sizeof(kernel2D_RenderArgs), "PrimaryRays::kernel2D_Render_RayQuery");
+        sizeof(kernel2D_RenderArgs), "PrimaryRays::kernel2D_Render_RayQuery", 0, crt_pipelineConstants);
   crt_pipelines.kernel2D_Render =
       crossrt::ComputePipeline(crt_ctx, PrimaryRays_kernel2D_Render_spv, PrimaryRays_kernel2D_Render_spvBytes, 12,
-                               sizeof(kernel2D_RenderArgs), "PrimaryRays::kernel2D_Render");
+                               sizeof(kernel2D_RenderArgs), "PrimaryRays::kernel2D_Render", crt_pipelineConstants);
   if (crt_ctx->hasRayQuery)  // m_pAccelStruct's ray queries on the ray tracing hardware: the shader needs them even to
                              // be created
     crt_pipelines.kernel1D_CastRays_RayQuery = crossrt::ComputePipeline(
@@ -66,10 +70,10 @@ void PrimaryRays_Vulkan::crt_InitPipelines()
         std::vector<VkDescriptorType>{VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
                                       VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
                                       VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR},
-        sizeof(kernel1D_CastRaysArgs), "PrimaryRays::kernel1D_CastRays_RayQuery");
+        sizeof(kernel1D_CastRaysArgs), "PrimaryRays::kernel1D_CastRays_RayQuery", 0, crt_pipelineConstants);
   crt_pipelines.kernel1D_CastRays =
       crossrt::ComputePipeline(crt_ctx, PrimaryRays_kernel1D_CastRays_spv, PrimaryRays_kernel1D_CastRays_spvBytes, 12,
-                               sizeof(kernel1D_CastRaysArgs), "PrimaryRays::kernel1D_CastRays");
+                               sizeof(kernel1D_CastRaysArgs), "PrimaryRays::kernel1D_CastRays", crt_pipelineConstants);
 }
 
 void PrimaryRays_Vulkan::UseRayTracingHardware(bool a_use)
@@ -125,6 +129,8 @@ void PrimaryRays_Vulkan::crt_UpdatePlainMembers()
   std::memcpy(&data.m_height, &m_height, sizeof(data.m_height));
   std::memcpy(&data.m_aoSamples, &m_aoSamples, sizeof(data.m_aoSamples));
   std::memcpy(&data.m_aoDistance, &m_aoDistance, sizeof(data.m_aoDistance));
+  std::memcpy(&data.m_pAccelStruct_m_sceneKinds, &crt_m_pAccelStruct()->m_sceneKinds,
+              sizeof(data.m_pAccelStruct_m_sceneKinds));
   data.crt_m_vertices_size = uint32_t(m_vertices.size());
   data.crt_m_vertices_capacity = uint32_t(m_vertices.capacity());
   data.crt_m_indices_size = uint32_t(m_indices.size());
@@ -235,10 +241,27 @@ void PrimaryRays_Vulkan::CommitDeviceData()
                                                  sizeof(unsigned int) * crt_m_pAccelStruct()->m_sdfWords.size());
   }
   crt_vdata.m_pAccelStruct_m_sdfWordsSize = crt_m_pAccelStruct()->m_sdfWords.size();
+  std::vector<uint32_t> crt_constants(crt_classConstants, VK_TRUE);
+  crt_constants.push_back(crossrt::SpecializationValue(
+      crt_m_pAccelStruct()->m_sceneKinds));    // BVHScene::m_sceneKinds through m_pAccelStruct (CRT_SPECIALIZE)
+  if (crt_constants != crt_pipelineConstants)  // made for another scene, or not made yet
+  {
+    crt_pipelineConstants = crt_constants;
+    crt_InitPipelines();
+  }
   if (crt_useRayTracingHardware)
     crt_CommitScene_m_pAccelStruct();
   crt_UpdatePlainMembers();
   crt_deviceDataCommitted = true;
+}
+
+bool PrimaryRays_Vulkan::crt_SpecializedMembersChanged() const
+{
+  if (crt_pipelineConstants.size() != 1)
+    return true;
+  if (crt_pipelineConstants[0] != crossrt::SpecializationValue(crt_m_pAccelStruct()->m_sceneKinds))
+    return true;
+  return false;
 }
 
 bool PrimaryRays_Vulkan::crt_VectorMembersResized() const
@@ -294,7 +317,9 @@ void PrimaryRays_Vulkan::Render(uint32_t* pixels)
   // std::vector members are uploaded by CommitDeviceData(): here once, and again whenever one
   // changed size (its device buffer would be too small). After changing the contents of a
   // vector without resizing it, call CommitDeviceData().
-  if (!crt_self->crt_deviceDataCommitted || crt_self->crt_VectorMembersResized())
+  // It makes the pipelines too: again whenever a CRT_SPECIALIZE member changed value.
+  if (!crt_self->crt_deviceDataCommitted || crt_self->crt_VectorMembersResized() ||
+      crt_self->crt_SpecializedMembersChanged())
     crt_self->CommitDeviceData();
 
   crossrt::CpuTimer crt_copyIn;
@@ -347,7 +372,9 @@ void PrimaryRays_Vulkan::CastRays(const float4* posAndNear, const float4* dirAnd
   // std::vector members are uploaded by CommitDeviceData(): here once, and again whenever one
   // changed size (its device buffer would be too small). After changing the contents of a
   // vector without resizing it, call CommitDeviceData().
-  if (!crt_self->crt_deviceDataCommitted || crt_self->crt_VectorMembersResized())
+  // It makes the pipelines too: again whenever a CRT_SPECIALIZE member changed value.
+  if (!crt_self->crt_deviceDataCommitted || crt_self->crt_VectorMembersResized() ||
+      crt_self->crt_SpecializedMembersChanged())
     crt_self->CommitDeviceData();
 
   crossrt::CpuTimer crt_copyIn;

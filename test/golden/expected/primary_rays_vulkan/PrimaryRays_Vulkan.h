@@ -87,6 +87,7 @@ protected:
     alignas(4) int m_height;
     alignas(4) int m_aoSamples;
     alignas(4) float m_aoDistance;
+    alignas(4) uint32_t m_pAccelStruct_m_sceneKinds;
     alignas(4) uint32_t crt_m_vertices_size;
     alignas(4) uint32_t crt_m_vertices_capacity;
     alignas(4) uint32_t crt_m_indices_size;
@@ -138,6 +139,13 @@ protected:
   } crt_vdata;
   // A std::vector or Image2D member changed size, or a sampler changed, since CommitDeviceData().
   virtual bool crt_VectorMembersResized() const;
+  // A CRT_SPECIALIZE member holds another value than the pipelines were made for.
+  virtual bool crt_SpecializedMembersChanged() const;
+  // The specialization the pipelines were made with by the last CommitDeviceData(), numbered as the
+  // shaders' constants crossrt::kClassConstantIdBase + i (1):
+  //   [0] BVHScene::m_sceneKinds through m_pAccelStruct (CRT_SPECIALIZE)
+  std::vector<uint32_t> crt_pipelineConstants;
+  static constexpr size_t crt_classConstants = 0;  // the (vector, class) constants first
   // m_pAccelStruct as the BVHScene whose traversal the kernels run and whose data they read; throws
   // when it holds another ISceneObject (or none).
   BVHScene* crt_m_pAccelStruct() const;

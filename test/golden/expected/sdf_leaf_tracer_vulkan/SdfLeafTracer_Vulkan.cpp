@@ -36,7 +36,7 @@ SdfLeafTracer_Vulkan::SdfLeafTracer_Vulkan(std::shared_ptr<crossrt::VulkanContex
   if (!crt_ctx->hasBufferDeviceAddress)
     throw crossrt::Error("SdfLeafTracer_Vulkan: device '" + crt_ctx->DeviceName() +
                          "' lacks bufferDeviceAddress, which virtual function calls in kernels need");
-  // The pipelines are made by CommitDeviceData(), for the classes the objects hold.
+  // The pipelines are made by CommitDeviceData(), for the scene it finds (the classes the objects hold).
 }
 
 std::shared_ptr<SdfLeafTracer> CreateSdfLeafTracer_Vulkan()
@@ -53,10 +53,11 @@ SdfLeafTracer_Vulkan::~SdfLeafTracer_Vulkan() = default;
 
 void SdfLeafTracer_Vulkan::crt_InitPipelines()
 {
-  // Kernels switch over the classes in crt_pipelineClasses only (specialization constants from
-  // crossrt::kClassConstantIdBase): the driver drops the cases of the others.
+  // The shaders are specialised to crt_pipelineConstants (specialization constants from
+  // crossrt::kClassConstantIdBase): the driver drops the code those values never reach, the cases of
+  // classes the objects do not hold.
   static_assert(crossrt::kClassConstantIdBase == 1800,
-                "the shaders and the runtime number the class constants differently");
+                "the shaders and the runtime number the specialization constants differently");
   if (crt_ctx->hasRayTracingPipeline)  // the leaves of m_scene->m_geom as intersection shaders, in a ray tracing
                                        // pipeline: the shader needs them even to be created
     crt_pipelines.kernel1D_Trace_Intersections = crossrt::RayTracingPipeline(
@@ -87,10 +88,10 @@ void SdfLeafTracer_Vulkan::crt_InitPipelines()
             VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
             VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
             VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR},
-        sizeof(kernel1D_TraceArgs), "SdfLeafTracer::kernel1D_Trace_Intersections");
+        sizeof(kernel1D_TraceArgs), "SdfLeafTracer::kernel1D_Trace_Intersections", 0, crt_pipelineConstants);
   crt_pipelines.kernel1D_Trace =
       crossrt::ComputePipeline(crt_ctx, SdfLeafTracer_kernel1D_Trace_spv, SdfLeafTracer_kernel1D_Trace_spvBytes, 15,
-                               sizeof(kernel1D_TraceArgs), "SdfLeafTracer::kernel1D_Trace", crt_pipelineClasses);
+                               sizeof(kernel1D_TraceArgs), "SdfLeafTracer::kernel1D_Trace", crt_pipelineConstants);
 }
 
 void SdfLeafTracer_Vulkan::UseRayTracingPipelines(bool a_use)
@@ -242,15 +243,15 @@ void SdfLeafTracer_Vulkan::CommitDeviceData()
                                            sizeof(unsigned int) * crt_m_scene()->m_brickValues.size());
   crt_vdata.m_scene_m_brickValuesSize = crt_m_scene()->m_brickValues.size();
   // Objects called through virtual functions, regrouped; the classes they hold, for the pipelines.
-  std::vector<VkBool32> crt_classesHeld(3, crt_specializeVirtualCalls ? VK_FALSE : VK_TRUE);
+  std::vector<uint32_t> crt_constants(crt_classConstants, crt_specializeVirtualCalls ? VK_FALSE : VK_TRUE);
   const std::vector<uint32_t> crt_m_scene_m_geomTags = CommitVirtual_m_scene_m_geom();
   for (size_t i = 0; i < crt_virtual.m_scene_m_geomSize; ++i)
-    crt_classesHeld[0 + crt_m_scene_m_geomTags[2 * i]] = VK_TRUE;
+    crt_constants[0 + crt_m_scene_m_geomTags[2 * i]] = VK_TRUE;
   if (crt_useRayTracingPipelines)
     crt_CommitLeaves_m_scene_m_geom(crt_m_scene_m_geomTags);
-  if (crt_classesHeld != crt_pipelineClasses)  // made for other classes, or not made yet
+  if (crt_constants != crt_pipelineConstants)  // made for another scene, or not made yet
   {
-    crt_pipelineClasses = crt_classesHeld;
+    crt_pipelineConstants = crt_constants;
     crt_InitPipelines();
   }
   crt_UpdatePlainMembers();

@@ -53,7 +53,7 @@ ShapeTracer_Vulkan::ShapeTracer_Vulkan(std::shared_ptr<crossrt::VulkanContext> a
   if (!crt_ctx->hasBufferDeviceAddress)
     throw crossrt::Error("ShapeTracer_Vulkan: device '" + crt_ctx->DeviceName() +
                          "' lacks bufferDeviceAddress, which virtual function calls in kernels need");
-  // The pipelines are made by CommitDeviceData(), for the classes the objects hold.
+  // The pipelines are made by CommitDeviceData(), for the scene it finds (the classes the objects hold).
 }
 
 std::shared_ptr<ShapeTracer> CreateShapeTracer_Vulkan()
@@ -70,10 +70,11 @@ ShapeTracer_Vulkan::~ShapeTracer_Vulkan() = default;
 
 void ShapeTracer_Vulkan::crt_InitPipelines()
 {
-  // Kernels switch over the classes in crt_pipelineClasses only (specialization constants from
-  // crossrt::kClassConstantIdBase): the driver drops the cases of the others.
+  // The shaders are specialised to crt_pipelineConstants (specialization constants from
+  // crossrt::kClassConstantIdBase): the driver drops the code those values never reach, the cases of
+  // classes the objects do not hold.
   static_assert(crossrt::kClassConstantIdBase == 1800,
-                "the shaders and the runtime number the class constants differently");
+                "the shaders and the runtime number the specialization constants differently");
   if (crt_ctx->hasRayTracingPipeline)  // the leaves of m_scene->m_shapes and m_scene->m_lights as intersection shaders,
                                        // in a ray tracing pipeline: the shader needs them even to be created
     crt_pipelines.kernel1D_Trace_Intersections = crossrt::RayTracingPipeline(
@@ -109,10 +110,10 @@ void ShapeTracer_Vulkan::crt_InitPipelines()
             VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
             VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
             VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR, VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR},
-        sizeof(kernel1D_TraceArgs), "ShapeTracer::kernel1D_Trace_Intersections");
+        sizeof(kernel1D_TraceArgs), "ShapeTracer::kernel1D_Trace_Intersections", 0, crt_pipelineConstants);
   crt_pipelines.kernel1D_Trace =
       crossrt::ComputePipeline(crt_ctx, ShapeTracer_kernel1D_Trace_spv, ShapeTracer_kernel1D_Trace_spvBytes, 6,
-                               sizeof(kernel1D_TraceArgs), "ShapeTracer::kernel1D_Trace", crt_pipelineClasses);
+                               sizeof(kernel1D_TraceArgs), "ShapeTracer::kernel1D_Trace", crt_pipelineConstants);
 }
 
 void ShapeTracer_Vulkan::UseRayTracingPipelines(bool a_use)
@@ -214,20 +215,20 @@ void ShapeTracer_Vulkan::CommitDeviceData()
                                           sizeof(LiteMath::float4) * crt_m_scene()->m_lightBoxes.size());
   crt_vdata.m_scene_m_lightBoxesSize = crt_m_scene()->m_lightBoxes.size();
   // Objects called through virtual functions, regrouped; the classes they hold, for the pipelines.
-  std::vector<VkBool32> crt_classesHeld(6, crt_specializeVirtualCalls ? VK_FALSE : VK_TRUE);
+  std::vector<uint32_t> crt_constants(crt_classConstants, crt_specializeVirtualCalls ? VK_FALSE : VK_TRUE);
   const std::vector<uint32_t> crt_m_scene_m_shapesTags = CommitVirtual_m_scene_m_shapes();
   for (size_t i = 0; i < crt_virtual.m_scene_m_shapesSize; ++i)
-    crt_classesHeld[0 + crt_m_scene_m_shapesTags[2 * i]] = VK_TRUE;
+    crt_constants[0 + crt_m_scene_m_shapesTags[2 * i]] = VK_TRUE;
   if (crt_useRayTracingPipelines)
     crt_CommitLeaves_m_scene_m_shapes(crt_m_scene_m_shapesTags);
   const std::vector<uint32_t> crt_m_scene_m_lightsTags = CommitVirtual_m_scene_m_lights();
   for (size_t i = 0; i < crt_virtual.m_scene_m_lightsSize; ++i)
-    crt_classesHeld[3 + crt_m_scene_m_lightsTags[2 * i]] = VK_TRUE;
+    crt_constants[3 + crt_m_scene_m_lightsTags[2 * i]] = VK_TRUE;
   if (crt_useRayTracingPipelines)
     crt_CommitLeaves_m_scene_m_lights(crt_m_scene_m_lightsTags);
-  if (crt_classesHeld != crt_pipelineClasses)  // made for other classes, or not made yet
+  if (crt_constants != crt_pipelineConstants)  // made for another scene, or not made yet
   {
-    crt_pipelineClasses = crt_classesHeld;
+    crt_pipelineConstants = crt_constants;
     crt_InitPipelines();
   }
   crt_UpdatePlainMembers();

@@ -118,6 +118,7 @@ layout(std430, binding = 0) buffer crt_PrimaryRaysData
   int m_height;
   int m_aoSamples;
   float m_aoDistance;
+  uint m_pAccelStruct_m_sceneKinds;
   uint crt_m_vertices_size;
   uint crt_m_vertices_capacity;
   uint crt_m_indices_size;
@@ -204,10 +205,16 @@ const uint m_pAccelStruct_kNoChild = 4294967295u;
 const uint m_pAccelStruct_kLeafFlag = 2147483648u;
 const uint m_pAccelStruct_kSdfMaskedVoxels = 4u;
 const int m_pAccelStruct_kSdfNewtonIterations = 4;
+const uint m_pAccelStruct_kSceneTriangles = 16u;
 const uint m_pAccelStruct_kInstanceMotion = 4u;
 const uint m_pAccelStruct_kInstanceIdentity = 1u;
+const uint m_pAccelStruct_kSceneTransformed = 32u;
 const float kCameraFar = 1e30;
 const uint kMissId = 4294967295u;
+
+// BVHScene::m_sceneKinds through m_pAccelStruct (CRT_SPECIALIZE): its value when the pipeline was made, which the
+// driver folds into the code
+layout(constant_id = 1800) const uint crt_m_pAccelStruct_m_sceneKinds_specialized = 0u;
 
 // from litert_detail::RayInterval
 bool m_pAccelStruct_RayInterval(vec4 posAndNear, vec4 dirAndFar, inout float tnear, inout float tfar)
@@ -795,7 +802,7 @@ bool m_pAccelStruct_IntersectBoxes(BVHTraceRay r, uint group, bool sdf, inout fl
     hits = hits & (hits - 1u);
     if (entries[lane] > tfar)
       continue;
-    if (sdf)
+    if ((crt_m_pAccelStruct_m_sceneKinds_specialized & m_pAccelStruct_kInstanceSdf) != 0u && sdf)
     {
       found = m_pAccelStruct_IntersectSdfBrick(r, m_pAccelStruct_m_boxes[group].child[lane], entries[lane], exits[lane],
                                                tfar, hit) ||
@@ -848,7 +855,8 @@ bool m_pAccelStruct_TraceMesh(BVHTraceRay ray, uint root, uint leaves, bool anyH
       const uint last = first + (node & 7u);
       for (uint g = first; g <= last; ++g)
       {
-        if ((leaves & m_pAccelStruct_kInstanceBoxes) != 0u)
+        if ((crt_m_pAccelStruct_m_sceneKinds_specialized & m_pAccelStruct_kInstanceBoxes) != 0u &&
+            (leaves & m_pAccelStruct_kInstanceBoxes) != 0u)
         {
           if (m_pAccelStruct_IntersectBoxes(ray, g, (leaves & m_pAccelStruct_kInstanceSdf) != 0u, tfar, hit))
           {
@@ -857,7 +865,7 @@ bool m_pAccelStruct_TraceMesh(BVHTraceRay ray, uint root, uint leaves, bool anyH
               return true;
           }
         }
-        else
+        else if ((crt_m_pAccelStruct_m_sceneKinds_specialized & m_pAccelStruct_kSceneTriangles) != 0u)
         {
           vec4 t = vec4(0);
           vec4 u = vec4(0);
@@ -903,7 +911,8 @@ bool m_pAccelStruct_TraceInstance(uint k, BVHTraceRay worldRay, float time, bool
   const BVHInstance inst = m_pAccelStruct_m_instances[k];
   const uint leaves = inst.flags & (m_pAccelStruct_kInstanceBoxes | m_pAccelStruct_kInstanceSdf);
   bool found = false;
-  if ((inst.flags & m_pAccelStruct_kInstanceMotion) != 0u)
+  if ((crt_m_pAccelStruct_m_sceneKinds_specialized & m_pAccelStruct_kInstanceMotion) != 0u &&
+      (inst.flags & m_pAccelStruct_kInstanceMotion) != 0u)
   {
     const float f = clamp(time, 0.0, 1.0) * float(inst.motionSteps - 1u);
     const uint step_ = min(uint(f), inst.motionSteps - 2u);
@@ -917,7 +926,8 @@ bool m_pAccelStruct_TraceInstance(uint k, BVHTraceRay worldRay, float time, bool
     found = m_pAccelStruct_TraceMesh(m_pAccelStruct_Prepare(org, toObject * worldRay.dir, worldRay.tnear), inst.root,
                                      leaves, anyHit, tfar, hit);
   }
-  else if ((inst.flags & m_pAccelStruct_kInstanceIdentity) != 0u)
+  else if ((crt_m_pAccelStruct_m_sceneKinds_specialized & m_pAccelStruct_kSceneTransformed) == 0u ||
+           (inst.flags & m_pAccelStruct_kInstanceIdentity) != 0u)
     found = m_pAccelStruct_TraceMesh(worldRay, inst.root, leaves, anyHit, tfar, hit);
   else
     found = m_pAccelStruct_TraceMesh(m_pAccelStruct_Prepare(m_pAccelStruct_ToObjectPoint(inst, worldRay.org),

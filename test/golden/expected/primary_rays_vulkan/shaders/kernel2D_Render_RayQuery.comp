@@ -26,6 +26,7 @@ layout(std430, binding = 0) buffer crt_PrimaryRaysData
   int m_height;
   int m_aoSamples;
   float m_aoDistance;
+  uint m_pAccelStruct_m_sceneKinds;
   uint crt_m_vertices_size;
   uint crt_m_vertices_capacity;
   uint crt_m_indices_size;
