@@ -1311,8 +1311,10 @@ bool BVHScene::TraceInstance(uint32_t k, const BVHTraceRay& worldRay, float time
 {
   const BVHInstance& inst = m_instances[k];
   const uint32_t leaves = inst.flags & (kInstanceBoxes | kInstanceSdf);
-  bool found = false;
-  // Branches on kinds the scene does not hold (m_sceneKinds) vanish from a specialised shader.
+  // The ray in object space; one call of TraceMesh below, so that a shader holds one copy of the walk
+  // (GLSL inlines every call). Branches on kinds the scene does not hold (m_sceneKinds) vanish from a
+  // specialised shader.
+  BVHTraceRay ray = worldRay;
   if ((m_sceneKinds & kInstanceMotion) != 0u && (inst.flags & kInstanceMotion) != 0u)
   {
     // Its object-to-world matrix at the ray's time, between the two steps around it, inverted.
@@ -1325,13 +1327,11 @@ bool BVHScene::TraceInstance(uint32_t k, const BVHTraceRay& worldRay, float time
     const float4 row2 = mix(m_motion[at + 2u], m_motion[at + 5u], w);
     const float3x3 toObject = inverse(make_float3x3_from_rows(to_float3(row0), to_float3(row1), to_float3(row2)));
     const float3 org = toObject * (worldRay.org - float3(row0.w, row1.w, row2.w));
-    found = TraceMesh(Prepare(org, toObject * worldRay.dir, worldRay.tnear), inst.root, leaves, anyHit, tfar, hit);
+    ray = Prepare(org, toObject * worldRay.dir, worldRay.tnear);
   }
-  else if ((m_sceneKinds & kSceneTransformed) == 0u || (inst.flags & kInstanceIdentity) != 0u)
-    found = TraceMesh(worldRay, inst.root, leaves, anyHit, tfar, hit);
-  else
-    found = TraceMesh(Prepare(ToObjectPoint(inst, worldRay.org), ToObjectVector(inst, worldRay.dir), worldRay.tnear), inst.root, leaves,
-                      anyHit, tfar, hit);
+  else if ((m_sceneKinds & kSceneTransformed) != 0u && (inst.flags & kInstanceIdentity) == 0u)
+    ray = Prepare(ToObjectPoint(inst, worldRay.org), ToObjectVector(inst, worldRay.dir), worldRay.tnear);
+  const bool found = TraceMesh(ray, inst.root, leaves, anyHit, tfar, hit);
   if (found)
   {
     hit.instId = inst.instId;
@@ -1350,12 +1350,12 @@ bool BVHScene::Trace(float4 posAndNear, float4 dirAndFar, float time, bool anyHi
   if (m_nodes.size() == 0 || !litert_detail::RayInterval(posAndNear, dirAndFar, tnear, tfar))
     return false;
   const BVHTraceRay worldRay = Prepare(to_float3(posAndNear), to_float3(dirAndFar), tnear);
-  if (m_instances.size() == 1)
-    return TraceInstance(0, worldRay, time, anyHit, tfar, hit);  // no top tree to walk: its root tests the same box
   uint32_t stack[kStackSize];
   float stackEntry[kStackSize];
   int top = 0;
-  uint32_t node = 0;
+  // The root; for a single instance, a leaf holding it (no top tree to walk: its root tests the same
+  // box), so that the loop below is the only call of TraceInstance and a shader holds one copy of it.
+  uint32_t node = m_instances.size() == 1 ? kLeafFlag : 0u;
   bool found = false;
   while (true)
   {

@@ -62,6 +62,13 @@
 #include "Projector_ISPC.h"
 #endif
 #endif
+#if __has_include("VectorFuncs_CPU.h")
+#include "VectorFuncs_CPU.h"
+#include "VectorFuncs_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "VectorFuncs_ISPC.h"
+#endif
+#endif
 
 using namespace conformance;
 using LiteMath::float4;
@@ -100,6 +107,17 @@ Register conversions(MakeCase<Conversions>(
       Outputs r = Flatten(out);
       for (auto& v : ints) r.insert(r.end(), {double(v.x), double(v.y), double(v.z), double(v.w)});
       return r;
+    }));
+#endif
+
+#if __has_include("VectorFuncs_CPU.h")
+Register vectorFuncs(MakeCase<VectorFuncs>(
+    "floor, ceil, fract, sign, sqrt, inversesqrt, sin, cos, exp, log, pow, step, mod, lerp, mix, smoothstep of float2/3/4",
+    "vector_funcs.h/.cpp", 1e-4, CONFORMANCE_MAKERS(VectorFuncs), [](VectorFuncs& f) {
+      // Points(n)'s x is between -3 and 3, y whole numbers from -5 to 5 (floor and step on the edge), z from 0.
+      std::vector<float4> in = Points(120), out(16 * 120);
+      f.Apply(in.data(), out.data(), 120);
+      return Flatten(out);
     }));
 #endif
 

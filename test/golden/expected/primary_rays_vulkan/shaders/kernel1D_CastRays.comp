@@ -193,19 +193,19 @@ layout(push_constant) uniform crt_kernel1D_CastRaysArgs
 };
 
 const uint m_pAccelStruct_kNoId = 4294967295u;
+const uint m_pAccelStruct_kLeafFlag = 2147483648u;
 const uint m_pAccelStruct_kInstanceSdf = 8u;
 const uint m_pAccelStruct_kInstanceBoxes = 2u;
+const uint m_pAccelStruct_kInstanceMotion = 4u;
+const uint m_pAccelStruct_kInstanceIdentity = 1u;
+const uint m_pAccelStruct_kSceneTransformed = 32u;
 const float m_pAccelStruct_kMissed = -1.0;
 const float m_pAccelStruct_kWiden = 1.00000036;
 const float m_pAccelStruct_kNotEntered = (1.0 / 0.0);
 const uint m_pAccelStruct_kNoChild = 4294967295u;
-const uint m_pAccelStruct_kLeafFlag = 2147483648u;
 const uint m_pAccelStruct_kSdfMaskedVoxels = 4u;
 const int m_pAccelStruct_kSdfNewtonIterations = 4;
 const uint m_pAccelStruct_kSceneTriangles = 16u;
-const uint m_pAccelStruct_kInstanceMotion = 4u;
-const uint m_pAccelStruct_kInstanceIdentity = 1u;
-const uint m_pAccelStruct_kSceneTransformed = 32u;
 
 // BVHScene::m_sceneKinds through m_pAccelStruct (CRT_SPECIALIZE): its value when the pipeline was made, which the
 // driver folds into the code
@@ -249,6 +249,20 @@ BVHTraceRay m_pAccelStruct_Prepare(vec3 org, vec3 dir, float tnear)
   r.sy = dir[r.ky] / dir[r.kz];
   r.sz = 1.0 / dir[r.kz];
   return r;
+}
+
+// from (anonymous namespace)::ToObjectPoint
+vec3 m_pAccelStruct_ToObjectPoint(BVHInstance inst, vec3 p)
+{
+  const vec4 h = vec4(p.x, p.y, p.z, 1.0);
+  return vec3(dot(inst.toObjectRow0, h), dot(inst.toObjectRow1, h), dot(inst.toObjectRow2, h));
+}
+
+// from (anonymous namespace)::ToObjectVector
+vec3 m_pAccelStruct_ToObjectVector(BVHInstance inst, vec3 d)
+{
+  const vec4 h = vec4(d.x, d.y, d.z, 0.0);
+  return vec3(dot(inst.toObjectRow0, h), dot(inst.toObjectRow1, h), dot(inst.toObjectRow2, h));
 }
 
 // from (anonymous namespace)::SlabEntriesParallelAxes
@@ -885,27 +899,13 @@ bool m_pAccelStruct_TraceMesh(BVHTraceRay ray, uint root, uint leaves, bool anyH
   }
 }
 
-// from (anonymous namespace)::ToObjectPoint
-vec3 m_pAccelStruct_ToObjectPoint(BVHInstance inst, vec3 p)
-{
-  const vec4 h = vec4(p.x, p.y, p.z, 1.0);
-  return vec3(dot(inst.toObjectRow0, h), dot(inst.toObjectRow1, h), dot(inst.toObjectRow2, h));
-}
-
-// from (anonymous namespace)::ToObjectVector
-vec3 m_pAccelStruct_ToObjectVector(BVHInstance inst, vec3 d)
-{
-  const vec4 h = vec4(d.x, d.y, d.z, 0.0);
-  return vec3(dot(inst.toObjectRow0, h), dot(inst.toObjectRow1, h), dot(inst.toObjectRow2, h));
-}
-
 // from BVHScene::TraceInstance
 bool m_pAccelStruct_TraceInstance(uint k, BVHTraceRay worldRay, float time, bool anyHit, inout float tfar,
                                   inout CRT_Hit hit)
 {
   const BVHInstance inst = m_pAccelStruct_m_instances[k];
   const uint leaves = inst.flags & (m_pAccelStruct_kInstanceBoxes | m_pAccelStruct_kInstanceSdf);
-  bool found = false;
+  BVHTraceRay ray = worldRay;
   if ((crt_m_pAccelStruct_m_sceneKinds_specialized & m_pAccelStruct_kInstanceMotion) != 0u &&
       (inst.flags & m_pAccelStruct_kInstanceMotion) != 0u)
   {
@@ -918,17 +918,13 @@ bool m_pAccelStruct_TraceInstance(uint k, BVHTraceRay worldRay, float time, bool
     const vec4 row2 = mix(m_pAccelStruct_m_motion[at + 2u], m_pAccelStruct_m_motion[at + 5u], w);
     const mat3 toObject = inverse(transpose(mat3((row0).xyz, (row1).xyz, (row2).xyz)));
     const vec3 org = toObject * (worldRay.org - vec3(row0.w, row1.w, row2.w));
-    found = m_pAccelStruct_TraceMesh(m_pAccelStruct_Prepare(org, toObject * worldRay.dir, worldRay.tnear), inst.root,
-                                     leaves, anyHit, tfar, hit);
+    ray = m_pAccelStruct_Prepare(org, toObject * worldRay.dir, worldRay.tnear);
   }
-  else if ((crt_m_pAccelStruct_m_sceneKinds_specialized & m_pAccelStruct_kSceneTransformed) == 0u ||
-           (inst.flags & m_pAccelStruct_kInstanceIdentity) != 0u)
-    found = m_pAccelStruct_TraceMesh(worldRay, inst.root, leaves, anyHit, tfar, hit);
-  else
-    found = m_pAccelStruct_TraceMesh(m_pAccelStruct_Prepare(m_pAccelStruct_ToObjectPoint(inst, worldRay.org),
-                                                            m_pAccelStruct_ToObjectVector(inst, worldRay.dir),
-                                                            worldRay.tnear),
-                                     inst.root, leaves, anyHit, tfar, hit);
+  else if ((crt_m_pAccelStruct_m_sceneKinds_specialized & m_pAccelStruct_kSceneTransformed) != 0u &&
+           (inst.flags & m_pAccelStruct_kInstanceIdentity) == 0u)
+    ray = m_pAccelStruct_Prepare(m_pAccelStruct_ToObjectPoint(inst, worldRay.org),
+                                 m_pAccelStruct_ToObjectVector(inst, worldRay.dir), worldRay.tnear);
+  const bool found = m_pAccelStruct_TraceMesh(ray, inst.root, leaves, anyHit, tfar, hit);
   if (found)
   {
     hit.instId = inst.instId;
@@ -945,12 +941,10 @@ bool m_pAccelStruct_Trace(vec4 posAndNear, vec4 dirAndFar, float time, bool anyH
   if (crt_m_pAccelStruct_m_nodes_size == 0u || !m_pAccelStruct_RayInterval(posAndNear, dirAndFar, tnear, tfar))
     return false;
   const BVHTraceRay worldRay = m_pAccelStruct_Prepare((posAndNear).xyz, (dirAndFar).xyz, tnear);
-  if (crt_m_pAccelStruct_m_instances_size == 1u)
-    return m_pAccelStruct_TraceInstance(0u, worldRay, time, anyHit, tfar, hit);
   uint stack[64];
   float stackEntry[64];
   int top = 0;
-  uint node = 0u;
+  uint node = crt_m_pAccelStruct_m_instances_size == 1u ? m_pAccelStruct_kLeafFlag : 0u;
   bool found = false;
   while (true)
   {
