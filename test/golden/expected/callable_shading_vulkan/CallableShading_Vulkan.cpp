@@ -43,7 +43,7 @@ CallableShading_Vulkan::CallableShading_Vulkan(std::shared_ptr<crossrt::VulkanCo
   if (!crt_ctx->hasBufferDeviceAddress)
     throw crossrt::Error("CallableShading_Vulkan: device '" + crt_ctx->DeviceName() +
                          "' lacks bufferDeviceAddress, which virtual function calls in kernels need");
-  // The pipelines are made by CommitDeviceData(), for the scene it finds (the classes the objects hold).
+  // The pipelines are made by CommitDeviceData(), for what it finds: the classes the objects hold.
 }
 
 std::shared_ptr<CallableShading> CreateCallableShading_Vulkan()

@@ -30,7 +30,7 @@ PrimaryRays_Vulkan::PrimaryRays_Vulkan(std::shared_ptr<crossrt::VulkanContext> a
   {
     crt_scenes.m_pAccelStruct = crossrt::RayTracingScene(crt_ctx);
   }
-  // The pipelines are made by CommitDeviceData(), for the scene it finds (the CRT_SPECIALIZE members' values).
+  // The pipelines are made by CommitDeviceData(), for what it finds: the CRT_SPECIALIZE members' values.
 }
 
 std::shared_ptr<PrimaryRays> CreatePrimaryRays_Vulkan(int width, int height)

@@ -36,7 +36,7 @@ SdfLeafTracer_Vulkan::SdfLeafTracer_Vulkan(std::shared_ptr<crossrt::VulkanContex
   if (!crt_ctx->hasBufferDeviceAddress)
     throw crossrt::Error("SdfLeafTracer_Vulkan: device '" + crt_ctx->DeviceName() +
                          "' lacks bufferDeviceAddress, which virtual function calls in kernels need");
-  // The pipelines are made by CommitDeviceData(), for the scene it finds (the classes the objects hold).
+  // The pipelines are made by CommitDeviceData(), for what it finds: the classes the objects hold.
 }
 
 std::shared_ptr<SdfLeafTracer> CreateSdfLeafTracer_Vulkan()

@@ -53,7 +53,7 @@ ShapeTracer_Vulkan::ShapeTracer_Vulkan(std::shared_ptr<crossrt::VulkanContext> a
   if (!crt_ctx->hasBufferDeviceAddress)
     throw crossrt::Error("ShapeTracer_Vulkan: device '" + crt_ctx->DeviceName() +
                          "' lacks bufferDeviceAddress, which virtual function calls in kernels need");
-  // The pipelines are made by CommitDeviceData(), for the scene it finds (the classes the objects hold).
+  // The pipelines are made by CommitDeviceData(), for what it finds: the classes the objects hold.
 }
 
 std::shared_ptr<ShapeTracer> CreateShapeTracer_Vulkan()
