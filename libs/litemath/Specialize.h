@@ -15,10 +15,12 @@
 //   - a data member of type bool, int, uint32_t or float, of the class or of a composed
 //     implementation (public there, as every member a composed traversal reads);
 //   - kernels read it and never write it;
-//   - a control function may not change it between kernel calls (the pipelines are made before it
-//     records its commands); change it before the call. A control function finds a changed value
-//     and calls CommitDeviceData() itself, which makes the pipelines again, so a value that changes
-//     every frame costs a pipeline compilation every frame: mark only what changes with the scene.
+//   - a control function may not change it where a kernel call can follow (the pipelines are made
+//     before it records its commands): change it before the call, or after its last kernel call
+//     (outside any loop that calls kernels), which the next call then sees. A control function
+//     finds a changed value and calls CommitDeviceData() itself, which makes the pipelines again, so
+//     a value that changes every frame costs a pipeline compilation every frame: mark only what
+//     changes with the scene.
 //
 // _CPU and _ISPC classes, and the class as written, read the member as any other: CRT_SPECIALIZE
 // changes what the GPU compiles, never what a kernel computes. Under GCC it expands to nothing.

@@ -456,10 +456,10 @@ protected:
 };
 )";
   };
-  auto source = [](const std::string& kernelWrite, const std::string& between) {
+  auto source = [](const std::string& kernelWrite, const std::string& between, const std::string& twice = "") {
     return R"(#include "Modes.h"
 void Modes::Run(int n, float* data) { kernel1D_Scale(n, data); }
-void Modes::Twice(int n, float* data) { kernel1D_Scale(n, data); )" + between + R"( kernel1D_Scale(n, data); }
+void Modes::Twice(int n, float* data) { )" + (twice.empty() ? "kernel1D_Scale(n, data); " + between + " kernel1D_Scale(n, data);" : twice) + R"( }
 void Modes::kernel1D_Scale(int n, float* data) { for (int i = 0; i < n; i++) {
   )" + kernelWrite + R"(
   data[i] = m_flip ? -data[i] * float(m_mode) : data[i] * float(m_mode); } }
@@ -481,6 +481,21 @@ void Modes::kernel1D_Scale(int n, float* data) { for (int i = 0; i < n; i++) {
     REQUIRE(glsl.find("layout(constant_id = 1800) const int crt_m_mode_specialized = 0;") != std::string::npos);
     REQUIRE(glsl.find("layout(constant_id = 1801) const bool crt_m_flip_specialized = false;") != std::string::npos);
     REQUIRE(glsl.find("crt_m_flip_specialized ? -data[i] * float(crt_m_mode_specialized)") != std::string::npos);
+  }
+  SECTION("changed after the last kernel call, also after a loop of them: it applies from the next call")
+  {
+    TempClass tc("Modes", header("int"), source("", "", "for (int k = 0; k < 2; k++) kernel1D_Scale(n, data); m_mode = m_mode + 1;"));
+    CommandResult r = translate(tc, "vulkan");
+    INFO(r.output);
+    REQUIRE(r.exitCode == 0);
+  }
+  SECTION("changed in a loop that calls kernels: the next round's kernel would run with the old pipelines")
+  {
+    TempClass tc("Modes", header("int"), source("", "", "for (int k = 0; k < 2; k++) { kernel1D_Scale(n, data); m_mode = m_mode + 1; }"));
+    CommandResult r = translate(tc, "vulkan");
+    INFO(r.output);
+    REQUIRE(r.exitCode == 1);
+    REQUIRE(r.output.find("control function 'Twice' changes member 'm_mode', which is CRT_SPECIALIZE") != std::string::npos);
   }
   const struct
   {

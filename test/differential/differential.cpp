@@ -50,6 +50,7 @@ std::vector<Value> Outputs(T& c) {
   out.push_back({"m_count", double(c.m_count), true});
   out.push_back({"m_k", double(c.m_k), true});
   out.push_back({"m_rounds", double(c.m_rounds), true});
+  out.push_back({"m_mode", double(c.m_mode), true});
   return out;
 }
 

@@ -5,7 +5,9 @@ Each seed gives one class in the supported subset, written as a user writes one:
 kernel1D_ loop nests (maps, integer maps, reductions into members, appends, atomic adds into a
 member vector, a member's data() to a kernel) and kernel2D_ nests, and a control function whose host code sits between the kernel calls: member writes,
 swaps of member vectors, member vectors' elements read and written, loops that stop early on a
-counter the kernels reduce, and a tail that reads the results. The tester (differential.cpp) runs each class as written, as _CPU, as _ISPC and
+counter the kernels reduce, and a tail that reads the results. A CRT_SPECIALIZE member (m_mode),
+which the Vulkan class's pipelines are compiled for, picks branches in kernels; the tail may change
+it, so that the second Run makes the pipelines again. The tester (differential.cpp) runs each class as written, as _CPU, as _ISPC and
 as _Vulkan and compares what they leave behind, the way Csmith and YARPGen find miscompilations.
 
 Only the C++ the generated classes run is random; everything else is fixed, so that a mismatch
@@ -24,6 +26,7 @@ import random
 class Gen:
     def __init__(self, seed):
         self.r = random.Random(seed)
+        self.rm = random.Random(seed * 7919 + 1)  # m_mode's uses, apart: the rest of a seed's class stays as it was
         self.seed = seed
         self.name = f"Diff{seed}"
 
@@ -97,6 +100,10 @@ class Gen:
                 line = f"m_max = std::max(m_max, {clamp(self.fexpr(2, fleaves))});"
             elif kind == "Found":
                 line = f"if ({self.iexpr(2, ileaves)} % {r.randint(2, 6)} == 0) m_found.push_back(i);"
+            elif kind == "Mode":  # branches on the CRT_SPECIALIZE member: folded in a specialised shader
+                c = self.rm.randint(0, 3)
+                line = (f"{self.pick('m_a', 'm_b')}[i] = m_mode == {c} ? {clamp(self.fexpr(2, fleaves))} : "
+                        f"(m_mode > {c} ? {clamp(self.fexpr(2, fleaves))} : float(m_mode) * 0.5f);")
             elif kind == "Hist":
                 line = f"InterlockedAdd(m_hist[({self.iexpr(2, ileaves)} & 1023) % 8], {self.pick('1', 'a_p', 'm_i[i] % 5')});"
             kernels.append((name, "int n, int a_p, float a_q", [line], "n, a_p, a_q"))
@@ -136,6 +143,8 @@ class Gen:
             s = r.randrange(10)
             if s <= 2:
                 kind = self.pick("Map", "Map", "Int", "Sum", "Max", "Hist", "Grid")
+                if self.rm.random() < 0.3:
+                    kind = "Mode"
                 body.append(grid_call() if kind == "Grid" else call(kind))
             elif s == 3:
                 body.append(f"m_scale = {self.pick('0.5f', '1.5f', 'a_q', '-1.0f')};")
@@ -172,6 +181,9 @@ class Gen:
         tail = self.pick("m_total = m_sum + float(m_count);", "m_total = m_max * 2.0f + float(m_k);", "")
         if tail:
             body.append(tail)
+        self.mode = self.rm.randint(0, 3)
+        if self.rm.random() < 0.5:  # after the last kernel call: the next Run's pipelines are made for it
+            body.append("m_mode = (m_mode + 1) & 3;")
         self.kernels, self.body = kernels, body
 
     def header(self):
@@ -180,6 +192,7 @@ class Gen:
 // CrossRT translates. Do not edit; regenerate.
 #pragma once
 #include "LiteMath.h"
+#include "Specialize.h"
 
 #include <cstdint>
 #include <vector>
@@ -200,6 +213,7 @@ public:
   std::vector<int> m_hist = std::vector<int>(8, 0);
   float m_sum = 0.0f, m_max = -1000.0f, m_scale = 1.0f, m_total = 0.0f;
   int m_count = 0, m_k = 1, m_rounds = 0;
+  CRT_SPECIALIZE int m_mode = {self.mode};
 
 protected:
 {decls}

@@ -361,6 +361,34 @@ void ControlRewriter::Note(const CXXMemberCallExpr* call) {
     m_ctrl.kernelsCalled.push_back(n);
 }
 
+// Whether a kernel may be called after statement s runs: one written after it, or one in a loop
+// around it (the next round calls it after s).
+static bool KernelMayFollow(ASTContext& ctx, const FunctionDecl* def, const Stmt* s) {
+  struct Finder : RecursiveASTVisitor<Finder> {
+    std::vector<const CXXMemberCallExpr*> kernels;
+    std::vector<const Stmt*> loops;
+    bool VisitCXXMemberCallExpr(CXXMemberCallExpr* call) {
+      if (auto* md = call->getMethodDecl(); md && IsKernelName(md->getName())) kernels.push_back(call);
+      return true;
+    }
+    bool VisitStmt(Stmt* st) {
+      if (isa<ForStmt, WhileStmt, DoStmt, CXXForRangeStmt>(st)) loops.push_back(st);
+      return true;
+    }
+  } finder;
+  finder.TraverseStmt(def->getBody());
+  const SourceManager& sm = ctx.getSourceManager();
+  auto before = [&](SourceLocation a, SourceLocation b) { return sm.isBeforeInTranslationUnit(a, b); };
+  auto within = [&](SourceLocation at, const Stmt* outer) { return !before(at, outer->getBeginLoc()) && !before(outer->getEndLoc(), at); };
+  for (auto* call : finder.kernels)
+    if (before(s->getEndLoc(), call->getBeginLoc())) return true;
+  for (auto* loop : finder.loops)
+    if (within(s->getBeginLoc(), loop))
+      for (auto* call : finder.kernels)
+        if (within(call->getBeginLoc(), loop)) return true;
+  return false;
+}
+
 void ControlRewriter::RecordMemberWrite(const Stmt* s) {
   if (std::find(m_tail.begin(), m_tail.end(), s) != m_tail.end()) return;  // runs on the host after the kernels
   RecordClear(s);
@@ -373,7 +401,7 @@ void ControlRewriter::RecordMemberWrite(const Stmt* s) {
   if (auto* uo = dyn_cast_or_null<UnaryOperator>(s); uo && uo->isIncrementDecrementOp()) lhs = uo->getSubExpr();
   const FieldDecl* f = lhs ? ThisField(lhs) : nullptr;
   const Member* m = f ? FindMember(m_c.model, f->getNameAsString()) : nullptr;
-  if (m && m->specialized) {
+  if (m && m->specialized && KernelMayFollow(m_c.ctx, m_def, s)) {
     m_c.rep.RecordingError(s->getBeginLoc(), "control function '" + m_ctrl.name + "' changes member '" + m->name +
                            "', which is CRT_SPECIALIZE, before or between its kernel calls: their pipelines are made for its value before the commands are recorded",
                            "set it before calling '" + m_ctrl.name + "' (the call then makes the pipelines again), or after its last kernel call");
