@@ -12,12 +12,14 @@
 // (BVHScene::m_sceneKinds); a renderer with one of several tonemapping curves gets that curve's.
 //
 // The rules:
-//   - a data member of type bool, int, uint32_t or float, of the class or of a composed
-//     implementation (public there, as every member a composed traversal reads);
-//   - kernels read it and never write it;
-//   - a control function may not change it where a kernel call can follow (the pipelines are made
-//     before it records its commands): change it before the call, or after its last kernel call
-//     (outside any loop that calls kernels), which the next call then sees. A control function
+//   - a data member of type bool, int, uint32_t, float or an enum of 32 bits, of the class or of a
+//     composed implementation (public there, as every member a composed traversal reads);
+//   - kernels read it and never write it (nor pass it to a non-const reference);
+//   - a control function may not change it where a kernel call can follow, in its body or in a
+//     member function it calls (the pipelines are made before it records its commands): change it
+//     before the call, or after its last kernel call (outside any loop that calls kernels), which
+//     the next call then sees. A control function's ...Cmd, recorded into your own command buffer,
+//     throws unless CommitDeviceData() has made the pipelines for the values the members hold. A control function
 //     finds a changed value and calls CommitDeviceData() itself, which makes the pipelines again, so
 //     a value that changes every frame costs a pipeline compilation every frame: mark only what
 //     changes with the scene.

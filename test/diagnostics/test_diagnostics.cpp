@@ -453,7 +453,9 @@ public:
   CRT_SPECIALIZE unsigned m_last = 0u;
 protected:
   void kernel1D_Scale(int n, float* data);
+  void Bump() { m_mode = m_mode + 1; }
 };
+enum Shade { kFlat, kSmooth };  // a plain enum: its constants are ints in expressions
 )";
   };
   auto source = [](const std::string& kernelWrite, const std::string& between, const std::string& twice = "") {
@@ -471,7 +473,7 @@ void Modes::kernel1D_Scale(int n, float* data) { for (int i = 0; i < n; i++) {
   };
   SECTION("read as specialization constants, numbered from kClassConstantIdBase in member order")
   {
-    TempClass tc("Modes", header("int"), source("", ""));
+    TempClass tc("Modes", header("int"), source("data[i] += float(i - kSmooth < 0 ? 1 : 0);", ""));
     CommandResult r = translate(tc, "vulkan");
     INFO(r.output);
     REQUIRE(r.exitCode == 0);
@@ -481,6 +483,7 @@ void Modes::kernel1D_Scale(int n, float* data) { for (int i = 0; i < n; i++) {
     REQUIRE(glsl.find("layout(constant_id = 1800) const int crt_m_mode_specialized = 0;") != std::string::npos);
     REQUIRE(glsl.find("layout(constant_id = 1801) const bool crt_m_flip_specialized = false;") != std::string::npos);
     REQUIRE(glsl.find("crt_m_flip_specialized ? -data[i] * float(crt_m_mode_specialized)") != std::string::npos);
+    REQUIRE(glsl.find("i - int(1) < 0") != std::string::npos);  // a plain enum's constant is an int, as in C++
   }
   SECTION("changed after the last kernel call, also after a loop of them: it applies from the next call")
   {
@@ -489,13 +492,19 @@ void Modes::kernel1D_Scale(int n, float* data) { for (int i = 0; i < n; i++) {
     INFO(r.output);
     REQUIRE(r.exitCode == 0);
   }
-  SECTION("changed in a loop that calls kernels: the next round's kernel would run with the old pipelines")
+  for (const char* twice : {"for (int k = 0; k < 2; k++) { kernel1D_Scale(n, data); m_mode = m_mode + 1; }",
+                            "for (m_mode = 0; m_mode < 2; ++m_mode) kernel1D_Scale(n, data);", "Bump(); kernel1D_Scale(n, data);",
+                            "int other = 3; std::swap(m_mode, other); kernel1D_Scale(n, data);"})
   {
-    TempClass tc("Modes", header("int"), source("", "", "for (int k = 0; k < 2; k++) { kernel1D_Scale(n, data); m_mode = m_mode + 1; }"));
-    CommandResult r = translate(tc, "vulkan");
-    INFO(r.output);
-    REQUIRE(r.exitCode == 1);
-    REQUIRE(r.output.find("control function 'Twice' changes member 'm_mode', which is CRT_SPECIALIZE") != std::string::npos);
+    DYNAMIC_SECTION("changed where a kernel call follows: " << twice)
+    {
+      TempClass tc("Modes", header("int"), "#include <utility>\n" + source("", "", twice));
+      CommandResult r = translate(tc, "vulkan");
+      INFO(r.output);
+      REQUIRE(r.exitCode == 1);
+      REQUIRE(r.output.find("control function 'Twice' changes member 'm_mode', which is CRT_SPECIALIZE, where a kernel call can follow") !=
+              std::string::npos);
+    }
   }
   const struct
   {
@@ -506,7 +515,7 @@ void Modes::kernel1D_Scale(int n, float* data) { for (int i = 0; i < n; i++) {
       {"written by a kernel", "int", "m_last = 1u;", "", "Modes.cpp:5:10: error: ", "kernel 'kernel1D_Scale' writes member 'm_last', which is CRT_SPECIALIZE",
        "set it on the host before calling the control function"},
       {"changed between kernel calls", "int", "", "m_flip = !m_flip;", "Modes.cpp:3:",
-       "control function 'Twice' changes member 'm_flip', which is CRT_SPECIALIZE, before or between its kernel calls", "set it before calling 'Twice'"},
+       "control function 'Twice' changes member 'm_flip', which is CRT_SPECIALIZE, where a kernel call can follow", "set it before calling 'Twice'"},
       {"of a type no specialization constant holds", "double", "", "", "Modes.h:10:", "member 'm_mode' is CRT_SPECIALIZE but of type 'double'",
        "CRT_SPECIALIZE takes a bool, int, uint32_t, float or enum member"},
   };

@@ -26,7 +26,7 @@ import random
 class Gen:
     def __init__(self, seed):
         self.r = random.Random(seed)
-        self.rm = random.Random(seed * 7919 + 1)  # m_mode's uses, apart: the rest of a seed's class stays as it was
+        self.rm = random.Random(seed * 7919 + 1)  # m_mode's uses and initial value
         self.seed = seed
         self.name = f"Diff{seed}"
 

@@ -138,11 +138,11 @@ bool ComposeFromTranslationUnit(ASTContext& ctx, Reporter& reporter, ClassModel&
         m.cppType = CppTypeName(ctx, f->getType());
         m.inClassData = FitsClassData(ctx, f->getType());
         if (auto layout = Std430Layout(ctx, f->getType(), false)) m.std430Align = unsigned(layout->align);
-        if (!m.inClassData && !IsSpecializedMember(f))
+        m.specialized = IsSpecializedMember(f) && CheckSpecialized(reporter, f);
+        if (!m.inClassData && !m.specialized)
           reporter.GpuError(f->getLocation(), "member '" + f->getNameAsString() + "' of type '" + f->getType().getAsString(ctx.getPrintingPolicy()) +
                          "' has a C++ layout that a GPU buffer cannot reproduce",
                          "use int instead of bool, float4x4 instead of float3x3");
-        m.specialized = IsSpecializedMember(f) && CheckSpecialized(reporter, f);
         m.usedByKernels = true;
         model.members.push_back(m);
       }

@@ -353,8 +353,13 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     void Written(const Expr* target, SourceLocation loc) {
       if (auto* f = RootField(target); f && IsSpecializedMember(f)) found.push_back({f, loc});
     }
-    bool VisitCallExpr(CallExpr* call) {
-      if (IsCrossrtAtomic(call->getDirectCallee()) && call->getNumArgs() > 0) Written(call->getArg(0), call->getExprLoc());
+    bool VisitCallExpr(CallExpr* call) {  // atomics, and helpers' non-const reference parameters (GLSL inout)
+      const FunctionDecl* fd = call->getDirectCallee();
+      if (IsCrossrtAtomic(fd) && call->getNumArgs() > 0) Written(call->getArg(0), call->getExprLoc());
+      for (unsigned i = 0; fd && i < call->getNumArgs() && i < fd->getNumParams(); ++i) {
+        const QualType t = fd->getParamDecl(i)->getType();
+        if (t->isLValueReferenceType() && !t.getNonReferenceType().isConstQualified()) Written(call->getArg(i), call->getExprLoc());
+      }
       return true;
     }
   } specializedWrites;

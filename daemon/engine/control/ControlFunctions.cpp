@@ -11,6 +11,7 @@
 #include "analyse/KernelParams.h"
 #include "analyse/Naming.h"
 #include "analyse/VirtualCalls.h"
+#include "analyse/WriteVisitor.h"
 
 #include <algorithm>
 #include <cctype>
@@ -100,6 +101,75 @@ std::string RenameIdentifiers(const std::string& text, const std::vector<std::pa
 
 }  // namespace
 
+// Whether a kernel may be called after statement s runs: one written after it, or one in a loop
+// around it (the next round calls it after s).
+static bool KernelMayFollow(ASTContext& ctx, const FunctionDecl* def, const Stmt* s) {
+  struct Finder : RecursiveASTVisitor<Finder> {
+    std::vector<const CXXMemberCallExpr*> kernels;
+    std::vector<const Stmt*> loops;
+    bool VisitCXXMemberCallExpr(CXXMemberCallExpr* call) {
+      if (auto* md = call->getMethodDecl(); md && IsKernelName(md->getName())) kernels.push_back(call);
+      return true;
+    }
+    bool VisitStmt(Stmt* st) {
+      if (isa<ForStmt, WhileStmt, DoStmt, CXXForRangeStmt>(st)) loops.push_back(st);
+      return true;
+    }
+  } finder;
+  finder.TraverseStmt(def->getBody());
+  const SourceManager& sm = ctx.getSourceManager();
+  auto before = [&](SourceLocation a, SourceLocation b) { return sm.isBeforeInTranslationUnit(a, b); };
+  auto within = [&](SourceLocation at, const Stmt* outer) { return !before(at, outer->getBeginLoc()) && !before(outer->getEndLoc(), at); };
+  for (auto* call : finder.kernels)
+    if (before(s->getEndLoc(), call->getBeginLoc())) return true;
+  for (auto* loop : finder.loops)
+    if (within(s->getBeginLoc(), loop))
+      for (auto* call : finder.kernels)
+        if (within(call->getBeginLoc(), loop)) return true;
+  return false;
+}
+
+// Changes of CRT_SPECIALIZE members in a control function: assignments anywhere in its body (a loop's
+// header, a case, a comma expression), in the member functions it calls (at the call), and through
+// non-const reference arguments (std::swap). Where a kernel call can follow, the Vulkan class would
+// run that kernel with pipelines made for the value before the change: an error there.
+static void CheckSpecializedChanges(Context& c, const std::string& control, const FunctionDecl* def) {
+  struct Changes : WriteVisitor<Changes> {
+    const CXXRecordDecl* cls = nullptr;
+    const Stmt* anchor = nullptr;  // while in a called member function's body: the call in the control function
+    std::set<const FunctionDecl*> seen;
+    std::vector<std::pair<const FieldDecl*, const Stmt*>> found;
+    void Written(const Expr* target, SourceLocation) {
+      if (auto* f = RootField(target); f && IsSpecializedMember(f)) found.push_back({f, anchor ? anchor : target});
+    }
+    bool VisitCallExpr(CallExpr* call) {
+      const FunctionDecl* fd = call->getDirectCallee();
+      if (!fd) return true;
+      for (unsigned i = 0; i < call->getNumArgs() && i < fd->getNumParams(); ++i) {
+        const QualType t = fd->getParamDecl(i)->getType();
+        if (t->isLValueReferenceType() && !t.getNonReferenceType().isConstQualified()) Written(call->getArg(i), call->getExprLoc());
+      }
+      auto* md = dyn_cast<CXXMethodDecl>(fd);
+      const FunctionDecl* body = nullptr;
+      if (md && !IsKernelName(md->getName()) && IsClassOrBase(md->getParent(), cls) && md->hasBody(body) && body && seen.insert(body).second) {
+        const Stmt* saved = anchor;
+        if (!anchor) anchor = call;
+        TraverseStmt(body->getBody());
+        anchor = saved;
+      }
+      return true;
+    }
+  } changes;
+  changes.cls = c.cls;
+  changes.TraverseStmt(def->getBody());
+  std::set<std::pair<const FieldDecl*, const Stmt*>> reported;
+  for (auto& [f, at] : changes.found)
+    if (reported.insert({f, at}).second && KernelMayFollow(c.ctx, def, at))
+      c.rep.RecordingError(at->getBeginLoc(), "control function '" + control + "' changes member '" + f->getNameAsString() +
+                           "', which is CRT_SPECIALIZE, where a kernel call can follow: the pipelines are made for its value before the commands are recorded",
+                           "set it before calling '" + control + "' (the call then makes the pipelines again), or after its last kernel call");
+}
+
 void AnalyzeControl(Context& c, const CXXMethodDecl* md, const FunctionDecl* def) {
   Control ctrl;
   ctrl.name = md->getNameAsString();
@@ -112,6 +182,7 @@ void AnalyzeControl(Context& c, const CXXMethodDecl* md, const FunctionDecl* def
                   " (as the factories return it) it runs " + c.cls->getNameAsString() + "::" + ctrl.name + " as written, on one CPU core",
                   "declare it 'virtual' in " + c.cls->getNameAsString() + " so that the generated classes override it; until then only a pointer to the "
                   "generated class (or its " + ctrl.name + "Cmd) runs it translated");
+  CheckSpecializedChanges(c, ctrl.name, def);
   if (!md->getReturnType()->isVoidType()) {
     c.rep.Error(md->getLocation(), "control function '" + ctrl.name + "' returns a value",
                 "return results through size-annotated pointer parameters or members; control functions return void");
@@ -361,34 +432,6 @@ void ControlRewriter::Note(const CXXMemberCallExpr* call) {
     m_ctrl.kernelsCalled.push_back(n);
 }
 
-// Whether a kernel may be called after statement s runs: one written after it, or one in a loop
-// around it (the next round calls it after s).
-static bool KernelMayFollow(ASTContext& ctx, const FunctionDecl* def, const Stmt* s) {
-  struct Finder : RecursiveASTVisitor<Finder> {
-    std::vector<const CXXMemberCallExpr*> kernels;
-    std::vector<const Stmt*> loops;
-    bool VisitCXXMemberCallExpr(CXXMemberCallExpr* call) {
-      if (auto* md = call->getMethodDecl(); md && IsKernelName(md->getName())) kernels.push_back(call);
-      return true;
-    }
-    bool VisitStmt(Stmt* st) {
-      if (isa<ForStmt, WhileStmt, DoStmt, CXXForRangeStmt>(st)) loops.push_back(st);
-      return true;
-    }
-  } finder;
-  finder.TraverseStmt(def->getBody());
-  const SourceManager& sm = ctx.getSourceManager();
-  auto before = [&](SourceLocation a, SourceLocation b) { return sm.isBeforeInTranslationUnit(a, b); };
-  auto within = [&](SourceLocation at, const Stmt* outer) { return !before(at, outer->getBeginLoc()) && !before(outer->getEndLoc(), at); };
-  for (auto* call : finder.kernels)
-    if (before(s->getEndLoc(), call->getBeginLoc())) return true;
-  for (auto* loop : finder.loops)
-    if (within(s->getBeginLoc(), loop))
-      for (auto* call : finder.kernels)
-        if (within(call->getBeginLoc(), loop)) return true;
-  return false;
-}
-
 void ControlRewriter::RecordMemberWrite(const Stmt* s) {
   if (std::find(m_tail.begin(), m_tail.end(), s) != m_tail.end()) return;  // runs on the host after the kernels
   RecordClear(s);
@@ -401,12 +444,6 @@ void ControlRewriter::RecordMemberWrite(const Stmt* s) {
   if (auto* uo = dyn_cast_or_null<UnaryOperator>(s); uo && uo->isIncrementDecrementOp()) lhs = uo->getSubExpr();
   const FieldDecl* f = lhs ? ThisField(lhs) : nullptr;
   const Member* m = f ? FindMember(m_c.model, f->getNameAsString()) : nullptr;
-  if (m && m->specialized && KernelMayFollow(m_c.ctx, m_def, s)) {
-    m_c.rep.RecordingError(s->getBeginLoc(), "control function '" + m_ctrl.name + "' changes member '" + m->name +
-                           "', which is CRT_SPECIALIZE, before or between its kernel calls: their pipelines are made for its value before the commands are recorded",
-                           "set it before calling '" + m_ctrl.name + "' (the call then makes the pipelines again), or after its last kernel call");
-    return;
-  }
   if (!m || m->kind != MemberKind::Plain || !m->inClassData) return;
   SourceLocation end = Lexer::findLocationAfterToken(s->getEndLoc(), tok::semi, m_c.ctx.getSourceManager(), m_c.ctx.getLangOpts(), false);
   if (end.isInvalid()) return;

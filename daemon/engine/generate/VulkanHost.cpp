@@ -15,6 +15,17 @@ namespace crossrt::engine {
 
 Data ControlsData(const ClassModel& model) {
   Data controls = List();
+  // Pipelines specialised to what CommitDeviceData() found: a user's own call of a control function's
+  // ...Cmd must not record with pipelines not made yet, or made for other values.
+  const bool virtuals = ClassConstantCount(model) > 0, members = !SpecializedMembers(model).empty();
+  std::string guard;
+  if (virtuals || members) {
+    const std::string what = std::string(virtuals ? "the classes the objects hold" : "") + (virtuals && members ? " and " : "") +
+                             (members ? "the CRT_SPECIALIZE members' values" : "");
+    guard = "  // The pipelines are made by CommitDeviceData() for " + what + ".\n"
+            "  if (!crt_deviceDataCommitted" + std::string(members ? " || crt_SpecializedMembersChanged()" : "") + ")\n"
+            "    throw crossrt::Error(\"" + model.generatedName + "::%sCmd: call CommitDeviceData() first: the pipelines are made for " + what + "\");\n";
+  }
   for (auto& c : model.controls) {
     Data x;
     x.set("name", c.name);
@@ -23,7 +34,13 @@ Data ControlsData(const ClassModel& model) {
     x.set("argsForward", c.argsForward);
     x.set("constQualifier", c.isConst ? " const" : "");
     x.set("notVirtual", !c.isVirtual);
-    x.set("cmdBody", IndentTail(c.vulkanCmdBody, ""));
+    std::string body = IndentTail(c.vulkanCmdBody, "");
+    if (!guard.empty() && body.rfind("{\n", 0) == 0) {
+      std::string g = guard;
+      g.replace(g.find("%s"), 2, c.name);
+      body.insert(2, g);
+    }
+    x.set("cmdBody", body);
     x.set("hostTail", c.hasHostTail);
     x.set("synchronizes", c.synchronizes);
     x.set("cpuBody", IndentTail(c.cpuBody, "  "));

@@ -548,9 +548,12 @@ std::string KernelPrinter::Expr(const clang::Expr* e) {
     if (valueParams.count(d))
       return Fail(e->getBeginLoc(), "'" + d->getNameAsString() + "' holds one value per thread (a local of the control function's thread loop), used here as a pointer",
                   "read and write it as *" + d->getNameAsString() + " or " + d->getNameAsString() + "->field");
-    if (auto* ec = dyn_cast<EnumConstantDecl>(d)) {  // its value, unsigned as its enum's type may be
+    if (auto* ec = dyn_cast<EnumConstantDecl>(d)) {
+      // Its value, in the type C++ gives it in an expression: an enum with a fixed type (enum class E :
+      // uint32_t) keeps it, a plain one promotes (to int, whatever Clang's own underlying type for it).
       const auto* ed = dyn_cast<EnumDecl>(ec->getDeclContext());
-      if (ed && ed->getIntegerType()->isUnsignedIntegerType()) return std::to_string(ec->getInitVal().getZExtValue()) + "u";
+      if (ed && (ed->isFixed() ? ed->getIntegerType() : ed->getPromotionType())->isUnsignedIntegerType())
+        return std::to_string(ec->getInitVal().getZExtValue()) + "u";
       return std::to_string(ec->getInitVal().getSExtValue());
     }
     if (auto object = m_objectLocals.find(d); object != m_objectLocals.end())

@@ -306,6 +306,10 @@ void CallableShading_Vulkan::RenderCmd(VkCommandBuffer crt_cmd, int width, int h
                                        [[maybe_unused]] const float4* normals,
                                        [[maybe_unused]] const uint32_t* materialIds, [[maybe_unused]] float4* colors)
 {
+  // The pipelines are made by CommitDeviceData() for the classes the objects hold.
+  if (!crt_deviceDataCommitted)
+    throw crossrt::Error("CallableShading_Vulkan::RenderCmd: call CommitDeviceData() first: the pipelines are made for "
+                         "the classes the objects hold");
   kernel2D_RenderCmd(crt_cmd, width, height, crt_inOut_Render.normals, crt_inOut_Render.materialIds,
                      crt_inOut_Render.colors);
 }

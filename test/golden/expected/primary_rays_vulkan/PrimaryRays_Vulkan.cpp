@@ -352,6 +352,10 @@ void PrimaryRays_Vulkan::Render(uint32_t* pixels)
 // The body of PrimaryRays::Render, with each kernel call turned into its ...Cmd.
 void PrimaryRays_Vulkan::RenderCmd(VkCommandBuffer crt_cmd, [[maybe_unused]] uint32_t* pixels)
 {
+  // The pipelines are made by CommitDeviceData() for the CRT_SPECIALIZE members' values.
+  if (!crt_deviceDataCommitted || crt_SpecializedMembersChanged())
+    throw crossrt::Error("PrimaryRays_Vulkan::RenderCmd: call CommitDeviceData() first: the pipelines are made for the "
+                         "CRT_SPECIALIZE members' values");
   kernel2D_RenderCmd(crt_cmd, crt_inOut_Render.pixels, m_width, m_height);
 }
 
@@ -418,6 +422,10 @@ void PrimaryRays_Vulkan::CastRays(const float4* posAndNear, const float4* dirAnd
 void PrimaryRays_Vulkan::CastRaysCmd(VkCommandBuffer crt_cmd, [[maybe_unused]] const float4* posAndNear,
                                      [[maybe_unused]] const float4* dirAndFar, [[maybe_unused]] CRT_Hit* hits, int n)
 {
+  // The pipelines are made by CommitDeviceData() for the CRT_SPECIALIZE members' values.
+  if (!crt_deviceDataCommitted || crt_SpecializedMembersChanged())
+    throw crossrt::Error("PrimaryRays_Vulkan::CastRaysCmd: call CommitDeviceData() first: the pipelines are made for "
+                         "the CRT_SPECIALIZE members' values");
   kernel1D_CastRaysCmd(crt_cmd, crt_inOut_CastRays.posAndNear, crt_inOut_CastRays.dirAndFar, crt_inOut_CastRays.hits,
                        n);
 }

@@ -439,6 +439,10 @@ void SdfLeafTracer_Vulkan::Trace(int n, const LiteMath::float4* origins, const L
 void SdfLeafTracer_Vulkan::TraceCmd(VkCommandBuffer crt_cmd, int n, [[maybe_unused]] const LiteMath::float4* origins,
                                     [[maybe_unused]] const LiteMath::float4* dirs, [[maybe_unused]] CRT_Hit* hits)
 {
+  // The pipelines are made by CommitDeviceData() for the classes the objects hold.
+  if (!crt_deviceDataCommitted)
+    throw crossrt::Error("SdfLeafTracer_Vulkan::TraceCmd: call CommitDeviceData() first: the pipelines are made for "
+                         "the classes the objects hold");
   kernel1D_TraceCmd(crt_cmd, n, crt_inOut_Trace.origins, crt_inOut_Trace.dirs, crt_inOut_Trace.hits);
 }
 

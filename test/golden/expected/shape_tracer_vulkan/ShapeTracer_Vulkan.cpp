@@ -467,6 +467,10 @@ void ShapeTracer_Vulkan::TraceCmd(VkCommandBuffer crt_cmd, int n, [[maybe_unused
                                   [[maybe_unused]] const LiteMath::float4* dirs, float far,
                                   [[maybe_unused]] ShapeHit* hits)
 {
+  // The pipelines are made by CommitDeviceData() for the classes the objects hold.
+  if (!crt_deviceDataCommitted)
+    throw crossrt::Error("ShapeTracer_Vulkan::TraceCmd: call CommitDeviceData() first: the pipelines are made for the "
+                         "classes the objects hold");
   kernel1D_TraceCmd(crt_cmd, n, crt_inOut_Trace.origins, crt_inOut_Trace.dirs, far, crt_inOut_Trace.hits);
 }
 
