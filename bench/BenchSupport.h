@@ -31,6 +31,14 @@ inline double MedianMs(int repeats, const std::function<void()>& work)
   return ms[ms.size() / 2];
 }
 
+// Wall time in seconds of one run of `work` (a first run, such as one that makes pipelines).
+inline double Seconds(const std::function<void()>& work)
+{
+  const auto t0 = std::chrono::steady_clock::now();
+  work();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
 // The median of times measured elsewhere (interleaved rounds); 0 for none.
 inline double MedianOf(std::vector<double> ms)
 {

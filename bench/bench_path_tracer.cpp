@@ -50,13 +50,6 @@ extern const size_t PathTracer_RenderPass_Megakernel_spvBytes;
 
 namespace {
 
-double Seconds(const std::function<void()>& work)
-{
-  const auto t0 = std::chrono::steady_clock::now();
-  work();
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
 // The generated class as a user subclasses it: the classes its pipelines were made for.
 class InspectedTracer : public PathTracer_Vulkan
 {

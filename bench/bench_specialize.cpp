@@ -34,13 +34,6 @@ using namespace LiteMath;
 
 namespace {
 
-double Seconds(const std::function<void()>& work)
-{
-  const auto t0 = std::chrono::steady_clock::now();
-  work();
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
 // A unit sphere of 2 * n * n triangles (the mesh when none is given).
 TriangleMesh SphereMesh(int n)
 {

@@ -356,10 +356,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     bool VisitCallExpr(CallExpr* call) {  // atomics, and helpers' non-const reference parameters (GLSL inout)
       const FunctionDecl* fd = call->getDirectCallee();
       if (IsCrossrtAtomic(fd) && call->getNumArgs() > 0) Written(call->getArg(0), call->getExprLoc());
-      for (unsigned i = 0; fd && i < call->getNumArgs() && i < fd->getNumParams(); ++i) {
-        const QualType t = fd->getParamDecl(i)->getType();
-        if (t->isLValueReferenceType() && !t.getNonReferenceType().isConstQualified()) Written(call->getArg(i), call->getExprLoc());
-      }
+      ReferenceArguments(call);
       return true;
     }
   } specializedWrites;

@@ -20,6 +20,15 @@ struct WriteVisitor : RecursiveASTVisitor<Derived> {
     if (op->isAssignmentOp() || op->getOperator() == OO_PlusPlus || op->getOperator() == OO_MinusMinus) Self().Written(op->getArg(0), op->getExprLoc());
     return true;
   }
+  // A call's arguments bound to non-const reference parameters (GLSL inout): written by the callee.
+  // Passes that count them call this from their VisitCallExpr.
+  void ReferenceArguments(const CallExpr* call) {
+    const FunctionDecl* fd = call->getDirectCallee();
+    for (unsigned i = 0; fd && i < call->getNumArgs() && i < fd->getNumParams(); ++i) {
+      const QualType t = fd->getParamDecl(i)->getType();
+      if (t->isLValueReferenceType() && !t.getNonReferenceType().isConstQualified()) Self().Written(call->getArg(i), call->getExprLoc());
+    }
+  }
   Derived& Self() { return static_cast<Derived&>(*this); }
 };
 

@@ -145,10 +145,7 @@ static void CheckSpecializedChanges(Context& c, const std::string& control, cons
     bool VisitCallExpr(CallExpr* call) {
       const FunctionDecl* fd = call->getDirectCallee();
       if (!fd) return true;
-      for (unsigned i = 0; i < call->getNumArgs() && i < fd->getNumParams(); ++i) {
-        const QualType t = fd->getParamDecl(i)->getType();
-        if (t->isLValueReferenceType() && !t.getNonReferenceType().isConstQualified()) Written(call->getArg(i), call->getExprLoc());
-      }
+      ReferenceArguments(call);
       auto* md = dyn_cast<CXXMethodDecl>(fd);
       const FunctionDecl* body = nullptr;
       if (md && !IsKernelName(md->getName()) && IsClassOrBase(md->getParent(), cls) && md->hasBody(body) && body && seen.insert(body).second) {
