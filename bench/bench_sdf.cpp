@@ -11,12 +11,14 @@
 // ISceneObject (BVHScene, 4 Newton iterations) and the same camera rays traced by the translated
 // SdfRender_CPU (all cores) and SdfRender_Vulkan (the default device); OpenVDB's intersector on all
 // cores too, one copy per thread. Writes out/bench_sdf.csv; bench/plot_sdf.py plots error against time.
-// Then the paper's Figure 9: render time against model size for SBS at growing depths, on the GPU,
-// software against hardware: SdfRender_Vulkan on BVHScene, and SdfRender_VulkanLeaves on
+// First, per mesh, the paper's Figure 9: render time against model size for SBS at growing depths,
+// on the GPU, software against hardware: SdfRender_Vulkan on BVHScene, and SdfRender_VulkanLeaves on
 // SdfLeafScene (the paper's level-3 form) with its switch over the representation and, where the
-// device has ray tracing pipelines, with intersection shaders. Writes out/bench_sdf_fig9.csv.
+// device has ray tracing pipelines, with intersection shaders. Writes out/bench_sdf_fig9.csv. Then
+// Figure 10: those SdfLeafScene frames split into the walk and the bricks' intersection, from frames
+// with each brick solved once and three times (out/bench_sdf_fig10.csv).
 //
-//   bench_sdf [--size N] [MESH...]     (default: bunny, armadillo and dragon from build/data/meshes)
+//   bench_sdf [--size N] [--figures] [MESH...]   (default: bunny, armadillo and dragon from build/data/meshes)
 #include "BenchSupport.h"
 #include "MeshIO.h"
 #include "SdfBVH.h"
@@ -35,6 +37,7 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -167,6 +170,86 @@ void TimeTranslated(Translated& tr, const std::function<uint32_t(ISceneObject&)>
   if (tr.vulkan) row.mraysVulkan = RenderMrays(*tr.vulkan, tr, scene);
 }
 
+// Frame times of one field: `ms` per frame, the median of rounds that alternate the settings.
+struct SplitMs {
+  double walk = 0, intersection = 0;  // ms per frame: the traversal (with its shader calls), the bricks' solves
+};
+
+// The paper's Figure 10 for one SdfLeafScene, traced by `r`: frames with each brick solved once and
+// three times (SdfLeafScene::m_intersectRepeats) take walk + k * intersection, so their difference
+// halved is the intersection's share. Rounds alternate k = 1 and 3; medians of 5.
+SplitMs SplitFrame(SdfRender& r, Translated& tr, const std::shared_ptr<SdfLeafScene>& scene) {
+  std::vector<double> once, thrice;
+  for (int round = 0; round < 5; ++round)
+    for (uint32_t k : {1u, 3u}) {
+      scene->m_intersectRepeats = k;
+      (k == 1 ? once : thrice).push_back(double(tr.size) * tr.size / 1000.0 / RenderMrays(r, tr, scene));
+    }
+  scene->m_intersectRepeats = 1;
+  auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+  };
+  SplitMs split;
+  split.intersection = std::max(0.0, (median(thrice) - median(once)) / 2.0);
+  split.walk = median(once) - split.intersection;
+  return split;
+}
+
+// The paper's Figures 9 and 10 on the GPU for one mesh, over SBSs of growing depth (brick 4, 1 B):
+// render time against model size, software against hardware, and the frame split into the walk and
+// the bricks' intersection.
+void GpuFigures(Translated& tr, const SdfMesh& mesh, const std::string& name, std::ofstream& fig9, std::ofstream& fig10) {
+  const float3 boxMin(-1.0f, -1.0f, -1.0f);
+  const int size = tr.size;
+  std::printf("\n%s, the paper's Figure 9: ms per %dx%d frame on the GPU against the SBS's size (brick 4, 1 B; SdfLeafScene holds it as floats)\n", name.c_str(), size, size);
+  std::printf("| %-8s | %9s | %18s | %22s | %26s |\n", "SBS", "MiB", "BVHScene (compute)", "SdfLeafScene, switch", "SdfLeafScene, intersection");
+  struct Split {
+    uint32_t depth;
+    double mib;
+    SplitMs software, hardware;
+  };
+  std::vector<Split> splits;
+  for (uint32_t depth : {5u, 6u, 7u}) {
+    const SdfSBS sbs = BuildSBS(mesh, boxMin, 2.0f, depth, 4, 1);
+    auto bvhScene = MakeSceneRT("sah");
+    bvhScene->AddInstance(bvhScene->AddGeom_SdfSBS(sbs), LiteMath::float4x4());
+    bvhScene->CommitScene();
+    auto leafScene = std::make_shared<SdfLeafScene>();
+    leafScene->AddInstance(leafScene->AddGeom_SdfSBS(sbs), LiteMath::float4x4());
+    leafScene->CommitScene();
+    const double rays = double(size) * size / 1000.0;  // per ms, in Mrays/s
+    const double bvhMs = rays / RenderMrays(*tr.vulkan, tr, bvhScene);
+    tr.leaves->UseRayTracingPipelines(false);
+    const double switchMs = rays / RenderMrays(*tr.leaves, tr, leafScene);
+    Split split{depth, double(sbs.Bytes()) / 1048576.0, SplitFrame(*tr.leaves, tr, leafScene), {}};
+    double hardwareMs = 0.0;
+    if (tr.hardware) {
+      tr.leaves->UseRayTracingPipelines(true);
+      hardwareMs = rays / RenderMrays(*tr.leaves, tr, leafScene);
+      split.hardware = SplitFrame(*tr.leaves, tr, leafScene);
+    }
+    const std::string hw = tr.hardware ? std::to_string(hardwareMs).substr(0, 7) : "no RT pipelines";
+    std::printf("| %5u^3  | %9.2f | %18.2f | %22.2f | %26s |\n", 1u << depth, split.mib, bvhMs, switchMs, hw.c_str());
+    std::fflush(stdout);
+    fig9 << name << "," << depth << "," << sbs.Bytes() << "," << bvhMs << "," << switchMs << "," << hardwareMs << "\n";
+    splits.push_back(split);
+  }
+  std::printf("\n%s, the paper's Figure 10: the same frames split into the walk and the bricks' intersection, ms per frame\n"
+              "(each brick solved once and three times, alternating, medians of 5: intersection = the difference / 2;\n"
+              "the walk includes the intersection shaders' calls)\n", name.c_str());
+  std::printf("| %-8s | %14s | %14s | %14s | %14s | %10s | %10s |\n", "SBS", "switch: walk", "intersection", "shaders: walk", "intersection",
+              "walk HW/SW", "isect HW/SW");
+  for (const Split& s : splits) {
+    auto ratio = [](double hw, double sw) { return hw > 0.0 && sw > 0.0 ? hw / sw : 0.0; };
+    std::printf("| %5u^3  | %14.2f | %14.2f | %14.2f | %14.2f | %9.2fx | %9.2fx |\n", 1u << s.depth, s.software.walk, s.software.intersection,
+                s.hardware.walk, s.hardware.intersection, ratio(s.hardware.walk, s.software.walk),
+                ratio(s.hardware.intersection, s.software.intersection));
+    fig10 << name << "," << s.depth << "," << s.mib << "," << s.software.walk << "," << s.software.intersection << "," << s.hardware.walk << ","
+          << s.hardware.intersection << "\n";
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -177,6 +260,8 @@ int main(int argc, char** argv) {
                            "surface error and image PSNR against the exact mesh distance. Writes out/bench_sdf.csv.");
   app.add_option("MESH", meshes, "meshes (default: bunny, armadillo and dragon from build/data/meshes, scripts/fetch-meshes.sh)");
   app.add_option("--size", size, "width and height of the images in pixels")->check(crossrt::Positive());
+  bool figuresOnly = false;
+  app.add_flag("--figures", figuresOnly, "only the GPU's tables (the paper's Figures 9 and 10), not the representations' sweep");
   if (const int status = crossrt::ParseCommandLine(app, argc, argv); status >= 0) return status;
   if (meshes.empty())
     for (const char* name : {"bunny00.off", "armadillo.off", "dragon_vrip_res2.ply.gz"})
@@ -213,6 +298,8 @@ int main(int argc, char** argv) {
   csv << "mesh,representation,knobs,build_ms,data_bytes,total_bytes,mrays_per_s,mrays_per_s_cpu,mrays_per_s_vulkan,mean_error,max_error,hit_agreement,depth_psnr,normal_psnr\n";
   std::ofstream fig9("out/bench_sdf_fig9.csv");
   fig9 << "mesh,depth,sbs_bytes,bvhscene_ms,leaves_switch_ms,leaves_hardware_ms\n";
+  std::ofstream fig10("out/bench_sdf_fig10.csv");
+  fig10 << "mesh,depth,sbs_mib,switch_walk_ms,switch_intersection_ms,shaders_walk_ms,shaders_intersection_ms\n";
 
   for (const std::string& path : meshes) {
     TriangleMesh tm;
@@ -229,6 +316,10 @@ int main(int argc, char** argv) {
                      LiteMath::normalize(LiteMath::cross(float3(0, 1, 0), float3(-1.2f, -0.9f, 2.6f))), float3(0, 0, 0)};
     Camera camera = cam;
     camera.up = LiteMath::cross(camera.forward, camera.right);
+    if (translated.vulkan)
+      GpuFigures(translated, mesh, name, fig9, fig10);
+    if (figuresOnly)
+      continue;
 
     // The reference: the exact distance, sphere-traced.
     double refRate = 0;
@@ -371,33 +462,7 @@ int main(int argc, char** argv) {
       row.mraysCpu = double(size) * size / (ms * 1000.0);
       emit(row, image);
     }
-    // Figure 9: render time against model size, software against hardware, on the GPU.
-    if (translated.vulkan) {
-      std::printf("\n%s, the paper's Figure 9: ms per %dx%d frame on the GPU against the SBS's size (brick 4, 1 B; SdfLeafScene holds it as floats)\n", name.c_str(), size, size);
-      std::printf("| %-8s | %9s | %18s | %22s | %26s |\n", "SBS", "MiB", "BVHScene (compute)", "SdfLeafScene, switch", "SdfLeafScene, intersection");
-      for (uint32_t depth : {5u, 6u, 7u}) {
-        const SdfSBS sbs = BuildSBS(mesh, boxMin, 2.0f, depth, 4, 1);
-        auto bvhScene = MakeSceneRT("sah");
-        bvhScene->AddInstance(bvhScene->AddGeom_SdfSBS(sbs), LiteMath::float4x4());
-        bvhScene->CommitScene();
-        auto leafScene = std::make_shared<SdfLeafScene>();
-        leafScene->AddInstance(leafScene->AddGeom_SdfSBS(sbs), LiteMath::float4x4());
-        leafScene->CommitScene();
-        const double rays = double(size) * size / 1000.0;  // per ms, in Mrays/s
-        const double bvhMs = rays / RenderMrays(*translated.vulkan, translated, bvhScene);
-        translated.leaves->UseRayTracingPipelines(false);
-        const double switchMs = rays / RenderMrays(*translated.leaves, translated, leafScene);
-        double hardwareMs = 0.0;
-        if (translated.hardware) {
-          translated.leaves->UseRayTracingPipelines(true);
-          hardwareMs = rays / RenderMrays(*translated.leaves, translated, leafScene);
-        }
-        const std::string hw = translated.hardware ? std::to_string(hardwareMs).substr(0, 7) : "no RT pipelines";
-        std::printf("| %5u^3  | %9.2f | %18.2f | %22.2f | %26s |\n", 1u << depth, double(sbs.Bytes()) / 1048576.0, bvhMs, switchMs, hw.c_str());
-        fig9 << name << "," << depth << "," << sbs.Bytes() << "," << bvhMs << "," << switchMs << "," << hardwareMs << "\n";
-      }
-    }
   }
-  std::printf("\nwrote out/bench_sdf.csv and out/bench_sdf_fig9.csv (plots: bench/plot_sdf.py)\n");
+  std::printf("\nwrote out/bench_sdf.csv, out/bench_sdf_fig9.csv and out/bench_sdf_fig10.csv (plots: bench/plot_sdf.py)\n");
   return 0;
 }

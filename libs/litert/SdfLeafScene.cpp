@@ -110,6 +110,21 @@ void SdfSBSLeaves::Intersect(float4 posAndNear, float4 dirAndFar, CRT_LeafInfo i
 litesdf::SdfHit SdfLeafScene::MarchBrick(float3 corner, float cell, int n, uint32_t first, uint32_t strideY, uint32_t strideZ, float3 org, float3 dir,
                                          float t0, float t1) const
 {
+  litesdf::SdfHit hit = MarchBrickOnce(corner, cell, n, first, strideY, strideZ, org, dir, t0, t1);
+  // Profiling only (m_intersectRepeats, in the header): the same brick again, its answer kept where
+  // it is nearer, which with m_repeatSlack = 0 it never is.
+  for (uint32_t r = 1; r < m_intersectRepeats; ++r)
+  {
+    const litesdf::SdfHit again = MarchBrickOnce(corner, cell, n, first, strideY, strideZ, org, dir, t0, t1 + m_repeatSlack);
+    if (again.t >= 0.0f && (hit.t < 0.0f || again.t < hit.t))
+      hit = again;
+  }
+  return hit;
+}
+
+litesdf::SdfHit SdfLeafScene::MarchBrickOnce(float3 corner, float cell, int n, uint32_t first, uint32_t strideY, uint32_t strideZ, float3 org,
+                                             float3 dir, float t0, float t1) const
+{
   // The cells in order along the ray (Amanatides and Woo), each solved until one is hit; a cell with
   // no corner at or inside the surface cannot hold it (litesdf's MayHoldSurface) and is not solved.
   // (litesdf's MarchVoxels walks the same way, but takes a callable, which kernels cannot pass.)

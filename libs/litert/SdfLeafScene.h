@@ -20,6 +20,7 @@
 #pragma once
 #include "CrossRT.h"
 #include "SdfStructures.h"
+#include "Specialize.h"
 
 #include <cstdint>
 #include <memory>
@@ -104,8 +105,20 @@ public:
 
   // The first hit of the ray (field space) with the cells of a brick of n^3 cells of edge `cell` from
   // `corner`, whose corner values are m_values[first + x + y * strideY + z * strideZ], within [t0, t1].
+  // MarchBrick solves the brick m_intersectRepeats times (see below) and returns the first answer.
   litesdf::SdfHit MarchBrick(LiteMath::float3 corner, float cell, int n, uint32_t first, uint32_t strideY, uint32_t strideZ,
                              LiteMath::float3 org, LiteMath::float3 dir, float t0, float t1) const;
+  litesdf::SdfHit MarchBrickOnce(LiteMath::float3 corner, float cell, int n, uint32_t first, uint32_t strideY, uint32_t strideZ,
+                                 LiteMath::float3 org, LiteMath::float3 dir, float t0, float t1) const;
+
+  // ---- Profiling: how a frame's time splits into the walk and the bricks' intersection. ----
+  // With m_intersectRepeats = k, every grid or SBS brick a ray reaches is solved k times; the hits do
+  // not change. A frame then takes walk + k * intersection, so two frames (k = 1 and k = 3) give both
+  // parts, on every backend and in intersection shaders alike (bench_sdf, the paper's Figure 10). The
+  // repeats end their span at t1 + m_repeatSlack, 0, which no compiler can prove equal to t1, so none
+  // merges them. A specialization constant on the GPU: the usual k = 1 compiles to one solve.
+  CRT_SPECIALIZE uint32_t m_intersectRepeats = 1;
+  float m_repeatSlack = 0.0f;
 
   // ---- Device data, rebuilt by CommitScene: what the traversal and the leaves read. ----
   std::vector<std::shared_ptr<ISdfLeaves>> m_geom;  // per instance, in instance order

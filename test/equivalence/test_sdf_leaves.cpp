@@ -38,6 +38,14 @@ std::shared_ptr<SdfLeafScene> ThreeFields()
   scene->CommitScene();
   return scene;
 }
+
+// SdfLeafTracer_Vulkan as a user subclasses it: the specialization its pipelines were made with.
+class InspectedLeafTracer : public SdfLeafTracer_Vulkan
+{
+public:
+  using SdfLeafTracer_Vulkan::SdfLeafTracer_Vulkan;
+  std::vector<uint32_t> PipelineConstants() const { return crt_pipelineConstants; }
+};
 }  // namespace
 
 TEST_CASE("Intersection functions of SDF representations reach the traversal's data through `this` (paper 3.10)", "[equivalence][composition][sdf][device-features]")
@@ -82,7 +90,7 @@ TEST_CASE("Intersection functions of SDF representations reach the traversal's d
 
   auto ctx = ValidatedContext();
   auto cpu = CreateSdfLeafTracer_CPU();
-  std::shared_ptr<SdfLeafTracer_Vulkan> gpu = ctx ? std::make_shared<SdfLeafTracer_Vulkan>(ctx) : nullptr;
+  std::shared_ptr<InspectedLeafTracer> gpu = ctx ? std::make_shared<InspectedLeafTracer>(ctx) : nullptr;
   struct Run
   {
     const char* name;
@@ -125,6 +133,21 @@ TEST_CASE("Intersection functions of SDF representations reach the traversal's d
         REQUIRE(hits[i].primId == expected[i].primId);  // of two equally near leaves the hardware may pick either
     }
     REQUIRE(same >= n - n / 200);
+    // The profiling knob (bench_sdf's Figure 10): each brick solved three times, the hits unchanged.
+    // On the GPU a specialization constant, so Trace makes the pipelines again.
+    scene->m_intersectRepeats = 3;
+    std::vector<CRT_Hit> repeated(n);
+    run.tracer->Trace(n, origins.data(), dirs.data(), repeated.data());
+    scene->m_intersectRepeats = 1;
+    if (run.tracer == gpu.get())
+      REQUIRE(gpu->PipelineConstants().back() == 3u);
+    for (int i = 0; i < n; ++i)
+    {
+      INFO("ray " << i << ", bricks solved three times");
+      REQUIRE(repeated[i].geomId == hits[i].geomId);
+      REQUIRE(repeated[i].primId == hits[i].primId);
+      REQUIRE(repeated[i].t == hits[i].t);
+    }
   }
   if (ctx)
     RequireNoValidationMessages(ctx);

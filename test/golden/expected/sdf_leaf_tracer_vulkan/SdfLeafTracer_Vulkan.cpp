@@ -36,7 +36,8 @@ SdfLeafTracer_Vulkan::SdfLeafTracer_Vulkan(std::shared_ptr<crossrt::VulkanContex
   if (!crt_ctx->hasBufferDeviceAddress)
     throw crossrt::Error("SdfLeafTracer_Vulkan: device '" + crt_ctx->DeviceName() +
                          "' lacks bufferDeviceAddress, which virtual function calls in kernels need");
-  // The pipelines are made by CommitDeviceData(), for what it finds: the classes the objects hold.
+  // The pipelines are made by CommitDeviceData(), for what it finds: the classes the objects hold and the
+  // CRT_SPECIALIZE members' values.
 }
 
 std::shared_ptr<SdfLeafTracer> CreateSdfLeafTracer_Vulkan()
@@ -145,6 +146,9 @@ void SdfLeafTracer_Vulkan::crt_UpdatePlainMembers()
   data.crt_m_scene_m_geom_SdfGridLeaves = crt_virtual.m_scene_m_geom_SdfGridLeaves.Address();
   data.crt_m_scene_m_geom_SdfSVSLeaves = crt_virtual.m_scene_m_geom_SdfSVSLeaves.Address();
   data.crt_m_scene_m_geom_SdfSBSLeaves = crt_virtual.m_scene_m_geom_SdfSBSLeaves.Address();
+  std::memcpy(&data.m_scene_m_repeatSlack, &crt_m_scene()->m_repeatSlack, sizeof(data.m_scene_m_repeatSlack));
+  std::memcpy(&data.m_scene_m_intersectRepeats, &crt_m_scene()->m_intersectRepeats,
+              sizeof(data.m_scene_m_intersectRepeats));
   data.crt_m_scene_m_geom_size = uint32_t(crt_m_scene()->m_geom.size());
   data.crt_m_scene_m_nodeMin_size = uint32_t(crt_m_scene()->m_nodeMin.size());
   data.crt_m_scene_m_nodeMin_capacity = uint32_t(crt_m_scene()->m_nodeMin.capacity());
@@ -249,6 +253,8 @@ void SdfLeafTracer_Vulkan::CommitDeviceData()
     crt_constants[0 + crt_m_scene_m_geomTags[2 * i]] = VK_TRUE;
   if (crt_useRayTracingPipelines)
     crt_CommitLeaves_m_scene_m_geom(crt_m_scene_m_geomTags);
+  crt_constants.push_back(crossrt::SpecializationValue(
+      crt_m_scene()->m_intersectRepeats));     // SdfLeafScene::m_intersectRepeats through m_scene (CRT_SPECIALIZE)
   if (crt_constants != crt_pipelineConstants)  // made for another scene, or not made yet
   {
     crt_pipelineConstants = crt_constants;
@@ -256,6 +262,15 @@ void SdfLeafTracer_Vulkan::CommitDeviceData()
   }
   crt_UpdatePlainMembers();
   crt_deviceDataCommitted = true;
+}
+
+bool SdfLeafTracer_Vulkan::crt_SpecializedMembersChanged() const
+{
+  if (crt_pipelineConstants.size() != 4)
+    return true;
+  if (crt_pipelineConstants[3] != crossrt::SpecializationValue(crt_m_scene()->m_intersectRepeats))
+    return true;
+  return false;
 }
 
 bool SdfLeafTracer_Vulkan::crt_VectorMembersResized() const
@@ -395,7 +410,9 @@ void SdfLeafTracer_Vulkan::Trace(int n, const LiteMath::float4* origins, const L
   // std::vector members are uploaded by CommitDeviceData(): here once, and again whenever one
   // changed size (its device buffer would be too small). After changing the contents of a
   // vector without resizing it, call CommitDeviceData().
-  if (!crt_self->crt_deviceDataCommitted || crt_self->crt_VectorMembersResized())
+  // It makes the pipelines too: again whenever a CRT_SPECIALIZE member changed value.
+  if (!crt_self->crt_deviceDataCommitted || crt_self->crt_VectorMembersResized() ||
+      crt_self->crt_SpecializedMembersChanged())
     crt_self->CommitDeviceData();
 
   crossrt::CpuTimer crt_copyIn;
@@ -439,10 +456,11 @@ void SdfLeafTracer_Vulkan::Trace(int n, const LiteMath::float4* origins, const L
 void SdfLeafTracer_Vulkan::TraceCmd(VkCommandBuffer crt_cmd, int n, [[maybe_unused]] const LiteMath::float4* origins,
                                     [[maybe_unused]] const LiteMath::float4* dirs, [[maybe_unused]] CRT_Hit* hits)
 {
-  // The pipelines are made by CommitDeviceData() for the classes the objects hold.
-  if (!crt_deviceDataCommitted)
+  // The pipelines are made by CommitDeviceData() for the classes the objects hold and the CRT_SPECIALIZE members'
+  // values.
+  if (!crt_deviceDataCommitted || crt_SpecializedMembersChanged())
     throw crossrt::Error("SdfLeafTracer_Vulkan::TraceCmd: call CommitDeviceData() first: the pipelines are made for "
-                         "the classes the objects hold");
+                         "the classes the objects hold and the CRT_SPECIALIZE members' values");
   kernel1D_TraceCmd(crt_cmd, n, crt_inOut_Trace.origins, crt_inOut_Trace.dirs, crt_inOut_Trace.hits);
 }
 

@@ -79,6 +79,8 @@ protected:
     alignas(8) uint64_t crt_m_scene_m_geom_SdfGridLeaves;
     alignas(8) uint64_t crt_m_scene_m_geom_SdfSVSLeaves;
     alignas(8) uint64_t crt_m_scene_m_geom_SdfSBSLeaves;
+    alignas(4) float m_scene_m_repeatSlack;
+    alignas(4) uint32_t m_scene_m_intersectRepeats;
     alignas(4) uint32_t crt_m_scene_m_nodeMin_size;
     alignas(4) uint32_t crt_m_scene_m_nodeMin_capacity;
     alignas(4) uint32_t crt_m_scene_m_nodeMax_size;
@@ -135,6 +137,8 @@ protected:
   } crt_vdata;
   // A std::vector or Image2D member changed size, or a sampler changed, since CommitDeviceData().
   virtual bool crt_VectorMembersResized() const;
+  // A CRT_SPECIALIZE member holds another value than the pipelines were made for.
+  virtual bool crt_SpecializedMembersChanged() const;
 
   // Virtual functions through m_scene->m_geom (level 2): the GPU keeps the objects of each class
   // (SdfGridLeaves, SdfSVSLeaves, SdfSBSLeaves) in a buffer of their own and a (class, index) tag per element.
@@ -174,8 +178,9 @@ protected:
   } crt_virtual;
   bool crt_specializeVirtualCalls = true;
   // The specialization the pipelines were made with by the last CommitDeviceData(), numbered as the
-  // shaders' constants crossrt::kClassConstantIdBase + i (3):
+  // shaders' constants crossrt::kClassConstantIdBase + i (4):
   //   [0, 3) per (vector, class): whether the kernels switch over that class (its objects were there);
+  //   [3] SdfLeafScene::m_intersectRepeats through m_scene (CRT_SPECIALIZE)
   std::vector<uint32_t> crt_pipelineConstants;
   static constexpr size_t crt_classConstants = 3;  // the (vector, class) constants first
   // m_scene as the SdfLeafScene whose traversal the kernels run and whose data they read; throws

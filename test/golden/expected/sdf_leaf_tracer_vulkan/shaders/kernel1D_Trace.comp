@@ -134,6 +134,8 @@ layout(std430, binding = 0) buffer crt_SdfLeafTracerData
   uvec2 crt_m_scene_m_geom_SdfGridLeaves;
   uvec2 crt_m_scene_m_geom_SdfSVSLeaves;
   uvec2 crt_m_scene_m_geom_SdfSBSLeaves;
+  float m_scene_m_repeatSlack;
+  uint m_scene_m_intersectRepeats;
   uint crt_m_scene_m_nodeMin_size;
   uint crt_m_scene_m_nodeMin_capacity;
   uint crt_m_scene_m_nodeMax_size;
@@ -225,6 +227,10 @@ layout(push_constant) uniform crt_kernel1D_TraceArgs
 const uint m_scene_kNoId = 4294967295u;
 const int m_scene_kNewtonIterations = 4;
 const int kNewtonIterations = 4;
+
+// SdfLeafScene::m_intersectRepeats through m_scene (CRT_SPECIALIZE): its value when the pipeline was made, which the
+// driver folds into the code
+layout(constant_id = 1803) const uint crt_m_scene_m_intersectRepeats_specialized = 0u;
 
 // from (anonymous namespace)::ToField
 void ToField(SdfPlacement place, vec4 posAndNear, vec4 dirAndFar, inout vec3 org, inout vec3 dir)
@@ -435,9 +441,9 @@ bool m_scene_MayHoldSurface(VoxelValues values)
   return lowest <= 0.0;
 }
 
-// from SdfLeafScene::MarchBrick
-SdfHit m_scene_MarchBrick(vec3 corner, float cell, int n, uint first, uint strideY, uint strideZ, vec3 org, vec3 dir,
-                          float t0, float t1)
+// from SdfLeafScene::MarchBrickOnce
+SdfHit m_scene_MarchBrickOnce(vec3 corner, float cell, int n, uint first, uint strideY, uint strideZ, vec3 org,
+                              vec3 dir, float t0, float t1)
 {
   const vec3 entry = (org + t0 * dir - corner) / cell;
   int at[3];
@@ -475,6 +481,21 @@ SdfHit m_scene_MarchBrick(vec3 corner, float cell, int n, uint first, uint strid
     tEnter = tNext[a];
     tNext[a] = tNext[a] + tDelta[a];
   }
+}
+
+// from SdfLeafScene::MarchBrick
+SdfHit m_scene_MarchBrick(vec3 corner, float cell, int n, uint first, uint strideY, uint strideZ, vec3 org, vec3 dir,
+                          float t0, float t1)
+{
+  SdfHit hit = m_scene_MarchBrickOnce(corner, cell, n, first, strideY, strideZ, org, dir, t0, t1);
+  for (uint r = 1u; r < crt_m_scene_m_intersectRepeats_specialized; ++r)
+  {
+    const SdfHit again =
+        m_scene_MarchBrickOnce(corner, cell, n, first, strideY, strideZ, org, dir, t0, t1 + m_scene_m_repeatSlack);
+    if (again.t >= 0.0 && (hit.t < 0.0 || again.t < hit.t))
+      hit = again;
+  }
+  return hit;
 }
 
 // from (anonymous namespace)::Record
