@@ -186,13 +186,9 @@ SplitMs SplitFrame(SdfRender& r, Translated& tr, const std::shared_ptr<SdfLeafSc
       (k == 1 ? once : thrice).push_back(double(tr.size) * tr.size / 1000.0 / RenderMrays(r, tr, scene));
     }
   scene->m_intersectRepeats = 1;
-  auto median = [](std::vector<double> v) {
-    std::sort(v.begin(), v.end());
-    return v[v.size() / 2];
-  };
   SplitMs split;
-  split.intersection = std::max(0.0, (median(thrice) - median(once)) / 2.0);
-  split.walk = median(once) - split.intersection;
+  split.intersection = std::max(0.0, (MedianOf(thrice) - MedianOf(once)) / 2.0);
+  split.walk = MedianOf(once) - split.intersection;
   return split;
 }
 
@@ -257,7 +253,9 @@ int main(int argc, char** argv) {
   std::vector<std::string> meshes;
   crossrt::CommandLine app("bench_sdf",
                            "SDF grid, sparse voxel and brick sets against OpenVDB: build time, bytes, Mrays/s (one thread),\n"
-                           "surface error and image PSNR against the exact mesh distance. Writes out/bench_sdf.csv.");
+                           "surface error and image PSNR against the exact mesh distance. Writes out/bench_sdf.csv. On the GPU,\n"
+                           "the paper's Figures 9 and 10: software against hardware over the SBS's size, and the frame split\n"
+                           "into traversal and intersection (out/bench_sdf_fig9.csv, out/bench_sdf_fig10.csv).");
   app.add_option("MESH", meshes, "meshes (default: bunny, armadillo and dragon from build/data/meshes, scripts/fetch-meshes.sh)");
   app.add_option("--size", size, "width and height of the images in pixels")->check(crossrt::Positive());
   bool figuresOnly = false;
@@ -283,7 +281,8 @@ int main(int argc, char** argv) {
     translated.vulkan = vulkan;
     translated.leaves = std::make_shared<SdfRender_VulkanLeaves>(ctx, size, size);
     translated.hardware = ctx->hasRayTracingPipeline;
-    std::printf("bench_sdf: the GPU is %s (%s ray tracing pipelines)\n", ctx->DeviceName().c_str(), translated.hardware ? "with" : "without");
+    std::printf("bench_sdf: the GPU is %s (%s ray tracing pipelines); the CPU is %s\n", ctx->DeviceName().c_str(),
+                translated.hardware ? "with" : "without", CpuModel().c_str());
   } catch (const std::exception& e) {
     std::cerr << "bench_sdf: Vulkan is not available, no SdfRender_Vulkan column: " << e.what() << "\n";
   }
