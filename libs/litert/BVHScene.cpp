@@ -597,7 +597,7 @@ void BVHScene::SetBoxes(Mesh& mesh, const CRT_AABB* boxes, size_t boxNumber, siz
   ClearDeviceData();
 }
 
-uint32_t BVHScene::AddGeom_AABB(uint32_t, const CRT_AABB* boxMinMaxF8, size_t boxNumber, void**, size_t customPrimCount)
+uint32_t BVHScene::AddGeom_AABB(uint32_t, const CRT_AABB* boxMinMaxF8, size_t boxNumber, uint32_t, void**, size_t customPrimCount)
 {
   Mesh mesh;
   SetBoxes(mesh, boxMinMaxF8, boxNumber, customPrimCount);
@@ -605,7 +605,8 @@ uint32_t BVHScene::AddGeom_AABB(uint32_t, const CRT_AABB* boxMinMaxF8, size_t bo
   return uint32_t(m_meshes.size() - 1) | CRT_GEOM_MASK_AABB_BIT;
 }
 
-void BVHScene::UpdateGeom_AABB(uint32_t geomId, uint32_t, const CRT_AABB* boxMinMaxF8, size_t boxNumber, void**, size_t customPrimCount)
+void BVHScene::UpdateGeom_AABB(uint32_t geomId, uint32_t, const CRT_AABB* boxMinMaxF8, size_t boxNumber, uint32_t, void**,
+                               size_t customPrimCount)
 {
   geomId &= CRT_GEOM_MASK_AABB_BIT_RM;
   if (geomId >= m_meshes.size() || !m_meshes[geomId].boxes || m_meshes[geomId].sdf)

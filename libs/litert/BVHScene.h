@@ -117,10 +117,12 @@ public:
   CRT_Hit RayQuery_NearestHit(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar) override;
   bool RayQuery_AnyHit(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar) override;
   // Box geometry and moving instances (CrossRT.h).
-  uint32_t AddGeom_AABB(uint32_t typeId, const CRT_AABB* boxMinMaxF8, size_t boxNumber, void** customPrimPtrs = nullptr,
-                        size_t customPrimCount = 0) override;
-  void UpdateGeom_AABB(uint32_t geomId, uint32_t typeId, const CRT_AABB* boxMinMaxF8, size_t boxNumber, void** customPrimPtrs = nullptr,
-                       size_t customPrimCount = 0) override;
+  using ISceneObject::AddGeom_AABB;  // and the forms without build flags
+  using ISceneObject::UpdateGeom_AABB;
+  uint32_t AddGeom_AABB(uint32_t typeId, const CRT_AABB* boxMinMaxF8, size_t boxNumber, uint32_t buildFlags, void** customPrimPtrs,
+                        size_t customPrimCount) override;
+  void UpdateGeom_AABB(uint32_t geomId, uint32_t typeId, const CRT_AABB* boxMinMaxF8, size_t boxNumber, uint32_t buildFlags,
+                       void** customPrimPtrs, size_t customPrimCount) override;
   uint32_t AddInstanceMotion(uint32_t geomId, const LiteMath::float4x4* matrices, uint32_t matrixNumber) override;
   // Signed distance fields (CrossRT.h): boxes of bricks (BVHSdfBrick) under a tree of their own.
   uint32_t AddGeom_SdfGrid(const litesdf::SdfGrid& grid, uint32_t flags = BUILD_HIGH) override;

@@ -104,21 +104,33 @@ struct ISceneObject
 
   // Boxes as a geometry, for custom primitives (paper 3.10): boxNumber boxes, a primitive per
   // boxNumber / customPrimCount of them (one each without customPrimPtrs); typeId names the kind of
-  // primitive. Returns the geometry id with CRT_GEOM_MASK_AABB_BIT set. Unless a subclass intersects
+  // primitive, buildFlags (BUILD_*) how well to build the boxes' tree, a hint an implementation may
+  // ignore. Returns the geometry id with CRT_GEOM_MASK_AABB_BIT set. Unless a subclass intersects
   // the primitives itself, a ray hits a box where it enters it (or at tmin, from inside): the hit's
   // primId is the primitive, its geomId the id returned, coords are 0. Implementations without box
-  // geometry throw std::runtime_error.
+  // geometry throw std::runtime_error. An implementation overrides these two; the two without
+  // buildFlags below (LiteRT's earlier form) call them with BUILD_HIGH.
+  virtual uint32_t AddGeom_AABB(uint32_t typeId, const CRT_AABB* boxMinMaxF8, size_t boxNumber, uint32_t buildFlags, void** customPrimPtrs,
+                                size_t customPrimCount)
+  {
+    (void)typeId, (void)boxMinMaxF8, (void)boxNumber, (void)buildFlags, (void)customPrimPtrs, (void)customPrimCount;
+    throw std::runtime_error(std::string(Name()) + ": this ISceneObject has no box geometry (AddGeom_AABB)");
+  }
+  virtual void UpdateGeom_AABB(uint32_t geomId, uint32_t typeId, const CRT_AABB* boxMinMaxF8, size_t boxNumber, uint32_t buildFlags,
+                               void** customPrimPtrs, size_t customPrimCount)
+  {
+    (void)geomId, (void)typeId, (void)boxMinMaxF8, (void)boxNumber, (void)buildFlags, (void)customPrimPtrs, (void)customPrimCount;
+    throw std::runtime_error(std::string(Name()) + ": this ISceneObject has no box geometry (UpdateGeom_AABB)");
+  }
   virtual uint32_t AddGeom_AABB(uint32_t typeId, const CRT_AABB* boxMinMaxF8, size_t boxNumber, void** customPrimPtrs = nullptr,
                                 size_t customPrimCount = 0)
   {
-    (void)typeId, (void)boxMinMaxF8, (void)boxNumber, (void)customPrimPtrs, (void)customPrimCount;
-    throw std::runtime_error(std::string(Name()) + ": this ISceneObject has no box geometry (AddGeom_AABB)");
+    return AddGeom_AABB(typeId, boxMinMaxF8, boxNumber, uint32_t(BUILD_HIGH), customPrimPtrs, customPrimCount);
   }
   virtual void UpdateGeom_AABB(uint32_t geomId, uint32_t typeId, const CRT_AABB* boxMinMaxF8, size_t boxNumber, void** customPrimPtrs = nullptr,
                                size_t customPrimCount = 0)
   {
-    (void)geomId, (void)typeId, (void)boxMinMaxF8, (void)boxNumber, (void)customPrimPtrs, (void)customPrimCount;
-    throw std::runtime_error(std::string(Name()) + ": this ISceneObject has no box geometry (UpdateGeom_AABB)");
+    UpdateGeom_AABB(geomId, typeId, boxMinMaxF8, boxNumber, uint32_t(BUILD_HIGH), customPrimPtrs, customPrimCount);
   }
 
   // Signed distance fields as geometry (paper 4.2): the surface where the trilinear interpolant of the

@@ -205,7 +205,10 @@ public:
     m_committed = false; // the top level has to be rebuilt around the changed mesh
   }
 
-  uint32_t AddGeom_AABB(uint32_t typeId, const CRT_AABB* boxMinMaxF8, size_t boxNumber, void** customPrimPtrs, size_t customPrimCount) override
+  using ISceneObject::AddGeom_AABB;  // and the forms without build flags
+  using ISceneObject::UpdateGeom_AABB;
+  uint32_t AddGeom_AABB(uint32_t typeId, const CRT_AABB* boxMinMaxF8, size_t boxNumber, uint32_t, void** customPrimPtrs,
+                        size_t customPrimCount) override
   {
     Mesh m;
     m.scene = rtcNewScene(m_device);
@@ -219,7 +222,7 @@ public:
   uint32_t AddGeom_SdfSVS(const litesdf::SdfSVS& svs, uint32_t) override { return addSdf("AddGeom_SdfSVS", svs); }
   uint32_t AddGeom_SdfSBS(const litesdf::SdfSBS& sbs, uint32_t) override { return addSdf("AddGeom_SdfSBS", sbs); }
 
-  void UpdateGeom_AABB(uint32_t geomId, uint32_t typeId, const CRT_AABB* boxMinMaxF8, size_t boxNumber, void** customPrimPtrs,
+  void UpdateGeom_AABB(uint32_t geomId, uint32_t typeId, const CRT_AABB* boxMinMaxF8, size_t boxNumber, uint32_t, void** customPrimPtrs,
                        size_t customPrimCount) override
   {
     geomId &= CRT_GEOM_MASK_AABB_BIT_RM;

@@ -55,6 +55,13 @@
 #include "Gather_ISPC.h"
 #endif
 #endif
+#if __has_include("PixelBlock_CPU.h")
+#include "PixelBlock_CPU.h"
+#include "PixelBlock_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "PixelBlock_ISPC.h"
+#endif
+#endif
 #if __has_include("SaxpyBlock_CPU.h")
 #include "SaxpyBlock_CPU.h"
 #include "SaxpyBlock_Vulkan.h"
@@ -172,6 +179,18 @@ Register saxpyBlock(MakeCase<SaxpyBlock>(
       s.RunBlock(n, 0.75f, x.data(), y.data(), out.data());
       Outputs r;
       Append(r, out);
+      return r;
+    }));
+#endif
+
+#if __has_include("PixelBlock_CPU.h")
+Register pixelBlock(MakeCase<PixelBlock>(
+    "a ...Block loop whose output's size is on the per-thread function it runs (kernel_slicer's MainFunc/MainFuncBlock)", "pixel_block.h/.cpp", 0.0,
+    CONFORMANCE_MAKERS(PixelBlock), [](PixelBlock& p) {
+      std::vector<uint32_t> colors(48 * 32, 0xdeadbeefu);
+      p.MainFuncBlock(48, 32, colors.data(), 2);
+      Outputs r;
+      Append(r, std::vector<float>(colors.begin(), colors.end()));
       return r;
     }));
 #endif

@@ -446,6 +446,66 @@ TEST_CASE("CrossRT box geometry: primitives of several boxes, instances and upda
   CHECK(scene->RayQuery_NearestHit(from(0.5f, 0.5f, 5.0f), down()).instId == 1);
 }
 
+namespace
+{
+// A user's scene written against LiteRT's newer ISceneObject, whose box functions take build flags
+// (kernel_slicer's tests 035-038 and 046 override these): it keeps the boxes and their flags.
+struct FlaggedBoxes : public ISceneObject
+{
+  const char* Name() const override { return "FlaggedBoxes"; }
+  void ClearGeom() override { boxes.clear(); }
+  uint32_t AddGeom_Triangles3f(const float*, size_t, const uint32_t*, size_t, uint32_t = BUILD_HIGH, size_t = 3 * sizeof(float)) override { return 0; }
+  void UpdateGeom_Triangles3f(uint32_t, const float*, size_t, const uint32_t*, size_t, uint32_t = BUILD_HIGH, size_t = 3 * sizeof(float)) override {}
+  uint32_t AddGeom_AABB(uint32_t, const CRT_AABB* boxMinMaxF8, size_t boxNumber, uint32_t buildFlags, void**, size_t) override
+  {
+    boxes.assign(boxMinMaxF8, boxMinMaxF8 + boxNumber);
+    flags = buildFlags;
+    return CRT_GEOM_MASK_AABB_BIT;
+  }
+  void UpdateGeom_AABB(uint32_t, uint32_t, const CRT_AABB* boxMinMaxF8, size_t boxNumber, uint32_t buildFlags, void**, size_t) override
+  {
+    boxes.assign(boxMinMaxF8, boxMinMaxF8 + boxNumber);
+    flags = buildFlags;
+  }
+  void ClearScene() override {}
+  uint32_t AddInstance(uint32_t, const float4x4&) override { return 0; }
+  void UpdateInstance(uint32_t, const float4x4&) override {}
+  void CommitScene(uint32_t = BUILD_HIGH) override {}
+  CRT_Hit RayQuery_NearestHit(float4, float4) override { return CRT_Hit{}; }
+  bool RayQuery_AnyHit(float4, float4) override { return false; }
+  std::vector<CRT_AABB> boxes;
+  uint32_t flags = 0;
+};
+}  // namespace
+
+TEST_CASE("CrossRT box geometry with build flags (LiteRT's newer form) and without", "[litert]")
+{
+  // Every implementation takes both forms: the same boxes, the same hits.
+  const char* impl = anyImplementation();
+  INFO(impl);
+  const CRT_AABB boxes[] = {box(0, 0, 0, 1, 1, 1), box(2, 0, 0, 3, 1, 1)};
+  auto scene = MakeSceneRT(impl);
+  const uint32_t g = scene->AddGeom_AABB(5, boxes, 2, uint32_t(BUILD_LOW), nullptr, 0);
+  REQUIRE((g & CRT_GEOM_MASK_AABB_BIT) != 0u);
+  scene->AddInstance(g, float4x4());
+  scene->CommitScene();
+  CHECK(scene->RayQuery_NearestHit(from(2.5f, 0.5f, 5.0f), down()).primId == 1);
+  const CRT_AABB moved[] = {box(0, 0, 0, 1, 1, 1), box(2, 0, 3, 3, 1, 4)};
+  scene->UpdateGeom_AABB(g, 5, moved, 2, uint32_t(BUILD_LOW), nullptr, 0);
+  scene->CommitScene();
+  CHECK(scene->RayQuery_NearestHit(from(2.5f, 0.5f, 5.0f), down()).t == Approx(1.0f));
+
+  // A scene that implements only the form with flags gets the older form's calls, with BUILD_HIGH.
+  FlaggedBoxes flagged;
+  ISceneObject& asInterface = flagged;
+  CHECK(asInterface.AddGeom_AABB(5, boxes, 2) == CRT_GEOM_MASK_AABB_BIT);
+  CHECK(flagged.boxes.size() == 2);
+  CHECK(flagged.flags == uint32_t(BUILD_HIGH));
+  asInterface.UpdateGeom_AABB(CRT_GEOM_MASK_AABB_BIT, 5, moved, 1);
+  CHECK(flagged.boxes.size() == 1);
+  CHECK(flagged.boxes[0].boxMax.x == 1.0f);
+}
+
 TEST_CASE("CrossRT motion instances interpolate their matrices over the ray's time", "[litert]")
 {
   const char* impl = anyImplementation();

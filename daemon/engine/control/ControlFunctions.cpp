@@ -167,6 +167,43 @@ static void CheckSpecializedChanges(Context& c, const std::string& control, cons
                            "set it before calling '" + control + "' (the call then makes the pipelines again), or after its last kernel call");
 }
 
+namespace {
+
+// kernel_slicer's ...Block form: `MainFuncBlock(tidX, tidY, out_color, passes)` runs the per-thread
+// `MainFunc(tidX, tidY, out_color)` over every thread, and the pointer sizes are written on MainFunc.
+// The size annotation of the sibling's parameter of the same name, where every name it uses is a
+// parameter of the Block function or a member of the class; "" otherwise.
+std::string SiblingSize(const CXXRecordDecl* cls, const CXXMethodDecl* block, const std::string& param) {
+  const std::string name = block->getNameAsString();
+  if (name.size() <= 5 || name.compare(name.size() - 5, 5, "Block") != 0) return "";
+  const std::string sibling = name.substr(0, name.size() - 5);
+  for (const CXXMethodDecl* m : cls->methods()) {
+    if (m->getNameAsString() != sibling) continue;
+    for (const FunctionDecl* redecl : m->redecls())
+      for (const ParmVarDecl* p : redecl->parameters()) {
+        if (p->getNameAsString() != param) continue;
+        for (auto* a : p->specific_attrs<AnnotateAttr>()) {
+          if (!a->getAnnotation().starts_with("crossrt.size=")) continue;
+          const std::string expr = a->getAnnotation().substr(13).str();
+          bool known = true;
+          for (size_t i = 0; i < expr.size() && known;) {
+            if (!(std::isalpha(static_cast<unsigned char>(expr[i])) || expr[i] == '_')) { ++i; continue; }
+            size_t end = i;
+            while (end < expr.size() && (std::isalnum(static_cast<unsigned char>(expr[end])) || expr[end] == '_')) ++end;
+            const std::string id = expr.substr(i, end - i);
+            known = std::any_of(block->param_begin(), block->param_end(), [&](const ParmVarDecl* b) { return b->getNameAsString() == id; }) ||
+                    std::any_of(cls->field_begin(), cls->field_end(), [&](const FieldDecl* f) { return f->getNameAsString() == id; });
+            i = end;
+          }
+          if (known) return expr;
+        }
+      }
+  }
+  return "";
+}
+
+}  // namespace
+
 void AnalyzeControl(Context& c, const CXXMethodDecl* md, const FunctionDecl* def) {
   Control ctrl;
   ctrl.name = md->getNameAsString();
@@ -209,6 +246,8 @@ void AnalyzeControl(Context& c, const CXXMethodDecl* md, const FunctionDecl* def
         for (auto* a : redecl->getParamDecl(i)->specific_attrs<AnnotateAttr>())
           if (a->getAnnotation().starts_with("crossrt.size=") && cp.sizeExpr.empty())
             cp.sizeExpr = RenameIdentifiers(a->getAnnotation().substr(13).str(), declaredNames);
+      if (cp.sizeExpr.empty())  // kernel_slicer's XBlock: the size is on X's parameter of the same name
+        cp.sizeExpr = RenameIdentifiers(SiblingSize(c.cls, md, p->getNameAsString()), declaredNames);
       if (cp.sizeExpr.empty() && !c.model.forCpu)  // (an ISPC class reads the C++ memory in place: no copies to size)
         c.rep.GpuError(p->getLocation(), "pointer parameter '" + cp.name + "' of control function '" + ctrl.name + "' has no size",
                     "annotate it with its element count, e.g. '[[crossrt::size(\"n\")]] const float* " + cp.name +

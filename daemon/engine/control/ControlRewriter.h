@@ -79,10 +79,13 @@ private:
   // A thread loop whose body calls such a function is the function's body with its parameters bound
   // to the call's arguments (`m_inlined`): Resolve() reads through them.
   std::map<const ParmVarDecl*, const Expr*> m_inlined;
+  const FunctionDecl* m_perThread = nullptr;  // that function's definition; its call may sit in a pass loop
   const Expr* Resolve(const Expr* e) const;
   // The source text of an argument, read through per-thread functions' parameters.
   std::string ResolvedText(const Expr* e) { return m_c.Text(Resolve(e)->getSourceRange()); }
 
+  // A call of the per-thread function being inlined (in a loop of the thread loop's body).
+  bool IsPerThreadCall(const CXXMethodDecl* md) const;
   // Variables passed as thread ids to RTV kernels anywhere inside `s`.
   std::set<const VarDecl*> ThreadIdVars(const Stmt* s);
 

@@ -111,12 +111,19 @@ std::string ControlRewriter::ThreadBodyGlsl(ThreadLoop& tl, KernelPrinter& print
   }
   auto* call = dyn_cast<CXXMemberCallExpr>(s);
   auto* md = call ? call->getMethodDecl() : nullptr;
+  if (IsPerThreadCall(md))  // kernel_slicer's pass loop around the per-thread function: its body here
+    return ThreadBodyGlsl(tl, printer, m_perThread->getBody(), indent);
   if (!md || !IsKernelName(md->getName()) || IpvDims(md->getName()) || !isa<CXXThisExpr>(call->getImplicitObjectArgument()->IgnoreParenImpCasts())) {
     Error(tl, s->getBeginLoc(), "the thread loop of '" + m_ctrl.name + "' may hold only per-thread local declarations, kernel_ calls and counted loops around them",
           "move this code into a kernel: the loop's body runs once per thread, on the GPU");
     return "";
   }
   return pad + KernelCallGlsl(tl, printer, call) + ";\n";
+}
+
+bool ControlRewriter::IsPerThreadCall(const CXXMethodDecl* md) const {
+  const FunctionDecl* def = nullptr;
+  return m_perThread && md && md->hasBody(def) && def == m_perThread;
 }
 
 std::string ControlRewriter::KernelCallGlsl(ThreadLoop& tl, KernelPrinter& printer, const CXXMemberCallExpr* call) {
@@ -237,6 +244,7 @@ std::string ControlRewriter::ThreadBodyCpp(ThreadLoop& tl, const Stmt* s) {
   if (isa<IfStmt>(s)) return "";  // a loop a kernel's result may end: the megakernel only
   auto* call = dyn_cast<CXXMemberCallExpr>(s);
   auto* md = call ? call->getMethodDecl() : nullptr;
+  if (IsPerThreadCall(md)) return ThreadBodyCpp(tl, m_perThread->getBody());
   if (!md || !IsKernelName(md->getName())) return "";  // declarations (their buffers are set up before), or reported
   std::string args;
   for (unsigned i = 0; i < call->getNumArgs() && i < md->getNumParams(); ++i) {

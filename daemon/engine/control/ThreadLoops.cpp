@@ -47,6 +47,7 @@ bool ControlRewriter::TryThreadLoop(const ForStmt* outerLoop) {
   // The innermost body a call of a per-thread function (kernel_slicer's ...Block form)? Then the
   // thread loop's body is that function's, its parameters bound to the call's arguments.
   m_inlined.clear();
+  m_perThread = nullptr;
   const Stmt* innermost = outerLoop;
   while (auto* fs = dyn_cast_or_null<ForStmt>(innermost)) innermost = SingleStatement(fs->getBody());
   const FunctionDecl* perThread = nullptr;
@@ -54,6 +55,7 @@ bool ControlRewriter::TryThreadLoop(const ForStmt* outerLoop) {
     if (auto* call = dyn_cast<CXXMemberCallExpr>(e->IgnoreImplicit()); call && IsPerThreadFunction(call->getMethodDecl(), m_c.cls)) {
       call->getMethodDecl()->hasBody(perThread);
       for (unsigned i = 0; i < call->getNumArgs() && i < perThread->getNumParams(); ++i) m_inlined[perThread->getParamDecl(i)] = call->getArg(i);
+      m_perThread = perThread;
     }
   const std::set<const VarDecl*> idVars = ThreadIdVars(perThread ? perThread->getBody() : outerLoop);
   ThreadLoop tl;
@@ -66,6 +68,7 @@ bool ControlRewriter::TryThreadLoop(const ForStmt* outerLoop) {
   }
   if (tl.loops.empty()) {
     m_inlined.clear();
+    m_perThread = nullptr;
     return false;
   }
   if (perThread && body == innermost) body = perThread->getBody();
@@ -82,6 +85,8 @@ bool ControlRewriter::TryThreadLoop(const ForStmt* outerLoop) {
     bool VisitVarDecl(VarDecl* vd) { out.insert(vd); return true; }
   } localFinder(tl.locals);
   localFinder.TraverseStmt(const_cast<Stmt*>(body));
+  if (perThread && body != perThread->getBody())  // the call in a pass loop: its locals too
+    localFinder.TraverseStmt(perThread->getBody());
 
   const unsigned index = ++m_threadLoops;
   tl.mega.name = m_ctrl.name + "_Megakernel" + (index > 1 ? std::to_string(index) : "");
@@ -152,6 +157,7 @@ bool ControlRewriter::TryThreadLoop(const ForStmt* outerLoop) {
   if (m_c.model.forIspc && IspcThreadLoop(tl, glsl, outerLoop)) {
     m_c.model.megakernels.push_back(tl.mega);
     m_inlined.clear();
+    m_perThread = nullptr;
     return true;
   }
   const std::string wavefront = ThreadBodyCpp(tl, body);  // after the counts
@@ -189,6 +195,7 @@ bool ControlRewriter::TryThreadLoop(const ForStmt* outerLoop) {
   // CPU: the loop as written, its threads on all cores (the locals are private to each iteration).
   ParallelOnCpu(outerLoop, tl.loops.front(), tl.loops.size());
   m_inlined.clear();
+  m_perThread = nullptr;
   return true;
 }
 

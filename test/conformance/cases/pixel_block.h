@@ -1,0 +1,21 @@
+// kernel_slicer's RTV form as its samples write it: the per-thread function MainFunc carries the
+// size of the output (in its thread counts, tidX by tidY), and the ...Block control function that
+// runs it over every pixel, a_numPasses times, has no size of its own.
+#pragma once
+#include "LiteMath.h"
+#include <cstdint>
+
+using LiteMath::float4;
+
+class PixelBlock
+{
+public:
+  void MainFunc(uint32_t tidX, uint32_t tidY, uint32_t* out_color __attribute__((size("tidX", "tidY"))));
+  virtual void MainFuncBlock(uint32_t tidX, uint32_t tidY, uint32_t* out_color, uint32_t a_numPasses = 1);
+  virtual void CommitDeviceData() {}
+
+  void kernel_InitRay(float4* rayDir, uint32_t tidX, uint32_t tidY);
+  void kernel_Shade(const float4* rayDir, uint32_t* out_color, uint32_t tidX, uint32_t tidY);
+
+  uint32_t m_width = 48;  // the image's row length, which the kernels index by
+};
