@@ -149,6 +149,7 @@ def write_project(project, root, found, backends):
             includes = [s["folder"], os.path.join(s["folder"], "include"), os.path.join(root, "apps", "LiteMathAux"),
                         os.path.join(root, "apps", "utils")]
             body.append(f"target_include_directories({t} PRIVATE {' '.join(includes)})")
+            body.append(f"target_link_libraries({t} PRIVATE crossrt::litemath crossrt::liteimage crossrt::litert)")
             compose = f" COMPOSE {' '.join(s['compose'])}" if s["compose"] else ""
             body.append(f"crossrt_add_class({t} {s['class']} BACKEND {b}{compose})")
         open(os.path.join(project, sub, "CMakeLists.txt"), "w").write("\n".join(body) + "\n")

@@ -88,7 +88,8 @@ struct ISceneObject
 {
   virtual ~ISceneObject() = default;
 
-  virtual const char* Name() const = 0;
+  // The implementation's name, for messages (LiteRT's older scenes do not name themselves).
+  virtual const char* Name() const { return "ISceneObject"; }
 
   // Removes all meshes. Instances reference meshes, so this also clears the scene (ClearScene).
   virtual void ClearGeom() = 0;

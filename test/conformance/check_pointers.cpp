@@ -187,10 +187,13 @@ Register saxpyBlock(MakeCase<SaxpyBlock>(
 Register pixelBlock(MakeCase<PixelBlock>(
     "a ...Block loop whose output's size is on the per-thread function it runs (kernel_slicer's MainFunc/MainFuncBlock)", "pixel_block.h/.cpp", 0.0,
     CONFORMANCE_MAKERS(PixelBlock), [](PixelBlock& p) {
-      std::vector<uint32_t> colors(48 * 32, 0xdeadbeefu);
-      p.MainFuncBlock(48, 32, colors.data(), 2);
       Outputs r;
-      Append(r, std::vector<float>(colors.begin(), colors.end()));
+      for (auto mode : {crossrt::ExecutionMode::Megakernel, crossrt::ExecutionMode::Wavefront}) {  // both ways on Vulkan
+        if (auto* gpu = dynamic_cast<PixelBlock_Vulkan*>(&p)) gpu->SetExecutionMode(mode);
+        std::vector<uint32_t> colors(48 * 32, 0xdeadbeefu);
+        p.MainFuncBlock(48, 32, colors.data(), 2);
+        Append(r, std::vector<double>(colors.begin(), colors.end()));
+      }
       return r;
     }));
 #endif

@@ -84,6 +84,8 @@ private:
   // The source text of an argument, read through per-thread functions' parameters.
   std::string ResolvedText(const Expr* e) { return m_c.Text(Resolve(e)->getSourceRange()); }
 
+  // A local of a thread loop's body that is a compile-time constant (const uint32_t c = 0xFF;).
+  bool IsConstantLocal(const VarDecl* vd) const;
   // A call of the per-thread function being inlined (in a loop of the thread loop's body).
   bool IsPerThreadCall(const CXXMethodDecl* md) const;
   // Variables passed as thread ids to RTV kernels anywhere inside `s`.

@@ -45,6 +45,13 @@ std::string ControlRewriter::ThreadBodyGlsl(ThreadLoop& tl, KernelPrinter& print
       auto* vd = dyn_cast<VarDecl>(d);
       if (!vd) continue;
       const Expr* init = vd->getInit();
+      if (IsConstantLocal(vd)) {  // the same for every thread: a constant of the shader, and of the host code
+        m_hostLoopVars.insert(vd);
+        const std::string type = *GlslTypeOf(vd->getType().getUnqualifiedType());
+        out += pad + "const " + (m_c.model.forIspc ? IspcTypeName(type) : type) + " " + KernelPrinter::SafeName(vd->getNameAsString()) + " = " +
+               printer.Expr(init) + ";\n";
+        continue;
+      }
       auto* construct = init ? dyn_cast<CXXConstructExpr>(init->IgnoreImplicit()) : nullptr;
       if (init && !(construct && construct->getNumArgs() == 0)) {
         Error(tl, vd->getLocation(), "per-thread local '" + vd->getNameAsString() + "' of the thread loop of '" + m_ctrl.name + "' has an initializer",
@@ -119,6 +126,12 @@ std::string ControlRewriter::ThreadBodyGlsl(ThreadLoop& tl, KernelPrinter& print
     return "";
   }
   return pad + KernelCallGlsl(tl, printer, call) + ";\n";
+}
+
+bool ControlRewriter::IsConstantLocal(const VarDecl* vd) const {
+  Expr::EvalResult r;
+  return vd->getInit() && vd->getType().isConstQualified() && vd->getType()->isArithmeticType() && GlslTypeOf(vd->getType().getUnqualifiedType()) &&
+         vd->getInit()->EvaluateAsRValue(r, m_c.ctx);
 }
 
 bool ControlRewriter::IsPerThreadCall(const CXXMethodDecl* md) const {
@@ -240,6 +253,13 @@ std::string ControlRewriter::ThreadBodyCpp(ThreadLoop& tl, const Stmt* s) {
               p->getNameAsString() + "', which '" + m_ctrl.name + "' passes as '" + ResolvedText(dr) + "'",
               "pass the values its loops read under the same names");
     return m_c.Text(SourceRange(fs->getBeginLoc(), fs->getRParenLoc())) + "\n{\n" + ThreadBodyCpp(tl, fs->getBody()) + "}\n";
+  }
+  if (auto* ds = dyn_cast<DeclStmt>(s)) {  // constants as written (the other locals' buffers are set up before)
+    std::string out;
+    for (auto* d : ds->decls())
+      if (auto* vd = dyn_cast<VarDecl>(d); vd && IsConstantLocal(vd))
+        out += "const " + CppTypeName(m_c.ctx, vd->getType().getUnqualifiedType()) + " " + vd->getNameAsString() + " = " + ResolvedText(vd->getInit()) + ";\n";
+    return out;
   }
   if (isa<IfStmt>(s)) return "";  // a loop a kernel's result may end: the megakernel only
   auto* call = dyn_cast<CXXMemberCallExpr>(s);

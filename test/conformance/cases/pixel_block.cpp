@@ -15,17 +15,18 @@ void PixelBlock::kernel_InitRay(float4* rayDir, uint32_t tidX, uint32_t tidY)
   *rayDir = LiteMath::normalize(float4(u, v, 1.0f, 0.0f));
 }
 
-void PixelBlock::kernel_Shade(const float4* rayDir, uint32_t* out_color, uint32_t tidX, uint32_t tidY)
+void PixelBlock::kernel_Shade(const float4* rayDir, uint32_t* out_color, uint32_t tidX, uint32_t tidY, uint32_t alpha)
 {
   const float4 d = *rayDir;
-  out_color[tidY * m_width + tidX] = PackColor(float4(0.5f + 0.5f * d.x, 0.5f + 0.5f * d.y, d.z * d.z, 1.0f));
+  out_color[tidY * m_width + tidX] = PackColor(float4(0.5f + 0.5f * d.x, 0.5f + 0.5f * d.y, d.z * d.z, 1.0f)) | (alpha << 24);
 }
 
 void PixelBlock::MainFunc(uint32_t tidX, uint32_t tidY, uint32_t* out_color)
 {
+  const uint32_t opaque = 0xFF;  // the same for every thread
   float4 rayDir;
   kernel_InitRay(&rayDir, tidX, tidY);
-  kernel_Shade(&rayDir, out_color, tidX, tidY);
+  kernel_Shade(&rayDir, out_color, tidX, tidY, opaque);
 }
 
 void PixelBlock::MainFuncBlock(uint32_t tidX, uint32_t tidY, uint32_t* out_color, uint32_t a_numPasses)
