@@ -7,7 +7,9 @@ kernel_slicer generated) that define the class's member functions, or those of i
 and composed implementations, and crossrt_add_class() for each backend. A sample's class is its
 kmake.json's mainClass, else the class that declares its kernel_ functions; its composition
 (kmake.json's composClasses, or -composInterface/-composImplementation in kernel_slicer's own
-.vscode/launch.json) becomes COMPOSE. Each target is built on its own; the
+.vscode/launch.json, or else the one class of the sample derived from the interface of a
+std::shared_ptr member, or BVHScene for an ISceneObject the sample does not implement) becomes
+COMPOSE. Each target is built on its own; the
 table gives per sample and backend "ok" or the first error (the translator's file:line:col: error,
 or the compiler's). Usable = translated and compiled (shaders included); nothing is run. Writes
 WORK/survey.csv.
@@ -15,7 +17,7 @@ WORK/survey.csv.
 kernel_slicer's LiteMath, LiteScene and RayTracing are git submodules: the samples get CrossRT's
 LiteMath, Image2d and CrossRT.h (ISceneObject) instead, as crossrt_add_class gives every class.
 
-usage: bench/kernel_slicer_survey.py KSLICER_DIR [--build BUILD] [--work WORK] [--backends vulkan,cpu,ispc] [--only PREFIX,...]"""
+usage: bench/kernel_slicer_survey.py KSLICER_DIR [--build BUILD] [--work WORK] [--backends vulkan,cpu,ispc] [--only PREFIX,...] [--include DIR]"""
 import argparse
 import csv
 import json
@@ -77,6 +79,23 @@ def compositions(kmake, folder, sources, launch):
     return pairs
 
 
+def implied_compositions(folder, main_class):
+    """INTERFACE=IMPLEMENTATION where the class holds a std::shared_ptr<INTERFACE> member and the
+    sample's headers derive exactly one class from INTERFACE (samples that name no composition)."""
+    text = ""
+    for name in sorted(os.listdir(folder)):
+        if name.endswith((".h", ".hpp")):
+            text += strip_comments(open(os.path.join(folder, name), encoding="utf-8", errors="replace").read())
+    pairs = []
+    for interface in sorted(set(re.findall(r"std::shared_ptr<\s*(\w+)\s*>\s*\w+\s*(?:=[^;]*)?;", text))):
+        derived = re.findall(r"\b(?:class|struct)\s+(\w+)\s*:\s*(?:public\s+)?" + re.escape(interface) + r"\b", text)
+        if len(derived) == 1 and derived[0] != main_class:
+            pairs.append(f"{interface}={derived[0]}")
+        elif not derived and interface == "ISceneObject":  # CreateSceneRT's scene: CrossRT's own, as the paper composes it
+            pairs.append("ISceneObject=BVHScene")
+    return pairs
+
+
 def defining_sources(folder, names, classes):
     """The .cpp files that define a member function of one of `classes` (kmake.json's "source" when it names them)."""
     found = []
@@ -118,6 +137,7 @@ def samples(root):
         main_class = kmake.get("mainClass") or (classes[-1] if classes else None)
         listed = [s for s in kmake.get("source", []) if s in candidates]
         compose = compositions(kmake, folder, [os.path.join(folder, s) for s in listed or candidates], launch)
+        compose += [p for p in implied_compositions(folder, main_class) if p.split("=")[0] not in {c.split("=")[0] for c in compose}]
         owners = [main_class] + list(kmake.get("baseClasses") or []) + [p.split("=")[1] for p in compose]
         sources = sorted(set(listed + defining_sources(folder, candidates, [c for c in owners if c])))
         yield {
@@ -133,7 +153,7 @@ def target_name(sample, backend):
     return re.sub(r"\W", "_", sample) + "_" + backend
 
 
-def write_project(project, root, found, backends):
+def write_project(project, root, found, backends, extra_includes):
     os.makedirs(project, exist_ok=True)
     lines = ["cmake_minimum_required(VERSION 3.22)", "project(kernel_slicer_survey CXX)", "set(CMAKE_CXX_STANDARD 17)",
              "find_package(CrossRT REQUIRED)"]
@@ -147,7 +167,7 @@ def write_project(project, root, found, backends):
             t = target_name(s["sample"], b)
             body.append(f"add_library({t} OBJECT {' '.join(s['sources'])})")
             includes = [s["folder"], os.path.join(s["folder"], "include"), os.path.join(root, "apps", "LiteMathAux"),
-                        os.path.join(root, "apps", "utils")]
+                        os.path.join(root, "apps", "utils")] + [os.path.abspath(d) for d in extra_includes]
             body.append(f"target_include_directories({t} PRIVATE {' '.join(includes)})")
             body.append(f"target_link_libraries({t} PRIVATE crossrt::litemath crossrt::liteimage crossrt::litert)")
             compose = f" COMPOSE {' '.join(s['compose'])}" if s["compose"] else ""
@@ -173,6 +193,8 @@ def main():
     parser.add_argument("--work", default="out/kernel_slicer_survey", help="where the project, its build and survey.csv go")
     parser.add_argument("--backends", default="vulkan,cpu", help="comma-separated: vulkan, cpu, ispc (default vulkan,cpu)")
     parser.add_argument("--only", default="", help="comma-separated prefixes of sample names (e.g. tests/003,04_)")
+    parser.add_argument("--include", action="append", default=[], metavar="DIR",
+                        help="an include folder for every sample, e.g. a LiteScene checkout for the samples that load meshes (cmesh4.h)")
     args = parser.parse_args()
     root = os.path.abspath(args.kslicer)
     if not os.path.isdir(os.path.join(root, "apps", "tests")):
@@ -183,7 +205,7 @@ def main():
     shutil.rmtree(project, ignore_errors=True)
     found = [s for s in samples(root) if not args.only or any(s["sample"].startswith(p) for p in args.only.split(","))]
     subprocess.run(["cmake", "--install", args.build, "--prefix", prefix], check=True, stdout=subprocess.DEVNULL)
-    write_project(project, root, found, backends)
+    write_project(project, root, found, backends, args.include)
     configure = subprocess.run(["cmake", "-S", project, "-B", build, "-G", "Ninja", "-DCMAKE_BUILD_TYPE=Release",
                                 f"-DCMAKE_PREFIX_PATH={prefix}"], capture_output=True, text=True)
     if configure.returncode != 0:

@@ -213,6 +213,7 @@ struct ControlParam {
   bool isConst = false;
   std::string pointeeCpp;    // element type of a pointer
   std::string sizeExpr;      // from [[crossrt::size("...")]]
+  bool hostOnly = false;     // a pointer no kernel gets (memcpy to it after the kernels): no device copy, no size
   // An Image2D (by reference or value): copied to a device image for the call, and back unless
   // const or by value. pointeeCpp is its texel type.
   bool isImage = false;

@@ -108,6 +108,7 @@ struct alignas(8) float2
   float x, y;
   float2() : x(0), y(0) {}
   explicit float2(float a) : x(a), y(a) {}
+  explicit float2(const float (&a)[2]) : x(a[0]), y(a[1]) {}  // from an array, as LiteMath's
   explicit float2(const int2& v);  // componentwise conversion
   explicit float2(const uint2& v);  // componentwise conversion
   float2(float a_x, float a_y) : x(a_x), y(a_y) {}
@@ -120,6 +121,7 @@ struct float3
   float x, y, z;
   float3() : x(0), y(0), z(0) {}
   explicit float3(float a) : x(a), y(a), z(a) {}
+  explicit float3(const float (&a)[3]) : x(a[0]), y(a[1]), z(a[2]) {}  // from an array, as LiteMath's
   explicit float3(const int3& v);  // componentwise conversion
   explicit float3(const uint3& v);  // componentwise conversion
   float3(float a_x, float a_y, float a_z) : x(a_x), y(a_y), z(a_z) {}
@@ -133,6 +135,7 @@ struct alignas(16) float4
   float x, y, z, w;
   float4() : x(0), y(0), z(0), w(0) {}
   explicit float4(float a) : x(a), y(a), z(a), w(a) {}
+  explicit float4(const float (&a)[4]) : x(a[0]), y(a[1]), z(a[2]), w(a[3]) {}  // from an array, as LiteMath's
   explicit float4(const int4& v);  // componentwise conversion
   explicit float4(const uint4& v);  // componentwise conversion
   explicit float4(const half4& v);  // componentwise conversion
@@ -147,6 +150,7 @@ struct alignas(8) int2
   int x, y;
   int2() : x(0), y(0) {}
   explicit int2(int a) : x(a), y(a) {}
+  explicit int2(const int (&a)[2]) : x(a[0]), y(a[1]) {}  // from an array, as LiteMath's
   explicit int2(const float2& v);  // componentwise conversion
   explicit int2(const uint2& v);  // componentwise conversion
   int2(int a_x, int a_y) : x(a_x), y(a_y) {}
@@ -159,6 +163,7 @@ struct int3
   int x, y, z;
   int3() : x(0), y(0), z(0) {}
   explicit int3(int a) : x(a), y(a), z(a) {}
+  explicit int3(const int (&a)[3]) : x(a[0]), y(a[1]), z(a[2]) {}  // from an array, as LiteMath's
   explicit int3(const float3& v);  // componentwise conversion
   explicit int3(const uint3& v);  // componentwise conversion
   int3(int a_x, int a_y, int a_z) : x(a_x), y(a_y), z(a_z) {}
@@ -172,6 +177,7 @@ struct alignas(16) int4
   int x, y, z, w;
   int4() : x(0), y(0), z(0), w(0) {}
   explicit int4(int a) : x(a), y(a), z(a), w(a) {}
+  explicit int4(const int (&a)[4]) : x(a[0]), y(a[1]), z(a[2]), w(a[3]) {}  // from an array, as LiteMath's
   explicit int4(const float4& v);  // componentwise conversion
   explicit int4(const uint4& v);  // componentwise conversion
   int4(int a_x, int a_y, int a_z, int a_w) : x(a_x), y(a_y), z(a_z), w(a_w) {}
@@ -185,6 +191,7 @@ struct alignas(8) uint2
   uint x, y;
   uint2() : x(0), y(0) {}
   explicit uint2(uint a) : x(a), y(a) {}
+  explicit uint2(const uint (&a)[2]) : x(a[0]), y(a[1]) {}  // from an array, as LiteMath's
   explicit uint2(const float2& v);  // componentwise conversion
   explicit uint2(const int2& v);  // componentwise conversion
   uint2(uint a_x, uint a_y) : x(a_x), y(a_y) {}
@@ -197,6 +204,7 @@ struct uint3
   uint x, y, z;
   uint3() : x(0), y(0), z(0) {}
   explicit uint3(uint a) : x(a), y(a), z(a) {}
+  explicit uint3(const uint (&a)[3]) : x(a[0]), y(a[1]), z(a[2]) {}  // from an array, as LiteMath's
   explicit uint3(const float3& v);  // componentwise conversion
   explicit uint3(const int3& v);  // componentwise conversion
   uint3(uint a_x, uint a_y, uint a_z) : x(a_x), y(a_y), z(a_z) {}
@@ -210,6 +218,7 @@ struct alignas(16) uint4
   uint x, y, z, w;
   uint4() : x(0), y(0), z(0), w(0) {}
   explicit uint4(uint a) : x(a), y(a), z(a), w(a) {}
+  explicit uint4(const uint (&a)[4]) : x(a[0]), y(a[1]), z(a[2]), w(a[3]) {}  // from an array, as LiteMath's
   explicit uint4(const float4& v);  // componentwise conversion
   explicit uint4(const int4& v);  // componentwise conversion
   uint4(uint a_x, uint a_y, uint a_z, uint a_w) : x(a_x), y(a_y), z(a_z), w(a_w) {}

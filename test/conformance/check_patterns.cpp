@@ -36,6 +36,13 @@
 #include "ShadedSpheres_ISPC.h"
 #endif
 #endif
+#if __has_include("PointerHits_CPU.h")
+#include "PointerHits_CPU.h"
+#include "PointerHits_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "PointerHits_ISPC.h"
+#endif
+#endif
 #if __has_include("StagedSaxpy_CPU.h")
 #include "StagedSaxpy_CPU.h"
 #include "StagedSaxpy_Vulkan.h"
@@ -94,6 +101,21 @@ Register redPixels(MakeCase<RedPixels>(
       Append(r, image);
       r.push_back(double(p.m_found.size()));
       r.push_back(double(p.m_redPixelsNum));
+      return r;
+    }));
+#endif
+
+#if __has_include("PointerHits_CPU.h")
+Register pointerHits(MakeCase<PointerHits>(
+    "virtual methods that report through a pointer, Intersect(..., &hit) over a std::vector of shapes", "pointer_hits.h/.cpp", 1e-5,
+    CONFORMANCE_MAKERS(PointerHits), [](PointerHits& p) {
+      p.CommitDeviceData();
+      const uint32_t n = 400;
+      std::vector<float4> dirs(n), out(n);
+      for (uint32_t i = 0; i < n; i++) dirs[i] = float4(-0.5f + float(i % 20) / 19.0f, -0.45f + float(i / 20) / 25.0f, 1.0f, 0.0f);
+      p.Trace(n, dirs.data(), out.data());
+      Outputs r;
+      for (const float4& o : out) Append(r, std::vector<float>{o.x, o.y, o.z});
       return r;
     }));
 #endif

@@ -55,6 +55,13 @@
 #include "Gather_ISPC.h"
 #endif
 #endif
+#if __has_include("BodiesOut_CPU.h")
+#include "BodiesOut_CPU.h"
+#include "BodiesOut_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "BodiesOut_ISPC.h"
+#endif
+#endif
 #if __has_include("PixelBlock_CPU.h")
 #include "PixelBlock_CPU.h"
 #include "PixelBlock_Vulkan.h"
@@ -179,6 +186,22 @@ Register saxpyBlock(MakeCase<SaxpyBlock>(
       s.RunBlock(n, 0.75f, x.data(), y.data(), out.data());
       Outputs r;
       Append(r, out);
+      return r;
+    }));
+#endif
+
+#if __has_include("BodiesOut_CPU.h")
+Register bodiesOut(MakeCase<BodiesOut>(
+    "an output pointer without a size that only host code fills (memcpy from a member vector after the kernels)", "bodies_out.h/.cpp", 1e-5,
+    CONFORMANCE_MAKERS(BodiesOut), [](BodiesOut& b) {
+      b.CommitDeviceData();
+      Outputs r;
+      for (uint32_t steps : {3u, 5u}) {  // twice, the host reading m_steps each time
+        b.SetSteps(steps);
+        std::vector<BodyState> out(b.m_bodies.size());
+        b.Perform(out.data());
+        for (const BodyState& s : out) Append(r, std::vector<float>{s.posAndMass.x, s.posAndMass.y, s.velocity.x, s.velocity.y});
+      }
       return r;
     }));
 #endif

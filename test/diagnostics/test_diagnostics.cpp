@@ -1675,3 +1675,58 @@ void Scaler::kernel1D_Scale(int n, float* data)
   const std::string text((std::istreambuf_iterator<char>(header)), std::istreambuf_iterator<char>());
   REQUIRE(text.find("namespace demo\n{\nclass Scaler_CPU : public Scaler") != std::string::npos);
 }
+
+TEST_CASE("kernel_slicer's setter form: writes through a member's pointers run on the CPU, and are a clear error on the GPU and ISPC",
+          "[diagnostics]")
+{
+  // The output pointers live in a member struct (kernel_slicer's [[kslicer::setter]] SetOutput). Each
+  // thread writes its own element: no data race, and the CPU class runs the kernel as written.
+  auto header = [](const std::string& name) {
+    return "#pragma once\nstruct Outputs { float* sums; float* products; };\nclass " + name + R"(
+{
+public:
+  virtual ~)" + name + R"(() = default;
+  void SetOutput(Outputs out) { m_out = out; }
+  virtual void Process(int n, [[crossrt::size("n")]] const float* a, [[crossrt::size("n")]] const float* b);
+protected:
+  void kernel1D_Process(int n, const float* a, const float* b);
+  Outputs m_out;
+};
+)";
+  };
+  auto source = [](const std::string& name, const std::string& write) {
+    return "#include \"" + name + ".h\"\nvoid " + name + "::Process(int n, const float* a, const float* b) { kernel1D_Process(n, a, b); }\nvoid " + name +
+           "::kernel1D_Process(int n, const float* a, const float* b)\n{\n  for (int i = 0; i < n; i++)\n  {\n    m_out.sums[i] = a[i] + b[i];\n    " + write +
+           "\n  }\n}\n";
+  };
+  auto translate = [](const TempClass& tc, const std::string& name, const std::string& backend) {
+    return RunCrossrt("translate --class " + name + " --backend " + backend + " --out " + (tc.dir / ("out_" + backend)).string() + " --source " +
+                      tc.Source(name) + " --templates " CROSSRT_SOURCE_DIR "/templates");
+  };
+  SECTION("each thread at its index")
+  {
+    TempClass tc("Setter", header("Setter"), source("Setter", "m_out.products[i] = a[i] * b[i];"));
+    CommandResult cpu = translate(tc, "Setter", "cpu");
+    INFO(cpu.output);
+    REQUIRE(cpu.exitCode == 0);
+    for (const char* backend : {"vulkan", "ispc"})
+    {
+      CommandResult r = translate(tc, "Setter", backend);
+      INFO(backend << ": " << r.output);
+      REQUIRE_FALSE(r.crashed);
+      REQUIRE(r.exitCode == 1);
+      REQUIRE(r.output.find("Setter.cpp:7:") != std::string::npos);
+      REQUIRE(r.output.find("kernel writes through pointer member 'm_out' (kernel_slicer's setter form)") != std::string::npos);
+      REQUIRE(r.output.find("the CPU backend runs this kernel as written") != std::string::npos);
+    }
+  }
+  SECTION("one element from every thread stays a data race on the CPU too")
+  {
+    TempClass tc("SetterRace", header("SetterRace"), source("SetterRace", "m_out.products[0] = a[i];"));
+    CommandResult cpu = translate(tc, "SetterRace", "cpu");
+    INFO(cpu.output);
+    REQUIRE(cpu.exitCode == 1);
+    REQUIRE(cpu.output.find("SetterRace.cpp:8:") != std::string::npos);
+    REQUIRE(cpu.output.find("kernel writes one element through pointer member 'm_out' from every thread (a data race)") != std::string::npos);
+  }
+}

@@ -78,7 +78,7 @@ void CallableDispatcher(ASTContext& ctx, Reporter& rep, ClassModel& model, Kerne
   for (unsigned i = 0; i < m->getNumParams(); ++i) {
     const ParmVarDecl* p = m->getParamDecl(i);
     Data x;
-    x.set("declaration", kernelPrinter.Declare(p->getType().getNonReferenceType().getUnqualifiedType(), CallArgumentName(m, i), p->getLocation()));
+    x.set("declaration", kernelPrinter.Declare(PassedType(m, i), CallArgumentName(m, i), p->getLocation()));
     fields.push_back(x);
   }
   payload.set("fields", fields);

@@ -84,14 +84,20 @@ std::string CallArgumentName(const CXXMethodDecl* m, unsigned i) {
 
 bool WrittenBack(const CXXMethodDecl* m, unsigned i) {
   QualType pt = m->getParamDecl(i)->getType();
+  if (pt->isPointerType()) return !pt->getPointeeType().isConstQualified();  // CRT_Hit* pHit: the one value it points at
   return pt->isReferenceType() && !pt.getNonReferenceType().isConstQualified();
+}
+
+QualType PassedType(const CXXMethodDecl* m, unsigned i) {
+  QualType pt = m->getParamDecl(i)->getType();
+  return (pt->isPointerType() ? pt->getPointeeType() : pt.getNonReferenceType()).getUnqualifiedType();
 }
 
 std::string DispatcherParams(KernelPrinter& printer, const CXXMethodDecl* m, bool forIspc) {
   std::string out;
   for (unsigned i = 0; i < m->getNumParams(); ++i) {
     if (KernelPrinter::PointsTo(m->getParamDecl(i)->getType(), printer.Class())) continue;  // the caller, left out (print/Owner.cpp)
-    std::string declared = printer.Declare(m->getParamDecl(i)->getType(), CallArgumentName(m, i), m->getParamDecl(i)->getLocation());
+    std::string declared = printer.Declare(PassedType(m, i), CallArgumentName(m, i), m->getParamDecl(i)->getLocation());
     if (WrittenBack(m, i) && forIspc) declared.insert(declared.rfind(' ') + 1, "&");  // ISPC: a reference
     else if (WrittenBack(m, i)) declared = "inout " + declared;
     out += ", " + declared;

@@ -29,8 +29,12 @@ void RequirePublicForComposition(Reporter& rep, const FieldDecl* f, const std::s
 // The GLSL name of a virtual method's parameter i: the interface's (it may leave it unnamed).
 std::string CallArgumentName(const CXXMethodDecl* m, unsigned i);
 
-// A non-const reference parameter of a virtual method: its value comes back to the caller.
+// A non-const reference parameter of a virtual method, or a pointer to a non-const value: its value
+// comes back to the caller.
 bool WrittenBack(const CXXMethodDecl* m, unsigned i);
+// The type of the value a dispatcher passes for parameter i: a reference's or a pointer's pointee
+// (a virtual method's pointer parameter is the one value the caller's &x points at).
+QualType PassedType(const CXXMethodDecl* m, unsigned i);
 
 // ", vec3 normal, inout float weight": a dispatcher's parameters after the element's index.
 std::string DispatcherParams(KernelPrinter& printer, const CXXMethodDecl* m, bool forIspc);

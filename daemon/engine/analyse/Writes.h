@@ -64,8 +64,54 @@ struct WriteScanner : RecursiveASTVisitor<WriteScanner> {
       for (auto* u : uses) reductionUses.insert(u);
       return;
     }
+    if (ThroughPointer(lhs)) {  // m_out.summ[i] = ...: the memory a pointer member points at, not the member
+      // The CPU class runs the kernel as written, each thread at its index (as through a kernel's
+      // pointer parameter); one constant element written from every thread stays a data race.
+      if (c.model.forCpu && !c.model.forIspc) {
+        if (!IndexedPerThread(lhs, c.ctx))
+          c.rep.Error(loc, "kernel writes one element through pointer member '" + root->getNameAsString() + "' from every thread (a data race)",
+                      "write at the thread's own index (p[i]), or accumulate in a member with 'm += x' (a reduction)");
+        return;
+      }
+      c.rep.Error(loc, "kernel writes through pointer member '" + root->getNameAsString() + "' (kernel_slicer's setter form)",
+                  c.model.forIspc ? "ISPC kernels reach memory through the class's buffers: pass the output as a size-annotated pointer parameter, "
+                                    "or write to a std::vector member (the CPU backend runs this kernel as written)"
+                                  : "GPU kernels reach memory through buffers: pass the output as a size-annotated pointer parameter, or write to "
+                                    "a std::vector member (the CPU backend runs this kernel as written)");
+      return;
+    }
     c.rep.Error(loc, "kernel writes class member '" + root->getNameAsString() + "' from every thread (a data race)",
                 "accumulate with 'm += x', 'm = std::min(m, x)' or 'm = std::max(m, x)' (a reduction), or write to an element of a std::vector member");
+  }
+  // Whether the written lvalue is reached through a pointer (p[i], *p, p->f on the way to the member).
+  static bool ThroughPointer(const Expr* e) {
+    for (e = e->IgnoreParenImpCasts();; e = e->IgnoreParenImpCasts()) {
+      if (auto* as = dyn_cast<ArraySubscriptExpr>(e)) {
+        if (as->getBase()->IgnoreParenImpCasts()->getType()->isPointerType()) return true;
+        e = as->getBase();
+      } else if (auto* uo = dyn_cast<UnaryOperator>(e); uo && uo->getOpcode() == UO_Deref) {
+        return true;
+      } else if (auto* me = dyn_cast<MemberExpr>(e)) {
+        if (me->isArrow() && !isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts())) return true;
+        e = me->getBase();
+      } else {
+        return false;
+      }
+    }
+  }
+  // p[k] with an index that is not a constant, on the way to the written lvalue.
+  static bool IndexedPerThread(const Expr* e, ASTContext& ctx) {
+    for (e = e->IgnoreParenImpCasts();; e = e->IgnoreParenImpCasts()) {
+      if (auto* as = dyn_cast<ArraySubscriptExpr>(e)) {
+        Expr::EvalResult r;
+        if (as->getBase()->IgnoreParenImpCasts()->getType()->isPointerType()) return !as->getIdx()->EvaluateAsInt(r, ctx);
+        e = as->getBase();
+      } else if (auto* me = dyn_cast<MemberExpr>(e)) {
+        e = me->getBase();
+      } else {
+        return false;
+      }
+    }
   }
   std::optional<ReduceOp> MinMax(const Expr* lhs, const Expr* rhs, std::vector<const MemberExpr*>& uses) {
     auto* call = dyn_cast<CallExpr>(rhs->IgnoreImplicit());

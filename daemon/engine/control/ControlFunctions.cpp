@@ -202,7 +202,50 @@ std::string SiblingSize(const CXXRecordDecl* cls, const CXXMethodDecl* block, co
   return "";
 }
 
+// Whether the control function hands pointer parameter `p` on: to a member function of the class
+// (a kernel, or one that may call kernels), or into a variable. Otherwise only host code uses it
+// (memcpy(out, m_v.data(), ...) after the kernels), as the original does, and no kernel needs a copy.
+bool HandedOn(const FunctionDecl* def, const ParmVarDecl* p, const CXXRecordDecl* cls) {
+  struct Finder : RecursiveASTVisitor<Finder> {
+    const ParmVarDecl* p; const CXXRecordDecl* cls; bool found = false;
+    bool Mentions(const Stmt* s) const {
+      struct Refs : RecursiveASTVisitor<Refs> {
+        const ParmVarDecl* p; bool found = false;
+        bool VisitDeclRefExpr(DeclRefExpr* dr) { found |= dr->getDecl() == p; return !found; }
+      } refs;
+      refs.p = p;
+      refs.TraverseStmt(const_cast<Stmt*>(s));
+      return refs.found;
+    }
+    bool VisitCXXMemberCallExpr(CXXMemberCallExpr* call) {
+      auto* md = call->getMethodDecl();
+      if (md && IsClassOrBase(md->getParent(), cls))
+        for (auto* arg : call->arguments()) found |= Mentions(arg);
+      return true;
+    }
+    bool VisitVarDecl(VarDecl* vd) { found |= vd->getInit() && vd->getType()->isPointerType() && Mentions(vd->getInit()); return true; }
+    bool VisitBinaryOperator(BinaryOperator* bo) { found |= bo->isAssignmentOp() && bo->getType()->isPointerType() && Mentions(bo->getRHS()); return true; }
+  } finder;
+  finder.p = p;
+  finder.cls = cls;
+  finder.TraverseStmt(def->getBody());
+  return finder.found;
+}
+
 }  // namespace
+
+bool IsHostOnlyPointer(const ParmVarDecl* p, const CXXRecordDecl* cls) {
+  auto* md = dyn_cast<CXXMethodDecl>(p->getDeclContext());
+  const FunctionDecl* def = nullptr;
+  if (!md || !p->getType()->isPointerType() || !md->hasBody(def) || !def || IsKernelName(md->getName())) return false;
+  unsigned index = p->getFunctionScopeIndex();
+  for (const FunctionDecl* redecl : md->redecls())
+    if (index < redecl->getNumParams())
+      for (auto* a : redecl->getParamDecl(index)->specific_attrs<AnnotateAttr>())
+        if (a->getAnnotation().starts_with("crossrt.size=")) return false;
+  if (!SiblingSize(cls, md, md->getParamDecl(index)->getNameAsString()).empty()) return false;
+  return !HandedOn(def, def->getParamDecl(index), cls);
+}
 
 void AnalyzeControl(Context& c, const CXXMethodDecl* md, const FunctionDecl* def) {
   Control ctrl;
@@ -248,7 +291,8 @@ void AnalyzeControl(Context& c, const CXXMethodDecl* md, const FunctionDecl* def
             cp.sizeExpr = RenameIdentifiers(a->getAnnotation().substr(13).str(), declaredNames);
       if (cp.sizeExpr.empty())  // kernel_slicer's XBlock: the size is on X's parameter of the same name
         cp.sizeExpr = RenameIdentifiers(SiblingSize(c.cls, md, p->getNameAsString()), declaredNames);
-      if (cp.sizeExpr.empty() && !c.model.forCpu)  // (an ISPC class reads the C++ memory in place: no copies to size)
+      cp.hostOnly = cp.sizeExpr.empty() && IsHostOnlyPointer(def->getParamDecl(i), c.cls);
+      if (cp.sizeExpr.empty() && !cp.hostOnly && !c.model.forCpu)  // (an ISPC class reads the C++ memory in place: no copies to size)
         c.rep.GpuError(p->getLocation(), "pointer parameter '" + cp.name + "' of control function '" + ctrl.name + "' has no size",
                     "annotate it with its element count, e.g. '[[crossrt::size(\"n\")]] const float* " + cp.name +
                     "' or 'const float* " + cp.name + " __attribute__((size(\"n\")))'");

@@ -15,6 +15,12 @@ bool IsPerThreadFunction(const CXXMethodDecl* md, const CXXRecordDecl* cls);
 
 const Stmt* SingleStatement(const Stmt* s);
 
+// A pointer parameter of a control function that has no size (on any declaration, nor on a ...Block
+// function's per-thread sibling) and that the function hands to no member function and stores in no
+// variable: only host code uses it (memcpy(out, m_v.data(), ...) after the kernels), so no kernel
+// needs a copy of it, and a library call on it is no GPU work.
+bool IsHostOnlyPointer(const ParmVarDecl* p, const CXXRecordDecl* cls);
+
 // The pass: control function `md` into a Control of the model (its ...Cmd body and its CPU body).
 void AnalyzeControl(Context& c, const CXXMethodDecl* md, const FunctionDecl* def);
 
@@ -33,6 +39,9 @@ struct KernelCallFinder : RecursiveASTVisitor<KernelCallFinder> {
     static const std::set<std::string> library = {"exclusive_scan", "inclusive_scan", "fill", "memcpy", "memmove", "sort"};
     // (memcpy from <string.h> is the C library's, outside std, as LibraryCalls.cpp takes it.)
     if (!fd || !(fd->isInStdNamespace() || IsSystemDecl(fd)) || !library.count(fd->getNameAsString()) || isa<CXXMemberCallExpr>(call)) return true;
+    for (auto* arg : call->arguments())  // host memory no kernel sees: the call runs on the host
+      if (auto* dr = dyn_cast<DeclRefExpr>(arg->IgnoreParenImpCasts()))
+        if (auto* p = dyn_cast<ParmVarDecl>(dr->getDecl()); p && IsHostOnlyPointer(p, cls)) return true;
     for (auto* arg : call->arguments()) {
       auto* mc = dyn_cast<CXXMemberCallExpr>(arg->IgnoreParenImpCasts());
       if (auto* bo = dyn_cast<BinaryOperator>(arg->IgnoreParenImpCasts())) mc = dyn_cast<CXXMemberCallExpr>(bo->getLHS()->IgnoreParenImpCasts());

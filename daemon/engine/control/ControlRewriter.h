@@ -252,6 +252,8 @@ private:
   static bool IsAddition(const Expr* op);
 
   bool TryLibraryCall(const CallExpr* call);
+  // Whether `e` uses a pointer parameter that only host code uses (ControlParam::hostOnly).
+  bool MentionsHostOnlyPointer(const Expr* e) const;
 
   void Visit(const Stmt* s);
 

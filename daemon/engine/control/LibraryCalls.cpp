@@ -5,6 +5,7 @@
 #include "generate/GeneratedNames.h"
 #include "analyse/AnalysisContext.h"
 #include "analyse/AstQueries.h"
+#include "control/ControlFunctions.h"
 #include "control/ControlRewriter.h"
 #include "analyse/LoopShape.h"
 
@@ -166,9 +167,25 @@ bool ControlRewriter::IsAddition(const Expr* op) {
   return a && b && a != b;
 }
 
+bool ControlRewriter::MentionsHostOnlyPointer(const Expr* e) const {
+  struct Refs : RecursiveASTVisitor<Refs> {
+    const CXXRecordDecl* cls; bool found = false;
+    bool VisitDeclRefExpr(DeclRefExpr* dr) {
+      if (auto* p = dyn_cast<ParmVarDecl>(dr->getDecl())) found |= IsHostOnlyPointer(p, cls);
+      return true;
+    }
+  } refs;
+  refs.cls = m_c.cls;
+  refs.TraverseStmt(const_cast<Expr*>(e));
+  return refs.found;
+}
+
 bool ControlRewriter::TryLibraryCall(const CallExpr* call) {
   auto* fd = call->getDirectCallee();
   if (!fd) return false;
+  // Host memory no kernel sees (memcpy(out, m_v.data(), ...) to a pointer only host code uses):
+  // the call runs on the host, as written, after what the kernels wrote is read back.
+  if (MentionsHostOnlyPointer(call)) return false;
   std::string name = fd->getNameAsString();
   if (name == "ReduceAddInit" && InLiteMath(fd)) return ReduceAddInit(call);
   bool inStd = fd->isInStdNamespace() || IsSystemDecl(fd);

@@ -48,7 +48,7 @@ Data ControlsData(const ClassModel& model) {
     Data ptrs = List(), outs = List();
     std::string bindDecl, bindArgs;
     for (auto& p : c.params) {
-      if (!p.isPointer) continue;
+      if (!p.isPointer || p.hostOnly) continue;  // host code alone uses a host-only pointer, as written
       Data y;
       y.set("name", p.name);
       y.set("control", c.name);

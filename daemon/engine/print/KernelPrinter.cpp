@@ -432,6 +432,11 @@ std::string KernelPrinter::VirtualCall(const CXXMemberCallExpr* mc) {
                     m_class->getNameAsString() + " other than the caller", "pass `this`: on the GPU the caller's data are the only ones");
       continue;
     }
+    if (p && p->getType()->isPointerType()) {  // &hit: the value it points at, inout (as a helper's pointer)
+      auto t = Pointer(mc->getArg(i));
+      args.push_back(t ? Pointee(*t, nullptr, mc->getArg(i)->getBeginLoc()) : "/*error*/");
+      continue;
+    }
     args.push_back(Expr(mc->getArg(i)));
   }
   Type(mc->getType(), mc->getBeginLoc());  // declares a returned struct
@@ -703,6 +708,8 @@ std::string KernelPrinter::Expr(const clang::Expr* e) {
     std::vector<const clang::Expr*> args(cons->arg_begin(), cons->arg_end());
     if (IsStdArray(cons->getType()) && args.size() == 1 && cons->getConstructor()->isCopyOrMoveConstructor()) return Expr(args[0]);  // arrays copy
     if (IsUserConstructor(cons->getConstructor())) return ConstructorCall(cons->getConstructor(), args, e->getBeginLoc());
+    if (args.size() == 1 && args[0]->IgnoreImplicit()->getType()->isConstantArrayType() && IsLiteMathType(cons->getType()))
+      return Fail(e->getBeginLoc(), "a LiteMath vector made from an array in a kernel", "name its elements: float3(a[0], a[1], a[2])");
     return Construct(cons->getType(), args, e->getBeginLoc());
   }
   if (auto* il = dyn_cast<InitListExpr>(e)) {
