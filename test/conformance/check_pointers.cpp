@@ -62,6 +62,13 @@
 #include "BodiesOut_ISPC.h"
 #endif
 #endif
+#if __has_include("LayerBlock_CPU.h")
+#include "LayerBlock_CPU.h"
+#include "LayerBlock_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "LayerBlock_ISPC.h"
+#endif
+#endif
 #if __has_include("PixelBlock_CPU.h")
 #include "PixelBlock_CPU.h"
 #include "PixelBlock_Vulkan.h"
@@ -201,6 +208,22 @@ Register bodiesOut(MakeCase<BodiesOut>(
         std::vector<BodyState> out(b.m_bodies.size());
         b.Perform(out.data());
         for (const BodyState& s : out) Append(r, std::vector<float>{s.posAndMass.x, s.posAndMass.y, s.velocity.x, s.velocity.y});
+      }
+      return r;
+    }));
+#endif
+
+#if __has_include("LayerBlock_CPU.h")
+Register layerBlock(MakeCase<LayerBlock>(
+    "a ...Block loop passing its per-thread function a constant for a loop bound, under a name the Block has too", "layer_block.h/.cpp", 1e-6,
+    CONFORMANCE_MAKERS(LayerBlock), [](LayerBlock& b) {
+      Outputs r;
+      for (auto mode : {crossrt::ExecutionMode::Megakernel, crossrt::ExecutionMode::Wavefront}) {  // both ways on Vulkan
+        if (auto* gpu = dynamic_cast<LayerBlock_Vulkan*>(&b)) gpu->SetExecutionMode(mode);
+        std::vector<float> out(300);
+        for (size_t i = 0; i < out.size(); i++) out[i] = 0.25f * float(i % 7);
+        b.AddBlock(uint32_t(out.size()), 5, out.data());
+        Append(r, out);
       }
       return r;
     }));

@@ -264,6 +264,7 @@ private:
   Rewriter m_gpu, m_cpu;
   unsigned m_threadLoops = 0;                  // thread loops seen so far (names the megakernels)
   int m_hostLoopDepth = 0;                     // counted loops around the statement of a thread loop being printed
+  int m_inlineDepth = -1;                      // m_hostLoopDepth where the per-thread function's body is printed (-1: none)
   std::set<const VarDecl*> m_hostLoopVars;     // counters of loops inside thread loops: the same for all threads
 };
 

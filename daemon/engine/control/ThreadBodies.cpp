@@ -106,20 +106,32 @@ std::string ControlRewriter::ThreadBodyGlsl(ThreadLoop& tl, KernelPrinter& print
     auto* kernelCall = dyn_cast<CXXMemberCallExpr>(cond);
     const Stmt* then = SingleStatement(is->getThen());
     const bool leaves = then && (isa<BreakStmt>(then) || isa<ContinueStmt>(then));
-    if (!kernelCall || !kernelCall->getMethodDecl() || !kernelCall->getMethodDecl()->getReturnType()->isBooleanType() || !leaves ||
-        is->getElse() || m_hostLoopDepth == 0) {
+    // `if (!kernel_RayTrace(...)) return;` in the per-thread function, outside its own loops: this
+    // thread's work ends (or, in a loop of passes around the call, this pass's).
+    auto* ret = dyn_cast_or_null<ReturnStmt>(then);
+    const bool returns = ret && !ret->getRetValue() && m_inlineDepth >= 0 && m_hostLoopDepth == m_inlineDepth;
+    if (!kernelCall || !kernelCall->getMethodDecl() || !kernelCall->getMethodDecl()->getReturnType()->isBooleanType() || !(leaves || returns) ||
+        is->getElse() || (m_hostLoopDepth == 0 && !returns)) {
       Error(tl, s->getBeginLoc(), "the thread loop of '" + m_ctrl.name + "' may branch only on a kernel's bool result, to leave a loop inside it",
-            "write if (!kernel_X(tid, ...)) break; (or continue) in a counted loop of the thread loop, and branch on anything else inside the kernels");
+            "write if (!kernel_X(tid, ...)) break; (or continue) in a counted loop of the thread loop, or return; at the top of the per-thread "
+            "function, and branch on anything else inside the kernels");
       return "";
     }
     tl.megakernelOnly = true;
-    return pad + "if (" + (negated ? "!" : "") + KernelCallGlsl(tl, printer, kernelCall) + ")\n" + pad + "  " +
-           (isa<BreakStmt>(then) ? "break;\n" : "continue;\n");
+    const std::string leave = returns ? (m_inlineDepth == 0 ? "return;  // from " + m_perThread->getNameAsString() + ": this thread is done\n"
+                                                            : "continue;  // return from " + m_perThread->getNameAsString() + ": this pass is done\n")
+                                      : isa<BreakStmt>(then) ? "break;\n" : "continue;\n";
+    return pad + "if (" + (negated ? "!" : "") + KernelCallGlsl(tl, printer, kernelCall) + ")\n" + pad + "  " + leave;
   }
   auto* call = dyn_cast<CXXMemberCallExpr>(s);
   auto* md = call ? call->getMethodDecl() : nullptr;
-  if (IsPerThreadCall(md))  // kernel_slicer's pass loop around the per-thread function: its body here
-    return ThreadBodyGlsl(tl, printer, m_perThread->getBody(), indent);
+  if (IsPerThreadCall(md)) {  // kernel_slicer's pass loop around the per-thread function: its body here
+    const int saved = m_inlineDepth;
+    m_inlineDepth = m_hostLoopDepth;
+    std::string out = ThreadBodyGlsl(tl, printer, m_perThread->getBody(), indent);
+    m_inlineDepth = saved;
+    return out;
+  }
   if (!md || !IsKernelName(md->getName()) || IpvDims(md->getName()) || !isa<CXXThisExpr>(call->getImplicitObjectArgument()->IgnoreParenImpCasts())) {
     Error(tl, s->getBeginLoc(), "the thread loop of '" + m_ctrl.name + "' may hold only per-thread local declarations, kernel_ calls and counted loops around them",
           "move this code into a kernel: the loop's body runs once per thread, on the GPU");
@@ -239,20 +251,31 @@ std::string ControlRewriter::ThreadBodyCpp(ThreadLoop& tl, const Stmt* s) {
     return out;
   }
   if (auto* fs = dyn_cast<ForStmt>(s)) {
-    // A host loop of a per-thread function runs in the control function: its parameters must be
-    // what the control function passes, under the same names.
+    // A host loop of a per-thread function runs in the control function: its parameters there are
+    // what the control function passes (StupidPathTrace(i, 6, ...) reads 6 for a_maxDepth).
     struct Refs : RecursiveASTVisitor<Refs> {
       std::vector<const DeclRefExpr*> found;
       bool VisitDeclRefExpr(DeclRefExpr* dr) { found.push_back(dr); return true; }
     } refs;
     for (const Stmt* part : {fs->getInit(), static_cast<const Stmt*>(fs->getCond()), static_cast<const Stmt*>(fs->getInc())})
       if (part) refs.TraverseStmt(const_cast<Stmt*>(part));
+    auto& sm = m_c.ctx.getSourceManager();
+    const SourceLocation begin = fs->getBeginLoc();
+    std::string header = m_c.Text(SourceRange(begin, fs->getRParenLoc()));
+    std::sort(refs.found.begin(), refs.found.end(), [&](const DeclRefExpr* a, const DeclRefExpr* b) {
+      return sm.getFileOffset(a->getBeginLoc()) > sm.getFileOffset(b->getBeginLoc());  // last first: earlier offsets stay valid
+    });
     for (auto* dr : refs.found)
-      if (auto* p = dyn_cast<ParmVarDecl>(dr->getDecl()); p && m_inlined.count(p) && ResolvedText(dr) != p->getNameAsString())
-        Error(tl, dr->getBeginLoc(), "a loop of '" + cast<FunctionDecl>(p->getDeclContext())->getNameAsString() + "' reads its parameter '" +
-              p->getNameAsString() + "', which '" + m_ctrl.name + "' passes as '" + ResolvedText(dr) + "'",
-              "pass the values its loops read under the same names");
-    return m_c.Text(SourceRange(fs->getBeginLoc(), fs->getRParenLoc())) + "\n{\n" + ThreadBodyCpp(tl, fs->getBody()) + "}\n";
+      if (auto* p = dyn_cast<ParmVarDecl>(dr->getDecl()); p && m_inlined.count(p) && ResolvedText(dr) != p->getNameAsString()) {
+        const unsigned at = sm.getFileOffset(dr->getBeginLoc()) - sm.getFileOffset(begin);
+        if (sm.getFileID(dr->getBeginLoc()) != sm.getFileID(begin) || at + p->getName().size() > header.size()) {
+          Error(tl, dr->getBeginLoc(), "a loop of '" + cast<FunctionDecl>(p->getDeclContext())->getNameAsString() + "' reads its parameter '" +
+                p->getNameAsString() + "' through a macro", "write the loop's header without macros");
+          continue;
+        }
+        header.replace(at, p->getName().size(), "(" + ResolvedText(dr) + ")");
+      }
+    return header + "\n{\n" + ThreadBodyCpp(tl, fs->getBody()) + "}\n";
   }
   if (auto* ds = dyn_cast<DeclStmt>(s)) {  // constants as written (the other locals' buffers are set up before)
     std::string out;

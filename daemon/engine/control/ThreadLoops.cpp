@@ -71,7 +71,11 @@ bool ControlRewriter::TryThreadLoop(const ForStmt* outerLoop) {
     m_perThread = nullptr;
     return false;
   }
-  if (perThread && body == innermost) body = perThread->getBody();
+  m_inlineDepth = -1;
+  if (perThread && body == innermost) {
+    body = perThread->getBody();
+    m_inlineDepth = 0;  // the thread loop's body is the per-thread function's
+  }
   else if (auto* e = dyn_cast_or_null<Expr>(body); e && isa<CXXMemberCallExpr>(e->IgnoreImplicit())) return false;  // one kernel: an RTV nest
   for (auto& h : tl.loops) {
     Expr::EvalResult r;
@@ -160,7 +164,8 @@ bool ControlRewriter::TryThreadLoop(const ForStmt* outerLoop) {
     m_perThread = nullptr;
     return true;
   }
-  const std::string wavefront = ThreadBodyCpp(tl, body);  // after the counts
+  // After the counts; none where a kernel's result ends a thread's loop (the megakernel in both modes).
+  const std::string wavefront = tl.megakernelOnly ? "" : ThreadBodyCpp(tl, body);
   tl.mega.glslBody = "// from " + m_c.cls->getNameAsString() + "::" + m_ctrl.name + " (" + m_ctrl.sourceFile +
                      "): the body of its thread loop, each kernel call a function call\nvoid " + tl.mega.name + "(" + signature + ")\n{\n" + glsl + "}\n";
   m_c.model.megakernels.push_back(tl.mega);
@@ -179,8 +184,8 @@ bool ControlRewriter::TryThreadLoop(const ForStmt* outerLoop) {
   for (auto& h : tl.loops) threads += (threads.empty() ? "" : " * ") + std::string("size_t(") + CountExpr(m_c, h) + ")";
   std::string text =
       "if (crt_executionMode == crossrt::ExecutionMode::Megakernel)  // the whole loop body in one shader\n" + tl.mega.name + "Cmd(crt_cmd" + tl.counts + tl.hostArgs +
-      ");\nelse  // wavefront: one dispatch per kernel call, each thread's locals in buffers between them\n{\nconst size_t crt_threads = " + threads + ";\n" + states +
-      wavefront + "}\n";
+      ");\nelse  // wavefront: one dispatch per kernel call, each thread's locals in buffers between them\n{\n" +
+      (states.empty() ? "" : "const size_t crt_threads = " + threads + ";\n" + states) + wavefront + "}\n";
   if (tl.megakernelOnly) {
     m_ctrl.threadStates.erase(m_ctrl.threadStates.end() - long(std::count_if(tl.stateBuffers.begin(), tl.stateBuffers.end(),
                                                                              [&](const auto& x) { return tl.passed.count(x.first) > 0; })),

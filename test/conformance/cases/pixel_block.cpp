@@ -8,11 +8,12 @@ static uint32_t PackColor(float4 c)
   return r | (g << 8) | (b << 16);
 }
 
-void PixelBlock::kernel_InitRay(float4* rayDir, uint32_t tidX, uint32_t tidY)
+bool PixelBlock::kernel_InitRay(float4* rayDir, uint32_t tidX, uint32_t tidY)
 {
   const float u = (float(tidX) + 0.5f) / float(m_width) * 2.0f - 1.0f;
   const float v = (float(tidY) + 0.5f) / float(m_width) * 2.0f - 1.0f;
   *rayDir = LiteMath::normalize(float4(u, v, 1.0f, 0.0f));
+  return u * u + v * v < 0.8f;  // the lens's disc
 }
 
 void PixelBlock::kernel_Shade(const float4* rayDir, uint32_t* out_color, uint32_t tidX, uint32_t tidY, uint32_t alpha)
@@ -25,7 +26,8 @@ void PixelBlock::MainFunc(uint32_t tidX, uint32_t tidY, uint32_t* out_color)
 {
   const uint32_t opaque = 0xFF;  // the same for every thread
   float4 rayDir;
-  kernel_InitRay(&rayDir, tidX, tidY);
+  if (!kernel_InitRay(&rayDir, tidX, tidY))
+    return;  // outside the lens: the pixel keeps what it had
   kernel_Shade(&rayDir, out_color, tidX, tidY, opaque);
 }
 
