@@ -43,9 +43,14 @@ struct KernelCallFinder : RecursiveASTVisitor<KernelCallFinder> {
       if (auto* dr = dyn_cast<DeclRefExpr>(arg->IgnoreParenImpCasts()))
         if (auto* p = dyn_cast<ParmVarDecl>(dr->getDecl()); p && IsHostOnlyPointer(p, cls)) return true;
     for (auto* arg : call->arguments()) {
-      auto* mc = dyn_cast<CXXMemberCallExpr>(arg->IgnoreParenImpCasts());
-      if (auto* bo = dyn_cast<BinaryOperator>(arg->IgnoreParenImpCasts())) mc = dyn_cast<CXXMemberCallExpr>(bo->getLHS()->IgnoreParenImpCasts());
-      if (mc && ThisField(mc->getImplicitObjectArgument()) && IsStdVector(ThisField(mc->getImplicitObjectArgument())->getType())) {
+      const Expr* base = arg->IgnoreParenImpCasts();
+      if (auto* bo = dyn_cast<BinaryOperator>(base)) base = bo->getLHS()->IgnoreParenImpCasts();
+      auto* mc = dyn_cast<CXXMemberCallExpr>(base);
+      auto* dr = dyn_cast<DeclRefExpr>(base);  // a sized pointer parameter: a device buffer of the call
+      auto* param = dr ? dyn_cast<ParmVarDecl>(dr->getDecl()) : nullptr;
+      if ((mc && ThisField(mc->getImplicitObjectArgument()) && IsStdVector(ThisField(mc->getImplicitObjectArgument())->getType())) ||
+          (param && param->getType()->isPointerType() && isa<CXXMethodDecl>(param->getDeclContext()) &&
+           !IsKernelName(cast<CXXMethodDecl>(param->getDeclContext())->getName()))) {
         calls.push_back(call);
         break;
       }

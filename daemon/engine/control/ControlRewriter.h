@@ -84,6 +84,8 @@ private:
   // The source text of an argument, read through per-thread functions' parameters.
   std::string ResolvedText(const Expr* e) { return m_c.Text(Resolve(e)->getSourceRange()); }
 
+  // Whether an expression calls a function (a condition of a thread loop's body may not).
+  static bool CallsAnything(const Expr* e);
   // A local of a thread loop's body that is a compile-time constant (const uint32_t c = 0xFF;).
   bool IsConstantLocal(const VarDecl* vd) const;
   // A call of the per-thread function being inlined (in a loop of the thread loop's body).

@@ -105,6 +105,18 @@ std::string ControlRewriter::ThreadBodyGlsl(ThreadLoop& tl, KernelPrinter& print
     }
     auto* kernelCall = dyn_cast<CXXMemberCallExpr>(cond);
     const Stmt* then = SingleStatement(is->getThen());
+    // `if (mid == uint(-1)) break;`: a test of this thread's locals (no calls) may leave too.
+    if (!kernelCall && then && !is->getElse() && !CallsAnything(is->getCond())) {
+      auto* ret = dyn_cast<ReturnStmt>(then);
+      const bool loopExit = (isa<BreakStmt>(then) || isa<ContinueStmt>(then)) && m_hostLoopDepth > 0;
+      const bool threadExit = ret && !ret->getRetValue() && m_inlineDepth >= 0 && m_hostLoopDepth == m_inlineDepth;
+      if (loopExit || threadExit) {
+        tl.megakernelOnly = true;
+        const std::string leave = threadExit ? (m_inlineDepth == 0 ? "return;\n" : "continue;  // return from " + m_perThread->getNameAsString() + "\n")
+                                             : isa<BreakStmt>(then) ? "break;\n" : "continue;\n";
+        return pad + "if (" + printer.Expr(is->getCond()) + ")\n" + pad + "  " + leave;
+      }
+    }
     const bool leaves = then && (isa<BreakStmt>(then) || isa<ContinueStmt>(then));
     // `if (!kernel_RayTrace(...)) return;` in the per-thread function, outside its own loops: this
     // thread's work ends (or, in a loop of passes around the call, this pass's).
@@ -138,6 +150,15 @@ std::string ControlRewriter::ThreadBodyGlsl(ThreadLoop& tl, KernelPrinter& print
     return "";
   }
   return pad + KernelCallGlsl(tl, printer, call) + ";\n";
+}
+
+bool ControlRewriter::CallsAnything(const Expr* e) {
+  struct Calls : RecursiveASTVisitor<Calls> {
+    bool found = false;
+    bool VisitCallExpr(CallExpr*) { found = true; return false; }
+  } calls;
+  calls.TraverseStmt(const_cast<Expr*>(e));
+  return calls.found;
 }
 
 bool ControlRewriter::IsConstantLocal(const VarDecl* vd) const {

@@ -305,7 +305,11 @@ std::string KernelPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation cal
       // buffer this copy of the helper is bound to.
       PointerTarget t;
       const std::string name = SafeName(p->getNameAsString());
-      if (auto bound = bufferBindings.find(i); bound != bufferBindings.end()) {
+      if (IsArrayValueParam(p)) {  // const float boxMin[3]: an array by value
+        t.array = name;
+        t.local = true;
+        os << Declare(p->getOriginalType().getUnqualifiedType(), p->getNameAsString(), p->getLocation());
+      } else if (auto bound = bufferBindings.find(i); bound != bufferBindings.end()) {
         t.array = PassesBuffers() ? name : bound->second;
         t.offset = name + "_offset";
         os << BufferParameter(p, name) << "uint " << t.offset;

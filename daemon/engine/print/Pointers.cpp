@@ -127,6 +127,12 @@ std::string KernelPrinter::Pointee(const PointerTarget& t, const clang::Expr* in
   return t.array + "[" + at + "]";
 }
 
+// A helper's parameter declared as a const array (`const float boxMin[3]`): an array parameter in
+// GLSL (by value) and ISPC (by address, as in C), the caller's array passed whole.
+bool KernelPrinter::IsArrayValueParam(const ParmVarDecl* p) const {
+  return p->getType()->isPointerType() && p->getType()->getPointeeType().isConstQualified() && p->getOriginalType()->isConstantArrayType();
+}
+
 // A helper's pointer parameter is a value (GLSL inout) when the helper only follows it to one
 // element: *p, p->f, p[0], or hands it on to a helper of the same kind.
 bool KernelPrinter::PointerIsValueOnly(const FunctionDecl* fn, const ParmVarDecl* p) {
@@ -181,6 +187,21 @@ std::vector<std::string> KernelPrinter::HelperArgs(const FunctionDecl* fd, const
     }
     // ISPC binds no reference to a buffer's element (one per lane, at different addresses): a helper
     // that writes through its pointer gets the buffer and the offset there.
+    if (IsArrayValueParam(p)) {  // const float boxMin[3]: the caller's array, whole and by value
+      auto* decay = dyn_cast<ImplicitCastExpr>(arg->IgnoreParens());
+      while (decay && decay->getCastKind() == CK_NoOp)  // float* to const float*
+        decay = dyn_cast<ImplicitCastExpr>(decay->getSubExpr()->IgnoreParens());
+      auto* passed = decay && decay->getCastKind() == CK_ArrayToPointerDecay ? m_ctx.getAsConstantArrayType(decay->getSubExpr()->getType()) : nullptr;
+      auto* declared = m_ctx.getAsConstantArrayType(p->getOriginalType());
+      if (passed && declared && passed->getSize() == declared->getSize() &&
+          m_ctx.hasSameUnqualifiedType(passed->getElementType(), declared->getElementType()))
+        args.push_back(Expr(decay->getSubExpr()));
+      else
+        args.push_back(Fail(arg->getBeginLoc(), "'" + fd->getNameAsString() + "' takes parameter '" + p->getNameAsString() + "' as an array of " +
+                            std::to_string(m_ctx.getAsConstantArrayType(p->getOriginalType())->getSize().getZExtValue()) +
+                            ", but gets a pointer", "pass an array of that size (a local's, a struct's field or a member's)"));
+      continue;
+    }
     const bool passedBufferElement = PassesBuffers() && !t->array.empty() && !t->local && !p->getType()->getPointeeType().isConstQualified();
     if (PointerIsValueOnly(def, p) && !passedBufferElement) {
       args.push_back(Pointee(*t, nullptr, arg->getBeginLoc()));

@@ -1,8 +1,8 @@
 // kernel_slicer's RTV form as its samples write it: the per-thread function MainFunc carries the
 // size of the output (in its thread counts, tidX by tidY), and the ...Block control function that
 // runs it over every pixel, a_numPasses times, has no size of its own. MainFunc keeps a constant in
-// a local and returns early where a kernel says so (if (!kernel_InitRay(...)) return;), as
-// kernel_slicer's samples do.
+// a local, returns early where a kernel says so (if (!kernel_InitRay(...)) return;) and leaves a
+// loop on a test of its own local (if (done != 0u) break;), as kernel_slicer's samples do.
 #pragma once
 #include "LiteMath.h"
 #include <cstdint>
@@ -17,6 +17,7 @@ public:
   virtual void CommitDeviceData() {}
 
   bool kernel_InitRay(float4* rayDir, uint32_t tidX, uint32_t tidY);
+  void kernel_Bounce(float4* rayDir, uint32_t* done, uint32_t tidX, uint32_t tidY);
   void kernel_Shade(const float4* rayDir, uint32_t* out_color, uint32_t tidX, uint32_t tidY, uint32_t alpha);
 
   uint32_t m_width = 48;  // the image's row length, which the kernels index by
