@@ -179,7 +179,7 @@ Register accumGrid(MakeCase<AccumGrid>(
 
 #if __has_include("Projector_CPU.h")
 Register projector(MakeCase<Projector>(
-    "a user's own perspectiveMatrix beside using namespace LiteMath", "projector.h/.cpp", 1e-5, CONFORMANCE_MAKERS(Projector),
+    "a user's own perspectiveMatrix beside using namespace LiteMath, float4x4::set_row in a kernel", "projector.h/.cpp", 1e-5, CONFORMANCE_MAKERS(Projector),
     [](Projector& p) {
       std::vector<float4> in = Points(100), out(100);
       for (auto& q : in) q.z -= 20.0f;

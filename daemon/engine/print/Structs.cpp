@@ -9,6 +9,7 @@
 #include "print/KernelPrinter.h"
 
 #include <clang/AST/DeclCXX.h>
+#include <clang/AST/RecursiveASTVisitor.h>
 
 #include <sstream>
 
@@ -172,8 +173,27 @@ std::string KernelPrinter::MatrixMethodCall(const CXXMemberCallExpr* call) {
   if ((n == "get_col" || n == "col") && call->getNumArgs() == 1) return m + "[" + Expr(call->getArg(0)) + "]";
   if (n == "get_row" && call->getNumArgs() == 1) return "transpose(" + m + ")[" + Expr(call->getArg(0)) + "]";
   if (n == "set_col" && call->getNumArgs() == 2) return m + "[" + Expr(call->getArg(0)) + "] = " + Expr(call->getArg(1));
+  if (n == "set_row" && call->getNumArgs() == 2) {  // one element per column, a statement each: m[c][i] = v[c]
+    const auto* rd = call->getImplicitObjectArgument()->getType()->getAsCXXRecordDecl();
+    const int columns = rd && rd->getName() == "float3x3" ? 3 : 4;
+    struct Calls : clang::RecursiveASTVisitor<Calls> {
+      bool found = false;
+      bool VisitCallExpr(clang::CallExpr*) { found = true; return false; }
+    } calls;
+    for (unsigned a = 0; a < 2; ++a) calls.TraverseStmt(const_cast<clang::Expr*>(call->getArg(a)));
+    if (calls.found)
+      return Fail(call->getBeginLoc(), "LiteMath's set_row with a computed row or value in a kernel",
+                  "compute the row index and the value into locals first: m.set_row(i, v)");
+    const std::string i = Expr(call->getArg(0)), v = Expr(call->getArg(1));
+    std::string out;
+    for (int c = 0; c < columns; ++c) {  // ISPC's vectors have no subscript: LiteMath.isph's crt_set
+      const std::string column = m + "[" + std::to_string(c) + "]", value = v + "." + "xyzw"[c];
+      out += (c ? "; " : "") + (PassesBuffers() ? "crt_set(" + column + ", " + i + ", " + value + ")" : column + "[" + i + "] = " + value);
+    }
+    return out;
+  }
   return Fail(call->getBeginLoc(), "LiteMath's " + call->getMethodDecl()->getQualifiedNameAsString() + " is not supported in kernels",
-              "use m[col] (a column), transpose(m)[row], m * v");
+              "use m[col] (a column), transpose(m)[row], set_col, set_row, m * v");
 }
 
 }  // namespace crossrt::engine

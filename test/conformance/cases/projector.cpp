@@ -21,7 +21,10 @@ void Projector::kernel1D_Project(int n, const float4* a_in, float4* a_out)
 {
   for (int i = 0; i < n; i++)
   {
-    const float4 clip = m_proj * a_in[i];
+    float4x4 proj = m_proj;  // its last row set per point, as kernel_slicer's test 031 writes rows
+    const float4 lastRow(0.0f, 0.0f, -1.0f, 0.001f * float(i % 5));
+    proj.set_row(3, lastRow);
+    const float4 clip = proj * a_in[i];
     a_out[i] = clip / clip.w;
   }
 }
