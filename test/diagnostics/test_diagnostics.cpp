@@ -1561,8 +1561,6 @@ TEST_CASE("Thread loops of several kernels that the GPU cannot run per thread ar
        "the thread loop of 'Run' may branch only on a kernel's bool result, to leave a loop inside it", "branch on anything else inside the kernels"},
       {"other code in the loop body", "", "    float v;\n    kernel_Init(i, &v);\n    n = n + 1;\n    kernel_Store(i, &v, out);\n", "", 7,
        "the thread loop of 'Run' may hold only per-thread local declarations, kernel_ calls and counted loops around them", "move this code into a kernel"},
-      {"a local with an initializer", "", "    float v = 1.0f;\n    kernel_Step(i, &v);\n    kernel_Store(i, &v, out);\n", "", 5,
-       "per-thread local 'v' of the thread loop of 'Run' has an initializer", "declare it without one"},
       {"a loop bound that differs per thread", "", "    float v;\n    kernel_Init(i, &v);\n    for (int s = 0; s < i; s++) kernel_Step(i, &v);\n    kernel_Store(i, &v, out);\n", "", 7,
        "'i' differs from thread to thread, but the loop's condition in the thread loop of 'Run' runs once for all threads in wavefront mode",
        "branch inside the kernels"},

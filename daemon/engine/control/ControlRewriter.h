@@ -67,6 +67,7 @@ private:
     std::vector<std::string> cppBufferArgs;        // the same buffers as the C++ passes them (the ISPC class's)
     std::set<const VarDecl*> locals;               // every local of the body (per-thread)
     std::set<const VarDecl*> passed;               // locals some kernel call gets the address of
+    std::map<const VarDecl*, std::string> startValues;  // initialised locals the wavefront fills: the host's value
     std::vector<const VarDecl*> outer;             // control-function variables the body reads, first read first
     Kernel mega;                                   // the megakernel, without its kernels' code yet
     std::string hostArgs;                          // ...Cmd arguments of the megakernel after the counts
@@ -84,6 +85,8 @@ private:
   // The source text of an argument, read through per-thread functions' parameters.
   std::string ResolvedText(const Expr* e) { return m_c.Text(Resolve(e)->getSourceRange()); }
 
+  // Whether `e` is the same for every thread of `tl` (reads no loop variable or per-thread local).
+  bool IsUniform(const ThreadLoop& tl, const Expr* e) const;
   // Whether an expression calls a function (a condition of a thread loop's body may not).
   static bool CallsAnything(const Expr* e);
   // A local of a thread loop's body that is a compile-time constant (const uint32_t c = 0xFF;).

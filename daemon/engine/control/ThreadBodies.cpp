@@ -53,11 +53,7 @@ std::string ControlRewriter::ThreadBodyGlsl(ThreadLoop& tl, KernelPrinter& print
         continue;
       }
       auto* construct = init ? dyn_cast<CXXConstructExpr>(init->IgnoreImplicit()) : nullptr;
-      if (init && !(construct && construct->getNumArgs() == 0)) {
-        Error(tl, vd->getLocation(), "per-thread local '" + vd->getNameAsString() + "' of the thread loop of '" + m_ctrl.name + "' has an initializer",
-              "declare it without one (it starts at zero on the GPU, as LiteMath types do) and set it in the first kernel");
-        continue;
-      }
+      const bool startsAtValue = init && !(construct && construct->getNumArgs() == 0);
       auto g = GlslTypeOf(vd->getType());
       if (!g || vd->getType()->isArrayType() || vd->getType()->isPointerType()) {
         Error(tl, vd->getLocation(), "per-thread local '" + vd->getNameAsString() + "' of type '" + vd->getType().getAsString(m_c.ctx.getPrintingPolicy()) +
@@ -67,6 +63,15 @@ std::string ControlRewriter::ThreadBodyGlsl(ThreadLoop& tl, KernelPrinter& print
       tl.stateBuffers.push_back({vd, m_ctrl.name + (m_threadLoops > 1 ? std::to_string(m_threadLoops) : "") + "_" + vd->getNameAsString()});
       static const std::regex zeroable(R"(^(float|int|uint|[iu]?vec[234]|mat[234])$)");
       std::string name = KernelPrinter::SafeName(vd->getNameAsString());
+      if (startsAtValue) {  // float v = 1.0f;: the megakernel sets it; the wavefront fills its buffer with the host's value
+        static const std::regex scalar32(R"(^(float|int|uint)$)");
+        if (IsUniform(tl, init) && std::regex_match(*g, scalar32))
+          tl.startValues[vd] = ResolvedText(init);
+        else
+          tl.megakernelOnly = true;  // a value per thread, or not one 32-bit word: computed by the thread itself
+        out += pad + (m_c.model.forIspc ? IspcTypeName(*g) : *g) + " " + name + " = " + printer.Expr(init) + ";\n";
+        continue;
+      }
       if (m_c.model.forIspc) {  // LiteMath's types start at zero in C++ too
         out += pad + IspcTypeName(*g) + " " + name + IspcZero(*g) + ";\n";
         continue;
@@ -150,6 +155,25 @@ std::string ControlRewriter::ThreadBodyGlsl(ThreadLoop& tl, KernelPrinter& print
     return "";
   }
   return pad + KernelCallGlsl(tl, printer, call) + ";\n";
+}
+
+bool ControlRewriter::IsUniform(const ThreadLoop& tl, const Expr* e) const {
+  struct Refs : RecursiveASTVisitor<Refs> {
+    std::vector<const DeclRefExpr*> found;
+    bool VisitDeclRefExpr(DeclRefExpr* dr) { found.push_back(dr); return true; }
+  } refs;
+  refs.TraverseStmt(const_cast<Expr*>(e));
+  for (auto* dr : refs.found) {
+    if (auto* p = dyn_cast<ParmVarDecl>(dr->getDecl()); p && m_inlined.count(p)) {
+      if (!IsUniform(tl, m_inlined.at(p))) return false;
+      continue;
+    }
+    auto* vd = dyn_cast<VarDecl>(dr->getDecl());
+    if (!vd || (vd->hasGlobalStorage() && !vd->isStaticLocal())) continue;
+    const bool loopVar = std::any_of(tl.loops.begin(), tl.loops.end(), [&](const LoopHeader& h) { return h.var == vd; });
+    if (loopVar || (tl.locals.count(vd) && !m_hostLoopVars.count(vd))) return false;
+  }
+  return true;
 }
 
 bool ControlRewriter::CallsAnything(const Expr* e) {

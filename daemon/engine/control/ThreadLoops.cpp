@@ -176,9 +176,12 @@ bool ControlRewriter::TryThreadLoop(const ForStmt* outerLoop) {
     if (!tl.passed.count(local)) continue;  // no kernel sees it: nothing to keep between dispatches
     std::string cppType = CppTypeName(m_c.ctx, local->getType().getUnqualifiedType());
     m_ctrl.threadStates.push_back({buffer, cppType, local->getNameAsString()});
+    auto start = tl.startValues.find(local);
     states += "crossrt::EnsureSize(crt_ctx, crt_threadState." + buffer + ", sizeof(" + cppType + ") * std::max<size_t>(1, crt_threads));\n"
-              "crossrt::FillCmd(crt_cmd, crt_threadState." + buffer + ".View(), sizeof(" + cppType + ") * crt_threads, 0);  // " +
-              local->getNameAsString() + " starts at zero\n";
+              "crossrt::FillCmd(crt_cmd, crt_threadState." + buffer + ".View(), sizeof(" + cppType + ") * crt_threads, " +
+              (start == tl.startValues.end() ? "0);  // " + local->getNameAsString() + " starts at zero\n"
+                                             : "crossrt::Bits32(static_cast<" + cppType + ">(" + start->second + ")));  // " + local->getNameAsString() +
+                                                   " starts at " + start->second + "\n");
   }
   std::string threads;
   for (auto& h : tl.loops) threads += (threads.empty() ? "" : " * ") + std::string("size_t(") + CountExpr(m_c, h) + ")";

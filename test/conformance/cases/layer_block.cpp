@@ -9,11 +9,16 @@ void LayerBlock::AddBlock(uint32_t n, uint32_t a_layers, float* out)
 
 void LayerBlock::Add(uint32_t tid, uint32_t a_layers, float* out)
 {
+  float amount = 1.5f;  // every thread starts at the same value, and halves it per layer
   for (uint32_t layer = 0; layer < a_layers; layer++)
-    kernel_AddOne(tid, out);
+    kernel_AddOne(tid, &amount, out);
   kernel_Halve(tid, out);
 }
 
-void LayerBlock::kernel_AddOne(uint32_t tid, float* out) { out[tid] += 1.0f + 0.5f * float(tid % 4); }
+void LayerBlock::kernel_AddOne(uint32_t tid, float* amount, float* out)
+{
+  out[tid] += *amount + 0.5f * float(tid % 4);
+  *amount *= 0.5f;
+}
 
 void LayerBlock::kernel_Halve(uint32_t tid, float* out) { out[tid] *= 0.5f; }
