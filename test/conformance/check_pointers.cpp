@@ -215,7 +215,7 @@ Register bodiesOut(MakeCase<BodiesOut>(
 
 #if __has_include("LayerBlock_CPU.h")
 Register layerBlock(MakeCase<LayerBlock>(
-    "a ...Block loop passing its per-thread function a constant for a loop bound, under a name the Block has too", "layer_block.h/.cpp", 1e-6,
+    "...Block loops: a constant for a loop bound under a name the Block has too, size(\"tid\") on the per-thread function", "layer_block.h/.cpp", 1e-6,
     CONFORMANCE_MAKERS(LayerBlock), [](LayerBlock& b) {
       Outputs r;
       for (auto mode : {crossrt::ExecutionMode::Megakernel, crossrt::ExecutionMode::Wavefront}) {  // both ways on Vulkan
@@ -223,6 +223,7 @@ Register layerBlock(MakeCase<LayerBlock>(
         std::vector<float> out(300);
         for (size_t i = 0; i < out.size(); i++) out[i] = 0.25f * float(i % 7);
         b.AddBlock(uint32_t(out.size()), 5, out.data());
+        b.QuarterBlock(out.data(), 200);  // the first 200 only
         Append(r, out);
       }
       return r;

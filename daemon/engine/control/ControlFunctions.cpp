@@ -13,6 +13,8 @@
 #include "analyse/VirtualCalls.h"
 #include "analyse/WriteVisitor.h"
 
+#include <clang/Lex/Lexer.h>
+
 #include <algorithm>
 #include <cctype>
 
@@ -169,14 +171,50 @@ static void CheckSpecializedChanges(Context& c, const std::string& control, cons
 
 namespace {
 
+// The bound of the Block's loop over `var` (for (int tid = 0; tid < a_size; tid++): "a_size"), or "".
+std::string LoopBound(const FunctionDecl* def, const VarDecl* var) {
+  struct Finder : RecursiveASTVisitor<Finder> {
+    const VarDecl* var; const Expr* bound = nullptr;
+    bool VisitForStmt(ForStmt* fs) {
+      auto* cond = dyn_cast_or_null<BinaryOperator>(fs->getCond());
+      auto* dr = cond && (cond->getOpcode() == BO_LT) ? dyn_cast<DeclRefExpr>(cond->getLHS()->IgnoreParenImpCasts()) : nullptr;
+      if (dr && dr->getDecl() == var) bound = cond->getRHS();
+      return !bound;
+    }
+  } finder;
+  finder.var = var;
+  finder.TraverseStmt(def->getBody());
+  if (!finder.bound) return "";
+  const ASTContext& ctx = def->getASTContext();
+  return Lexer::getSourceText(CharSourceRange::getTokenRange(finder.bound->getSourceRange()), ctx.getSourceManager(), ctx.getLangOpts()).str();
+}
+
 // kernel_slicer's ...Block form: `MainFuncBlock(tidX, tidY, out_color, passes)` runs the per-thread
 // `MainFunc(tidX, tidY, out_color)` over every thread, and the pointer sizes are written on MainFunc.
-// The size annotation of the sibling's parameter of the same name, where every name it uses is a
-// parameter of the Block function or a member of the class; "" otherwise.
+// The size annotation of the sibling's parameter of the same name, in the Block's terms: a name of
+// the Block's parameters or the class's members as it is; the sibling's thread id (size("tid")) as
+// the bound of the Block's loop whose variable the Block passes for it. "" where a name is neither.
 std::string SiblingSize(const CXXRecordDecl* cls, const CXXMethodDecl* block, const std::string& param) {
   const std::string name = block->getNameAsString();
   if (name.size() <= 5 || name.compare(name.size() - 5, 5, "Block") != 0) return "";
   const std::string sibling = name.substr(0, name.size() - 5);
+  const FunctionDecl* blockDef = nullptr;
+  block->hasBody(blockDef);
+  // The sibling's parameters as the Block's call passes them: index -> the Block's loop variable.
+  auto passedLoopVar = [&](const CXXMethodDecl* m, unsigned index) -> const VarDecl* {
+    struct Calls : RecursiveASTVisitor<Calls> {
+      const CXXMethodDecl* m; unsigned index; const VarDecl* var = nullptr;
+      bool VisitCXXMemberCallExpr(CXXMemberCallExpr* call) {
+        if (call->getMethodDecl() && call->getMethodDecl()->getCanonicalDecl() == m->getCanonicalDecl() && index < call->getNumArgs())
+          if (auto* dr = dyn_cast<DeclRefExpr>(call->getArg(index)->IgnoreParenImpCasts())) var = dyn_cast<VarDecl>(dr->getDecl());
+        return !var;
+      }
+    } calls;
+    calls.m = m;
+    calls.index = index;
+    if (blockDef) calls.TraverseStmt(blockDef->getBody());
+    return calls.var;
+  };
   for (const CXXMethodDecl* m : cls->methods()) {
     if (m->getNameAsString() != sibling) continue;
     for (const FunctionDecl* redecl : m->redecls())
@@ -185,17 +223,28 @@ std::string SiblingSize(const CXXRecordDecl* cls, const CXXMethodDecl* block, co
         for (auto* a : p->specific_attrs<AnnotateAttr>()) {
           if (!a->getAnnotation().starts_with("crossrt.size=")) continue;
           const std::string expr = a->getAnnotation().substr(13).str();
+          std::string out;
           bool known = true;
           for (size_t i = 0; i < expr.size() && known;) {
-            if (!(std::isalpha(static_cast<unsigned char>(expr[i])) || expr[i] == '_')) { ++i; continue; }
+            if (!(std::isalpha(static_cast<unsigned char>(expr[i])) || expr[i] == '_')) { out += expr[i++]; continue; }
             size_t end = i;
             while (end < expr.size() && (std::isalnum(static_cast<unsigned char>(expr[end])) || expr[end] == '_')) ++end;
             const std::string id = expr.substr(i, end - i);
-            known = std::any_of(block->param_begin(), block->param_end(), [&](const ParmVarDecl* b) { return b->getNameAsString() == id; }) ||
-                    std::any_of(cls->field_begin(), cls->field_end(), [&](const FieldDecl* f) { return f->getNameAsString() == id; });
             i = end;
+            if (std::any_of(block->param_begin(), block->param_end(), [&](const ParmVarDecl* b) { return b->getNameAsString() == id; }) ||
+                std::any_of(cls->field_begin(), cls->field_end(), [&](const FieldDecl* f) { return f->getNameAsString() == id; })) {
+              out += id;
+              continue;
+            }
+            // The sibling's thread id: the count of the Block's loop that passes it.
+            std::string bound;
+            for (unsigned k = 0; k < redecl->getNumParams() && bound.empty(); ++k)
+              if (redecl->getParamDecl(k)->getNameAsString() == id && IsThreadIdName(id))
+                if (const VarDecl* var = passedLoopVar(m, k); var && blockDef) bound = LoopBound(blockDef, var);
+            known = !bound.empty();
+            out += "(" + bound + ")";
           }
-          if (known) return expr;
+          if (known) return out;
         }
       }
   }

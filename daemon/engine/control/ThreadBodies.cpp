@@ -54,6 +54,11 @@ std::string ControlRewriter::ThreadBodyGlsl(ThreadLoop& tl, KernelPrinter& print
       }
       auto* construct = init ? dyn_cast<CXXConstructExpr>(init->IgnoreImplicit()) : nullptr;
       const bool startsAtValue = init && !(construct && construct->getNumArgs() == 0);
+      if (startsAtValue && CallsAnything(init)) {  // the thread loop's body calls kernels only
+        Error(tl, vd->getLocation(), "per-thread local '" + vd->getNameAsString() + "' of the thread loop of '" + m_ctrl.name + "' starts at a call's result",
+              "start it at a value without calls (float v = 1.0f;), or compute it in the first kernel");
+        continue;
+      }
       auto g = GlslTypeOf(vd->getType());
       if (!g || vd->getType()->isArrayType() || vd->getType()->isPointerType()) {
         Error(tl, vd->getLocation(), "per-thread local '" + vd->getNameAsString() + "' of type '" + vd->getType().getAsString(m_c.ctx.getPrintingPolicy()) +

@@ -21,4 +21,16 @@ void LayerBlock::kernel_AddOne(uint32_t tid, float* amount, float* out)
   *amount *= 0.5f;
 }
 
+void LayerBlock::QuarterBlock(float* out, uint32_t a_count)
+{
+  for (uint32_t tid = 0; tid < a_count; tid++)
+    Quarter(out, tid);
+}
+
+void LayerBlock::Quarter(float* out, uint32_t tid)
+{
+  kernel_Halve(tid, out);
+  kernel_Halve(tid, out);
+}
+
 void LayerBlock::kernel_Halve(uint32_t tid, float* out) { out[tid] *= 0.5f; }

@@ -12,6 +12,11 @@ public:
   virtual void AddBlock(uint32_t n, uint32_t a_layers, float* out [[size("n")]]);
   virtual void CommitDeviceData() {}
 
+  // kernel_slicer's test 051: the size is on the per-thread function, in its thread id's name
+  // (the count of the Block's loop that passes it).
+  virtual void QuarterBlock(float* out, uint32_t a_count);
+  void Quarter(float* out [[size("tid")]], uint32_t tid);
+
   void Add(uint32_t tid, uint32_t a_layers, float* out);  // one thread's work
   void kernel_AddOne(uint32_t tid, float* amount, float* out);
   void kernel_Halve(uint32_t tid, float* out);
