@@ -438,6 +438,11 @@ std::string KernelPrinter::VirtualCall(const CXXMemberCallExpr* mc) {
     }
     if (p && p->getType()->isPointerType()) {  // &hit: the value it points at, inout (as a helper's pointer)
       auto t = Pointer(mc->getArg(i));
+      if (t && PassesBuffers() && !t->array.empty() && !t->local && !p->getType()->getPointeeType().isConstQualified()) {
+        args.push_back(Fail(mc->getArg(i)->getBeginLoc(), "a buffer's element passed to " + method->getNameAsString() + "'s pointer parameter '" +
+                            p->getNameAsString() + "' in an ISPC kernel", "pass the address of a local (&hit) and store it into the buffer after the call"));
+        continue;
+      }
       args.push_back(t ? Pointee(*t, nullptr, mc->getArg(i)->getBeginLoc()) : "/*error*/");
       continue;
     }
