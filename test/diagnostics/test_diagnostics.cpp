@@ -1559,8 +1559,6 @@ TEST_CASE("Thread loops of several kernels that the GPU cannot run per thread ar
   const Case cases[] = {
       {"a branch in the loop body", "", "    float v;\n    kernel_Init(i, &v);\n    if (n > 2) kernel_Step(i, &v);\n    kernel_Store(i, &v, out);\n", "", 7,
        "the thread loop of 'Run' may branch only on a kernel's bool result, to leave a loop inside it", "branch on anything else inside the kernels"},
-      {"a local that starts at a call's result", "  static float Start() { return 2.0f; }", "    float v = Start();\n    kernel_Step(i, &v);\n    kernel_Store(i, &v, out);\n", "", 5,
-       "per-thread local 'v' of the thread loop of 'Run' starts at a call's result", "compute it in the first kernel"},
       {"other code in the loop body", "", "    float v;\n    kernel_Init(i, &v);\n    n = n + 1;\n    kernel_Store(i, &v, out);\n", "", 7,
        "the thread loop of 'Run' may hold only per-thread local declarations, kernel_ calls and counted loops around them", "move this code into a kernel"},
       {"a loop bound that differs per thread", "", "    float v;\n    kernel_Init(i, &v);\n    for (int s = 0; s < i; s++) kernel_Step(i, &v);\n    kernel_Store(i, &v, out);\n", "", 7,

@@ -17,7 +17,7 @@ namespace {
 // (composed code included, so after composition), buffers and images.
 static void MergeMegakernelCode(ClassModel& model) {
   for (auto& mk : model.megakernels) {
-    std::vector<std::string> functions;
+    std::vector<std::string> functions = mk.functionList;  // the thread loop's own helpers first
     auto addUnique = [](auto& list, const auto& x) {
       if (std::find(list.begin(), list.end(), x) == list.end()) list.push_back(x);
     };

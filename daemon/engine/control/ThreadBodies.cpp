@@ -54,11 +54,6 @@ std::string ControlRewriter::ThreadBodyGlsl(ThreadLoop& tl, KernelPrinter& print
       }
       auto* construct = init ? dyn_cast<CXXConstructExpr>(init->IgnoreImplicit()) : nullptr;
       const bool startsAtValue = init && !(construct && construct->getNumArgs() == 0);
-      if (startsAtValue && CallsAnything(init)) {  // the thread loop's body calls kernels only
-        Error(tl, vd->getLocation(), "per-thread local '" + vd->getNameAsString() + "' of the thread loop of '" + m_ctrl.name + "' starts at a call's result",
-              "start it at a value without calls (float v = 1.0f;), or compute it in the first kernel");
-        continue;
-      }
       auto g = GlslTypeOf(vd->getType());
       if (!g || vd->getType()->isArrayType() || vd->getType()->isPointerType()) {
         Error(tl, vd->getLocation(), "per-thread local '" + vd->getNameAsString() + "' of type '" + vd->getType().getAsString(m_c.ctx.getPrintingPolicy()) +
@@ -70,10 +65,10 @@ std::string ControlRewriter::ThreadBodyGlsl(ThreadLoop& tl, KernelPrinter& print
       std::string name = KernelPrinter::SafeName(vd->getNameAsString());
       if (startsAtValue) {  // float v = 1.0f;: the megakernel sets it; the wavefront fills its buffer with the host's value
         static const std::regex scalar32(R"(^(float|int|uint)$)");
-        if (IsUniform(tl, init) && std::regex_match(*g, scalar32))
+        if (IsUniform(tl, init) && !CallsAnything(init) && std::regex_match(*g, scalar32))
           tl.startValues[vd] = ResolvedText(init);
         else
-          tl.megakernelOnly = true;  // a value per thread, or not one 32-bit word: computed by the thread itself
+          tl.megakernelOnly = true;  // a value per thread, a call's, or not one 32-bit word: computed by the thread itself
         out += pad + (m_c.model.forIspc ? IspcTypeName(*g) : *g) + " " + name + " = " + printer.Expr(init) + ";\n";
         continue;
       }

@@ -107,9 +107,10 @@ bool ControlRewriter::TryThreadLoop(const ForStmt* outerLoop) {
   if (!tl.ok) return true;
   for (auto* f : printer.Uses().plainMembers)
     if (auto* m = FindMember(m_c.model, f->getNameAsString())) m->usedByKernels = true;
-  if (!printer.Uses().memberVectors.empty() || !printer.Uses().helpers.empty())
-    Error(tl, outerLoop->getBeginLoc(), "the host code of a thread loop of '" + m_ctrl.name + "' uses member vectors or calls functions",
+  if (!printer.Uses().memberVectors.empty())
+    Error(tl, outerLoop->getBeginLoc(), "the host code of a thread loop of '" + m_ctrl.name + "' uses member vectors",
           "count host loops with plain members, parameters or constants; move other work into a kernel");
+  tl.mega.functionList = printer.Functions();  // helpers the body calls (float x = testFun();), ahead of the kernels'
   const bool axesCovered = tl.axisOf.size() == tl.loops.size() &&
                            std::all_of(tl.axisOf.begin(), tl.axisOf.end(), [&](const auto& x) { return x.second < tl.loops.size(); });
   if (!axesCovered) {

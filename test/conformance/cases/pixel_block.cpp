@@ -14,6 +14,8 @@ struct Tint
   float rgb[3];
 };
 
+static float Exposure() { return 0.9f; }  // a helper of the .cpp the per-thread function calls
+
 static float Weighted3(const float values[3], const float weights[3])
 {
   return values[0] * weights[0] + values[1] * weights[1] + values[2] * weights[2];
@@ -34,9 +36,9 @@ void PixelBlock::kernel_Bounce(float4* rayDir, uint32_t* done, uint32_t tidX, ui
   *done = rayDir->x > 0.3f + 0.002f * float(tidX) ? 1u : 0u;
 }
 
-void PixelBlock::kernel_Shade(const float4* rayDir, uint32_t* out_color, uint32_t tidX, uint32_t tidY, uint32_t alpha)
+void PixelBlock::kernel_Shade(const float4* rayDir, const float* exposure, uint32_t* out_color, uint32_t tidX, uint32_t tidY, uint32_t alpha)
 {
-  const float4 d = *rayDir;
+  const float4 d = *rayDir * *exposure;
   Tint tint;
   tint.rgb[0] = d.x;
   tint.rgb[1] = 0.5f;
@@ -59,7 +61,8 @@ void PixelBlock::MainFunc(uint32_t tidX, uint32_t tidY, uint32_t* out_color)
     if (done != 0u)
       break;  // a test of the thread's own local
   }
-  kernel_Shade(&rayDir, out_color, tidX, tidY, opaque);
+  float exposure = Exposure();  // starts at a call's result: the megakernel computes it per thread
+  kernel_Shade(&rayDir, &exposure, out_color, tidX, tidY, opaque);
 }
 
 void PixelBlock::MainFuncBlock(uint32_t tidX, uint32_t tidY, uint32_t* out_color, uint32_t a_numPasses)

@@ -18,7 +18,7 @@ public:
 
   bool kernel_InitRay(float4* rayDir, uint32_t tidX, uint32_t tidY);
   void kernel_Bounce(float4* rayDir, uint32_t* done, uint32_t tidX, uint32_t tidY);
-  void kernel_Shade(const float4* rayDir, uint32_t* out_color, uint32_t tidX, uint32_t tidY, uint32_t alpha);
+  void kernel_Shade(const float4* rayDir, const float* exposure, uint32_t* out_color, uint32_t tidX, uint32_t tidY, uint32_t alpha);
 
   uint32_t m_width = 48;  // the image's row length, which the kernels index by
 };
