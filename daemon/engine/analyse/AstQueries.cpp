@@ -197,4 +197,23 @@ bool AppendsThroughCalls(const FunctionDecl* fn, const CXXRecordDecl* cls, std::
   return memo[fn] = finder.found;
 }
 
+bool ContainsCall(const Stmt* s) {
+  struct Calls : RecursiveASTVisitor<Calls> {
+    bool found = false;
+    bool VisitCallExpr(CallExpr*) { found = true; return false; }
+  } calls;
+  calls.TraverseStmt(const_cast<Stmt*>(s));
+  return calls.found;
+}
+
+bool Mentions(const Stmt* s, const Decl* d) {
+  struct Refs : RecursiveASTVisitor<Refs> {
+    const Decl* d; bool found = false;
+    bool VisitDeclRefExpr(DeclRefExpr* dr) { found = dr->getDecl() == d; return !found; }
+  } refs;
+  refs.d = d;
+  refs.TraverseStmt(const_cast<Stmt*>(s));
+  return refs.found;
+}
+
 }  // namespace crossrt::engine

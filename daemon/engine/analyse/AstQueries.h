@@ -60,6 +60,12 @@ const VarDecl* AddressedVar(const Expr* arg);
 // The class's own member function a call `this->f(...)` reaches, defined, else null.
 const FunctionDecl* ThisMethodDef(const CXXMemberCallExpr* call, const CXXRecordDecl* cls);
 
+// Whether `s` calls a function anywhere inside it.
+bool ContainsCall(const Stmt* s);
+
+// Whether `s` names declaration `d` anywhere inside it.
+bool Mentions(const Stmt* s, const Decl* d);
+
 // Whether `fn` appends to a member vector, itself or through the class's member functions it calls.
 bool AppendsThroughCalls(const FunctionDecl* fn, const CXXRecordDecl* cls, std::map<const FunctionDecl*, bool>& memo);
 

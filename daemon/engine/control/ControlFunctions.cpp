@@ -257,23 +257,14 @@ std::string SiblingSize(const CXXRecordDecl* cls, const CXXMethodDecl* block, co
 bool HandedOn(const FunctionDecl* def, const ParmVarDecl* p, const CXXRecordDecl* cls) {
   struct Finder : RecursiveASTVisitor<Finder> {
     const ParmVarDecl* p; const CXXRecordDecl* cls; bool found = false;
-    bool Mentions(const Stmt* s) const {
-      struct Refs : RecursiveASTVisitor<Refs> {
-        const ParmVarDecl* p; bool found = false;
-        bool VisitDeclRefExpr(DeclRefExpr* dr) { found |= dr->getDecl() == p; return !found; }
-      } refs;
-      refs.p = p;
-      refs.TraverseStmt(const_cast<Stmt*>(s));
-      return refs.found;
-    }
     bool VisitCXXMemberCallExpr(CXXMemberCallExpr* call) {
       auto* md = call->getMethodDecl();
       if (md && IsClassOrBase(md->getParent(), cls))
-        for (auto* arg : call->arguments()) found |= Mentions(arg);
+        for (auto* arg : call->arguments()) found |= Mentions(arg, p);
       return true;
     }
-    bool VisitVarDecl(VarDecl* vd) { found |= vd->getInit() && vd->getType()->isPointerType() && Mentions(vd->getInit()); return true; }
-    bool VisitBinaryOperator(BinaryOperator* bo) { found |= bo->isAssignmentOp() && bo->getType()->isPointerType() && Mentions(bo->getRHS()); return true; }
+    bool VisitVarDecl(VarDecl* vd) { found |= vd->getInit() && vd->getType()->isPointerType() && Mentions(vd->getInit(), p); return true; }
+    bool VisitBinaryOperator(BinaryOperator* bo) { found |= bo->isAssignmentOp() && bo->getType()->isPointerType() && Mentions(bo->getRHS(), p); return true; }
   } finder;
   finder.p = p;
   finder.cls = cls;

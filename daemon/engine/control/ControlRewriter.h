@@ -7,6 +7,8 @@
 #include "analyse/AnalysisContext.h"
 #include "analyse/LoopShape.h"
 
+#include <functional>
+
 namespace crossrt::engine {
 
 class ControlRewriter {
@@ -87,8 +89,9 @@ private:
 
   // Whether `e` is the same for every thread of `tl` (reads no loop variable or per-thread local).
   bool IsUniform(const ThreadLoop& tl, const Expr* e) const;
-  // Whether an expression calls a function (a condition of a thread loop's body may not).
-  static bool CallsAnything(const Expr* e);
+  // Each variable `e` reads (through per-thread functions' parameters): perThread where its value
+  // differs from thread to thread (a loop variable of the thread loop, or one of its locals).
+  void ForEachVariable(const ThreadLoop& tl, const Expr* e, const std::function<void(const DeclRefExpr*, const VarDecl*, bool perThread)>& visit) const;
   // A local of a thread loop's body that is a compile-time constant (const uint32_t c = 0xFF;).
   bool IsConstantLocal(const VarDecl* vd) const;
   // A call of the per-thread function being inlined (in a loop of the thread loop's body).

@@ -65,7 +65,7 @@ std::string ControlRewriter::ThreadBodyGlsl(ThreadLoop& tl, KernelPrinter& print
       std::string name = KernelPrinter::SafeName(vd->getNameAsString());
       if (startsAtValue) {  // float v = 1.0f;: the megakernel sets it; the wavefront fills its buffer with the host's value
         static const std::regex scalar32(R"(^(float|int|uint)$)");
-        if (IsUniform(tl, init) && !CallsAnything(init) && std::regex_match(*g, scalar32))
+        if (IsUniform(tl, init) && !ContainsCall(init) && std::regex_match(*g, scalar32))
           tl.startValues[vd] = ResolvedText(init);
         else
           tl.megakernelOnly = true;  // a value per thread, a call's, or not one 32-bit word: computed by the thread itself
@@ -111,7 +111,7 @@ std::string ControlRewriter::ThreadBodyGlsl(ThreadLoop& tl, KernelPrinter& print
     auto* kernelCall = dyn_cast<CXXMemberCallExpr>(cond);
     const Stmt* then = SingleStatement(is->getThen());
     // `if (mid == uint(-1)) break;`: a test of this thread's locals (no calls) may leave too.
-    if (!kernelCall && then && !is->getElse() && !CallsAnything(is->getCond())) {
+    if (!kernelCall && then && !is->getElse() && !ContainsCall(is->getCond())) {
       auto* ret = dyn_cast<ReturnStmt>(then);
       const bool loopExit = (isa<BreakStmt>(then) || isa<ContinueStmt>(then)) && m_hostLoopDepth > 0;
       const bool threadExit = ret && !ret->getRetValue() && m_inlineDepth >= 0 && m_hostLoopDepth == m_inlineDepth;
@@ -158,31 +158,9 @@ std::string ControlRewriter::ThreadBodyGlsl(ThreadLoop& tl, KernelPrinter& print
 }
 
 bool ControlRewriter::IsUniform(const ThreadLoop& tl, const Expr* e) const {
-  struct Refs : RecursiveASTVisitor<Refs> {
-    std::vector<const DeclRefExpr*> found;
-    bool VisitDeclRefExpr(DeclRefExpr* dr) { found.push_back(dr); return true; }
-  } refs;
-  refs.TraverseStmt(const_cast<Expr*>(e));
-  for (auto* dr : refs.found) {
-    if (auto* p = dyn_cast<ParmVarDecl>(dr->getDecl()); p && m_inlined.count(p)) {
-      if (!IsUniform(tl, m_inlined.at(p))) return false;
-      continue;
-    }
-    auto* vd = dyn_cast<VarDecl>(dr->getDecl());
-    if (!vd || (vd->hasGlobalStorage() && !vd->isStaticLocal())) continue;
-    const bool loopVar = std::any_of(tl.loops.begin(), tl.loops.end(), [&](const LoopHeader& h) { return h.var == vd; });
-    if (loopVar || (tl.locals.count(vd) && !m_hostLoopVars.count(vd))) return false;
-  }
-  return true;
-}
-
-bool ControlRewriter::CallsAnything(const Expr* e) {
-  struct Calls : RecursiveASTVisitor<Calls> {
-    bool found = false;
-    bool VisitCallExpr(CallExpr*) { found = true; return false; }
-  } calls;
-  calls.TraverseStmt(const_cast<Expr*>(e));
-  return calls.found;
+  bool uniform = true;
+  ForEachVariable(tl, e, [&](const DeclRefExpr*, const VarDecl*, bool perThread) { uniform = uniform && !perThread; });
+  return uniform;
 }
 
 bool ControlRewriter::IsConstantLocal(const VarDecl* vd) const {

@@ -219,7 +219,8 @@ void ControlRewriter::Error(ThreadLoop& tl, SourceLocation loc, const std::strin
   tl.ok = false;
 }
 
-void ControlRewriter::CheckUniform(ThreadLoop& tl, const Expr* e, const std::string& where, bool readOnGpu) {
+void ControlRewriter::ForEachVariable(const ThreadLoop& tl, const Expr* e,
+                                      const std::function<void(const DeclRefExpr*, const VarDecl*, bool)>& visit) const {
   struct Finder : RecursiveASTVisitor<Finder> {
     std::vector<const DeclRefExpr*> refs;
     bool VisitDeclRefExpr(DeclRefExpr* dr) { refs.push_back(dr); return true; }
@@ -227,18 +228,24 @@ void ControlRewriter::CheckUniform(ThreadLoop& tl, const Expr* e, const std::str
   finder.TraverseStmt(const_cast<Expr*>(e));
   for (auto* dr : finder.refs) {
     if (auto* p = dyn_cast<ParmVarDecl>(dr->getDecl()); p && m_inlined.count(p)) {  // a per-thread function's parameter
-      CheckUniform(tl, m_inlined.at(p), where, readOnGpu);
+      ForEachVariable(tl, m_inlined.at(p), visit);
       continue;
     }
     auto* vd = dyn_cast<VarDecl>(dr->getDecl());
     if (!vd || (vd->hasGlobalStorage() && !vd->isStaticLocal())) continue;
-    bool isLoopVar = std::any_of(tl.loops.begin(), tl.loops.end(), [&](const LoopHeader& h) { return h.var == vd; });
-    if (isLoopVar || !StateBuffer(tl, vd).empty() || (tl.locals.count(vd) && !m_hostLoopVars.count(vd)))
+    const bool isLoopVar = std::any_of(tl.loops.begin(), tl.loops.end(), [&](const LoopHeader& h) { return h.var == vd; });
+    visit(dr, vd, isLoopVar || !StateBuffer(tl, vd).empty() || (tl.locals.count(vd) && !m_hostLoopVars.count(vd)));
+  }
+}
+
+void ControlRewriter::CheckUniform(ThreadLoop& tl, const Expr* e, const std::string& where, bool readOnGpu) {
+  ForEachVariable(tl, e, [&](const DeclRefExpr* dr, const VarDecl* vd, bool perThread) {
+    if (perThread)
       Error(tl, dr->getBeginLoc(), "'" + vd->getNameAsString() + "' differs from thread to thread, but " + where + " in the thread loop of '" + m_ctrl.name +
             "' runs once for all threads in wavefront mode", "pass per-thread values to kernels by address (&" + vd->getNameAsString() + ") and branch inside the kernels");
     else if (readOnGpu && !tl.locals.count(vd) && std::find(tl.outer.begin(), tl.outer.end(), vd) == tl.outer.end())
       tl.outer.push_back(vd);
-  }
+  });
 }
 
 bool ControlRewriter::TryRtvNest(const ForStmt* outer) {

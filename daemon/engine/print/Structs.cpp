@@ -6,10 +6,10 @@
 //   complex(re, im)   -> complex_ctor(re, im)        a user-provided constructor, which builds `self`
 // The struct's members read and write `self`. LiteMath's vectors and matrices are GLSL's own types
 // and keep GLSL's operators; their few member functions (get_col, ...) are mapped by name.
+#include "analyse/AstQueries.h"
 #include "print/KernelPrinter.h"
 
 #include <clang/AST/DeclCXX.h>
-#include <clang/AST/RecursiveASTVisitor.h>
 
 #include <sstream>
 
@@ -176,12 +176,7 @@ std::string KernelPrinter::MatrixMethodCall(const CXXMemberCallExpr* call) {
   if (n == "set_row" && call->getNumArgs() == 2) {  // one element per column, a statement each: m[c][i] = v[c]
     const auto* rd = call->getImplicitObjectArgument()->getType()->getAsCXXRecordDecl();
     const int columns = rd && rd->getName() == "float3x3" ? 3 : 4;
-    struct Calls : clang::RecursiveASTVisitor<Calls> {
-      bool found = false;
-      bool VisitCallExpr(clang::CallExpr*) { found = true; return false; }
-    } calls;
-    for (unsigned a = 0; a < 2; ++a) calls.TraverseStmt(const_cast<clang::Expr*>(call->getArg(a)));
-    if (calls.found)
+    if (ContainsCall(call->getArg(0)) || ContainsCall(call->getArg(1)))
       return Fail(call->getBeginLoc(), "LiteMath's set_row with a computed row or value in a kernel",
                   "compute the row index and the value into locals first: m.set_row(i, v)");
     const std::string i = Expr(call->getArg(0)), v = Expr(call->getArg(1));
