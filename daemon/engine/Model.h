@@ -24,7 +24,8 @@ struct BlockField {
   std::string assignExpr;  // values the generated class computes (device addresses)
 };
 
-// TextureArray: std::vector<LiteImage::Texture2D<T>>, an array of combined image samplers.
+// TextureArray: std::vector<LiteImage::Texture2D<T>>, an array of combined image samplers (or
+// kernel_slicer's ICombinedImageSampler pointers).
 enum class MemberKind { Plain, Vector, Image, Sampler, TextureArray };
 
 struct Member {
@@ -45,6 +46,9 @@ struct Member {
   bool inClassData = false;     // plain: accessible, and its C++ layout matches std430
   unsigned std430Align = 4;     // plain: alignment in a std430 block
   bool specialized = false;     // plain: CRT_SPECIALIZE (Specialize.h), a specialization constant in GLSL
+  // texture array: kernel_slicer's ICombinedImageSampler pointers (a vector of them, or one: `singleTexture`),
+  // whose texels the generated class gets as float4 textures (LiteImage::TexturesOf)
+  bool combinedSamplers = false, singleTexture = false;
 };
 
 enum class ReduceOp { Add, Sub, Min, Max };

@@ -122,8 +122,9 @@ bool writePFM(const char* a_path, int a_width, int a_height, int a_channels, con
   return ok;
 }
 
+// Written in the format the file name's extension names, or in `a_format` ("bmp") when given.
 bool writeFile(const char* a_path, int a_width, int a_height, int a_channels, OIIO::TypeDesc a_type,
-               const void* a_data)
+               const void* a_data, const char* a_format = nullptr)
 {
   if (a_path == nullptr)
   {
@@ -135,11 +136,11 @@ bool writeFile(const char* a_path, int a_width, int a_height, int a_channels, OI
     std::fprintf(stderr, "[LiteImage] SaveImage: '%s': image is empty (%dx%d)\n", a_path, a_width, a_height);
     return false;
   }
-  if (lowerExtension(a_path) == "pfm" && a_type == OIIO::TypeDesc::FLOAT)
+  if (a_format == nullptr && lowerExtension(a_path) == "pfm" && a_type == OIIO::TypeDesc::FLOAT)
     return writePFM(a_path, a_width, a_height, a_channels, static_cast<const float*>(a_data));
   try
   {
-    auto out = OIIO::ImageOutput::create(a_path);
+    auto out = OIIO::ImageOutput::create(a_format != nullptr ? a_format : a_path);
     if (!out)
     {
       std::fprintf(stderr, "[LiteImage] SaveImage: no writer for '%s': %s\n", a_path, OIIO::geterror().c_str());
@@ -289,6 +290,34 @@ bool SaveImage(const char* a_path, const Image2D<uint32_t>& a_img)
     for (int c = 0; c < channels; c++)
       buf[i * channels + c] = uint8_t((src[i] >> (8 * c)) & 0xFFu);
   return writeFile(a_path, int(a_img.width()), int(a_img.height()), channels, OIIO::TypeDesc::UINT8, buf.data());
+}
+
+bool SaveBMP(const char* a_path, const unsigned int* a_pixels, int a_width, int a_height)
+{
+  if (a_pixels == nullptr && a_width > 0 && a_height > 0)
+  {
+    std::fprintf(stderr, "[LiteImage] SaveBMP: '%s': no pixels\n", a_path ? a_path : "(null)");
+    return false;
+  }
+  const size_t         n = a_width > 0 && a_height > 0 ? size_t(a_width) * size_t(a_height) : 0;
+  std::vector<uint8_t> rgb(n * 3);
+  for (size_t i = 0; i < n; i++)
+    for (int c = 0; c < 3; c++)
+      rgb[i * 3 + c] = uint8_t((a_pixels[i] >> (8 * c)) & 0xFFu);
+  return writeFile(a_path, a_width, a_height, 3, OIIO::TypeDesc::UINT8, rgb.data(), "bmp");
+}
+
+std::vector<unsigned int> LoadBMP(const char* a_path, int* a_width, int* a_height)
+{
+  Image2D<uint32_t> image;
+  const bool        ok = LoadImage(a_path, image);
+  if (a_width != nullptr)
+    *a_width = ok ? int(image.width()) : 0;
+  if (a_height != nullptr)
+    *a_height = ok ? int(image.height()) : 0;
+  if (!ok)
+    return {};
+  return std::vector<unsigned int>(image.data(), image.data() + size_t(image.width()) * image.height());
 }
 
 } // namespace LiteImage

@@ -3,7 +3,10 @@
 
 #include "LiteMath.h"
 
+#include <cmath>
 #include <cstdint>
+#include <memory>
+#include <stdexcept>
 #include <utility>
 #include <vector>
 
@@ -105,6 +108,11 @@ public:
     m_data.shrink_to_fit();
   }
 
+  // Whether 8-bit texels hold sRGB-encoded colour (as LiteImage's setSRGB): combined image samplers
+  // read them linearized, as a GPU reads VK_FORMAT_R8G8B8A8_SRGB. sample() and the IO ignore it.
+  void setSRGB(bool a_srgb) { m_srgb = a_srgb; }
+  bool srgb() const { return m_srgb; }
+
   // Samples with normalized coordinates; texel centers are at ((i + 0.5) / w, (j + 0.5) / h)
   // as in Vulkan. Implemented for T = float and T = float4. An empty image returns T().
   T sample(const Sampler& a_sampler, float2 a_uv) const;
@@ -129,19 +137,26 @@ private:
   uint32_t       m_width  = 0;
   uint32_t       m_height = 0;
   std::vector<T> m_data;
+  bool           m_srgb = false;
 };
 
-template <typename T>
-T Image2D<T>::sample(const Sampler& a_sampler, float2 a_uv) const
+namespace detail
 {
-  if (m_width == 0 || m_height == 0)
-    return T();
+// Nearest or bilinear filtering of a w x h grid of texels with normalized coordinates, texel
+// centers at ((i + 0.5) / w, (j + 0.5) / h) as in Vulkan. fetch(x, y) gives the texel (of type R)
+// at a possibly out-of-range index, after the sampler's address modes. Every sample() of LiteImage
+// is this one sequence of float operations, which the GPU's buffer sampling repeats exactly.
+template <typename R, typename Fetch>
+R filterTexels(uint32_t a_width, uint32_t a_height, const Sampler& a_sampler, float2 a_uv, const Fetch& fetch)
+{
+  if (a_width == 0 || a_height == 0)
+    return R();
 
-  const float x = detail::sanitizeCoord(a_uv.x * float(m_width));
-  const float y = detail::sanitizeCoord(a_uv.y * float(m_height));
+  const float x = sanitizeCoord(a_uv.x * float(a_width));
+  const float y = sanitizeCoord(a_uv.y * float(a_height));
 
   if (a_sampler.filter == Sampler::Filter::NEAREST)
-    return fetch(a_sampler, int(std::floor(x)), int(std::floor(y)));
+    return fetch(int(std::floor(x)), int(std::floor(y)));
 
   // Bilinear: shift by half a texel so that integer positions are texel centers.
   const float fx = x - 0.5f, fy = y - 0.5f;
@@ -149,13 +164,20 @@ T Image2D<T>::sample(const Sampler& a_sampler, float2 a_uv) const
   const float tx = fx - x0, ty = fy - y0;
   const int   ix = int(x0), iy = int(y0);
 
-  const T t00 = fetch(a_sampler, ix, iy);
-  const T t10 = fetch(a_sampler, ix + 1, iy);
-  const T t01 = fetch(a_sampler, ix, iy + 1);
-  const T t11 = fetch(a_sampler, ix + 1, iy + 1);
-  const T top    = t00 * (1.0f - tx) + t10 * tx;
-  const T bottom = t01 * (1.0f - tx) + t11 * tx;
+  const R t00 = fetch(ix, iy);
+  const R t10 = fetch(ix + 1, iy);
+  const R t01 = fetch(ix, iy + 1);
+  const R t11 = fetch(ix + 1, iy + 1);
+  const R top    = t00 * (1.0f - tx) + t10 * tx;
+  const R bottom = t01 * (1.0f - tx) + t11 * tx;
   return top * (1.0f - ty) + bottom * ty;
+}
+} // namespace detail
+
+template <typename T>
+T Image2D<T>::sample(const Sampler& a_sampler, float2 a_uv) const
+{
+  return detail::filterTexels<T>(m_width, m_height, a_sampler, a_uv, [&](int x, int y) { return fetch(a_sampler, x, y); });
 }
 
 // An image with the sampler it is read through: what Vulkan calls a combined image sampler.
@@ -186,6 +208,135 @@ private:
   Sampler    m_sampler;
 };
 
+// ---- combined image samplers, as kernel_slicer's samples write them ----
+// An image of any texel type with its sampler, behind an interface: kernels call sample(uv) on a
+// std::shared_ptr<ICombinedImageSampler> or ICombinedImageSampler* member, or on an element of a
+// std::vector of them, and get a float4 whatever the image holds. Texels read as Vulkan reads them:
+// float4 as is, float as (v, 0, 0, 1), uint32_t as RGBA8 unorm (R in the lowest byte, each channel
+// c / 255, and R, G and B then linearized where the image is setSRGB(true)); then filtered as
+// Image2D<float4> filters (a BORDER texel is the sampler's borderColor).
+struct ICombinedImageSampler
+{
+  virtual ~ICombinedImageSampler() = default;
+  virtual float4 sample(float2 a_uv) const = 0;
+
+  virtual unsigned int width() const  = 0;
+  virtual unsigned int height() const = 0;
+  virtual unsigned int depth() const  = 0;
+  virtual unsigned int bpp() const    = 0;  // bytes per texel
+  virtual unsigned int format() const = 0;  // the VkFormat of the texels, as a number
+  virtual Sampler      sampler() const = 0;
+  virtual const void*  data() const    = 0;
+};
+
+namespace detail
+{
+inline float srgbToLinear(float c) { return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f); }
+inline float4 texelAsFloat4(const float4& t, bool) { return t; }
+inline float4 texelAsFloat4(float t, bool) { return float4(t, 0.0f, 0.0f, 1.0f); }
+inline float4 texelAsFloat4(uint32_t t, bool a_srgb)
+{
+  float4 c(float(t & 0xFFu) / 255.0f, float((t >> 8) & 0xFFu) / 255.0f, float((t >> 16) & 0xFFu) / 255.0f, float(t >> 24) / 255.0f);
+  if (a_srgb)  // colour channels only, as the GPU's sRGB formats
+    c = float4(srgbToLinear(c.x), srgbToLinear(c.y), srgbToLinear(c.z), c.w);
+  return c;
+}
+// VkFormat numbers of the texel types (VK_FORMAT_R8G8B8A8_UNORM or _SRGB, R32_SFLOAT, R32G32B32A32_SFLOAT).
+inline unsigned int formatOf(const uint32_t*, bool a_srgb) { return a_srgb ? 43u : 37u; }
+inline unsigned int formatOf(const float*, bool) { return 100u; }
+inline unsigned int formatOf(const float4*, bool) { return 109u; }
+
+// What MakeCombinedTexture2D makes: the only combined image samplers whose texels TexturesOf can
+// hand to a GPU knowing it samples them as sample() does.
+struct CombinedTexels : ICombinedImageSampler
+{
+  virtual Texture2D<float4> texturesAsFloat4() const = 0;
+};
+
+template <typename T>
+struct CombinedTexture2D final : CombinedTexels
+{
+  CombinedTexture2D(std::shared_ptr<Image2D<T>> a_image, const Sampler& a_sampler) : image(std::move(a_image)), samplerState(a_sampler) {}
+
+  float4 sample(float2 a_uv) const override
+  {
+    if (!image)
+      return float4(0.0f);
+    return filterTexels<float4>(image->width(), image->height(), samplerState, a_uv, [&](int x, int y) { return fetch(x, y); });
+  }
+  unsigned int width() const override { return image ? image->width() : 0u; }
+  unsigned int height() const override { return image ? image->height() : 0u; }
+  unsigned int depth() const override { return 1u; }
+  unsigned int bpp() const override { return unsigned(sizeof(T)); }
+  unsigned int format() const override { return formatOf(static_cast<const T*>(nullptr), image && image->srgb()); }
+  Sampler      sampler() const override { return samplerState; }
+  const void*  data() const override { return image ? image->data() : nullptr; }
+
+  Texture2D<float4> texturesAsFloat4() const override
+  {
+    Image2D<float4> texels(width(), height());
+    for (uint32_t y = 0; y < height(); y++)
+      for (uint32_t x = 0; x < width(); x++)
+        texels.at(int(x), int(y)) = texelAsFloat4(image->at(int(x), int(y)), image->srgb());
+    return Texture2D<float4>(std::move(texels), samplerState);
+  }
+
+  std::shared_ptr<Image2D<T>> image;
+  Sampler                     samplerState;
+
+private:
+  float4 fetch(int x, int y) const
+  {
+    const int xi = addressTexel(x, int(image->width()), samplerState.addressU);
+    const int yi = addressTexel(y, int(image->height()), samplerState.addressV);
+    if (xi < 0 || yi < 0)
+      return samplerState.borderColor;
+    return texelAsFloat4(image->at(xi, yi), image->srgb());
+  }
+};
+} // namespace detail
+
+// The image (shared, not copied: later changes to its texels are seen) read through the sampler.
+// T is float4, float or uint32_t.
+template <typename T>
+std::shared_ptr<ICombinedImageSampler> MakeCombinedTexture2D(std::shared_ptr<Image2D<T>> a_image, Sampler a_sampler)
+{
+  return std::make_shared<detail::CombinedTexture2D<T>>(std::move(a_image), a_sampler);
+}
+
+// The textures a GPU samples for combined image samplers, as Texture2D<float4>s whose sample() gives
+// each one's sample() bit for bit (what the generated classes upload). A null pointer gives an empty
+// texture. Throws std::invalid_argument for an ICombinedImageSampler that MakeCombinedTexture2D did
+// not make: its sample() may compute anything, so no texels stand for it.
+inline Texture2D<float4> TextureOf(const ICombinedImageSampler* a_sampler)
+{
+  if (a_sampler == nullptr)
+    return Texture2D<float4>();
+  auto* texels = dynamic_cast<const detail::CombinedTexels*>(a_sampler);
+  if (texels == nullptr)
+    throw std::invalid_argument("LiteImage: an ICombinedImageSampler not made by MakeCombinedTexture2D cannot be sampled on the GPU "
+                                "(its sample() is the class's own code); make it with MakeCombinedTexture2D(image, sampler)");
+  return texels->texturesAsFloat4();
+}
+inline const ICombinedImageSampler* heldSampler(const ICombinedImageSampler* a_sampler) { return a_sampler; }
+template <typename P>
+const ICombinedImageSampler* heldSampler(const std::shared_ptr<P>& a_sampler) { return a_sampler.get(); }
+template <typename P>
+const ICombinedImageSampler* heldSampler(const std::unique_ptr<P>& a_sampler) { return a_sampler.get(); }
+
+// One texture per element of a vector of pointers, or one for a single pointer.
+template <typename P>
+std::vector<Texture2D<float4>> TexturesOf(const std::vector<P>& a_samplers)
+{
+  std::vector<Texture2D<float4>> textures;
+  textures.reserve(a_samplers.size());
+  for (const auto& p : a_samplers)
+    textures.push_back(TextureOf(heldSampler(p)));
+  return textures;
+}
+template <typename P>
+std::vector<Texture2D<float4>> TexturesOf(const P& a_sampler) { return {TextureOf(heldSampler(a_sampler))}; }
+
 // ---- image file IO (OpenImageIO) ----
 // Float data is written as-is to float formats (.exr, .hdr, .pfm, .tif/.tiff). Other formats
 // (.png, .jpg, .ppm, ...) are 8-bit: values are clamped to [0,1] and quantized, WITHOUT any gamma
@@ -200,5 +351,11 @@ bool LoadImage(const char* a_path, Image2D<uint32_t>& a_out);
 bool SaveImage(const char* a_path, const Image2D<float4>& a_img);
 bool SaveImage(const char* a_path, const Image2D<float>& a_img);
 bool SaveImage(const char* a_path, const Image2D<uint32_t>& a_img);
+
+// kernel_slicer's spelling: w x h packed RGBA8 pixels (R in the lowest byte), top row first, saved
+// as a 24-bit BMP file (alpha dropped). Returns false and prints a message on failure.
+bool SaveBMP(const char* a_path, const unsigned int* a_pixels, int a_width, int a_height);
+// And its reading: any image file as packed RGBA8 pixels (empty, with a message, on failure).
+std::vector<unsigned int> LoadBMP(const char* a_path, int* a_width, int* a_height);
 
 } // namespace LiteImage

@@ -1727,4 +1727,58 @@ protected:
     REQUIRE(cpu.output.find("SetterRace.cpp:8:") != std::string::npos);
     REQUIRE(cpu.output.find("kernel writes one element through pointer member 'm_out' from every thread (a data race)") != std::string::npos);
   }
+  SECTION("a helper member function writing at the index it is given (kernel_slicer's test 005)")
+  {
+    auto withHelper = [&](const std::string& name, const std::string& index) {
+      std::string h = header(name);
+      h.insert(h.find("  Outputs m_out;"), "  void SetProduct(int i, float v) { m_out.products[" + index + "] = v; }\n");
+      return TempClass(name, h, source(name, "SetProduct(i, a[i] * b[i]);"));
+    };
+    TempClass tc = withHelper("SetterHelper", "i");
+    CommandResult cpu = translate(tc, "SetterHelper", "cpu");
+    INFO(cpu.output);
+    REQUIRE(cpu.exitCode == 0);
+    CommandResult gpu = translate(tc, "SetterHelper", "vulkan");
+    REQUIRE(gpu.exitCode == 1);
+    REQUIRE(gpu.output.find("helper function 'SetProduct' writes through pointer member 'm_out' (kernel_slicer's setter form)") != std::string::npos);
+    TempClass race = withHelper("SetterHelperRace", "0");
+    CommandResult raced = translate(race, "SetterHelperRace", "cpu");
+    INFO(raced.output);
+    REQUIRE(raced.exitCode == 1);
+    REQUIRE(raced.output.find("helper function 'SetProduct' writes one element through pointer member 'm_out' from every thread (a data race)") !=
+            std::string::npos);
+  }
+}
+
+TEST_CASE("Elements of a member array reduced in a kernel: the CPU backend's form, a clear error on the GPU and ISPC", "[diagnostics]")
+{
+  TempClass tc("ArrayReduce", R"(#pragma once
+class ArrayReduce
+{
+public:
+  virtual ~ArrayReduce() = default;
+  virtual void Sum(int n, [[crossrt::size("n")]] const float* a);
+  float m_sums[2];
+protected:
+  void kernel1D_Sum(int n, const float* a);
+};
+)",
+               "#include \"ArrayReduce.h\"\nvoid ArrayReduce::Sum(int n, const float* a) { kernel1D_Sum(n, a); }\n"
+               "void ArrayReduce::kernel1D_Sum(int n, const float* a)\n{\n  for (int i = 0; i < n; i++)\n  {\n    m_sums[0] += a[i];\n    m_sums[1] += 2.0f * a[i];\n  }\n}\n");
+  for (const char* backend : {"cpu", "vulkan", "ispc"})
+  {
+    CommandResult r = RunCrossrt("translate --class ArrayReduce --backend " + std::string(backend) + " --out " + (tc.dir / backend).string() +
+                                 " --source " + tc.Source("ArrayReduce") + " --templates " CROSSRT_SOURCE_DIR "/templates");
+    INFO(backend << ": " << r.output);
+    REQUIRE_FALSE(r.crashed);
+    if (std::string(backend) == "cpu")
+    {
+      REQUIRE(r.exitCode == 0);
+      continue;
+    }
+    REQUIRE(r.exitCode == 1);
+    REQUIRE(r.output.find("ArrayReduce.cpp:7:") != std::string::npos);
+    REQUIRE(r.output.find("kernel reduces elements of member array 'm_sums' (m_sums[k] += x)") != std::string::npos);
+    REQUIRE(r.output.find("the CPU backend reduces them as written") != std::string::npos);
+  }
 }

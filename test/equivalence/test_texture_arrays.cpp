@@ -13,9 +13,16 @@
 #include "TexturedMaterials_ISPC.h"
 #endif
 #include "TexturedHits_Vulkan.h"
+#include "CombinedSamplers.h"
+#include "CombinedSamplers_CPU.h"
+#include "CombinedSamplers_Vulkan.h"
+#ifdef CROSSRT_HAS_ISPC
+#include "CombinedSamplers_ISPC.h"
+#endif
 #include "ImageSupport.h"
 #include "TestSupport.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -280,4 +287,101 @@ TEST_CASE("Arrays of textures with ray queries in one kernel: the texture of the
     CHECK(close >= size_t(n) * 99 / 100);
   }
   RequireNoValidationMessages(ctx);
+}
+
+namespace
+{
+std::vector<float4> RunCombined(CombinedSamplers& c, int w, int h)
+{
+  std::vector<float4> out(size_t(w) * h, float4(-7.0f));
+  c.Run(w, h, out.data());
+  return out;
+}
+}  // namespace
+
+// kernel_slicer's form of combined image samplers: ICombinedImageSampler pointers, one and vectors
+// of them, over RGBA8, float and float4 images; sampled from buffers (lavapipe) bit for bit as
+// their sample() does.
+TEST_CASE("ICombinedImageSampler members (kernel_slicer's form) sample as on the CPU", "[equivalence][textures][device-features]")
+{
+  auto ctx = ValidatedContext();
+  const int w = 37, h = 23;
+  CombinedSamplers reference;
+  const std::vector<float4> expected = RunCombined(reference, w, h);
+  // The original against what the test computes: pixel (0, 0) from each sampler's own sample().
+  {
+    const float2 uv = float2(0.5f / w, 0.5f / h) * 1.6f - float2(0.3f, 0.3f);
+    const float4 want = reference.m_pLogo->sample(uv) + clamp(reference.m_textures[0]->sample(uv), 0.0f, 1.0f) * 2.0f +
+                        reference.m_views[1]->sample(uv * 0.5f) + reference.m_pMask->sample(uv) * float(4 + 3);
+    REQUIRE(Same(expected[0], want));
+  }
+  std::vector<std::pair<const char*, std::shared_ptr<CombinedSamplers>>> impls = {{"CPU", CreateCombinedSamplers_CPU()}};
+#ifdef CROSSRT_HAS_ISPC
+  impls.push_back({"ISPC", CreateCombinedSamplers_ISPC()});
+#endif
+  if (ctx) impls.push_back({"Vulkan", CreateCombinedSamplers_Vulkan(ctx)});
+  for (auto& [name, impl] : impls)
+  {
+    INFO(name);
+    auto* vulkan = dynamic_cast<CombinedSamplers_Vulkan*>(impl.get());
+    const bool exact = !vulkan || !vulkan->UsesTextureHardware();
+    auto agree = [&](const std::vector<float4>& want) {
+      const std::vector<float4> got = RunCombined(*impl, w, h);
+      size_t same = 0;
+      for (size_t i = 0; i < want.size(); ++i)
+        same += exact ? Same(got[i], want[i]) : MaxDifference(got[i], want[i]) <= 16.0f / 512.0f;
+      UNSCOPED_INFO(same << " of " << want.size() << " pixels agree; pixel 1: " << got[1].x << " vs " << want[1].x);
+      return exact ? same == want.size() : same >= want.size() * 98 / 100;
+    };
+    REQUIRE(agree(expected));
+    CombinedSamplers original;  // changed as the translated class is
+    // New texels in a shared image: CommitDeviceData() sends them.
+    for (auto* c : {impl.get(), &original})
+    {
+      c->m_logoImage->set(2, 1, 0xFFFFFFFFu);
+      c->m_logoImage->set(0, 0, 0x00000000u);
+      c->CommitDeviceData();
+    }
+    const std::vector<float4> changed = RunCombined(original, w, h);
+    REQUIRE_FALSE(std::equal(changed.begin(), changed.end(), expected.begin(), Same));
+    REQUIRE(agree(changed));
+    // One texture fewer: the next call sees it by itself.
+    for (auto* c : {impl.get(), &original})
+    {
+      c->m_views.erase(std::find(c->m_views.begin(), c->m_views.end(), c->m_textures.back().get()));  // it points into m_textures
+      c->m_textures.pop_back();
+    }
+    REQUIRE(agree(RunCombined(original, w, h)));
+  }
+  RequireNoValidationMessages(ctx);
+}
+
+TEST_CASE("An ICombinedImageSampler of the user's own is an error on the GPU, not a wrong sample", "[equivalence][textures]")
+{
+  auto ctx = ValidatedContext();
+  if (!ctx) return;
+  struct Procedural : ICombinedImageSampler
+  {
+    float4 sample(float2 uv) const override { return float4(uv.x, uv.y, 0.0f, 1.0f); }
+    unsigned int width() const override { return 1; }
+    unsigned int height() const override { return 1; }
+    unsigned int depth() const override { return 1; }
+    unsigned int bpp() const override { return 16; }
+    unsigned int format() const override { return 109; }
+    Sampler sampler() const override { return Sampler(); }
+    const void* data() const override { return &texel; }
+    float4 texel = float4(1.0f);
+  };
+  auto gpu = CreateCombinedSamplers_Vulkan(ctx);
+  gpu->m_pLogo = std::make_shared<Procedural>();
+  std::vector<float4> out(4);
+  try
+  {
+    gpu->Run(2, 2, out.data());
+    FAIL("a procedural ICombinedImageSampler was sampled on the GPU");
+  }
+  catch (const std::invalid_argument& e)
+  {
+    CHECK(std::string(e.what()).find("MakeCombinedTexture2D") != std::string::npos);
+  }
 }

@@ -274,3 +274,99 @@ TEST_CASE("Image2D IO failures return false", "[liteimage]")
   }
   CHECK_FALSE(LoadImage(tmp.path.c_str(), img4));
 }
+
+TEST_CASE("SaveBMP writes packed RGBA8 pixels as a BMP that reads back", "[liteimage]")
+{
+  const std::vector<unsigned int> pixels = {0x000000FFu, 0x0000FF00u, 0x00FF0000u, 0xFF102030u, 0x00FFFFFFu, 0x00000000u};
+  TempFile tmp("bmp");
+  REQUIRE(SaveBMP(tmp.path.c_str(), pixels.data(), 3, 2));
+  Image2D<uint32_t> back;
+  REQUIRE(LoadImage(tmp.path.c_str(), back));
+  REQUIRE(back.width() == 3);
+  REQUIRE(back.height() == 2);
+  for (size_t i = 0; i < pixels.size(); i++)  // alpha is dropped: reads back as 255
+    CHECK(back.data()[i] == ((pixels[i] & 0x00FFFFFFu) | 0xFF000000u));
+  CHECK_FALSE(SaveBMP("/nonexistent/dir/out.bmp", pixels.data(), 3, 2));
+  CHECK_FALSE(SaveBMP(tmp.path.c_str(), nullptr, 3, 2));
+  CHECK_FALSE(SaveBMP(tmp.path.c_str(), pixels.data(), 0, 2));
+}
+
+TEST_CASE("Combined image samplers read every texel type as Vulkan does", "[liteimage]")
+{
+  Sampler nearest = makeSampler(Sampler::AddressMode::CLAMP, Sampler::Filter::NEAREST);
+  // RGBA8 unorm, R in the lowest byte.
+  const std::vector<uint32_t> rgba = {0x80FF4000u, 0x00000000u};
+  auto bytes = MakeCombinedTexture2D(std::make_shared<Image2D<uint32_t>>(2, 1, rgba.data()), nearest);
+  const float4 t0 = bytes->sample(float2(0.25f, 0.5f));
+  CHECK(t0.x == 0.0f);
+  CHECK(t0.y == 64.0f / 255.0f);
+  CHECK(t0.z == 1.0f);
+  CHECK(t0.w == 128.0f / 255.0f);
+  CHECK(bytes->width() == 2);
+  CHECK(bytes->bpp() == 4);
+  CHECK(bytes->format() == 37u);  // VK_FORMAT_R8G8B8A8_UNORM
+  // float as (v, 0, 0, 1); BORDER gives the border colour whatever the texels are.
+  const std::vector<float> gray = {0.5f, 2.0f};
+  auto floats = MakeCombinedTexture2D(std::make_shared<Image2D<float>>(2, 1, gray.data()), makeSampler(Sampler::AddressMode::BORDER, Sampler::Filter::NEAREST));
+  const float4 f1 = floats->sample(float2(0.75f, 0.5f)), outside = floats->sample(float2(1.5f, 0.5f));
+  CHECK((f1.x == 2.0f && f1.y == 0.0f && f1.z == 0.0f && f1.w == 1.0f));
+  CHECK((outside.x == -1.0f && outside.y == -2.0f && outside.z == -3.0f && outside.w == -4.0f));
+  // float4 images sample bit for bit as Image2D<float4> does, and the image is shared, not copied.
+  auto image = std::make_shared<Image2D<float4>>(makeTestImage(5, 3));
+  const Sampler linear = makeSampler(Sampler::AddressMode::MIRROR, Sampler::Filter::LINEAR);
+  auto shared = MakeCombinedTexture2D(image, linear);
+  image->set(1, 1, float4(9.0f));
+  for (float u = -1.3f; u < 2.0f; u += 0.173f)
+  {
+    const float4 a = shared->sample(float2(u, 0.61f - u)), b = image->sample(linear, float2(u, 0.61f - u));
+    REQUIRE((a.x == b.x && a.y == b.y && a.z == b.z && a.w == b.w));
+  }
+  // The textures a GPU gets sample as the combined samplers do.
+  const std::vector<std::shared_ptr<ICombinedImageSampler>> list = {bytes, floats, shared, nullptr};
+  const std::vector<Texture2D<float4>> textures = TexturesOf(list);
+  REQUIRE(textures.size() == 4);
+  CHECK(textures[3].width() == 0);
+  for (size_t i = 0; i < 3; i++)
+    for (float u = -0.7f; u < 1.8f; u += 0.117f)
+    {
+      const float4 a = list[i]->sample(float2(u, 1.0f - u)), b = textures[i].sample(float2(u, 1.0f - u));
+      REQUIRE((a.x == b.x && a.y == b.y && a.z == b.z && a.w == b.w));
+    }
+  // A combined sampler of the user's own has no texels that stand for its sample().
+  struct Procedural : ICombinedImageSampler
+  {
+    float4       sample(float2 uv) const override { return float4(uv.x, uv.y, 0.0f, 1.0f); }
+    unsigned int width() const override { return 1; }
+    unsigned int height() const override { return 1; }
+    unsigned int depth() const override { return 1; }
+    unsigned int bpp() const override { return 16; }
+    unsigned int format() const override { return 109; }
+    Sampler      sampler() const override { return Sampler(); }
+    const void*  data() const override { return nullptr; }
+  } procedural;
+  CHECK_THROWS_AS(TextureOf(&procedural), std::invalid_argument);
+}
+
+TEST_CASE("LoadBMP reads what SaveBMP wrote; sRGB images sample linearized through combined samplers", "[liteimage]")
+{
+  const std::vector<unsigned int> pixels = {0x00336699u, 0x00FFFFFFu};
+  TempFile tmp("bmp");
+  REQUIRE(SaveBMP(tmp.path.c_str(), pixels.data(), 2, 1));
+  int w = -1, h = -1;
+  const std::vector<unsigned int> back = LoadBMP(tmp.path.c_str(), &w, &h);
+  REQUIRE((w == 2 && h == 1 && back.size() == 2));
+  CHECK(back[0] == 0xFF336699u);
+  CHECK(LoadBMP("/nonexistent/dir/in.bmp", &w, &h).empty());
+  CHECK((w == 0 && h == 0));
+
+  auto image = std::make_shared<Image2D<uint32_t>>(2, 1, pixels.data());
+  image->setSRGB(true);
+  auto combined = MakeCombinedTexture2D(image, makeSampler(Sampler::AddressMode::CLAMP, Sampler::Filter::NEAREST));
+  CHECK(combined->format() == 43u);  // VK_FORMAT_R8G8B8A8_SRGB
+  const float4 c = combined->sample(float2(0.25f, 0.5f));
+  CHECK(c.x == Approx(std::pow((153.0f / 255.0f + 0.055f) / 1.055f, 2.4f)));  // 0x99, red
+  CHECK(c.z == Approx(std::pow((51.0f / 255.0f + 0.055f) / 1.055f, 2.4f)));   // 0x33, blue
+  CHECK(c.w == 0.0f);                                                          // alpha stays linear
+  const float4 white = combined->sample(float2(0.75f, 0.5f));
+  CHECK(white.x == 1.0f);
+}

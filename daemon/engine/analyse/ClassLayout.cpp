@@ -69,7 +69,7 @@ void FinishModel(ClassModel& model) {
     fields.push_back({generated::ImageSizeField(m.name, "height"), "uint32_t", "uint", 4, "", m.hostExpr + ".height()"});
   }
   for (auto& m : model.members)
-    if (m.usedByKernels && m.kind == MemberKind::TextureArray) fields.push_back({generated::SizeField(m.name), "uint32_t", "uint", 4, "", "uint32_t(" + m.hostExpr + ".size())"});
+    if (m.usedByKernels && m.kind == MemberKind::TextureArray) fields.push_back({generated::SizeField(m.name), "uint32_t", "uint", 4, "", m.singleTexture ? std::string("1u") : "uint32_t(" + m.hostExpr + ".size())"});
   // Virtual functions: where each vector's tags and each implementation's objects are on the device.
   for (auto& v : model.virtuals) {
     fields.push_back({generated::VirtualTagsField(v.member), "uint64_t", "uvec2", 8, "", generated::kVirtualObjects + "." + v.member + "_tags.Address()"});

@@ -72,12 +72,13 @@ void AnalyzeMembers(Context& c) {
     m.hostExpr = m.name;
     QualType elem;
     if (IsTextureArray(f->getType(), &elem)) {
-      auto format = ImageFormatOf(elem);
+      auto format = TextureArrayFormat(f->getType());
       if (!format || format->texel == "uint") continue;  // reported if a kernel uses it
       m.kind = MemberKind::TextureArray;
       m.glslType = format->texel;
       m.vkFormat = format->vkFormat;
-      m.elemCppType = CppTypeName(c.ctx, elem);
+      m.combinedSamplers = IsCombinedSamplers(f->getType(), &m.singleTexture);
+      m.elemCppType = m.combinedSamplers ? "LiteMath::float4" : CppTypeName(c.ctx, elem);
       m.cppType = CppTypeName(c.ctx, f->getType());
     } else if (IsImage2D(f->getType(), &elem)) {
       auto format = ImageFormatOf(elem);

@@ -51,9 +51,42 @@ struct WriteScanner : RecursiveASTVisitor<WriteScanner> {
       memberWrites.insert(root);
       return;
     }
+    if (ThroughPointer(lhs)) {  // m_out.summ[i] = ...: the memory a pointer member points at, not the member
+      // The CPU class runs the kernel and its helpers as written, each thread at its index (as
+      // through a kernel's pointer parameter); one constant element written from every thread stays
+      // a data race.
+      if (c.model.forCpu && !c.model.forIspc) {
+        if (!IndexedPerThread(lhs, c.ctx))
+          c.rep.Error(loc, std::string(helper ? "helper function '" + helper->getNameAsString() + "'" : "kernel") + " writes one element through pointer member '" + root->getNameAsString() + "' from every thread (a data race)",
+                      "write at the thread's own index (p[i]), or accumulate in a member with 'm += x' (a reduction)");
+        return;
+      }
+      c.rep.Error(loc, std::string(helper ? "helper function '" + helper->getNameAsString() + "'" : "kernel") + " writes through pointer member '" +
+                           root->getNameAsString() + "' (kernel_slicer's setter form)",
+                  c.model.forIspc ? "ISPC kernels reach memory through the class's buffers: pass the output as a size-annotated pointer parameter, "
+                                    "or write to a std::vector member (the CPU backend runs this kernel as written)"
+                                  : "GPU kernels reach memory through buffers: pass the output as a size-annotated pointer parameter, or write to "
+                                    "a std::vector member (the CPU backend runs this kernel as written)");
+      return;
+    }
     if (helper) {
       c.rep.Error(loc, "helper function '" + helper->getNameAsString() + "' writes class member '" + root->getNameAsString() + "' (called from every thread: a data race)",
                   "accumulate in the kernel's loop body (m += x, min, max), or return the value from the helper");
+      return;
+    }
+    if (auto* element = op && !direct ? ConstantElement(lhs, root) : nullptr) {  // coefs[2] += x: an element of a member array
+      if (!c.model.forCpu || c.model.forIspc) {
+        c.rep.Error(loc, "kernel reduces elements of member array '" + root->getNameAsString() + "' (" + root->getNameAsString() + "[k] += x)",
+                    std::string("the CPU backend reduces them as written; ") + (c.model.forIspc ? "ISPC" : "GPU") +
+                    " kernels reduce whole members: reduce each element in a member of its own (m_coef0 += x), or a local declared before the loop");
+        return;
+      }
+      auto [it, fresh] = reductions.emplace(root, *op);
+      if (!fresh && it->second != *op)
+        c.rep.Error(loc, "member '" + root->getNameAsString() + "' is reduced with two different operations in one kernel",
+                    "use one of +=, -=, min or max per member");
+      reductionUses.insert(element);
+      for (auto* u : uses) reductionUses.insert(u);
       return;
     }
     if (op && direct) {
@@ -64,24 +97,17 @@ struct WriteScanner : RecursiveASTVisitor<WriteScanner> {
       for (auto* u : uses) reductionUses.insert(u);
       return;
     }
-    if (ThroughPointer(lhs)) {  // m_out.summ[i] = ...: the memory a pointer member points at, not the member
-      // The CPU class runs the kernel as written, each thread at its index (as through a kernel's
-      // pointer parameter); one constant element written from every thread stays a data race.
-      if (c.model.forCpu && !c.model.forIspc) {
-        if (!IndexedPerThread(lhs, c.ctx))
-          c.rep.Error(loc, "kernel writes one element through pointer member '" + root->getNameAsString() + "' from every thread (a data race)",
-                      "write at the thread's own index (p[i]), or accumulate in a member with 'm += x' (a reduction)");
-        return;
-      }
-      c.rep.Error(loc, "kernel writes through pointer member '" + root->getNameAsString() + "' (kernel_slicer's setter form)",
-                  c.model.forIspc ? "ISPC kernels reach memory through the class's buffers: pass the output as a size-annotated pointer parameter, "
-                                    "or write to a std::vector member (the CPU backend runs this kernel as written)"
-                                  : "GPU kernels reach memory through buffers: pass the output as a size-annotated pointer parameter, or write to "
-                                    "a std::vector member (the CPU backend runs this kernel as written)");
-      return;
-    }
     c.rep.Error(loc, "kernel writes class member '" + root->getNameAsString() + "' from every thread (a data race)",
                 "accumulate with 'm += x', 'm = std::min(m, x)' or 'm = std::max(m, x)' (a reduction), or write to an element of a std::vector member");
+  }
+  // `arr[K]` with K a constant and arr the one-dimensional array member `root`: arr's MemberExpr.
+  const MemberExpr* ConstantElement(const Expr* lhs, const FieldDecl* root) const {
+    auto* as = dyn_cast<ArraySubscriptExpr>(lhs->IgnoreParenImpCasts());
+    auto* me = as ? AsThisMember(as->getBase()) : nullptr;
+    Expr::EvalResult r;
+    if (!me || me->getMemberDecl() != root || !as->getIdx()->EvaluateAsInt(r, c.ctx)) return nullptr;
+    auto* arr = dyn_cast<ConstantArrayType>(root->getType().getCanonicalType().getTypePtr());
+    return arr && !isa<ArrayType>(arr->getElementType().getCanonicalType().getTypePtr()) ? me : nullptr;
   }
   // Whether the written lvalue is reached through a pointer (p[i], *p, p->f on the way to the member).
   static bool ThroughPointer(const Expr* e) {

@@ -41,6 +41,10 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
       x.set("name", m.name);
       x.set("host", m.hostExpr);
       x.set("vkFormat", m.vkFormat);
+      // kernel_slicer's ICombinedImageSampler pointers: their texels as float4 textures, converted by CommitDeviceData()
+      x.set("combined", m.combinedSamplers);
+      x.set("textures", m.combinedSamplers ? "crt_" + m.name + "Textures" : m.hostExpr);
+      x.set("count", m.singleTexture ? std::string("size_t(1)") : m.hostExpr + ".size()");
       textureArrays.push_back(x);
     }
     d.set("hasTextureArrays", !textureArrays.is_empty_list());
@@ -108,6 +112,7 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
   if (model.forIspc) IspcHostData(model, d);
   Data kernels = List(), ompReductions = List();
   std::set<std::string> declared;
+  bool arrayReductions = false;  // elements of a member array reduced (coefs[k] += x)
   for (auto& k : model.kernels) {
     if (k.rtv) continue;  // kernel_* bodies are inherited; their loops are parallelised in the control function
     Data x = CpuKernelData(k);
@@ -124,21 +129,27 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
     Data reds = List();
     for (auto& r : k.reductions) {
       // A member is reduced through a local copy (crt_<member>Local); a local is reduced itself.
-      const std::string reduced = r.local ? r.member : generated::ReductionLocal(r.member);
+      // An array member (its elements reduced, coefs[k] += x, on the CPU backend only) as an array section.
+      const auto [element, dims] = SplitArray(r.glslType);
+      const std::string count = dims.empty() ? "" : dims.substr(1, dims.size() - 2);
+      const std::string reduced = (r.local ? r.member : generated::ReductionLocal(r.member)) + (count.empty() ? "" : "[:" + count + "]");
       if (!r.local) {
         Data y;
         y.set("member", r.member);
+        y.set("arraySize", count);
+        y.set("whole", count.empty());
         reds.push_back(y);
+        arrayReductions = arrayReductions || !count.empty();
       }
       std::string cppType = ReductionCppType(model, r);
-      bool scalar = r.glslType == "float" || r.glslType == "int" || r.glslType == "uint";
+      bool scalar = element == "float" || element == "int" || element == "uint";
       if (scalar) {
         clauses += " reduction(" + ScalarOmpOp(r.op) + ":" + reduced + ")";
         continue;
       }
       // LiteMath vectors need a declared reduction.
       std::string opName = std::string(r.op == ReduceOp::Min ? "min" : r.op == ReduceOp::Max ? "max" : "add");
-      std::string name = "crossrt_" + opName + "_" + SplitArray(r.glslType).first;
+      std::string name = "crossrt_" + opName + "_" + element;
       clauses += " reduction(" + name + ":" + reduced + ")";
       if (declared.insert(name).second) {
         Data o;
@@ -155,6 +166,7 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
   }
   d.set("kernels", kernels);
   d.set("ompReductions", ompReductions);
+  d.set("hasArrayReductions", arrayReductions);
   Data copies = List();
   for (auto& lc : model.lockedCopies) {
     Data x;

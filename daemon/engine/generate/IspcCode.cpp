@@ -187,7 +187,11 @@ void IspcHostData(const ClassModel& model, Data& d) {
     x.set("expr", m.hostExpr.empty() ? m.name : m.hostExpr);  // a composed member: through its holder
     if (!m.composedFrom.empty()) x.set("composedFrom", m.composedFrom);  // its comment
     if (m.kind == MemberKind::Image) x.set("image", "ispc::crt_Image_" + IspcTypeName(m.glslType));
-    if (m.kind == MemberKind::TextureArray) x.set("texture", "ispc::crt_Texture_" + IspcTypeName(m.glslType));
+    if (m.kind == MemberKind::TextureArray) {
+      x.set("texture", "ispc::crt_Texture_" + IspcTypeName(m.glslType));
+      x.set("combined", m.combinedSamplers);  // ICombinedImageSampler pointers: their texels as float4 textures
+      x.set("textures", m.combinedSamplers ? "crt_" + m.name + "Texels" : (m.hostExpr.empty() ? m.name : m.hostExpr));
+    }
     if (m.kind == MemberKind::Plain || m.kind == MemberKind::Image || m.kind == MemberKind::Sampler) members.push_back(x);
     if (m.kind == MemberKind::Vector) vectors.push_back(x);
     if (m.kind == MemberKind::TextureArray) textures.push_back(x);

@@ -280,10 +280,11 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   for (size_t i = 0; i < k.textureArrays.size(); ++i) {
     auto* m = FindMember(model, k.textureArrays[i]);
     const std::string& a = k.textureArrays[i];
-    const std::string cppType = "std::vector<LiteImage::Texture2D<" + (m ? m->elemCppType : std::string("?")) + ">>";
+    const bool combined = m && m->combinedSamplers;  // ICombinedImageSampler pointers: float4 textures
+    const std::string cppType = combined ? m->cppType : "std::vector<LiteImage::Texture2D<" + (m ? m->elemCppType : std::string("?")) + ">>";
     Data x = Binding(binding++, a);
     x.set("textureSizes", true);
-    x.set("comment", "member " + cppType + " " + a + ": its textures' sizes and samplers");
+    x.set("comment", "member " + cppType + " " + a + (combined ? " (as float4 textures)" : "") + ": its textures' sizes and samplers");
     images.push_back(x);
     if (hardwareTextures) {
       Data y = Binding(0, a);

@@ -80,7 +80,32 @@ bool IsImageSampler(QualType type) {
   return rd && rd->getName() == "Sampler" && InNamespace(rd, "LiteImage");
 }
 
+bool IsCombinedSamplerPointer(QualType type) {
+  type = type.getNonReferenceType().getCanonicalType();
+  const CXXRecordDecl* pointee = nullptr;
+  if (type->isPointerType()) pointee = type->getPointeeType()->getAsCXXRecordDecl();
+  else if (auto* spec = dyn_cast_or_null<ClassTemplateSpecializationDecl>(type->getAsCXXRecordDecl());
+           spec && spec->isInStdNamespace() && (spec->getName() == "shared_ptr" || spec->getName() == "unique_ptr"))
+    pointee = spec->getTemplateArgs()[0].getAsType()->getAsCXXRecordDecl();
+  return pointee && pointee->getName() == "ICombinedImageSampler" && InNamespace(pointee, "LiteImage");
+}
+
+bool IsCombinedSamplers(QualType type, bool* single) {
+  QualType elem;
+  const bool vector = IsStdVector(type.getNonReferenceType(), &elem);
+  if (single) *single = !vector;
+  return IsCombinedSamplerPointer(vector ? elem : type);
+}
+
+std::optional<ImageFormat> TextureArrayFormat(QualType type) {
+  if (IsCombinedSamplers(type)) return ImageFormat{"rgba32f", "VK_FORMAT_R32G32B32A32_SFLOAT", "vec4", ""};
+  QualType texel;
+  if (!IsTextureArray(type, &texel)) return std::nullopt;
+  return ImageFormatOf(texel);
+}
+
 bool IsTextureArray(QualType type, QualType* texel) {
+  if (IsCombinedSamplers(type)) return true;
   QualType elem;
   if (!IsStdVector(type.getNonReferenceType(), &elem)) return false;
   auto* spec = dyn_cast_or_null<ClassTemplateSpecializationDecl>(elem.getCanonicalType()->getAsCXXRecordDecl());

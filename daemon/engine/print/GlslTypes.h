@@ -26,12 +26,21 @@ bool IsStdArray(clang::QualType type, clang::QualType* element = nullptr, uint64
 bool IsImage2D(clang::QualType type, clang::QualType* texel = nullptr);
 // LiteImage::Sampler: filtering and address modes of image samples.
 bool IsImageSampler(clang::QualType type);
-// std::vector<LiteImage::Texture2D<T>>: an array of textures (combined image samplers), and T.
+// A member kernels sample as an array of textures (combined image samplers): a
+// std::vector<LiteImage::Texture2D<T>> (and T), or kernel_slicer's form, a std::vector of
+// shared_ptr, unique_ptr or plain pointers to LiteImage::ICombinedImageSampler, or one such pointer
+// (an array of one texture). Those read float4 texels, whatever their images hold; `texel` stays null.
 bool IsTextureArray(clang::QualType type, clang::QualType* texel = nullptr);
+// kernel_slicer's form of the above; `single` tells one pointer from a vector of them.
+bool IsCombinedSamplers(clang::QualType type, bool* single = nullptr);
+// A (smart) pointer to LiteImage::ICombinedImageSampler.
+bool IsCombinedSamplerPointer(clang::QualType type);
 // GPU image format of an Image2D<T>: GLSL format qualifier, Vulkan format, texel GLSL type,
 // image/texture type prefix ("" or "u"); nullopt for texel types the GPU cannot hold.
 struct ImageFormat { std::string glslFormat, vkFormat, texel, prefix; };
 std::optional<ImageFormat> ImageFormatOf(clang::QualType texel);
+// The format of an array of textures' texels (IsTextureArray): float4 for combined image samplers.
+std::optional<ImageFormat> TextureArrayFormat(clang::QualType type);
 bool IsSystemDecl(const clang::Decl* decl);
 // Whether `d` is declared inside a namespace named `ns` (at any depth).
 bool InNamespace(const clang::Decl* d, const char* ns);

@@ -103,8 +103,16 @@ const FieldDecl* KernelPrinter::SampledWith(const ValueDecl* image, const ImageF
 // Kernels call crt_<array>_sample, _texel, _width and _height (templates/glsl/texture_array.glsl), which
 // each variant of the shader defines its own way: GPU samplers, or buffers and LiteImage's sampling.
 
+// m_textures[i], m_samplers[i]-> (ICombinedImageSampler pointers) or m_pSampler-> (one: index null).
 const FieldDecl* KernelPrinter::TextureElement(const clang::Expr* e, const clang::Expr** index) {
-  auto* op = dyn_cast<CXXOperatorCallExpr>(e->IgnoreParenImpCasts());
+  e = e->IgnoreParenImpCasts();
+  if (auto* arrow = dyn_cast<CXXOperatorCallExpr>(e); arrow && arrow->getOperator() == OO_Arrow) e = arrow->getArg(0)->IgnoreParenImpCasts();
+  bool single = false;
+  if (auto* f = ThisMemberField(e); f && IsCombinedSamplers(f->getType(), &single) && single) {
+    if (index) *index = nullptr;
+    return f;
+  }
+  auto* op = dyn_cast<CXXOperatorCallExpr>(e);
   if (!op || op->getOperator() != OO_Subscript) return nullptr;
   auto* f = ThisMemberField(op->getArg(0));
   if (!f || !IsTextureArray(f->getType())) return nullptr;
@@ -115,7 +123,7 @@ const FieldDecl* KernelPrinter::TextureElement(const clang::Expr* e, const clang
 bool KernelPrinter::UsableTextures(const FieldDecl* array, SourceLocation use) {
   QualType texel;
   IsTextureArray(array->getType(), &texel);
-  auto format = ImageFormatOf(texel);
+  auto format = TextureArrayFormat(array->getType());
   if (!format || format->texel == "uint")
     Fail(use, "array of textures '" + array->getNameAsString() + "' has a texel type GPU samplers cannot filter ('" +
          texel.getAsString(m_ctx.getPrintingPolicy()) + "')", "use LiteImage::Texture2D<float4> or Texture2D<float>");

@@ -463,6 +463,7 @@ const CXXRecordDecl* PolymorphicPointee(QualType t) {
   else if (auto* spec = dyn_cast_or_null<ClassTemplateSpecializationDecl>(t->getAsCXXRecordDecl());
            spec && spec->isInStdNamespace() && (spec->getName() == "shared_ptr" || spec->getName() == "unique_ptr"))
     pointee = spec->getTemplateArgs()[0].getAsType()->getAsCXXRecordDecl();
+  if (IsCombinedSamplerPointer(t)) return nullptr;  // a texture (IsTextureArray), not an object of the user's
   return pointee && pointee->hasDefinition() && pointee->isPolymorphic() ? pointee->getDefinition() : nullptr;
 }
 

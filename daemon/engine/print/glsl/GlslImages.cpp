@@ -19,6 +19,7 @@ namespace crossrt::engine {
 namespace {
 // A texture index as the generated functions take it (uint).
 std::string TextureIndex(const clang::Expr* index, const std::string& printed) {
+  if (!index) return "0u";  // the one texture of an ICombinedImageSampler pointer
   return index->getType()->isUnsignedIntegerType() ? printed : "uint(" + printed + ")";
 }
 }  // namespace
@@ -69,17 +70,17 @@ std::string GlslPrinter::TextureCall(const FieldDecl* array, const clang::Expr* 
   const std::string name = array->getNameAsString();
   const std::string method = call->getMethodDecl()->getNameAsString();
   if (!UsableTextures(array, call->getBeginLoc())) return "/*error*/";
-  const std::string i = TextureIndex(index, Expr(index));
+  const std::string i = TextureIndex(index, index ? Expr(index) : "");
   if (method == "sample" && call->getNumArgs() == 1) return "crt_" + name + "_sample(" + i + ", " + Expr(call->getArg(0)) + ")";
   if ((method == "width" || method == "height") && call->getNumArgs() == 0) return "crt_" + name + "_" + method + "(" + i + ")";
-  return Fail(call->getBeginLoc(), "Texture2D::" + method + " is not supported in kernels",
+  return Fail(call->getBeginLoc(), call->getMethodDecl()->getParent()->getNameAsString() + "::" + method + " is not supported in kernels",
               "kernels sample textures of an array (" + name + "[i].sample(uv)), read texels (" + name + "[i][p]) and read width() and height()");
 }
 
 std::string GlslPrinter::TextureTexel(const FieldDecl* array, const clang::Expr* index, const clang::Expr* coord, SourceLocation loc) {
   if (!UsableTextures(array, loc)) return "/*error*/";
   const bool ivec = GlslTypeOf(coord->getType()).value_or("") == "ivec2";
-  return "crt_" + array->getNameAsString() + "_texel(" + TextureIndex(index, Expr(index)) + ", " + (ivec ? Expr(coord) : "ivec2(" + Expr(coord) + ")") + ")";
+  return "crt_" + array->getNameAsString() + "_texel(" + TextureIndex(index, index ? Expr(index) : "") + ", " + (ivec ? Expr(coord) : "ivec2(" + Expr(coord) + ")") + ")";
 }
 
 std::string GlslPrinter::TexelRead(const CXXOperatorCallExpr* op, const ValueDecl* image) {

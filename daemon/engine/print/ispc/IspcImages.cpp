@@ -80,10 +80,10 @@ std::string IspcPrinter::ImageCall(const ValueDecl* image, const CXXMemberCallEx
 std::string IspcPrinter::TextureCall(const FieldDecl* array, const clang::Expr* index, const CXXMemberCallExpr* call) {
   const std::string method = call->getMethodDecl()->getNameAsString();
   if (!UsableTextures(array, call->getBeginLoc())) return "/*error*/";
-  const std::string texture = Member(array->getNameAsString()) + "[" + Expr(index) + "]";
+  const std::string texture = Member(array->getNameAsString()) + "[" + (index ? Expr(index) : "0") + "]";  // one ICombinedImageSampler: 0
   if (method == "sample" && call->getNumArgs() == 1) return "crt_sample(" + texture + ", " + Expr(call->getArg(0)) + ")";  // LiteMath.isph
   if ((method == "width" || method == "height") && call->getNumArgs() == 0) return texture + "." + method;
-  return Fail(call->getBeginLoc(), "Texture2D::" + method + " is not supported in kernels",
+  return Fail(call->getBeginLoc(), call->getMethodDecl()->getParent()->getNameAsString() + "::" + method + " is not supported in kernels",
               "kernels sample textures of an array (" + array->getNameAsString() + "[i].sample(uv)), read texels (" + array->getNameAsString() +
               "[i][p]) and read width() and height()");
 }

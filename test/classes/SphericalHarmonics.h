@@ -1,0 +1,25 @@
+// Elements of a member array reduced in a kernel, as kernel_slicer's spherical-harmonics sample
+// writes them (coefs[0] += color; ... coefs[8] += ...): the CPU backend reduces them as written, in
+// an OpenMP array section (test/equivalence/test_array_reductions.cpp). GPU and ISPC kernels reduce
+// whole members: there it is a diagnostic.
+#pragma once
+#include "LiteMath.h"
+
+#include <cstdint>
+
+class SphericalHarmonics
+{
+public:
+  static constexpr int kCoefficients = 9;
+
+  virtual ~SphericalHarmonics() = default;
+  // Projects an RGBA8 environment map (a_width x a_height, latitude rows) onto 9 SH coefficients.
+  virtual void Project(const uint32_t* a_data __attribute__((size("a_width", "a_height"))), uint32_t a_width, uint32_t a_height);
+  virtual void CommitDeviceData() {}
+
+  LiteMath::float3 coefs[kCoefficients];
+  int m_texels = 0;  // a whole member reduced beside them
+
+protected:
+  virtual void kernel2D_Project(const uint32_t* a_data, uint32_t a_width, uint32_t a_height);
+};
