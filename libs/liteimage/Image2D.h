@@ -17,15 +17,23 @@ using LiteMath::float4;
 using LiteMath::int2;
 
 // Mirrors the relevant part of VkSamplerCreateInfo. Defaults: WRAP (repeat) + NEAREST.
+// MIRROR_ONCE is Vulkan's mirror-clamp-to-edge: mirrored once around 0, then clamped.
 struct Sampler
 {
-  enum class AddressMode { WRAP, MIRROR, CLAMP, BORDER };
-  enum class Filter { NEAREST, LINEAR };
+  enum class AddressMode { WRAP = 0, MIRROR = 1, CLAMP = 2, BORDER = 3, MIRROR_ONCE = 4 };
+  enum class Filter { NEAREST = 0, LINEAR = 1 };
 
   AddressMode addressU    = AddressMode::WRAP;
   AddressMode addressV    = AddressMode::WRAP;
   Filter      filter      = Filter::NEAREST;
   float4      borderColor = float4(0.0f); // returned for texels outside the image in BORDER mode
+  // The rest of kernel_slicer's LiteImage::Sampler, for code that sets or compares them. Images
+  // here are 2D with one mip level: the third axis, anisotropy and the level of detail do not apply.
+  AddressMode addressW      = AddressMode::WRAP;
+  uint32_t    maxAnisotropy = 1;
+  uint32_t    maxLOD        = 32;
+  uint32_t    minLOD        = 0;
+  uint32_t    mipLODBias    = 0;
 };
 
 namespace detail
@@ -46,6 +54,11 @@ inline int addressTexel(int i, int size, Sampler::AddressMode mode)
   }
   case Sampler::AddressMode::CLAMP:
     return i < 0 ? 0 : (i >= size ? size - 1 : i);
+  case Sampler::AddressMode::MIRROR_ONCE:
+  {
+    const int m = i < 0 ? -1 - i : i;
+    return m >= size ? size - 1 : m;
+  }
   case Sampler::AddressMode::BORDER:
   default:
     return (i < 0 || i >= size) ? -1 : i;

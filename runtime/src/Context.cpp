@@ -381,6 +381,7 @@ void VulkanContext::CreateDevice(const ContextOptions& options) {
   if (vk12) {
     enable12.scalarBlockLayout = supported12.scalarBlockLayout;
     enable12.bufferDeviceAddress = supported12.bufferDeviceAddress;
+    enable12.samplerMirrorClampToEdge = supported12.samplerMirrorClampToEdge;
     // Arrays of textures indexed per thread (TextureArray): all four or none.
     if (!mask.Hidden(DeviceFeature::TextureArrays) &&
         supported12.runtimeDescriptorArray && supported12.shaderSampledImageArrayNonUniformIndexing &&
@@ -454,6 +455,7 @@ void VulkanContext::CreateDevice(const ContextOptions& options) {
   hasShaderFloat64 = enable.features.shaderFloat64 == VK_TRUE;
   hasScalarBlockLayout = enable12.scalarBlockLayout == VK_TRUE;
   hasBufferDeviceAddress = enable12.bufferDeviceAddress == VK_TRUE;
+  hasMirrorClampToEdge = enable12.samplerMirrorClampToEdge == VK_TRUE;
   hasRayQuery = enableRq.rayQuery == VK_TRUE;
   hasFloatAtomicAdd = enableAf.shaderBufferFloat32AtomicAdd == VK_TRUE;
   hasRayTracingPipeline = enableRt.rayTracingPipeline == VK_TRUE;

@@ -183,6 +183,9 @@ Sampler::Sampler(std::shared_ptr<VulkanContext> ctx, const SamplerDesc& desc, co
   info.mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST;
   info.addressModeU = desc.addressU;
   info.addressModeV = desc.addressV;
+  if ((desc.addressU == VK_SAMPLER_ADDRESS_MODE_MIRROR_CLAMP_TO_EDGE || desc.addressV == VK_SAMPLER_ADDRESS_MODE_MIRROR_CLAMP_TO_EDGE) &&
+      !ctx_->hasMirrorClampToEdge)
+    throw Error(name + ": address mode MIRROR_ONCE needs samplerMirrorClampToEdge, which device '" + ctx_->DeviceName() + "' lacks");
   info.addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
   info.maxLod = 0.0f;  // one mip level, as Image2D has
   const float* c = desc.border;

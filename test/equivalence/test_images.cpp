@@ -97,7 +97,7 @@ TEST_CASE("Image2D members sampled with nearest and bilinear filtering in every 
   std::vector<float2> uv(n);
   for (int i = 0; i < n; ++i) uv[i] = float2(coords[2 * i], coords[2 * i + 1]);
   using Mode = Sampler::AddressMode;
-  for (Mode mode : {Mode::WRAP, Mode::MIRROR, Mode::CLAMP, Mode::BORDER})
+  for (Mode mode : {Mode::WRAP, Mode::MIRROR, Mode::CLAMP, Mode::BORDER, Mode::MIRROR_ONCE})
   {
     DYNAMIC_SECTION("address mode " << int(mode))
     {

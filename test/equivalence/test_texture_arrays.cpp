@@ -55,7 +55,7 @@ void Fill(TexturedMaterials& m)
   m.m_albedo.emplace_back(RandomImage(16, 9, 2), MakeSampler(Mode::MIRROR, Mode::MIRROR, true));
   m.m_albedo.emplace_back(RandomImage(3, 1, 3), MakeSampler(Mode::BORDER, Mode::BORDER, true, float4(0.0f, 0.0f, 0.0f, 1.0f)));
   m.m_albedo.emplace_back(Image2D<float4>(), MakeSampler(Mode::WRAP, Mode::WRAP, true));
-  m.m_albedo.emplace_back(RandomImage(5, 4, 4), MakeSampler(Mode::CLAMP, Mode::WRAP, true));
+  m.m_albedo.emplace_back(RandomImage(5, 4, 4), MakeSampler(Mode::MIRROR_ONCE, Mode::WRAP, true));
   const auto a = RandomFloats(11 * 3, 5, -2.0f, 2.0f), b = RandomFloats(4 * 4, 6, -2.0f, 2.0f);
   m.m_bumps.clear();
   m.m_bumps.emplace_back(Image2D<float>(11, 3, a.data()), MakeSampler(Mode::CLAMP, Mode::CLAMP, true));

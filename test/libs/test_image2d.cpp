@@ -370,3 +370,17 @@ TEST_CASE("LoadBMP reads what SaveBMP wrote; sRGB images sample linearized throu
   const float4 white = combined->sample(float2(0.75f, 0.5f));
   CHECK(white.x == 1.0f);
 }
+
+TEST_CASE("Image2D MIRROR_ONCE mirrors once around 0, then clamps (Vulkan's mirror clamp to edge)", "[liteimage]")
+{
+  const std::vector<float> row = {1.0f, 2.0f, 3.0f, 4.0f};
+  Image2D<float> img(4, 1, row.data());
+  Sampler s = makeSampler(Sampler::AddressMode::MIRROR_ONCE, Sampler::Filter::NEAREST);
+  auto at = [&](int texel) { return img.sample(s, float2((float(texel) + 0.5f) / 4.0f, 0.5f)); };
+  CHECK(at(0) == 1.0f);
+  CHECK(at(3) == 4.0f);
+  CHECK(at(-1) == 1.0f);  // mirrored
+  CHECK(at(-4) == 4.0f);
+  CHECK(at(-9) == 4.0f);  // then clamped
+  CHECK(at(6) == 4.0f);   // past the far edge: clamped
+}

@@ -533,15 +533,33 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     Rewriter rw(c.ctx.getSourceManager(), c.ctx.getLangOpts());
     // Reduction targets get their per-thread names; appends go through a lock.
     struct Renamer : RecursiveASTVisitor<Renamer> {
-      Rewriter& rw; const std::map<const FieldDecl*, ReduceOp>& red;
-      Renamer(Rewriter& r, const std::map<const FieldDecl*, ReduceOp>& m) : rw(r), red(m) {}
+      Rewriter& rw; const std::map<const FieldDecl*, ReduceOp>& red; ASTContext& ctx;
+      Renamer(Rewriter& r, const std::map<const FieldDecl*, ReduceOp>& m, ASTContext& cx) : rw(r), red(m), ctx(cx) {}
       bool VisitMemberExpr(MemberExpr* me) {
         auto* f = dyn_cast<FieldDecl>(me->getMemberDecl());
         if (f && red.count(f) && me->isImplicitAccess()) rw.ReplaceText(me->getMemberLoc(), f->getName().size(), generated::ReductionLocal(f->getNameAsString()));
         else if (f && red.count(f)) rw.ReplaceText(me->getSourceRange(), generated::ReductionLocal(f->getNameAsString()));
         return true;
       }
-    } renamer(rw, ws.reductions);
+      // A private static constant of the class (static constexpr float PI): the derived class cannot
+      // name it, so the loop gets its value, exactly (a float in hexadecimal), with its name beside.
+      bool VisitDeclRefExpr(DeclRefExpr* dr) {
+        auto* vd = dyn_cast<VarDecl>(dr->getDecl());
+        Expr::EvalResult r;
+        if (!vd || !vd->isStaticDataMember() || vd->getAccess() != AS_private || dr->getBeginLoc().isMacroID() || !dr->EvaluateAsRValue(r, ctx)) return true;
+        std::string value;
+        if (r.Val.isInt()) value = (r.Val.getInt().isSigned() ? std::to_string(r.Val.getInt().getExtValue()) : std::to_string(r.Val.getInt().getZExtValue())) + (dr->getType()->isUnsignedIntegerType() ? "u" : "");
+        else if (r.Val.isFloat()) {
+          char buf[64];
+          std::snprintf(buf, sizeof buf, "%a", r.Val.getFloat().convertToDouble());
+          value = buf;
+        } else
+          return true;
+        rw.ReplaceText(dr->getSourceRange(), "static_cast<" + dr->getType().getUnqualifiedType().getAsString(ctx.getPrintingPolicy()) + ">(" + value +
+                                                 " /*" + vd->getQualifiedNameAsString() + "*/)");
+        return true;
+      }
+    } renamer(rw, ws.reductions, c.ctx);
     const ForStmt* outer = nullptr;
     for (auto* s : body->body())
       if ((outer = dyn_cast<ForStmt>(s))) break;

@@ -120,6 +120,8 @@ public:
   // set layout of one such array, of up to maxTextureArraySize textures.
   bool hasTextureArrays = false;
   uint32_t maxTextureArraySize = 0;
+  // Samplers that mirror once, then clamp (LiteImage's MIRROR_ONCE): Vulkan 1.2's samplerMirrorClampToEdge.
+  bool hasMirrorClampToEdge = false;
   VkDescriptorSetLayout textureArrayLayout = VK_NULL_HANDLE;
   // Subgroups of compute shaders: generated reductions need arithmetic ops and >= 4 lanes.
   uint32_t subgroupSize = 0;
@@ -318,6 +320,7 @@ VkSamplerAddressMode AddressModeOf(Mode m) {
     case Mode::MIRROR: return VK_SAMPLER_ADDRESS_MODE_MIRRORED_REPEAT;
     case Mode::CLAMP: return VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
     case Mode::BORDER: return VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_BORDER;
+    case Mode::MIRROR_ONCE: return VK_SAMPLER_ADDRESS_MODE_MIRROR_CLAMP_TO_EDGE;  // needs samplerMirrorClampToEdge
     default: return VK_SAMPLER_ADDRESS_MODE_REPEAT;
   }
 }
@@ -513,7 +516,7 @@ void GrowScratch(std::shared_ptr<VulkanContext> ctx, Buffer& b, VkDeviceSize byt
 struct TextureInfo {
   uint32_t offset = 0;  // its first texel in the texel buffer
   uint32_t width = 0, height = 0;
-  uint32_t mode = 0;    // addressU | addressV << 2 | linear << 4; address modes numbered as LiteImage's
+  uint32_t mode = 0;    // addressU | addressV << 3 | linear << 6; address modes numbered as LiteImage's
   float border[4] = {0, 0, 0, 0};
 };
 
@@ -525,7 +528,7 @@ TextureInfo DescribeTexture(const Texture& t, uint32_t offset) {
   info.offset = offset;
   info.width = t.width();
   info.height = t.height();
-  info.mode = uint32_t(t.sampler().addressU) | uint32_t(t.sampler().addressV) << 2 | uint32_t(t.sampler().filter == Filter::LINEAR) << 4;
+  info.mode = uint32_t(t.sampler().addressU) | uint32_t(t.sampler().addressV) << 3 | uint32_t(t.sampler().filter == Filter::LINEAR) << 6;
   info.border[0] = t.sampler().borderColor.x;
   info.border[1] = t.sampler().borderColor.y;
   info.border[2] = t.sampler().borderColor.z;
