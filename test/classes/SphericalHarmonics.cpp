@@ -19,7 +19,7 @@ void SphericalHarmonics::kernel2D_Project(const uint32_t* a_data, uint32_t a_wid
   {
     for (uint32_t j = 0; j < a_width; ++j)
     {
-      const float  phi       = (float(i) + 0.5f) / float(a_height) * 6.2831853f;
+      const float  phi       = (float(i) + 0.5f) / float(a_height) * 2.0f * PI;
       const float  theta     = 2.0f * std::acos(std::sqrt(1.0f - (float(j) + 0.5f) / float(a_width)));
       const float3 d         = float3(std::cos(phi) * std::sin(theta), std::sin(phi) * std::sin(theta), std::cos(theta));
       const uint32_t texel   = a_data[i * a_width + j];
@@ -33,10 +33,10 @@ void SphericalHarmonics::kernel2D_Project(const uint32_t* a_data, uint32_t a_wid
       coefs[6] += color * (2.0f * d.z * d.z - d.x * d.x - d.y * d.y);
       coefs[7] += color * d.x * d.z;
       coefs[8] += color * (d.x * d.x - d.y * d.y);
-      m_texels += 1;
+      m_texels += int(kOneTexel);
     }
   }
-  const float norm = 4.0f * 3.14159265f / float(a_width * a_height);
+  const float norm = 4.0f * PI / float(a_width * a_height);
   for (int k = 0; k < kCoefficients; ++k)
     coefs[k] *= norm;
 }

@@ -22,4 +22,10 @@ public:
 
 protected:
   virtual void kernel2D_Project(const uint32_t* a_data, uint32_t a_width, uint32_t a_height);
+
+private:
+  // Private constants the kernel reads, in its loop and after it (the generated class derives from
+  // this one: it gets their values).
+  static constexpr float    PI       = 3.14159265358979323846f;
+  static constexpr uint32_t kOneTexel = 1u;
 };

@@ -533,14 +533,18 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     Rewriter rw(c.ctx.getSourceManager(), c.ctx.getLangOpts());
     // Reduction targets get their per-thread names; appends go through a lock.
     struct Renamer : RecursiveASTVisitor<Renamer> {
-      Rewriter& rw; const std::map<const FieldDecl*, ReduceOp>& red; ASTContext& ctx;
-      Renamer(Rewriter& r, const std::map<const FieldDecl*, ReduceOp>& m, ASTContext& cx) : rw(r), red(m), ctx(cx) {}
+      Rewriter& rw; const std::map<const FieldDecl*, ReduceOp>& red;
+      Renamer(Rewriter& r, const std::map<const FieldDecl*, ReduceOp>& m) : rw(r), red(m) {}
       bool VisitMemberExpr(MemberExpr* me) {
         auto* f = dyn_cast<FieldDecl>(me->getMemberDecl());
         if (f && red.count(f) && me->isImplicitAccess()) rw.ReplaceText(me->getMemberLoc(), f->getName().size(), generated::ReductionLocal(f->getNameAsString()));
         else if (f && red.count(f)) rw.ReplaceText(me->getSourceRange(), generated::ReductionLocal(f->getNameAsString()));
         return true;
       }
+    } renamer(rw, ws.reductions);
+    struct PrivateConstants : RecursiveASTVisitor<PrivateConstants> {
+      Rewriter& rw; ASTContext& ctx;
+      PrivateConstants(Rewriter& r, ASTContext& cx) : rw(r), ctx(cx) {}
       // A private static constant of the class (static constexpr float PI): the derived class cannot
       // name it, so the loop gets its value, exactly (a float in hexadecimal), with its name beside.
       bool VisitDeclRefExpr(DeclRefExpr* dr) {
@@ -559,11 +563,14 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
                                                  " /*" + vd->getQualifiedNameAsString() + "*/)");
         return true;
       }
-    } renamer(rw, ws.reductions, c.ctx);
+    } constants(rw, c.ctx);
     const ForStmt* outer = nullptr;
     for (auto* s : body->body())
       if ((outer = dyn_cast<ForStmt>(s))) break;
     renamer.TraverseStmt(const_cast<ForStmt*>(outer));
+    for (auto* list : {&before, &after})
+      for (auto* st : *list) constants.TraverseStmt(const_cast<Stmt*>(st));
+    constants.TraverseStmt(const_cast<ForStmt*>(outer));
     // A flag every thread may set: stored atomically, so that the threads do not race on it.
     for (auto* bo : ws.constantStoreExprs) {
       SourceLocation end = Lexer::findLocationAfterToken(bo->getEndLoc(), tok::semi, c.ctx.getSourceManager(), c.ctx.getLangOpts(), false);
@@ -579,13 +586,21 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     // The CPU class copies the loop nest and what it uses; so does the ISPC class, whose kernels run
     // the nest as the CPU class does when that has been faster than SIMD lanes (crossrt::LaneChoice).
     if (c.model.forCpu) CopySourceDeclarations(c, def->getBody(), "kernel '" + k.name + "'");
-    for (auto* s : before) k.cpuPreamble += StatementText(c, s) + "\n";
+    // The statements around the nest, with the private constants' values too.
+    auto rewritten = [&](const Stmt* st) {
+      auto& sm = c.ctx.getSourceManager();
+      SourceLocation stEnd = Lexer::findLocationAfterToken(st->getEndLoc(), tok::semi, sm, c.ctx.getLangOpts(), false);
+      if (st->getBeginLoc().isMacroID() || st->getEndLoc().isMacroID()) return StatementText(c, st);
+      if (stEnd.isInvalid()) return rw.getRewrittenText(st->getSourceRange());  // a declaration, a block: its ';' or '}' included
+      return rw.getRewrittenText(CharSourceRange::getCharRange(st->getBeginLoc(), stEnd));
+    };
+    for (auto* s : before) k.cpuPreamble += rewritten(s) + "\n";
     for (auto* s : before)
       if (auto* ds = dyn_cast<DeclStmt>(s))
         for (auto* d : ds->decls())
           if (auto* vd = dyn_cast<VarDecl>(d)) k.preambleLocals.push_back(vd->getNameAsString());
     k.cpuPreamble = CanonicalCode(k.cpuPreamble);
-    for (auto* s : after) k.cpuPostamble += StatementText(c, s) + "\n";
+    for (auto* s : after) k.cpuPostamble += rewritten(s) + "\n";
     k.cpuPostamble = CanonicalCode(k.cpuPostamble);
   }
   c.model.kernels.push_back(k);
