@@ -13,7 +13,7 @@ namespace crossrt::client {
 namespace {
 
 // libcrossrt-engine.so sits next to crossrt in the build tree, in ../lib/crossrt when installed.
-void* LoadEngine() {
+std::vector<std::string> EngineCandidates() {
   std::vector<std::string> candidates;
   if (const char* env = std::getenv("CROSSRT_ENGINE")) candidates.push_back(env);
   char self[PATH_MAX];
@@ -25,8 +25,12 @@ void* LoadEngine() {
     candidates.push_back(dir + "/libcrossrt-engine.so");
     candidates.push_back(dir + "/../lib/crossrt/libcrossrt-engine.so");
   }
+  return candidates;
+}
+
+void* LoadEngine() {
   std::string errors;
-  for (auto& path : candidates) {
+  for (auto& path : EngineCandidates()) {
     if (access(path.c_str(), R_OK) != 0) continue;
     if (void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL)) return handle;
     errors += std::string("\n  ") + dlerror();
@@ -35,6 +39,12 @@ void* LoadEngine() {
 }
 
 }  // namespace
+
+std::string EnginePath() {
+  for (auto& path : EngineCandidates())
+    if (access(path.c_str(), R_OK) == 0) return path;
+  return "";
+}
 
 engine::TranslateResult TranslateInProcess(const engine::TranslateRequest& request) {
   static void* engineModule = LoadEngine();

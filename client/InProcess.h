@@ -10,4 +10,7 @@ namespace crossrt::client {
 // Throws std::runtime_error when the engine module cannot be loaded or fails.
 engine::TranslateResult TranslateInProcess(const engine::TranslateRequest& request);
 
+// The engine library the client loads when it translates in-process, or "" when none is found.
+std::string EnginePath();
+
 }  // namespace crossrt::client

@@ -327,7 +327,12 @@ int main(int argc, char** argv) {
     return 1;
   }
   if (!fromRemote && remote.Enabled()) remote.Store(request, result);
-  if (!depfile.empty() && !WriteDepfile(depfile, depfileTarget.empty() ? depfile : depfileTarget, result.inputs)) {
+  // The engine is an input too (the daemon and the library the client loads): a rebuilt or upgraded
+  // CrossRT translates again, in the build tree and against an installed package alike.
+  std::vector<std::string> inputs = result.inputs;
+  for (const std::string& engine : {crossrt::client::DaemonExecutable(), crossrt::client::EnginePath()})
+    if (!engine.empty() && access(engine.c_str(), R_OK) == 0) inputs.push_back(std::filesystem::weakly_canonical(engine).string());
+  if (!depfile.empty() && !WriteDepfile(depfile, depfileTarget.empty() ? depfile : depfileTarget, inputs)) {
     std::cerr << "crossrt: error: cannot write depfile '" << depfile << "'\n";
     return 1;
   }

@@ -12,7 +12,7 @@ struct crt_TextureInfo
   uint offset;
   uint width;
   uint height;
-  uint mode;  // addressU | addressV << 2 | linear << 4
+  uint mode;  // addressU | addressV << 3 | linear << 6
   vec4 border;
 };
 
@@ -72,7 +72,7 @@ layout(push_constant) uniform crt_kernel1D_ShadeArgs
 };
 
 // Arrays of textures sampled in software: the address modes of LiteImage::Sampler (WRAP, MIRROR,
-// CLAMP, BORDER: 0-3) as Image2D.h maps a texel index into [0, size), -1 for the border.
+// CLAMP, BORDER, MIRROR_ONCE: 0-4) as Image2D.h maps a texel index into [0, size), -1 for the border.
 // GLSL's % is undefined for negative operands: a - b * (a / b) is C++'s remainder.
 int crt_addressTexel(int i, int size, uint mode)
 {
@@ -90,6 +90,8 @@ int crt_addressTexel(int i, int size, uint mode)
   }
   if (mode == 2u)
     return clamp(i, 0, size - 1);
+  if (mode == 4u)
+    return min(i < 0 ? -1 - i : i, size - 1);
   return i < 0 || i >= size ? -1 : i;
 }
 
@@ -104,8 +106,8 @@ float crt_sanitizeCoord(float x)
 // m_albedo[i] texel (x, y) after its sampler's address modes; outside a BORDER sampler's image its border colour.
 vec4 crt_m_albedo_fetch(crt_TextureInfo t, int x, int y)
 {
-  const int xi = crt_addressTexel(x, int(t.width), t.mode & 3u);
-  const int yi = crt_addressTexel(y, int(t.height), (t.mode >> 2) & 3u);
+  const int xi = crt_addressTexel(x, int(t.width), t.mode & 7u);
+  const int yi = crt_addressTexel(y, int(t.height), (t.mode >> 3) & 7u);
   if (xi < 0 || yi < 0)
     return t.border;
   return crt_m_albedo_texels[t.offset + uint(yi) * t.width + uint(xi)];
@@ -120,7 +122,7 @@ vec4 crt_m_albedo_sample(uint i, vec2 uv)
   // `precise`: no fused multiply-adds, which the CPU does not do.
   precise float x = crt_sanitizeCoord(uv.x * float(t.width));
   precise float y = crt_sanitizeCoord(uv.y * float(t.height));
-  if ((t.mode & 16u) == 0u)
+  if ((t.mode & 64u) == 0u)
     return crt_m_albedo_fetch(t, int(floor(x)), int(floor(y)));
   // Bilinear: integer positions are texel centres.
   precise float fx = x - 0.5, fy = y - 0.5;
@@ -157,8 +159,8 @@ uint crt_m_albedo_height(uint i)
 // m_bumps[i] texel (x, y) after its sampler's address modes; outside a BORDER sampler's image its border colour.
 float crt_m_bumps_fetch(crt_TextureInfo t, int x, int y)
 {
-  const int xi = crt_addressTexel(x, int(t.width), t.mode & 3u);
-  const int yi = crt_addressTexel(y, int(t.height), (t.mode >> 2) & 3u);
+  const int xi = crt_addressTexel(x, int(t.width), t.mode & 7u);
+  const int yi = crt_addressTexel(y, int(t.height), (t.mode >> 3) & 7u);
   if (xi < 0 || yi < 0)
     return t.border.x;
   return crt_m_bumps_texels[t.offset + uint(yi) * t.width + uint(xi)];
@@ -173,7 +175,7 @@ float crt_m_bumps_sample(uint i, vec2 uv)
   // `precise`: no fused multiply-adds, which the CPU does not do.
   precise float x = crt_sanitizeCoord(uv.x * float(t.width));
   precise float y = crt_sanitizeCoord(uv.y * float(t.height));
-  if ((t.mode & 16u) == 0u)
+  if ((t.mode & 64u) == 0u)
     return crt_m_bumps_fetch(t, int(floor(x)), int(floor(y)));
   // Bilinear: integer positions are texel centres.
   precise float fx = x - 0.5, fy = y - 0.5;

@@ -13,7 +13,7 @@ struct crt_TextureInfo
   uint offset;
   uint width;
   uint height;
-  uint mode;  // addressU | addressV << 2 | linear << 4
+  uint mode;  // addressU | addressV << 3 | linear << 6
   vec4 border;
 };
 
@@ -67,7 +67,7 @@ layout(push_constant) uniform crt_kernel1D_ShadeArgs
 };
 
 // Arrays of textures sampled in software: the address modes of LiteImage::Sampler (WRAP, MIRROR,
-// CLAMP, BORDER: 0-3) as Image2D.h maps a texel index into [0, size), -1 for the border.
+// CLAMP, BORDER, MIRROR_ONCE: 0-4) as Image2D.h maps a texel index into [0, size), -1 for the border.
 // GLSL's % is undefined for negative operands: a - b * (a / b) is C++'s remainder.
 int crt_addressTexel(int i, int size, uint mode)
 {
@@ -85,6 +85,8 @@ int crt_addressTexel(int i, int size, uint mode)
   }
   if (mode == 2u)
     return clamp(i, 0, size - 1);
+  if (mode == 4u)
+    return min(i < 0 ? -1 - i : i, size - 1);
   return i < 0 || i >= size ? -1 : i;
 }
 
@@ -100,8 +102,8 @@ float crt_sanitizeCoord(float x)
 // a BORDER sampler's image its border colour.
 vec4 crt_m_albedo_fetch(uint i, crt_TextureInfo t, int x, int y)
 {
-  const int xi = crt_addressTexel(x, int(t.width), t.mode & 3u);
-  const int yi = crt_addressTexel(y, int(t.height), (t.mode >> 2) & 3u);
+  const int xi = crt_addressTexel(x, int(t.width), t.mode & 7u);
+  const int yi = crt_addressTexel(y, int(t.height), (t.mode >> 3) & 7u);
   if (xi < 0 || yi < 0)
     return t.border;
   return texelFetch(m_albedo[nonuniformEXT(i)], ivec2(xi, yi), 0);
@@ -122,7 +124,7 @@ vec4 crt_m_albedo_sample(uint i, vec2 uv)
     return textureLod(m_albedo[nonuniformEXT(i)], uv, 0.0);
   x = crt_sanitizeCoord(x);
   y = crt_sanitizeCoord(y);
-  if ((t.mode & 16u) == 0u)
+  if ((t.mode & 64u) == 0u)
     return crt_m_albedo_fetch(i, t, int(floor(x)), int(floor(y)));
   precise float fx = x - 0.5, fy = y - 0.5;
   const float x0 = floor(fx), y0 = floor(fy);
@@ -158,8 +160,8 @@ uint crt_m_albedo_height(uint i)
 // a BORDER sampler's image its border colour.
 float crt_m_bumps_fetch(uint i, crt_TextureInfo t, int x, int y)
 {
-  const int xi = crt_addressTexel(x, int(t.width), t.mode & 3u);
-  const int yi = crt_addressTexel(y, int(t.height), (t.mode >> 2) & 3u);
+  const int xi = crt_addressTexel(x, int(t.width), t.mode & 7u);
+  const int yi = crt_addressTexel(y, int(t.height), (t.mode >> 3) & 7u);
   if (xi < 0 || yi < 0)
     return t.border.x;
   return texelFetch(m_bumps[nonuniformEXT(i)], ivec2(xi, yi), 0).x;
@@ -180,7 +182,7 @@ float crt_m_bumps_sample(uint i, vec2 uv)
     return textureLod(m_bumps[nonuniformEXT(i)], uv, 0.0).x;
   x = crt_sanitizeCoord(x);
   y = crt_sanitizeCoord(y);
-  if ((t.mode & 16u) == 0u)
+  if ((t.mode & 64u) == 0u)
     return crt_m_bumps_fetch(i, t, int(floor(x)), int(floor(y)));
   precise float fx = x - 0.5, fy = y - 0.5;
   const float x0 = floor(fx), y0 = floor(fy);
