@@ -76,6 +76,13 @@
 #include "PixelBlock_ISPC.h"
 #endif
 #endif
+#if __has_include("LoopSized_CPU.h")
+#include "LoopSized_CPU.h"
+#include "LoopSized_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "LoopSized_ISPC.h"
+#endif
+#endif
 #if __has_include("SaxpyBlock_CPU.h")
 #include "SaxpyBlock_CPU.h"
 #include "SaxpyBlock_Vulkan.h"
@@ -192,6 +199,24 @@ Register saxpyBlock(MakeCase<SaxpyBlock>(
       std::vector<float> x = Wave(n, 0.2f), y = Wave(n, 2.0f), out(n);
       s.RunBlock(n, 0.75f, x.data(), y.data(), out.data());
       Outputs r;
+      Append(r, out);
+      return r;
+    }));
+#endif
+
+#if __has_include("LoopSized_CPU.h")
+Register loopSized(MakeCase<LoopSized>(
+    "pointers without a size, handed to kernels that index them by their loop's variable (the loop gives the size)", "loop_sized.h/.cpp", 1e-6,
+    CONFORMANCE_MAKERS(LoopSized), [](LoopSized& l) {
+      l.CommitDeviceData();
+      Outputs r;
+      std::vector<int> data(97);
+      for (size_t i = 0; i < data.size(); ++i) data[i] = int(i * 37 % 23) - 9;
+      l.Sum(data.data(), unsigned(data.size() - 1));  // its last element counts too (i <= a_last)
+      Append(r, std::vector<float>{float(l.m_sum)});
+      std::vector<float> in(61), out(61, -1.0f);
+      for (size_t i = 0; i < in.size(); ++i) in[i] = 0.25f * float(i) - 3.0f;
+      l.Scale(in.data(), out.data(), uint32_t(in.size()));
       Append(r, out);
       return r;
     }));

@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <set>
 
 using namespace clang;
 
@@ -251,6 +252,77 @@ std::string SiblingSize(const CXXRecordDecl* cls, const CXXMethodDecl* block, co
   return "";
 }
 
+// A pointer the size annotation forgot, as kernel_slicer infers it: where the control function only
+// passes `p` to kernel1D_ kernels, straight, for a parameter each reads and writes only as
+// `q[i]`, with i its loop's variable counting from 0 to a bound it was given (`i < n`, `i <= n`),
+// the size is that bound in the control function's terms ("a_size", "a_size + 1"). "" otherwise.
+std::string LoopSize(const FunctionDecl* def, const ParmVarDecl* p, const CXXRecordDecl* cls) {
+  struct Calls : RecursiveASTVisitor<Calls> {
+    const ParmVarDecl* p; const CXXRecordDecl* cls; std::set<std::string> sizes; bool other = false; int passed = 0;  // uses not yet known to be kernels' arguments
+    bool VisitDeclRefExpr(DeclRefExpr* dr) {
+      if (dr->getDecl() == p) ++passed;  // every use of p must be an argument of a kernel below
+      return true;
+    }
+    bool VisitCXXMemberCallExpr(CXXMemberCallExpr* call) {
+      auto* kernel = call->getMethodDecl();
+      const FunctionDecl* kdef = nullptr;
+      for (unsigned i = 0; i < call->getNumArgs(); ++i) {
+        auto* arg = dyn_cast<DeclRefExpr>(call->getArg(i)->IgnoreParenImpCasts());
+        if (!arg || arg->getDecl() != p) continue;
+        if (!kernel || !kernel->getName().starts_with("kernel1D_") || !kernel->hasBody(kdef) || !kdef || i >= kdef->getNumParams()) {
+          other = true;
+          continue;
+        }
+        std::string size = KernelLoopSize(call, kdef, kdef->getParamDecl(i));
+        if (size.empty()) other = true;
+        else sizes.insert(size), --passed;
+      }
+      return true;
+    }
+    // The size the kernel's loop gives its parameter q, in terms of the call's arguments, or "".
+    std::string KernelLoopSize(const CXXMemberCallExpr* call, const FunctionDecl* kdef, const ParmVarDecl* q) {
+      const ForStmt* loop = nullptr;
+      if (auto* body = dyn_cast<CompoundStmt>(kdef->getBody()))
+        for (auto* st : body->body())
+          if ((loop = dyn_cast<ForStmt>(st))) break;
+      auto* init = loop ? dyn_cast_or_null<DeclStmt>(loop->getInit()) : nullptr;
+      auto* var = init && init->isSingleDecl() ? dyn_cast<VarDecl>(init->getSingleDecl()) : nullptr;
+      auto* cond = loop ? dyn_cast_or_null<BinaryOperator>(loop->getCond()) : nullptr;
+      Expr::EvalResult start;
+      if (!var || !var->getInit() || !var->getInit()->EvaluateAsInt(start, kdef->getASTContext()) || start.Val.getInt() != 0 || !cond ||
+          (cond->getOpcode() != BO_LT && cond->getOpcode() != BO_LE))
+        return "";
+      auto* lhs = dyn_cast<DeclRefExpr>(cond->getLHS()->IgnoreParenImpCasts());
+      auto* bound = dyn_cast<DeclRefExpr>(cond->getRHS()->IgnoreParenImpCasts());
+      auto* boundParam = bound ? dyn_cast<ParmVarDecl>(bound->getDecl()) : nullptr;
+      if (!lhs || lhs->getDecl() != var || !boundParam || boundParam->getFunctionScopeIndex() >= call->getNumArgs()) return "";
+      auto* boundArg = dyn_cast<DeclRefExpr>(call->getArg(boundParam->getFunctionScopeIndex())->IgnoreParenImpCasts());
+      if (!boundArg || !isa<ParmVarDecl>(boundArg->getDecl())) return "";
+      // Every use of q in the kernel: q[var].
+      struct Uses : RecursiveASTVisitor<Uses> {
+        const ParmVarDecl* q; const VarDecl* var; unsigned all = 0, indexed = 0;
+        bool VisitDeclRefExpr(DeclRefExpr* dr) { all += dr->getDecl() == q; return true; }
+        bool VisitArraySubscriptExpr(ArraySubscriptExpr* as) {
+          auto* base = dyn_cast<DeclRefExpr>(as->getBase()->IgnoreParenImpCasts());
+          auto* index = dyn_cast<DeclRefExpr>(as->getIdx()->IgnoreParenImpCasts());
+          indexed += base && base->getDecl() == q && index && index->getDecl() == var;
+          return true;
+        }
+      } uses;
+      uses.q = q;
+      uses.var = var;
+      uses.TraverseStmt(kdef->getBody());
+      if (uses.all == 0 || uses.all != uses.indexed) return "";
+      const std::string n = boundArg->getDecl()->getNameAsString();
+      return cond->getOpcode() == BO_LE ? n + " + 1" : n;
+    }
+  } calls;
+  calls.p = p;
+  calls.cls = cls;
+  calls.TraverseStmt(def->getBody());
+  return !calls.other && calls.passed == 0 && calls.sizes.size() == 1 ? *calls.sizes.begin() : "";
+}
+
 // Whether the control function hands pointer parameter `p` on: to a member function of the class
 // (a kernel, or one that may call kernels), or into a variable. Otherwise only host code uses it
 // (memcpy(out, m_v.data(), ...) after the kernels), as the original does, and no kernel needs a copy.
@@ -332,6 +404,12 @@ void AnalyzeControl(Context& c, const CXXMethodDecl* md, const FunctionDecl* def
       if (cp.sizeExpr.empty())  // kernel_slicer's XBlock: the size is on X's parameter of the same name
         cp.sizeExpr = RenameIdentifiers(SiblingSize(c.cls, md, p->getNameAsString()), declaredNames);
       cp.hostOnly = cp.sizeExpr.empty() && IsHostOnlyPointer(def->getParamDecl(i), c.cls);
+      if (cp.sizeExpr.empty() && !cp.hostOnly && !c.model.forCpu) {  // kernel_slicer's way: from the loop that indexes it
+        cp.sizeExpr = LoopSize(def, def->getParamDecl(i), c.cls);
+        if (!cp.sizeExpr.empty())
+          c.rep.Note(p->getLocation(), "pointer parameter '" + cp.name + "' of control function '" + ctrl.name + "' has no size: " + cp.sizeExpr +
+                                           " elements, as the loop of the kernel it is handed to indexes them");
+      }
       if (cp.sizeExpr.empty() && !cp.hostOnly && !c.model.forCpu)  // (an ISPC class reads the C++ memory in place: no copies to size)
         c.rep.GpuError(p->getLocation(), "pointer parameter '" + cp.name + "' of control function '" + ctrl.name + "' has no size",
                     "annotate it with its element count, e.g. '[[crossrt::size(\"n\")]] const float* " + cp.name +
