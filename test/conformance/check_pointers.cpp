@@ -76,6 +76,13 @@
 #include "PixelBlock_ISPC.h"
 #endif
 #endif
+#if __has_include("SaxpyNames_CPU.h")
+#include "SaxpyNames_CPU.h"
+#include "SaxpyNames_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "SaxpyNames_ISPC.h"
+#endif
+#endif
 #if __has_include("LoopSized_CPU.h")
 #include "LoopSized_CPU.h"
 #include "LoopSized_Vulkan.h"
@@ -199,6 +206,19 @@ Register saxpyBlock(MakeCase<SaxpyBlock>(
       std::vector<float> x = Wave(n, 0.2f), y = Wave(n, 2.0f), out(n);
       s.RunBlock(n, 0.75f, x.data(), y.data(), out.data());
       Outputs r;
+      Append(r, out);
+      return r;
+    }));
+#endif
+
+#if __has_include("SaxpyNames_CPU.h")
+Register saxpyNames(MakeCase<SaxpyNames>(
+    "two kernels of a thread loop whose parameters of one name get different buffers (wavefront in both modes)", "saxpy_names.h/.cpp", 1e-6,
+    CONFORMANCE_MAKERS(SaxpyNames), [](SaxpyNames& s) {
+      const unsigned n = 777;
+      std::vector<float> a = Wave(int(n), 0.1f), b = Wave(int(n), 1.3f), c = Wave(int(n), 2.9f), out(n, -1.0f);
+      Outputs r;
+      s.SaxpyBlock(a.data(), b.data(), c.data(), out.data(), n);  // (SaxpyNames_Vulkan has no megakernel to switch to)
       Append(r, out);
       return r;
     }));

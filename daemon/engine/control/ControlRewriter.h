@@ -75,6 +75,11 @@ private:
     std::string hostArgs;                          // ...Cmd arguments of the megakernel after the counts
     std::string counts;                            // ", (w), (h)": threads per axis, x first
     bool megakernelOnly = false;                   // a kernel's result ends a thread's loop: no wavefront form
+    // Two kernels' parameters of one name get different buffers (kernel_slicer's test 051): the
+    // megakernel, which binds each under the parameter's name, cannot be made; wavefront runs in
+    // both modes. Why, and where.
+    std::string wavefrontOnly;
+    clang::SourceLocation wavefrontOnlyAt;
     bool ok = true;
   };
 
@@ -121,13 +126,15 @@ private:
   // A kernel call in the thread loop's body, as the megakernel calls the kernel's thread function.
   std::string KernelCallGlsl(ThreadLoop& tl, KernelPrinter& printer, const CXXMemberCallExpr* call);
 
-  // A pointer argument of a kernel in a thread loop: in the megakernel, a buffer named as the
-  // kernel's parameter (its code refers to that name). Two kernels naming different buffers alike
-  // would collide there.
   // The name kernel md's thread function gives its parameter i (the definition's, as GLSL spells it).
   std::string KernelParamName(const CXXMethodDecl* md, unsigned i) const;
-  void AddMegakernelBuffer(ThreadLoop& tl, const CXXMethodDecl* md, const ParmVarDecl* p, const std::string& hostArg, const std::string& cppArg,
-                           SourceLocation loc);
+  // A pointer argument of a kernel in a thread loop: in the megakernel, a buffer named as the
+  // kernel's parameter (its code refers to that name). Where two kernels name different buffers
+  // alike, the GLSL megakernel cannot be made (the loop runs wavefront only: tl.wavefrontOnly), and
+  // the ISPC thread loop, which passes each kernel its buffers, names the second one apart. Returns
+  // the name the thread loop binds the buffer under, or "".
+  std::string AddMegakernelBuffer(ThreadLoop& tl, const CXXMethodDecl* md, const ParmVarDecl* p, const std::string& hostArg,
+                                  const std::string& cppArg, SourceLocation loc);
 
   // The ISPC class: the thread loop's body as an ISPC function of one thread (tl.mega.glslBody) and
   // the control function's loop replaced by chunks of it on all cores, in SIMD lanes. False where

@@ -219,9 +219,9 @@ std::string ControlRewriter::KernelCallGlsl(ThreadLoop& tl, KernelPrinter& print
       } else {
         CheckNotThreadState(md, p, arg);
         CheckUniform(tl, arg, "a buffer argument", false);  // bound by the host
-        AddMegakernelBuffer(tl, md, p, BufferArg(Resolve(arg)), ResolvedText(arg), arg->getBeginLoc());
+        const std::string bound = AddMegakernelBuffer(tl, md, p, BufferArg(Resolve(arg)), ResolvedText(arg), arg->getBeginLoc());
         if (!p->getType()->getPointeeType().isConstQualified()) WrittenThrough(Resolve(arg));
-        buffers += ", " + KernelParamName(md, i);
+        buffers += ", " + (bound.empty() ? KernelParamName(md, i) : bound);
         continue;  // a global buffer of the megakernel, named as the kernel names it
       }
     } else {
@@ -242,29 +242,42 @@ std::string ControlRewriter::KernelParamName(const CXXMethodDecl* md, unsigned i
   return KernelPrinter::SafeName(md->getParamDecl(i)->getNameAsString());
 }
 
-void ControlRewriter::AddMegakernelBuffer(ThreadLoop& tl, const CXXMethodDecl* md, const ParmVarDecl* p, const std::string& hostArg,
-                                          const std::string& cppArg, SourceLocation loc) {
+std::string ControlRewriter::AddMegakernelBuffer(ThreadLoop& tl, const CXXMethodDecl* md, const ParmVarDecl* p, const std::string& hostArg,
+                                                 const std::string& cppArg, SourceLocation loc) {
   const KernelParam* kp = nullptr;
   for (auto& k : m_c.model.kernels)
     if (k.name == md->getNameAsString())
       for (auto& x : k.params)
         if (x.name == p->getNameAsString()) kp = &x;
-  if (!kp) return;  // the kernel failed analysis (reported there)
+  if (!kp) return "";  // the kernel failed analysis (reported there)
+  std::string name = kp->glslName;
   for (unsigned i = 0; i < tl.mega.params.size(); ++i) {
     KernelParam& have = tl.mega.params[i];
-    if (have.name != kp->glslName) continue;
-    if (tl.bufferArgs[i] != hostArg || have.glslType != kp->glslType)
-      Error(tl, loc, "parameter '" + p->getNameAsString() + "' of '" + md->getNameAsString() + "' is given another buffer than a parameter of the same name of another kernel in the thread loop",
-            "rename one of them: the megakernel binds each kernel's buffers under the parameter's name");
-    have.isConstPointee = have.isConstPointee && kp->isConstPointee;
-    return;
+    if (have.name != name) continue;
+    if (tl.bufferArgs[i] == hostArg && have.glslType == kp->glslType) {
+      have.isConstPointee = have.isConstPointee && kp->isConstPointee;
+      return name;
+    }
+    // Two kernels' parameters of one name get different buffers (kernel_slicer's test 051).
+    if (!m_c.model.forIspc) {  // GLSL: the megakernel binds each under the parameter's name, which its kernels' code reads
+      if (tl.wavefrontOnly.empty()) {
+        tl.wavefrontOnly = "parameter '" + p->getNameAsString() + "' of '" + md->getNameAsString() +
+                           "' is given another buffer than a parameter of the same name of another kernel in the thread loop";
+        tl.wavefrontOnlyAt = loc;
+      }
+      return "";
+    }
+    name = kp->glslName + "_" + md->getNameAsString();  // ISPC passes buffers to each kernel: another name for this one
+    i = unsigned(-1);  // and look again
   }
   KernelParam b = *kp;
-  b.name = kp->glslName;
+  b.name = name;
+  b.glslName = name;
   tl.mega.params.push_back(b);
   tl.bufferArgs.push_back(hostArg);
   tl.cppBufferArgs.push_back(cppArg);
   tl.hostArgs += ", " + hostArg;
+  return name;
 }
 
 std::string ControlRewriter::ThreadBodyCpp(ThreadLoop& tl, const Stmt* s) {

@@ -165,11 +165,17 @@ bool ControlRewriter::TryThreadLoop(const ForStmt* outerLoop) {
     m_perThread = nullptr;
     return true;
   }
+  if (!tl.wavefrontOnly.empty() && tl.megakernelOnly) {
+    Error(tl, tl.wavefrontOnlyAt, tl.wavefrontOnly, "rename one of them: the megakernel, which this thread loop needs, binds each kernel's buffers under the parameter's name");
+    return true;
+  }
+  if (!tl.wavefrontOnly.empty())
+    m_c.rep.Note(tl.wavefrontOnlyAt, "the thread loop of '" + m_ctrl.name + "' runs one dispatch per kernel call (wavefront) in both execution modes: " + tl.wavefrontOnly);
   // After the counts; none where a kernel's result ends a thread's loop (the megakernel in both modes).
   const std::string wavefront = tl.megakernelOnly ? "" : ThreadBodyCpp(tl, body);
   tl.mega.glslBody = "// from " + m_c.cls->getNameAsString() + "::" + m_ctrl.name + " (" + m_ctrl.sourceFile +
                      "): the body of its thread loop, each kernel call a function call\nvoid " + tl.mega.name + "(" + signature + ")\n{\n" + glsl + "}\n";
-  m_c.model.megakernels.push_back(tl.mega);
+  if (tl.wavefrontOnly.empty()) m_c.model.megakernels.push_back(tl.mega);
 
   // Vulkan: both modes, picked when recording.
   std::string states;
@@ -190,6 +196,10 @@ bool ControlRewriter::TryThreadLoop(const ForStmt* outerLoop) {
       "if (crt_executionMode == crossrt::ExecutionMode::Megakernel)  // the whole loop body in one shader\n" + tl.mega.name + "Cmd(crt_cmd" + tl.counts + tl.hostArgs +
       ");\nelse  // wavefront: one dispatch per kernel call, each thread's locals in buffers between them\n{\n" +
       (states.empty() ? "" : "const size_t crt_threads = " + threads + ";\n" + states) + wavefront + "}\n";
+  if (!tl.wavefrontOnly.empty())
+    text = "// Two kernels' parameters of one name get different buffers here, which the megakernel would\n"
+           "// bind under one name: one dispatch per kernel call (wavefront) in both execution modes.\n{\n" +
+           (states.empty() ? "" : "const size_t crt_threads = " + threads + ";\n" + states) + wavefront + "}\n";
   if (tl.megakernelOnly) {
     m_ctrl.threadStates.erase(m_ctrl.threadStates.end() - long(std::count_if(tl.stateBuffers.begin(), tl.stateBuffers.end(),
                                                                              [&](const auto& x) { return tl.passed.count(x.first) > 0; })),

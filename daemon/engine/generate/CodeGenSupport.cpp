@@ -300,6 +300,9 @@ Data Common(const ClassModel& model, const GenerateOptions& opt) {
   d.set("usingDecls", usings);
   d.set("hasUsingDecls", !usings.empty());
   d.set("hasMegakernels", !model.megakernels.empty());
+  d.set("hasThreadStates", !model.megakernels.empty() || std::any_of(model.controls.begin(), model.controls.end(), [](const Control& c) {
+    return !c.threadStates.empty();  // a thread loop that runs wavefront only has no megakernel
+  }));
   d.set("hasTemporaries", std::any_of(model.controls.begin(), model.controls.end(), [](const Control& c) { return !c.temporaries.empty(); }));
   d.set("defaultExecutionMode", model.megakernelByDefault ? "Megakernel" : "Wavefront");
   Data comps = List();
