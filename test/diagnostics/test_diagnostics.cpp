@@ -818,6 +818,32 @@ void Blocks::Run(int n, float* out) { kernelBE1D_Fill(n, out); }
   REQUIRE(r.exitCode != 0);
   CHECK(r.output.find("Blocks.h:8:8: error: 'kernelBE1D_Fill' is one of kernel_slicer's block-expansion kernels") != std::string::npos);
   CHECK(r.output.find("hint: write it as a kernel1D_ loop") != std::string::npos);
+  // As kernel_slicer's test 030 writes it: a template over the block size, which is not a method
+  // until it is instantiated (it was "class has no kernels", with no line).
+  TempClass templated("BlockSizes", R"(#pragma once
+class BlockSizes
+{
+public:
+  virtual ~BlockSizes() = default;
+  virtual void Run(unsigned n, [[crossrt::size("n")]] float* out);
+  template <unsigned bsize>
+  void kernelBE1D_Fill(unsigned blocks, float* out);
+};
+)",
+                      R"(#include "BlockSizes.h"
+template <unsigned bsize>
+void BlockSizes::kernelBE1D_Fill(unsigned blocks, float* out) { for (unsigned b = 0; b < blocks; b++) for (unsigned i = 0; i < bsize; i++) out[b * bsize + i] = 1.0f; }
+void BlockSizes::Run(unsigned n, float* out) { kernelBE1D_Fill<64>(n / 64, out); }
+)");
+  for (const char* backend : {"vulkan", "cpu"})
+  {
+    CommandResult t = RunCrossrt("translate --class BlockSizes --backend " + std::string(backend) + " --out " + (templated.dir / backend).string() +
+                                 " --source " + templated.Source("BlockSizes") + " --templates " CROSSRT_SOURCE_DIR "/templates");
+    INFO(backend << ": " << t.output);
+    REQUIRE_FALSE(t.crashed);
+    REQUIRE(t.exitCode != 0);
+    CHECK(t.output.find("BlockSizes.h:8:8: error: 'kernelBE1D_Fill' is one of kernel_slicer's block-expansion kernels") != std::string::npos);
+  }
 }
 
 TEST_CASE("Locals reduced in a loop nest may only be reduced there, one way, and read after it", "[diagnostics]")

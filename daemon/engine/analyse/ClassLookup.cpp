@@ -122,6 +122,12 @@ bool AnalyzeTranslationUnit(ASTContext& ctx, const IncludesSeen& includes, const
     std::string text = c.Text(d->getSourceRange()) + ";";
     if (std::find(model.usingDecls.begin(), model.usingDecls.end(), text) == model.usingDecls.end()) model.usingDecls.push_back(text);
   }
+  // kernel_slicer's block-expansion kernels are templates over the block size (template <uint bsize>
+  // void kernelBE1D_X(...)), which the methods below do not list.
+  for (auto* d : cls->decls())
+    if (auto* ft = dyn_cast<FunctionTemplateDecl>(d); ft && ft->getNameAsString().rfind("kernelBE", 0) == 0)
+      c.rep.Error(ft->getLocation(), "'" + ft->getNameAsString() + "' is one of kernel_slicer's block-expansion kernels (kernelBE1D_), which CrossRT does not translate yet",
+                  "write it as a kernel1D_ loop with one iteration per thread, and keep work that a block shares in a separate kernel or a reduction");
   // Kernels first: control functions refer to them.
   for (int pass = 0; pass < 2; ++pass) {
     for (auto* md : ClassMethods(cls)) {
