@@ -256,6 +256,16 @@ struct Control {
   SourcePlace definedAt;  // its definition's name
 };
 
+// kernel_slicer's block-expansion kernel (kernelBE1D_), for the CPU class: its blocks on all cores
+// (analyse/BlockKernels.h).
+struct BlockKernel {
+  std::string name;
+  std::string templateHead;  // "template <uint bsize>", or "" for a plain method
+  std::string paramsDecl;    // as the definition names them
+  std::string body;          // the definition's body, the loop over blocks under an OpenMP pragma
+  std::string sourceFile;
+};
+
 struct Constructor {
   std::string paramsDecl;  // "int a_w, int a_h"
   std::string paramsWithDefaults;  // "int a_w = 64, int a_h = 48": for declarations
@@ -350,6 +360,7 @@ struct ClassModel {
   std::string headerFile;      // header declaring the class (as included by generated code)
   std::vector<Member> members;
   std::vector<Kernel> kernels;
+  std::vector<BlockKernel> blockKernels;  // the CPU backend's only
   std::vector<Control> controls;
   std::vector<Constructor> constructors;
   bool usesScanner = false;  // control functions scan on the GPU (std::exclusive_scan / inclusive_scan)

@@ -109,7 +109,7 @@ std::string WholeClassProblems(const TranslateRequest& request, const ClassModel
              comp.implName + ", but no source file defines class " + comp.implName +
              " with the bodies of the methods they call\nnote: hint: list the implementation's source file (e.g. BVHScene.cpp) in "
              "crossrt_add_class(... SOURCES ...)\n";
-  if (model.kernels.empty())
+  if (model.kernels.empty() && model.blockKernels.empty())
     return model.headerFile + ": error: class '" + request.className +
            "' has no kernels\nnote: hint: kernels are member functions named kernel1D_*, kernel2D_*, kernel3D_* (holding loops) or "
            "kernel_* (taking tid)\n";

@@ -263,7 +263,7 @@ inline unsigned int formatOf(const float4*, bool) { return 109u; }
 // hand to a GPU knowing it samples them as sample() does.
 struct CombinedTexels : ICombinedImageSampler
 {
-  virtual Texture2D<float4> texturesAsFloat4() const = 0;
+  virtual Texture2D<float4> textureAsFloat4() const = 0;
 };
 
 template <typename T>
@@ -285,7 +285,7 @@ struct CombinedTexture2D final : CombinedTexels
   Sampler      sampler() const override { return samplerState; }
   const void*  data() const override { return image ? image->data() : nullptr; }
 
-  Texture2D<float4> texturesAsFloat4() const override
+  Texture2D<float4> textureAsFloat4() const override
   {
     Image2D<float4> texels(width(), height());
     for (uint32_t y = 0; y < height(); y++)
@@ -329,7 +329,7 @@ inline Texture2D<float4> TextureOf(const ICombinedImageSampler* a_sampler)
   if (texels == nullptr)
     throw std::invalid_argument("LiteImage: an ICombinedImageSampler not made by MakeCombinedTexture2D cannot be sampled on the GPU "
                                 "(its sample() is the class's own code); make it with MakeCombinedTexture2D(image, sampler)");
-  return texels->texturesAsFloat4();
+  return texels->textureAsFloat4();
 }
 inline const ICombinedImageSampler* heldSampler(const ICombinedImageSampler* a_sampler) { return a_sampler; }
 template <typename P>

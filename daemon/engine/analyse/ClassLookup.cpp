@@ -3,6 +3,7 @@
 
 #include "analyse/AnalysisContext.h"
 #include "analyse/AstQueries.h"
+#include "analyse/BlockKernels.h"
 #include "control/ControlFunctions.h"
 #include "analyse/Kernels.h"
 #include "analyse/Members.h"
@@ -122,12 +123,7 @@ bool AnalyzeTranslationUnit(ASTContext& ctx, const IncludesSeen& includes, const
     std::string text = c.Text(d->getSourceRange()) + ";";
     if (std::find(model.usingDecls.begin(), model.usingDecls.end(), text) == model.usingDecls.end()) model.usingDecls.push_back(text);
   }
-  // kernel_slicer's block-expansion kernels are templates over the block size (template <uint bsize>
-  // void kernelBE1D_X(...)), which the methods below do not list.
-  for (auto* d : cls->decls())
-    if (auto* ft = dyn_cast<FunctionTemplateDecl>(d); ft && ft->getNameAsString().rfind("kernelBE", 0) == 0)
-      c.rep.Error(ft->getLocation(), "'" + ft->getNameAsString() + "' is one of kernel_slicer's block-expansion kernels (kernelBE1D_), which CrossRT does not translate yet",
-                  "write it as a kernel1D_ loop with one iteration per thread, and keep work that a block shares in a separate kernel or a reduction");
+  AnalyzeBlockKernels(c);  // kernel_slicer's kernelBE1D_ (often templates, which the methods below do not list)
   // Kernels first: control functions refer to them.
   for (int pass = 0; pass < 2; ++pass) {
     for (auto* md : ClassMethods(cls)) {
@@ -136,9 +132,6 @@ bool AnalyzeTranslationUnit(ASTContext& ctx, const IncludesSeen& includes, const
       // A method defined in a header is seen by every source file: analyse it once.
       std::string n = md->getNameAsString();
       bool isKernel = IsKernelName(n);
-      if (pass == 0 && (n.rfind("kernelBE", 0) == 0))  // kernel_slicer's block-expansion kernels
-        c.rep.Error(md->getLocation(), "'" + n + "' is one of kernel_slicer's block-expansion kernels (kernelBE1D_), which CrossRT does not translate yet",
-                    "write it as a kernel1D_ loop with one iteration per thread, and keep work that a block shares in a separate kernel or a reduction");
       if (pass == 0 && isKernel && !known(model.kernels, n)) AnalyzeKernel(c, md, def);
       if (pass == 1 && !isKernel && !known(model.controls, n) && !IsPerThreadFunction(md, cls)) {  // those run inside thread loops
         KernelCallFinder kc(cls);

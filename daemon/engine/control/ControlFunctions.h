@@ -4,6 +4,7 @@
 #pragma once
 #include "analyse/AnalysisContext.h"
 #include "analyse/AstQueries.h"
+#include "analyse/BlockKernels.h"
 #include "analyse/Naming.h"
 
 namespace crossrt::engine {
@@ -30,7 +31,8 @@ struct KernelCallFinder : RecursiveASTVisitor<KernelCallFinder> {
   explicit KernelCallFinder(const CXXRecordDecl* c) : cls(c) {}
   bool VisitCXXMemberCallExpr(CXXMemberCallExpr* call) {
     auto* md = call->getMethodDecl();
-    if (md && (IsKernelName(md->getName()) || IsPerThreadFunction(md, cls)) && isa<CXXThisExpr>(call->getImplicitObjectArgument()->IgnoreParenImpCasts()))
+    if (md && (IsKernelName(md->getName()) || IsBlockKernelName(md->getName()) || IsPerThreadFunction(md, cls)) &&
+        isa<CXXThisExpr>(call->getImplicitObjectArgument()->IgnoreParenImpCasts()))
       calls.push_back(call);
     return true;
   }

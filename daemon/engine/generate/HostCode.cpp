@@ -165,6 +165,17 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
     kernels.push_back(x);
   }
   d.set("kernels", kernels);
+  Data blockKernels = List();
+  for (auto& bk : model.blockKernels) {
+    Data x;
+    x.set("name", bk.name);
+    x.set("templateHead", bk.templateHead.empty() ? "" : bk.templateHead + "\n");
+    x.set("paramsDecl", bk.paramsDecl);
+    x.set("body", bk.body);
+    x.set("sourceFile", bk.sourceFile);
+    blockKernels.push_back(x);
+  }
+  d.set("blockKernels", blockKernels);
   d.set("ompReductions", ompReductions);
   d.set("hasArrayReductions", arrayReductions);
   Data copies = List();

@@ -93,7 +93,7 @@ std::string IspcPrinter::TextureTexel(const FieldDecl* array, const clang::Expr*
   if (coord->HasSideEffects(m_ctx, /*IncludePossibleEffects=*/false))
     return Fail(coord->getBeginLoc(), "a texel coordinate with side effects in an ISPC kernel", "compute the coordinate into a variable first");
   const std::string p = "(" + Expr(coord) + ")";
-  return "crt_texel_of(" + Member(array->getNameAsString()) + "[" + Expr(index) + "], (int)(" + p + ".x), (int)(" + p + ".y))";
+  return "crt_texel_of(" + Member(array->getNameAsString()) + "[" + (index ? Expr(index) : "0") + "], (int)(" + p + ".x), (int)(" + p + ".y))";
 }
 
 std::string IspcPrinter::TexelRead(const CXXOperatorCallExpr* op, const ValueDecl* image) {
