@@ -1,5 +1,6 @@
 // A class as a new user writes it first: its control function takes pointers without saying how
-// many elements they hold, which the Vulkan class needs to know (the language server test fixes it).
+// many elements they hold, which the Vulkan class needs to know, and its kernel's loop does not say
+// either (two elements a thread; the language server test fixes it).
 #pragma once
 
 class Scale {

@@ -147,7 +147,7 @@ def main_session(crossrtd, work):
     # An error in a helper the kernel calls: related information points back at the kernel.
     text = open(source).read()
     helper = "static float Twice(float v) { float* p = new float[1]; p[0] = v; const float r = 2.0f * p[0]; delete[] p; return r; }\n\n"
-    broken = text.replace("void Scale::kernel1D_Scale", helper + "void Scale::kernel1D_Scale").replace("in[i] * m_factor", "Twice(in[i]) * m_factor")
+    broken = text.replace("void Scale::kernel1D_Scale", helper + "void Scale::kernel1D_Scale").replace("in[2 * i] * m_factor", "Twice(in[2 * i]) * m_factor")
     c.notify("textDocument/didChange", {"textDocument": {"uri": uri(source), "version": 3}, "contentChanges": [{"text": broken}]})
     _, diags = c.diagnostics(source, lambda d: len(d) > 0, version=3)
     new = next(d for d in diags if "'new'" in d["message"])
