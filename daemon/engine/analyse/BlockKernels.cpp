@@ -2,6 +2,7 @@
 #include "analyse/BlockKernels.h"
 
 #include "analyse/AstQueries.h"
+#include "analyse/CpuCopies.h"
 #include "generate/Canonical.h"
 
 #include <clang/Rewrite/Core/Rewriter.h>
@@ -39,6 +40,7 @@ void AddBlockKernel(Context& c, const FunctionDecl* decl, const FunctionDecl* de
   const std::string body = rw.getRewrittenText(def->getBody()->getSourceRange());
   k.body = CanonicalCode(std::regex_replace(body, std::regex(R"(\[\[\s*parallel\s*\]\])"), ""));
   c.model.blockKernels.push_back(k);
+  CopySourceDeclarations(c, def->getBody(), "kernel '" + k.name + "'");  // static helpers and constants of the .cpp it calls
 }
 
 }  // namespace
