@@ -39,6 +39,14 @@ std::shared_ptr<SdfLeafScene> ThreeFields()
   return scene;
 }
 
+// Whether p lies in the box, give or take the hits' tolerance in t (1e-4 t, t < 10 here).
+bool Contains(const CRT_AABB& box, float3 p)
+{
+  const float slack = 1e-3f;  // a 125th of a voxel's edge
+  return p.x >= box.boxMin.x - slack && p.y >= box.boxMin.y - slack && p.z >= box.boxMin.z - slack && p.x <= box.boxMax.x + slack &&
+         p.y <= box.boxMax.y + slack && p.z <= box.boxMax.z + slack;
+}
+
 // SdfLeafTracer_Vulkan as a user subclasses it: the specialization its pipelines were made with.
 class InspectedLeafTracer : public SdfLeafTracer_Vulkan
 {
@@ -88,6 +96,10 @@ TEST_CASE("Intersection functions of SDF representations reach the traversal's d
     REQUIRE(perField[g] > n / 40);
   REQUIRE(misses > n / 10);
 
+  std::vector<std::vector<CRT_AABB>> leafBoxes;
+  for (uint32_t k = 0; k < 3; ++k)
+    leafBoxes.push_back(scene->LeafBoxes(k));
+
   auto ctx = ValidatedContext();
   auto cpu = CreateSdfLeafTracer_CPU();
   std::shared_ptr<InspectedLeafTracer> gpu = ctx ? std::make_shared<InspectedLeafTracer>(ctx) : nullptr;
@@ -115,7 +127,7 @@ TEST_CASE("Intersection functions of SDF representations reach the traversal's d
     run.tracer->CommitDeviceData();
     std::vector<CRT_Hit> hits(n);
     run.tracer->Trace(n, origins.data(), dirs.data(), hits.data());
-    int same = 0;
+    int same = 0, sharedLeaf = 0;
     for (int i = 0; i < n; ++i)
     {
       if (hits[i].geomId != expected[i].geomId)
@@ -129,10 +141,19 @@ TEST_CASE("Intersection functions of SDF representations reach the traversal's d
       REQUIRE(std::fabs(hits[i].coords[0] - expected[i].coords[0]) + std::fabs(hits[i].coords[1] - expected[i].coords[1]) +
                   std::fabs(hits[i].coords[2] - expected[i].coords[2]) <=
               2e-3f);
-      if (!run.intersectionShaders)
-        REQUIRE(hits[i].primId == expected[i].primId);  // of two equally near leaves the hardware may pick either
+      if (!run.intersectionShaders && hits[i].primId != expected[i].primId)
+      {
+        // Of two leaves that share the hit point, a GPU's fused arithmetic may find it in either
+        // (NVIDIA's did, for 1 of 3,000 rays); any other leaf is a wrong hit. The hardware's own
+        // walk may pick either of two equally near leaves, so only the switch is checked.
+        const float3 p = to_float3(origins[i]) + hits[i].t * to_float3(dirs[i]);
+        REQUIRE(Contains(leafBoxes[hits[i].geomId].at(hits[i].primId), p));
+        REQUIRE(Contains(leafBoxes[hits[i].geomId].at(expected[i].primId), p));
+        ++sharedLeaf;
+      }
     }
     REQUIRE(same >= n - n / 200);
+    REQUIRE(sharedLeaf <= n / 200);
     // The profiling knob (bench_sdf's Figure 10): each brick solved three times, the hits unchanged.
     // On the GPU a specialization constant, so Trace makes the pipelines again.
     scene->m_intersectRepeats = 3;
