@@ -182,6 +182,7 @@ std::shared_ptr<VulkanContext> VulkanContext::Create(const ContextOptions& optio
 
 void VulkanContext::Init(const ContextOptions& options) {
   forceStaging = options.forceStaging;
+  stagingCache = MakeStagingCache();
   CreateInstance(options);
   CreateDevice(options);
 
@@ -543,6 +544,7 @@ void VulkanContext::CreateDevice(const ContextOptions& options) {
 VulkanContext::~VulkanContext() {
   if (device) {
     vkDeviceWaitIdle(device);
+    stagingCache.reset();  // its buffers, before the device goes
     SavePipelineCache();
     if (pipelineCache) vkDestroyPipelineCache(device, pipelineCache, nullptr);
     if (commandPool) vkDestroyCommandPool(device, commandPool, nullptr);

@@ -73,11 +73,16 @@ struct Staging {
   const VulkanContext& ctx;
   Allocation a;
   void* mapped = nullptr;
-  Staging(const VulkanContext& c, VkDeviceSize size, VkBufferUsageFlags usage);
+  VkDeviceSize size = 0;
+  Staging(const VulkanContext& c, VkDeviceSize bytes, VkBufferUsageFlags usage);
   ~Staging() { Free(); }
   void Free();
   Staging(const Staging&) = delete;
   Staging& operator=(const Staging&) = delete;
 };
+
+// The reused staging buffers of a context (Buffer.cpp).
+std::shared_ptr<VulkanContext::StagingCache> MakeStagingCache();
+
 
 }  // namespace crossrt

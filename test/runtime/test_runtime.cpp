@@ -1,5 +1,6 @@
 // Tests of the CrossRT Vulkan runtime on a real device (lavapipe in CI) with validation enabled.
 // Shaders are GLSL compiled at test time with glslangValidator.
+#include <atomic>
 #include <cctype>
 #include <catch2/catch.hpp>
 
@@ -14,6 +15,7 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #ifndef CROSSRT_GLSLANG_VALIDATOR
@@ -185,6 +187,40 @@ TEST_CASE("Upload/Download through the staging path", "[runtime]") {
   uint32_t word = 0;
   buf.Download(&word, 4, 0);
   CHECK(word == 0x01020304u);
+
+  // The context reuses its staging buffers: a smaller copy after a larger one, a larger one that
+  // grows them, one past their limit (64 MiB) through a buffer of its own, and copies from two
+  // threads at once, each of its own buffer.
+  std::vector<uint8_t> small(1000, 0xAB);
+  buf.Upload(small.data(), small.size(), 5);
+  std::vector<uint8_t> smallBack(1010);
+  buf.Download(smallBack.data(), smallBack.size(), 0);
+  CHECK(std::vector<uint8_t>(smallBack.begin() + 5, smallBack.begin() + 1005) == small);
+  CHECK(smallBack[1005] == 0x03);  // the fill's bytes around it (0x01020304, little-endian)
+  CHECK(smallBack[1008] == 0x04);
+  for (size_t size : {size_t(3) << 20, (size_t(64) << 20) + 4096}) {
+    std::vector<uint8_t> big(size);
+    for (size_t i = 0; i < size; ++i) big[i] = static_cast<uint8_t>(i * 2654435761u >> 24);
+    Buffer large(ctx, size);
+    large.Upload(big.data(), size);
+    std::vector<uint8_t> bigBack(size);
+    large.Download(bigBack.data(), size);
+    CHECK(bigBack == big);
+  }
+  std::vector<std::thread> threads;
+  std::atomic<int> wrong{0};
+  for (int t = 0; t < 2; ++t)
+    threads.emplace_back([&, t] {
+      Buffer mine(ctx, 4096 * 4);
+      for (int round = 0; round < 20; ++round) {
+        std::vector<uint32_t> values(4096, uint32_t(t * 1000 + round)), got(4096);
+        mine.Upload(values.data(), values.size() * 4);
+        mine.Download(got.data(), got.size() * 4);
+        wrong += got != values;
+      }
+    });
+  for (auto& th : threads) th.join();
+  CHECK(wrong == 0);
   RequireNoValidationMessages(*ctx);
 }
 
@@ -750,27 +786,29 @@ TEST_CASE("CPU radix sort: stable for keys that need 0, 1, 2 and 3 passes, small
 
 // crossrt::ParallelChoice, with the times given: the way that measured faster is taken, the other
 // is tried again after 16 calls, then 64..., a loop whose parallel run takes longer than a time
-// slice always runs on all cores, and a loop of one iteration never does.
+// slice always runs on all cores, loops of sizes 4x apart choose apart, and a loop of one
+// iteration never does.
 TEST_CASE("ParallelChoice takes the faster way and tries the other now and then", "[runtime][parallel]")
 {
   const int threadsBefore = omp_get_max_threads();
   omp_set_num_threads(2);
-  auto count = [](crossrt::ParallelChoice& choice, int calls, double parallelMs, double serialMs) {
+  auto count = [](crossrt::ParallelChoice& choice, int calls, double parallelMs, double serialMs, long long iterations = 1000) {
     int parallel = 0;
     for (int i = 0; i < calls; ++i) {
-      const bool p = choice.Choose(1000);
-      choice.Record(p, 1000, p ? parallelMs : serialMs);
+      const bool p = choice.Choose(iterations);
+      choice.Record(p, iterations, p ? parallelMs : serialMs);
       parallel += p;
     }
     return parallel;
   };
   SECTION("short loops: the measured times decide") {
     crossrt::ParallelChoice choice;
+    choice.AssumeOthersRunnable(0);
     REQUIRE(choice.Choose(1000));  // first the way the loop is written for
     choice.Record(true, 1000, 1.0);
     REQUIRE_FALSE(choice.Choose(1000));  // then one run on this thread, cheap (1 ms)
     choice.Record(false, 1000, 0.5);
-    REQUIRE(choice.Mean(false) == Approx(0.0005f));
+    REQUIRE(choice.Mean(false, 1000) == Approx(0.0005f));
     // One core wins: of the next 16 calls, one tries all cores again; after that try lost, 64
     // calls pass before the next.
     CHECK(count(choice, 16, 1.0, 0.5) == 1);
@@ -781,11 +819,44 @@ TEST_CASE("ParallelChoice takes the faster way and tries the other now and then"
     CHECK(count(choice, 256, 0.1, 0.5) == 1);
     CHECK(count(choice, 64, 0.1, 0.5) == 63);
   }
-  SECTION("a long loop always runs on all cores, slowed or not") {
+  SECTION("on a quiet machine, a loop longer than a time slice always runs on all cores") {
     crossrt::ParallelChoice choice;
+    choice.AssumeOthersRunnable(0);
     CHECK(count(choice, 100, 8.0, 4.0) == 100);
     CHECK(count(choice, 100, 30.0, 4.0) == 100);
-    CHECK(choice.Mean(false) < 0.0f);  // never tried on one core
+    CHECK(choice.Mean(false, 1000) < 0.0f);  // never tried on one core
+  }
+  SECTION("beside other runnable threads, a loop of under 40 ms is tried on one core") {
+    crossrt::ParallelChoice choice;
+    choice.AssumeOthersRunnable(3);
+    CHECK(count(choice, 2, 8.0, 6.0) == 1);  // all cores, then one core once
+    CHECK(choice.Mean(false, 1000) == Approx(0.006f));
+    CHECK(count(choice, 20, 8.0, 6.0) == 1);  // one core wins; all cores tried once in 16 calls
+    // The load goes: all cores win their next try (after 64 calls, the 60th here). One core, 6 ms
+    // of work, is tried again (once in 16 calls) only while others are runnable.
+    CHECK(count(choice, 64, 1.0, 6.0) == 5);
+    choice.AssumeOthersRunnable(0);
+    CHECK(count(choice, 300, 1.0, 6.0) == 300);
+    // A loop whose run on all cores took over 40 ms is never tried on one core, loaded or not.
+    crossrt::ParallelChoice longLoop;
+    longLoop.AssumeOthersRunnable(3);
+    CHECK(count(longLoop, 50, 60.0, 100.0) == 50);
+    CHECK(longLoop.Mean(false, 1000) < 0.0f);
+  }
+  SECTION("each size class has its own choice") {
+    crossrt::ParallelChoice choice;
+    choice.AssumeOthersRunnable(0);
+    // Small loops: starting the threads costs more than the loop, one core wins.
+    CHECK(count(choice, 2, 1.0, 0.5) == 1);
+    CHECK(count(choice, 10, 1.0, 0.5) == 0);
+    // Loops 100x as long, where all cores take a fifth of one core's time: all cores from their
+    // first call (measured with the small loops, one core's time per iteration was the lower).
+    CHECK(count(choice, 20, 10.0, 50.0, 100000) == 20);
+    CHECK(choice.Mean(false, 100000) < 0.0f);
+    CHECK(choice.Mean(true, 100000) == Approx(0.0001f));
+    // Small again: one core, as before.
+    CHECK(count(choice, 5, 1.0, 0.5) == 0);
+    CHECK(crossrt::LoopSizeClass(1100) == crossrt::LoopSizeClass(4000));  // [4^5, 4^6)
   }
   SECTION("nothing to share") {
     crossrt::ParallelChoice choice;

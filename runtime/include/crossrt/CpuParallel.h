@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <utility>
@@ -134,6 +135,17 @@ class MeasuredWays {
   std::atomic<bool> m_tryingOther{false};
 };
 
+// Iterations of a loop in classes 4x apart: [4^c, 4^(c+1)), the last open-ended. A loop's ways are
+// measured per class (ParallelChoice, LaneChoice): what is small may run best one way and what is
+// large the other, and a time per iteration measured on small loops, where starting the threads
+// dominates, says nothing of a large one.
+constexpr int kLoopSizeClasses = 16;
+inline int LoopSizeClass(long long iterations) {
+  int c = 0;
+  for (long long n = iterations; n >= 4 && c + 1 < kLoopSizeClasses; n /= 4) ++c;
+  return c;
+}
+
 // Whether a kernel's loop runs on all cores this call, or on the calling thread alone: each
 // generated _CPU and _ISPC kernel keeps one (a static of its method) and asks it before the loop,
 //   static crossrt::ParallelChoice crt_choice;
@@ -150,22 +162,39 @@ class MeasuredWays {
 // (OMP_WAIT_POLICY) collapsed the same way; beside this choice they help (runtime/src/CpuWaitPolicy.cpp).
 //
 // So each loop runs the way that has been faster here, as measured (MeasuredWays: all cores are
-// way 1, one core way 0). One core can only win where the wait for a descheduled thread (a time
-// slice, kSliceMs) is more than what the other threads save, so only loops whose fastest parallel
-// run, times the other threads, is below it are ever tried on one core: a long loop always runs on
-// all cores (with one core busy, Bloom_CPU's 25-tap blur measured 1.18x and 1.53x of the original
-// when its loops could be tried on one core once slowed, 1.69x and 1.60x on all cores). Loops
-// inside a parallel region run on their thread, as OpenMP would.
+// way 1, one core way 0), per size class of its iterations (LoopSizeClass). A try of one core costs
+// the loop's work, so it is made only where one core can win and the try is cheap (MayTryOneCore):
+//   - where the loop's work on one core is under a time slice (kSliceMs): a parallel run waits up to
+//     a time slice for a descheduled thread, so it can lose to one core only there, quiet or not;
+//   - where other threads are runnable (Loaded: the kernel's procs_running beyond this thread) and
+//     the work is under kLoadedTryMs: then a parallel run can wait several time slices, one for each
+//     worker that shares its core with another program. On a 16-core Intel Xeon with 16 busy
+//     threads, Particles_CPU's step (12 ms of work on one core) took 32 ms on all cores against the
+//     original's 20.
+// The work is a measured time on one core per iteration (of this size class, or the nearest class
+// that has one: it hardly depends on the loop's length), times the iterations. Before any, the
+// loop's fastest parallel run, times the threads, bounds it on a quiet machine; under load, the
+// first try is made where that run took under kLoadedTryMs, and it measures the work. A long loop
+// always runs on all cores (with one core busy, Bloom_CPU's 25-tap blur measured 1.18x and 1.53x of
+// the original when its loops could be tried on one core once slowed, 1.69x and 1.60x on all
+// cores). Loops inside a parallel region run on their thread, as OpenMP would.
+//
+// Why size classes: measured together, a kernel called first on a 992-triangle mesh (where one core
+// wins, starting 16 threads costing more than the loop) kept that verdict for its loops over 871k
+// triangles, where all cores were many times faster, and ran them on one core until its next try
+// (LBVH_ISPC built that mesh in 2.8x LBVH_CPU's time on a 16-core Intel Xeon).
 // CROSSRT_CPU_PARALLEL=always turns the choice off: every loop runs on all cores.
 //
 // Both ways compute the same loop: the _ISPC classes fold their chunks in order, so their results
 // do not change with the number of threads; the _CPU classes' reductions already differ in their
 // last bits from run to run (the dynamic schedule hands out iterations in any order).
-class ParallelChoice : public MeasuredWays {
+class ParallelChoice {
  public:
   // A time slice of a loaded Linux scheduler (CFS gives 3-4 ms each to two runnable threads on a
-  // core): the most a parallel loop waits for a descheduled thread, so the most one core can save.
+  // core): what a parallel loop waits for a descheduled thread.
   static constexpr double kSliceMs = 4.0;
+  // Under load, loops of up to this much work are tried on one core.
+  static constexpr double kLoadedTryMs = 10 * kSliceMs;
 
   struct Run {
     bool parallel;
@@ -185,25 +214,32 @@ class ParallelChoice : public MeasuredWays {
     const int threads = omp_get_max_threads();
     if (iterations < 2 || omp_in_parallel() || threads < 2) return false;
     if (AlwaysAllCores()) return true;
-    const float serial = Mean(false), parallel = Mean(true);
+    Ways& ways = m_bySize[LoopSizeClass(iterations)];
+    const float serial = ways.Mean(0), parallel = ways.Mean(1);
     if (parallel < 0.0f) return true;  // first, the way the loop is written for
-    if (serial >= 0.0f && serial < parallel) return TimeToTry();  // one core has been faster: all, now and then
-    // What the other threads save at best: when it is more than a time slice, one core never wins.
-    const double saved = double(m_fastestParallel.load(std::memory_order_relaxed)) * double(iterations) * double(threads - 1);
-    if (saved > kSliceMs) return true;
+    if (serial >= 0.0f && serial < parallel) return ways.TimeToTry();  // one core has been faster: all, now and then
+    if (!MayTryOneCore(iterations, threads)) return true;
     if (serial < 0.0f) {  // one core, once, to compare
-      Try();
+      ways.Try();
       return false;
     }
-    return !TimeToTry();
+    return !ways.TimeToTry();
   }
 
   void Record(bool parallel, long long iterations, double ms) {
     if (iterations < 2 || omp_in_parallel() || omp_get_max_threads() < 2) return;
+    Ways& ways = m_bySize[LoopSizeClass(iterations)];
     const float now = float(ms / double(iterations));
-    MeasuredWays::Record(parallel, now);
-    if (parallel && now < m_fastestParallel.load(std::memory_order_relaxed)) m_fastestParallel.store(now, std::memory_order_relaxed);
+    ways.Record(parallel, now);
+    if (parallel && now < ways.fastestParallel.load(std::memory_order_relaxed)) ways.fastestParallel.store(now, std::memory_order_relaxed);
   }
+
+  // The mean ms per iteration of a way (all cores: true) for loops of this many iterations (-1
+  // before the first), for tests and benchmarks.
+  float Mean(bool parallel, long long iterations) const { return m_bySize[LoopSizeClass(iterations)].Mean(parallel); }
+
+  // Tests: take `others` threads as runnable beside this one, instead of reading /proc/stat.
+  void AssumeOthersRunnable(int others) { m_othersForTests = others; }
 
   // CROSSRT_CPU_PARALLEL=always: every loop on all cores, as OpenMP alone would (to compare).
   static bool AlwaysAllCores() {
@@ -214,8 +250,48 @@ class ParallelChoice : public MeasuredWays {
     return always;
   }
 
+  // Threads that the kernel counts as runnable beside the calling one (procs_running in /proc/stat,
+  // read at most every 20 ms; 0 where it cannot be read).
+  static int OthersRunnable() {
+    using Clock = std::chrono::steady_clock;
+    static std::atomic<long long> readAt{-1000000000};
+    static std::atomic<int> others{0};
+    const long long now = std::chrono::duration_cast<std::chrono::microseconds>(Clock::now().time_since_epoch()).count();
+    if (now - readAt.load(std::memory_order_relaxed) < 20000) return others.load(std::memory_order_relaxed);
+    readAt.store(now, std::memory_order_relaxed);
+    int running = 1;
+    if (std::FILE* f = std::fopen("/proc/stat", "r")) {
+      char line[256];
+      while (std::fgets(line, sizeof line, f))
+        if (std::sscanf(line, "procs_running %d", &running) == 1) break;
+      std::fclose(f);
+    }
+    others.store(std::max(0, running - 1), std::memory_order_relaxed);
+    return std::max(0, running - 1);
+  }
+
  private:
-  std::atomic<float> m_fastestParallel{3.0e38f};
+  struct Ways : MeasuredWays {
+    std::atomic<float> fastestParallel{3.0e38f};
+  };
+
+  bool Loaded() const { return (m_othersForTests >= 0 ? m_othersForTests : OthersRunnable()) > 0; }
+
+  // Whether a try of one core may pay, and costs little (see above).
+  bool MayTryOneCore(long long iterations, int threads) const {
+    const int size = LoopSizeClass(iterations);
+    for (int d = 0; d < kLoopSizeClasses; ++d)  // this size class, then the nearest with a time on one core
+      for (int c : {size - d, size + d})
+        if (c >= 0 && c < kLoopSizeClasses && m_bySize[c].Mean(0) >= 0.0f) {
+          const double work = double(m_bySize[c].Mean(0)) * double(iterations);
+          return work < kSliceMs || (work < kLoadedTryMs && Loaded());
+        }
+    const double fastestMs = double(m_bySize[size].fastestParallel.load(std::memory_order_relaxed)) * double(iterations);
+    return fastestMs * double(threads - 1) < kSliceMs || (fastestMs < kLoadedTryMs && Loaded());
+  }
+
+  Ways m_bySize[kLoopSizeClasses];
+  int m_othersForTests = -1;
 };
 
 // Whether an _ISPC class's kernel runs its loop nest in SIMD lanes (the ISPC function) this call,
@@ -247,7 +323,6 @@ class ParallelChoice : public MeasuredWays {
 class LaneChoice {
  public:
   enum class Mode { Measure, Always, Never };
-  static constexpr int kSizeClasses = 16;  // iterations [4^c, 4^(c+1)), the last open-ended
 
   struct Run {
     bool lanes;
@@ -287,11 +362,7 @@ class LaneChoice {
   // The mean ms per iteration of a way in the size class of the last call (-1 before the first).
   float Mean(int way) const { return m_bySize[m_lastSize.load(std::memory_order_relaxed)].Mean(way); }
 
-  static int SizeClass(long long iterations) {
-    int c = 0;
-    for (long long n = iterations; n >= 4 && c + 1 < kSizeClasses; n /= 4) ++c;
-    return c;
-  }
+  static int SizeClass(long long iterations) { return LoopSizeClass(iterations); }
 
   // CROSSRT_ISPC_LANES: always, never, or (unset) measure.
   static Mode LanesMode() {
@@ -305,7 +376,7 @@ class LaneChoice {
   }
 
  private:
-  MeasuredWays m_bySize[kSizeClasses];
+  MeasuredWays m_bySize[kLoopSizeClasses];
   std::atomic<int> m_lastSize{0};
   std::atomic<bool> m_warm{false};
 };

@@ -127,6 +127,9 @@ public:
   uint32_t subgroupSize = 0;
   bool hasSubgroupArithmetic = false;
   bool forceStaging = false;  // see ContextOptions::forceStaging
+  // The staging buffers that Buffer::Upload and Download reuse (runtime/src/Buffer.cpp).
+  struct StagingCache;
+  std::shared_ptr<StagingCache> stagingCache;
   // Kernels that call crossrt atomics fence them (memoryBarrierBuffer) for acquire-release order,
   // under the specialization constant kFenceAtomicsConstantId, which every pipeline's shaders get
   // from here. Off on llvmpipe: its atomics are sequentially consistent already, and its memory
