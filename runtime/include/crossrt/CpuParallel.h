@@ -19,77 +19,6 @@
 
 namespace crossrt {
 
-// Stable LSD radix sort of n records of key.strideWords words, on all cores: per pass of 11 bits
-// (three passes cover a 32-bit key), each thread counts the digits of its slice, the counts are
-// scanned in (digit, thread) order, and each thread moves its slice's records to their places. A
-// pass whose digit is the same in every record moves nothing and is skipped (keys below 2^22 take
-// two passes).
-inline void RadixSortWords(uint32_t* records, size_t n, const SortKey& key) {
-  constexpr uint32_t kDigitBits = 11, kDigits = 1u << kDigitBits;
-  const size_t stride = key.strideWords;
-  // The scratch copy is kept for the next sort of this thread: a fresh one would be zeroed (and
-  // its pages faulted in) on every call, only for the sort to overwrite it.
-  static thread_local std::vector<uint32_t> scratch;
-  if (scratch.size() < n * stride) scratch.resize(n * stride);
-  uint32_t* src = records;
-  uint32_t* dst = scratch.data();
-  // Below 2^15 records, waking the other threads costs more than they save: with this, the LBVH
-  // build of the 992-triangle teapot went from 1.1x to 0.8x of Embree LOW's time.
-  const int threads = n < (size_t(1) << 15) ? 1 : omp_get_max_threads();
-  std::vector<size_t> counts(size_t(threads) * kDigits);
-  for (uint32_t shift = 0; shift < 32; shift += kDigitBits) {
-    std::fill(counts.begin(), counts.end(), 0);
-    bool oneDigit = false;
-#pragma omp parallel num_threads(threads)
-    {
-      const int t = omp_get_thread_num(), used = omp_get_num_threads();
-      const size_t begin = n * t / used, end = n * (t + 1) / used;
-      size_t* mine = &counts[size_t(t) * kDigits];
-      for (size_t i = begin; i < end; ++i) ++mine[(SortableBits(src[i * stride + key.keyWord], key) >> shift) & (kDigits - 1)];
-#pragma omp barrier
-#pragma omp single
-      {
-        size_t position = 0;
-        for (uint32_t digit = 0; digit < kDigits; ++digit) {
-          size_t inDigit = 0;
-          for (int u = 0; u < used; ++u) {
-            const size_t c = counts[size_t(u) * kDigits + digit];
-            counts[size_t(u) * kDigits + digit] = position;
-            position += c;
-            inDigit += c;
-          }
-          oneDigit = oneDigit || inDigit == n;
-        }
-      }  // (the implicit barrier publishes oneDigit)
-      if (!oneDigit)
-        for (size_t i = begin; i < end; ++i) {
-          const uint32_t digit = (SortableBits(src[i * stride + key.keyWord], key) >> shift) & (kDigits - 1);
-          const size_t to = mine[digit]++;
-          if (stride == 1)  // the common shapes, without a call to memcpy per record
-            dst[to] = src[i];
-          else if (stride == 2)
-            std::memcpy(dst + 2 * to, src + 2 * i, 8);
-          else
-            std::memcpy(dst + to * stride, src + i * stride, stride * sizeof(uint32_t));
-        }
-    }
-    if (!oneDigit) std::swap(src, dst);
-  }
-  if (src != records) {  // an odd number of passes moved records: the result is in scratch
-#pragma omp parallel for num_threads(threads) schedule(static)
-    for (long long i = 0; i < static_cast<long long>(n * stride); ++i) records[i] = src[i];
-  }
-}
-
-// std::sort of a range the translator recognized (see SortKey), on all cores.
-template <typename Iterator>
-void RadixSort(Iterator first, Iterator last, const SortKey& key) {
-  const auto n = last - first;
-  if (n <= 1) return;
-  static_assert(sizeof(*first) % 4 == 0, "records of whole 32-bit words");
-  RadixSortWords(reinterpret_cast<uint32_t*>(&*first), size_t(n), key);
-}
-
 // Two ways of running one loop, way 1 the one it is written for and way 0 the other, each with
 // its mean time per iteration as measured (an exponential moving average, outliers and all). The
 // slower way is tried again now and then, after 16 calls, then 64, 256, up to 1024 while it keeps
@@ -107,9 +36,11 @@ class MeasuredWays {
   // The next run is a try of the way that is not the faster one (or has not run yet).
   void Try() { m_tryingOther.store(true, std::memory_order_relaxed); }
 
-  // Counts a call that keeps to the faster way; true when the slower one is due for a try.
-  bool TimeToTry() {
-    if (m_calls.fetch_add(1, std::memory_order_relaxed) + 1 < m_nextTry.load(std::memory_order_relaxed)) return false;
+  // Counts a call that keeps to the faster way; true when the slower one is due for a try (after
+  // at least `atLeast` calls since the last).
+  bool TimeToTry(unsigned atLeast = 0) {
+    const unsigned wait = std::max(atLeast, m_nextTry.load(std::memory_order_relaxed));
+    if (m_calls.fetch_add(1, std::memory_order_relaxed) + 1 < wait) return false;
     m_calls.store(0, std::memory_order_relaxed);
     Try();
     return true;
@@ -177,7 +108,9 @@ inline int LoopSizeClass(long long iterations) {
 // first try is made where that run took under kLoadedTryMs, and it measures the work. A long loop
 // always runs on all cores (with one core busy, Bloom_CPU's 25-tap blur measured 1.18x and 1.53x of
 // the original when its loops could be tried on one core once slowed, 1.69x and 1.60x on all
-// cores). Loops inside a parallel region run on their thread, as OpenMP would.
+// cores). Under load, tries of all cores cost what one core saves, so they come rarer (the first
+// after 64 calls), and a loop of a new size class whose work is known to be under a time slice
+// starts on one core. Loops inside a parallel region run on their thread, as OpenMP would.
 //
 // Why size classes: measured together, a kernel called first on a 992-triangle mesh (where one core
 // wins, starting 16 threads costing more than the loop) kept that verdict for its loops over 871k
@@ -216,9 +149,19 @@ class ParallelChoice {
     if (AlwaysAllCores()) return true;
     Ways& ways = m_bySize[LoopSizeClass(iterations)];
     const float serial = ways.Mean(0), parallel = ways.Mean(1);
-    if (parallel < 0.0f) return true;  // first, the way the loop is written for
-    if (serial >= 0.0f && serial < parallel) return ways.TimeToTry();  // one core has been faster: all, now and then
-    if (!MayTryOneCore(iterations, threads)) return true;
+    const double work = Work(iterations);
+    // First the way the loop is written for; under load, one core where its work is known to be
+    // under a time slice (a parallel run would wait longer than that: 8 ms each, beside one busy
+    // thread on 2 cores).
+    if (parallel < 0.0f && !(work >= 0.0 && work < kSliceMs && Loaded())) return true;
+    if (parallel < 0.0f || (serial >= 0.0f && serial < parallel)) {
+      // One core has been faster: all cores now and then. While others are runnable the first try
+      // waits 64 calls, not 16: beside one busy thread, a try of the LBVH build's sort of 75,408
+      // records on all cores took 12-64 ms, against 0.6 ms on one.
+      if (serial < 0.0f) return false;
+      return ways.TimeToTry(Loaded() ? 4 * MeasuredWays::kFirstWait : 0);
+    }
+    if (!MayTryOneCore(iterations, threads, work)) return true;
     if (serial < 0.0f) {  // one core, once, to compare
       ways.Try();
       return false;
@@ -277,22 +220,105 @@ class ParallelChoice {
 
   bool Loaded() const { return (m_othersForTests >= 0 ? m_othersForTests : OthersRunnable()) > 0; }
 
-  // Whether a try of one core may pay, and costs little (see above).
-  bool MayTryOneCore(long long iterations, int threads) const {
+  // The loop's work in ms on one core: its time per iteration there (in its size class, else the
+  // nearest class that has one: it hardly depends on the loop's length) times the iterations; -1
+  // before any run on one core.
+  double Work(long long iterations) const {
     const int size = LoopSizeClass(iterations);
-    for (int d = 0; d < kLoopSizeClasses; ++d)  // this size class, then the nearest with a time on one core
+    for (int d = 0; d < kLoopSizeClasses; ++d)
       for (int c : {size - d, size + d})
-        if (c >= 0 && c < kLoopSizeClasses && m_bySize[c].Mean(0) >= 0.0f) {
-          const double work = double(m_bySize[c].Mean(0)) * double(iterations);
-          return work < kSliceMs || (work < kLoadedTryMs && Loaded());
-        }
-    const double fastestMs = double(m_bySize[size].fastestParallel.load(std::memory_order_relaxed)) * double(iterations);
+        if (c >= 0 && c < kLoopSizeClasses && m_bySize[c].Mean(0) >= 0.0f) return double(m_bySize[c].Mean(0)) * double(iterations);
+    return -1.0;
+  }
+
+  // Whether a try of one core may pay, and costs little (see above).
+  bool MayTryOneCore(long long iterations, int threads, double work) const {
+    if (work >= 0.0) return work < kSliceMs || (work < kLoadedTryMs && Loaded());
+    const double fastestMs = double(m_bySize[LoopSizeClass(iterations)].fastestParallel.load(std::memory_order_relaxed)) * double(iterations);
     return fastestMs * double(threads - 1) < kSliceMs || (fastestMs < kLoadedTryMs && Loaded());
   }
 
   Ways m_bySize[kLoopSizeClasses];
   int m_othersForTests = -1;
 };
+
+// Stable LSD radix sort of n records of key.strideWords words, on all cores: per pass of 11 bits
+// (three passes cover a 32-bit key), each thread counts the digits of its slice, the counts are
+// scanned in (digit, thread) order, and each thread moves its slice's records to their places. A
+// pass whose digit is the same in every record moves nothing and is skipped (keys below 2^22 take
+// two passes).
+inline void RadixSortWords(uint32_t* records, size_t n, const SortKey& key) {
+  constexpr uint32_t kDigitBits = 11, kDigits = 1u << kDigitBits;
+  const size_t stride = key.strideWords;
+  // The scratch copy is kept for the next sort of this thread: a fresh one would be zeroed (and
+  // its pages faulted in) on every call, only for the sort to overwrite it.
+  static thread_local std::vector<uint32_t> scratch;
+  if (scratch.size() < n * stride) scratch.resize(n * stride);
+  uint32_t* src = records;
+  uint32_t* dst = scratch.data();
+  // Below 2^15 records, waking the other threads costs more than they save: with this, the LBVH
+  // build of the 992-triangle teapot went from 1.1x to 0.8x of Embree LOW's time. Above, the sort
+  // runs on all cores or one as a kernel's loop does (ParallelChoice): its passes wait at barriers,
+  // and beside one busy thread on 2 cores the LBVH build of 47,794 triangles took 53 ms in some
+  // runs, against 2-4 ms in others.
+  static ParallelChoice choice;
+  const bool large = n >= (size_t(1) << 15);
+  const ParallelChoice::Run run = choice.Begin(large ? static_cast<long long>(n) : 1);
+  const int threads = large && run.parallel ? omp_get_max_threads() : 1;
+  std::vector<size_t> counts(size_t(threads) * kDigits);
+  for (uint32_t shift = 0; shift < 32; shift += kDigitBits) {
+    std::fill(counts.begin(), counts.end(), 0);
+    bool oneDigit = false;
+#pragma omp parallel num_threads(threads)
+    {
+      const int t = omp_get_thread_num(), used = omp_get_num_threads();
+      const size_t begin = n * t / used, end = n * (t + 1) / used;
+      size_t* mine = &counts[size_t(t) * kDigits];
+      for (size_t i = begin; i < end; ++i) ++mine[(SortableBits(src[i * stride + key.keyWord], key) >> shift) & (kDigits - 1)];
+#pragma omp barrier
+#pragma omp single
+      {
+        size_t position = 0;
+        for (uint32_t digit = 0; digit < kDigits; ++digit) {
+          size_t inDigit = 0;
+          for (int u = 0; u < used; ++u) {
+            const size_t c = counts[size_t(u) * kDigits + digit];
+            counts[size_t(u) * kDigits + digit] = position;
+            position += c;
+            inDigit += c;
+          }
+          oneDigit = oneDigit || inDigit == n;
+        }
+      }  // (the implicit barrier publishes oneDigit)
+      if (!oneDigit)
+        for (size_t i = begin; i < end; ++i) {
+          const uint32_t digit = (SortableBits(src[i * stride + key.keyWord], key) >> shift) & (kDigits - 1);
+          const size_t to = mine[digit]++;
+          if (stride == 1)  // the common shapes, without a call to memcpy per record
+            dst[to] = src[i];
+          else if (stride == 2)
+            std::memcpy(dst + 2 * to, src + 2 * i, 8);
+          else
+            std::memcpy(dst + to * stride, src + i * stride, stride * sizeof(uint32_t));
+        }
+    }
+    if (!oneDigit) std::swap(src, dst);
+  }
+  if (src != records) {  // an odd number of passes moved records: the result is in scratch
+#pragma omp parallel for num_threads(threads) schedule(static)
+    for (long long i = 0; i < static_cast<long long>(n * stride); ++i) records[i] = src[i];
+  }
+  choice.End(run);
+}
+
+// std::sort of a range the translator recognized (see SortKey), on all cores.
+template <typename Iterator>
+void RadixSort(Iterator first, Iterator last, const SortKey& key) {
+  const auto n = last - first;
+  if (n <= 1) return;
+  static_assert(sizeof(*first) % 4 == 0, "records of whole 32-bit words");
+  RadixSortWords(reinterpret_cast<uint32_t*>(&*first), size_t(n), key);
+}
 
 // Whether an _ISPC class's kernel runs its loop nest in SIMD lanes (the ISPC function) this call,
 // or as the _CPU class runs it, one iteration at a time per core: each kernel of an _ISPC class
