@@ -36,11 +36,9 @@ class MeasuredWays {
   // The next run is a try of the way that is not the faster one (or has not run yet).
   void Try() { m_tryingOther.store(true, std::memory_order_relaxed); }
 
-  // Counts a call that keeps to the faster way; true when the slower one is due for a try (after
-  // at least `atLeast` calls since the last).
-  bool TimeToTry(unsigned atLeast = 0) {
-    const unsigned wait = std::max(atLeast, m_nextTry.load(std::memory_order_relaxed));
-    if (m_calls.fetch_add(1, std::memory_order_relaxed) + 1 < wait) return false;
+  // Counts a call that keeps to the faster way; true when the slower one is due for a try.
+  bool TimeToTry() {
+    if (m_calls.fetch_add(1, std::memory_order_relaxed) + 1 < m_nextTry.load(std::memory_order_relaxed)) return false;
     m_calls.store(0, std::memory_order_relaxed);
     Try();
     return true;
@@ -94,23 +92,23 @@ inline int LoopSizeClass(long long iterations) {
 //
 // So each loop runs the way that has been faster here, as measured (MeasuredWays: all cores are
 // way 1, one core way 0), per size class of its iterations (LoopSizeClass). A try of one core costs
-// the loop's work, so it is made only where one core can win and the try is cheap (MayTryOneCore):
-//   - where the loop's work on one core is under a time slice (kSliceMs): a parallel run waits up to
-//     a time slice for a descheduled thread, so it can lose to one core only there, quiet or not;
-//   - where other threads are runnable (Loaded: the kernel's procs_running beyond this thread) and
-//     the work is under kLoadedTryMs: then a parallel run can wait several time slices, one for each
-//     worker that shares its core with another program. On a 16-core Intel Xeon with 16 busy
-//     threads, Particles_CPU's step (12 ms of work on one core) took 32 ms on all cores against the
-//     original's 20.
-// The work is a measured time on one core per iteration (of this size class, or the nearest class
-// that has one: it hardly depends on the loop's length), times the iterations. Before any, the
-// loop's fastest parallel run, times the threads, bounds it on a quiet machine; under load, the
-// first try is made where that run took under kLoadedTryMs, and it measures the work. A long loop
-// always runs on all cores (with one core busy, Bloom_CPU's 25-tap blur measured 1.18x and 1.53x of
-// the original when its loops could be tried on one core once slowed, 1.69x and 1.60x on all
-// cores). Under load, tries of all cores cost what one core saves, so they come rarer (the first
-// after 64 calls), and a loop of a new size class whose work is known to be under a time slice
-// starts on one core. Loops inside a parallel region run on their thread, as OpenMP would.
+// the loop's work, so it is made only where one core can win (MayTryOneCore): where what the other
+// threads save, the work on one core times (threads - 1) / threads, is under a time slice
+// (kSliceMs), since a parallel run waits up to a time slice for a descheduled thread. The work is a
+// measured time on one core per iteration (of this size class, or the nearest class that has one:
+// it hardly depends on the loop's length) times the iterations. Before a loop has run on one core,
+// its fastest parallel run, times the other threads, stands in for it; that overstates it under
+// load, so while other threads are runnable (Loaded: the kernel's procs_running beyond this thread)
+// a parallel run of under kLoadedTryMs gets the first try too. On a 16-core Intel Xeon with 16 busy
+// threads the first parallel runs of the LBVH build's kernels took about 8 ms each, and without a
+// try the build of 11,102 triangles took 116 ms against the original's 1.7 (1.1 ms with it).
+// A long loop always runs on all cores (with one core busy, Bloom_CPU's 25-tap blur measured 1.18x
+// and 1.53x of the original when its loops could be tried on one core once slowed, 1.69x and 1.60x
+// on all cores). Loops inside a parallel region run on their thread, as OpenMP would.
+//
+// procs_running decides nothing more: it also counts threads that yield their cores at once (TBB's
+// workers spinning after an Embree build, most likely), and with tries of up to 40 ms of work
+// whenever it was over 0, a quiet 16-core Xeon built 52k-202k triangles in 3x OpenMP's time.
 //
 // Why size classes: measured together, a kernel called first on a 992-triangle mesh (where one core
 // wins, starting 16 threads costing more than the loop) kept that verdict for its loops over 871k
@@ -126,7 +124,8 @@ class ParallelChoice {
   // A time slice of a loaded Linux scheduler (CFS gives 3-4 ms each to two runnable threads on a
   // core): what a parallel loop waits for a descheduled thread.
   static constexpr double kSliceMs = 4.0;
-  // Under load, loops of up to this much work are tried on one core.
+  // While other threads are runnable, a loop whose fastest parallel run took under this gets its
+  // first try on one core.
   static constexpr double kLoadedTryMs = 10 * kSliceMs;
 
   struct Run {
@@ -149,19 +148,9 @@ class ParallelChoice {
     if (AlwaysAllCores()) return true;
     Ways& ways = m_bySize[LoopSizeClass(iterations)];
     const float serial = ways.Mean(0), parallel = ways.Mean(1);
-    const double work = Work(iterations);
-    // First the way the loop is written for; under load, one core where its work is known to be
-    // under a time slice (a parallel run would wait longer than that: 8 ms each, beside one busy
-    // thread on 2 cores).
-    if (parallel < 0.0f && !(work >= 0.0 && work < kSliceMs && Loaded())) return true;
-    if (parallel < 0.0f || (serial >= 0.0f && serial < parallel)) {
-      // One core has been faster: all cores now and then. While others are runnable the first try
-      // waits 64 calls, not 16: beside one busy thread, a try of the LBVH build's sort of 75,408
-      // records on all cores took 12-64 ms, against 0.6 ms on one.
-      if (serial < 0.0f) return false;
-      return ways.TimeToTry(Loaded() ? 4 * MeasuredWays::kFirstWait : 0);
-    }
-    if (!MayTryOneCore(iterations, threads, work)) return true;
+    if (parallel < 0.0f) return true;  // first, the way the loop is written for
+    if (serial >= 0.0f && serial < parallel) return ways.TimeToTry();  // one core has been faster: all, now and then
+    if (!MayTryOneCore(iterations, threads, Work(iterations))) return true;
     if (serial < 0.0f) {  // one core, once, to compare
       ways.Try();
       return false;
@@ -233,7 +222,7 @@ class ParallelChoice {
 
   // Whether a try of one core may pay, and costs little (see above).
   bool MayTryOneCore(long long iterations, int threads, double work) const {
-    if (work >= 0.0) return work < kSliceMs || (work < kLoadedTryMs && Loaded());
+    if (work >= 0.0) return work * double(threads - 1) / double(threads) < kSliceMs;
     const double fastestMs = double(m_bySize[LoopSizeClass(iterations)].fastestParallel.load(std::memory_order_relaxed)) * double(iterations);
     return fastestMs * double(threads - 1) < kSliceMs || (fastestMs < kLoadedTryMs && Loaded());
   }
