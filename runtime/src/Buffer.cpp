@@ -169,7 +169,7 @@ Staging& StagingFor(const VulkanContext& ctx, VkDeviceSize bytes, VkBufferUsageF
   lock = std::unique_lock<std::mutex>(cache->mutex);
   std::unique_ptr<Staging>& reused = usage == VK_BUFFER_USAGE_TRANSFER_SRC_BIT ? cache->upload : cache->download;
   if (!reused || reused->size < bytes) {
-    reused.reset();  // the smaller one first: both at once could fail where one fits
+    reused.reset();  // free the smaller one first: holding both could fail where the larger alone fits
     reused = std::make_unique<Staging>(ctx, bytes, usage);
   }
   return *reused;

@@ -84,5 +84,4 @@ struct Staging {
 // The reused staging buffers of a context (Buffer.cpp).
 std::shared_ptr<VulkanContext::StagingCache> MakeStagingCache();
 
-
 }  // namespace crossrt

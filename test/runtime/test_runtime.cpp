@@ -839,6 +839,11 @@ TEST_CASE("ParallelChoice takes the faster way and tries the other now and then"
     crossrt::ParallelChoice quiet;
     quiet.AssumeOthersRunnable(0);
     CHECK(count(quiet, 20, 8.0, 6.0) == 20);
+    // 15 ms of work on one core, of which the other thread would save 7.5: tried once, then all
+    // cores even though one core measured faster.
+    crossrt::ParallelChoice longer;
+    longer.AssumeOthersRunnable(1);
+    CHECK(count(longer, 20, 20.0, 15.0) == 19);
     // A loop whose parallel runs took over 40 ms is never tried on one core, loaded or not.
     crossrt::ParallelChoice longLoop;
     longLoop.AssumeOthersRunnable(3);

@@ -101,7 +101,7 @@ inline int LoopSizeClass(long long iterations) {
 // load, so while other threads are runnable (Loaded: the kernel's procs_running beyond this thread)
 // a parallel run of under kLoadedTryMs gets the first try too. On a 16-core Intel Xeon with 16 busy
 // threads the first parallel runs of the LBVH build's kernels took about 8 ms each, and without a
-// try the build of 11,102 triangles took 116 ms against the original's 1.7 (1.1 ms with it).
+// try the build of 11,102 triangles took 116 ms against the original's 1.7 (1.3 ms with it).
 // A long loop always runs on all cores (with one core busy, Bloom_CPU's 25-tap blur measured 1.18x
 // and 1.53x of the original when its loops could be tried on one core once slowed, 1.69x and 1.60x
 // on all cores). Loops inside a parallel region run on their thread, as OpenMP would.
@@ -149,8 +149,15 @@ class ParallelChoice {
     Ways& ways = m_bySize[LoopSizeClass(iterations)];
     const float serial = ways.Mean(0), parallel = ways.Mean(1);
     if (parallel < 0.0f) return true;  // first, the way the loop is written for
-    if (serial >= 0.0f && serial < parallel) return ways.TimeToTry();  // one core has been faster: all, now and then
-    if (!MayTryOneCore(iterations, threads, Work(iterations))) return true;
+    const double work = Work(iterations);
+    if (serial >= 0.0f && serial < parallel) {
+      // One core has been faster: all cores now and then. But a long loop runs on all cores even
+      // so (its parallel runs under load vary by time slices; with the choice's first try under
+      // load and no such rule, Bloom_CPU beside one busy thread fell to 0.84-1.26x of the original).
+      if (!MayTryOneCore(iterations, threads, work) && work >= 0.0) return true;
+      return ways.TimeToTry();
+    }
+    if (!MayTryOneCore(iterations, threads, work)) return true;
     if (serial < 0.0f) {  // one core, once, to compare
       ways.Try();
       return false;
@@ -231,11 +238,11 @@ class ParallelChoice {
   int m_othersForTests = -1;
 };
 
-// Stable LSD radix sort of n records of key.strideWords words, on all cores: per pass of 11 bits
-// (three passes cover a 32-bit key), each thread counts the digits of its slice, the counts are
-// scanned in (digit, thread) order, and each thread moves its slice's records to their places. A
-// pass whose digit is the same in every record moves nothing and is skipped (keys below 2^22 take
-// two passes).
+// Stable LSD radix sort of n records of key.strideWords words, on all cores or one (see below):
+// per pass of 11 bits (three passes cover a 32-bit key), each thread counts the digits of its
+// slice, the counts are scanned in (digit, thread) order, and each thread moves its slice's records
+// to their places. A pass whose digit is the same in every record moves nothing and is skipped
+// (keys below 2^22 take two passes).
 inline void RadixSortWords(uint32_t* records, size_t n, const SortKey& key) {
   constexpr uint32_t kDigitBits = 11, kDigits = 1u << kDigitBits;
   const size_t stride = key.strideWords;
