@@ -154,7 +154,7 @@ class ParallelChoice {
       // One core has been faster: all cores now and then. But a long loop runs on all cores even
       // so (its parallel runs under load vary by time slices; with the choice's first try under
       // load and no such rule, Bloom_CPU beside one busy thread fell to 0.84-1.26x of the original).
-      if (!MayTryOneCore(iterations, threads, work) && work >= 0.0) return true;
+      if (work >= 0.0 && !MayTryOneCore(iterations, threads, work)) return true;  // (no procs_running read here)
       return ways.TimeToTry();
     }
     if (!MayTryOneCore(iterations, threads, work)) return true;
