@@ -118,6 +118,45 @@ BVHTraceRay Prepare(float3 org, float3 dir, float tnear)
   return max(max(nearX, nearY), max(nearZ, float4(r.tnear)));
 }
 
+// One box of a node, [lo, hi], as SlabEntries and SlabEntriesParallelAxes test a lane of four: the
+// same arithmetic, so the same entry (returned) and exit. Packet traversal tests a node's boxes one
+// at a time against its gang's rays: four at once hold eight values per ray, which spill AVX2's
+// sixteen registers.
+[[gnu::noinline]] float SlabEntryParallelAxes(const BVHTraceRay& r, float3 lo, float3 hi, float tfar, float& exit)
+{
+  float tmin = r.tnear;
+  float tmax = tfar;
+  bool inside = lo.x <= hi.x;  // an empty lane is never entered
+  for (int a = 0; a < 3; ++a)
+  {
+    if (r.invDir[a] == 0.0f)
+    {
+      inside = inside && r.org[a] >= lo[a] && r.org[a] <= hi[a];
+      continue;
+    }
+    const float t0 = (lo[a] - r.org[a]) * r.invDir[a];
+    const float t1 = (hi[a] - r.org[a]) * r.invDir[a];
+    tmin = std::max(tmin, std::min(t0, t1));
+    tmax = std::min(tmax, std::max(t0, t1) * kWiden);
+  }
+  exit = inside ? tmax : kMissed;
+  return inside ? tmin : 0.0f;
+}
+
+[[gnu::always_inline]] inline float SlabEntry(const BVHTraceRay& r, float3 lo, float3 hi, float tfar, float& exit)
+{
+  if (r.anyZeroAxis)
+    return SlabEntryParallelAxes(r, lo, hi, tfar, exit);
+  const float nearX = ((r.invDir.x < 0.0f ? hi.x : lo.x) - r.org.x) * r.invDir.x;
+  const float farX = ((r.invDir.x < 0.0f ? lo.x : hi.x) - r.org.x) * r.invDir.x;
+  const float nearY = ((r.invDir.y < 0.0f ? hi.y : lo.y) - r.org.y) * r.invDir.y;
+  const float farY = ((r.invDir.y < 0.0f ? lo.y : hi.y) - r.org.y) * r.invDir.y;
+  const float nearZ = ((r.invDir.z < 0.0f ? hi.z : lo.z) - r.org.z) * r.invDir.z;
+  const float farZ = ((r.invDir.z < 0.0f ? lo.z : hi.z) - r.org.z) * r.invDir.z;
+  exit = std::min(std::min(std::min(farX, farY), farZ) * kWiden, tfar);
+  return std::max(std::max(nearX, nearY), std::max(nearZ, r.tnear));
+}
+
 // Puts lanes i < j of (entries, children) in order of entry.
 inline void OrderLanes(float4& entries, uint4& children, int i, int j)
 {
@@ -967,6 +1006,38 @@ uint32_t BVHScene::IntersectGroup(const BVHTraceRay& r, uint32_t group, int kx, 
   return hits;
 }
 
+// Triangle `lane` of group g, as IntersectGroup tests it among four: the same arithmetic on that lane,
+// so the same hit, t, u and v. Packet traversal tests a leaf's triangles one at a time against its
+// gang's rays (a triangle's nine corner coordinates are then one load each, and four at once would
+// spill). IntersectGroup decides every lane exactly where one lane's edge function is zero; this sets
+// `onEdge` where this triangle's is, and leaves the group's exact test to its caller.
+bool BVHScene::IntersectTriangle(const BVHTraceRay& r, uint32_t group, int lane, int kx, int ky, int kz, float tfar, float& t, float& u,
+                                 float& v, bool& onEdge) const
+{
+  const float ox = r.org[kx];
+  const float oy = r.org[ky];
+  const float oz = r.org[kz];
+  const float az = m_triangles[group].coord[kz][lane] - oz;
+  const float bz = m_triangles[group].coord[3 + kz][lane] - oz;
+  const float cz = m_triangles[group].coord[6 + kz][lane] - oz;
+  const float ax = (m_triangles[group].coord[kx][lane] - ox) - r.sx * az;
+  const float ay = (m_triangles[group].coord[ky][lane] - oy) - r.sy * az;
+  const float bx = (m_triangles[group].coord[3 + kx][lane] - ox) - r.sx * bz;
+  const float by = (m_triangles[group].coord[3 + ky][lane] - oy) - r.sy * bz;
+  const float cx = (m_triangles[group].coord[6 + kx][lane] - ox) - r.sx * cz;
+  const float cy = (m_triangles[group].coord[6 + ky][lane] - oy) - r.sy * cz;
+  const float eu = cx * by - cy * bx;
+  const float ev = ax * cy - ay * cx;
+  const float ew = bx * ay - by * ax;
+  onEdge = onEdge || std::min(std::min(std::fabs(eu), std::fabs(ev)), std::fabs(ew)) <= 0.0f;
+  const float det = eu + ev + ew;
+  t = (eu * (r.sz * az) + ev * (r.sz * bz) + ew * (r.sz * cz)) / det;
+  u = ev / det;
+  v = ew / det;
+  const bool inside = 0.0f <= std::min(std::min(eu, ev), ew) || std::max(std::max(eu, ev), ew) <= 0.0f;
+  return inside && !(det <= 0.0f && 0.0f <= det) && r.tnear <= t && t <= tfar;  // NaN (an empty lane) fails
+}
+
 // The four boxes of box geometry's m_boxes[group], as a node's lanes: a ray hits one where it enters
 // it (at tnear from inside), or for a signed distance field where it meets the surface in the brick
 // the lane holds. On a hit nearer than tfar: sets tfar and the hit's t, primId and coords.
@@ -1232,52 +1303,47 @@ bool BVHScene::TraceMeshTogether(const BVHTraceRay& ray, uint32_t root, bool any
   {
     while ((node & kLeafFlag) == 0)
     {
-      float4 exits;
-      const float4 entries = SlabEntries(ray, m_nodes[node], tfar, exits);
-      const uint32_t mask = entry <= tfar ? lane_mask_le(entries, exits) : 0u;
-      // The lanes of the node some ray enters: their children, the least entry of any ray, and this ray's.
-      CRT_UNIFORM uint32_t children[4];
-      CRT_UNIFORM float nearest[4];
-      float entered[4];
-      CRT_UNIFORM int count = 0;
+      // The node's boxes one at a time, each against every ray. Of the lanes some ray enters, the
+      // gang goes on into the one some ray enters before it enters the others so far (Embree's
+      // order: no reduction over the lanes), and the others wait on the stack.
+      CRT_UNIFORM uint32_t next = kNoChild;
+      float nextEntry = kNotEntered;
+      const bool active = entry <= tfar;
       for (int lane = 0; lane < 4; ++lane)
       {
-        const bool enters = ((mask >> lane) & 1u) != 0u;
+        float exit = 0.0f;
+        const float3 lo = float3(m_nodes[node].minX[lane], m_nodes[node].minY[lane], m_nodes[node].minZ[lane]);
+        const float3 hi = float3(m_nodes[node].maxX[lane], m_nodes[node].maxY[lane], m_nodes[node].maxZ[lane]);
+        const float boxEntry = SlabEntry(ray, lo, hi, tfar, exit);
+        const bool enters = active && boxEntry <= exit;
         if (crossrt::AnyLane(enters))
         {
-          children[count] = m_nodes[node].child[lane];
-          entered[count] = enters ? entries[lane] : kNotEntered;
-          nearest[count] = crossrt::MinOverLanes(entered[count]);
-          count = count + 1;
+          const float childEntry = enters ? boxEntry : kNotEntered;
+          if (next == kNoChild)
+          {
+            next = m_nodes[node].child[lane];
+            nextEntry = childEntry;
+          }
+          else if (crossrt::AnyLane(childEntry < nextEntry))
+          {
+            stack[top] = next;
+            stackEntry[top] = nextEntry;
+            top = top + 1;
+            next = m_nodes[node].child[lane];
+            nextEntry = childEntry;
+          }
+          else
+          {
+            stack[top] = m_nodes[node].child[lane];
+            stackEntry[top] = childEntry;
+            top = top + 1;
+          }
         }
       }
-      if (count == 0)
-      {
-        node = kNoChild;
+      node = next;
+      entry = nextEntry;
+      if (next == kNoChild)
         break;
-      }
-      for (int i = 1; i < count; ++i)  // nearest first: an insertion sort of at most four
-        for (int j = i; j > 0; --j)
-          if (nearest[j] < nearest[j - 1])
-          {
-            CRT_UNIFORM const float n = nearest[j];
-            nearest[j] = nearest[j - 1];
-            nearest[j - 1] = n;
-            CRT_UNIFORM const uint32_t c = children[j];
-            children[j] = children[j - 1];
-            children[j - 1] = c;
-            const float e = entered[j];
-            entered[j] = entered[j - 1];
-            entered[j - 1] = e;
-          }
-      for (int i = count - 1; i > 0; --i)  // the farthest lowest on the stack
-      {
-        stack[top] = children[i];
-        stackEntry[top] = entered[i];
-        top = top + 1;
-      }
-      node = children[0];
-      entry = entered[0];
     }
     if (node != kNoChild && entry <= tfar)
     {
@@ -1285,10 +1351,26 @@ bool BVHScene::TraceMeshTogether(const BVHTraceRay& ray, uint32_t root, bool any
       CRT_UNIFORM const uint32_t last = first + (node & 7u);
       for (uint32_t g = first; g <= last; ++g)
       {
+        // The group's triangles one at a time; where a ray meets one on an edge (rare), the whole
+        // group again as a ray alone tests it, so that every ray gets the same t, u and v.
         float4 t;
         float4 u;
         float4 v;
-        const uint32_t hits = IntersectGroup(ray, g, kx, ky, kz, tfar, t, u, v);
+        uint32_t hits = 0u;
+        bool onEdge = false;
+        for (int lane = 0; lane < 4; ++lane)
+        {
+          float tl = 0.0f;
+          float ul = 0.0f;
+          float vl = 0.0f;
+          if (IntersectTriangle(ray, g, lane, kx, ky, kz, tfar, tl, ul, vl, onEdge))
+            hits = hits | (1u << uint32_t(lane));
+          t[lane] = tl;
+          u[lane] = ul;
+          v[lane] = vl;
+        }
+        if (crossrt::AnyLane(onEdge))
+          hits = IntersectGroup(ray, g, kx, ky, kz, tfar, t, u, v);
         found = TakeNearestHit(g, hits, t, u, v, anyHit, tfar, hit) || found;
       }
       if (anyHit && found)

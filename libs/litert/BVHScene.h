@@ -187,6 +187,8 @@ private:
                       bool anyHit, float& tfar, CRT_Hit& hit) const;
   uint32_t IntersectGroup(const BVHTraceRay& r, uint32_t group, int kx, int ky, int kz, float tfar, LiteMath::float4& t, LiteMath::float4& u,
                           LiteMath::float4& v) const;
+  bool IntersectTriangle(const BVHTraceRay& r, uint32_t group, int lane, int kx, int ky, int kz, float tfar, float& t, float& u, float& v,
+                         bool& onEdge) const;
   bool IntersectBoxes(const BVHTraceRay& r, uint32_t group, bool sdf, float& tfar, CRT_Hit& hit) const;
   bool IntersectSdfBrick(const BVHTraceRay& r, uint32_t brick, float tEnter, float tExit, float& tfar, CRT_Hit& hit) const;
   uint32_t SdfCode(uint32_t at, uint32_t bytes) const;

@@ -202,10 +202,10 @@ const uint m_pAccelStruct_kInstanceBoxes = 2u;
 const uint m_pAccelStruct_kInstanceMotion = 4u;
 const uint m_pAccelStruct_kInstanceIdentity = 1u;
 const uint m_pAccelStruct_kSceneTransformed = 32u;
-const float m_pAccelStruct_kMissed = -1.0;
-const float m_pAccelStruct_kWiden = 1.00000036;
-const float m_pAccelStruct_kNotEntered = (1.0 / 0.0);
 const uint m_pAccelStruct_kNoChild = 4294967295u;
+const float m_pAccelStruct_kNotEntered = (1.0 / 0.0);
+const float m_pAccelStruct_kWiden = 1.00000036;
+const float m_pAccelStruct_kMissed = -1.0;
 const uint m_pAccelStruct_kSdfMaskedVoxels = 4u;
 const int m_pAccelStruct_kSdfNewtonIterations = 4;
 const uint m_pAccelStruct_kSceneTriangles = 16u;
@@ -270,52 +270,69 @@ vec3 m_pAccelStruct_ToObjectVector(BVHInstance inst, vec3 d)
   return vec3(dot(inst.toObjectRow0, h), dot(inst.toObjectRow1, h), dot(inst.toObjectRow2, h));
 }
 
-// from (anonymous namespace)::SlabEntriesParallelAxes
-vec4 m_pAccelStruct_SlabEntriesParallelAxes(BVHTraceRay r, BVH4Node n, float tfar, inout vec4 exits)
+// from (anonymous namespace)::SlabEntryParallelAxes
+float m_pAccelStruct_SlabEntryParallelAxes(BVHTraceRay r, vec3 lo, vec3 hi, float tfar, inout float exit)
 {
-  vec4 entries = vec4(0.0);
-  exits = vec4(m_pAccelStruct_kMissed);
-  for (int lane = 0; lane < 4; ++lane)
+  float tmin = r.tnear;
+  float tmax = tfar;
+  bool inside = lo.x <= hi.x;
+  for (int a = 0; a < 3; ++a)
   {
-    const vec3 lo = vec3(n.minX[lane], n.minY[lane], n.minZ[lane]);
-    const vec3 hi = vec3(n.maxX[lane], n.maxY[lane], n.maxZ[lane]);
-    float tmin = r.tnear;
-    float tmax = tfar;
-    bool inside = lo.x <= hi.x;
-    for (int a = 0; a < 3; ++a)
+    if (r.invDir[a] == 0.0)
     {
-      if (r.invDir[a] == 0.0)
-      {
-        inside = inside && r.org[a] >= lo[a] && r.org[a] <= hi[a];
-        continue;
-      }
-      const float t0 = (lo[a] - r.org[a]) * r.invDir[a];
-      const float t1 = (hi[a] - r.org[a]) * r.invDir[a];
-      tmin = max(tmin, min(t0, t1));
-      tmax = min(tmax, max(t0, t1) * m_pAccelStruct_kWiden);
+      inside = inside && r.org[a] >= lo[a] && r.org[a] <= hi[a];
+      continue;
     }
-    if (inside)
-    {
-      entries[lane] = tmin;
-      exits[lane] = tmax;
-    }
+    const float t0 = (lo[a] - r.org[a]) * r.invDir[a];
+    const float t1 = (hi[a] - r.org[a]) * r.invDir[a];
+    tmin = max(tmin, min(t0, t1));
+    tmax = min(tmax, max(t0, t1) * m_pAccelStruct_kWiden);
   }
-  return entries;
+  exit = inside ? tmax : m_pAccelStruct_kMissed;
+  return inside ? tmin : 0.0;
 }
 
-// from (anonymous namespace)::SlabEntries
-vec4 m_pAccelStruct_SlabEntries(BVHTraceRay r, BVH4Node n, float tfar, inout vec4 exits)
+// from (anonymous namespace)::SlabEntry
+float m_pAccelStruct_SlabEntry(BVHTraceRay r, vec3 lo, vec3 hi, float tfar, inout float exit)
 {
   if (r.anyZeroAxis)
-    return m_pAccelStruct_SlabEntriesParallelAxes(r, n, tfar, exits);
-  const vec4 nearX = ((r.invDir.x < 0.0 ? n.maxX : n.minX) - r.org.x) * r.invDir.x;
-  const vec4 farX = ((r.invDir.x < 0.0 ? n.minX : n.maxX) - r.org.x) * r.invDir.x;
-  const vec4 nearY = ((r.invDir.y < 0.0 ? n.maxY : n.minY) - r.org.y) * r.invDir.y;
-  const vec4 farY = ((r.invDir.y < 0.0 ? n.minY : n.maxY) - r.org.y) * r.invDir.y;
-  const vec4 nearZ = ((r.invDir.z < 0.0 ? n.maxZ : n.minZ) - r.org.z) * r.invDir.z;
-  const vec4 farZ = ((r.invDir.z < 0.0 ? n.minZ : n.maxZ) - r.org.z) * r.invDir.z;
-  exits = min(min(min(farX, farY), farZ) * m_pAccelStruct_kWiden, vec4(tfar));
-  return max(max(nearX, nearY), max(nearZ, vec4(r.tnear)));
+    return m_pAccelStruct_SlabEntryParallelAxes(r, lo, hi, tfar, exit);
+  const float nearX = ((r.invDir.x < 0.0 ? hi.x : lo.x) - r.org.x) * r.invDir.x;
+  const float farX = ((r.invDir.x < 0.0 ? lo.x : hi.x) - r.org.x) * r.invDir.x;
+  const float nearY = ((r.invDir.y < 0.0 ? hi.y : lo.y) - r.org.y) * r.invDir.y;
+  const float farY = ((r.invDir.y < 0.0 ? lo.y : hi.y) - r.org.y) * r.invDir.y;
+  const float nearZ = ((r.invDir.z < 0.0 ? hi.z : lo.z) - r.org.z) * r.invDir.z;
+  const float farZ = ((r.invDir.z < 0.0 ? lo.z : hi.z) - r.org.z) * r.invDir.z;
+  exit = min(min(min(farX, farY), farZ) * m_pAccelStruct_kWiden, tfar);
+  return max(max(nearX, nearY), max(nearZ, r.tnear));
+}
+
+// from BVHScene::IntersectTriangle
+bool m_pAccelStruct_IntersectTriangle(BVHTraceRay r, uint group, int lane, int kx, int ky, int kz, float tfar,
+                                      inout float t, inout float u, inout float v, inout bool onEdge)
+{
+  const float ox = r.org[kx];
+  const float oy = r.org[ky];
+  const float oz = r.org[kz];
+  const float az = m_pAccelStruct_m_triangles[group].coord[kz][lane] - oz;
+  const float bz = m_pAccelStruct_m_triangles[group].coord[3 + kz][lane] - oz;
+  const float cz = m_pAccelStruct_m_triangles[group].coord[6 + kz][lane] - oz;
+  const float ax = (m_pAccelStruct_m_triangles[group].coord[kx][lane] - ox) - r.sx * az;
+  const float ay = (m_pAccelStruct_m_triangles[group].coord[ky][lane] - oy) - r.sy * az;
+  const float bx = (m_pAccelStruct_m_triangles[group].coord[3 + kx][lane] - ox) - r.sx * bz;
+  const float by = (m_pAccelStruct_m_triangles[group].coord[3 + ky][lane] - oy) - r.sy * bz;
+  const float cx = (m_pAccelStruct_m_triangles[group].coord[6 + kx][lane] - ox) - r.sx * cz;
+  const float cy = (m_pAccelStruct_m_triangles[group].coord[6 + ky][lane] - oy) - r.sy * cz;
+  const float eu = cx * by - cy * bx;
+  const float ev = ax * cy - ay * cx;
+  const float ew = bx * ay - by * ax;
+  onEdge = onEdge || min(min(abs(eu), abs(ev)), abs(ew)) <= 0.0;
+  const float det = eu + ev + ew;
+  t = (eu * (r.sz * az) + ev * (r.sz * bz) + ew * (r.sz * cz)) / det;
+  u = ev / det;
+  v = ew / det;
+  const bool inside = 0.0 <= min(min(eu, ev), ew) || max(max(eu, ev), ew) <= 0.0;
+  return inside && !(det <= 0.0 && 0.0 <= det) && r.tnear <= t && t <= tfar;
 }
 
 // from (anonymous namespace)::DifferenceOfProducts
@@ -413,51 +430,46 @@ bool m_pAccelStruct_TraceMeshTogether(BVHTraceRay ray, uint root, bool anyHit, i
   {
     while ((node & m_pAccelStruct_kLeafFlag) == 0u)
     {
-      vec4 exits = vec4(0);
-      const vec4 entries = m_pAccelStruct_SlabEntries(ray, m_pAccelStruct_m_nodes[node], tfar, exits);
-      const uint mask = entry <= tfar ? uint(dot(vec4(lessThanEqual(entries, exits)), vec4(1.0, 2.0, 4.0, 8.0))) : 0u;
-      uint children[4];
-      float nearest[4];
-      float entered[4];
-      int count = 0;
+      uint next = m_pAccelStruct_kNoChild;
+      float nextEntry = m_pAccelStruct_kNotEntered;
+      const bool active_ = entry <= tfar;
       for (int lane = 0; lane < 4; ++lane)
       {
-        const bool enters = ((mask >> lane) & 1u) != 0u;
+        float exit = 0.0;
+        const vec3 lo = vec3(m_pAccelStruct_m_nodes[node].minX[lane], m_pAccelStruct_m_nodes[node].minY[lane],
+                             m_pAccelStruct_m_nodes[node].minZ[lane]);
+        const vec3 hi = vec3(m_pAccelStruct_m_nodes[node].maxX[lane], m_pAccelStruct_m_nodes[node].maxY[lane],
+                             m_pAccelStruct_m_nodes[node].maxZ[lane]);
+        const float boxEntry = m_pAccelStruct_SlabEntry(ray, lo, hi, tfar, exit);
+        const bool enters = active_ && boxEntry <= exit;
         if ((enters))
         {
-          children[count] = m_pAccelStruct_m_nodes[node].child[lane];
-          entered[count] = enters ? entries[lane] : m_pAccelStruct_kNotEntered;
-          nearest[count] = (entered[count]);
-          count = count + 1;
+          const float childEntry = enters ? boxEntry : m_pAccelStruct_kNotEntered;
+          if (next == m_pAccelStruct_kNoChild)
+          {
+            next = m_pAccelStruct_m_nodes[node].child[lane];
+            nextEntry = childEntry;
+          }
+          else if ((childEntry < nextEntry))
+          {
+            stack[top] = next;
+            stackEntry[top] = nextEntry;
+            top = top + 1;
+            next = m_pAccelStruct_m_nodes[node].child[lane];
+            nextEntry = childEntry;
+          }
+          else
+          {
+            stack[top] = m_pAccelStruct_m_nodes[node].child[lane];
+            stackEntry[top] = childEntry;
+            top = top + 1;
+          }
         }
       }
-      if (count == 0)
-      {
-        node = m_pAccelStruct_kNoChild;
+      node = next;
+      entry = nextEntry;
+      if (next == m_pAccelStruct_kNoChild)
         break;
-      }
-      for (int i = 1; i < count; ++i)
-        for (int j = i; j > 0; --j)
-          if (nearest[j] < nearest[j - 1])
-          {
-            const float n = nearest[j];
-            nearest[j] = nearest[j - 1];
-            nearest[j - 1] = n;
-            const uint c = children[j];
-            children[j] = children[j - 1];
-            children[j - 1] = c;
-            const float e = entered[j];
-            entered[j] = entered[j - 1];
-            entered[j - 1] = e;
-          }
-      for (int i = count - 1; i > 0; --i)
-      {
-        stack[top] = children[i];
-        stackEntry[top] = entered[i];
-        top = top + 1;
-      }
-      node = children[0];
-      entry = entered[0];
     }
     if (node != m_pAccelStruct_kNoChild && entry <= tfar)
     {
@@ -468,7 +480,21 @@ bool m_pAccelStruct_TraceMeshTogether(BVHTraceRay ray, uint root, bool anyHit, i
         vec4 t = vec4(0);
         vec4 u = vec4(0);
         vec4 v = vec4(0);
-        const uint hits = m_pAccelStruct_IntersectGroup(ray, g, kx, ky, kz, tfar, t, u, v);
+        uint hits = 0u;
+        bool onEdge = false;
+        for (int lane = 0; lane < 4; ++lane)
+        {
+          float tl = 0.0;
+          float ul = 0.0;
+          float vl = 0.0;
+          if (m_pAccelStruct_IntersectTriangle(ray, g, lane, kx, ky, kz, tfar, tl, ul, vl, onEdge))
+            hits = hits | (1u << uint(lane));
+          t[lane] = tl;
+          u[lane] = ul;
+          v[lane] = vl;
+        }
+        if ((onEdge))
+          hits = m_pAccelStruct_IntersectGroup(ray, g, kx, ky, kz, tfar, t, u, v);
         found = m_pAccelStruct_TakeNearestHit(g, hits, t, u, v, anyHit, tfar, hit) || found;
       }
       if (anyHit && found)
@@ -483,6 +509,54 @@ bool m_pAccelStruct_TraceMeshTogether(BVHTraceRay ray, uint root, bool anyHit, i
     node = stack[top];
     entry = stackEntry[top];
   }
+}
+
+// from (anonymous namespace)::SlabEntriesParallelAxes
+vec4 m_pAccelStruct_SlabEntriesParallelAxes(BVHTraceRay r, BVH4Node n, float tfar, inout vec4 exits)
+{
+  vec4 entries = vec4(0.0);
+  exits = vec4(m_pAccelStruct_kMissed);
+  for (int lane = 0; lane < 4; ++lane)
+  {
+    const vec3 lo = vec3(n.minX[lane], n.minY[lane], n.minZ[lane]);
+    const vec3 hi = vec3(n.maxX[lane], n.maxY[lane], n.maxZ[lane]);
+    float tmin = r.tnear;
+    float tmax = tfar;
+    bool inside = lo.x <= hi.x;
+    for (int a = 0; a < 3; ++a)
+    {
+      if (r.invDir[a] == 0.0)
+      {
+        inside = inside && r.org[a] >= lo[a] && r.org[a] <= hi[a];
+        continue;
+      }
+      const float t0 = (lo[a] - r.org[a]) * r.invDir[a];
+      const float t1 = (hi[a] - r.org[a]) * r.invDir[a];
+      tmin = max(tmin, min(t0, t1));
+      tmax = min(tmax, max(t0, t1) * m_pAccelStruct_kWiden);
+    }
+    if (inside)
+    {
+      entries[lane] = tmin;
+      exits[lane] = tmax;
+    }
+  }
+  return entries;
+}
+
+// from (anonymous namespace)::SlabEntries
+vec4 m_pAccelStruct_SlabEntries(BVHTraceRay r, BVH4Node n, float tfar, inout vec4 exits)
+{
+  if (r.anyZeroAxis)
+    return m_pAccelStruct_SlabEntriesParallelAxes(r, n, tfar, exits);
+  const vec4 nearX = ((r.invDir.x < 0.0 ? n.maxX : n.minX) - r.org.x) * r.invDir.x;
+  const vec4 farX = ((r.invDir.x < 0.0 ? n.minX : n.maxX) - r.org.x) * r.invDir.x;
+  const vec4 nearY = ((r.invDir.y < 0.0 ? n.maxY : n.minY) - r.org.y) * r.invDir.y;
+  const vec4 farY = ((r.invDir.y < 0.0 ? n.minY : n.maxY) - r.org.y) * r.invDir.y;
+  const vec4 nearZ = ((r.invDir.z < 0.0 ? n.maxZ : n.minZ) - r.org.z) * r.invDir.z;
+  const vec4 farZ = ((r.invDir.z < 0.0 ? n.minZ : n.maxZ) - r.org.z) * r.invDir.z;
+  exits = min(min(min(farX, farY), farZ) * m_pAccelStruct_kWiden, vec4(tfar));
+  return max(max(nearX, nearY), max(nearZ, vec4(r.tnear)));
 }
 
 // from (anonymous namespace)::OrderLanes
