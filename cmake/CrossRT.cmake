@@ -52,6 +52,9 @@ include_guard(GLOBAL)
 # compiled for, dispatched at run time (crossrt::IspcPick in IspcSupport.h lists the same ISAs).
 find_program(CROSSRT_ISPC_EXECUTABLE ispc DOC "The ISPC compiler, for crossrt_add_class(... BACKEND ispc)")
 set(CROSSRT_ISPC_TARGETS sse4-i32x4 avx2-i32x8 avx512skx-x16)
+# ISPC's warnings as errors where generated code is compiled (this tree sets it: generated kernels
+# compile without a warning; performance remarks are off either way).
+option(CROSSRT_ISPC_WERROR "Compile the generated ISPC kernels with --werror" OFF)
 
 set(CROSSRT_REMOTE_STORAGE "" CACHE STRING
     "Remote translation caches: redis://host[:port] or http[s]://host/path, space-separated, each with optional |read-only")
@@ -247,6 +250,7 @@ function(crossrt_add_class target class)
       OUTPUT ${ispc_objects} ${ispc_header}
       COMMAND ${CROSSRT_ISPC_EXECUTABLE} ${ispc_source} -o ${ispc_object} -h ${ispc_header}
               --target=${ispc_targets} -O2 --pic --wno-perf --opt=disable-fma --enable-llvm-intrinsics
+              "$<$<BOOL:${CROSSRT_ISPC_WERROR}>:--werror>"
               "$<$<BOOL:${runtime_inc}>:-I$<JOIN:${runtime_inc},$<SEMICOLON>-I>>"
               -M -MF ${ispc_object}.d -MT ${ispc_object}
       DEPENDS ${ispc_source}

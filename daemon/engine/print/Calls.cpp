@@ -30,10 +30,10 @@ bool IsHeapFunction(const std::string& n) {
   return n == "malloc" || n == "calloc" || n == "realloc" || n == "free" || n == "aligned_alloc";
 }
 
-// std::numeric_limits<float, int or uint>::infinity(), max() and the like as GLSL constant
-// expressions, which global constants need. GLSL has no literal for infinity and NaN; glslang
-// folds 1.0 / 0.0 to +inf and 0.0 / 0.0 to NaN. Empty for anything else.
-std::string NumericLimit(const FunctionDecl* fd) {
+// std::numeric_limits<float, int or uint>::infinity(), max() and the like as constant expressions,
+// which global constants need; infinity and NaN as the language spells them (`infinity`, `nan`:
+// neither language has a literal for them). Empty for anything else.
+std::string NumericLimit(const FunctionDecl* fd, const std::string& infinity, const std::string& nan) {
   auto* spec = dyn_cast_or_null<ClassTemplateSpecializationDecl>(fd->getDeclContext());
   if (!spec || spec->getName() != "numeric_limits" || !spec->isInStdNamespace() || spec->getTemplateArgs().size() != 1)
     return "";
@@ -41,8 +41,8 @@ std::string NumericLimit(const FunctionDecl* fd) {
   const std::string n = fd->getNameAsString();
   if (t->isSpecificBuiltinType(BuiltinType::Float)) {
     // Nine significant digits: each literal rounds to exactly the float it names.
-    static const std::map<std::string, std::string> values = {
-        {"infinity", "(1.0 / 0.0)"},      {"quiet_NaN", "(0.0 / 0.0)"},  {"max", "3.40282347e+38"},
+    const std::map<std::string, std::string> values = {
+        {"infinity", infinity}, {"quiet_NaN", nan}, {"max", "3.40282347e+38"},
         {"lowest", "-3.40282347e+38"},    {"min", "1.17549435e-38"},    {"epsilon", "1.1920929e-07"},
         {"denorm_min", "1.40129846e-45"}};
     auto it = values.find(n);
@@ -70,7 +70,7 @@ std::string CallText(const std::string& f, const std::vector<std::string>& args)
 // std::numeric_limits (the limits and the bit builtins here, the rest by the language: LibraryCall).
 std::string KernelPrinter::Builtin(const FunctionDecl* fd, const std::vector<std::string>& a, const CallExpr* call) {
   std::string n = fd->getNameAsString();
-  if (std::string limit = NumericLimit(fd); !limit.empty()) return limit;
+  if (std::string limit = NumericLimit(fd, FloatInfinity(), FloatNaN()); !limit.empty()) return limit;
   // The functions each language spells as GLSL does (LibraryCall gets them).
   static const std::map<std::string, std::string> same = {
       {"sqrt", "sqrt"}, {"sqrtf", "sqrt"}, {"abs", "abs"}, {"fabs", "abs"}, {"fabsf", "abs"},

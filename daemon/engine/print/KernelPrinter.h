@@ -197,6 +197,8 @@ protected:
   virtual std::string StructBody(const clang::RecordDecl* rd) = 0;
   virtual std::string ConstantQualifier() const = 0;  // before a constant's type
   virtual std::string FloatSuffix(const clang::FloatingLiteral* literal) const = 0;
+  virtual std::string FloatInfinity() const = 0;  // a constant expression for +inf (and for NaN)
+  virtual std::string FloatNaN() const = 0;
   // Conversions: a double narrowed to float, an integer made real (`conversion` is the cast node),
   // a value converted to a GPU type (`target`, GLSL's spelling) other than bool.
   virtual std::string NarrowedDouble(const clang::Expr* sub) = 0;

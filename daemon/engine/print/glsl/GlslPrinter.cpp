@@ -54,6 +54,9 @@ std::string GlslPrinter::StructBody(const RecordDecl* rd) {
 std::string GlslPrinter::ConstantQualifier() const { return "const "; }
 
 std::string GlslPrinter::FloatSuffix(const FloatingLiteral*) const { return ""; }
+// GLSL has no literal for either; glslang folds these.
+std::string GlslPrinter::FloatInfinity() const { return "(1.0 / 0.0)"; }
+std::string GlslPrinter::FloatNaN() const { return "(0.0 / 0.0)"; }
 
 std::string GlslPrinter::NarrowedDouble(const clang::Expr* sub) { return Expr(sub); }
 

@@ -177,6 +177,9 @@ std::string IspcPrinter::ConstantQualifier() const { return "static const unifor
 
 // ISPC's double literal where the kernel computes in double (an unsuffixed one is a float).
 std::string IspcPrinter::FloatSuffix(const FloatingLiteral* literal) const { return InDoubleContext(literal) ? "d" : ""; }
+// LiteMath.isph's constants: ISPC folds 1.0 / 0.0 too, but warns of it wherever it is written.
+std::string IspcPrinter::FloatInfinity() const { return "crt_infinity"; }
+std::string IspcPrinter::FloatNaN() const { return "crt_nan"; }
 
 std::string IspcPrinter::NarrowedDouble(const clang::Expr* sub) {
   return DeclaredDouble(sub) ? "((float)(" + Expr(sub) + "))" : Expr(sub);

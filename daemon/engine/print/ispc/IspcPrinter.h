@@ -18,6 +18,8 @@ protected:
   std::string StructBody(const clang::RecordDecl* rd) override;
   std::string ConstantQualifier() const override;
   std::string FloatSuffix(const clang::FloatingLiteral* literal) const override;
+  std::string FloatInfinity() const override;
+  std::string FloatNaN() const override;
   std::string NarrowedDouble(const clang::Expr* sub) override;
   std::string IntegerToReal(const clang::Expr* sub, const clang::Expr* conversion) override;
   std::string ConvertedTo(const std::string& target, const clang::Expr* sub) override;

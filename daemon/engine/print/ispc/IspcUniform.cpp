@@ -58,7 +58,13 @@ bool IspcPrinter::Uniform(const clang::Expr* e) const {
     const CXXMethodDecl* method = mc->getMethodDecl();
     if (!method || !composedPrefix.empty() || selfClass || m_structSelf) return false;
     const clang::Expr* object = mc->getImplicitObjectArgument();
-    if (method->getName() == "width" || method->getName() == "height") return IsImage2D(object->getType().getNonReferenceType());
+    if (method->getName() == "width" || method->getName() == "height") {
+      if (IsImage2D(object->getType().getNonReferenceType())) return true;
+      // a texture of a member array at a shared index (self->m_textures[k].width)
+      auto* op = dyn_cast<CXXOperatorCallExpr>(object->IgnoreParenImpCasts());
+      return op && op->getOperator() == OO_Subscript && op->getNumArgs() == 2 && ThisMemberField(op->getArg(0)) &&
+             IsTextureArray(ThisMemberField(op->getArg(0))->getType()) && Uniform(op->getArg(1));
+    }
     auto* f = ThisMemberField(object);
     return f && method->getName() == "size" && IsStdVector(f->getType());
   }
