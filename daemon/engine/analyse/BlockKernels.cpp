@@ -3,6 +3,7 @@
 
 #include "analyse/AstQueries.h"
 #include "analyse/CpuCopies.h"
+#include "analyse/LoopShape.h"
 #include "generate/Canonical.h"
 
 #include <clang/Rewrite/Core/Rewriter.h>
@@ -36,7 +37,16 @@ void AddBlockKernel(Context& c, const FunctionDecl* decl, const FunctionDecl* de
   if (params) k.templateHead = c.Text(params->getSourceRange());
   for (unsigned i = 0; i < def->getNumParams(); ++i) k.paramsDecl += (i ? ", " : "") + ParamDecl(c.ctx, def->getParamDecl(i), i);
   Rewriter rw(c.ctx.getSourceManager(), c.ctx.getLangOpts());
-  rw.InsertTextBefore(blocks->getBeginLoc(), "#pragma omp parallel for  // the blocks, one per core at a time\n");
+  // The blocks on all cores, or on this thread while that has been faster (crossrt::ParallelChoice, as
+  // every other parallel loop of the CPU class), taken one at a time by whichever thread is free.
+  LoopHeader h;
+  if (LoopShapeProblem(c.ctx, blocks, h).empty() && isa<CompoundStmt>(blocks->getBody())) {
+    rw.InsertTextBefore(blocks->getBeginLoc(), "static crossrt::ParallelChoice crt_choice;\nconst auto crt_loop = crt_choice.Begin(" + CountExpr(c, h) +
+                                                   ");\n#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic)  // the blocks\n");
+    rw.InsertTextAfterToken(blocks->getEndLoc(), "\ncrt_choice.End(crt_loop);");
+  } else {
+    rw.InsertTextBefore(blocks->getBeginLoc(), "#pragma omp parallel for schedule(dynamic)  // the blocks, one per core at a time\n");
+  }
   const std::string body = rw.getRewrittenText(def->getBody()->getSourceRange());
   k.body = CanonicalCode(std::regex_replace(body, std::regex(R"(\[\[\s*parallel\s*\]\])"), ""));
   c.model.blockKernels.push_back(k);
