@@ -211,6 +211,44 @@ void Buffer::Download(void* dst, size_t bytes, size_t srcOffset) const {
   std::memcpy(dst, staging.mapped, bytes);
 }
 
+void Downloads::Add(const Buffer& from, void* to, size_t bytes, size_t srcOffset) {
+  CheckRange(from, bytes, srcOffset, "Downloads::Add");
+  if (from.ctx_ != ctx_) throw Error("Downloads::Add: the buffer belongs to another Vulkan context");
+  copies_.push_back({&from, to, bytes, srcOffset});
+}
+
+void Downloads::Run() {
+  std::vector<Copy> staged;
+  VkDeviceSize total = 0;
+  for (const Copy& c : copies_) {
+    if (c.bytes == 0) continue;
+    if (c.from->mapped_ && c.from->hostCached_)
+      std::memcpy(c.to, static_cast<const char*>(c.from->mapped_) + c.srcOffset, c.bytes);
+    else {
+      staged.push_back(c);
+      total += (c.bytes + 15) / 16 * 16;
+    }
+  }
+  copies_.clear();
+  if (staged.empty()) return;
+  std::unique_lock<std::mutex> lock;
+  std::unique_ptr<Staging> own;
+  Staging& staging = StagingFor(*ctx_, total, VK_BUFFER_USAGE_TRANSFER_DST_BIT, lock, own);
+  VkCommandBuffer cmd = ctx_->BeginOneShot();
+  VkDeviceSize at = 0;
+  for (const Copy& c : staged) {
+    VkBufferCopy region{c.srcOffset, at, c.bytes};
+    vkCmdCopyBuffer(cmd, c.from->buffer_, staging.a.buffer, 1, &region);
+    at += (c.bytes + 15) / 16 * 16;
+  }
+  ctx_->SubmitAndWait(cmd);  // ends with a transfer -> host barrier
+  at = 0;
+  for (const Copy& c : staged) {
+    std::memcpy(c.to, static_cast<const char*>(staging.mapped) + at, c.bytes);
+    at += (c.bytes + 15) / 16 * 16;
+  }
+}
+
 void Buffer::Fill(uint32_t value) {
   if (Empty()) throw Error("Buffer::Fill: the buffer is empty (default-constructed or moved-from)");
   VkCommandBuffer cmd = ctx_->BeginOneShot();

@@ -232,6 +232,7 @@ public:
   VkDeviceAddress Address() const { return address_; }  // 0 if unsupported
 
 private:
+  friend class Downloads;
   void Release() noexcept;
 
   std::shared_ptr<VulkanContext> ctx_;
@@ -465,6 +466,27 @@ struct Binding {
 
 private:
   Binding(VkDescriptorType t, VkImageView v, VkSampler s) : type(t), view(v), sampler(s) {}
+};
+
+// Buffer::Download for several buffers at once: the copies that go through a staging buffer share
+// one, recorded in one command buffer, with one submit and one wait (a generated class reads the
+// member vectors a control function wrote back so: LBVH_Vulkan's build reads nine).
+class Downloads {
+ public:
+  explicit Downloads(std::shared_ptr<VulkanContext> ctx) : ctx_(std::move(ctx)) {}
+  // `bytes` of `from` at `srcOffset` to `to`, when Run() is called (a buffer of this context).
+  void Add(const Buffer& from, void* to, size_t bytes, size_t srcOffset = 0);
+  // All copies added since the last Run.
+  void Run();
+
+ private:
+  struct Copy {
+    const Buffer* from;
+    void* to;
+    size_t bytes, srcOffset;
+  };
+  std::shared_ptr<VulkanContext> ctx_;
+  std::vector<Copy> copies_;
 };
 
 // The object a composed member (shared_ptr, unique_ptr or plain pointer) holds, or null.

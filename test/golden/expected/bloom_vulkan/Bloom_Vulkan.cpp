@@ -109,10 +109,12 @@ bool Bloom_Vulkan::crt_VectorMembersResized() const
 void Bloom_Vulkan::crt_ReadVectorMembers(const char* a_funcName)
 {
   (void)a_funcName;
+  crossrt::Downloads crt_downloads(crt_ctx);  // the vectors' copies, with one wait for all (Run, below)
   if (std::strcmp(a_funcName, "Run") == 0 && !m_bright.empty())
-    crt_vdata.m_bright.Download(m_bright.data(), sizeof(LiteMath::float4) * m_bright.size());
+    crt_downloads.Add(crt_vdata.m_bright, m_bright.data(), sizeof(LiteMath::float4) * m_bright.size());
   if (std::strcmp(a_funcName, "Run") == 0 && !m_blurred.empty())
-    crt_vdata.m_blurred.Download(m_blurred.data(), sizeof(LiteMath::float4) * m_blurred.size());
+    crt_downloads.Add(crt_vdata.m_blurred, m_blurred.data(), sizeof(LiteMath::float4) * m_blurred.size());
+  crt_downloads.Run();
 }
 
 void Bloom_Vulkan::GetExecutionTime(const char* a_funcName, float a_out[4])

@@ -234,6 +234,8 @@ std::vector<uint32_t> CallableShading_Vulkan::CommitVirtual_m_materials()
 void CallableShading_Vulkan::crt_ReadVectorMembers(const char* a_funcName)
 {
   (void)a_funcName;
+  crossrt::Downloads crt_downloads(crt_ctx);  // the vectors' copies, with one wait for all (Run, below)
+  crt_downloads.Run();
 }
 
 void CallableShading_Vulkan::GetExecutionTime(const char* a_funcName, float a_out[4])

@@ -195,24 +195,26 @@ bool LBVH_Vulkan::crt_VectorMembersResized() const
 void LBVH_Vulkan::crt_ReadVectorMembers(const char* a_funcName)
 {
   (void)a_funcName;
+  crossrt::Downloads crt_downloads(crt_ctx);  // the vectors' copies, with one wait for all (Run, below)
   if (std::strcmp(a_funcName, "Build") == 0 && !m_codes.empty())
-    crt_vdata.m_codes.Download(m_codes.data(), sizeof(LiteMath::uint2) * m_codes.size());
+    crt_downloads.Add(crt_vdata.m_codes, m_codes.data(), sizeof(LiteMath::uint2) * m_codes.size());
   if (std::strcmp(a_funcName, "Build") == 0 && !m_newGroup.empty())
-    crt_vdata.m_newGroup.Download(m_newGroup.data(), sizeof(unsigned int) * m_newGroup.size());
+    crt_downloads.Add(crt_vdata.m_newGroup, m_newGroup.data(), sizeof(unsigned int) * m_newGroup.size());
   if (std::strcmp(a_funcName, "Build") == 0 && !m_primIndices.empty())
-    crt_vdata.m_primIndices.Download(m_primIndices.data(), sizeof(unsigned int) * m_primIndices.size());
+    crt_downloads.Add(crt_vdata.m_primIndices, m_primIndices.data(), sizeof(unsigned int) * m_primIndices.size());
   if (std::strcmp(a_funcName, "Build") == 0 && !m_leafCode.empty())
-    crt_vdata.m_leafCode.Download(m_leafCode.data(), sizeof(unsigned int) * m_leafCode.size());
+    crt_downloads.Add(crt_vdata.m_leafCode, m_leafCode.data(), sizeof(unsigned int) * m_leafCode.size());
   if (std::strcmp(a_funcName, "Build") == 0 && !m_leafFirst.empty())
-    crt_vdata.m_leafFirst.Download(m_leafFirst.data(), sizeof(unsigned int) * m_leafFirst.size());
+    crt_downloads.Add(crt_vdata.m_leafFirst, m_leafFirst.data(), sizeof(unsigned int) * m_leafFirst.size());
   if (std::strcmp(a_funcName, "Build") == 0 && !m_arrivals.empty())
-    crt_vdata.m_arrivals.Download(m_arrivals.data(), sizeof(unsigned int) * m_arrivals.size());
+    crt_downloads.Add(crt_vdata.m_arrivals, m_arrivals.data(), sizeof(unsigned int) * m_arrivals.size());
   if (std::strcmp(a_funcName, "Build") == 0 && !m_nodes.empty())
-    crt_vdata.m_nodes.Download(m_nodes.data(), sizeof(BVHNode) * m_nodes.size());
+    crt_downloads.Add(crt_vdata.m_nodes, m_nodes.data(), sizeof(BVHNode) * m_nodes.size());
   if (std::strcmp(a_funcName, "Build") == 0 && !m_parent.empty())
-    crt_vdata.m_parent.Download(m_parent.data(), sizeof(unsigned int) * m_parent.size());
+    crt_downloads.Add(crt_vdata.m_parent, m_parent.data(), sizeof(unsigned int) * m_parent.size());
   if (std::strcmp(a_funcName, "Build") == 0 && !m_groupOf.empty())
-    crt_vdata.m_groupOf.Download(m_groupOf.data(), sizeof(unsigned int) * m_groupOf.size());
+    crt_downloads.Add(crt_vdata.m_groupOf, m_groupOf.data(), sizeof(unsigned int) * m_groupOf.size());
+  crt_downloads.Run();
 }
 
 void LBVH_Vulkan::GetExecutionTime(const char* a_funcName, float a_out[4])

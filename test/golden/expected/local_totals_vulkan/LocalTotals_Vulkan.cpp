@@ -92,6 +92,8 @@ bool LocalTotals_Vulkan::crt_VectorMembersResized() const
 void LocalTotals_Vulkan::crt_ReadVectorMembers(const char* a_funcName)
 {
   (void)a_funcName;
+  crossrt::Downloads crt_downloads(crt_ctx);  // the vectors' copies, with one wait for all (Run, below)
+  crt_downloads.Run();
 }
 
 void LocalTotals_Vulkan::GetExecutionTime(const char* a_funcName, float a_out[4])

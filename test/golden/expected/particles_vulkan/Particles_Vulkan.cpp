@@ -106,6 +106,8 @@ bool Particles_Vulkan::crt_VectorMembersResized() const
 void Particles_Vulkan::crt_ReadVectorMembers(const char* a_funcName)
 {
   (void)a_funcName;
+  crossrt::Downloads crt_downloads(crt_ctx);  // the vectors' copies, with one wait for all (Run, below)
+  crt_downloads.Run();
 }
 
 void Particles_Vulkan::GetExecutionTime(const char* a_funcName, float a_out[4])

@@ -283,6 +283,8 @@ bool PrimaryRays_Vulkan::crt_VectorMembersResized() const
 void PrimaryRays_Vulkan::crt_ReadVectorMembers(const char* a_funcName)
 {
   (void)a_funcName;
+  crossrt::Downloads crt_downloads(crt_ctx);  // the vectors' copies, with one wait for all (Run, below)
+  crt_downloads.Run();
 }
 
 BVHScene* PrimaryRays_Vulkan::crt_m_pAccelStruct() const

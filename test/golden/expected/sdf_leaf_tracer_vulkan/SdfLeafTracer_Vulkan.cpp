@@ -373,6 +373,8 @@ std::vector<uint32_t> SdfLeafTracer_Vulkan::CommitVirtual_m_scene_m_geom()
 void SdfLeafTracer_Vulkan::crt_ReadVectorMembers(const char* a_funcName)
 {
   (void)a_funcName;
+  crossrt::Downloads crt_downloads(crt_ctx);  // the vectors' copies, with one wait for all (Run, below)
+  crt_downloads.Run();
 }
 
 SdfLeafScene* SdfLeafTracer_Vulkan::crt_m_scene() const

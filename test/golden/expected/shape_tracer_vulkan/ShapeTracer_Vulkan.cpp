@@ -384,6 +384,8 @@ std::vector<uint32_t> ShapeTracer_Vulkan::CommitVirtual_m_scene_m_lights()
 void ShapeTracer_Vulkan::crt_ReadVectorMembers(const char* a_funcName)
 {
   (void)a_funcName;
+  crossrt::Downloads crt_downloads(crt_ctx);  // the vectors' copies, with one wait for all (Run, below)
+  crt_downloads.Run();
 }
 
 ShapeScene* ShapeTracer_Vulkan::crt_m_scene() const

@@ -82,8 +82,10 @@ bool SortPairs_Vulkan::crt_VectorMembersResized() const
 void SortPairs_Vulkan::crt_ReadVectorMembers(const char* a_funcName)
 {
   (void)a_funcName;
+  crossrt::Downloads crt_downloads(crt_ctx);  // the vectors' copies, with one wait for all (Run, below)
   if (std::strcmp(a_funcName, "MakeAndSort") == 0 && !m_pairs.empty())
-    crt_vdata.m_pairs.Download(m_pairs.data(), sizeof(LiteMath::uint2) * m_pairs.size());
+    crt_downloads.Add(crt_vdata.m_pairs, m_pairs.data(), sizeof(LiteMath::uint2) * m_pairs.size());
+  crt_downloads.Run();
 }
 
 void SortPairs_Vulkan::GetExecutionTime(const char* a_funcName, float a_out[4])

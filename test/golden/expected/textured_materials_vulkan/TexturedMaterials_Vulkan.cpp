@@ -132,6 +132,8 @@ bool TexturedMaterials_Vulkan::crt_VectorMembersResized() const
 void TexturedMaterials_Vulkan::crt_ReadVectorMembers(const char* a_funcName)
 {
   (void)a_funcName;
+  crossrt::Downloads crt_downloads(crt_ctx);  // the vectors' copies, with one wait for all (Run, below)
+  crt_downloads.Run();
 }
 
 void TexturedMaterials_Vulkan::GetExecutionTime(const char* a_funcName, float a_out[4])
