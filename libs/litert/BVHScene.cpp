@@ -66,38 +66,40 @@ BVHTraceRay Prepare(float3 org, float3 dir, float tnear)
   return r;
 }
 
-// The entry and exit distances of the ray into the four boxes of `n`, within [tnear, tfar]: a
-// lane whose entry is beyond its exit is missed (so is an empty lane). For rays with a zero
-// direction component (rare): per lane and axis. Such a ray is inside a slab when its origin is,
-// boundaries included.
+// The entry (returned) and exit distances of a ray with a zero direction component (rare) into the
+// box [lo, hi], within [tnear, tfar]: per axis. Such a ray is inside a slab when its origin is,
+// boundaries included. A box whose entry is beyond its exit is missed (so is an empty box).
+inline float SlabEntryParallelAxes(const BVHTraceRay& r, float3 lo, float3 hi, float tfar, float& exit)
+{
+  float tmin = r.tnear;
+  float tmax = tfar;
+  bool inside = lo.x <= hi.x;  // an empty lane is never entered
+  for (int a = 0; a < 3; ++a)
+  {
+    if (r.invDir[a] == 0.0f)
+    {
+      inside = inside && r.org[a] >= lo[a] && r.org[a] <= hi[a];
+      continue;
+    }
+    const float t0 = (lo[a] - r.org[a]) * r.invDir[a];
+    const float t1 = (hi[a] - r.org[a]) * r.invDir[a];
+    tmin = std::max(tmin, std::min(t0, t1));
+    tmax = std::min(tmax, std::max(t0, t1) * kWiden);
+  }
+  exit = inside ? tmax : kMissed;
+  return inside ? tmin : 0.0f;
+}
+
+// The same for the four boxes of `n`.
 [[gnu::noinline]] float4 SlabEntriesParallelAxes(const BVHTraceRay& r, const BVH4Node& n, float tfar, float4& exits)
 {
   float4 entries = float4(0.0f);
-  exits = float4(kMissed);
   for (int lane = 0; lane < 4; ++lane)
   {
-    const float3 lo = float3(n.minX[lane], n.minY[lane], n.minZ[lane]);
-    const float3 hi = float3(n.maxX[lane], n.maxY[lane], n.maxZ[lane]);
-    float tmin = r.tnear;
-    float tmax = tfar;
-    bool inside = lo.x <= hi.x;  // an empty lane is never entered
-    for (int a = 0; a < 3; ++a)
-    {
-      if (r.invDir[a] == 0.0f)
-      {
-        inside = inside && r.org[a] >= lo[a] && r.org[a] <= hi[a];
-        continue;
-      }
-      const float t0 = (lo[a] - r.org[a]) * r.invDir[a];
-      const float t1 = (hi[a] - r.org[a]) * r.invDir[a];
-      tmin = std::max(tmin, std::min(t0, t1));
-      tmax = std::min(tmax, std::max(t0, t1) * kWiden);
-    }
-    if (inside)
-    {
-      entries[lane] = tmin;
-      exits[lane] = tmax;
-    }
+    float exit = 0.0f;
+    entries[lane] = SlabEntryParallelAxes(r, float3(n.minX[lane], n.minY[lane], n.minZ[lane]), float3(n.maxX[lane], n.maxY[lane], n.maxZ[lane]),
+                                          tfar, exit);
+    exits[lane] = exit;
   }
   return entries;
 }
@@ -122,27 +124,6 @@ BVHTraceRay Prepare(float3 org, float3 dir, float tnear)
 // same arithmetic, so the same entry (returned) and exit. Packet traversal tests a node's boxes one
 // at a time against its gang's rays: four at once hold eight values per ray, which spill AVX2's
 // sixteen registers.
-[[gnu::noinline]] float SlabEntryParallelAxes(const BVHTraceRay& r, float3 lo, float3 hi, float tfar, float& exit)
-{
-  float tmin = r.tnear;
-  float tmax = tfar;
-  bool inside = lo.x <= hi.x;  // an empty lane is never entered
-  for (int a = 0; a < 3; ++a)
-  {
-    if (r.invDir[a] == 0.0f)
-    {
-      inside = inside && r.org[a] >= lo[a] && r.org[a] <= hi[a];
-      continue;
-    }
-    const float t0 = (lo[a] - r.org[a]) * r.invDir[a];
-    const float t1 = (hi[a] - r.org[a]) * r.invDir[a];
-    tmin = std::max(tmin, std::min(t0, t1));
-    tmax = std::min(tmax, std::max(t0, t1) * kWiden);
-  }
-  exit = inside ? tmax : kMissed;
-  return inside ? tmin : 0.0f;
-}
-
 [[gnu::always_inline]] inline float SlabEntry(const BVHTraceRay& r, float3 lo, float3 hi, float tfar, float& exit)
 {
   if (r.anyZeroAxis)

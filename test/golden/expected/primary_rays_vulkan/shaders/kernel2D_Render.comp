@@ -515,31 +515,12 @@ bool m_pAccelStruct_TraceMeshTogether(BVHTraceRay ray, uint root, bool anyHit, i
 vec4 m_pAccelStruct_SlabEntriesParallelAxes(BVHTraceRay r, BVH4Node n, float tfar, inout vec4 exits)
 {
   vec4 entries = vec4(0.0);
-  exits = vec4(m_pAccelStruct_kMissed);
   for (int lane = 0; lane < 4; ++lane)
   {
-    const vec3 lo = vec3(n.minX[lane], n.minY[lane], n.minZ[lane]);
-    const vec3 hi = vec3(n.maxX[lane], n.maxY[lane], n.maxZ[lane]);
-    float tmin = r.tnear;
-    float tmax = tfar;
-    bool inside = lo.x <= hi.x;
-    for (int a = 0; a < 3; ++a)
-    {
-      if (r.invDir[a] == 0.0)
-      {
-        inside = inside && r.org[a] >= lo[a] && r.org[a] <= hi[a];
-        continue;
-      }
-      const float t0 = (lo[a] - r.org[a]) * r.invDir[a];
-      const float t1 = (hi[a] - r.org[a]) * r.invDir[a];
-      tmin = max(tmin, min(t0, t1));
-      tmax = min(tmax, max(t0, t1) * m_pAccelStruct_kWiden);
-    }
-    if (inside)
-    {
-      entries[lane] = tmin;
-      exits[lane] = tmax;
-    }
+    float exit = 0.0;
+    entries[lane] = m_pAccelStruct_SlabEntryParallelAxes(r, vec3(n.minX[lane], n.minY[lane], n.minZ[lane]),
+                                                         vec3(n.maxX[lane], n.maxY[lane], n.maxZ[lane]), tfar, exit);
+    exits[lane] = exit;
   }
   return entries;
 }
