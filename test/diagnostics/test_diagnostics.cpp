@@ -183,7 +183,7 @@ std::string IspcKernelsOf(const TempClass& tc, const std::string& name)
 
 }  // namespace
 
-TEST_CASE("ISPC: a loop whose bounds every lane shares is uniform; one the lanes differ in, or leave early, is varying", "[diagnostics][ispc]")
+TEST_CASE("ISPC: a loop whose bounds every lane shares is uniform, and leaves early only all at once; one the lanes differ in, or leave early apart, is varying", "[diagnostics][ispc]")
 {
   TempClass tc("Loops", R"(#pragma once
 class Loops
@@ -211,12 +211,24 @@ void Loops::kernel1D_Run(int n, int taps, float* data)
     for (int e = 0; e < taps; e++)
       if (x > 100.0f)
         break;
+    for (int s = 0; s < taps; s++)  // leaves early, but every lane at once (its conditions are shared)
+    {
+      if (s * m_radius > 8)
+        break;
+      if (s == 1)
+        continue;
+      for (int w = 0; w < i % 3; w++)  // a varying inner loop's break leaves only that loop
+        if (x > 50.0f)
+          break;
+      x += float(s);
+    }
     data[i] = x;
   }
 }
 )");
   const std::string text = IspcKernelsOf(tc, "Loops");
   INFO(text);
+  REQUIRE(text.find("for (uniform int s = 0; s < taps; s++)") != std::string::npos);  // shared early exits
   REQUIRE(text.find("for (uniform int k = -self->m_radius; k <= self->m_radius; k++)") != std::string::npos);  // members
   REQUIRE(text.find("for (uniform int t = 0; t < taps * k; t += 2)") != std::string::npos);  // a parameter, an outer uniform loop
   REQUIRE(text.find("for (int j = 0;") != std::string::npos);  // a bound per lane

@@ -86,7 +86,7 @@ private:
   void CheckSharedAssignment(const clang::Expr* target, const clang::Expr* value);
   void SharedValueExpected(const clang::VarDecl* vd, const clang::Expr* where, bool isIndex);
   std::string Variability(const clang::Expr* sub) const;
-  const clang::VarDecl* UniformLoop(const clang::ForStmt* fs) const;
+  const clang::VarDecl* UniformLoop(const clang::ForStmt* fs);
   // What ISPC has no counterpart for (yet): an error with the hint to use the Vulkan or CPU class.
   std::string Unsupported(clang::SourceLocation loc, const std::string& what);
   // The function that builds a struct from its fields (make_S, or crt_make_S beside the user's).

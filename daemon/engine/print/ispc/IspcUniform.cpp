@@ -84,7 +84,7 @@ bool IspcPrinter::Uniform(const clang::Expr* e) const {
   return false;
 }
 
-const VarDecl* IspcPrinter::UniformLoop(const ForStmt* fs) const {
+const VarDecl* IspcPrinter::UniformLoop(const ForStmt* fs) {
   // for (int k = start; k < bound; ++k) with start and bound shared,
   auto* ds = dyn_cast_or_null<DeclStmt>(fs->getInit());
   auto* v = ds && ds->isSingleDecl() ? dyn_cast<VarDecl>(ds->getSingleDecl()) : nullptr;
@@ -100,22 +100,47 @@ const VarDecl* IspcPrinter::UniformLoop(const ForStmt* fs) const {
   if (auto* ca = dyn_cast_or_null<CompoundAssignOperator>(inc))
     step = (ca->getOpcode() == BO_AddAssign || ca->getOpcode() == BO_SubAssign) && NamedVar(ca->getLHS()) == v && Uniform(ca->getRHS());
   if (!step) return nullptr;
-  // and a body that neither changes k nor leaves the loop early in some lanes only.
+  // and a body that neither changes k nor leaves the loop early in some lanes only: a break,
+  // continue or return only under conditions every lane shares (k taken as shared: if it is, so
+  // are they, and the gang leaves together), as `if (m_nodes[node].child[lane] == kNoChild) break;`.
   struct Body : WriteVisitor<Body> {
+    const IspcPrinter* printer;
     const VarDecl* v;
     bool bad = false;
+    int varyingIfs = 0, innerLoops = 0, innerSwitches = 0;  // around the statement being visited
     void Written(const clang::Expr* target, SourceLocation) { bad |= WrittenVar(target) == v; }
     bool VisitUnaryOperator(UnaryOperator* uo) {
       if (uo->getOpcode() == UO_AddrOf) bad |= WrittenVar(uo->getSubExpr()) == v;
       return WriteVisitor<Body>::VisitUnaryOperator(uo);
     }
-    bool VisitBreakStmt(BreakStmt*) { return !(bad = true); }
-    bool VisitContinueStmt(ContinueStmt*) { return !(bad = true); }
-    bool VisitReturnStmt(ReturnStmt*) { return !(bad = true); }
+    bool TraverseIfStmt(IfStmt* is) {
+      const bool shared = printer->Uniform(is->getCond());
+      if (is->getInit()) TraverseStmt(is->getInit());
+      TraverseStmt(is->getCond());
+      varyingIfs += shared ? 0 : 1;
+      TraverseStmt(is->getThen());
+      if (is->getElse()) TraverseStmt(is->getElse());
+      varyingIfs -= shared ? 0 : 1;
+      return true;
+    }
+    using Base = RecursiveASTVisitor<Body>;
+    // A break in an inner loop or switch leaves that; a continue in an inner loop continues that.
+    bool TraverseForStmt(ForStmt* s) { ++innerLoops; const bool r = Base::TraverseForStmt(s); --innerLoops; return r; }
+    bool TraverseWhileStmt(WhileStmt* s) { ++innerLoops; const bool r = Base::TraverseWhileStmt(s); --innerLoops; return r; }
+    bool TraverseDoStmt(DoStmt* s) { ++innerLoops; const bool r = Base::TraverseDoStmt(s); --innerLoops; return r; }
+    bool TraverseCXXForRangeStmt(CXXForRangeStmt* s) { ++innerLoops; const bool r = Base::TraverseCXXForRangeStmt(s); --innerLoops; return r; }
+    bool TraverseSwitchStmt(SwitchStmt* s) { ++innerSwitches; const bool r = Base::TraverseSwitchStmt(s); --innerSwitches; return r; }
+    bool VisitBreakStmt(BreakStmt*) { bad |= innerLoops == 0 && innerSwitches == 0 && varyingIfs > 0; return true; }
+    bool VisitContinueStmt(ContinueStmt*) { bad |= innerLoops == 0 && varyingIfs > 0; return true; }
+    bool VisitReturnStmt(ReturnStmt*) { bad |= varyingIfs > 0; return true; }
     bool VisitGotoStmt(GotoStmt*) { return !(bad = true); }
   } body;
+  body.printer = this;
   body.v = v;
+  const bool known = uniformValues.count(v) > 0;
+  uniformValues.insert(v);
   body.TraverseStmt(const_cast<clang::Stmt*>(fs->getBody()));
+  if (!known) uniformValues.erase(v);
   return body.bad ? nullptr : v;
 }
 
