@@ -222,6 +222,15 @@ void Loops::kernel1D_Run(int n, int taps, float* data)
           break;
       x += float(s);
     }
+    for (int c = 0; c < taps; c++)  // leaves in the lanes whose case it is
+    {
+      switch (i % 2)
+      {
+        case 0: continue;
+        default: break;
+      }
+      x += 1.0f;
+    }
     data[i] = x;
   }
 }
@@ -229,6 +238,7 @@ void Loops::kernel1D_Run(int n, int taps, float* data)
   const std::string text = IspcKernelsOf(tc, "Loops");
   INFO(text);
   REQUIRE(text.find("for (uniform int s = 0; s < taps; s++)") != std::string::npos);  // shared early exits
+  REQUIRE(text.find("for (int c = 0;") != std::string::npos);  // a continue under a per-lane switch
   REQUIRE(text.find("for (uniform int k = -self->m_radius; k <= self->m_radius; k++)") != std::string::npos);  // members
   REQUIRE(text.find("for (uniform int t = 0; t < taps * k; t += 2)") != std::string::npos);  // a parameter, an outer uniform loop
   REQUIRE(text.find("for (int j = 0;") != std::string::npos);  // a bound per lane

@@ -129,10 +129,18 @@ const VarDecl* IspcPrinter::UniformLoop(const ForStmt* fs) {
     bool TraverseWhileStmt(WhileStmt* s) { ++innerLoops; const bool r = Base::TraverseWhileStmt(s); --innerLoops; return r; }
     bool TraverseDoStmt(DoStmt* s) { ++innerLoops; const bool r = Base::TraverseDoStmt(s); --innerLoops; return r; }
     bool TraverseCXXForRangeStmt(CXXForRangeStmt* s) { ++innerLoops; const bool r = Base::TraverseCXXForRangeStmt(s); --innerLoops; return r; }
-    bool TraverseSwitchStmt(SwitchStmt* s) { ++innerSwitches; const bool r = Base::TraverseSwitchStmt(s); --innerSwitches; return r; }
+    bool TraverseSwitchStmt(SwitchStmt* s) {  // its cases run under its condition, as an if's branches do
+      const int varying = printer->Uniform(s->getCond()) ? 0 : 1;
+      ++innerSwitches;
+      varyingIfs += varying;
+      const bool r = Base::TraverseSwitchStmt(s);
+      varyingIfs -= varying;
+      --innerSwitches;
+      return r;
+    }
     bool VisitBreakStmt(BreakStmt*) { bad |= innerLoops == 0 && innerSwitches == 0 && varyingIfs > 0; return true; }
     bool VisitContinueStmt(ContinueStmt*) { bad |= innerLoops == 0 && varyingIfs > 0; return true; }
-    bool VisitReturnStmt(ReturnStmt*) { bad |= varyingIfs > 0; return true; }
+    bool VisitReturnStmt(ReturnStmt*) { bad |= varyingIfs > 0 || innerLoops > 0; return true; }  // (an inner loop's lanes may part)
     bool VisitGotoStmt(GotoStmt*) { return !(bad = true); }
   } body;
   body.printer = this;
