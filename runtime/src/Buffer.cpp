@@ -155,10 +155,6 @@ struct VulkanContext::StagingCache {
 
 std::shared_ptr<VulkanContext::StagingCache> MakeStagingCache() { return std::make_shared<VulkanContext::StagingCache>(); }
 
-namespace {
-
-// A staging buffer for one copy of `bytes`: the context's reused one for the direction (locked by
-// `lock` until the copy is done), or `own`, made for this copy.
 Staging& StagingFor(const VulkanContext& ctx, VkDeviceSize bytes, VkBufferUsageFlags usage, std::unique_lock<std::mutex>& lock,
                     std::unique_ptr<Staging>& own) {
   VulkanContext::StagingCache* cache = ctx.stagingCache.get();
@@ -174,8 +170,6 @@ Staging& StagingFor(const VulkanContext& ctx, VkDeviceSize bytes, VkBufferUsageF
   }
   return *reused;
 }
-
-}  // namespace
 
 void Buffer::Upload(const void* src, size_t bytes, size_t dstOffset) {
   CheckRange(*this, bytes, dstOffset, "Buffer::Upload");

@@ -141,7 +141,9 @@ void Image::Upload(const void* texels, size_t bytes) {
   if (Empty()) throw Error("Image::Upload: the image is empty (default-constructed or moved-from)");
   if (bytes != Bytes())
     throw Error("Image::Upload: " + std::to_string(bytes) + " bytes for an image of " + std::to_string(Bytes()) + " bytes");
-  Staging staging(*ctx_, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+  std::unique_lock<std::mutex> lock;
+  std::unique_ptr<Staging> own;
+  Staging& staging = StagingFor(*ctx_, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, lock, own);  // the context's, reused
   std::memcpy(staging.mapped, texels, bytes);
   VkCommandBuffer cmd = ctx_->BeginOneShot();
   Transition(cmd, image_, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);  // earlier kernels are done
@@ -155,7 +157,9 @@ void Image::Download(void* texels, size_t bytes) const {
   if (Empty()) throw Error("Image::Download: the image is empty (default-constructed or moved-from)");
   if (bytes != Bytes())
     throw Error("Image::Download: " + std::to_string(bytes) + " bytes for an image of " + std::to_string(Bytes()) + " bytes");
-  Staging staging(*ctx_, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT);
+  std::unique_lock<std::mutex> lock;
+  std::unique_ptr<Staging> own;
+  Staging& staging = StagingFor(*ctx_, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, lock, own);  // the context's, reused
   VkCommandBuffer cmd = ctx_->BeginOneShot();
   Transition(cmd, image_, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);  // kernels are done
   const VkBufferImageCopy region = WholeImage(width_, height_);

@@ -6,6 +6,8 @@
 #include <vulkan/vulkan.h>
 
 #include <initializer_list>
+#include <memory>
+#include <mutex>
 #include <string>
 
 namespace crossrt {
@@ -83,5 +85,11 @@ struct Staging {
 
 // The reused staging buffers of a context (Buffer.cpp).
 std::shared_ptr<VulkanContext::StagingCache> MakeStagingCache();
+
+// A staging buffer for one copy of `bytes` (usage TRANSFER_SRC to upload, TRANSFER_DST to
+// download): the context's reused one for the direction, locked by `lock` until the copy is done,
+// or `own`, made for this copy where it is larger than the reused ones may grow (Buffer.cpp).
+Staging& StagingFor(const VulkanContext& ctx, VkDeviceSize bytes, VkBufferUsageFlags usage, std::unique_lock<std::mutex>& lock,
+                    std::unique_ptr<Staging>& own);
 
 }  // namespace crossrt

@@ -252,6 +252,17 @@ TEST_CASE("Upload/Download through the staging path", "[runtime]") {
     CHECK(std::all_of(largeBack.begin(), largeBack.end(), [](uint8_t v) { return v == 0x5A; }));
     CHECK(std::equal(aBack.begin(), aBack.begin() + 16, aData.begin()));
   }
+
+  // Images copy through the same reused staging buffers: a small image, then one larger than any
+  // copy before (the buffers grow), then the small one again.
+  for (uint32_t side : {7u, 1100u, 7u}) {
+    Image img(ctx, side, side, VK_FORMAT_R32_SFLOAT, "staged");
+    std::vector<float> texels(size_t(side) * side), texelsBack(texels.size());
+    for (size_t i = 0; i < texels.size(); ++i) texels[i] = float(i % 9973) * 0.25f + float(side);
+    img.Upload(texels.data(), texels.size() * sizeof(float));
+    img.Download(texelsBack.data(), texelsBack.size() * sizeof(float));
+    CHECK(texelsBack == texels);
+  }
   RequireNoValidationMessages(*ctx);
 }
 
