@@ -191,18 +191,9 @@ void Buffer::Upload(const void* src, size_t bytes, size_t dstOffset) {
 void Buffer::Download(void* dst, size_t bytes, size_t srcOffset) const {
   CheckRange(*this, bytes, srcOffset, "Buffer::Download");
   if (bytes == 0) return;
-  if (mapped_ && hostCached_) {
-    std::memcpy(dst, static_cast<const char*>(mapped_) + srcOffset, bytes);
-    return;
-  }
-  std::unique_lock<std::mutex> lock;
-  std::unique_ptr<Staging> own;
-  Staging& staging = StagingFor(*ctx_, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, lock, own);
-  VkCommandBuffer cmd = ctx_->BeginOneShot();
-  VkBufferCopy region{srcOffset, 0, bytes};
-  vkCmdCopyBuffer(cmd, buffer_, staging.a.buffer, 1, &region);
-  ctx_->SubmitAndWait(cmd);  // ends with a transfer -> host barrier
-  std::memcpy(dst, staging.mapped, bytes);
+  Downloads one(ctx_);
+  one.Add(*this, dst, bytes, srcOffset);
+  one.Run();
 }
 
 void Downloads::Add(const Buffer& from, void* to, size_t bytes, size_t srcOffset) {
@@ -212,6 +203,7 @@ void Downloads::Add(const Buffer& from, void* to, size_t bytes, size_t srcOffset
 }
 
 void Downloads::Run() {
+  auto padded = [](size_t bytes) { return VkDeviceSize(bytes + 15) / 16 * 16; };  // each copy's place in the staging buffer
   std::vector<Copy> staged;
   VkDeviceSize total = 0;
   for (const Copy& c : copies_) {
@@ -220,7 +212,7 @@ void Downloads::Run() {
       std::memcpy(c.to, static_cast<const char*>(c.from->mapped_) + c.srcOffset, c.bytes);
     else {
       staged.push_back(c);
-      total += (c.bytes + 15) / 16 * 16;
+      total += padded(c.bytes);
     }
   }
   copies_.clear();
@@ -233,13 +225,13 @@ void Downloads::Run() {
   for (const Copy& c : staged) {
     VkBufferCopy region{c.srcOffset, at, c.bytes};
     vkCmdCopyBuffer(cmd, c.from->buffer_, staging.a.buffer, 1, &region);
-    at += (c.bytes + 15) / 16 * 16;
+    at += padded(c.bytes);
   }
   ctx_->SubmitAndWait(cmd);  // ends with a transfer -> host barrier
   at = 0;
   for (const Copy& c : staged) {
     std::memcpy(c.to, static_cast<const char*>(staging.mapped) + at, c.bytes);
-    at += (c.bytes + 15) / 16 * 16;
+    at += padded(c.bytes);
   }
 }
 

@@ -40,9 +40,11 @@ std::string NumericLimit(const FunctionDecl* fd, const std::string& infinity, co
   const QualType t = spec->getTemplateArgs()[0].getAsType().getCanonicalType();
   const std::string n = fd->getNameAsString();
   if (t->isSpecificBuiltinType(BuiltinType::Float)) {
+    if (n == "infinity") return infinity;
+    if (n == "quiet_NaN") return nan;
     // Nine significant digits: each literal rounds to exactly the float it names.
-    const std::map<std::string, std::string> values = {
-        {"infinity", infinity}, {"quiet_NaN", nan}, {"max", "3.40282347e+38"},
+    static const std::map<std::string, std::string> values = {
+        {"max", "3.40282347e+38"},
         {"lowest", "-3.40282347e+38"},    {"min", "1.17549435e-38"},    {"epsilon", "1.1920929e-07"},
         {"denorm_min", "1.40129846e-45"}};
     auto it = values.find(n);
