@@ -161,6 +161,7 @@ struct Kernel {
   std::string indirectVector;
   std::string glslBody;               // the thread's code, as a GLSL function body
   std::string cpuLoopNest;            // IPV, CPU backend: the loop nest with reductions renamed
+  std::string cpuLoopHead;            // IPV, CPU backend: crossrt::ParallelFor(...) { before the nest's chunk [crt_first, crt_last)
   std::string cpuPreamble;            // IPV, CPU backend: statements before the loops
   std::vector<std::string> preambleLocals;  // the locals they declare (an ISPC kernel computes its own)
   std::string cpuPostamble;           // IPV, CPU backend: statements after the loops

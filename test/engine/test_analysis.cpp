@@ -122,7 +122,8 @@ TEST_CASE("Analysis finds kernels, control functions, members and reductions", "
   CHECK_FALSE(run.params[2].isConst);
   CHECK(run.vulkanCmdBody.find("kernel1D_ScaleCmd(crt_cmd, n, crt_inOut_Run.in, crt_inOut_Run.out)") != std::string::npos);
   CHECK(rtv.vulkanCmdBody.find("kernel_PixelCmd(crt_cmd, w, h, w, crt_inOut_RunRtv.img);") != std::string::npos);
-  CHECK(rtv.cpuBody.find("#pragma omp parallel for") != std::string::npos);
+  CHECK(rtv.cpuBody.find("crossrt::ParallelFor<") != std::string::npos);
+  CHECK(rtv.cpuBody.find("crt_first") != std::string::npos);
 
   // Members: plain data and vectors; the vector of float3 needs the scalar layout to match C++.
   bool sawItems = false, sawPoints = false, sawName = false;
@@ -196,20 +197,26 @@ void Limits::kernel1D_Fill(int n, float* out, int* ints)
   CHECK(glsl.find(Squeezed("0x7FFFFFFF")) != std::string::npos);
 }
 
-TEST_CASE("The CPU backend parallelises kernels with OpenMP", "[engine]")
+TEST_CASE("The CPU backend parallelises kernels on all cores, each chunk with parts of the reductions", "[engine]")
 {
   TempClass tc("Finder", kHeader, kSource);
   TranslateResult r = Translate(MakeRequest(tc, "Finder", Backend::Cpu));
   INFO(r.diagnostics);
   REQUIRE(r.ok);
   const std::string cpp = Squeezed(r.files.at("Finder_CPU.cpp"));
-  // (The formatter may continue the pragma on a second line.)
-  CHECK(cpp.find(Squeezed("#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1024) reduction(+:crt_m_totalLocal)")) != std::string::npos);
-  CHECK(cpp.find(Squeezed("reduction(crossrt_min_vec3:crt_m_loLocal) for (int i = 0; i < n; i++)")) != std::string::npos);
+  // Chunks of the outer loop on the pool's threads and this one (crossrt::ParallelFor).
+  CHECK(cpp.find(Squeezed("crossrt::ParallelFor<int>(crt_loop.parallel, 0, n, 1024, [&](int crt_first, int crt_last) {")) != std::string::npos);
+  CHECK(cpp.find(Squeezed("for (int i = crt_first; i < crt_last; i++)")) != std::string::npos);
+  CHECK(cpp.find("#pragma omp") == std::string::npos);
+  // Each chunk reduces into its own part, merged into the total after its iterations.
+  CHECK(cpp.find(Squeezed("crt_reductions.StartFromZero(crt_m_totalLocal);")) != std::string::npos);
+  CHECK(cpp.find(Squeezed("crt_m_totalLocal += out[i];")) != std::string::npos);
+  CHECK(cpp.find(Squeezed("crt_reductions.Merge(crt_m_totalTotal, crt_m_totalLocal, crossrt::Sum());")) != std::string::npos);
+  CHECK(cpp.find(Squeezed("crt_reductions.StartFromTotal(crt_m_loLocal, crt_m_loTotal);")) != std::string::npos);
+  CHECK(cpp.find(Squeezed("crt_reductions.Merge(crt_m_loTotal, crt_m_loLocal, crossrt::Minimum());")) != std::string::npos);
   // On all cores, or on this thread while that has been faster here (crossrt::ParallelChoice).
   CHECK(cpp.find(Squeezed("static crossrt::ParallelChoice crt_choice;")) != std::string::npos);
   CHECK(cpp.find(Squeezed("crt_choice.End(crt_loop);")) != std::string::npos);
-  CHECK(cpp.find(Squeezed("crt_m_totalLocal += out[i];")) != std::string::npos);
 }
 
 TEST_CASE("Target compile options: meaning-changing flags are kept, GCC-only ones dropped", "[engine]")
@@ -417,7 +424,10 @@ void Walk::kernel_Scale(uint32_t tidX, uint32_t tidY, uint32_t w, float gain, fl
   const size_t scalar = host.find(Squeezed("kernel_Start(x, y, &p);"));
   CHECK(choice != std::string::npos);
   CHECK((choice < lanes && lanes != std::string::npos && lanes < scalar && scalar != std::string::npos));
-  CHECK(host.find(Squeezed("#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 16) collapse(2)"), lanes) < scalar);
+  // (its rows in chunks of one on all cores)
+  const size_t rows = host.find(Squeezed("crossrt::ParallelFor<"), lanes);
+  CHECK(rows < scalar);
+  CHECK(host.find(Squeezed("(crt_loop.parallel, 0, h, 1, [&]("), lanes) < scalar);
   // A loop nest around one kernel: its export function calls the kernel's thread function itself.
   CHECK(ispc.find(Squeezed("export void Walk_Scale_kernel_Scale(uniform Walk_Data *uniform self, uniform int crt_begin, uniform int crt_end, "
                            "uniform int crt_startX, uniform int crt_countX, uniform uint crt_w, uniform float crt_gain, uniform float4 *uniform crt_out_)")) !=

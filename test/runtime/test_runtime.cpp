@@ -13,8 +13,11 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <random>
+#include <set>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
@@ -824,6 +827,116 @@ TEST_CASE("CPU radix sort: stable for keys that need 0, 1, 2 and 3 passes, small
       for (size_t i = 0; i < n; ++i) wrong += records[2 * i] != expected[i].first || records[2 * i + 1] != expected[i].second;
       REQUIRE(wrong == 0);
     }
+}
+
+// crossrt::ParallelFor (CpuLoops.h), the generated loops' runner: every iteration once, from any
+// first value and of any integer type, on all cores or on this thread; loops inside a chunk, and a
+// loop of another thread while the pool is busy, run on their thread; a chunk's exception reaches
+// the caller and leaves the pool working; chunks' parts of reductions add up to the whole.
+TEST_CASE("ParallelFor runs every iteration once, on the pool's threads and the caller's", "[runtime][parallel]")
+{
+  auto coverage = [](auto begin, auto end, long long grain, bool parallel) {
+    using T = decltype(begin);
+    std::vector<std::atomic<int>> seen(begin < end ? size_t(end - begin) + 1 : 1);
+    std::atomic<int> outside{0};
+    crossrt::ParallelFor<T>(parallel, begin, end, grain, [&](T first, T last) {
+      for (T i = first; i < last; i++) {
+        if (i < begin || i >= end) ++outside;
+        else ++seen[size_t(i - begin)];
+      }
+    });
+    int wrong = outside.load();
+    for (size_t i = 0; i + 1 < seen.size(); ++i) wrong += seen[i].load() != 1;
+    return wrong;
+  };
+  for (bool parallel : {true, false}) {
+    CHECK(coverage(0, 10000, 1024, parallel) == 0);
+    CHECK(coverage(-37, 1001, 16, parallel) == 0);
+    CHECK(coverage(5, 6, 1, parallel) == 0);
+    CHECK(coverage(uint32_t(3), uint32_t(4099), 7, parallel) == 0);
+    CHECK(coverage(size_t(0), size_t(333), 1000, parallel) == 0);
+  }
+  CHECK(coverage(10, 10, 16, true) == 0);  // empty
+  CHECK(coverage(10, 3, 16, true) == 0);   // empty, end before begin
+
+  if (crossrt::LoopThreads() > 1) {
+    // Chunks long enough for a worker to wake and take some.
+    std::mutex m;
+    std::set<std::thread::id> threads;
+    crossrt::ParallelFor<int>(true, 0, 64, 1, [&](int, int) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      const std::lock_guard<std::mutex> lock(m);
+      threads.insert(std::this_thread::get_id());
+    });
+    CHECK(threads.size() > 1);
+  }
+
+  // A loop inside a chunk runs on the chunk's thread.
+  std::atomic<int> innerOnOtherThreads{0}, inner{0};
+  crossrt::ParallelFor<int>(true, 0, 8, 1, [&](int, int) {
+    const auto self = std::this_thread::get_id();
+    CHECK(crossrt::InParallelLoop());
+    crossrt::ParallelFor<int>(true, 0, 100, 1, [&](int first, int last) {
+      inner += last - first;
+      if (std::this_thread::get_id() != self) ++innerOnOtherThreads;
+    });
+  });
+  CHECK(inner.load() == 800);
+  CHECK(innerOnOtherThreads.load() == 0);
+  CHECK_FALSE(crossrt::InParallelLoop());
+
+  // Another thread's loop, while this one holds the pool, runs whole on that thread.
+  std::atomic<int> otherCount{0};
+  std::atomic<bool> otherDone{false};
+  crossrt::ParallelFor<int>(true, 0, 2, 1, [&](int first, int) {
+    if (first != 0) return;
+    std::thread other([&] {
+      crossrt::ParallelFor<int>(true, 0, 1000, 10, [&](int f, int l) { otherCount += l - f; });
+      otherDone = true;
+    });
+    other.join();
+  });
+  CHECK(otherDone.load());
+  CHECK(otherCount.load() == 1000);
+
+  // An exception in a chunk reaches the caller after the other chunks; the pool keeps working.
+  std::atomic<int> ran{0};
+  CHECK_THROWS_WITH(crossrt::ParallelFor<int>(true, 0, 100, 1,
+                                              [&](int first, int) {
+                                                ++ran;
+                                                if (first == 50) throw std::runtime_error("chunk 50");
+                                              }),
+                    "chunk 50");
+  CHECK(ran.load() == 100);
+  CHECK(coverage(0, 5000, 64, true) == 0);
+}
+
+TEST_CASE("LoopReductions: chunks' parts of sums, minima and arrays add up to the whole", "[runtime][parallel]")
+{
+  const int n = 100000;
+  long long sumTotal = 7;  // the total before the loop counts too
+  float minTotal = 1.0e30f;
+  int histogramTotal[4] = {1, 1, 1, 1};
+  crossrt::LoopReductions reductions;
+  crossrt::ParallelFor<int>(true, 0, n, 1024, [&](int first, int last) {
+    long long sum;
+    reductions.StartFromZero(sum);
+    float lowest;
+    reductions.StartFromTotal(lowest, minTotal);
+    int histogram[4];
+    reductions.StartFromZero(histogram);
+    for (int i = first; i < last; i++) {
+      sum += i;
+      lowest = std::min(lowest, float((i * 7919) % n) - 5.0f);
+      histogram[i % 4] += 1;
+    }
+    reductions.Merge(sumTotal, sum, crossrt::Sum());
+    reductions.Merge(minTotal, lowest, crossrt::Minimum());
+    reductions.Merge(histogramTotal, histogram, crossrt::Sum());
+  });
+  CHECK(sumTotal == 7 + (long long)n * (n - 1) / 2);
+  CHECK(minTotal == -5.0f);
+  for (int h : histogramTotal) CHECK(h == 1 + n / 4);
 }
 
 // crossrt::ParallelChoice, with the times given: the way that measured faster is taken, the other

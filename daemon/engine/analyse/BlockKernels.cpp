@@ -18,7 +18,8 @@ bool IsBlockKernelName(llvm::StringRef name) { return name.starts_with("kernelBE
 
 namespace {
 
-// The CPU class's copy of the kernel: the loop over blocks under an OpenMP pragma, the [[parallel]]
+// The CPU class's copy of the kernel: the loop over blocks on all cores (crossrt::ParallelFor, or an
+// OpenMP pragma where its header is not `for (T i = a; i < b; ++i)`), the [[parallel]]
 // markers of the block's loops dropped (each block's thread runs them in order).
 void AddBlockKernel(Context& c, const FunctionDecl* decl, const FunctionDecl* def, const TemplateParameterList* params) {
   const ForStmt* blocks = nullptr;
@@ -41,9 +42,11 @@ void AddBlockKernel(Context& c, const FunctionDecl* decl, const FunctionDecl* de
   // every other parallel loop of the CPU class), taken one at a time by whichever thread is free.
   LoopHeader h;
   if (LoopShapeProblem(c.ctx, blocks, h).empty() && isa<CompoundStmt>(blocks->getBody())) {
-    rw.InsertTextBefore(blocks->getBeginLoc(), "static crossrt::ParallelChoice crt_choice;\nconst auto crt_loop = crt_choice.Begin(" + CountExpr(c, h) +
-                                                   ");\n#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic)  // the blocks\n");
-    rw.InsertTextAfterToken(blocks->getEndLoc(), "\ncrt_choice.End(crt_loop);");
+    const std::string count = CountExpr(c, h);
+    const ChunkedLoop chunked = ChunkLoop(rw, c.ctx, blocks, h, "crt_loop.parallel", "1");
+    rw.InsertTextBefore(blocks->getBeginLoc(), "static crossrt::ParallelChoice crt_choice;\nconst auto crt_loop = crt_choice.Begin(" + count + ");\n" +
+                                                   chunked.head + "  // the blocks\n");
+    rw.InsertTextAfterToken(blocks->getEndLoc(), "\n" + chunked.tail + "\ncrt_choice.End(crt_loop);");
   } else {
     rw.InsertTextBefore(blocks->getBeginLoc(), "#pragma omp parallel for schedule(dynamic)  // the blocks, one per core at a time\n");
   }

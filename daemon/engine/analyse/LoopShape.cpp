@@ -58,6 +58,16 @@ std::string CountExpr(Context& c, const LoopHeader& h) {
   return h.inclusive ? count + " + 1" : count;
 }
 
+ChunkedLoop ChunkLoop(Rewriter& rw, ASTContext& ctx, const ForStmt* fs, const LoopHeader& h, const std::string& parallel, const std::string& grain) {
+  const std::string type = h.var->getType().getUnqualifiedType().getAsString(ctx.getPrintingPolicy());
+  const std::string begin = rw.getRewrittenText(h.start->getSourceRange()), end = rw.getRewrittenText(h.end->getSourceRange());
+  rw.ReplaceText(h.start->getSourceRange(), "crt_first");
+  rw.ReplaceText(fs->getCond()->getSourceRange(), h.var->getNameAsString() + " < crt_last");
+  return {"crossrt::ParallelFor<" + type + ">(" + parallel + ", " + begin + ", " + (h.inclusive ? AsOperand(end) + " + 1" : end) + ", " + grain + ", [&](" +
+              type + " crt_first, " + type + " crt_last) {",
+          "});"};
+}
+
 namespace {
 
 // The locals a statement declares (a loop's variable, a block's temporaries): its own to set.

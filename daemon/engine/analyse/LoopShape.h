@@ -3,6 +3,8 @@
 #pragma once
 #include "analyse/AnalysisContext.h"
 
+#include <clang/Rewrite/Core/Rewriter.h>
+
 namespace crossrt::engine {
 
 // The statements before a kernelND_'s loop nest that do nothing but set locals declared before it
@@ -42,5 +44,16 @@ bool ParseLoop(Context& c, const ForStmt* fs, LoopHeader& h, const std::string& 
 std::string AsOperand(const std::string& expr);
 
 std::string CountExpr(Context& c, const LoopHeader& h);
+
+// A loop whose iterations run in chunks on all cores (crossrt::ParallelFor, CpuLoops.h): its header
+// rewritten in `rw` to run [crt_first, crt_last), and the call's text around the loop, in which its
+// bounds are evaluated once (as OpenMP evaluates them). `parallel` is the C++ condition for all
+// cores (crt_loop.parallel), `grain` the iterations of a chunk.
+struct ChunkedLoop {
+  std::string head;  // crossrt::ParallelFor<T>(parallel, begin, end, grain, [&](T crt_first, T crt_last) {
+  std::string tail;  // });
+};
+ChunkedLoop ChunkLoop(clang::Rewriter& rw, clang::ASTContext& ctx, const clang::ForStmt* fs, const LoopHeader& h, const std::string& parallel,
+                      const std::string& grain);
 
 }  // namespace crossrt::engine

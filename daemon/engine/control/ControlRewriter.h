@@ -110,10 +110,11 @@ private:
 
   void Error(ThreadLoop& tl, SourceLocation loc, const std::string& message, const std::string& hint);
   // The _CPU class's loop over threads (of `nest` loops, `outer` the outermost, its header
-  // `outermost`): an OpenMP loop on all cores, or on this thread while that has been faster
-  // (crossrt::ParallelChoice), in a block of its own.
+  // `outermost`): chunks of its outer loop on all cores (crossrt::ParallelFor), or on this thread
+  // while that has been faster (crossrt::ParallelChoice), in a block of its own.
   void ParallelOnCpu(const ForStmt* outer, const LoopHeader& outermost, size_t nest);
-  // What ParallelOnCpu writes before and after the loop nest.
+  // What ParallelOnCpu writes before and after the loop nest; the outer loop's header, rewritten in
+  // m_cpu, runs a chunk.
   std::pair<std::string, std::string> ParallelChoiceAround(const ForStmt* outer, const LoopHeader& outermost, size_t nest);
 
   // Checks that `e` does not depend on the thread (host code and by-value kernel arguments run once

@@ -40,10 +40,11 @@ std::string ChunksOnAllCores(const ClassModel& model, const std::string& what, c
   text += "static const auto crt_run = crossrt::IspcPick(ispc::" + symbol + ", {" + IspcTargetFunctions(symbol) + "});\n"
           "static crossrt::ParallelChoice crt_choice;  // all cores, or this thread while that has been faster\n"
           "const auto crt_loop = crt_choice.Begin(" + outer + ");\n"
-          "#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1)\n"
-          "for (int crt_chunk = 0; crt_chunk < (" + outer + " + " + chunk + " - 1) / " + chunk + "; ++crt_chunk)\n"
-          "  crt_run(const_cast<ispc::" + model.symbolPrefix + "_Data*>(&crt_self), crt_chunk * " + chunk + ", std::min(" + outer + ", (crt_chunk + 1) * " + chunk + ")" +
+          "crossrt::ParallelFor<int>(crt_loop.parallel, 0, (" + outer + " + " + chunk + " - 1) / " + chunk + ", 1, [&](int crt_first, int crt_last) {\n"
+          "  for (int crt_chunk = crt_first; crt_chunk < crt_last; ++crt_chunk)\n"
+          "    crt_run(const_cast<ispc::" + model.symbolPrefix + "_Data*>(&crt_self), crt_chunk * " + chunk + ", std::min(" + outer + ", (crt_chunk + 1) * " + chunk + ")" +
           (dims == 2 ? ", 0, crt_countX" : "") + cppArgs + ");\n"
+          "});\n"
           "crt_choice.End(crt_loop);\n"
           "IspcWrittenBack(crt_self);  // members the kernels set\n}\n";
   return text;

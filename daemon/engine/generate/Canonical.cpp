@@ -14,11 +14,19 @@ namespace crossrt::engine {
 
 namespace {
 
-// clang-format in the layout of generated code: Allman braces, 2-space indents, `float* p`, two
+// clang-format in the layout of generated code: Allman braces (but lambdas'), 2-space indents, `float* p`, two
 // spaces before a trailing comment; `wholeFile`: one-line inline functions stay on their line.
 std::string Reformat(const std::string& code, unsigned columns, bool wholeFile) {
   clang::format::FormatStyle style = clang::format::getLLVMStyle();
-  style.BreakBeforeBraces = clang::format::FormatStyle::BS_Allman;
+  // Allman's braces, but a lambda's body opens on its line and is indented from the statement (the
+  // chunks of a parallel loop: crossrt::ParallelFor(..., [&](int crt_first, int crt_last) {).
+  style.BreakBeforeBraces = clang::format::FormatStyle::BS_Custom;
+  auto& wrap = style.BraceWrapping;
+  wrap.AfterCaseLabel = wrap.AfterClass = wrap.AfterEnum = wrap.AfterFunction = wrap.AfterNamespace = wrap.AfterStruct = wrap.AfterUnion = true;
+  wrap.AfterExternBlock = wrap.BeforeCatch = wrap.BeforeElse = true;
+  wrap.AfterControlStatement = clang::format::FormatStyle::BWACS_Always;
+  wrap.BeforeLambdaBody = false;
+  style.LambdaBodyIndentation = clang::format::FormatStyle::LBI_OuterScope;
   style.IndentWidth = 2;
   style.ColumnLimit = columns;
   style.AllowShortFunctionsOnASingleLine = clang::format::FormatStyle::SFS_None;

@@ -12,12 +12,6 @@
 
 namespace crossrt::engine {
 
-namespace {
-
-std::string ScalarOmpOp(ReduceOp op) { return op == ReduceOp::Min ? "min" : op == ReduceOp::Max ? "max" : "+"; }
-
-}  // namespace
-
 std::map<std::string, std::string> GenerateHost(const ClassModel& model, const GenerateOptions& opt, bool vulkan) {
   std::map<std::string, std::string> files;
   Data d = Common(model, opt);
@@ -110,58 +104,37 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
                                         "that has been faster here);\n// everything else is inherited unchanged."
                                   : "The kernels of " + model.className + " run here on all\n// CPU cores with OpenMP; everything else is inherited unchanged.");
   if (model.forIspc) IspcHostData(model, d);
-  Data kernels = List(), ompReductions = List();
-  std::set<std::string> declared;
-  bool arrayReductions = false;  // elements of a member array reduced (coefs[k] += x)
+  Data kernels = List();
   for (auto& k : model.kernels) {
     if (k.rtv) continue;  // kernel_* bodies are inherited; their loops are parallelised in the control function
     Data x = CpuKernelData(k);
     // The _ISPC class keeps this form as the scalar way of a kernel (IspcHostData has the other).
     x.set("method", model.forIspc ? generated::ScalarMethod(k.name) : k.name);
     x.set("wayParam", model.forIspc ? KernelWayParam(k) : "");
-    x.set("loopNest", IndentTail(k.cpuLoopNest, "  "));
-    x.set("iterations", k.loops.empty() ? "1" : k.loops[0].countCpp);  // the outer loop's, which OpenMP shares out
-    // Dynamic chunks: iterations may cost very different amounts (a ray that hits against one that
-    // misses). With static halves PrimaryRays_CPU cast the bunny's rays at 0.57-0.63x of Embree,
-    // with chunks of 1024 at 0.71-0.75x (bench_lbvh, 2 threads). 2D kernels hand out rows.
-    x.set("schedule", k.dims == 1 ? "dynamic, 1024" : "dynamic, 1");
-    std::string clauses;
+    x.set("loopNest", IndentTail(k.cpuLoopNest, "    "));
+    x.set("iterations", k.loops.empty() ? "1" : k.loops[0].countCpp);  // the outer loop's, which the cores share
+    x.set("loopHead", k.cpuLoopHead);
     Data reds = List();
     for (auto& r : k.reductions) {
-      // A member is reduced through a local copy (crt_<member>Local); a local is reduced itself.
-      // An array member (its elements reduced, coefs[k] += x, on the CPU backend only) as an array section.
+      // Each chunk reduces into a part of its own, crt_<name>Local (Kernels.cpp renames the target in
+      // the loop nest), merged into crt_<name>Total: a copy of a member, or a reference to a local.
+      // An array member (its elements reduced, coefs[k] += x, on the CPU backend only) element by element.
       const auto [element, dims] = SplitArray(r.glslType);
       const std::string count = dims.empty() ? "" : dims.substr(1, dims.size() - 2);
-      const std::string reduced = (r.local ? r.member : generated::ReductionLocal(r.member)) + (count.empty() ? "" : "[:" + count + "]");
-      if (!r.local) {
-        Data y;
-        y.set("member", r.member);
-        y.set("arraySize", count);
-        y.set("whole", count.empty());
-        reds.push_back(y);
-        arrayReductions = arrayReductions || !count.empty();
-      }
-      std::string cppType = ReductionCppType(model, r);
-      bool scalar = element == "float" || element == "int" || element == "uint";
-      if (scalar) {
-        clauses += " reduction(" + ScalarOmpOp(r.op) + ":" + reduced + ")";
-        continue;
-      }
-      // LiteMath vectors need a declared reduction.
-      std::string opName = std::string(r.op == ReduceOp::Min ? "min" : r.op == ReduceOp::Max ? "max" : "add");
-      std::string name = "crossrt_" + opName + "_" + element;
-      clauses += " reduction(" + name + ":" + reduced + ")";
-      if (declared.insert(name).second) {
-        Data o;
-        o.set("name", name);
-        o.set("cppType", cppType);
-        o.set("combine", r.op == ReduceOp::Min ? "LiteMath::min(omp_out, omp_in)" : r.op == ReduceOp::Max ? "LiteMath::max(omp_out, omp_in)" : "omp_out + omp_in");
-        o.set("init", r.op == ReduceOp::Min || r.op == ReduceOp::Max ? "omp_orig" : cppType + "()");
-        ompReductions.push_back(o);
-      }
+      Data y;
+      y.set("member", r.member);
+      y.set("arraySize", count);
+      y.set("whole", count.empty());
+      y.set("ofMember", !r.local);
+      y.set("part", generated::ReductionLocal(r.member));
+      y.set("total", "crt_" + r.member + "Total");
+      const bool minMax = r.op == ReduceOp::Min || r.op == ReduceOp::Max;
+      y.set("fromTotal", minMax);
+      y.set("op", r.op == ReduceOp::Min ? "crossrt::Minimum()" : r.op == ReduceOp::Max ? "crossrt::Maximum()" : "crossrt::Sum()");
+      reds.push_back(y);
     }
     x.set("reductions", reds);
-    x.set("ompClauses", clauses);
+    x.set("hasReductions", !k.reductions.empty());
     kernels.push_back(x);
   }
   d.set("kernels", kernels);
@@ -176,8 +149,6 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
     blockKernels.push_back(x);
   }
   d.set("blockKernels", blockKernels);
-  d.set("ompReductions", ompReductions);
-  d.set("hasArrayReductions", arrayReductions);
   Data copies = List();
   for (auto& lc : model.lockedCopies) {
     Data x;

@@ -2,6 +2,7 @@
 // the choice of each kernel's loop between all cores and one, and an _ISPC kernel's between SIMD
 // lanes and its scalar loop (header only; OpenMP).
 #pragma once
+#include "CpuLoops.h"
 #include "SortKey.h"
 
 #include <omp.h>
@@ -79,13 +80,14 @@ inline int LoopSizeClass(long long iterations) {
 // generated _CPU and _ISPC kernel keeps one (a static of its method) and asks it before the loop,
 //   static crossrt::ParallelChoice crt_choice;
 //   const auto crt_loop = crt_choice.Begin(count);
-//   #pragma omp parallel for if(crt_loop.parallel) ...
+//   crossrt::ParallelFor<int>(crt_loop.parallel, 0, count, grain, [&](int crt_first, int crt_last) { ... });
 //   crt_choice.End(crt_loop);
 //
 // Why: a parallel loop ends when its slowest thread does. On a machine where other programs keep
 // cores busy, the scheduler takes a worker off its core for a time slice (milliseconds) now and
 // then, and the loop waits for it. A loop of a few hundred microseconds then takes ten or a
-// hundred times that: beside one busy thread on 2 cores (AMD EPYC, bench_lbvh --load 1), the
+// hundred times that (ParallelFor no longer waits for a worker that never started, but still for
+// one taken off its core in the middle of a chunk): beside one busy thread on 2 cores (AMD EPYC, bench_lbvh --load 1), the
 // LBVH_CPU build of an 11,102-triangle mesh (eight kernel calls) took 4.3-4.8 ms, and 54 ms in some
 // runs, against 1.0 ms quiet and 1.9 ms for the single-threaded original. Passive waits alone
 // (OMP_WAIT_POLICY) collapsed the same way; beside this choice they help (runtime/src/CpuWaitPolicy.cpp).
@@ -144,7 +146,7 @@ class ParallelChoice {
   // The decision and the measurement apart, for tests.
   bool Choose(long long iterations) {
     const int threads = omp_get_max_threads();
-    if (iterations < 2 || omp_in_parallel() || threads < 2) return false;
+    if (iterations < 2 || InParallelLoop() || threads < 2) return false;
     if (AlwaysAllCores()) return true;
     Ways& ways = m_bySize[LoopSizeClass(iterations)];
     const float serial = ways.Mean(0), parallel = ways.Mean(1);
@@ -166,7 +168,7 @@ class ParallelChoice {
   }
 
   void Record(bool parallel, long long iterations, double ms) {
-    if (iterations < 2 || omp_in_parallel() || omp_get_max_threads() < 2) return;
+    if (iterations < 2 || InParallelLoop() || omp_get_max_threads() < 2) return;
     Ways& ways = m_bySize[LoopSizeClass(iterations)];
     const float now = float(ms / double(iterations));
     ways.Record(parallel, now);

@@ -4,8 +4,10 @@
 
 #include <crossrt/CpuParallel.h>
 
+#include <algorithm>
 #include <chrono>
-#include <omp.h>
+#include <iterator>
+#include <type_traits>
 
 // As in the class's source files: the bodies below are copied from them.
 #include <algorithm>
@@ -13,11 +15,6 @@
 using LiteMath::Box4f;
 using LiteMath::float3;
 using LiteMath::uint2;
-
-#pragma omp declare reduction(crossrt_min_vec3 : LiteMath::float3 : omp_out = LiteMath::min(omp_out, omp_in)) \
-    initializer(omp_priv = omp_orig)
-#pragma omp declare reduction(crossrt_max_vec3 : LiteMath::float3 : omp_out = LiteMath::max(omp_out, omp_in)) \
-    initializer(omp_priv = omp_orig)
 
 LBVH_CPU::LBVH_CPU() : LBVH()
 {
@@ -40,8 +37,7 @@ void LBVH_CPU::Build(int count, const LiteMath::Box4f* boxes)
 {
   const auto crt_start = std::chrono::steady_clock::now();
   // The body of LBVH::Build, run as a lambda so that an early 'return' still gets timed.
-  [&]()
-  {
+  [&]() {
     m_centerMin = float3(+1e30f);
     m_centerMax = float3(-1e30f);
     kernel1D_Bounds(count, boxes);
@@ -64,21 +60,29 @@ void LBVH_CPU::Build(int count, const LiteMath::Box4f* boxes)
 // thread while that has been faster: crossrt::ParallelChoice).
 void LBVH_CPU::kernel1D_Bounds(int count, const LiteMath::Box4f* boxes)
 {
-  auto crt_m_centerMinLocal = m_centerMin;
-  auto crt_m_centerMaxLocal = m_centerMax;
+  auto crt_m_centerMinTotal = m_centerMin;
+  auto crt_m_centerMaxTotal = m_centerMax;
+  crossrt::LoopReductions crt_reductions;
   static crossrt::ParallelChoice crt_choice;
   const auto crt_loop = crt_choice.Begin(count);
-#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1024) \
-    reduction(crossrt_min_vec3 : crt_m_centerMinLocal) reduction(crossrt_max_vec3 : crt_m_centerMaxLocal)
-  for (int i = 0; i < count; i++)
-  {
-    const float3 center = 0.5f * (to_float3(boxes[i].boxMin) + to_float3(boxes[i].boxMax));
-    crt_m_centerMinLocal = min(crt_m_centerMinLocal, center);
-    crt_m_centerMaxLocal = max(crt_m_centerMaxLocal, center);
-  }
+  crossrt::ParallelFor<int>(crt_loop.parallel, 0, count, 1024, [&](int crt_first, int crt_last) {
+    // This chunk's parts of the reductions, merged into their totals after its iterations.
+    std::remove_reference_t<decltype(crt_m_centerMinTotal)> crt_m_centerMinLocal;
+    crt_reductions.StartFromTotal(crt_m_centerMinLocal, crt_m_centerMinTotal);
+    std::remove_reference_t<decltype(crt_m_centerMaxTotal)> crt_m_centerMaxLocal;
+    crt_reductions.StartFromTotal(crt_m_centerMaxLocal, crt_m_centerMaxTotal);
+    for (int i = crt_first; i < crt_last; i++)
+    {
+      const float3 center = 0.5f * (to_float3(boxes[i].boxMin) + to_float3(boxes[i].boxMax));
+      crt_m_centerMinLocal = min(crt_m_centerMinLocal, center);
+      crt_m_centerMaxLocal = max(crt_m_centerMaxLocal, center);
+    }
+    crt_reductions.Merge(crt_m_centerMinTotal, crt_m_centerMinLocal, crossrt::Minimum());
+    crt_reductions.Merge(crt_m_centerMaxTotal, crt_m_centerMaxLocal, crossrt::Maximum());
+  });
   crt_choice.End(crt_loop);
-  m_centerMin = crt_m_centerMinLocal;
-  m_centerMax = crt_m_centerMaxLocal;
+  m_centerMin = crt_m_centerMinTotal;
+  m_centerMax = crt_m_centerMaxTotal;
 }
 
 // From LBVH::kernel1D_EvalMC (LBVH.cpp): the outer loop runs on all cores (or on this
@@ -87,19 +91,20 @@ void LBVH_CPU::kernel1D_EvalMC(int count, const LiteMath::Box4f* boxes)
 {
   static crossrt::ParallelChoice crt_choice;
   const auto crt_loop = crt_choice.Begin(count);
-#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1024)
-  for (int i = 0; i < count; i++)
-  {
-    const float3 center = 0.5f * (to_float3(boxes[i].boxMin) + to_float3(boxes[i].boxMax));
-    const float3 extent = m_centerMax - m_centerMin;
-    const float3 scale =
-        float3(extent.x > 0.0f ? 1023.0f / extent.x : 0.0f, extent.y > 0.0f ? 1023.0f / extent.y : 0.0f,
-               extent.z > 0.0f ? 1023.0f / extent.z : 0.0f);
-    const float3 cell = clamp((center - m_centerMin) * scale, float3(0.0f), float3(1023.0f));
-    const uint32_t code = (MortonExpandBits(uint32_t(cell.x)) << 2) | (MortonExpandBits(uint32_t(cell.y)) << 1) |
-                          MortonExpandBits(uint32_t(cell.z));
-    m_codes[i] = uint2(code, uint32_t(i));
-  }
+  crossrt::ParallelFor<int>(crt_loop.parallel, 0, count, 1024, [&](int crt_first, int crt_last) {
+    for (int i = crt_first; i < crt_last; i++)
+    {
+      const float3 center = 0.5f * (to_float3(boxes[i].boxMin) + to_float3(boxes[i].boxMax));
+      const float3 extent = m_centerMax - m_centerMin;
+      const float3 scale =
+          float3(extent.x > 0.0f ? 1023.0f / extent.x : 0.0f, extent.y > 0.0f ? 1023.0f / extent.y : 0.0f,
+                 extent.z > 0.0f ? 1023.0f / extent.z : 0.0f);
+      const float3 cell = clamp((center - m_centerMin) * scale, float3(0.0f), float3(1023.0f));
+      const uint32_t code = (MortonExpandBits(uint32_t(cell.x)) << 2) | (MortonExpandBits(uint32_t(cell.y)) << 1) |
+                            MortonExpandBits(uint32_t(cell.z));
+      m_codes[i] = uint2(code, uint32_t(i));
+    }
+  });
   crt_choice.End(crt_loop);
 }
 
@@ -109,12 +114,13 @@ void LBVH_CPU::kernel1D_AppendInit(int count)
 {
   static crossrt::ParallelChoice crt_choice;
   const auto crt_loop = crt_choice.Begin(count);
-#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1024)
-  for (int i = 0; i < count; i++)
-  {
-    m_newGroup[i] = (i == 0 || m_codes[i].x != m_codes[i - 1].x) ? 1u : 0u;
-    m_primIndices[i] = m_codes[i].y;
-  }
+  crossrt::ParallelFor<int>(crt_loop.parallel, 0, count, 1024, [&](int crt_first, int crt_last) {
+    for (int i = crt_first; i < crt_last; i++)
+    {
+      m_newGroup[i] = (i == 0 || m_codes[i].x != m_codes[i - 1].x) ? 1u : 0u;
+      m_primIndices[i] = m_codes[i].y;
+    }
+  });
   crt_choice.End(crt_loop);
 }
 
@@ -122,22 +128,28 @@ void LBVH_CPU::kernel1D_AppendInit(int count)
 // thread while that has been faster: crossrt::ParallelChoice).
 void LBVH_CPU::kernel1D_AppendComplete(int count)
 {
-  auto crt_m_leafCountLocal = m_leafCount;
+  auto crt_m_leafCountTotal = m_leafCount;
+  crossrt::LoopReductions crt_reductions;
   static crossrt::ParallelChoice crt_choice;
   const auto crt_loop = crt_choice.Begin(count);
-#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1024) reduction(+ : crt_m_leafCountLocal)
-  for (int i = 0; i < count; i++)
-  {
-    if (m_newGroup[i] != 0u)
+  crossrt::ParallelFor<int>(crt_loop.parallel, 0, count, 1024, [&](int crt_first, int crt_last) {
+    // This chunk's parts of the reductions, merged into their totals after its iterations.
+    std::remove_reference_t<decltype(crt_m_leafCountTotal)> crt_m_leafCountLocal;
+    crt_reductions.StartFromZero(crt_m_leafCountLocal);
+    for (int i = crt_first; i < crt_last; i++)
     {
-      m_leafFirst[m_groupOf[i]] = uint32_t(i);
-      m_leafCode[m_groupOf[i]] = m_codes[i].x;
+      if (m_newGroup[i] != 0u)
+      {
+        m_leafFirst[m_groupOf[i]] = uint32_t(i);
+        m_leafCode[m_groupOf[i]] = m_codes[i].x;
+      }
+      if (i == count - 1)
+        crt_m_leafCountLocal += m_groupOf[i] + m_newGroup[i];
     }
-    if (i == count - 1)
-      crt_m_leafCountLocal += m_groupOf[i] + m_newGroup[i];
-  }
+    crt_reductions.Merge(crt_m_leafCountTotal, crt_m_leafCountLocal, crossrt::Sum());
+  });
   crt_choice.End(crt_loop);
-  m_leafCount = crt_m_leafCountLocal;
+  m_leafCount = crt_m_leafCountTotal;
 }
 
 // From LBVH::kernel1D_Karras12 (LBVH.cpp): the outer loop runs on all cores (or on this
@@ -146,42 +158,43 @@ void LBVH_CPU::kernel1D_Karras12(int count)
 {
   static crossrt::ParallelChoice crt_choice;
   const auto crt_loop = crt_choice.Begin(count);
-#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1024)
-  for (int i = 0; i < count; i++)
-  {
-    const int leaves = int(m_leafCount);
-    if (i >= leaves - 1)
-      continue;
-    const int d = Delta(i, i + 1) > Delta(i, i - 1) ? 1 : -1;
-    const int deltaMin = Delta(i, i - d);
-    int lengthMax = 2;
-    while (Delta(i, i + lengthMax * d) > deltaMin)
-      lengthMax *= 2;
-    int length = 0;
-    for (int step = lengthMax / 2; step >= 1; step /= 2)
-      if (Delta(i, i + (length + step) * d) > deltaMin)
-        length += step;
-    const int j = i + length * d;
-    const int deltaNode = Delta(i, j);
-    int split = 0;
-    for (int divisor = 2; divisor < 2 * length + 2; divisor *= 2)
+  crossrt::ParallelFor<int>(crt_loop.parallel, 0, count, 1024, [&](int crt_first, int crt_last) {
+    for (int i = crt_first; i < crt_last; i++)
     {
-      const int step = (length + divisor - 1) / divisor;
-      if (Delta(i, i + (split + step) * d) > deltaNode)
-        split += step;
-      if (step == 1)
-        break;
+      const int leaves = int(m_leafCount);
+      if (i >= leaves - 1)
+        continue;
+      const int d = Delta(i, i + 1) > Delta(i, i - 1) ? 1 : -1;
+      const int deltaMin = Delta(i, i - d);
+      int lengthMax = 2;
+      while (Delta(i, i + lengthMax * d) > deltaMin)
+        lengthMax *= 2;
+      int length = 0;
+      for (int step = lengthMax / 2; step >= 1; step /= 2)
+        if (Delta(i, i + (length + step) * d) > deltaMin)
+          length += step;
+      const int j = i + length * d;
+      const int deltaNode = Delta(i, j);
+      int split = 0;
+      for (int divisor = 2; divisor < 2 * length + 2; divisor *= 2)
+      {
+        const int step = (length + divisor - 1) / divisor;
+        if (Delta(i, i + (split + step) * d) > deltaNode)
+          split += step;
+        if (step == 1)
+          break;
+      }
+      const int gamma = i + split * d + std::min(d, 0);
+      const int first = std::min(i, j), last = std::max(i, j);
+      const uint32_t left = uint32_t(first == gamma ? leaves - 1 + gamma : gamma);
+      const uint32_t right = uint32_t(last == gamma + 1 ? leaves + gamma : gamma + 1);
+      m_nodes[i].left = left;
+      m_nodes[i].right = right;
+      m_parent[left] = uint32_t(i);
+      m_parent[right] = uint32_t(i);
+      m_arrivals[i] = 0u;
     }
-    const int gamma = i + split * d + std::min(d, 0);
-    const int first = std::min(i, j), last = std::max(i, j);
-    const uint32_t left = uint32_t(first == gamma ? leaves - 1 + gamma : gamma);
-    const uint32_t right = uint32_t(last == gamma + 1 ? leaves + gamma : gamma + 1);
-    m_nodes[i].left = left;
-    m_nodes[i].right = right;
-    m_parent[left] = uint32_t(i);
-    m_parent[right] = uint32_t(i);
-    m_arrivals[i] = 0u;
-  }
+  });
   crt_choice.End(crt_loop);
 }
 
@@ -191,26 +204,27 @@ void LBVH_CPU::kernel1D_MakeLeaves(int count, const LiteMath::Box4f* boxes)
 {
   static crossrt::ParallelChoice crt_choice;
   const auto crt_loop = crt_choice.Begin(count);
-#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1024)
-  for (int leaf = 0; leaf < count; leaf++)
-  {
-    if (uint32_t(leaf) >= m_leafCount)
-      continue;
-    const uint32_t first = m_leafFirst[leaf];
-    const uint32_t last = uint32_t(leaf) + 1 < m_leafCount ? m_leafFirst[leaf + 1] : uint32_t(count);
-    float3 boxMin = float3(+1e30f), boxMax = float3(-1e30f);
-    for (uint32_t k = first; k < last; k++)
+  crossrt::ParallelFor<int>(crt_loop.parallel, 0, count, 1024, [&](int crt_first, int crt_last) {
+    for (int leaf = crt_first; leaf < crt_last; leaf++)
     {
-      const Box4f box = boxes[m_primIndices[k]];
-      boxMin = min(boxMin, to_float3(box.boxMin));
-      boxMax = max(boxMax, to_float3(box.boxMax));
+      if (uint32_t(leaf) >= m_leafCount)
+        continue;
+      const uint32_t first = m_leafFirst[leaf];
+      const uint32_t last = uint32_t(leaf) + 1 < m_leafCount ? m_leafFirst[leaf + 1] : uint32_t(count);
+      float3 boxMin = float3(+1e30f), boxMax = float3(-1e30f);
+      for (uint32_t k = first; k < last; k++)
+      {
+        const Box4f box = boxes[m_primIndices[k]];
+        boxMin = min(boxMin, to_float3(box.boxMin));
+        boxMax = max(boxMax, to_float3(box.boxMax));
+      }
+      const uint32_t node = m_leafCount - 1 + uint32_t(leaf);
+      m_nodes[node].boxMin = boxMin;
+      m_nodes[node].boxMax = boxMax;
+      m_nodes[node].left = kLeafFlag | first;
+      m_nodes[node].right = last - first;
     }
-    const uint32_t node = m_leafCount - 1 + uint32_t(leaf);
-    m_nodes[node].boxMin = boxMin;
-    m_nodes[node].boxMax = boxMax;
-    m_nodes[node].left = kLeafFlag | first;
-    m_nodes[node].right = last - first;
-  }
+  });
   crt_choice.End(crt_loop);
 }
 
@@ -220,34 +234,35 @@ void LBVH_CPU::kernel1D_Refit(int count)
 {
   static crossrt::ParallelChoice crt_choice;
   const auto crt_loop = crt_choice.Begin(count);
-#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1024)
-  for (int leaf = 0; leaf < count; leaf++)
-  {
-    if (uint32_t(leaf) >= m_leafCount)
-      continue;
-    const uint32_t firstLeaf = m_leafCount - 1;
-    uint32_t node = firstLeaf + uint32_t(leaf);
-    float3 boxMin = m_nodes[node].boxMin, boxMax = m_nodes[node].boxMax;
-    while (node != 0u)
+  crossrt::ParallelFor<int>(crt_loop.parallel, 0, count, 1024, [&](int crt_first, int crt_last) {
+    for (int leaf = crt_first; leaf < crt_last; leaf++)
     {
-      const uint32_t parent = m_parent[node];
-      const uint32_t left = m_nodes[parent].left, right = m_nodes[parent].right;
-      const uint32_t sibling = left == node ? right : left;
-      if (sibling >= firstLeaf)
+      if (uint32_t(leaf) >= m_leafCount)
+        continue;
+      const uint32_t firstLeaf = m_leafCount - 1;
+      uint32_t node = firstLeaf + uint32_t(leaf);
+      float3 boxMin = m_nodes[node].boxMin, boxMax = m_nodes[node].boxMax;
+      while (node != 0u)
       {
-        if (node >= firstLeaf && node == right)
+        const uint32_t parent = m_parent[node];
+        const uint32_t left = m_nodes[parent].left, right = m_nodes[parent].right;
+        const uint32_t sibling = left == node ? right : left;
+        if (sibling >= firstLeaf)
+        {
+          if (node >= firstLeaf && node == right)
+            break;
+        }
+        else if (node >= firstLeaf)
           break;
+        else if (crossrt::AtomicAdd(m_arrivals[parent], 1u) == 0u)
+          break;
+        boxMin = min(boxMin, m_nodes[sibling].boxMin);
+        boxMax = max(boxMax, m_nodes[sibling].boxMax);
+        m_nodes[parent].boxMin = boxMin;
+        m_nodes[parent].boxMax = boxMax;
+        node = parent;
       }
-      else if (node >= firstLeaf)
-        break;
-      else if (crossrt::AtomicAdd(m_arrivals[parent], 1u) == 0u)
-        break;
-      boxMin = min(boxMin, m_nodes[sibling].boxMin);
-      boxMax = max(boxMax, m_nodes[sibling].boxMax);
-      m_nodes[parent].boxMin = boxMin;
-      m_nodes[parent].boxMax = boxMax;
-      node = parent;
     }
-  }
+  });
   crt_choice.End(crt_loop);
 }

@@ -4,18 +4,14 @@
 
 #include <crossrt/CpuParallel.h>
 
+#include <algorithm>
 #include <chrono>
-#include <omp.h>
+#include <iterator>
+#include <type_traits>
 
 // As in the class's source files: the bodies below are copied from them.
 #include <chrono>
 using namespace LiteMath;
-
-#pragma omp declare reduction(crossrt_min_vec4:float4 : omp_out = LiteMath::min(omp_out, omp_in)) \
-    initializer(omp_priv = omp_orig)
-#pragma omp declare reduction(crossrt_max_vec4:float4 : omp_out = LiteMath::max(omp_out, omp_in)) \
-    initializer(omp_priv = omp_orig)
-#pragma omp declare reduction(crossrt_add_vec4:float4 : omp_out = omp_out + omp_in) initializer(omp_priv = float4())
 
 Particles_CPU::Particles_CPU() : Particles()
 {
@@ -38,8 +34,7 @@ void Particles_CPU::Step(int n, float dt, float4* positions, float4* velocities)
 {
   const auto crt_start = std::chrono::steady_clock::now();
   // The body of Particles::Step, run as a lambda so that an early 'return' still gets timed.
-  [&]()
-  {
+  [&]() {
     const auto start = std::chrono::steady_clock::now();
     m_boxMin = float4(INF_POSITIVE);
     m_boxMax = float4(INF_NEGATIVE);
@@ -58,53 +53,72 @@ void Particles_CPU::Step(int n, float dt, float4* positions, float4* velocities)
 // thread while that has been faster: crossrt::ParallelChoice).
 void Particles_CPU::kernel1D_Advance(int n, float dt, float4* positions, float4* velocities)
 {
-  auto crt_m_bouncesLocal = m_bounces;
+  auto crt_m_bouncesTotal = m_bounces;
+  crossrt::LoopReductions crt_reductions;
   static crossrt::ParallelChoice crt_choice;
   const auto crt_loop = crt_choice.Begin(n);
-#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1024) reduction(+ : crt_m_bouncesLocal)
-  for (int i = 0; i < n; i++)
-  {
-    float4 v = velocities[i];
-    float4 p = positions[i] + v * dt;
-    v.y += m_gravity * dt;
-    if (p.y < 0.0f)
+  crossrt::ParallelFor<int>(crt_loop.parallel, 0, n, 1024, [&](int crt_first, int crt_last) {
+    // This chunk's parts of the reductions, merged into their totals after its iterations.
+    std::remove_reference_t<decltype(crt_m_bouncesTotal)> crt_m_bouncesLocal;
+    crt_reductions.StartFromZero(crt_m_bouncesLocal);
+    for (int i = crt_first; i < crt_last; i++)
     {
-      p.y = -p.y * m_restitution;
-      v.y = -v.y * m_restitution;
-      crt_m_bouncesLocal += 1;
+      float4 v = velocities[i];
+      float4 p = positions[i] + v * dt;
+      v.y += m_gravity * dt;
+      if (p.y < 0.0f)
+      {
+        p.y = -p.y * m_restitution;
+        v.y = -v.y * m_restitution;
+        crt_m_bouncesLocal += 1;
+      }
+      positions[i] = p;
+      velocities[i] = v;
     }
-    positions[i] = p;
-    velocities[i] = v;
-  }
+    crt_reductions.Merge(crt_m_bouncesTotal, crt_m_bouncesLocal, crossrt::Sum());
+  });
   crt_choice.End(crt_loop);
-  m_bounces = crt_m_bouncesLocal;
+  m_bounces = crt_m_bouncesTotal;
 }
 
 // From Particles::kernel1D_Measure (Particles.cpp): the outer loop runs on all cores (or on this
 // thread while that has been faster: crossrt::ParallelChoice).
 void Particles_CPU::kernel1D_Measure(int n, const float4* positions, const float4* velocities)
 {
-  auto crt_m_boxMinLocal = m_boxMin;
-  auto crt_m_boxMaxLocal = m_boxMax;
-  auto crt_m_momentumLocal = m_momentum;
-  auto crt_m_kineticEnergyLocal = m_kineticEnergy;
+  auto crt_m_boxMinTotal = m_boxMin;
+  auto crt_m_boxMaxTotal = m_boxMax;
+  auto crt_m_momentumTotal = m_momentum;
+  auto crt_m_kineticEnergyTotal = m_kineticEnergy;
+  crossrt::LoopReductions crt_reductions;
   static crossrt::ParallelChoice crt_choice;
   const auto crt_loop = crt_choice.Begin(n);
-#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1024) \
-    reduction(crossrt_min_vec4 : crt_m_boxMinLocal) reduction(crossrt_max_vec4 : crt_m_boxMaxLocal) \
-    reduction(crossrt_add_vec4 : crt_m_momentumLocal) reduction(+ : crt_m_kineticEnergyLocal)
-  for (int i = 0; i < n; i++)
-  {
-    const float4 p = positions[i];
-    const float4 v = velocities[i];
-    crt_m_boxMinLocal = min(crt_m_boxMinLocal, p);
-    crt_m_boxMaxLocal = max(crt_m_boxMaxLocal, p);
-    crt_m_momentumLocal += v;
-    crt_m_kineticEnergyLocal += 0.5f * dot(v, v);
-  }
+  crossrt::ParallelFor<int>(crt_loop.parallel, 0, n, 1024, [&](int crt_first, int crt_last) {
+    // This chunk's parts of the reductions, merged into their totals after its iterations.
+    std::remove_reference_t<decltype(crt_m_boxMinTotal)> crt_m_boxMinLocal;
+    crt_reductions.StartFromTotal(crt_m_boxMinLocal, crt_m_boxMinTotal);
+    std::remove_reference_t<decltype(crt_m_boxMaxTotal)> crt_m_boxMaxLocal;
+    crt_reductions.StartFromTotal(crt_m_boxMaxLocal, crt_m_boxMaxTotal);
+    std::remove_reference_t<decltype(crt_m_momentumTotal)> crt_m_momentumLocal;
+    crt_reductions.StartFromZero(crt_m_momentumLocal);
+    std::remove_reference_t<decltype(crt_m_kineticEnergyTotal)> crt_m_kineticEnergyLocal;
+    crt_reductions.StartFromZero(crt_m_kineticEnergyLocal);
+    for (int i = crt_first; i < crt_last; i++)
+    {
+      const float4 p = positions[i];
+      const float4 v = velocities[i];
+      crt_m_boxMinLocal = min(crt_m_boxMinLocal, p);
+      crt_m_boxMaxLocal = max(crt_m_boxMaxLocal, p);
+      crt_m_momentumLocal += v;
+      crt_m_kineticEnergyLocal += 0.5f * dot(v, v);
+    }
+    crt_reductions.Merge(crt_m_boxMinTotal, crt_m_boxMinLocal, crossrt::Minimum());
+    crt_reductions.Merge(crt_m_boxMaxTotal, crt_m_boxMaxLocal, crossrt::Maximum());
+    crt_reductions.Merge(crt_m_momentumTotal, crt_m_momentumLocal, crossrt::Sum());
+    crt_reductions.Merge(crt_m_kineticEnergyTotal, crt_m_kineticEnergyLocal, crossrt::Sum());
+  });
   crt_choice.End(crt_loop);
-  m_boxMin = crt_m_boxMinLocal;
-  m_boxMax = crt_m_boxMaxLocal;
-  m_momentum = crt_m_momentumLocal;
-  m_kineticEnergy = crt_m_kineticEnergyLocal;
+  m_boxMin = crt_m_boxMinTotal;
+  m_boxMax = crt_m_boxMaxTotal;
+  m_momentum = crt_m_momentumTotal;
+  m_kineticEnergy = crt_m_kineticEnergyTotal;
 }

@@ -4,8 +4,10 @@
 
 #include <crossrt/CpuParallel.h>
 
+#include <algorithm>
 #include <chrono>
-#include <omp.h>
+#include <iterator>
+#include <type_traits>
 
 // As in the class's source files: the bodies below are copied from them.
 #include <cmath>
@@ -54,19 +56,20 @@ void PrimaryRays_CPU::kernel2D_Render(uint32_t* pixels, int width, int height)
 {
   static crossrt::ParallelChoice crt_choice;
   const auto crt_loop = crt_choice.Begin(height);
-#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1)
-  for (int y = 0; y < height; ++y)
-  {
-    for (int x = 0; x < width; ++x)
+  crossrt::ParallelFor<int>(crt_loop.parallel, 0, height, 1, [&](int crt_first, int crt_last) {
+    for (int y = crt_first; y < crt_last; ++y)
     {
-      const float sx = 2.0f * (float(x) + 0.5f) / float(width) - 1.0f;
-      const float sy = 1.0f - 2.0f * (float(y) + 0.5f) / float(height);
-      const float4 dir = m_forward + m_right * sx + m_up * sy;
-      const CRT_Hit hit = m_pAccelStruct->RayQuery_NearestHit(m_eye, float4(dir.x, dir.y, dir.z, kCameraFar));
-      const uint32_t pixel = uint32_t(y * width + x);
-      pixels[pixel] = PackRGBA8(Shade(hit, to_float3(m_eye), to_float3(dir), pixel));
+      for (int x = 0; x < width; ++x)
+      {
+        const float sx = 2.0f * (float(x) + 0.5f) / float(width) - 1.0f;
+        const float sy = 1.0f - 2.0f * (float(y) + 0.5f) / float(height);
+        const float4 dir = m_forward + m_right * sx + m_up * sy;
+        const CRT_Hit hit = m_pAccelStruct->RayQuery_NearestHit(m_eye, float4(dir.x, dir.y, dir.z, kCameraFar));
+        const uint32_t pixel = uint32_t(y * width + x);
+        pixels[pixel] = PackRGBA8(Shade(hit, to_float3(m_eye), to_float3(dir), pixel));
+      }
     }
-  }
+  });
   crt_choice.End(crt_loop);
 }
 
@@ -76,8 +79,9 @@ void PrimaryRays_CPU::kernel1D_CastRays(const float4* posAndNear, const float4* 
 {
   static crossrt::ParallelChoice crt_choice;
   const auto crt_loop = crt_choice.Begin(n);
-#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1024)
-  for (int i = 0; i < n; ++i)
-    hits[i] = m_pAccelStruct->RayQuery_NearestHit(posAndNear[i], dirAndFar[i]);
+  crossrt::ParallelFor<int>(crt_loop.parallel, 0, n, 1024, [&](int crt_first, int crt_last) {
+    for (int i = crt_first; i < crt_last; ++i)
+      hits[i] = m_pAccelStruct->RayQuery_NearestHit(posAndNear[i], dirAndFar[i]);
+  });
   crt_choice.End(crt_loop);
 }

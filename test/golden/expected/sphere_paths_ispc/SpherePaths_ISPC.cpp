@@ -7,11 +7,12 @@
 
 #include "SpherePaths_ISPC_kernels_ispc.h"
 
+#include <algorithm>
 #include <chrono>
-#include <stdexcept>
+#include <iterator>
 #include <type_traits>
+#include <stdexcept>
 #include <typeinfo>
-#include <omp.h>
 
 // As in the class's source files: the bodies below are copied from them.
 #include <chrono>
@@ -49,8 +50,7 @@ void SpherePaths_ISPC::Render(uint32_t width, uint32_t height, int samples, floa
 {
   const auto crt_start = std::chrono::steady_clock::now();
   // The body of SpherePaths::Render, run as a lambda so that an early 'return' still gets timed.
-  [&]()
-  {
+  [&]() {
     const auto start = std::chrono::steady_clock::now();
     {
       static crossrt::LaneChoice crt_lanes;
@@ -67,11 +67,12 @@ void SpherePaths_ISPC::Render(uint32_t width, uint32_t height, int samples, floa
                                SpherePaths_Render_Megakernel_avx512skx});
         static crossrt::ParallelChoice crt_choice;
         const auto crt_loop = crt_choice.Begin(crt_countY);
-#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 1)
-        for (int crt_chunk = 0; crt_chunk < (crt_countY + 4 - 1) / 4; ++crt_chunk)
-          crt_run(const_cast<ispc::SpherePaths_Data*>(&crt_self), crt_chunk * 4,
-                  std::min(crt_countY, (crt_chunk + 1) * 4), 0, crt_countX,
-                  crossrt::IspcPointer<ispc::float4*>(out_color), samples, width, height);
+        crossrt::ParallelFor<int>(crt_loop.parallel, 0, (crt_countY + 4 - 1) / 4, 1, [&](int crt_first, int crt_last) {
+          for (int crt_chunk = crt_first; crt_chunk < crt_last; ++crt_chunk)
+            crt_run(const_cast<ispc::SpherePaths_Data*>(&crt_self), crt_chunk * 4,
+                    std::min(crt_countY, (crt_chunk + 1) * 4), 0, crt_countX,
+                    crossrt::IspcPointer<ispc::float4*>(out_color), samples, width, height);
+        });
         crt_choice.End(crt_loop);
         IspcWrittenBack(crt_self);
       }
@@ -79,23 +80,24 @@ void SpherePaths_ISPC::Render(uint32_t width, uint32_t height, int samples, floa
       {
         static crossrt::ParallelChoice crt_choice;
         const auto crt_loop = crt_choice.Begin(height);
-#pragma omp parallel for if (crt_loop.parallel) schedule(dynamic, 16) collapse(2)
-        for (uint32_t y = 0; y < height; y++)
-          for (uint32_t x = 0; x < width; x++)
-          {
-            float4 rayPos, rayDir, throughput, color;
-            SphereHit hit;
-            for (int sample = 0; sample < samples; sample++)
+        crossrt::ParallelFor<uint32_t>(crt_loop.parallel, 0, height, 1, [&](uint32_t crt_first, uint32_t crt_last) {
+          for (uint32_t y = crt_first; y < crt_last; y++)
+            for (uint32_t x = 0; x < width; x++)
             {
-              kernel_InitEyeRay(x, y, width, height, sample, &rayPos, &rayDir, &throughput);
-              for (int bounce = 0; bounce < m_maxDepth; bounce++)
+              float4 rayPos, rayDir, throughput, color;
+              SphereHit hit;
+              for (int sample = 0; sample < samples; sample++)
               {
-                kernel_RayTrace(x, y, &rayPos, &rayDir, &throughput, &hit);
-                kernel_NextBounce(x, y, width, sample, bounce, &hit, &rayPos, &rayDir, &throughput, &color);
+                kernel_InitEyeRay(x, y, width, height, sample, &rayPos, &rayDir, &throughput);
+                for (int bounce = 0; bounce < m_maxDepth; bounce++)
+                {
+                  kernel_RayTrace(x, y, &rayPos, &rayDir, &throughput, &hit);
+                  kernel_NextBounce(x, y, width, sample, bounce, &hit, &rayPos, &rayDir, &throughput, &color);
+                }
               }
+              kernel_Contribute(x, y, width, samples, &color, out_color);
             }
-            kernel_Contribute(x, y, width, samples, &color, out_color);
-          }
+        });
         crt_choice.End(crt_loop);
       }
       crt_lanes.End(crt_way);
