@@ -31,9 +31,11 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdint>
+#include <cstdlib>
 #include <cstddef>
 #include <exception>
 #include <mutex>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -157,6 +159,16 @@ class LoopPool {
 // and so on this thread alone.
 inline bool InParallelLoop() { return detail::InPoolChunk() || omp_in_parallel(); }
 
+// CROSSRT_CPU_LOOPS=openmp: ParallelFor hands its chunks to an OpenMP loop instead of the pool (as
+// the generated code did before the pool), to compare the two.
+inline bool OpenMPLoops() {
+  static const bool openmp = [] {
+    const char* v = std::getenv("CROSSRT_CPU_LOOPS");
+    return v != nullptr && std::string(v) == "openmp";
+  }();
+  return openmp;
+}
+
 // The threads a parallel loop runs on: the pool's workers and the calling thread.
 inline int LoopThreads() { return detail::LoopPool::Instance().Workers() + 1; }
 
@@ -184,6 +196,11 @@ void ParallelFor(bool parallel, T begin, T end, long long grain, Body&& body) {
         c.body(from, to);
       }
     } chunked{body, begin, end, grain};
+    if (OpenMPLoops()) {  // to compare
+#pragma omp parallel for schedule(dynamic, 1)
+      for (long long chunk = 0; chunk < chunks; ++chunk) Chunks::Run(&chunked, chunk, chunk + 1);
+      return;
+    }
     if (detail::LoopPool::Instance().Run(chunks, &Chunks::Run, &chunked)) return;
   }
   body(begin, end);

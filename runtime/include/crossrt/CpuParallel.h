@@ -241,9 +241,9 @@ class ParallelChoice {
 };
 
 // Stable LSD radix sort of n records of key.strideWords words, on all cores or one (see below):
-// per pass of 11 bits (three passes cover a 32-bit key), each thread counts the digits of its
-// slice, the counts are scanned in (digit, thread) order, and each thread moves its slice's records
-// to their places. A pass whose digit is the same in every record moves nothing and is skipped
+// per pass of 11 bits (three passes cover a 32-bit key), the digits of each slice of the records
+// (one slice per thread) are counted, the counts scanned in (digit, slice) order, and each slice's
+// records moved to their places. A pass whose digit is the same in every record moves nothing and is skipped
 // (keys below 2^22 take two passes).
 inline void RadixSortWords(uint32_t* records, size_t n, const SortKey& key) {
   constexpr uint32_t kDigitBits = 11, kDigits = 1u << kDigitBits;
@@ -256,39 +256,51 @@ inline void RadixSortWords(uint32_t* records, size_t n, const SortKey& key) {
   uint32_t* dst = scratch.data();
   // Below 2^15 records, waking the other threads costs more than they save: with this, the LBVH
   // build of the 992-triangle teapot went from 1.1x to 0.8x of Embree LOW's time. Above, the sort
-  // runs on all cores or one as a kernel's loop does (ParallelChoice): its passes wait at barriers,
-  // and beside one busy thread on 2 cores the LBVH build of 47,794 triangles took 53 ms in some
-  // runs, against 2-4 ms in others.
+  // runs on all cores or one as a kernel's loop does (ParallelChoice). When its passes met at
+  // OpenMP barriers, beside one busy thread on 2 cores the LBVH build of 47,794 triangles took 53 ms
+  // in some runs, against 2-4 ms in others; on the pool, the OpenMP threads no longer take turns
+  // with the pool's on the cores either.
   static ParallelChoice choice;
   const bool large = n >= (size_t(1) << 15);
   const ParallelChoice::Run run = choice.Begin(large ? static_cast<long long>(n) : 1);
-  const int threads = large && run.parallel ? omp_get_max_threads() : 1;
-  std::vector<size_t> counts(size_t(threads) * kDigits);
+  // The records in slices, one per thread, each counted and moved in order by whichever thread
+  // takes it (ParallelFor, as the kernels' loops: no barrier waits for a thread that never started).
+  const bool parallel = large && run.parallel;
+  const int slices = parallel ? LoopThreads() : 1;
+  std::vector<size_t> counts(size_t(slices) * kDigits);
+  auto slice = [&](int s, size_t& begin, size_t& end) {
+    begin = n * size_t(s) / size_t(slices);
+    end = n * size_t(s + 1) / size_t(slices);
+  };
   for (uint32_t shift = 0; shift < 32; shift += kDigitBits) {
     std::fill(counts.begin(), counts.end(), 0);
+    ParallelFor<int>(parallel, 0, slices, 1, [&](int first, int last) {
+      for (int s = first; s < last; ++s) {
+        size_t begin, end;
+        slice(s, begin, end);
+        size_t* mine = &counts[size_t(s) * kDigits];
+        for (size_t i = begin; i < end; ++i) ++mine[(SortableBits(src[i * stride + key.keyWord], key) >> shift) & (kDigits - 1)];
+      }
+    });
+    // Each (digit, slice)'s first place, in that order: the sort is stable.
     bool oneDigit = false;
-#pragma omp parallel num_threads(threads)
-    {
-      const int t = omp_get_thread_num(), used = omp_get_num_threads();
-      const size_t begin = n * t / used, end = n * (t + 1) / used;
-      size_t* mine = &counts[size_t(t) * kDigits];
-      for (size_t i = begin; i < end; ++i) ++mine[(SortableBits(src[i * stride + key.keyWord], key) >> shift) & (kDigits - 1)];
-#pragma omp barrier
-#pragma omp single
-      {
-        size_t position = 0;
-        for (uint32_t digit = 0; digit < kDigits; ++digit) {
-          size_t inDigit = 0;
-          for (int u = 0; u < used; ++u) {
-            const size_t c = counts[size_t(u) * kDigits + digit];
-            counts[size_t(u) * kDigits + digit] = position;
-            position += c;
-            inDigit += c;
-          }
-          oneDigit = oneDigit || inDigit == n;
-        }
-      }  // (the implicit barrier publishes oneDigit)
-      if (!oneDigit)
+    size_t position = 0;
+    for (uint32_t digit = 0; digit < kDigits; ++digit) {
+      size_t inDigit = 0;
+      for (int s = 0; s < slices; ++s) {
+        const size_t c = counts[size_t(s) * kDigits + digit];
+        counts[size_t(s) * kDigits + digit] = position;
+        position += c;
+        inDigit += c;
+      }
+      oneDigit = oneDigit || inDigit == n;
+    }
+    if (oneDigit) continue;
+    ParallelFor<int>(parallel, 0, slices, 1, [&](int first, int last) {
+      for (int s = first; s < last; ++s) {
+        size_t begin, end;
+        slice(s, begin, end);
+        size_t* mine = &counts[size_t(s) * kDigits];
         for (size_t i = begin; i < end; ++i) {
           const uint32_t digit = (SortableBits(src[i * stride + key.keyWord], key) >> shift) & (kDigits - 1);
           const size_t to = mine[digit]++;
@@ -299,12 +311,13 @@ inline void RadixSortWords(uint32_t* records, size_t n, const SortKey& key) {
           else
             std::memcpy(dst + to * stride, src + i * stride, stride * sizeof(uint32_t));
         }
-    }
-    if (!oneDigit) std::swap(src, dst);
+      }
+    });
+    std::swap(src, dst);
   }
   if (src != records) {  // an odd number of passes moved records: the result is in scratch
-#pragma omp parallel for num_threads(threads) schedule(static)
-    for (long long i = 0; i < static_cast<long long>(n * stride); ++i) records[i] = src[i];
+    const long long words = static_cast<long long>(n * stride);
+    ParallelFor<long long>(parallel, 0, words, 1 << 16, [&](long long first, long long last) { std::copy(src + first, src + last, records + first); });
   }
   choice.End(run);
 }
