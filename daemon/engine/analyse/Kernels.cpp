@@ -1,6 +1,6 @@
 // One kernel from start to end: its loop nest, parameters, writes and reductions, the GLSL of its body
-// through the printer, and the CPU copy whose outer loop runs in chunks on all cores. Takes a kernel's method; adds a Kernel
-// to the model.
+// through the printer, and the CPU copy whose outer loop runs in chunks on all cores. Takes a
+// kernel's method; adds a Kernel to the model.
 #include "analyse/Kernels.h"
 
 #include "analyse/AnalysisContext.h"

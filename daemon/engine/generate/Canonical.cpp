@@ -14,8 +14,9 @@ namespace crossrt::engine {
 
 namespace {
 
-// clang-format in the layout of generated code: Allman braces (but lambdas'), 2-space indents, `float* p`, two
-// spaces before a trailing comment; `wholeFile`: one-line inline functions stay on their line.
+// clang-format in the layout of generated code: Allman braces (but lambdas'), 2-space indents,
+// `float* p`, two spaces before a trailing comment; `wholeFile`: one-line inline functions stay on
+// their line.
 std::string Reformat(const std::string& code, unsigned columns, bool wholeFile) {
   clang::format::FormatStyle style = clang::format::getLLVMStyle();
   // Allman's braces, but a lambda's body opens on its line and is indented from the statement (the

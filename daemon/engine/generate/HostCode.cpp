@@ -102,7 +102,7 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
                                         "// of its control functions (one or two thread ids), run here as ISPC (" + model.generatedName +
                                         "_kernels.ispc), on all CPU cores,\n// each in SIMD lanes (a kernel as the _CPU class runs it where "
                                         "that has been faster here);\n// everything else is inherited unchanged."
-                                  : "The kernels of " + model.className + " run here on all\n// CPU cores with OpenMP; everything else is inherited unchanged.");
+                                  : "The kernels of " + model.className + " run here on all\n// CPU cores (crossrt::ParallelFor); everything else is inherited unchanged.");
   if (model.forIspc) IspcHostData(model, d);
   Data kernels = List();
   for (auto& k : model.kernels) {

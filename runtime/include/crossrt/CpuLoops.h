@@ -16,12 +16,13 @@
 // after the loop finds nothing to take and sleeps again. Loops inside a loop's body (and loops in
 // an OpenMP parallel region) run on their thread. While one thread's loop runs on the pool, another
 // thread's loop runs on its own thread alone. The iterations are what the loop's own code makes of
-// [first, last), so a loop computes the same thing whichever thread runs each chunk.
+// [first, last), so a loop computes the same thing whichever thread runs each chunk. What the
+// pool cannot save is a chunk whose worker loses its core while it runs it: the loop waits for it.
 //
 // The pool has omp_get_max_threads() - 1 workers (OMP_NUM_THREADS is honoured), started on the first
 // parallel loop. A worker that finds no work spins for about 20 us, then sleeps on a condition
-// variable (what OMP_WAIT_POLICY=passive does after its spin), so that an idle pool leaves the
-// cores to other programs. The pool is never destroyed: its threads end with the process.
+// variable (as libgomp's threads do at once under OMP_WAIT_POLICY=passive), so that an idle pool
+// leaves the cores to other programs. The pool is never destroyed: its threads end with the process.
 #pragma once
 
 #include <omp.h>
@@ -30,9 +31,9 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <cstddef>
 #include <cstdint>
 #include <cstdlib>
-#include <cstddef>
 #include <exception>
 #include <mutex>
 #include <string>
@@ -72,7 +73,7 @@ class LoopPool {
     m_chunks.store(chunks, std::memory_order_relaxed);
     m_done.store(0, std::memory_order_relaxed);
     m_failure = nullptr;
-    const uint64_t generation = Generation(m_claim.load(std::memory_order_relaxed)) + 1;
+    const uint64_t generation = (Generation(m_claim.load(std::memory_order_relaxed)) + 1) & kGenerations;  // (wraps after 2^24 loops)
     m_claim.store(generation << kIndexBits, std::memory_order_seq_cst);  // publishes the loop (seq_cst: see Work)
     if (m_sleeping.load(std::memory_order_seq_cst) > 0) {
       std::lock_guard<std::mutex> lock(m_sleep);
@@ -80,7 +81,7 @@ class LoopPool {
     }
     TakeChunks(generation);
     // Every chunk is taken: wait for those workers are still running (not for workers that never
-    // started), yielding the core to them after a short spin.
+    // started), yielding the core after a short spin.
     for (int spins = 0; m_done.load(std::memory_order_acquire) < chunks; ++spins)
       if (spins > 64) std::this_thread::yield();
     if (m_failure) std::rethrow_exception(m_failure);
@@ -89,6 +90,7 @@ class LoopPool {
 
  private:
   static constexpr int kIndexBits = 40;  // the claim word: generation above, next chunk below
+  static constexpr uint64_t kGenerations = (uint64_t(1) << (64 - kIndexBits)) - 1;
   static uint64_t Generation(uint64_t claim) { return claim >> kIndexBits; }
   static long long Index(uint64_t claim) { return static_cast<long long>(claim & ((uint64_t(1) << kIndexBits) - 1)); }
 
