@@ -911,6 +911,37 @@ TEST_CASE("ParallelFor runs every iteration once, on the pool's threads and the 
   CHECK(coverage(0, 5000, 64, true) == 0);
 }
 
+// Many short loops back to back, from three threads at once, some with loops inside their chunks:
+// workers that wake late for one loop must never run a chunk of the next one twice or skip one.
+TEST_CASE("ParallelFor under stress: loops back to back from several threads", "[runtime][parallel]")
+{
+  std::atomic<int> wrong{0};
+  auto loops = [&](unsigned seed) {
+    std::mt19937 rng(seed);
+    for (int loop = 0; loop < 400; ++loop) {
+      const int n = int(rng() % 3000);
+      const long long grain = 1 + rng() % 64;
+      const bool nested = rng() % 8 == 0;
+      std::vector<std::atomic<int>> seen(size_t(n) + 1);
+      crossrt::ParallelFor<int>(true, 0, n, grain, [&](int first, int last) {
+        for (int i = first; i < last; i++) {
+          if (nested) {
+            std::atomic<int> inner{0};
+            crossrt::ParallelFor<int>(true, 0, 3, 1, [&](int f, int l) { inner += l - f; });
+            if (inner.load() != 3) ++wrong;
+          }
+          ++seen[size_t(i)];
+        }
+      });
+      for (int i = 0; i < n; ++i) wrong += seen[size_t(i)].load() != 1;
+    }
+  };
+  std::vector<std::thread> threads;
+  for (unsigned t = 0; t < 3; ++t) threads.emplace_back(loops, 1000 + t);
+  for (auto& t : threads) t.join();
+  CHECK(wrong.load() == 0);
+}
+
 TEST_CASE("LoopReductions: chunks' parts of sums, minima and arrays add up to the whole", "[runtime][parallel]")
 {
   const int n = 100000;
