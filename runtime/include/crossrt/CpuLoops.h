@@ -174,9 +174,9 @@ inline bool OpenMPLoops() {
 // The threads a parallel loop runs on: the pool's workers and the calling thread.
 inline int LoopThreads() { return detail::LoopPool::Instance().Workers() + 1; }
 
-// Runs body(first, last) over [begin, end) in chunks of `grain` iterations or more (see below): on the pool and this
-// thread when `parallel` (and not inside another parallel loop), else once, on this thread, over
-// the whole range. The generated loops call it as
+// Runs body(first, last) over [begin, end) in chunks of `grain` iterations or more (see below): on
+// the pool and this thread when `parallel` (and not inside another parallel loop), else once, on
+// this thread, over the whole range. The generated loops call it as
 //   crossrt::ParallelFor<int>(crt_loop.parallel, 0, n, 1024, [&](int crt_first, int crt_last) {
 //     for (int i = crt_first; i < crt_last; i++) { ...the loop's body... }
 //   });
@@ -185,9 +185,9 @@ void ParallelFor(bool parallel, T begin, T end, long long grain, Body&& body) {
   if (!(begin < end)) return;
   const long long count = static_cast<long long>(end - begin);
   // At most kChunksPerThread chunks a thread: enough to even out iterations of unequal cost, and
-  // few enough that claiming chunks and merging reductions (a lock per chunk) stay cheap, also
-  // when a thread holding the lock is taken off its core (Particles_CPU, 1M particles in chunks of
-  // 1024, fell from 1.9x to 1.3x of the original beside two busy threads on 2 cores).
+  // few enough that claiming chunks and merging reductions (a lock per chunk) stay cheap. With
+  // chunks of 1024 for 1M particles, Particles_CPU (four reductions) ran at 1.74-1.78x of the
+  // original on 2 threads; with this limit, at 2.41-2.47x (AMD EPYC, quiet).
   constexpr long long kChunksPerThread = 32;
   const long long threads = parallel ? LoopThreads() : 1;
   grain = std::max({1LL, grain, (count + threads * kChunksPerThread - 1) / (threads * kChunksPerThread)});
@@ -214,10 +214,6 @@ void ParallelFor(bool parallel, T begin, T end, long long grain, Body&& body) {
   body(begin, end);
 }
 
-// The reductions of one ParallelFor (a generated loop's crt_reductions): each chunk reduces into
-// parts of its own, started from zero (sums) or from the total so far (min, max: taking a value
-// twice changes nothing), and merges them into the totals under one lock when its iterations are
-// done. Whole values (scalars, LiteMath vectors) and arrays of them (coefs[k] += x) alike.
 // The reductions' operations, for scalars and LiteMath vectors alike (min and max found by ADL).
 struct Sum {
   template <typename T>
@@ -238,6 +234,10 @@ struct Maximum {
   }
 };
 
+// The reductions of one ParallelFor (a generated loop's crt_reductions): each chunk reduces into
+// parts of its own, started from zero (sums) or from the total so far (min, max: taking a value
+// twice changes nothing), and merges them into the totals under one lock when its iterations are
+// done. Whole values (scalars, LiteMath vectors) and arrays of them (coefs[k] += x) alike.
 class LoopReductions {
  public:
   template <typename T>
