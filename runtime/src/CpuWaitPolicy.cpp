@@ -10,7 +10,9 @@
 // program. With one busy thread beside bench_lbvh on 2 cores (AMD EPYC), the LBVH_CPU build of the
 // 75,408-triangle bunny took 41 and 68 ms in two runs of four with the default policy (14-17 ms
 // in the others; the single-threaded original 15-21 ms), and 12.1-18.3 ms in four runs of four
-// with passive waits. Quiet, the two policies build at the same speed.
+// with passive waits. Quiet, the two policies build at the same speed. (Those loops were OpenMP
+// loops then; since the generated loops run on CrossRT's own pool (CpuLoops.h), the policy is
+// for the OpenMP regions the program runs itself, and for CROSSRT_CPU_LOOPS=openmp.)
 //
 // libgomp reads the variable once, in its own initialiser, so it is set from the executable's
 // .preinit_array, which the dynamic loader runs before every shared library's initialiser. A

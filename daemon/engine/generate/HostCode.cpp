@@ -119,7 +119,7 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
       // Each chunk reduces into a part of its own, crt_<name>Local (Kernels.cpp renames the target in
       // the loop nest), merged into crt_<name>Total: a copy of a member, or a reference to a local.
       // An array member (its elements reduced, coefs[k] += x, on the CPU backend only) element by element.
-      const auto [element, dims] = SplitArray(r.glslType);
+      const std::string dims = SplitArray(r.glslType).second;
       const std::string count = dims.empty() ? "" : dims.substr(1, dims.size() - 2);
       Data y;
       y.set("member", r.member);
