@@ -67,6 +67,15 @@ inline std::vector<std::vector<double>> InterleavedMs(const std::vector<std::fun
   return ms;
 }
 
+// The q-quantile (0 <= q <= 1) of times measured elsewhere, the nearest measured time below it: 0.9
+// for the 90th percentile, 1 for the slowest; 0 for none.
+inline double QuantileOf(std::vector<double> ms, double q)
+{
+  if (ms.empty()) return 0.0;
+  std::sort(ms.begin(), ms.end());
+  return ms[size_t(q * double(ms.size() - 1))];
+}
+
 // The median over the rounds of a[r] / b[r] (times of InterleavedMs).
 inline double PairedRatio(const std::vector<double>& a, const std::vector<double>& b)
 {
@@ -106,29 +115,35 @@ inline const char* IspcLanes()
   }
 }
 
-// N threads that keep a core each busy for as long as this object lives: `--load N`, the other
-// work on a user's machine (an IDE, a browser, a build) beside a measurement. Each spins on
-// arithmetic without sleeping, as `yes > /dev/null` does.
+// N threads that keep a core each busy while started (from construction until Stop, and again after
+// Start): `--load N`, the other work on a user's machine (an IDE, a browser, a build) beside a
+// measurement. Each spins on arithmetic without sleeping, as `yes > /dev/null` does.
 class BusyThreads
 {
 public:
-  explicit BusyThreads(int n)
+  explicit BusyThreads(int n) : m_count(n) { Start(); }
+  ~BusyThreads() { Stop(); }
+  void Start()
   {
-    for (int i = 0; i < n; ++i)
+    if (!m_threads.empty()) return;
+    m_stop = false;
+    for (int i = 0; i < m_count; ++i)
       m_threads.emplace_back([this] {
         volatile unsigned x = 1;
         while (!m_stop.load(std::memory_order_relaxed))
           for (int k = 0; k < 4096; ++k) x = x * 1664525u + 1013904223u;
       });
   }
-  ~BusyThreads()
+  void Stop()
   {
     m_stop = true;
     for (auto& t : m_threads) t.join();
+    m_threads.clear();
   }
-  int Count() const { return int(m_threads.size()); }
+  int Count() const { return m_count; }
 
 private:
+  int m_count;
   std::atomic<bool> m_stop{false};
   std::vector<std::thread> m_threads;
 };

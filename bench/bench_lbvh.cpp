@@ -13,7 +13,10 @@
 //
 //   bench_lbvh [--load N] [--meshes NAME,...] [MESH_DIR (default build/data/meshes)] [TRADEOFF.csv (default out/bvh_tradeoff.csv)]
 // --load N runs N busy threads beside the measurement; warning rows at the end name each translated
-// builder or tracer slower than the original (on one thread) or _ISPC slower than _CPU.
+// builder or tracer slower than the original (on one thread) or _ISPC slower than _CPU. Under load a
+// slowdown table follows the build table: the CPU builders' rounds again with the busy threads
+// stopped, and each builder's loaded times over its quiet median (median, 90th percentile, slowest),
+// with a warning row for a translated builder that slows down more than Embree LOW (TBB's threads).
 #include "BenchSupport.h"
 #include "BVHScene.h"
 #include "CrossRT.h"
@@ -171,10 +174,11 @@ int main(int argc, char** argv)
   std::shared_ptr<crossrt::VulkanContext> ctx;
   try { ctx = crossrt::VulkanContext::CreateDefault(); }
   catch (const std::exception& e) { std::printf("no Vulkan device (%s): the _Vulkan column is left out\n", e.what()); }
-  const BusyThreads busy(load);
+  BusyThreads busy(load);  // stopped for the quiet rounds of the slowdown table
   std::printf("CPU: %s, %d threads; ISPC target: %s (%s); Vulkan device: %s; load: %d busy threads beside the measurement\n", CpuModel().c_str(),
               omp_get_max_threads(), IspcTarget().c_str(), IspcLanes(), ctx ? ctx->DeviceName().c_str() : "none", busy.Count());
   std::vector<std::string> slower;  // translated classes slower than the original, for the warning rows at the end
+  std::vector<std::string> slowdowns;  // under --load: the slowdown table's rows
 
   std::printf("\nBuild time, ms (ratio = time / Embree LOW; the CPU builders' medians of %d interleaved rounds, their ratios\n"
               "medians of the rounds' ratios; Vulkan: median of 3 wall times with copies, its ratio one of medians, [GPU time])\n",
@@ -223,6 +227,39 @@ int main(int argc, char** argv)
                                           lbvhIspc->Build(n, boxes.data());
                                       }},
                                      buildRounds);
+    if (busy.Count() > 0)
+    {
+      // The same builders quiet, after the loaded rounds (so that the loaded ones are measured as
+      // without this table): how much each slows down under the load, Embree's TBB build the peer.
+      busy.Stop();
+      const auto quietMs = InterleavedMs({[&] { embree.Build(row.mesh, RTC_BUILD_QUALITY_LOW); }, [&] { original.Build(n, boxes.data()); },
+                                          [&] { lbvhCpu->Build(n, boxes.data()); },
+                                          [&] {
+                                            if (lbvhIspc)
+                                              lbvhIspc->Build(n, boxes.data());
+                                          }},
+                                         buildRounds);
+      busy.Start();
+      const int loadedOf[] = {0, 2, 3, 5};
+      const char* builders[] = {"Embree LOW", "LBVH original", "LBVH_CPU", "LBVH_ISPC"};
+      char line[256];
+      int at = std::snprintf(line, sizeof(line), "| %-22s |", name);
+      double embreeSlowdown[2] = {0.0, 0.0};
+      for (int b = 0; b < (lbvhIspc ? 4 : 3); ++b)
+      {
+        const double quiet = MedianOf(quietMs[b]);
+        const double median = MedianOf(cpuMs[loadedOf[b]]) / quiet, p90 = QuantileOf(cpuMs[loadedOf[b]], 0.9) / quiet;
+        at += std::snprintf(line + at, sizeof(line) - at, " %6.1f %6.2fx %6.2fx %7.2fx |", quiet, median, p90,
+                            QuantileOf(cpuMs[loadedOf[b]], 1.0) / quiet);
+        if (b == 0)
+          embreeSlowdown[0] = median, embreeSlowdown[1] = p90;
+        else if (b >= 2 && (median > embreeSlowdown[0] || p90 > embreeSlowdown[1]))
+          slower.push_back(std::string(name) + ": " + builders[b] + " slows down under load " + std::to_string(median).substr(0, 4) + "x (90th percentile " +
+                           std::to_string(p90).substr(0, 4) + "x), Embree LOW " + std::to_string(embreeSlowdown[0]).substr(0, 4) + "x (" +
+                           std::to_string(embreeSlowdown[1]).substr(0, 4) + "x)");
+      }
+      slowdowns.push_back(line);
+    }
     const double low = MedianOf(cpuMs[0]), medium = MedianOf(cpuMs[1]), originalMs = MedianOf(cpuMs[2]);
     row.lbvh = original.Tree(n);
     row.lbvhCpuMs = MedianOf(cpuMs[3]);
@@ -262,6 +299,18 @@ int main(int argc, char** argv)
       slowerThan(5, 3, "LBVH_ISPC", "LBVH_CPU");
     }
     rows.push_back(std::move(row));
+  }
+
+  if (!slowdowns.empty())
+  {
+    std::printf("\nSlowdown under load: each CPU builder's quiet median, ms (the same rounds again after the loaded ones, with\n"
+                "the %d busy threads stopped), then its loaded time over that: median, 90th percentile and slowest of the rounds\n",
+                busy.Count());
+    std::printf("| %-22s | %-31s | %-31s | %-31s | %-31s |\n", "mesh", "Embree LOW (TBB)", "LBVH original (1 thread)", "LBVH_CPU", "LBVH_ISPC");
+    std::printf("| %-22s |", "");
+    for (int b = 0; b < 4; ++b) std::printf(" %6s %7s %7s %8s |", "quiet", "median", "p90", "worst");
+    std::printf("\n|%s|\n", std::string(158, '-').c_str());
+    for (auto& line : slowdowns) std::printf("%s\n", line.c_str());
   }
 
   // The warning rows, after the last table this run prints.
