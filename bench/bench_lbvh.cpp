@@ -254,9 +254,12 @@ int main(int argc, char** argv)
         if (b == 0)
           embreeSlowdown[0] = median, embreeSlowdown[1] = p90;
         else if (b >= 2 && (median > embreeSlowdown[0] || p90 > embreeSlowdown[1]))
-          slower.push_back(std::string(name) + ": " + builders[b] + " slows down under load " + std::to_string(median).substr(0, 4) + "x (90th percentile " +
-                           std::to_string(p90).substr(0, 4) + "x), Embree LOW " + std::to_string(embreeSlowdown[0]).substr(0, 4) + "x (" +
-                           std::to_string(embreeSlowdown[1]).substr(0, 4) + "x)");
+        {
+          char warning[256];
+          std::snprintf(warning, sizeof(warning), "%s: %s slows down under load %.2fx (90th percentile %.2fx), Embree LOW %.2fx (%.2fx)", name,
+                        builders[b], median, p90, embreeSlowdown[0], embreeSlowdown[1]);
+          slower.push_back(warning);
+        }
       }
       slowdowns.push_back(line);
     }
