@@ -11,12 +11,14 @@
 // Then the speed-against-quality trade of LBVH against binned SAH, as a table and as CSV, which
 // bench/plot_bvh_tradeoff.py plots with matplotlib.
 //
-//   bench_lbvh [--load N] [--meshes NAME,...] [MESH_DIR (default build/data/meshes)] [TRADEOFF.csv (default out/bvh_tradeoff.csv)]
+//   bench_lbvh [--load N [--slowdown-csv CSV]] [--meshes NAME,...] [MESH_DIR (default build/data/meshes)] [TRADEOFF.csv (default out/bvh_tradeoff.csv)]
 // --load N runs N busy threads beside the measurement; warning rows at the end name each translated
 // builder or tracer slower than the original (on one thread) or _ISPC slower than _CPU. Under load a
 // slowdown table follows the build table: the CPU builders' rounds again with the busy threads
 // stopped, and each builder's loaded times over its quiet median (median, 90th percentile, slowest),
-// with a warning row for a translated builder that slows down more than Embree LOW (TBB's threads).
+// with a warning row for a translated builder that slows down more than Embree LOW (TBB's threads);
+// the table goes to CSV too (--slowdown-csv, default out/bvh_slowdown.csv), which
+// bench/plot_bvh_slowdown.py plots.
 #include "BenchSupport.h"
 #include "BVHScene.h"
 #include "CrossRT.h"
@@ -143,6 +145,26 @@ void WriteTradeOffCsv(const std::vector<TradeOff>& rows, const std::string& path
   std::fclose(f);
 }
 
+// How much one CPU builder slowed down under --load: its quiet median and its loaded times over it.
+struct Slowdown { std::string mesh, builder; double quietMs, median, p90, worst; };
+
+// The slowdown table as CSV, which bench/plot_bvh_slowdown.py plots.
+void WriteSlowdownCsv(const std::vector<Slowdown>& rows, const std::string& path, const std::string& cpu, const std::string& ispcTarget, int load)
+{
+  if (std::filesystem::path(path).has_parent_path()) std::filesystem::create_directories(std::filesystem::path(path).parent_path());
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (!f)
+  {
+    std::fprintf(stderr, "bench_lbvh: cannot write %s\n", path.c_str());
+    return;
+  }
+  std::fprintf(f, "cpu,ispc_target,busy_threads,mesh,builder,quiet_ms,loaded_median_x,loaded_p90_x,loaded_worst_x\n");
+  for (auto& r : rows)
+    std::fprintf(f, "\"%s\",%s,%d,%s,%s,%.4f,%.3f,%.3f,%.3f\n", cpu.c_str(), ispcTarget.c_str(), load, r.mesh.c_str(), r.builder.c_str(), r.quietMs,
+                 r.median, r.p90, r.worst);
+  std::fclose(f);
+}
+
 }  // namespace
 
 int main(int argc, char** argv)
@@ -152,6 +174,7 @@ int main(int argc, char** argv)
   int load = 0, buildRounds = 7;
   bool buildsOnly = false;
   std::string dir = "build/data/meshes", csvPath = "out/bvh_tradeoff.csv";
+  std::string slowdownCsv = "out/bvh_slowdown.csv";
   crossrt::CommandLine app("bench_lbvh",
                            "BVH build and traversal against Embree on the meshes scripts/fetch-meshes.sh cached in MESH_DIR, in the\n"
                            "form of the paper's Tables 1 and 3. The speed-against-quality table goes to TRADEOFF.csv too;\n"
@@ -161,6 +184,7 @@ int main(int argc, char** argv)
   app.add_option("--load", load, "busy threads beside every measurement (a user's machine is never quiet)")->check(CLI::Range(0, 256));
   app.add_option("--meshes", only, "only the meshes whose file names start with one of these (e.g. teapot,dragon_vrip_res4)")->delimiter(',');
   app.add_flag("--builds-only", buildsOnly, "the build table alone (no traversal, no trade-off table or CSV)");
+  app.add_option("--slowdown-csv", slowdownCsv, "under --load: where the slowdown table goes as CSV (bench/plot_bvh_slowdown.py plots it)");
   app.add_option("--build-rounds", buildRounds, "interleaved rounds of the CPU builders: more for a loaded machine")->check(CLI::Range(1, 1000));
   if (const int status = crossrt::ParseCommandLine(app, argc, argv); status >= 0) return status;
   auto chosen = [&](const std::string& name) {
@@ -178,7 +202,7 @@ int main(int argc, char** argv)
   std::printf("CPU: %s, %d threads; ISPC target: %s (%s); Vulkan device: %s; load: %d busy threads beside the measurement\n", CpuModel().c_str(),
               omp_get_max_threads(), IspcTarget().c_str(), IspcLanes(), ctx ? ctx->DeviceName().c_str() : "none", busy.Count());
   std::vector<std::string> slower;  // translated classes slower than the original, for the warning rows at the end
-  std::vector<std::string> slowdowns;  // under --load: the slowdown table's rows
+  std::vector<Slowdown> slowdowns;  // under --load: the slowdown table's rows
 
   std::printf("\nBuild time, ms (ratio = time / Embree LOW; the CPU builders' medians of %d interleaved rounds, their ratios\n"
               "medians of the rounds' ratios; Vulkan: median of 3 wall times with copies, its ratio one of medians, [GPU time])\n",
@@ -242,26 +266,21 @@ int main(int argc, char** argv)
       busy.Start();
       const int loadedOf[] = {0, 2, 3, 5};
       const char* builders[] = {"Embree LOW", "LBVH original", "LBVH_CPU", "LBVH_ISPC"};
-      char line[256];
-      int at = std::snprintf(line, sizeof(line), "| %-22s |", name);
-      double embreeSlowdown[2] = {0.0, 0.0};
       for (int b = 0; b < (lbvhIspc ? 4 : 3); ++b)
       {
         const double quiet = MedianOf(quietMs[b]);
-        const double median = MedianOf(cpuMs[loadedOf[b]]) / quiet, p90 = QuantileOf(cpuMs[loadedOf[b]], 0.9) / quiet;
-        at += std::snprintf(line + at, sizeof(line) - at, " %6.1f %6.2fx %6.2fx %7.2fx |", quiet, median, p90,
-                            QuantileOf(cpuMs[loadedOf[b]], 1.0) / quiet);
-        if (b == 0)
-          embreeSlowdown[0] = median, embreeSlowdown[1] = p90;
-        else if (b >= 2 && (median > embreeSlowdown[0] || p90 > embreeSlowdown[1]))
+        const std::vector<double>& loaded = cpuMs[loadedOf[b]];
+        slowdowns.push_back({name, builders[b], quiet, MedianOf(loaded) / quiet, QuantileOf(loaded, 0.9) / quiet, QuantileOf(loaded, 1.0) / quiet});
+        const Slowdown& embree = slowdowns[slowdowns.size() - b - 1], &mine = slowdowns.back();
+        auto above = [](double a, double b) { return std::lround(a * 100.0) > std::lround(b * 100.0); };  // as printed
+        if (b >= 2 && (above(mine.median, embree.median) || above(mine.p90, embree.p90)))
         {
           char warning[256];
           std::snprintf(warning, sizeof(warning), "%s: %s slows down under load %.2fx (90th percentile %.2fx), Embree LOW %.2fx (%.2fx)", name,
-                        builders[b], median, p90, embreeSlowdown[0], embreeSlowdown[1]);
+                        builders[b], mine.median, mine.p90, embree.median, embree.p90);
           slower.push_back(warning);
         }
       }
-      slowdowns.push_back(line);
     }
     const double low = MedianOf(cpuMs[0]), medium = MedianOf(cpuMs[1]), originalMs = MedianOf(cpuMs[2]);
     row.lbvh = original.Tree(n);
@@ -313,7 +332,15 @@ int main(int argc, char** argv)
     std::printf("| %-22s |", "");
     for (int b = 0; b < 4; ++b) std::printf(" %6s %7s %7s %8s |", "quiet", "median", "p90", "worst");
     std::printf("\n|%s|\n", std::string(158, '-').c_str());
-    for (auto& line : slowdowns) std::printf("%s\n", line.c_str());
+    for (size_t r = 0; r < slowdowns.size(); ++r)
+    {
+      const Slowdown& d = slowdowns[r];
+      if (r == 0 || d.mesh != slowdowns[r - 1].mesh) std::printf("%s| %-22s |", r == 0 ? "" : "\n", d.mesh.c_str());
+      std::printf(" %6.1f %6.2fx %6.2fx %7.2fx |", d.quietMs, d.median, d.p90, d.worst);
+    }
+    std::printf("\n");
+    WriteSlowdownCsv(slowdowns, slowdownCsv, CpuModel(), IspcTarget(), busy.Count());
+    std::printf("table: %s (plot it: bench/plot_bvh_slowdown.py %s out/bvh_slowdown.png)\n", slowdownCsv.c_str(), slowdownCsv.c_str());
   }
 
   // The warning rows, after the last table this run prints.
