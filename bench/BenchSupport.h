@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iterator>
@@ -82,6 +83,17 @@ inline double PairedRatio(const std::vector<double>& a, const std::vector<double
   std::vector<double> r;
   for (size_t i = 0; i < a.size() && i < b.size(); ++i) r.push_back(a[i] / b[i]);
   return MedianOf(r);
+}
+
+// A CSV table's file, opened for writing after making its folder; null, with `program: cannot write
+// PATH` on stderr, where it cannot be.
+inline std::FILE* OpenCsv(const std::string& path, const char* program)
+{
+  std::error_code ignored;  // (a folder that cannot be made shows as the file that cannot be opened)
+  if (std::filesystem::path(path).has_parent_path()) std::filesystem::create_directories(std::filesystem::path(path).parent_path(), ignored);
+  std::FILE* f = std::fopen(path.c_str(), "w");
+  if (!f) std::fprintf(stderr, "%s: cannot write %s\n", program, path.c_str());
+  return f;
 }
 
 // The CPU's model name (/proc/cpuinfo), which every table of speed figures prints.

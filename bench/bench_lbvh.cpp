@@ -131,38 +131,28 @@ std::vector<Box4f> TriangleBoxes(const TriangleMesh& mesh)
 struct TradeOff { std::string mesh; double lbvhBuildMs, lbvhMrays, sahBuildMs, sahMrays; };
 
 // The trade as CSV, which bench/plot_bvh_tradeoff.py plots.
-void WriteTradeOffCsv(const std::vector<TradeOff>& rows, const std::string& path)
+bool WriteTradeOffCsv(const std::vector<TradeOff>& rows, const std::string& path)
 {
-  if (std::filesystem::path(path).has_parent_path()) std::filesystem::create_directories(std::filesystem::path(path).parent_path());
-  std::FILE* f = std::fopen(path.c_str(), "w");
-  if (!f)
-  {
-    std::fprintf(stderr, "bench_lbvh: cannot write %s\n", path.c_str());
-    return;
-  }
+  std::FILE* f = OpenCsv(path, "bench_lbvh");
+  if (!f) return false;
   std::fprintf(f, "mesh,lbvh_build_ms,lbvh_mrays_per_s,sah_build_ms,sah_mrays_per_s\n");
   for (auto& r : rows) std::fprintf(f, "%s,%.3f,%.3f,%.3f,%.3f\n", r.mesh.c_str(), r.lbvhBuildMs, r.lbvhMrays, r.sahBuildMs, r.sahMrays);
-  std::fclose(f);
+  return std::fclose(f) == 0;
 }
 
 // How much one CPU builder slowed down under --load: its quiet median and its loaded times over it.
 struct Slowdown { std::string mesh, builder; double quietMs, median, p90, worst; };
 
 // The slowdown table as CSV, which bench/plot_bvh_slowdown.py plots.
-void WriteSlowdownCsv(const std::vector<Slowdown>& rows, const std::string& path, const std::string& cpu, const std::string& ispcTarget, int load)
+bool WriteSlowdownCsv(const std::vector<Slowdown>& rows, const std::string& path, const std::string& cpu, const std::string& ispcTarget, int load)
 {
-  if (std::filesystem::path(path).has_parent_path()) std::filesystem::create_directories(std::filesystem::path(path).parent_path());
-  std::FILE* f = std::fopen(path.c_str(), "w");
-  if (!f)
-  {
-    std::fprintf(stderr, "bench_lbvh: cannot write %s\n", path.c_str());
-    return;
-  }
+  std::FILE* f = OpenCsv(path, "bench_lbvh");
+  if (!f) return false;
   std::fprintf(f, "cpu,ispc_target,busy_threads,mesh,builder,quiet_ms,loaded_median_x,loaded_p90_x,loaded_worst_x\n");
   for (auto& r : rows)
     std::fprintf(f, "\"%s\",%s,%d,%s,%s,%.4f,%.3f,%.3f,%.3f\n", cpu.c_str(), ispcTarget.c_str(), load, r.mesh.c_str(), r.builder.c_str(), r.quietMs,
                  r.median, r.p90, r.worst);
-  std::fclose(f);
+  return std::fclose(f) == 0;
 }
 
 }  // namespace
@@ -203,6 +193,7 @@ int main(int argc, char** argv)
               omp_get_max_threads(), IspcTarget().c_str(), IspcLanes(), ctx ? ctx->DeviceName().c_str() : "none", busy.Count());
   std::vector<std::string> slower;  // translated classes slower than the original, for the warning rows at the end
   std::vector<Slowdown> slowdowns;  // under --load: the slowdown table's rows
+  int status = 0;                   // 1 once a table could not be written
 
   std::printf("\nBuild time, ms (ratio = time / Embree LOW; the CPU builders' medians of %d interleaved rounds, their ratios\n"
               "medians of the rounds' ratios; Vulkan: median of 3 wall times with copies, its ratio one of medians, [GPU time])\n",
@@ -339,8 +330,10 @@ int main(int argc, char** argv)
       std::printf(" %6.1f %6.2fx %6.2fx %7.2fx |", d.quietMs, d.median, d.p90, d.worst);
     }
     std::printf("\n");
-    WriteSlowdownCsv(slowdowns, slowdownCsv, CpuModel(), IspcTarget(), busy.Count());
-    std::printf("table: %s (plot it: bench/plot_bvh_slowdown.py %s out/bvh_slowdown.png)\n", slowdownCsv.c_str(), slowdownCsv.c_str());
+    if (!WriteSlowdownCsv(slowdowns, slowdownCsv, CpuModel(), IspcTarget(), busy.Count()))
+      status = 1;
+    else
+      std::printf("table: %s (plot it: bench/plot_bvh_slowdown.py %s out/bvh_slowdown.png)\n", slowdownCsv.c_str(), slowdownCsv.c_str());
   }
 
   // The warning rows, after the last table this run prints.
@@ -352,7 +345,7 @@ int main(int argc, char** argv)
   if (buildsOnly)
   {
     printSlower();
-    return 0;
+    return status;
   }
 
   std::printf("\nTraversal of %dx%d primary rays, Mrays/s, all %d threads but 1T (ratio against Embree rtcIntersect1 on all\n"
@@ -592,7 +585,7 @@ int main(int argc, char** argv)
                 t.sahMrays, after);
   }
   printSlower();
-  WriteTradeOffCsv(trade, csvPath);
+  if (!WriteTradeOffCsv(trade, csvPath)) return 1;
   std::printf("table: %s (plot it: bench/plot_bvh_tradeoff.py %s out/bvh_tradeoff.png)\n", csvPath.c_str(), csvPath.c_str());
-  return 0;
+  return status;
 }
