@@ -1061,8 +1061,8 @@ TEST_CASE("ParallelChoice takes the faster way and tries the other now and then"
 
 // crossrt::LaneChoice, with the times given: an _ISPC kernel runs in SIMD lanes on its first two
 // calls (the first not counted), tries its scalar loop on the third, then takes the faster way and
-// tries the other after 16 calls, then 64... while it loses; sizes a factor of 4 apart are chosen
-// apart; a call that ran no loop counts for nothing.
+// tries the other after 16 calls, then 64... while it loses, on the cores the verdict's last run
+// ran on; sizes a factor of 4 apart are chosen apart; a call that ran no loop counts for nothing.
 TEST_CASE("LaneChoice runs a kernel in lanes or as a scalar loop, whichever has been faster", "[runtime][parallel]")
 {
   if (const char* forced = std::getenv("CROSSRT_ISPC_LANES"); forced && std::string(forced) == "never")
@@ -1122,6 +1122,29 @@ TEST_CASE("LaneChoice runs a kernel in lanes or as a scalar loop, whichever has 
     CHECK(count(choice, 10, 3.0, 1.0) <= 2);
     CHECK(crossrt::LaneChoice::SizeClass(1100) == crossrt::LaneChoice::SizeClass(4000));  // [4^5, 4^6)
     CHECK(crossrt::LaneChoice::SizeClass(1000) != crossrt::LaneChoice::SizeClass(100000));
+  }
+  SECTION("a try of the way that is not the verdict runs on the cores the verdict's last run ran on") {
+    crossrt::LaneChoice choice;
+    for (int call = 0; call < 2; ++call) {  // lanes, the verdict so far; their loop ran on one core
+      crossrt::LaneChoice::Run way = choice.Begin();
+      REQUIRE(way.lanes);
+      REQUIRE_FALSE(way.trying);
+      way.iterations = 1000, way.cores = 0;
+      choice.End(way);
+    }
+    crossrt::LaneChoice::Run tried = choice.Begin();  // the scalar loop, once
+    REQUIRE_FALSE(tried.lanes);
+    REQUIRE(tried.trying);
+    CHECK(tried.verdictCores == 0);
+    // A way's ParallelChoice that has measured nothing starts on all cores, but not in a try.
+    crossrt::ParallelChoice fresh, alsoFresh;
+    CHECK_FALSE(fresh.Begin(1000, tried).parallel);
+    CHECK(tried.cores == 0);
+    crossrt::LaneChoice::Run verdict{true, 0, std::chrono::steady_clock::now()};
+    CHECK(alsoFresh.Begin(1000, verdict).parallel == (omp_get_max_threads() > 1));
+    CHECK(verdict.cores == (omp_get_max_threads() > 1 ? 1 : 0));
+    tried.verdictCores = 1;
+    CHECK(fresh.Begin(1000, tried).parallel == (omp_get_max_threads() > 1));
   }
   SECTION("a call with an empty loop counts for nothing") {
     crossrt::LaneChoice choice;

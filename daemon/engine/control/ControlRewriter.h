@@ -114,8 +114,10 @@ private:
   // while that has been faster (crossrt::ParallelChoice), in a block of its own.
   void ParallelOnCpu(const ForStmt* outer, const LoopHeader& outermost, size_t nest);
   // What ParallelOnCpu writes before and after the loop nest; the outer loop's header, rewritten in
-  // m_cpu, runs a chunk.
-  std::pair<std::string, std::string> ParallelChoiceAround(const ForStmt* outer, const LoopHeader& outermost, size_t nest);
+  // m_cpu, runs a chunk. In an _ISPC class's scalar way, `way` names its crossrt::LaneChoice::Run,
+  // which the choice of cores is told (a try of this way runs on the cores its verdict ran on).
+  std::pair<std::string, std::string> ParallelChoiceAround(const ForStmt* outer, const LoopHeader& outermost, size_t nest,
+                                                           const std::string& way = "");
 
   // Checks that `e` does not depend on the thread (host code and by-value kernel arguments run once
   // for all threads in wavefront mode) and collects the control function's variables it reads.

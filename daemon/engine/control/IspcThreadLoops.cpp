@@ -39,7 +39,7 @@ std::string ChunksOnAllCores(const ClassModel& model, const std::string& what, c
   if (dims == 2) text += "const int crt_countY = std::max(0, int(" + counts[1] + "));\n";
   text += "static const auto crt_run = crossrt::IspcPick(ispc::" + symbol + ", {" + IspcTargetFunctions(symbol) + "});\n"
           "static crossrt::ParallelChoice crt_choice;  // all cores, or this thread while that has been faster\n"
-          "const auto crt_loop = crt_choice.Begin(" + outer + ");\n"
+          "const auto crt_loop = crt_choice.Begin(" + outer + ", crt_way);\n"
           "crossrt::ParallelFor<int>(crt_loop.parallel, 0, (" + outer + " + " + chunk + " - 1) / " + chunk + ", 1, [&](int crt_first, int crt_last) {\n"
           "  for (int crt_chunk = crt_first; crt_chunk < crt_last; ++crt_chunk)\n"
           "    crt_run(const_cast<ispc::" + model.symbolPrefix + "_Data*>(&crt_self), crt_chunk * " + chunk + ", std::min(" + outer + ", (crt_chunk + 1) * " + chunk + ")" +
@@ -187,7 +187,7 @@ bool ControlRewriter::IspcRtvNest(const ForStmt* outer, const CXXMemberCallExpr*
 void ControlRewriter::LanesOrScalarLoop(const ForStmt* loop, const LoopHeader& outermost, size_t nest, const std::string& lanes, const std::string& threads) {
   SourceLocation end = Lexer::findLocationAfterToken(loop->getEndLoc(), tok::semi, m_c.ctx.getSourceManager(), m_c.ctx.getLangOpts(), false);
   CharSourceRange range = end.isValid() ? CharSourceRange::getCharRange(loop->getBeginLoc(), end) : CharSourceRange::getTokenRange(loop->getSourceRange());
-  const auto [before, after] = ParallelChoiceAround(loop, outermost, nest);
+  const auto [before, after] = ParallelChoiceAround(loop, outermost, nest, "crt_way");
   std::string scalar = before + m_cpu.getRewrittenText(range) + after + "\n";
   if (!m_c.model.virtuals.empty())  // as the lanes' class data does: an element without an object throws
     scalar = "{\n(void)IspcData();  // checks the vectors of objects as the lanes' way does\n" + scalar + "}\n";

@@ -309,13 +309,14 @@ bool ControlRewriter::TryRtvNest(const ForStmt* outer) {
   return true;
 }
 
-std::pair<std::string, std::string> ControlRewriter::ParallelChoiceAround(const ForStmt* outer, const LoopHeader& outermost, size_t nest) {
+std::pair<std::string, std::string> ControlRewriter::ParallelChoiceAround(const ForStmt* outer, const LoopHeader& outermost, size_t nest,
+                                                                          const std::string& way) {
   const unsigned col = m_c.ctx.getSourceManager().getExpansionColumnNumber(outer->getBeginLoc());
   const std::string indent(col > 0 ? col - 1 : 0, ' ');
   // Chunks of 16 threads; a nest's rows one at a time (its inner loops run whole in each).
   const ChunkedLoop chunked = ChunkLoop(m_cpu, m_c.ctx, outer, outermost, "crt_loop.parallel", nest > 1 ? "1" : "16");
   return {"{  // crossrt: on all cores, or on this thread while that has been faster\n" + indent + "static crossrt::ParallelChoice crt_choice;\n" + indent +
-              "const auto crt_loop = crt_choice.Begin(" + CountExpr(m_c, outermost) + ");\n" + indent + chunked.head + "\n" + indent,
+              "const auto crt_loop = crt_choice.Begin(" + CountExpr(m_c, outermost) + (way.empty() ? "" : ", " + way) + ");\n" + indent + chunked.head + "\n" + indent,
           "\n" + indent + chunked.tail + "\n" + indent + "crt_choice.End(crt_loop);\n" + indent + "}"};
 }
 

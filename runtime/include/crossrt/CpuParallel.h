@@ -138,6 +138,19 @@ class ParallelChoice {
 
   Run Begin(long long iterations) { return {Choose(iterations), iterations, std::chrono::steady_clock::now()}; }
 
+  // The same for a way of an _ISPC kernel (its LaneChoice::Run, defined below): while LaneChoice
+  // tries the way that is not its verdict, the try runs on as many cores as the verdict's last run
+  // of loops of that size did, so that the two ways are timed alike. (Beside two busy threads, a
+  // try on all cores of a way whose verdict ran on one core waited a time slice for a worker taken
+  // off its core, and a lanes' way lost for that.) The way learns which it ran on.
+  template <typename Way>
+  Run Begin(long long iterations, Way& way) {
+    const int verdict = way.trying ? way.verdictCores : -1;
+    const bool parallel = verdict >= 0 && iterations >= 2 && !InParallelLoop() && omp_get_max_threads() >= 2 ? verdict == 1 : Choose(iterations);
+    way.cores = parallel ? 1 : 0;
+    return {parallel, iterations, std::chrono::steady_clock::now()};
+  }
+
   void End(const Run& run) {
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - run.start).count();
     Record(run.parallel, run.iterations, ms);
@@ -365,27 +378,49 @@ class LaneChoice {
     bool lanes;
     long long iterations;  // set by the way that runs: its loop's count
     std::chrono::steady_clock::time_point start;
+    bool trying = false;    // the way that is not the verdict, tried
+    int verdictCores = -1;  // when trying: what the verdict's last run ran on (1 all cores, 0 one core, -1 unknown)
+    int cores = -1;         // what this run's loop ran on, as ParallelChoice tells it
   };
 
-  Run Begin() { return {Choose(), 0, std::chrono::steady_clock::now()}; }
+  LaneChoice() {
+    for (auto& cores : m_verdictCores) cores.store(-1, std::memory_order_relaxed);
+  }
+
+  Run Begin() {
+    bool trying = false;
+    const bool lanes = Choose(trying);
+    // (A call is taken to be of the size of the call before it, as in Choose.)
+    const int verdictCores = trying ? m_verdictCores[m_lastSize.load(std::memory_order_relaxed)].load(std::memory_order_relaxed) : -1;
+    return {lanes, 0, std::chrono::steady_clock::now(), trying, verdictCores};
+  }
 
   void End(const Run& run) {
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - run.start).count();
     Record(run.lanes, run.iterations, ms);
+    if (!run.trying && run.cores >= 0 && run.iterations >= 1)
+      m_verdictCores[SizeClass(run.iterations)].store(run.cores, std::memory_order_relaxed);
   }
 
-  // The decision and the measurement apart, for tests.
+  // The decision and the measurement apart, for tests; `trying` tells a try of the way that is not
+  // the verdict.
   bool Choose() {
+    bool trying = false;
+    return Choose(trying);
+  }
+  bool Choose(bool& trying) {
+    trying = false;
     if (LanesMode() != Mode::Measure) return LanesMode() == Mode::Always;
     MeasuredWays& ways = m_bySize[m_lastSize.load(std::memory_order_relaxed)];
     const float scalar = ways.Mean(0), lanes = ways.Mean(1);
     if (lanes < 0.0f) return true;  // first the lanes, the way this class is for
     if (scalar < 0.0f) {  // then the scalar loop, once, to compare
       ways.Try();
+      trying = true;
       return false;
     }
-    if (scalar < lanes) return ways.TimeToTry();  // the scalar loop has been faster: lanes now and then
-    return !ways.TimeToTry();
+    trying = ways.TimeToTry();
+    return scalar < lanes ? trying : !trying;  // the faster way, the other now and then
   }
 
   void Record(bool lanes, long long iterations, double ms) {
@@ -414,6 +449,7 @@ class LaneChoice {
 
  private:
   MeasuredWays m_bySize[kLoopSizeClasses];
+  std::atomic<int> m_verdictCores[kLoopSizeClasses];  // per size class: what the verdict's last run ran on, -1 before one
   std::atomic<int> m_lastSize{0};
   std::atomic<bool> m_warm{false};
 };

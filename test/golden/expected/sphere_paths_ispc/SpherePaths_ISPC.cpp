@@ -66,7 +66,7 @@ void SpherePaths_ISPC::Render(uint32_t width, uint32_t height, int samples, floa
                               {SpherePaths_Render_Megakernel_sse4, SpherePaths_Render_Megakernel_avx2,
                                SpherePaths_Render_Megakernel_avx512skx});
         static crossrt::ParallelChoice crt_choice;
-        const auto crt_loop = crt_choice.Begin(crt_countY);
+        const auto crt_loop = crt_choice.Begin(crt_countY, crt_way);
         crossrt::ParallelFor<int>(crt_loop.parallel, 0, (crt_countY + 4 - 1) / 4, 1, [&](int crt_first, int crt_last) {
           for (int crt_chunk = crt_first; crt_chunk < crt_last; ++crt_chunk)
             crt_run(const_cast<ispc::SpherePaths_Data*>(&crt_self), crt_chunk * 4,
@@ -79,7 +79,7 @@ void SpherePaths_ISPC::Render(uint32_t width, uint32_t height, int samples, floa
       else
       {
         static crossrt::ParallelChoice crt_choice;
-        const auto crt_loop = crt_choice.Begin(height);
+        const auto crt_loop = crt_choice.Begin(height, crt_way);
         crossrt::ParallelFor<uint32_t>(crt_loop.parallel, 0, height, 1, [&](uint32_t crt_first, uint32_t crt_last) {
           for (uint32_t y = crt_first; y < crt_last; y++)
             for (uint32_t x = 0; x < width; x++)
