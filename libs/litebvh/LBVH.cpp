@@ -110,25 +110,26 @@ void LBVH::kernel1D_Karras12(int count)
     const int leaves = int(m_leafCount);
     if (i >= leaves - 1)
       continue;
+    const uint32_t code = m_leafCode[i];
     // Direction of the range: towards the neighbour sharing the longer prefix.
-    const int d = Delta(i, i + 1) > Delta(i, i - 1) ? 1 : -1;
+    const int d = CommonPrefix(code, i + 1) > CommonPrefix(code, i - 1) ? 1 : -1;
     // Upper bound of the range's length, then its exact other end j by binary search.
-    const int deltaMin = Delta(i, i - d);
+    const int deltaMin = CommonPrefix(code, i - d);
     int lengthMax = 2;
-    while (Delta(i, i + lengthMax * d) > deltaMin)
+    while (CommonPrefix(code, i + lengthMax * d) > deltaMin)
       lengthMax *= 2;
     int length = 0;
     for (int step = lengthMax / 2; step >= 1; step /= 2)
-      if (Delta(i, i + (length + step) * d) > deltaMin)
+      if (CommonPrefix(code, i + (length + step) * d) > deltaMin)
         length += step;
     const int j = i + length * d;
     // The split: the last leaf sharing more than the range's common prefix with i.
-    const int deltaNode = Delta(i, j);
+    const int deltaNode = CommonPrefix(code, j);
     int split = 0;
     for (int divisor = 2; divisor < 2 * length + 2; divisor *= 2)
     {
       const int step = (length + divisor - 1) / divisor;
-      if (Delta(i, i + (split + step) * d) > deltaNode)
+      if (CommonPrefix(code, i + (split + step) * d) > deltaNode)
         split += step;
       if (step == 1)
         break;

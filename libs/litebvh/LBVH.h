@@ -63,13 +63,15 @@ protected:
   // left leaf when both children are leaves, from its inner child when one is, and from the second
   // to arrive (crossrt::AtomicAdd) when both are inner; the others stop
   void kernel1D_Refit(int count);
-  // Length of the common prefix of leaf codes i and j; -1 when j is outside the leaves. Defined
-  // here so that the translated CPU class, compiled apart, can inline it into Karras12's searches.
-  int Delta(int i, int j) const
+  // Karras's delta(i, j): the length of the common prefix of leaf i's code, `code` (which Karras12's
+  // searches compare with many others: read once, one load fewer per step in SIMD lanes), and leaf
+  // j's; -1 when j is outside the leaves. Defined here so that the translated CPU class, compiled
+  // apart, can inline it into Karras12's searches.
+  int CommonPrefix(uint32_t code, int j) const
   {
     if (j < 0 || j >= int(m_leafCount))
       return -1;
-    return __builtin_clz(m_leafCode[i] ^ m_leafCode[j]);
+    return __builtin_clz(code ^ m_leafCode[j]);
   }
 
   LiteMath::float3 m_centerMin, m_centerMax;

@@ -61,12 +61,12 @@ layout(push_constant) uniform crt_kernel1D_Karras12Args
   int count;
 };
 
-// from LBVH::Delta
-int Delta(int i, int j)
+// from LBVH::CommonPrefix
+int CommonPrefix(uint code, int j)
 {
   if (j < 0 || j >= int(m_leafCount))
     return -1;
-  return (31 - findMSB(uint(m_leafCode[uint(i)] ^ m_leafCode[uint(j)])));
+  return (31 - findMSB(uint(code ^ m_leafCode[uint(j)])));
 }
 
 // from LBVH::kernel1D_Karras12 (LBVH.cpp)
@@ -75,22 +75,23 @@ void kernel1D_Karras12(int i)
   const int leaves = int(m_leafCount);
   if (i >= leaves - 1)
     return;  // 'continue' ends this thread
-  const int d = Delta(i, i + 1) > Delta(i, i - 1) ? 1 : -1;
-  const int deltaMin = Delta(i, i - d);
+  const uint code = m_leafCode[uint(i)];
+  const int d = CommonPrefix(code, i + 1) > CommonPrefix(code, i - 1) ? 1 : -1;
+  const int deltaMin = CommonPrefix(code, i - d);
   int lengthMax = 2;
-  while (Delta(i, i + lengthMax * d) > deltaMin)
+  while (CommonPrefix(code, i + lengthMax * d) > deltaMin)
     lengthMax *= 2;
   int length_ = 0;
   for (int step_ = lengthMax / 2; step_ >= 1; step_ /= 2)
-    if (Delta(i, i + (length_ + step_) * d) > deltaMin)
+    if (CommonPrefix(code, i + (length_ + step_) * d) > deltaMin)
       length_ += step_;
   const int j = i + length_ * d;
-  const int deltaNode = Delta(i, j);
+  const int deltaNode = CommonPrefix(code, j);
   int split = 0;
   for (int divisor = 2; divisor < 2 * length_ + 2; divisor *= 2)
   {
     const int step_ = (length_ + divisor - 1) / divisor;
-    if (Delta(i, i + (split + step_) * d) > deltaNode)
+    if (CommonPrefix(code, i + (split + step_) * d) > deltaNode)
       split += step_;
     if (step_ == 1)
       break;
