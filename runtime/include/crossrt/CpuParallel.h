@@ -143,10 +143,11 @@ class ParallelChoice {
   // of loops of that size did, so that the two ways are timed alike. (Beside two busy threads, a
   // try on all cores of a way whose verdict ran on one core waited a time slice for a worker taken
   // off its core, and a lanes' way lost for that.) The way learns which it ran on.
+  // (CROSSRT_CPU_PARALLEL=always still puts every loop on all cores.)
   template <typename Way>
   Run Begin(long long iterations, Way& way) {
-    const int verdict = way.trying ? way.verdictCores : -1;
-    const bool parallel = verdict >= 0 && iterations >= 2 && !InParallelLoop() && omp_get_max_threads() >= 2 ? verdict == 1 : Choose(iterations);
+    const bool followVerdict = way.trying && way.verdictCores >= 0 && !AlwaysAllCores() && !OneThreadOnly(iterations);
+    const bool parallel = followVerdict ? way.verdictCores == 1 : Choose(iterations);
     way.cores = parallel ? 1 : 0;
     return {parallel, iterations, std::chrono::steady_clock::now()};
   }
@@ -159,7 +160,7 @@ class ParallelChoice {
   // The decision and the measurement apart, for tests.
   bool Choose(long long iterations) {
     const int threads = omp_get_max_threads();
-    if (iterations < 2 || InParallelLoop() || threads < 2) return false;
+    if (OneThreadOnly(iterations)) return false;
     if (AlwaysAllCores()) return true;
     Ways& ways = m_bySize[LoopSizeClass(iterations)];
     const float serial = ways.Mean(0), parallel = ways.Mean(1);
@@ -181,7 +182,7 @@ class ParallelChoice {
   }
 
   void Record(bool parallel, long long iterations, double ms) {
-    if (iterations < 2 || InParallelLoop() || omp_get_max_threads() < 2) return;
+    if (OneThreadOnly(iterations)) return;
     Ways& ways = m_bySize[LoopSizeClass(iterations)];
     const float now = float(ms / double(iterations));
     ways.Record(parallel, now);
@@ -228,6 +229,9 @@ class ParallelChoice {
   struct Ways : MeasuredWays {
     std::atomic<float> fastestParallel{3.0e38f};
   };
+
+  // A loop that can only run on this thread: one iteration, inside a parallel loop, or one thread in all.
+  static bool OneThreadOnly(long long iterations) { return iterations < 2 || InParallelLoop() || omp_get_max_threads() < 2; }
 
   bool Loaded() const { return (m_othersForTests >= 0 ? m_othersForTests : OthersRunnable()) > 0; }
 
