@@ -9,9 +9,11 @@
 // the CPU tracers in rounds that run each in turn (7 and 5), with ratios as medians of the rounds'
 // ratios; the Vulkan figures as medians of 3 after a warm-up.
 // Then the speed-against-quality trade of LBVH against binned SAH, as a table and as CSV, which
-// bench/plot_bvh_tradeoff.py plots with matplotlib.
+// bench/plot_bvh_tradeoff.py plots with matplotlib. Embree runs the SIMD width the _ISPC classes run
+// (--embree-isa matched, the default: AVX2 when CROSSRT_ISPC_TARGET=avx2 on an AVX-512 CPU, as on a
+// CPU without AVX-512), or its widest (--embree-isa native); the header says which.
 //
-//   bench_lbvh [--load N [--slowdown-csv CSV]] [--meshes NAME,...] [MESH_DIR (default build/data/meshes)] [TRADEOFF.csv (default out/bvh_tradeoff.csv)]
+//   bench_lbvh [--load N [--slowdown-csv CSV]] [--embree-isa matched|native] [--meshes NAME,...] [MESH_DIR (default build/data/meshes)] [TRADEOFF.csv (default out/bvh_tradeoff.csv)]
 // --load N runs N busy threads beside the measurement; warning rows at the end name each translated
 // builder or tracer slower than the original (on one thread) or _ISPC slower than _CPU. Under load a
 // slowdown table follows the build table: the CPU builders' rounds again with the busy threads
@@ -88,10 +90,24 @@ Camera LookAtMesh(const TriangleMesh& mesh)
   return c;
 }
 
+// The Embree device's configuration (rtcNewDevice): "isa=..." caps the SIMD width Embree picks.
+std::string g_embreeConfig;
+
+// Embree's name for the ISA of one of crossrt::kIspcTargets, so that Embree runs the SIMD width
+// _ISPC runs: "avx2" on an AVX-512 CPU is what an AVX2-only CPU (most desktops) gives both. Embree
+// 3 takes a name it does not know as SSE2 without a word, so only these three are passed.
+std::string EmbreeIsaOf(const std::string& ispcTarget)
+{
+  if (ispcTarget == "sse4") return "sse4.2";
+  if (ispcTarget == "avx2") return "avx2";
+  if (ispcTarget == "avx512skx") return "avx512";
+  return "";
+}
+
 // Embree over one mesh, with the build quality given; returns the commit time.
 struct EmbreeMesh
 {
-  RTCDevice device = rtcNewDevice(nullptr);
+  RTCDevice device = rtcNewDevice(g_embreeConfig.empty() ? nullptr : g_embreeConfig.c_str());
   RTCScene scene = nullptr;
   double Build(const TriangleMesh& mesh, RTCBuildQuality quality)
   {
@@ -165,6 +181,7 @@ int main(int argc, char** argv)
   bool buildsOnly = false;
   std::string dir = "build/data/meshes", csvPath = "out/bvh_tradeoff.csv";
   std::string slowdownCsv = "out/bvh_slowdown.csv";
+  std::string embreeIsa = "matched";
   crossrt::CommandLine app("bench_lbvh",
                            "BVH build and traversal against Embree on the meshes scripts/fetch-meshes.sh cached in MESH_DIR, in the\n"
                            "form of the paper's Tables 1 and 3. The speed-against-quality table goes to TRADEOFF.csv too;\n"
@@ -176,7 +193,11 @@ int main(int argc, char** argv)
   app.add_flag("--builds-only", buildsOnly, "the build table alone (no traversal, no trade-off table or CSV)");
   app.add_option("--slowdown-csv", slowdownCsv, "under --load: where the slowdown table goes as CSV (bench/plot_bvh_slowdown.py plots it)");
   app.add_option("--build-rounds", buildRounds, "interleaved rounds of the CPU builders: more for a loaded machine")->check(CLI::Range(1, 1000));
+  app.add_option("--embree-isa", embreeIsa,
+                 "the SIMD width Embree may use: 'matched' (the ISPC target's: avx2 when CROSSRT_ISPC_TARGET=avx2) or 'native' (its widest)")
+      ->check(CLI::IsMember({"matched", "native"}));
   if (const int status = crossrt::ParseCommandLine(app, argc, argv); status >= 0) return status;
+  if (embreeIsa == "matched" && !EmbreeIsaOf(IspcTarget()).empty()) g_embreeConfig = "isa=" + EmbreeIsaOf(IspcTarget());
   auto chosen = [&](const std::string& name) {
     if (only.empty()) return true;
     for (auto& prefix : only)
@@ -189,8 +210,9 @@ int main(int argc, char** argv)
   try { ctx = crossrt::VulkanContext::CreateDefault(); }
   catch (const std::exception& e) { std::printf("no Vulkan device (%s): the _Vulkan column is left out\n", e.what()); }
   BusyThreads busy(load);  // stopped for the quiet rounds of the slowdown table
-  std::printf("CPU: %s, %d threads; ISPC target: %s (%s); Vulkan device: %s; load: %d busy threads beside the measurement\n", CpuModel().c_str(),
-              omp_get_max_threads(), IspcTarget().c_str(), IspcLanes(), ctx ? ctx->DeviceName().c_str() : "none", busy.Count());
+  std::printf("CPU: %s, %d threads; ISPC target: %s (%s); Embree ISA: %s; Vulkan device: %s; load: %d busy threads beside the measurement\n",
+              CpuModel().c_str(), omp_get_max_threads(), IspcTarget().c_str(), IspcLanes(),
+              g_embreeConfig.empty() ? "its widest" : g_embreeConfig.substr(4).c_str(), ctx ? ctx->DeviceName().c_str() : "none", busy.Count());
   std::vector<std::string> slower;  // translated classes slower than the original, for the warning rows at the end
   std::vector<Slowdown> slowdowns;  // under --load: the slowdown table's rows
   int status = 0;                   // 1 once a table could not be written

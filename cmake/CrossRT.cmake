@@ -272,7 +272,7 @@ function(crossrt_add_class target class)
     target_link_libraries(${target} PRIVATE crossrt::runtime)
   elseif(linked_type MATCHES "^(STATIC|OBJECT)_LIBRARY$")
     # The executables that link a static library of CPU classes get the runtime's usage
-    # requirements too: passive OpenMP waits (src/CpuWaitPolicy.cpp of the runtime).
+    # requirements too: passive OpenMP waits (src/OpenMPWaits.cpp of the runtime).
     target_link_libraries(${target} PUBLIC crossrt::cpu_runtime)
   else()
     target_link_libraries(${target} PRIVATE crossrt::cpu_runtime)

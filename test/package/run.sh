@@ -57,6 +57,12 @@ if ninja -C "$work/build" -n | grep -q "CrossRT: translating"; then
   exit 1
 fi
 "$work/build/app"
+# Its OpenMP threads sleep after a parallel region (libcrossrt_openmp_waits.so, after libgomp).
+if ! env -u OMP_WAIT_POLICY -u GOMP_SPINCOUNT OMP_DISPLAY_ENV=verbose "$work/build/app" 2>&1 | grep -q "GOMP_SPINCOUNT = '0'"; then
+  echo "the project's app keeps libgomp's spinning: libcrossrt_openmp_waits.so is missing or before libgomp:" >&2
+  readelf -d "$work/build/app" | grep NEEDED >&2
+  exit 1
+fi
 if [ "$mode" = install ]; then
   # An upgraded CrossRT (here its engine, newer) translates the classes again, though the client
   # and the sources did not change.

@@ -90,7 +90,7 @@ inline int LoopSizeClass(long long iterations) {
 // one taken off its core in the middle of a chunk): beside one busy thread on 2 cores (AMD EPYC, bench_lbvh --load 1), the
 // LBVH_CPU build of an 11,102-triangle mesh (eight kernel calls) took 4.3-4.8 ms, and 54 ms in some
 // runs, against 1.0 ms quiet and 1.9 ms for the single-threaded original. Passive waits alone
-// (OMP_WAIT_POLICY) collapsed the same way; beside this choice they help (runtime/src/CpuWaitPolicy.cpp).
+// (OMP_WAIT_POLICY) collapsed the same way; beside this choice they help (runtime/src/OpenMPWaits.cpp).
 //
 // So each loop runs the way that has been faster here, as measured (MeasuredWays: all cores are
 // way 1, one core way 0), per size class of its iterations (LoopSizeClass). A try of one core costs
