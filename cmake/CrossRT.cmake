@@ -277,6 +277,16 @@ function(crossrt_add_class target class)
   else()
     target_link_libraries(${target} PRIVATE crossrt::cpu_runtime)
   endif()
+  if(NOT suffix STREQUAL "Vulkan" AND CROSSRT_LIBRARY_DIR AND linked_type MATCHES "^(EXECUTABLE|SHARED_LIBRARY|MODULE_LIBRARY)$"
+     AND NOT CROSSRT_LIBRARY_DIR IN_LIST CMAKE_CXX_IMPLICIT_LINK_DIRECTORIES)
+    # An installed CrossRT outside the system's library folders: the target, once installed, finds
+    # libcrossrt_openmp_waits.so there (CMake's build-tree RPATH finds it before that). A program
+    # that links a static library of CPU classes sets its own INSTALL_RPATH.
+    get_target_property(install_rpath ${target} INSTALL_RPATH)
+    if(NOT CROSSRT_LIBRARY_DIR IN_LIST install_rpath)
+      set_property(TARGET ${target} APPEND PROPERTY INSTALL_RPATH "${CROSSRT_LIBRARY_DIR}")
+    endif()
+  endif()
   target_link_libraries(${target} PRIVATE crossrt::litemath)
   # The size annotation is for the translator; compilers need not warn about it.
   if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU" AND CMAKE_CXX_COMPILER_VERSION VERSION_GREATER_EQUAL 12)
