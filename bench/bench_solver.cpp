@@ -4,7 +4,7 @@
 // the residual after every step, SolveChecked(k) only every k steps. On Vulkan each read splits the
 // recording (submit, wait, read the members back), so checking every step costs a round trip per
 // step; checking every k steps, one per k. Each implementation runs as the original single-threaded
-// C++, as _CPU (OpenMP), as _ISPC (where ISPC is found) and as _Vulkan on the default device, in
+// C++, as _CPU (all cores), as _ISPC (where ISPC is found) and as _Vulkan on the default device, in
 // interleaved rounds (the machine's noise spreads over all rows alike); each figure is the median.
 // The table also goes to CSV (default out/bench_solver.csv), which bench/plot_solver.py plots.
 //   bench_solver [SIDE (default 64)] [ROUNDS (default 3)] [CSV]

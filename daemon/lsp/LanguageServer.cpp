@@ -678,7 +678,7 @@ std::string Server::Describe(const Function& f, const Job& job) {
     } else {
       const bool ispc = job.cls.request.backend == engine::Backend::Ispc;
       s += k->rtv ? "called per thread of its control function's loop"
-                  : std::string(ispc ? "its loop nest in SIMD lanes (foreach) over chunks on all cores" : "its loop nest on all cores (OpenMP)");
+                  : std::string(ispc ? "its loop nest in SIMD lanes (foreach) over chunks on all cores" : "its loop nest on all cores (crossrt::ParallelFor)");
       if (!over.empty()) s += ", " + over;
       s += link;
     }

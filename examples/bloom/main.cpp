@@ -63,7 +63,7 @@ int main(int argc, char** argv)
   struct Run { const char* name; std::shared_ptr<Bloom> impl; std::vector<float4> out; double ms = 0.0; };
   std::vector<Run> runs;
   runs.push_back({"original (1 thread)", std::make_shared<Bloom>(w, h, 12, 5.0f), {}});
-  runs.push_back({"Bloom_CPU (OpenMP)", CreateBloom_CPU(w, h, 12, 5.0f), {}});
+  runs.push_back({"Bloom_CPU (all cores)", CreateBloom_CPU(w, h, 12, 5.0f), {}});
 #ifdef CROSSRT_HAS_ISPC
   runs.push_back({"Bloom_ISPC", CreateBloom_ISPC(w, h, 12, 5.0f), {}});
 #endif

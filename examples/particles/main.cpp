@@ -48,7 +48,7 @@ int main(int argc, char** argv)
 
   std::vector<Run> runs;
   runs.push_back({"original (1 thread)", pos, vel, std::make_shared<Particles>()});
-  runs.push_back({"Particles_CPU (OpenMP)", pos, vel, CreateParticles_CPU()});
+  runs.push_back({"Particles_CPU (all cores)", pos, vel, CreateParticles_CPU()});
 #ifdef CROSSRT_HAS_ISPC
   runs.push_back({"Particles_ISPC", pos, vel, CreateParticles_ISPC()});
 #endif

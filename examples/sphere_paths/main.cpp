@@ -68,7 +68,7 @@ int main(int argc, char** argv)
 
   std::vector<Run> runs;
   runs.push_back({"original (1 thread)", std::make_shared<SpherePaths>(), {}});
-  runs.push_back({"SpherePaths_CPU (OpenMP)", CreateSpherePaths_CPU(), {}});
+  runs.push_back({"SpherePaths_CPU (all cores)", CreateSpherePaths_CPU(), {}});
   try
   {
     auto ctx = crossrt::VulkanContext::CreateDefault();

@@ -139,14 +139,14 @@ TEST_CASE("What the ISPC backend does not translate yet is an error at the user'
 {
   const Case ispcCases[] = {
       {"hmax of an expression with side effects", "    int k = 0; x = LiteMath::hmax(LiteMath::float4(float(k++)));", "", "",
-       "hmin/hmax of an expression with side effects is not translated to ISPC yet", "BACKEND cpu (OpenMP) or vulkan", 8},
+       "hmin/hmax of an expression with side effects is not translated to ISPC yet", "BACKEND cpu (all cores, no SIMD lanes) or vulkan", 8},
       {"a component updated through an index with side effects", "    LiteMath::float4 v(x); int k = i; v[k++ % 4] += 1.0f; x = v.x;", "", "",
        "compound assignment to a vector's component whose vector or index has side effects is not translated to ISPC yet",
-       "BACKEND cpu (OpenMP) or vulkan", 8},
+       "BACKEND cpu (all cores, no SIMD lanes) or vulkan", 8},
       // (A local matrix's column, m[k++] += v, translates: the transforms conformance case.)
       {"a column of an array's matrix updated through an index with side effects",
        "    LiteMath::float4x4 ms[2]; int k = 0; ms[1][k++] += LiteMath::float4(x); x = ms[1](0, 0);", "",
-       "", "compound assignment to a vector whose address has side effects, other than an element of a buffer, member vector or local array, is not translated to ISPC yet", "BACKEND cpu (OpenMP) or vulkan", 8},
+       "", "compound assignment to a vector whose address has side effects, other than an element of a buffer, member vector or local array, is not translated to ISPC yet", "BACKEND cpu (all cores, no SIMD lanes) or vulkan", 8},
       // The gang (Gang.h): what a CRT_UNIFORM local holds must be the same in every lane.
       {"a per-lane value kept in a CRT_UNIFORM local", "    CRT_UNIFORM int k = 0;\n    k = i;\n    x += float(k);", "", "",
        "a value that may differ between the lanes of an ISPC gang is assigned to CRT_UNIFORM 'k'", "crossrt::AnyLane, FirstLane or MinOverLanes", 9},

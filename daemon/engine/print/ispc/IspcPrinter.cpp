@@ -17,7 +17,7 @@ using namespace clang;
 namespace crossrt::engine {
 
 std::string IspcPrinter::Unsupported(SourceLocation loc, const std::string& what) {
-  return Fail(loc, what + " is not translated to ISPC yet", "translate this class with BACKEND cpu (OpenMP) or vulkan");
+  return Fail(loc, what + " is not translated to ISPC yet", "translate this class with BACKEND cpu (all cores, no SIMD lanes) or vulkan");
 }
 
 // ISPC: the function that builds a struct from its fields, make_S, or crt_make_S where the user's
