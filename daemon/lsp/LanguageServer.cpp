@@ -117,6 +117,7 @@ public:
 private:
   bool OnMessage(const std::string& body);  // false: exit
   void OnRequest(const json& id, const std::string& method, const json& params);
+  void Release();  // the reader's staged requests to the worker
   bool OnNotification(const std::string& method, const json& params);
   json Initialize(const json& params);
   void Edit(const std::string& method, const json& params);
@@ -164,6 +165,7 @@ private:
     json params;
   };
   std::deque<Pending> m_requests;
+  std::vector<Pending> m_staged;             // read, not yet handed to the worker (the reader's own)
   std::set<std::string> m_cancelled;         // request ids, as JSON text
   std::map<std::string, json> m_published;   // path -> the diagnostics last sent
   std::set<std::string> m_toldUnknown;       // files said to belong to no class
@@ -196,6 +198,7 @@ void Server::Send() {
 int Server::Run() {
   if (!m_options.logPath.empty()) m_log.open(m_options.logPath, std::ios::app);
   Log("crossrtd --lsp started");
+  m_io.BeforeWaiting([this] { Release(); });
   std::thread worker([this] { Work(); });
   int code = 1;
   for (;;) {
@@ -286,10 +289,21 @@ void Server::OnRequest(const json& id, const std::string& method, const json& pa
   static const std::set<std::string> answered = {"textDocument/hover", "textDocument/codeLens", "textDocument/definition",
                                                  "textDocument/codeAction", "workspace/executeCommand"};
   if (!answered.count(method)) return Error(id, kMethodNotFound, "crossrtd does not answer '" + method + "'");
+  m_staged.push_back({id, method, params});  // the worker gets it once the reader has caught up (Release)
+}
+
+// Hands the requests read so far to the worker. The reader calls it when it has read every message
+// received and is about to wait for more, so that a $/cancelRequest sent with its request always
+// finds it unanswered: handed over one at a time, the worker, woken by the request, could answer it
+// before the reader had read the cancel that came in the same write (lsp.protocol failed so
+// beside two busy threads, once in 12 runs).
+void Server::Release() {
+  if (m_staged.empty()) return;
   {
     std::lock_guard<std::mutex> guard(m_mutex);
-    m_requests.push_back({id, method, params});
+    for (auto& request : m_staged) m_requests.push_back(std::move(request));
   }
+  m_staged.clear();
   m_wake.notify_all();
 }
 

@@ -14,6 +14,7 @@ bool Transport::Fill() {
     m_buffer.clear();
     m_pos = 0;
   }
+  if (m_beforeWaiting) m_beforeWaiting();
   char chunk[65536];
   for (;;) {
     ssize_t n = read(m_in, chunk, sizeof chunk);

@@ -7,6 +7,7 @@
 #pragma once
 #include <nlohmann/json.hpp>
 
+#include <functional>
 #include <mutex>
 #include <string>
 
@@ -23,6 +24,9 @@ public:
   ReadStatus Read(std::string& body);
   // False when the peer is gone.
   bool Write(const nlohmann::json& message);
+  // Called each time the reader is about to wait for more input: every message already received
+  // has been read by then.
+  void BeforeWaiting(std::function<void()> hook) { m_beforeWaiting = std::move(hook); }
 
 private:
   bool Fill();                       // more bytes into m_buffer; false at end of input
@@ -31,6 +35,7 @@ private:
   std::string m_buffer;
   size_t m_pos = 0;
   std::mutex m_writeMutex;
+  std::function<void()> m_beforeWaiting;
 };
 
 }  // namespace crossrt::lsp
