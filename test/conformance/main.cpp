@@ -57,8 +57,13 @@ Verdict Compare(const Run& original, const Run& translated, double tolerance) {
   size_t at = 0;
   for (size_t i = 0; i < original.outputs.size(); ++i) {
     const double a = original.outputs[i], b = translated.outputs[i];
-    const double d = std::isnan(a) && std::isnan(b) ? 0.0 : std::fabs(a - b) / std::max(1.0, std::fabs(a));
-    if (!(d <= worst)) {
+    const double d = a == b || (std::isnan(a) && std::isnan(b)) ? 0.0 : std::fabs(a - b) / std::max(1.0, std::fabs(a));  // (equal infinities: 0)
+    if (std::isnan(d)) {  // a NaN on one side only: the verdict, kept (a later 0 must not replace it)
+      worst = d;
+      at = i;
+      break;
+    }
+    if (d > worst) {
       worst = d;
       at = i;
     }

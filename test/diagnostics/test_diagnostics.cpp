@@ -183,7 +183,7 @@ std::string IspcKernelsOf(const TempClass& tc, const std::string& name)
 
 }  // namespace
 
-TEST_CASE("ISPC: a loop whose bounds every lane shares is uniform, and leaves early only all at once; one the lanes differ in, or leave early apart, is varying", "[diagnostics][ispc]")
+TEST_CASE("ISPC: a loop whose bounds every lane shares is uniform, and leaves early only all at once, one the lanes differ in, or leave early apart, is varying", "[diagnostics][ispc]")
 {
   TempClass tc("Loops", R"(#pragma once
 class Loops
@@ -346,7 +346,7 @@ void Lookup::kernel1D_Run(int n, const unsigned* keys, float* out)
   REQUIRE(text.find("const Big mine = self->m_big[keys[i]];") != std::string::npos);               // not const: as written
 }
 
-TEST_CASE("ISPC: a float4 read whole through a pointer at a per-lane index goes through crt_load4, one stored whole through crt_store4; a field of it does neither",
+TEST_CASE("ISPC: a float4 read whole through a pointer at a per-lane index goes through crt_load4, one stored whole through crt_store4, a field of it does neither",
           "[diagnostics][ispc]")
 {
   TempClass tc("Rows", R"(#pragma once
@@ -384,7 +384,7 @@ void Rows::kernel1D_Run(int n, const float4* in, float4* out)
   REQUIRE(text.find("out_[i].w = 1.0") != std::string::npos);                                 // one field: a scatter
 }
 
-TEST_CASE("ISPC: a struct of eight 32-bit words stored whole at a per-lane index goes through a crt_store_ helper of its own; other structs scatter",
+TEST_CASE("ISPC: a struct of eight 32-bit words stored whole at a per-lane index goes through a crt_store_ helper of its own, other structs scatter",
           "[diagnostics][ispc]")
 {
   TempClass tc("Hits", R"(#pragma once
@@ -596,7 +596,7 @@ void NotVirtual::kernel1D_Fill(int n, float* out) { for (int i = 0; i < n; i++) 
   REQUIRE(text.find("virtual void RunCmd(VkCommandBuffer crt_cmd") != std::string::npos);
 }
 
-TEST_CASE("Host code that reads what kernels write runs after the last kernel; between kernels it is reported", "[diagnostics]")
+TEST_CASE("Host code that reads what kernels write runs after the last kernel, between kernels it is reported", "[diagnostics]")
 {
   // m_total is a member reduction. The Vulkan class records the whole control function before any
   // kernel runs: read after the last kernel, it is read once the results are back; read between
@@ -923,7 +923,7 @@ void Sums::kernel1D_Sum(int n, float* data, float* total)
   }
 }
 
-TEST_CASE("A statement before a loop nest that sets a local and does more is refused; one that only sets locals is not", "[diagnostics]")
+TEST_CASE("A statement before a loop nest that sets a local and does more is refused, one that only sets locals is not", "[diagnostics]")
 {
   const char* header = R"(#pragma once
 #include "LiteMath.h"

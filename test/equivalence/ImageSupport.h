@@ -15,8 +15,12 @@ inline LiteImage::Image2D<LiteMath::float4> RandomImage(uint32_t w, uint32_t h, 
   return img;
 }
 
-// The largest difference of two texels over their channels.
+// The largest difference of two texels over their channels; NaN where a channel's is (std::max
+// would drop it, and `MaxDifference(...) <= tolerance` would pass).
 inline float MaxDifference(const LiteMath::float4& a, const LiteMath::float4& b)
 {
-  return std::max(std::max(std::fabs(a.x - b.x), std::fabs(a.y - b.y)), std::max(std::fabs(a.z - b.z), std::fabs(a.w - b.w)));
+  float worst = 0.0f;
+  for (int c = 0; c < 4; ++c)
+    if (const float d = std::fabs(a[c] - b[c]); std::isnan(d) || d > worst) worst = d;
+  return worst;
 }

@@ -33,8 +33,8 @@ size_t DifferentPixels(const std::vector<float4>& a, const std::vector<float4>& 
 {
   size_t count = 0;
   for (size_t i = 0; i < a.size(); ++i)
-    if (std::fabs(a[i].x - b[i].x) > tolerance || std::fabs(a[i].y - b[i].y) > tolerance || std::fabs(a[i].z - b[i].z) > tolerance ||
-        a[i].w != b[i].w)
+    if (!(std::fabs(a[i].x - b[i].x) <= tolerance) || !(std::fabs(a[i].y - b[i].y) <= tolerance) || !(std::fabs(a[i].z - b[i].z) <= tolerance) ||
+        a[i].w != b[i].w)  // (written so that a NaN counts)
       ++count;
   return count;
 }

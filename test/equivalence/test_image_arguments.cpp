@@ -61,7 +61,8 @@ TEST_CASE("Image2D parameters: read, written and sized by kernels, at any size, 
       REQUIRE(out.height() == h);
       float worst = 0.0f;
       for (uint32_t y = 0; y < h; ++y)
-        for (uint32_t x = 0; x < w; ++x) worst = std::max(worst, MaxDifference(out.at(x, y), ExpectedBlur(in, int(x), int(y), 1.5f)));
+        for (uint32_t x = 0; x < w; ++x)
+          if (const float d = MaxDifference(out.at(x, y), ExpectedBlur(in, int(x), int(y), 1.5f)); std::isnan(d) || d > worst) worst = d;
       REQUIRE(worst <= 1e-6f);
     }
     // Empty images: no thread runs and nothing is copied; the output stays empty.
@@ -91,7 +92,7 @@ TEST_CASE("Image2D parameters in place: a thread function scales the texels of a
   RequireNoValidationMessages(ctx);
 }
 
-TEST_CASE("Image2D members given to kernels' image parameters are written back; parameters read beside them", "[equivalence][images]")
+TEST_CASE("Image2D members given to kernels' image parameters are written back, parameters read beside them", "[equivalence][images]")
 {
   auto ctx = ValidatedContext();
   const uint32_t w = 29, h = 17;

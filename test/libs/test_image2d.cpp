@@ -347,7 +347,7 @@ TEST_CASE("Combined image samplers read every texel type as Vulkan does", "[lite
   CHECK_THROWS_AS(TextureOf(&procedural), std::invalid_argument);
 }
 
-TEST_CASE("LoadBMP reads what SaveBMP wrote; sRGB images sample linearized through combined samplers", "[liteimage]")
+TEST_CASE("LoadBMP reads what SaveBMP wrote, sRGB images sample linearized through combined samplers", "[liteimage]")
 {
   const std::vector<unsigned int> pixels = {0x00336699u, 0x00FFFFFFu};
   TempFile tmp("bmp");

@@ -188,7 +188,7 @@ TEST_CASE("materials: Sample draws the density Evaluate states (chi-square), wit
       }
 }
 
-TEST_CASE("materials: every BRDF is reciprocal; the rough dielectric's BTDF scales radiance by 1 / eta^2", "[materials]")
+TEST_CASE("materials: every BRDF is reciprocal, the rough dielectric's BTDF scales radiance by 1 / eta^2", "[materials]")
 {
   std::mt19937 rng(3);
   std::uniform_real_distribution<float> uniform(0.0f, 1.0f);

@@ -41,5 +41,13 @@ end
 if not vim.wait(60000, function() return #vim.diagnostic.get(buf) == 0 end, 20) then
   return finish(false, "the diagnostics did not clear after the fix (" .. #vim.diagnostic.get(buf) .. " left)")
 end
+-- Neovim clears a client's diagnostics when the client exits too: the server must still be there,
+-- and answer.
+local c = vim.lsp.get_client_by_id(client)
+if not c or c.is_stopped() then return finish(false, "crossrtd went away after the edit") end
+local answered = c.request_sync("textDocument/codeLens", { textDocument = vim.lsp.util.make_text_document_params(buf) }, 60000, buf)
+if not answered or answered.err then
+  return finish(false, "crossrtd did not answer after the edit: " .. vim.inspect(answered and answered.err))
+end
 vim.lsp.stop_client(client)
 finish(true, "Neovim showed the translator's diagnostics and cleared them after the fix")
