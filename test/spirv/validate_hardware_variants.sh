@@ -22,8 +22,17 @@ mapfile -t shaders < <(find "$build" \( -path "$build/test/package-*" -o -path "
                          -o -name '*.rgen' -o -name '*.rcall' -o -name '*.rint' -o -name '*.rchit' -o -name '*.rmiss' \) -path '*/shaders/*' -print | sort -u)
 status=0
 for expected in "$@"; do
-  if ! printf '%s\n' "${shaders[@]}" | grep -q -- "/$expected\$"; then
+  found=$(printf '%s\n' "${shaders[@]}" | grep -- "/$expected\$" | head -1)
+  if [ -z "$found" ]; then
     echo "FAIL: no generated shader ends with $expected"
+    status=1
+    continue
+  fi
+  # Written by the class's last translation, not left from an earlier one (outputs are never
+  # deleted): the class folder's manifest lists it.
+  class_dir=${found%/shaders/*}
+  if ! grep -q "\"shaders/${found##*/shaders/}\"" "$class_dir/.crossrt-manifest.json" 2> /dev/null; then
+    echo "FAIL: $found is not among the outputs of its class's last translation ($class_dir/.crossrt-manifest.json)"
     status=1
   fi
 done
