@@ -11,6 +11,15 @@
 //   AllLanes(b)       b holds in every active lane         (ISPC's all)
 //   FirstLane(v)      v in the first active lane, for all  (ISPC's extract at the lowest lane)
 //   MinOverLanes(v)   the least v over the active lanes    (ISPC's reduce_min)
+//   AllLanesOn()      every lane of the gang runs here: none was switched off by a branch, a loop
+//                     or a return before this point        (ISPC: popcnt(lanemask()) == programCount)
+//
+// An `if` whose condition is AllLanesOn() && other terms every lane shares (AllLanes(...), GangSize(),
+// members, CRT_UNIFORM locals) runs its then-branch on ISPC as `unmasked`: ISPC then knows that every
+// lane is on, and keeps the branch's local structs (float3, float4, the user's) in registers. Under a
+// mask it only knows at run time, each write to a field of a local struct is a masked store to
+// memory, and a load that follows it waits for it (vmaskmovps with AVX2). Where the condition is not
+// shared by every lane, the branch is printed as a plain `if`.
 //
 // CRT_UNIFORM before a local variable's declaration says the gang shares one copy of it (ISPC's
 // `uniform`): it may only be assigned values every active lane agrees on (the results of the
@@ -45,5 +54,6 @@ inline T MinOverLanes(T v)
 {
   return v;
 }
+inline bool AllLanesOn() { return true; }
 
 }  // namespace crossrt

@@ -14,6 +14,11 @@ void KeyCounter::kernel1D_Count(int n, const float* queries, uint32_t* counts)
   for (int i = 0; i < n; i++)
   {
     const float q = queries[i];
+    if (!(q == q))  // a NaN query is no count; its lane leaves, and the gang walks on without it
+    {
+      counts[i] = kNoCount;
+      continue;
+    }
     CRT_UNIFORM const int blocks = int(m_keys.size()) / kBlock;
     // Together: past each block whose last key some query of the gang is at or beyond.
     CRT_UNIFORM int block = 0;
@@ -27,7 +32,17 @@ void KeyCounter::kernel1D_Count(int n, const float* queries, uint32_t* counts)
     const int end = mine < blocks ? (mine + 1) * kBlock : int(m_keys.size());  // the last block takes the tail
     for (int k = mine * kBlock; k < end; k++)
       c += AtOrBelow(m_keys[k], q);
-    counts[i] = c;
-    m_total += c;
+    // Every lane on (a full gang without a NaN query): ISPC runs this branch unmasked. Where a lane
+    // is off, the else: an unmasked write there would give a NaN query a count instead of kNoCount.
+    if (crossrt::AllLanesOn())
+    {
+      counts[i] = c;
+      m_total += c;
+    }
+    else
+    {
+      counts[i] = c;
+      m_total += c;
+    }
   }
 }

@@ -3,7 +3,9 @@
 // kernel and a mean written after it. Each query counts the keys at or below it. The gang moves past
 // whole blocks of keys together while any of its queries lies beyond them (one load of a block's
 // last key for all lanes on ISPC); each query then steps back alone to its own block and counts in
-// it, so its count never depends on the queries beside it (test/equivalence/test_gang.cpp).
+// it, so its count never depends on the queries beside it (test/equivalence/test_gang.cpp). A NaN
+// query gets kNoCount and leaves its gang's walk; where no lane has left, the results are written in
+// a branch that crossrt::AllLanesOn() guards (ISPC: unmasked).
 #pragma once
 #include "Gang.h"
 
@@ -16,11 +18,12 @@ public:
   explicit KeyCounter(std::vector<float> sortedKeys) : m_keys(std::move(sortedKeys)) {}
   virtual ~KeyCounter() = default;
 
-  // counts[i] = the keys <= queries[i]; m_total their sum, m_mean their mean.
+  // counts[i] = the keys <= queries[i] (kNoCount for a NaN); m_total their sum, m_mean their mean.
   virtual void Count(int n, [[crossrt::size("n")]] const float* queries, [[crossrt::size("n")]] uint32_t* counts);
   virtual void CommitDeviceData() {}
 
   static constexpr int kBlock = 8;
+  static constexpr uint32_t kNoCount = 0xFFFFFFFFu;  // a NaN query's count
   std::vector<float> m_keys;  // ascending
   uint32_t m_total = 0;
   float m_mean = 0.0f;

@@ -161,6 +161,10 @@ TEST_CASE("What the ISPC backend does not translate yet is an error at the user'
        "CRT_UNIFORM 'k' is passed to reference parameter 'k', which holds one value per lane on ISPC", "return the new value", 9},
       {"the first lane of a vector", "    x += crossrt::FirstLane(LiteMath::float2(x, x)).x;", "", "",
        "crossrt::FirstLane of a 'LiteMath::float2'", "one field at a time", 8},
+      // An AllLanesOn branch is `unmasked` on ISPC, which a return inside mishandles.
+      {"a return inside a crossrt::AllLanesOn() branch", "    x = Twice(x);", "  float Twice(float v) const;",
+       "float Bad::Twice(float v) const { if (crossrt::AllLanesOn()) return v * 2.0f; return v + v; }\n",
+       "'return' inside a crossrt::AllLanesOn() branch", "assign the result to a local declared before the if", 12},
   };
   for (const Case& c : ispcCases)
   {

@@ -111,7 +111,7 @@ std::string KernelPrinter::Builtin(const FunctionDecl* fd, const std::vector<std
 // ---- crossrt::GangSize, AnyLane, ... (Gang.h): each language's GangCall ----
 
 bool IsGangFunction(const FunctionDecl* fd) {
-  static const std::set<std::string> names = {"GangSize", "AnyLane", "AllLanes", "FirstLane", "MinOverLanes"};
+  static const std::set<std::string> names = {"GangSize", "AnyLane", "AllLanes", "FirstLane", "MinOverLanes", "AllLanesOn"};
   return fd && InNamespace(fd, "crossrt") && names.count(fd->getNameAsString()) > 0;
 }
 

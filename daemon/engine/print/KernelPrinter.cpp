@@ -829,6 +829,8 @@ std::string KernelPrinter::RangeFor(const CXXForRangeStmt* rf, int indent) {
          TrimmedSourceText(m_ctx, range->getSourceRange()) + ")\n" + pad + "{\n" + element + inner + pad + "}\n";
 }
 
+std::string KernelPrinter::ThenBranch(const clang::IfStmt* is, int indent) { return Stmt(is->getThen(), isa<CompoundStmt>(is->getThen()) ? indent : indent + 1); }
+
 std::string KernelPrinter::Stmt(const clang::Stmt* s, int indent) {
   std::string pad(indent * 2, ' ');
   if (!s) return pad + ";\n";
@@ -912,7 +914,7 @@ std::string KernelPrinter::Stmt(const clang::Stmt* s, int indent) {
   if (auto* is = dyn_cast<IfStmt>(s)) {
     if (is->getConditionVariable() || is->getInit())
       Fail(is->getBeginLoc(), "declaration inside an if condition in a kernel", "declare the variable before the if");
-    std::string out = pad + "if (" + Expr(is->getCond()) + ")\n" + Stmt(is->getThen(), isa<CompoundStmt>(is->getThen()) ? indent : indent + 1);
+    std::string out = pad + "if (" + Expr(is->getCond()) + ")\n" + ThenBranch(is, indent);
     if (is->getElse()) out += pad + "else\n" + Stmt(is->getElse(), isa<CompoundStmt>(is->getElse()) ? indent : indent + 1);
     return out;
   }

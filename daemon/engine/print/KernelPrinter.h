@@ -278,6 +278,8 @@ protected:
   virtual std::string RangeCounter(bool exits) const = 0;
   virtual std::string LoopInit(const clang::ForStmt* fs, const std::string& init) = 0;
   virtual std::string ArrayCopy(const clang::VarDecl* vd, const clang::CXXConstructExpr* copy, const std::string& pad) = 0;
+  // An if's then-branch, as printed after its `if (...)` line (ISPC marks some `unmasked`).
+  virtual std::string ThenBranch(const clang::IfStmt* is, int indent);
   // The gang (Gang.h): crossrt::GangSize, AnyLane, AllLanes, FirstLane and MinOverLanes; what a
   // local's declaration starts with besides `const` (ISPC's `uniform` for a CRT_UNIFORM local).
   virtual std::string GangCall(const clang::FunctionDecl* fd, const clang::CallExpr* call) = 0;

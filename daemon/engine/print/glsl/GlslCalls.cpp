@@ -123,6 +123,7 @@ std::string GlslPrinter::LibraryCall(const FunctionDecl* fd, const std::vector<s
 // does, and a CRT_UNIFORM local is a thread's own.
 std::string GlslPrinter::GangCall(const FunctionDecl* fd, const CallExpr* call) {
   if (fd->getName() == "GangSize") return "1";
+  if (fd->getName() == "AllLanesOn") return "true";
   return "(" + Expr(call->getArg(0)) + ")";
 }
 

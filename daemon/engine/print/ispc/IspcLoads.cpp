@@ -61,7 +61,8 @@ std::string IspcPrinter::CoherentLoad(const clang::CXXOperatorCallExpr* op) {
        << "  for (uniform int k = 0; k < " << kAgreedValues << "; ++k)\n  {\n"
        << "    if (!any(pending))\n      return e;\n"
        << "    const uniform uint agreed = extract(i, count_trailing_zeros(lanemask() & packmask(pending)));\n"
-       << "    if (i == agreed)\n    {\n      e = a[agreed];\n      pending = false;\n    }\n  }\n"
+       << "    cif (i == agreed)  // coherent: where every lane is on and agrees, e stays in registers (no masked stores)\n"
+       << "    {\n      e = a[agreed];\n      pending = false;\n    }\n  }\n"
        << "  if (pending)\n    e = a[i];\n"
        << "  return e;\n}\n";
     m_functions.push_back(os.str());

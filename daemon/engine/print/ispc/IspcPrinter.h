@@ -70,6 +70,7 @@ protected:
   std::string RangeCounter(bool exits) const override;
   std::string LoopInit(const clang::ForStmt* fs, const std::string& init) override;
   std::string ArrayCopy(const clang::VarDecl* vd, const clang::CXXConstructExpr* copy, const std::string& pad) override;
+  std::string ThenBranch(const clang::IfStmt* is, int indent) override;
   std::string GangCall(const clang::FunctionDecl* fd, const clang::CallExpr* call) override;
   std::string LocalQualifier(const clang::VarDecl* vd) override;
   void ReferenceArgument(const clang::ParmVarDecl* p, const clang::Expr* arg) override;

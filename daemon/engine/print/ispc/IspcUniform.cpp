@@ -157,6 +157,7 @@ const VarDecl* IspcPrinter::UniformLoop(const ForStmt* fs) {
 std::string IspcPrinter::GangCall(const FunctionDecl* fd, const CallExpr* call) {
   const std::string name = fd->getNameAsString();
   if (name == "GangSize") return "programCount";
+  if (name == "AllLanesOn") return "(popcnt(lanemask()) == programCount)";
   const std::string value = Expr(call->getArg(0));
   if (name == "AnyLane") return "any(" + value + ")";
   if (name == "AllLanes") return "all(" + value + ")";
@@ -167,6 +168,53 @@ std::string IspcPrinter::GangCall(const FunctionDecl* fd, const CallExpr* call) 
     return Fail(call->getArg(0)->getExprLoc(), "crossrt::" + name + " of a '" + t.getAsString(m_ctx.getPrintingPolicy()) + "'",
                 "pass an int, unsigned, float" + std::string(name == "FirstLane" ? " or bool" : "") + ", one field at a time");
   return (name == "FirstLane" ? "crt_first_lane(" : "reduce_min(") + value + ")";
+}
+
+// Whether e is crossrt::AllLanesOn() or a conjunction (&&) with it as one of its terms.
+static bool ConjoinsAllLanesOn(const clang::Expr* e) {
+  e = e->IgnoreParenImpCasts();
+  if (auto* bo = dyn_cast<BinaryOperator>(e); bo && bo->getOpcode() == BO_LAnd)
+    return ConjoinsAllLanesOn(bo->getLHS()) || ConjoinsAllLanesOn(bo->getRHS());
+  auto* call = dyn_cast<CallExpr>(e);
+  return call && IsGangFunction(call->getDirectCallee()) && call->getDirectCallee()->getName() == "AllLanesOn";
+}
+
+// The first statement in s that leaves it: a return, or a break or continue outside the loops and
+// switches within s (nullptr if none).
+static const clang::Stmt* ExitFrom(const clang::Stmt* s) {
+  struct Exits : RecursiveASTVisitor<Exits> {
+    const clang::Stmt* found = nullptr;
+    int inner = 0;  // loops and switches around the statement being visited
+    bool VisitReturnStmt(ReturnStmt* r) { found = found ? found : r; return true; }
+    bool VisitBreakStmt(BreakStmt* b) { found = found || inner ? found : b; return true; }
+    bool VisitContinueStmt(ContinueStmt* c) { found = found || inner ? found : c; return true; }
+    using Base = RecursiveASTVisitor<Exits>;
+    bool TraverseForStmt(ForStmt* f) { ++inner; Base::TraverseForStmt(f); --inner; return true; }
+    bool TraverseWhileStmt(WhileStmt* w) { ++inner; Base::TraverseWhileStmt(w); --inner; return true; }
+    bool TraverseDoStmt(DoStmt* d) { ++inner; Base::TraverseDoStmt(d); --inner; return true; }
+    bool TraverseCXXForRangeStmt(CXXForRangeStmt* f) { ++inner; Base::TraverseCXXForRangeStmt(f); --inner; return true; }
+    bool TraverseSwitchStmt(SwitchStmt* w) { ++inner; Base::TraverseSwitchStmt(w); --inner; return true; }
+  } exits;
+  exits.TraverseStmt(const_cast<clang::Stmt*>(s));
+  return exits.found;
+}
+
+// `if (crossrt::AllLanesOn() && ...)` with a condition every lane shares: its then-branch runs with
+// every lane on, so it is `unmasked`, and ISPC compiles it with the mask known (Gang.h). The branch
+// may not return, break or continue out of itself: ISPC 1.28 mixes up which lanes have returned
+// after a return inside `unmasked` (a test image differed in 8 pixels of 6144).
+std::string IspcPrinter::ThenBranch(const clang::IfStmt* is, int indent) {
+  if (!ConjoinsAllLanesOn(is->getCond()) || !Uniform(is->getCond())) return KernelPrinter::ThenBranch(is, indent);
+  if (const clang::Stmt* exit = ExitFrom(is->getThen()))
+    return Fail(exit->getBeginLoc(), std::string("'") + (isa<ReturnStmt>(exit) ? "return" : isa<BreakStmt>(exit) ? "break" : "continue") +
+                                         "' inside a crossrt::AllLanesOn() branch",
+                "ISPC runs the branch unmasked, and cannot leave it so: assign the result to a local declared before the if, and "
+                "return (break, continue) after it"),
+           "";
+  const std::string pad(2 * (indent + 1), ' ');
+  std::string body = Stmt(is->getThen(), isa<CompoundStmt>(is->getThen()) ? indent + 1 : indent + 2);
+  if (!isa<CompoundStmt>(is->getThen())) body = pad + "{\n" + body + pad + "}\n";
+  return pad + "unmasked  // every lane is on (crossrt::AllLanesOn): the mask is known, local structs stay in registers\n" + body;
 }
 
 // A CRT_UNIFORM local: `uniform`, if it holds numbers and starts shared.

@@ -196,7 +196,6 @@ layout(push_constant) uniform crt_kernel2D_RenderArgs
 };
 
 const uint m_pAccelStruct_kNoId = 4294967295u;
-const uint m_pAccelStruct_kLeafFlag = 2147483648u;
 const uint m_pAccelStruct_kInstanceSdf = 8u;
 const uint m_pAccelStruct_kInstanceBoxes = 2u;
 const uint m_pAccelStruct_kInstanceMotion = 4u;
@@ -206,6 +205,7 @@ const float m_pAccelStruct_kWiden = 1.00000036;
 const float m_pAccelStruct_kMissed = -1.0;
 const float m_pAccelStruct_kNotEntered = (1.0 / 0.0);
 const uint m_pAccelStruct_kNoChild = 4294967295u;
+const uint m_pAccelStruct_kLeafFlag = 2147483648u;
 const uint m_pAccelStruct_kSdfMaskedVoxels = 4u;
 const int m_pAccelStruct_kSdfNewtonIterations = 4;
 const uint m_pAccelStruct_kSceneTriangles = 16u;
@@ -242,14 +242,11 @@ BVHTraceRay m_pAccelStruct_Prepare(vec3 org, vec3 dir, float tnear)
   r.anyZeroAxis = r.invDir.x == 0.0 || r.invDir.y == 0.0 || r.invDir.z == 0.0;
   const vec3 ad = vec3(abs(dir.x), abs(dir.y), abs(dir.z));
   r.kz = ad.x >= ad.y && ad.x >= ad.z ? 0 : ad.y >= ad.z ? 1 : 2;
-  r.kx = r.kz == 2 ? 0 : r.kz + 1;
-  r.ky = r.kx == 2 ? 0 : r.kx + 1;
-  if (dir[r.kz] < 0.0)
-  {
-    const int k = r.kx;
-    r.kx = r.ky;
-    r.ky = k;
-  }
+  const int kx = r.kz == 2 ? 0 : r.kz + 1;
+  const int ky = kx == 2 ? 0 : kx + 1;
+  const bool swap = dir[r.kz] < 0.0;
+  r.kx = swap ? ky : kx;
+  r.ky = swap ? kx : ky;
   r.sx = dir[r.kx] / dir[r.kz];
   r.sy = dir[r.ky] / dir[r.kz];
   r.sz = 1.0 / dir[r.kz];
@@ -430,7 +427,7 @@ bool m_pAccelStruct_TraceMeshTogether(BVHTraceRay ray, uint root, bool anyHit, i
   {
     while ((node & m_pAccelStruct_kLeafFlag) == 0u)
     {
-      const bool active_ = entry <= tfar;
+      const bool active_ = entry <= tfar && !(anyHit && found);
       float childEntry[4];
       uint entered = 0u;
       for (int lane = 0; lane < 4; ++lane)
@@ -476,8 +473,9 @@ bool m_pAccelStruct_TraceMeshTogether(BVHTraceRay ray, uint root, bool anyHit, i
       if (next == m_pAccelStruct_kNoChild)
         break;
     }
-    if (node != m_pAccelStruct_kNoChild && entry <= tfar)
+    if (node != m_pAccelStruct_kNoChild && (entry <= tfar))
     {
+      const bool inLeaf = entry <= tfar && !(anyHit && found);
       const uint first = (node & ~m_pAccelStruct_kLeafFlag) >> 3;
       const uint last = first + (node & 7u);
       for (uint g = first; g <= last; ++g)
@@ -498,11 +496,12 @@ bool m_pAccelStruct_TraceMeshTogether(BVHTraceRay ray, uint root, bool anyHit, i
           u[lane] = ul;
           v[lane] = vl;
         }
-        if ((onEdge))
+        if ((inLeaf && onEdge))
           hits = m_pAccelStruct_IntersectGroup(ray, g, kx, ky, kz, tfar, t, u, v);
+        hits = inLeaf ? hits : 0u;
         found = m_pAccelStruct_TakeNearestHit(g, hits, t, u, v, anyHit, tfar, hit) || found;
       }
-      if (anyHit && found)
+      if (anyHit && (found))
         return true;
     }
     do
@@ -897,7 +896,14 @@ bool m_pAccelStruct_IntersectBoxes(BVHTraceRay r, uint group, bool sdf, inout fl
 bool m_pAccelStruct_TraceMesh(BVHTraceRay ray, uint root, uint leaves, bool anyHit, inout float tfar, inout CRT_Hit hit)
 {
   if (1 > 1 && (leaves == 0u && root == (root) && ray.kx == (ray.kx) && ray.kz == (ray.kz)))
-    return m_pAccelStruct_TraceMeshTogether(ray, root, anyHit, tfar, hit);
+  {
+    bool together = false;
+    if (true)
+      together = m_pAccelStruct_TraceMeshTogether(ray, root, anyHit, tfar, hit);
+    else
+      together = m_pAccelStruct_TraceMeshTogether(ray, root, anyHit, tfar, hit);
+    return together;
+  }
   uint stack[64];
   float stackEntry[64];
   int top = 0;
@@ -990,11 +996,8 @@ bool m_pAccelStruct_TraceInstance(uint k, BVHTraceRay worldRay, float time, bool
     ray = m_pAccelStruct_Prepare(m_pAccelStruct_ToObjectPoint(inst, worldRay.org),
                                  m_pAccelStruct_ToObjectVector(inst, worldRay.dir), worldRay.tnear);
   const bool found = m_pAccelStruct_TraceMesh(ray, inst.root, leaves, anyHit, tfar, hit);
-  if (found)
-  {
-    hit.instId = inst.instId;
-    hit.geomId = inst.geomId;
-  }
+  hit.instId = found ? inst.instId : hit.instId;
+  hit.geomId = found ? inst.geomId : hit.geomId;
   return found;
 }
 
@@ -1003,9 +1006,13 @@ bool m_pAccelStruct_Trace(vec4 posAndNear, vec4 dirAndFar, float time, bool anyH
 {
   float tnear = 0.0;
   float tfar = 0.0;
-  if (crt_m_pAccelStruct_m_nodes_size == 0u || !m_pAccelStruct_RayInterval(posAndNear, dirAndFar, tnear, tfar))
+  const bool valid = m_pAccelStruct_RayInterval(posAndNear, dirAndFar, tnear, tfar);
+  if (crt_m_pAccelStruct_m_nodes_size == 0u || !(valid))
     return false;
+  tfar = valid ? tfar : -1.0;
   const BVHTraceRay worldRay = m_pAccelStruct_Prepare((posAndNear).xyz, (dirAndFar).xyz, tnear);
+  if (1 > 1 && crt_m_pAccelStruct_m_instances_size == 1u)
+    return m_pAccelStruct_TraceInstance(0u, worldRay, time, anyHit, tfar, hit);
   uint stack[64];
   float stackEntry[64];
   int top = 0;
