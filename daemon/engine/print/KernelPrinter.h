@@ -280,7 +280,7 @@ protected:
   virtual std::string ArrayCopy(const clang::VarDecl* vd, const clang::CXXConstructExpr* copy, const std::string& pad) = 0;
   // An if's then-branch, as printed after its `if (...)` line (ISPC marks some `unmasked`).
   virtual std::string ThenBranch(const clang::IfStmt* is, int indent);
-  // The gang (Gang.h): crossrt::GangSize, AnyLane, AllLanes, FirstLane and MinOverLanes; what a
+  // The gang (Gang.h): crossrt::GangSize, AnyLane, AllLanes, FirstLane, MinOverLanes and AllLanesOn; what a
   // local's declaration starts with besides `const` (ISPC's `uniform` for a CRT_UNIFORM local).
   virtual std::string GangCall(const clang::FunctionDecl* fd, const clang::CallExpr* call) = 0;
   virtual std::string LocalQualifier(const clang::VarDecl* vd) = 0;

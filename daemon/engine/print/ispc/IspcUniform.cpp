@@ -7,7 +7,8 @@
 // And the gang of Gang.h: a CRT_UNIFORM local is `uniform`, and every value assigned to it must be
 // shared (reported at the user's line otherwise, not as an ISPC error in the generated file);
 // crossrt::AnyLane, AllLanes, FirstLane, MinOverLanes and GangSize are ISPC's any, all, extract at
-// the lowest active lane, reduce_min and programCount. Part of IspcPrinter (IspcPrinter.h).
+// the lowest active lane, reduce_min and programCount; AllLanesOn tests lanemask(), and the branch of
+// an `if` it guards is `unmasked`. Part of IspcPrinter (IspcPrinter.h).
 #include "analyse/AstQueries.h"
 #include "print/ispc/IspcPrinter.h"
 #include "print/PrinterParts.h"
@@ -194,6 +195,7 @@ static const clang::Stmt* ExitFrom(const clang::Stmt* s) {
     bool TraverseDoStmt(DoStmt* d) { ++inner; Base::TraverseDoStmt(d); --inner; return true; }
     bool TraverseCXXForRangeStmt(CXXForRangeStmt* f) { ++inner; Base::TraverseCXXForRangeStmt(f); --inner; return true; }
     bool TraverseSwitchStmt(SwitchStmt* w) { ++inner; Base::TraverseSwitchStmt(w); --inner; return true; }
+    bool TraverseLambdaExpr(LambdaExpr*) { return true; }  // a lambda's return leaves the lambda
   } exits;
   exits.TraverseStmt(const_cast<clang::Stmt*>(s));
   return exits.found;
