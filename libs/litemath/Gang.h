@@ -13,6 +13,20 @@
 //   MinOverLanes(v)   the least v over the active lanes    (ISPC's reduce_min)
 //   AllLanesOn()      every lane of the gang runs here: none was switched off by a branch, a loop
 //                     or a return before this point        (ISPC: popcnt(lanemask()) == programCount)
+//   LaneIndex()       this lane's place in the gang, 0 to GangSize() - 1      (ISPC's programIndex)
+//   LaneBits(b)       the active lanes where b holds, as bits: bit i for lane i (ISPC's packmask)
+//   LaneValue(v, i)   v in lane i, an active lane, for all      (ISPC's extract)
+//   LaneOf(v, first)  component first + LaneIndex() of v, a LiteMath 4-vector, in the lanes where that
+//                     is below 4, and the last component in the others: where v is a member or a
+//                     CRT_UNIFORM local at an index the gang shares, ISPC reads the components in one
+//                     load, not a gather
+//
+// With LaneIndex, the lanes of a gang can share out one thread's work: a loop
+// `for (int first = 0; first < 4; first += GangSize())` (a loop the gang runs together: its start,
+// bound and step are shared) whose lanes take items first + LaneIndex() below 4 runs four times in a
+// gang of one and once in a gang of four or more, and LaneBits and LaneValue bring the lanes' results back to values the gang shares
+// (BVHScene::TraceMeshAlone tests a node's four boxes so, one a lane, for one ray, and reads their
+// planes with LaneOf).
 //
 // An `if` whose condition is AllLanesOn() && other terms every lane shares (AllLanes(...), GangSize(),
 // members, CRT_UNIFORM locals) runs its then-branch on ISPC as `unmasked`: ISPC then knows that every
@@ -32,6 +46,8 @@
 // kernel must give every thread the result it would give alone (BVHScene's packet traversal finds
 // each ray's nearest hit whichever rays share its gang), or the ISPC class and the others disagree.
 #pragma once
+
+#include <type_traits>
 
 #if defined(__clang__)
 #define CRT_UNIFORM [[clang::annotate("crossrt::uniform")]]
@@ -55,5 +71,17 @@ inline T MinOverLanes(T v)
   return v;
 }
 inline bool AllLanesOn() { return true; }
+inline int LaneIndex() { return 0; }
+inline unsigned LaneBits(bool b) { return b ? 1u : 0u; }
+template <typename T>
+inline T LaneValue(T v, int)
+{
+  return v;
+}
+template <typename V>
+inline typename std::decay<decltype(std::declval<const V&>()[0])>::type LaneOf(const V& v, int first)
+{
+  return v[first + LaneIndex() < 3 ? first + LaneIndex() : 3];
+}
 
 }  // namespace crossrt

@@ -183,12 +183,15 @@ private:
   bool TraceInstance(uint32_t k, const BVHTraceRay& worldRay, float time, bool anyHit, float& tfar, CRT_Hit& hit) const;
   bool TraceMesh(const BVHTraceRay& ray, uint32_t root, uint32_t leaves, bool anyHit, float& tfar, CRT_Hit& hit) const;
   bool TraceMeshTogether(const BVHTraceRay& ray, uint32_t root, bool anyHit, float& tfar, CRT_Hit& hit) const;
+  bool TraceMeshAlone(const BVHTraceRay& gangRay, int at, uint32_t root, bool anyHit, float& tfar, CRT_Hit& hit) const;
   bool TakeNearestHit(uint32_t g, uint32_t hits, const LiteMath::float4& t, const LiteMath::float4& u, const LiteMath::float4& v,
                       bool anyHit, float& tfar, CRT_Hit& hit) const;
   uint32_t IntersectGroup(const BVHTraceRay& r, uint32_t group, int kx, int ky, int kz, float tfar, LiteMath::float4& t, LiteMath::float4& u,
                           LiteMath::float4& v) const;
   bool IntersectTriangle(const BVHTraceRay& r, uint32_t group, int lane, int kx, int ky, int kz, float tfar, float& t, float& u, float& v,
                          bool& onEdge) const;
+  bool IntersectCorners(const BVHTraceRay& r, int kx, int ky, int kz, LiteMath::float3 a, LiteMath::float3 b, LiteMath::float3 c, float tfar,
+                        float& t, float& u, float& v, bool& onEdge) const;
   bool IntersectBoxes(const BVHTraceRay& r, uint32_t group, bool sdf, float& tfar, CRT_Hit& hit) const;
   bool IntersectSdfBrick(const BVHTraceRay& r, uint32_t brick, float tEnter, float tExit, float& tfar, CRT_Hit& hit) const;
   uint32_t SdfCode(uint32_t at, uint32_t bytes) const;

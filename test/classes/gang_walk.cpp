@@ -1,5 +1,7 @@
 #include "gang_walk.h"
 
+#include <algorithm>
+
 static uint32_t AtOrBelow(float key, float q) { return key <= q ? 1u : 0u; }
 
 void KeyCounter::Count(int n, const float* queries, uint32_t* counts)
@@ -28,10 +30,25 @@ void KeyCounter::kernel1D_Count(int n, const float* queries, uint32_t* counts)
     int mine = block;
     while (mine > 0 && m_keys[mine * kBlock - 1] > q)
       mine = mine - 1;
+    // Counted in it by the whole gang, one query at a time: the lanes share out the block's keys
+    // (in a gang of one, the loop takes them one after another).
     uint32_t c = uint32_t(mine * kBlock);
-    const int end = mine < blocks ? (mine + 1) * kBlock : int(m_keys.size());  // the last block takes the tail
-    for (int k = mine * kBlock; k < end; k++)
-      c += AtOrBelow(m_keys[k], q);
+    CRT_UNIFORM uint32_t waiting = crossrt::LaneBits(true);  // the lanes still on: not the NaN queries'
+    while (waiting != 0u)
+    {
+      CRT_UNIFORM const int lane = __builtin_ctz(waiting);
+      waiting = waiting & (waiting - 1u);
+      CRT_UNIFORM const float itsQuery = crossrt::LaneValue(q, lane);
+      CRT_UNIFORM const int itsBlock = crossrt::LaneValue(mine, lane);
+      CRT_UNIFORM const int end = itsBlock < blocks ? (itsBlock + 1) * kBlock : int(m_keys.size());  // the last block takes the tail
+      CRT_UNIFORM uint32_t inBlock = 0u;
+      for (int first = itsBlock * kBlock; first < end; first += crossrt::GangSize())
+      {
+        const int k = first + crossrt::LaneIndex();
+        inBlock = inBlock + uint32_t(__builtin_popcount(crossrt::LaneBits(k < end && AtOrBelow(m_keys[std::min(k, end - 1)], itsQuery) != 0u)));
+      }
+      c = crossrt::LaneIndex() == lane ? c + inBlock : c;
+    }
     // Every lane on (a full gang without a NaN query): ISPC runs this branch unmasked. Where a lane
     // is off, the else: an unmasked write there would give a NaN query a count instead of kNoCount.
     if (crossrt::AllLanesOn())

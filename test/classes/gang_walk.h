@@ -2,8 +2,9 @@
 // would: in a file not named after the class, a static helper in the .cpp, a sum set up before the
 // kernel and a mean written after it. Each query counts the keys at or below it. The gang moves past
 // whole blocks of keys together while any of its queries lies beyond them (one load of a block's
-// last key for all lanes on ISPC); each query then steps back alone to its own block and counts in
-// it, so its count never depends on the queries beside it (test/equivalence/test_gang.cpp). A NaN
+// last key for all lanes on ISPC); each query then steps back alone to its own block, and the gang
+// counts in each query's block in turn, its lanes sharing out the keys (LaneBits, LaneValue,
+// LaneIndex), so a count never depends on the queries beside it (test/equivalence/test_gang.cpp). A NaN
 // query gets kNoCount and leaves its gang's walk; where no lane has left, the results are written in
 // a branch that crossrt::AllLanesOn() guards (ISPC: unmasked).
 #pragma once

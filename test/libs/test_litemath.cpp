@@ -2,6 +2,7 @@
 // (double precision Gauss-Jordan, explicit trigonometry), not by the functions under test.
 #include <catch2/catch.hpp>
 
+#include "Gang.h"
 #include "LiteMath.h"
 
 #include <cstddef>
@@ -468,4 +469,24 @@ TEST_CASE("LiteMath Box4f", "[litemath]")
   CHECK(INF_NEGATIVE < -1e38f);
   CHECK(EPSILON == 1e-6f);
   CHECK(DEG_TO_RAD * 180.0f == Approx(M_PI_F));
+}
+
+TEST_CASE("Gang.h in a gang of one: a lane's share of a loop is the whole loop", "[litemath][gang]")
+{
+  // The original class and the CPU and Vulkan backends run a gang of one; ISPC prints these as
+  // programIndex, packmask, extract and a load of the components across the lanes.
+  CHECK(crossrt::GangSize() == 1);
+  CHECK(crossrt::LaneIndex() == 0);
+  CHECK(crossrt::LaneBits(true) == 1u);
+  CHECK(crossrt::LaneBits(false) == 0u);
+  CHECK(crossrt::LaneValue(7, 0) == 7);
+  CHECK(crossrt::LaneValue(2.5f, 0) == 2.5f);
+  const LiteMath::float4 v(1.0f, 2.0f, 3.0f, 4.0f);
+  float sum = 0.0f;
+  for (int first = 0; first < 4; first += crossrt::GangSize())
+    sum += crossrt::LaneOf(v, first);
+  CHECK(sum == 10.0f);
+  CHECK(crossrt::LaneOf(v, 2) == 3.0f);
+  CHECK(crossrt::LaneOf(v, 6) == 4.0f);  // past the last component: the last
+  CHECK(crossrt::LaneOf(LiteMath::uint4(5u, 6u, 7u, 8u), 1) == 6u);
 }

@@ -71,6 +71,7 @@ void CopySourceDeclarations(Context& c, const Stmt* body, const std::string& wha
     // The declaration of the main file a use refers to, at namespace scope, or null.
     const Decl* FileLevel(const Decl* d) {
       if (!d || isa<ParmVarDecl, FieldDecl, CXXMethodDecl>(d) || d->getDeclContext()->isFunctionOrMethod() || d->getDeclContext()->isRecord()) return nullptr;
+      if (d->isImplicit()) return nullptr;  // a builtin (__builtin_ctz), declared where the file first calls it
       if (auto* vd = dyn_cast<VarDecl>(d); vd && vd->isLocalVarDeclOrParm()) return nullptr;
       if (auto* fd = dyn_cast<FunctionDecl>(d)) {
         if (auto* pattern = fd->getTemplateInstantiationPattern()) fd = pattern;

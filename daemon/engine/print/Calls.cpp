@@ -98,7 +98,7 @@ std::string KernelPrinter::Builtin(const FunctionDecl* fd, const std::vector<std
       {"determinant", "determinant"}, {"inverse3x3", "inverse"}};
   // GCC/Clang bit builtins (C++ leaves clz and ctz of 0 undefined).
   if (fd->getBuiltinID() != 0) {
-    const std::string u = BitArgument(a[0]);
+    const std::string u = BitArgument(a[0], call->getArg(0));
     if (n == "__builtin_clz") return "(31 - findMSB(" + u + "))";
     if (n == "__builtin_ctz") return "findLSB(" + u + ")";
     if (n == "__builtin_popcount") return "bitCount(" + u + ")";
@@ -111,7 +111,8 @@ std::string KernelPrinter::Builtin(const FunctionDecl* fd, const std::vector<std
 // ---- crossrt::GangSize, AnyLane, ... (Gang.h): each language's GangCall ----
 
 bool IsGangFunction(const FunctionDecl* fd) {
-  static const std::set<std::string> names = {"GangSize", "AnyLane", "AllLanes", "FirstLane", "MinOverLanes", "AllLanesOn"};
+  static const std::set<std::string> names = {"GangSize", "AnyLane", "AllLanes", "FirstLane", "MinOverLanes", "AllLanesOn",
+                                                "LaneIndex", "LaneBits", "LaneValue", "LaneOf"};
   return fd && InNamespace(fd, "crossrt") && names.count(fd->getNameAsString()) > 0;
 }
 

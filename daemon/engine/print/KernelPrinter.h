@@ -248,7 +248,7 @@ protected:
   // InterlockedAdd and ReduceAdd; the function std::min and std::max of a list fold with.
   virtual std::string LibraryCall(const clang::FunctionDecl* fd, const std::vector<std::string>& args, const clang::CallExpr* call,
                                   const std::map<std::string, std::string>& same) = 0;
-  virtual std::string BitArgument(const std::string& value) const = 0;
+  virtual std::string BitArgument(const std::string& value, const clang::Expr* arg) const = 0;
   virtual std::string AtomicOperation(const std::string& name, const std::vector<std::string>& args) = 0;
   virtual std::string InterlockedCall(const clang::FunctionDecl* fd, const clang::CallExpr* call) = 0;
   virtual std::string FoldFunction(const std::string& name) const = 0;
@@ -280,6 +280,8 @@ protected:
   virtual std::string ArrayCopy(const clang::VarDecl* vd, const clang::CXXConstructExpr* copy, const std::string& pad) = 0;
   // An if's then-branch, as printed after its `if (...)` line (ISPC marks some `unmasked`).
   virtual std::string ThenBranch(const clang::IfStmt* is, int indent);
+  // A counted loop, whole (ISPC runs a loop whose lanes share out its items `unmasked`).
+  virtual std::string ForLoop(const clang::ForStmt* fs, int indent);
   // The gang (Gang.h): crossrt::GangSize, AnyLane, AllLanes, FirstLane, MinOverLanes and AllLanesOn; what a
   // local's declaration starts with besides `const` (ISPC's `uniform` for a CRT_UNIFORM local).
   virtual std::string GangCall(const clang::FunctionDecl* fd, const clang::CallExpr* call) = 0;

@@ -124,7 +124,10 @@ std::string GlslPrinter::LibraryCall(const FunctionDecl* fd, const std::vector<s
 std::string GlslPrinter::GangCall(const FunctionDecl* fd, const CallExpr* call) {
   if (fd->getName() == "GangSize") return "1";
   if (fd->getName() == "AllLanesOn") return "true";
-  return "(" + Expr(call->getArg(0)) + ")";
+  if (fd->getName() == "LaneIndex") return "0";
+  if (fd->getName() == "LaneOf") return "(" + Expr(call->getArg(0)) + ")[min(" + Expr(call->getArg(1)) + ", 3)]";
+  if (fd->getName() == "LaneBits") return "((" + Expr(call->getArg(0)) + ") ? 1u : 0u)";
+  return "(" + Expr(call->getArg(0)) + ")";  // AnyLane, AllLanes, FirstLane, MinOverLanes, LaneValue: the thread's own value
 }
 
 std::string GlslPrinter::LocalQualifier(const VarDecl*) { return ""; }
@@ -141,7 +144,7 @@ std::string GlslPrinter::AtomicOperation(const std::string& name, const std::vec
   return s + "))";
 }
 
-std::string GlslPrinter::BitArgument(const std::string& value) const { return "uint(" + value + ")"; }
+std::string GlslPrinter::BitArgument(const std::string& value, const clang::Expr*) const { return "uint(" + value + ")"; }
 
 std::string GlslPrinter::FoldFunction(const std::string& name) const { return name; }
 

@@ -48,7 +48,7 @@ protected:
   std::string VectorMethod(const clang::FieldDecl* field, const clang::CXXMemberCallExpr* call, const std::string& name) override;
   std::string LibraryCall(const clang::FunctionDecl* fd, const std::vector<std::string>& args, const clang::CallExpr* call,
                           const std::map<std::string, std::string>& same) override;
-  std::string BitArgument(const std::string& value) const override;
+  std::string BitArgument(const std::string& value, const clang::Expr* arg) const override;
   std::string AtomicOperation(const std::string& name, const std::vector<std::string>& args) override;
   std::string InterlockedCall(const clang::FunctionDecl* fd, const clang::CallExpr* call) override;
   std::string FoldFunction(const std::string& name) const override;

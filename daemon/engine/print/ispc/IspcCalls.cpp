@@ -139,7 +139,9 @@ std::string IspcPrinter::InterlockedCall(const FunctionDecl* fd, const CallExpr*
   return call->getNumArgs() == 3 ? Expr(call->getArg(2)) + " = " + add : add;
 }
 
-std::string IspcPrinter::BitArgument(const std::string& value) const { return "((uint)(" + value + "))"; }
+std::string IspcPrinter::BitArgument(const std::string& value, const clang::Expr* arg) const {
+  return (Uniform(arg) ? "((uniform uint)(" : "((uint)(") + value + "))";  // a shared value's bits stay shared
+}
 
 std::string IspcPrinter::FoldFunction(const std::string& name) const { return "crt_" + name; }
 

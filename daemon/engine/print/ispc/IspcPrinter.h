@@ -49,7 +49,7 @@ protected:
   std::string VectorMethod(const clang::FieldDecl* field, const clang::CXXMemberCallExpr* call, const std::string& name) override;
   std::string LibraryCall(const clang::FunctionDecl* fd, const std::vector<std::string>& args, const clang::CallExpr* call,
                           const std::map<std::string, std::string>& same) override;
-  std::string BitArgument(const std::string& value) const override;
+  std::string BitArgument(const std::string& value, const clang::Expr* arg) const override;
   std::string AtomicOperation(const std::string& name, const std::vector<std::string>& args) override;
   std::string InterlockedCall(const clang::FunctionDecl* fd, const clang::CallExpr* call) override;
   std::string FoldFunction(const std::string& name) const override;
@@ -71,6 +71,7 @@ protected:
   std::string LoopInit(const clang::ForStmt* fs, const std::string& init) override;
   std::string ArrayCopy(const clang::VarDecl* vd, const clang::CXXConstructExpr* copy, const std::string& pad) override;
   std::string ThenBranch(const clang::IfStmt* is, int indent) override;
+  std::string ForLoop(const clang::ForStmt* fs, int indent) override;
   std::string GangCall(const clang::FunctionDecl* fd, const clang::CallExpr* call) override;
   std::string LocalQualifier(const clang::VarDecl* vd) override;
   void ReferenceArgument(const clang::ParmVarDecl* p, const clang::Expr* arg) override;

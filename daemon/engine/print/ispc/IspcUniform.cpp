@@ -6,8 +6,9 @@
 //
 // And the gang of Gang.h: a CRT_UNIFORM local is `uniform`, and every value assigned to it must be
 // shared (reported at the user's line otherwise, not as an ISPC error in the generated file);
-// crossrt::AnyLane, AllLanes, FirstLane, MinOverLanes and GangSize are ISPC's any, all, extract at
-// the lowest active lane, reduce_min and programCount; AllLanesOn tests lanemask(), and the branch of
+// crossrt::AnyLane, AllLanes, FirstLane, MinOverLanes, GangSize, LaneIndex, LaneBits and LaneValue are
+// ISPC's any, all, extract at the lowest active lane, reduce_min, programCount, programIndex,
+// packmask and extract; AllLanesOn tests lanemask(), and the branch of
 // an `if` it guards is `unmasked`. Part of IspcPrinter (IspcPrinter.h).
 #include "analyse/AstQueries.h"
 #include "print/ispc/IspcPrinter.h"
@@ -39,7 +40,13 @@ bool IspcPrinter::Uniform(const clang::Expr* e) const {
   if (isa<IntegerLiteral, FloatingLiteral, CXXBoolLiteralExpr, CharacterLiteral>(e)) return true;
   if (auto* call = dyn_cast<CallExpr>(e); call && IsGangFunction(call->getDirectCallee())) {
     const std::string name = call->getDirectCallee()->getNameAsString();
-    return name != "FirstLane" && name != "MinOverLanes" ? true : call->getArg(0)->getType()->isArithmeticType();
+    if (name == "LaneIndex" || name == "LaneOf") return false;  // values that differ in every lane
+    if (name == "FirstLane" || name == "MinOverLanes" || name == "LaneValue") return call->getArg(0)->getType()->isArithmeticType();
+    return true;
+  }
+  if (auto* call = dyn_cast<CallExpr>(e); call && call->getDirectCallee() && call->getNumArgs() == 1) {  // a bit count of a shared value
+    const unsigned id = call->getDirectCallee()->getBuiltinID();
+    if (id == Builtin::BI__builtin_ctz || id == Builtin::BI__builtin_clz || id == Builtin::BI__builtin_popcount) return Uniform(call->getArg(0));
   }
   if ((isa<MemberExpr, ArraySubscriptExpr, CXXOperatorCallExpr>(e)) && e->getType()->isArithmeticType() && SharedPlace(e)) return true;
   if (auto* c = dyn_cast<CStyleCastExpr>(e)) return c->getType()->isArithmeticType() && Uniform(c->getSubExpr());
@@ -159,15 +166,33 @@ std::string IspcPrinter::GangCall(const FunctionDecl* fd, const CallExpr* call) 
   const std::string name = fd->getNameAsString();
   if (name == "GangSize") return "programCount";
   if (name == "AllLanesOn") return "(popcnt(lanemask()) == programCount)";
+  if (name == "LaneIndex") return "programIndex";
   const std::string value = Expr(call->getArg(0));
+  if (name == "LaneOf") {
+    // Components first, first + 1, ... of a 4-vector across the lanes: from memory the gang shares, a load.
+    const QualType vt = call->getArg(0)->getType().getNonReferenceType().getUnqualifiedType();
+    if (!IsLiteMathType(vt, "float4") && !IsLiteMathType(vt, "int4") && !IsLiteMathType(vt, "uint4"))
+      return Fail(call->getArg(0)->getExprLoc(), "crossrt::LaneOf of a '" + vt.getAsString(m_ctx.getPrintingPolicy()) + "'",
+                  "pass a LiteMath float4, int4 or uint4");
+    if (!Uniform(call->getArg(1)))
+      return Fail(call->getArg(1)->getExprLoc(), "the first component of crossrt::LaneOf may differ between the lanes of an ISPC gang",
+                  "pass a component every lane shares: a constant, a CRT_UNIFORM local or a shared loop's variable");
+    const std::string first = Expr(call->getArg(1));
+    return SharedPlace(call->getArg(0)) ? "crt_lane_of(&(" + value + "), " + first + ")" : "crt_lane_of(" + value + ", " + first + ")";
+  }
   if (name == "AnyLane") return "any(" + value + ")";
   if (name == "AllLanes") return "all(" + value + ")";
-  // FirstLane and MinOverLanes: of a 32-bit number (a bool too, for FirstLane).
+  if (name == "LaneBits") return "((uniform uint)packmask(" + value + "))";
+  // FirstLane, LaneValue and MinOverLanes: of a 32-bit number (a bool too, for FirstLane and LaneValue).
   const QualType t = call->getArg(0)->getType().getCanonicalType().getUnqualifiedType();
   const bool bit32 = t->isArithmeticType() && !t->isBooleanType() && m_ctx.getTypeSize(t) == 32;
-  if (!bit32 && !(name == "FirstLane" && t->isBooleanType()))
+  if (!bit32 && !(name != "MinOverLanes" && t->isBooleanType()))
     return Fail(call->getArg(0)->getExprLoc(), "crossrt::" + name + " of a '" + t.getAsString(m_ctx.getPrintingPolicy()) + "'",
-                "pass an int, unsigned, float" + std::string(name == "FirstLane" ? " or bool" : "") + ", one field at a time");
+                "pass an int, unsigned, float" + std::string(name != "MinOverLanes" ? " or bool" : "") + ", one field at a time");
+  if (name == "LaneValue" && !Uniform(call->getArg(1)))
+    return Fail(call->getArg(1)->getExprLoc(), "the lane of crossrt::LaneValue may differ between the lanes of an ISPC gang",
+                "pass a lane every lane shares: a CRT_UNIFORM local, or FirstLane of a parameter");
+  if (name == "LaneValue") return "crt_lane_value(" + value + ", " + Expr(call->getArg(1)) + ")";
   return (name == "FirstLane" ? "crt_first_lane(" : "reduce_min(") + value + ")";
 }
 
@@ -199,6 +224,56 @@ static const clang::Stmt* ExitFrom(const clang::Stmt* s) {
   } exits;
   exits.TraverseStmt(const_cast<clang::Stmt*>(s));
   return exits.found;
+}
+
+// Whether fs steps by crossrt::GangSize(): `for (int first = a; first < b; first += crossrt::GangSize())`,
+// whose lanes share out its items (item first + LaneIndex() in each lane).
+static bool StepsByGangSize(const ForStmt* fs) {
+  auto* ca = dyn_cast_or_null<CompoundAssignOperator>(fs->getInc() ? fs->getInc()->IgnoreParenImpCasts() : nullptr);
+  auto* call = ca && ca->getOpcode() == BO_AddAssign ? dyn_cast<CallExpr>(ca->getRHS()->IgnoreParenImpCasts()) : nullptr;
+  return call && IsGangFunction(call->getDirectCallee()) && call->getDirectCallee()->getName() == "GangSize";
+}
+
+// A loop the gang runs together (UniformLoop) whose lanes share out its items, by a step of
+// crossrt::GangSize(): every lane of the gang takes an item, also the lanes that a branch, a loop or
+// a return had switched off, so ISPC runs it `unmasked` (crossrt::LaneBits and LaneValue then see
+// every lane, and a gang with some queries done still counts its share). Such a loop may write only
+// its own locals and CRT_UNIFORM ones, and may not return: an unmasked write to anything else would
+// write the lanes that are off too.
+std::string IspcPrinter::ForLoop(const ForStmt* fs, int indent) {
+  if (!StepsByGangSize(fs) || !UniformLoop(fs)) return KernelPrinter::ForLoop(fs, indent);
+  struct Writes : WriteVisitor<Writes> {
+    const IspcPrinter* printer;
+    std::set<const VarDecl*> own;  // the loop's variable and the locals declared in its body
+    const clang::Expr* bad = nullptr;
+    const ReturnStmt* ret = nullptr;
+    void Written(const clang::Expr* target, SourceLocation) {
+      const VarDecl* v = WrittenVar(target);
+      if (!bad && !(v && (own.count(v) || printer->uniformValues.count(v)))) bad = target;
+    }
+    bool VisitVarDecl(VarDecl* vd) { own.insert(vd); return true; }
+    bool VisitCallExpr(CallExpr* call) { ReferenceArguments(call); return true; }
+    bool VisitReturnStmt(ReturnStmt* r) { ret = ret ? ret : r; return true; }
+    bool TraverseLambdaExpr(LambdaExpr*) { return true; }
+  } writes;
+  writes.printer = this;
+  if (auto* ds = dyn_cast_or_null<DeclStmt>(fs->getInit()))
+    for (auto* d : ds->decls())
+      if (auto* vd = dyn_cast<VarDecl>(d)) writes.own.insert(vd);
+  writes.TraverseStmt(const_cast<clang::Stmt*>(fs->getBody()));
+  const std::string hint = "a loop stepping by crossrt::GangSize() runs on every lane of the gang, those switched off before it too";
+  if (writes.ret)
+    return Fail(writes.ret->getBeginLoc(), "'return' inside a loop that shares its items out over the gang's lanes",
+                "ISPC runs the loop unmasked (" + hint + "), and cannot leave it so: keep the result in a CRT_UNIFORM local and return after the loop"),
+           "";
+  if (writes.bad)
+    return Fail(writes.bad->getExprLoc(), "a write to '" + TrimmedSourceText(m_ctx, writes.bad->getSourceRange()) +
+                                              "' inside a loop that shares its items out over the gang's lanes",
+                hint + ", and would write theirs: write the loop's own locals and CRT_UNIFORM locals (crossrt::LaneBits, LaneValue), and the rest after it"),
+           "";
+  const std::string pad(indent * 2, ' ');
+  return pad + "unmasked  // the lanes share out this loop's items (a step of crossrt::GangSize()): every lane takes part\n" + pad + "{\n" +
+         KernelPrinter::ForLoop(fs, indent + 1) + pad + "}\n";
 }
 
 // `if (crossrt::AllLanesOn() && ...)` with a condition every lane shares: its then-branch runs with
@@ -269,7 +344,7 @@ void IspcPrinter::SharedValueExpected(const VarDecl* vd, const clang::Expr* wher
   Fail(where->getExprLoc(),
        std::string(isIndex ? "an index" : "a value") + " that may differ between the lanes of an ISPC gang " + (isIndex ? "into" : "is assigned to") +
            " CRT_UNIFORM '" + vd->getNameAsString() + "'",
-       "assign what every lane shares (constants, members, CRT_UNIFORM locals, crossrt::AnyLane, FirstLane or MinOverLanes of a "
+       "assign what every lane shares (constants, members, CRT_UNIFORM locals, crossrt::AnyLane, FirstLane, LaneValue, LaneBits or MinOverLanes of a "
        "value), or declare '" + vd->getNameAsString() + "' without CRT_UNIFORM");
 }
 

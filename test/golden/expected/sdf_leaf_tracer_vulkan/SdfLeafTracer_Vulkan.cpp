@@ -146,9 +146,9 @@ void SdfLeafTracer_Vulkan::crt_UpdatePlainMembers()
   data.crt_m_scene_m_geom_SdfGridLeaves = crt_virtual.m_scene_m_geom_SdfGridLeaves.Address();
   data.crt_m_scene_m_geom_SdfSVSLeaves = crt_virtual.m_scene_m_geom_SdfSVSLeaves.Address();
   data.crt_m_scene_m_geom_SdfSBSLeaves = crt_virtual.m_scene_m_geom_SdfSBSLeaves.Address();
-  std::memcpy(&data.m_scene_m_repeatSlack, &crt_m_scene()->m_repeatSlack, sizeof(data.m_scene_m_repeatSlack));
   std::memcpy(&data.m_scene_m_intersectRepeats, &crt_m_scene()->m_intersectRepeats,
               sizeof(data.m_scene_m_intersectRepeats));
+  std::memcpy(&data.m_scene_m_repeatSlack, &crt_m_scene()->m_repeatSlack, sizeof(data.m_scene_m_repeatSlack));
   data.crt_m_scene_m_geom_size = uint32_t(crt_m_scene()->m_geom.size());
   data.crt_m_scene_m_nodeMin_size = uint32_t(crt_m_scene()->m_nodeMin.size());
   data.crt_m_scene_m_nodeMin_capacity = uint32_t(crt_m_scene()->m_nodeMin.capacity());

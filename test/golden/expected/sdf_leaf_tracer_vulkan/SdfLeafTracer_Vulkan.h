@@ -79,8 +79,8 @@ protected:
     alignas(8) uint64_t crt_m_scene_m_geom_SdfGridLeaves;
     alignas(8) uint64_t crt_m_scene_m_geom_SdfSVSLeaves;
     alignas(8) uint64_t crt_m_scene_m_geom_SdfSBSLeaves;
-    alignas(4) float m_scene_m_repeatSlack;
     alignas(4) uint32_t m_scene_m_intersectRepeats;
+    alignas(4) float m_scene_m_repeatSlack;
     alignas(4) uint32_t crt_m_scene_m_nodeMin_size;
     alignas(4) uint32_t crt_m_scene_m_nodeMin_capacity;
     alignas(4) uint32_t crt_m_scene_m_nodeMax_size;

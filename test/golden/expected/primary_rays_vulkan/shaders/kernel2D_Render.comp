@@ -203,9 +203,10 @@ const uint m_pAccelStruct_kInstanceIdentity = 1u;
 const uint m_pAccelStruct_kSceneTransformed = 32u;
 const float m_pAccelStruct_kWiden = 1.00000036;
 const float m_pAccelStruct_kMissed = -1.0;
-const float m_pAccelStruct_kNotEntered = (1.0 / 0.0);
 const uint m_pAccelStruct_kNoChild = 4294967295u;
+const float m_pAccelStruct_kNotEntered = (1.0 / 0.0);
 const uint m_pAccelStruct_kLeafFlag = 2147483648u;
+const int m_pAccelStruct_kRaysAlone = 2;
 const uint m_pAccelStruct_kSdfMaskedVoxels = 4u;
 const int m_pAccelStruct_kSdfNewtonIterations = 4;
 const uint m_pAccelStruct_kSceneTriangles = 16u;
@@ -267,6 +268,26 @@ vec3 m_pAccelStruct_ToObjectVector(BVHInstance inst, vec3 d)
   return vec3(dot(inst.toObjectRow0, h), dot(inst.toObjectRow1, h), dot(inst.toObjectRow2, h));
 }
 
+// from (anonymous namespace)::RayOfLane
+BVHTraceRay m_pAccelStruct_RayOfLane(BVHTraceRay ray, int at)
+{
+  const int lane = (at);
+  BVHTraceRay r =
+      BVHTraceRay(vec3(0), vec3(0), vec3(0), float(0), int(0), int(0), int(0), float(0), float(0), float(0), bool(0));
+  r.org = vec3((ray.org.x), (ray.org.y), (ray.org.z));
+  r.dir = vec3((ray.dir.x), (ray.dir.y), (ray.dir.z));
+  r.invDir = vec3((ray.invDir.x), (ray.invDir.y), (ray.invDir.z));
+  r.tnear = (ray.tnear);
+  r.kx = (ray.kx);
+  r.ky = (ray.ky);
+  r.kz = (ray.kz);
+  r.sx = (ray.sx);
+  r.sy = (ray.sy);
+  r.sz = (ray.sz);
+  r.anyZeroAxis = (ray.anyZeroAxis);
+  return r;
+}
+
 // from (anonymous namespace)::SlabEntryParallelAxes
 float m_pAccelStruct_SlabEntryParallelAxes(BVHTraceRay r, vec3 lo, vec3 hi, float tfar, inout float exit)
 {
@@ -304,22 +325,22 @@ float m_pAccelStruct_SlabEntry(BVHTraceRay r, vec3 lo, vec3 hi, float tfar, inou
   return max(max(nearX, nearY), max(nearZ, r.tnear));
 }
 
-// from BVHScene::IntersectTriangle
-bool m_pAccelStruct_IntersectTriangle(BVHTraceRay r, uint group, int lane, int kx, int ky, int kz, float tfar,
-                                      inout float t, inout float u, inout float v, inout bool onEdge)
+// from BVHScene::IntersectCorners
+bool m_pAccelStruct_IntersectCorners(BVHTraceRay r, int kx, int ky, int kz, vec3 a, vec3 b, vec3 c, float tfar,
+                                     inout float t, inout float u, inout float v, inout bool onEdge)
 {
   const float ox = r.org[kx];
   const float oy = r.org[ky];
   const float oz = r.org[kz];
-  const float az = m_pAccelStruct_m_triangles[group].coord[kz][lane] - oz;
-  const float bz = m_pAccelStruct_m_triangles[group].coord[3 + kz][lane] - oz;
-  const float cz = m_pAccelStruct_m_triangles[group].coord[6 + kz][lane] - oz;
-  const float ax = (m_pAccelStruct_m_triangles[group].coord[kx][lane] - ox) - r.sx * az;
-  const float ay = (m_pAccelStruct_m_triangles[group].coord[ky][lane] - oy) - r.sy * az;
-  const float bx = (m_pAccelStruct_m_triangles[group].coord[3 + kx][lane] - ox) - r.sx * bz;
-  const float by = (m_pAccelStruct_m_triangles[group].coord[3 + ky][lane] - oy) - r.sy * bz;
-  const float cx = (m_pAccelStruct_m_triangles[group].coord[6 + kx][lane] - ox) - r.sx * cz;
-  const float cy = (m_pAccelStruct_m_triangles[group].coord[6 + ky][lane] - oy) - r.sy * cz;
+  const float az = a.z - oz;
+  const float bz = b.z - oz;
+  const float cz = c.z - oz;
+  const float ax = (a.x - ox) - r.sx * az;
+  const float ay = (a.y - oy) - r.sy * az;
+  const float bx = (b.x - ox) - r.sx * bz;
+  const float by = (b.y - oy) - r.sy * bz;
+  const float cx = (c.x - ox) - r.sx * cz;
+  const float cy = (c.y - oy) - r.sy * cz;
   const float eu = cx * by - cy * bx;
   const float ev = ax * cy - ay * cx;
   const float ew = bx * ay - by * ax;
@@ -387,6 +408,195 @@ uint m_pAccelStruct_IntersectGroup(BVHTraceRay r, uint group, int kx, int ky, in
   return hits;
 }
 
+// from BVHScene::TraceMeshAlone
+bool m_pAccelStruct_TraceMeshAlone(BVHTraceRay gangRay, int at, uint root, bool anyHit, inout float tfar,
+                                   inout CRT_Hit hit)
+{
+  const int lane = (at);
+  const BVHTraceRay ray = m_pAccelStruct_RayOfLane(gangRay, lane);
+  const int kx = (gangRay.kx);
+  const int ky = (gangRay.ky);
+  const int kz = (gangRay.kz);
+  const bool firstHit = (anyHit);
+  float rayTfar = (tfar);
+  float hitT = (hit.t);
+  uint hitPrimId = (hit.primId);
+  float hitU = (hit.coords[0]);
+  float hitV = (hit.coords[1]);
+  bool found = false;
+  uint stack[64];
+  float stackEntry[64];
+  int top = 0;
+  uint node = (root);
+  while (true)
+  {
+    while ((node & m_pAccelStruct_kLeafFlag) == 0u)
+    {
+      uint entered = 0u;
+      float entries[4];
+      for (int firstBox = 0; firstBox < 4; firstBox += 1)
+      {
+        float exit = 0.0;
+        const vec3 lo = vec3((m_pAccelStruct_m_nodes[node].minX)[min(firstBox, 3)],
+                             (m_pAccelStruct_m_nodes[node].minY)[min(firstBox, 3)],
+                             (m_pAccelStruct_m_nodes[node].minZ)[min(firstBox, 3)]);
+        const vec3 hi = vec3((m_pAccelStruct_m_nodes[node].maxX)[min(firstBox, 3)],
+                             (m_pAccelStruct_m_nodes[node].maxY)[min(firstBox, 3)],
+                             (m_pAccelStruct_m_nodes[node].maxZ)[min(firstBox, 3)]);
+        const float boxEntry = m_pAccelStruct_SlabEntry(ray, lo, hi, rayTfar, exit);
+        uint bits = ((firstBox + 0 < 4 && boxEntry <= exit) ? 1u : 0u);
+        entered = entered | (bits << uint(firstBox));
+        while (bits != 0u)
+        {
+          const int k = findLSB(uint(bits));
+          bits = bits & (bits - 1u);
+          entries[firstBox + k] = (boxEntry);
+        }
+      }
+      if (entered == 0u)
+      {
+        node = m_pAccelStruct_kNoChild;
+        break;
+      }
+      uint next = m_pAccelStruct_kNoChild;
+      float nextEntry = m_pAccelStruct_kNotEntered;
+      for (int box = 0; box < 4; ++box)
+      {
+        if ((entered & (1u << uint(box))) == 0u)
+          continue;
+        if (next == m_pAccelStruct_kNoChild)
+        {
+          next = m_pAccelStruct_m_nodes[node].child[box];
+          nextEntry = entries[box];
+        }
+        else if (entries[box] < nextEntry)
+        {
+          stack[top] = next;
+          stackEntry[top] = nextEntry;
+          top = top + 1;
+          next = m_pAccelStruct_m_nodes[node].child[box];
+          nextEntry = entries[box];
+        }
+        else
+        {
+          stack[top] = m_pAccelStruct_m_nodes[node].child[box];
+          stackEntry[top] = entries[box];
+          top = top + 1;
+        }
+      }
+      node = next;
+    }
+    if (node != m_pAccelStruct_kNoChild)
+    {
+      const uint first = (node & ~m_pAccelStruct_kLeafFlag) >> 3;
+      const uint last = first + (node & 7u);
+      for (uint g = first; g <= last; ++g)
+      {
+        uint hits = 0u;
+        bool onEdge = false;
+        float ts[4];
+        float us[4];
+        float vs[4];
+        for (int firstTriangle = 0; firstTriangle < 4; firstTriangle += 1)
+        {
+          const bool inGroup = firstTriangle + 0 < 4;
+          const vec3 a = vec3((m_pAccelStruct_m_triangles[g].coord[kx])[min(firstTriangle, 3)],
+                              (m_pAccelStruct_m_triangles[g].coord[ky])[min(firstTriangle, 3)],
+                              (m_pAccelStruct_m_triangles[g].coord[kz])[min(firstTriangle, 3)]);
+          const vec3 b = vec3((m_pAccelStruct_m_triangles[g].coord[3 + kx])[min(firstTriangle, 3)],
+                              (m_pAccelStruct_m_triangles[g].coord[3 + ky])[min(firstTriangle, 3)],
+                              (m_pAccelStruct_m_triangles[g].coord[3 + kz])[min(firstTriangle, 3)]);
+          const vec3 c = vec3((m_pAccelStruct_m_triangles[g].coord[6 + kx])[min(firstTriangle, 3)],
+                              (m_pAccelStruct_m_triangles[g].coord[6 + ky])[min(firstTriangle, 3)],
+                              (m_pAccelStruct_m_triangles[g].coord[6 + kz])[min(firstTriangle, 3)]);
+          float t = 0.0;
+          float u = 0.0;
+          float v = 0.0;
+          bool edge = false;
+          const bool hitsIt = m_pAccelStruct_IntersectCorners(ray, kx, ky, kz, a, b, c, rayTfar, t, u, v, edge);
+          onEdge = onEdge || (inGroup && edge);
+          uint bits = ((inGroup && hitsIt) ? 1u : 0u);
+          hits = hits | (bits << uint(firstTriangle));
+          while (bits != 0u)
+          {
+            const int k = findLSB(uint(bits));
+            bits = bits & (bits - 1u);
+            ts[firstTriangle + k] = (t);
+            us[firstTriangle + k] = (u);
+            vs[firstTriangle + k] = (v);
+          }
+        }
+        if (onEdge)
+        {
+          vec4 t4 = vec4(0);
+          vec4 u4 = vec4(0);
+          vec4 v4 = vec4(0);
+          hits = (m_pAccelStruct_IntersectGroup(ray, g, kx, ky, kz, rayTfar, t4, u4, v4));
+          for (int k = 0; k < 4; ++k)
+          {
+            ts[k] = (t4[k]);
+            us[k] = (u4[k]);
+            vs[k] = (v4[k]);
+          }
+        }
+        while (hits != 0u)
+        {
+          const int k = findLSB(uint(hits));
+          hits = hits & (hits - 1u);
+          const uint primId = m_pAccelStruct_m_primIds[4u * g + uint(k)];
+          if (ts[k] > rayTfar || (ts[k] == rayTfar && primId >= hitPrimId))
+            continue;
+          found = true;
+          rayTfar = ts[k];
+          hitT = ts[k];
+          hitPrimId = primId;
+          hitU = us[k];
+          hitV = vs[k];
+          if (firstHit)
+            break;
+        }
+        if (firstHit && found)
+        {
+          top = 0;
+          break;
+        }
+      }
+    }
+    bool popped = false;
+    while (top > 0 && !popped)
+    {
+      top = top - 1;
+      popped = stackEntry[top] <= rayTfar;
+    }
+    if (!popped)
+      break;
+    node = stack[top];
+  }
+  const bool mine = 0 == lane;
+  tfar = mine ? rayTfar : tfar;
+  hit.t = mine ? hitT : hit.t;
+  hit.primId = mine ? hitPrimId : hit.primId;
+  hit.coords[0] = mine ? hitU : hit.coords[0];
+  hit.coords[1] = mine ? hitV : hit.coords[1];
+  return mine && found;
+}
+
+// from BVHScene::IntersectTriangle
+bool m_pAccelStruct_IntersectTriangle(BVHTraceRay r, uint group, int lane, int kx, int ky, int kz, float tfar,
+                                      inout float t, inout float u, inout float v, inout bool onEdge)
+{
+  const vec3 a =
+      vec3(m_pAccelStruct_m_triangles[group].coord[kx][lane], m_pAccelStruct_m_triangles[group].coord[ky][lane],
+           m_pAccelStruct_m_triangles[group].coord[kz][lane]);
+  const vec3 b =
+      vec3(m_pAccelStruct_m_triangles[group].coord[3 + kx][lane], m_pAccelStruct_m_triangles[group].coord[3 + ky][lane],
+           m_pAccelStruct_m_triangles[group].coord[3 + kz][lane]);
+  const vec3 c =
+      vec3(m_pAccelStruct_m_triangles[group].coord[6 + kx][lane], m_pAccelStruct_m_triangles[group].coord[6 + ky][lane],
+           m_pAccelStruct_m_triangles[group].coord[6 + kz][lane]);
+  return m_pAccelStruct_IntersectCorners(r, kx, ky, kz, a, b, c, tfar, t, u, v, onEdge);
+}
+
 // from BVHScene::TakeNearestHit
 bool m_pAccelStruct_TakeNearestHit(uint g, uint hits, vec4 t, vec4 u, vec4 v, bool anyHit, inout float tfar,
                                    inout CRT_Hit hit)
@@ -425,6 +635,17 @@ bool m_pAccelStruct_TraceMeshTogether(BVHTraceRay ray, uint root, bool anyHit, i
   bool found = false;
   while (true)
   {
+    uint alone = ((entry <= tfar && !(anyHit && found)) ? 1u : 0u);
+    if (1 == 4 && bitCount(uint(alone)) <= m_pAccelStruct_kRaysAlone)
+    {
+      while (alone != 0u)
+      {
+        const int lane = findLSB(uint(alone));
+        alone = alone & (alone - 1u);
+        found = m_pAccelStruct_TraceMeshAlone(ray, lane, node, anyHit, tfar, hit) || found;
+      }
+      node = m_pAccelStruct_kNoChild;
+    }
     while ((node & m_pAccelStruct_kLeafFlag) == 0u)
     {
       const bool active_ = entry <= tfar && !(anyHit && found);

@@ -134,8 +134,8 @@ layout(std430, binding = 0) buffer crt_SdfLeafTracerData
   uvec2 crt_m_scene_m_geom_SdfGridLeaves;
   uvec2 crt_m_scene_m_geom_SdfSVSLeaves;
   uvec2 crt_m_scene_m_geom_SdfSBSLeaves;
-  float m_scene_m_repeatSlack;
   uint m_scene_m_intersectRepeats;
+  float m_scene_m_repeatSlack;
   uint crt_m_scene_m_nodeMin_size;
   uint crt_m_scene_m_nodeMin_capacity;
   uint crt_m_scene_m_nodeMax_size;
