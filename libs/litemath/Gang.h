@@ -22,11 +22,13 @@
 //                     load, not a gather
 //
 // With LaneIndex, the lanes of a gang can share out one thread's work: a loop
-// `for (int first = 0; first < 4; first += GangSize())` (a loop the gang runs together: its start,
-// bound and step are shared) whose lanes take items first + LaneIndex() below 4 runs four times in a
-// gang of one and once in a gang of four or more, and LaneBits and LaneValue bring the lanes' results back to values the gang shares
+// `for (int first = 0; first < 4; first += GangSize())` (its start and bound shared) whose lanes
+// take items first + LaneIndex() below 4 runs four times in a gang of one and once in a gang of four
+// or more, and LaneBits and LaneValue bring the lanes' results back to values the gang shares
 // (BVHScene::TraceMeshAlone tests a node's four boxes so, one a lane, for one ray, and reads their
-// planes with LaneOf).
+// planes with LaneOf). ISPC runs such a loop on every lane, those that a branch, a loop or a return
+// switched off before it too (`unmasked`), so inside it LaneBits sees every lane; it may write only
+// its own locals and CRT_UNIFORM ones, and may not return (diagnostics at the line otherwise).
 //
 // An `if` whose condition is AllLanesOn() && other terms every lane shares (AllLanes(...), GangSize(),
 // members, CRT_UNIFORM locals) runs its then-branch on ISPC as `unmasked`: ISPC then knows that every

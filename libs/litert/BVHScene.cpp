@@ -1325,9 +1325,10 @@ bool BVHScene::TraceMeshTogether(const BVHTraceRay& ray, uint32_t root, bool any
   {
     // In a gang of four (SSE), where two of its rays or fewer are left in the subtree (deep in the
     // tree, where the rays of a tile part ways), each walks it alone, the four lanes across a
-    // node's four boxes (Embree's switch to rays alone): 1-8% faster on every mesh (AMD EPYC,
-    // Zen 4). Gangs of 8 and 16 lanes, which a walk alone fills only in part, traced the 871k
-    // dragon 1-7% faster so but the other meshes 3-11% slower, and walk together throughout.
+    // node's four boxes (Embree's switch to rays alone): faster on six meshes of seven, up to 12%,
+    // within 1% on the seventh (AMD EPYC, Zen 4). Gangs of 8 and 16 lanes, which a walk alone fills
+    // only in part, traced the 871k dragon 1-7% faster so but the other meshes 3-11% slower, and
+    // walk together throughout (GangSize() is a constant there: the walk alone is not compiled).
     CRT_UNIFORM uint32_t alone = crossrt::LaneBits(entry <= tfar && !(anyHit && found));
     if (crossrt::GangSize() == 4 && __builtin_popcount(alone) <= kRaysAlone)
     {

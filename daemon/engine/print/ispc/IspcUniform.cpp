@@ -8,7 +8,8 @@
 // shared (reported at the user's line otherwise, not as an ISPC error in the generated file);
 // crossrt::AnyLane, AllLanes, FirstLane, MinOverLanes, GangSize, LaneIndex, LaneBits and LaneValue are
 // ISPC's any, all, extract at the lowest active lane, reduce_min, programCount, programIndex,
-// packmask and extract; AllLanesOn tests lanemask(), and the branch of
+// packmask and extract, and LaneOf a load of a vector's components across the lanes (crt_lane_of);
+// a loop stepping by GangSize() runs `unmasked`; AllLanesOn tests lanemask(), and the branch of
 // an `if` it guards is `unmasked`. Part of IspcPrinter (IspcPrinter.h).
 #include "analyse/AstQueries.h"
 #include "print/ispc/IspcPrinter.h"
