@@ -1442,12 +1442,12 @@ bool BVHScene::TraceMeshTogether(const BVHTraceRay& ray, uint32_t root, bool any
   }
 }
 
-// One ray of the gang, the one in lane `lane`, walks the subtree at `root` alone: the gang's lanes
+// One ray of the gang, the one in lane `at`, walks the subtree at `root` alone: the gang's lanes
 // share out its work, a lane a box of each node and a triangle of each leaf group (SIMD across a
 // node, as Embree's walk of one ray; in a gang of one the loops below take the four boxes and the
-// four triangles one after another). The arithmetic is TraceMesh's (SlabEntry, IntersectTriangle
-// and, where the ray meets a triangle on an edge, IntersectGroup), and so is the hit. Updates that
-// ray's tfar and hit, and returns true in its lane where it found one.
+// four triangles one after another). The arithmetic is TraceMesh's (SlabEntry, IntersectCorners as
+// IntersectTriangle calls it and, where the ray meets a triangle on an edge, IntersectGroup), and so
+// is the hit. Updates that ray's tfar and hit, and returns true in its lane where it found one.
 bool BVHScene::TraceMeshAlone(const BVHTraceRay& gangRay, int at, uint32_t root, bool anyHit, float& tfar, CRT_Hit& hit) const
 {
   CRT_UNIFORM const int lane = crossrt::FirstLane(at);
