@@ -1,6 +1,7 @@
 #include "Manifest.h"
 
 #include "DaemonClient.h"
+#include "InProcess.h"
 #include "Protocol.h"
 
 #include <nlohmann/json.hpp>
@@ -23,8 +24,9 @@ std::string Hex(uint64_t v) {
 }  // namespace
 
 std::string OptionsKey(const engine::TranslateRequest& r) {
-  // The translator's build is part of the key: a rebuilt translator translates again.
-  std::string text = protocol::TranslatorIdentity(DaemonExecutable()) + '\n' + r.className + '\n' +
+  // The translator's build is part of the key: a rebuilt translator translates again, the daemon's
+  // and the engine module's that --no-daemon loads (a target may be rebuilt alone).
+  std::string text = protocol::TranslatorIdentity(DaemonExecutable()) + '\n' + protocol::TranslatorIdentity(EnginePath()) + '\n' + r.className + '\n' +
                      engine::BackendName(r.backend) + '\n' + r.templateDir;
   for (auto& s : r.sources) text += "\nsrc " + s;
   for (auto& a : r.compileArgs) text += "\narg " + a;

@@ -30,6 +30,10 @@
 // switched off before it too (`unmasked`), so inside it LaneBits sees every lane; it may write only
 // its own locals and CRT_UNIFORM ones, and may not return (diagnostics at the line otherwise).
 //
+// In GLSL, where the gang is one thread, an `if` whose condition GangSize() decides alone
+// (`GangSize() == 4 && ...`, `GangSize() > 1 && ...`) prints only the branch it takes, with a comment
+// saying so: the shaders carry no walk written for wider gangs.
+//
 // An `if` whose condition is AllLanesOn() && other terms every lane shares (AllLanes(...), GangSize(),
 // members, CRT_UNIFORM locals) runs its then-branch on ISPC as `unmasked`: ISPC then knows that every
 // lane is on, and keeps the branch's local structs (float3, float4, the user's) in registers. Under a

@@ -2,6 +2,11 @@
 
 #include <cmath>
 
+namespace
+{
+constexpr int kRounds = 2;
+}
+
 void Semantics::Evaluate(int n, float* out)
 {
   kernel1D_Evaluate(n, out);
@@ -25,6 +30,14 @@ void Semantics::kernel1D_Evaluate(int n, float* out)
     int sum = 0;
     for (int j = 0, k = 3; j < 4; ++j, --k)              // two loop variables
       sum += j * k;
+    {                                                   // names that shadow others (valid C++)
+      const int n = kRounds;                            // the parameter n
+      for (int i = 0; i < n; ++i)                       // the loop's i
+      {
+        const int kRounds = 10;                         // a namespace constant
+        sum += i * kRounds;
+      }
+    }
     out[i * 8 + 0] = v.x + v.y * 0.5;                   // promoted to double in C++
     out[i * 8 + 1] = float((i - 7) % 5);                // negative remainders keep C++'s sign
     out[i * 8 + 2] = std::round(x * 0.5f);              // halves away from zero

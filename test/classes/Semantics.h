@@ -1,7 +1,7 @@
 // C++ semantics the GPU code must keep (found in review): matrices, double promotions, signed
 // remainders, rounding, default member initialisers, array fillers, member updates between
 // kernels, RTV loops inside host loops, struct members' std430 alignment, locals set by statements
-// before a loop nest.
+// before a loop nest, locals that shadow a parameter, a loop variable or a namespace constant.
 #pragma once
 #include "LiteMath.h"
 

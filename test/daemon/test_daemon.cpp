@@ -184,6 +184,28 @@ TEST_CASE("Unchanged inputs write nothing, and comment or whitespace edits leave
   REQUIRE(after["Scale_Vulkan.h"] == before["Scale_Vulkan.h"]);
 }
 
+TEST_CASE("A rebuilt engine module translates again without the daemon", "[daemon]")
+{
+  // The engine --no-daemon loads, a copy of the build's, rebuilt (here: touched) alone, as
+  // `ninja bin/libcrossrt-engine.so` does: the class is translated again, not answered from the manifest.
+  DaemonFixture f;
+  const fs::path engine = f.tc.dir / "libcrossrt-engine.so";
+  fs::copy_file(fs::path(CROSSRT_CLIENT).parent_path() / "libcrossrt-engine.so", engine);
+  setenv("CROSSRT_ENGINE", engine.c_str(), 1);
+  auto key = [&] { return nlohmann::json::parse(ReadText(f.out / ".crossrt-manifest.json"))["optionsKey"].get<std::string>(); };
+  REQUIRE(RunCrossrt(f.TranslateArgs(f.out, false)).exitCode == 0);
+  const std::string first = key();
+  REQUIRE(RunCrossrt(f.TranslateArgs(f.out, false)).exitCode == 0);
+  CHECK(key() == first);  // nothing changed
+  fs::last_write_time(engine, fs::last_write_time(engine) + std::chrono::seconds(2));
+  auto r = RunCrossrt(f.TranslateArgs(f.out, false));
+  unsetenv("CROSSRT_ENGINE");
+  INFO(r.output);
+  REQUIRE(r.exitCode == 0);
+  CHECK(key() != first);
+  CHECK(ReadText(f.out / "shaders/kernel1D_Scale.comp").find("m_factor") != std::string::npos);
+}
+
 TEST_CASE("A SIGKILL of the daemon at any stage of a request still gives the right output", "[daemon]")
 {
   for (const char* stage : {"accepted", "read", "parsed", "translated", "responding"}) {

@@ -5,7 +5,8 @@ Each seed gives one class in the supported subset, written as a user writes one:
 kernel1D_ loop nests (maps, integer maps, reductions into members, appends, atomic adds into a
 member vector, a member's data() to a kernel) and kernel2D_ nests, and a control function whose host code sits between the kernel calls: member writes,
 swaps of member vectors, member vectors' elements read and written, loops that stop early on a
-counter the kernels reduce, and a tail that reads the results. A CRT_SPECIALIZE member (m_mode),
+counter the kernels reduce, and a tail that reads the results. Some kernels declare locals that
+shadow their parameters. A CRT_SPECIALIZE member (m_mode),
 which the Vulkan class's pipelines are compiled for, picks branches in kernels; the tail may change
 it, so that the second Run makes the pipelines again. The tester (differential.cpp) runs each class as written, as _CPU, as _ISPC and
 as _Vulkan and compares what they leave behind, the way Csmith and YARPGen find miscompilations.
@@ -27,6 +28,7 @@ class Gen:
     def __init__(self, seed):
         self.r = random.Random(seed)
         self.rm = random.Random(seed * 7919 + 1)  # m_mode's uses and initial value
+        self.rs = random.Random(seed * 104729 + 3)  # which kernels declare locals that shadow parameters
         self.seed = seed
         self.name = f"Diff{seed}"
 
@@ -106,7 +108,18 @@ class Gen:
                         f"(m_mode > {c} ? {clamp(self.fexpr(2, fleaves))} : float(m_mode) * 0.5f);")
             elif kind == "Hist":
                 line = f"InterlockedAdd(m_hist[({self.iexpr(2, ileaves)} & 1023) % 8], {self.pick('1', 'a_p', 'm_i[i] % 5')});"
-            kernels.append((name, "int n, int a_p, float a_q", [line], "n, a_p, a_q"))
+            lines = [line]
+            if kind in ("Map", "Int", "Sum") and self.rs.random() < 0.25:
+                # Locals that shadow the kernel's parameters (valid C++): per element where the
+                # parameters are shared, so the generated code must keep them apart.
+                lines = ["{",
+                         f"  const int a_p = (m_i[i] & {self.rs.choice([3, 7])}) + 1;  // shadows the parameter a_p",
+                         "  float a_q = 0.0f;                  // and a_q",
+                         "  for (int n = 0; n < a_p; ++n)      // and n",
+                         "    a_q += float(n) * 0.5f;",
+                         "  " + line,
+                         "}"]
+            kernels.append((name, "int n, int a_p, float a_q", lines, "n, a_p, a_q"))
             return name
 
         def grid_call():

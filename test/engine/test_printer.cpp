@@ -105,3 +105,30 @@ TEST_CASE("Printer: recursion in a kernel's reach is a diagnostic at the call", 
   CHECK(r.diagnostics.find("Printer.cpp:6:59: error: recursive call to 'Printer::Falloff' in a kernel") != std::string::npos);
   CHECK(r.diagnostics.find("hint:") != std::string::npos);
 }
+
+TEST_CASE("Printer: a branch that GangSize() decides prints only the branch a gang of one takes; a local that shadows a parameter takes a suffix",
+          "[engine][printer]")
+{
+  std::string source = kSource;
+  source.replace(source.find("#include <cmath>"), 16, "#include <cmath>\n#include \"Gang.h\"");
+  const std::string last = "    out[i] = v * m_exposure";
+  source.replace(source.find(last), last.size(),
+                 "    if (crossrt::GangSize() > 1 && v > 0.0f) v = -7.0f;\n"               // never with a gang of one
+                 "    if (!(crossrt::GangSize() == 4) || Falloff(v) < 0.0f) v += 0.125f;\n"  // always, Falloff not called
+                 "    if (crossrt::GangSize() != 1) v = -9.0f; else v *= 3.0f;\n"           // the else-branch alone
+                 "    { const int n = 2; v += float(n); }\n"                                 // shadows the parameter n
+                 + last);
+  TempClass tc("Printer", kHeader, source);
+  const TranslateResult r = Translate(MakeRequest(tc, "Printer"));
+  INFO(r.diagnostics);
+  REQUIRE(r.ok);
+  const std::string text = r.files.at("shaders/kernel1D_Shade.comp"), glsl = Squeezed(text);
+  INFO(text);
+  CHECK(glsl.find("-7.0") == std::string::npos);
+  CHECK(glsl.find("-9.0") == std::string::npos);
+  CHECK(glsl.find(Squeezed("// if (crossrt::GangSize() > 1 && v > 0.0f): false with a gang of 1")) != std::string::npos);
+  CHECK(glsl.find(Squeezed("): true with a gang of 1\nv += 0.125;")) != std::string::npos);
+  CHECK(glsl.find(Squeezed("): false with a gang of 1\nv *= 3.0;")) != std::string::npos);
+  CHECK(Count(glsl, "Falloff(v)<0.0)") == 0);  // (the comment has the C++, 0.0f)
+  CHECK(glsl.find(Squeezed("{ const int n_1 = 2; v += float(n_1); }")) != std::string::npos);
+}

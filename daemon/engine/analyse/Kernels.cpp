@@ -10,6 +10,7 @@
 #include "analyse/LoopShape.h"
 #include "analyse/Members.h"
 #include "analyse/Naming.h"
+#include "analyse/Shadowing.h"
 #include "analyse/VirtualCalls.h"
 #include "analyse/WriteVisitor.h"
 #include "analyse/Writes.h"
@@ -531,14 +532,22 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
   // CPU backend: the loop nest as the user wrote it, reduction targets renamed.
   if (!k.rtv) {
     Rewriter rw(c.ctx.getSourceManager(), c.ctx.getLangOpts());
-    // Reduction targets get their per-thread names; appends go through a lock.
+    // Reduction targets get their per-thread names, shadowing locals their suffixes; appends go through a lock.
     // (Reduced locals too: each chunk of the loop reduces into a part of its own, crt_<local>Local.)
     struct Renamer : RecursiveASTVisitor<Renamer> {
-      Rewriter& rw; const std::map<const FieldDecl*, ReduceOp>& red; const std::set<const VarDecl*>& locals;
-      Renamer(Rewriter& r, const std::map<const FieldDecl*, ReduceOp>& m, const std::set<const VarDecl*>& l) : rw(r), red(m), locals(l) {}
+      Rewriter& rw; ASTContext& ctx; const std::map<const FieldDecl*, ReduceOp>& red; const std::set<const VarDecl*>& locals;
+      Renamer(Rewriter& r, ASTContext& cx, const std::map<const FieldDecl*, ReduceOp>& m, const std::set<const VarDecl*>& l) : rw(r), ctx(cx), red(m), locals(l) {}
       bool VisitDeclRefExpr(DeclRefExpr* dr) {
         auto* vd = dyn_cast<VarDecl>(dr->getDecl());
         if (vd && locals.count(vd)) rw.ReplaceText(dr->getLocation(), vd->getName().size(), generated::ReductionLocal(vd->getNameAsString()));
+        else if (std::string name = vd && !dr->getLocation().isMacroID() ? ShadowingLocalName(ctx, vd) : ""; !name.empty())
+          rw.ReplaceText(dr->getLocation(), vd->getName().size(), name);
+        return true;
+      }
+      // A local that shadows another name takes the suffix the GPU code gives it (-Wshadow).
+      bool VisitVarDecl(VarDecl* vd) {
+        if (std::string name = vd->getLocation().isMacroID() ? "" : ShadowingLocalName(ctx, vd); !name.empty())
+          rw.ReplaceText(vd->getLocation(), vd->getName().size(), name);
         return true;
       }
       bool VisitMemberExpr(MemberExpr* me) {
@@ -547,7 +556,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
         else if (f && red.count(f)) rw.ReplaceText(me->getSourceRange(), generated::ReductionLocal(f->getNameAsString()));
         return true;
       }
-    } renamer(rw, ws.reductions, reducedLocals);
+    } renamer(rw, c.ctx, ws.reductions, reducedLocals);
     struct PrivateConstants : RecursiveASTVisitor<PrivateConstants> {
       Rewriter& rw; ASTContext& ctx;
       PrivateConstants(Rewriter& r, ASTContext& cx) : rw(r), ctx(cx) {}

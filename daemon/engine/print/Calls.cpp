@@ -116,6 +116,56 @@ bool IsGangFunction(const FunctionDecl* fd) {
   return fd && InNamespace(fd, "crossrt") && names.count(fd->getNameAsString()) > 0;
 }
 
+// Folded where it decides alone: `GangSize() > 1 && rest` is false with a gang of one, whatever the
+// rest; comparisons of GangSize() with a constant, !, && and ||. GangSize() itself has no effect.
+std::optional<bool> KernelPrinter::GangCondition(const clang::Expr* e) const {
+  const std::optional<int> size = FixedGangSize();
+  if (!size) return std::nullopt;
+  e = e->IgnoreParenImpCasts();
+  auto value = [&](const clang::Expr* side) -> std::optional<int64_t> {
+    side = side->IgnoreParenImpCasts();
+    if (auto* call = dyn_cast<CallExpr>(side); call && IsGangFunction(call->getDirectCallee()) && call->getDirectCallee()->getName() == "GangSize")
+      return *size;
+    clang::Expr::EvalResult r;
+    if (!side->isValueDependent() && side->EvaluateAsInt(r, m_ctx)) return r.Val.getInt().getExtValue();
+    return std::nullopt;
+  };
+  if (auto* u = dyn_cast<UnaryOperator>(e); u && u->getOpcode() == UO_LNot) {
+    auto inner = GangCondition(u->getSubExpr());
+    return inner ? std::optional<bool>(!*inner) : std::nullopt;
+  }
+  auto* bo = dyn_cast<BinaryOperator>(e);
+  if (!bo) return std::nullopt;
+  if (bo->getOpcode() == BO_LAnd || bo->getOpcode() == BO_LOr) {
+    // As C++ evaluates them: where the left side decides, the right is never evaluated; where the
+    // right side does, the left is, so it may be left out only where it has no effect.
+    const bool decides = bo->getOpcode() == BO_LOr;  // the value of one side that decides the whole
+    auto l = GangCondition(bo->getLHS());
+    if (l) return *l == decides ? std::optional<bool>(decides) : GangCondition(bo->getRHS());
+    auto r = GangCondition(bo->getRHS());
+    if (r && *r == decides && !bo->getLHS()->HasSideEffects(m_ctx)) return decides;
+    return std::nullopt;
+  }
+  if (!bo->isComparisonOp()) return std::nullopt;
+  const bool onGang = [&] {
+    for (const clang::Expr* side : {bo->getLHS(), bo->getRHS()})
+      if (auto* call = dyn_cast<CallExpr>(side->IgnoreParenImpCasts()); call && IsGangFunction(call->getDirectCallee()))
+        return true;
+    return false;
+  }();
+  auto l = value(bo->getLHS()), r = value(bo->getRHS());
+  if (!onGang || !l || !r) return std::nullopt;
+  switch (bo->getOpcode()) {
+    case BO_EQ: return *l == *r;
+    case BO_NE: return *l != *r;
+    case BO_LT: return *l < *r;
+    case BO_GT: return *l > *r;
+    case BO_LE: return *l <= *r;
+    case BO_GE: return *l >= *r;
+    default: return std::nullopt;
+  }
+}
+
 bool IsUniformLocal(const VarDecl* vd) {
   if (!vd || !vd->isLocalVarDecl()) return false;
   for (const auto* a : vd->specific_attrs<AnnotateAttr>())

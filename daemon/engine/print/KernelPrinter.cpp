@@ -3,6 +3,7 @@
 // lambdas and the owner of composed objects have files of their own; types and layouts are
 // GlslTypes.cpp's.
 #include "print/KernelPrinter.h"
+#include "analyse/Shadowing.h"
 #include "generate/GeneratedNames.h"
 #include "print/PrinterParts.h"
 
@@ -12,6 +13,7 @@
 #include <clang/AST/RecursiveASTVisitor.h>
 #include <clang/Lex/Lexer.h>
 
+#include <cctype>
 #include <cstdio>
 #include <map>
 #include <set>
@@ -74,6 +76,14 @@ KernelPrinter::KernelPrinter(ASTContext& ctx, const CXXRecordDecl* cls, Reporter
 // in GLSL, and shadow in ISPC's standard library: `float distance` in Attenuate), takes a '_'.
 std::string KernelPrinter::SafeName(const std::string& name) {
   return GlslKeywords().count(name) || IsGlslBuiltinFunction(name) ? name + "_" : name;
+}
+
+// A local that shadows another name takes a suffix (analyse/Shadowing.cpp); the others, SafeName's.
+std::string KernelPrinter::LocalName(const VarDecl* vd) {
+  if (auto it = renames.find(vd); it != renames.end()) return it->second;
+  const std::string renamed = ShadowingLocalName(m_ctx, vd);
+  if (renamed.empty()) return SafeName(vd->getNameAsString());
+  return renames[vd] = renamed;
 }
 
 std::string KernelPrinter::Fail(SourceLocation loc, const std::string& message, const std::string& hint) {
@@ -424,7 +434,7 @@ std::string KernelPrinter::VirtualCall(const CXXMemberCallExpr* mc) {
     return Fail(mc->getBeginLoc(), "call of the non-virtual " + method->getQualifiedNameAsString() + " through '" + field->getNameAsString() + "' in a kernel",
                 "the GPU picks the implementation by the object's type: make the method virtual in the interface");
   auto* local = dyn_cast<DeclRefExpr>(indexExpr);
-  std::vector<std::string> args = {local && m_objectLocals.count(local->getDecl()) ? SafeName(local->getDecl()->getNameAsString())  // already the index
+  std::vector<std::string> args = {local && m_objectLocals.count(local->getDecl()) ? LocalName(cast<VarDecl>(local->getDecl()))  // already the index
                                                                       : ObjectIndex(indexExpr)};
   if (std::string data = ClassDataArgument(); !data.empty()) args.insert(args.begin(), data);  // the dispatcher finds the tags and the objects in the class data
   for (unsigned i = 0; i < mc->getNumArgs(); ++i) {
@@ -585,7 +595,7 @@ std::string KernelPrinter::Expr(const clang::Expr* e) {
       }
       if (vd->isStaticLocal())
         return Fail(e->getBeginLoc(), "static local variable in a kernel", "use a class member or a constant");
-      return SafeName(vd->getNameAsString());
+      return LocalName(vd);
     }
     return Fail(e->getBeginLoc(), "'" + d->getNameAsString() + "' cannot be used in a kernel", "");
   }
@@ -824,7 +834,7 @@ std::string KernelPrinter::Stmt(const clang::Stmt* s, int indent) {
         Fail(vd->getLocation(), "non-const reference variable in a kernel: " + why,
              "GLSL has no references: write through the original expression, e.g. arr[i].x = ...");
       }
-      std::string decl = Declare(t, vd->getNameAsString(), vd->getLocation());
+      std::string decl = Declare(t, LocalName(vd), vd->getLocation());
       std::string cnst = t.getNonReferenceType().isConstQualified() && !t->isArrayType() ? "const " : "";
       out += pad + cnst + LocalQualifier(vd) + decl;
       std::string after;
@@ -837,7 +847,7 @@ std::string KernelPrinter::Stmt(const clang::Stmt* s, int indent) {
         auto* arr = dyn_cast<ConstantArrayType>(t.getCanonicalType().getTypePtr());
         if (!trivialDefault && cons && cons->getNumArgs() == 0 && arr && arr->getSize().getZExtValue() > 8) {
           // A long array of class type: each element constructed in a loop, not in one long constructor.
-          const std::string n = std::to_string(arr->getSize().getZExtValue()), name = SafeName(vd->getNameAsString());
+          const std::string n = std::to_string(arr->getSize().getZExtValue()), name = LocalName(vd);
           after = pad + "for (int crt_i = 0; crt_i < " + n + "; ++crt_i)  // each element default-constructed, as in C++\n" + pad + "  " +
                   name + "[crt_i] = " + Construct(arr->getElementType(), {}, vd->getLocation()) + ";\n";
         } else if (std::string copy = cons && cons->getNumArgs() == 1 && IsStdArray(t) && cons->getConstructor()->isCopyOrMoveConstructor()
@@ -856,6 +866,15 @@ std::string KernelPrinter::Stmt(const clang::Stmt* s, int indent) {
   if (auto* is = dyn_cast<IfStmt>(s)) {
     if (is->getConditionVariable() || is->getInit())
       Fail(is->getBeginLoc(), "declaration inside an if condition in a kernel", "declare the variable before the if");
+    if (auto taken = GangCondition(is->getCond())) {
+      // A branch on the gang's size, which this language fixes: the branch not taken is not printed.
+      std::string cond;
+      for (char ch : TrimmedSourceText(m_ctx, is->getCond()->getSourceRange()))  // on one line
+        if (!std::isspace(static_cast<unsigned char>(ch)) || (!cond.empty() && cond.back() != ' ')) cond += std::isspace(static_cast<unsigned char>(ch)) ? ' ' : ch;
+      const clang::Stmt* branch = *taken ? is->getThen() : is->getElse();
+      return pad + "// if (" + cond + "): " + (*taken ? "true" : "false") + " with a gang of " + std::to_string(*FixedGangSize()) + "\n" +
+             (branch ? Stmt(branch, indent) : "");
+    }
     std::string out = pad + "if (" + Expr(is->getCond()) + ")\n" + ThenBranch(is, indent);
     if (is->getElse()) out += pad + "else\n" + Stmt(is->getElse(), isa<CompoundStmt>(is->getElse()) ? indent : indent + 1);
     return out;

@@ -177,6 +177,9 @@ public:
   // Structs declared once for the whole class (the class-data block needs them): not emitted again.
   std::set<std::string> predeclaredStructs;
   static std::string SafeName(const std::string& name);  // renames GLSL keywords
+  // A local's name in the printed code: SafeName's, or a new one where it shadows a name of an
+  // enclosing scope, which ISPC warns of (analyse/Shadowing.cpp).
+  std::string LocalName(const clang::VarDecl* vd);
 
 protected:
   // What a pointer in a kernel points at (Pointers.cpp).
@@ -285,6 +288,8 @@ protected:
   // The gang (Gang.h): crossrt::GangSize, AnyLane, AllLanes, FirstLane, MinOverLanes and AllLanesOn; what a
   // local's declaration starts with besides `const` (ISPC's `uniform` for a CRT_UNIFORM local).
   virtual std::string GangCall(const clang::FunctionDecl* fd, const clang::CallExpr* call) = 0;
+  // The gang's size where the language fixes it (GLSL: 1), else nullopt (ISPC: its target's).
+  virtual std::optional<int> FixedGangSize() const = 0;
   virtual std::string LocalQualifier(const clang::VarDecl* vd) = 0;
   // An argument bound to a helper's non-const reference parameter (ISPC reports a CRT_UNIFORM local
   // there: a lane's reference cannot bind the gang's variable).
@@ -294,6 +299,9 @@ protected:
   // The per-thread value parameter `e` reads (*p, p[0]; with pointerItself, p), or null.
   const clang::ValueDecl* ValueParamOf(const clang::Expr* e, bool pointerItself = false) const;
   std::string Call(const clang::CallExpr* call);
+  // What a condition on crossrt::GangSize() is where the language fixes the size (`GangSize() == 4
+  // && ...` is false in GLSL), or nullopt: an `if` prints only its branch taken (Calls.cpp).
+  std::optional<bool> GangCondition(const clang::Expr* e) const;
   std::string Builtin(const clang::FunctionDecl* fd, const std::vector<std::string>& args, const clang::CallExpr* call);
   std::string Construct(clang::QualType t, const std::vector<const clang::Expr*>& args, clang::SourceLocation loc);
   std::string Literal(const clang::Expr* e);

@@ -48,7 +48,8 @@ std::string KernelPrinter::LambdaCall(const CXXOperatorCallExpr* op) {
       if (std::string data = ClassDataArgument(); !data.empty()) args = data + std::string(args.empty() ? "" : ", ") + args;
       continue;
     }
-    if (capture.capturesVariable()) args += (args.empty() ? "" : ", ") + SafeName(capture.getCapturedVar()->getNameAsString());
+    if (auto* var = capture.capturesVariable() ? dyn_cast<VarDecl>(capture.getCapturedVar()) : nullptr)
+      args += (args.empty() ? "" : ", ") + LocalName(var);
   }
   return name + "(" + args + ")";
 }
@@ -90,7 +91,7 @@ std::string KernelPrinter::EmitLambda(const LambdaExpr* lambda, const std::strin
       return Fail(capture.getLocation(), "a lambda in a kernel capturing '" + var->getNameAsString() + "', a pointer or reference",
                   "capture the value it refers to, copied into a local first");
     const bool byReference = capture.getCaptureKind() == LCK_ByRef && !t.isConstQualified();
-    add(byReference ? WritableParam(t, var->getNameAsString(), var->getLocation()) : Declare(t, var->getNameAsString(), var->getLocation()));
+    add(byReference ? WritableParam(t, LocalName(var), var->getLocation()) : Declare(t, LocalName(var), var->getLocation()));
   }
   os << params << ")\n" << FunctionBody(call->getBody());
   m_uses.helpers.push_back(call);  // its writes to members count as a helper's

@@ -19,7 +19,7 @@ std::string KernelPrinter::ForLoop(const ForStmt* fs, int indent) {
     // `for (int i = 0, j = n - 1; ...)`: one declaration with several variables.
     for (auto* d : ds->decls()) {
       auto* vd = cast<VarDecl>(d);
-      std::string one = init.empty() ? Declare(vd->getType(), vd->getNameAsString(), vd->getLocation()) : SafeName(vd->getNameAsString());
+      std::string one = init.empty() ? Declare(vd->getType(), LocalName(vd), vd->getLocation()) : LocalName(vd);
       init += (init.empty() ? "" : ", ") + one + (vd->getInit() ? " = " + Expr(vd->getInit()) : "");
     }
   } else if (fs->getInit()) {
@@ -66,7 +66,7 @@ std::string KernelPrinter::RangeFor(const CXXForRangeStmt* rf, int indent) {
     m_uses.sizeReads.emplace(field, rf->getColonLoc());
     n = SizeAsInt(MemberAccess(generated::SizeField(field->getNameAsString())));
   }
-  const std::string element = pad + "  " + (t.getNonReferenceType().isConstQualified() ? "const " : "") + Declare(t, var->getNameAsString(), var->getLocation()) +
+  const std::string element = pad + "  " + (t.getNonReferenceType().isConstQualified() ? "const " : "") + Declare(t, LocalName(var), var->getLocation()) +
                               " = " + Expr(range) + "[" + k + "];\n";
   ++m_loopDepth;
   const clang::Stmt* body = rf->getBody();

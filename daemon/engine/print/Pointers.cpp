@@ -245,8 +245,8 @@ std::string KernelPrinter::PointerLocal(const VarDecl* vd, const std::string& pa
   if (const FieldDecl* objects = ObjectLocal(vd, &objectIndex)) {
     m_objectLocals[vd] = objects;
     const std::string index = Expr(objectIndex);
-    return pad + "const uint " + SafeName(vd->getNameAsString()) + " = " + ObjectLocalIndex(index) + ";  // " +
-           vd->getNameAsString() + " points at " + objects->getNameAsString() + "[" + SafeName(vd->getNameAsString()) + "]\n";
+    return pad + "const uint " + LocalName(vd) + " = " + ObjectLocalIndex(index) + ";  // " +
+           vd->getNameAsString() + " points at " + objects->getNameAsString() + "[" + LocalName(vd) + "]\n";
   }
   auto t = Pointer(init);
   if (!t) {
@@ -257,7 +257,7 @@ std::string KernelPrinter::PointerLocal(const VarDecl* vd, const std::string& pa
   }
   std::string out;
   if (!t->offset.empty()) {
-    const std::string offset = SafeName(vd->getNameAsString()) + "_offset";
+    const std::string offset = LocalName(vd) + "_offset";
     out = pad + "const uint " + offset + " = " + t->offset + ";  // " + vd->getNameAsString() + " points to " + t->array + "[" + offset + "]\n";
     t->offset = offset;
   }

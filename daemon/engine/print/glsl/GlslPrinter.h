@@ -70,6 +70,7 @@ protected:
   std::string LoopInit(const clang::ForStmt* fs, const std::string& init) override;
   std::string ArrayCopy(const clang::VarDecl* vd, const clang::CXXConstructExpr* copy, const std::string& pad) override;
   std::string GangCall(const clang::FunctionDecl* fd, const clang::CallExpr* call) override;
+  std::optional<int> FixedGangSize() const override { return 1; }  // a thread is a gang of one
   std::string LocalQualifier(const clang::VarDecl* vd) override;
 
 private:

@@ -309,7 +309,7 @@ std::string IspcPrinter::LoopInit(const ForStmt* fs, const std::string& init) {
 
 // ISPC arrays do not copy whole (C's rule): element by element.
 std::string IspcPrinter::ArrayCopy(const VarDecl* vd, const CXXConstructExpr* cons, const std::string& pad) {
-  const std::string name = SafeName(vd->getNameAsString());
+  const std::string name = LocalName(vd);
   uint64_t n = 0;
   IsStdArray(vd->getType(), nullptr, &n);
   return pad + "for (uniform int crt_i = 0; crt_i < " + std::to_string(n) + "; ++crt_i)  // a copy of " + TrimmedSourceText(m_ctx, cons->getArg(0)->getSourceRange()) +

@@ -73,6 +73,7 @@ protected:
   std::string ThenBranch(const clang::IfStmt* is, int indent) override;
   std::string ForLoop(const clang::ForStmt* fs, int indent) override;
   std::string GangCall(const clang::FunctionDecl* fd, const clang::CallExpr* call) override;
+  std::optional<int> FixedGangSize() const override { return std::nullopt; }  // the target's: ISPC folds programCount
   std::string LocalQualifier(const clang::VarDecl* vd) override;
   void ReferenceArgument(const clang::ParmVarDecl* p, const clang::Expr* arg) override;
 

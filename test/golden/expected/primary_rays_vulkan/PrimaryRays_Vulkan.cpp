@@ -141,16 +141,16 @@ void PrimaryRays_Vulkan::crt_UpdatePlainMembers()
   data.crt_m_pAccelStruct_m_instances_capacity = uint32_t(crt_m_pAccelStruct()->m_instances.capacity());
   data.crt_m_pAccelStruct_m_motion_size = uint32_t(crt_m_pAccelStruct()->m_motion.size());
   data.crt_m_pAccelStruct_m_motion_capacity = uint32_t(crt_m_pAccelStruct()->m_motion.capacity());
-  data.crt_m_pAccelStruct_m_triangles_size = uint32_t(crt_m_pAccelStruct()->m_triangles.size());
-  data.crt_m_pAccelStruct_m_triangles_capacity = uint32_t(crt_m_pAccelStruct()->m_triangles.capacity());
-  data.crt_m_pAccelStruct_m_primIds_size = uint32_t(crt_m_pAccelStruct()->m_primIds.size());
-  data.crt_m_pAccelStruct_m_primIds_capacity = uint32_t(crt_m_pAccelStruct()->m_primIds.capacity());
   data.crt_m_pAccelStruct_m_boxes_size = uint32_t(crt_m_pAccelStruct()->m_boxes.size());
   data.crt_m_pAccelStruct_m_boxes_capacity = uint32_t(crt_m_pAccelStruct()->m_boxes.capacity());
   data.crt_m_pAccelStruct_m_sdfBricks_size = uint32_t(crt_m_pAccelStruct()->m_sdfBricks.size());
   data.crt_m_pAccelStruct_m_sdfBricks_capacity = uint32_t(crt_m_pAccelStruct()->m_sdfBricks.capacity());
   data.crt_m_pAccelStruct_m_sdfWords_size = uint32_t(crt_m_pAccelStruct()->m_sdfWords.size());
   data.crt_m_pAccelStruct_m_sdfWords_capacity = uint32_t(crt_m_pAccelStruct()->m_sdfWords.capacity());
+  data.crt_m_pAccelStruct_m_triangles_size = uint32_t(crt_m_pAccelStruct()->m_triangles.size());
+  data.crt_m_pAccelStruct_m_triangles_capacity = uint32_t(crt_m_pAccelStruct()->m_triangles.capacity());
+  data.crt_m_pAccelStruct_m_primIds_size = uint32_t(crt_m_pAccelStruct()->m_primIds.size());
+  data.crt_m_pAccelStruct_m_primIds_capacity = uint32_t(crt_m_pAccelStruct()->m_primIds.capacity());
   crt_classDataBuffer.Upload(&data, sizeof(data));
 }
 
@@ -198,24 +198,6 @@ void PrimaryRays_Vulkan::CommitDeviceData()
   crt_vdata.m_pAccelStruct_m_motionSize = crt_m_pAccelStruct()->m_motion.size();
   if (!crt_useRayTracingHardware)  // only the translated traversal reads it
   {
-    crossrt::EnsureSize(crt_ctx, crt_vdata.m_pAccelStruct_m_triangles,
-                        sizeof(BVHTriangle4) * crt_m_pAccelStruct()->m_triangles.capacity());
-    if (!crt_m_pAccelStruct()->m_triangles.empty())
-      crt_vdata.m_pAccelStruct_m_triangles.Upload(crt_m_pAccelStruct()->m_triangles.data(),
-                                                  sizeof(BVHTriangle4) * crt_m_pAccelStruct()->m_triangles.size());
-  }
-  crt_vdata.m_pAccelStruct_m_trianglesSize = crt_m_pAccelStruct()->m_triangles.size();
-  if (!crt_useRayTracingHardware)  // only the translated traversal reads it
-  {
-    crossrt::EnsureSize(crt_ctx, crt_vdata.m_pAccelStruct_m_primIds,
-                        sizeof(unsigned int) * crt_m_pAccelStruct()->m_primIds.capacity());
-    if (!crt_m_pAccelStruct()->m_primIds.empty())
-      crt_vdata.m_pAccelStruct_m_primIds.Upload(crt_m_pAccelStruct()->m_primIds.data(),
-                                                sizeof(unsigned int) * crt_m_pAccelStruct()->m_primIds.size());
-  }
-  crt_vdata.m_pAccelStruct_m_primIdsSize = crt_m_pAccelStruct()->m_primIds.size();
-  if (!crt_useRayTracingHardware)  // only the translated traversal reads it
-  {
     crossrt::EnsureSize(crt_ctx, crt_vdata.m_pAccelStruct_m_boxes,
                         sizeof(BVH4Node) * crt_m_pAccelStruct()->m_boxes.capacity());
     if (!crt_m_pAccelStruct()->m_boxes.empty())
@@ -241,6 +223,24 @@ void PrimaryRays_Vulkan::CommitDeviceData()
                                                  sizeof(unsigned int) * crt_m_pAccelStruct()->m_sdfWords.size());
   }
   crt_vdata.m_pAccelStruct_m_sdfWordsSize = crt_m_pAccelStruct()->m_sdfWords.size();
+  if (!crt_useRayTracingHardware)  // only the translated traversal reads it
+  {
+    crossrt::EnsureSize(crt_ctx, crt_vdata.m_pAccelStruct_m_triangles,
+                        sizeof(BVHTriangle4) * crt_m_pAccelStruct()->m_triangles.capacity());
+    if (!crt_m_pAccelStruct()->m_triangles.empty())
+      crt_vdata.m_pAccelStruct_m_triangles.Upload(crt_m_pAccelStruct()->m_triangles.data(),
+                                                  sizeof(BVHTriangle4) * crt_m_pAccelStruct()->m_triangles.size());
+  }
+  crt_vdata.m_pAccelStruct_m_trianglesSize = crt_m_pAccelStruct()->m_triangles.size();
+  if (!crt_useRayTracingHardware)  // only the translated traversal reads it
+  {
+    crossrt::EnsureSize(crt_ctx, crt_vdata.m_pAccelStruct_m_primIds,
+                        sizeof(unsigned int) * crt_m_pAccelStruct()->m_primIds.capacity());
+    if (!crt_m_pAccelStruct()->m_primIds.empty())
+      crt_vdata.m_pAccelStruct_m_primIds.Upload(crt_m_pAccelStruct()->m_primIds.data(),
+                                                sizeof(unsigned int) * crt_m_pAccelStruct()->m_primIds.size());
+  }
+  crt_vdata.m_pAccelStruct_m_primIdsSize = crt_m_pAccelStruct()->m_primIds.size();
   std::vector<uint32_t> crt_constants(crt_classConstants, VK_TRUE);
   crt_constants.push_back(crossrt::SpecializationValue(
       crt_m_pAccelStruct()->m_sceneKinds));    // BVHScene::m_sceneKinds through m_pAccelStruct (CRT_SPECIALIZE)
@@ -272,11 +272,11 @@ bool PrimaryRays_Vulkan::crt_VectorMembersResized() const
   resized = resized || crt_m_pAccelStruct()->m_nodes.size() != crt_vdata.m_pAccelStruct_m_nodesSize;
   resized = resized || crt_m_pAccelStruct()->m_instances.size() != crt_vdata.m_pAccelStruct_m_instancesSize;
   resized = resized || crt_m_pAccelStruct()->m_motion.size() != crt_vdata.m_pAccelStruct_m_motionSize;
-  resized = resized || crt_m_pAccelStruct()->m_triangles.size() != crt_vdata.m_pAccelStruct_m_trianglesSize;
-  resized = resized || crt_m_pAccelStruct()->m_primIds.size() != crt_vdata.m_pAccelStruct_m_primIdsSize;
   resized = resized || crt_m_pAccelStruct()->m_boxes.size() != crt_vdata.m_pAccelStruct_m_boxesSize;
   resized = resized || crt_m_pAccelStruct()->m_sdfBricks.size() != crt_vdata.m_pAccelStruct_m_sdfBricksSize;
   resized = resized || crt_m_pAccelStruct()->m_sdfWords.size() != crt_vdata.m_pAccelStruct_m_sdfWordsSize;
+  resized = resized || crt_m_pAccelStruct()->m_triangles.size() != crt_vdata.m_pAccelStruct_m_trianglesSize;
+  resized = resized || crt_m_pAccelStruct()->m_primIds.size() != crt_vdata.m_pAccelStruct_m_primIdsSize;
   return resized;
 }
 

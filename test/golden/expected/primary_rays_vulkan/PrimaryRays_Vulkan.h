@@ -98,16 +98,16 @@ protected:
     alignas(4) uint32_t crt_m_pAccelStruct_m_instances_capacity;
     alignas(4) uint32_t crt_m_pAccelStruct_m_motion_size;
     alignas(4) uint32_t crt_m_pAccelStruct_m_motion_capacity;
-    alignas(4) uint32_t crt_m_pAccelStruct_m_triangles_size;
-    alignas(4) uint32_t crt_m_pAccelStruct_m_triangles_capacity;
-    alignas(4) uint32_t crt_m_pAccelStruct_m_primIds_size;
-    alignas(4) uint32_t crt_m_pAccelStruct_m_primIds_capacity;
     alignas(4) uint32_t crt_m_pAccelStruct_m_boxes_size;
     alignas(4) uint32_t crt_m_pAccelStruct_m_boxes_capacity;
     alignas(4) uint32_t crt_m_pAccelStruct_m_sdfBricks_size;
     alignas(4) uint32_t crt_m_pAccelStruct_m_sdfBricks_capacity;
     alignas(4) uint32_t crt_m_pAccelStruct_m_sdfWords_size;
     alignas(4) uint32_t crt_m_pAccelStruct_m_sdfWords_capacity;
+    alignas(4) uint32_t crt_m_pAccelStruct_m_triangles_size;
+    alignas(4) uint32_t crt_m_pAccelStruct_m_triangles_capacity;
+    alignas(4) uint32_t crt_m_pAccelStruct_m_primIds_size;
+    alignas(4) uint32_t crt_m_pAccelStruct_m_primIds_capacity;
   };
 
   std::shared_ptr<crossrt::VulkanContext> crt_ctx;
@@ -126,16 +126,16 @@ protected:
     size_t m_pAccelStruct_m_instancesSize = 0;  // elements at the last CommitDeviceData()
     crossrt::Buffer m_pAccelStruct_m_motion;
     size_t m_pAccelStruct_m_motionSize = 0;  // elements at the last CommitDeviceData()
-    crossrt::Buffer m_pAccelStruct_m_triangles;
-    size_t m_pAccelStruct_m_trianglesSize = 0;  // elements at the last CommitDeviceData()
-    crossrt::Buffer m_pAccelStruct_m_primIds;
-    size_t m_pAccelStruct_m_primIdsSize = 0;  // elements at the last CommitDeviceData()
     crossrt::Buffer m_pAccelStruct_m_boxes;
     size_t m_pAccelStruct_m_boxesSize = 0;  // elements at the last CommitDeviceData()
     crossrt::Buffer m_pAccelStruct_m_sdfBricks;
     size_t m_pAccelStruct_m_sdfBricksSize = 0;  // elements at the last CommitDeviceData()
     crossrt::Buffer m_pAccelStruct_m_sdfWords;
     size_t m_pAccelStruct_m_sdfWordsSize = 0;  // elements at the last CommitDeviceData()
+    crossrt::Buffer m_pAccelStruct_m_triangles;
+    size_t m_pAccelStruct_m_trianglesSize = 0;  // elements at the last CommitDeviceData()
+    crossrt::Buffer m_pAccelStruct_m_primIds;
+    size_t m_pAccelStruct_m_primIdsSize = 0;  // elements at the last CommitDeviceData()
   } crt_vdata;
   // A std::vector or Image2D member changed size, or a sampler changed, since CommitDeviceData().
   virtual bool crt_VectorMembersResized() const;

@@ -90,11 +90,6 @@ struct Cubic
   float c3;
 };
 
-struct BVHTriangle4
-{
-  vec4 coord[9];
-};
-
 struct BVHSdfBrick
 {
   vec4 minAndVoxelSize;
@@ -105,6 +100,11 @@ struct BVHSdfBrick
   uint localId;
   uint occupied[2];
   uint unused;
+};
+
+struct BVHTriangle4
+{
+  vec4 coord[9];
 };
 
 // Data members of PrimaryRays, uploaded before every control function call.
@@ -129,16 +129,16 @@ layout(std430, binding = 0) buffer crt_PrimaryRaysData
   uint crt_m_pAccelStruct_m_instances_capacity;
   uint crt_m_pAccelStruct_m_motion_size;
   uint crt_m_pAccelStruct_m_motion_capacity;
-  uint crt_m_pAccelStruct_m_triangles_size;
-  uint crt_m_pAccelStruct_m_triangles_capacity;
-  uint crt_m_pAccelStruct_m_primIds_size;
-  uint crt_m_pAccelStruct_m_primIds_capacity;
   uint crt_m_pAccelStruct_m_boxes_size;
   uint crt_m_pAccelStruct_m_boxes_capacity;
   uint crt_m_pAccelStruct_m_sdfBricks_size;
   uint crt_m_pAccelStruct_m_sdfBricks_capacity;
   uint crt_m_pAccelStruct_m_sdfWords_size;
   uint crt_m_pAccelStruct_m_sdfWords_capacity;
+  uint crt_m_pAccelStruct_m_triangles_size;
+  uint crt_m_pAccelStruct_m_triangles_capacity;
+  uint crt_m_pAccelStruct_m_primIds_size;
+  uint crt_m_pAccelStruct_m_primIds_capacity;
 };
 layout(std430, binding = 1) buffer crt_pixelsBuffer
 {
@@ -196,6 +196,7 @@ layout(push_constant) uniform crt_kernel2D_RenderArgs
 };
 
 const uint m_pAccelStruct_kNoId = 4294967295u;
+const uint m_pAccelStruct_kLeafFlag = 2147483648u;
 const uint m_pAccelStruct_kInstanceSdf = 8u;
 const uint m_pAccelStruct_kInstanceBoxes = 2u;
 const uint m_pAccelStruct_kInstanceMotion = 4u;
@@ -204,9 +205,6 @@ const uint m_pAccelStruct_kSceneTransformed = 32u;
 const float m_pAccelStruct_kWiden = 1.00000036;
 const float m_pAccelStruct_kMissed = -1.0;
 const uint m_pAccelStruct_kNoChild = 4294967295u;
-const float m_pAccelStruct_kNotEntered = (1.0 / 0.0);
-const uint m_pAccelStruct_kLeafFlag = 2147483648u;
-const int m_pAccelStruct_kRaysAlone = 2;
 const uint m_pAccelStruct_kSdfMaskedVoxels = 4u;
 const int m_pAccelStruct_kSdfNewtonIterations = 4;
 const uint m_pAccelStruct_kSceneTriangles = 16u;
@@ -268,26 +266,6 @@ vec3 m_pAccelStruct_ToObjectVector(BVHInstance inst, vec3 d)
   return vec3(dot(inst.toObjectRow0, h), dot(inst.toObjectRow1, h), dot(inst.toObjectRow2, h));
 }
 
-// from (anonymous namespace)::RayOfLane
-BVHTraceRay m_pAccelStruct_RayOfLane(BVHTraceRay ray, int at)
-{
-  const int lane = (at);
-  BVHTraceRay r =
-      BVHTraceRay(vec3(0), vec3(0), vec3(0), float(0), int(0), int(0), int(0), float(0), float(0), float(0), bool(0));
-  r.org = vec3((ray.org.x), (ray.org.y), (ray.org.z));
-  r.dir = vec3((ray.dir.x), (ray.dir.y), (ray.dir.z));
-  r.invDir = vec3((ray.invDir.x), (ray.invDir.y), (ray.invDir.z));
-  r.tnear = (ray.tnear);
-  r.kx = (ray.kx);
-  r.ky = (ray.ky);
-  r.kz = (ray.kz);
-  r.sx = (ray.sx);
-  r.sy = (ray.sy);
-  r.sz = (ray.sz);
-  r.anyZeroAxis = (ray.anyZeroAxis);
-  return r;
-}
-
 // from (anonymous namespace)::SlabEntryParallelAxes
 float m_pAccelStruct_SlabEntryParallelAxes(BVHTraceRay r, vec3 lo, vec3 hi, float tfar, inout float exit)
 {
@@ -308,432 +286,6 @@ float m_pAccelStruct_SlabEntryParallelAxes(BVHTraceRay r, vec3 lo, vec3 hi, floa
   }
   exit = inside ? tmax : m_pAccelStruct_kMissed;
   return inside ? tmin : 0.0;
-}
-
-// from (anonymous namespace)::SlabEntry
-float m_pAccelStruct_SlabEntry(BVHTraceRay r, vec3 lo, vec3 hi, float tfar, inout float exit)
-{
-  if (r.anyZeroAxis)
-    return m_pAccelStruct_SlabEntryParallelAxes(r, lo, hi, tfar, exit);
-  const float nearX = ((r.invDir.x < 0.0 ? hi.x : lo.x) - r.org.x) * r.invDir.x;
-  const float farX = ((r.invDir.x < 0.0 ? lo.x : hi.x) - r.org.x) * r.invDir.x;
-  const float nearY = ((r.invDir.y < 0.0 ? hi.y : lo.y) - r.org.y) * r.invDir.y;
-  const float farY = ((r.invDir.y < 0.0 ? lo.y : hi.y) - r.org.y) * r.invDir.y;
-  const float nearZ = ((r.invDir.z < 0.0 ? hi.z : lo.z) - r.org.z) * r.invDir.z;
-  const float farZ = ((r.invDir.z < 0.0 ? lo.z : hi.z) - r.org.z) * r.invDir.z;
-  exit = min(min(min(farX, farY), farZ) * m_pAccelStruct_kWiden, tfar);
-  return max(max(nearX, nearY), max(nearZ, r.tnear));
-}
-
-// from BVHScene::IntersectCorners
-bool m_pAccelStruct_IntersectCorners(BVHTraceRay r, int kx, int ky, int kz, vec3 a, vec3 b, vec3 c, float tfar,
-                                     inout float t, inout float u, inout float v, inout bool onEdge)
-{
-  const float ox = r.org[kx];
-  const float oy = r.org[ky];
-  const float oz = r.org[kz];
-  const float az = a.z - oz;
-  const float bz = b.z - oz;
-  const float cz = c.z - oz;
-  const float ax = (a.x - ox) - r.sx * az;
-  const float ay = (a.y - oy) - r.sy * az;
-  const float bx = (b.x - ox) - r.sx * bz;
-  const float by = (b.y - oy) - r.sy * bz;
-  const float cx = (c.x - ox) - r.sx * cz;
-  const float cy = (c.y - oy) - r.sy * cz;
-  const float eu = cx * by - cy * bx;
-  const float ev = ax * cy - ay * cx;
-  const float ew = bx * ay - by * ax;
-  onEdge = onEdge || min(min(abs(eu), abs(ev)), abs(ew)) <= 0.0;
-  const float det = eu + ev + ew;
-  t = (eu * (r.sz * az) + ev * (r.sz * bz) + ew * (r.sz * cz)) / det;
-  u = ev / det;
-  v = ew / det;
-  const bool inside = 0.0 <= min(min(eu, ev), ew) || max(max(eu, ev), ew) <= 0.0;
-  return inside && !(det <= 0.0 && 0.0 <= det) && r.tnear <= t && t <= tfar;
-}
-
-// from (anonymous namespace)::DifferenceOfProducts
-float m_pAccelStruct_DifferenceOfProducts(float a, float b, float c, float d)
-{
-  const float cd = c * d;
-  const float error = fma(-c, d, cd);
-  return fma(a, b, -cd) + error;
-}
-
-// from (anonymous namespace)::DifferenceOfProducts
-vec4 m_pAccelStruct_DifferenceOfProducts(vec4 a, vec4 b, vec4 c, vec4 d)
-{
-  return vec4(
-      m_pAccelStruct_DifferenceOfProducts(a.x, b.x, c.x, d.x), m_pAccelStruct_DifferenceOfProducts(a.y, b.y, c.y, d.y),
-      m_pAccelStruct_DifferenceOfProducts(a.z, b.z, c.z, d.z), m_pAccelStruct_DifferenceOfProducts(a.w, b.w, c.w, d.w));
-}
-
-// from BVHScene::IntersectGroup
-uint m_pAccelStruct_IntersectGroup(BVHTraceRay r, uint group, int kx, int ky, int kz, float tfar, inout vec4 t,
-                                   inout vec4 u, inout vec4 v)
-{
-  const float ox = r.org[kx];
-  const float oy = r.org[ky];
-  const float oz = r.org[kz];
-  const vec4 az = m_pAccelStruct_m_triangles[group].coord[kz] - oz;
-  const vec4 bz = m_pAccelStruct_m_triangles[group].coord[3 + kz] - oz;
-  const vec4 cz = m_pAccelStruct_m_triangles[group].coord[6 + kz] - oz;
-  const vec4 ax = (m_pAccelStruct_m_triangles[group].coord[kx] - ox) - r.sx * az;
-  const vec4 ay = (m_pAccelStruct_m_triangles[group].coord[ky] - oy) - r.sy * az;
-  const vec4 bx = (m_pAccelStruct_m_triangles[group].coord[3 + kx] - ox) - r.sx * bz;
-  const vec4 by = (m_pAccelStruct_m_triangles[group].coord[3 + ky] - oy) - r.sy * bz;
-  const vec4 cx = (m_pAccelStruct_m_triangles[group].coord[6 + kx] - ox) - r.sx * cz;
-  const vec4 cy = (m_pAccelStruct_m_triangles[group].coord[6 + ky] - oy) - r.sy * cz;
-  vec4 eu = cx * by - cy * bx;
-  vec4 ev = ax * cy - ay * cx;
-  vec4 ew = bx * ay - by * ax;
-  const vec4 zero = vec4(0.0);
-  if (uint(dot(vec4(lessThanEqual(min(min(abs(eu), abs(ev)), abs(ew)), zero)), vec4(1.0, 2.0, 4.0, 8.0))) != 0u)
-  {
-    eu = m_pAccelStruct_DifferenceOfProducts(cx, by, cy, bx);
-    ev = m_pAccelStruct_DifferenceOfProducts(ax, cy, ay, cx);
-    ew = m_pAccelStruct_DifferenceOfProducts(bx, ay, by, ax);
-  }
-  uint hits = uint(dot(vec4(lessThanEqual(zero, min(min(eu, ev), ew))), vec4(1.0, 2.0, 4.0, 8.0))) |
-              uint(dot(vec4(lessThanEqual(max(max(eu, ev), ew), zero)), vec4(1.0, 2.0, 4.0, 8.0)));
-  const vec4 det = eu + ev + ew;
-  hits = hits & ~(uint(dot(vec4(lessThanEqual(det, zero)), vec4(1.0, 2.0, 4.0, 8.0))) &
-                  uint(dot(vec4(lessThanEqual(zero, det)), vec4(1.0, 2.0, 4.0, 8.0))));
-  t = (eu * (r.sz * az) + ev * (r.sz * bz) + ew * (r.sz * cz)) / det;
-  hits = hits & uint(dot(vec4(lessThanEqual(vec4(r.tnear), t)), vec4(1.0, 2.0, 4.0, 8.0))) &
-         uint(dot(vec4(lessThanEqual(t, vec4(tfar))), vec4(1.0, 2.0, 4.0, 8.0)));
-  u = ev / det;
-  v = ew / det;
-  return hits;
-}
-
-// from BVHScene::TraceMeshAlone
-bool m_pAccelStruct_TraceMeshAlone(BVHTraceRay gangRay, int at, uint root, bool anyHit, inout float tfar,
-                                   inout CRT_Hit hit)
-{
-  const int lane = (at);
-  const BVHTraceRay ray = m_pAccelStruct_RayOfLane(gangRay, lane);
-  const int kx = (gangRay.kx);
-  const int ky = (gangRay.ky);
-  const int kz = (gangRay.kz);
-  const bool firstHit = (anyHit);
-  float rayTfar = (tfar);
-  float hitT = (hit.t);
-  uint hitPrimId = (hit.primId);
-  float hitU = (hit.coords[0]);
-  float hitV = (hit.coords[1]);
-  bool found = false;
-  uint stack[64];
-  float stackEntry[64];
-  int top = 0;
-  uint node = (root);
-  while (true)
-  {
-    while ((node & m_pAccelStruct_kLeafFlag) == 0u)
-    {
-      uint entered = 0u;
-      float entries[4];
-      for (int firstBox = 0; firstBox < 4; firstBox += 1)
-      {
-        float exit = 0.0;
-        const vec3 lo = vec3((m_pAccelStruct_m_nodes[node].minX)[min(firstBox, 3)],
-                             (m_pAccelStruct_m_nodes[node].minY)[min(firstBox, 3)],
-                             (m_pAccelStruct_m_nodes[node].minZ)[min(firstBox, 3)]);
-        const vec3 hi = vec3((m_pAccelStruct_m_nodes[node].maxX)[min(firstBox, 3)],
-                             (m_pAccelStruct_m_nodes[node].maxY)[min(firstBox, 3)],
-                             (m_pAccelStruct_m_nodes[node].maxZ)[min(firstBox, 3)]);
-        const float boxEntry = m_pAccelStruct_SlabEntry(ray, lo, hi, rayTfar, exit);
-        uint bits = ((firstBox + 0 < 4 && boxEntry <= exit) ? 1u : 0u);
-        entered = entered | (bits << uint(firstBox));
-        while (bits != 0u)
-        {
-          const int k = findLSB(uint(bits));
-          bits = bits & (bits - 1u);
-          entries[firstBox + k] = (boxEntry);
-        }
-      }
-      if (entered == 0u)
-      {
-        node = m_pAccelStruct_kNoChild;
-        break;
-      }
-      uint next = m_pAccelStruct_kNoChild;
-      float nextEntry = m_pAccelStruct_kNotEntered;
-      for (int box = 0; box < 4; ++box)
-      {
-        if ((entered & (1u << uint(box))) == 0u)
-          continue;
-        if (next == m_pAccelStruct_kNoChild)
-        {
-          next = m_pAccelStruct_m_nodes[node].child[box];
-          nextEntry = entries[box];
-        }
-        else if (entries[box] < nextEntry)
-        {
-          stack[top] = next;
-          stackEntry[top] = nextEntry;
-          top = top + 1;
-          next = m_pAccelStruct_m_nodes[node].child[box];
-          nextEntry = entries[box];
-        }
-        else
-        {
-          stack[top] = m_pAccelStruct_m_nodes[node].child[box];
-          stackEntry[top] = entries[box];
-          top = top + 1;
-        }
-      }
-      node = next;
-    }
-    if (node != m_pAccelStruct_kNoChild)
-    {
-      const uint first = (node & ~m_pAccelStruct_kLeafFlag) >> 3;
-      const uint last = first + (node & 7u);
-      for (uint g = first; g <= last; ++g)
-      {
-        uint hits = 0u;
-        bool onEdge = false;
-        float ts[4];
-        float us[4];
-        float vs[4];
-        for (int firstTriangle = 0; firstTriangle < 4; firstTriangle += 1)
-        {
-          const bool inGroup = firstTriangle + 0 < 4;
-          const vec3 a = vec3((m_pAccelStruct_m_triangles[g].coord[kx])[min(firstTriangle, 3)],
-                              (m_pAccelStruct_m_triangles[g].coord[ky])[min(firstTriangle, 3)],
-                              (m_pAccelStruct_m_triangles[g].coord[kz])[min(firstTriangle, 3)]);
-          const vec3 b = vec3((m_pAccelStruct_m_triangles[g].coord[3 + kx])[min(firstTriangle, 3)],
-                              (m_pAccelStruct_m_triangles[g].coord[3 + ky])[min(firstTriangle, 3)],
-                              (m_pAccelStruct_m_triangles[g].coord[3 + kz])[min(firstTriangle, 3)]);
-          const vec3 c = vec3((m_pAccelStruct_m_triangles[g].coord[6 + kx])[min(firstTriangle, 3)],
-                              (m_pAccelStruct_m_triangles[g].coord[6 + ky])[min(firstTriangle, 3)],
-                              (m_pAccelStruct_m_triangles[g].coord[6 + kz])[min(firstTriangle, 3)]);
-          float t = 0.0;
-          float u = 0.0;
-          float v = 0.0;
-          bool edge = false;
-          const bool hitsIt = m_pAccelStruct_IntersectCorners(ray, kx, ky, kz, a, b, c, rayTfar, t, u, v, edge);
-          onEdge = onEdge || (inGroup && edge);
-          uint bits = ((inGroup && hitsIt) ? 1u : 0u);
-          hits = hits | (bits << uint(firstTriangle));
-          while (bits != 0u)
-          {
-            const int k = findLSB(uint(bits));
-            bits = bits & (bits - 1u);
-            ts[firstTriangle + k] = (t);
-            us[firstTriangle + k] = (u);
-            vs[firstTriangle + k] = (v);
-          }
-        }
-        if (onEdge)
-        {
-          vec4 t4 = vec4(0);
-          vec4 u4 = vec4(0);
-          vec4 v4 = vec4(0);
-          hits = (m_pAccelStruct_IntersectGroup(ray, g, kx, ky, kz, rayTfar, t4, u4, v4));
-          for (int k = 0; k < 4; ++k)
-          {
-            ts[k] = (t4[k]);
-            us[k] = (u4[k]);
-            vs[k] = (v4[k]);
-          }
-        }
-        while (hits != 0u)
-        {
-          const int k = findLSB(uint(hits));
-          hits = hits & (hits - 1u);
-          const uint primId = m_pAccelStruct_m_primIds[4u * g + uint(k)];
-          if (ts[k] > rayTfar || (ts[k] == rayTfar && primId >= hitPrimId))
-            continue;
-          found = true;
-          rayTfar = ts[k];
-          hitT = ts[k];
-          hitPrimId = primId;
-          hitU = us[k];
-          hitV = vs[k];
-          if (firstHit)
-            break;
-        }
-        if (firstHit && found)
-        {
-          top = 0;
-          break;
-        }
-      }
-    }
-    bool popped = false;
-    while (top > 0 && !popped)
-    {
-      top = top - 1;
-      popped = stackEntry[top] <= rayTfar;
-    }
-    if (!popped)
-      break;
-    node = stack[top];
-  }
-  const bool mine = 0 == lane;
-  tfar = mine ? rayTfar : tfar;
-  hit.t = mine ? hitT : hit.t;
-  hit.primId = mine ? hitPrimId : hit.primId;
-  hit.coords[0] = mine ? hitU : hit.coords[0];
-  hit.coords[1] = mine ? hitV : hit.coords[1];
-  return mine && found;
-}
-
-// from BVHScene::IntersectTriangle
-bool m_pAccelStruct_IntersectTriangle(BVHTraceRay r, uint group, int lane, int kx, int ky, int kz, float tfar,
-                                      inout float t, inout float u, inout float v, inout bool onEdge)
-{
-  const vec3 a =
-      vec3(m_pAccelStruct_m_triangles[group].coord[kx][lane], m_pAccelStruct_m_triangles[group].coord[ky][lane],
-           m_pAccelStruct_m_triangles[group].coord[kz][lane]);
-  const vec3 b =
-      vec3(m_pAccelStruct_m_triangles[group].coord[3 + kx][lane], m_pAccelStruct_m_triangles[group].coord[3 + ky][lane],
-           m_pAccelStruct_m_triangles[group].coord[3 + kz][lane]);
-  const vec3 c =
-      vec3(m_pAccelStruct_m_triangles[group].coord[6 + kx][lane], m_pAccelStruct_m_triangles[group].coord[6 + ky][lane],
-           m_pAccelStruct_m_triangles[group].coord[6 + kz][lane]);
-  return m_pAccelStruct_IntersectCorners(r, kx, ky, kz, a, b, c, tfar, t, u, v, onEdge);
-}
-
-// from BVHScene::TakeNearestHit
-bool m_pAccelStruct_TakeNearestHit(uint g, uint hits, vec4 t, vec4 u, vec4 v, bool anyHit, inout float tfar,
-                                   inout CRT_Hit hit)
-{
-  bool taken = false;
-  while (hits != 0u)
-  {
-    const int lane = findLSB(uint(hits));
-    hits = hits & (hits - 1u);
-    const uint primId = m_pAccelStruct_m_primIds[4u * g + uint(lane)];
-    if (t[lane] > tfar || (t[lane] == tfar && primId >= hit.primId))
-      continue;
-    taken = true;
-    tfar = t[lane];
-    hit.t = t[lane];
-    hit.primId = primId;
-    hit.coords[0] = u[lane];
-    hit.coords[1] = v[lane];
-    if (anyHit)
-      return true;
-  }
-  return taken;
-}
-
-// from BVHScene::TraceMeshTogether
-bool m_pAccelStruct_TraceMeshTogether(BVHTraceRay ray, uint root, bool anyHit, inout float tfar, inout CRT_Hit hit)
-{
-  uint stack[64];
-  float stackEntry[64];
-  int top = 0;
-  uint node = (root);
-  const int kx = (ray.kx);
-  const int ky = (ray.ky);
-  const int kz = (ray.kz);
-  float entry = ray.tnear;
-  bool found = false;
-  while (true)
-  {
-    uint alone = ((entry <= tfar && !(anyHit && found)) ? 1u : 0u);
-    if (1 == 4 && bitCount(uint(alone)) <= m_pAccelStruct_kRaysAlone)
-    {
-      while (alone != 0u)
-      {
-        const int lane = findLSB(uint(alone));
-        alone = alone & (alone - 1u);
-        found = m_pAccelStruct_TraceMeshAlone(ray, lane, node, anyHit, tfar, hit) || found;
-      }
-      node = m_pAccelStruct_kNoChild;
-    }
-    while ((node & m_pAccelStruct_kLeafFlag) == 0u)
-    {
-      const bool active_ = entry <= tfar && !(anyHit && found);
-      float childEntry[4];
-      uint entered = 0u;
-      for (int lane = 0; lane < 4; ++lane)
-      {
-        float exit = 0.0;
-        const vec3 lo = vec3(m_pAccelStruct_m_nodes[node].minX[lane], m_pAccelStruct_m_nodes[node].minY[lane],
-                             m_pAccelStruct_m_nodes[node].minZ[lane]);
-        const vec3 hi = vec3(m_pAccelStruct_m_nodes[node].maxX[lane], m_pAccelStruct_m_nodes[node].maxY[lane],
-                             m_pAccelStruct_m_nodes[node].maxZ[lane]);
-        const float boxEntry = m_pAccelStruct_SlabEntry(ray, lo, hi, tfar, exit);
-        const bool enters = active_ && boxEntry <= exit;
-        childEntry[lane] = enters ? boxEntry : m_pAccelStruct_kNotEntered;
-        entered = entered | ((enters) ? 1u << uint(lane) : 0u);
-      }
-      uint next = m_pAccelStruct_kNoChild;
-      float nextEntry = m_pAccelStruct_kNotEntered;
-      for (int lane = 0; lane < 4; ++lane)
-      {
-        if ((entered & (1u << uint(lane))) == 0u)
-          continue;
-        if (next == m_pAccelStruct_kNoChild)
-        {
-          next = m_pAccelStruct_m_nodes[node].child[lane];
-          nextEntry = childEntry[lane];
-        }
-        else if ((childEntry[lane] < nextEntry))
-        {
-          stack[top] = next;
-          stackEntry[top] = nextEntry;
-          top = top + 1;
-          next = m_pAccelStruct_m_nodes[node].child[lane];
-          nextEntry = childEntry[lane];
-        }
-        else
-        {
-          stack[top] = m_pAccelStruct_m_nodes[node].child[lane];
-          stackEntry[top] = childEntry[lane];
-          top = top + 1;
-        }
-      }
-      node = next;
-      entry = nextEntry;
-      if (next == m_pAccelStruct_kNoChild)
-        break;
-    }
-    if (node != m_pAccelStruct_kNoChild && (entry <= tfar))
-    {
-      const bool inLeaf = entry <= tfar && !(anyHit && found);
-      const uint first = (node & ~m_pAccelStruct_kLeafFlag) >> 3;
-      const uint last = first + (node & 7u);
-      for (uint g = first; g <= last; ++g)
-      {
-        vec4 t = vec4(0);
-        vec4 u = vec4(0);
-        vec4 v = vec4(0);
-        uint hits = 0u;
-        bool onEdge = false;
-        for (int lane = 0; lane < 4; ++lane)
-        {
-          float tl = 0.0;
-          float ul = 0.0;
-          float vl = 0.0;
-          if (m_pAccelStruct_IntersectTriangle(ray, g, lane, kx, ky, kz, tfar, tl, ul, vl, onEdge))
-            hits = hits | (1u << uint(lane));
-          t[lane] = tl;
-          u[lane] = ul;
-          v[lane] = vl;
-        }
-        if ((inLeaf && onEdge))
-          hits = m_pAccelStruct_IntersectGroup(ray, g, kx, ky, kz, tfar, t, u, v);
-        hits = inLeaf ? hits : 0u;
-        found = m_pAccelStruct_TakeNearestHit(g, hits, t, u, v, anyHit, tfar, hit) || found;
-      }
-      if (anyHit && (found))
-        return true;
-    }
-    do
-    {
-      if (top == 0)
-        return found;
-      top = top - 1;
-    } while (!(stackEntry[top] <= tfar));
-    node = stack[top];
-    entry = stackEntry[top];
-  }
 }
 
 // from (anonymous namespace)::SlabEntriesParallelAxes
@@ -1113,18 +665,90 @@ bool m_pAccelStruct_IntersectBoxes(BVHTraceRay r, uint group, bool sdf, inout fl
   return found;
 }
 
+// from (anonymous namespace)::DifferenceOfProducts
+float m_pAccelStruct_DifferenceOfProducts(float a, float b, float c, float d)
+{
+  const float cd = c * d;
+  const float error = fma(-c, d, cd);
+  return fma(a, b, -cd) + error;
+}
+
+// from (anonymous namespace)::DifferenceOfProducts
+vec4 m_pAccelStruct_DifferenceOfProducts(vec4 a, vec4 b, vec4 c, vec4 d)
+{
+  return vec4(
+      m_pAccelStruct_DifferenceOfProducts(a.x, b.x, c.x, d.x), m_pAccelStruct_DifferenceOfProducts(a.y, b.y, c.y, d.y),
+      m_pAccelStruct_DifferenceOfProducts(a.z, b.z, c.z, d.z), m_pAccelStruct_DifferenceOfProducts(a.w, b.w, c.w, d.w));
+}
+
+// from BVHScene::IntersectGroup
+uint m_pAccelStruct_IntersectGroup(BVHTraceRay r, uint group, int kx, int ky, int kz, float tfar, inout vec4 t,
+                                   inout vec4 u, inout vec4 v)
+{
+  const float ox = r.org[kx];
+  const float oy = r.org[ky];
+  const float oz = r.org[kz];
+  const vec4 az = m_pAccelStruct_m_triangles[group].coord[kz] - oz;
+  const vec4 bz = m_pAccelStruct_m_triangles[group].coord[3 + kz] - oz;
+  const vec4 cz = m_pAccelStruct_m_triangles[group].coord[6 + kz] - oz;
+  const vec4 ax = (m_pAccelStruct_m_triangles[group].coord[kx] - ox) - r.sx * az;
+  const vec4 ay = (m_pAccelStruct_m_triangles[group].coord[ky] - oy) - r.sy * az;
+  const vec4 bx = (m_pAccelStruct_m_triangles[group].coord[3 + kx] - ox) - r.sx * bz;
+  const vec4 by = (m_pAccelStruct_m_triangles[group].coord[3 + ky] - oy) - r.sy * bz;
+  const vec4 cx = (m_pAccelStruct_m_triangles[group].coord[6 + kx] - ox) - r.sx * cz;
+  const vec4 cy = (m_pAccelStruct_m_triangles[group].coord[6 + ky] - oy) - r.sy * cz;
+  vec4 eu = cx * by - cy * bx;
+  vec4 ev = ax * cy - ay * cx;
+  vec4 ew = bx * ay - by * ax;
+  const vec4 zero = vec4(0.0);
+  if (uint(dot(vec4(lessThanEqual(min(min(abs(eu), abs(ev)), abs(ew)), zero)), vec4(1.0, 2.0, 4.0, 8.0))) != 0u)
+  {
+    eu = m_pAccelStruct_DifferenceOfProducts(cx, by, cy, bx);
+    ev = m_pAccelStruct_DifferenceOfProducts(ax, cy, ay, cx);
+    ew = m_pAccelStruct_DifferenceOfProducts(bx, ay, by, ax);
+  }
+  uint hits = uint(dot(vec4(lessThanEqual(zero, min(min(eu, ev), ew))), vec4(1.0, 2.0, 4.0, 8.0))) |
+              uint(dot(vec4(lessThanEqual(max(max(eu, ev), ew), zero)), vec4(1.0, 2.0, 4.0, 8.0)));
+  const vec4 det = eu + ev + ew;
+  hits = hits & ~(uint(dot(vec4(lessThanEqual(det, zero)), vec4(1.0, 2.0, 4.0, 8.0))) &
+                  uint(dot(vec4(lessThanEqual(zero, det)), vec4(1.0, 2.0, 4.0, 8.0))));
+  t = (eu * (r.sz * az) + ev * (r.sz * bz) + ew * (r.sz * cz)) / det;
+  hits = hits & uint(dot(vec4(lessThanEqual(vec4(r.tnear), t)), vec4(1.0, 2.0, 4.0, 8.0))) &
+         uint(dot(vec4(lessThanEqual(t, vec4(tfar))), vec4(1.0, 2.0, 4.0, 8.0)));
+  u = ev / det;
+  v = ew / det;
+  return hits;
+}
+
+// from BVHScene::TakeNearestHit
+bool m_pAccelStruct_TakeNearestHit(uint g, uint hits, vec4 t, vec4 u, vec4 v, bool anyHit, inout float tfar,
+                                   inout CRT_Hit hit)
+{
+  bool taken = false;
+  while (hits != 0u)
+  {
+    const int lane = findLSB(uint(hits));
+    hits = hits & (hits - 1u);
+    const uint primId = m_pAccelStruct_m_primIds[4u * g + uint(lane)];
+    if (t[lane] > tfar || (t[lane] == tfar && primId >= hit.primId))
+      continue;
+    taken = true;
+    tfar = t[lane];
+    hit.t = t[lane];
+    hit.primId = primId;
+    hit.coords[0] = u[lane];
+    hit.coords[1] = v[lane];
+    if (anyHit)
+      return true;
+  }
+  return taken;
+}
+
 // from BVHScene::TraceMesh
 bool m_pAccelStruct_TraceMesh(BVHTraceRay ray, uint root, uint leaves, bool anyHit, inout float tfar, inout CRT_Hit hit)
 {
-  if (1 > 1 && (leaves == 0u && root == (root) && ray.kx == (ray.kx) && ray.kz == (ray.kz)))
-  {
-    bool together = false;
-    if (true)
-      together = m_pAccelStruct_TraceMeshTogether(ray, root, anyHit, tfar, hit);
-    else
-      together = m_pAccelStruct_TraceMeshTogether(ray, root, anyHit, tfar, hit);
-    return together;
-  }
+  // if (crossrt::GangSize() > 1 && crossrt::AllLanes(leaves == 0u && root == crossrt::FirstLane(root) && ray.kx ==
+  // crossrt::FirstLane(ray.kx) && ray.kz == crossrt::FirstLane(ray.kz))): false with a gang of 1
   uint stack[64];
   float stackEntry[64];
   int top = 0;
@@ -1232,8 +856,7 @@ bool m_pAccelStruct_Trace(vec4 posAndNear, vec4 dirAndFar, float time, bool anyH
     return false;
   tfar = valid ? tfar : -1.0;
   const BVHTraceRay worldRay = m_pAccelStruct_Prepare((posAndNear).xyz, (dirAndFar).xyz, tnear);
-  if (1 > 1 && crt_m_pAccelStruct_m_instances_size == 1u)
-    return m_pAccelStruct_TraceInstance(0u, worldRay, time, anyHit, tfar, hit);
+  // if (crossrt::GangSize() > 1 && m_instances.size() == 1): false with a gang of 1
   uint stack[64];
   float stackEntry[64];
   int top = 0;

@@ -37,16 +37,16 @@ layout(std430, binding = 0) buffer crt_PrimaryRaysData
   uint crt_m_pAccelStruct_m_instances_capacity;
   uint crt_m_pAccelStruct_m_motion_size;
   uint crt_m_pAccelStruct_m_motion_capacity;
-  uint crt_m_pAccelStruct_m_triangles_size;
-  uint crt_m_pAccelStruct_m_triangles_capacity;
-  uint crt_m_pAccelStruct_m_primIds_size;
-  uint crt_m_pAccelStruct_m_primIds_capacity;
   uint crt_m_pAccelStruct_m_boxes_size;
   uint crt_m_pAccelStruct_m_boxes_capacity;
   uint crt_m_pAccelStruct_m_sdfBricks_size;
   uint crt_m_pAccelStruct_m_sdfBricks_capacity;
   uint crt_m_pAccelStruct_m_sdfWords_size;
   uint crt_m_pAccelStruct_m_sdfWords_capacity;
+  uint crt_m_pAccelStruct_m_triangles_size;
+  uint crt_m_pAccelStruct_m_triangles_capacity;
+  uint crt_m_pAccelStruct_m_primIds_size;
+  uint crt_m_pAccelStruct_m_primIds_capacity;
 };
 layout(std430, binding = 1) buffer crt_pixelsBuffer
 {
