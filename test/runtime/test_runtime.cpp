@@ -970,8 +970,8 @@ TEST_CASE("LoopReductions: chunks' parts of sums, minima and arrays add up to th
   for (int h : histogramTotal) CHECK(h == 1 + n / 4);
 }
 
-// crossrt::ParallelChoice, with the times given: the way that measured faster is taken, the other
-// is tried again after 16 calls, then 64..., a loop whose parallel run takes longer than a time
+// crossrt::ParallelChoice, with the times given: the way that measured faster is taken (a try that
+// wins is made twice before it is believed), the other is tried again after 16 calls, then 64..., a loop whose parallel run takes longer than a time
 // slice always runs on all cores, loops of sizes 4x apart choose apart, and a loop of one
 // iteration never does.
 TEST_CASE("ParallelChoice takes the faster way and tries the other now and then", "[runtime][parallel]")
@@ -994,14 +994,17 @@ TEST_CASE("ParallelChoice takes the faster way and tries the other now and then"
     choice.Record(true, 1000, 1.0);
     REQUIRE_FALSE(choice.Choose(1000));  // then one run on this thread, cheap (1 ms)
     choice.Record(false, 1000, 0.5);
+    REQUIRE(choice.Mean(false, 1000) < 0.0f);  // faster once: not believed yet
+    REQUIRE_FALSE(choice.Choose(1000));  // so tried again
+    choice.Record(false, 1000, 0.5);
     REQUIRE(choice.Mean(false, 1000) == Approx(0.0005f));
     // One core wins: of the next 16 calls, one tries all cores again; after that try lost, 64
     // calls pass before the next.
     CHECK(count(choice, 16, 1.0, 0.5) == 1);
     CHECK(count(choice, 63, 1.0, 0.5) == 0);
     CHECK(count(choice, 1, 1.0, 0.5) == 1);
-    // The load goes away: all cores become faster. Tried after 256 calls, they win, and keep
-    // winning but for the tries of one core (after 16 calls, then 64).
+    // The load goes away: all cores become faster. Tried after 256 calls (and again on the next,
+    // to believe it), they win, and keep winning but for the tries of one core (after 16 calls, then 64).
     CHECK(count(choice, 256, 0.1, 0.5) == 1);
     CHECK(count(choice, 64, 0.1, 0.5) == 63);
   }
@@ -1015,21 +1018,21 @@ TEST_CASE("ParallelChoice takes the faster way and tries the other now and then"
   SECTION("beside other runnable threads, a loop's slowed parallel runs do not hold back its first try of one core") {
     crossrt::ParallelChoice choice;
     choice.AssumeOthersRunnable(3);
-    CHECK(count(choice, 2, 8.0, 6.0) == 1);  // all cores (two time slices), then one core once
+    CHECK(count(choice, 3, 8.0, 6.0) == 1);  // all cores (two time slices), then one core twice (faster: tried again)
     CHECK(choice.Mean(false, 1000) == Approx(0.006f));
     CHECK(count(choice, 20, 8.0, 6.0) == 1);  // one core wins; all cores tried once in 16 calls
-    // The load goes: all cores win their next try (after 64 calls, the 60th here). One core, 6 ms
+    // The load goes: all cores win their next try (after 64 calls, the 60th here) and the one after. One core, 6 ms
     // of work of which the other thread saves 3, under a time slice, is tried again 16 calls later.
     CHECK(count(choice, 64, 1.0, 6.0) == 5);
     // Quiet, the same first parallel run gets no try: its other thread saves 8 ms.
     crossrt::ParallelChoice quiet;
     quiet.AssumeOthersRunnable(0);
     CHECK(count(quiet, 20, 8.0, 6.0) == 20);
-    // 15 ms of work on one core, of which the other thread would save 7.5: tried once, then all
-    // cores even though one core measured faster.
+    // 15 ms of work on one core, of which the other thread would save 7.5: tried (twice, to believe
+    // it), then all cores even though one core measured faster.
     crossrt::ParallelChoice longer;
     longer.AssumeOthersRunnable(1);
-    CHECK(count(longer, 20, 20.0, 15.0) == 19);
+    CHECK(count(longer, 20, 20.0, 15.0) == 18);
     // A loop whose parallel runs took over 40 ms is never tried on one core, loaded or not.
     crossrt::ParallelChoice longLoop;
     longLoop.AssumeOthersRunnable(3);
@@ -1060,7 +1063,8 @@ TEST_CASE("ParallelChoice takes the faster way and tries the other now and then"
 }
 
 // crossrt::LaneChoice, with the times given: an _ISPC kernel runs in SIMD lanes on its first two
-// calls (the first not counted), tries its scalar loop on the third, then takes the faster way and
+// calls (the first not counted), tries its scalar loop on the third (and the fourth, where it was
+// faster: a way that wins once is tried again before it is believed), then takes the faster way and
 // tries the other after 16 calls, then 64... while it loses, on the cores the verdict's last run
 // ran on; sizes a factor of 4 apart are chosen apart; a call that ran no loop counts for nothing.
 TEST_CASE("LaneChoice runs a kernel in lanes or as a scalar loop, whichever has been faster", "[runtime][parallel]")
@@ -1096,8 +1100,12 @@ TEST_CASE("LaneChoice runs a kernel in lanes or as a scalar loop, whichever has 
     REQUIRE(choice.Choose());
     choice.Record(true, 1000, 3.0);
     CHECK(choice.Mean(1) == Approx(0.003f));
-    REQUIRE_FALSE(choice.Choose());  // the scalar loop, once
+    REQUIRE_FALSE(choice.Choose());  // the scalar loop
     choice.Record(false, 1000, 1.0);
+    CHECK(choice.Mean(0) < 0.0f);    // faster once: not believed yet
+    REQUIRE_FALSE(choice.Choose());  // so tried again
+    choice.Record(false, 1000, 1.4);
+    CHECK(choice.Mean(0) == Approx(0.0012f));  // the mean of both tries
     CHECK(count(choice, 16, 3.0, 1.0) == 1);  // lanes tried once in 16 calls, and lost
     CHECK(count(choice, 63, 3.0, 1.0) == 0);
     CHECK(count(choice, 1, 3.0, 1.0) == 1);
@@ -1109,6 +1117,38 @@ TEST_CASE("LaneChoice runs a kernel in lanes or as a scalar loop, whichever has 
     CHECK(count(choice, 16, 1.0, 3.0) == 16);
     CHECK(count(choice, 64, 1.0, 3.0) == 63);
     CHECK(choice.Mean(0) == Approx(0.003f));
+  }
+  SECTION("one fast call of the other way does not switch: the next call tries it again, and the mean of both decides") {
+    crossrt::LaneChoice choice;
+    CHECK(count(choice, 2, 1.0, 3.0) == 2);
+    REQUIRE_FALSE(choice.Choose());
+    choice.Record(false, 1000, 0.5);  // the scalar loop, once faster (noise)
+    REQUIRE_FALSE(choice.Choose());
+    choice.Record(false, 1000, 3.0);  // and then not
+    CHECK(choice.Mean(0) == Approx(0.00175f));
+    CHECK(count(choice, 64, 1.0, 3.0) == 63);  // lanes, the scalar loop tried again after 64 calls
+    // Later the lanes slow down (the machine got loaded), and the scalar loop, tried after 256
+    // calls, wins twice in a row: it becomes the verdict.
+    CHECK(count(choice, 255, 3.0, 0.5) == 255);
+    CHECK(count(choice, 2, 3.0, 0.5) == 0);
+    CHECK(count(choice, 15, 3.0, 0.5) == 0);
+    CHECK(count(choice, 1, 3.0, 0.5) == 1);  // lanes tried after 16 calls
+  }
+  SECTION("one fast call of the other way does not switch: the next call tries it again, and the mean of both decides") {
+    crossrt::LaneChoice choice;
+    CHECK(count(choice, 2, 1.0, 3.0) == 2);
+    REQUIRE_FALSE(choice.Choose());
+    choice.Record(false, 1000, 0.5);  // the scalar loop, once faster (noise)
+    REQUIRE_FALSE(choice.Choose());
+    choice.Record(false, 1000, 3.0);  // and then not
+    CHECK(choice.Mean(0) == Approx(0.00175f));
+    CHECK(count(choice, 64, 1.0, 3.0) == 63);  // lanes, the scalar loop tried again after 64 calls
+    // Later the lanes slow down (the machine got loaded), and the scalar loop, tried after 256
+    // calls, wins twice in a row: it becomes the verdict.
+    CHECK(count(choice, 255, 3.0, 0.5) == 255);
+    CHECK(count(choice, 2, 3.0, 0.5) == 0);
+    CHECK(count(choice, 15, 3.0, 0.5) == 0);
+    CHECK(count(choice, 1, 3.0, 0.5) == 1);  // lanes tried after 16 calls
   }
   SECTION("each size class has its own choice") {
     crossrt::LaneChoice choice;
