@@ -1064,7 +1064,8 @@ TEST_CASE("ParallelChoice takes the faster way and tries the other now and then"
 
 // crossrt::LaneChoice, with the times given: an _ISPC kernel runs in SIMD lanes on its first two
 // calls (the first not counted), tries its scalar loop on the third (and the fourth, where it was
-// faster: a way that wins once is tried again before it is believed), then takes the faster way and
+// faster: a way that wins once is tried again before it is believed; where the work grows and the
+// faster way's mean passes the other's old one, the other is tried, not taken), then takes the faster way and
 // tries the other after 16 calls, then 64... while it loses, on the cores the verdict's last run
 // ran on; sizes a factor of 4 apart are chosen apart; a call that ran no loop counts for nothing.
 TEST_CASE("LaneChoice runs a kernel in lanes or as a scalar loop, whichever has been faster", "[runtime][parallel]")
@@ -1117,6 +1118,23 @@ TEST_CASE("LaneChoice runs a kernel in lanes or as a scalar loop, whichever has 
     CHECK(count(choice, 16, 1.0, 3.0) == 16);
     CHECK(count(choice, 64, 1.0, 3.0) == 63);
     CHECK(choice.Mean(0) == Approx(0.003f));
+  }
+  SECTION("where the work grows, the lanes' mean passing the scalar loop's old one makes the next call a try, not a switch") {
+    crossrt::LaneChoice choice;
+    CHECK(count(choice, 3, 1.0, 3.0) == 2);  // lanes, then the scalar loop's try: 3 ms, it lost
+    // Ten times the work (a larger mesh): lanes take 10 ms, the scalar loop 30. Its mean, 0.003 ms
+    // per iteration from the small work, is soon below the lanes' mean.
+    int scalarRuns = 0, tries = 0;
+    for (int i = 0; i < 30; ++i) {
+      bool trying = false;
+      const bool lanes = choice.Choose(trying);
+      scalarRuns += !lanes;
+      tries += !lanes && trying;
+      choice.Record(lanes, 1000, lanes ? 10.0 : 30.0);
+    }
+    CHECK(scalarRuns == 1);  // measured again, once, and it lost
+    CHECK(tries == 1);
+    CHECK(choice.Mean(0) == Approx(0.03f));
   }
   SECTION("one fast call of the other way does not switch: the next call tries it again, and the mean of both decides") {
     crossrt::LaneChoice choice;

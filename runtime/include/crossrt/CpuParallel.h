@@ -45,16 +45,23 @@ class MeasuredWays {
     return true;
   }
 
-  // A try that beats the faster way's mean is not believed at once: one noisy call (a thread taken
-  // off its core, a page fault) would switch the kernel to the slower way until the next try. The
-  // next call tries it again, and the mean of both tries decides. (bench_lbvh once traced dragon res2
-  // with PrimaryRays_ISPC's scalar loop, at 0.85x of Embree against 1.06x in lanes, on one such call.)
+  // The way that has been faster (1 or 0), or -1 before both have run. It changes only on a try of
+  // the other way: where the work changes (another mesh, 10x the size) the verdict's mean follows it
+  // while the other's stays what it measured long ago, and comparing the two would switch on a stale
+  // number. (bench_lbvh's PrimaryRays_ISPC so ran its scalar loop, at 0.72-0.79x of Embree against
+  // 0.95-1.03x in lanes, on the largest mesh: its lanes' mean had grown past the scalar loop's, measured
+  // on a smaller mesh.) So where the verdict's mean passes the other's, the next call tries the other.
+  int Verdict() const { return m_verdict.load(std::memory_order_relaxed); }
+
+  // A try that beats the verdict's mean is not believed at once either: one noisy call (a thread
+  // taken off its core, a page fault) would switch the kernel to the slower way until the next try.
+  // The next call tries it again, and the mean of both tries decides.
   void Record(int way, float msPerIteration) {
     const int w = way ? 1 : 0;
     const bool tried = m_tryingOther.exchange(false, std::memory_order_relaxed);
-    const float before = Mean(w), verdict = Mean(1 - w);
+    const float before = Mean(w), other = Mean(1 - w);
     const float firstTry = m_firstTry.load(std::memory_order_relaxed);
-    if (tried && firstTry < 0.0f && verdict >= 0.0f && msPerIteration < verdict) {
+    if (tried && firstTry < 0.0f && other >= 0.0f && msPerIteration < other) {
       m_firstTry.store(msPerIteration, std::memory_order_relaxed);  // faster once: tried again on the next call
       m_calls.store(m_nextTry.load(std::memory_order_relaxed), std::memory_order_relaxed);
       return;
@@ -66,10 +73,16 @@ class MeasuredWays {
     }
     // A way tried again after a while starts its mean afresh: what it measured then is stale.
     m_msPerIteration[w].store(before < 0.0f || tried ? msPerIteration : before + 0.3f * (msPerIteration - before), std::memory_order_relaxed);
-    if (tried) {  // when the way tried still loses, the next try waits four times as long
-      const int faster = Mean(0) < 0.0f || Mean(1) <= Mean(0) ? 1 : 0;
-      const unsigned wait = m_nextTry.load(std::memory_order_relaxed);
-      m_nextTry.store(faster == w ? kFirstWait : std::min(wait * 4u, kLongestWait), std::memory_order_relaxed);
+    if (Mean(0) < 0.0f || Mean(1) < 0.0f) return;
+    const int faster = Mean(1) <= Mean(0) ? 1 : 0;
+    if (tried || Verdict() < 0) {
+      m_verdict.store(faster, std::memory_order_relaxed);
+      if (tried) {  // when the way tried still loses, the next try waits four times as long
+        const unsigned wait = m_nextTry.load(std::memory_order_relaxed);
+        m_nextTry.store(faster == w ? kFirstWait : std::min(wait * 4u, kLongestWait), std::memory_order_relaxed);
+      }
+    } else if (faster != Verdict()) {
+      m_calls.store(m_nextTry.load(std::memory_order_relaxed), std::memory_order_relaxed);  // the other way, measured again next
     }
   }
 
@@ -79,6 +92,7 @@ class MeasuredWays {
   std::atomic<unsigned> m_nextTry{kFirstWait};
   std::atomic<bool> m_tryingOther{false};
   std::atomic<float> m_firstTry{-1.0f};  // a try that won once, waiting for its second
+  std::atomic<int> m_verdict{-1};
 };
 
 // Iterations of a loop in classes 4x apart: [4^c, 4^(c+1)), the last open-ended. A loop's ways are
@@ -182,7 +196,7 @@ class ParallelChoice {
     const float serial = ways.Mean(0), parallel = ways.Mean(1);
     if (parallel < 0.0f) return true;  // first, the way the loop is written for
     const double work = Work(iterations);
-    if (serial >= 0.0f && serial < parallel) {
+    if (serial >= 0.0f && ways.Verdict() == 0) {
       // One core has been faster: all cores now and then. But a long loop runs on all cores even
       // so (its parallel runs under load vary by time slices; with the choice's first try under
       // load and no such rule, Bloom_CPU beside one busy thread fell to 0.84-1.26x of the original).
@@ -384,7 +398,9 @@ void RadixSort(Iterator first, Iterator last, const SortKey& key) {
 // and what is large the other). Lanes run first; the very first call pays for touching memory and
 // is not counted. The next call of a size class whose lanes have a time tries the scalar loop
 // (twice where it was faster: MeasuredWays believes a try that wins on its second); after that the
-// faster way runs, the other tried again after 16, 64, ... 1024 calls. A
+// faster way runs, the other tried again after 16, 64, ... 1024 calls, or on the next call where the
+// faster way's mean passes the other's (the work changed: the other is measured again, not taken on
+// its old number). A
 // kernel called once or twice always runs in lanes.
 // CROSSRT_ISPC_LANES=always keeps every kernel in lanes (as before this choice), =never runs every
 // kernel's scalar loop (to test or compare it).
@@ -441,7 +457,7 @@ class LaneChoice {
       return false;
     }
     trying = ways.TimeToTry();
-    return scalar < lanes ? trying : !trying;  // the faster way, the other now and then
+    return ways.Verdict() == 0 ? trying : !trying;  // the faster way, the other now and then
   }
 
   void Record(bool lanes, long long iterations, double ms) {
