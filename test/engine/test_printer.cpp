@@ -106,7 +106,7 @@ TEST_CASE("Printer: recursion in a kernel's reach is a diagnostic at the call", 
   CHECK(r.diagnostics.find("hint:") != std::string::npos);
 }
 
-TEST_CASE("Printer: a branch that GangSize() decides prints only the branch a gang of one takes; a local that shadows a parameter takes a suffix",
+TEST_CASE("Printer: a branch that GangSize() decides prints only the branch a gang of one takes, and a local that shadows a parameter takes a suffix",
           "[engine][printer]")
 {
   std::string source = kSource;
