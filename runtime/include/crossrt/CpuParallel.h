@@ -299,6 +299,22 @@ inline void RadixSortWords(uint32_t* records, size_t n, const SortKey& key) {
   // its pages faulted in) on every call, only for the sort to overwrite it.
   static thread_local std::vector<uint32_t> scratch;
   if (scratch.size() < n * stride) scratch.resize(n * stride);
+  // Below 4,096 records the passes' 2,048 digits cost more than the records: a comparison sort of
+  // (key, place) pairs, in the same stable order, then the records moved to their places. (1,024
+  // records of two words: 12 us against the passes' 20 on an AMD EPYC, Zen 4; with the passes, the
+  // LBVH_CPU build of the 992-triangle teapot took 1.08x the original's time, which std::sort's.)
+  if (n < 4096) {
+    static thread_local std::vector<uint64_t> order;
+    order.resize(n);
+    for (size_t i = 0; i < n; ++i) order[i] = (uint64_t(SortableBits(records[i * stride + key.keyWord], key)) << 32) | i;
+    std::sort(order.begin(), order.end());
+    for (size_t i = 0; i < n; ++i) {  // (word by word: a copy call per record cost more than the sort)
+      const uint32_t* from = records + (order[i] & 0xffffffffu) * stride;
+      for (size_t w = 0; w < stride; ++w) scratch[i * stride + w] = from[w];
+    }
+    std::copy(scratch.data(), scratch.data() + n * stride, records);
+    return;
+  }
   uint32_t* src = records;
   uint32_t* dst = scratch.data();
   // Below 2^15 records, waking the other threads costs more than they save: with this, the LBVH
