@@ -1153,22 +1153,6 @@ TEST_CASE("LaneChoice runs a kernel in lanes or as a scalar loop, whichever has 
     CHECK(count(choice, 15, 3.0, 0.5) == 0);
     CHECK(count(choice, 1, 3.0, 0.5) == 1);  // lanes tried after 16 calls
   }
-  SECTION("one fast call of the other way does not switch: the next call tries it again, and the mean of both decides") {
-    crossrt::LaneChoice choice;
-    CHECK(count(choice, 2, 1.0, 3.0) == 2);
-    REQUIRE_FALSE(choice.Choose());
-    choice.Record(false, 1000, 0.5);  // the scalar loop, once faster (noise)
-    REQUIRE_FALSE(choice.Choose());
-    choice.Record(false, 1000, 3.0);  // and then not
-    CHECK(choice.Mean(0) == Approx(0.00175f));
-    CHECK(count(choice, 64, 1.0, 3.0) == 63);  // lanes, the scalar loop tried again after 64 calls
-    // Later the lanes slow down (the machine got loaded), and the scalar loop, tried after 256
-    // calls, wins twice in a row: it becomes the verdict.
-    CHECK(count(choice, 255, 3.0, 0.5) == 255);
-    CHECK(count(choice, 2, 3.0, 0.5) == 0);
-    CHECK(count(choice, 15, 3.0, 0.5) == 0);
-    CHECK(count(choice, 1, 3.0, 0.5) == 1);  // lanes tried after 16 calls
-  }
   SECTION("each size class has its own choice") {
     crossrt::LaneChoice choice;
     CHECK(count(choice, 3, 3.0, 1.0) == 2);  // small loops: the scalar loop wins
