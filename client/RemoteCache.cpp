@@ -3,6 +3,7 @@
 #include "RemoteCache.h"
 
 #include "DaemonClient.h"
+#include "InProcess.h"
 #include "Protocol.h"
 #include "RemoteRejections.h"
 
@@ -124,18 +125,21 @@ bool ParseManifest(const std::string& body, const std::string& identity, std::ve
 }
 
 // The translator's identity across machines: its version and a hash of the daemon's bytes (the
-// engine is linked into it), remembered in the build tree by the file's size, time and inode.
+// engine is linked into it) and of the engine module's (which --no-daemon loads: a build may
+// rebuild it alone), remembered in the build tree by the files' sizes, times and inodes.
 std::string TranslatorContentIdentity(const std::string& buildDir) {
-  const std::string executable = DaemonExecutable(), local = protocol::TranslatorIdentity(executable);
+  const std::string executable = DaemonExecutable(), module = EnginePath();
+  const std::string local = protocol::TranslatorIdentity(executable) + "+" + protocol::TranslatorIdentity(module);
   const std::string memo = buildDir.empty() ? "" : buildDir + "/.crossrt-translator-identity";
   if (!memo.empty()) {
     std::ifstream in(memo);
     std::string statIdentity, contentIdentity;
     if (in >> statIdentity >> contentIdentity && statIdentity == local) return contentIdentity;
   }
-  bool ok = false;
-  const std::string bytes = ReadFile(executable, ok);
-  const std::string identity = std::string(engine::kTranslatorVersion) + "/" + (ok ? Hex128(bytes) : "unknown");
+  bool ok = false, moduleOk = false;
+  const std::string bytes = ReadFile(executable, ok), moduleBytes = module.empty() ? "" : ReadFile(module, moduleOk);
+  const std::string identity = std::string(engine::kTranslatorVersion) + "/" + (ok ? Hex128(bytes) : "unknown") + "+" +
+                               (moduleOk ? Hex128(moduleBytes) : "none");
   if (!memo.empty() && ok) {
     const std::string tmp = memo + "." + std::to_string(::getpid());
     std::ofstream(tmp) << local << " " << identity << "\n";

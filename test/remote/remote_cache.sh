@@ -42,6 +42,18 @@ for storage in "redis://127.0.0.1:$redis_port" "http://127.0.0.1:$http_port/cach
   translate "tree-$kind-b" "$storage" > /dev/null 2>&1 || fail "an edited tree"
   [ "$(translations "tree-$kind-b")" -eq 1 ] || fail "an edit did not translate"
 
+  if [ "$kind" = redis ]; then
+    # The engine module that --no-daemon loads, rebuilt alone (here: a byte appended): its
+    # translations are its own, stored beside the old engine's, not fetched from them.
+    echo "== redis: an engine module rebuilt alone does not take the old engine's entries"
+    cp "$(dirname "$crossrt")/libcrossrt-engine.so" "$work/engine.so" && printf 'x' >> "$work/engine.so"
+    before=$(redis-cli -p "$redis_port" --scan --pattern 'crossrt:*' | wc -l)
+    new_tree "tree-engine"
+    CROSSRT_ENGINE="$work/engine.so" translate "tree-engine" "$storage" --no-daemon > "$work/out.txt" 2>&1 ||
+      { cat "$work/out.txt"; fail "a rebuilt engine module"; }
+    after=$(redis-cli -p "$redis_port" --scan --pattern 'crossrt:*' | wc -l)
+    [ "$after" -gt "$before" ] || fail "a rebuilt engine module took the old engine's entry ($before entries before, $after after)"
+  fi
   echo "== $kind: corrupt entries are ignored and replaced"
   if [ "$kind" = redis ]; then
     for k in $(redis-cli -p "$redis_port" --scan --pattern 'crossrt:*'); do
