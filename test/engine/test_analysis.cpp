@@ -419,7 +419,7 @@ void Walk::kernel_Scale(uint32_t tidX, uint32_t tidY, uint32_t w, float gain, fl
   CHECK(host.find(Squeezed("crossrt::IspcPointer<ispc::float4*>(out), steps, w);")) != std::string::npos);
   // Or, where that has been faster here (crossrt::LaneChoice), the loop as the _CPU class runs it:
   // the lanes' chunks first, then the loop as written, on all cores.
-  const size_t choice = host.find(Squeezed("static crossrt::LaneChoice crt_lanes; crossrt::LaneChoice::Run crt_way = crt_lanes.Begin();"));
+  const size_t choice = host.find(Squeezed("static crossrt::LaneChoice crt_lanes(\"Walk::Run, a loop of it\"); crossrt::LaneChoice::Run crt_way = crt_lanes.Begin();"));
   const size_t lanes = host.find(Squeezed("if (crt_way.lanes) {"));
   const size_t scalar = host.find(Squeezed("kernel_Start(x, y, &p);"));
   CHECK(choice != std::string::npos);

@@ -192,7 +192,8 @@ void ControlRewriter::LanesOrScalarLoop(const ForStmt* loop, const LoopHeader& o
   if (!m_c.model.virtuals.empty())  // as the lanes' class data does: an element without an object throws
     scalar = "{\n(void)IspcData();  // checks the vectors of objects as the lanes' way does\n" + scalar + "}\n";
   m_cpu.ReplaceText(range, "{  // in SIMD lanes, or as the _CPU class runs it, whichever has been faster here (crossrt::LaneChoice)\n"
-                           "static crossrt::LaneChoice crt_lanes;\n"
+                           "static crossrt::LaneChoice crt_lanes(\"" + m_c.cls->getQualifiedNameAsString() + "::" + m_md->getNameAsString() +
+                           ", a loop of it\");\n"
                            "crossrt::LaneChoice::Run crt_way = crt_lanes.Begin();\n"
                            "crt_way.iterations = " + threads + ";\n"
                            "if (crt_way.lanes)\n" + lanes + "else\n" + scalar + "crt_lanes.End(crt_way);\n}\n");

@@ -436,7 +436,8 @@ class LaneChoice {
     int cores = -1;         // what this run's loop ran on, as ParallelChoice tells it
   };
 
-  LaneChoice() {
+  // `name` (a string literal: the generated code's Class::kernel) names the kernel in the log.
+  explicit LaneChoice(const char* name = nullptr) : m_name(name) {
     for (auto& cores : m_verdictCores) cores.store(-1, std::memory_order_relaxed);
   }
 
@@ -453,6 +454,23 @@ class LaneChoice {
     Record(run.lanes, run.iterations, ms);
     if (!run.trying && run.cores >= 0 && run.iterations >= 1)
       m_verdictCores[SizeClass(run.iterations)].store(run.cores, std::memory_order_relaxed);
+    if (Logged()) {  // CROSSRT_ISPC_LANES_LOG=1: a line per call, to see what the choice does and why
+      char lanes[32] = "not measured", scalar[32] = "not measured";
+      if (Mean(1) >= 0.0f) std::snprintf(lanes, sizeof lanes, "%.4g", 1000.0 * Mean(1));
+      if (Mean(0) >= 0.0f) std::snprintf(scalar, sizeof scalar, "%.4g", 1000.0 * Mean(0));
+      std::fprintf(stderr, "crossrt: %s: %s%s, %lld iterations in %.3f ms on %s; mean ms per 1,000 iterations: lanes %s, scalar loop %s\n",
+                   m_name != nullptr ? m_name : "a kernel", run.lanes ? "SIMD lanes" : "scalar loop", run.trying ? " (a try)" : "",
+                   run.iterations, ms, run.cores == 1 ? "all cores" : run.cores == 0 ? "one core" : "the cores it chose", lanes, scalar);
+    }
+  }
+
+  // CROSSRT_ISPC_LANES_LOG=1: each call's way, time and the means that chose it, on stderr.
+  static bool Logged() {
+    static const bool logged = [] {
+      const char* v = std::getenv("CROSSRT_ISPC_LANES_LOG");
+      return v != nullptr && std::strcmp(v, "1") == 0;
+    }();
+    return logged;
   }
 
   // The decision and the measurement apart, for tests; `trying` tells a try of the way that is not
@@ -505,6 +523,7 @@ class LaneChoice {
   std::atomic<int> m_verdictCores[kLoopSizeClasses];  // per size class: what the verdict's last run ran on, -1 before one
   std::atomic<int> m_lastSize{0};
   std::atomic<bool> m_warm{false};
+  const char* m_name;
 };
 
 // `v.push_back(x)` in a kernel whose loop runs on all cores: the generated code calls

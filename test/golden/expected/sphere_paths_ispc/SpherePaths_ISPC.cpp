@@ -53,7 +53,7 @@ void SpherePaths_ISPC::Render(uint32_t width, uint32_t height, int samples, floa
   [&]() {
     const auto start = std::chrono::steady_clock::now();
     {
-      static crossrt::LaneChoice crt_lanes;
+      static crossrt::LaneChoice crt_lanes("SpherePaths::Render, a loop of it");
       crossrt::LaneChoice::Run crt_way = crt_lanes.Begin();
       crt_way.iterations = (long long)std::max(0, int(width)) * std::max(0, int(height));
       if (crt_way.lanes)
