@@ -536,18 +536,22 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     // (Reduced locals too: each chunk of the loop reduces into a part of its own, crt_<local>Local.)
     struct Renamer : RecursiveASTVisitor<Renamer> {
       Rewriter& rw; ASTContext& ctx; const std::map<const FieldDecl*, ReduceOp>& red; const std::set<const VarDecl*>& locals;
+      std::map<const VarDecl*, std::string> shadowing;  // ShadowingLocalName's answers, asked once per local
       Renamer(Rewriter& r, ASTContext& cx, const std::map<const FieldDecl*, ReduceOp>& m, const std::set<const VarDecl*>& l) : rw(r), ctx(cx), red(m), locals(l) {}
+      // A local that shadows another name takes the suffix the GPU code gives it (-Wshadow).
+      void Rename(const VarDecl* vd, SourceLocation at) {
+        auto it = shadowing.find(vd);
+        if (it == shadowing.end()) it = shadowing.emplace(vd, ShadowingLocalName(ctx, vd)).first;
+        if (!it->second.empty() && !at.isMacroID()) rw.ReplaceText(at, vd->getName().size(), it->second);
+      }
       bool VisitDeclRefExpr(DeclRefExpr* dr) {
         auto* vd = dyn_cast<VarDecl>(dr->getDecl());
         if (vd && locals.count(vd)) rw.ReplaceText(dr->getLocation(), vd->getName().size(), generated::ReductionLocal(vd->getNameAsString()));
-        else if (std::string name = vd && !dr->getLocation().isMacroID() ? ShadowingLocalName(ctx, vd) : ""; !name.empty())
-          rw.ReplaceText(dr->getLocation(), vd->getName().size(), name);
+        else if (vd) Rename(vd, dr->getLocation());
         return true;
       }
-      // A local that shadows another name takes the suffix the GPU code gives it (-Wshadow).
       bool VisitVarDecl(VarDecl* vd) {
-        if (std::string name = vd->getLocation().isMacroID() ? "" : ShadowingLocalName(ctx, vd); !name.empty())
-          rw.ReplaceText(vd->getLocation(), vd->getName().size(), name);
+        Rename(vd, vd->getLocation());
         return true;
       }
       bool VisitMemberExpr(MemberExpr* me) {

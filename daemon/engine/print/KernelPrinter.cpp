@@ -79,11 +79,13 @@ std::string KernelPrinter::SafeName(const std::string& name) {
 }
 
 // A local that shadows another name takes a suffix (analyse/Shadowing.cpp); the others, SafeName's.
+// Asked once per local: every reference to it asks again.
 std::string KernelPrinter::LocalName(const VarDecl* vd) {
   if (auto it = renames.find(vd); it != renames.end()) return it->second;
+  if (auto it = m_localNames.find(vd); it != m_localNames.end()) return it->second;
   const std::string renamed = ShadowingLocalName(m_ctx, vd);
-  if (renamed.empty()) return SafeName(vd->getNameAsString());
-  return renames[vd] = renamed;
+  if (!renamed.empty()) renames[vd] = renamed;
+  return m_localNames[vd] = renamed.empty() ? SafeName(vd->getNameAsString()) : renamed;
 }
 
 std::string KernelPrinter::Fail(SourceLocation loc, const std::string& message, const std::string& hint) {

@@ -356,6 +356,7 @@ protected:
   std::string TextOf(const clang::Expr* e) const;
   std::map<const clang::ValueDecl*, PointerTarget> m_pointers;  // pointer locals and helper parameters in scope
   std::map<const clang::ValueDecl*, const clang::FieldDecl*> m_objectLocals;  // `T* p = m_v[i]`: p holds i (ObjectLocal)
+  std::map<const clang::VarDecl*, std::string> m_localNames;  // LocalName's answers
   std::set<std::string> m_emittedCopies;                         // helpers bound to buffers, by name
   const clang::Expr* m_fieldBase = nullptr;                      // the base of the field access being printed
   std::vector<std::string> m_reduceAddVectors;                   // member vectors with a ReduceAdd function
