@@ -20,15 +20,24 @@
 //                     is below 4, and the last component in the others: where v is a member or a
 //                     CRT_UNIFORM local at an index the gang shares, ISPC reads the components in one
 //                     load, not a gather
+//   LaneOfQuad(v)     component LaneIndex() % 4 of v, a LiteMath 4-vector: each quad of four lanes holds
+//                     all of v (a gang of 8 holds it twice, of 16 four times); from memory the gang
+//                     shares, ISPC reads the components in one load and spreads them
+//   FromLane(v, i)    v in lane i, where i may differ between lanes: each lane reads the lane it
+//                     names, an active one (ISPC's shuffle; in a gang of one, i is 0 and this is v)
 //
 // With LaneIndex, the lanes of a gang can share out one thread's work: a loop
 // `for (int first = 0; first < 4; first += GangSize())` (its start and bound shared) whose lanes
 // take items first + LaneIndex() below 4 runs four times in a gang of one and once in a gang of four
 // or more, and LaneBits and LaneValue bring the lanes' results back to values the gang shares
-// (BVHScene::TraceMeshAlone tests a node's four boxes so, one a lane, for one ray, and reads their
-// planes with LaneOf). ISPC runs such a loop on every lane, those that a branch, a loop or a return
+// (test/classes/gang_walk.cpp counts a query's block of a table so, and reads it with LaneOf). ISPC runs such a loop on every lane, those that a branch, a loop or a return
 // switched off before it too (`unmasked`), so inside it LaneBits sees every lane; it may write only
 // its own locals and CRT_UNIFORM ones, and may not return (diagnostics at the line otherwise).
+//
+// With LaneOfQuad and FromLane, a gang can share out the work of GangSize() / 4 threads, a quad of
+// lanes each (BVHScene::TraceMeshQuads walks a few rays so, each quad a ray, each lane of a quad a box
+// of a node, whose planes it reads with LaneOfQuad). They read lanes that may be off: call them where
+// every lane is on (in the branch of an `if (AllLanesOn() && ...)`, or a loop stepping by GangSize()).
 //
 // In GLSL, where the gang is one thread, an `if` whose condition GangSize() decides alone
 // (`GangSize() == 4 && ...`, `GangSize() > 1 && ...`) prints only the branch it takes, with a comment
@@ -88,6 +97,16 @@ template <typename V>
 inline typename std::decay<decltype(std::declval<const V&>()[0])>::type LaneOf(const V& v, int first)
 {
   return v[first + LaneIndex() < 3 ? first + LaneIndex() : 3];
+}
+template <typename V>
+inline typename std::decay<decltype(std::declval<const V&>()[0])>::type LaneOfQuad(const V& v)
+{
+  return v[LaneIndex() % 4];
+}
+template <typename T>
+inline T FromLane(T v, int)
+{
+  return v;
 }
 
 }  // namespace crossrt

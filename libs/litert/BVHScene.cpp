@@ -39,24 +39,23 @@ static_assert(kWiden == 1.0f + 2.0f * (3.0f * std::numeric_limits<float>::epsilo
               "kWiden is 1 + 2 gamma(3)");
 constexpr float kMissed = -1.0f;  // an exit before every entry (entries are >= 0): a missed box
 constexpr float kNotEntered = std::numeric_limits<float>::infinity();  // a ray's entry into a subtree it does not enter
-constexpr int kRaysAlone = 2;  // packet traversal: the rays left in a subtree that walk it one at a time (TraceMeshAlone; best of 0-2 with SSE)
 
-// The ray of the gang's lane `at`, in every lane (crossrt::LaneValue, field by field).
-BVHTraceRay RayOfLane(const BVHTraceRay& ray, int at)
+// The ray of lane `from` in each lane (crossrt::FromLane, field by field): a lane that works for
+// another lane's ray (TraceMeshQuads) takes that ray whole.
+BVHTraceRay RayFromLane(const BVHTraceRay& ray, int from)
 {
-  CRT_UNIFORM const int lane = crossrt::FirstLane(at);
   BVHTraceRay r;
-  r.org = float3(crossrt::LaneValue(ray.org.x, lane), crossrt::LaneValue(ray.org.y, lane), crossrt::LaneValue(ray.org.z, lane));
-  r.dir = float3(crossrt::LaneValue(ray.dir.x, lane), crossrt::LaneValue(ray.dir.y, lane), crossrt::LaneValue(ray.dir.z, lane));
-  r.invDir = float3(crossrt::LaneValue(ray.invDir.x, lane), crossrt::LaneValue(ray.invDir.y, lane), crossrt::LaneValue(ray.invDir.z, lane));
-  r.tnear = crossrt::LaneValue(ray.tnear, lane);
-  r.kx = crossrt::LaneValue(ray.kx, lane);
-  r.ky = crossrt::LaneValue(ray.ky, lane);
-  r.kz = crossrt::LaneValue(ray.kz, lane);
-  r.sx = crossrt::LaneValue(ray.sx, lane);
-  r.sy = crossrt::LaneValue(ray.sy, lane);
-  r.sz = crossrt::LaneValue(ray.sz, lane);
-  r.anyZeroAxis = crossrt::LaneValue(ray.anyZeroAxis, lane);
+  r.org = float3(crossrt::FromLane(ray.org.x, from), crossrt::FromLane(ray.org.y, from), crossrt::FromLane(ray.org.z, from));
+  r.dir = float3(crossrt::FromLane(ray.dir.x, from), crossrt::FromLane(ray.dir.y, from), crossrt::FromLane(ray.dir.z, from));
+  r.invDir = float3(crossrt::FromLane(ray.invDir.x, from), crossrt::FromLane(ray.invDir.y, from), crossrt::FromLane(ray.invDir.z, from));
+  r.tnear = crossrt::FromLane(ray.tnear, from);
+  r.kx = crossrt::FromLane(ray.kx, from);
+  r.ky = crossrt::FromLane(ray.ky, from);
+  r.kz = crossrt::FromLane(ray.kz, from);
+  r.sx = crossrt::FromLane(ray.sx, from);
+  r.sy = crossrt::FromLane(ray.sy, from);
+  r.sz = crossrt::FromLane(ray.sz, from);
+  r.anyZeroAxis = crossrt::FromLane(ray.anyZeroAxis, from);
   return r;
 }
 
@@ -1323,20 +1322,25 @@ bool BVHScene::TraceMeshTogether(const BVHTraceRay& ray, uint32_t root, bool any
   bool found = false;
   while (true)
   {
-    // In a gang of four (SSE), where two of its rays or fewer are left in the subtree (deep in the
-    // tree, where the rays of a tile part ways), each walks it alone, the four lanes across a
-    // node's four boxes (Embree's switch to rays alone): faster on six meshes of seven, up to 12%,
-    // within 1% on the seventh (AMD EPYC, Zen 4). Gangs of 8 and 16 lanes, which a walk alone fills
-    // only in part, traced the 871k dragon 1-7% faster so but the other meshes 3-11% slower, and
-    // walk together throughout (GangSize() is a constant there: the walk alone is not compiled).
+    // Where half the gang's rays or fewer are left in the subtree (deep in the tree, where the rays of
+    // a tile part ways), they walk it a few at a time, a quad of lanes per ray across a node's four
+    // boxes (TraceMeshQuads; Embree's switch to rays alone): testing each box against the whole gang
+    // would leave most of its lanes idle there. Measured on an AMD EPYC (Zen 4), against the walk
+    // together throughout: the 871k-triangle dragon 10% faster with avx2 and 15-20% with avx512skx,
+    // the smaller meshes within 3%. Switching at 2, 3 or 4 rays left was the same with avx2; with
+    // avx512skx at 8 beat 4 and 2 on that dragon. With sse4 this is the walk of one ray at a time
+    // across the four lanes, which had paid there on six meshes of seven.
     CRT_UNIFORM uint32_t alone = crossrt::LaneBits(entry <= tfar && !(anyHit && found));
-    if (crossrt::GangSize() == 4 && __builtin_popcount(alone) <= kRaysAlone)
+    if (crossrt::GangSize() >= 4 && crossrt::AllLanesOn() && __builtin_popcount(alone) <= crossrt::GangSize() / 2)
     {
       while (alone != 0u)
       {
-        CRT_UNIFORM const int lane = __builtin_ctz(alone);
-        alone = alone & (alone - 1u);
-        found = TraceMeshAlone(ray, lane, node, anyHit, tfar, hit) || found;
+        // The next GangSize() / 4 of them, a quad each.
+        CRT_UNIFORM uint32_t some = 0u;
+        for (int q = 0; q < crossrt::GangSize() / 4; ++q)
+          some = some | (alone & ~some & (0u - (alone & ~some)));
+        alone = alone & ~some;
+        found = TraceMeshQuads(ray, some, node, anyHit, tfar, hit) || found;
       }
       node = kNoChild;  // on to the stack
     }
@@ -1442,88 +1446,105 @@ bool BVHScene::TraceMeshTogether(const BVHTraceRay& ray, uint32_t root, bool any
   }
 }
 
-// One ray of the gang, the one in lane `at`, walks the subtree at `root` alone: the gang's lanes
-// share out its work, a lane a box of each node and a triangle of each leaf group (SIMD across a
-// node, as Embree's walk of one ray; in a gang of one the loops below take the four boxes and the
-// four triangles one after another). The arithmetic is TraceMesh's (SlabEntry, IntersectCorners as
-// IntersectTriangle calls it and, where the ray meets a triangle on an edge, IntersectGroup), and so
-// is the hit. Updates that ray's tfar and hit, and returns true in its lane where it found one.
-bool BVHScene::TraceMeshAlone(const BVHTraceRay& gangRay, int at, uint32_t root, bool anyHit, float& tfar, CRT_Hit& hit) const
+// A few rays of the gang, those in the lanes `rays` (bits; GangSize() / 4 of them at most), walk the
+// subtree at `root` together, a quad of four lanes per ray: each lane of a quad tests a box of each
+// node and a triangle of each leaf group for its quad's ray (SIMD across a node, as Embree's walk of
+// one ray), and the quads share the node and the stack (a packet of a few rays). Gangs of 8 and 16
+// lanes walk so where few of their rays are left in a subtree, deep in the tree, where
+// TraceMeshTogether would test each box with most of its lanes idle. The arithmetic is TraceMesh's
+// (SlabEntry, IntersectCorners as IntersectTriangle calls it and, where a ray meets a triangle on an
+// edge, IntersectGroup), and so is each ray's hit. Runs with every lane of the gang on (its caller
+// tests AllLanesOn()): a lane works for another lane's ray. Updates those rays' tfar and hit in their
+// own lanes, and returns true in the lanes of those that found one.
+bool BVHScene::TraceMeshQuads(const BVHTraceRay& gangRay, uint32_t rays, uint32_t root, bool anyHit, float& tfar, CRT_Hit& hit) const
 {
-  CRT_UNIFORM const int lane = crossrt::FirstLane(at);
-  const BVHTraceRay ray = RayOfLane(gangRay, lane);
-  CRT_UNIFORM const int kx = crossrt::LaneValue(gangRay.kx, lane);
-  CRT_UNIFORM const int ky = crossrt::LaneValue(gangRay.ky, lane);
-  CRT_UNIFORM const int kz = crossrt::LaneValue(gangRay.kz, lane);
-  CRT_UNIFORM const bool firstHit = crossrt::LaneValue(anyHit, lane);
-  CRT_UNIFORM float rayTfar = crossrt::LaneValue(tfar, lane);
-  CRT_UNIFORM float hitT = crossrt::LaneValue(hit.t, lane);
-  CRT_UNIFORM uint32_t hitPrimId = crossrt::LaneValue(hit.primId, lane);
-  CRT_UNIFORM float hitU = crossrt::LaneValue(hit.coords[0], lane);
-  CRT_UNIFORM float hitV = crossrt::LaneValue(hit.coords[1], lane);
-  CRT_UNIFORM bool found = false;
+  CRT_UNIFORM const uint32_t raySet = crossrt::FirstLane(rays);
+  if (raySet == 0u)
+    return false;
+  // This lane's place in its quad (the box, or the triangle, it tests), and the lane whose ray its quad
+  // works for: quad q takes the q-th ray of the set.
+  const int quad = crossrt::LaneIndex() / 4;
+  const int box = crossrt::LaneIndex() % 4;
+  int from = 0;
+  bool inQuad = false;  // the quad has a ray
+  CRT_UNIFORM uint32_t left = raySet;
+  for (int q = 0; q < crossrt::GangSize() / 4; ++q)
+  {
+    if (left == 0u)
+      break;
+    CRT_UNIFORM const int lane = __builtin_ctz(left);
+    left = left & (left - 1u);
+    from = quad == q ? lane : from;
+    inQuad = inQuad || quad == q;
+  }
+  const BVHTraceRay ray = RayFromLane(gangRay, from);
+  CRT_UNIFORM const int kx = crossrt::FirstLane(gangRay.kx);  // the gang's rays share their axes (TraceMeshTogether)
+  CRT_UNIFORM const int ky = crossrt::FirstLane(gangRay.ky);
+  CRT_UNIFORM const int kz = crossrt::FirstLane(gangRay.kz);
+  const bool firstHit = crossrt::FromLane(anyHit, from);
+  // The quad's ray's tfar and hit, in each lane of the quad.
+  float rayTfar = crossrt::FromLane(tfar, from);
+  float hitT = crossrt::FromLane(hit.t, from);
+  uint32_t hitPrimId = crossrt::FromLane(hit.primId, from);
+  float hitU = crossrt::FromLane(hit.coords[0], from);
+  float hitV = crossrt::FromLane(hit.coords[1], from);
+  bool found = false;
   CRT_UNIFORM uint32_t stack[kStackSize];
-  CRT_UNIFORM float stackEntry[kStackSize];
+  float stackEntry[kStackSize];  // the quad's ray's entry into each subtree on the stack, kNotEntered if it does not enter it
   CRT_UNIFORM int top = 0;
   CRT_UNIFORM uint32_t node = crossrt::FirstLane(root);
+  float entry = ray.tnear;  // the quad's ray's entry into `node`
   while (true)
   {
     while ((node & kLeafFlag) == 0)
     {
-      // The boxes the ray enters (bits) and its entries into them.
-      CRT_UNIFORM uint32_t entered = 0u;
-      CRT_UNIFORM float entries[4];
-      for (int firstBox = 0; firstBox < 4; firstBox += crossrt::GangSize())
-      {
-        // Box firstBox + LaneIndex() (lanes past the fourth box repeat it, and count for nothing).
-        float exit = 0.0f;
-        const float3 lo = float3(crossrt::LaneOf(m_nodes[node].minX, firstBox), crossrt::LaneOf(m_nodes[node].minY, firstBox),
-                                 crossrt::LaneOf(m_nodes[node].minZ, firstBox));
-        const float3 hi = float3(crossrt::LaneOf(m_nodes[node].maxX, firstBox), crossrt::LaneOf(m_nodes[node].maxY, firstBox),
-                                 crossrt::LaneOf(m_nodes[node].maxZ, firstBox));
-        const float boxEntry = SlabEntry(ray, lo, hi, rayTfar, exit);
-        CRT_UNIFORM uint32_t bits = crossrt::LaneBits(firstBox + crossrt::LaneIndex() < 4 && boxEntry <= exit);
-        entered = entered | (bits << uint32_t(firstBox));
-        while (bits != 0u)
-        {
-          CRT_UNIFORM const int k = __builtin_ctz(bits);
-          bits = bits & (bits - 1u);
-          entries[firstBox + k] = crossrt::LaneValue(boxEntry, k);
-        }
-      }
+      // Box `box` of the node, for the quad's ray; then the boxes some ray enters, as TraceMeshTogether
+      // takes them: on into the one some ray enters before the others taken so far, the others on the stack.
+      const bool active = inQuad && entry <= rayTfar && !(firstHit && found);
+      float exit = 0.0f;
+      const float3 lo = float3(crossrt::LaneOfQuad(m_nodes[node].minX), crossrt::LaneOfQuad(m_nodes[node].minY),
+                               crossrt::LaneOfQuad(m_nodes[node].minZ));
+      const float3 hi = float3(crossrt::LaneOfQuad(m_nodes[node].maxX), crossrt::LaneOfQuad(m_nodes[node].maxY),
+                               crossrt::LaneOfQuad(m_nodes[node].maxZ));
+      const float boxEntry = SlabEntry(ray, lo, hi, rayTfar, exit);
+      const bool enters = active && boxEntry <= exit;
+      const float childEntry = enters ? boxEntry : kNotEntered;
+      CRT_UNIFORM const uint32_t bits = crossrt::LaneBits(enters);
+      CRT_UNIFORM const uint32_t entered = (bits | bits >> 4u | bits >> 8u | bits >> 12u) & 15u;
       if (entered == 0u)
       {
         node = kNoChild;
         break;
       }
-      // On into the nearest entered box of those taken so far (Embree's order), the others on the stack.
       CRT_UNIFORM uint32_t next = kNoChild;
-      CRT_UNIFORM float nextEntry = kNotEntered;
-      for (int box = 0; box < 4; ++box)
+      float nextEntry = kNotEntered;
+      for (int b = 0; b < 4; ++b)
       {
-        if ((entered & (1u << uint32_t(box))) == 0u)
+        if ((entered & (1u << uint32_t(b))) == 0u)
           continue;
+        const float boxEntryOfRay = crossrt::FromLane(childEntry, crossrt::LaneIndex() - box + b);  // the quad's ray's, into box b
         if (next == kNoChild)
         {
-          next = m_nodes[node].child[box];
-          nextEntry = entries[box];
+          next = m_nodes[node].child[b];
+          nextEntry = boxEntryOfRay;
         }
-        else if (entries[box] < nextEntry)
+        else if (crossrt::AnyLane(boxEntryOfRay < nextEntry))
         {
           stack[top] = next;
           stackEntry[top] = nextEntry;
           top = top + 1;
-          next = m_nodes[node].child[box];
-          nextEntry = entries[box];
+          next = m_nodes[node].child[b];
+          nextEntry = boxEntryOfRay;
         }
         else
         {
-          stack[top] = m_nodes[node].child[box];
-          stackEntry[top] = entries[box];
+          stack[top] = m_nodes[node].child[b];
+          stackEntry[top] = boxEntryOfRay;
           top = top + 1;
         }
       }
       node = next;
+      entry = nextEntry;
     }
     if (node != kNoChild)
     {
@@ -1531,98 +1552,89 @@ bool BVHScene::TraceMeshAlone(const BVHTraceRay& gangRay, int at, uint32_t root,
       CRT_UNIFORM const uint32_t last = first + (node & 7u);
       for (uint32_t g = first; g <= last; ++g)
       {
-        // The group's triangles the ray hits (bits), with their t, u and v.
-        CRT_UNIFORM uint32_t hits = 0u;
-        CRT_UNIFORM bool onEdge = false;
-        CRT_UNIFORM float ts[4];
-        CRT_UNIFORM float us[4];
-        CRT_UNIFORM float vs[4];
-        for (int firstTriangle = 0; firstTriangle < 4; firstTriangle += crossrt::GangSize())
+        // Triangle `box` of the group, for the quad's ray.
+        const bool live = inQuad && entry <= rayTfar && !(firstHit && found);
+        const float3 a = float3(crossrt::LaneOfQuad(m_triangles[g].coord[kx]), crossrt::LaneOfQuad(m_triangles[g].coord[ky]),
+                                crossrt::LaneOfQuad(m_triangles[g].coord[kz]));
+        const float3 b = float3(crossrt::LaneOfQuad(m_triangles[g].coord[3 + kx]), crossrt::LaneOfQuad(m_triangles[g].coord[3 + ky]),
+                                crossrt::LaneOfQuad(m_triangles[g].coord[3 + kz]));
+        const float3 c = float3(crossrt::LaneOfQuad(m_triangles[g].coord[6 + kx]), crossrt::LaneOfQuad(m_triangles[g].coord[6 + ky]),
+                                crossrt::LaneOfQuad(m_triangles[g].coord[6 + kz]));
+        float t = 0.0f;
+        float u = 0.0f;
+        float v = 0.0f;
+        bool edge = false;
+        bool hitsIt = IntersectCorners(ray, kx, ky, kz, a, b, c, rayTfar, t, u, v, edge);
+        if (crossrt::AnyLane(live && edge))
         {
-          // Triangle firstTriangle + LaneIndex() (lanes past the fourth repeat it, and count for nothing).
-          const bool inGroup = firstTriangle + crossrt::LaneIndex() < 4;
-          const float3 a = float3(crossrt::LaneOf(m_triangles[g].coord[kx], firstTriangle), crossrt::LaneOf(m_triangles[g].coord[ky], firstTriangle),
-                                  crossrt::LaneOf(m_triangles[g].coord[kz], firstTriangle));
-          const float3 b = float3(crossrt::LaneOf(m_triangles[g].coord[3 + kx], firstTriangle),
-                                  crossrt::LaneOf(m_triangles[g].coord[3 + ky], firstTriangle),
-                                  crossrt::LaneOf(m_triangles[g].coord[3 + kz], firstTriangle));
-          const float3 c = float3(crossrt::LaneOf(m_triangles[g].coord[6 + kx], firstTriangle),
-                                  crossrt::LaneOf(m_triangles[g].coord[6 + ky], firstTriangle),
-                                  crossrt::LaneOf(m_triangles[g].coord[6 + kz], firstTriangle));
-          float t = 0.0f;
-          float u = 0.0f;
-          float v = 0.0f;
-          bool edge = false;
-          const bool hitsIt = IntersectCorners(ray, kx, ky, kz, a, b, c, rayTfar, t, u, v, edge);
-          onEdge = onEdge || crossrt::AnyLane(inGroup && edge);
-          CRT_UNIFORM uint32_t bits = crossrt::LaneBits(inGroup && hitsIt);
-          hits = hits | (bits << uint32_t(firstTriangle));
-          while (bits != 0u)
-          {
-            CRT_UNIFORM const int k = __builtin_ctz(bits);
-            bits = bits & (bits - 1u);
-            ts[firstTriangle + k] = crossrt::LaneValue(t, k);
-            us[firstTriangle + k] = crossrt::LaneValue(u, k);
-            vs[firstTriangle + k] = crossrt::LaneValue(v, k);
-          }
-        }
-        if (onEdge)
-        {
-          // A triangle on an edge in float: the whole group as TraceMesh tests it, exactly.
+          // A triangle on an edge in float: as TraceMesh tests it, in its group, exactly.
           float4 t4;
           float4 u4;
           float4 v4;
-          hits = crossrt::FirstLane(IntersectGroup(ray, g, kx, ky, kz, rayTfar, t4, u4, v4));
-          for (int k = 0; k < 4; ++k)
+          const uint32_t groupHits = IntersectGroup(ray, g, kx, ky, kz, rayTfar, t4, u4, v4);
+          hitsIt = edge ? ((groupHits >> uint32_t(box)) & 1u) != 0u : hitsIt;
+          t = edge ? t4[box] : t;
+          u = edge ? u4[box] : u;
+          v = edge ? v4[box] : v;
+        }
+        hitsIt = hitsIt && live;
+        if (crossrt::AnyLane(hitsIt))
+        {
+          // The quad's nearest hit, or as near with a lower primId, in each of its lanes (lanes 1 and 2
+          // apart swap theirs); taken where TakeNearestHit would take it.
+          bool best = hitsIt;
+          float bestT = t;
+          uint32_t bestPrimId = m_primIds[4u * g + uint32_t(box)];
+          float bestU = u;
+          float bestV = v;
+          for (int apart = 1; apart < 4; apart = apart * 2)
           {
-            ts[k] = crossrt::FirstLane(t4[k]);
-            us[k] = crossrt::FirstLane(u4[k]);
-            vs[k] = crossrt::FirstLane(v4[k]);
+            const int other = crossrt::LaneIndex() ^ apart;
+            const bool otherBest = crossrt::FromLane(best, other);
+            const float otherT = crossrt::FromLane(bestT, other);
+            const uint32_t otherPrimId = crossrt::FromLane(bestPrimId, other);
+            const float otherU = crossrt::FromLane(bestU, other);
+            const float otherV = crossrt::FromLane(bestV, other);
+            const bool takeOther = otherBest && (!best || otherT < bestT || (otherT == bestT && otherPrimId < bestPrimId));
+            best = best || otherBest;
+            bestT = takeOther ? otherT : bestT;
+            bestPrimId = takeOther ? otherPrimId : bestPrimId;
+            bestU = takeOther ? otherU : bestU;
+            bestV = takeOther ? otherV : bestV;
           }
-        }
-        // The nearest, or as near with a lower primId, as TakeNearestHit takes it.
-        while (hits != 0u)
-        {
-          CRT_UNIFORM const int k = __builtin_ctz(hits);
-          hits = hits & (hits - 1u);
-          CRT_UNIFORM const uint32_t primId = m_primIds[4u * g + uint32_t(k)];
-          if (ts[k] > rayTfar || (ts[k] == rayTfar && primId >= hitPrimId))
-            continue;
-          found = true;
-          rayTfar = ts[k];
-          hitT = ts[k];
-          hitPrimId = primId;
-          hitU = us[k];
-          hitV = vs[k];
-          if (firstHit)
-            break;
-        }
-        if (firstHit && found)
-        {
-          top = 0;  // done
-          break;
+          const bool nearer = best && (bestT < rayTfar || (bestT == rayTfar && bestPrimId < hitPrimId));
+          found = found || nearer;
+          rayTfar = nearer ? bestT : rayTfar;
+          hitT = nearer ? bestT : hitT;
+          hitPrimId = nearer ? bestPrimId : hitPrimId;
+          hitU = nearer ? bestU : hitU;
+          hitV = nearer ? bestV : hitV;
         }
       }
+      if (firstHit && crossrt::AllLanes(!inQuad || found))
+        break;  // every any-hit ray found one
     }
-    // Pop the next subtree that may still hold something nearer than rayTfar.
+    // Pop the next subtree that some ray may still find something nearer in.
     CRT_UNIFORM bool popped = false;
     while (top > 0 && !popped)
     {
       top = top - 1;
-      popped = stackEntry[top] <= rayTfar;
+      popped = crossrt::AnyLane(inQuad && stackEntry[top] <= rayTfar && !(firstHit && found));
     }
     if (!popped)
       break;
     node = stack[top];
+    entry = stackEntry[top];
   }
-  // Back into the ray's lane.
-  const bool mine = crossrt::LaneIndex() == lane;
-  tfar = mine ? rayTfar : tfar;
-  hit.t = mine ? hitT : hit.t;
-  hit.primId = mine ? hitPrimId : hit.primId;
-  hit.coords[0] = mine ? hitU : hit.coords[0];
-  hit.coords[1] = mine ? hitV : hit.coords[1];
-  return mine && found;
+  // Back into the rays' lanes: the ray of lane L is the quad's whose place among the rays is L's.
+  const bool mine = ((raySet >> uint32_t(crossrt::LaneIndex())) & 1u) != 0u;
+  const int source = mine ? 4 * __builtin_popcount(raySet & ((1u << uint32_t(crossrt::LaneIndex())) - 1u)) : 0;
+  tfar = mine ? crossrt::FromLane(rayTfar, source) : tfar;
+  hit.t = mine ? crossrt::FromLane(hitT, source) : hit.t;
+  hit.primId = mine ? crossrt::FromLane(hitPrimId, source) : hit.primId;
+  hit.coords[0] = mine ? crossrt::FromLane(hitU, source) : hit.coords[0];
+  hit.coords[1] = mine ? crossrt::FromLane(hitV, source) : hit.coords[1];
+  return mine && crossrt::FromLane(found, source);
 }
 
 // Traces instance m_instances[k] in object space (affine maps keep t: the object-space ray is not

@@ -183,7 +183,7 @@ private:
   bool TraceInstance(uint32_t k, const BVHTraceRay& worldRay, float time, bool anyHit, float& tfar, CRT_Hit& hit) const;
   bool TraceMesh(const BVHTraceRay& ray, uint32_t root, uint32_t leaves, bool anyHit, float& tfar, CRT_Hit& hit) const;
   bool TraceMeshTogether(const BVHTraceRay& ray, uint32_t root, bool anyHit, float& tfar, CRT_Hit& hit) const;
-  bool TraceMeshAlone(const BVHTraceRay& gangRay, int at, uint32_t root, bool anyHit, float& tfar, CRT_Hit& hit) const;
+  bool TraceMeshQuads(const BVHTraceRay& gangRay, uint32_t rays, uint32_t root, bool anyHit, float& tfar, CRT_Hit& hit) const;
   bool TakeNearestHit(uint32_t g, uint32_t hits, const LiteMath::float4& t, const LiteMath::float4& u, const LiteMath::float4& v,
                       bool anyHit, float& tfar, CRT_Hit& hit) const;
   uint32_t IntersectGroup(const BVHTraceRay& r, uint32_t group, int kx, int ky, int kz, float tfar, LiteMath::float4& t, LiteMath::float4& u,

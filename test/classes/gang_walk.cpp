@@ -63,3 +63,49 @@ void KeyCounter::kernel1D_Count(int n, const float* queries, uint32_t* counts)
     }
   }
 }
+
+void KeyCounter::CountQuarters(int n, const float* queries, uint32_t* counts) { kernel1D_CountQuarters(n, queries, counts); }
+
+void KeyCounter::kernel1D_CountQuarters(int n, const float* queries, uint32_t* counts)
+{
+  for (int i = 0; i < n; i++)
+  {
+    const float q = queries[i];
+    if (!(q == q))
+    {
+      counts[i] = kNoCount;
+      continue;
+    }
+    uint32_t c = 0u;
+    if (crossrt::GangSize() >= 4 && crossrt::AllLanesOn())
+    {
+      // A quad of lanes per query, each lane a key: the quad takes its lanes' queries in turn.
+      const int quadStart = crossrt::LaneIndex() - crossrt::LaneIndex() % 4;
+      for (int k = 0; k < 4; ++k)
+      {
+        const float itsQuery = crossrt::FromLane(q, quadStart + k);  // the query of the quad's lane k
+        CRT_UNIFORM const uint32_t bits = crossrt::LaneBits(crossrt::LaneOfQuad(m_quarters) <= itsQuery);
+        const uint32_t inQuad = uint32_t(__builtin_popcount((bits >> uint32_t(quadStart)) & 15u));
+        c = crossrt::LaneIndex() == quadStart + k ? inQuad : c;
+      }
+    }
+    else
+    {
+      // The gang's lanes share out each query's four keys, one query at a time (one after another in
+      // a gang of one).
+      CRT_UNIFORM uint32_t waiting = crossrt::LaneBits(true);
+      while (waiting != 0u)
+      {
+        CRT_UNIFORM const int lane = __builtin_ctz(waiting);
+        waiting = waiting & (waiting - 1u);
+        CRT_UNIFORM const float itsQuery = crossrt::LaneValue(q, lane);
+        CRT_UNIFORM uint32_t inQuarters = 0u;
+        for (int first = 0; first < 4; first += crossrt::GangSize())
+          inQuarters = inQuarters + uint32_t(__builtin_popcount(
+                                        crossrt::LaneBits(first + crossrt::LaneIndex() < 4 && crossrt::LaneOf(m_quarters, first) <= itsQuery)));
+        c = crossrt::LaneIndex() == lane ? inQuarters : c;
+      }
+    }
+    counts[i] = c;
+  }
+}

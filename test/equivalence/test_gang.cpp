@@ -1,7 +1,8 @@
 // A class that walks with its gang (Gang.h: CRT_UNIFORM, crossrt::AnyLane) gives every query the
 // count it gives alone, on every backend: against the original class and against std::upper_bound,
 // for queries in order (the gang's lanes agree for long) and shuffled (they part at once), with NaN
-// queries that leave their gang early (crossrt::AllLanesOn() is false there).
+// queries that leave their gang early (crossrt::AllLanesOn() is false there); and the count of the
+// quarters' first keys, which ISPC's whole gangs take a quad of lanes per query (LaneOfQuad, FromLane).
 #include "gang_walk.h"
 #include "KeyCounter_CPU.h"
 #ifdef CROSSRT_HAS_ISPC
@@ -40,6 +41,12 @@ TEST_CASE("A gang walking a sorted table together counts each query as the origi
         expected[i] = std::isnan(queries[i]) ? KeyCounter::kNoCount : uint32_t(std::upper_bound(keys.begin(), keys.end(), queries[i]) - keys.begin());
         total += std::isnan(queries[i]) ? 0u : expected[i];
       }
+      std::vector<uint32_t> expectedQuarters(queries.size());
+      const float starts[4] = {keys[0], keys[keys.size() / 4], keys[2 * (keys.size() / 4)], keys[3 * (keys.size() / 4)]};
+      for (size_t i = 0; i < queries.size(); ++i)
+        expectedQuarters[i] = std::isnan(queries[i]) ? KeyCounter::kNoCount : uint32_t(std::count_if(starts, starts + 4, [&](float k) { return k <= queries[i]; }));
+      for (uint32_t c = 0; c <= 4; ++c)  // every count, from below the first key to beyond the last quarter's
+        REQUIRE(std::count(expectedQuarters.begin(), expectedQuarters.end(), c) > 0);
       REQUIRE(*std::min_element(expected.begin(), expected.end()) == 0u);  // queries below every key,
       REQUIRE(std::count(expected.begin(), expected.end(), uint32_t(keys.size())) > 0);  // and above
 
@@ -60,6 +67,13 @@ TEST_CASE("A gang walking a sorted table together counts each query as the origi
         REQUIRE(wrong == 0);
         REQUIRE(impl->m_total == total);
         REQUIRE(impl->m_mean == float(total) / float(queries.size()));
+        // The quarters' first keys, a quad of lanes per query on ISPC where a gang is whole.
+        std::vector<uint32_t> quarters(queries.size(), 0xEEEEEEEEu);
+        impl->CountQuarters(int(queries.size()), queries.data(), quarters.data());
+        wrong = 0;
+        for (size_t i = 0; i < quarters.size(); ++i)
+          wrong += quarters[i] != expectedQuarters[i];
+        REQUIRE(wrong == 0);
       }
     }
   }

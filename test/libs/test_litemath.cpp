@@ -489,4 +489,9 @@ TEST_CASE("Gang.h in a gang of one: a lane's share of a loop is the whole loop",
   CHECK(crossrt::LaneOf(v, 2) == 3.0f);
   CHECK(crossrt::LaneOf(v, 6) == 4.0f);  // past the last component: the last
   CHECK(crossrt::LaneOf(LiteMath::uint4(5u, 6u, 7u, 8u), 1) == 6u);
+  // A gang of one is a quad's first lane, and reads its own lane.
+  CHECK(crossrt::LaneOfQuad(v) == 1.0f);
+  CHECK(crossrt::LaneOfQuad(LiteMath::int4(-3, 6, 7, 8)) == -3);
+  CHECK(crossrt::FromLane(2.5f, 0) == 2.5f);
+  CHECK(crossrt::FromLane(true, 0));
 }

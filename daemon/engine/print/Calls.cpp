@@ -112,7 +112,7 @@ std::string KernelPrinter::Builtin(const FunctionDecl* fd, const std::vector<std
 
 bool IsGangFunction(const FunctionDecl* fd) {
   static const std::set<std::string> names = {"GangSize", "AnyLane", "AllLanes", "FirstLane", "MinOverLanes", "AllLanesOn",
-                                                "LaneIndex", "LaneBits", "LaneValue", "LaneOf"};
+                                                "LaneIndex", "LaneBits", "LaneValue", "LaneOf", "LaneOfQuad", "FromLane"};
   return fd && InNamespace(fd, "crossrt") && names.count(fd->getNameAsString()) > 0;
 }
 

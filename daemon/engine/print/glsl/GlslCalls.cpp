@@ -126,8 +126,9 @@ std::string GlslPrinter::GangCall(const FunctionDecl* fd, const CallExpr* call) 
   if (fd->getName() == "AllLanesOn") return "true";
   if (fd->getName() == "LaneIndex") return "0";
   if (fd->getName() == "LaneOf") return "(" + Expr(call->getArg(0)) + ")[min(" + Expr(call->getArg(1)) + ", 3)]";
+  if (fd->getName() == "LaneOfQuad") return "(" + Expr(call->getArg(0)) + ")[0]";
   if (fd->getName() == "LaneBits") return "((" + Expr(call->getArg(0)) + ") ? 1u : 0u)";
-  return "(" + Expr(call->getArg(0)) + ")";  // AnyLane, AllLanes, FirstLane, MinOverLanes, LaneValue: the thread's own value
+  return "(" + Expr(call->getArg(0)) + ")";  // AnyLane, AllLanes, FirstLane, MinOverLanes, LaneValue, FromLane: the thread's own value
 }
 
 std::string GlslPrinter::LocalQualifier(const VarDecl*) { return ""; }

@@ -6,9 +6,10 @@
 //
 // And the gang of Gang.h: a CRT_UNIFORM local is `uniform`, and every value assigned to it must be
 // shared (reported at the user's line otherwise, not as an ISPC error in the generated file);
-// crossrt::AnyLane, AllLanes, FirstLane, MinOverLanes, GangSize, LaneIndex, LaneBits and LaneValue are
-// ISPC's any, all, extract at the lowest active lane, reduce_min, programCount, programIndex,
-// packmask and extract, and LaneOf a load of a vector's components across the lanes (crt_lane_of);
+// crossrt::AnyLane, AllLanes, FirstLane, MinOverLanes, GangSize, LaneIndex, LaneBits, LaneValue and
+// FromLane are ISPC's any, all, extract at the lowest active lane, reduce_min, programCount,
+// programIndex, packmask, extract and shuffle, and LaneOf and LaneOfQuad a load of a vector's
+// components across the lanes (crt_lane_of, crt_lane_of_quad);
 // a loop stepping by GangSize() runs `unmasked`; AllLanesOn tests lanemask(), and the branch of
 // an `if` it guards is `unmasked`. Part of IspcPrinter (IspcPrinter.h).
 #include "analyse/AstQueries.h"
@@ -41,7 +42,7 @@ bool IspcPrinter::Uniform(const clang::Expr* e) const {
   if (isa<IntegerLiteral, FloatingLiteral, CXXBoolLiteralExpr, CharacterLiteral>(e)) return true;
   if (auto* call = dyn_cast<CallExpr>(e); call && IsGangFunction(call->getDirectCallee())) {
     const std::string name = call->getDirectCallee()->getNameAsString();
-    if (name == "LaneIndex" || name == "LaneOf") return false;  // values that differ in every lane
+    if (name == "LaneIndex" || name == "LaneOf" || name == "LaneOfQuad" || name == "FromLane") return false;  // values that differ in every lane
     if (name == "FirstLane" || name == "MinOverLanes" || name == "LaneValue") return call->getArg(0)->getType()->isArithmeticType();
     return true;
   }
@@ -169,12 +170,15 @@ std::string IspcPrinter::GangCall(const FunctionDecl* fd, const CallExpr* call) 
   if (name == "AllLanesOn") return "(popcnt(lanemask()) == programCount)";
   if (name == "LaneIndex") return "programIndex";
   const std::string value = Expr(call->getArg(0));
-  if (name == "LaneOf") {
-    // Components first, first + 1, ... of a 4-vector across the lanes: from memory the gang shares, a load.
+  if (name == "LaneOf" || name == "LaneOfQuad") {
+    // Components first, first + 1, ... of a 4-vector across the lanes (LaneOfQuad: 0 to 3 in each quad
+    // of lanes): from memory the gang shares, a load.
     const QualType vt = call->getArg(0)->getType().getNonReferenceType().getUnqualifiedType();
     if (!IsLiteMathType(vt, "float4") && !IsLiteMathType(vt, "int4") && !IsLiteMathType(vt, "uint4"))
-      return Fail(call->getArg(0)->getExprLoc(), "crossrt::LaneOf of a '" + vt.getAsString(m_ctx.getPrintingPolicy()) + "'",
+      return Fail(call->getArg(0)->getExprLoc(), "crossrt::" + name + " of a '" + vt.getAsString(m_ctx.getPrintingPolicy()) + "'",
                   "pass a LiteMath float4, int4 or uint4");
+    if (name == "LaneOfQuad")
+      return SharedPlace(call->getArg(0)) ? "crt_lane_of_quad(&(" + value + "))" : "crt_lane_of_quad(" + value + ")";
     if (!Uniform(call->getArg(1)))
       return Fail(call->getArg(1)->getExprLoc(), "the first component of crossrt::LaneOf may differ between the lanes of an ISPC gang",
                   "pass a component every lane shares: a constant, a CRT_UNIFORM local or a shared loop's variable");
@@ -184,7 +188,7 @@ std::string IspcPrinter::GangCall(const FunctionDecl* fd, const CallExpr* call) 
   if (name == "AnyLane") return "any(" + value + ")";
   if (name == "AllLanes") return "all(" + value + ")";
   if (name == "LaneBits") return "((uniform uint)packmask(" + value + "))";
-  // FirstLane, LaneValue and MinOverLanes: of a 32-bit number (a bool too, for FirstLane and LaneValue).
+  // FirstLane, LaneValue, FromLane and MinOverLanes: of a 32-bit number (a bool too, but for MinOverLanes).
   const QualType t = call->getArg(0)->getType().getCanonicalType().getUnqualifiedType();
   const bool bit32 = t->isArithmeticType() && !t->isBooleanType() && m_ctx.getTypeSize(t) == 32;
   if (!bit32 && !(name != "MinOverLanes" && t->isBooleanType()))
@@ -194,6 +198,7 @@ std::string IspcPrinter::GangCall(const FunctionDecl* fd, const CallExpr* call) 
     return Fail(call->getArg(1)->getExprLoc(), "the lane of crossrt::LaneValue may differ between the lanes of an ISPC gang",
                 "pass a lane every lane shares: a CRT_UNIFORM local, or FirstLane of a parameter");
   if (name == "LaneValue") return "crt_lane_value(" + value + ", " + Expr(call->getArg(1)) + ")";
+  if (name == "FromLane") return "crt_from_lane(" + value + ", " + Expr(call->getArg(1)) + ")";
   return (name == "FirstLane" ? "crt_first_lane(" : "reduce_min(") + value + ")";
 }
 
