@@ -79,12 +79,14 @@ void KeyCounter::kernel1D_CountQuarters(int n, const float* queries, uint32_t* c
     uint32_t c = 0u;
     if (crossrt::GangSize() >= 4 && crossrt::AllLanesOn())
     {
-      // A quad of lanes per query, each lane a key: the quad takes its lanes' queries in turn.
+      // A quad of lanes per query, each lane a key: the quad takes its lanes' queries in turn. (The
+      // keys from a local copy: BVHScene's traversal reads a member's components, in memory.)
+      const LiteMath::float4 quarters = m_quarters;
       const int quadStart = crossrt::LaneIndex() - crossrt::LaneIndex() % 4;
       for (int k = 0; k < 4; ++k)
       {
         const float itsQuery = crossrt::FromLane(q, quadStart + k);  // the query of the quad's lane k
-        CRT_UNIFORM const uint32_t bits = crossrt::LaneBits(crossrt::LaneOfQuad(m_quarters) <= itsQuery);
+        CRT_UNIFORM const uint32_t bits = crossrt::LaneBits(crossrt::LaneOfQuad(quarters) <= itsQuery);
         const uint32_t inQuad = uint32_t(__builtin_popcount((bits >> uint32_t(quadStart)) & 15u));
         c = crossrt::LaneIndex() == quadStart + k ? inQuad : c;
       }
