@@ -937,3 +937,56 @@ void Names::kernel1D_Run(int n, const Tap* taps, uint32_t* image)
   CHECK(glsl.find(Squeezed("const float length_ = taps[i].sample_ + length(vec2(taps[i].step_, 1.0));")) != std::string::npos);
   CHECK(glsl.find(Squeezed("image[i] = uint(length_);")) != std::string::npos);
 }
+
+TEST_CASE("ISPC: a composed object's scalar members are shared by the gang: CRT_UNIFORM locals take them, and loops they bound are uniform", "[engine][composition][ispc]")
+{
+  TempClass tc("Summer", R"(#pragma once
+#include "Gang.h"
+#include <cstdint>
+#include <memory>
+#include <vector>
+struct IField { virtual ~IField() = default; virtual float Sum(float x) const = 0; };
+struct Field : IField {
+  std::vector<float> m_values;
+  int m_count = 0;
+  float Sum(float x) const override;
+};
+class Summer {
+public:
+  virtual ~Summer() = default;
+  virtual void Run(int n, [[crossrt::size("n")]] float* data);
+  virtual void CommitDeviceData() {}
+protected:
+  void kernel1D_Run(int n, float* data);
+  std::shared_ptr<IField> m_field;
+};
+)",
+               R"(#include "Summer.h"
+float Field::Sum(float x) const
+{
+  CRT_UNIFORM const int count = m_count;
+  float s = x;
+  for (int k = 0; k < count; ++k)
+    s += m_values[k];
+  for (int k = 0; k < m_count; ++k)
+    s += m_values[k];
+  return s;
+}
+void Summer::Run(int n, float* data) { kernel1D_Run(n, data); }
+void Summer::kernel1D_Run(int n, float* data)
+{
+  for (int i = 0; i < n; ++i)
+    data[i] = m_field->Sum(data[i]);
+}
+)");
+  TranslateRequest r = MakeRequest(tc, "Summer", Backend::Ispc);
+  r.compositions = {"IField=Field"};
+  const TranslateResult result = Translate(r);
+  INFO(result.diagnostics);
+  REQUIRE(result.ok);
+  const std::string ispc = Squeezed(result.files.at("Summer_ISPC_kernels.ispc"));
+  INFO(ispc);
+  CHECK(ispc.find(Squeezed("const uniform int count = self->m_field_m_count;")) != std::string::npos);
+  CHECK(ispc.find(Squeezed("for (uniform int k = 0; k < count; ++k)")) != std::string::npos);
+  CHECK(ispc.find(Squeezed("for (uniform int k = 0; k < self->m_field_m_count; ++k)")) != std::string::npos);
+}

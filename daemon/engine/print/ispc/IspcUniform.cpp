@@ -59,9 +59,9 @@ bool IspcPrinter::Uniform(const clang::Expr* e) const {
     return vd && vd->getType().isConstQualified() && vd->getType()->isArithmeticType() && vd->getInit() &&
            vd->getInit()->isEvaluatable(m_ctx);
   }
-  if (auto* me = dyn_cast<MemberExpr>(e)) {  // a scalar data member: self->m_x
+  if (auto* me = dyn_cast<MemberExpr>(e)) {  // a scalar data member: self->m_x (a composed object's: self->m_pAccelStruct_m_x)
     auto* f = dyn_cast<FieldDecl>(me->getMemberDecl());
-    return f && isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts()) && f->getType()->isArithmeticType() && composedPrefix.empty() && !selfClass &&
+    return f && isa<CXXThisExpr>(me->getBase()->IgnoreParenImpCasts()) && f->getType()->isArithmeticType() && !selfClass &&
            !m_structSelf;  // in a plain struct's method, `this` is the struct (a varying value), not the class
   }
   if (auto* mc = dyn_cast<CXXMemberCallExpr>(e)) {  // a member vector's size() (self->m_v_size), an image's width() or height()
@@ -80,7 +80,7 @@ bool IspcPrinter::Uniform(const clang::Expr* e) const {
   }
   if (auto* op = dyn_cast<CXXOperatorCallExpr>(e); op && op->getOperator() == OO_Subscript && op->getNumArgs() == 2) {
     // an element of a member vector at a shared index (self->m_v[k]: one load for the gang)
-    if (!composedPrefix.empty() || selfClass || m_structSelf || !op->getType()->isArithmeticType()) return false;
+    if (selfClass || m_structSelf || !op->getType()->isArithmeticType()) return false;
     auto* f = ThisMemberField(op->getArg(0));
     return f && IsStdVector(f->getType()) && Uniform(op->getArg(1));
   }
