@@ -30,14 +30,16 @@
 // `for (int first = 0; first < 4; first += GangSize())` (its start and bound shared) whose lanes
 // take items first + LaneIndex() below 4 runs four times in a gang of one and once in a gang of four
 // or more, and LaneBits and LaneValue bring the lanes' results back to values the gang shares
-// (test/classes/gang_walk.cpp counts a query's block of a table so, and reads it with LaneOf). ISPC runs such a loop on every lane, those that a branch, a loop or a return
-// switched off before it too (`unmasked`), so inside it LaneBits sees every lane; it may write only
-// its own locals and CRT_UNIFORM ones, and may not return (diagnostics at the line otherwise).
+// (test/classes/gang_walk.cpp counts a query's keys so: those of its block of the table, and with
+// LaneOf those of a float4). ISPC runs such a loop on every lane, those that a branch, a loop or a
+// return switched off before it too (`unmasked`), so inside it LaneBits sees every lane; it may write
+// only its own locals and CRT_UNIFORM ones, and may not return (diagnostics at the line otherwise).
 //
 // With LaneOfQuad and FromLane, a gang can share out the work of GangSize() / 4 threads, a quad of
 // lanes each (BVHScene::TraceMeshQuads walks a few rays so, each quad a ray, each lane of a quad a box
-// of a node, whose planes it reads with LaneOfQuad). They read lanes that may be off: call them where
-// every lane is on (in the branch of an `if (AllLanesOn() && ...)`, or a loop stepping by GangSize()).
+// of a node, whose planes it reads with LaneOfQuad). FromLane reads lanes that may be off: call it
+// where every lane is on (in the branch of an `if (AllLanesOn() && ...)`, or a loop stepping by
+// GangSize()), as a lane that is off holds no value of its own there.
 //
 // In GLSL, where the gang is one thread, an `if` whose condition GangSize() decides alone
 // (`GangSize() == 4 && ...`, `GangSize() > 1 && ...`) prints only the branch it takes, with a comment
