@@ -1364,11 +1364,12 @@ bool BVHScene::TraceMeshTogether(const BVHTraceRay& ray, uint32_t root, bool any
     while ((node & kLeafFlag) == 0)
     {
       // The node's four boxes first, one at a time, each against every ray, with no branch between
-      // them (`facing` is the same throughout the walk): which boxes a gang enters is data, and a mispredicted branch after each box had the
-      // AVX2 walk wait there (about 11% of its samples; on an AMD EPYC the 871k-triangle dragon
-      // traced 12% faster so with avx2, 7% with avx512skx). Then, of the lanes some ray enters, the gang goes on into the one some ray enters
-      // before it enters the others so far (Embree's order: no reduction over the lanes), and the
-      // others wait on the stack.
+      // them (`facing` is the same throughout the walk): which boxes a gang enters is data, and a
+      // mispredicted branch after each box had the AVX2 walk wait there (about 11% of its samples;
+      // on an AMD EPYC the 871k-triangle dragon traced 12% faster so with avx2, 7% with avx512skx).
+      // Then, of the lanes some ray enters, the gang goes on into the one some ray enters before it
+      // enters the others so far (Embree's order: no reduction over the lanes), and the others wait
+      // on the stack.
       const bool active = entry <= tfar && !(anyHit && found);  // an any-hit ray that found one is done
       float childEntry[4];  // this ray's entry into each lane's box, kNotEntered where it does not enter it
       CRT_UNIFORM uint32_t entered = 0u;  // the lanes some ray enters
