@@ -1461,9 +1461,10 @@ bool BVHScene::TraceMeshTogether(const BVHTraceRay& ray, uint32_t root, bool any
         hits = inLeaf ? hits : 0u;
         found = TakeNearestHit(g, hits, t, u, v, anyHit, tfar, hit) || found;
       }
-      // Any-hit rays that found one are done; the gang returns when all are. (A return of some lanes
-      // only would switch them off for the rest of the walk: ISPC's masked stores again.)
-      if (anyHit && crossrt::AllLanes(found))
+      // Any-hit rays that found one are done; the gang returns when all are, on a condition the gang
+      // shares. (A return of some lanes only would switch them off for the rest of the walk: ISPC's
+      // masked stores again.)
+      if (crossrt::AllLanes(anyHit && found))
         return true;
     }
     // Pop the next subtree that some ray may still find something nearer in.
@@ -1643,8 +1644,8 @@ bool BVHScene::TraceMeshQuads(const BVHTraceRay& gangRay, uint32_t rays, uint32_
           hitV = nearer ? bestV : hitV;
         }
       }
-      if (firstHit && crossrt::AllLanes(!inQuad || found))
-        break;  // every any-hit ray found one
+      if (crossrt::AllLanes(!inQuad || (firstHit && found)))
+        break;  // every any-hit ray found one (a condition the gang shares: the walk stays the gang's)
     }
     // Pop the next subtree that some ray may still find something nearer in.
     CRT_UNIFORM bool popped = false;
