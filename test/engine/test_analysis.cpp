@@ -990,3 +990,55 @@ void Summer::kernel1D_Run(int n, float* data)
   CHECK(ispc.find(Squeezed("for (uniform int k = 0; k < count; ++k)")) != std::string::npos);
   CHECK(ispc.find(Squeezed("for (uniform int k = 0; k < self->m_field_m_count; ++k)")) != std::string::npos);
 }
+
+TEST_CASE("ISPC: a loop is shared where its start is and its condition is, given its variable shared (k + 1 < top, 2 * k < n)", "[engine][ispc]")
+{
+  TempClass tc("Sorter", R"(#pragma once
+#include "Gang.h"
+class Sorter {
+public:
+  virtual ~Sorter() = default;
+  virtual void Run(int n, [[crossrt::size("n")]] float* data);
+  virtual void CommitDeviceData() {}
+protected:
+  void kernel1D_Run(int n, float* data);
+  int m_rounds = 2;
+};
+)",
+               R"(#include "Sorter.h"
+void Sorter::Run(int n, float* data) { kernel1D_Run(n, data); }
+void Sorter::kernel1D_Run(int n, float* data)
+{
+  for (int i = 0; i < n; ++i)
+  {
+    CRT_UNIFORM int keys[4] = {3, 1, 2, 0};
+    CRT_UNIFORM const int top = 4;
+    CRT_UNIFORM const int below = top - 3;
+    // a pass of bubble sort over keys[below, top): the gang swaps the shared keys together
+    for (int k = below; k + 1 < top; ++k)
+    {
+      if (keys[k] > keys[k + 1])
+      {
+        CRT_UNIFORM const int kept = keys[k];
+        keys[k] = keys[k + 1];
+        keys[k + 1] = kept;
+      }
+    }
+    float s = data[i];
+    for (int k = 0; 2 * k < m_rounds; ++k)
+      s += float(keys[k]);
+    for (int k = 0; k + i < n && k < 3; ++k)  // bound by the thread's index: not shared
+      s += 0.5f;
+    data[i] = s;
+  }
+}
+)");
+  const TranslateResult result = Translate(MakeRequest(tc, "Sorter", Backend::Ispc));
+  INFO(result.diagnostics);
+  REQUIRE(result.ok);
+  const std::string ispc = Squeezed(result.files.at("Sorter_ISPC_kernels.ispc"));
+  INFO(ispc);
+  CHECK(ispc.find(Squeezed("for (uniform int k = below; k + 1 < top; ++k)")) != std::string::npos);
+  CHECK(ispc.find(Squeezed("for (uniform int k = 0; 2 * k < self->m_rounds; ++k)")) != std::string::npos);
+  CHECK(ispc.find(Squeezed("for (int k = 0; k + i < n && k < 3; ++k)")) != std::string::npos);
+}

@@ -95,14 +95,16 @@ bool IspcPrinter::Uniform(const clang::Expr* e) const {
 }
 
 const VarDecl* IspcPrinter::UniformLoop(const ForStmt* fs) {
-  // for (int k = start; k < bound; ++k) with start and bound shared,
+  // for (int k = start; condition; ++k) with start shared and a condition shared where k is
+  // (k < bound, k + 1 < top, 2 * k < n, with bound, top and n shared),
   auto* ds = dyn_cast_or_null<DeclStmt>(fs->getInit());
   auto* v = ds && ds->isSingleDecl() ? dyn_cast<VarDecl>(ds->getSingleDecl()) : nullptr;
-  if (!v || !v->getType()->isIntegerType() || !v->getInit() || !Uniform(v->getInit())) return nullptr;
-  auto* cond = dyn_cast_or_null<BinaryOperator>(fs->getCond() ? fs->getCond()->IgnoreParenImpCasts() : nullptr);
-  if (!cond || !cond->isComparisonOp()) return nullptr;
-  const bool lhsIsVar = NamedVar(cond->getLHS()) == v, rhsIsVar = NamedVar(cond->getRHS()) == v;
-  if (!(lhsIsVar ? Uniform(cond->getRHS()) : rhsIsVar && Uniform(cond->getLHS()))) return nullptr;
+  if (!v || !v->getType()->isIntegerType() || !v->getInit() || !Uniform(v->getInit()) || !fs->getCond()) return nullptr;
+  const bool known = uniformValues.count(v) > 0;
+  uniformValues.insert(v);
+  const bool sharedCond = Uniform(fs->getCond());
+  if (!known) uniformValues.erase(v);
+  if (!sharedCond) return nullptr;
   // a step of ++k, k++, --k, k--, k += shared or k -= shared,
   const clang::Expr* inc = fs->getInc() ? fs->getInc()->IgnoreParenImpCasts() : nullptr;
   bool step = false;
@@ -155,7 +157,6 @@ const VarDecl* IspcPrinter::UniformLoop(const ForStmt* fs) {
   } body;
   body.printer = this;
   body.v = v;
-  const bool known = uniformValues.count(v) > 0;
   uniformValues.insert(v);
   body.TraverseStmt(const_cast<clang::Stmt*>(fs->getBody()));
   if (!known) uniformValues.erase(v);
