@@ -112,13 +112,17 @@ class Gen:
             if kind in ("Map", "Int", "Sum") and self.rs.random() < 0.25:
                 # Locals that shadow the kernel's parameters (valid C++): per element where the
                 # parameters are shared, so the generated code must keep them apart.
-                lines = ["{",
-                         f"  const int a_p = (m_i[i] & {self.rs.choice([3, 7])}) + 1;  // shadows the parameter a_p",
-                         "  float a_q = 0.0f;                  // and a_q",
-                         "  for (int n = 0; n < a_p; ++n)      // and n",
-                         "    a_q += float(n) * 0.5f;",
-                         "  " + line,
-                         "}"]
+                # The loop's bound is the per-element a_p, or the kernel's a_p, which every thread
+                # shares (ISPC: a uniform loop), in one of the forms a person writes.
+                shadow = self.rs.random() < 0.5
+                cond = self.rs.choice(["n < a_p", "n + 1 <= a_p", "2 * n < a_p + 1", "n * n < 4 * a_p"])
+                lines = (["{"] +
+                         ([f"  const int a_p = (m_i[i] & {self.rs.choice([3, 7])}) + 1;  // shadows the parameter a_p"] if shadow else []) +
+                         ["  float a_q = 0.0f;                  // shadows a_q",
+                          f"  for (int n = 0; {cond}; ++n)      // and n",
+                          "    a_q += float(n) * 0.5f;",
+                          "  " + line,
+                          "}"])
             kernels.append((name, "int n, int a_p, float a_q", lines, "n, a_p, a_q"))
             return name
 
