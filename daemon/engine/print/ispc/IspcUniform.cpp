@@ -1,6 +1,7 @@
 // ISPC uniformity: which values of a kernel every lane of a gang shares. The printer declares a
-// loop variable `uniform` when its start, bound and step are shared (a kernel's scalar parameters,
-// members, the outer loops of a 2D or 3D nest, constants) and nothing else changes it: the loop
+// loop variable `uniform` when its start and step are shared (a kernel's scalar parameters, members,
+// the outer loops of a 2D or 3D nest, constants), its condition is shared where the variable is
+// (k < n, k + 1 < top, with n and top shared), and nothing else changes it: the loop
 // then runs once per gang, and what it indexes with the variable (m_weights[k + m_radius]) is one
 // load for all lanes instead of a gather, and a shared value.
 //
