@@ -319,7 +319,7 @@ std::string KernelPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation cal
       if (IsArrayValueParam(p)) {  // const float boxMin[3]: an array by value
         t.array = name;
         t.local = true;
-        os << Declare(p->getOriginalType().getUnqualifiedType(), p->getNameAsString(), p->getLocation());
+        os << ArrayValueParamQualifier() << Declare(p->getOriginalType().getUnqualifiedType(), p->getNameAsString(), p->getLocation());
       } else if (auto bound = bufferBindings.find(i); bound != bufferBindings.end()) {
         t.array = PassesBuffers() ? name : bound->second;
         t.offset = name + "_offset";

@@ -228,8 +228,10 @@ protected:
   virtual std::string ObjectDataStruct(const clang::CXXRecordDecl* cls) const = 0;
   virtual std::string OwnerParameter(const clang::ParmVarDecl* p) = 0;
   virtual bool PassesBuffers() const = 0;
-  // A helper's parameter declared as a const array (const float boxMin[3]): the caller's array, whole.
+  // A helper's parameter declared as a const array (const float boxMin[3]): the caller's array, whole;
+  // before its declaration, what the language needs there ("const " where it passes the address).
   bool IsArrayValueParam(const clang::ParmVarDecl* p) const;
+  virtual std::string ArrayValueParamQualifier() const = 0;
   virtual std::string BufferParameter(const clang::ParmVarDecl* p, const std::string& name) = 0;
   virtual std::string WritableParam(clang::QualType type, const std::string& name, clang::SourceLocation loc) = 0;
   // Members of the class data, by name; a vector's size as an int; whether a size is 0; a size as

@@ -136,6 +136,8 @@ std::string GlslPrinter::OwnerParameter(const ParmVarDecl*) { return ""; }  // t
 
 bool GlslPrinter::PassesBuffers() const { return false; }
 
+std::string GlslPrinter::ArrayValueParamQualifier() const { return ""; }  // GLSL passes arrays by value
+
 std::string GlslPrinter::BufferParameter(const ParmVarDecl*, const std::string&) { return ""; }
 
 std::string GlslPrinter::ObjectIndex(const clang::Expr* index) { return "uint(" + Expr(index) + ")"; }

@@ -35,6 +35,7 @@ protected:
   std::string ObjectDataStruct(const clang::CXXRecordDecl* cls) const override;
   std::string OwnerParameter(const clang::ParmVarDecl* p) override;
   bool PassesBuffers() const override;
+  std::string ArrayValueParamQualifier() const override;
   std::string BufferParameter(const clang::ParmVarDecl* p, const std::string& name) override;
   std::string WritableParam(clang::QualType type, const std::string& name, clang::SourceLocation loc) override;
   std::string MemberAccess(const std::string& name) const override;

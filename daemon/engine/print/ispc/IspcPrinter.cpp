@@ -243,6 +243,10 @@ std::string IspcPrinter::OwnerParameter(const ParmVarDecl* p) {
 
 bool IspcPrinter::PassesBuffers() const { return true; }
 
+// `const float boxMin[3]` is a pointer in ISPC, as in C: a const array (a const local struct's field)
+// converts only to a pointer to const.
+std::string IspcPrinter::ArrayValueParamQualifier() const { return "const "; }
+
 std::string IspcPrinter::BufferParameter(const ParmVarDecl* p, const std::string& name) {
   const QualType pt = p->getType();
   auto element = Type(pt->getPointeeType().getUnqualifiedType(), p->getLocation());
@@ -268,7 +272,41 @@ std::string IspcPrinter::TexelAssignment(const CXXOperatorCallExpr*) { return ""
 
 std::string IspcPrinter::Assignment(const BinaryOperator* bo) {
   CheckSharedAssignment(bo->getLHS(), bo->getRHS());
+  if (std::string store = SharedIndexStore(bo); !store.empty()) return store;
   return ComponentAssignment(bo);
+}
+
+// `p[k] = v` or `p[k] += v` through a buffer pointer, or into a member vector (m_v[k]), at an index
+// every lane shares, of a value that may differ between them (`if (i == 0) a_data[0] = v.x;`): ISPC
+// takes p[0] for one uniform element, to which a varying value does not convert. The lanes that run
+// the statement store the last one's value (crt_store_last: the original's last iteration's), or
+// add all of theirs (crt_add_lanes), as one statement. "" otherwise.
+std::string IspcPrinter::SharedIndexStore(const BinaryOperator* bo) {
+  if (bo->getOpcode() != BO_Assign && bo->getOpcode() != BO_AddAssign) return "";
+  const clang::Expr* target = bo->getLHS()->IgnoreParenImpCasts();
+  const auto glsl = GlslTypeOf(target->getType().getUnqualifiedType());
+  if (!glsl || (*glsl != "float" && *glsl != "int" && *glsl != "uint" && *glsl != "double") || Uniform(bo->getRHS())) return "";
+  auto parents = m_ctx.getParents(*static_cast<const clang::Stmt*>(bo));  // a statement of its own: its value is not used
+  if (parents.size() != 1 || parents[0].get<clang::Expr>() || !parents[0].get<clang::Stmt>()) return "";
+  std::string array, index;
+  if (auto* as = dyn_cast<ArraySubscriptExpr>(target)) {
+    auto* decay = dyn_cast<ImplicitCastExpr>(as->getBase()->IgnoreParens());
+    if ((decay && decay->getCastKind() == CK_ArrayToPointerDecay) || !as->getBase()->getType()->isPointerType() || !Uniform(as->getIdx())) return "";
+    auto t = Pointer(as->getBase());
+    if (!t || !t->value.empty() || t->local || t->array.empty()) return "";
+    array = t->array;
+    index = t->offset.empty() ? Expr(as->getIdx()) : t->offset + " + " + Expr(as->getIdx());
+  } else if (auto* op = dyn_cast<CXXOperatorCallExpr>(target); op && op->getOperator() == OO_Subscript && op->getNumArgs() == 2) {
+    const FieldDecl* f = ThisMemberField(op->getArg(0));
+    if (!f || !IsStdVector(f->getType()) || !Uniform(op->getArg(1))) return "";
+    array = Expr(op->getArg(0));
+    index = Expr(op->getArg(1));
+  } else {
+    return "";
+  }
+  const std::string type = IspcTypeName(*glsl);
+  return std::string(bo->getOpcode() == BO_Assign ? "crt_store_last(" : "crt_add_lanes(") + array + ", (uniform int)(" + index + "), (varying " + type +
+         ")(" + Expr(bo->getRHS()) + "))";
 }
 
 // ISPC divides the masked-off lanes too, whose divisor may be 0 (a masked gather's): a per-lane

@@ -36,6 +36,7 @@ protected:
   std::string ObjectDataStruct(const clang::CXXRecordDecl* cls) const override;
   std::string OwnerParameter(const clang::ParmVarDecl* p) override;
   bool PassesBuffers() const override;
+  std::string ArrayValueParamQualifier() const override;
   std::string BufferParameter(const clang::ParmVarDecl* p, const std::string& name) override;
   std::string WritableParam(clang::QualType type, const std::string& name, clang::SourceLocation loc) override;
   std::string MemberAccess(const std::string& name) const override;
@@ -105,6 +106,7 @@ private:
   // `v[i] op= a` with i known only at run time, `m(r, c) = a` ("" for other assignments).
   std::string VectorOperation(const clang::CXXOperatorCallExpr* op);
   std::string ComponentAssignment(const clang::BinaryOperator* bo);
+  std::string SharedIndexStore(const clang::BinaryOperator* bo);
   std::string CompoundAssignOnce(const clang::CXXOperatorCallExpr* op);
   // Loads better than a gather (IspcLoads.cpp): a member vector's struct element read whole at a
   // per-lane index, through a helper that loads what the lanes agree on once; a float4, int4 or

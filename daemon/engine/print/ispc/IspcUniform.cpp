@@ -302,9 +302,15 @@ std::string IspcPrinter::ThenBranch(const clang::IfStmt* is, int indent) {
   return pad + "unmasked  // every lane is on (crossrt::AllLanesOn): the mask is known, local structs stay in registers\n" + body;
 }
 
-// A CRT_UNIFORM local: `uniform`, if it holds numbers and starts shared.
+// A CRT_UNIFORM local: `uniform`, if it holds numbers and starts shared. And a constant (a const
+// number with a constant initialiser, `const int numSamples = 16;`), which Uniform() takes as
+// shared: declared varying, its uses in `(uniform float)numSamples` would not compile.
 std::string IspcPrinter::LocalQualifier(const VarDecl* vd) {
-  if (!IsUniformLocal(vd)) return "";
+  if (!IsUniformLocal(vd)) {
+    const QualType t = vd->getType();
+    if (t.isConstQualified() && t->isArithmeticType() && vd->getInit() && vd->getInit()->isEvaluatable(m_ctx)) return "uniform ";
+    return "";
+  }
   const QualType t = vd->getType();
   if (t->isReferenceType() || !m_ctx.getBaseElementType(t)->isArithmeticType()) {
     Fail(vd->getLocation(), "CRT_UNIFORM local '" + vd->getNameAsString() + "' of type '" + t.getAsString(m_ctx.getPrintingPolicy()) + "'",
