@@ -170,7 +170,7 @@ Register firstThread(MakeCase<FirstThread>(
     "one thread writing elements at constant indices (if (i == 0) a_out[0] = v.x), a const local in a cast, a const array parameter",
     "first_thread.h/.cpp", 1e-6, CONFORMANCE_MAKERS(FirstThread), [](FirstThread& f) {
       std::vector<float> in = {0.75f, -1.5f, 2.0f, 0.125f, -0.5f, 1.25f, 3.0f, -2.25f, 0.0f, 0.5f, 1.0f, -1.0f};
-      std::vector<float> out(in.size(), 10.0f);  // out[1] is added to
+      std::vector<float> out(in.size(), 10.0f);  // out[1] and out[3] are added to
       f.Run(int(in.size()), in.data(), out.data());
       Outputs r(out.begin(), out.end());
       r.insert(r.end(), f.m_firsts.begin(), f.m_firsts.end());

@@ -32,8 +32,15 @@ void FirstThread::kernel1D_Run(int n, const float* a_in, float* a_out)
       const Slab slab = m_slabs[s % 2];
       sum += Extent(p + float3(0.01f * float(s)), slab.lo, slab.hi);
     }
-    if (i >= 2)
-      a_out[i] = sum * (1.0f / float(numSamples));
+    float* mine = a_out + i;  // a row pointer whose offset differs per thread, at a constant index
+    if (i >= 4)
+      mine[0] = sum * (1.0f / float(numSamples));
+    if (i == 1)
+    {
+      float* tail = a_out + 2;  // one shared by every thread
+      tail[0] = a_in[1] * 3.0f;
+      tail[1] += a_in[1];
+    }
     if (i == 0)
     {
       const float2 v = float2(a_in[0] + 1.0f, a_in[0] * 2.0f);

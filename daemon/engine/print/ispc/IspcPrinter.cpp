@@ -280,7 +280,9 @@ std::string IspcPrinter::Assignment(const BinaryOperator* bo) {
 // every lane shares, of a value that may differ between them (`if (i == 0) a_data[0] = v.x;`): ISPC
 // takes p[0] for one uniform element, to which a varying value does not convert. The lanes that run
 // the statement store the last one's value (crt_store_last: the original's last iteration's), or
-// add all of theirs (crt_add_lanes), as one statement. "" otherwise.
+// add all of theirs (crt_add_lanes), as one statement; through a pointer with an offset (a row,
+// `float* row = a_out + y * w`), where the lanes' elements may differ, each stores its own.
+// "" otherwise.
 std::string IspcPrinter::SharedIndexStore(const BinaryOperator* bo) {
   if (bo->getOpcode() != BO_Assign && bo->getOpcode() != BO_AddAssign) return "";
   const clang::Expr* target = bo->getLHS()->IgnoreParenImpCasts();
@@ -295,7 +297,7 @@ std::string IspcPrinter::SharedIndexStore(const BinaryOperator* bo) {
     auto t = Pointer(as->getBase());
     if (!t || !t->value.empty() || t->local || t->array.empty()) return "";
     array = t->array;
-    index = t->offset.empty() ? Expr(as->getIdx()) : t->offset + " + " + Expr(as->getIdx());
+    index = t->offset.empty() ? Expr(as->getIdx()) : t->offset + " + " + Expr(as->getIdx());  // (an offset may differ per lane)
   } else if (auto* op = dyn_cast<CXXOperatorCallExpr>(target); op && op->getOperator() == OO_Subscript && op->getNumArgs() == 2) {
     const FieldDecl* f = ThisMemberField(op->getArg(0));
     if (!f || !IsStdVector(f->getType()) || !Uniform(op->getArg(1))) return "";
@@ -305,7 +307,7 @@ std::string IspcPrinter::SharedIndexStore(const BinaryOperator* bo) {
     return "";
   }
   const std::string type = IspcTypeName(*glsl);
-  return std::string(bo->getOpcode() == BO_Assign ? "crt_store_last(" : "crt_add_lanes(") + array + ", (uniform int)(" + index + "), (varying " + type +
+  return std::string(bo->getOpcode() == BO_Assign ? "crt_store_last(" : "crt_add_lanes(") + array + ", (varying int)(" + index + "), (varying " + type +
          ")(" + Expr(bo->getRHS()) + "))";
 }
 
