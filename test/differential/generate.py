@@ -96,6 +96,13 @@ class Gen:
                 line = f"m_i[i] = {self.iexpr(3, ileaves)} & 1023;"
             elif kind == "Sum":
                 line = f"m_sum += {clamp(self.fexpr(2, fleaves))};"
+            elif kind == "First":  # one thread writes an element at a constant index (ISPC: a per-lane value at a shared index)
+                j, c = r.randrange(self.n), r.randrange(self.n)
+                if r.random() < 0.5:
+                    value = clamp("m_b[i] * 0.5f + " + self.fexpr(2, fleaves))  # m_b[i]: a value of the thread's own
+                    line = f"if (i == {j}) {self.pick('m_a', 'm_b')}[{c}] {self.pick('=', '+=')} {value};"
+                else:
+                    line = f"if (i == {j}) m_i[{c}] = (i + {self.iexpr(2, ileaves)}) & 1023;"
             elif kind == "Count":
                 line = f"m_count += ({self.iexpr(2, ileaves)} % {r.randint(2, 5)} == 0) ? 1 : 0;"
             elif kind == "Max":
@@ -159,7 +166,7 @@ class Gen:
         for _ in range(r.randint(2, 5)):
             s = r.randrange(10)
             if s <= 2:
-                kind = self.pick("Map", "Map", "Int", "Sum", "Max", "Hist", "Grid")
+                kind = self.pick("Map", "Map", "Int", "Sum", "Max", "Hist", "Grid", "First")
                 if self.rm.random() < 0.3:
                     kind = "Mode"
                 body.append(grid_call() if kind == "Grid" else call(kind))

@@ -1,5 +1,7 @@
 #include "first_thread.h"
 
+#include <algorithm>
+
 using LiteMath::float2;
 using LiteMath::float3;
 
@@ -48,6 +50,7 @@ void FirstThread::kernel1D_Run(int n, const float* a_in, float* a_out)
       a_out[1] += v.y;
       m_firsts[0] = v.x * v.y;
       m_firsts[3] = float(numSamples) + v.y;
+      m_firsts[2] += std::min(v.x, 0.5f * v.y);  // (std::min's references: a statement with cleanups)
     }
   }
 }

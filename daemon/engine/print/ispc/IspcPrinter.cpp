@@ -288,7 +288,9 @@ std::string IspcPrinter::SharedIndexStore(const BinaryOperator* bo) {
   const clang::Expr* target = bo->getLHS()->IgnoreParenImpCasts();
   const auto glsl = GlslTypeOf(target->getType().getUnqualifiedType());
   if (!glsl || (*glsl != "float" && *glsl != "int" && *glsl != "uint" && *glsl != "double") || Uniform(bo->getRHS())) return "";
-  auto parents = m_ctx.getParents(*static_cast<const clang::Stmt*>(bo));  // a statement of its own: its value is not used
+  // A statement of its own (its value is not used), with any temporaries' cleanups (std::min's).
+  auto parents = m_ctx.getParents(*static_cast<const clang::Stmt*>(bo));
+  while (parents.size() == 1 && parents[0].get<ExprWithCleanups>()) parents = m_ctx.getParents(*parents[0].get<ExprWithCleanups>());
   if (parents.size() != 1 || parents[0].get<clang::Expr>() || !parents[0].get<clang::Stmt>()) return "";
   std::string array, index;
   if (auto* as = dyn_cast<ArraySubscriptExpr>(target)) {
