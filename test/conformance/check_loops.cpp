@@ -163,8 +163,6 @@ Register localTotals(MakeCase<LocalTotals>(
     }));
 #endif
 
-}  // namespace
-
 #if __has_include("FirstThread_CPU.h")
 Register firstThread(MakeCase<FirstThread>(
     "one thread writing elements at constant indices (if (i == 0) a_out[0] = v.x), a const local in a cast, a const array parameter",
@@ -177,3 +175,5 @@ Register firstThread(MakeCase<FirstThread>(
       return r;
     }));
 #endif
+
+}  // namespace

@@ -1,9 +1,9 @@
 // Three things kernel_slicer's samples write that the ISPC backend once printed as code ISPC does
-// not compile: one thread writing buffer elements at constant indices (`if (i == 0) a_out[0] =
-// v.x;`, its test of constructors; here also through row pointers, a shared one and one per thread),
-// a const local with a constant value in a cast
-// (`float(numSamples)`, its shadow sample), and a helper's `const float lo[3]` given a const local
-// struct's array field (its BVH walk).
+// not compile: one thread writing elements at constant indices (`if (i == 0) a_out[0] = v.x;`, its
+// test of constructors; here also into a member vector, with += and std::min, and through row
+// pointers, one every thread shares and one per thread), a const local with a constant value in a
+// cast (`float(numSamples)`, its shadow sample), and a helper's `const float lo[3]` given a const
+// local struct's array field (its BVH walk).
 #pragma once
 #include "LiteMath.h"
 
