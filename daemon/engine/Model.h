@@ -45,6 +45,7 @@ struct Member {
   bool appendedByKernels = false;  // vector: kernels push_back to it (its size counts on the GPU)
   bool inClassData = false;     // plain: accessible, and its C++ layout matches std430
   unsigned std430Align = 4;     // plain: alignment in a std430 block
+  bool padded3 = false;         // plain: an array of LiteMath 3-vectors, held as 4-vectors in the class data (IsArrayOf3Vectors)
   bool specialized = false;     // plain: CRT_SPECIALIZE (Specialize.h), a specialization constant in GLSL
   // texture array: kernel_slicer's ICombinedImageSampler pointers (a vector of them, or one: `singleTexture`),
   // whose texels the generated class gets as float4 textures (LiteImage::TexturesOf)

@@ -1,7 +1,6 @@
 // Elements of a member array reduced in a kernel, as kernel_slicer's spherical-harmonics sample
-// writes them (coefs[0] += color; ... coefs[8] += ...): the CPU backend reduces them as written, in
-// an OpenMP array section (test/equivalence/test_array_reductions.cpp). GPU and ISPC kernels reduce
-// whole members: there it is a diagnostic.
+// writes them (coefs[0] += color; ... coefs[8] += ...), in a 2D loop nest: every backend reduces
+// them (test/equivalence/test_array_reductions.cpp).
 #pragma once
 #include "LiteMath.h"
 

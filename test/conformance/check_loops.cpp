@@ -19,6 +19,13 @@
 #include "FirstThread_ISPC.h"
 #endif
 #endif
+#if __has_include("ElementTotals_CPU.h")
+#include "ElementTotals_CPU.h"
+#include "ElementTotals_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "ElementTotals_ISPC.h"
+#endif
+#endif
 #if __has_include("HalfSum_CPU.h")
 #include "HalfSum_CPU.h"
 #include "HalfSum_Vulkan.h"
@@ -172,6 +179,28 @@ Register firstThread(MakeCase<FirstThread>(
       f.Run(int(in.size()), in.data(), out.data());
       Outputs r(out.begin(), out.end());
       r.insert(r.end(), f.m_firsts.begin(), f.m_firsts.end());
+      return r;
+    }));
+#endif
+
+#if __has_include("ElementTotals_CPU.h")
+Register elementTotals(MakeCase<ElementTotals>(
+    "elements of member arrays reduced: at constant indices (m_moments[3] += c * d.x), at a computed one (m_bins[bin] += 1), with std::min",
+    "element_totals.h/.cpp", 1e-5, CONFORMANCE_MAKERS(ElementTotals), [](ElementTotals& t) {
+      const int n = 1500;  // several workgroups and chunks
+      std::vector<float4> samples(n);
+      for (int i = 0; i < n; ++i)
+        samples[i] = float4(std::sin(0.37f * float(i)), std::cos(0.11f * float(i)), float(i % 5) * 0.25f - 0.5f, float((i * 37) % 101) / 101.0f);
+      for (int k = 0; k < ElementTotals::kMoments; ++k)
+        t.m_moments[k] = float3(-9.0f);  // the kernel sets them up itself
+      t.m_count = 77;
+      t.Measure(n, samples.data());
+      Outputs r;
+      for (auto& m : t.m_moments) Append(r, std::vector<float>{m.x, m.y, m.z});
+      Append(r, std::vector<float>(std::begin(t.m_bins), std::end(t.m_bins)));
+      r.push_back(float(t.m_least[0]));
+      r.push_back(float(t.m_least[1]));
+      r.push_back(float(t.m_count));
       return r;
     }));
 #endif

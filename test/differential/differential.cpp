@@ -43,6 +43,7 @@ std::vector<Value> Outputs(T& c) {
   std::sort(found.begin(), found.end());
   out.push_back({"m_found.size()", double(found.size()), true});
   for (size_t i = 0; i < found.size(); ++i) out.push_back({"sorted m_found[" + std::to_string(i) + "]", double(found[i]), true});
+  for (int i = 0; i < 4; ++i) out.push_back({"m_bins[" + std::to_string(i) + "]", c.m_bins[i], false});
   out.push_back({"m_sum", c.m_sum, false});
   out.push_back({"m_max", c.m_max, false});
   out.push_back({"m_scale", c.m_scale, false});

@@ -2,8 +2,9 @@
 """Random small classes for CrossRT's differential tester.
 
 Each seed gives one class in the supported subset, written as a user writes one: member vectors,
-kernel1D_ loop nests (maps, integer maps, reductions into members, appends, atomic adds into a
-member vector, a member's data() to a kernel) and kernel2D_ nests, and a control function whose host code sits between the kernel calls: member writes,
+kernel1D_ loop nests (maps, integer maps, reductions into members and into elements of a member
+array, appends, atomic adds into a member vector, a member's data() to a kernel) and kernel2D_
+nests, and a control function whose host code sits between the kernel calls: member writes,
 swaps of member vectors, member vectors' elements read and written, loops that stop early on a
 counter the kernels reduce, and a tail that reads the results. Some kernels declare locals that
 shadow their parameters. A CRT_SPECIALIZE member (m_mode),
@@ -113,6 +114,12 @@ class Gen:
                 c = self.rm.randint(0, 3)
                 line = (f"{self.pick('m_a', 'm_b')}[i] = m_mode == {c} ? {clamp(self.fexpr(2, fleaves))} : "
                         f"(m_mode > {c} ? {clamp(self.fexpr(2, fleaves))} : float(m_mode) * 0.5f);")
+            elif kind == "Bins":  # elements of a member array reduced: a constant index or one the thread computes
+                at = self.pick(str(r.randrange(4)), f"({self.iexpr(2, ileaves)} & 1023) % 4")
+                if r.random() < 0.7:
+                    line = f"m_bins[{at}] {self.pick('+=', '-=')} {clamp(self.fexpr(2, fleaves))};"
+                else:
+                    line = f"m_bins[{at}] = std::{self.pick('min', 'max')}(m_bins[{at}], {clamp(self.fexpr(2, fleaves))});"
             elif kind == "Hist":
                 line = f"InterlockedAdd(m_hist[({self.iexpr(2, ileaves)} & 1023) % 8], {self.pick('1', 'a_p', 'm_i[i] % 5')});"
             lines = [line]
@@ -166,7 +173,7 @@ class Gen:
         for _ in range(r.randint(2, 5)):
             s = r.randrange(10)
             if s <= 2:
-                kind = self.pick("Map", "Map", "Int", "Sum", "Max", "Hist", "Grid", "First")
+                kind = self.pick("Map", "Map", "Int", "Sum", "Max", "Hist", "Grid", "First", "Bins")
                 if self.rm.random() < 0.3:
                     kind = "Mode"
                 body.append(grid_call() if kind == "Grid" else call(kind))
@@ -235,6 +242,7 @@ public:
   std::vector<int> m_i;
   std::vector<int> m_found;
   std::vector<int> m_hist = std::vector<int>(8, 0);
+  float m_bins[4] = {0.0f, 1.0f, -2.0f, 0.5f};
   float m_sum = 0.0f, m_max = -1000.0f, m_scale = 1.0f, m_total = 0.0f;
   int m_count = 0, m_k = 1, m_rounds = 0;
   CRT_SPECIALIZE int m_mode = {self.mode};

@@ -57,7 +57,7 @@ void FinishModel(ClassModel& model) {
   std::vector<BlockField> fields;
   for (auto& m : model.members)
     if (m.kind == MemberKind::Plain && m.inClassData && (m.usedByKernels || m.hostExpr == m.name))
-      fields.push_back({m.name, m.cppType, m.glslType, m.std430Align, m.hostExpr, ""});
+      fields.push_back({m.name, m.padded3 ? m.cppType.substr(0, m.cppType.size() - 1) + "4" : m.cppType, m.glslType, m.std430Align, m.hostExpr, ""});
   for (auto& m : model.members) {
     if (!m.usedByKernels || m.kind != MemberKind::Vector) continue;
     fields.push_back({generated::SizeField(m.name), "uint32_t", "uint", 4, "", ""});

@@ -25,6 +25,10 @@ using namespace clang;
 
 namespace crossrt::engine {
 
+// The most bytes of a member array whose elements one kernel reduces on the GPU (float coefs[64],
+// float3 coefs[16]): each thread holds them, and each workgroup 64 copies in shared memory.
+constexpr unsigned kMaxReducedArrayBytes = 256;
+
 // A reduction's type: GLSL's, or on ISPC also double (a sum of doubles stays double there).
 static std::string ReductionType(Context& c, QualType t) {
   if (c.model.forIspc && t.getCanonicalType()->isSpecificBuiltinType(BuiltinType::Double)) return "double";
@@ -53,7 +57,10 @@ static std::string IspcThreadHead(Context& c, const Kernel& k, const std::vector
     if (p.isPointer) head += std::string(", ") + (p.isConstPointee ? "const " : "") + "uniform " + base + " *uniform " + p.glslName;
     else head += ", uniform " + base + " " + p.glslName + dims;
   }
-  for (auto& r : k.reductions) head += ", " + IspcTypeName(r.glslType) + " &" + generated::ReductionLocal(r.member);
+  for (auto& r : k.reductions) {  // a member array's elements: the lane's array (ISPC passes it by pointer)
+    const auto [base, dims] = SplitArray(IspcTypeName(r.glslType));
+    head += ", " + base + (dims.empty() ? " &" : " ") + generated::ReductionLocal(r.member) + dims;
+  }
   return head + ")";
 }
 
@@ -179,14 +186,15 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     }
   } else {
     // kernelND_: optional declarations, then N perfectly nested loops.
-    // [statements before] N perfectly nested loops [statements after]: the first for loop of the
-    // body is the nest; what comes before and after it (the paper's loop_start and loop_end) runs
-    // on one thread. The declarations before it are also evaluated by every thread.
-    const ForStmt* outer = nullptr;
+    // [statements before] N perfectly nested loops [statements after]: the body's first for loop
+    // to a bound that is not a constant is the nest (KernelLoopNest); what comes before and after
+    // it (the paper's loop_start and loop_end) runs on one thread. The declarations before it are
+    // also evaluated by every thread.
+    const ForStmt* outer = KernelLoopNest(c.ctx, body);
+    bool past = false;
     for (auto* s : body->body()) {
-      if (isa<NullStmt>(s)) continue;
-      if (!outer && isa<ForStmt>(s)) outer = cast<ForStmt>(s);
-      else (outer ? after : before).push_back(s);
+      if (isa<NullStmt>(s) || s == outer) past |= s == outer;
+      else (past ? after : before).push_back(s);
     }
     if (!outer) {
       c.rep.Error(md->getLocation(), "kernel '" + k.name + "' has no loop", "a kernel" + std::to_string(k.dims) + "D_ function holds " + std::to_string(k.dims) + " nested for loops whose iterations become GPU threads");
@@ -336,7 +344,17 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     r.member = field->getNameAsString();
     r.op = op;
     r.glslType = ReductionType(c, field->getType());
-    r.identity = Identity(op, r.glslType);
+    r.identity = Identity(op, SplitArray(r.glslType).first);  // of one element, for a member array's elements
+    // A member array's elements (coefs[k] += x): every GPU thread holds a copy of the array, and each
+    // workgroup one per subgroup in shared memory (templates/glsl/kernel.comp), up to 16 KiB.
+    if (const std::string elements = SplitArray(r.glslType).second; !elements.empty() && !c.model.forIspc) {
+      const unsigned count = unsigned(std::stoul(elements.substr(1))), bytes = count * Std430VectorStride(SplitArray(r.glslType).first);
+      if (bytes > kMaxReducedArrayBytes)
+        c.rep.GpuError(ws.reductionSites.count(field) ? ws.reductionSites.at(field) : field->getLocation(),
+                       "kernel '" + k.name + "' reduces the " + std::to_string(count) + " elements of member array '" + r.member + "' (" +
+                           std::to_string(bytes) + " bytes; a GPU thread holds at most " + std::to_string(kMaxReducedArrayBytes) + ")",
+                       "count into a std::vector member with LiteMath's InterlockedAdd (atomics), or reduce fewer elements per kernel");
+    }
     printer.renames[field] = generated::ReductionLocal(r.member);
     k.reductions.push_back(r);
   }
@@ -583,9 +601,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
         return true;
       }
     } constants(rw, c.ctx);
-    const ForStmt* outer = nullptr;
-    for (auto* s : body->body())
-      if ((outer = dyn_cast<ForStmt>(s))) break;
+    const ForStmt* outer = KernelLoopNest(c.ctx, body);
     renamer.TraverseStmt(const_cast<ForStmt*>(outer));
     for (auto* list : {&before, &after})
       for (auto* st : *list) constants.TraverseStmt(const_cast<Stmt*>(st));

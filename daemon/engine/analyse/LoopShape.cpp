@@ -35,6 +35,18 @@ std::string LoopShapeProblem(ASTContext& ctx, const ForStmt* fs, LoopHeader& h) 
   return "";
 }
 
+const ForStmt* KernelLoopNest(ASTContext& ctx, const CompoundStmt* body) {
+  const ForStmt* first = nullptr;
+  for (auto* s : body->body()) {
+    auto* fs = dyn_cast<ForStmt>(s);
+    if (!fs) continue;
+    if (!first) first = fs;
+    auto* cond = dyn_cast_or_null<BinaryOperator>(fs->getCond() ? fs->getCond()->IgnoreImplicit() : nullptr);
+    if (!cond || cond->getRHS()->isValueDependent() || !cond->getRHS()->isIntegerConstantExpr(ctx)) return fs;
+  }
+  return first;
+}
+
 bool ParseLoop(Context& c, const ForStmt* fs, LoopHeader& h, const std::string& kernel) {
   const std::string problem = LoopShapeProblem(c.ctx, fs, h);
   if (problem.empty()) return true;

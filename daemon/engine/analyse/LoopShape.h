@@ -23,6 +23,11 @@ bool CheckLoopEnds(Context& c, const std::string& kernel, const std::vector<cons
                    const std::vector<const Stmt*>& after, const Stmt* threadBody, const std::set<const Expr*>& reductionTargets,
                    const std::set<const Stmt*>& settingLocals);
 
+// The loop nest of a kernelND_ body: its first top-level `for` whose end is not a constant (a loop
+// over kMoments zeroing an array before the nest is a statement before it, run by one thread), or
+// its first `for` where every end is a constant. Null when the body has no `for`.
+const ForStmt* KernelLoopNest(ASTContext& ctx, const CompoundStmt* body);
+
 struct LoopHeader {
   const VarDecl* var = nullptr;
   const Expr* start = nullptr;

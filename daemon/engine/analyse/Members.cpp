@@ -15,8 +15,16 @@ using namespace clang;
 
 namespace crossrt::engine {
 
+bool IsArrayOf3Vectors(QualType t) {
+  auto* arr = dyn_cast<ConstantArrayType>(t.getCanonicalType().getTypePtr());
+  if (!arr) return false;
+  QualType e = arr->getElementType().getCanonicalType();
+  return IsLiteMathType(e, "float3") || IsLiteMathType(e, "int3") || IsLiteMathType(e, "uint3");
+}
+
 bool FitsClassData(ASTContext& ctx, QualType t) {
   t = t.getCanonicalType();
+  if (IsArrayOf3Vectors(t)) return true;
   if (IsLiteMathType(t)) return !IsLiteMathType(t, "float3x3");
   if (t->isBuiltinType() || t->isEnumeralType()) return Std430Layout(ctx, t, false).has_value();
   return LayoutMatchesCpp(ctx, t, false);
@@ -110,6 +118,7 @@ void AnalyzeMembers(Context& c) {
       QualType base = f->getType();
       while (auto* arr = dyn_cast<ConstantArrayType>(base.getCanonicalType().getTypePtr())) base = arr->getElementType();
       m.cppType = CppTypeName(c.ctx, base);
+      m.padded3 = IsArrayOf3Vectors(f->getType());
       m.inClassData = f->getAccess() != AS_private && (*g == "double" || FitsClassData(c.ctx, f->getType()));  // ISPC's double: as in C++
       if (auto layout = Std430Layout(c.ctx, f->getType(), false)) m.std430Align = unsigned(layout->align);
       if (m.inClassData) structs.Type(f->getType(), f->getLocation());

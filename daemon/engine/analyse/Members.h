@@ -7,8 +7,12 @@
 namespace crossrt::engine {
 
 // A single member of the class-data block: the C++ mirror declares it with alignas(std430
-// alignment), so a lone float3 matches; float3x3, bool and arrays of float3 do not.
+// alignment), so a lone float3 matches; float3x3 and bool do not. Arrays of float3 are held as
+// arrays of float4 (IsArrayOf3Vectors).
 bool FitsClassData(ASTContext& ctx, QualType t);
+// A one-dimensional array of LiteMath 3-vectors (float3 coefs[9]): 12 bytes an element in C++, 16
+// in std430. The class data holds it as 4-vectors, copied element by element.
+bool IsArrayOf3Vectors(QualType t);
 
 // A CRT_SPECIALIZE member's type is one a specialization constant can hold (else an error at it).
 bool CheckSpecialized(Reporter& rep, const FieldDecl* f);

@@ -18,6 +18,7 @@ struct WriteScanner : RecursiveASTVisitor<WriteScanner> {
   Context& c;
   std::map<const FieldDecl*, ReduceOp> reductions;
   std::set<const MemberExpr*> reductionUses;  // member references that belong to a reduction statement
+  std::map<const FieldDecl*, SourceLocation> reductionSites;  // the first reduction of a member array's elements
   std::set<const FieldDecl*> vectorWrites;
   std::set<const FieldDecl*> atomicMembers;  // plain data members written by crossrt::Atomic*
   const FunctionDecl* helper = nullptr;  // scanning a helper's body: reductions are not allowed there
@@ -74,19 +75,14 @@ struct WriteScanner : RecursiveASTVisitor<WriteScanner> {
                   "accumulate in the kernel's loop body (m += x, min, max), or return the value from the helper");
       return;
     }
-    if (auto* element = op && !direct ? ConstantElement(lhs, root) : nullptr) {  // coefs[2] += x: an element of a member array
-      if (!c.model.forCpu || c.model.forIspc) {
-        c.rep.Error(loc, "kernel reduces elements of member array '" + root->getNameAsString() + "' (" + root->getNameAsString() + "[k] += x)",
-                    std::string("the CPU backend reduces them as written; ") + (c.model.forIspc ? "ISPC" : "GPU") +
-                    " kernels reduce whole members: reduce each element in a member of its own (m_coef0 += x), or a local declared before the loop");
-        return;
-      }
+    if (auto* element = op && !direct ? ReducedElement(lhs, root) : nullptr) {  // coefs[2] += x, bins[b] += 1: elements of a member array
       auto [it, fresh] = reductions.emplace(root, *op);
       if (!fresh && it->second != *op)
         c.rep.Error(loc, "member '" + root->getNameAsString() + "' is reduced with two different operations in one kernel",
                     "use one of +=, -=, min or max per member");
       reductionUses.insert(element);
       for (auto* u : uses) reductionUses.insert(u);
+      reductionSites.emplace(root, loc);
       return;
     }
     if (op && direct) {
@@ -100,12 +96,12 @@ struct WriteScanner : RecursiveASTVisitor<WriteScanner> {
     c.rep.Error(loc, "kernel writes class member '" + root->getNameAsString() + "' from every thread (a data race)",
                 "accumulate with 'm += x', 'm = std::min(m, x)' or 'm = std::max(m, x)' (a reduction), or write to an element of a std::vector member");
   }
-  // `arr[K]` with K a constant and arr the one-dimensional array member `root`: arr's MemberExpr.
-  const MemberExpr* ConstantElement(const Expr* lhs, const FieldDecl* root) const {
+  // `arr[k]` with arr the one-dimensional array member `root` (k a constant, or any index a thread
+  // computes): arr's MemberExpr. Each thread reduces into an array of its own.
+  const MemberExpr* ReducedElement(const Expr* lhs, const FieldDecl* root) const {
     auto* as = dyn_cast<ArraySubscriptExpr>(lhs->IgnoreParenImpCasts());
     auto* me = as ? AsThisMember(as->getBase()) : nullptr;
-    Expr::EvalResult r;
-    if (!me || me->getMemberDecl() != root || !as->getIdx()->EvaluateAsInt(r, c.ctx)) return nullptr;
+    if (!me || me->getMemberDecl() != root) return nullptr;
     auto* arr = dyn_cast<ConstantArrayType>(root->getType().getCanonicalType().getTypePtr());
     return arr && !isa<ArrayType>(arr->getElementType().getCanonicalType().getTypePtr()) ? me : nullptr;
   }
@@ -151,6 +147,22 @@ struct WriteScanner : RecursiveASTVisitor<WriteScanner> {
         uses.push_back(me);
         return isMin ? ReduceOp::Min : ReduceOp::Max;
       }
+    // m_lo[k] = std::min(m_lo[k], x): the same element of a member array on both sides.
+    auto* element = dyn_cast<ArraySubscriptExpr>(lhs->IgnoreParenImpCasts());
+    auto* array = element ? AsThisMember(element->getBase()) : nullptr;
+    if (!array) return std::nullopt;
+    llvm::FoldingSetNodeID written;
+    element->Profile(written, c.ctx, true);
+    for (auto* arg : call->arguments()) {
+      auto* read = dyn_cast<ArraySubscriptExpr>(arg->IgnoreParenImpCasts());
+      auto* me = read ? AsThisMember(read->getBase()) : nullptr;
+      if (!me || me->getMemberDecl() != array->getMemberDecl()) continue;
+      llvm::FoldingSetNodeID same;
+      read->Profile(same, c.ctx, true);
+      if (same != written) continue;
+      uses.push_back(me);
+      return isMin ? ReduceOp::Min : ReduceOp::Max;
+    }
     return std::nullopt;
   }
   // `m = constant;` of a scalar member from the threads (kernel_slicer's flags: m_found = 1): every

@@ -227,6 +227,11 @@ std::string ReductionCppType(const ClassModel& model, const Reduction& r) {
   return m ? m->cppType : "float";
 }
 
+std::string ReductionElements(const Reduction& r) {
+  const std::string dims = SplitArray(r.glslType).second;
+  return dims.empty() ? "" : dims.substr(1, dims.size() - 2);
+}
+
 namespace {
 
 Data ClassDataList(const ClassModel& model) {
@@ -241,7 +246,8 @@ Data ClassDataList(const ClassModel& model) {
     d.set("align", std::to_string(f.std430Align));
     d.set("decl", base + " " + f.name + dims);
     auto* m = FindMember(model, f.name);
-    d.set("isPlain", m != nullptr);
+    d.set("isPlain", m != nullptr && !m->padded3);
+    d.set("isPadded", m != nullptr && m->padded3);  // 3-vectors held as 4-vectors: copied element by element
     d.set("computed", !f.assignExpr.empty());
     d.set("assignExpr", f.assignExpr);
     d.set("written", m != nullptr && m->writtenByKernels);

@@ -34,13 +34,15 @@ std::string IspcIdentity(ReduceOp op, const std::string& glslType) {
   return IsScalar(glslType) ? scalar : "make_" + t + "(" + scalar + ")";
 }
 
-// The lanes' accumulators reduced to one uniform value, component by component, into *partial.
-std::string IspcLaneReduce(ReduceOp op, const std::string& glslType, const std::string& v, const std::string& partial) {
+// The lanes' accumulators reduced to one uniform value, component by component, into *partial (or,
+// with `element`, into the lvalue `partial`; the lines joined by `newline`).
+std::string IspcLaneReduce(ReduceOp op, const std::string& glslType, const std::string& v, const std::string& partial,
+                           const std::string& newline = "\n  ", bool element = false) {
   const std::string f = op == ReduceOp::Min ? "reduce_min" : op == ReduceOp::Max ? "reduce_max" : "reduce_add";
-  if (IsScalar(glslType)) return "*" + partial + " = " + f + "(" + v + ");";
+  if (IsScalar(glslType)) return (element ? "" : "*") + partial + " = " + f + "(" + v + ");";
   const int n = IspcTypeName(glslType).back() - '0';
   std::string out;
-  for (int i = 0; i < n; ++i) out += std::string(i ? "\n  " : "") + partial + "->" + "xyzw"[i] + " = " + f + "(" + v + "." + "xyzw"[i] + ");";
+  for (int i = 0; i < n; ++i) out += std::string(i ? newline : "") + partial + (element ? "." : "->") + "xyzw"[i] + " = " + f + "(" + v + "." + "xyzw"[i] + ");";
   return out;
 }
 
@@ -125,13 +127,22 @@ std::string GenerateIspcKernels(const ClassModel& model, const GenerateOptions& 
     }
     Data reds = List();
     for (auto& r : k.reductions) {
-      params += ", uniform " + IspcTypeName(r.glslType) + " *uniform " + generated::ReductionPartials(r.member);
-      args += ", " + generated::ReductionLocal(r.member);
+      const auto [base, dims] = SplitArray(IspcTypeName(r.glslType));
+      const std::string local = generated::ReductionLocal(r.member), partials = generated::ReductionPartials(r.member);
+      const std::string elements = ReductionElements(r), baseGlsl = SplitArray(r.glslType).first;
+      params += ", uniform " + base + " *uniform " + partials;
+      args += ", " + local;
       Data y;
-      y.set("member", r.member);
-      y.set("type", IspcTypeName(r.glslType));
-      y.set("identity", IspcIdentity(r.op, r.glslType));
-      y.set("reduced", IspcLaneReduce(r.op, r.glslType, generated::ReductionLocal(r.member), generated::ReductionPartials(r.member)));
+      if (elements.empty()) {
+        y.set("declare", base + " " + local + " = " + IspcIdentity(r.op, r.glslType) + ";");
+        y.set("reduced", IspcLaneReduce(r.op, r.glslType, local, partials));
+      } else {  // the elements of a member array (coefs[k] += x): an array a lane, reduced element by element
+        const std::string each = "for (uniform int crt_e = 0; crt_e < " + elements + "; ++crt_e)";
+        y.set("declare", base + " " + local + "[" + elements + "];  // this lane's part of each element of " + r.member + "\n  " + each +
+                             "\n    " + local + "[crt_e] = " + IspcIdentity(r.op, baseGlsl) + ";");
+        y.set("reduced", each + (IsScalar(baseGlsl) ? "\n    " : "\n  {\n    ") +
+                             IspcLaneReduce(r.op, baseGlsl, local + "[crt_e]", partials + "[crt_e]", "\n    ", true) + (IsScalar(baseGlsl) ? "" : "\n  }"));
+      }
       reds.push_back(y);
     }
     x.set("params", innerParams + params);
@@ -231,15 +242,24 @@ void IspcHostData(const ClassModel& model, Data& d) {
     }
     Data reds = List();
     for (auto& r : k.reductions) {
-      const std::string cppType = ReductionCppType(model, r);
-      args += ", crossrt::IspcPointer<" + IspcCppType(r.glslType) + "*>(&" + generated::ReductionPartials(r.member) + "[crt_chunk])";
+      // A member array's elements (coefs[k] += x): each chunk's partials are elements of their own.
+      const std::string cppType = ReductionCppType(model, r), elements = ReductionElements(r), baseGlsl = SplitArray(r.glslType).first;
+      const std::string partials = generated::ReductionPartials(r.member);
+      args += ", crossrt::IspcPointer<" + IspcCppType(baseGlsl) + "*>(&" + partials + "[crt_chunk" + (elements.empty() ? "" : " * " + elements) + "])";
       Data y;
       y.set("member", r.member);
       y.set("cppType", cppType);
-      const char* ns = IsScalar(r.glslType) ? "std::" : "LiteMath::";
-      y.set("fold", r.op == ReduceOp::Min   ? std::string(ns) + "min(" + r.member + ", partial)"
-                    : r.op == ReduceOp::Max ? std::string(ns) + "max(" + r.member + ", partial)"
-                                            : r.member + " + partial");
+      y.set("partialCount", elements.empty() ? "crt_chunks" : "crt_chunks * " + elements);
+      const std::string target = elements.empty() ? r.member : r.member + "[crt_at % " + elements + "]";
+      const std::string partial = elements.empty() ? "partial" : partials + "[crt_at]";
+      y.set("foldHead", elements.empty() ? "for (const auto& partial : " + partials + ")"
+                                         : "for (size_t crt_at = 0; crt_at < " + partials + ".size(); ++crt_at)  // chunk crt_at / " + elements +
+                                               ", element crt_at % " + elements);
+      y.set("target", target);
+      const char* ns = IsScalar(baseGlsl) ? "std::" : "LiteMath::";
+      y.set("fold", r.op == ReduceOp::Min   ? std::string(ns) + "min(" + target + ", " + partial + ")"
+                    : r.op == ReduceOp::Max ? std::string(ns) + "max(" + target + ", " + partial + ")"
+                                            : target + " + " + partial);
       reds.push_back(y);
     }
     // Plain members the kernels write (atomics among them) go back from the ISPC class data after

@@ -222,24 +222,35 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
     buffers.push_back(b);
   }
   Data reductions = List();
+  bool anyWhole = false;
   for (auto& r : k.reductions) {
+    // A member array's elements (coefs[k] += x): each thread an array, each workgroup a partial
+    // result per element (partials[group * elements + element]).
+    const std::string elements = ReductionElements(r), type = SplitArray(r.glslType).first;
+    anyWhole |= elements.empty();
     Data b;
     b.set("layout", "std430");
     b.set("binding", std::to_string(binding++));
     b.set("access", r.local ? "" : "writeonly ");  // a local's total is read back after the nest
     b.set("blockName", generated::BlockName(r.member + "Partials"));  // crt_<member>PartialsBuffer
-    b.set("type", r.glslType);
+    b.set("type", type);
     b.set("name", generated::ReductionPartials(r.member));
-    b.set("comment", "per-workgroup partial results of the reduction of " + std::string(r.local ? "local " : "") + r.member);
+    b.set("comment", "per-workgroup partial results of the reduction of " + std::string(r.local ? "local " : "") + r.member +
+                         (elements.empty() ? "" : ", " + elements + " elements a workgroup"));
     buffers.push_back(b);
     Data x;
-    x.set("type", r.glslType);
+    x.set("type", type);
     x.set("member", r.member);
     x.set("identity", r.identity);
-    x.set("combineGroup", Combine(r.op, generated::ReductionGroup(r.member), generated::ReductionShared(r.member) + "[s]"));
+    x.set("whole", elements.empty());
+    x.set("isArray", !elements.empty());
+    x.set("elements", elements);
+    const std::string group = generated::ReductionGroup(r.member), shared = generated::ReductionShared(r.member);
+    x.set("combineGroup", Combine(r.op, group, shared + (elements.empty() ? "[s]" : "[crt_e * (" + std::to_string(shape.x * shape.y * shape.z) + " / 4) + s]")));
     x.set("subgroupOp", r.op == ReduceOp::Min ? "subgroupMin" : r.op == ReduceOp::Max ? "subgroupMax" : "subgroupAdd");
     reductions.push_back(x);
   }
+  d.set("anyWholeReductions", anyWhole);
   // Images and samplers follow the buffers (the host pushes them in this order).
   Data images = List();
   for (auto& ib : k.images) {
@@ -472,20 +483,26 @@ std::string ReduceGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   Data reductions = List();
   unsigned binding = 1;
   for (auto& r : k.reductions) {
+    const std::string elements = ReductionElements(r);
     Data x;
-    x.set("type", r.glslType);
+    x.set("type", SplitArray(r.glslType).first);
     x.set("member", r.member);
     x.set("identity", r.identity);
     x.set("binding", std::to_string(binding++));
+    x.set("whole", elements.empty());
+    x.set("isArray", !elements.empty());  // a member array's elements (coefs[k] += x), one after another
+    x.set("elements", elements);
     const std::string shared = generated::ReductionShared(r.member);
     x.set("combineShared", Combine(r.op, shared + "[local]", shared + "[local + stride]"));
-    x.set("combinePartial", Combine(r.op, generated::ReductionLocal(r.member), generated::ReductionPartials(r.member) + "[i]"));
-    x.set("combineMember", Combine(r.op, r.member, shared + "[0]"));
+    x.set("combinePartial", Combine(r.op, generated::ReductionLocal(r.member),
+                                    generated::ReductionPartials(r.member) + (elements.empty() ? "[i]" : "[i * " + elements + "u + crt_e]")));
+    x.set("combineMember", Combine(r.op, r.member + (elements.empty() ? "" : "[crt_e]"), shared + "[0]"));
     x.set("local", r.local);  // its total goes to element 0 of its partials, for <kernel>_Finish
     x.set("access", r.local ? "" : "readonly ");
     reductions.push_back(x);
   }
   d.set("reductions", reductions);
+  d.set("anyWholeReductions", std::any_of(k.reductions.begin(), k.reductions.end(), [](const Reduction& r) { return ReductionElements(r).empty(); }));
   d.set("usesInfinity", UsesInfinity(k));
   return Render(opt.templateDir + "/glsl/reduce.comp.mustache", d);
 }

@@ -380,9 +380,11 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
       Data y;
       y.set("kernel", k.name);
       y.set("member", r.member);
-      y.set("cppType", ReductionCppType(model, r));
-      // The GPU writes an std430 array: a vec3 element takes 16 bytes, not sizeof(float3).
-      y.set("partialStride", std::to_string(Std430VectorStride(r.glslType)));
+      // The GPU writes an std430 array: a vec3 element takes 16 bytes, not sizeof(float3). A member
+      // array's elements (coefs[k] += x) take as many a workgroup as the array has.
+      const std::string elements = ReductionElements(r);
+      y.set("cppType", ReductionCppType(model, r) + (elements.empty() ? "" : "[" + elements + "]"));
+      y.set("partialStride", std::to_string(Std430VectorStride(SplitArray(r.glslType).first)) + (elements.empty() ? "" : " * " + elements));
       y.set("groupCountExpr", GroupCountExpr(k));
       reds.push_back(y);
     }

@@ -44,7 +44,11 @@ const std::set<std::string>& GlslKeywords() {
       // ISPC's keywords and built-ins, for the ISPC dialect of the printer.
       "export", "task", "launch", "sync", "soa", "foreach", "foreach_tiled", "foreach_active", "foreach_unique", "programIndex",
       "programCount", "cif", "cfor", "cdo", "cwhile", "unmasked", "new", "delete", "int8", "int16", "int32", "int64", "uint8",
-      "uint16", "uint32", "uint64", "float16", "print"};
+      "uint16", "uint32", "uint64", "float16", "print",
+      // Macros ISPC 1.28 predefines: a constant named so (static constexpr float PI) would be replaced.
+      "PI", "FLT_MAX", "FLT_MIN", "DBL_MAX", "DBL_MIN", "F16_MAX", "F16_MIN", "INT8_MAX", "INT8_MIN", "INT16_MAX", "INT16_MIN",
+      "INT32_MAX", "INT32_MIN", "INT64_MAX", "INT64_MIN", "UINT8_MAX", "UINT16_MAX", "UINT32_MAX", "UINT64_MAX", "ISPC",
+      "TARGET_WIDTH", "TARGET_ELEMENT_WIDTH", "SizeType", "IntMaskType", "UIntMaskType", "UniformMaskType", "alloca", "assert"};
   return words;
 }
 
@@ -157,7 +161,7 @@ void KernelPrinter::NeedStruct(const RecordDecl* rd) {
 // Composed code's constants keep its holder's prefix; the namespace-scope constants that objects'
 // methods use are shared, as the free functions calling them are (a class's static members are not).
 std::string KernelPrinter::ConstantName(const VarDecl* vd) const {
-  return (selfClass && !vd->isStaticDataMember() ? "" : composedPrefix) + vd->getName().str();
+  return (selfClass && !vd->isStaticDataMember() ? "" : composedPrefix) + SafeName(vd->getName().str());
 }
 
 std::string KernelPrinter::NeedConstant(const VarDecl* vd) {

@@ -1,0 +1,50 @@
+#include "element_totals.h"
+
+#include <algorithm>
+
+using LiteMath::float3;
+using LiteMath::float4;
+
+// The bin of a value in [0, 1): kBins equal parts, the ends clamped.
+static int BinOf(float value)
+{
+  const int bin = int(value * float(ElementTotals::kBins));
+  return std::max(0, std::min(ElementTotals::kBins - 1, bin));
+}
+
+void ElementTotals::Measure(int n, const float4* a_samples)
+{
+  kernel1D_Measure(n, a_samples);
+}
+
+void ElementTotals::kernel1D_Measure(int n, const float4* a_samples)
+{
+  for (int k = 0; k < kMoments; ++k)
+    m_moments[k] = float3(0.0f);
+  for (int b = 0; b < kBins; ++b)
+    m_bins[b] = 0.0f;
+  m_least[0] = m_least[1] = 1000000;
+  m_count = 0;
+  for (int i = 0; i < n; ++i)
+  {
+    const float4 s = a_samples[i];
+    const float3 d = normalize(float3(s.x, s.y, s.z) + float3(0.0f, 0.0f, 2.0f));
+    const float3 colour = float3(s.w, 0.5f * s.w, 1.0f - s.w);
+    m_moments[0] += colour;
+    m_moments[1] += colour * d.y;
+    m_moments[2] += colour * d.z;
+    m_moments[3] += colour * d.x;
+    m_moments[4] += colour * d.x * d.y;
+    m_moments[5] += colour * d.y * d.z;
+    m_moments[6] += colour * (2.0f * d.z * d.z - d.x * d.x - d.y * d.y);
+    m_moments[7] += colour * d.x * d.z;
+    m_moments[8] += colour * (d.x * d.x - d.y * d.y);
+    m_bins[BinOf(s.w)] += 1.0f;
+    const int value = int(s.w * 1000.0f) + i % 7;
+    m_least[i % 2] = std::min(m_least[i % 2], value);
+    m_count += 1;
+  }
+  const float scale = 1.0f / float(std::max(n, 1));
+  for (int k = 0; k < kMoments; ++k)
+    m_moments[k] *= scale;
+}

@@ -1,0 +1,25 @@
+// Elements of member arrays reduced in a kernel loop: nine colour moments at constant indices, as
+// kernel_slicer's spherical harmonics write them (m_moments[0] += c; m_moments[1] += c * d.y; ...),
+// a histogram at an index each thread computes (m_bins[bin] += 1), the least value of each of two
+// classes (m_least[k] = std::min(m_least[k], v)), and a whole member reduced beside them.
+#pragma once
+#include "LiteMath.h"
+
+class ElementTotals
+{
+public:
+  static constexpr int kMoments = 9;
+  static constexpr int kBins = 6;
+
+  virtual ~ElementTotals() = default;
+  virtual void Measure(int n, const LiteMath::float4* a_samples [[size("n")]]);
+  virtual void CommitDeviceData() {}
+
+  LiteMath::float3 m_moments[kMoments];
+  float m_bins[kBins];
+  int m_least[2];
+  int m_count = 0;
+
+protected:
+  virtual void kernel1D_Measure(int n, const LiteMath::float4* a_samples);
+};
