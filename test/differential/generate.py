@@ -242,7 +242,7 @@ public:
   std::vector<int> m_i;
   std::vector<int> m_found;
   std::vector<int> m_hist = std::vector<int>(8, 0);
-  float m_bins[4] = {0.0f, 1.0f, -2.0f, 0.5f};
+  float m_bins[4] = {{0.0f, 1.0f, -2.0f, 0.5f}};
   float m_sum = 0.0f, m_max = -1000.0f, m_scale = 1.0f, m_total = 0.0f;
   int m_count = 0, m_k = 1, m_rounds = 0;
   CRT_SPECIALIZE int m_mode = {self.mode};
