@@ -185,7 +185,7 @@ Register firstThread(MakeCase<FirstThread>(
 
 #if __has_include("ElementTotals_CPU.h")
 Register elementTotals(MakeCase<ElementTotals>(
-    "elements of member arrays reduced: at constant indices (m_moments[3] += c * d.x), at a computed one (m_bins[bin] += 1), with std::min",
+    "elements of arrays reduced: members at constant indices (m_moments[3] += c * d.x), at a computed one (m_bins[bin] += 1), with std::min; locals",
     "element_totals.h/.cpp", 1e-5, CONFORMANCE_MAKERS(ElementTotals), [](ElementTotals& t) {
       const int n = 1500;  // several workgroups and chunks
       std::vector<float4> samples(n);
@@ -201,6 +201,8 @@ Register elementTotals(MakeCase<ElementTotals>(
       r.push_back(float(t.m_least[0]));
       r.push_back(float(t.m_least[1]));
       r.push_back(float(t.m_count));
+      Append(r, std::vector<float>(std::begin(t.m_spread), std::end(t.m_spread)));
+      Append(r, std::vector<float>(std::begin(t.m_highest), std::end(t.m_highest)));
       return r;
     }));
 #endif

@@ -1850,4 +1850,22 @@ TEST_CASE("Elements of a member array reduced in a kernel: every backend, and on
       REQUIRE(r.output.find("InterlockedAdd") != std::string::npos);
     }
   }
+  // A local array declared before the loop, reduced element by element: the same limit on the GPU.
+  TempClass local("LocalBins100", "#pragma once\nclass LocalBins100\n{\npublic:\n  virtual ~LocalBins100() = default;\n"
+                  "  virtual void Sum(int n, [[crossrt::size(\"n\")]] const float* a, [[crossrt::size(\"1\")]] float* a_out);\nprotected:\n"
+                  "  void kernel1D_Sum(int n, const float* a, float* a_out);\n};\n",
+                  "#include \"LocalBins100.h\"\nvoid LocalBins100::Sum(int n, const float* a, float* a_out) { kernel1D_Sum(n, a, a_out); }\n"
+                  "void LocalBins100::kernel1D_Sum(int n, const float* a, float* a_out)\n{\n  float bins[100] = {};\n"
+                  "  for (int i = 0; i < n; i++)\n    bins[i % 100] += a[i];\n  a_out[0] = bins[7];\n}\n");
+  for (const char* backend : {"cpu", "vulkan", "ispc"})
+  {
+    CommandResult r = RunCrossrt("translate --class LocalBins100 --backend " + std::string(backend) + " --out " + (local.dir / backend).string() +
+                                 " --source " + local.Source("LocalBins100") + " --templates " CROSSRT_SOURCE_DIR "/templates");
+    INFO(backend << ": " << r.output);
+    REQUIRE_FALSE(r.crashed);
+    REQUIRE(r.exitCode == (std::string(backend) == "vulkan" ? 1 : 0));
+    if (r.exitCode == 1)
+      REQUIRE(r.output.find("LocalBins100.cpp:5:9: error: kernel 'kernel1D_Sum' reduces the 100 elements of local array 'bins' (400 bytes") !=
+              std::string::npos);
+  }
 }

@@ -25,9 +25,19 @@ using namespace clang;
 
 namespace crossrt::engine {
 
-// The most bytes of a member array whose elements one kernel reduces on the GPU (float coefs[64],
-// float3 coefs[16]): each thread holds them, and each workgroup 64 copies in shared memory.
+// The most bytes of an array whose elements one kernel reduces on the GPU (float coefs[64], float3
+// coefs[16]): each thread holds them, and each workgroup 64 copies in shared memory (templates/glsl/
+// kernel.comp), up to 16 KiB. Past that, an error at `at` (the first reduction of a member's elements).
 constexpr unsigned kMaxReducedArrayBytes = 256;
+static void CheckReducedArraySize(Context& c, const Kernel& k, const Reduction& r, SourceLocation at) {
+  const auto [base, dims] = SplitArray(r.glslType);
+  if (dims.empty() || c.model.forIspc) return;
+  const unsigned count = unsigned(std::stoul(dims.substr(1))), bytes = count * Std430VectorStride(base);
+  if (bytes > kMaxReducedArrayBytes)
+    c.rep.GpuError(at, "kernel '" + k.name + "' reduces the " + std::to_string(count) + " elements of " + (r.local ? "local" : "member") + " array '" +
+                           r.member + "' (" + std::to_string(bytes) + " bytes; a GPU thread holds at most " + std::to_string(kMaxReducedArrayBytes) + ")",
+                   "count into a std::vector member with LiteMath's InterlockedAdd (atomics), or reduce fewer elements per kernel");
+}
 
 // A reduction's type: GLSL's, or on ISPC also double (a sum of doubles stays double there).
 static std::string ReductionType(Context& c, QualType t) {
@@ -321,9 +331,12 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
       r.member = vd->getNameAsString();
       r.op = found->second;
       r.glslType = ReductionType(c, vd->getType());
-      r.identity = Identity(r.op, r.glslType);
+      r.identity = Identity(r.op, SplitArray(r.glslType).first);  // of one element, for an array's elements
       r.local = true;
-      r.cppType = vd->getType().getUnqualifiedType().getAsString(c.ctx.getPrintingPolicy());
+      QualType element = vd->getType();  // an array's (float bins[4]; bins[b] += x): its element's
+      if (auto* arr = dyn_cast<ConstantArrayType>(element.getCanonicalType().getTypePtr())) element = arr->getElementType();
+      r.cppType = element.getUnqualifiedType().getAsString(c.ctx.getPrintingPolicy());
+      CheckReducedArraySize(c, k, r, vd->getLocation());
       printer.renames[vd] = generated::ReductionLocal(r.member);
       k.reductions.push_back(r);
     }
@@ -345,16 +358,7 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
     r.op = op;
     r.glslType = ReductionType(c, field->getType());
     r.identity = Identity(op, SplitArray(r.glslType).first);  // of one element, for a member array's elements
-    // A member array's elements (coefs[k] += x): every GPU thread holds a copy of the array, and each
-    // workgroup one per subgroup in shared memory (templates/glsl/kernel.comp), up to 16 KiB.
-    if (const std::string elements = SplitArray(r.glslType).second; !elements.empty() && !c.model.forIspc) {
-      const unsigned count = unsigned(std::stoul(elements.substr(1))), bytes = count * Std430VectorStride(SplitArray(r.glslType).first);
-      if (bytes > kMaxReducedArrayBytes)
-        c.rep.GpuError(ws.reductionSites.count(field) ? ws.reductionSites.at(field) : field->getLocation(),
-                       "kernel '" + k.name + "' reduces the " + std::to_string(count) + " elements of member array '" + r.member + "' (" +
-                           std::to_string(bytes) + " bytes; a GPU thread holds at most " + std::to_string(kMaxReducedArrayBytes) + ")",
-                       "count into a std::vector member with LiteMath's InterlockedAdd (atomics), or reduce fewer elements per kernel");
-    }
+    CheckReducedArraySize(c, k, r, ws.reductionSites.count(field) ? ws.reductionSites.at(field) : field->getLocation());
     printer.renames[field] = generated::ReductionLocal(r.member);
     k.reductions.push_back(r);
   }
@@ -436,10 +440,16 @@ void AnalyzeKernel(Context& c, const CXXMethodDecl* md, const FunctionDecl* def)
       for (unsigned a = 0; a < k.dims; ++a) anyThreads += std::string(a ? " && " : "") + "crt_count" + "XYZ"[a] + " != 0u";
       for (auto& r : k.reductions)
         if (r.local) {
-          const std::string total = generated::ReductionPartials(r.member) + "[0]";
-          const std::string combined = r.op == ReduceOp::Min ? "min(" + r.member + ", " + total + ")"
-                                       : r.op == ReduceOp::Max ? "max(" + r.member + ", " + total + ")" : r.member + " + " + total;
-          k.glslFinish += "  if (" + anyThreads + ")\n    " + r.member + " = " + combined + ";  // the threads' total\n";
+          // An array's elements (bins[b] += x): the totals of its elements in elements 0... of the partials.
+          const std::string elements = SplitArray(r.glslType).second, at = elements.empty() ? "" : "[crt_e]";
+          const std::string total = generated::ReductionPartials(r.member) + (elements.empty() ? "[0]" : "[crt_e]"), mine = r.member + at;
+          const std::string combined = r.op == ReduceOp::Min ? "min(" + mine + ", " + total + ")"
+                                       : r.op == ReduceOp::Max ? "max(" + mine + ", " + total + ")" : mine + " + " + total;
+          if (elements.empty())
+            k.glslFinish += "  if (" + anyThreads + ")\n    " + mine + " = " + combined + ";  // the threads' total\n";
+          else
+            k.glslFinish += "  if (" + anyThreads + ")  // the threads' totals\n    for (int crt_e = 0; crt_e < " + elements.substr(1, elements.size() - 2) +
+                            "; ++crt_e)\n      " + mine + " = " + combined + ";\n";
         }
       for (auto* s : after) k.glslFinish += printer.Stmt(s, 1);
       k.glslFinish += "}\n";

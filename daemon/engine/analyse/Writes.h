@@ -284,18 +284,33 @@ struct LocalReductionScanner : RecursiveASTVisitor<LocalReductionScanner> {
     auto* dr = dyn_cast<DeclRefExpr>(e->IgnoreParenImpCasts());
     return dr && isa<VarDecl>(dr->getDecl()) && locals.count(cast<VarDecl>(dr->getDecl())) ? dr : nullptr;
   }
-  // x = min(x, v) / max(v, x) (std::, fmin/fmax, LiteMath's): the operation, and the reference to x among the arguments.
-  std::optional<ReduceOp> MinMax(const DeclRefExpr* target, const Expr* rhs, const DeclRefExpr*& use) const {
+  // x, or an element of a one-dimensional local array (bins[b], reduced element by element): x's
+  // reference; `e` itself must have the reduced type.
+  const DeclRefExpr* Target(const Expr* e) const {
+    if (auto* r = Ref(e)) return r;
+    auto* as = dyn_cast<ArraySubscriptExpr>(e->IgnoreParenImpCasts());
+    auto* r = as ? Ref(as->getBase()) : nullptr;
+    auto* arr = r ? dyn_cast<ConstantArrayType>(r->getType().getCanonicalType().getTypePtr()) : nullptr;
+    return arr && !isa<ArrayType>(arr->getElementType().getCanonicalType().getTypePtr()) ? r : nullptr;
+  }
+  // x = min(x, v) / max(v, x) (std::, fmin/fmax, LiteMath's), or bins[k] = min(bins[k], v): the
+  // operation, and the reference to x among the arguments.
+  std::optional<ReduceOp> MinMax(const Expr* lhs, const DeclRefExpr* target, const Expr* rhs, const DeclRefExpr*& use) const {
     auto* call = dyn_cast<CallExpr>(rhs->IgnoreImplicit());
     if (!call || !call->getDirectCallee() || call->getNumArgs() != 2) return std::nullopt;
     const std::string n = call->getDirectCallee()->getNameAsString();
     const bool isMin = n == "min" || n == "fmin" || n == "fminf", isMax = n == "max" || n == "fmax" || n == "fmaxf";
     if (!isMin && !isMax) return std::nullopt;
-    for (auto* arg : call->arguments())
-      if (auto* r = Ref(arg); r && r->getDecl() == target->getDecl()) {
+    llvm::FoldingSetNodeID written;
+    lhs->IgnoreParenImpCasts()->Profile(written, c.ctx, true);
+    for (auto* arg : call->arguments()) {
+      llvm::FoldingSetNodeID read;
+      arg->IgnoreParenImpCasts()->Profile(read, c.ctx, true);
+      if (auto* r = Target(arg); r && r->getDecl() == target->getDecl() && read == written) {
         use = r;
         return isMin ? ReduceOp::Min : ReduceOp::Max;
       }
+    }
     return std::nullopt;
   }
   void Found(const Expr* lhs, const DeclRefExpr* target, ReduceOp op, const DeclRefExpr* other, SourceLocation loc) {
@@ -309,31 +324,31 @@ struct LocalReductionScanner : RecursiveASTVisitor<LocalReductionScanner> {
     if (other) uses.insert(other);
   }
   bool VisitBinaryOperator(BinaryOperator* bo) {
-    auto* target = bo->isAssignmentOp() ? Ref(bo->getLHS()) : nullptr;
-    if (!target || !target->getType()->isArithmeticType()) return true;
+    auto* target = bo->isAssignmentOp() ? Target(bo->getLHS()) : nullptr;
+    if (!target || !bo->getLHS()->getType()->isArithmeticType()) return true;
     const DeclRefExpr* other = nullptr;
     std::optional<ReduceOp> op;
     if (bo->getOpcode() == BO_AddAssign) op = ReduceOp::Add;
     else if (bo->getOpcode() == BO_SubAssign) op = ReduceOp::Sub;
-    else if (bo->getOpcode() == BO_Assign) op = MinMax(target, bo->getRHS(), other);
+    else if (bo->getOpcode() == BO_Assign) op = MinMax(bo->getLHS(), target, bo->getRHS(), other);
     if (op) Found(bo->getLHS(), target, *op, other, bo->getExprLoc());
     return true;
   }
   bool VisitCXXOperatorCallExpr(CXXOperatorCallExpr* call) {  // LiteMath vectors: v += x, v = min(v, x)
     auto k = call->getOperator();
-    auto* target = (k == OO_PlusEqual || k == OO_MinusEqual || k == OO_Equal) ? Ref(call->getArg(0)) : nullptr;
-    if (!target || !GlslTypeOf(target->getType())) return true;
+    auto* target = (k == OO_PlusEqual || k == OO_MinusEqual || k == OO_Equal) ? Target(call->getArg(0)) : nullptr;
+    if (!target || !GlslTypeOf(call->getArg(0)->getType())) return true;
     const DeclRefExpr* other = nullptr;
     std::optional<ReduceOp> op;
     if (k == OO_PlusEqual) op = ReduceOp::Add;
     else if (k == OO_MinusEqual) op = ReduceOp::Sub;
-    else op = MinMax(target, call->getArg(1), other);
+    else op = MinMax(call->getArg(0), target, call->getArg(1), other);
     if (op) Found(call->getArg(0), target, *op, other, call->getExprLoc());
     return true;
   }
   bool VisitUnaryOperator(UnaryOperator* uo) {  // n++ and n-- count
-    auto* target = uo->isIncrementDecrementOp() ? Ref(uo->getSubExpr()) : nullptr;
-    if (target && target->getType()->isArithmeticType())
+    auto* target = uo->isIncrementDecrementOp() ? Target(uo->getSubExpr()) : nullptr;
+    if (target && uo->getSubExpr()->getType()->isArithmeticType())
       Found(uo->getSubExpr(), target, uo->isIncrementOp() ? ReduceOp::Add : ReduceOp::Sub, nullptr, uo->getExprLoc());
     return true;
   }

@@ -25,6 +25,8 @@ void ElementTotals::kernel1D_Measure(int n, const float4* a_samples)
     m_bins[b] = 0.0f;
   m_least[0] = m_least[1] = 1000000;
   m_count = 0;
+  float spread[3] = {0.0f, 0.0f, 0.0f};
+  float highest[2] = {-10.0f, -10.0f};
   for (int i = 0; i < n; ++i)
   {
     const float4 s = a_samples[i];
@@ -43,8 +45,14 @@ void ElementTotals::kernel1D_Measure(int n, const float4* a_samples)
     const int value = int(s.w * 1000.0f) + i % 7;
     m_least[i % 2] = std::min(m_least[i % 2], value);
     m_count += 1;
+    spread[i % 3] += s.x;
+    highest[(i / 7) % 2] = std::max(highest[(i / 7) % 2], s.y);
   }
   const float scale = 1.0f / float(std::max(n, 1));
   for (int k = 0; k < kMoments; ++k)
     m_moments[k] *= scale;
+  for (int k = 0; k < 3; ++k)
+    m_spread[k] = spread[k] * 3.0f * scale;
+  m_highest[0] = highest[0];
+  m_highest[1] = highest[1];
 }

@@ -1,7 +1,8 @@
 // Elements of member arrays reduced in a kernel loop: nine colour moments at constant indices, as
 // kernel_slicer's spherical harmonics write them (m_moments[0] += c; m_moments[1] += c * d.y; ...),
 // a histogram at an index each thread computes (m_bins[bin] += 1), the least value of each of two
-// classes (m_least[k] = std::min(m_least[k], v)), and a whole member reduced beside them.
+// classes (m_least[k] = std::min(m_least[k], v)), and a whole member reduced beside them; and the
+// same into local arrays declared before the loop, whose totals the statements after it write out.
 #pragma once
 #include "LiteMath.h"
 
@@ -19,6 +20,8 @@ public:
   float m_bins[kBins];
   int m_least[2];
   int m_count = 0;
+  float m_spread[3];  // from local arrays: the mean of x per third of the samples, then the largest y of each half
+  float m_highest[2];
 
 protected:
   virtual void kernel1D_Measure(int n, const LiteMath::float4* a_samples);
