@@ -173,7 +173,7 @@ class Gen:
         for _ in range(r.randint(2, 5)):
             s = r.randrange(10)
             if s <= 2:
-                kind = self.pick("Map", "Map", "Int", "Sum", "Max", "Hist", "Grid", "First", "Bins")
+                kind = self.pick("Map", "Map", "Int", "Sum", "Max", "Hist", "Grid", "First", "Bins", "Bins")
                 if self.rm.random() < 0.3:
                     kind = "Mode"
                 body.append(grid_call() if kind == "Grid" else call(kind))

@@ -100,9 +100,9 @@ std::string DispatchExpr(const Kernel& k);
 // rows of 65536, within every device's launch width (maxComputeWorkGroupCount[0] x group size).
 std::string LaunchSize(const Kernel& k);
 
-// The C++ type of a reduction's value (of one element, where a member array's elements are reduced).
+// The C++ type of a reduction's value (of one element, where an array's elements are reduced).
 std::string ReductionCppType(const ClassModel& model, const Reduction& r);
-// How many elements of a member array a reduction reduces (coefs[k] += x), or "" for a whole value.
+// How many elements of an array a reduction reduces (a member's coefs[k] += x, a local's bins[b] += x), or "" for a whole value.
 std::string ReductionElements(const Reduction& r);
 
 Data Common(const ClassModel& model, const GenerateOptions& opt);

@@ -118,7 +118,7 @@ std::map<std::string, std::string> GenerateHost(const ClassModel& model, const G
     for (auto& r : k.reductions) {
       // Each chunk reduces into a part of its own, crt_<name>Local (Kernels.cpp renames the target in
       // the loop nest), merged into crt_<name>Total: a copy of a member, or a reference to a local.
-      // An array member (its elements reduced, coefs[k] += x) element by element.
+      // An array (its elements reduced: coefs[k] += x, bins[b] += x) element by element.
       const std::string count = ReductionElements(r);
       Data y;
       y.set("member", r.member);

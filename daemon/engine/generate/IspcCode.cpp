@@ -136,7 +136,7 @@ std::string GenerateIspcKernels(const ClassModel& model, const GenerateOptions& 
       if (elements.empty()) {
         y.set("declare", base + " " + local + " = " + IspcIdentity(r.op, r.glslType) + ";");
         y.set("reduced", IspcLaneReduce(r.op, r.glslType, local, partials));
-      } else {  // the elements of a member array (coefs[k] += x): an array a lane, reduced element by element
+      } else {  // the elements of an array (coefs[k] += x, bins[b] += x): an array a lane, reduced element by element
         const std::string each = "for (uniform int crt_e = 0; crt_e < " + elements + "; ++crt_e)";
         y.set("declare", base + " " + local + "[" + elements + "];  // this lane's part of each element of " + r.member + "\n  " + each +
                              "\n    " + local + "[crt_e] = " + IspcIdentity(r.op, baseGlsl) + ";");
@@ -242,7 +242,7 @@ void IspcHostData(const ClassModel& model, Data& d) {
     }
     Data reds = List();
     for (auto& r : k.reductions) {
-      // A member array's elements (coefs[k] += x): each chunk's partials are elements of their own.
+      // An array's elements (coefs[k] += x, bins[b] += x): each chunk's partials are elements of their own.
       const std::string cppType = ReductionCppType(model, r), elements = ReductionElements(r), baseGlsl = SplitArray(r.glslType).first;
       const std::string partials = generated::ReductionPartials(r.member);
       args += ", crossrt::IspcPointer<" + IspcCppType(baseGlsl) + "*>(&" + partials + "[crt_chunk" + (elements.empty() ? "" : " * " + elements) + "])";

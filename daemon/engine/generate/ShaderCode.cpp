@@ -224,7 +224,7 @@ std::string KernelGlsl(const ClassModel& model, const Kernel& k, const GenerateO
   Data reductions = List();
   bool anyWhole = false;
   for (auto& r : k.reductions) {
-    // A member array's elements (coefs[k] += x): each thread an array, each workgroup a partial
+    // An array's elements (coefs[k] += x, bins[b] += x): each thread an array, each workgroup a partial
     // result per element (partials[group * elements + element]).
     const std::string elements = ReductionElements(r), type = SplitArray(r.glslType).first;
     anyWhole |= elements.empty();
@@ -490,7 +490,7 @@ std::string ReduceGlsl(const ClassModel& model, const Kernel& k, const GenerateO
     x.set("identity", r.identity);
     x.set("binding", std::to_string(binding++));
     x.set("whole", elements.empty());
-    x.set("isArray", !elements.empty());  // a member array's elements (coefs[k] += x), one after another
+    x.set("isArray", !elements.empty());  // an array's elements (coefs[k] += x, bins[b] += x), one after another
     x.set("elements", elements);
     const std::string shared = generated::ReductionShared(r.member);
     x.set("combineShared", Combine(r.op, shared + "[local]", shared + "[local + stride]"));

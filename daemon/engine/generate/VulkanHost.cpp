@@ -380,7 +380,7 @@ Data VulkanKernelsData(const ClassModel& model, unsigned& indirectSlots) {
       Data y;
       y.set("kernel", k.name);
       y.set("member", r.member);
-      // The GPU writes an std430 array: a vec3 element takes 16 bytes, not sizeof(float3). A member
+      // The GPU writes an std430 array: a vec3 element takes 16 bytes, not sizeof(float3). An
       // array's elements (coefs[k] += x) take as many a workgroup as the array has.
       const std::string elements = ReductionElements(r);
       y.set("cppType", ReductionCppType(model, r) + (elements.empty() ? "" : "[" + elements + "]"));
