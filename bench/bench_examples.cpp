@@ -7,7 +7,9 @@
 // classes: medians of as many calls after a warm-up. The table goes to CSV too (default out/bench_examples.csv), which
 // bench/plot_examples.py plots.
 // SpherePaths runs on Vulkan in both execution modes: wavefront (one dispatch per kernel call) and
-// megakernel (its thread loop as one shader).
+// megakernel (its thread loop as one shader). SphericalHarmonics (test/classes, kernel_slicer's
+// spherical harmonics) reduces the nine elements of a member array over an image half as high as
+// the bloom's is wide.
 //   bench_examples [--load N] [particles] [bloom side] [paths side] [CSV]
 // --load N runs N busy threads beside the measurement, and a warning row follows the table for
 // each translated CPU class slower than the original (or _ISPC slower than _CPU).
@@ -18,6 +20,7 @@
 #include "Bloom_ISPC.h"
 #include "Particles_ISPC.h"
 #include "SpherePaths_ISPC.h"
+#include "SphericalHarmonics_ISPC.h"
 #endif
 #include "Bloom_Vulkan.h"
 #include "Particles.h"
@@ -26,6 +29,9 @@
 #include "SpherePaths.h"
 #include "SpherePaths_CPU.h"
 #include "SpherePaths_Vulkan.h"
+#include "SphericalHarmonics.h"
+#include "SphericalHarmonics_CPU.h"
+#include "SphericalHarmonics_Vulkan.h"
 #include "CommandLine.h"
 
 #include <cstdio>
@@ -204,13 +210,33 @@ int main(int argc, char** argv)
     }
     Measure("paths", impls, 5);
   }
+  {  // spharm: kernel_slicer's spherical harmonics, a 2D kernel reducing the nine elements of a member array
+    const uint32_t w = uint32_t(side), h = uint32_t(side / 2);
+    std::vector<uint32_t> texels(size_t(w) * h);
+    for (size_t i = 0; i < texels.size(); ++i) texels[i] = uint32_t(i * 2654435761u) ^ uint32_t(i >> 3);
+    std::vector<std::pair<std::string, std::shared_ptr<SphericalHarmonics>>> classes = {{"original", std::make_shared<SphericalHarmonics>()},
+                                                                                         {"Harmonics_CPU", CreateSphericalHarmonics_CPU()}};
+#ifdef CROSSRT_HAS_ISPC
+    classes.push_back({"Harmonics_ISPC", CreateSphericalHarmonics_ISPC()});
+#endif
+    std::shared_ptr<SphericalHarmonics_Vulkan> vulkan = ctx ? std::make_shared<SphericalHarmonics_Vulkan>(ctx) : nullptr;
+    if (vulkan) classes.push_back({"Harmonics_Vulkan", vulkan});
+    std::vector<Impl> impls;
+    for (auto& [name, sh] : classes)
+    {
+      sh->CommitDeviceData();
+      impls.push_back({name, [sh = sh, &texels, w, h] { sh->Project(texels.data(), w, h); }, nullptr});
+    }
+    if (vulkan) impls.back().gpuMs = [vulkan] { float t[4]; vulkan->GetExecutionTime("Project", t); return double(t[0]); };
+    Measure("spharm", impls, 5);
+  }
   if (!g_slower.empty())
   {
     std::printf("\nWARNING: translated classes slower than they should be (load: %d busy threads):\n", busy.Count());
     for (auto& line : g_slower) std::printf("| WARNING | %s |\n", line.c_str());
   }
-  std::printf("\nparticles: %d particles per step; bloom: %dx%d image, radius 12; paths: %dx%d pixels, %d paths per pixel, 4 bounces.\n", particles, side,
-              side, pathSide, pathSide, pathSamples);
+  std::printf("\nparticles: %d particles per step; bloom: %dx%d image, radius 12; paths: %dx%d pixels, %d paths per pixel, 4 bounces;\n"
+              "spharm: a %dx%d environment map onto 9 coefficients.\n", particles, side, side, pathSide, pathSide, pathSamples, side, side / 2);
   std::printf("ms/call: medians of interleaved rounds (CPU classes); vs orig: medians of the rounds' ratios (GPU: ratios of medians).\n");
   std::printf("_Vulkan ms/call includes copying the arguments in and out; 'GPU ms' is the timestamp-measured kernel time.\n");
   std::printf("table: %s (plot it: bench/plot_examples.py %s out/bench_examples.png)\n", csvPath.c_str(), csvPath.c_str());
