@@ -3,7 +3,8 @@
 
 Each seed gives one class in the supported subset, written as a user writes one: member vectors,
 kernel1D_ loop nests (maps, integer maps, reductions into members and into elements of a member
-array, appends, atomic adds into a member vector, a member's data() to a kernel) and kernel2D_
+array or of a local array read after the loop, appends, atomic adds into a member vector, a
+member's data() to a kernel) and kernel2D_
 nests, and a control function whose host code sits between the kernel calls: member writes,
 swaps of member vectors, member vectors' elements read and written, loops that stop early on a
 counter the kernels reduce, and a tail that reads the results. Some kernels declare locals that
@@ -32,6 +33,7 @@ class Gen:
         self.rs = random.Random(seed * 104729 + 3)  # which kernels declare locals that shadow parameters
         self.seed = seed
         self.name = f"Diff{seed}"
+        self.around = {}  # a kernel's statements before and after its loop nest, by name
 
     def pick(self, *options):
         return self.r.choice(options)
@@ -120,6 +122,15 @@ class Gen:
                     line = f"m_bins[{at}] {self.pick('+=', '-=')} {clamp(self.fexpr(2, fleaves))};"
                 else:
                     line = f"m_bins[{at}] = std::{self.pick('min', 'max')}(m_bins[{at}], {clamp(self.fexpr(2, fleaves))});"
+            elif kind == "LocalBins":  # elements of a local array reduced, its totals added to m_bins after the loop
+                at = self.pick(str(r.randrange(3)), f"({self.iexpr(2, ileaves)} & 1023) % 3")
+                if r.random() < 0.7:
+                    line = f"bins[{at}] += {clamp(self.fexpr(2, fleaves))};"
+                else:
+                    line = f"bins[{at}] = std::{self.pick('min', 'max')}(bins[{at}], {clamp(self.fexpr(2, fleaves))});"
+                # Before the loop nest, one thread halves m_bins in a loop of constant count (not the nest).
+                self.around[name] = (["float bins[3] = {0.5f, 0.0f, -1.0f};", "for (int k = 0; k < 4; ++k)", "  m_bins[k] *= 0.5f;"],
+                                     ["for (int k = 0; k < 3; ++k)", "  m_bins[k + 1] += bins[k];"])
             elif kind == "Hist":
                 line = f"InterlockedAdd(m_hist[({self.iexpr(2, ileaves)} & 1023) % 8], {self.pick('1', 'a_p', 'm_i[i] % 5')});"
             lines = [line]
@@ -173,7 +184,7 @@ class Gen:
         for _ in range(r.randint(2, 5)):
             s = r.randrange(10)
             if s <= 2:
-                kind = self.pick("Map", "Map", "Int", "Sum", "Max", "Hist", "Grid", "First", "Bins", "Bins")
+                kind = self.pick("Map", "Map", "Int", "Sum", "Max", "Hist", "Grid", "First", "Bins", "LocalBins")
                 if self.rm.random() < 0.3:
                     kind = "Mode"
                 body.append(grid_call() if kind == "Grid" else call(kind))
@@ -263,9 +274,10 @@ protected:
             if args == "2d":  # the lines are the loop nest
                 out += [f"void {self.name}::{name}({params})", "{"] + ["  " + line for line in lines] + ["}", ""]
                 continue
-            out += [f"void {self.name}::{name}({params})", "{", "  for (int i = 0; i < n; ++i)", "  {"]
+            before, after = self.around.get(name, ([], []))
+            out += [f"void {self.name}::{name}({params})", "{"] + ["  " + line for line in before] + ["  for (int i = 0; i < n; ++i)", "  {"]
             out += ["    " + line for line in lines]
-            out += ["  }", "}", ""]
+            out += ["  }"] + ["  " + line for line in after] + ["}", ""]
         out += [f"void {self.name}::Run(int n, int a_p, float a_q)", "{"]
         out += ["  " + s for s in self.body]
         out += ["}", ""]
