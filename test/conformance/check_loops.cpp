@@ -185,7 +185,7 @@ Register firstThread(MakeCase<FirstThread>(
 
 #if __has_include("ElementTotals_CPU.h")
 Register elementTotals(MakeCase<ElementTotals>(
-    "elements of arrays reduced: members at constant indices (m_moments[3] += c * d.x), at a computed one (m_bins[bin] += 1), with std::min; locals",
+    "elements of arrays reduced: members at constant indices (m_moments[3] += c * d.x), at a computed one (m_bins[bin] += 1), with std::min; locals; uint, int2, uint3, float4",
     "element_totals.h/.cpp", 1e-5, CONFORMANCE_MAKERS(ElementTotals), [](ElementTotals& t) {
       const int n = 1500;  // several workgroups and chunks
       std::vector<float4> samples(n);
@@ -203,6 +203,10 @@ Register elementTotals(MakeCase<ElementTotals>(
       r.push_back(float(t.m_count));
       Append(r, std::vector<float>(std::begin(t.m_spread), std::end(t.m_spread)));
       Append(r, std::vector<float>(std::begin(t.m_highest), std::end(t.m_highest)));
+      for (uint32_t v : t.m_top) r.push_back(float(v));
+      for (auto& p : t.m_pairs) Append(r, std::vector<float>{float(p.x), float(p.y)});
+      for (auto& c : t.m_counts) Append(r, std::vector<float>{float(c.x), float(c.y), float(c.z)});
+      for (auto& l : t.m_low) Append(r, std::vector<float>{l.x, l.y, l.z, l.w});
       return r;
     }));
 #endif

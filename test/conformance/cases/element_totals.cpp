@@ -15,6 +15,25 @@ static int BinOf(float value)
 void ElementTotals::Measure(int n, const float4* a_samples)
 {
   kernel1D_Measure(n, a_samples);
+  kernel1D_Extremes(n, a_samples);
+}
+
+void ElementTotals::kernel1D_Extremes(int n, const float4* a_samples)
+{
+  for (int k = 0; k < 3; ++k)
+    m_top[k] = 0u;
+  m_pairs[0] = m_pairs[1] = LiteMath::int2(0);
+  m_counts[0] = m_counts[1] = LiteMath::uint3(7u);
+  m_low[0] = m_low[1] = float4(100.0f);
+  for (int i = 0; i < n; ++i)
+  {
+    const float4 s = a_samples[i];
+    const uint32_t v = uint32_t(s.w * 1000.0f);
+    m_top[i % 3] = std::max(m_top[i % 3], v);
+    m_pairs[i & 1] += LiteMath::int2(i % 11, 1);
+    m_counts[1] += LiteMath::uint3(1u, v & 1u, 2u);
+    m_low[(i / 5) & 1] = min(m_low[(i / 5) & 1], s);
+  }
 }
 
 void ElementTotals::kernel1D_Measure(int n, const float4* a_samples)

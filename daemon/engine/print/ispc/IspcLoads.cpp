@@ -196,6 +196,8 @@ std::string IspcPrinter::ConsecutiveStore(const clang::CXXOperatorCallExpr* op) 
   if (op->getOperator() != OO_Equal || op->getNumArgs() != 2) return "";
   const auto* as = dyn_cast<ArraySubscriptExpr>(op->getArg(0)->IgnoreParenImpCasts());
   if (!as || !as->getBase()->getType()->isPointerType() || Uniform(as->getIdx())) return "";
+  // A member array whose elements the kernel reduces is each lane's own array (crt_m_lowLocal), not memory.
+  if (auto* me = dyn_cast<MemberExpr>(as->getBase()->IgnoreParenImpCasts()); me && renames.count(me->getMemberDecl())) return "";
   const QualType element = as->getType().getUnqualifiedType();
   // A struct of eight words (a CRT_Hit) goes through a helper of its own: crt_store_words8 after
   // packing its fields, or the scatters.
