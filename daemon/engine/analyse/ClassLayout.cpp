@@ -48,6 +48,13 @@ static void MergeMegakernelCode(ClassModel& model) {
   }
 }
 
+// The 4-vector the class data holds an element of an array of 3-vectors as (vec3[9] -> float4),
+// whatever the C++ spells the element (a typedef of float3 too).
+std::string PaddedElementType(const std::string& glslType) {
+  const char kind = glslType[0];
+  return kind == 'i' ? "LiteMath::int4" : kind == 'u' ? "LiteMath::uint4" : "LiteMath::float4";
+}
+
 }  // namespace
 
 void FinishModel(ClassModel& model) {
@@ -57,7 +64,7 @@ void FinishModel(ClassModel& model) {
   std::vector<BlockField> fields;
   for (auto& m : model.members)
     if (m.kind == MemberKind::Plain && m.inClassData && (m.usedByKernels || m.hostExpr == m.name))
-      fields.push_back({m.name, m.padded3 ? m.cppType.substr(0, m.cppType.size() - 1) + "4" : m.cppType, m.glslType, m.std430Align, m.hostExpr, ""});
+      fields.push_back({m.name, m.padded3 ? PaddedElementType(m.glslType) : m.cppType, m.glslType, m.std430Align, m.hostExpr, ""});
   for (auto& m : model.members) {
     if (!m.usedByKernels || m.kind != MemberKind::Vector) continue;
     fields.push_back({generated::SizeField(m.name), "uint32_t", "uint", 4, "", ""});
