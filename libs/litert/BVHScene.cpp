@@ -37,6 +37,13 @@ constexpr float kWiden = 1.00000036f;
 static_assert(kWiden == 1.0f + 2.0f * (3.0f * std::numeric_limits<float>::epsilon() * 0.5f) /
                                    (1.0f - 3.0f * std::numeric_limits<float>::epsilon() * 0.5f),
               "kWiden is 1 + 2 gamma(3)");
+// How far past tfar the walks still enter a box: its entry and a hit's t are rounded apart, and a
+// hit at a vertex or an edge lies on the boxes of the leaves around it. With this slack every
+// triangle a ray meets at its nearest t is tested, whichever leaf a walk reaches first, so the lowest
+// primId among them wins in every walk (TakeNearestHit): the scalar one, the gang's and a GPU's.
+// 1 + 2^-19, about 16 ulp: more than the few rounding steps of each side.
+constexpr float kReach = 1.0f + 1.0f / 524288.0f;
+inline float Reach(float tfar) { return tfar * kReach; }
 constexpr float kMissed = -1.0f;  // an exit before every entry (entries are >= 0): a missed box
 constexpr float kNotEntered = std::numeric_limits<float>::infinity();  // a ray's entry into a subtree it does not enter
 
@@ -57,6 +64,13 @@ BVHTraceRay RayFromLane(const BVHTraceRay& ray, int from)
   r.sz = crossrt::FromLane(ray.sz, from);
   r.anyZeroAxis = crossrt::FromLane(ray.anyZeroAxis, from);
   return r;
+}
+
+// p's coordinates along the axes kx, ky and kz, as a triangle's corners are given to IntersectCorners.
+// Selects, so that lanes whose rays run along different axes pick theirs from the same loads.
+float3 AlongAxes(float3 p, int kx, int ky, int kz)
+{
+  return float3(kx == 0 ? p.x : kx == 1 ? p.y : p.z, ky == 0 ? p.x : ky == 1 ? p.y : p.z, kz == 0 ? p.x : kz == 1 ? p.y : p.z);
 }
 
 BVHTraceRay Prepare(float3 org, float3 dir, float tnear)
@@ -1200,8 +1214,7 @@ bool BVHScene::TraceMesh(const BVHTraceRay& ray, uint32_t root, uint32_t leaves,
   // With every lane on (a full gang, no lane ended before), ISPC compiles the walk with its mask
   // known, and keeps its structs in registers (Gang.h's AllLanesOn): 1.4x the walk's speed with
   // AVX2 on an AMD EPYC, Zen 4 (bunny).
-  if (crossrt::GangSize() > 1 && crossrt::AllLanes(leaves == 0u && root == crossrt::FirstLane(root) && ray.kx == crossrt::FirstLane(ray.kx) &&
-                                                    ray.kz == crossrt::FirstLane(ray.kz)))
+  if (crossrt::GangSize() > 1 && crossrt::AllLanes(leaves == 0u && root == crossrt::FirstLane(root)))
   {
     bool together = false;  // (a return inside the AllLanesOn branch is refused: ISPC's unmasked cannot return)
     if (crossrt::AllLanesOn())
@@ -1224,7 +1237,7 @@ bool BVHScene::TraceMesh(const BVHTraceRay& ray, uint32_t root, uint32_t leaves,
     {
       float4 entries;
       uint4 children;
-      const int entered = EnteredLanes(ray, m_nodes[node], tfar, entries, children);
+      const int entered = EnteredLanes(ray, m_nodes[node], Reach(tfar), entries, children);
       if (entered == 0)
       {
         node = kNoChild;
@@ -1277,7 +1290,7 @@ bool BVHScene::TraceMesh(const BVHTraceRay& ray, uint32_t root, uint32_t leaves,
       if (top == 0)
         return found;
       top = top - 1;
-    } while (stackEntry[top] > tfar);
+    } while (stackEntry[top] > Reach(tfar));
     node = stack[top];
   }
 }
@@ -1322,6 +1335,9 @@ bool BVHScene::TraceMeshTogether(const BVHTraceRay& ray, uint32_t root, bool any
   float stackEntry[kStackSize];  // this ray's entry into each subtree on the stack, kNotEntered if it does not enter it
   CRT_UNIFORM int top = 0;
   CRT_UNIFORM uint32_t node = crossrt::FirstLane(root);
+  // Where the rays share their axes (a camera's, shadow rays to one light), a triangle's corners are
+  // read at them, one load for the gang; other rays (bounces, ambient occlusion) read each its own.
+  CRT_UNIFORM const bool sameAxes = crossrt::AllLanes(ray.kx == crossrt::FirstLane(ray.kx) && ray.kz == crossrt::FirstLane(ray.kz));
   CRT_UNIFORM const int kx = crossrt::FirstLane(ray.kx);
   CRT_UNIFORM const int ky = crossrt::FirstLane(ray.ky);
   CRT_UNIFORM const int kz = crossrt::FirstLane(ray.kz);
@@ -1347,7 +1363,7 @@ bool BVHScene::TraceMeshTogether(const BVHTraceRay& ray, uint32_t root, bool any
     // the smaller meshes within 3%. Switching at 2, 3 or 4 rays left was the same with avx2; with
     // avx512skx at 8 beat 4 and 2 on that dragon. With sse4 this is the walk of one ray at a time
     // across the four lanes, which had paid there on six meshes of seven.
-    CRT_UNIFORM uint32_t alone = crossrt::LaneBits(entry <= tfar && !(anyHit && found));
+    CRT_UNIFORM uint32_t alone = crossrt::LaneBits(entry <= Reach(tfar) && !(anyHit && found));
     if (crossrt::GangSize() >= 4 && crossrt::AllLanesOn() && __builtin_popcount(alone) <= crossrt::GangSize() / 2)
     {
       while (alone != 0u)
@@ -1370,7 +1386,7 @@ bool BVHScene::TraceMeshTogether(const BVHTraceRay& ray, uint32_t root, bool any
       // Then, of the lanes some ray enters, the gang goes on into the one some ray enters before it
       // enters the others so far (Embree's order: no reduction over the lanes), and the others wait
       // on the stack.
-      const bool active = entry <= tfar && !(anyHit && found);  // an any-hit ray that found one is done
+      const bool active = entry <= Reach(tfar) && !(anyHit && found);  // an any-hit ray that found one is done
       float childEntry[4];  // this ray's entry into each lane's box, kNotEntered where it does not enter it
       CRT_UNIFORM uint32_t entered = 0u;  // the lanes some ray enters
       for (int lane = 0; lane < 4; ++lane)
@@ -1385,13 +1401,13 @@ bool BVHScene::TraceMeshTogether(const BVHTraceRay& ray, uint32_t root, bool any
           CRT_UNIFORM const float farX = negX ? m_nodes[node].minX[lane] : m_nodes[node].maxX[lane];
           CRT_UNIFORM const float farY = negY ? m_nodes[node].minY[lane] : m_nodes[node].maxY[lane];
           CRT_UNIFORM const float farZ = negZ ? m_nodes[node].minZ[lane] : m_nodes[node].maxZ[lane];
-          boxEntry = SlabEntryFacing(ray, float3(nearX, nearY, nearZ), float3(farX, farY, farZ), tfar, exit);
+          boxEntry = SlabEntryFacing(ray, float3(nearX, nearY, nearZ), float3(farX, farY, farZ), Reach(tfar), exit);
         }
         else
         {
           const float3 lo = float3(m_nodes[node].minX[lane], m_nodes[node].minY[lane], m_nodes[node].minZ[lane]);
           const float3 hi = float3(m_nodes[node].maxX[lane], m_nodes[node].maxY[lane], m_nodes[node].maxZ[lane]);
-          boxEntry = SlabEntry(ray, lo, hi, tfar, exit);
+          boxEntry = SlabEntry(ray, lo, hi, Reach(tfar), exit);
         }
         const bool enters = active && boxEntry <= exit;
         childEntry[lane] = enters ? boxEntry : kNotEntered;
@@ -1431,9 +1447,9 @@ bool BVHScene::TraceMeshTogether(const BVHTraceRay& ray, uint32_t root, bool any
     // The leaf, for the rays still in it. The gang tests its triangles together, whichever rays
     // are in it, and the others take no hit (hits 0): a branch that differs between lanes would
     // make each write of t, u and v below a masked store to memory on ISPC.
-    if (node != kNoChild && crossrt::AnyLane(entry <= tfar))
+    if (node != kNoChild && crossrt::AnyLane(entry <= Reach(tfar)))
     {
-      const bool inLeaf = entry <= tfar && !(anyHit && found);
+      const bool inLeaf = entry <= Reach(tfar) && !(anyHit && found);
       CRT_UNIFORM const uint32_t first = (node & ~kLeafFlag) >> 3;
       CRT_UNIFORM const uint32_t last = first + (node & 7u);
       for (uint32_t g = first; g <= last; ++g)
@@ -1450,14 +1466,28 @@ bool BVHScene::TraceMeshTogether(const BVHTraceRay& ray, uint32_t root, bool any
           float tl = 0.0f;
           float ul = 0.0f;
           float vl = 0.0f;
-          if (IntersectTriangle(ray, g, lane, kx, ky, kz, tfar, tl, ul, vl, onEdge))
-            hits = hits | (1u << uint32_t(lane));
+          bool hitsIt = false;
+          if (sameAxes)
+            hitsIt = IntersectTriangle(ray, g, lane, kx, ky, kz, tfar, tl, ul, vl, onEdge);
+          else
+          {
+            // The nine coordinates, each one load for the gang, and each ray's picked with selects (its
+            // own axes would be nine gathers: half the walk's time in a path tracer's bounces).
+            const float3 a = AlongAxes(float3(m_triangles[g].coord[0][lane], m_triangles[g].coord[1][lane], m_triangles[g].coord[2][lane]),
+                                       ray.kx, ray.ky, ray.kz);
+            const float3 b = AlongAxes(float3(m_triangles[g].coord[3][lane], m_triangles[g].coord[4][lane], m_triangles[g].coord[5][lane]),
+                                       ray.kx, ray.ky, ray.kz);
+            const float3 c = AlongAxes(float3(m_triangles[g].coord[6][lane], m_triangles[g].coord[7][lane], m_triangles[g].coord[8][lane]),
+                                       ray.kx, ray.ky, ray.kz);
+            hitsIt = IntersectCorners(ray, ray.kx, ray.ky, ray.kz, a, b, c, tfar, tl, ul, vl, onEdge);
+          }
+          hits = hitsIt ? hits | (1u << uint32_t(lane)) : hits;
           t[lane] = tl;
           u[lane] = ul;
           v[lane] = vl;
         }
         if (crossrt::AnyLane(inLeaf && onEdge))
-          hits = IntersectGroup(ray, g, kx, ky, kz, tfar, t, u, v);
+          hits = IntersectGroup(ray, g, ray.kx, ray.ky, ray.kz, tfar, t, u, v);
         hits = inLeaf ? hits : 0u;
         found = TakeNearestHit(g, hits, t, u, v, anyHit, tfar, hit) || found;
       }
@@ -1473,7 +1503,7 @@ bool BVHScene::TraceMeshTogether(const BVHTraceRay& ray, uint32_t root, bool any
       if (top == 0)
         return found;
       top = top - 1;
-    } while (!crossrt::AnyLane(stackEntry[top] <= tfar));
+    } while (!crossrt::AnyLane(stackEntry[top] <= Reach(tfar)));
     node = stack[top];
     entry = stackEntry[top];
   }
@@ -1511,7 +1541,10 @@ bool BVHScene::TraceMeshQuads(const BVHTraceRay& gangRay, uint32_t rays, uint32_
     inQuad = inQuad || quad == q;
   }
   const BVHTraceRay ray = RayFromLane(gangRay, from);
-  CRT_UNIFORM const int kx = crossrt::FirstLane(gangRay.kx);  // the gang's rays share their axes (TraceMeshTogether)
+  // The axes, where the gang's rays share them (TraceMeshTogether): a triangle's corners along them
+  // are then three loads of the group. Otherwise each quad reads all nine and picks its ray's.
+  CRT_UNIFORM const bool sameAxes = crossrt::AllLanes(gangRay.kx == crossrt::FirstLane(gangRay.kx) && gangRay.kz == crossrt::FirstLane(gangRay.kz));
+  CRT_UNIFORM const int kx = crossrt::FirstLane(gangRay.kx);
   CRT_UNIFORM const int ky = crossrt::FirstLane(gangRay.ky);
   CRT_UNIFORM const int kz = crossrt::FirstLane(gangRay.kz);
   const bool firstHit = crossrt::FromLane(anyHit, from);
@@ -1533,13 +1566,13 @@ bool BVHScene::TraceMeshQuads(const BVHTraceRay& gangRay, uint32_t rays, uint32_
     {
       // Box `box` of the node, for the quad's ray; then the boxes some ray enters, as TraceMeshTogether
       // takes them: on into the one some ray enters before the others taken so far, the others on the stack.
-      const bool active = inQuad && entry <= rayTfar && !(firstHit && found);
+      const bool active = inQuad && entry <= Reach(rayTfar) && !(firstHit && found);
       float exit = 0.0f;
       const float3 lo = float3(crossrt::LaneOfQuad(m_nodes[node].minX), crossrt::LaneOfQuad(m_nodes[node].minY),
                                crossrt::LaneOfQuad(m_nodes[node].minZ));
       const float3 hi = float3(crossrt::LaneOfQuad(m_nodes[node].maxX), crossrt::LaneOfQuad(m_nodes[node].maxY),
                                crossrt::LaneOfQuad(m_nodes[node].maxZ));
-      const float boxEntry = SlabEntry(ray, lo, hi, rayTfar, exit);
+      const float boxEntry = SlabEntry(ray, lo, hi, Reach(rayTfar), exit);
       const bool enters = active && boxEntry <= exit;
       const float childEntry = enters ? boxEntry : kNotEntered;
       CRT_UNIFORM const uint32_t bits = crossrt::LaneBits(enters);
@@ -1586,29 +1619,50 @@ bool BVHScene::TraceMeshQuads(const BVHTraceRay& gangRay, uint32_t rays, uint32_
       for (uint32_t g = first; g <= last; ++g)
       {
         // Triangle `box` of the group, for the quad's ray.
-        const bool live = inQuad && entry <= rayTfar && !(firstHit && found);
-        const float3 a = float3(crossrt::LaneOfQuad(m_triangles[g].coord[kx]), crossrt::LaneOfQuad(m_triangles[g].coord[ky]),
-                                crossrt::LaneOfQuad(m_triangles[g].coord[kz]));
-        const float3 b = float3(crossrt::LaneOfQuad(m_triangles[g].coord[3 + kx]), crossrt::LaneOfQuad(m_triangles[g].coord[3 + ky]),
-                                crossrt::LaneOfQuad(m_triangles[g].coord[3 + kz]));
-        const float3 c = float3(crossrt::LaneOfQuad(m_triangles[g].coord[6 + kx]), crossrt::LaneOfQuad(m_triangles[g].coord[6 + ky]),
-                                crossrt::LaneOfQuad(m_triangles[g].coord[6 + kz]));
+        const bool live = inQuad && entry <= Reach(rayTfar) && !(firstHit && found);
         float t = 0.0f;
         float u = 0.0f;
         float v = 0.0f;
         bool edge = false;
-        bool hitsIt = IntersectCorners(ray, kx, ky, kz, a, b, c, rayTfar, t, u, v, edge);
-        if (crossrt::AnyLane(live && edge))
+        bool hitsIt = false;
+        if (sameAxes)
         {
-          // A triangle on an edge in float: as TraceMesh tests it, in its group, exactly.
+          const float3 a = float3(crossrt::LaneOfQuad(m_triangles[g].coord[kx]), crossrt::LaneOfQuad(m_triangles[g].coord[ky]),
+                                  crossrt::LaneOfQuad(m_triangles[g].coord[kz]));
+          const float3 b = float3(crossrt::LaneOfQuad(m_triangles[g].coord[3 + kx]), crossrt::LaneOfQuad(m_triangles[g].coord[3 + ky]),
+                                  crossrt::LaneOfQuad(m_triangles[g].coord[3 + kz]));
+          const float3 c = float3(crossrt::LaneOfQuad(m_triangles[g].coord[6 + kx]), crossrt::LaneOfQuad(m_triangles[g].coord[6 + ky]),
+                                  crossrt::LaneOfQuad(m_triangles[g].coord[6 + kz]));
+          hitsIt = IntersectCorners(ray, kx, ky, kz, a, b, c, rayTfar, t, u, v, edge);
+        }
+        else
+        {
+          const float3 a = AlongAxes(float3(crossrt::LaneOfQuad(m_triangles[g].coord[0]), crossrt::LaneOfQuad(m_triangles[g].coord[1]),
+                                            crossrt::LaneOfQuad(m_triangles[g].coord[2])),
+                                     ray.kx, ray.ky, ray.kz);
+          const float3 b = AlongAxes(float3(crossrt::LaneOfQuad(m_triangles[g].coord[3]), crossrt::LaneOfQuad(m_triangles[g].coord[4]),
+                                            crossrt::LaneOfQuad(m_triangles[g].coord[5])),
+                                     ray.kx, ray.ky, ray.kz);
+          const float3 c = AlongAxes(float3(crossrt::LaneOfQuad(m_triangles[g].coord[6]), crossrt::LaneOfQuad(m_triangles[g].coord[7]),
+                                            crossrt::LaneOfQuad(m_triangles[g].coord[8])),
+                                     ray.kx, ray.ky, ray.kz);
+          hitsIt = IntersectCorners(ray, ray.kx, ray.ky, ray.kz, a, b, c, rayTfar, t, u, v, edge);
+        }
+        CRT_UNIFORM const uint32_t edges = crossrt::LaneBits(live && edge);
+        if (edges != 0u)
+        {
+          // A triangle on an edge in float: as TraceMesh tests it, in its group, exactly. IntersectGroup
+          // then decides all four triangles of the group so (their t, u and v to the last bit), so every
+          // lane of a quad where one is on an edge takes the group's answer, not its own.
+          const bool exact = ((edges >> uint32_t(4 * quad)) & 15u) != 0u;
           float4 t4;
           float4 u4;
           float4 v4;
-          const uint32_t groupHits = IntersectGroup(ray, g, kx, ky, kz, rayTfar, t4, u4, v4);
-          hitsIt = edge ? ((groupHits >> uint32_t(box)) & 1u) != 0u : hitsIt;
-          t = edge ? t4[box] : t;
-          u = edge ? u4[box] : u;
-          v = edge ? v4[box] : v;
+          const uint32_t groupHits = IntersectGroup(ray, g, ray.kx, ray.ky, ray.kz, rayTfar, t4, u4, v4);
+          hitsIt = exact ? ((groupHits >> uint32_t(box)) & 1u) != 0u : hitsIt;
+          t = exact ? t4[box] : t;
+          u = exact ? u4[box] : u;
+          v = exact ? v4[box] : v;
         }
         hitsIt = hitsIt && live;
         if (crossrt::AnyLane(hitsIt))
@@ -1652,7 +1706,7 @@ bool BVHScene::TraceMeshQuads(const BVHTraceRay& gangRay, uint32_t rays, uint32_
     while (top > 0 && !popped)
     {
       top = top - 1;
-      popped = crossrt::AnyLane(inQuad && stackEntry[top] <= rayTfar && !(firstHit && found));
+      popped = crossrt::AnyLane(inQuad && stackEntry[top] <= Reach(rayTfar) && !(firstHit && found));
     }
     if (!popped)
       break;
@@ -1722,6 +1776,19 @@ bool BVHScene::Trace(float4 posAndNear, float4 dirAndFar, float time, bool anyHi
   // packet walk, and ISPC keeps its structs in registers there. (A gang of one takes the loop.)
   if (crossrt::GangSize() > 1 && m_instances.size() == 1)
     return TraceInstance(0u, worldRay, time, anyHit, tfar, hit);
+  // Several instances in SIMD lanes: the gang walks the top tree together, so that it enters each
+  // instance's mesh from one root and walks that together too (TraceMesh). One lane a ray, each lane
+  // gathering its own nodes and instances, had traced a path tracer's bounces at a third of the
+  // scalar loop's speed with avx2 on an AMD EPYC (Zen 4).
+  if (crossrt::GangSize() > 1 && m_instances.size() > 1)
+  {
+    bool together = false;  // (a return inside the AllLanesOn branch is refused: ISPC's unmasked cannot return)
+    if (crossrt::AllLanesOn())
+      together = TraceTogether(worldRay, time, anyHit, tfar, hit);
+    else
+      together = TraceTogether(worldRay, time, anyHit, tfar, hit);
+    return together;
+  }
   uint32_t stack[kStackSize];
   float stackEntry[kStackSize];
   int top = 0;
@@ -1749,7 +1816,7 @@ bool BVHScene::Trace(float4 posAndNear, float4 dirAndFar, float time, bool anyHi
       // Go on with the nearest lane entered; the others wait on the stack, the farthest lowest.
       float4 entries;
       uint4 children;
-      const int entered = EnteredLanes(worldRay, m_nodes[node], tfar, entries, children);
+      const int entered = EnteredLanes(worldRay, m_nodes[node], Reach(tfar), entries, children);
       if (entered > 0)
       {
         for (int lane = entered - 1; lane > 0; --lane)
@@ -1767,8 +1834,99 @@ bool BVHScene::Trace(float4 posAndNear, float4 dirAndFar, float time, bool anyHi
       if (top == 0)
         return found;
       top = top - 1;
-    } while (stackEntry[top] > tfar);
+    } while (stackEntry[top] > Reach(tfar));
     node = stack[top];
+  }
+}
+
+// The top tree, walked by the rays of a gang together, as TraceMeshTogether walks a mesh's: the node,
+// the stack and the order of descent are the gang's, and each ray keeps its own entry into each
+// subtree on the stack. At a leaf the gang traces each instance in it for all its rays at once; a ray
+// that is not in the leaf takes part with an interval that enters nothing (tfar -1), so the lanes stay
+// on together and each instance's mesh is entered by the whole gang from its root. Each ray gets the
+// hit Trace's walk gives it alone: every instance whose box it enters within its tfar is traced.
+bool BVHScene::TraceTogether(const BVHTraceRay& ray, float time, bool anyHit, float& tfar, CRT_Hit& hit) const
+{
+  CRT_UNIFORM uint32_t stack[kStackSize];
+  float stackEntry[kStackSize];  // this ray's entry into each subtree on the stack, kNotEntered if it does not enter it
+  CRT_UNIFORM int top = 0;
+  CRT_UNIFORM uint32_t node = 0u;
+  float entry = ray.tnear;  // this ray's entry into `node`
+  bool found = false;
+  while (true)
+  {
+    while ((node & kLeafFlag) == 0u)
+    {
+      // The four boxes, each against every ray; then on into the lane some ray enters first, as
+      // TraceMeshTogether goes, the others on the stack.
+      const bool active = entry <= Reach(tfar) && !(anyHit && found);
+      float childEntry[4];
+      CRT_UNIFORM uint32_t entered = 0u;
+      for (int lane = 0; lane < 4; ++lane)
+      {
+        float exit = 0.0f;
+        const float3 lo = float3(m_nodes[node].minX[lane], m_nodes[node].minY[lane], m_nodes[node].minZ[lane]);
+        const float3 hi = float3(m_nodes[node].maxX[lane], m_nodes[node].maxY[lane], m_nodes[node].maxZ[lane]);
+        const float boxEntry = SlabEntry(ray, lo, hi, Reach(tfar), exit);
+        const bool enters = active && boxEntry <= exit;
+        childEntry[lane] = enters ? boxEntry : kNotEntered;
+        entered = entered | (crossrt::AnyLane(enters) ? 1u << uint32_t(lane) : 0u);
+      }
+      CRT_UNIFORM uint32_t next = kNoChild;
+      float nextEntry = kNotEntered;
+      for (int lane = 0; lane < 4; ++lane)
+      {
+        if ((entered & (1u << uint32_t(lane))) == 0u)
+          continue;
+        if (next == kNoChild)
+        {
+          next = m_nodes[node].child[lane];
+          nextEntry = childEntry[lane];
+        }
+        else if (crossrt::AnyLane(childEntry[lane] < nextEntry))
+        {
+          stack[top] = next;
+          stackEntry[top] = nextEntry;
+          top = top + 1;
+          next = m_nodes[node].child[lane];
+          nextEntry = childEntry[lane];
+        }
+        else
+        {
+          stack[top] = m_nodes[node].child[lane];
+          stackEntry[top] = childEntry[lane];
+          top = top + 1;
+        }
+      }
+      node = next;
+      entry = nextEntry;
+      if (next == kNoChild)
+        break;
+    }
+    if (node != kNoChild && crossrt::AnyLane(entry <= Reach(tfar) && !(anyHit && found)))
+    {
+      CRT_UNIFORM const uint32_t first = (node & ~kLeafFlag) >> 3;
+      CRT_UNIFORM const uint32_t last = first + (node & 7u);
+      for (uint32_t k = first; k <= last; ++k)
+      {
+        const bool inLeaf = entry <= Reach(tfar) && !(anyHit && found);
+        float leafTfar = inLeaf ? tfar : -1.0f;  // enters nothing: no hit is taken
+        const bool foundHere = TraceInstance(k, ray, time, anyHit, leafTfar, hit);
+        tfar = inLeaf ? leafTfar : tfar;
+        found = found || (inLeaf && foundHere);
+      }
+      if (crossrt::AllLanes(anyHit && found))
+        return true;
+    }
+    // Pop the next subtree that some ray may still find something nearer in.
+    do
+    {
+      if (top == 0)
+        return found;
+      top = top - 1;
+    } while (!crossrt::AnyLane(stackEntry[top] <= Reach(tfar) && !(anyHit && found)));
+    node = stack[top];
+    entry = stackEntry[top];
   }
 }
 

@@ -180,6 +180,7 @@ private:
   CRT_Hit NearestHit(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar, float time) const;
   bool AnyHit(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar, float time) const;
   bool Trace(LiteMath::float4 posAndNear, LiteMath::float4 dirAndFar, float time, bool anyHit, CRT_Hit& hit) const;
+  bool TraceTogether(const BVHTraceRay& ray, float time, bool anyHit, float& tfar, CRT_Hit& hit) const;
   bool TraceInstance(uint32_t k, const BVHTraceRay& worldRay, float time, bool anyHit, float& tfar, CRT_Hit& hit) const;
   bool TraceMesh(const BVHTraceRay& ray, uint32_t root, uint32_t leaves, bool anyHit, float& tfar, CRT_Hit& hit) const;
   bool TraceMeshTogether(const BVHTraceRay& ray, uint32_t root, bool anyHit, float& tfar, CRT_Hit& hit) const;

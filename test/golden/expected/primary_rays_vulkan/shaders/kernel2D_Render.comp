@@ -202,6 +202,7 @@ const uint m_pAccelStruct_kInstanceBoxes = 2u;
 const uint m_pAccelStruct_kInstanceMotion = 4u;
 const uint m_pAccelStruct_kInstanceIdentity = 1u;
 const uint m_pAccelStruct_kSceneTransformed = 32u;
+const float m_pAccelStruct_kReach = 1.0 + 1.0 / 524288.0;
 const float m_pAccelStruct_kWiden = 1.00000036;
 const float m_pAccelStruct_kMissed = -1.0;
 const uint m_pAccelStruct_kNoChild = 4294967295u;
@@ -264,6 +265,12 @@ vec3 m_pAccelStruct_ToObjectVector(BVHInstance inst, vec3 d)
 {
   const vec4 h = vec4(d.x, d.y, d.z, 0.0);
   return vec3(dot(inst.toObjectRow0, h), dot(inst.toObjectRow1, h), dot(inst.toObjectRow2, h));
+}
+
+// from (anonymous namespace)::Reach
+float m_pAccelStruct_Reach(float tfar)
+{
+  return tfar * m_pAccelStruct_kReach;
 }
 
 // from (anonymous namespace)::SlabEntryParallelAxes
@@ -747,8 +754,8 @@ bool m_pAccelStruct_TakeNearestHit(uint g, uint hits, vec4 t, vec4 u, vec4 v, bo
 // from BVHScene::TraceMesh
 bool m_pAccelStruct_TraceMesh(BVHTraceRay ray, uint root, uint leaves, bool anyHit, inout float tfar, inout CRT_Hit hit)
 {
-  // if (crossrt::GangSize() > 1 && crossrt::AllLanes(leaves == 0u && root == crossrt::FirstLane(root) && ray.kx ==
-  // crossrt::FirstLane(ray.kx) && ray.kz == crossrt::FirstLane(ray.kz))): false with a gang of 1
+  // if (crossrt::GangSize() > 1 && crossrt::AllLanes(leaves == 0u && root == crossrt::FirstLane(root))): false with a
+  // gang of 1
   uint stack[64];
   float stackEntry[64];
   int top = 0;
@@ -760,7 +767,8 @@ bool m_pAccelStruct_TraceMesh(BVHTraceRay ray, uint root, uint leaves, bool anyH
     {
       vec4 entries = vec4(0);
       uvec4 children = uvec4(0);
-      const int entered = m_pAccelStruct_EnteredLanes(ray, m_pAccelStruct_m_nodes[node], tfar, entries, children);
+      const int entered =
+          m_pAccelStruct_EnteredLanes(ray, m_pAccelStruct_m_nodes[node], m_pAccelStruct_Reach(tfar), entries, children);
       if (entered == 0)
       {
         node = m_pAccelStruct_kNoChild;
@@ -810,7 +818,7 @@ bool m_pAccelStruct_TraceMesh(BVHTraceRay ray, uint root, uint leaves, bool anyH
       if (top == 0)
         return found;
       top = top - 1;
-    } while (stackEntry[top] > tfar);
+    } while (stackEntry[top] > m_pAccelStruct_Reach(tfar));
     node = stack[top];
   }
 }
@@ -857,6 +865,7 @@ bool m_pAccelStruct_Trace(vec4 posAndNear, vec4 dirAndFar, float time, bool anyH
   tfar = valid ? tfar : -1.0;
   const BVHTraceRay worldRay = m_pAccelStruct_Prepare((posAndNear).xyz, (dirAndFar).xyz, tnear);
   // if (crossrt::GangSize() > 1 && m_instances.size() == 1): false with a gang of 1
+  // if (crossrt::GangSize() > 1 && m_instances.size() > 1): false with a gang of 1
   uint stack[64];
   float stackEntry[64];
   int top = 0;
@@ -881,7 +890,8 @@ bool m_pAccelStruct_Trace(vec4 posAndNear, vec4 dirAndFar, float time, bool anyH
     {
       vec4 entries = vec4(0);
       uvec4 children = uvec4(0);
-      const int entered = m_pAccelStruct_EnteredLanes(worldRay, m_pAccelStruct_m_nodes[node], tfar, entries, children);
+      const int entered = m_pAccelStruct_EnteredLanes(worldRay, m_pAccelStruct_m_nodes[node],
+                                                      m_pAccelStruct_Reach(tfar), entries, children);
       if (entered > 0)
       {
         for (int lane = entered - 1; lane > 0; --lane)
@@ -899,7 +909,7 @@ bool m_pAccelStruct_Trace(vec4 posAndNear, vec4 dirAndFar, float time, bool anyH
       if (top == 0)
         return found;
       top = top - 1;
-    } while (stackEntry[top] > tfar);
+    } while (stackEntry[top] > m_pAccelStruct_Reach(tfar));
     node = stack[top];
   }
 }
