@@ -266,13 +266,15 @@ constexpr uint32_t kMergeSize = 4;  // subtrees of up to this many primitives be
 uint32_t LeafRef(uint32_t first, uint32_t count) { return kLeafFlag | first << 3 | (count - 1); }
 
 // Collapses a binary tree into BVH4Nodes: each node takes its two children, then opens the child
-// with the largest surface area (an inner node, or a leaf of more than kMaxLeafSize primitives,
+// with the largest surface area (an inner node, or a leaf of more than leafSize primitives,
 // which is halved) until it has four or nothing is left to open.
 class Collapse
 {
 public:
-  // primBox(k): the box of primitive tree.primIndices[k].
-  Collapse(const BVHTree& tree, std::function<Box4f(uint32_t)> primBox) : m_tree(tree), m_primBox(std::move(primBox))
+  // primBox(k): the box of primitive tree.primIndices[k]. Leaves hold up to leafSize primitives, and
+  // a subtree of up to min(leafSize, kMergeSize) consecutive ones becomes one leaf.
+  Collapse(const BVHTree& tree, std::function<Box4f(uint32_t)> primBox, uint32_t leafSize)
+      : m_tree(tree), m_primBox(std::move(primBox)), m_leafSize(leafSize), m_mergeSize(std::min(leafSize, kMergeSize))
   {
     m_first.resize(tree.nodes.size());
     m_count.resize(tree.nodes.size());
@@ -320,7 +322,7 @@ private:
     const Box4f box(float4(n.boxMin, 0.0f), float4(n.boxMax, 0.0f));
     // A small subtree over consecutive primitives becomes one leaf: testing its few triangles
     // costs less than a step over their boxes.
-    if ((n.left & kLeafFlag) || (m_count[index] > 0 && m_count[index] <= kMergeSize))
+    if ((n.left & kLeafFlag) || (m_count[index] > 0 && m_count[index] <= m_mergeSize))
       return {kNoChild, m_first[index], m_count[index], box};
     return {index, 0, 0, box};
   }
@@ -333,7 +335,7 @@ private:
     return part;
   }
 
-  static bool Openable(const Part& p) { return p.node != kNoChild || p.count > kMaxLeafSize; }
+  bool Openable(const Part& p) const { return p.node != kNoChild || p.count > m_leafSize; }
 
   void Open(const Part& p, Part& a, Part& b) const
   {
@@ -401,6 +403,7 @@ private:
 
   const BVHTree& m_tree;
   std::function<Box4f(uint32_t)> m_primBox;
+  uint32_t m_leafSize, m_mergeSize;
   std::vector<uint32_t> m_first, m_count;
   std::vector<BVH4Node> m_nodes;
 };
@@ -494,10 +497,10 @@ void GroupBoxes(std::vector<BVH4Node>& wide, const std::vector<Box4f>& boxes, co
       [](int) {});
 }
 
-std::vector<BVH4Node> CollapseTree(const BVHTree& tree, std::function<Box4f(uint32_t)> primBox)
+std::vector<BVH4Node> CollapseTree(const BVHTree& tree, std::function<Box4f(uint32_t)> primBox, uint32_t leafSize = kMaxLeafSize)
 {
   int stackNeed = 0;
-  std::vector<BVH4Node> nodes = Collapse(tree, std::move(primBox)).Run(stackNeed);
+  std::vector<BVH4Node> nodes = Collapse(tree, std::move(primBox), leafSize).Run(stackNeed);
   if (stackNeed > kStackSize)
     throw std::length_error("BVHScene: the tree is too deep for the traversal's stack (" + std::to_string(stackNeed) + " entries, " +
                             std::to_string(kStackSize) + " available)");
@@ -871,7 +874,9 @@ void BVHScene::CommitScene(uint32_t)
   const BVHTree top = m_builder(boxes.data(), int(boxes.size()));
 
   // Device data: the top tree first, so its root is node 0, then each mesh that has triangles.
-  const std::vector<BVH4Node> topNodes = CollapseTree(top, [&](uint32_t k) { return boxes[top.primIndices[k]]; });
+  // One instance a leaf: a ray then enters only the instances whose boxes it enters, not a leaf's
+  // others with them (each an object-space ray to prepare and a mesh's root to test).
+  const std::vector<BVH4Node> topNodes = CollapseTree(top, [&](uint32_t k) { return boxes[top.primIndices[k]]; }, 1u);
   size_t nodeCount = topNodes.size(), groupCount = 0;
   for (const Mesh& mesh : m_meshes)
   {
