@@ -116,6 +116,7 @@ TEST_CASE("Printer: a branch that GangSize() decides prints only the branch a ga
                  "    if (crossrt::GangSize() > 1 && v > 0.0f) v = -7.0f;\n"               // never with a gang of one
                  "    if (!(crossrt::GangSize() == 4) || Falloff(v) < 0.0f) v += 0.125f;\n"  // always, Falloff not called
                  "    if (crossrt::GangSize() != 1) v = -9.0f; else v *= 3.0f;\n"           // the else-branch alone
+                 "    if (crossrt::GangSize() == 1 && v > 2.0f) v -= 0.0625f;\n"            // the gang's term left out
                  "    { const int n = 2; v += float(n); }\n"                                 // shadows the parameter n
                  + last);
   TempClass tc("Printer", kHeader, source);
@@ -129,6 +130,7 @@ TEST_CASE("Printer: a branch that GangSize() decides prints only the branch a ga
   CHECK(glsl.find(Squeezed("// if (crossrt::GangSize() > 1 && v > 0.0f): false with a gang of 1")) != std::string::npos);
   CHECK(glsl.find(Squeezed("): true with a gang of 1\nv += 0.125;")) != std::string::npos);
   CHECK(glsl.find(Squeezed("): false with a gang of 1\nv *= 3.0;")) != std::string::npos);
+  CHECK(glsl.find(Squeezed("if (v > 2.0) v -= 0.0625;")) != std::string::npos);
   CHECK(Count(glsl, "Falloff(v)<0.0)") == 0);  // (the comment has the C++, 0.0f)
   CHECK(glsl.find(Squeezed("{ const int n_1 = 2; v += float(n_1); }")) != std::string::npos);
 }

@@ -166,6 +166,16 @@ std::optional<bool> KernelPrinter::GangCondition(const clang::Expr* e) const {
   }
 }
 
+// An if's condition: `GangSize() == 1 && rest` (or `rest && ...`) where the gang's term holds in
+// this language's gang is printed as `rest` alone, as a gang of one evaluates it.
+std::string KernelPrinter::IfCondition(const clang::Expr* cond) {
+  if (auto* bo = dyn_cast<BinaryOperator>(cond->IgnoreParenImpCasts()); bo && bo->getOpcode() == BO_LAnd) {
+    if (auto l = GangCondition(bo->getLHS()); l && *l) return IfCondition(bo->getRHS());
+    if (auto r = GangCondition(bo->getRHS()); r && *r) return IfCondition(bo->getLHS());
+  }
+  return Expr(cond);
+}
+
 bool IsUniformLocal(const VarDecl* vd) {
   if (!vd || !vd->isLocalVarDecl()) return false;
   for (const auto* a : vd->specific_attrs<AnnotateAttr>())

@@ -881,7 +881,7 @@ std::string KernelPrinter::Stmt(const clang::Stmt* s, int indent) {
       return pad + "// if (" + cond + "): " + (*taken ? "true" : "false") + " with a gang of " + std::to_string(*FixedGangSize()) + "\n" +
              (branch ? Stmt(branch, indent) : "");
     }
-    std::string out = pad + "if (" + Expr(is->getCond()) + ")\n" + ThenBranch(is, indent);
+    std::string out = pad + "if (" + IfCondition(is->getCond()) + ")\n" + ThenBranch(is, indent);
     if (is->getElse()) out += pad + "else\n" + Stmt(is->getElse(), isa<CompoundStmt>(is->getElse()) ? indent : indent + 1);
     return out;
   }

@@ -304,6 +304,7 @@ protected:
   // What a condition on crossrt::GangSize() is where the language fixes the size (`GangSize() == 4
   // && ...` is false in GLSL), or nullopt: an `if` prints only its branch taken (Calls.cpp).
   std::optional<bool> GangCondition(const clang::Expr* e) const;
+  std::string IfCondition(const clang::Expr* cond);
   std::string Builtin(const clang::FunctionDecl* fd, const std::vector<std::string>& args, const clang::CallExpr* call);
   std::string Construct(clang::QualType t, const std::vector<const clang::Expr*>& args, clang::SourceLocation loc);
   std::string Literal(const clang::Expr* e);
