@@ -43,7 +43,8 @@
 //
 // In GLSL, where the gang is one thread, an `if` whose condition GangSize() decides alone
 // (`GangSize() == 4 && ...`, `GangSize() > 1 && ...`) prints only the branch it takes, with a comment
-// saying so: the shaders carry no walk written for wider gangs.
+// saying so: the shaders carry no walk written for wider gangs. Where the gang's term holds and the
+// rest decides (`GangSize() == 1 && done`), the condition prints as the rest alone (`if (done)`).
 //
 // An `if` whose condition is AllLanesOn() && other terms every lane shares (AllLanes(...), GangSize(),
 // members, CRT_UNIFORM locals) runs its then-branch on ISPC as `unmasked`: ISPC then knows that every
