@@ -1865,7 +1865,8 @@ bool BVHScene::TraceTogether(const BVHTraceRay& ray, float time, bool anyHit, fl
     while ((node & kLeafFlag) == 0u)
     {
       // The four boxes, each against every ray; then on into the lane some ray enters first, as
-      // TraceMeshTogether goes, the others on the stack.
+      // TraceMeshTogether goes, the others on the stack. (Written again rather than shared: a helper
+      // could not take the gang's CRT_UNIFORM stack by reference, nor return `entered` as shared.)
       const bool active = entry <= Reach(tfar) && !(anyHit && found);
       float childEntry[4];
       CRT_UNIFORM uint32_t entered = 0u;
