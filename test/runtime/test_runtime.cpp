@@ -1201,3 +1201,58 @@ TEST_CASE("LaneChoice runs a kernel in lanes or as a scalar loop, whichever has 
     CHECK(choice.Mean(0) < 0.0f);
   }
 }
+
+// crossrt::LaneMemory: a kernel's first call in a run takes the way that was faster in the last run
+// on this machine (the file CROSSRT_LANE_MEMORY names), the other way is tried after 16 calls, and at
+// exit what this run measured replaces that kernel's lines, keeping other machines' and kernels'.
+// Each test case runs in a process of its own, so this one is the first to ask for the memory.
+TEST_CASE("LaneChoice remembers the faster way for the next run", "[runtime][parallel]")
+{
+  const std::filesystem::path file = std::filesystem::temp_directory_path() / ("crossrt_lane_memory_" + std::to_string(getpid()) + ".tsv");
+  setenv("CROSSRT_LANE_MEMORY", file.c_str(), 1);
+  const std::string machine = crossrt::LaneMemory::Machine();
+  {
+    std::ofstream out(file);
+    // This machine's last run: the scalar loop three times faster, in the size class of 1000
+    // iterations (4^4 <= 1000 < 4^5); another machine's line, another kernel's, and a broken line.
+    out << machine << "\tRemembered::kernel1D_Walk\t4\t0.003\t0.001\t1\n"
+        << "Another CPU, avx2, 8 threads\tRemembered::kernel1D_Walk\t4\t0.001\t0.003\t1\n"
+        << machine << "\tOther::kernel1D_Scan\t2\t0.5\t0.25\t1\n"
+        << machine << "\tBroken::kernel1D_Line\tnot a number\n";
+  }
+  {
+    crossrt::LaneChoice choice("Remembered::kernel1D_Walk");
+    if (crossrt::LaneChoice::LanesMode() != crossrt::LaneChoice::Mode::Measure) {
+      // CROSSRT_ISPC_LANES=always or never: the memory is neither read nor written.
+      CHECK(choice.Choose() == (crossrt::LaneChoice::LanesMode() == crossrt::LaneChoice::Mode::Always));
+      std::filesystem::remove(file);
+      return;
+    }
+    int lanes = 0;
+    for (int call = 0; call < 16; ++call) {
+      const bool l = choice.Choose();
+      if (call == 0) CHECK_FALSE(l);  // the first call: the scalar loop, as the last run found faster
+      choice.Record(l, 1000, l ? 3.0 : 1.0);
+      lanes += l;
+    }
+    CHECK(lanes == 1);  // lanes tried once in 16 calls
+    CHECK(choice.Mean(0) == Approx(0.001f));
+    CHECK(choice.Mean(1) == Approx(0.003f));
+    // A kernel the file does not name starts in lanes, as in a first run.
+    crossrt::LaneChoice fresh("Unremembered::kernel1D_Walk");
+    CHECK(fresh.Choose());
+  }
+  // The choices above are gone: at exit their means are written, here at once.
+  REQUIRE(crossrt::LaneMemory::Get().Save());
+  std::ifstream in(file);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  const auto has = [&](const std::string& start) {
+    return std::count_if(lines.begin(), lines.end(), [&](const std::string& l) { return l.rfind(start, 0) == 0; });
+  };
+  CHECK(lines.size() == 3);  // the broken line dropped, the kernel never measured not written
+  CHECK(has(machine + "\tRemembered::kernel1D_Walk\t4\t0.003\t0.001\t1") == 1);
+  CHECK(has("Another CPU, avx2, 8 threads\tRemembered::kernel1D_Walk\t4\t0.001\t0.003\t1") == 1);
+  CHECK(has(machine + "\tOther::kernel1D_Scan\t2\t0.5\t0.25\t1") == 1);
+  std::filesystem::remove(file);
+}

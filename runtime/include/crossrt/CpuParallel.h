@@ -3,6 +3,7 @@
 // lanes and its scalar loop (header only; OpenMP).
 #pragma once
 #include "CpuLoops.h"
+#include "LaneMemory.h"
 #include "SortKey.h"
 
 #include <omp.h>
@@ -36,6 +37,16 @@ class MeasuredWays {
 
   // The next run is a try of the way that is not the faster one (or has not run yet).
   void Try() { m_tryingOther.store(true, std::memory_order_relaxed); }
+
+  // Both ways' means as an earlier run left them (LaneMemory): the faster is the verdict, and the
+  // other is tried after kFirstWait calls. A way's first run here replaces its remembered mean.
+  void Seed(float way1Ms, float way0Ms) {
+    m_msPerIteration[1].store(way1Ms, std::memory_order_relaxed);
+    m_msPerIteration[0].store(way0Ms, std::memory_order_relaxed);
+    m_remembered[1].store(true, std::memory_order_relaxed);
+    m_remembered[0].store(true, std::memory_order_relaxed);
+    m_verdict.store(way1Ms <= way0Ms ? 1 : 0, std::memory_order_relaxed);
+  }
 
   // Counts a call that keeps to the faster way; true when the slower one is due for a try.
   bool TimeToTry() {
@@ -71,8 +82,10 @@ class MeasuredWays {
       m_firstTry.store(-1.0f, std::memory_order_relaxed);
       m_calls.store(0, std::memory_order_relaxed);
     }
-    // A way tried again after a while starts its mean afresh: what it measured then is stale.
-    m_msPerIteration[w].store(before < 0.0f || tried ? msPerIteration : before + 0.3f * (msPerIteration - before), std::memory_order_relaxed);
+    // A way tried again after a while starts its mean afresh: what it measured then is stale; so does
+    // a way's first run after a mean remembered from an earlier run (Seed).
+    const bool fresh = before < 0.0f || tried || m_remembered[w].exchange(false, std::memory_order_relaxed);
+    m_msPerIteration[w].store(fresh ? msPerIteration : before + 0.3f * (msPerIteration - before), std::memory_order_relaxed);
     if (Mean(0) < 0.0f || Mean(1) < 0.0f) return;
     const int faster = Mean(1) <= Mean(0) ? 1 : 0;
     if (tried || Verdict() < 0) {
@@ -93,6 +106,7 @@ class MeasuredWays {
   std::atomic<bool> m_tryingOther{false};
   std::atomic<float> m_firstTry{-1.0f};  // a try that won once, waiting for its second
   std::atomic<int> m_verdict{-1};
+  std::atomic<bool> m_remembered[2] = {false, false};  // the way's mean is an earlier run's (Seed)
 };
 
 // Iterations of a loop in classes 4x apart: [4^c, 4^(c+1)), the last open-ended. A loop's ways are
@@ -413,12 +427,14 @@ void RadixSort(Iterator first, Iterator last, const SortKey& key) {
 // loop way 0), per size class: loops within a factor of 4 of each other in iterations share one,
 // and a call is taken to be of the size of the call before it (what is small may run best one way
 // and what is large the other). Lanes run first; the very first call pays for touching memory and
-// is not counted. The next call of a size class whose lanes have a time tries the scalar loop
-// (twice where it was faster: MeasuredWays believes a try that wins on its second); after that the
-// faster way runs, the other tried again after 16, 64, ... 1024 calls, or on the next call where the
-// faster way's mean passes the other's (the work changed: the other is measured again, not taken on
-// its old number). A
-// kernel called once or twice always runs in lanes.
+// is not counted (whichever way it runs). The next call of a size class whose lanes have a time
+// tries the scalar loop (twice where it was faster: MeasuredWays believes a try that wins on its
+// second); after that the faster way runs, the other tried again after 16, 64, ... 1024 calls, or
+// on the next call where the faster way's mean passes the other's (the work changed: the other is
+// measured again, not taken on its old number). The means are kept from run to run (LaneMemory.h,
+// per CPU model and ISPC target): a kernel's first call in the next run takes the way that was
+// faster then, in the size class of the last call then. Only on a machine that never ran it does a
+// kernel called once or twice run in lanes.
 // CROSSRT_ISPC_LANES=always keeps every kernel in lanes (as before this choice), =never runs every
 // kernel's scalar loop (to test or compare it).
 //
@@ -440,6 +456,18 @@ class LaneChoice {
   // `name` (a string literal: the generated code's Class::kernel) names the kernel in the log.
   explicit LaneChoice(const char* name = nullptr) : m_name(name) {
     for (auto& cores : m_verdictCores) cores.store(-1, std::memory_order_relaxed);
+    if (Remembers()) LaneMemory::Get();  // made before this choice, so that it outlives it
+  }
+
+  // What this run measured goes to LaneMemory, for the next run's first calls.
+  ~LaneChoice() {
+    if (!Remembers()) return;
+    std::vector<RememberedWays> ways;
+    const int last = m_lastSize.load(std::memory_order_relaxed);
+    for (int size = 0; size < kLoopSizeClasses; ++size)
+      if (m_bySize[size].Mean(1) > 0.0f && m_bySize[size].Mean(0) > 0.0f)
+        ways.push_back({size, m_bySize[size].Mean(1), m_bySize[size].Mean(0), size == last});
+    if (!ways.empty()) LaneMemory::Get().Remember(m_name, std::move(ways));
   }
 
   Run Begin() {
@@ -483,6 +511,11 @@ class LaneChoice {
   bool Choose(bool& trying) {
     trying = false;
     if (LanesMode() != Mode::Measure) return LanesMode() == Mode::Always;
+    if (Remembers() && !m_recalled.exchange(true, std::memory_order_relaxed))  // the first call: what the last run measured
+      for (const RememberedWays& remembered : LaneMemory::Get().Recall(m_name)) {
+        m_bySize[remembered.sizeClass % kLoopSizeClasses].Seed(remembered.lanesMs, remembered.scalarMs);
+        if (remembered.last) m_lastSize.store(remembered.sizeClass % kLoopSizeClasses, std::memory_order_relaxed);
+      }
     MeasuredWays& ways = m_bySize[m_lastSize.load(std::memory_order_relaxed)];
     const float scalar = ways.Mean(0), lanes = ways.Mean(1);
     if (lanes < 0.0f) return true;  // first the lanes, the way this class is for
@@ -499,7 +532,7 @@ class LaneChoice {
     if (iterations < 1 || LanesMode() != Mode::Measure) return;  // (an early return ran no loop)
     const int size = SizeClass(iterations);
     m_lastSize.store(size, std::memory_order_relaxed);
-    if (lanes && !m_warm.exchange(true, std::memory_order_relaxed)) return;  // the first run touched the memory
+    if (!m_warm.exchange(true, std::memory_order_relaxed)) return;  // the first run touched the memory
     m_bySize[size].Record(lanes, float(ms / double(iterations)));
   }
 
@@ -520,7 +553,11 @@ class LaneChoice {
   }
 
  private:
+  // Whether this choice keeps what it measures for the next run (a named kernel's, while measuring).
+  bool Remembers() const { return m_name != nullptr && LanesMode() == Mode::Measure; }
+
   MeasuredWays m_bySize[kLoopSizeClasses];
+  std::atomic<bool> m_recalled{false};
   std::atomic<int> m_verdictCores[kLoopSizeClasses];  // per size class: what the verdict's last run ran on, -1 before one
   std::atomic<int> m_lastSize{0};
   std::atomic<bool> m_warm{false};

@@ -1,0 +1,214 @@
+// A program's first BVH build, as a program that builds once sees it: each builder's first Build in
+// a process of its own (a child of this one), on the meshes scripts/fetch-meshes.sh cached. The
+// builds of bench_lbvh come after three untimed calls, by which each _ISPC kernel has chosen
+// between its SIMD lanes and its scalar loop (crossrt::LaneChoice); a program's first calls come
+// before. LBVH_ISPC runs twice here:
+// - "first run": no lane choices remembered (CROSSRT_LANE_MEMORY=off), as on a machine that never
+//   ran it: each kernel's first call runs in lanes;
+// - "remembered": after one earlier run of 24 builds on this machine (crossrt::LaneMemory), each
+//   kernel's first call runs the way that was faster then.
+// Each cell is the median of --children runs (5), its ratio the time over LBVH_CPU's first build.
+// The table goes to CSV too (bench/plot_first_build.py plots it).
+//
+//   bench_first_build [--meshes NAME,...] [--children N] [MESH_DIR (default build/data/meshes)] [CSV (default out/first_build.csv)]
+#include "BenchSupport.h"
+#include "CommandLine.h"
+#include "LBVH.h"
+#include "LBVH_CPU.h"
+#ifdef CROSSRT_HAS_ISPC
+#include "LBVH_ISPC.h"
+#endif
+#include "MeshIO.h"
+
+#include <embree3/rtcore.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+using LiteMath::Box4f;
+using LiteMath::float4;
+
+namespace {
+
+double MsSince(std::chrono::steady_clock::time_point t0)
+{
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+std::vector<Box4f> TriangleBoxes(const TriangleMesh& mesh)
+{
+  std::vector<Box4f> boxes(mesh.TriangleCount());
+  for (size_t t = 0; t < boxes.size(); ++t)
+    for (int k = 0; k < 3; ++k)
+    {
+      const uint32_t v = mesh.indices[3 * t + k];
+      boxes[t].include(float4(mesh.positions[3 * v], mesh.positions[3 * v + 1], mesh.positions[3 * v + 2], 0.0f));
+    }
+  return boxes;
+}
+
+// Embree's LOW-quality build of the mesh (its commit), as bench_lbvh times it.
+double EmbreeLowMs(const TriangleMesh& mesh)
+{
+  RTCDevice device = rtcNewDevice(nullptr);
+  const auto t0 = std::chrono::steady_clock::now();
+  RTCScene scene = rtcNewScene(device);
+  rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_LOW);
+  RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+  rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, mesh.positions.data(), 0, 12, mesh.VertexCount());
+  rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, mesh.indices.data(), 0, 12, mesh.TriangleCount());
+  rtcSetGeometryBuildQuality(geom, RTC_BUILD_QUALITY_LOW);
+  rtcCommitGeometry(geom);
+  rtcAttachGeometry(scene, geom);
+  rtcReleaseGeometry(geom);
+  rtcCommitScene(scene);
+  const double ms = MsSince(t0);
+  rtcReleaseScene(scene);
+  rtcReleaseDevice(device);
+  return ms;
+}
+
+// The child: builds the mesh `calls` times with one builder and prints the first build's ms.
+int RunChild(const std::string& builder, const std::string& path, int calls)
+{
+  const TriangleMesh mesh = LoadMesh(path);
+  if (builder == "embree")
+  {
+    std::printf("%.4f\n", EmbreeLowMs(mesh));
+    return 0;
+  }
+  std::shared_ptr<LBVH> lbvh;
+  if (builder == "lbvh_cpu") lbvh = CreateLBVH_CPU();
+#ifdef CROSSRT_HAS_ISPC
+  if (builder == "lbvh_ispc") lbvh = CreateLBVH_ISPC();
+#endif
+  if (!lbvh)
+  {
+    std::fprintf(stderr, "bench_first_build: no builder '%s' here\n", builder.c_str());
+    return 2;
+  }
+  const std::vector<Box4f> boxes = TriangleBoxes(mesh);
+  lbvh->Reserve(int(boxes.size()));
+  lbvh->CommitDeviceData();
+  double first = 0.0;
+  for (int call = 0; call < calls; ++call)
+  {
+    const auto t0 = std::chrono::steady_clock::now();
+    lbvh->Build(int(boxes.size()), boxes.data());
+    if (call == 0) first = MsSince(t0);
+  }
+  std::printf("%.4f\n", first);
+  return 0;
+}
+
+std::string Quoted(const std::string& s)
+{
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+// One child's first build, in ms (negative where it failed), with CROSSRT_LANE_MEMORY=memory.
+double ChildMs(const std::string& self, const std::string& builder, const std::string& mesh, const std::string& memory, int calls = 1)
+{
+  const std::string command = "CROSSRT_LANE_MEMORY=" + Quoted(memory) + " " + Quoted(self) + " --child " + builder + " --calls " +
+                              std::to_string(calls) + " " + Quoted(mesh);
+  std::FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) return -1.0;
+  double ms = -1.0;
+  if (std::fscanf(pipe, "%lf", &ms) != 1) ms = -1.0;
+  return pclose(pipe) == 0 ? ms : -1.0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv)
+{
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
+  std::vector<std::string> only;
+  std::string dir = "build/data/meshes", csvPath = "out/first_build.csv", child;
+  int children = 5, calls = 1;
+  crossrt::CommandLine app("bench_first_build",
+                           "A program's first BVH build: each builder's first Build in a fresh process, LBVH_ISPC without and with\n"
+                           "the lane choices an earlier run remembered (crossrt::LaneMemory), against LBVH_CPU and Embree LOW.\n"
+                           "The table goes to CSV too; bench/plot_first_build.py plots it.");
+  app.add_option("MESH_DIR", dir, "the meshes' folder (a mesh file, with --child)");
+  app.add_option("CSV", csvPath, "the table's CSV file");
+  app.add_option("--meshes", only, "only the meshes whose file names start with one of these (e.g. bunny,dragon_vrip_res2)")->delimiter(',');
+  app.add_option("--children", children, "fresh processes per cell (the median is printed)")->check(CLI::Range(1, 100));
+  app.add_option("--child", child, "(internal) build MESH_DIR, a mesh file, with this builder and print the first build's ms")
+      ->check(CLI::IsMember({"embree", "lbvh_cpu", "lbvh_ispc"}));
+  app.add_option("--calls", calls, "(internal, with --child) builds in the child")->check(CLI::Range(1, 1000));
+  if (const int status = crossrt::ParseCommandLine(app, argc, argv); status >= 0) return status;
+  if (!child.empty()) return RunChild(child, dir, calls);
+
+  const std::string self = std::filesystem::canonical("/proc/self/exe").string();
+  const std::string memory = (std::filesystem::temp_directory_path() / ("crossrt_first_build_" + std::to_string(getpid()) + ".tsv")).string();
+  std::printf("CPU: %s, %d threads; ISPC target: %s; each cell the median of %d fresh processes' first build\n", CpuModel().c_str(),
+              int(std::thread::hardware_concurrency()), IspcTarget().c_str(), children);
+  std::printf("| %-24s | %9s | %10s | %8s | %23s | %23s |\n", "mesh", "triangles", "Embree LOW", "LBVH_CPU", "LBVH_ISPC first run",
+              "LBVH_ISPC remembered");
+  std::printf("|%s|\n", std::string(116, '-').c_str());
+  std::FILE* csv = OpenCsv(csvPath, "bench_first_build");
+  if (csv)
+    std::fprintf(csv, "cpu,ispc_target,mesh,triangles,embree_low_ms,lbvh_cpu_ms,lbvh_ispc_first_run_ms,lbvh_ispc_remembered_ms\n");
+  const char* names[] = {"teapot.obj", "dragon_vrip_res4.ply.gz", "dragon_vrip_res3.ply.gz", "armadillo.off", "bunny00.off",
+                         "dragon_vrip_res2.ply.gz", "dragon_vrip.ply.gz"};
+  int status = 0;
+  for (const char* name : names)
+  {
+    bool chosen = only.empty();
+    for (const auto& prefix : only) chosen = chosen || std::string(name).rfind(prefix, 0) == 0;
+    const std::string path = dir + "/" + name;
+    if (!chosen) continue;
+    if (!std::filesystem::exists(path))
+    {
+      std::printf("| %-24s | skipped: not in %s (run scripts/fetch-meshes.sh)\n", name, dir.c_str());
+      continue;
+    }
+    const size_t triangles = LoadMesh(path).TriangleCount();
+    auto median = [&](const std::string& builder, const std::string& memoryFile) {
+      std::vector<double> ms;
+      for (int k = 0; k < children; ++k)
+      {
+        const double m = ChildMs(self, builder, path, memoryFile);
+        if (m < 0.0) return -1.0;
+        ms.push_back(m);
+      }
+      return MedianOf(ms);
+    };
+    std::filesystem::remove(memory);
+    const double embree = median("embree", "off"), cpu = median("lbvh_cpu", "off");
+    double firstRun = -1.0, remembered = -1.0;
+#ifdef CROSSRT_HAS_ISPC
+    firstRun = median("lbvh_ispc", "off");
+    if (ChildMs(self, "lbvh_ispc", path, memory, 24) >= 0.0)  // the earlier run, which leaves its choices in `memory`
+      remembered = median("lbvh_ispc", memory);
+#endif
+    if (embree < 0.0 || cpu < 0.0)
+    {
+      std::printf("| %-24s | a child failed\n", name);
+      status = 1;
+      continue;
+    }
+    auto cell = [&](double ms) {
+      char text[32];
+      if (ms < 0.0) return std::string("n/a");
+      std::snprintf(text, sizeof text, "%.2f (%.2fx)", ms, ms / cpu);
+      return std::string(text);
+    };
+    std::printf("| %-24s | %9zu | %10.2f | %8.2f | %23s | %23s |\n", name, triangles, embree, cpu, cell(firstRun).c_str(), cell(remembered).c_str());
+    if (csv)
+      std::fprintf(csv, "\"%s\",%s,%s,%zu,%.4f,%.4f,%.4f,%.4f\n", CpuModel().c_str(), IspcTarget().c_str(), name, triangles, embree, cpu, firstRun,
+                   remembered);
+  }
+  std::filesystem::remove(memory);
+  if (!csv || std::fclose(csv) != 0) status = 1;
+  return status;
+}
