@@ -11,7 +11,7 @@
 //
 // The file: CROSSRT_LANE_MEMORY if set (`off`: nothing is read or written), else
 // $XDG_CACHE_HOME/crossrt/lane-choices.tsv, else $HOME/.cache/crossrt/lane-choices.tsv. A line per
-// kernel and size class, tab-separated: the machine (CPU model, ISPC target, hardware threads), the
+// kernel and size class, tab-separated: the machine (CPU model, ISPC target, threads), the
 // kernel (Class::kernel), the size class, the lanes' and the scalar loop's mean ms per iteration,
 // and 1 on the size class of the kernel's last call. Lines of other machines are kept, the oldest
 // dropped past kMaxLines. A file that cannot be read or written only costs the measuring again
@@ -20,6 +20,7 @@
 #pragma once
 #include "IspcSupport.h"
 
+#include <sched.h>
 #include <unistd.h>
 #if defined(__x86_64__) || defined(__i386__)
 #include <cpuid.h>
@@ -116,7 +117,7 @@ class LaneMemory {
   ~LaneMemory() { Save(); }
 
   // This machine, as the file names it: the CPU's model, the ISPC target the kernels run, and the
-  // hardware threads.
+  // threads the program may use.
   static std::string Machine() {
     // The brand string CPUID gives (/proc/cpuinfo's "model name"), read at once: /proc/cpuinfo
     // takes a while to read on a machine of many cores, and this is a kernel's first call.
@@ -141,7 +142,12 @@ class LaneMemory {
     else
       for (int i = 0; i < int(std::size(kIspcTargets)); ++i)
         if (CpuRunsIspcTarget(i)) target = kIspcTargets[i];
-    std::string machine = model + ", " + target + ", " + std::to_string(std::thread::hardware_concurrency()) + " threads";
+    // The threads this program may run on (its affinity: one system call, where the machine's count
+    // reads /sys): the means are of loops on all of them.
+    cpu_set_t cores;
+    CPU_ZERO(&cores);
+    const int threads = sched_getaffinity(0, sizeof cores, &cores) == 0 ? CPU_COUNT(&cores) : int(std::thread::hardware_concurrency());
+    std::string machine = model + ", " + target + ", " + std::to_string(threads) + " threads";
     for (char& c : machine)
       if (c == '\t' || c == '\n') c = ' ';
     return machine;
