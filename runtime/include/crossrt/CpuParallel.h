@@ -38,14 +38,16 @@ class MeasuredWays {
   // The next run is a try of the way that is not the faster one (or has not run yet).
   void Try() { m_tryingOther.store(true, std::memory_order_relaxed); }
 
-  // Both ways' means as an earlier run left them (LaneMemory): the faster is the verdict, and the
-  // other is tried after kFirstWait calls. A way's first run here replaces its remembered mean.
+  // The ways' means as earlier runs left them (LaneMemory; -1 for a way none measured): where both
+  // have one, the faster is the verdict and the other is tried after kFirstWait calls. A way's
+  // first run here replaces its remembered mean.
   void Seed(float way1Ms, float way0Ms) {
-    m_msPerIteration[1].store(way1Ms, std::memory_order_relaxed);
-    m_msPerIteration[0].store(way0Ms, std::memory_order_relaxed);
-    m_remembered[1].store(true, std::memory_order_relaxed);
-    m_remembered[0].store(true, std::memory_order_relaxed);
-    m_verdict.store(way1Ms <= way0Ms ? 1 : 0, std::memory_order_relaxed);
+    const float ms[2] = {way0Ms, way1Ms};
+    for (int w = 0; w < 2; ++w) {
+      m_msPerIteration[w].store(ms[w] > 0.0f ? ms[w] : -1.0f, std::memory_order_relaxed);
+      m_remembered[w].store(ms[w] > 0.0f, std::memory_order_relaxed);
+    }
+    if (way1Ms > 0.0f && way0Ms > 0.0f) m_verdict.store(way1Ms <= way0Ms ? 1 : 0, std::memory_order_relaxed);
   }
 
   // Counts a call that keeps to the faster way; true when the slower one is due for a try.
@@ -459,14 +461,20 @@ class LaneChoice {
     if (Remembers()) LaneMemory::Get();  // made before this choice, so that it outlives it
   }
 
-  // What this run measured goes to LaneMemory, for the next run's first calls.
+  // What this run measured goes to LaneMemory, for the next run's first calls: each way's mean, or
+  // where it has none (a kernel called once a run), its time on the run's first call. A program
+  // that calls a kernel once so runs it in lanes in its first run, tries the scalar loop in its
+  // second (the way with no time), and from its third takes the way whose first call was faster.
   ~LaneChoice() {
     if (!Remembers()) return;
     std::vector<RememberedWays> ways;
     const int last = m_lastSize.load(std::memory_order_relaxed);
-    for (int size = 0; size < kLoopSizeClasses; ++size)
-      if (m_bySize[size].Mean(1) > 0.0f && m_bySize[size].Mean(0) > 0.0f)
-        ways.push_back({size, m_bySize[size].Mean(1), m_bySize[size].Mean(0), size == last});
+    for (int size = 0; size < kLoopSizeClasses; ++size) {
+      float ms[2];
+      for (int w = 0; w < 2; ++w)
+        ms[w] = m_bySize[size].Mean(w) > 0.0f ? m_bySize[size].Mean(w) : m_firstCallMs[size][w].load(std::memory_order_relaxed);
+      if (ms[1] > 0.0f || ms[0] > 0.0f) ways.push_back({size, ms[1], ms[0], size == last});
+    }
     if (!ways.empty()) LaneMemory::Get().Remember(m_name, std::move(ways));
   }
 
@@ -532,7 +540,10 @@ class LaneChoice {
     if (iterations < 1 || LanesMode() != Mode::Measure) return;  // (an early return ran no loop)
     const int size = SizeClass(iterations);
     m_lastSize.store(size, std::memory_order_relaxed);
-    if (!m_warm.exchange(true, std::memory_order_relaxed)) return;  // the first run touched the memory
+    if (!m_warm.exchange(true, std::memory_order_relaxed)) {  // the first run touched the memory: not counted here,
+      m_firstCallMs[size][lanes ? 1 : 0].store(float(ms / double(iterations)), std::memory_order_relaxed);  // but kept for the next run
+      return;
+    }
     m_bySize[size].Record(lanes, float(ms / double(iterations)));
   }
 
@@ -557,6 +568,7 @@ class LaneChoice {
   bool Remembers() const { return m_name != nullptr && LanesMode() == Mode::Measure; }
 
   MeasuredWays m_bySize[kLoopSizeClasses];
+  std::atomic<float> m_firstCallMs[kLoopSizeClasses][2] = {};  // per size class and way: the run's first call, ms per iteration
   std::atomic<bool> m_recalled{false};
   std::atomic<int> m_verdictCores[kLoopSizeClasses];  // per size class: what the verdict's last run ran on, -1 before one
   std::atomic<int> m_lastSize{0};

@@ -4,19 +4,23 @@
 // an AMD EPYC (Zen 4) with AVX2 the LBVH build's lanes took 2-4x its scalar loop's time in five
 // kernels of seven, so a program's one LBVH_ISPC build took about twice LBVH_CPU's.
 //
-// So at exit each LaneChoice hands its means (per size class, both ways measured) to LaneMemory,
-// which writes them to a file; in the next run, a kernel's first call takes the way that was faster
-// then, in the size class of the last call then, and the other way is tried after 16 calls as
-// usual, so that a stale verdict (a new CPU under the same name, a changed kernel) corrects itself.
+// So at exit each LaneChoice hands its means (per size class; a way's first call where it ran only
+// once) to LaneMemory, which writes them to a file; in the next run, a kernel's first call takes
+// the way that was faster then, in the size class of the last call then, or, where one way has no
+// time yet, that way. The other way is tried after 16 calls as usual, so that in a program that
+// calls a kernel often a stale verdict (a new CPU under the same name, a changed kernel) corrects
+// itself. A program that calls a kernel once runs it in lanes in its first run, as its scalar loop
+// in its second, and from its third the way whose first call was faster.
 //
 // The file: CROSSRT_LANE_MEMORY if set (`off`: nothing is read or written), else
 // $XDG_CACHE_HOME/crossrt/lane-choices.tsv, else $HOME/.cache/crossrt/lane-choices.tsv. A line per
-// kernel and size class, tab-separated: the machine (CPU model, ISPC target, threads), the
-// kernel (Class::kernel), the size class, the lanes' and the scalar loop's mean ms per iteration,
-// and 1 on the size class of the kernel's last call. Lines of other machines are kept, the oldest
-// dropped past kMaxLines. A file that cannot be read or written only costs the measuring again
-// (CROSSRT_ISPC_LANES_LOG=1 says so); two programs that exit at once each replace the file whole
-// (written beside it, then renamed), and the later one's measurements win.
+// kernel and size class, tab-separated: the machine (CPU model, ISPC target, threads), the kernel
+// (Class::kernel), the size class, the lanes' and the scalar loop's mean ms per iteration (-1 for a
+// way that has not run), and 1 on the size class of the kernel's last call. Lines of other
+// machines are kept, the oldest dropped past kMaxLines. A file that cannot be read or written only
+// costs the measuring again (CROSSRT_ISPC_LANES_LOG=1 says so); two programs that exit at once
+// each replace the file whole (written beside it, then renamed), and the later one's measurements
+// win.
 #pragma once
 #include "IspcSupport.h"
 
@@ -44,7 +48,7 @@ namespace crossrt {
 // A kernel's means in one size class (LoopSizeClass), as a run left them.
 struct RememberedWays {
   int sizeClass;
-  float lanesMs, scalarMs;  // mean ms per iteration
+  float lanesMs, scalarMs;  // mean ms per iteration (or the first call's, where that was the only one), -1 where that way did not run
   bool last;                // the size class of the kernel's last call
 };
 
@@ -95,7 +99,8 @@ class LaneMemory {
     for (size_t k = total > kMaxLines ? std::min(kept.size(), total - kMaxLines) : 0; k < kept.size(); ++k) text << kept[k] << '\n';
     for (const auto& [kernel, ways] : m_measured)
       for (const RememberedWays& w : ways)
-        text << m_machine << '\t' << kernel << '\t' << w.sizeClass << '\t' << w.lanesMs << '\t' << w.scalarMs << '\t' << (w.last ? 1 : 0) << '\n';
+        text << m_machine << '\t' << kernel << '\t' << w.sizeClass << '\t' << (w.lanesMs > 0.0f ? w.lanesMs : -1.0f) << '\t'
+             << (w.scalarMs > 0.0f ? w.scalarMs : -1.0f) << '\t' << (w.last ? 1 : 0) << '\n';
     std::error_code error;
     const std::filesystem::path file(m_path);
     if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path(), error);
@@ -192,9 +197,9 @@ class LaneMemory {
       const long sizeClass = std::strtol(fields[2].c_str(), &end, 10);
       if (*end != '\0' || sizeClass < 0 || sizeClass >= 64) continue;
       const float lanes = std::strtof(fields[3].c_str(), &end);
-      if (*end != '\0' || !(lanes > 0.0f)) continue;
+      if (*end != '\0' || !(lanes > 0.0f || lanes == -1.0f)) continue;
       const float scalar = std::strtof(fields[4].c_str(), &end);
-      if (*end != '\0' || !(scalar > 0.0f)) continue;
+      if (*end != '\0' || !(scalar > 0.0f || scalar == -1.0f) || !(lanes > 0.0f || scalar > 0.0f)) continue;
       if (fields[5] != "0" && fields[5] != "1") continue;
       line.ways = {int(sizeClass), lanes, scalar, fields[5] == "1"};
       lines.push_back(line);
