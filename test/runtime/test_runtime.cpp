@@ -1205,7 +1205,8 @@ TEST_CASE("LaneChoice runs a kernel in lanes or as a scalar loop, whichever has 
 // crossrt::LaneMemory: a kernel's first call in a run takes the way that was faster in the last run
 // on this machine (the file CROSSRT_LANE_MEMORY names), the other way is tried after 16 calls, and at
 // exit what this run measured replaces that kernel's lines, keeping other machines' and kernels'.
-// Each test case runs in a process of its own, so this one is the first to ask for the memory.
+// The memory is read as a program with an _ISPC class starts; this test names its file later and
+// reads it again (Reload).
 TEST_CASE("LaneChoice remembers the faster way for the next run", "[runtime][parallel]")
 {
   const std::filesystem::path file = std::filesystem::temp_directory_path() / ("crossrt_lane_memory_" + std::to_string(getpid()) + ".tsv");
@@ -1221,6 +1222,7 @@ TEST_CASE("LaneChoice remembers the faster way for the next run", "[runtime][par
         << machine << "\tOnce::kernel1D_Build\t4\t0.002\t-1\t1\n"  // called once a run: its lanes' first call alone
         << machine << "\tBroken::kernel1D_Line\tnot a number\n";
   }
+  crossrt::LaneMemory::Get().Reload();
   {
     crossrt::LaneChoice choice("Remembered::kernel1D_Walk");
     if (crossrt::LaneChoice::LanesMode() != crossrt::LaneChoice::Mode::Measure) {

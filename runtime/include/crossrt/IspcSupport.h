@@ -4,6 +4,8 @@
 #pragma once
 
 #include "crossrt/ClassName.h"
+#include "crossrt/IspcTargets.h"
+#include "crossrt/LaneMemory.h"
 #include <cstdlib>
 #include <cstring>
 #include <initializer_list>
@@ -52,20 +54,6 @@ auto* IspcHeld(const Smart& p) {
   return p.get();
 }
 
-// The ISPC targets every generated class is compiled for, in the order of CrossRT.cmake's
-// CROSSRT_ISPC_TARGETS, and whether this CPU runs each.
-inline const char* const kIspcTargets[] = {"sse4", "avx2", "avx512skx"};
-inline bool CpuRunsIspcTarget(int index) {
-  __builtin_cpu_init();
-  switch (index) {
-    case 0: return __builtin_cpu_supports("sse4.2");
-    case 1: return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-    default:
-      return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512cd") &&
-             __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl");
-  }
-}
-
 // The function an ISPC kernel runs: `dispatch` (ISPC's own choice of the best target this CPU has)
 // unless CROSSRT_ISPC_TARGET names one of kIspcTargets, whose version of the function it then is.
 // A name it does not know, or a target this CPU cannot run, throws with what to set instead.
@@ -82,5 +70,10 @@ F IspcPick(F dispatch, std::initializer_list<F> perTarget) {
   }
   throw std::runtime_error(std::string("CROSSRT_ISPC_TARGET=") + forced + " is not a target the ISPC classes are built for (" + known + ", or auto)");
 }
+
+// The lane choices an earlier run left (LaneMemory), read as the program starts rather than at its
+// first kernel call, which would pay the tenth of a millisecond it takes. Every program with an
+// _ISPC class includes this header; the _CPU classes do not.
+inline const bool kLaneMemoryRead = (LaneMemory::Get(), true);
 
 }  // namespace crossrt

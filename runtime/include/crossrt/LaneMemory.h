@@ -22,7 +22,7 @@
 // each replace the file whole (written beside it, then renamed), and the later one's measurements
 // win.
 #pragma once
-#include "IspcSupport.h"
+#include "IspcTargets.h"
 
 #include <sched.h>
 #include <unistd.h>
@@ -84,6 +84,14 @@ class LaneMemory {
     m_measured[kernel] = std::move(ways);
   }
 
+  // Reads the file again, where the environment names it now (the memory is read as the program
+  // starts: a test that sets CROSSRT_LANE_MEMORY later calls this). What this run measured stays.
+  void Reload() {
+    std::lock_guard<std::mutex> lock(m_mutex);
+    m_path = Path();
+    Read();
+  }
+
   // Writes what this run measured, merged into the file as it is now. False where it could not.
   bool Save() {
     std::lock_guard<std::mutex> lock(m_mutex);
@@ -140,13 +148,7 @@ class LaneMemory {
       if (model.empty()) model = "unknown CPU";
     }
 #endif
-    std::string target = "none";
-    const char* forced = std::getenv("CROSSRT_ISPC_TARGET");
-    if (forced && *forced && std::strcmp(forced, "auto") != 0)
-      target = forced;
-    else
-      for (int i = 0; i < int(std::size(kIspcTargets)); ++i)
-        if (CpuRunsIspcTarget(i)) target = kIspcTargets[i];
+    const std::string target = IspcTargetInUse();
     // The threads this program may run on (its affinity: one system call, where the machine's count
     // reads /sys): the means are of loops on all of them.
     cpu_set_t cores;
@@ -164,7 +166,10 @@ class LaneMemory {
     RememberedWays ways;
   };
 
-  LaneMemory() : m_path(Path()), m_machine(Machine()) {
+  LaneMemory() : m_path(Path()), m_machine(Machine()) { Read(); }
+
+  void Read() {
+    m_recalled.clear();
     if (m_path.empty()) return;
     for (const Line& line : ReadLines(m_path))
       if (line.machine == m_machine) m_recalled[line.kernel].push_back(line.ways);
@@ -217,7 +222,8 @@ class LaneMemory {
   }
 
   std::mutex m_mutex;
-  const std::string m_path, m_machine;
+  std::string m_path;
+  const std::string m_machine;
   std::map<std::string, std::vector<RememberedWays>> m_recalled, m_measured;  // by kernel
 };
 

@@ -1,0 +1,37 @@
+// The ISPC targets the generated _ISPC classes are compiled for, and which of them this CPU runs
+// (header only): IspcPick (IspcSupport.h) chooses among them, and LaneMemory names the one in use.
+#pragma once
+
+#include <cstdlib>
+#include <cstring>
+#include <iterator>
+#include <string>
+
+namespace crossrt {
+
+// The ISPC targets every generated class is compiled for, in the order of CrossRT.cmake's
+// CROSSRT_ISPC_TARGETS, and whether this CPU runs each.
+inline const char* const kIspcTargets[] = {"sse4", "avx2", "avx512skx"};
+inline bool CpuRunsIspcTarget(int index) {
+  __builtin_cpu_init();
+  switch (index) {
+    case 0: return __builtin_cpu_supports("sse4.2");
+    case 1: return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+    default:
+      return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512cd") &&
+             __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl");
+  }
+}
+
+// The target the _ISPC classes run: CROSSRT_ISPC_TARGET where it names one (IspcPick checks that it
+// is one this CPU runs), else the widest this CPU runs, as ISPC's own dispatch picks it.
+inline std::string IspcTargetInUse() {
+  const char* forced = std::getenv("CROSSRT_ISPC_TARGET");
+  if (forced && *forced && std::strcmp(forced, "auto") != 0) return forced;
+  std::string widest = "none";
+  for (int i = 0; i < int(std::size(kIspcTargets)); ++i)
+    if (CpuRunsIspcTarget(i)) widest = kIspcTargets[i];
+  return widest;
+}
+
+}  // namespace crossrt
