@@ -13,6 +13,7 @@
 // (bench/plot_first_build.py plots it).
 //
 //   bench_first_build [--meshes NAME,...] [--children N] [MESH_DIR (default build/data/meshes)] [CSV (default out/first_build.csv)]
+#include "BenchMeshes.h"
 #include "BenchSupport.h"
 #include "CommandLine.h"
 #include "LBVH.h"
@@ -22,7 +23,6 @@
 #endif
 #include "MeshIO.h"
 
-#include <embree3/rtcore.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -35,7 +35,6 @@
 #include <vector>
 
 using LiteMath::Box4f;
-using LiteMath::float4;
 
 namespace {
 
@@ -44,46 +43,14 @@ double MsSince(std::chrono::steady_clock::time_point t0)
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-std::vector<Box4f> TriangleBoxes(const TriangleMesh& mesh)
-{
-  std::vector<Box4f> boxes(mesh.TriangleCount());
-  for (size_t t = 0; t < boxes.size(); ++t)
-    for (int k = 0; k < 3; ++k)
-    {
-      const uint32_t v = mesh.indices[3 * t + k];
-      boxes[t].include(float4(mesh.positions[3 * v], mesh.positions[3 * v + 1], mesh.positions[3 * v + 2], 0.0f));
-    }
-  return boxes;
-}
-
-// Embree's LOW-quality build of the mesh (its commit), as bench_lbvh times it.
-double EmbreeLowMs(const TriangleMesh& mesh)
-{
-  RTCDevice device = rtcNewDevice(nullptr);
-  const auto t0 = std::chrono::steady_clock::now();
-  RTCScene scene = rtcNewScene(device);
-  rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_LOW);
-  RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-  rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, mesh.positions.data(), 0, 12, mesh.VertexCount());
-  rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, mesh.indices.data(), 0, 12, mesh.TriangleCount());
-  rtcSetGeometryBuildQuality(geom, RTC_BUILD_QUALITY_LOW);
-  rtcCommitGeometry(geom);
-  rtcAttachGeometry(scene, geom);
-  rtcReleaseGeometry(geom);
-  rtcCommitScene(scene);
-  const double ms = MsSince(t0);
-  rtcReleaseScene(scene);
-  rtcReleaseDevice(device);
-  return ms;
-}
-
 // The child: builds the mesh `calls` times with one builder and prints the first build's ms.
 int RunChild(const std::string& builder, const std::string& path, int calls)
 {
   const TriangleMesh mesh = LoadMesh(path);
   if (builder == "embree")
   {
-    std::printf("%.4f\n", EmbreeLowMs(mesh));
+    EmbreeMesh embree;
+    std::printf("%.4f\n", embree.Build(mesh, RTC_BUILD_QUALITY_LOW));
     return 0;
   }
   std::shared_ptr<LBVH> lbvh;

@@ -21,6 +21,7 @@
 // with a warning row for a translated builder that slows down more than Embree LOW (TBB's threads);
 // the table goes to CSV too (--slowdown-csv, default out/bvh_slowdown.csv), which
 // bench/plot_bvh_slowdown.py plots.
+#include "BenchMeshes.h"
 #include "BenchSupport.h"
 #include "BVHScene.h"
 #include "CrossRT.h"
@@ -102,46 +103,6 @@ std::string EmbreeIsaOf(const std::string& ispcTarget)
   if (ispcTarget == "avx2") return "avx2";
   if (ispcTarget == "avx512skx") return "avx512";
   return "";
-}
-
-// Embree over one mesh, with the build quality given; returns the commit time.
-struct EmbreeMesh
-{
-  RTCDevice device = rtcNewDevice(g_embreeConfig.empty() ? nullptr : g_embreeConfig.c_str());
-  RTCScene scene = nullptr;
-  double Build(const TriangleMesh& mesh, RTCBuildQuality quality)
-  {
-    if (scene) rtcReleaseScene(scene);
-    auto t0 = std::chrono::steady_clock::now();
-    scene = rtcNewScene(device);
-    rtcSetSceneBuildQuality(scene, quality);
-    RTCGeometry geom = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, mesh.positions.data(), 0, 12, mesh.VertexCount());
-    rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, mesh.indices.data(), 0, 12, mesh.TriangleCount());
-    rtcSetGeometryBuildQuality(geom, quality);
-    rtcCommitGeometry(geom);
-    rtcAttachGeometry(scene, geom);
-    rtcReleaseGeometry(geom);
-    rtcCommitScene(scene);
-    return Ms(std::chrono::steady_clock::now() - t0);
-  }
-  ~EmbreeMesh()
-  {
-    if (scene) rtcReleaseScene(scene);
-    rtcReleaseDevice(device);
-  }
-};
-
-std::vector<Box4f> TriangleBoxes(const TriangleMesh& mesh)
-{
-  std::vector<Box4f> boxes(mesh.TriangleCount());
-  for (size_t t = 0; t < boxes.size(); ++t)
-    for (int k = 0; k < 3; ++k)
-    {
-      const uint32_t v = mesh.indices[3 * t + k];
-      boxes[t].include(float4(mesh.positions[3 * v], mesh.positions[3 * v + 1], mesh.positions[3 * v + 2], 0.0f));
-    }
-  return boxes;
 }
 
 struct TradeOff { std::string mesh; double lbvhBuildMs, lbvhMrays, sahBuildMs, sahMrays; };
@@ -244,7 +205,7 @@ int main(int argc, char** argv)
     Row row{name, LoadMesh(path), {}, {}, 0.0, 0.0};
     const std::vector<Box4f> boxes = TriangleBoxes(row.mesh);
     const int n = int(boxes.size());
-    EmbreeMesh embree;
+    EmbreeMesh embree(g_embreeConfig);
     LBVH original;
     original.Reserve(n);
     lbvhCpu->Reserve(n);
@@ -402,7 +363,7 @@ int main(int argc, char** argv)
   {
     const Camera cam = LookAtMesh(row.mesh);
     const int pixels = kImageSize * kImageSize;
-    EmbreeMesh embree;
+    EmbreeMesh embree(g_embreeConfig);
     embree.Build(row.mesh, RTC_BUILD_QUALITY_MEDIUM);
     // Every tracer reads the same batch of rays, as PrimaryRays::CastRays takes it (4x4 tiles of
     // pixels, the tiles in rows: the order a renderer hands out coherent rays), and writes each
