@@ -1216,10 +1216,12 @@ TEST_CASE("LaneChoice remembers the faster way for the next run", "[runtime][par
     std::ofstream out(file);
     // This machine's last run: the scalar loop three times faster, in the size class of 1000
     // iterations (4^4 <= 1000 < 4^5); another machine's line, another kernel's, and a broken line.
-    out << machine << "\tRemembered::kernel1D_Walk\t4\t0.003\t0.001\t1\n"
-        << "Another CPU, avx2, 8 threads\tRemembered::kernel1D_Walk\t4\t0.001\t0.003\t1\n"
-        << machine << "\tOther::kernel1D_Scan\t2\t0.5\t0.25\t1\n"
-        << machine << "\tOnce::kernel1D_Build\t4\t0.002\t-1\t1\n"  // called once a run: its lanes' first call alone
+    out << machine << "\tRemembered::kernel1D_Walk\t4\t0.003\t0.001\t1\t0\n"
+        << "Another CPU, avx2, 8 threads\tRemembered::kernel1D_Walk\t4\t0.001\t0.003\t1\t0\n"
+        << machine << "\tOther::kernel1D_Scan\t2\t0.5\t0.25\t1\t0\n"
+        << machine << "\tOnce::kernel1D_Build\t4\t0.002\t-1\t1\t0\n"  // called once a run: its lanes' first call alone
+        << machine << "\tSteady::kernel1D_Step\t4\t0.003\t0.001\t1\t3\n"    // the scalar loop alone in the last 3 runs
+        << machine << "\tDue::kernel1D_Step\t4\t0.003\t0.001\t1\t15\n"      // and in the last 15
         << machine << "\tBroken::kernel1D_Line\tnot a number\n";
   }
   crossrt::LaneMemory::Get().Reload();
@@ -1250,6 +1252,16 @@ TEST_CASE("LaneChoice remembers the faster way for the next run", "[runtime][par
     REQUIRE_FALSE(once.Choose());
     once.Record(false, 1000, 1.0);
     CHECK(once.Mean(0) < 0.0f);
+    // Called once a run, the scalar loop the verdict: the 4th such run takes it again, the 16th
+    // tries the lanes (its first call then replaces their remembered time).
+    crossrt::LaneChoice steady("Steady::kernel1D_Step");
+    REQUIRE_FALSE(steady.Choose());
+    steady.Record(false, 1000, 1.0);
+    crossrt::LaneChoice due("Due::kernel1D_Step");
+    bool trying = false;
+    REQUIRE(due.Choose(trying));
+    CHECK(trying);
+    due.Record(true, 1000, 2.0);
   }
   // The choices above are gone: at exit their means are written, here at once.
   REQUIRE(crossrt::LaneMemory::Get().Save());
@@ -1259,10 +1271,12 @@ TEST_CASE("LaneChoice remembers the faster way for the next run", "[runtime][par
   const auto has = [&](const std::string& start) {
     return std::count_if(lines.begin(), lines.end(), [&](const std::string& l) { return l.rfind(start, 0) == 0; });
   };
-  CHECK(lines.size() == 4);  // the broken line dropped, the kernel never measured not written
-  CHECK(has(machine + "\tOnce::kernel1D_Build\t4\t0.002\t0.001\t1") == 1);  // both ways' first calls now
-  CHECK(has(machine + "\tRemembered::kernel1D_Walk\t4\t0.003\t0.001\t1") == 1);
-  CHECK(has("Another CPU, avx2, 8 threads\tRemembered::kernel1D_Walk\t4\t0.001\t0.003\t1") == 1);
-  CHECK(has(machine + "\tOther::kernel1D_Scan\t2\t0.5\t0.25\t1") == 1);
+  CHECK(lines.size() == 6);  // the broken line dropped, the kernel never measured not written
+  CHECK(has(machine + "\tOnce::kernel1D_Build\t4\t0.002\t0.001\t1\t0") == 1);  // both ways' first calls now
+  CHECK(has(machine + "\tSteady::kernel1D_Step\t4\t0.003\t0.001\t1\t4") == 1);
+  CHECK(has(machine + "\tDue::kernel1D_Step\t4\t0.002\t0.001\t1\t0") == 1);
+  CHECK(has(machine + "\tRemembered::kernel1D_Walk\t4\t0.003\t0.001\t1\t0") == 1);
+  CHECK(has("Another CPU, avx2, 8 threads\tRemembered::kernel1D_Walk\t4\t0.001\t0.003\t1\t0") == 1);
+  CHECK(has(machine + "\tOther::kernel1D_Scan\t2\t0.5\t0.25\t1\t0") == 1);
   std::filesystem::remove(file);
 }

@@ -39,16 +39,23 @@ class MeasuredWays {
   void Try() { m_tryingOther.store(true, std::memory_order_relaxed); }
 
   // The ways' means as earlier runs left them (LaneMemory; -1 for a way none measured): where both
-  // have one, the faster is the verdict and the other is tried after kFirstWait calls. A way's
-  // first run here replaces its remembered mean.
-  void Seed(float way1Ms, float way0Ms) {
+  // have one, the faster is the verdict and the other is tried after kFirstWait calls, or at once
+  // where the verdict alone has run in the last kFirstWait - 1 runs (a program that calls the loop
+  // once a run). A way's first run here replaces its remembered mean.
+  void Seed(float way1Ms, float way0Ms, int verdictOnlyRuns) {
     const float ms[2] = {way0Ms, way1Ms};
     for (int w = 0; w < 2; ++w) {
       m_msPerIteration[w].store(ms[w] > 0.0f ? ms[w] : -1.0f, std::memory_order_relaxed);
       m_remembered[w].store(ms[w] > 0.0f, std::memory_order_relaxed);
     }
-    if (way1Ms > 0.0f && way0Ms > 0.0f) m_verdict.store(way1Ms <= way0Ms ? 1 : 0, std::memory_order_relaxed);
+    if (way1Ms > 0.0f && way0Ms > 0.0f) {
+      m_verdict.store(way1Ms <= way0Ms ? 1 : 0, std::memory_order_relaxed);
+      if (verdictOnlyRuns + 1 >= int(kFirstWait)) m_calls.store(m_nextTry.load(std::memory_order_relaxed), std::memory_order_relaxed);
+    }
   }
+
+  // Whether a way's mean is still the one an earlier run left (Seed): none of its runs here counted.
+  bool MeanRemembered(int way) const { return m_remembered[way ? 1 : 0].load(std::memory_order_relaxed); }
 
   // Counts a call that keeps to the faster way; true when the slower one is due for a try.
   bool TimeToTry() {
@@ -462,18 +469,28 @@ class LaneChoice {
   }
 
   // What this run measured goes to LaneMemory, for the next run's first calls: each way's mean, or
-  // where it has none (a kernel called once a run), its time on the run's first call. A program
-  // that calls a kernel once so runs it in lanes in its first run, tries the scalar loop in its
-  // second (the way with no time), and from its third takes the way whose first call was faster.
+  // where it has none counted here (a kernel called once a run), its time on the run's first call.
+  // A program that calls a kernel once so runs it in lanes in its first run, tries the scalar loop
+  // in its second (the way with no time), and from its third takes the way whose first call was
+  // faster, the other tried again every 16th run (the runs in a row that ran the verdict alone are
+  // counted).
   ~LaneChoice() {
     if (!Remembers()) return;
     std::vector<RememberedWays> ways;
     const int last = m_lastSize.load(std::memory_order_relaxed);
     for (int size = 0; size < kLoopSizeClasses; ++size) {
+      const MeasuredWays& measured = m_bySize[size];
       float ms[2];
-      for (int w = 0; w < 2; ++w)
-        ms[w] = m_bySize[size].Mean(w) > 0.0f ? m_bySize[size].Mean(w) : m_firstCallMs[size][w].load(std::memory_order_relaxed);
-      if (ms[1] > 0.0f || ms[0] > 0.0f) ways.push_back({size, ms[1], ms[0], size == last});
+      for (int w = 0; w < 2; ++w) {
+        const float first = m_firstCallMs[size][w].load(std::memory_order_relaxed);
+        ms[w] = measured.Mean(w) > 0.0f && !(measured.MeanRemembered(w) && first > 0.0f) ? measured.Mean(w) : first;
+      }
+      if (!(ms[1] > 0.0f || ms[0] > 0.0f)) continue;
+      const int verdict = measured.Verdict();
+      const bool ran = m_ran[size][0].load(std::memory_order_relaxed) || m_ran[size][1].load(std::memory_order_relaxed);
+      const bool otherRan = verdict < 0 || m_ran[size][1 - verdict].load(std::memory_order_relaxed);
+      const int runs = m_verdictOnlyRuns[size].load(std::memory_order_relaxed);
+      ways.push_back({size, ms[1], ms[0], size == last, !ran ? runs : otherRan ? 0 : runs + 1});
     }
     if (!ways.empty()) LaneMemory::Get().Remember(m_name, std::move(ways));
   }
@@ -521,8 +538,10 @@ class LaneChoice {
     if (LanesMode() != Mode::Measure) return LanesMode() == Mode::Always;
     if (Remembers() && !m_recalled.exchange(true, std::memory_order_relaxed))  // the first call: what the last run measured
       for (const RememberedWays& remembered : LaneMemory::Get().Recall(m_name)) {
-        m_bySize[remembered.sizeClass % kLoopSizeClasses].Seed(remembered.lanesMs, remembered.scalarMs);
-        if (remembered.last) m_lastSize.store(remembered.sizeClass % kLoopSizeClasses, std::memory_order_relaxed);
+        const int size = remembered.sizeClass % kLoopSizeClasses;
+        m_bySize[size].Seed(remembered.lanesMs, remembered.scalarMs, remembered.verdictOnlyRuns);
+        m_verdictOnlyRuns[size].store(remembered.verdictOnlyRuns, std::memory_order_relaxed);
+        if (remembered.last) m_lastSize.store(size, std::memory_order_relaxed);
       }
     MeasuredWays& ways = m_bySize[m_lastSize.load(std::memory_order_relaxed)];
     const float scalar = ways.Mean(0), lanes = ways.Mean(1);
@@ -540,6 +559,7 @@ class LaneChoice {
     if (iterations < 1 || LanesMode() != Mode::Measure) return;  // (an early return ran no loop)
     const int size = SizeClass(iterations);
     m_lastSize.store(size, std::memory_order_relaxed);
+    m_ran[size][lanes ? 1 : 0].store(true, std::memory_order_relaxed);
     if (!m_warm.exchange(true, std::memory_order_relaxed)) {  // the first run touched the memory: not counted here,
       m_firstCallMs[size][lanes ? 1 : 0].store(float(ms / double(iterations)), std::memory_order_relaxed);  // but kept for the next run
       return;
@@ -569,6 +589,8 @@ class LaneChoice {
 
   MeasuredWays m_bySize[kLoopSizeClasses];
   std::atomic<float> m_firstCallMs[kLoopSizeClasses][2] = {};  // per size class and way: the run's first call, ms per iteration
+  std::atomic<bool> m_ran[kLoopSizeClasses][2] = {};           // per size class and way: whether it ran in this run
+  std::atomic<int> m_verdictOnlyRuns[kLoopSizeClasses] = {};   // per size class: earlier runs in a row that ran the verdict alone
   std::atomic<bool> m_recalled{false};
   std::atomic<int> m_verdictCores[kLoopSizeClasses];  // per size class: what the verdict's last run ran on, -1 before one
   std::atomic<int> m_lastSize{0};

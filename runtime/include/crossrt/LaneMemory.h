@@ -10,13 +10,15 @@
 // time yet, that way. The other way is tried after 16 calls as usual, so that in a program that
 // calls a kernel often a stale verdict (a new CPU under the same name, a changed kernel) corrects
 // itself. A program that calls a kernel once runs it in lanes in its first run, as its scalar loop
-// in its second, and from its third the way whose first call was faster.
+// in its second, and from its third the way whose first call was faster, the other again in every
+// 16th run.
 //
 // The file: CROSSRT_LANE_MEMORY if set (`off`: nothing is read or written), else
 // $XDG_CACHE_HOME/crossrt/lane-choices.tsv, else $HOME/.cache/crossrt/lane-choices.tsv. A line per
 // kernel and size class, tab-separated: the machine (CPU model, ISPC target, threads), the kernel
 // (Class::kernel), the size class, the lanes' and the scalar loop's mean ms per iteration (-1 for a
-// way that has not run), and 1 on the size class of the kernel's last call. Lines of other
+// way that has not run), 1 on the size class of the kernel's last call, and the runs in a row that
+// ran only the faster way (in the 16th the other is tried again). Lines of other
 // machines are kept, the oldest dropped past kMaxLines. A file that cannot be read or written only
 // costs the measuring again (CROSSRT_ISPC_LANES_LOG=1 says so); two programs that exit at once
 // each replace the file whole (written beside it, then renamed), and the later one's measurements
@@ -50,6 +52,7 @@ struct RememberedWays {
   int sizeClass;
   float lanesMs, scalarMs;  // mean ms per iteration (or the first call's, where that was the only one), -1 where that way did not run
   bool last;                // the size class of the kernel's last call
+  int verdictOnlyRuns = 0;  // runs in a row that ran only the faster way (every 16th tries the other)
 };
 
 class LaneMemory {
@@ -108,7 +111,7 @@ class LaneMemory {
     for (const auto& [kernel, ways] : m_measured)
       for (const RememberedWays& w : ways)
         text << m_machine << '\t' << kernel << '\t' << w.sizeClass << '\t' << (w.lanesMs > 0.0f ? w.lanesMs : -1.0f) << '\t'
-             << (w.scalarMs > 0.0f ? w.scalarMs : -1.0f) << '\t' << (w.last ? 1 : 0) << '\n';
+             << (w.scalarMs > 0.0f ? w.scalarMs : -1.0f) << '\t' << (w.last ? 1 : 0) << '\t' << w.verdictOnlyRuns << '\n';
     std::error_code error;
     const std::filesystem::path file(m_path);
     if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path(), error);
@@ -195,7 +198,7 @@ class LaneMemory {
         if (tab == std::string::npos) break;
         start = tab + 1;
       }
-      if (fields.size() != 6) continue;
+      if (fields.size() != 7) continue;
       char* end = nullptr;
       line.machine = fields[0];
       line.kernel = fields[1];
@@ -206,7 +209,9 @@ class LaneMemory {
       const float scalar = std::strtof(fields[4].c_str(), &end);
       if (*end != '\0' || !(scalar > 0.0f || scalar == -1.0f) || !(lanes > 0.0f || scalar > 0.0f)) continue;
       if (fields[5] != "0" && fields[5] != "1") continue;
-      line.ways = {int(sizeClass), lanes, scalar, fields[5] == "1"};
+      const long runs = std::strtol(fields[6].c_str(), &end, 10);
+      if (*end != '\0' || fields[6].empty() || runs < 0 || runs > 1000000) continue;
+      line.ways = {int(sizeClass), lanes, scalar, fields[5] == "1", int(runs)};
       lines.push_back(line);
     }
     std::free(buffer);
