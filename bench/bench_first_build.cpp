@@ -43,8 +43,8 @@ double MsSince(std::chrono::steady_clock::time_point t0)
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// The child: builds the mesh `calls` times with one builder and prints the first build's ms.
-int RunChild(const std::string& builder, const std::string& path, int calls)
+// The child: builds the mesh once with one builder and prints the build's ms.
+int RunChild(const std::string& builder, const std::string& path)
 {
   const TriangleMesh mesh = LoadMesh(path);
   if (builder == "embree")
@@ -66,14 +66,9 @@ int RunChild(const std::string& builder, const std::string& path, int calls)
   const std::vector<Box4f> boxes = TriangleBoxes(mesh);
   lbvh->Reserve(int(boxes.size()));
   lbvh->CommitDeviceData();
-  double first = 0.0;
-  for (int call = 0; call < calls; ++call)
-  {
-    const auto t0 = std::chrono::steady_clock::now();
-    lbvh->Build(int(boxes.size()), boxes.data());
-    if (call == 0) first = MsSince(t0);
-  }
-  std::printf("%.4f\n", first);
+  const auto t0 = std::chrono::steady_clock::now();
+  lbvh->Build(int(boxes.size()), boxes.data());
+  std::printf("%.4f\n", MsSince(t0));
   return 0;
 }
 
@@ -85,10 +80,9 @@ std::string Quoted(const std::string& s)
 }
 
 // One child's first build, in ms (negative where it failed), with CROSSRT_LANE_MEMORY=memory.
-double ChildMs(const std::string& self, const std::string& builder, const std::string& mesh, const std::string& memory, int calls = 1)
+double ChildMs(const std::string& self, const std::string& builder, const std::string& mesh, const std::string& memory)
 {
-  const std::string command = "CROSSRT_LANE_MEMORY=" + Quoted(memory) + " " + Quoted(self) + " --child " + builder + " --calls " +
-                              std::to_string(calls) + " " + Quoted(mesh);
+  const std::string command = "CROSSRT_LANE_MEMORY=" + Quoted(memory) + " " + Quoted(self) + " --child " + builder + " " + Quoted(mesh);
   std::FILE* pipe = popen(command.c_str(), "r");
   if (!pipe) return -1.0;
   double ms = -1.0;
@@ -103,7 +97,7 @@ int main(int argc, char** argv)
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   std::vector<std::string> only;
   std::string dir = "build/data/meshes", csvPath = "out/first_build.csv", child;
-  int children = 5, calls = 1;
+  int children = 5;
   crossrt::CommandLine app("bench_first_build",
                            "A program's first BVH build: each builder's first Build in a fresh process, LBVH_ISPC in the first,\n"
                            "second and later runs of a program that builds once (crossrt::LaneMemory), against LBVH_CPU and Embree LOW.\n"
@@ -114,9 +108,8 @@ int main(int argc, char** argv)
   app.add_option("--children", children, "fresh processes per cell (the median is printed)")->check(CLI::Range(1, 100));
   app.add_option("--child", child, "(internal) build MESH_DIR, a mesh file, with this builder and print the first build's ms")
       ->check(CLI::IsMember({"embree", "lbvh_cpu", "lbvh_ispc"}));
-  app.add_option("--calls", calls, "(internal, with --child) builds in the child")->check(CLI::Range(1, 1000));
   if (const int status = crossrt::ParseCommandLine(app, argc, argv); status >= 0) return status;
-  if (!child.empty()) return RunChild(child, dir, calls);
+  if (!child.empty()) return RunChild(child, dir);
 
   const std::string self = std::filesystem::canonical("/proc/self/exe").string();
   const std::string memory = (std::filesystem::temp_directory_path() / ("crossrt_first_build_" + std::to_string(getpid()) + ".tsv")).string();
