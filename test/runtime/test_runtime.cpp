@@ -1191,6 +1191,46 @@ TEST_CASE("LaneChoice runs a kernel in lanes or as a scalar loop, whichever has 
     tried.verdictCores = 1;
     CHECK(fresh.Begin(1000, tried).parallel == (omp_get_max_threads() > 1));
   }
+  SECTION("a run on the cores ParallelChoice is trying counts for neither choice") {
+    // The second call of a kernel is where its ParallelChoice tries one core. Counted, that call put
+    // one core's time into the lanes' mean, and the scalar loop's try followed it onto one core.
+    crossrt::LaneChoice choice;
+    auto call = [&](bool coresTried, int cores) {
+      crossrt::LaneChoice::Run way = choice.Begin();
+      way.iterations = 1000, way.cores = cores, way.coresTried = coresTried;
+      choice.End(way);
+      return way;
+    };
+    CHECK(call(false, 1).lanes);  // the first call, on all cores: memory touched, not counted
+    CHECK(call(true, 0).lanes);   // lanes on the one core ParallelChoice tries: not counted
+    CHECK(choice.Mean(1) < 0.0f);
+    CHECK(call(false, 1).lanes);  // lanes on all cores, the verdict's cores: counted
+    CHECK(choice.Mean(1) >= 0.0f);
+    crossrt::LaneChoice::Run tried = choice.Begin();
+    CHECK_FALSE(tried.lanes);
+    CHECK(tried.trying);
+    CHECK(tried.verdictCores == 1);  // the scalar loop's try runs where the lanes' counted run did
+    // The other way round: ParallelChoice leaves a lanes' try out of its means, and tells the way
+    // when it tries one core.
+    crossrt::ParallelChoice cores;
+    tried.verdictCores = 1;
+    const auto followed = cores.Begin(1000, tried);
+    CHECK_FALSE(followed.counted);
+    cores.End(followed);
+    CHECK(cores.Mean(true, 1000) < 0.0f);
+    if (omp_get_max_threads() > 1 && !crossrt::ParallelChoice::AlwaysAllCores()) {
+      crossrt::LaneChoice::Run verdict{true, 0, std::chrono::steady_clock::now()};
+      const auto first = cores.Begin(1000, verdict);  // all cores first, the way the loop is written for
+      CHECK(first.parallel);
+      CHECK_FALSE(verdict.coresTried);
+      cores.End(first);
+      const auto second = cores.Begin(1000, verdict);  // one core, once, to compare (a fast loop)
+      CHECK_FALSE(second.parallel);
+      CHECK(verdict.coresTried);
+      cores.End(second);
+      CHECK(cores.Mean(false, 1000) >= 0.0f);
+    }
+  }
   SECTION("a call with an empty loop counts for nothing") {
     crossrt::LaneChoice choice;
     for (int i = 0; i < 5; ++i) {

@@ -37,6 +37,8 @@ class MeasuredWays {
 
   // The next run is a try of the way that is not the faster one (or has not run yet).
   void Try() { m_tryingOther.store(true, std::memory_order_relaxed); }
+  // Whether the run now under way is such a try (between the choice and its Record).
+  bool Trying() const { return m_tryingOther.load(std::memory_order_relaxed); }
 
   // The ways' means as earlier runs left them (LaneMemory; -1 for a way none measured): where both
   // have one, the faster is the verdict and the other is tried after kFirstWait calls, or at once
@@ -187,6 +189,7 @@ class ParallelChoice {
     bool parallel;
     long long iterations;
     std::chrono::steady_clock::time_point start;
+    bool counted = true;  // false: a run this choice did not choose (an _ISPC way's try), not in its means
   };
 
   Run Begin(long long iterations) { return {Choose(iterations), iterations, std::chrono::steady_clock::now()}; }
@@ -197,17 +200,26 @@ class ParallelChoice {
   // try on all cores of a way whose verdict ran on one core waited a time slice for a worker taken
   // off its core, and a lanes' way lost for that.) The way learns which it ran on.
   // (CROSSRT_CPU_PARALLEL=always still puts every loop on all cores.)
+  //
+  // Each of the two choices counts only the runs where the other took its verdict: a lanes' try is
+  // not in this choice's means, and the way learns when this choice tries the cores that are not its
+  // verdict (coresTried), which LaneChoice then leaves out of its own. Before, a kernel's second call
+  // (this choice's try of one core) put one core's time into the lanes' mean and made it the cores
+  // the scalar loop's try followed: LBVH_ISPC's kernel1D_MakeLeaves so measured its scalar loop once
+  // on one core, at 10.3 ms against the lanes' 3.2 on all cores, and ran in lanes, which take 3.2 ms
+  // to the scalar loop's 2.4 on all cores (avx2, AMD EPYC, Zen 4, 2 threads; bench_lbvh, dragon res2).
   template <typename Way>
   Run Begin(long long iterations, Way& way) {
     const bool followVerdict = way.trying && way.verdictCores >= 0 && !AlwaysAllCores() && !OneThreadOnly(iterations);
     const bool parallel = followVerdict ? way.verdictCores == 1 : Choose(iterations);
     way.cores = parallel ? 1 : 0;
-    return {parallel, iterations, std::chrono::steady_clock::now()};
+    way.coresTried = !followVerdict && !OneThreadOnly(iterations) && m_bySize[LoopSizeClass(iterations)].Trying();
+    return {parallel, iterations, std::chrono::steady_clock::now(), !followVerdict};
   }
 
   void End(const Run& run) {
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - run.start).count();
-    Record(run.parallel, run.iterations, ms);
+    if (run.counted) Record(run.parallel, run.iterations, ms);
   }
 
   // The decision and the measurement apart, for tests.
@@ -460,6 +472,7 @@ class LaneChoice {
     bool trying = false;    // the way that is not the verdict, tried
     int verdictCores = -1;  // when trying: what the verdict's last run ran on (1 all cores, 0 one core, -1 unknown)
     int cores = -1;         // what this run's loop ran on, as ParallelChoice tells it
+    bool coresTried = false;  // ParallelChoice ran this loop on the cores that are not its verdict, to measure them
   };
 
   // `name` (a string literal: the generated code's Class::kernel) names the kernel in the log.
@@ -505,16 +518,21 @@ class LaneChoice {
 
   void End(const Run& run) {
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - run.start).count();
-    Record(run.lanes, run.iterations, ms);
-    if (!run.trying && run.cores >= 0 && run.iterations >= 1)
+    // A run on the cores ParallelChoice was trying measured those cores, not this way: left out, and
+    // not the cores the next try follows (ParallelChoice::Begin). A try of this choice's own counts
+    // whatever it ran on, as the try is then over.
+    const bool counted = !run.coresTried || run.trying;
+    if (counted) Record(run.lanes, run.iterations, ms);
+    if (counted && !run.trying && run.cores >= 0 && run.iterations >= 1)
       m_verdictCores[SizeClass(run.iterations)].store(run.cores, std::memory_order_relaxed);
     if (Logged()) {  // CROSSRT_ISPC_LANES_LOG=1: a line per call, to see what the choice does and why
       char lanes[32] = "not measured", scalar[32] = "not measured";
       if (Mean(1) >= 0.0f) std::snprintf(lanes, sizeof lanes, "%.4g", 1000.0 * Mean(1));
       if (Mean(0) >= 0.0f) std::snprintf(scalar, sizeof scalar, "%.4g", 1000.0 * Mean(0));
-      std::fprintf(stderr, "crossrt: %s: %s%s, %lld iterations in %.3f ms on %s; mean ms per 1,000 iterations: lanes %s, scalar loop %s\n",
+      std::fprintf(stderr, "crossrt: %s: %s%s, %lld iterations in %.3f ms on %s%s; mean ms per 1,000 iterations: lanes %s, scalar loop %s\n",
                    m_name != nullptr ? m_name : "a kernel", run.lanes ? "SIMD lanes" : "scalar loop", run.trying ? " (a try)" : "",
-                   run.iterations, ms, run.cores == 1 ? "all cores" : run.cores == 0 ? "one core" : "the cores it chose", lanes, scalar);
+                   run.iterations, ms, run.cores == 1 ? "all cores" : run.cores == 0 ? "one core" : "the cores it chose",
+                   counted ? "" : " (a try of the cores, not counted)", lanes, scalar);
     }
   }
 
