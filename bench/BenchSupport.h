@@ -96,13 +96,24 @@ inline std::FILE* OpenCsv(const std::string& path, const char* program)
   return f;
 }
 
-// The CPU's model name (/proc/cpuinfo), which every table of speed figures prints.
+// The CPU's model name (/proc/cpuinfo), which every table of speed figures prints, with its family
+// and model numbers: a virtual machine's name can say only "AMD EPYC" for a Zen 4 (family 25) and a
+// Zen 5 (family 26) alike.
 inline std::string CpuModel()
 {
   std::ifstream in("/proc/cpuinfo");
-  for (std::string line; std::getline(in, line);)
-    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-  return "unknown";
+  std::string name = "unknown", family, model;
+  auto value = [](const std::string& line) { return line.substr(line.find(':') + 2); };
+  for (std::string line; std::getline(in, line) && line.find_first_not_of(" \t") != std::string::npos;) {
+    if (line.rfind("model name", 0) == 0)
+      name = value(line);
+    else if (line.rfind("cpu family", 0) == 0)
+      family = value(line);
+    else if (line.rfind("model\t", 0) == 0 || line.rfind("model ", 0) == 0)
+      model = value(line);
+  }
+  if (!family.empty() && !model.empty()) name += " (family " + family + ", model " + model + ")";
+  return name;
 }
 
 // The ISPC target the _ISPC classes run here: CROSSRT_ISPC_TARGET, else the widest this CPU has.
