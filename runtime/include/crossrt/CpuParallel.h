@@ -207,7 +207,7 @@ class ParallelChoice {
   // (this choice's try of one core) put one core's time into the lanes' mean and made it the cores
   // the scalar loop's try followed: LBVH_ISPC's kernel1D_MakeLeaves so measured its scalar loop once
   // on one core, at 10.3 ms against the lanes' 3.2 on all cores, and ran in lanes, which take 3.2 ms
-  // to the scalar loop's 2.4 on all cores (avx2, AMD EPYC, Zen 4, 2 threads; bench_lbvh, dragon res2).
+  // to the scalar loop's 2.4 on all cores (avx2, AMD EPYC, Zen 5, 2 threads; bench_lbvh, dragon res2).
   template <typename Way>
   Run Begin(long long iterations, Way& way) {
     const bool followVerdict = way.trying && way.verdictCores >= 0 && !AlwaysAllCores() && !OneThreadOnly(iterations);
