@@ -977,6 +977,14 @@ TEST_CASE("LoopReductions: chunks' parts of sums, minima and arrays add up to th
 // iteration never does.
 TEST_CASE("ParallelChoice takes the faster way and tries the other now and then", "[runtime][parallel]")
 {
+  if (crossrt::ParallelChoice::AlwaysAllCores()) {  // CROSSRT_CPU_PARALLEL=always: no choice to test, every loop on all cores
+    crossrt::ParallelChoice choice;
+    for (int i = 0; i < 20; ++i) {
+      REQUIRE(choice.Choose(1000) == (omp_get_max_threads() > 1));
+      choice.Record(true, 1000, 8.0);
+    }
+    return;
+  }
   const int threadsBefore = omp_get_max_threads();
   omp_set_num_threads(2);
   auto count = [](crossrt::ParallelChoice& choice, int calls, double parallelMs, double serialMs, long long iterations = 1000) {
