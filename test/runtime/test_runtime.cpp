@@ -6,6 +6,7 @@
 #include <catch2/catch.hpp>
 
 #include <crossrt/CpuParallel.h>
+#include <crossrt/IspcSupport.h>
 #include <crossrt/VulkanRuntime.h>
 
 #include <cstdio>
@@ -975,6 +976,24 @@ TEST_CASE("LoopReductions: chunks' parts of sums, minima and arrays add up to th
 // wins is made twice before it is believed), the other is tried again after 16 calls, then 64..., a loop whose parallel run takes longer than a time
 // slice always runs on all cores, loops of sizes 4x apart choose apart, and a loop of one
 // iteration never does.
+// The generated _ISPC classes take each kernel's function through IspcPick: the version of the
+// widest target this CPU runs, not ISPC's dispatch function (whose first call asks the CPU with
+// CPUID, 27 us in a virtual machine), or the one CROSSRT_ISPC_TARGET names.
+TEST_CASE("IspcPick takes the widest ISPC target this CPU runs, or the one CROSSRT_ISPC_TARGET names", "[runtime]")
+{
+  using Fn = int (*)();
+  const Fn dispatch = [] { return -1; };
+  const std::initializer_list<Fn> perTarget = {[] { return 0; }, [] { return 1; }, [] { return 2; }};
+  int expected = -1;
+  const char* forced = std::getenv("CROSSRT_ISPC_TARGET");
+  for (int i = 0; i < int(std::size(crossrt::kIspcTargets)); ++i)
+    if (forced && *forced && std::string(forced) != "auto" ? forced == std::string(crossrt::kIspcTargets[i]) : crossrt::CpuRunsIspcTarget(i))
+      expected = i;
+  REQUIRE(expected >= 0);  // every x86-64 CPU these tests run on has SSE4.2
+  CHECK(crossrt::IspcPick(dispatch, perTarget)() == expected);
+  CHECK(crossrt::IspcTargetInUse() == crossrt::kIspcTargets[expected]);  // what LaneMemory names the machine by
+}
+
 TEST_CASE("ParallelChoice takes the faster way and tries the other now and then", "[runtime][parallel]")
 {
   if (crossrt::ParallelChoice::AlwaysAllCores()) {  // CROSSRT_CPU_PARALLEL=always: no choice to test, every loop on all cores

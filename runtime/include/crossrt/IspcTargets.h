@@ -16,7 +16,8 @@ inline bool CpuRunsIspcTarget(int index) {
   __builtin_cpu_init();
   switch (index) {
     case 0: return __builtin_cpu_supports("sse4.2");
-    case 1: return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+    // (ISPC compiles its avx2 target for a Haswell, whose BMI2 and F16C its code may use.)
+    case 1: return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("bmi2") && __builtin_cpu_supports("f16c");
     default:
       return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512cd") &&
              __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl");
