@@ -972,10 +972,6 @@ TEST_CASE("LoopReductions: chunks' parts of sums, minima and arrays add up to th
   for (int h : histogramTotal) CHECK(h == 1 + n / 4);
 }
 
-// crossrt::ParallelChoice, with the times given: the way that measured faster is taken (a try that
-// wins is made twice before it is believed), the other is tried again after 16 calls, then 64..., a loop whose parallel run takes longer than a time
-// slice always runs on all cores, loops of sizes 4x apart choose apart, and a loop of one
-// iteration never does.
 // The generated _ISPC classes take each kernel's function through IspcPick: the version of the
 // widest target this CPU runs, not ISPC's dispatch function (whose first call asks the CPU with
 // CPUID, 27 us in a virtual machine), or the one CROSSRT_ISPC_TARGET names.
@@ -994,6 +990,10 @@ TEST_CASE("IspcPick takes the widest ISPC target this CPU runs, or the one CROSS
   CHECK(crossrt::IspcTargetInUse() == crossrt::kIspcTargets[expected]);  // what LaneMemory names the machine by
 }
 
+// crossrt::ParallelChoice, with the times given: the way that measured faster is taken (a try that
+// wins is made twice before it is believed), the other is tried again after 16 calls, then 64..., a loop whose parallel run takes longer than a time
+// slice always runs on all cores, loops of sizes 4x apart choose apart, and a loop of one
+// iteration never does.
 TEST_CASE("ParallelChoice takes the faster way and tries the other now and then", "[runtime][parallel]")
 {
   if (crossrt::ParallelChoice::AlwaysAllCores()) {  // CROSSRT_CPU_PARALLEL=always: no choice to test, every loop on all cores
@@ -1247,8 +1247,8 @@ TEST_CASE("LaneChoice runs a kernel in lanes or as a scalar loop, whichever has 
     const auto followed = cores.Begin(1000, tried);
     CHECK(followed.counted == !choosing);
     cores.End(followed);
-    if (choosing) CHECK(cores.Mean(true, 1000) < 0.0f);
     if (choosing) {
+      CHECK(cores.Mean(true, 1000) < 0.0f);
       crossrt::LaneChoice::Run verdict{true, 0, std::chrono::steady_clock::now()};
       const auto first = cores.Begin(1000, verdict);  // all cores first, the way the loop is written for
       CHECK(first.parallel);

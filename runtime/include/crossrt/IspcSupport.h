@@ -6,7 +6,6 @@
 #include "crossrt/ClassName.h"
 #include "crossrt/IspcTargets.h"
 #include "crossrt/LaneMemory.h"
-#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <initializer_list>
@@ -62,15 +61,15 @@ auto* IspcHeld(const Smart& p) {
 //
 // Why not `dispatch`: ISPC's dispatch asks the CPU with CPUID at its first call in each module, and
 // in a virtual machine each CPUID leaves to the hypervisor: on an AMD EPYC VM (Zen 5) a CPUID took
-// 6.5 us, and an _ISPC class's first kernel call 27 us more than its next. CpuRunsIspcTarget reads
+// 6.5 us, and an _ISPC class's first kernel call 27 us more than its next. WidestIspcTarget reads
 // what the C runtime learnt as the program started.
 template <class F>
 F IspcPick(F dispatch, std::initializer_list<F> perTarget) {
   const char* forced = std::getenv("CROSSRT_ISPC_TARGET");
   if (!forced || !*forced || std::string(forced) == "auto") {
-    for (int i = std::min(int(std::size(kIspcTargets)), int(perTarget.size())) - 1; i >= 0; --i)
-      if (CpuRunsIspcTarget(i)) return perTarget.begin()[i];
-    return dispatch;  // (a CPU without SSE4.2: ISPC's dispatch says so)
+    const int widest = WidestIspcTarget();
+    // (A CPU without SSE4.2: ISPC's dispatch says so.)
+    return widest >= 0 && widest < int(perTarget.size()) ? perTarget.begin()[widest] : dispatch;
   }
   std::string known;
   for (int i = 0; i < int(std::size(kIspcTargets)); ++i) {

@@ -24,15 +24,21 @@ inline bool CpuRunsIspcTarget(int index) {
   }
 }
 
+// The widest of kIspcTargets this CPU runs, as an index into it (-1 for none), as ISPC's own
+// dispatch would pick it.
+inline int WidestIspcTarget() {
+  for (int i = int(std::size(kIspcTargets)) - 1; i >= 0; --i)
+    if (CpuRunsIspcTarget(i)) return i;
+  return -1;
+}
+
 // The target the _ISPC classes run: CROSSRT_ISPC_TARGET where it names one (IspcPick checks that it
-// is one this CPU runs), else the widest this CPU runs, as ISPC's own dispatch picks it.
+// is one this CPU runs), else the widest this CPU runs.
 inline std::string IspcTargetInUse() {
   const char* forced = std::getenv("CROSSRT_ISPC_TARGET");
   if (forced && *forced && std::strcmp(forced, "auto") != 0) return forced;
-  std::string widest = "none";
-  for (int i = 0; i < int(std::size(kIspcTargets)); ++i)
-    if (CpuRunsIspcTarget(i)) widest = kIspcTargets[i];
-  return widest;
+  const int widest = WidestIspcTarget();
+  return widest >= 0 ? kIspcTargets[widest] : "none";
 }
 
 }  // namespace crossrt
