@@ -6,16 +6,17 @@
 // LBVH and over the SAH tree, the kind Embree MEDIUM builds) and PrimaryRays_Vulkan, which compose BVHScene's
 // traversal), with ratios against Embree. Every tracer reads the same batch of rays (4x4 tiles of
 // pixels) and writes each hit as a CRT_Hit, as CastRays does. Every figure is measured in this run: the CPU builders and
-// the CPU tracers in rounds that run each in turn (7 and 5), with ratios as medians of the rounds'
-// ratios; the Vulkan figures as medians of 3 after a warm-up.
+// the CPU tracers in rounds that run each in turn (7 and 5 unless --build-rounds and --trace-rounds),
+// with ratios as medians of the rounds' ratios; the Vulkan figures as medians of 3 after a warm-up.
 // Then the speed-against-quality trade of LBVH against binned SAH, as a table and as CSV, which
 // bench/plot_bvh_tradeoff.py plots with matplotlib. Embree runs the SIMD width the _ISPC classes run
 // (--embree-isa matched, the default: AVX2 when CROSSRT_ISPC_TARGET=avx2 on an AVX-512 CPU, as on a
 // CPU without AVX-512), or its widest (--embree-isa native); the header says which.
 //
-//   bench_lbvh [--load N [--slowdown-csv CSV]] [--embree-isa matched|native] [--meshes NAME,...] [MESH_DIR (default build/data/meshes)] [TRADEOFF.csv (default out/bvh_tradeoff.csv)]
+//   bench_lbvh [--load N [--slowdown-csv CSV]] [--embree-isa matched|native] [--build-rounds N] [--trace-rounds N] [--builds-only] [--meshes NAME,...] [MESH_DIR (default build/data/meshes)] [TRADEOFF.csv (default out/bvh_tradeoff.csv)]
 // --load N runs N busy threads beside the measurement; warning rows at the end name each translated
-// builder or tracer slower than the original (on one thread) or _ISPC slower than _CPU. Under load a
+// builder or tracer slower than the original (on one thread), _ISPC slower than _CPU, and an _ISPC
+// tracer slower than Embree's packets (rtcIntersect16, issue 53's goal). Under load a
 // slowdown table follows the build table: the CPU builders' rounds again with the busy threads
 // stopped, and each builder's loaded times over its quiet median (median, 90th percentile, slowest),
 // with a warning row for a translated builder that slows down more than Embree LOW (TBB's threads);
@@ -58,7 +59,6 @@ using namespace LiteMath;
 namespace {
 
 constexpr int kImageSize = 1024;
-constexpr int kTraceRounds = 5;  // interleaved rounds of the CPU tracers
 
 double Ms(std::chrono::steady_clock::duration d) { return std::chrono::duration<double, std::milli>(d).count(); }
 
@@ -138,7 +138,7 @@ int main(int argc, char** argv)
 {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // tables appear as they are measured
   std::vector<std::string> only;
-  int load = 0, buildRounds = 7;
+  int load = 0, buildRounds = 7, traceRounds = 5;
   bool buildsOnly = false;
   std::string dir = "build/data/meshes", csvPath = "out/bvh_tradeoff.csv";
   std::string slowdownCsv = "out/bvh_slowdown.csv";
@@ -154,6 +154,7 @@ int main(int argc, char** argv)
   app.add_flag("--builds-only", buildsOnly, "the build table alone (no traversal, no trade-off table or CSV)");
   app.add_option("--slowdown-csv", slowdownCsv, "under --load: where the slowdown table goes as CSV (bench/plot_bvh_slowdown.py plots it)");
   app.add_option("--build-rounds", buildRounds, "interleaved rounds of the CPU builders: more for a loaded machine")->check(CLI::Range(1, 1000));
+  app.add_option("--trace-rounds", traceRounds, "interleaved rounds of the CPU tracers: more for a noisy machine")->check(CLI::Range(1, 1000));
   app.add_option("--embree-isa", embreeIsa,
                  "the SIMD width Embree may use: 'matched' (the ISPC target's: avx2 when CROSSRT_ISPC_TARGET=avx2) or 'native' (its widest)")
       ->check(CLI::IsMember({"matched", "native"}));
@@ -336,7 +337,7 @@ int main(int argc, char** argv)
               "Each tracer reads the same rays (4x4 tiles of pixels, in rows of tiles) and writes CRT_Hit (t, ids, u, v), as CastRays does\n"
               "ray queries [GPU]: PrimaryRays_Vulkan on the device's ray tracing hardware, Mrays/s of GPU time (x its translated traversal's,\n"
               "the GPU-time ratio of Table 6's hardware column; on lavapipe both run on the CPU: only the ratio means anything)\n",
-              kImageSize, kImageSize, omp_get_max_threads(), kTraceRounds);
+              kImageSize, kImageSize, omp_get_max_threads(), traceRounds);
   std::printf("| %-22s | %9s | %15s | %15s | %15s | %15s | %15s | %15s | %15s | %23s | %16s | %9s | %9s | %8s |\n", "mesh", "Embree 1",
               "Embree 16", "CrossRT LBVH", "CrossRT LBVH 1T", "LBVH _CPU", "LBVH _ISPC", "CrossRT SAH", "SAH _ISPC", "LBVH _Vulkan [GPU]",
               "ray queries [GPU]", "SAH cost L", "SAH cost S", "same hit");
@@ -472,7 +473,7 @@ int main(int argc, char** argv)
                                           if (castIspcSah)
                                             castIspcSah->CastRays(rayPos.data(), rayDir.data(), ispcSahHits.data(), pixels);
                                         }},
-                                       kTraceRounds);
+                                       traceRounds);
     const double embree1 = MedianOf(traceMs[0]), embree16 = MedianOf(traceMs[1]), lbvhMs = MedianOf(traceMs[2]), lbvh1T = MedianOf(traceMs[3]),
                  castCpuMs = MedianOf(traceMs[4]), sahMs = MedianOf(traceMs[5]);
     auto againstEmbree1 = [&](int work) { return PairedRatio(traceMs[0], traceMs[work]); };  // throughput ratio
@@ -538,7 +539,8 @@ int main(int argc, char** argv)
                 againstEmbree1(3), mrays(castCpuMs), againstEmbree1(4), ispcCast, mrays(sahMs), againstEmbree1(5), ispcSahCast, gpuCast, gpuHardware,
                 SAHCost(row.lbvh), SAHCost(row.sah), 100.0 * same / pixels);
     trade.push_back({row.name, row.lbvhCpuMs, mrays(lbvhMs), row.sahMs, mrays(sahMs)});
-    // Warning rows: a translated tracer slower than the original traversal on one thread, or _ISPC below _CPU.
+    // Warning rows: a translated tracer slower than the original traversal on one thread, _ISPC below
+    // _CPU, or _ISPC below Embree's packets.
     auto slowerTrace = [&](int work, int base, const char* what, const char* than) {
       const double ratio = PairedRatio(traceMs[work], traceMs[base]);
       if (ratio > 1.0)
@@ -549,6 +551,8 @@ int main(int argc, char** argv)
     {
       slowerTrace(6, 3, "LBVH _ISPC", "the original on one thread");
       slowerTrace(6, 4, "LBVH _ISPC", "LBVH _CPU");
+      slowerTrace(6, 1, "LBVH _ISPC", "Embree rtcIntersect16");
+      slowerTrace(7, 1, "SAH _ISPC", "Embree rtcIntersect16");
     }
   }
 

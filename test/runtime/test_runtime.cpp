@@ -873,15 +873,17 @@ TEST_CASE("ParallelFor runs every iteration once, on the pool's threads and the 
     CHECK(threads.size() > 1);
   }
 
-  // A loop inside a chunk runs on the chunk's thread.
+  // A loop inside a chunk runs on the chunk's thread. (With one thread, OMP_NUM_THREADS=1, there is
+  // no pool: the outer loop is one chunk on this thread, not inside a parallel loop.)
   std::atomic<int> innerOnOtherThreads{0}, inner{0};
-  crossrt::ParallelFor<int>(true, 0, 8, 1, [&](int, int) {
+  crossrt::ParallelFor<int>(true, 0, 8, 1, [&](int outerFirst, int outerLast) {
     const auto self = std::this_thread::get_id();
-    CHECK(crossrt::InParallelLoop());
-    crossrt::ParallelFor<int>(true, 0, 100, 1, [&](int first, int last) {
-      inner += last - first;
-      if (std::this_thread::get_id() != self) ++innerOnOtherThreads;
-    });
+    CHECK(crossrt::InParallelLoop() == (crossrt::LoopThreads() > 1));
+    for (int outer = outerFirst; outer < outerLast; ++outer)
+      crossrt::ParallelFor<int>(true, 0, 100, 1, [&](int first, int last) {
+        inner += last - first;
+        if (std::this_thread::get_id() != self) ++innerOnOtherThreads;
+      });
   });
   CHECK(inner.load() == 800);
   CHECK(innerOnOtherThreads.load() == 0);
