@@ -2,7 +2,8 @@
 //   1. the paper's Table 10 form: samples per second of the class as written (one thread),
 //      PathTracer_CPU (all cores), PathTracer_Vulkan as a megakernel and as plain wavefront, and
 //      PathTracer_ISPC (SIMD lanes, where ISPC was found) beside PathTracer_CPU over the same BVHScene,
-//      in interleaved rounds (medians), with the ratio to the original;
+//      in interleaved rounds (medians), with the ratio to the original, and a warning row for a
+//      translated CPU class slower than the original or PathTracer_ISPC slower than its peer;
 //   2. the paper's Table 11 form: PathTracer_Vulkan translated at virtual levels 1 (one array of
 //      equal slots, PathTracer_VulkanLevel1), 2 (a buffer per class, PathTracer_Vulkan) and 3 (2 plus
 //      callable shaders where the device has ray tracing pipelines, PathTracer_VulkanLevel3), both
@@ -279,6 +280,26 @@ int main(int argc, char** argv)
       std::printf("| %s | %s | %d | %.2f | %.3f | %.2fx |\n", r.name.c_str(), r.mode.c_str(), r.spp, rate, rate * paths * 1e-6, rate / originalRate);
       csv << "throughput," << r.name << "," << r.mode << "," << r.spp << "," << Median(r.seconds) << "," << rate << "," << rate * paths * 1e-6 << ","
           << rate / originalRate << ",,\n";
+    }
+    // Warning rows: a translated CPU class slower than the original, or PathTracer_ISPC slower than
+    // its like-for-like peer, PathTracer_CPU over BVHScene (no ISPC target may fall below it).
+    std::vector<std::string> slower;
+    const Row* cpuOverBvh = nullptr;
+    for (auto& r : rows)
+    {
+      const double rate = r.spp / Median(r.seconds);
+      const bool translatedCpu = r.name.rfind("PathTracer_CPU", 0) == 0 || r.name.rfind("PathTracer_ISPC", 0) == 0;
+      if (translatedCpu && rate < originalRate)
+        slower.push_back(r.name + " at " + std::to_string(rate / originalRate).substr(0, 4) + "x the original's samples per second");
+      if (r.name == "PathTracer_CPU (all cores, BVHScene)") cpuOverBvh = &r;
+      if (cpuOverBvh && r.name == "PathTracer_ISPC (all cores, BVHScene)" && rate < cpuOverBvh->spp / Median(cpuOverBvh->seconds))
+        slower.push_back(r.name + " at " + std::to_string(rate / (cpuOverBvh->spp / Median(cpuOverBvh->seconds))).substr(0, 4) + "x the samples per second of " +
+                         cpuOverBvh->name);
+    }
+    if (!slower.empty())
+    {
+      std::printf("\nWARNING: translated classes slower than they should be:\n");
+      for (auto& line : slower) std::printf("| WARNING | %s |\n", line.c_str());
     }
 
     // ---- 2. Table 11: virtual levels
