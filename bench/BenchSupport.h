@@ -116,16 +116,6 @@ inline std::string CpuModel()
   return name;
 }
 
-// The ISPC target the _ISPC classes run here: CROSSRT_ISPC_TARGET, else the widest this CPU has.
-inline std::string IspcTarget()
-{
-  const char* forced = std::getenv("CROSSRT_ISPC_TARGET");
-  if (forced && *forced) return forced;
-  for (int i = int(std::size(crossrt::kIspcTargets)) - 1; i >= 0; --i)
-    if (crossrt::CpuRunsIspcTarget(i)) return crossrt::kIspcTargets[i];
-  return "none";
-}
-
 // How the _ISPC classes' kernels pick between SIMD lanes and their scalar loop (CROSSRT_ISPC_LANES,
 // crossrt::LaneChoice): "lanes or scalar, measured", "lanes always" or "scalar always".
 inline const char* IspcLanes()

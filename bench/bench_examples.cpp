@@ -143,7 +143,7 @@ int main(int argc, char** argv)
 
   const BusyThreads busy(load);
   std::printf("CPU: %s, %u threads; ISPC target: %s (%s); Vulkan device: %s; load: %d busy threads beside the measurement\n\n", CpuModel().c_str(),
-              std::thread::hardware_concurrency(), IspcTarget().c_str(), IspcLanes(), ctx ? ctx->DeviceName().c_str() : "none", busy.Count());
+              std::thread::hardware_concurrency(), crossrt::IspcTargetInUse().c_str(), IspcLanes(), ctx ? ctx->DeviceName().c_str() : "none", busy.Count());
   std::printf("| %-10s | %-18s | %10s | %9s | %12s |\n|%s|\n", "example", "implementation", "ms/call", "vs orig", "GPU ms/call", std::string(73, '-').c_str());
 
   {  // particles: two 1D kernels, one with 4 member reductions

@@ -114,7 +114,7 @@ int main(int argc, char** argv)
   const std::string self = std::filesystem::canonical("/proc/self/exe").string();
   const std::string memory = (std::filesystem::temp_directory_path() / ("crossrt_first_build_" + std::to_string(getpid()) + ".tsv")).string();
   std::printf("CPU: %s, %d threads; ISPC target: %s; each cell the median of %d fresh processes' first build\n", CpuModel().c_str(),
-              int(std::thread::hardware_concurrency()), IspcTarget().c_str(), children);
+              int(std::thread::hardware_concurrency()), crossrt::IspcTargetInUse().c_str(), children);
   std::printf("| %-24s | %9s | %10s | %8s | %19s | %19s | %19s |\n", "mesh", "triangles", "Embree LOW", "LBVH_CPU", "LBVH_ISPC run 1",
               "LBVH_ISPC run 2", "LBVH_ISPC runs 3 on");
   std::printf("|%s|\n", std::string(134, '-').c_str());
@@ -176,7 +176,7 @@ int main(int argc, char** argv)
     std::printf("| %-24s | %9zu | %10.2f | %8.2f | %19s | %19s | %19s |\n", name, triangles, embree, cpu, cell(run1).c_str(), cell(run2).c_str(),
                 cell(later).c_str());
     if (csv)
-      std::fprintf(csv, "\"%s\",%s,%s,%zu,%.4f,%.4f,%.4f,%.4f,%.4f\n", CpuModel().c_str(), IspcTarget().c_str(), name, triangles, embree, cpu,
+      std::fprintf(csv, "\"%s\",%s,%s,%zu,%.4f,%.4f,%.4f,%.4f,%.4f\n", CpuModel().c_str(), crossrt::IspcTargetInUse().c_str(), name, triangles, embree, cpu,
                    run1, run2, later);
   }
   std::filesystem::remove(memory);

@@ -159,7 +159,7 @@ int main(int argc, char** argv)
                  "the SIMD width Embree may use: 'matched' (the ISPC target's: avx2 when CROSSRT_ISPC_TARGET=avx2) or 'native' (its widest)")
       ->check(CLI::IsMember({"matched", "native"}));
   if (const int status = crossrt::ParseCommandLine(app, argc, argv); status >= 0) return status;
-  if (embreeIsa == "matched" && !EmbreeIsaOf(IspcTarget()).empty()) g_embreeConfig = "isa=" + EmbreeIsaOf(IspcTarget());
+  if (embreeIsa == "matched" && !EmbreeIsaOf(crossrt::IspcTargetInUse()).empty()) g_embreeConfig = "isa=" + EmbreeIsaOf(crossrt::IspcTargetInUse());
   auto chosen = [&](const std::string& name) {
     if (only.empty()) return true;
     for (auto& prefix : only)
@@ -173,7 +173,7 @@ int main(int argc, char** argv)
   catch (const std::exception& e) { std::printf("no Vulkan device (%s): the _Vulkan column is left out\n", e.what()); }
   BusyThreads busy(load);  // stopped for the quiet rounds of the slowdown table
   std::printf("CPU: %s, %d threads; ISPC target: %s (%s); Embree ISA: %s; Vulkan device: %s; load: %d busy threads beside the measurement\n",
-              CpuModel().c_str(), omp_get_max_threads(), IspcTarget().c_str(), IspcLanes(),
+              CpuModel().c_str(), omp_get_max_threads(), crossrt::IspcTargetInUse().c_str(), IspcLanes(),
               g_embreeConfig.empty() ? "its widest" : g_embreeConfig.substr(4).c_str(), ctx ? ctx->DeviceName().c_str() : "none", busy.Count());
   std::vector<std::string> slower;  // translated classes slower than the original, for the warning rows at the end
   std::vector<Slowdown> slowdowns;  // under --load: the slowdown table's rows
@@ -314,7 +314,7 @@ int main(int argc, char** argv)
       std::printf(" %6.1f %6.2fx %6.2fx %7.2fx |", d.quietMs, d.median, d.p90, d.worst);
     }
     std::printf("\n");
-    if (!WriteSlowdownCsv(slowdowns, slowdownCsv, CpuModel(), IspcTarget(), busy.Count()))
+    if (!WriteSlowdownCsv(slowdowns, slowdownCsv, CpuModel(), crossrt::IspcTargetInUse(), busy.Count()))
       status = 1;
     else
       std::printf("table: %s (plot it: bench/plot_bvh_slowdown.py %s out/bvh_slowdown.png)\n", slowdownCsv.c_str(), slowdownCsv.c_str());

@@ -189,7 +189,7 @@ int main(int argc, char** argv)
     ApplySceneDefaults(s.scene);
     const double paths = double(s.size) * s.size;
     std::printf("bench_path_tracer: %s, %ux%u, depth %d, %d interleaved rounds\n", scenePath.c_str(), s.size, s.size, s.depth, rounds);
-    std::printf("CPU: %s, %u threads; ISPC target: %s (%s)\n\n", CpuModel().c_str(), std::thread::hardware_concurrency(), IspcTarget().c_str(),
+    std::printf("CPU: %s, %u threads; ISPC target: %s (%s)\n\n", CpuModel().c_str(), std::thread::hardware_concurrency(), crossrt::IspcTargetInUse().c_str(),
                 IspcLanes());
 
     // ---- 1. Table 10: megakernel against wavefront

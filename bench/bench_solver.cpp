@@ -99,7 +99,7 @@ int main(int argc, char** argv)
       r.steps = d->Steps();
     }
   std::printf("CPU: %s, %u threads; ISPC target: %s (%s); Vulkan device: %s\n", CpuModel().c_str(), std::thread::hardware_concurrency(),
-              IspcTarget().c_str(), IspcLanes(), ctx ? ctx->DeviceName().c_str() : "none");
+              crossrt::IspcTargetInUse().c_str(), IspcLanes(), ctx ? ctx->DeviceName().c_str() : "none");
   std::printf("HeatDiffusion %dx%d, tolerance %g, at most %d steps; median of %d interleaved rounds\n\n", side, side, tolerance, maxSteps, rounds);
   std::printf("| %-9s | %-12s | %6s | %10s | %9s | %12s | %14s |\n|%s|\n", "impl", "residual read", "steps", "ms", "us/step",
               "vs original", "vs every step", std::string(90, '-').c_str());
