@@ -368,16 +368,12 @@ int main(int argc, char** argv)
     embree.Build(row.mesh, RTC_BUILD_QUALITY_MEDIUM);
     // Every tracer reads the same batch of rays, as PrimaryRays::CastRays takes it (4x4 tiles of
     // pixels, the tiles in rows: the order a renderer hands out coherent rays), and writes each
-    // nearest hit as a CRT_Hit: the same work on both sides of each ratio. Within a tile the pixels
-    // go in Z order: 2x2 quads, two quads a 4x2 half, two halves the tile. So a gang of 4, 8 or 16
-    // lanes takes a square-ish block, as a 2D kernel's foreach_tiled hands them out, and Embree's
-    // packet of 16 the whole tile as before.
+    // nearest hit as a CRT_Hit: the same work on both sides of each ratio.
     std::vector<float4> rayPos(pixels, float4(cam.eye.x, cam.eye.y, cam.eye.z, 0.0f)), rayDir(pixels);
     for (int i = 0; i < pixels; ++i)
     {
       const int tile = i / 16, k = i % 16;
-      const int x = (k & 1) | (k >> 1 & 2), y = (k >> 1 & 1) | (k >> 2 & 2);  // k's bits, x y x y from the lowest
-      rayDir[i] = cam.Ray(tile % (kImageSize / 4) * 4 + x, tile / (kImageSize / 4) * 4 + y);
+      rayDir[i] = cam.Ray(tile % (kImageSize / 4) * 4 + k % 4, tile / (kImageSize / 4) * 4 + k / 4);
     }
     std::vector<CRT_Hit> embreeHits(pixels), embreePacketHits(pixels), ourHits(pixels), ourHits1T(pixels), sahHits(pixels);
     auto embreeHit = [](const RTCRayHit& rh, float tfar) {
