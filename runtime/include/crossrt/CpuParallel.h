@@ -463,8 +463,9 @@ void RadixSort(Iterator first, Iterator last, const SortKey& key) {
 // on the next call where the faster way's mean passes the other's (the work changed: the other is
 // measured again, not taken on its old number). The means are kept from run to run (LaneMemory.h,
 // per CPU model and ISPC target): a kernel's first call in the next run takes the way that was
-// faster then, in the size class of the last call then. Only on a machine that never ran it does a
-// kernel called once or twice run in lanes.
+// faster then, in the size class of the last call then, and where the other way's remembered mean
+// is within a quarter of the verdict's new one, that way is measured again on the next call. Only on
+// a machine that never ran it does a kernel called once or twice run in lanes.
 // CROSSRT_ISPC_LANES=always keeps every kernel in lanes (as before this choice), =never runs every
 // kernel's scalar loop (to test or compare it).
 //

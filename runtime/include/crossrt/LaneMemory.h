@@ -7,9 +7,10 @@
 // So at exit each LaneChoice hands its means (per size class; a way's first call where it ran only
 // once) to LaneMemory, which writes them to a file; in the next run, a kernel's first call takes
 // the way that was faster then, in the size class of the last call then, or, where one way has no
-// time yet, that way. The other way is tried after 16 calls as usual, so that in a program that
-// calls a kernel often a stale verdict (a new CPU under the same name, a changed kernel) corrects
-// itself. A program that calls a kernel once runs it in lanes in its first run, as its scalar loop
+// time yet, that way. The other way is tried after 16 calls as usual (on the next call where its
+// remembered mean is within a quarter of the verdict's: MeasuredWays::kCloseToVerdict), so that in
+// a program that calls a kernel often a stale verdict (a new CPU under the same name, a changed
+// kernel, another workload) corrects itself. A program that calls a kernel once runs it in lanes in its first run, as its scalar loop
 // in its second, and from its third the way whose first call was faster, the other again in every
 // 16th run.
 //
