@@ -10,9 +10,9 @@
 // time yet, that way. The other way is tried after 16 calls as usual (on the next call where its
 // remembered mean is within a quarter of the verdict's: MeasuredWays::kCloseToVerdict), so that in
 // a program that calls a kernel often a stale verdict (a new CPU under the same name, a changed
-// kernel, another workload) corrects itself. A program that calls a kernel once runs it in lanes in its first run, as its scalar loop
-// in its second, and from its third the way whose first call was faster, the other again in every
-// 16th run.
+// kernel, another workload) corrects itself. A program that calls a kernel once runs it in lanes
+// in its first run, as its scalar loop in its second, and from its third the way whose first call
+// was faster, the other again in every 16th run.
 //
 // The file: CROSSRT_LANE_MEMORY if set (`off`: nothing is read or written), else
 // $XDG_CACHE_HOME/crossrt/lane-choices.tsv, else $HOME/.cache/crossrt/lane-choices.tsv. A line per
