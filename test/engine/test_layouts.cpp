@@ -110,3 +110,51 @@ TEST_CASE("Layouts: elements no GPU layout reproduces are a diagnostic", "[engin
   CHECK(r.diagnostics.find("layout") != std::string::npos);
   CHECK(r.diagnostics.find("hint:") != std::string::npos);
 }
+
+TEST_CASE("Layouts: ISPC structs pad to C++'s offsets in 32-bit words where they can", "[engine][layout][ispc]")
+{
+  // A struct returned from a helper inside an `if` is stored masked on ISPC, member by member: a
+  // padding byte array is a store per lane and byte with avx2 (no masked byte stores there), a
+  // padding word array a masked vector store per word. The fields stay where C++ has them.
+  const char* header = R"(#pragma once
+#include "LiteMath.h"
+#include <vector>
+using namespace LiteMath;
+struct Sample { float4 dir; uint32_t flags; };  // 12 bytes of padding after flags
+struct Marked { float4 dir; bool hit; };        // 15 after hit: 3 to its word, then 12
+class Padding
+{
+public:
+  virtual ~Padding() = default;
+  virtual void Run(int n);
+protected:
+  void kernel1D_Pick(int n);
+  std::vector<Sample> m_samples;
+  std::vector<float4> m_out;
+};
+)";
+  const char* source = R"(#include "Padding.h"
+static Sample Pick(float4 d, uint32_t f) { Sample s; s.dir = d; s.flags = f; return s; }
+static Marked Mark(float4 d) { Marked m; m.dir = d; m.hit = d.x > 0.0f; return m; }
+void Padding::Run(int n) { kernel1D_Pick(n); }
+void Padding::kernel1D_Pick(int n)
+{
+  for (int i = 0; i < n; ++i)
+  {
+    Sample s = m_samples[i];
+    if (s.flags != 0u)
+      s = Pick(s.dir * 2.0f, s.flags + 1u);
+    const Marked m = Mark(s.dir);
+    m_out[i] = m.hit ? s.dir : float4(float(s.flags));
+  }
+}
+)";
+  TempClass tc("Padding", header, source);
+  const TranslateResult t = Translate(MakeRequest(tc, "Padding", Backend::Ispc));
+  INFO(t.diagnostics);
+  REQUIRE(t.ok);
+  const std::string ispc = Squeezed(t.files.at("Padding_ISPC_kernels.ispc"));
+  CHECK(ispc.find(Squeezed("float4 dir; uint flags; uint32 crt_pad0[3]; };")) != std::string::npos);
+  CHECK(ispc.find(Squeezed("float4 dir; bool hit; uint8 crt_pad0[3]; uint32 crt_pad1[3]; };")) != std::string::npos);
+  CHECK(ispc.find("uint8 crt_pad0[12]") == std::string::npos);
+}

@@ -142,13 +142,23 @@ std::optional<std::string> IspcPrinter::SpellType(QualType t, const std::string&
   return IspcTypeName(gpuType);
 }
 
+// The padding from byte `at` to byte `to`: 32-bit words where it can be, bytes where it must. A
+// varying struct assigned under a mask (a value returned in an `if`) stores each member masked;
+// AVX2 has masked stores of 32-bit elements only, so ISPC stores a byte array one lane and one byte
+// at a time, a branch each (12 padding bytes of PathTracer's LightSample and BsdfSample: 96 such
+// stores per assignment with avx2, where 3 words are 3 vector stores).
+static void Pad(std::ostream& os, uint64_t at, uint64_t to, unsigned& pads) {
+  const uint64_t wordsFrom = std::min(to, (at + 3) / 4 * 4), wordsTo = std::max(wordsFrom, to / 4 * 4);
+  if (wordsFrom > at) os << "  uint8 crt_pad" << pads++ << "[" << (wordsFrom - at) << "];\n";
+  if (wordsTo > wordsFrom) os << "  uint32 crt_pad" << pads++ << "[" << (wordsTo - wordsFrom) / 4 << "];\n";
+  if (to > wordsTo) os << "  uint8 crt_pad" << pads++ << "[" << (to - wordsTo) << "];\n";
+}
+
 // ISPC aligns every member of these types to 4 bytes; C++ may align more (LiteMath's float4 to
 // 16): explicit padding puts each field where C++ has it, so that buffers are shared as they are.
 // A struct without arrays gets its maker, make_S(fields...).
 std::string IspcPrinter::StructBody(const RecordDecl* rd) {
   std::ostringstream os;
-  // ISPC aligns every member of these types to 4 bytes; C++ may align more (LiteMath's float4 to
-  // 16): explicit padding puts each field where C++ has it, so that buffers are shared as they are.
   const ASTRecordLayout& layout = m_ctx.getASTRecordLayout(rd);
   uint64_t at = 0;
   unsigned index = 0, pads = 0;
@@ -156,7 +166,7 @@ std::string IspcPrinter::StructBody(const RecordDecl* rd) {
   bool constructible = true;
   for (auto* f : rd->fields()) {
     const uint64_t offset = layout.getFieldOffset(index++) / 8;
-    if (offset > at) os << "  uint8 crt_pad" << pads++ << "[" << (offset - at) << "];\n";
+    if (offset > at) Pad(os, at, offset, pads);
     os << "  " << Declare(f->getType(), f->getName().str(), f->getLocation()) << ";\n";
     at = offset + m_ctx.getTypeSizeInChars(f->getType()).getQuantity();
     constructible &= !f->getType()->isArrayType();
@@ -165,7 +175,7 @@ std::string IspcPrinter::StructBody(const RecordDecl* rd) {
     assigns += " r." + SafeName(f->getName().str()) + " = " + SafeName(f->getName().str()) + ";";
   }
   const uint64_t size = layout.getSize().getQuantity();
-  if (size > at) os << "  uint8 crt_pad" << pads++ << "[" << (size - at) << "];\n";
+  if (size > at) Pad(os, at, size, pads);
   os << "};\n";
   if (constructible)
     os << "static inline " << rd->getName().str() << " " << StructMaker(rd) << "(" << params << ")\n{\n  "

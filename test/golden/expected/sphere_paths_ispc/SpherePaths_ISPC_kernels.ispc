@@ -19,7 +19,7 @@ struct SphereHit {
   float4 position;
   float4 normal;
   int sphere;
-  uint8 crt_pad0[12];
+  uint32 crt_pad0[3];
 };
 static inline SphereHit make_SphereHit(float4 position, float4 normal, int sphere)
 {
