@@ -134,3 +134,43 @@ TEST_CASE("Printer: a branch that GangSize() decides prints only the branch a ga
   CHECK(Count(glsl, "Falloff(v)<0.0)") == 0);  // (the comment has the C++, 0.0f)
   CHECK(glsl.find(Squeezed("{ const int n_1 = 2; v += float(n_1); }")) != std::string::npos);
 }
+
+TEST_CASE("Printer: a helper marked noinline stays a call on ISPC, in both spellings; GLSL has no such qualifier", "[engine][printer][ispc]")
+{
+  const char* header = R"(#pragma once
+#include <vector>
+class Cold
+{
+public:
+  virtual ~Cold() = default;
+  virtual void Run(int n, float* out);
+protected:
+  void kernel1D_Run(int n, float* out);
+};
+)";
+  const char* source = R"(#include "Cold.h"
+[[gnu::noinline]] static float Rare(float x) { return x * x - 1.0f; }
+__attribute__((noinline)) static float Rarer(float x) { return 2.0f * x; }
+static float Hot(float x) { return x + 1.0f; }
+void Cold::Run(int n, float* out) { kernel1D_Run(n, out); }
+void Cold::kernel1D_Run(int n, float* out)
+{
+  for (int i = 0; i < n; ++i)
+    out[i] = i % 7 == 0 ? Rare(float(i)) + Rarer(float(i)) : Hot(float(i));
+}
+)";
+  TempClass tc("Cold", header, source);
+  const TranslateResult ispc = Translate(MakeRequest(tc, "Cold", Backend::Ispc));
+  INFO(ispc.diagnostics);
+  REQUIRE(ispc.ok);
+  const std::string kernels = Squeezed(ispc.files.at("Cold_ISPC_kernels.ispc"));
+  CHECK(kernels.find(Squeezed("static noinline float Rare(float x)")) != std::string::npos);
+  CHECK(kernels.find(Squeezed("static noinline float Rarer(float x)")) != std::string::npos);
+  CHECK(kernels.find(Squeezed("static inline float Hot(float x)")) != std::string::npos);
+  TempClass again("Cold", header, source);
+  const TranslateResult glsl = Translate(MakeRequest(again, "Cold"));
+  REQUIRE(glsl.ok);
+  const std::string shader = Squeezed(glsl.files.at("shaders/kernel1D_Run.comp"));
+  CHECK(shader.find(Squeezed("float Rare(float x)")) != std::string::npos);
+  CHECK(shader.find("noinline") == std::string::npos);
+}

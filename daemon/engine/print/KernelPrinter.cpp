@@ -285,7 +285,7 @@ std::string KernelPrinter::EmitHelper(const FunctionDecl* fd, SourceLocation cal
   m_inProgress.insert(def);
   std::ostringstream os;
   auto ret = Type(def->getReturnType(), def->getLocation());
-  os << "// from " << def->getQualifiedNameAsString() << "\n" << FunctionQualifiers() << (ret ? *ret : "void") << " " << name << "(";
+  os << "// from " << def->getQualifiedNameAsString() << "\n" << FunctionQualifiers(def) << (ret ? *ret : "void") << " " << name << "(";
   // The class's own methods reach its members as the kernels do: through the class data where the
   // language passes it (ClassDataParameter).
   const bool method = isa<CXXMethodDecl>(def) && !cast<CXXMethodDecl>(def)->isStatic();

@@ -216,12 +216,13 @@ protected:
   virtual std::string ListConstruct(clang::QualType t, const std::string& base, const std::string& dims,
                                     const std::vector<const clang::Expr*>& args, clang::SourceLocation loc) = 0;
   virtual std::string ArrayValue(const std::string& type, const std::string& list) = 0;
-  // Functions: what precedes a function's return type; the class data as the first parameter of the
-  // class's methods and as the first argument of their calls ("" where it is global); a struct's
-  // method's writable `self`; an object's data struct; the traversal passed to an object's method
-  // ("" where it is left out); whether buffers are passed to helpers (else each copy of a helper
-  // indexes the buffers it is bound to), and such a buffer's parameter; a writable parameter.
-  virtual std::string FunctionQualifiers() const = 0;
+  // Functions: what precedes function fd's return type (fd's noinline, say); the class data as the
+  // first parameter of the class's methods and as the first argument of their calls ("" where it is
+  // global); a struct's method's writable `self`; an object's data struct; the traversal passed to
+  // an object's method ("" where it is left out); whether buffers are passed to helpers (else each
+  // copy of a helper indexes the buffers it is bound to), and such a buffer's parameter; a writable
+  // parameter.
+  virtual std::string FunctionQualifiers(const clang::FunctionDecl* fd) const = 0;
   virtual std::string ClassDataParameter() const = 0;
   virtual std::string ClassDataArgument() const = 0;
   virtual std::string WritableSelf(const std::string& structName) const = 0;

@@ -67,7 +67,7 @@ std::string KernelPrinter::EmitLambda(const LambdaExpr* lambda, const std::strin
              ? cast<FunctionDecl>(lambda->getLambdaClass()->getDeclContext())->getQualifiedNameAsString()
              : std::string("the kernel"))
      << "\n"
-     << FunctionQualifiers() << (ret ? *ret : "void") << " " << name << "(";
+     << FunctionQualifiers(call) << (ret ? *ret : "void") << " " << name << "(";
   std::string params;
   auto add = [&](const std::string& p) { params += (params.empty() ? "" : ", ") + p; };
   bool capturesThis = false;

@@ -2,14 +2,14 @@
 #include <algorithm>
 #include <cmath>
 
-static uint32_t PcgHash(uint32_t v)
+__attribute__((noinline)) static uint32_t PcgHash(uint32_t v)
 {
   const uint32_t state = v * 747796405u + 2891336453u;
   const uint32_t word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
   return (word >> 22u) ^ word;
 }
 
-static Pair MakePair(float a, int b) { return Pair{a, b}; }
+[[gnu::noinline]] static Pair MakePair(float a, int b) { return Pair{a, b}; }  // called under a condition that differs per lane
 
 void HashNoise::Run(int w, int h, float* out) { kernel2D_Run(w, h, out); }
 

@@ -1,7 +1,8 @@
 // A per-pixel generator as users write one: a struct whose non-const method advances its own state
 // (a local of the thread, not the class), a static hash helper, a static constexpr member as an
 // array size, {} zero-initialisation, a struct-returning helper in a conditional, a structured
-// binding, std::fmod, std::isnan and std::isfinite, and an early continue.
+// binding, std::fmod, std::isnan and std::isfinite, and an early continue. Both helpers are marked
+// noinline, in the two spellings (a call on ISPC too).
 #pragma once
 #include "LiteMath.h"
 #include <cstdint>

@@ -122,7 +122,8 @@ std::string GlslPrinter::AppendFunction(const FieldDecl* field, const CallExpr* 
   return name;
 }
 
-std::string GlslPrinter::FunctionQualifiers() const { return ""; }
+// GLSL has no qualifier for it: a helper the user marked noinline is inlined as the compiler likes.
+std::string GlslPrinter::FunctionQualifiers(const clang::FunctionDecl*) const { return ""; }
 
 std::string GlslPrinter::ClassDataParameter() const { return ""; }  // the class data is a global block
 

@@ -236,7 +236,12 @@ std::string IspcPrinter::AppendFunction(const FieldDecl* field, const CallExpr* 
   return name;
 }
 
-std::string IspcPrinter::FunctionQualifiers() const { return "static inline "; }
+// A helper the user marked noinline ([[gnu::noinline]], __attribute__((noinline))) stays a call on
+// ISPC too: a cold path kept out of a kernel's hot code. Every other helper is inline, as ISPC
+// inlines anyway.
+std::string IspcPrinter::FunctionQualifiers(const clang::FunctionDecl* fd) const {
+  return fd && fd->hasAttr<clang::NoInlineAttr>() ? "static noinline " : "static inline ";
+}
 
 std::string IspcPrinter::ClassDataParameter() const { return "uniform " + DataStruct() + " *uniform self"; }
 

@@ -29,7 +29,7 @@ protected:
   std::string ListConstruct(clang::QualType t, const std::string& base, const std::string& dims, const std::vector<const clang::Expr*>& args,
                             clang::SourceLocation loc) override;
   std::string ArrayValue(const std::string& type, const std::string& list) override;
-  std::string FunctionQualifiers() const override;
+  std::string FunctionQualifiers(const clang::FunctionDecl* fd) const override;
   std::string ClassDataParameter() const override;
   std::string ClassDataArgument() const override;
   std::string WritableSelf(const std::string& structName) const override;
