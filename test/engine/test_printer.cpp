@@ -135,7 +135,7 @@ TEST_CASE("Printer: a branch that GangSize() decides prints only the branch a ga
   CHECK(glsl.find(Squeezed("{ const int n_1 = 2; v += float(n_1); }")) != std::string::npos);
 }
 
-TEST_CASE("Printer: a helper marked noinline stays a call on ISPC, in both spellings; GLSL has no such qualifier", "[engine][printer][ispc]")
+TEST_CASE("Printer: a helper marked noinline stays a call on ISPC, in both spellings, and GLSL has no such qualifier", "[engine][printer][ispc]")
 {
   const char* header = R"(#pragma once
 #include <vector>
