@@ -143,11 +143,11 @@ std::optional<std::string> IspcPrinter::SpellType(QualType t, const std::string&
 }
 
 // The padding from byte `at` to byte `to`: 32-bit words where it can be, bytes where it must. A
-// varying struct assigned under a mask (a value returned in an `if`) stores each member masked;
-// AVX2 has masked stores of 32-bit elements only, so ISPC stores a byte array one lane and one byte
-// at a time, a branch each (12 padding bytes of PathTracer's LightSample and BsdfSample: 96 such
-// stores per assignment with avx2, where 3 words are 3 vector stores; PathTracer_ISPC's lanes went
-// from 0.95x of PathTracer_CPU's speed to 1.22x with avx2 on an AMD EPYC, Zen 5).
+// varying struct assigned under a mask (a value returned in an `if`) stores each member masked.
+// AVX2 has masked stores of 32- and 64-bit elements only, so ISPC stores a byte array one lane and
+// one byte at a time, a branch each: 96 such stores for the 12 padding bytes of PathTracer's
+// LightSample or BsdfSample, where 3 words are 3 vector stores (PathTracer_ISPC's lanes went from
+// 0.95x of PathTracer_CPU's speed to 1.22x with avx2 on an AMD EPYC, Zen 5).
 static void Pad(std::ostream& os, uint64_t at, uint64_t to, unsigned& pads) {
   const uint64_t wordsFrom = std::min(to, (at + 3) / 4 * 4), wordsTo = std::max(wordsFrom, to / 4 * 4);
   if (wordsFrom > at) os << "  uint8 crt_pad" << pads++ << "[" << (wordsFrom - at) << "];\n";
