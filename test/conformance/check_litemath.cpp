@@ -3,9 +3,18 @@
 #include "Conformance.h"
 
 #include "LiteMath.h"
+#include <cmath>
 #include <stdexcept>
+#include <vector>
 
 // A case compiles where this build translated its class (CONFORMANCE_CLASSES); main checks that all were.
+#if __has_include("BoxFields_CPU.h")
+#include "BoxFields_CPU.h"
+#include "BoxFields_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "BoxFields_ISPC.h"
+#endif
+#endif
 #if __has_include("Transforms_CPU.h")
 #include "Transforms_CPU.h"
 #include "Transforms_Vulkan.h"
@@ -185,6 +194,40 @@ Register projector(MakeCase<Projector>(
       for (auto& q : in) q.z -= 20.0f;
       p.Project(100, in.data(), out.data());
       return Flatten(out);
+    }));
+#endif
+
+#if __has_include("BoxFields_CPU.h")
+Register boxFields(MakeCase<BoxFields>(
+    "fields of arrays of structs (Box4f, structs of three and four 4-vector rows through pointers and a member vector) at the loop's index and a shuffled one",
+    "box_fields.h/.cpp", 1e-5, CONFORMANCE_MAKERS(BoxFields), [](BoxFields& b) {
+      const int n = 61;  // leaves a part of a gang of 4, 8 and 16 lanes
+      std::vector<Box4f> boxes(n);
+      std::vector<Stroke> strokes(n);
+      std::vector<int> order(n);
+      for (int i = 0; i < n; i++)
+      {
+        const float f = float(i);
+        boxes[i].boxMin = float4(-f, 0.5f * f, 1.0f, 0.0f);
+        boxes[i].boxMax = float4(f, 2.0f * f, 3.0f + f, 1.0f);
+        strokes[i].from = float4(0.1f * f, 1.0f, -f, 0.0f);
+        strokes[i].to = float4(f, 1.5f, f, 2.0f);
+        strokes[i].tag = int4(i % 4, -1, 2, i % 3);
+        order[i] = (7 * i + 3) % n;
+      }
+      std::vector<float4> out(n, float4(-1.0f));
+      b.CommitDeviceData();
+      b.Combine(n, boxes.data(), strokes.data(), order.data(), out.data());
+      // A known answer: element 0 (order 3, i % 3 == 0). center (0, 0, 2, 0.5), far = box 3's max (3, 6, 6, 1),
+      // along (0, 0.5, 0, 2) x tag 0 + 0, moved = swimmer 0 (0, 1, 0, 1) + vel x 0, tint = swimmer 3's colour,
+      // then + from 0 x 2 (0, 2, 0, 0) + center.
+      const float4 expected = float4(0.0f, 0.0f, 2.0f, 0.5f) + 0.25f * float4(3.0f, 6.0f, 6.0f, 1.0f) + float4(0.0f, 1.0f, 0.0f, 1.0f) +
+                              float4(0.03f, 0.5f, 0.97f, 0.25f) + float4(0.0f, 2.0f, 0.0f, 0.0f) + float4(0.0f, 0.0f, 2.0f, 0.5f);
+      for (int c = 0; c < 4; c++)
+        if (std::abs(out[0][c] - expected[c]) > 1e-5f) throw std::runtime_error("element 0 should be the known answer");
+      Outputs r;
+      for (const float4& v : out) Append(r, std::vector<float>{v.x, v.y, v.z, v.w});
+      return r;
     }));
 #endif
 

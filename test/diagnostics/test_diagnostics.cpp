@@ -401,6 +401,61 @@ void Rows::kernel1D_Run(int n, const float4* in, float4* out)
   REQUIRE(text.find("out_[i].w = 1.0") != std::string::npos);                                 // one field: a scatter
 }
 
+TEST_CASE("ISPC: a 4-vector field of a struct of two to four 16-byte rows read at a per-lane index goes through crt_load4_field",
+          "[diagnostics][ispc]")
+{
+  TempClass tc("Fields", R"(#pragma once
+#include "LiteMath.h"
+#include <vector>
+using namespace LiteMath;
+struct Three { float4 a; float4 b; int4 c; };               // 48 bytes: three rows
+struct Four { float4 p; float4 q; float4 r; uint4 ids; };  // 64 bytes: four rows
+struct Five { float4 v[5]; };                              // 80 bytes: too many rows
+struct Mixed { float3 lo; float w; float4 hi; };           // two rows, one of them a float3 and a float
+class Fields
+{
+public:
+  virtual ~Fields() = default;
+  virtual void Run(int n, [[crossrt::size("n")]] const Box4f* boxes, [[crossrt::size("n")]] const Three* threes,
+                   [[crossrt::size("n")]] const Five* fives, [[crossrt::size("n")]] const Mixed* mixed, [[crossrt::size("n")]] float4* out);
+protected:
+  void kernel1D_Run(int n, const Box4f* boxes, const Three* threes, const Five* fives, const Mixed* mixed, float4* out);
+  std::vector<Four> m_fours;
+};
+)",
+               R"(#include "Fields.h"
+void Fields::Run(int n, const Box4f* boxes, const Three* threes, const Five* fives, const Mixed* mixed, float4* out)
+{
+  kernel1D_Run(n, boxes, threes, fives, mixed, out);
+}
+void Fields::kernel1D_Run(int n, const Box4f* boxes, const Three* threes, const Five* fives, const Mixed* mixed, float4* out)
+{
+  for (int i = 0; i < n; i++)
+  {
+    const float4 lo = boxes[i].boxMin;
+    const int4 c = threes[i].c;
+    const uint4 ids = m_fours[i].ids;
+    float4 sum = lo + boxes[i].boxMax + to_float4(c) + to_float4(ids) + m_fours[i].q;
+    sum += fives[i].v[1] + mixed[i].hi + float4(boxes[0].boxMax.x) + float4(boxes[i].boxMin.y);
+    const float3 m = mixed[i].lo;
+    out[i] = sum + float4(m.x, m.y, m.z, 0.0f);
+  }
+}
+)");
+  const std::string text = IspcKernelsOf(tc, "Fields");
+  INFO(text);
+  REQUIRE(text.find("const float4 lo = crt_load4_field((const uniform float4 *uniform)(boxes), (int)(i), 2, 0);") != std::string::npos);
+  REQUIRE(text.find("crt_load4_field((const uniform float4 *uniform)(boxes), (int)(i), 2, 1)") != std::string::npos);  // by const reference
+  REQUIRE(text.find("const int4 c = crt_load4_field((const uniform int4 *uniform)(threes), (int)(i), 3, 2);") != std::string::npos);
+  REQUIRE(text.find("const uint4 ids = crt_load4_field((const uniform uint4 *uniform)(self->m_fours), (int)(i), 4, 3);") != std::string::npos);
+  REQUIRE(text.find("crt_load4_field((const uniform float4 *uniform)(self->m_fours), (int)(i), 4, 1)") != std::string::npos);
+  REQUIRE(text.find("fives[i].v[1]") != std::string::npos);        // five rows, and an array field: as written
+  REQUIRE(text.find("crt_load4_field((const uniform float4 *uniform)(mixed), (int)(i), 2, 1)") != std::string::npos);
+  REQUIRE(text.find("const float3 m = mixed[i].lo;") != std::string::npos);  // a float3 field: as written
+  REQUIRE(text.find("boxes[0].boxMax.x") != std::string::npos);    // one element for all lanes
+  REQUIRE(text.find("boxes[i].boxMin.y") != std::string::npos);    // one component of the field: a gather
+}
+
 TEST_CASE("ISPC: a struct of eight 32-bit words stored whole at a per-lane index goes through a crt_store_ helper of its own, other structs scatter",
           "[diagnostics][ispc]")
 {

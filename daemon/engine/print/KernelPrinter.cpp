@@ -634,6 +634,7 @@ std::string KernelPrinter::Expr(const clang::Expr* e) {
       auto t = Pointer(me->getBase());
       return t ? Pointee(*t, nullptr, e->getBeginLoc()) + "." + SafeName(field->getNameAsString()) : "/*error*/";
     }
+    if (std::string load = FieldRead(me); !load.empty()) return load;
     m_fieldBase = me->getBase()->IgnoreParenImpCasts();
     return Expr(me->getBase()) + "." + SafeName(field->getNameAsString());
   }

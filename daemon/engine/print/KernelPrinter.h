@@ -265,13 +265,15 @@ protected:
   virtual std::string TextureTexel(const clang::FieldDecl* array, const clang::Expr* index, const clang::Expr* coord, clang::SourceLocation loc) = 0;
   // Operators the language prints its own way, or "" for the common spelling: LiteMath's vector
   // operators; an element of a member vector; a store through a pointer; an assignment to a texel
-  // (an operator call or built in); any assignment; an element read through a pointer.
+  // (an operator call or built in); any assignment; an element read through a pointer; a field of
+  // an element (a[i].f) read through a pointer or from a member vector.
   virtual std::string VectorOperator(const clang::CXXOperatorCallExpr* op) = 0;
   virtual std::string ElementRead(const clang::CXXOperatorCallExpr* op) = 0;
   virtual std::string WholeStore(const clang::CXXOperatorCallExpr* op) = 0;
   virtual std::string TexelAssignment(const clang::CXXOperatorCallExpr* op) = 0;
   virtual std::string Assignment(const clang::BinaryOperator* bo) = 0;
   virtual std::string PointerRead(const clang::ArraySubscriptExpr* as, const PointerTarget& t) = 0;
+  virtual std::string FieldRead(const clang::MemberExpr* me) = 0;
   // The divisor of an integer division or remainder; a LiteMath matrix's columns (as an expression
   // and as the object of a method); a matrix's row (get_row), or "" for the common spelling.
   virtual std::string Divisor(const clang::BinaryOperator* bo) = 0;

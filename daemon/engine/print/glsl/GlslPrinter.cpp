@@ -190,6 +190,8 @@ std::string GlslPrinter::WholeStore(const CXXOperatorCallExpr*) { return ""; }
 
 std::string GlslPrinter::PointerRead(const ArraySubscriptExpr*, const PointerTarget&) { return ""; }
 
+std::string GlslPrinter::FieldRead(const MemberExpr*) { return ""; }
+
 std::string GlslPrinter::ArrayValue(const std::string& type, const std::string& list) { return type + "(" + list + ")"; }
 
 std::string GlslPrinter::ListConstruct(QualType, const std::string& base, const std::string& dims, const std::vector<const clang::Expr*>& args,

@@ -63,6 +63,7 @@ protected:
   std::string TexelAssignment(const clang::CXXOperatorCallExpr* op) override;
   std::string Assignment(const clang::BinaryOperator* bo) override;
   std::string PointerRead(const clang::ArraySubscriptExpr* as, const PointerTarget& t) override;
+  std::string FieldRead(const clang::MemberExpr* me) override;
   std::string Divisor(const clang::BinaryOperator* bo) override;
   std::string MatrixColumns(const std::string& matrix) const override;
   std::string MatrixObject(const std::string& matrix) const override;

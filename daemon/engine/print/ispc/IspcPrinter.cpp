@@ -348,6 +348,8 @@ std::string IspcPrinter::WholeStore(const CXXOperatorCallExpr* op) { return Cons
 
 std::string IspcPrinter::PointerRead(const ArraySubscriptExpr* as, const PointerTarget& t) { return ConsecutiveLoad(as, t); }
 
+std::string IspcPrinter::FieldRead(const MemberExpr* me) { return ConsecutiveFieldLoad(me); }
+
 std::string IspcPrinter::ArrayValue(const std::string&, const std::string& list) { return "{" + list + "}"; }
 
 std::string IspcPrinter::ListConstruct(QualType t, const std::string& base, const std::string&, const std::vector<const clang::Expr*>& args,

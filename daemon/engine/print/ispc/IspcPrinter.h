@@ -64,6 +64,7 @@ protected:
   std::string TexelAssignment(const clang::CXXOperatorCallExpr* op) override;
   std::string Assignment(const clang::BinaryOperator* bo) override;
   std::string PointerRead(const clang::ArraySubscriptExpr* as, const PointerTarget& t) override;
+  std::string FieldRead(const clang::MemberExpr* me) override;
   std::string Divisor(const clang::BinaryOperator* bo) override;
   std::string MatrixColumns(const std::string& matrix) const override;
   std::string MatrixObject(const std::string& matrix) const override;
@@ -110,9 +111,11 @@ private:
   std::string CompoundAssignOnce(const clang::CXXOperatorCallExpr* op);
   // Loads better than a gather (IspcLoads.cpp): a member vector's struct element read whole at a
   // per-lane index, through a helper that loads what the lanes agree on once; a float4, int4 or
-  // uint4 read or stored whole through a pointer at a per-lane index (crt_load4, crt_store4).
+  // uint4 read or stored whole through a pointer at a per-lane index (crt_load4, crt_store4), or
+  // read as a field of a struct of such rows (crt_load4_field).
   std::string CoherentLoad(const clang::CXXOperatorCallExpr* op);
   std::string ConsecutiveLoad(const clang::ArraySubscriptExpr* as, const PointerTarget& t);
+  std::string ConsecutiveFieldLoad(const clang::MemberExpr* me);
   std::string ConsecutiveStore(const clang::CXXOperatorCallExpr* op);
   bool ReadWhole(const clang::Expr* e);  // e's value is copied or passed by value or const reference
   // Where a kernel computes in double (IspcDoubles.cpp).
