@@ -17,12 +17,13 @@
 // own that packs the words for crt_store_words8: eight vector stores instead of eight scatters.
 //
 // Fields of structs of such rows. A 4-vector field at a 16-byte offset of a struct of two to four
-// 16-byte rows (a Box4f's boxMin), read through a pointer or from a member vector at a per-lane
-// index, goes through crt_load4_field: where all lanes read consecutive elements, the elements'
-// rows are vector loads and transposes, and each lane picks its field's row with shuffles, instead
-// of four gathers at the struct's stride (LBVH::kernel1D_Bounds reads boxes[i].boxMin so: its lanes
-// went from 2.9x the scalar loop's time to 0.6x, with AVX2 on an AMD EPYC, Zen 5). Where the lanes
-// read one element, it is one load.
+// 16-byte rows (a Box4f's boxMin), read through a pointer or from a member vector at the index of
+// a thread loop (boxes[i] in kernel1D_'s loop over i), goes through crt_load4_field: where all lanes
+// read consecutive elements, the elements' rows are vector loads and transposes, and each lane picks
+// its field's row with shuffles, instead of four gathers at the struct's stride (LBVH::kernel1D_Bounds
+// reads boxes[i].boxMin so: its lanes went from 2.9x the scalar loop's time to 0.6x, with AVX2 on an
+// AMD EPYC, Zen 5). Any other index keeps the gathers: a loop over spheres inside each thread, where
+// every lane reads the same element, ran 20% slower through the helper's tests.
 //
 // And a vector updated through an address with side effects, p[k++] += v: the address found once.
 // Part of IspcPrinter (IspcPrinter.h).
@@ -124,6 +125,30 @@ std::string IspcPrinter::ConsecutiveLoad(const clang::ArraySubscriptExpr* as, co
   return "crt_load4(" + t.array + ", (int)(" + (t.offset.empty() ? i : t.offset + " + " + i) + "))";
 }
 
+// Whether e is the variable of one of a kernelND_ function's D thread loops (the loop nest whose
+// iterations are the threads, and so neighbouring SIMD lanes), not of a loop inside a thread.
+static bool IsThreadLoopVariable(ASTContext& ctx, const clang::Expr* e) {
+  const auto* ref = dyn_cast<DeclRefExpr>(e->IgnoreParenImpCasts());
+  const auto* var = ref ? dyn_cast<VarDecl>(ref->getDecl()) : nullptr;
+  if (!var) return false;
+  const ForStmt* loop = nullptr;
+  int loops = 0;  // the for loops around e, out to the function
+  DynTypedNode node = DynTypedNode::create(*e);
+  while (true) {
+    const auto parents = ctx.getParents(node);
+    if (parents.size() != 1) return false;
+    node = parents[0];
+    if (const auto* fs = node.get<ForStmt>()) {
+      ++loops;
+      if (const auto* init = dyn_cast_or_null<DeclStmt>(fs->getInit()); init && init->isSingleDecl() && init->getSingleDecl() == var) loop = fs;
+    } else if (const auto* fd = node.get<FunctionDecl>()) {
+      const std::string name = fd->getNameAsString();
+      const int dims = name.rfind("kernel1D_", 0) == 0 ? 1 : name.rfind("kernel2D_", 0) == 0 ? 2 : name.rfind("kernel3D_", 0) == 0 ? 3 : 0;
+      return loop && loops <= dims;
+    }
+  }
+}
+
 std::string IspcPrinter::ConsecutiveFieldLoad(const clang::MemberExpr* me) {
   const auto* field = dyn_cast<FieldDecl>(me->getMemberDecl());
   if (me->isArrow() || !field) return "";
@@ -139,14 +164,17 @@ std::string IspcPrinter::ConsecutiveFieldLoad(const clang::MemberExpr* me) {
   std::string array, index;
   if (auto* as = dyn_cast<ArraySubscriptExpr>(base)) {  // p[i].f through a pointer
     auto* decay = dyn_cast<ImplicitCastExpr>(as->getBase()->IgnoreParens());
-    if ((decay && decay->getCastKind() == CK_ArrayToPointerDecay) || !as->getBase()->getType()->isPointerType() || Uniform(as->getIdx())) return "";
+    if ((decay && decay->getCastKind() == CK_ArrayToPointerDecay) || !as->getBase()->getType()->isPointerType() || Uniform(as->getIdx()) ||
+        !IsThreadLoopVariable(m_ctx, as->getIdx()))
+      return "";
     auto t = Pointer(as->getBase());
     if (!t || !t->value.empty() || t->local || t->array.empty()) return "";
     array = t->array;
     index = t->offset.empty() ? Expr(as->getIdx()) : t->offset + " + " + Expr(as->getIdx());
   } else if (auto* sub = dyn_cast<CXXOperatorCallExpr>(base); sub && sub->getOperator() == OO_Subscript) {  // m_v[i].f
     const FieldDecl* member = ThisMemberField(sub->getArg(0));
-    if (!member || !IsStdVector(member->getType()) || renames.count(member) || Uniform(sub->getArg(1))) return "";
+    if (!member || !IsStdVector(member->getType()) || renames.count(member) || Uniform(sub->getArg(1)) || !IsThreadLoopVariable(m_ctx, sub->getArg(1)))
+      return "";
     array = Expr(sub->getArg(0));
     index = Expr(sub->getArg(1)->IgnoreImpCasts());  // i, not its conversion to size_t
   } else {

@@ -80,7 +80,7 @@ static inline void kernel_RayTrace(uniform SpherePaths_Data *uniform self, uint 
   float nearest = 1e30;
   for (int i = 0; i < ((uniform int)(self->crt_m_spheres_size)); i++)
   {
-    const float3 center = to_float3(crt_load4_field((const uniform float4 *uniform)(self->m_spheres), (int)(i), 2, 0));
+    const float3 center = to_float3(self->m_spheres[((uint)(i))].centerRadius);
     const float radius = self->m_spheres[((uint)(i))].centerRadius.w;
     const float3 oc = origin - center;
     const float b = dot(oc, dir);
@@ -101,7 +101,7 @@ static inline void kernel_RayTrace(uniform SpherePaths_Data *uniform self, uint 
   if (nearest == 1e30)
     return;
   const float3 p = origin + dir * nearest;
-  const float3 n = normalize(p - to_float3(crt_load4_field((const uniform float4 *uniform)(self->m_spheres), (int)(hit.sphere), 2, 0)));
+  const float3 n = normalize(p - to_float3(self->m_spheres[((uint)(hit.sphere))].centerRadius));
   hit.position = make_float4(p.x, p.y, p.z, 1.0);
   hit.normal = make_float4(n.x, n.y, n.z, 0.0);
 }
