@@ -438,8 +438,8 @@ void Fields::kernel1D_Run(int n, const Box4f* boxes, const Three* threes, const 
     float4 sum = lo + boxes[i].boxMax + to_float4(c) + to_float4(ids) + m_fours[i].q;
     sum += fives[i].v[1] + mixed[i].hi + float4(boxes[0].boxMax.x) + float4(boxes[i].boxMin.y);
     const float3 m = mixed[i].lo;
-    for (int k = 0; k < 2; k++)  // a loop inside the thread: its index is not the lanes'
-      sum += boxes[k].boxMax;
+    for (int k = 0; k < 2; k++)  // a loop inside the thread: its index is not the lanes', i still is
+      sum += boxes[k].boxMax + threes[i].a;
     out[i] = sum + float4(m.x, m.y, m.z, 0.0f);
   }
 }
@@ -456,7 +456,7 @@ void Fields::kernel1D_Run(int n, const Box4f* boxes, const Three* threes, const 
   REQUIRE(text.find("const float3 m = mixed[i].lo;") != std::string::npos);  // a float3 field: as written
   REQUIRE(text.find("boxes[0].boxMax.x") != std::string::npos);    // one element for all lanes
   REQUIRE(text.find("boxes[i].boxMin.y") != std::string::npos);    // one component of the field: a gather
-  REQUIRE(text.find("boxes[k].boxMax") != std::string::npos);      // an inner loop's index: as written
+  REQUIRE(text.find("boxes[k].boxMax + crt_load4_field((const uniform float4 *uniform)(threes), (int)(i), 3, 0)") != std::string::npos);
 }
 
 TEST_CASE("ISPC: a struct of eight 32-bit words stored whole at a per-lane index goes through a crt_store_ helper of its own, other structs scatter",

@@ -125,26 +125,26 @@ std::string IspcPrinter::ConsecutiveLoad(const clang::ArraySubscriptExpr* as, co
   return "crt_load4(" + t.array + ", (int)(" + (t.offset.empty() ? i : t.offset + " + " + i) + "))";
 }
 
-// Whether e is the variable of one of a kernelND_ function's D thread loops (the loop nest whose
-// iterations are the threads, and so neighbouring SIMD lanes), not of a loop inside a thread.
+// Whether e is the variable of the innermost of a kernelND_ function's D thread loops (the loop
+// whose iterations neighbouring SIMD lanes run), not of an outer one or of a loop inside a thread.
 static bool IsThreadLoopVariable(ASTContext& ctx, const clang::Expr* e) {
   const auto* ref = dyn_cast<DeclRefExpr>(e->IgnoreParenImpCasts());
   const auto* var = ref ? dyn_cast<VarDecl>(ref->getDecl()) : nullptr;
   if (!var) return false;
-  const ForStmt* loop = nullptr;
-  int loops = 0;  // the for loops around e, out to the function
+  std::vector<const ForStmt*> loops;  // the for loops around e, from the innermost out to the function
   DynTypedNode node = DynTypedNode::create(*e);
   while (true) {
     const auto parents = ctx.getParents(node);
     if (parents.size() != 1) return false;
     node = parents[0];
     if (const auto* fs = node.get<ForStmt>()) {
-      ++loops;
-      if (const auto* init = dyn_cast_or_null<DeclStmt>(fs->getInit()); init && init->isSingleDecl() && init->getSingleDecl() == var) loop = fs;
+      loops.push_back(fs);
     } else if (const auto* fd = node.get<FunctionDecl>()) {
       const std::string name = fd->getNameAsString();
-      const int dims = name.rfind("kernel1D_", 0) == 0 ? 1 : name.rfind("kernel2D_", 0) == 0 ? 2 : name.rfind("kernel3D_", 0) == 0 ? 3 : 0;
-      return loop && loops <= dims;
+      const size_t dims = name.rfind("kernel1D_", 0) == 0 ? 1 : name.rfind("kernel2D_", 0) == 0 ? 2 : name.rfind("kernel3D_", 0) == 0 ? 3 : 0;
+      if (dims == 0 || loops.size() < dims) return false;
+      const auto* init = dyn_cast_or_null<DeclStmt>(loops[loops.size() - dims]->getInit());
+      return init && init->isSingleDecl() && init->getSingleDecl() == var;
     }
   }
 }
