@@ -430,6 +430,9 @@ void Fields::Run(int n, const Box4f* boxes, const Three* threes, const Five* fiv
 }
 void Fields::kernel1D_Run(int n, const Box4f* boxes, const Three* threes, const Five* fives, const Mixed* mixed, float4* out)
 {
+  float4 first = float4(0.0f);
+  for (int j = 0; j < 2; j++)  // before the nest: one thread's loop, not the lanes'
+    first += boxes[j].boxMin;
   for (int i = 0; i < n; i++)
   {
     const float4 lo = boxes[i].boxMin;
@@ -440,7 +443,7 @@ void Fields::kernel1D_Run(int n, const Box4f* boxes, const Three* threes, const 
     const float3 m = mixed[i].lo;
     for (int k = 0; k < 2; k++)  // a loop inside the thread: its index is not the lanes', i still is
       sum += boxes[k].boxMax + threes[i].a;
-    out[i] = sum + float4(m.x, m.y, m.z, 0.0f);
+    out[i] = sum + first + float4(m.x, m.y, m.z, 0.0f);
   }
 }
 )");
@@ -456,6 +459,7 @@ void Fields::kernel1D_Run(int n, const Box4f* boxes, const Three* threes, const 
   REQUIRE(text.find("const float3 m = mixed[i].lo;") != std::string::npos);  // a float3 field: as written
   REQUIRE(text.find("boxes[0].boxMax.x") != std::string::npos);    // one element for all lanes
   REQUIRE(text.find("boxes[i].boxMin.y") != std::string::npos);    // one component of the field: a gather
+  REQUIRE(text.find("boxes[j].boxMin") != std::string::npos);  // a loop before the nest: as written
   REQUIRE(text.find("boxes[k].boxMax + crt_load4_field((const uniform float4 *uniform)(threes), (int)(i), 3, 0)") != std::string::npos);
 }
 

@@ -23,11 +23,13 @@
 // its field's row with shuffles, instead of four gathers at the struct's stride (LBVH::kernel1D_Bounds
 // reads boxes[i].boxMin so: its lanes went from 2.9x the scalar loop's time to 0.6x, with AVX2 on an
 // AMD EPYC, Zen 5). Any other index keeps the gathers: a loop over spheres inside each thread, where
-// every lane reads the same element, ran 20% slower through the helper's tests.
+// every lane reads the same element, ran 20% slower through the helper's tests (SpherePaths_ISPC,
+// avx512skx, the same CPU).
 //
 // And a vector updated through an address with side effects, p[k++] += v: the address found once.
 // Part of IspcPrinter (IspcPrinter.h).
 #include "analyse/AstQueries.h"
+#include "analyse/LoopShape.h"
 #include "print/ispc/IspcPrinter.h"
 #include "print/ispc/IspcTypes.h"
 #include "print/PrinterParts.h"
@@ -126,7 +128,8 @@ std::string IspcPrinter::ConsecutiveLoad(const clang::ArraySubscriptExpr* as, co
 }
 
 // Whether e is the variable of the innermost of a kernelND_ function's D thread loops (the loop
-// whose iterations neighbouring SIMD lanes run), not of an outer one or of a loop inside a thread.
+// whose iterations neighbouring SIMD lanes run), not of an outer one, of a loop inside a thread, or
+// of a loop before the nest (KernelLoopNest decides which loop the nest is, as the analysis does).
 static bool IsThreadLoopVariable(ASTContext& ctx, const clang::Expr* e) {
   const auto* ref = dyn_cast<DeclRefExpr>(e->IgnoreParenImpCasts());
   const auto* var = ref ? dyn_cast<VarDecl>(ref->getDecl()) : nullptr;
@@ -142,7 +145,8 @@ static bool IsThreadLoopVariable(ASTContext& ctx, const clang::Expr* e) {
     } else if (const auto* fd = node.get<FunctionDecl>()) {
       const std::string name = fd->getNameAsString();
       const size_t dims = name.rfind("kernel1D_", 0) == 0 ? 1 : name.rfind("kernel2D_", 0) == 0 ? 2 : name.rfind("kernel3D_", 0) == 0 ? 3 : 0;
-      if (dims == 0 || loops.size() < dims) return false;
+      const auto* body = dyn_cast_or_null<CompoundStmt>(fd->getBody());
+      if (dims == 0 || loops.size() < dims || !body || loops.back() != KernelLoopNest(ctx, body)) return false;
       const auto* init = dyn_cast_or_null<DeclStmt>(loops[loops.size() - dims]->getInit());
       return init && init->isSingleDecl() && init->getSingleDecl() == var;
     }
