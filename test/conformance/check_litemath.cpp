@@ -5,9 +5,17 @@
 #include "LiteMath.h"
 #include <cmath>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 // A case compiles where this build translated its class (CONFORMANCE_CLASSES); main checks that all were.
+#if __has_include("BitScans_CPU.h")
+#include "BitScans_CPU.h"
+#include "BitScans_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "BitScans_ISPC.h"
+#endif
+#endif
 #if __has_include("BoxFields_CPU.h")
 #include "BoxFields_CPU.h"
 #include "BoxFields_Vulkan.h"
@@ -194,6 +202,42 @@ Register projector(MakeCase<Projector>(
       for (auto& q : in) q.z -= 20.0f;
       p.Project(100, in.data(), out.data());
       return Flatten(out);
+    }));
+#endif
+
+#if __has_include("BitScans_CPU.h")
+Register bitScans(MakeCase<BitScans>(
+    "__builtin_clz, __builtin_ctz and __builtin_popcount of 32-bit words, in a static helper and inline", "bit_scans.h/.cpp", 0.0,
+    CONFORMANCE_MAKERS(BitScans), [](BitScans& b) {
+      // The edges: zero, each bit alone, each run of low and of high bits, and words about 2^24 (where
+      // a float holds a word exactly no more), then scrambled words; a count that leaves part of a gang.
+      std::vector<uint32_t> words = {0u, 1u, 0x80000000u, 0x01000000u, 0x01FFFFFFu, 0xFFFFFFFFu, 0x00FFFFFFu, 0x00FFFFFEu, 0xFFFFFF80u};
+      for (uint32_t k = 0; k < 32; k++)
+      {
+        words.push_back(1u << k);
+        words.push_back((1u << k) - 1u);
+        words.push_back(~((1u << k) - 1u));
+      }
+      uint32_t h = 12345u;
+      while (words.size() < 200)
+      {
+        h = h * 1664525u + 1013904223u;
+        words.push_back(h >> (h % 29u));
+      }
+      const int n = int(words.size()) - 3;  // 197
+      std::vector<int4> counts(n, int4(-7));
+      b.CommitDeviceData();
+      b.Scan(n, words.data(), counts.data());
+      // Known answers for the first words: 0, 1, 2^31, 2^24, 2^25 - 1, then 2^32 - 1 (leading, trailing, ones).
+      const int known[6][3] = {{32, 32, 0}, {31, 0, 1}, {0, 31, 1}, {7, 24, 1}, {7, 0, 25}, {0, 0, 32}};
+      for (int i = 0; i < 6; i++)
+        if (counts[i].x != known[i][0] || counts[i].y != known[i][1] || counts[i].z != known[i][2])
+          throw std::runtime_error("word " + std::to_string(i) + " should have its known counts");
+      if (counts[3].w != 100 * 23 + 24)  // 2^24 against 2^25 - 1: bit 24 they share, bit 23 they do not
+        throw std::runtime_error("2^24 and 2^25 - 1 should first differ at bit 23");
+      Outputs r;
+      for (const int4& c : counts) Append(r, std::vector<int>{c.x, c.y, c.z, c.w});
+      return r;
     }));
 #endif
 
