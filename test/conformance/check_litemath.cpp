@@ -4,11 +4,19 @@
 
 #include "LiteMath.h"
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 // A case compiles where this build translated its class (CONFORMANCE_CLASSES); main checks that all were.
+#if __has_include("IntDivision_CPU.h")
+#include "IntDivision_CPU.h"
+#include "IntDivision_Vulkan.h"
+#ifdef CONFORMANCE_ISPC
+#include "IntDivision_ISPC.h"
+#endif
+#endif
 #if __has_include("BitScans_CPU.h")
 #include "BitScans_CPU.h"
 #include "BitScans_Vulkan.h"
@@ -202,6 +210,43 @@ Register projector(MakeCase<Projector>(
       for (auto& q : in) q.z -= 20.0f;
       p.Project(100, in.data(), out.data());
       return Flatten(out);
+    }));
+#endif
+
+#if __has_include("IntDivision_CPU.h")
+Register intDivision(MakeCase<IntDivision>(
+    "integer / and % by a divisor per thread, by a member, by a constant; negative operands, unsigned above 2^31", "int_division.h/.cpp", 0.0,
+    CONFORMANCE_MAKERS(IntDivision), [](IntDivision& d) {
+      std::vector<int> a = {INT32_MIN, INT32_MIN, INT32_MAX, -7, 7, -7, 0, 123456789, -123456789, 1 << 30, INT32_MIN + 1, -1};
+      std::vector<int> b = {2, 7, -3, 2, -2, -2, 5, 10, 10, 3, INT32_MAX, 4};
+      std::vector<uint32_t> u = {0xFFFFFFFFu, 0x80000000u, 0x80000001u, 4000000000u, 0u, 1u, 7u, 0xFFFFFFFEu, 3000000000u, 12345u, 0x7FFFFFFFu, 99u};
+      uint32_t h = 2024u;
+      while (a.size() < 101)  // a count that leaves part of a gang
+      {
+        h = h * 1664525u + 1013904223u;
+        a.push_back(int(h));
+        h = h * 1664525u + 1013904223u;
+        b.push_back(int(h) >> (h % 31u));  // from 0 (the kernel takes 1) to large, either sign
+        h = h * 1664525u + 1013904223u;
+        u.push_back(h);
+        if (a.back() == INT32_MIN && b.back() == -1) b.back() = 1;  // undefined in C++
+      }
+      const int n = int(a.size());
+      std::vector<int4> q(n, int4(-9));
+      std::vector<uint4> uq(n, uint4(9u));
+      d.SetStep(-5);
+      d.CommitDeviceData();
+      d.Divide(n, a.data(), b.data(), u.data(), q.data(), uq.data());
+      // Known answers: INT_MIN / 2, INT_MIN % 7 (-2147483648 = 7 x -306783378 - 2), -7 / 2 and -7 % 2
+      // (towards zero), 7 / -2, 0xFFFFFFFF / 2 and % 2, 0x80000000 / 7.
+      if (q[0].x != -1073741824 || q[1].y != -2 || q[3].x != -3 || q[3].y != -1 || q[4].x != -3 || q[4].y != 1)
+        throw std::runtime_error("the signed quotients and remainders should truncate towards zero");
+      if (uq[0].x != 0x7FFFFFFFu || uq[0].y != 1u || uq[1].x != 306783378u)
+        throw std::runtime_error("the unsigned quotients should be exact above 2^31");
+      Outputs r;
+      for (int i = 0; i < n; i++) Append(r, std::vector<double>{double(q[i].x), double(q[i].y), double(q[i].z), double(q[i].w),
+                                                               double(uq[i].x), double(uq[i].y), double(uq[i].z), double(uq[i].w)});
+      return r;
     }));
 #endif
 

@@ -174,3 +174,62 @@ void Cold::kernel1D_Run(int n, float* out)
   CHECK(shader.find(Squeezed("float Rare(float x)")) != std::string::npos);
   CHECK(shader.find("noinline") == std::string::npos);
 }
+
+TEST_CASE("Printer: ISPC divides 32-bit integers that differ per lane through crt_div and crt_rem, and keeps / and % for constants, uniform operands and 64 bits",
+          "[engine][printer][ispc]")
+{
+  const char* header = R"(#pragma once
+#include <cstdint>
+class Quotients
+{
+public:
+  virtual ~Quotients() = default;
+  virtual void Run(int n, const int* a, int* out, unsigned* outU);
+protected:
+  void kernel1D_Run(int n, const int* a, int* out, unsigned* outU);
+  int m_step = 3;
+  unsigned m_count = 5u;
+};
+)";
+  const char* source = R"(#include "Quotients.h"
+void Quotients::Run(int n, const int* a, int* out, unsigned* outU) { kernel1D_Run(n, a, out, outU); }
+void Quotients::kernel1D_Run(int n, const int* a, int* out, unsigned* outU)
+{
+  for (int i = 0; i < n; ++i)
+  {
+    const int x = a[i];
+    const int perLane = x / (i + 1) + x % (i + 1);
+    const int shared = x / m_step;
+    const int constant = x / 7 + x % 8;
+    const int uniformOnly = m_step / 2 + n / m_step;
+    const unsigned u = unsigned(x) / m_count + unsigned(x) % m_count;
+    const long long wide = (long long)x / (long long)(i + 1);
+    out[i] = perLane + shared + constant + uniformOnly + int(wide);
+    outU[i] = u;
+  }
+}
+)";
+  TempClass tc("Quotients", header, source);
+  const TranslateResult ispc = Translate(MakeRequest(tc, "Quotients", Backend::Ispc));
+  INFO(ispc.diagnostics);
+  REQUIRE(ispc.ok);
+  const std::string kernels = Squeezed(ispc.files.at("Quotients_ISPC_kernels.ispc"));
+  INFO(kernels);
+  // Per lane, or a lane's value by a member all lanes share: in the vector.
+  CHECK(kernels.find(Squeezed("crt_div((varying int)(x), (varying int)((i + 1)))")) != std::string::npos);
+  CHECK(kernels.find(Squeezed("crt_rem((varying int)(x), (varying int)((i + 1)))")) != std::string::npos);
+  CHECK(kernels.find(Squeezed("crt_div((varying int)(x), (varying int)(self->m_step))")) != std::string::npos);
+  CHECK(Count(kernels, Squeezed("crt_div((varying uint)")) == 1);
+  CHECK(Count(kernels, Squeezed("crt_rem((varying uint)")) == 1);
+  // A constant divisor (a multiplication to ISPC), uniform operands and 64-bit integers keep the operator.
+  CHECK(kernels.find(Squeezed("x / 7")) != std::string::npos);
+  CHECK(kernels.find(Squeezed("(varying int)(self->m_step), (varying int)(2)")) == std::string::npos);
+  CHECK(kernels.find(Squeezed("crt_div((varying int)(n)")) == std::string::npos);
+  CHECK(Count(kernels, "crt_div(") == 3);
+  CHECK(Count(kernels, "crt_rem(") == 2);
+  // GLSL divides in the vector: the operators as written.
+  TempClass again("Quotients", header, source);
+  const TranslateResult glsl = Translate(MakeRequest(again, "Quotients"));
+  REQUIRE(glsl.ok);
+  CHECK(glsl.files.at("shaders/kernel1D_Run.comp").find("crt_div") == std::string::npos);
+}

@@ -702,6 +702,8 @@ std::string KernelPrinter::Expr(const clang::Expr* e) {
   if (auto* bo = dyn_cast<BinaryOperator>(e)) {
     if (bo->isAssignmentOp())
       if (std::string set = Assignment(bo); !set.empty()) return set;
+    if (bo->getOpcode() == BO_Div || bo->getOpcode() == BO_Rem)
+      if (std::string own = IntegerDivision(bo); !own.empty()) return own;
     const bool division = bo->getOpcode() == BO_Div || bo->getOpcode() == BO_Rem || bo->getOpcode() == BO_DivAssign || bo->getOpcode() == BO_RemAssign;
     const std::string rhs = division ? Divisor(bo) : Expr(bo->getRHS());
     // C++ gives the remainder the dividend's sign; GLSL's % is undefined for negative operands.

@@ -277,6 +277,9 @@ protected:
   // The divisor of an integer division or remainder; a LiteMath matrix's columns (as an expression
   // and as the object of a method); a matrix's row (get_row), or "" for the common spelling.
   virtual std::string Divisor(const clang::BinaryOperator* bo) = 0;
+  // A 32-bit integer division or remainder (a / b, a % b) in a language's own form, or "" for the
+  // common spelling.
+  virtual std::string IntegerDivision(const clang::BinaryOperator* bo) = 0;
   virtual std::string MatrixColumns(const std::string& matrix) const = 0;
   virtual std::string MatrixObject(const std::string& matrix) const = 0;
   virtual std::string MatrixRow(const clang::CXXMemberCallExpr* call) = 0;

@@ -65,6 +65,7 @@ protected:
   std::string PointerRead(const clang::ArraySubscriptExpr* as, const PointerTarget& t) override;
   std::string FieldRead(const clang::MemberExpr* me) override;
   std::string Divisor(const clang::BinaryOperator* bo) override;
+  std::string IntegerDivision(const clang::BinaryOperator*) override { return ""; }  // GLSL divides in the vector
   std::string MatrixColumns(const std::string& matrix) const override;
   std::string MatrixObject(const std::string& matrix) const override;
   std::string MatrixRow(const clang::CXXMemberCallExpr* call) override;
