@@ -1,5 +1,7 @@
 // Cases about the paper's LiteMath API in kernels: matrices, conversions and constants, half4,
-// complex, InterlockedAdd, the ReduceAdd family, and a user's own function named like a LiteMath one.
+// complex, InterlockedAdd, the ReduceAdd family, a user's own function named like a LiteMath one,
+// fields of arrays of structs, and the integer arithmetic the ISPC classes compute their own way
+// (bit scans and counts, division and remainder).
 #include "Conformance.h"
 
 #include "LiteMath.h"
