@@ -339,8 +339,8 @@ std::string IspcPrinter::Divisor(const BinaryOperator* bo) {
 // x86 has no vector instruction for integer division, and ISPC divides a value per lane by
 // another, or by a uniform variable, one lane at a time (idiv). A 32-bit quotient is exact through
 // doubles, in the vector (LiteMath.isph's crt_div and crt_rem): 5.4x as fast with avx2, 8.9x with
-// avx512skx. A constant divisor, which ISPC turns into a multiplication, and uniform operands keep
-// the operator; so do 64-bit integers, which a double does not hold.
+// avx512skx, on an AMD EPYC (Zen 5). A constant divisor, which ISPC turns into a multiplication, and
+// uniform operands keep the operator; so do 64-bit integers, which a double does not hold.
 std::string IspcPrinter::IntegerDivision(const BinaryOperator* bo) {
   const QualType t = bo->getType().getCanonicalType();
   if (!t->isIntegerType() || t->isBooleanType() || m_ctx.getTypeSize(t) != 32) return "";
