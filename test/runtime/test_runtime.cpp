@@ -1280,8 +1280,9 @@ TEST_CASE("LaneChoice runs a kernel in lanes or as a scalar loop, whichever has 
 }
 
 // crossrt::LaneMemory: a kernel's first call in a run takes the way that was faster in the last run
-// on this machine (the file CROSSRT_LANE_MEMORY names), the other way is tried after 16 calls, and at
-// exit what this run measured replaces that kernel's lines, keeping other machines' and kernels'.
+// on this machine (the file CROSSRT_LANE_MEMORY names), the other way is tried after 16 calls (at
+// once where the remembered means are close, or the verdict's proves off), and at exit what this run
+// measured replaces that kernel's lines, keeping other machines' and kernels'.
 // The memory is read as a program with an _ISPC class starts; this test names its file later and
 // reads it again (Reload).
 TEST_CASE("LaneChoice remembers the faster way for the next run", "[runtime][parallel]")
@@ -1300,6 +1301,8 @@ TEST_CASE("LaneChoice remembers the faster way for the next run", "[runtime][par
         << machine << "\tSteady::kernel1D_Step\t4\t0.003\t0.001\t1\t3\n"    // the scalar loop alone in the last 3 runs
         << machine << "\tDue::kernel1D_Step\t4\t0.003\t0.001\t1\t15\n"      // and in the last 15
         << machine << "\tClose::kernel1D_Walk\t4\t0.0012\t0.001\t1\t0\n"    // the lanes within a quarter of the scalar loop
+        << machine << "\tStale::kernel1D_Walk\t4\t0.009\t0.002\t1\t0\n"     // both from work unlike this run's
+        << machine << "\tPending::kernel1D_Walk\t4\t0.009\t0.001\t1\t0\n"   // the lanes far behind
         << machine << "\tBroken::kernel1D_Line\tnot a number\n";
   }
   crossrt::LaneMemory::Get().Reload();
@@ -1352,6 +1355,30 @@ TEST_CASE("LaneChoice remembers the faster way for the next run", "[runtime][par
     }
     CHECK(closeWays == std::vector<bool>{false, false, true, true, true, true});
     CHECK(close.Mean(1) == Approx(0.0008f));
+    // Where the verdict's remembered mean proves off (the scalar loop takes half its remembered
+    // time here: the last run measured other work), the lanes' remembered mean is no better, however
+    // far behind: they are tried on the next call, and win twice.
+    crossrt::LaneChoice stale("Stale::kernel1D_Walk");
+    std::vector<bool> staleWays;
+    for (int call = 0; call < 6; ++call) {
+      const bool l = stale.Choose();
+      stale.Record(l, 1000, l ? 0.7 : 1.0);
+      staleWays.push_back(l);
+    }
+    CHECK(staleWays == std::vector<bool>{false, false, true, true, true, true});
+    // The scalar loop as remembered, the lanes far behind: tried on the 16th call, they win once,
+    // and the run ends before their second try. That time, not the remembered one, goes to the
+    // next run (which then starts in lanes, and measures them again).
+    crossrt::LaneChoice pending("Pending::kernel1D_Walk");
+    std::vector<bool> pendingWays;
+    for (int call = 0; call < 16; ++call) {
+      const bool l = pending.Choose();
+      pending.Record(l, 1000, l ? 0.5 : 1.0);
+      pendingWays.push_back(l);
+    }
+    CHECK(std::count(pendingWays.begin(), pendingWays.end(), true) == 1);
+    CHECK(pendingWays.back());
+    CHECK(pending.Mean(1) == Approx(0.009f));  // not believed in this run yet
   }
   // The choices above are gone: at exit their means are written, here at once.
   REQUIRE(crossrt::LaneMemory::Get().Save());
@@ -1361,8 +1388,10 @@ TEST_CASE("LaneChoice remembers the faster way for the next run", "[runtime][par
   const auto has = [&](const std::string& start) {
     return std::count_if(lines.begin(), lines.end(), [&](const std::string& l) { return l.rfind(start, 0) == 0; });
   };
-  CHECK(lines.size() == 7);  // the broken line dropped, the kernel never measured not written
+  CHECK(lines.size() == 9);  // the broken line dropped, the kernel never measured not written
   CHECK(has(machine + "\tClose::kernel1D_Walk\t4\t0.0008\t0.001\t1\t0") == 1);
+  CHECK(has(machine + "\tStale::kernel1D_Walk\t4\t0.0007\t0.001\t1\t0") == 1);
+  CHECK(has(machine + "\tPending::kernel1D_Walk\t4\t0.0005\t0.001\t1\t0") == 1);
   CHECK(has(machine + "\tOnce::kernel1D_Build\t4\t0.002\t0.001\t1\t0") == 1);  // both ways' first calls now
   CHECK(has(machine + "\tSteady::kernel1D_Step\t4\t0.003\t0.001\t1\t4") == 1);
   CHECK(has(machine + "\tDue::kernel1D_Step\t4\t0.002\t0.001\t1\t0") == 1);

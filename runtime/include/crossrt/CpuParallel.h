@@ -31,7 +31,8 @@ class MeasuredWays {
   // Calls between tries of the slower way: the first wait, 4x longer after each try it lost, up to
   // the longest.
   static constexpr unsigned kFirstWait = 16, kLongestWait = 1024;
-  // A remembered mean of the slower way within this factor of the verdict's is tried at once (Record).
+  // A remembered mean of the slower way within this factor of the verdict's is tried at once (Record),
+  // and so is any remembered mean of it where the verdict's own remembered mean proved off by more.
   static constexpr float kCloseToVerdict = 1.25f;
 
   // The mean ms per iteration measured for a way (-1 before the first), for tests and benchmarks.
@@ -61,6 +62,13 @@ class MeasuredWays {
   // Whether a way's mean is still the one an earlier run left (Seed): none of its runs here counted.
   bool MeanRemembered(int way) const { return m_remembered[way ? 1 : 0].load(std::memory_order_relaxed); }
 
+  // The time of a try of `way` that beat the other's mean once and waits for its second (Record),
+  // or -1. At the program's end it is that way's latest time, and what the next run should start
+  // from: the mean it would replace may be an earlier run's.
+  float PendingTry(int way) const {
+    return m_firstTryWay.load(std::memory_order_relaxed) == (way ? 1 : 0) ? m_firstTry.load(std::memory_order_relaxed) : -1.0f;
+  }
+
   // Counts a call that keeps to the faster way; true when the slower one is due for a try.
   bool TimeToTry() {
     if (m_calls.fetch_add(1, std::memory_order_relaxed) + 1 < m_nextTry.load(std::memory_order_relaxed)) return false;
@@ -87,12 +95,14 @@ class MeasuredWays {
     const float firstTry = m_firstTry.load(std::memory_order_relaxed);
     if (tried && firstTry < 0.0f && other >= 0.0f && msPerIteration < other) {
       m_firstTry.store(msPerIteration, std::memory_order_relaxed);  // faster once: tried again on the next call
+      m_firstTryWay.store(w, std::memory_order_relaxed);
       m_calls.store(m_nextTry.load(std::memory_order_relaxed), std::memory_order_relaxed);
       return;
     }
     if (tried && firstTry >= 0.0f) {  // the second try: the mean of both
       msPerIteration = 0.5f * (firstTry + msPerIteration);
       m_firstTry.store(-1.0f, std::memory_order_relaxed);
+      m_firstTryWay.store(-1, std::memory_order_relaxed);
       m_calls.store(0, std::memory_order_relaxed);
     }
     // A way tried again after a while starts its mean afresh: what it measured then is stale; so does
@@ -108,13 +118,19 @@ class MeasuredWays {
         const unsigned wait = m_nextTry.load(std::memory_order_relaxed);
         m_nextTry.store(faster == w ? kFirstWait : std::min(wait * 4u, kLongestWait), std::memory_order_relaxed);
       }
-    } else if (faster != Verdict() || (MeanRemembered(1 - Verdict()) && Mean(1 - Verdict()) <= kCloseToVerdict * Mean(Verdict()))) {
+    } else if (faster != Verdict() || (MeanRemembered(1 - Verdict()) && Mean(1 - Verdict()) <= kCloseToVerdict * Mean(Verdict())) ||
+               (w == Verdict() && remembered && MeanRemembered(1 - w) && !WithinFactor(msPerIteration, before, kCloseToVerdict))) {
       // The other way, measured again next: it is faster by the means, or its mean is an earlier run's
       // and close to the verdict's (within kCloseToVerdict), too close to trust across runs that may
       // have traced another mesh or run another build of the kernel, and a try of it costs a fraction
       // of one call. (bench_lbvh's PrimaryRays_ISPC, sse4 on an AMD EPYC, Zen 5: the lanes' mean that
       // another build had left, 0.060 ms per 1,000 rays, kept the 871k-triangle dragon on the scalar
       // loop at 0.054-0.060 for 15 calls in a row; the lanes, tried at last, took 0.044.)
+      // Nor is the other's remembered mean trusted, however far, where the verdict's own, measured in
+      // the same earlier run, proves off by more than that factor: that run's work or machine was not
+      // this one's. (The same bench, 2026-12-02: remembered lanes at 0.092 ms per 1,000 rays beside a
+      // remembered scalar loop at 0.084, which here took 0.041; the lanes, tried on the 16th call,
+      // took 0.029, the process ended before their second try, and each run started the same way.)
       m_calls.store(m_nextTry.load(std::memory_order_relaxed), std::memory_order_relaxed);
     }
   }
@@ -124,7 +140,10 @@ class MeasuredWays {
   std::atomic<unsigned> m_calls{0};
   std::atomic<unsigned> m_nextTry{kFirstWait};
   std::atomic<bool> m_tryingOther{false};
+  static bool WithinFactor(float a, float b, float factor) { return a <= factor * b && b <= factor * a; }
+
   std::atomic<float> m_firstTry{-1.0f};  // a try that won once, waiting for its second
+  std::atomic<int> m_firstTryWay{-1};    // the way of that try
   std::atomic<int> m_verdict{-1};
   std::atomic<bool> m_remembered[2] = {false, false};  // the way's mean is an earlier run's (Seed)
 };
@@ -492,7 +511,8 @@ class LaneChoice {
   }
 
   // What this run measured goes to LaneMemory, for the next run's first calls: each way's mean, or
-  // where it has none counted here (a kernel called once a run), its time on the run's first call.
+  // where it has none counted here (a kernel called once a run), its time on the run's first call,
+  // or a try that won once and whose second try the run ended before (MeasuredWays::PendingTry).
   // A program that calls a kernel once so runs it in lanes in its first run, tries the scalar loop
   // in its second (the way with no time), and from its third takes the way whose first call was
   // faster, the other tried again every 16th run (the runs in a row that ran the verdict alone are
@@ -507,6 +527,7 @@ class LaneChoice {
       for (int w = 0; w < 2; ++w) {
         const float first = m_firstCallMs[size][w].load(std::memory_order_relaxed);
         ms[w] = measured.Mean(w) > 0.0f && !(measured.MeanRemembered(w) && first > 0.0f) ? measured.Mean(w) : first;
+        if (measured.PendingTry(w) > 0.0f) ms[w] = measured.PendingTry(w);  // this run's latest time of that way
       }
       if (!(ms[1] > 0.0f || ms[0] > 0.0f)) continue;
       const int verdict = measured.Verdict();
