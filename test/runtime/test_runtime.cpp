@@ -1281,7 +1281,7 @@ TEST_CASE("LaneChoice runs a kernel in lanes or as a scalar loop, whichever has 
 
 // crossrt::LaneMemory: a kernel's first call in a run takes the way that was faster in the last run
 // on this machine (the file CROSSRT_LANE_MEMORY names), the other way is tried after 16 calls (at
-// once where the remembered means are close, or the verdict's proves off), and at exit what this run
+// once where its remembered mean is close to the verdict's, new or remembered), and at exit what this run
 // measured replaces that kernel's lines, keeping other machines' and kernels'.
 // The memory is read as a program with an _ISPC class starts; this test names its file later and
 // reads it again (Reload).
@@ -1301,7 +1301,8 @@ TEST_CASE("LaneChoice remembers the faster way for the next run", "[runtime][par
         << machine << "\tSteady::kernel1D_Step\t4\t0.003\t0.001\t1\t3\n"    // the scalar loop alone in the last 3 runs
         << machine << "\tDue::kernel1D_Step\t4\t0.003\t0.001\t1\t15\n"      // and in the last 15
         << machine << "\tClose::kernel1D_Walk\t4\t0.0012\t0.001\t1\t0\n"    // the lanes within a quarter of the scalar loop
-        << machine << "\tStale::kernel1D_Walk\t4\t0.009\t0.002\t1\t0\n"     // both from work unlike this run's
+        << machine << "\tStale::kernel1D_Walk\t4\t0.0022\t0.002\t1\t0\n"    // close, from work unlike this run's
+        << machine << "\tFar::kernel1D_Walk\t4\t0.02\t0.002\t1\t0\n"        // the lanes 10x behind
         << machine << "\tPending::kernel1D_Walk\t4\t0.009\t0.001\t1\t0\n"   // the lanes far behind
         << machine << "\tBroken::kernel1D_Line\tnot a number\n";
   }
@@ -1355,9 +1356,9 @@ TEST_CASE("LaneChoice remembers the faster way for the next run", "[runtime][par
     }
     CHECK(closeWays == std::vector<bool>{false, false, true, true, true, true});
     CHECK(close.Mean(1) == Approx(0.0008f));
-    // Where the verdict's remembered mean proves off (the scalar loop takes half its remembered
-    // time here: the last run measured other work), the lanes' remembered mean is no better, however
-    // far behind: they are tried on the next call, and win twice.
+    // Remembered within a quarter of the scalar loop's remembered mean, the lanes are tried on the
+    // next call too where the scalar loop's new time is half its old one (the last run measured
+    // heavier work), and win twice.
     crossrt::LaneChoice stale("Stale::kernel1D_Walk");
     std::vector<bool> staleWays;
     for (int call = 0; call < 6; ++call) {
@@ -1366,6 +1367,14 @@ TEST_CASE("LaneChoice remembers the faster way for the next run", "[runtime][par
       staleWays.push_back(l);
     }
     CHECK(staleWays == std::vector<bool>{false, false, true, true, true, true});
+    // Ten times behind, they are not, though the scalar loop's time moved by half (a try would cost
+    // several calls' time): tried on the 16th call as usual.
+    crossrt::LaneChoice far("Far::kernel1D_Walk");
+    for (int call = 0; call < 6; ++call) {
+      const bool l = far.Choose();
+      far.Record(l, 1000, l ? 20.0 : 3.0);
+      CHECK_FALSE(l);
+    }
     // The scalar loop as remembered, the lanes far behind: tried on the 16th call, they win once,
     // and the run ends before their second try. That time, not the remembered one, goes to the
     // next run (which then starts in lanes, and measures them again).
@@ -1388,10 +1397,11 @@ TEST_CASE("LaneChoice remembers the faster way for the next run", "[runtime][par
   const auto has = [&](const std::string& start) {
     return std::count_if(lines.begin(), lines.end(), [&](const std::string& l) { return l.rfind(start, 0) == 0; });
   };
-  CHECK(lines.size() == 9);  // the broken line dropped, the kernel never measured not written
+  CHECK(lines.size() == 10);  // the broken line dropped, the kernel never measured not written
   CHECK(has(machine + "\tClose::kernel1D_Walk\t4\t0.0008\t0.001\t1\t0") == 1);
   CHECK(has(machine + "\tStale::kernel1D_Walk\t4\t0.0007\t0.001\t1\t0") == 1);
   CHECK(has(machine + "\tPending::kernel1D_Walk\t4\t0.0005\t0.001\t1\t0") == 1);
+  CHECK(has(machine + "\tFar::kernel1D_Walk\t4\t0.02\t0.003\t1\t1") == 1);
   CHECK(has(machine + "\tOnce::kernel1D_Build\t4\t0.002\t0.001\t1\t0") == 1);  // both ways' first calls now
   CHECK(has(machine + "\tSteady::kernel1D_Step\t4\t0.003\t0.001\t1\t4") == 1);
   CHECK(has(machine + "\tDue::kernel1D_Step\t4\t0.002\t0.001\t1\t0") == 1);

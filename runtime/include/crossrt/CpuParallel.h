@@ -31,8 +31,8 @@ class MeasuredWays {
   // Calls between tries of the slower way: the first wait, 4x longer after each try it lost, up to
   // the longest.
   static constexpr unsigned kFirstWait = 16, kLongestWait = 1024;
-  // A remembered mean of the slower way within this factor of the verdict's is tried at once (Record),
-  // and so is any remembered mean of it where the verdict's own remembered mean proved off by more.
+  // A remembered mean of the slower way within this factor of the verdict's (its new mean, or the
+  // one remembered beside it) is tried at once (Record).
   static constexpr float kCloseToVerdict = 1.25f;
 
   // The mean ms per iteration measured for a way (-1 before the first), for tests and benchmarks.
@@ -119,18 +119,20 @@ class MeasuredWays {
         m_nextTry.store(faster == w ? kFirstWait : std::min(wait * 4u, kLongestWait), std::memory_order_relaxed);
       }
     } else if (faster != Verdict() || (MeanRemembered(1 - Verdict()) && Mean(1 - Verdict()) <= kCloseToVerdict * Mean(Verdict())) ||
-               (w == Verdict() && remembered && MeanRemembered(1 - w) && !WithinFactor(msPerIteration, before, kCloseToVerdict))) {
+               (w == Verdict() && remembered && MeanRemembered(1 - w) && Mean(1 - w) <= kCloseToVerdict * before)) {
       // The other way, measured again next: it is faster by the means, or its mean is an earlier run's
       // and close to the verdict's (within kCloseToVerdict), too close to trust across runs that may
       // have traced another mesh or run another build of the kernel, and a try of it costs a fraction
       // of one call. (bench_lbvh's PrimaryRays_ISPC, sse4 on an AMD EPYC, Zen 5: the lanes' mean that
       // another build had left, 0.060 ms per 1,000 rays, kept the 871k-triangle dragon on the scalar
       // loop at 0.054-0.060 for 15 calls in a row; the lanes, tried at last, took 0.044.)
-      // Nor is the other's remembered mean trusted, however far, where the verdict's own, measured in
-      // the same earlier run, proves off by more than that factor: that run's work or machine was not
-      // this one's. (The same bench, 2026-12-02: remembered lanes at 0.092 ms per 1,000 rays beside a
-      // remembered scalar loop at 0.084, which here took 0.041; the lanes, tried on the 16th call,
-      // took 0.029, the process ended before their second try, and each run started the same way.)
+      // The same where the two were that close in the earlier run (the verdict's first mean here being
+      // its first counted run after Seed): where this run's work is lighter or heavier (another mesh),
+      // both ways' times move, and the other's old mean against the verdict's new one says nothing.
+      // (The same bench, 2026-12-02: the lanes remembered at 0.092 ms per 1,000 rays beside the scalar
+      // loop at 0.084, which took 0.041 here; tried on the 16th call, the lanes took 0.029.) Where the
+      // two were far apart, no such try: on the 992-triangle teapot, LBVH_ISPC's Refit tried its lanes
+      // so at 0.079 ms against its scalar loop's 0.013, and the build took 1.3x the original's time.
       m_calls.store(m_nextTry.load(std::memory_order_relaxed), std::memory_order_relaxed);
     }
   }
@@ -140,8 +142,6 @@ class MeasuredWays {
   std::atomic<unsigned> m_calls{0};
   std::atomic<unsigned> m_nextTry{kFirstWait};
   std::atomic<bool> m_tryingOther{false};
-  static bool WithinFactor(float a, float b, float factor) { return a <= factor * b && b <= factor * a; }
-
   std::atomic<float> m_firstTry{-1.0f};  // a try that won once, waiting for its second
   std::atomic<int> m_firstTryWay{-1};    // the way of that try
   std::atomic<int> m_verdict{-1};
