@@ -1347,44 +1347,33 @@ TEST_CASE("LaneChoice remembers the faster way for the next run", "[runtime][par
     // Remembered lanes within a quarter of the scalar loop's time are tried on the call after the
     // first counted one, not the 16th: another mesh or another build of the kernel may have left
     // them. Faster twice here, they are the verdict from the fourth call on.
+    // (The ways `calls` calls take, lanes true, each call taking the time given for its way.)
+    const auto ways = [](crossrt::LaneChoice& choice, int calls, double lanesMs, double scalarMs) {
+      std::vector<bool> taken;
+      for (int call = 0; call < calls; ++call) {
+        const bool l = choice.Choose();
+        choice.Record(l, 1000, l ? lanesMs : scalarMs);
+        taken.push_back(l);
+      }
+      return taken;
+    };
     crossrt::LaneChoice close("Close::kernel1D_Walk");
-    std::vector<bool> closeWays;
-    for (int call = 0; call < 6; ++call) {
-      const bool l = close.Choose();
-      close.Record(l, 1000, l ? 0.8 : 1.0);
-      closeWays.push_back(l);
-    }
-    CHECK(closeWays == std::vector<bool>{false, false, true, true, true, true});
+    CHECK(ways(close, 6, 0.8, 1.0) == std::vector<bool>{false, false, true, true, true, true});
     CHECK(close.Mean(1) == Approx(0.0008f));
     // Remembered within a quarter of the scalar loop's remembered mean, the lanes are tried on the
     // next call too where the scalar loop's new time is half its old one (the last run measured
     // heavier work), and win twice.
     crossrt::LaneChoice stale("Stale::kernel1D_Walk");
-    std::vector<bool> staleWays;
-    for (int call = 0; call < 6; ++call) {
-      const bool l = stale.Choose();
-      stale.Record(l, 1000, l ? 0.7 : 1.0);
-      staleWays.push_back(l);
-    }
-    CHECK(staleWays == std::vector<bool>{false, false, true, true, true, true});
-    // Ten times behind, they are not, though the scalar loop's time moved by half (a try would cost
-    // several calls' time): tried on the 16th call as usual.
+    CHECK(ways(stale, 6, 0.7, 1.0) == std::vector<bool>{false, false, true, true, true, true});
+    // Ten times behind, they are not, though the scalar loop takes half as long again as it did (a
+    // try would cost several calls' time): tried on the 16th call as usual.
     crossrt::LaneChoice far("Far::kernel1D_Walk");
-    for (int call = 0; call < 6; ++call) {
-      const bool l = far.Choose();
-      far.Record(l, 1000, l ? 20.0 : 3.0);
-      CHECK_FALSE(l);
-    }
+    CHECK(ways(far, 6, 20.0, 3.0) == std::vector<bool>(6, false));
     // The scalar loop as remembered, the lanes far behind: tried on the 16th call, they win once,
     // and the run ends before their second try. That time, not the remembered one, goes to the
     // next run (which then starts in lanes, and measures them again).
     crossrt::LaneChoice pending("Pending::kernel1D_Walk");
-    std::vector<bool> pendingWays;
-    for (int call = 0; call < 16; ++call) {
-      const bool l = pending.Choose();
-      pending.Record(l, 1000, l ? 0.5 : 1.0);
-      pendingWays.push_back(l);
-    }
+    const std::vector<bool> pendingWays = ways(pending, 16, 0.5, 1.0);
     CHECK(std::count(pendingWays.begin(), pendingWays.end(), true) == 1);
     CHECK(pendingWays.back());
     CHECK(pending.Mean(1) == Approx(0.009f));  // not believed in this run yet
