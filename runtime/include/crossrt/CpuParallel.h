@@ -131,8 +131,9 @@ class MeasuredWays {
       // both ways' times move, and the other's old mean against the verdict's new one says nothing.
       // (The same bench, 2026-12-02: the lanes remembered at 0.092 ms per 1,000 rays beside the scalar
       // loop at 0.084, which took 0.041 here; tried on the 16th call, the lanes took 0.029.) Where the
-      // two were far apart, no such try: on the 992-triangle teapot, LBVH_ISPC's Refit tried its lanes
-      // so at 0.079 ms against its scalar loop's 0.013, and the build took 1.3x the original's time.
+      // two were far apart, no such try: a first version tried the other way wherever the verdict's
+      // time moved by more than a quarter, noise on a kernel of microseconds, and on the 992-triangle
+      // teapot LBVH_ISPC's Refit so tried its lanes at 0.079 ms against its scalar loop's 0.013.
       m_calls.store(m_nextTry.load(std::memory_order_relaxed), std::memory_order_relaxed);
     }
   }
